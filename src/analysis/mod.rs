@@ -1,0 +1,187 @@
+//! The analyses of seed 004, each a plain function from the model (or an earlier result) to a
+//! result value, and [`analyse`], which runs them all in order.
+//!
+//! - [`accesses`]: IN/OUT per rung;
+//! - [`dependences`]: flow/anti/output pairs and the paper's data levels;
+//! - [`cfg`]: the control-flow graph;
+//! - [`control`]: post-dominators and control dependences (FOW);
+//! - [`levels`]: ASAP levelling of any dependence graph (the paper's control view);
+//! - [`schedule`]: the correct combined schedule (data + control, loops whole);
+//! - [`cost`]: the cost model, work, span and makespans.
+//!
+//! Nothing here prints or allocates per-rung strings; reports render these values.
+
+pub mod accesses;
+pub mod cfg;
+pub mod control;
+pub mod cost;
+pub mod dependences;
+pub mod levels;
+pub mod schedule;
+
+use crate::model::*;
+pub use accesses::{accesses, Accesses, VarSets};
+pub use cfg::{control_flow_graph, Branch, Cfg, CfgEdge, EdgeKind};
+pub use control::{control_dependences, post_dominators, ControlDependence, PostDominators};
+pub use cost::CostSummary;
+pub use dependences::{data_dependences, data_levels, DataDependence, DepKind};
+pub use schedule::{combined_schedule, Guard, Schedule, Successor, Task};
+
+/// A control dependence of the paper's control view.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub struct PaperControl {
+    pub from: RungId,
+    pub to: RungId,
+    pub cause: ControlCause,
+}
+
+/// Why a rung is control dependent on another in the paper's view.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum ControlCause {
+    /// FOW control dependence through CFG edge `edge` (an index into `Cfg::edges`).
+    Branch { edge: u32 },
+    /// The rung reads a field of a timer or counter instance whose box is on `from` (the paper
+    /// counts these as control dependences).
+    Instance { var: VarId },
+}
+
+/// Something the user should know that is not an error.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Warning {
+    /// Main-program rungs that can never run.
+    Unreachable(Vec<RungId>),
+    /// Rungs that can never reach the end of the scan (an endless loop).
+    Endless(Vec<RungId>),
+    /// A subroutine nothing calls.
+    Uncalled(PouId),
+}
+
+/// Everything `plc-deps report` shows.
+#[derive(Clone, Debug)]
+pub struct Analysis {
+    pub accesses: Accesses,
+    /// Data dependences between rungs in listing order (unit index = `RungId`).
+    pub data: Vec<DataDependence>,
+    /// Paper data view: level per rung (0-based).
+    pub data_levels: Vec<u32>,
+    pub cfg: Cfg,
+    pub post_dominators: PostDominators,
+    /// FOW control dependences over the whole CFG (controller/dependent are CFG nodes).
+    pub control: Vec<ControlDependence>,
+    /// The paper's control view: CDG without self edges, plus instance reads.
+    pub paper_control: Vec<PaperControl>,
+    /// Paper control view: level per rung (0-based).
+    pub control_levels: Vec<u32>,
+    pub schedule: Schedule,
+    pub cost: CostSummary,
+    /// Cost of each rung (calls included, loop multipliers applied).
+    pub rung_costs: Vec<u64>,
+    pub warnings: Vec<Warning>,
+}
+
+/// Runs every analysis on `p`.
+pub fn analyse(p: &Program) -> Analysis {
+    let acc = accesses(p);
+    let data = data_dependences(&acc.reads, &acc.writes);
+    let data_lv = data_levels(&acc.reads, &acc.writes);
+    let cfg = control_flow_graph(p);
+    let pairs: Vec<(u32, u32)> = cfg.edges.iter().map(|e| (e.from, e.to)).collect();
+    let pdom = post_dominators(cfg.node_count(), &pairs, cfg.stop());
+    let reachable = cfg.reachable();
+    let control = control_dependences(&pairs, &pdom, |a| reachable[a as usize]);
+    let paper_control = paper_control_view(p, &control);
+    let n = p.rungs.len();
+    let cv_edges: Vec<(u32, u32)> = paper_control.iter().map(|d| (d.from.0, d.to.0)).filter(|(a, b)| a != b).collect();
+    let control_lv = levels::asap_levels(n, &cv_edges);
+    let schedule = combined_schedule(p, &cfg, &acc);
+    let base = cost::rung_costs(p);
+    let mut rung_costs = base.clone();
+    for pou in 0..p.pous.len() {
+        let pou = PouId(pou as u32);
+        for (r, m) in p.pou_rungs(pou).zip(cost::multipliers(p, pou)) {
+            rung_costs[r.index()] = base[r.index()] * m;
+        }
+    }
+    let task_costs: Vec<u64> = schedule.tasks.iter().map(|t| t.rungs.iter().map(|r| rung_costs[r.index()]).sum()).collect();
+    let task_levels: Vec<u32> = schedule.tasks.iter().map(|t| t.level).collect();
+    let cost = cost::summarise(&task_costs, &schedule.preds, &task_levels);
+    let mut warnings = Vec::new();
+    if !schedule.unreachable.is_empty() {
+        warnings.push(Warning::Unreachable(schedule.unreachable.clone()));
+    }
+    for region in &pdom.endless {
+        let rungs: Vec<RungId> = region.iter().filter(|&&v| (v as usize) < n).map(|&v| RungId(v)).collect();
+        if !rungs.is_empty() {
+            warnings.push(Warning::Endless(rungs));
+        }
+    }
+    for &pou in &cfg.uncalled {
+        warnings.push(Warning::Uncalled(pou));
+    }
+    Analysis {
+        accesses: acc,
+        data,
+        data_levels: data_lv,
+        cfg,
+        post_dominators: pdom,
+        control,
+        paper_control,
+        control_levels: control_lv,
+        schedule,
+        cost,
+        rung_costs,
+        warnings,
+    }
+}
+
+/// The paper's control view: FOW dependences between rungs, and reads of a timer or counter
+/// instance's fields after the rung holding its box.
+fn paper_control_view(p: &Program, control: &[ControlDependence]) -> Vec<PaperControl> {
+    let n = p.rungs.len() as u32;
+    let mut out: Vec<PaperControl> = control
+        .iter()
+        .filter(|d| d.controller < n && d.dependent < n)
+        .map(|d| PaperControl { from: RungId(d.controller), to: RungId(d.dependent), cause: ControlCause::Branch { edge: d.edge } })
+        .collect();
+    // Box rungs per instance, in order; then each field read pairs with earlier box rungs.
+    let mut boxes: Vec<Vec<RungId>> = vec![Vec::new(); p.vars.len()];
+    for r in p.rung_ids() {
+        let mut field_reads: Vec<VarId> = Vec::new();
+        let mut own_boxes: Vec<VarId> = Vec::new();
+        walk_elements(&p.rung(r).series, &mut |e| match e {
+            Element::Timer { instance, .. } | Element::Ctu { instance, .. } | Element::Ctd { instance, .. } => own_boxes.push(*instance),
+            Element::Contact { var, .. } if var.field.is_some() => field_reads.push(var.var),
+            Element::Compare { a, b, .. } | Element::Arith { a, b, .. } => {
+                for o in [a, b] {
+                    if let Operand::Var(v) = o {
+                        if v.field.is_some() {
+                            field_reads.push(v.var);
+                        }
+                    }
+                }
+            }
+            Element::Move { from: o, .. } => {
+                if let Operand::Var(v) = o {
+                    if v.field.is_some() {
+                        field_reads.push(v.var);
+                    }
+                }
+            }
+            _ => {}
+        });
+        field_reads.sort_unstable();
+        field_reads.dedup();
+        for &v in &field_reads {
+            for &s in &boxes[v.index()] {
+                out.push(PaperControl { from: s, to: r, cause: ControlCause::Instance { var: v } });
+            }
+        }
+        for v in own_boxes {
+            if boxes[v.index()].last() != Some(&r) {
+                boxes[v.index()].push(r);
+            }
+        }
+    }
+    out.sort_unstable();
+    out
+}

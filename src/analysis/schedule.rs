@@ -1,0 +1,277 @@
+//! The combined schedule: data and control dependences together, loops kept whole — the
+//! levelling that a parallel scan can actually run (the correction to seed 004's two views).
+//!
+//! Units are *tasks* of the main program: a rung, or a loop — a strongly connected part of the
+//! main program's CFG (FOR/NEXT, backward jumps) — run sequentially as one task. Calls are not
+//! separate units: a CALL runs its subroutine inside the calling rung's task, so the call and
+//! return edges are dropped here and the calling rung's IN/OUT (which include the callee's) stand
+//! for it. Main-program rungs that START cannot reach never run and are left out.
+//!
+//! Contract (what the executor relies on): run the levels in order; inside a level, run every
+//! task whose guard holds, in any order or at once; the result equals the sequential scan's.
+//! It holds because
+//! - tasks are ordered by a topological order of the condensed CFG that keeps program order
+//!   wherever the CFG allows; any two tasks that run in the same scan run in this order
+//!   sequentially, so data dependences are computed over it;
+//! - a task whose execution depends on a decision (a jump, RET/END, a loop's exit) has a *guard*:
+//!   the FOW control dependences of the condensed CFG, each "task A ran and left towards
+//!   successor B"; it runs iff one of them holds (no guard: it always runs), and it is placed at
+//!   a later level than every task that guards it;
+//! - a loop task entered at more than one rung also comes after all its possible predecessors,
+//!   so that the executor can tell where it was entered.
+//!
+//! Cost: O(rungs + CFG edges + accesses + control dependences).
+
+use super::accesses::Accesses;
+use super::cfg::{Cfg, EdgeKind};
+use super::control::{control_dependences, post_dominators, PostDominators};
+use super::dependences::Leveller;
+use crate::graph::{strongly_connected_components, Csr};
+use crate::model::*;
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+
+/// Where control goes after a task: another task or the end of the scan.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Successor {
+    Task(u32),
+    Stop,
+}
+
+/// One disjunct of a guard: task `controller` ran and left towards `successor`.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Guard {
+    pub controller: u32,
+    pub successor: Successor,
+}
+
+/// A unit of the combined schedule.
+#[derive(Clone, Debug)]
+pub struct Task {
+    /// Its rungs, ascending (one for a plain rung).
+    pub rungs: Vec<RungId>,
+    /// True if the task is a loop (the rungs form a cycle of the CFG).
+    pub is_loop: bool,
+    /// Rungs where control can enter the task.
+    pub entries: Vec<RungId>,
+    /// Runs iff any of these holds; empty means always.
+    pub guard: Vec<Guard>,
+    /// Level, 0-based.
+    pub level: u32,
+}
+
+/// The combined schedule of a program.
+#[derive(Clone, Debug)]
+pub struct Schedule {
+    /// Tasks in sequential order.
+    pub tasks: Vec<Task>,
+    /// Task of each rung (main-program rungs that run; `None` otherwise).
+    pub task_of: Vec<Option<u32>>,
+    /// Task indices per level, in sequential order.
+    pub levels: Vec<Vec<u32>>,
+    /// Main-program rungs that can never run.
+    pub unreachable: Vec<RungId>,
+    /// For each task, the earlier tasks it must wait for (data and control), deduplicated.
+    pub preds: Vec<Vec<u32>>,
+    /// Regions of the main program that can never reach the end of the scan.
+    pub endless: Vec<Vec<RungId>>,
+}
+
+impl Schedule {
+    /// The first rung of task `t` (its name in reports).
+    pub fn head(&self, t: u32) -> RungId {
+        self.tasks[t as usize].rungs[0]
+    }
+}
+
+/// Builds the combined schedule from the program, its CFG and its accesses.
+pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
+    let main = p.main().rungs.clone();
+    let n = cfg.node_count();
+    let (start, stop) = (cfg.start(), cfg.stop());
+    let in_main = |v: u32| main.contains(&v) || v == start || v == stop;
+    // The main program's own CFG: no call or return edges.
+    let edges: Vec<(u32, u32)> = cfg
+        .edges
+        .iter()
+        .filter(|e| !matches!(e.kind, EdgeKind::Call | EdgeKind::Return) && in_main(e.from) && in_main(e.to))
+        .map(|e| (e.from, e.to))
+        .collect();
+    let g = Csr::from_edges(n, &edges);
+    let mut reach = vec![false; n];
+    let mut stack = vec![start];
+    reach[start as usize] = true;
+    while let Some(v) = stack.pop() {
+        for &s in g.successors(v) {
+            if !reach[s as usize] {
+                reach[s as usize] = true;
+                stack.push(s);
+            }
+        }
+    }
+    let unreachable: Vec<RungId> = main.clone().filter(|&r| !reach[r as usize]).map(RungId).collect();
+    let live_edges: Vec<(u32, u32)> = edges.iter().copied().filter(|&(a, _)| reach[a as usize]).collect();
+    let live = Csr::from_edges(n, &live_edges);
+    let sccs = strongly_connected_components(&live);
+
+    // Components of live rungs become tasks, ordered topologically, program order first.
+    let comp_count = sccs.len();
+    let mut comp_is_task = vec![false; comp_count];
+    for r in main.clone() {
+        if reach[r as usize] {
+            comp_is_task[sccs.component_of(r) as usize] = true;
+        }
+    }
+    let mut indeg = vec![0u32; comp_count];
+    let mut comp_edges: Vec<(u32, u32)> = Vec::new();
+    for &(a, b) in &live_edges {
+        let (ca, cb) = (sccs.component_of(a), sccs.component_of(b));
+        if ca != cb && comp_is_task[ca as usize] && comp_is_task[cb as usize] {
+            comp_edges.push((ca, cb));
+            indeg[cb as usize] += 1;
+        }
+    }
+    let comp_graph = Csr::from_edges(comp_count, &comp_edges);
+    let first = |c: u32| sccs.members(c)[0];
+    let mut heap: BinaryHeap<Reverse<(u32, u32)>> = (0..comp_count as u32)
+        .filter(|&c| comp_is_task[c as usize] && indeg[c as usize] == 0)
+        .map(|c| Reverse((first(c), c)))
+        .collect();
+    let mut task_of_comp = vec![u32::MAX; comp_count];
+    let mut tasks: Vec<Task> = Vec::new();
+    while let Some(Reverse((_, c))) = heap.pop() {
+        task_of_comp[c as usize] = tasks.len() as u32;
+        let members = sccs.members(c);
+        tasks.push(Task {
+            rungs: members.iter().map(|&m| RungId(m)).collect(),
+            is_loop: sccs.is_cyclic(c, &live),
+            entries: Vec::new(),
+            guard: Vec::new(),
+            level: 0,
+        });
+        for &d in comp_graph.successors(c) {
+            indeg[d as usize] -= 1;
+            if indeg[d as usize] == 0 {
+                heap.push(Reverse((first(d), d)));
+            }
+        }
+    }
+    let mut task_of: Vec<Option<u32>> = vec![None; p.rungs.len()];
+    for r in main.clone() {
+        if reach[r as usize] {
+            task_of[r as usize] = Some(task_of_comp[sccs.component_of(r) as usize]);
+        }
+    }
+    // Condensed CFG over tasks: nodes 0..t, START = t, STOP = t + 1.
+    let t = tasks.len() as u32;
+    let (cstart, cstop) = (t, t + 1);
+    let node = |v: u32| -> u32 {
+        if v == start {
+            cstart
+        } else if v == stop {
+            cstop
+        } else {
+            task_of[v as usize].expect("live rung")
+        }
+    };
+    let mut cedges: Vec<(u32, u32)> = Vec::new();
+    let mut entry_preds: Vec<Vec<u32>> = vec![Vec::new(); t as usize];
+    for &(a, b) in &live_edges {
+        let (ca, cb) = (node(a), node(b));
+        if ca != cb {
+            cedges.push((ca, cb));
+            if cb < t {
+                let task = &mut tasks[cb as usize];
+                if !task.entries.contains(&RungId(b)) {
+                    task.entries.push(RungId(b));
+                }
+                if ca < t {
+                    entry_preds[cb as usize].push(ca);
+                }
+            }
+        }
+    }
+    cedges.sort_unstable();
+    cedges.dedup();
+    let pdom: PostDominators = post_dominators(t as usize + 2, &cedges, cstop);
+    let endless: Vec<Vec<RungId>> = pdom
+        .endless
+        .iter()
+        .map(|region| region.iter().filter(|&&c| c < t).flat_map(|&c| tasks[c as usize].rungs.iter().copied()).collect())
+        .filter(|r: &Vec<RungId>| !r.is_empty())
+        .collect();
+    for d in control_dependences(&cedges, &pdom, |_| true) {
+        let (a, b) = cedges[d.edge as usize];
+        if a == cstart || d.dependent >= t || d.dependent == a {
+            continue;
+        }
+        let successor = if b == cstop { Successor::Stop } else { Successor::Task(b) };
+        let guard = Guard { controller: a, successor };
+        let task = &mut tasks[d.dependent as usize];
+        if !task.guard.contains(&guard) {
+            task.guard.push(guard);
+        }
+    }
+    // Levels: data (over task accesses in task order) and control floors.
+    let var_count = p.vars.len();
+    let mut leveller = Leveller::new(var_count);
+    let mut preds: Vec<Vec<u32>> = vec![Vec::new(); t as usize];
+    let mut last_writer: Vec<u32> = vec![u32::MAX; var_count];
+    let mut readers: Vec<Vec<u32>> = vec![Vec::new(); var_count];
+    let mut reads = Vec::new();
+    let mut writes = Vec::new();
+    for i in 0..t as usize {
+        reads.clear();
+        writes.clear();
+        for &r in &tasks[i].rungs {
+            reads.extend_from_slice(acc.ins(r));
+            writes.extend_from_slice(acc.outs(r));
+        }
+        reads.sort_unstable();
+        reads.dedup();
+        writes.sort_unstable();
+        writes.dedup();
+        let mut ps: Vec<u32> = tasks[i].guard.iter().map(|g| g.controller).collect();
+        if tasks[i].entries.len() > 1 {
+            ps.extend_from_slice(&entry_preds[i]);
+        }
+        for &x in &reads {
+            if last_writer[x.index()] != u32::MAX {
+                ps.push(last_writer[x.index()]);
+            }
+        }
+        for &x in &writes {
+            if last_writer[x.index()] != u32::MAX {
+                ps.push(last_writer[x.index()]);
+            }
+            ps.extend(readers[x.index()].drain(..).filter(|&r| r as usize != i));
+        }
+        ps.sort_unstable();
+        ps.dedup();
+        let floor = ps.iter().filter(|&&q| (q as usize) < i).map(|&q| tasks[q as usize].level + 1).max().unwrap_or(0);
+        let level = leveller.place(&reads, &writes, floor);
+        tasks[i].level = level;
+        for &x in &reads {
+            readers[x.index()].push(i as u32);
+        }
+        for &x in &writes {
+            last_writer[x.index()] = i as u32;
+            readers[x.index()].clear();
+        }
+        ps.retain(|&q| (q as usize) < i);
+        preds[i] = ps;
+    }
+    let mut levels: Vec<Vec<u32>> = Vec::new();
+    for (i, task) in tasks.iter().enumerate() {
+        let l = task.level as usize;
+        if levels.len() <= l {
+            levels.resize(l + 1, Vec::new());
+        }
+        levels[l].push(i as u32);
+    }
+    for task in &mut tasks {
+        task.entries.sort_unstable();
+        task.guard.sort_unstable();
+    }
+    Schedule { tasks, task_of, levels, unreachable, preds, endless }
+}

@@ -1,0 +1,340 @@
+//! Elementary IEC 61131-3 types, values and operands of the program model.
+//!
+//! TIME values are held as signed 32-bit milliseconds (CODESYS and S7 `TIME` are 32-bit ms).
+//! Function block types (TON, TOF, TP, CTU, CTD) are instance types: a variable of such a type is
+//! an instance, and its readable fields are listed by [`Field`].
+
+use super::VarId;
+use std::fmt;
+
+/// The IEC type of a variable or operand.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
+pub enum Type {
+    Bool,
+    /// 16-bit signed integer.
+    Int,
+    /// 32-bit signed integer.
+    Dint,
+    /// 32-bit IEEE 754 float.
+    Real,
+    /// Milliseconds, 32-bit signed.
+    Time,
+    /// A function block instance.
+    Fb(FbKind),
+}
+
+/// Standard function block types that can be instantiated.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
+pub enum FbKind {
+    Ton,
+    Tof,
+    Tp,
+    Ctu,
+    Ctd,
+}
+
+/// The three IEC timers.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
+pub enum TimerKind {
+    Ton,
+    Tof,
+    Tp,
+}
+
+impl TimerKind {
+    pub fn fb(self) -> FbKind {
+        match self {
+            TimerKind::Ton => FbKind::Ton,
+            TimerKind::Tof => FbKind::Tof,
+            TimerKind::Tp => FbKind::Tp,
+        }
+    }
+    pub fn name(self) -> &'static str {
+        match self {
+            TimerKind::Ton => "ton",
+            TimerKind::Tof => "tof",
+            TimerKind::Tp => "tp",
+        }
+    }
+}
+
+impl Type {
+    /// Parses a type name of the program format.
+    pub fn parse(s: &str) -> Option<Type> {
+        Some(match s {
+            "BOOL" => Type::Bool,
+            "INT" => Type::Int,
+            "DINT" => Type::Dint,
+            "REAL" => Type::Real,
+            "TIME" => Type::Time,
+            "TON" => Type::Fb(FbKind::Ton),
+            "TOF" => Type::Fb(FbKind::Tof),
+            "TP" => Type::Fb(FbKind::Tp),
+            "CTU" => Type::Fb(FbKind::Ctu),
+            "CTD" => Type::Fb(FbKind::Ctd),
+            _ => return None,
+        })
+    }
+    /// True for INT, DINT, REAL and TIME (the types compare and arithmetic accept).
+    pub fn is_numeric(self) -> bool {
+        matches!(self, Type::Int | Type::Dint | Type::Real | Type::Time)
+    }
+    /// The zero value (FALSE, 0, 0.0, T#0ms); instances have no scalar value.
+    pub fn zero(self) -> Value {
+        match self {
+            Type::Bool => Value::Bool(false),
+            Type::Int => Value::Int(0),
+            Type::Dint => Value::Dint(0),
+            Type::Real => Value::Real(0.0),
+            Type::Time | Type::Fb(_) => Value::Time(0),
+        }
+    }
+}
+
+impl fmt::Display for Type {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Type::Bool => "BOOL",
+            Type::Int => "INT",
+            Type::Dint => "DINT",
+            Type::Real => "REAL",
+            Type::Time => "TIME",
+            Type::Fb(FbKind::Ton) => "TON",
+            Type::Fb(FbKind::Tof) => "TOF",
+            Type::Fb(FbKind::Tp) => "TP",
+            Type::Fb(FbKind::Ctu) => "CTU",
+            Type::Fb(FbKind::Ctd) => "CTD",
+        })
+    }
+}
+
+/// A readable field of a function block instance.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
+pub enum Field {
+    /// Output (timers and counters), BOOL.
+    Q,
+    /// Elapsed time (timers), TIME.
+    Et,
+    /// Preset time (timers), TIME.
+    Pt,
+    /// Current value (counters), INT.
+    Cv,
+    /// Preset value (counters), INT.
+    Pv,
+}
+
+impl Field {
+    /// The field of `fb` called `name`, with its type.
+    pub fn lookup(fb: FbKind, name: &str) -> Option<(Field, Type)> {
+        let timer = matches!(fb, FbKind::Ton | FbKind::Tof | FbKind::Tp);
+        Some(match (name, timer) {
+            ("Q", _) => (Field::Q, Type::Bool),
+            ("ET", true) => (Field::Et, Type::Time),
+            ("PT", true) => (Field::Pt, Type::Time),
+            ("CV", false) => (Field::Cv, Type::Int),
+            ("PV", false) => (Field::Pv, Type::Int),
+            _ => return None,
+        })
+    }
+    pub fn name(self) -> &'static str {
+        match self {
+            Field::Q => "Q",
+            Field::Et => "ET",
+            Field::Pt => "PT",
+            Field::Cv => "CV",
+            Field::Pv => "PV",
+        }
+    }
+    /// The names of the fields of `fb`, for error messages.
+    pub fn names(fb: FbKind) -> &'static str {
+        match fb {
+            FbKind::Ton | FbKind::Tof | FbKind::Tp => "Q, ET, PT",
+            FbKind::Ctu | FbKind::Ctd => "Q, CV, PV",
+        }
+    }
+}
+
+/// A reference to a variable or to a field of an instance.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
+pub struct VarRef {
+    pub var: VarId,
+    pub field: Option<Field>,
+}
+
+/// A constant value.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub enum Value {
+    Bool(bool),
+    Int(i16),
+    Dint(i32),
+    Real(f32),
+    /// Milliseconds.
+    Time(i32),
+}
+
+impl Value {
+    pub fn ty(self) -> Type {
+        match self {
+            Value::Bool(_) => Type::Bool,
+            Value::Int(_) => Type::Int,
+            Value::Dint(_) => Type::Dint,
+            Value::Real(_) => Type::Real,
+            Value::Time(_) => Type::Time,
+        }
+    }
+}
+
+impl fmt::Display for Value {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Value::Bool(b) => write!(f, "{}", if *b { "TRUE" } else { "FALSE" }),
+            Value::Int(v) => write!(f, "{v}"),
+            Value::Dint(v) => write!(f, "{v}"),
+            Value::Real(v) => write!(f, "{v:?}"),
+            Value::Time(ms) => write!(f, "T#{ms}ms"),
+        }
+    }
+}
+
+/// An operand: a variable (or field) read, or a constant.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub enum Operand {
+    Var(VarRef),
+    Const(Value),
+}
+
+impl Operand {
+    /// The variable the operand reads, if any.
+    pub fn var(&self) -> Option<VarId> {
+        match self {
+            Operand::Var(r) => Some(r.var),
+            Operand::Const(_) => None,
+        }
+    }
+}
+
+/// Comparison operators of the compare contact.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
+pub enum CmpOp {
+    Eq,
+    Ne,
+    Lt,
+    Le,
+    Gt,
+    Ge,
+}
+
+impl CmpOp {
+    pub fn parse(s: &str) -> Option<CmpOp> {
+        Some(match s {
+            "EQ" => CmpOp::Eq,
+            "NE" => CmpOp::Ne,
+            "LT" => CmpOp::Lt,
+            "LE" => CmpOp::Le,
+            "GT" => CmpOp::Gt,
+            "GE" => CmpOp::Ge,
+            _ => return None,
+        })
+    }
+    pub fn name(self) -> &'static str {
+        match self {
+            CmpOp::Eq => "EQ",
+            CmpOp::Ne => "NE",
+            CmpOp::Lt => "LT",
+            CmpOp::Le => "LE",
+            CmpOp::Gt => "GT",
+            CmpOp::Ge => "GE",
+        }
+    }
+}
+
+/// Arithmetic box operators.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
+pub enum ArithOp {
+    Add,
+    Sub,
+    Mul,
+    Div,
+    Mod,
+}
+
+impl ArithOp {
+    pub fn parse(s: &str) -> Option<ArithOp> {
+        Some(match s {
+            "ADD" => ArithOp::Add,
+            "SUB" => ArithOp::Sub,
+            "MUL" => ArithOp::Mul,
+            "DIV" => ArithOp::Div,
+            "MOD" => ArithOp::Mod,
+            _ => return None,
+        })
+    }
+    pub fn name(self) -> &'static str {
+        match self {
+            ArithOp::Add => "ADD",
+            ArithOp::Sub => "SUB",
+            ArithOp::Mul => "MUL",
+            ArithOp::Div => "DIV",
+            ArithOp::Mod => "MOD",
+        }
+    }
+}
+
+/// Parses an IEC TIME literal (`T#1s`, `T#250ms`, `TIME#1m30s`, `T#1.5s`) into milliseconds.
+pub fn parse_time_literal(s: &str) -> Option<i64> {
+    let rest = s
+        .strip_prefix("T#")
+        .or_else(|| s.strip_prefix("t#"))
+        .or_else(|| s.strip_prefix("TIME#"))
+        .or_else(|| s.strip_prefix("time#"))?;
+    let (neg, mut rest) = match rest.strip_prefix('-') {
+        Some(r) => (true, r),
+        None => (false, rest),
+    };
+    if rest.is_empty() {
+        return None;
+    }
+    let mut total = 0f64;
+    while !rest.is_empty() {
+        let num_len = rest
+            .find(|c: char| !(c.is_ascii_digit() || c == '.' || c == '_'))
+            .unwrap_or(rest.len());
+        if num_len == 0 {
+            return None;
+        }
+        let number: f64 = rest[..num_len].replace('_', "").parse().ok()?;
+        rest = &rest[num_len..];
+        let unit_len = rest
+            .find(|c: char| c.is_ascii_digit() || c == '.')
+            .unwrap_or(rest.len());
+        let factor = match rest[..unit_len].to_ascii_lowercase().as_str() {
+            "d" => 86_400_000.0,
+            "h" => 3_600_000.0,
+            "m" => 60_000.0,
+            "s" => 1000.0,
+            "ms" => 1.0,
+            _ => return None,
+        };
+        rest = &rest[unit_len..];
+        total += number * factor;
+    }
+    let ms = total.round() as i64;
+    Some(if neg { -ms } else { ms })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn time_literals() {
+        assert_eq!(parse_time_literal("T#1s"), Some(1000));
+        assert_eq!(parse_time_literal("T#250ms"), Some(250));
+        assert_eq!(parse_time_literal("TIME#1m30s"), Some(90_000));
+        assert_eq!(parse_time_literal("T#1.5s"), Some(1500));
+        assert_eq!(parse_time_literal("T#-2s"), Some(-2000));
+        assert_eq!(parse_time_literal("T#"), None);
+        assert_eq!(parse_time_literal("T#5x"), None);
+        assert_eq!(parse_time_literal("5s"), None);
+    }
+}

@@ -1,0 +1,140 @@
+//! Structural checks that need the whole resolved program: FOR/NEXT pairing and nesting, no jump
+//! into a FOR body from outside it, no recursive subroutine calls.
+//!
+//! S7-200 rules (seed 004's instruction set): FOR/NEXT pairs nest like brackets inside one POU;
+//! a jump may leave a loop body but not enter one (the loop head would be bypassed); subroutines
+//! may nest but not recurse (the call graph is acyclic, which also keeps every CALL's access
+//! summary finite).
+
+use super::error::{Invalid, LoadError};
+use crate::model::*;
+
+pub(crate) fn check(p: &mut Program) -> Result<(), LoadError> {
+    pair_loops(p)?;
+    check_jumps(p)?;
+    check_recursion(p)
+}
+
+fn err(p: &Program, r: RungId, suffix: &str, kind: Invalid) -> LoadError {
+    let rung = p.rung(r);
+    LoadError::invalid(Some(&rung.id), &format!("{}{suffix}", rung.path), kind)
+}
+
+fn last_top(rung: &Rung) -> Option<&Element> {
+    rung.series.last()
+}
+
+fn pair_loops(p: &mut Program) -> Result<(), LoadError> {
+    for pou in 0..p.pous.len() {
+        let mut stack: Vec<RungId> = Vec::new();
+        for r in p.pou_rungs(PouId(pou as u32)) {
+            match last_top(p.rung(r)) {
+                Some(Element::For { .. }) => stack.push(r),
+                Some(Element::Next { .. }) => {
+                    let head = stack.pop().ok_or_else(|| err(p, r, ".ld[0]", Invalid::NextWithoutFor))?;
+                    if let Some(Element::Next { head: h }) = p.rungs[r.index()].series.last_mut() {
+                        *h = head;
+                    }
+                    if let Some(Element::For { next, .. }) = p.rungs[head.index()].series.last_mut() {
+                        *next = r;
+                    }
+                }
+                _ => {}
+            }
+        }
+        if let Some(head) = stack.pop() {
+            let n = p.rung(head).series.len();
+            return Err(err(p, head, &format!(".ld[{}]", n - 1), Invalid::ForWithoutNext));
+        }
+    }
+    Ok(())
+}
+
+/// Jumps may leave loop bodies but not enter them.
+fn check_jumps(p: &Program) -> Result<(), LoadError> {
+    // body[r] = innermost FOR head whose body (head+1 ..= next) holds r.
+    let mut body: Vec<Option<RungId>> = vec![None; p.rungs.len()];
+    for r in p.rung_ids() {
+        if let Some(Element::For { next, .. }) = last_top(p.rung(r)) {
+            for b in r.0 + 1..=next.0 {
+                body[b as usize] = Some(r);
+            }
+        }
+    }
+    // `body` now holds the innermost head (later, inner heads overwrote outer ones).
+    let encloses = |head: RungId, r: RungId| -> bool {
+        let next = match last_top(p.rung(head)) {
+            Some(Element::For { next, .. }) => *next,
+            _ => return false,
+        };
+        r.0 >= head.0 && r.0 <= next.0
+    };
+    for r in p.rung_ids() {
+        let mut bad = None;
+        walk_elements(&p.rung(r).series, &mut |e| {
+            if let Element::Jmp { label, target } = e {
+                let mut h = body[target.index()];
+                while let Some(head) = h {
+                    if !encloses(head, r) && bad.is_none() {
+                        bad = Some((label.clone(), head));
+                    }
+                    h = if head.0 == 0 { None } else { body[head.index()] };
+                }
+            }
+        });
+        if let Some((label, head)) = bad {
+            return Err(err(p, r, ".ld", Invalid::JumpIntoLoop { label, head: p.rung(head).id.clone() }));
+        }
+    }
+    Ok(())
+}
+
+fn check_recursion(p: &Program) -> Result<(), LoadError> {
+    // Callees per POU, with the rung that makes the call.
+    let mut calls: Vec<Vec<(PouId, RungId)>> = vec![Vec::new(); p.pous.len()];
+    for r in p.rung_ids() {
+        let pou = p.rung(r).pou;
+        walk_elements(&p.rung(r).series, &mut |e| {
+            if let Element::Call { pou: callee } = e {
+                calls[pou.index()].push((*callee, r));
+            }
+        });
+    }
+    // Iterative DFS with colours over the (small) call graph.
+    #[derive(Clone, Copy, PartialEq)]
+    enum Colour {
+        White,
+        Grey,
+        Black,
+    }
+    let mut colour = vec![Colour::White; p.pous.len()];
+    for root in 0..p.pous.len() {
+        if colour[root] != Colour::White {
+            continue;
+        }
+        let mut stack: Vec<(usize, usize)> = vec![(root, 0)];
+        colour[root] = Colour::Grey;
+        while let Some(&mut (pou, ref mut i)) = stack.last_mut() {
+            if let Some(&(callee, rung)) = calls[pou].get(*i) {
+                *i += 1;
+                match colour[callee.index()] {
+                    Colour::White => {
+                        colour[callee.index()] = Colour::Grey;
+                        stack.push((callee.index(), 0));
+                    }
+                    Colour::Grey => {
+                        let start = stack.iter().position(|&(q, _)| q == callee.index()).unwrap_or(0);
+                        let mut chain: Vec<&str> = stack[start..].iter().map(|&(q, _)| p.pous[q].name.as_str()).collect();
+                        chain.push(&p.pou(callee).name);
+                        return Err(err(p, rung, ".ld", Invalid::Recursion { name: p.pou(callee).name.clone(), chain: chain.join(" → ") }));
+                    }
+                    Colour::Black => {}
+                }
+            } else {
+                colour[pou] = Colour::Black;
+                stack.pop();
+            }
+        }
+    }
+    Ok(())
+}
