@@ -1,0 +1,105 @@
+//! The commands behind the binary, as library functions over validated configurations.
+//!
+//! `main.rs` turns command-line arguments into these configs and calls one function; everything
+//! here returns a [`CliError`] instead of printing or exiting, and writes an output file only when
+//! the whole output is ready (written to a temporary file beside it, then renamed), so a failure
+//! never leaves a half-written file.
+
+use crate::analysis::analyse;
+use crate::model::Program;
+use crate::read::{program_from_json, LoadError};
+use crate::report::{render_dot, render_json, render_text, View};
+use std::path::{Path, PathBuf};
+
+/// An error of a command, with what the user needs to find its cause.
+#[derive(Debug, thiserror::Error)]
+pub enum CliError {
+    /// The program file is not a valid program: `file:line:column: message` for syntax
+    /// errors, `file: rung R at path: message` for the others.
+    #[error("{file}{}{error}", if matches!(error, LoadError::Syntax { .. }) { ":" } else { ": " })]
+    Load { file: String, error: LoadError },
+    /// A file could not be read or written.
+    #[error("{path}: {message}")]
+    Io { path: String, message: String },
+    /// An argument is not valid.
+    #[error("{0}")]
+    Usage(String),
+}
+
+impl CliError {
+    /// Exit code: 2 for bad input (program, arguments), 1 for I/O failures.
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            CliError::Load { .. } | CliError::Usage(_) => 2,
+            CliError::Io { .. } => 1,
+        }
+    }
+}
+
+/// Reads and checks a program file.
+pub fn load_program(path: &Path) -> Result<Program, CliError> {
+    let text = std::fs::read_to_string(path).map_err(|e| CliError::Io { path: path.display().to_string(), message: e.to_string() })?;
+    program_from_json(&text).map_err(|error| CliError::Load { file: path.display().to_string(), error })
+}
+
+/// Writes `contents` to `out` (atomically) or to standard output.
+pub fn write_output(out: Option<&Path>, contents: &str) -> Result<(), CliError> {
+    use std::io::Write;
+    match out {
+        None => {
+            let mut stdout = std::io::stdout().lock();
+            // A closed pipe (`| head`) is not an error worth reporting.
+            let _ = stdout.write_all(contents.as_bytes());
+            let _ = stdout.flush();
+            Ok(())
+        }
+        Some(path) => {
+            let io = |e: std::io::Error| CliError::Io { path: path.display().to_string(), message: e.to_string() };
+            let mut tmp: PathBuf = path.to_path_buf();
+            let name = format!(".{}.tmp-{}", path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default(), std::process::id());
+            tmp.set_file_name(name);
+            std::fs::write(&tmp, contents).map_err(io)?;
+            std::fs::rename(&tmp, path).map_err(|e| {
+                let _ = std::fs::remove_file(&tmp);
+                io(e)
+            })
+        }
+    }
+}
+
+/// Output format of `report`.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum ReportFormat {
+    Text,
+    Json,
+    Dot,
+}
+
+/// A validated `plc-deps report` invocation.
+#[derive(Clone, Debug)]
+pub struct ReportConfig {
+    pub input: PathBuf,
+    pub format: ReportFormat,
+    pub view: View,
+    pub output: Option<PathBuf>,
+}
+
+/// Renders the report of a loaded program.
+pub fn render_report(p: &Program, format: ReportFormat, view: View) -> String {
+    let a = analyse(p);
+    match format {
+        ReportFormat::Text => render_text(p, &a, view),
+        ReportFormat::Json => render_json(p, &a),
+        ReportFormat::Dot => render_dot(p, &a, view),
+    }
+}
+
+/// `plc-deps report`.
+pub fn report(c: &ReportConfig) -> Result<(), CliError> {
+    let p = load_program(&c.input)?;
+    let out = render_report(&p, c.format, c.view);
+    write_output(c.output.as_deref(), &out)
+}
+
+/// The JSON Schema of the program format (`plc-deps schema`).
+pub const PROGRAM_SCHEMA: &str = include_str!("../schema/program.schema.json");
