@@ -55,7 +55,7 @@ pub fn program_from_value(doc: &Json) -> Result<Program> {
             let pou = PouId(b.pous.len() as u32);
             b.locals.push(HashMap::new());
             if let Some(vars) = body.get("vars") {
-                b.declare_vars(vars, &format!("{path}.vars"), Some(pou))?;
+                b.declare_vars(vars, &format!("{path}.vars"), Some((pou, sname)))?;
             }
             let rungs_path = format!("{path}.rungs");
             let rungs = array(required(body, "rungs", "a subroutine", &path, None)?, &rungs_path, None)?;
@@ -103,7 +103,7 @@ struct Scope<'s> {
 }
 
 impl<'a> Builder<'a> {
-    fn declare_vars(&mut self, vars: &Json, path: &str, scope: Option<PouId>) -> Result<()> {
+    fn declare_vars(&mut self, vars: &Json, path: &str, scope: Option<(PouId, &str)>) -> Result<()> {
         for (i, v) in array(vars, path, None)?.iter().enumerate() {
             let p = format!("{path}[{i}]");
             let o = object(v, &p, None, "a variable")?;
@@ -154,7 +154,7 @@ impl<'a> Builder<'a> {
             };
             let table = match scope {
                 None => &mut self.globals,
-                Some(p) => &mut self.locals[p.index()],
+                Some((p, _)) => &mut self.locals[p.index()],
             };
             if table.contains_key(name) {
                 return Err(LoadError::invalid(None, &format!("{p}.name"), Invalid::DuplicateVar { name: name.into() }));
@@ -163,9 +163,9 @@ impl<'a> Builder<'a> {
             table.insert(name.to_owned(), id);
             let display = match scope {
                 None => name.to_owned(),
-                Some(_) => format!("{}:{name}", self.pous.last().map(|p| p.name.as_str()).unwrap_or("")),
+                Some((_, pou)) => format!("{pou}:{name}"),
             };
-            self.vars.push(Var { name: display, ty, class, init, scope, hidden: false });
+            self.vars.push(Var { name: display, ty, class, init, scope: scope.map(|(p, _)| p), hidden: false });
         }
         Ok(())
     }

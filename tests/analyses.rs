@@ -1,0 +1,52 @@
+//! Data-driven worked examples: every `analyses/*/program.json` has its committed reports
+//! (`report.txt`, `report.json`) beside it. This test regenerates them all and fails on any
+//! difference; `UPDATE_EXPECT=1 cargo test --test analyses` re-blesses them.
+
+use plc_deps::app::{render_report, ReportFormat};
+use plc_deps::read::program_from_json;
+use plc_deps::report::View;
+use std::path::{Path, PathBuf};
+
+fn examples() -> Vec<PathBuf> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("analyses");
+    let mut dirs: Vec<PathBuf> = std::fs::read_dir(&root)
+        .expect("analyses/ exists")
+        .map(|e| e.expect("readable entry").path())
+        .filter(|p| p.join("program.json").is_file())
+        .collect();
+    dirs.sort();
+    dirs
+}
+
+/// Compares `actual` with the committed file, or writes it when re-blessing.
+fn check(path: &Path, actual: &str, failures: &mut Vec<String>) {
+    if std::env::var_os("UPDATE_EXPECT").is_some() {
+        std::fs::write(path, actual).expect("write expectation");
+        return;
+    }
+    let expected = std::fs::read_to_string(path).unwrap_or_default();
+    if expected != actual {
+        let line = expected.lines().zip(actual.lines()).position(|(a, b)| a != b).unwrap_or_else(|| expected.lines().count().min(actual.lines().count()));
+        failures.push(format!(
+            "{} differs at line {}:\n  committed: {:?}\n  now:       {:?}",
+            path.display(),
+            line + 1,
+            expected.lines().nth(line).unwrap_or("<end>"),
+            actual.lines().nth(line).unwrap_or("<end>")
+        ));
+    }
+}
+
+#[test]
+fn every_worked_example_matches_its_committed_reports() {
+    let dirs = examples();
+    assert!(dirs.len() >= 5, "expected the worked examples in analyses/, found {}", dirs.len());
+    let mut failures = Vec::new();
+    for dir in dirs {
+        let text = std::fs::read_to_string(dir.join("program.json")).expect("read program");
+        let program = program_from_json(&text).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
+        check(&dir.join("report.txt"), &render_report(&program, ReportFormat::Text, View::All), &mut failures);
+        check(&dir.join("report.json"), &render_report(&program, ReportFormat::Json, View::All), &mut failures);
+    }
+    assert!(failures.is_empty(), "{}\n(re-bless with UPDATE_EXPECT=1 if the change is intended)", failures.join("\n"));
+}
