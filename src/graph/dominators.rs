@@ -207,47 +207,53 @@ pub fn dominators(g: &Csr, root: u32) -> DominatorTree {
         "dominators: root {root} out of range for a graph with {n} nodes"
     );
 
-    // ---- 1. Stackless iterative DFS: preorder numbers and DFS parents. ----
+    // ---- 1. Iterative DFS: preorder numbers, DFS parents, predecessor counts. ----
     // pre[node] = preorder number or NONE; vertex[i] = node numbered i.
+    // `stack` holds only the nodes that still have unexplored edges, as
+    // (preorder number, next edge, end of edges): a node is popped as soon as
+    // its last edge is taken, so a chain keeps the stack at one entry and
+    // nothing is walked back up when a branch is finished.
     let mut pre = vec![NONE; n];
     let mut vertex: Vec<u32> = Vec::with_capacity(n);
     let mut parent: Vec<u32> = Vec::with_capacity(n);
-    let mut cursor: Vec<u32> = Vec::with_capacity(n);
+    // Counts of predecessors per preorder number (shifted by one), gathered
+    // while every edge is examined once; cut down to k + 1 entries below.
+    let mut pred_offsets = vec![0u32; n + 1];
+    let mut stack: Vec<(u32, u32, u32)> = Vec::new();
     pre[root as usize] = 0;
     vertex.push(root);
     parent.push(0);
-    cursor.push(g.offsets[root as usize]);
-    let mut cur = 0usize;
-    loop {
-        let v = vertex[cur] as usize;
-        let pos = cursor[cur];
-        if pos < g.offsets[v + 1] {
-            cursor[cur] = pos + 1;
-            let w = g.targets[pos as usize] as usize;
-            if pre[w] == NONE {
-                let i = vertex.len();
-                pre[w] = i as u32;
-                vertex.push(w as u32);
-                parent.push(cur as u32);
-                cursor.push(g.offsets[w]);
-                cur = i;
-            }
-        } else if cur == 0 {
-            break;
-        } else {
-            cur = parent[cur] as usize;
-        }
+    let (first, end) = g.edge_range(root);
+    if first < end {
+        stack.push((0, first, end));
     }
+    while let Some(top) = stack.last_mut() {
+        let (i, pos, end) = *top;
+        if pos + 1 == end {
+            stack.pop();
+        } else {
+            top.1 = pos + 1;
+        }
+        let w = g.targets[pos as usize] as usize;
+        let mut j = pre[w];
+        if j == NONE {
+            j = vertex.len() as u32;
+            pre[w] = j;
+            vertex.push(w as u32);
+            parent.push(i);
+            let (first, end) = g.edge_range(w as u32);
+            if first < end {
+                stack.push((j, first, end));
+            }
+        }
+        pred_offsets[j as usize + 1] += 1;
+    }
+    drop(stack);
     let k = vertex.len();
+    pred_offsets.truncate(k + 1);
 
     // ---- 2. Predecessors in preorder space (ascending in each list). ----
     // Every successor of a reachable node is reachable, so no edge is lost.
-    let mut pred_offsets = vec![0u32; k + 1];
-    for &v in &vertex {
-        for &w in g.successors(v) {
-            pred_offsets[pre[w as usize] as usize + 1] += 1;
-        }
-    }
     prefix_sum(&mut pred_offsets);
     let mut preds = vec![0u32; pred_offsets[k] as usize];
     for (i, &v) in vertex.iter().enumerate() {
@@ -264,7 +270,7 @@ pub fn dominators(g: &Csr, root: u32) -> DominatorTree {
     // once its semi-dominator is known, i.e. for all w' > current w.
     // label[v]: min sdom on the forest path from v up to, excluding,
     // ancestor[v]. Once ancestor[v] is unprocessed, label[v] is EVAL(v).
-    let mut semi = cursor; // the DFS cursors are dead; reuse the buffer
+    let mut semi = vec![0u32; k];
     let mut label = vec![0u32; k];
     let mut ancestor = parent.clone();
     let mut path: Vec<u32> = Vec::new();
@@ -320,7 +326,6 @@ pub fn dominators(g: &Csr, root: u32) -> DominatorTree {
             d as u32
         };
     }
-    drop(jump);
 
     // ---- 5. Subtree sizes and dominator-tree preorder, no traversal. ----
     let mut size = semi;
@@ -328,7 +333,8 @@ pub fn dominators(g: &Csr, root: u32) -> DominatorTree {
     for w in (1..k).rev() {
         size[idom[w] as usize] += size[w];
     }
-    let mut tree_pre = vec![0u32; k];
+    let mut tree_pre = jump; // dead jump pointers; every entry is rewritten
+    tree_pre[..k.min(1)].fill(0);
     let mut next = pred_offsets; // k + 1 long, dead: per-node "next free number"
     if k > 0 {
         next[0] = 1;

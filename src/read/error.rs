@@ -44,8 +44,8 @@ pub enum Invalid {
     MissingField { field: &'static str, what: &'static str },
     #[error("unknown field `{field}` in {what} (allowed: {allowed})")]
     UnknownField { field: String, what: &'static str, allowed: String },
-    #[error("element has none of the known element keys (contact, compare, or, coil, set, reset, branch, ton, tof, tp, ctu, ctd, move, op, jmp, ret, end, call, for, next)")]
-    UnknownElement,
+    #[error("unknown element {{{keys}}} (an element has one of the keys contact, compare, or, coil, set, reset, branch, ton, tof, tp, ctu, ctd, move, op, jmp, ret, end, call, for, next)")]
+    UnknownElement { keys: String },
     #[error("`{name}` is not a valid name (letters, digits and _, not starting with a digit)")]
     BadName { name: String },
     #[error("unknown type `{name}` (expected BOOL, INT, DINT, REAL, TIME, TON, TOF, TP, CTU or CTD)")]

@@ -278,7 +278,10 @@ impl<'a> Builder<'a> {
         let kind = ELEMENT_KINDS
             .iter()
             .find(|(k, _)| o.contains_key(*k))
-            .ok_or_else(|| LoadError::invalid(rid, path, Invalid::UnknownElement))?;
+            .ok_or_else(|| {
+                let keys = o.keys().map(|k| format!("\"{k}\": …")).collect::<Vec<_>>().join(", ");
+                LoadError::invalid(rid, path, Invalid::UnknownElement { keys })
+            })?;
         let (key, allowed) = *kind;
         let what = element_what(key);
         check_keys(o, allowed, what, path, rid)?;
