@@ -95,14 +95,30 @@ pub struct GenConfig {
 impl Default for GenConfig {
     /// 1000 rungs, 32 lanes, seed 0, all knobs off.
     fn default() -> Self {
-        GenConfig { rungs: 1000, width: 32, seed: 0, timers: false, loops: false, jumps: false, calls: false }
+        GenConfig {
+            rungs: 1000,
+            width: 32,
+            seed: 0,
+            timers: false,
+            loops: false,
+            jumps: false,
+            calls: false,
+        }
     }
 }
 
 impl GenConfig {
     /// The same shape with every knob (timers, loops, jumps, calls) on.
     pub fn all_features(rungs: usize, width: usize, seed: u64) -> Self {
-        GenConfig { rungs, width, seed, timers: true, loops: true, jumps: true, calls: true }
+        GenConfig {
+            rungs,
+            width,
+            seed,
+            timers: true,
+            loops: true,
+            jumps: true,
+            calls: true,
+        }
     }
 }
 
@@ -246,33 +262,69 @@ impl Timer {
 }
 
 fn counter_is_ctu(j: usize, p: usize) -> bool {
-    (j + p) % 2 == 0
+    (j + p).is_multiple_of(2)
 }
 
 #[derive(Clone, Debug)]
 enum Elem {
-    Contact { var: Opnd, negated: bool, edge: Option<&'static str> },
-    Compare { op: &'static str, a: Opnd, b: Opnd },
+    Contact {
+        var: Opnd,
+        negated: bool,
+        edge: Option<&'static str>,
+    },
+    Compare {
+        op: &'static str,
+        a: Opnd,
+        b: Opnd,
+    },
     Or(Vec<Vec<Elem>>),
-    Coil { var: Name, negated: bool },
+    Coil {
+        var: Name,
+        negated: bool,
+    },
     Set(Name),
     Reset(Name),
     Branch(Vec<Vec<Elem>>),
-    Timer { kind: Timer, var: Name },
-    Ctu { var: Name, pv: Opnd, reset: Opnd },
-    Ctd { var: Name, pv: Opnd, load: Opnd },
-    Move { from: Opnd, to: Name },
-    Op { op: &'static str, a: Opnd, b: Opnd, out: Name },
+    Timer {
+        kind: Timer,
+        var: Name,
+    },
+    Ctu {
+        var: Name,
+        pv: Opnd,
+        reset: Opnd,
+    },
+    Ctd {
+        var: Name,
+        pv: Opnd,
+        load: Opnd,
+    },
+    Move {
+        from: Opnd,
+        to: Name,
+    },
+    Op {
+        op: &'static str,
+        a: Opnd,
+        b: Opnd,
+        out: Name,
+    },
     Jmp(usize),
     Ret,
     End,
     Call(usize),
-    For { k: usize },
+    For {
+        k: usize,
+    },
     Next,
 }
 
 fn contact(n: Name, negated: bool) -> Elem {
-    Elem::Contact { var: Opnd::Var(n), negated, edge: None }
+    Elem::Contact {
+        var: Opnd::Var(n),
+        negated,
+        edge: None,
+    }
 }
 
 fn write_series<W: Write>(w: &mut W, series: &[Elem]) -> io::Result<()> {
@@ -311,16 +363,30 @@ fn write_elem<W: Write>(w: &mut W, e: &Elem) -> io::Result<()> {
         }
         Elem::Compare { op, a, b } => write!(w, "{{\"compare\":\"{op}\",\"a\":{a},\"b\":{b}}}"),
         Elem::Or(b) => write_branches(w, "or", b),
-        Elem::Coil { var, negated: false } => write!(w, "{{\"coil\":\"{var}\"}}"),
+        Elem::Coil {
+            var,
+            negated: false,
+        } => write!(w, "{{\"coil\":\"{var}\"}}"),
         Elem::Coil { var, negated: true } => write!(w, "{{\"coil\":\"{var}\",\"negated\":true}}"),
         Elem::Set(v) => write!(w, "{{\"set\":\"{v}\"}}"),
         Elem::Reset(v) => write!(w, "{{\"reset\":\"{v}\"}}"),
         Elem::Branch(b) => write_branches(w, "branch", b),
-        Elem::Timer { kind, var } => write!(w, "{{\"{}\":\"{var}\",\"pt\":\"{}\"}}", kind.key(), kind.pt()),
-        Elem::Ctu { var, pv, reset } => write!(w, "{{\"ctu\":\"{var}\",\"pv\":{pv},\"reset\":{reset}}}"),
-        Elem::Ctd { var, pv, load } => write!(w, "{{\"ctd\":\"{var}\",\"pv\":{pv},\"load\":{load}}}"),
+        Elem::Timer { kind, var } => write!(
+            w,
+            "{{\"{}\":\"{var}\",\"pt\":\"{}\"}}",
+            kind.key(),
+            kind.pt()
+        ),
+        Elem::Ctu { var, pv, reset } => {
+            write!(w, "{{\"ctu\":\"{var}\",\"pv\":{pv},\"reset\":{reset}}}")
+        }
+        Elem::Ctd { var, pv, load } => {
+            write!(w, "{{\"ctd\":\"{var}\",\"pv\":{pv},\"load\":{load}}}")
+        }
         Elem::Move { from, to } => write!(w, "{{\"move\":{from},\"to\":\"{to}\"}}"),
-        Elem::Op { op, a, b, out } => write!(w, "{{\"op\":\"{op}\",\"in\":[{a},{b}],\"out\":\"{out}\"}}"),
+        Elem::Op { op, a, b, out } => {
+            write!(w, "{{\"op\":\"{op}\",\"in\":[{a},{b}],\"out\":\"{out}\"}}")
+        }
         Elem::Jmp(l) => write!(w, "{{\"jmp\":\"L{l}\"}}"),
         Elem::Ret => w.write_all(b"{\"ret\":true}"),
         Elem::End => w.write_all(b"{\"end\":true}"),
@@ -416,13 +482,24 @@ impl Generator {
         let r = &mut self.sub_rng;
         let count = r.range(2, 4);
         for k in 0..count {
-            let rungs = if k == 0 { r.range(4, 10) } else { r.range(3, 10) };
+            let rungs = if k == 0 {
+                r.range(4, 10)
+            } else {
+                r.range(3, 10)
+            };
             let ret_at = (rungs >= 4 && (k == 0 || r.one_in(2))).then_some(rungs - 2);
             let call_next = k + 1 < count && r.one_in(2);
             let jump_to = (self.cfg.jumps && rungs >= 5 && r.one_in(2)).then(|| r.range(2, 3));
             let input = r.below(self.inputs);
             let global_lane = (self.phases > 0).then(|| r.below(self.lanes));
-            self.subs.push(SubPlan { rungs, ret_at, call_next, jump_to, input, global_lane });
+            self.subs.push(SubPlan {
+                rungs,
+                ret_at,
+                call_next,
+                jump_to,
+                input,
+                global_lane,
+            });
         }
     }
 
@@ -431,7 +508,7 @@ impl Generator {
         let j = r % self.lanes;
         // The last rung of the lane; the end rung (if any) hands the job to the one before.
         let limit = if self.has_end { self.n - 1 } else { self.n };
-        (j % 16 == 0 && r < limit && r + self.lanes >= limit).then_some(j / 16)
+        (j.is_multiple_of(16) && r < limit && r + self.lanes >= limit).then_some(j / 16)
     }
 
     fn write<W: Write>(&mut self, w: &mut W) -> io::Result<()> {
@@ -446,15 +523,19 @@ impl Generator {
 
     fn write_globals<W: Write>(&self, w: &mut W) -> io::Result<()> {
         let mut first = true;
-        let mut var = |w: &mut W, name: Name, ty: &str, class: &str, init: Option<&str>| -> io::Result<()> {
-            w.write_all(if first { b"\n" } else { b",\n" })?;
-            first = false;
-            write!(w, "{{\"name\":\"{name}\",\"type\":\"{ty}\",\"class\":\"{class}\"")?;
-            if let Some(init) = init {
-                write!(w, ",\"init\":{init}")?;
-            }
-            w.write_all(b"}")
-        };
+        let mut var =
+            |w: &mut W, name: Name, ty: &str, class: &str, init: Option<&str>| -> io::Result<()> {
+                w.write_all(if first { b"\n" } else { b",\n" })?;
+                first = false;
+                write!(
+                    w,
+                    "{{\"name\":\"{name}\",\"type\":\"{ty}\",\"class\":\"{class}\""
+                )?;
+                if let Some(init) = init {
+                    write!(w, ",\"init\":{init}")?;
+                }
+                w.write_all(b"}")
+            };
         for i in 0..self.inputs {
             var(w, Name::I(i), "BOOL", "input", None)?;
         }
@@ -463,7 +544,13 @@ impl Generator {
         }
         for p in 0..self.phases {
             for j in 0..self.lanes {
-                var(w, Name::M(j, p), "BOOL", "memory", ((j + p) % 7 == 3).then_some("true"))?;
+                var(
+                    w,
+                    Name::M(j, p),
+                    "BOOL",
+                    "memory",
+                    ((j + p) % 7 == 3).then_some("true"),
+                )?;
             }
         }
         let inits = ["1", "2", "5", "10", "100"];
@@ -476,7 +563,13 @@ impl Generator {
         if self.cfg.timers {
             for p in 0..self.phases {
                 for j in 0..self.lanes {
-                    var(w, Name::T(j, p), Timer::of(j, p).type_name(), "memory", None)?;
+                    var(
+                        w,
+                        Name::T(j, p),
+                        Timer::of(j, p).type_name(),
+                        "memory",
+                        None,
+                    )?;
                 }
             }
             for p in 0..self.phases {
@@ -498,7 +591,14 @@ impl Generator {
     }
 
     /// Rung `{"id": ..., "label"?, "comment"?, "ld": [conds..., tail...]}` on its own line.
-    fn write_rung<W: Write>(&self, w: &mut W, first: bool, id: usize, label: Option<usize>, comment: Option<usize>) -> io::Result<()> {
+    fn write_rung<W: Write>(
+        &self,
+        w: &mut W,
+        first: bool,
+        id: usize,
+        label: Option<usize>,
+        comment: Option<usize>,
+    ) -> io::Result<()> {
         w.write_all(if first { b"\n" } else { b",\n" })?;
         write!(w, "{{\"id\":\"R{id}\"")?;
         if let Some(l) = label {
@@ -623,8 +723,16 @@ impl Generator {
             i = (i + 1) % self.inputs;
         }
         let e = if self.rng.one_in(25) {
-            let edge = if self.rng.one_in(2) { "rising" } else { "falling" };
-            Elem::Contact { var: Opnd::Var(Name::I(i)), negated: false, edge: Some(edge) }
+            let edge = if self.rng.one_in(2) {
+                "rising"
+            } else {
+                "falling"
+            };
+            Elem::Contact {
+                var: Opnd::Var(Name::I(i)),
+                negated: false,
+                edge: Some(edge),
+            }
         } else {
             contact(Name::I(i), self.rng.one_in(6))
         };
@@ -693,15 +801,27 @@ impl Generator {
                 if let Some(l) = self.flagged(&lanes[..len], F_TIMER) {
                     if self.rng.one_in(2) {
                         let neg = self.rng.one_in(4);
-                        self.conds.push(Elem::Contact { var: Opnd::Field(Name::T(l, pp), "Q"), negated: neg, edge: None });
+                        self.conds.push(Elem::Contact {
+                            var: Opnd::Field(Name::T(l, pp), "Q"),
+                            negated: neg,
+                            edge: None,
+                        });
                     }
                 }
                 if let Some(l) = self.flagged(&lanes[..len], F_COUNTER) {
                     if self.rng.one_in(2) {
                         self.conds.push(if self.rng.one_in(2) {
-                            Elem::Contact { var: Opnd::Field(Name::C(l, pp), "Q"), negated: false, edge: None }
+                            Elem::Contact {
+                                var: Opnd::Field(Name::C(l, pp), "Q"),
+                                negated: false,
+                                edge: None,
+                            }
                         } else {
-                            Elem::Compare { op: "GE", a: Opnd::Field(Name::C(l, pp), "CV"), b: Opnd::Int(3) }
+                            Elem::Compare {
+                                op: "GE",
+                                a: Opnd::Field(Name::C(l, pp), "CV"),
+                                b: Opnd::Int(3),
+                            }
                         });
                     }
                 }
@@ -710,7 +830,11 @@ impl Generator {
                 let l = self.flagged(&lanes[..len], F_INT).unwrap_or(j);
                 let op = CMP_OPS[self.rng.below(6)];
                 let b = self.rng.range(0, 20) as i64 - 5;
-                self.conds.push(Elem::Compare { op, a: Opnd::Var(Name::N(l, pp)), b: Opnd::Int(b) });
+                self.conds.push(Elem::Compare {
+                    op,
+                    a: Opnd::Var(Name::N(l, pp)),
+                    b: Opnd::Int(b),
+                });
             }
             if self.cfg.calls && self.rng.one_in(100) {
                 let k = self.rng.below(self.subs.len());
@@ -719,7 +843,11 @@ impl Generator {
         }
         if self.rng.one_in(8) {
             let b = if self.rng.one_in(3) {
-                let (a, b, c) = (self.conds.remove(0), self.conds.remove(0), self.conds.remove(0));
+                let (a, b, c) = (
+                    self.conds.remove(0),
+                    self.conds.remove(0),
+                    self.conds.remove(0),
+                );
                 vec![vec![a, b], vec![c]]
             } else {
                 let (a, b) = (self.conds.remove(0), self.conds.remove(0));
@@ -729,20 +857,36 @@ impl Generator {
         }
         // Boxes.
         if let Some(k) = body {
-            self.tail.push(Elem::Op { op: "ADD", a: Opnd::Var(Name::N(j, p)), b: Opnd::Var(Name::Idx(k)), out: Name::N(j, p) });
+            self.tail.push(Elem::Op {
+                op: "ADD",
+                a: Opnd::Var(Name::N(j, p)),
+                b: Opnd::Var(Name::Idx(k)),
+                out: Name::N(j, p),
+            });
             self.cur[j] |= F_INT;
         }
         if self.cfg.timers {
             if self.rng.one_in(20) {
-                self.tail.push(Elem::Timer { kind: Timer::of(j, p), var: Name::T(j, p) });
+                self.tail.push(Elem::Timer {
+                    kind: Timer::of(j, p),
+                    var: Name::T(j, p),
+                });
                 self.cur[j] |= F_TIMER;
             } else if self.rng.one_in(57) {
                 let c = Name::C(j, p);
                 let ctl = Opnd::Var(Name::I(self.rng.below(self.inputs)));
                 self.tail.push(if counter_is_ctu(j, p) {
-                    Elem::Ctu { var: c, pv: Opnd::Int(5), reset: ctl }
+                    Elem::Ctu {
+                        var: c,
+                        pv: Opnd::Int(5),
+                        reset: ctl,
+                    }
                 } else {
-                    Elem::Ctd { var: c, pv: Opnd::Int(5), load: ctl }
+                    Elem::Ctd {
+                        var: c,
+                        pv: Opnd::Int(5),
+                        load: ctl,
+                    }
                 });
                 self.cur[j] |= F_COUNTER;
             }
@@ -757,7 +901,11 @@ impl Generator {
                 Opnd::Var(to)
             };
             let e = if self.rng.one_in(2) {
-                let from = if self.rng.one_in(2) { Opnd::Int(self.rng.range(0, 100) as i64) } else { src };
+                let from = if self.rng.one_in(2) {
+                    Opnd::Int(self.rng.range(0, 100) as i64)
+                } else {
+                    src
+                };
                 Elem::Move { from, to }
             } else {
                 let (op, c) = match self.rng.below(5) {
@@ -767,7 +915,12 @@ impl Generator {
                     3 => ("DIV", self.rng.range(1, 9)),
                     _ => ("MOD", self.rng.range(2, 9)),
                 };
-                Elem::Op { op, a: src, b: Opnd::Int(c as i64), out: to }
+                Elem::Op {
+                    op,
+                    a: src,
+                    b: Opnd::Int(c as i64),
+                    out: to,
+                }
             };
             self.cur[j] |= F_INT;
             if self.rng.one_in(2) {
@@ -780,9 +933,15 @@ impl Generator {
         let m = Name::M(j, p);
         let q = self.q_of(r);
         if q.is_some() || extra_path.is_some() {
-            let mut paths = vec![vec![Elem::Coil { var: m, negated: false }]];
+            let mut paths = vec![vec![Elem::Coil {
+                var: m,
+                negated: false,
+            }]];
             if let Some(q) = q {
-                paths.push(vec![Elem::Coil { var: Name::Q(q), negated: false }]);
+                paths.push(vec![Elem::Coil {
+                    var: Name::Q(q),
+                    negated: false,
+                }]);
             }
             if let Some(e) = extra_path {
                 paths.push(vec![e]);
@@ -792,8 +951,14 @@ impl Generator {
             self.tail.push(match self.rng.below(40) {
                 0..=3 => Elem::Set(m),
                 4..=7 => Elem::Reset(m),
-                8 => Elem::Coil { var: m, negated: true },
-                _ => Elem::Coil { var: m, negated: false },
+                8 => Elem::Coil {
+                    var: m,
+                    negated: true,
+                },
+                _ => Elem::Coil {
+                    var: m,
+                    negated: false,
+                },
             });
         }
     }
@@ -813,7 +978,11 @@ impl Generator {
             let sp = &self.subs[k];
             for i in 0..sp.rungs {
                 let sep = if i == 0 { "" } else { "," };
-                write!(w, "{sep}\n{{\"name\":\"{}\",\"type\":\"BOOL\",\"class\":\"memory\"}}", Name::Sb(k, i))?;
+                write!(
+                    w,
+                    "{sep}\n{{\"name\":\"{}\",\"type\":\"BOOL\",\"class\":\"memory\"}}",
+                    Name::Sb(k, i)
+                )?;
             }
             write!(w, ",\n{{\"name\":\"{}\",\"type\":\"INT\",\"class\":\"memory\",\"init\":0}}\n],\"rungs\":[", Name::Sn(k))?;
             let jump_label = sp.jump_to.map(|_| {
@@ -821,8 +990,14 @@ impl Generator {
                 self.labels - 1
             });
             let sp = &self.subs[k];
-            let (rungs, ret_at, call_next, jump_to, input, global) =
-                (sp.rungs, sp.ret_at, sp.call_next, sp.jump_to, sp.input, sp.global_lane);
+            let (rungs, ret_at, call_next, jump_to, input, global) = (
+                sp.rungs,
+                sp.ret_at,
+                sp.call_next,
+                sp.jump_to,
+                sp.input,
+                sp.global_lane,
+            );
             // The op goes on the first plain rung after rung 0.
             let plain = |i: usize| i != 0 && Some(i) != ret_at && !(call_next && i == 1);
             let op_at = (1..rungs).find(|&i| plain(i)).unwrap_or(rungs - 1);
@@ -856,20 +1031,38 @@ impl Generator {
                         }
                     }
                     if i == op_at {
-                        self.tail.push(Elem::Op { op: "ADD", a: Opnd::Var(Name::Sn(k)), b: Opnd::Int(1), out: Name::Sn(k) });
+                        self.tail.push(Elem::Op {
+                            op: "ADD",
+                            a: Opnd::Var(Name::Sn(k)),
+                            b: Opnd::Int(1),
+                            out: Name::Sn(k),
+                        });
                     }
                     let b = Name::Sb(k, i);
                     if i + 1 == rungs {
-                        self.conds.push(Elem::Compare { op: "GT", a: Opnd::Var(Name::Sn(k)), b: Opnd::Int(10) });
+                        self.conds.push(Elem::Compare {
+                            op: "GT",
+                            a: Opnd::Var(Name::Sn(k)),
+                            b: Opnd::Int(10),
+                        });
                         self.tail.push(Elem::Branch(vec![
-                            vec![Elem::Coil { var: b, negated: false }],
-                            vec![Elem::Coil { var: Name::Sr(k), negated: false }],
+                            vec![Elem::Coil {
+                                var: b,
+                                negated: false,
+                            }],
+                            vec![Elem::Coil {
+                                var: Name::Sr(k),
+                                negated: false,
+                            }],
                         ]));
                     } else {
                         self.tail.push(match r.below(12) {
                             0 => Elem::Set(b),
                             1 => Elem::Reset(b),
-                            _ => Elem::Coil { var: b, negated: false },
+                            _ => Elem::Coil {
+                                var: b,
+                                negated: false,
+                            },
                         });
                     }
                 }

@@ -63,7 +63,12 @@ impl Checker<'_> {
         self.locals
             .get(name)
             .or_else(|| self.globals.get(name))
-            .ok_or_else(|| format!("{}: undeclared variable {name:?} in {}", self.rung, self.pou))
+            .ok_or_else(|| {
+                format!(
+                    "{}: undeclared variable {name:?} in {}",
+                    self.rung, self.pou
+                )
+            })
     }
 
     /// Type of an operand; `"NUM"` for a plain number literal.
@@ -74,7 +79,8 @@ impl Checker<'_> {
             Value::String(s) if s.starts_with("T#") => {
                 let body = &s[2..];
                 let ok = ["ms", "s", "m", "h"].iter().any(|u| {
-                    body.strip_suffix(u).is_some_and(|d| !d.is_empty() && d.chars().all(|c| c.is_ascii_digit()))
+                    body.strip_suffix(u)
+                        .is_some_and(|d| !d.is_empty() && d.chars().all(|c| c.is_ascii_digit()))
                 });
                 if ok {
                     Ok("TIME".into())
@@ -99,7 +105,10 @@ impl Checker<'_> {
         let t = self.operand(v)?;
         let ok = t == ty || (t == "NUM" && matches!(ty, "INT" | "DINT" | "REAL"));
         if !ok {
-            return fail(format!("{}: {what} {v} has type {t}, expected {ty}", self.rung));
+            return fail(format!(
+                "{}: {what} {v} has type {t}, expected {ty}",
+                self.rung
+            ));
         }
         if let (Some(x), "INT") = (v.as_i64(), ty) {
             if i16::try_from(x).is_err() {
@@ -110,14 +119,19 @@ impl Checker<'_> {
     }
 
     fn writable(&self, v: &Value, ty: Option<&str>, what: &str) -> Result<String, String> {
-        let name = v.as_str().ok_or_else(|| format!("{}: {what} target not a string", self.rung))?;
+        let name = v
+            .as_str()
+            .ok_or_else(|| format!("{}: {what} target not a string", self.rung))?;
         let d = self.decl(name)?;
         if d.class == "input" {
             return fail(format!("{}: {what} writes input {name}", self.rung));
         }
         if let Some(ty) = ty {
             if d.ty != ty {
-                return fail(format!("{}: {what} on {name}: {}, expected {ty}", self.rung, d.ty));
+                return fail(format!(
+                    "{}: {what} on {name}: {}, expected {ty}",
+                    self.rung, d.ty
+                ));
             }
         }
         Ok(d.ty.clone())
@@ -132,14 +146,21 @@ impl Checker<'_> {
 
     /// `place`: "top", "branch" or "or".
     fn series(&mut self, v: &Value, place: &str) -> Result<(), String> {
-        let items = v.as_array().ok_or_else(|| format!("{}: series is not an array", self.rung))?;
+        let items = v
+            .as_array()
+            .ok_or_else(|| format!("{}: series is not an array", self.rung))?;
         for (i, e) in items.iter().enumerate() {
-            let o = e.as_object().ok_or_else(|| format!("{}: element is not an object", self.rung))?;
+            let o = e
+                .as_object()
+                .ok_or_else(|| format!("{}: element is not an object", self.rung))?;
             // Boxes first: a `ctu` box has a `reset` operand, which is not a reset coil.
-            let key = ["ctu", "ctd", "ton", "tof", "tp", "move", "op", "compare", "contact", "or", "coil", "set", "reset", "branch", "jmp", "ret", "end", "call", "for", "next"]
-                .into_iter()
-                .find(|k| o.contains_key(*k))
-                .ok_or_else(|| format!("{}: unknown element {e}", self.rung))?;
+            let key = [
+                "ctu", "ctd", "ton", "tof", "tp", "move", "op", "compare", "contact", "or", "coil",
+                "set", "reset", "branch", "jmp", "ret", "end", "call", "for", "next",
+            ]
+            .into_iter()
+            .find(|k| o.contains_key(*k))
+            .ok_or_else(|| format!("{}: unknown element {e}", self.rung))?;
             if place == "or" && !matches!(key, "contact" | "compare" | "or") {
                 return fail(format!("{}: {key} inside or", self.rung));
             }
@@ -172,7 +193,9 @@ impl Checker<'_> {
                     self.expect(&o["b"], ty, "compare b")?;
                 }
                 "or" | "branch" => {
-                    let branches = o[key].as_array().ok_or_else(|| format!("{}: {key} not an array", self.rung))?;
+                    let branches = o[key]
+                        .as_array()
+                        .ok_or_else(|| format!("{}: {key} not an array", self.rung))?;
                     if branches.len() < 2 {
                         return fail(format!("{}: {key} with fewer than 2 branches", self.rung));
                     }
@@ -209,7 +232,10 @@ impl Checker<'_> {
                     if !["INT", "DINT"].contains(&ty.as_str()) {
                         return fail(format!("{}: op on {ty}", self.rung));
                     }
-                    let ins = o["in"].as_array().filter(|a| a.len() == 2).ok_or_else(|| format!("{}: op needs 2 inputs", self.rung))?;
+                    let ins = o["in"]
+                        .as_array()
+                        .filter(|a| a.len() == 2)
+                        .ok_or_else(|| format!("{}: op needs 2 inputs", self.rung))?;
                     for x in ins {
                         self.expect(x, &ty, "op input")?;
                     }
@@ -218,7 +244,9 @@ impl Checker<'_> {
                     }
                 }
                 "jmp" => {
-                    let l = o["jmp"].as_str().ok_or_else(|| format!("{}: jmp label not a string", self.rung))?;
+                    let l = o["jmp"]
+                        .as_str()
+                        .ok_or_else(|| format!("{}: jmp label not a string", self.rung))?;
                     self.jumps.push(l.to_owned());
                 }
                 "ret" => self.flag(o, "ret")?,
@@ -239,7 +267,9 @@ impl Checker<'_> {
                     if place != "top" || i + 1 != items.len() {
                         return fail(format!("{}: for not last in its rung", self.rung));
                     }
-                    let f = o["for"].as_object().ok_or_else(|| format!("{}: bad for", self.rung))?;
+                    let f = o["for"]
+                        .as_object()
+                        .ok_or_else(|| format!("{}: bad for", self.rung))?;
                     self.writable(&f["var"], Some("INT"), "for index")?;
                     self.expect(&f["from"], "INT", "for from")?;
                     self.expect(&f["to"], "INT", "for to")?;
@@ -257,12 +287,24 @@ impl Checker<'_> {
     }
 }
 
-fn declare(vars: &Value, into: &mut HashMap<String, Decl>, all: &mut HashSet<String>) -> Result<(), String> {
+fn declare(
+    vars: &Value,
+    into: &mut HashMap<String, Decl>,
+    all: &mut HashSet<String>,
+) -> Result<(), String> {
     for v in vars.as_array().ok_or("vars is not an array")? {
         let name = v["name"].as_str().ok_or("var without name")?.to_owned();
         let ty = v["type"].as_str().ok_or("var without type")?.to_owned();
-        let class = v.get("class").and_then(Value::as_str).unwrap_or("memory").to_owned();
-        if !["BOOL", "INT", "DINT", "REAL", "TIME", "TON", "TOF", "TP", "CTU", "CTD"].contains(&ty.as_str()) {
+        let class = v
+            .get("class")
+            .and_then(Value::as_str)
+            .unwrap_or("memory")
+            .to_owned();
+        if ![
+            "BOOL", "INT", "DINT", "REAL", "TIME", "TON", "TOF", "TP", "CTU", "CTD",
+        ]
+        .contains(&ty.as_str())
+        {
             return fail(format!("{name}: unknown type {ty}"));
         }
         if !["input", "output", "memory"].contains(&class.as_str()) {
@@ -296,15 +338,22 @@ fn validate(text: &str) -> Result<Stats, String> {
             return fail(format!("unknown top-level key {k}"));
         }
     }
-    top.get("program").and_then(Value::as_str).ok_or("program name missing")?;
+    top.get("program")
+        .and_then(Value::as_str)
+        .ok_or("program name missing")?;
     let mut all = HashSet::new();
     let mut globals = HashMap::new();
     declare(&v["vars"], &mut globals, &mut all)?;
     let empty = Map::new();
-    let subs_obj = top.get("subroutines").map(|s| s.as_object().ok_or("subroutines is not an object")).transpose()?.unwrap_or(&empty);
+    let subs_obj = top
+        .get("subroutines")
+        .map(|s| s.as_object().ok_or("subroutines is not an object"))
+        .transpose()?
+        .unwrap_or(&empty);
     let subs: HashSet<String> = subs_obj.keys().cloned().collect();
 
-    let mut pous: Vec<(String, &Value, HashMap<String, Decl>)> = vec![("main".into(), &v["rungs"], HashMap::new())];
+    let mut pous: Vec<(String, &Value, HashMap<String, Decl>)> =
+        vec![("main".into(), &v["rungs"], HashMap::new())];
     for (name, body) in subs_obj {
         let mut locals = HashMap::new();
         declare(&body["vars"], &mut locals, &mut all)?;
@@ -315,7 +364,9 @@ fn validate(text: &str) -> Result<Stats, String> {
     let mut calls = Vec::new();
     let mut ids = Vec::new();
     for (pi, (pou, rungs, locals)) in pous.into_iter().enumerate() {
-        let rungs = rungs.as_array().ok_or_else(|| format!("{pou}: rungs is not an array"))?;
+        let rungs = rungs
+            .as_array()
+            .ok_or_else(|| format!("{pou}: rungs is not an array"))?;
         if pi == 0 {
             stats.main_rungs = rungs.len();
         } else {
@@ -338,19 +389,27 @@ fn validate(text: &str) -> Result<Stats, String> {
             jumps: Vec::new(),
         };
         for (ri, r) in rungs.iter().enumerate() {
-            let o = r.as_object().ok_or_else(|| format!("{pou}: rung {ri} is not an object"))?;
+            let o = r
+                .as_object()
+                .ok_or_else(|| format!("{pou}: rung {ri} is not an object"))?;
             for k in o.keys() {
                 if !["id", "label", "comment", "ld"].contains(&k.as_str()) {
                     return fail(format!("{pou}: rung {ri}: unknown key {k}"));
                 }
             }
-            let id = o.get("id").and_then(Value::as_str).ok_or_else(|| format!("{pou}: rung {ri} without id"))?;
+            let id = o
+                .get("id")
+                .and_then(Value::as_str)
+                .ok_or_else(|| format!("{pou}: rung {ri} without id"))?;
             ids.push(id.to_owned());
             if let Some(c) = o.get("comment") {
-                c.as_str().ok_or_else(|| format!("{id}: comment not a string"))?;
+                c.as_str()
+                    .ok_or_else(|| format!("{id}: comment not a string"))?;
             }
             if let Some(l) = o.get("label") {
-                let l = l.as_str().ok_or_else(|| format!("{id}: label not a string"))?;
+                let l = l
+                    .as_str()
+                    .ok_or_else(|| format!("{id}: label not a string"))?;
                 if labels.insert(l.to_owned(), ri).is_some() {
                     return fail(format!("{pou}: duplicate label {l}"));
                 }
@@ -360,7 +419,9 @@ fn validate(text: &str) -> Result<Stats, String> {
             for l in checker.jumps.drain(..) {
                 jumps.push((ri, l));
             }
-            let ld = o["ld"].as_array().ok_or_else(|| format!("{id}: ld not an array"))?;
+            let ld = o["ld"]
+                .as_array()
+                .ok_or_else(|| format!("{id}: ld not an array"))?;
             let last = ld.last().and_then(Value::as_object);
             enclosing.push(stack.clone());
             if last.is_some_and(|e| e.contains_key("for")) {
@@ -373,12 +434,18 @@ fn validate(text: &str) -> Result<Stats, String> {
             return fail(format!("{pou}: {} for without next", stack.len()));
         }
         for (src, l) in jumps {
-            let &t = labels.get(&l).ok_or_else(|| format!("{pou}: jmp to missing label {l}"))?;
+            let &t = labels
+                .get(&l)
+                .ok_or_else(|| format!("{pou}: jmp to missing label {l}"))?;
             if t <= src {
-                return fail(format!("{pou}: jmp {l} from rung {src} goes backwards to {t}"));
+                return fail(format!(
+                    "{pou}: jmp {l} from rung {src} goes backwards to {t}"
+                ));
             }
             if enclosing[t] != enclosing[src] {
-                return fail(format!("{pou}: jmp {l} from rung {src} enters or leaves a FOR body"));
+                return fail(format!(
+                    "{pou}: jmp {l} from rung {src} enters or leaves a FOR body"
+                ));
             }
         }
     }
@@ -399,7 +466,12 @@ fn validate(text: &str) -> Result<Stats, String> {
     for (a, b) in &calls {
         edges.entry(a.as_str()).or_default().push(b.as_str());
     }
-    fn visit<'s>(n: &'s str, edges: &HashMap<&'s str, Vec<&'s str>>, path: &mut Vec<&'s str>, done: &mut HashSet<&'s str>) -> Result<(), String> {
+    fn visit<'s>(
+        n: &'s str,
+        edges: &HashMap<&'s str, Vec<&'s str>>,
+        path: &mut Vec<&'s str>,
+        done: &mut HashSet<&'s str>,
+    ) -> Result<(), String> {
         if path.contains(&n) {
             return fail(format!("recursive call chain {path:?} → {n}"));
         }
@@ -423,7 +495,15 @@ fn validate(text: &str) -> Result<Stats, String> {
 }
 
 fn cfg(rungs: usize, width: usize, seed: u64, on: bool) -> GenConfig {
-    GenConfig { rungs, width, seed, timers: on, loops: on, jumps: on, calls: on }
+    GenConfig {
+        rungs,
+        width,
+        seed,
+        timers: on,
+        loops: on,
+        jumps: on,
+        calls: on,
+    }
 }
 
 fn check(c: &GenConfig) -> Stats {
@@ -456,7 +536,11 @@ fn valid_and_exact_counts_over_many_shapes() {
                     if c.calls {
                         let n = stats.sub_rungs.len();
                         assert!((2..=4).contains(&n), "{c:?}: {n} subroutines");
-                        assert!(stats.sub_rungs.values().all(|r| (3..=10).contains(r)), "{c:?}: {:?}", stats.sub_rungs);
+                        assert!(
+                            stats.sub_rungs.values().all(|r| (3..=10).contains(r)),
+                            "{c:?}: {:?}",
+                            stats.sub_rungs
+                        );
                     } else {
                         assert!(stats.sub_rungs.is_empty());
                     }
@@ -469,10 +553,29 @@ fn valid_and_exact_counts_over_many_shapes() {
 #[test]
 fn knobs_off_means_no_structure() {
     let s = check(&cfg(5000, 40, 9, false));
-    for k in ["ton", "tof", "tp", "ctu", "ctd", "for", "next", "jmp", "ret", "end", "call"] {
-        assert!(!s.kinds.contains_key(k), "{k} present with knobs off: {:?}", s.kinds);
+    for k in [
+        "ton", "tof", "tp", "ctu", "ctd", "for", "next", "jmp", "ret", "end", "call",
+    ] {
+        assert!(
+            !s.kinds.contains_key(k),
+            "{k} present with knobs off: {:?}",
+            s.kinds
+        );
     }
-    for k in ["contact", "contact.negated", "contact.edge", "compare", "or", "coil", "coil.negated", "set", "reset", "branch", "move", "op"] {
+    for k in [
+        "contact",
+        "contact.negated",
+        "contact.edge",
+        "compare",
+        "or",
+        "coil",
+        "coil.negated",
+        "set",
+        "reset",
+        "branch",
+        "move",
+        "op",
+    ] {
         assert!(s.kinds.contains_key(k), "{k} missing: {:?}", s.kinds);
     }
 }
@@ -482,8 +585,29 @@ fn all_element_kinds_appear_with_all_knobs() {
     let s = check(&GenConfig::all_features(5000, 32, 7));
     println!("element counts: {:?}", s.kinds);
     let all = [
-        "contact", "contact.negated", "contact.edge", "compare", "or", "coil", "coil.negated", "set", "reset", "branch", "ton", "tof",
-        "tp", "ctu", "ctd", "move", "op", "jmp", "ret", "end", "call", "for", "next",
+        "contact",
+        "contact.negated",
+        "contact.edge",
+        "compare",
+        "or",
+        "coil",
+        "coil.negated",
+        "set",
+        "reset",
+        "branch",
+        "ton",
+        "tof",
+        "tp",
+        "ctu",
+        "ctd",
+        "move",
+        "op",
+        "jmp",
+        "ret",
+        "end",
+        "call",
+        "for",
+        "next",
     ];
     for k in all {
         assert!(s.kinds.contains_key(k), "{k} missing: {:?}", s.kinds);
@@ -492,7 +616,11 @@ fn all_element_kinds_appear_with_all_knobs() {
     let n = |k: &str| s.kinds.get(k).copied().unwrap_or(0);
     assert!((10..=50).contains(&n("for")), "for: {}", n("for"));
     assert!((20..=100).contains(&n("jmp")), "jmp: {}", n("jmp"));
-    assert!((120..=400).contains(&(n("ton") + n("tof") + n("tp"))), "timers: {:?}", s.kinds);
+    assert!(
+        (120..=400).contains(&(n("ton") + n("tof") + n("tp"))),
+        "timers: {:?}",
+        s.kinds
+    );
 }
 
 #[test]
@@ -525,7 +653,12 @@ fn stage_lane_layout() {
         }
     }
     assert_eq!(memory_vars, 4 * w);
-    let inputs = v["vars"].as_array().unwrap().iter().filter(|x| x["class"] == "input").count();
+    let inputs = v["vars"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|x| x["class"] == "input")
+        .count();
     assert_eq!(inputs, 8.max(w / 8));
     let mut q_written = HashSet::new();
     for (r, rung) in rungs.iter().enumerate() {
@@ -553,12 +686,19 @@ fn stage_lane_layout() {
         }
         assert!(reads.len() >= 4, "rung {r} reads only {reads:?}");
     }
-    assert_eq!(q_written.len(), w.div_ceil(16), "outputs written: {q_written:?}");
+    assert_eq!(
+        q_written.len(),
+        w.div_ceil(16),
+        "outputs written: {q_written:?}"
+    );
 }
 
 /// Variable names read (contacts, compare and box operands) and written (coils, box outputs).
 fn collect(series: &Value, reads: &mut Vec<String>, writes: &mut Vec<String>) {
-    let name = |v: &Value| v.as_str().map(|s| s.split('.').next().unwrap_or(s).to_owned());
+    let name = |v: &Value| {
+        v.as_str()
+            .map(|s| s.split('.').next().unwrap_or(s).to_owned())
+    };
     for e in series.as_array().unwrap() {
         let o = e.as_object().unwrap();
         for k in ["or", "branch"] {
@@ -628,15 +768,27 @@ impl Write for Counter {
 /// One million rungs (100,000 in debug builds), streamed to a counting sink; prints the time.
 #[test]
 fn million_rungs_stream() {
-    let n = if cfg!(debug_assertions) { 100_000 } else { 1_000_000 };
+    let n = if cfg!(debug_assertions) {
+        100_000
+    } else {
+        1_000_000
+    };
     for (width, on) in [(1000usize, false), (1000, true), (64, true)] {
         let c = cfg(n, width, 1, on);
-        let mut sink = Counter { bytes: 0, rungs: 0, matched: 0 };
+        let mut sink = Counter {
+            bytes: 0,
+            rungs: 0,
+            matched: 0,
+        };
         let t = Instant::now();
         write_program(&c, &mut sink).unwrap();
         let dt = t.elapsed();
         let subs = if on { sink.rungs - n } else { 0 };
-        assert!(sink.rungs >= n && subs <= 40, "{} rung lines for {n}", sink.rungs);
+        assert!(
+            sink.rungs >= n && subs <= 40,
+            "{} rung lines for {n}",
+            sink.rungs
+        );
         println!(
             "gen {n} rungs, width {width}, knobs {}: {:.3} s, {:.1} MB ({:.0} B/rung, {subs} subroutine rungs)",
             if on { "on" } else { "off" },

@@ -29,11 +29,15 @@
 //!
 //! 1. **DFS.** An iterative depth-first search from the root numbers the
 //!    reachable nodes in preorder `0..k` (root = 0) and records the DFS-tree
-//!    parent of each. It needs no stack: each preorder slot keeps a cursor
-//!    into its successor list, and "return" follows the parent link. All later
-//!    phases work on preorder numbers, in dense arrays of length `k`.
+//!    parent of each. Its explicit stack holds only nodes that still have
+//!    unexplored edges: a node is popped when its last edge is taken (a tail
+//!    call), so on a chain the stack holds a single entry and finished
+//!    branches are never walked back up. The same pass counts the
+//!    predecessors of every node. All later phases work on preorder numbers,
+//!    in dense arrays of length `k`.
 //! 2. **Predecessors.** The predecessor lists of the reachable nodes are
-//!    built as a CSR in preorder space (one counting sort).
+//!    filled into a CSR in preorder space (the second half of a counting
+//!    sort), each list ascending.
 //! 3. **Semi-dominators.** For `w = k-1 ..= 1`, `sdom(w)` is the minimum of
 //!    the predecessors `v ≤ w` and of `min sdom` over the already-processed
 //!    part of the DFS-tree path above each predecessor `v > w`. The latter is
@@ -61,11 +65,16 @@
 //! algorithm* (Software Practice & Experience 4, 2001) is the iterative
 //! data-flow algorithm used by petgraph's `simple_fast`. It is fast on small
 //! graphs but **O(V²)** in the worst case, and slow exactly on the shape of
-//! our input: long chains, where each pass of its "intersect" walks long
-//! `idom` chains and loops need extra passes. rustc used it and replaced it
-//! with Lengauer–Tarjan / Semi-NCA after it proved slow on long chains of
-//! basic blocks (rust-lang/rust#107449 and related). A ladder program with a
-//! million rungs is precisely a million-node chain.
+//! our input: its "intersect" step walks `idom` chains one link at a time,
+//! which on long chains means long walks, and loops need extra passes.
+//! rustc used it and replaced it with simple Lengauer–Tarjan
+//! (rust-lang/rust#85013, 2021) because it "proves slow on long 'parallel'
+//! chains where the nearest common ancestor lookup does not quickly identify
+//! a root"; Wasmtime (bytecodealliance/wasmtime#9481) and SpiderMonkey moved
+//! to Semi-NCA for the same quadratic worst case. A ladder program with a
+//! million rungs is precisely a million-node chain. (rustc preferred simple
+//! Lengauer–Tarjan over Semi-NCA for its robustness on pathological inputs;
+//! the jump pointers of step 4 remove that weakness of Semi-NCA.)
 //!
 //! # Complexity
 //!
@@ -73,8 +82,10 @@
 //!
 //! * Time: **O(V + E log V)** worst case (path compression without balancing;
 //!   `O(log V)` per NCA query), linear in practice on control-flow graphs.
-//! * Space: the result holds `5V + k` `u32`s (plus one); the computation uses
-//!   `V + 6k + E` more `u32`s at its peak, in a fixed number of allocations.
+//! * Space: the result holds `5V + k` `u32`s; the computation needs about
+//!   `V + 5k + E` more at its peak (plus the DFS stack, 12 bytes per node
+//!   with unexplored edges on the current path), in a fixed number of
+//!   allocations: buffers are reused from phase to phase.
 //!
 //! # Invariants
 //!
@@ -301,11 +312,10 @@ pub fn dominators(g: &Csr, root: u32) -> DominatorTree {
     let mut idom = parent;
     let mut depth = label;
     let mut jump = ancestor;
-    if k > 0 {
-        idom[0] = 0;
-        depth[0] = 0;
-        jump[0] = 0;
-    }
+    // k >= 1: the root is always reachable.
+    idom[0] = 0;
+    depth[0] = 0;
+    jump[0] = 0;
     for w in 1..k {
         let s = semi[w];
         let mut d = idom[w]; // still parent(w)
@@ -333,12 +343,10 @@ pub fn dominators(g: &Csr, root: u32) -> DominatorTree {
     for w in (1..k).rev() {
         size[idom[w] as usize] += size[w];
     }
-    let mut tree_pre = jump; // dead jump pointers; every entry is rewritten
-    tree_pre[..k.min(1)].fill(0);
+    // The jump pointers are dead: reuse them. tree_pre[0] = jump[0] = 0.
+    let mut tree_pre = jump;
     let mut next = pred_offsets; // k + 1 long, dead: per-node "next free number"
-    if k > 0 {
-        next[0] = 1;
-    }
+    next[0] = 1;
     for w in 1..k {
         let p = idom[w] as usize;
         tree_pre[w] = next[p];
