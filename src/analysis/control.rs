@@ -16,7 +16,7 @@
 //!
 //! Control dependences by the FOW walk: for each edge A→B where B does not post-dominate A, every
 //! node on the tree path from B up to ipdom(A) (exclusive) is control dependent on A; when that
-//! path meets A itself (a loop), A is included. Each dependence keeps the edge that causes it.
+//! path meets A itself (a loop), A is included; a self loop A→A makes A depend on itself. Each dependence keeps the edge that causes it.
 //! Cost: O(E + |CD|).
 
 use crate::graph::{dominators, strongly_connected_components, Csr, DominatorTree};
@@ -116,7 +116,16 @@ pub struct ControlDependence {
 pub fn control_dependences(edges: &[(u32, u32)], pdom: &PostDominators, include: impl Fn(u32) -> bool) -> Vec<ControlDependence> {
     let mut out = Vec::new();
     for (i, &(a, b)) in edges.iter().enumerate() {
-        if !include(a) || pdom.post_dominates(b, a) {
+        if !include(a) {
+            continue;
+        }
+        if a == b {
+            // A self loop: the rung decides whether it runs again (the walk below would stop at
+            // once, since every node post-dominates itself).
+            out.push(ControlDependence { controller: a, dependent: a, edge: i as u32 });
+            continue;
+        }
+        if pdom.post_dominates(b, a) {
             continue;
         }
         let stop_at = pdom.immediate(a);

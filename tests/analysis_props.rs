@@ -1,0 +1,177 @@
+//! Property tests of the clever algorithms against their definitions, on thousands of random
+//! inputs: data dependences and levels against the pairwise definition, post-dominators and
+//! control dependences against set-based fixpoints, and the combined schedule against the
+//! pairwise conditions that make it safe.
+
+mod common;
+
+use plc_deps::analysis::accesses::VarSets;
+use plc_deps::analysis::{analyse, control_dependences, data_dependences, data_levels, post_dominators};
+use plc_deps::analysis::dependences::data_dependences_pairwise;
+use plc_deps::analysis::levels::asap_levels;
+use plc_deps::model::VarId;
+use proptest::prelude::*;
+
+fn var_sets() -> impl Strategy<Value = (VarSets, VarSets)> {
+    (1usize..40).prop_flat_map(|n| {
+        let set = proptest::collection::vec(0u32..8, 0..4);
+        (proptest::collection::vec(set.clone(), n), proptest::collection::vec(set, n)).prop_map(|(r, w)| {
+            let f = |l: Vec<Vec<u32>>| VarSets::from_lists(l.into_iter().map(|s| s.into_iter().map(VarId).collect::<Vec<_>>()));
+            (f(r), f(w))
+        })
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(3000))]
+
+    #[test]
+    fn dependences_and_levels_match_the_pairwise_definition((reads, writes) in var_sets()) {
+        let fast = data_dependences(&reads, &writes);
+        let brute = data_dependences_pairwise(&reads, &writes);
+        prop_assert_eq!(&fast, &brute);
+        // Levels: ASAP over every pair (reference) == O(accesses) levelling.
+        let edges: Vec<(u32, u32)> = brute.iter().map(|d| (d.from, d.to)).collect();
+        prop_assert_eq!(data_levels(&reads, &writes), asap_levels(reads.len(), &edges));
+    }
+}
+
+/// Post-dominator sets by the textbook fixpoint: pdom(STOP) = {STOP};
+/// pdom(n) = {n} ∪ ⋂ pdom(s) over successors s.
+fn brute_pdom(n: usize, edges: &[(u32, u32)], stop: usize) -> Vec<Vec<bool>> {
+    let mut pd = vec![vec![true; n]; n];
+    pd[stop] = (0..n).map(|i| i == stop).collect();
+    loop {
+        let mut changed = false;
+        for v in 0..n {
+            if v == stop {
+                continue;
+            }
+            let mut set = vec![true; n];
+            let mut any = false;
+            for &(a, b) in edges {
+                if a as usize == v {
+                    any = true;
+                    for i in 0..n {
+                        set[i] &= pd[b as usize][i];
+                    }
+                }
+            }
+            if !any {
+                set = vec![false; n];
+            }
+            set[v] = true;
+            if set != pd[v] {
+                pd[v] = set;
+                changed = true;
+            }
+        }
+        if !changed {
+            return pd;
+        }
+    }
+}
+
+fn cfg() -> impl Strategy<Value = (usize, Vec<(u32, u32)>)> {
+    // Nodes 0..n-1; n-1 is STOP; a chain keeps every node able to reach STOP.
+    (3usize..24).prop_flat_map(|n| {
+        proptest::collection::vec((0..n as u32 - 1, 0..n as u32), 0..2 * n).prop_map(move |extra| {
+            let mut edges: Vec<(u32, u32)> = (0..n as u32 - 1).map(|i| (i, i + 1)).collect();
+            edges.extend(extra);
+            (n, edges)
+        })
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(2000))]
+
+    #[test]
+    fn post_dominators_and_control_dependences_match_their_definitions((n, edges) in cfg()) {
+        let stop = n - 1;
+        let pd = post_dominators(n, &edges, stop as u32);
+        let sets = brute_pdom(n, &edges, stop);
+        for a in 0..n {
+            for b in 0..n {
+                prop_assert_eq!(pd.post_dominates(a as u32, b as u32), sets[b][a], "pdom({}, {})", a, b);
+            }
+        }
+        // Y is control dependent on X iff X has a successor S with Y pdom S, and Y does not
+        // strictly post-dominate X.
+        let mut want = std::collections::BTreeSet::new();
+        for &(x, s) in &edges {
+            for y in 0..n {
+                if sets[s as usize][y] && !(sets[x as usize][y] && y != x as usize) {
+                    want.insert((x, y as u32));
+                }
+            }
+        }
+        let got: std::collections::BTreeSet<(u32, u32)> =
+            control_dependences(&edges, &pd, |_| true).iter().map(|d| (d.controller, d.dependent)).collect();
+        prop_assert_eq!(got, want);
+    }
+}
+
+/// Checks the combined schedule's safety conditions pairwise on one program.
+fn check_schedule(text: &str) -> Result<bool, TestCaseError> {
+    let Ok(p) = plc_deps::read::program_from_json(text) else { return Ok(false) };
+    let a = analyse(&p);
+    let s = &a.schedule;
+    let task_acc: Vec<(Vec<VarId>, Vec<VarId>)> = s
+        .tasks
+        .iter()
+        .map(|t| {
+            let mut r: Vec<VarId> = t.rungs.iter().flat_map(|&x| a.accesses.ins(x).iter().copied()).collect();
+            let mut w: Vec<VarId> = t.rungs.iter().flat_map(|&x| a.accesses.outs(x).iter().copied()).collect();
+            r.sort();
+            w.sort();
+            (r, w)
+        })
+        .collect();
+    let meets = |a: &[VarId], b: &[VarId]| a.iter().any(|x| b.binary_search(x).is_ok());
+    for j in 0..s.tasks.len() {
+        for i in 0..j {
+            let (ri, wi) = &task_acc[i];
+            let (rj, wj) = &task_acc[j];
+            if meets(wi, rj) || meets(ri, wj) || meets(wi, wj) {
+                prop_assert!(s.tasks[i].level < s.tasks[j].level, "tasks {:?} and {:?} conflict but are not ordered", s.tasks[i].rungs, s.tasks[j].rungs);
+            }
+        }
+        for g in &s.tasks[j].guard {
+            prop_assert!(s.tasks[g.controller as usize].level < s.tasks[j].level);
+        }
+    }
+    // Every main rung is in one task or unreachable; every CFG cycle of the main program stays
+    // inside one task (no edge leads from a later task back to an earlier one).
+    let main = p.main().rungs.clone();
+    for r in main.clone() {
+        let in_task = s.task_of[r as usize].is_some();
+        let unreachable = s.unreachable.iter().any(|u| u.0 == r);
+        prop_assert!(in_task != unreachable);
+    }
+    for e in &a.cfg.edges {
+        if main.contains(&e.from) && main.contains(&e.to) {
+            if let (Some(x), Some(y)) = (s.task_of[e.from as usize], s.task_of[e.to as usize]) {
+                prop_assert!(x <= y, "edge {} → {} goes backwards between tasks", e.from, e.to);
+            }
+        }
+    }
+    // Levels are ASAP: every task above level 0 has a predecessor exactly one level below.
+    for (t, task) in s.tasks.iter().enumerate() {
+        if task.level > 0 {
+            prop_assert!(s.preds[t].iter().any(|&q| s.tasks[q as usize].level + 1 == task.level));
+        }
+    }
+    Ok(true)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(3000))]
+
+    #[test]
+    fn combined_schedule_is_safe_on_random_programs(seed in any::<u64>()) {
+        let text = common::random_program(seed, 24);
+        let loaded = check_schedule(&text)?;
+        prop_assume!(loaded);
+    }
+}

@@ -1,0 +1,183 @@
+//! Random ladder programs for property tests: every element kind, jumps (forward and backward),
+//! FOR/NEXT loops, calls, timers, counters, set/reset and edges. Programs are built as JSON text
+//! from a seed, so a failing case is reproducible and printable.
+#![allow(dead_code)]
+
+use serde_json::{json, Value};
+
+/// A small deterministic PRNG (splitmix64).
+pub struct Rng(u64);
+
+impl Rng {
+    pub fn new(seed: u64) -> Rng {
+        Rng(seed ^ 0x9E37_79B9_7F4A_7C15)
+    }
+    pub fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    pub fn below(&mut self, n: u64) -> u64 {
+        self.next() % n.max(1)
+    }
+    pub fn chance(&mut self, percent: u64) -> bool {
+        self.below(100) < percent
+    }
+    pub fn pick<'a, T>(&mut self, items: &'a [T]) -> &'a T {
+        &items[self.below(items.len() as u64) as usize]
+    }
+}
+
+pub const BOOLS: &[&str] = &["b0", "b1", "b2", "b3", "b4", "b5"];
+pub const INPUTS: &[&str] = &["i0", "i1", "i2"];
+pub const INTS: &[&str] = &["n0", "n1", "n2"];
+
+fn vars() -> Vec<Value> {
+    let mut v = Vec::new();
+    for i in INPUTS {
+        v.push(json!({"name": i, "type": "BOOL", "class": "input"}));
+    }
+    v.push(json!({"name": "k", "type": "INT", "class": "input"}));
+    for b in BOOLS {
+        v.push(json!({"name": b, "type": "BOOL"}));
+    }
+    for (i, n) in INTS.iter().enumerate() {
+        v.push(json!({"name": n, "type": "INT", "init": i as i64 * 3}));
+    }
+    v.push(json!({"name": "q", "type": "BOOL", "class": "output"}));
+    v.push(json!({"name": "r", "type": "REAL"}));
+    v.push(json!({"name": "t0", "type": "TON"}));
+    v.push(json!({"name": "t1", "type": "TOF"}));
+    v.push(json!({"name": "t2", "type": "TP"}));
+    v.push(json!({"name": "c0", "type": "CTU"}));
+    v.push(json!({"name": "c1", "type": "CTD"}));
+    v.push(json!({"name": "li", "type": "INT"}));
+    v
+}
+
+fn bool_read(rng: &mut Rng) -> &'static str {
+    match rng.below(10) {
+        0..=3 => *rng.pick(BOOLS),
+        4..=6 => *rng.pick(INPUTS),
+        7 => "t0.Q",
+        8 => "c0.Q",
+        _ => *rng.pick(&["t1.Q", "t2.Q", "c1.Q", "q"]),
+    }
+}
+
+fn int_operand(rng: &mut Rng) -> Value {
+    match rng.below(5) {
+        0 => json!(rng.below(7) as i64 - 2),
+        1 => json!("k"),
+        2 => json!("c0.CV"),
+        _ => json!(rng.pick(INTS)),
+    }
+}
+
+fn condition(rng: &mut Rng, depth: u32) -> Value {
+    match rng.below(if depth > 1 { 8 } else { 10 }) {
+        0..=3 => json!({"contact": bool_read(rng)}),
+        4 => json!({"contact": bool_read(rng), "negated": true}),
+        5 => json!({"contact": bool_read(rng), "edge": if rng.chance(50) { "rising" } else { "falling" }}),
+        6 | 7 => json!({"compare": rng.pick(&["EQ", "NE", "LT", "LE", "GT", "GE"]), "a": int_operand(rng), "b": int_operand(rng)}),
+        _ => {
+            let n = 2 + rng.below(2);
+            let branches: Vec<Value> = (0..n).map(|_| Value::Array((0..1 + rng.below(2)).map(|_| condition(rng, depth + 1)).collect())).collect();
+            json!({"or": branches})
+        }
+    }
+}
+
+/// An output, box or control element; `labels` are the jump targets available in this POU.
+fn action(rng: &mut Rng, labels: &[String], subs: &[String], depth: u32) -> Value {
+    let w = *rng.pick(BOOLS);
+    match rng.below(if depth > 0 { 16 } else { 18 }) {
+        0..=2 => json!({"coil": w}),
+        3 => json!({"coil": w, "negated": true}),
+        4 => json!({"set": w}),
+        5 => json!({"reset": w}),
+        6 => json!({"ton": "t0", "pt": *rng.pick(&["T#20ms", "T#30ms", "T#0ms"])}),
+        7 => json!({"tof": "t1", "pt": "T#20ms"}),
+        8 => json!({"tp": "t2", "pt": "T#30ms"}),
+        9 => json!({"ctu": "c0", "pv": 3, "reset": bool_read(rng)}),
+        10 => json!({"ctd": "c1", "pv": 2, "load": bool_read(rng)}),
+        11 => json!({"move": int_operand(rng), "to": rng.pick(INTS)}),
+        12 => json!({"op": rng.pick(&["ADD", "SUB", "MUL", "DIV", "MOD"]), "in": [int_operand(rng), int_operand(rng)], "out": rng.pick(INTS)}),
+        13 => json!({"op": rng.pick(&["ADD", "MUL", "DIV"]), "in": ["r", 1.5], "out": "r"}),
+        14 if !labels.is_empty() => json!({"jmp": rng.pick(labels)}),
+        14 | 15 if !subs.is_empty() => json!({"call": rng.pick(subs)}),
+        14 | 15 => json!({"coil": "q"}),
+        _ => {
+            let n = 2 + rng.below(2);
+            let branches: Vec<Value> = (0..n)
+                .map(|_| {
+                    let mut s: Vec<Value> = (0..rng.below(2)).map(|_| condition(rng, 1)).collect();
+                    s.push(action(rng, labels, subs, depth + 1));
+                    Value::Array(s)
+                })
+                .collect();
+            json!({"branch": branches})
+        }
+    }
+}
+
+/// Rungs of one POU: `prefix` names them, `subs` are callable subroutines.
+fn rungs(rng: &mut Rng, prefix: &str, count: usize, subs: &[String], main: bool, loops: bool) -> Vec<Value> {
+    let labels: Vec<String> = (0..count).filter(|i| i % 3 == 1).map(|i| format!("{prefix}L{i}")).collect();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < count {
+        let id = format!("{prefix}{i}");
+        let label = if i % 3 == 1 { Some(format!("{prefix}L{i}")) } else { None };
+        let mut series: Vec<Value> = (0..rng.below(3)).map(|_| condition(rng, 0)).collect();
+        // A FOR/NEXT block of 1–2 body rungs with a constant bound.
+        if loops && main && rng.chance(8) && i + 3 < count && label.is_none() {
+            series.push(json!({"for": {"var": "li", "from": 0, "to": rng.below(3) as i64}}));
+            out.push(json!({"id": id, "ld": series}));
+            let body = 1 + rng.below(2) as usize;
+            for b in 0..body {
+                let s = vec![condition(rng, 0), action(rng, &[], subs, 0)];
+                out.push(json!({"id": format!("{prefix}{}", i + 1 + b), "ld": s}));
+            }
+            out.push(json!({"id": format!("{prefix}{}", i + 1 + body), "ld": [{"next": true}]}));
+            i += body + 2;
+            continue;
+        }
+        let n = 1 + rng.below(2);
+        for _ in 0..n {
+            series.push(action(rng, &labels, subs, 0));
+        }
+        if rng.chance(4) {
+            series.push(if main && rng.chance(50) { json!({"end": true}) } else { json!({"ret": true}) });
+        }
+        let mut r = json!({"id": id, "ld": series});
+        if let Some(l) = label {
+            r["label"] = json!(l);
+        }
+        out.push(r);
+        i += 1;
+    }
+    out
+}
+
+/// A random program; it may be rejected by the loader (a jump into a FOR body), so callers
+/// skip those.
+pub fn random_program(seed: u64, max_rungs: usize) -> String {
+    let mut rng = Rng::new(seed);
+    let nsubs = rng.below(3) as usize;
+    let mut subroutines = serde_json::Map::new();
+    let mut names: Vec<String> = Vec::new();
+    // S1 may call S0; S0 calls nothing: no recursion.
+    for s in 0..nsubs {
+        let name = format!("S{s}");
+        let count = 1 + rng.below(3) as usize;
+        let body = rungs(&mut rng, &format!("{name}_"), count, &names, false, false);
+        subroutines.insert(name.clone(), json!({"rungs": body}));
+        names.push(name);
+    }
+    let count = 1 + rng.below(max_rungs as u64) as usize;
+    let main = rungs(&mut rng, "R", count, &names, true, true);
+    json!({"program": "random", "vars": vars(), "rungs": main, "subroutines": subroutines}).to_string()
+}
