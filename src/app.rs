@@ -44,13 +44,19 @@ pub fn load_program(path: &Path) -> Result<Program, CliError> {
 
 /// Writes `contents` to `out` (atomically) or to standard output.
 pub fn write_output(out: Option<&Path>, contents: &str) -> Result<(), CliError> {
+    write_output_with(out, |w| w.write_all(contents.as_bytes()))
+}
+
+/// Streams output produced by `write` to `out` or to standard output. A file is written under a
+/// temporary name beside `out` and renamed into place only when `write` succeeded, so a failure
+/// never leaves a partial file.
+pub fn write_output_with(out: Option<&Path>, write: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>) -> Result<(), CliError> {
     use std::io::Write;
     match out {
         None => {
-            let mut stdout = std::io::stdout().lock();
+            let mut stdout = std::io::BufWriter::new(std::io::stdout().lock());
             // A closed pipe (`| head`) is not an error worth reporting.
-            let _ = stdout.write_all(contents.as_bytes());
-            let _ = stdout.flush();
+            let _ = write(&mut stdout).and_then(|_| stdout.flush());
             Ok(())
         }
         Some(path) => {
@@ -58,11 +64,18 @@ pub fn write_output(out: Option<&Path>, contents: &str) -> Result<(), CliError> 
             let mut tmp: PathBuf = path.to_path_buf();
             let name = format!(".{}.tmp-{}", path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default(), std::process::id());
             tmp.set_file_name(name);
-            std::fs::write(&tmp, contents).map_err(io)?;
-            std::fs::rename(&tmp, path).map_err(|e| {
-                let _ = std::fs::remove_file(&tmp);
-                io(e)
-            })
+            let result = std::fs::File::create(&tmp).and_then(|f| {
+                let mut w = std::io::BufWriter::new(f);
+                write(&mut w)?;
+                w.flush()
+            });
+            match result.and_then(|_| std::fs::rename(&tmp, path)) {
+                Ok(()) => Ok(()),
+                Err(e) => {
+                    let _ = std::fs::remove_file(&tmp);
+                    Err(io(e))
+                }
+            }
         }
     }
 }

@@ -15,21 +15,22 @@
 //! * **Variables (all declared up front; a few may end up unused).** Globals, in this order:
 //!   `I0..I{ni-1}` BOOL inputs with `ni = max(8, W/8)`; `Q0..Q{nq-1}` BOOL outputs with
 //!   `nq = ceil(W/16)`; `M{j}_{p}` BOOL memory and `N{j}_{p}` INT memory for every lane `j < W`
-//!   and phase `p < min(4, S)` (a few carry a non-zero `init`); with `timers`, `T{j}_{p}` timer
+//!   and phase `p ≤ max phase(s) for s < S` (a few carry a non-zero `init`); with `timers`, `T{j}_{p}` timer
 //!   instances (TON mostly, TOF or TP for some `(j, p)`, fixed by `(5j + 3p) % 8`: 0 → TOF,
 //!   1 → TP, else TON) and `C{j}_{p}` counter instances (CTU if `j + p` is even, else CTD); with
-//!   `loops`, INT FOR indices `i0..i3`; with `calls`, `SR{k}` BOOL results of the subroutines.
-//! * **Normal rung** (stage `s`, lane `j`, phase `p = s % 4`): a series of conditions, optional
-//!   boxes, then one output writing the lane's own `M{j}_{p}` (memory is recycled every 4 stages,
-//!   so there are ~4·W memory variables, anti and output dependences occur, and the data-flow
-//!   depth stays ≈ `S = n / W`).
+//!   `loops`, INT FOR indices `i0..i{W-1}` (one per lane); with `calls`, `SR{k}` BOOL results of the subroutines.
+//! * **Normal rung** (stage `s`, lane `j`, phase `p = phase(s) = (s / 8) * 4 + s % 4`): a series
+//!   of conditions, optional boxes, then one output writing the lane's own `M{j}_{p}` (memory is
+//!   recycled every 4 stages within each section of 8 stages, so each variable has at most two
+//!   writers, anti and output dependences occur, the number of dependence pairs stays linear in
+//!   the program size, and the data-flow depth stays ≈ `S = n / W`).
 //!   - Stage 0 reads inputs only: 4–6 distinct `I..` contacts (1 in 6 negated, 1 in 25 with a
 //!     rising/falling edge).
-//!   - Stage `s ≥ 1` reads 3–5 of the variables `M{l}_{(s-1)%4}` written by stage `s-1` in the
+//!   - Stage `s ≥ 1` reads 3–5 of the variables `M{l}_{phase(s-1)}` written by stage `s-1` in the
 //!     nearby lanes `l ∈ j-2..=j+2` (mod W, distinct; 1 in 4 negated), one input contact half
 //!     of the time (or as many as needed to reach 4 conditions), and now and then: the `.Q` of a
 //!     nearby timer of stage `s-1` (`timers`), the `.Q` or `.CV ≥ 3` of a nearby counter of
-//!     stage `s-1` (`timers`), an INT `compare` of `N{l}_{(s-1)%4}` with a constant (1 in 30;
+//!     stage `s-1` (`timers`), an INT `compare` of `N{l}_{phase(s-1)}` with a constant (1 in 30;
 //!     lanes whose `N` was written in stage `s-1` preferred), a subroutine result `SR{k}`
 //!     (`calls`, 1 in 100). 1 in 8 rungs wraps their first 2 or 3 conditions into an
 //!     `{"or": [[a], [b]]}` or `{"or": [[a, b], [c]]}`.
@@ -44,8 +45,8 @@
 //!     stage, or the stage before when that one is cut short) is the writer of `Q{j/16}`: its
 //!     output is `{"branch": [[{"coil": "M{j}_{p}"}], [{"coil": "Q{j/16}"}]]}`.
 //! * **`loops`**: 1 in 200 rungs (outside any other structure) starts a FOR block: a header
-//!   rung with 2–3 conditions then `{"for": {"var": "i{k}", "from": 1, "to": 3}}` (`k` = block
-//!   number mod 4), 2–4 body rungs (normal rungs that also accumulate
+//!   rung with 2–3 conditions then `{"for": {"var": "i{k}", "from": 1, "to": 3}}` (`k` = the
+//!   header's lane), 2–4 body rungs (normal rungs that also accumulate
 //!   `{"op": "ADD", "in": ["N{j}_{p}", "i{k}"], "out": "N{j}_{p}"}` before their output) and a
 //!   `[{"next": true}]` rung. Blocks are not nested. Header, body and NEXT rungs all count in
 //!   `n` and occupy their stage/lane slots (header and NEXT write no `M`).
@@ -417,6 +418,13 @@ struct SubPlan {
     global_lane: Option<usize>,
 }
 
+/// The variable phase of stage `s`: memory is recycled every 4 stages within sections of 8
+/// stages (`(s / 8) * 4 + s % 4`), so each lane variable has at most two writers, the way real
+/// programs keep variables local to a section; the number of dependence pairs stays linear.
+pub fn phase(s: usize) -> usize {
+    (s / 8) * 4 + s % 4
+}
+
 struct Generator {
     cfg: GenConfig,
     n: usize,
@@ -451,7 +459,7 @@ impl Generator {
         let n = cfg.rungs;
         let lanes = cfg.width.clamp(1, n.max(1));
         let stages = n.div_ceil(lanes);
-        let phases = stages.min(4);
+        let phases = (stages.saturating_sub(8)..stages).map(|s| phase(s) + 1).max().unwrap_or(0);
         let inputs = (lanes / 8).max(8);
         let outputs = lanes.div_ceil(16);
         let mut g = Generator {
@@ -580,7 +588,7 @@ impl Generator {
             }
         }
         if self.cfg.loops {
-            for k in 0..4 {
+            for k in 0..self.lanes {
                 var(w, Name::Idx(k), "INT", "memory", None)?;
             }
         }
@@ -622,7 +630,6 @@ impl Generator {
         let usable = if self.has_end { n - 1 } else { n };
         let mut pending: Option<(usize, usize)> = None; // (target rung, label)
         let mut in_for: Option<(usize, usize)> = None; // (next rung, k)
-        let mut blocks = 0usize;
         for r in 0..n {
             let (s, j) = (r / self.lanes, r % self.lanes);
             if j == 0 && s > 0 {
@@ -650,8 +657,8 @@ impl Generator {
                 let body = self.rng.range(2, 4);
                 let next = r + body + 1;
                 if pending.is_none() && !is_q && next < usable && self.q_of(next).is_none() {
-                    let k = blocks % 4;
-                    blocks += 1;
+                    // One index per lane: a block's index is local to it, as in real programs.
+                    let k = r % self.lanes;
                     in_for = Some((next, k));
                     Kind::ForHead(k)
                 } else {
@@ -750,7 +757,7 @@ impl Generator {
                 self.conds.push(e);
             }
         } else {
-            let pp = (s - 1) % 4;
+            let pp = phase(s - 1);
             let (lanes, len) = self.nearby(j);
             for &l in lanes.iter().take(count.min(len)) {
                 let neg = self.rng.one_in(4);
@@ -765,7 +772,7 @@ impl Generator {
 
     fn normal_rung(&mut self, r: usize, body: Option<usize>) {
         let (s, j) = (r / self.lanes, r % self.lanes);
-        let p = s % 4;
+        let p = phase(s);
         // Conditions.
         if s == 0 {
             let count = self.rng.range(4, 6);
@@ -776,7 +783,7 @@ impl Generator {
                 self.conds.push(e);
             }
         } else {
-            let pp = (s - 1) % 4;
+            let pp = phase(s - 1);
             let (lanes, len) = self.nearby(j);
             let take = self.rng.range(3, 5).min(len);
             for &l in &lanes[..take] {
@@ -896,7 +903,7 @@ impl Generator {
             let to = Name::N(j, p);
             let src = if s > 0 {
                 let l = (j + self.lanes * 2 + self.rng.below(5) - 2) % self.lanes;
-                Opnd::Var(Name::N(l, (s - 1) % 4))
+                Opnd::Var(Name::N(l, phase(s - 1)))
             } else {
                 Opnd::Var(to)
             };

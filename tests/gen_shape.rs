@@ -1,7 +1,7 @@
 //! Shape and validity of the synthetic program generator (`plc_deps::gen`), checked on the JSON
 //! text alone (serde_json), independently of the crate's reader.
 
-use plc_deps::gen::{generate_string, write_program, GenConfig};
+use plc_deps::gen::{generate_string, phase, write_program, GenConfig};
 use proptest::prelude::*;
 use serde_json::{Map, Value};
 use std::collections::{BTreeMap, HashMap, HashSet};
@@ -638,8 +638,8 @@ fn deterministic_and_seed_sensitive() {
     }
 }
 
-/// The documented stage/lane layout: normal rung (s, j) writes `M{j}_{s%4}` and reads only
-/// inputs (stage 0) or `M{l}_{(s-1)%4}` with `l` within 2 lanes of `j` (mod W).
+/// The documented stage/lane layout: normal rung (s, j) writes `M{j}_{phase(s)}` and reads only
+/// inputs (stage 0) or `M{l}_{phase(s-1)}` with `l` within 2 lanes of `j` (mod W).
 #[test]
 fn stage_lane_layout() {
     let (n, w) = (4000usize, 50usize);
@@ -652,7 +652,8 @@ fn stage_lane_layout() {
             memory_vars += 1;
         }
     }
-    assert_eq!(memory_vars, 4 * w);
+    let phases = (0..n.div_ceil(w)).map(|s| phase(s) + 1).max().unwrap();
+    assert_eq!(memory_vars, phases * w);
     let inputs = v["vars"]
         .as_array()
         .unwrap()
@@ -666,23 +667,23 @@ fn stage_lane_layout() {
         let mut reads = Vec::new();
         let mut writes = Vec::new();
         collect(&rung["ld"], &mut reads, &mut writes);
-        let own = format!("M{j}_{}", s % 4);
+        let own = format!("M{j}_{}", phase(s));
         let ms: Vec<&String> = writes.iter().filter(|x| x.starts_with('M')).collect();
         assert_eq!(ms, vec![&own], "rung {r} writes {writes:?}");
         q_written.extend(writes.iter().filter(|x| x.starts_with('Q')).cloned());
         for x in &reads {
             // Inputs, and the lane's own INT (an `op` at stage 0 may accumulate into it).
-            if x.starts_with('I') || *x == format!("N{j}_{}", s % 4) {
+            if x.starts_with('I') || *x == format!("N{j}_{}", phase(s)) {
                 continue;
             }
             if s == 0 {
                 panic!("stage 0 rung {r} reads {x}");
             }
-            let (lane, phase) = x[1..].split_once('_').unwrap();
-            let (lane, phase): (usize, usize) = (lane.parse().unwrap(), phase.parse().unwrap());
+            let (lane, ph) = x[1..].split_once('_').unwrap();
+            let (lane, ph): (usize, usize) = (lane.parse().unwrap(), ph.parse().unwrap());
             let d = (lane + w - j) % w;
             assert!(d <= 2 || d >= w - 2, "rung {r} (lane {j}) reads {x}");
-            assert_eq!(phase, (s - 1) % 4, "rung {r} (stage {s}) reads {x}");
+            assert_eq!(ph, phase(s - 1), "rung {r} (stage {s}) reads {x}");
         }
         assert!(reads.len() >= 4, "rung {r} reads only {reads:?}");
     }

@@ -35,6 +35,18 @@ impl VarSets {
         }
         s
     }
+    /// Builds from lists that are already sorted and duplicate-free.
+    pub fn from_sorted(lists: &[Vec<VarId>]) -> VarSets {
+        let total = lists.iter().map(Vec::len).sum();
+        let mut s = VarSets { offsets: Vec::with_capacity(lists.len() + 1), vars: Vec::with_capacity(total) };
+        s.offsets.push(0);
+        for l in lists {
+            debug_assert!(l.windows(2).all(|w| w[0] < w[1]));
+            s.vars.extend_from_slice(l);
+            s.offsets.push(s.vars.len() as u32);
+        }
+        s
+    }
     pub fn len(&self) -> usize {
         self.offsets.len() - 1
     }
@@ -69,43 +81,54 @@ impl Accesses {
 
 /// Computes IN and OUT for every rung of the program.
 pub fn accesses(p: &Program) -> Accesses {
-    // Summaries per POU, callees first: repeat over POUs in reverse until stable is not needed
-    // because the call graph is acyclic; order POUs by a DFS post-order.
-    let order = callee_first_order(p);
+    // Summaries of called subroutines, callees first (the call graph is acyclic).
     let mut summary: Vec<(Vec<VarId>, Vec<VarId>)> = vec![(Vec::new(), Vec::new()); p.pous.len()];
-    let mut per_rung: Vec<(Vec<VarId>, Vec<VarId>)> = vec![(Vec::new(), Vec::new()); p.rungs.len()];
-    for pou in order {
-        let mut all_r = Vec::new();
-        let mut all_w = Vec::new();
+    let mut reads_of: Vec<Vec<VarId>> = vec![Vec::new(); p.rungs.len()];
+    let mut writes_of: Vec<Vec<VarId>> = vec![Vec::new(); p.rungs.len()];
+    let mut reads = Vec::new();
+    let mut writes = Vec::new();
+    for pou in callee_first_order(p) {
+        let is_sub = pou.index() != 0;
+        let (mut all_r, mut all_w) = (Vec::new(), Vec::new());
         for r in p.pou_rungs(pou) {
-            let (mut reads, mut writes) = (Vec::new(), Vec::new());
-            rung_accesses(&p.rung(r).series, &mut reads, &mut writes, &mut |callee, reads, writes| {
-                let (sr, sw) = &summary[callee.index()];
-                reads.extend_from_slice(sr);
-                writes.extend_from_slice(sw);
-            });
-            if let Some(Element::Next { head }) = p.rung(r).series.last() {
-                if let Some(Element::For { var, .. }) = p.rung(*head).series.last() {
-                    reads.push(*var);
-                    writes.push(*var);
-                }
+            one_rung(p, r, &summary, &mut reads, &mut writes);
+            if is_sub {
+                all_r.extend_from_slice(&reads);
+                all_w.extend_from_slice(&writes);
             }
-            for l in [&mut reads, &mut writes] {
+            reads_of[r.index()] = reads.clone();
+            writes_of[r.index()] = writes.clone();
+        }
+        if is_sub {
+            for l in [&mut all_r, &mut all_w] {
                 l.sort_unstable();
                 l.dedup();
             }
-            all_r.extend_from_slice(&reads);
-            all_w.extend_from_slice(&writes);
-            per_rung[r.index()] = (reads, writes);
+            summary[pou.index()] = (all_r, all_w);
         }
-        all_r.sort_unstable();
-        all_r.dedup();
-        all_w.sort_unstable();
-        all_w.dedup();
-        summary[pou.index()] = (all_r, all_w);
     }
-    let (reads, writes): (Vec<_>, Vec<_>) = per_rung.into_iter().unzip();
-    Accesses { reads: VarSets::from_lists(reads), writes: VarSets::from_lists(writes) }
+    Accesses { reads: VarSets::from_sorted(&reads_of), writes: VarSets::from_sorted(&writes_of) }
+}
+
+/// The sorted IN and OUT of one rung, into `reads` and `writes` (cleared first).
+fn one_rung(p: &Program, r: RungId, summary: &[(Vec<VarId>, Vec<VarId>)], reads: &mut Vec<VarId>, writes: &mut Vec<VarId>) {
+    reads.clear();
+    writes.clear();
+    rung_accesses(&p.rung(r).series, reads, writes, &mut |callee, reads, writes| {
+        let (sr, sw) = &summary[callee.index()];
+        reads.extend_from_slice(sr);
+        writes.extend_from_slice(sw);
+    });
+    if let Some(Element::Next { head }) = p.rung(r).series.last() {
+        if let Some(Element::For { var, .. }) = p.rung(*head).series.last() {
+            reads.push(*var);
+            writes.push(*var);
+        }
+    }
+    for l in [reads, writes] {
+        l.sort_unstable();
+        l.dedup();
+    }
 }
 
 /// POUs ordered so that every callee comes before its callers.
