@@ -4,6 +4,7 @@
 //! program) → [`analysis`] (plain functions from the model to result values) → [`report`]
 //! (text, JSON, DOT). [`graph`] holds the generic graph algorithms the analyses use.
 pub mod analysis;
+pub mod exec;
 pub mod app;
 pub mod graph;
 pub mod model;

@@ -7,9 +7,9 @@
 //! - output S δo T: x ∈ OUT(S) ∧ x ∈ OUT(T)  (write after write)
 //!
 //! [`data_dependences`] lists every such pair, exactly as the paper defines them, in
-//! O(accesses + pairs): it keeps, per variable, the units that have read it and those that have
-//! written it so far, and pairs each new access only with earlier accesses it conflicts with; no
-//! two units are ever compared blindly. [`data_levels`] levels the units in O(accesses) without
+//! O(accesses + pairs) (plus a binary search per access): it indexes, per variable, the units
+//! that read it and those that write it, in order, and pairs each access only with the earlier
+//! accesses it conflicts with; no two units are ever compared blindly. [`data_levels`] levels the units in O(accesses) without
 //! looking at pairs at all: per variable it keeps the level of the last writer and the highest
 //! level of the readers since then, which is all that ASAP levelling needs (a later writer must
 //! follow those readers and that writer; a reader must follow that writer).
@@ -56,36 +56,65 @@ fn var_count(reads: &VarSets, writes: &VarSets) -> usize {
     max(reads).max(max(writes))
 }
 
+/// For each variable, the units that access it (through `sets`), in unit order, as one flat
+/// array: `units[start[x]..start[x + 1]]`.
+struct ByVar {
+    start: Vec<u32>,
+    units: Vec<u32>,
+}
+
+impl ByVar {
+    fn new(sets: &VarSets, vars: usize) -> ByVar {
+        let mut start = vec![0u32; vars + 1];
+        for i in 0..sets.len() {
+            for x in sets.list(i) {
+                start[x.index() + 1] += 1;
+            }
+        }
+        for x in 0..vars {
+            start[x + 1] += start[x];
+        }
+        let mut fill = start.clone();
+        let mut units = vec![0u32; sets.total()];
+        for i in 0..sets.len() {
+            for x in sets.list(i) {
+                units[fill[x.index()] as usize] = i as u32;
+                fill[x.index()] += 1;
+            }
+        }
+        ByVar { start, units }
+    }
+    /// The units accessing `x` before unit `t`.
+    fn before(&self, x: VarId, t: u32) -> &[u32] {
+        let all = &self.units[self.start[x.index()] as usize..self.start[x.index() + 1] as usize];
+        &all[..all.partition_point(|&u| u < t)]
+    }
+}
+
 /// Every flow, anti and output dependence, sorted by (to, from, kind, var).
 pub fn data_dependences(reads: &VarSets, writes: &VarSets) -> Vec<DataDependence> {
     let n = reads.len();
     let vars = var_count(reads, writes);
-    let mut readers: Vec<Vec<u32>> = vec![Vec::new(); vars];
-    let mut writers: Vec<Vec<u32>> = vec![Vec::new(); vars];
+    let readers = ByVar::new(reads, vars);
+    let writers = ByVar::new(writes, vars);
     let mut out = Vec::new();
     for t in 0..n {
         let start = out.len();
         let tu = t as u32;
         for &x in reads.list(t) {
-            for &s in &writers[x.index()] {
+            for &s in writers.before(x, tu) {
                 out.push(DataDependence { from: s, to: tu, kind: DepKind::Flow, var: x });
             }
         }
         for &x in writes.list(t) {
-            for &s in &readers[x.index()] {
+            for &s in readers.before(x, tu) {
                 out.push(DataDependence { from: s, to: tu, kind: DepKind::Anti, var: x });
             }
-            for &s in &writers[x.index()] {
+            for &s in writers.before(x, tu) {
                 out.push(DataDependence { from: s, to: tu, kind: DepKind::Output, var: x });
             }
         }
         out[start..].sort_unstable();
-        for &x in reads.list(t) {
-            readers[x.index()].push(tu);
-        }
-        for &x in writes.list(t) {
-            writers[x.index()].push(tu);
-        }
     }
     out
 }

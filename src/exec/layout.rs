@@ -102,7 +102,11 @@ impl Layout {
             starts.push(next);
             next += w;
         }
-        Layout { starts, widths, total: next }
+        Layout {
+            starts,
+            widths,
+            total: next,
+        }
     }
 
     /// A layout from explicit first slots (`starts[v]` for variable `v`) and a total slot count.
@@ -110,7 +114,10 @@ impl Layout {
     pub fn from_starts(p: &Program, starts: Vec<u32>, total: u32) -> Result<Layout, LayoutError> {
         let widths: Vec<u32> = p.vars.iter().map(|v| slot_width(v.ty)).collect();
         if starts.len() != widths.len() {
-            return Err(LayoutError::WrongLength { expected: widths.len(), found: starts.len() });
+            return Err(LayoutError::WrongLength {
+                expected: widths.len(),
+                found: starts.len(),
+            });
         }
         let mut order: Vec<u32> = (0..starts.len() as u32).collect();
         order.sort_unstable_by_key(|&v| starts[v as usize]);
@@ -119,7 +126,12 @@ impl Layout {
             let start = starts[v as usize];
             let end = start as u64 + widths[v as usize] as u64;
             if end > total as u64 {
-                return Err(LayoutError::OutOfRange { var: v, start, end: end.min(u32::MAX as u64) as u32, total });
+                return Err(LayoutError::OutOfRange {
+                    var: v,
+                    start,
+                    end: end.min(u32::MAX as u64) as u32,
+                    total,
+                });
             }
             if let Some((a, prev_end)) = prev {
                 if start < prev_end {
@@ -128,14 +140,22 @@ impl Layout {
             }
             prev = Some((v, end as u32));
         }
-        Ok(Layout { starts, widths, total })
+        Ok(Layout {
+            starts,
+            widths,
+            total,
+        })
     }
 
     /// Groups of variables, each group dense and starting at a multiple of `align` slots; the
     /// variables in no group follow, in declaration order, in a last aligned group. The total is
     /// rounded up to `align`. With `align = 8` (64-byte lines of 8-byte slots), variables of
     /// different groups never share a cache line.
-    pub fn from_groups(p: &Program, groups: &[Vec<VarId>], align: u32) -> Result<Layout, LayoutError> {
+    pub fn from_groups(
+        p: &Program,
+        groups: &[Vec<VarId>],
+        align: u32,
+    ) -> Result<Layout, LayoutError> {
         if align == 0 {
             return Err(LayoutError::ZeroAlign);
         }
@@ -161,7 +181,11 @@ impl Layout {
                 next += widths[v];
             }
         }
-        Ok(Layout { starts, widths, total: round(next) })
+        Ok(Layout {
+            starts,
+            widths,
+            total: round(next),
+        })
     }
 
     /// The slots of `var` (its fields and internal state for an instance).

@@ -44,8 +44,12 @@ impl Num {
 pub(crate) enum Op {
     /// Start of a rung: leave if the rung is outside the region being run; power := TRUE.
     Rung { id: u32 },
-    /// Contact on a BOOL slot: `p &= slot ^ neg`.
-    Contact { slot: u32, neg: u32 },
+    /// Contact on a BOOL slot: `p &= slot ^ neg` (`neg` 0 or 1).
+    Contact { neg: u8, slot: u32 },
+    /// Two consecutive contacts (negation bits 0 and 1 of `neg`).
+    Contact2 { neg: u8, a: u32, b: u32 },
+    /// Three consecutive contacts (negation bits 0, 1 and 2 of `neg`).
+    Contact3 { neg: u8, a: u32, b: u32, c: u32 },
     /// Rising-edge contact with its memory slot.
     Rising { slot: u32, mem: u32 },
     /// Falling-edge contact with its memory slot.
@@ -81,7 +85,13 @@ pub(crate) enum Op {
     /// MOVE box.
     Move { from: u32, to: u32 },
     /// Arithmetic box.
-    Arith { op: ArithOp, num: Num, a: u32, b: u32, out: u32 },
+    Arith {
+        op: ArithOp,
+        num: Num,
+        a: u32,
+        b: u32,
+        out: u32,
+    },
     /// Forward jump to the instruction index `to` (a `Rung`).
     Jmp { to: u32 },
     /// Backward (or same-rung) jump: counts one loop iteration.
@@ -173,7 +183,10 @@ struct Lowerer<'p> {
 
 pub(crate) fn lower(p: &Program, layout: &Layout) -> Result<Code, LowerError> {
     if layout.var_count() != p.vars.len() {
-        return Err(LowerError::LayoutMismatch { expected: p.vars.len(), found: layout.var_count() });
+        return Err(LowerError::LayoutMismatch {
+            expected: p.vars.len(),
+            found: layout.var_count(),
+        });
     }
     if layout.slot_count() >= CONST {
         return Err(LowerError::TooLarge);
@@ -206,7 +219,10 @@ pub(crate) fn lower(p: &Program, layout: &Layout) -> Result<Code, LowerError> {
             l.max_depth = 0;
             l.series(RungId(r), &rung.series);
             if l.max_depth > 64 {
-                return Err(LowerError::TooDeep { rung: rung.id.clone(), bits: l.max_depth });
+                return Err(LowerError::TooDeep {
+                    rung: rung.id.clone(),
+                    bits: l.max_depth,
+                });
             }
         }
         pou_end.push(l.code.ops.len() as u32);
@@ -215,7 +231,13 @@ pub(crate) fn lower(p: &Program, layout: &Layout) -> Result<Code, LowerError> {
     if l.code.ops.len() >= CONST as usize || l.code.consts.len() >= CONST as usize {
         return Err(LowerError::TooLarge);
     }
-    let Lowerer { mut code, jumps, calls, for_nexts, .. } = l;
+    let Lowerer {
+        mut code,
+        jumps,
+        calls,
+        for_nexts,
+        ..
+    } = l;
     for (at, target) in jumps {
         let to = code.rung_op[target.index()];
         match &mut code.ops[at] {
@@ -231,7 +253,11 @@ pub(crate) fn lower(p: &Program, layout: &Layout) -> Result<Code, LowerError> {
     for (f, next) in for_nexts {
         let pou = p.rung(next).pou;
         let after = next.0 + 1;
-        code.fors[f].exit = if after < p.pou(pou).rungs.end { code.rung_op[after as usize] } else { pou_end[pou.index()] };
+        code.fors[f].exit = if after < p.pou(pou).rungs.end {
+            code.rung_op[after as usize]
+        } else {
+            pou_end[pou.index()]
+        };
     }
     Ok(code)
 }
@@ -264,7 +290,9 @@ impl Lowerer<'_> {
             Operand::Var(r) => {
                 let ty = self.p.var(r.var).ty;
                 match (ty, r.field) {
-                    (Type::Fb(fb), Some(f)) => Field::lookup(fb, f.name()).map_or(Type::Bool, |(_, t)| t),
+                    (Type::Fb(fb), Some(f)) => {
+                        Field::lookup(fb, f.name()).map_or(Type::Bool, |(_, t)| t)
+                    }
                     (ty, _) => ty,
                 }
             }
@@ -273,6 +301,29 @@ impl Lowerer<'_> {
 
     fn push(&mut self, op: Op) {
         self.code.ops.push(op);
+    }
+
+    /// Emits a plain contact, fused with the previous instruction when that is a plain contact
+    /// (or a pair). Sound because no jump or FOR ever targets a contact instruction.
+    fn contact(&mut self, slot: u32, neg: u8) {
+        match self.code.ops.last_mut() {
+            Some(Op::Contact { neg: n, slot: a }) => {
+                *self.code.ops.last_mut().unwrap() = Op::Contact2 {
+                    neg: *n | neg << 1,
+                    a: *a,
+                    b: slot,
+                }
+            }
+            Some(Op::Contact2 { neg: n, a, b }) => {
+                *self.code.ops.last_mut().unwrap() = Op::Contact3 {
+                    neg: *n | neg << 2,
+                    a: *a,
+                    b: *b,
+                    c: slot,
+                }
+            }
+            _ => self.code.ops.push(Op::Contact { neg, slot }),
+        }
     }
 
     fn grow(&mut self, bits: u32) {
@@ -291,17 +342,27 @@ impl Lowerer<'_> {
             Element::Contact { var, kind } => {
                 let slot = self.slot(*var);
                 let op = match kind {
-                    ContactKind::Normal => Op::Contact { slot, neg: 0 },
-                    ContactKind::Negated => Op::Contact { slot, neg: 1 },
-                    ContactKind::Rising { memory } => Op::Rising { slot, mem: self.layout.start(*memory) },
-                    ContactKind::Falling { memory } => Op::Falling { slot, mem: self.layout.start(*memory) },
+                    ContactKind::Normal => return self.contact(slot, 0),
+                    ContactKind::Negated => return self.contact(slot, 1),
+                    ContactKind::Rising { memory } => Op::Rising {
+                        slot,
+                        mem: self.layout.start(*memory),
+                    },
+                    ContactKind::Falling { memory } => Op::Falling {
+                        slot,
+                        mem: self.layout.start(*memory),
+                    },
                 };
                 self.push(op);
             }
             Element::Compare { op, a, b } => {
                 let real = self.operand_type(a) == Type::Real;
                 let (a, b) = (self.operand(a), self.operand(b));
-                self.push(if real { Op::CmpReal { op: *op, a, b } } else { Op::CmpInt { op: *op, a, b } });
+                self.push(if real {
+                    Op::CmpReal { op: *op, a, b }
+                } else {
+                    Op::CmpInt { op: *op, a, b }
+                });
             }
             Element::Or(branches) => {
                 self.grow(2);
@@ -329,7 +390,10 @@ impl Lowerer<'_> {
             }
             Element::Coil { var, negated } => {
                 let slot = self.layout.start(*var);
-                self.push(Op::Coil { slot, neg: *negated as u32 });
+                self.push(Op::Coil {
+                    slot,
+                    neg: *negated as u32,
+                });
             }
             Element::Set(v) => {
                 let slot = self.layout.start(*v);
@@ -342,9 +406,17 @@ impl Lowerer<'_> {
             Element::Timer { kind, instance, pt } => {
                 let inst = self.layout.start(*instance);
                 let pt = self.operand(pt);
-                self.push(Op::Timer { kind: *kind, inst, pt });
+                self.push(Op::Timer {
+                    kind: *kind,
+                    inst,
+                    pt,
+                });
             }
-            Element::Ctu { instance, pv, reset } => {
+            Element::Ctu {
+                instance,
+                pv,
+                reset,
+            } => {
                 let inst = self.layout.start(*instance);
                 let (pv, reset) = (self.operand(pv), self.operand(reset));
                 self.push(Op::Ctu { inst, pv, reset });
@@ -363,11 +435,21 @@ impl Lowerer<'_> {
                 let num = Num::of(self.p.var(*out).ty);
                 let (a, b) = (self.operand(a), self.operand(b));
                 let out = self.layout.start(*out);
-                self.push(Op::Arith { op: *op, num, a, b, out });
+                self.push(Op::Arith {
+                    op: *op,
+                    num,
+                    a,
+                    b,
+                    out,
+                });
             }
             Element::Jmp { target, .. } => {
                 self.jumps.push((self.code.ops.len(), *target));
-                self.push(if target.0 <= rung.0 { Op::JmpBack { to: 0 } } else { Op::Jmp { to: 0 } });
+                self.push(if target.0 <= rung.0 {
+                    Op::JmpBack { to: 0 }
+                } else {
+                    Op::Jmp { to: 0 }
+                });
             }
             Element::Ret => self.push(Op::Ret),
             Element::End => self.push(Op::End),
@@ -375,7 +457,12 @@ impl Lowerer<'_> {
                 self.calls.push((self.code.ops.len(), *pou));
                 self.push(Op::Call { to: 0 });
             }
-            Element::For { var, from, to, next } => {
+            Element::For {
+                var,
+                from,
+                to,
+                next,
+            } => {
                 let f = self.code.fors.len();
                 let (from, to) = (self.operand(from), self.operand(to));
                 let test = self.code.ops.len() as u32 + 1;

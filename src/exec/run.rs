@@ -76,7 +76,14 @@ impl Machine {
     /// Runs instructions from `pc` until the POU ends, the scan stops, or control reaches a rung
     /// (or FOR test) for which `inside` is false. `rung` is the rung `pc` belongs to (for faults
     /// before the first rung marker, i.e. when resuming at a FOR test).
-    pub(crate) fn exec<S, F>(&self, st: &mut S, ctx: &mut ScanCtx<'_>, mut pc: usize, mut rung: u32, inside: &F) -> Flow
+    pub(crate) fn exec<S, F>(
+        &self,
+        st: &mut S,
+        ctx: &mut ScanCtx<'_>,
+        mut pc: usize,
+        mut rung: u32,
+        inside: &F,
+    ) -> Flow
     where
         S: Store + ?Sized,
         F: Fn(RungId) -> bool,
@@ -95,7 +102,16 @@ impl Machine {
                     rung = id;
                     p = 1;
                 }
-                Op::Contact { slot, neg } => p &= st.get(slot) ^ neg as u64,
+                Op::Contact { neg, slot } => p &= st.get(slot) ^ neg as u64,
+                Op::Contact2 { neg, a, b } => {
+                    // Both BOOLs (each 0 or 1) must equal their negation bit's complement.
+                    let bits = st.get(a) | st.get(b) << 1;
+                    p &= ((bits ^ neg as u64) == 3) as u64;
+                }
+                Op::Contact3 { neg, a, b, c } => {
+                    let bits = st.get(a) | st.get(b) << 1 | st.get(c) << 2;
+                    p &= ((bits ^ neg as u64) == 7) as u64;
+                }
                 Op::Rising { slot, mem } => {
                     let v = st.get(slot);
                     p &= v & !st.get(mem) & 1;
@@ -106,9 +122,14 @@ impl Machine {
                     p &= !v & st.get(mem) & 1;
                     st.set(mem, v);
                 }
-                Op::CmpInt { op, a, b } => p &= cmp_int(op, self.src(st, a) as i64, self.src(st, b) as i64) as u64,
+                Op::CmpInt { op, a, b } => {
+                    p &= cmp_int(op, self.src(st, a) as i64, self.src(st, b) as i64) as u64
+                }
                 Op::CmpReal { op, a, b } => {
-                    let (a, b) = (f32::from_bits(self.src(st, a) as u32), f32::from_bits(self.src(st, b) as u32));
+                    let (a, b) = (
+                        f32::from_bits(self.src(st, a) as u32),
+                        f32::from_bits(self.src(st, b) as u32),
+                    );
                     p &= cmp_real(op, a, b) as u64;
                 }
                 Op::OrOpen => s = (s << 2) | (p << 1),
@@ -167,7 +188,11 @@ impl Machine {
                         let v = match arith(op, num, a, b) {
                             Some(v) => v,
                             None => {
-                                ctx.faults.push(Fault { scan: ctx.scan, rung: RungId(rung), kind: FaultKind::DivByZero });
+                                ctx.faults.push(Fault {
+                                    scan: ctx.scan,
+                                    rung: RungId(rung),
+                                    kind: FaultKind::DivByZero,
+                                });
                                 0
                             }
                         };
@@ -198,7 +223,8 @@ impl Machine {
                     }
                 }
                 Op::Call { to } => {
-                    if p != 0 && self.exec(st, ctx, to as usize, rung, &everywhere) != Flow::Return {
+                    if p != 0 && self.exec(st, ctx, to as usize, rung, &everywhere) != Flow::Return
+                    {
                         return Flow::Stop;
                     }
                 }
@@ -239,7 +265,11 @@ impl Machine {
     fn count_iteration(&self, ctx: &mut ScanCtx<'_>, rung: u32) -> bool {
         ctx.iterations += 1;
         if ctx.iterations > self.config.loop_cap as u64 {
-            ctx.faults.push(Fault { scan: ctx.scan, rung: RungId(rung), kind: FaultKind::LoopCap });
+            ctx.faults.push(Fault {
+                scan: ctx.scan,
+                rung: RungId(rung),
+                kind: FaultKind::LoopCap,
+            });
             false
         } else {
             true
@@ -364,7 +394,14 @@ fn tp<S: Store + ?Sized>(st: &mut S, now: i64, i: u32, pt: i64, input: u64) -> u
 
 /// CTU (`up`) or CTD on the instance at `i`: `clock` is CU/CD, `preset` R (CTU) or LD (CTD).
 #[inline]
-fn counter<S: Store + ?Sized>(st: &mut S, i: u32, pv: i64, clock: u64, preset: bool, up: bool) -> u64 {
+fn counter<S: Store + ?Sized>(
+    st: &mut S,
+    i: u32,
+    pv: i64,
+    clock: u64,
+    preset: bool,
+    up: bool,
+) -> u64 {
     st.set(i + PT, pv as u64);
     let rising = clock & !st.get(i + PREV) & 1 != 0;
     st.set(i + PREV, clock);

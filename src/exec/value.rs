@@ -111,7 +111,9 @@ fn scalar_json(v: Value) -> Json {
         Value::Real(f) => {
             // The shortest decimal that reads back as this f32 (0.1, not 0.10000000149…).
             let shortest: f64 = format!("{f}").parse().unwrap_or(f64::NAN);
-            serde_json::Number::from_f64(shortest).map(Json::Number).unwrap_or(Json::Null)
+            serde_json::Number::from_f64(shortest)
+                .map(Json::Number)
+                .unwrap_or(Json::Null)
         }
     }
 }

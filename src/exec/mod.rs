@@ -1,0 +1,400 @@
+//! The scan interpreter: executes a [`Program`] scan by scan on virtual time.
+//!
+//! # Use
+//! ```
+//! use plc_deps::exec::{ExecConfig, Layout, Machine};
+//! use plc_deps::model::{Value, VarId};
+//! let p = plc_deps::read::program_from_json(r#"{"program": "p",
+//!     "vars": [{"name": "a", "type": "BOOL", "class": "input"}, {"name": "q", "type": "BOOL", "class": "output"}],
+//!     "rungs": [{"id": "R1", "ld": [{"contact": "a"}, {"coil": "q"}]}]}"#).unwrap();
+//! let m = Machine::new(&p, Layout::dense(&p), &ExecConfig::default()).unwrap();
+//! let mut state = m.initial_state();
+//! let mut faults = Vec::new();
+//! m.set_inputs(&mut state, &[(VarId(0), Value::Bool(true))]);
+//! m.run_scan(&mut state, 0, &mut faults);
+//! assert_eq!(m.value(&state, VarId(1)).as_bool(), Some(true));
+//! ```
+//!
+//! # Scan semantics (the contract)
+//! - **A scan**: the caller copies the scan's input values into the input variables
+//!   ([`Machine::set_inputs`]); [`Machine::run_scan`] executes the main program's rungs from the
+//!   first; the outputs are then the output variables. All variables keep their values from scan
+//!   to scan (everything is retentive); initial values are the declarations' `init` (zero when
+//!   absent; instances start with every field and internal state zero).
+//! - **Virtual time**: scan `k` (0-based) runs at `now = k × cycle_ms` ms; timers read only
+//!   `now`, never a clock.
+//! - **Power flow** through a series starts TRUE at the left rail:
+//!   - contact: `power &= v` (negated: `&= !v`). Edge contact: `out = power && edge`, edge being
+//!     `v && !mem` (rising) or `!v && mem` (falling); then `mem := v`. The memory is the hidden
+//!     BOOL of `ContactKind::Rising{memory}` and is updated at *every* evaluation of the contact,
+//!     whatever the incoming power.
+//!   - compare: `power &= a OP b`, in the operands' type (INT, DINT, TIME as integers, REAL as
+//!     IEEE 754 `f32`: any comparison with NaN is false except NE).
+//!   - or: every branch is evaluated (in order, from the same power in; no short circuit, so edge
+//!     contacts in any branch always update their memory); power out = OR of the branches.
+//!   - coil: `v := power` (negated: `!power`); set: if power, `v := TRUE`; reset: if power,
+//!     `v := FALSE`.
+//!   - branch: each branch series gets the same power in, in order; power out = power in.
+//!   - TON/TOF/TP (IN = power, PT operand, power out = Q), IEC 61131-3 on virtual time:
+//!     TON: IN false → Q false, ET 0; IN true → start = now on the first such evaluation,
+//!     `ET = min(now − start, PT)`, `Q = ET ≥ PT`. TOF: IN true → Q true, ET 0; IN falling →
+//!     start = now; while IN false and timing, `ET = min(now − start, PT)` and Q false once
+//!     `ET ≥ PT` (timing then stops; ET stays PT). TP: a rising IN while not pulsing starts a
+//!     pulse (start = now); while pulsing (IN is ignored) Q true and `ET = now − start`; at the
+//!     evaluation where `ET ≥ PT`: Q false, pulse over, ET = PT. When not pulsing, ET stays as it
+//!     is while IN is true and becomes 0 as soon as IN is false (already at the evaluation that
+//!     ends the pulse, if IN is false then). The PT field is the PT of the last evaluation.
+//!   - CTU (CU = power, R, PV): if R, CV := 0, else if CU rose since this instance's previous
+//!     evaluation and `CV < 32767`, CV += 1; `Q = CV ≥ PV`. CTD (CD = power, LD, PV): if LD,
+//!     CV := PV, else if CD rose and `CV > −32768`, CV −= 1; `Q = CV ≤ 0`. Power out = Q. The
+//!     previous CU/CD is recorded at every evaluation (also while R or LD holds). PV field = the
+//!     PV of the last evaluation.
+//!   - move: if power, `to := from`; arithmetic ADD SUB MUL DIV MOD: if power, `out := a op b`;
+//!     power out = power in. INT (16 bit), DINT and TIME (32 bit ms) wrap in two's complement;
+//!     DIV truncates toward zero and MOD takes the sign of the dividend (IEC); an integer DIV or
+//!     MOD by zero gives 0 and records [`FaultKind::DivByZero`]; REAL is IEEE 754 `f32` (DIV by
+//!     zero gives ±inf or NaN, no fault).
+//!   - jmp: if power, execution continues at the first element of the target rung; nothing after
+//!     the jump in this rung is evaluated. ret: if power, the current POU ends (in the main
+//!     program: the scan ends). end: if power, the scan ends. call: if power, the subroutine runs
+//!     from its first rung until its end or a taken ret, then this rung's series continues with
+//!     the same power. Subroutine locals are ordinary retentive variables.
+//!   - FOR rung (`Element::For` last in its rung): if the head rung's power is TRUE,
+//!     `var := from` and go to TEST, otherwise to the rung after the NEXT. TEST: if `var ≤ to`
+//!     (integer compare; `to` is re-read at every test) the body (the next rung) runs, otherwise
+//!     control goes to the rung after the NEXT. NEXT rung: `var := var + 1` (wrapping in var's
+//!     type), back to TEST, without re-evaluating the head rung's conditions. After a normal exit
+//!     `var` holds the first value that failed the test.
+//!   - Elements in rungs that control skips (jumped over, loop not entered, subroutine not called)
+//!     are not evaluated at all in that scan: their timers do not see IN, their edge memories and
+//!     counters' previous CU keep their values.
+//! - **Iteration cap** ([`ExecConfig::loop_cap`], default 100 000 per scan): every NEXT and every
+//!   taken backward jump (to the same rung or an earlier one, in any POU) counts one iteration.
+//!   The iteration that would exceed the cap is not performed: the scan ends at once and
+//!   [`FaultKind::LoopCap`] is recorded on the rung of that NEXT or jump. A scan never hangs.
+//! - **Faults** are data ([`Fault`]: scan, rung, kind), appended to a caller-owned `Vec` (no
+//!   allocation when there are none, or when its capacity is reused).
+//!
+//! # Design
+//! The model is lowered once ([`Machine::new`]) into a flat array of 16-byte instructions over a
+//! flat array of `u64` slots; a scan walks it with no allocation, hashing or strings. Contacts on
+//! BOOLs and coils are a load, an and (xor for negation) and a store; `or`/`branch` keep their
+//! saved powers in a 64-bit register. The slot of each variable comes from a [`Layout`], so a
+//! parallel executor can permute and pad variables. Memory is accessed through the [`Store`]
+//! trait, monomorphised, so the same interpreter runs on a plain `[u64]` and on a shared store.
+//!
+//! For the parallel executor (tasks of `analysis::schedule`): [`Machine::run_from`] runs from a
+//! rung while control stays in a region (`inside`) and reports where it left ([`Exit`]);
+//! [`Machine::run_scan`] is `run_from(first main rung, everywhere)`. Per-scan context (time,
+//! scan index, iteration counter, fault sink) is explicit in [`ScanCtx`].
+#![warn(missing_docs)]
+
+mod layout;
+mod lower;
+mod run;
+mod store;
+mod value;
+
+pub use layout::{field_offset, slot_width, Layout, LayoutError, COUNTER_SLOTS, TIMER_SLOTS};
+pub use lower::LowerError;
+pub use store::Store;
+pub use value::{decode, encode, VarValue};
+
+use crate::model::{Program, RungId, Type, Value, VarClass, VarId, VarRef};
+use lower::{ForLoop, Op};
+use run::{everywhere, Flow};
+
+/// Execution parameters.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub struct ExecConfig {
+    /// Virtual scan period: scan `k` runs at `k × cycle_ms` ms.
+    pub cycle_ms: u32,
+    /// Loop iterations (NEXTs plus taken backward jumps) allowed per scan.
+    pub loop_cap: u32,
+}
+
+impl Default for ExecConfig {
+    /// 10 ms cycle, 100 000 iterations.
+    fn default() -> Self {
+        ExecConfig {
+            cycle_ms: 10,
+            loop_cap: 100_000,
+        }
+    }
+}
+
+/// The memory of a running program: every variable's slots (see [`Layout`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct State {
+    /// The slots, encoded as described in [`encode`].
+    pub slots: Vec<u64>,
+}
+
+/// What went wrong in a scan.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
+pub enum FaultKind {
+    /// An integer DIV or MOD by zero (the result was 0).
+    DivByZero,
+    /// The scan hit the iteration cap and was ended.
+    LoopCap,
+}
+
+impl FaultKind {
+    /// Short name (`div-by-zero`, `loop-cap`).
+    pub fn name(self) -> &'static str {
+        match self {
+            FaultKind::DivByZero => "div-by-zero",
+            FaultKind::LoopCap => "loop-cap",
+        }
+    }
+}
+
+/// A fault: in which scan, at which rung (of any POU), what.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
+pub struct Fault {
+    /// Scan index, 0-based.
+    pub scan: u64,
+    /// The rung whose element faulted.
+    pub rung: RungId,
+    /// What happened.
+    pub kind: FaultKind,
+}
+
+/// Where control went when [`Machine::run_from`] returned.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
+pub enum Exit {
+    /// To the start of this (main-program) rung, which is outside the region.
+    Rung(RungId),
+    /// From a NEXT back to the test of this FOR head rung, which is outside the region. (Never
+    /// happens when the region is a task of the combined schedule: a FOR head and its NEXT are
+    /// always in the same loop task.)
+    ForTest(RungId),
+    /// The scan is over: the main program ended (last rung, RET, END) or the loop cap hit.
+    Stop,
+}
+
+/// Per-scan execution context.
+#[derive(Debug)]
+pub struct ScanCtx<'f> {
+    /// Scan index, 0-based (recorded in faults).
+    pub scan: u64,
+    /// Virtual time of the scan, ms.
+    pub now: i64,
+    /// Loop iterations counted so far with this context (see [`ExecConfig::loop_cap`]).
+    pub iterations: u64,
+    /// Where faults are appended.
+    pub faults: &'f mut Vec<Fault>,
+}
+
+#[derive(Copy, Clone, Debug)]
+struct VarInfo {
+    ty: Type,
+    class: VarClass,
+}
+
+/// A lowered program with its layout, ready to run scans. Immutable and `Sync`: one machine can
+/// drive many states, and many threads can run it at once on disjoint (or shared) stores.
+#[derive(Debug)]
+pub struct Machine {
+    ops: Vec<Op>,
+    consts: Vec<u64>,
+    fors: Vec<ForLoop>,
+    rung_op: Vec<u32>,
+    for_of_head: Vec<u32>,
+    pou_entry: Vec<u32>,
+    main_first: u32,
+    vars: Vec<VarInfo>,
+    inits: Vec<Value>,
+    layout: Layout,
+    config: ExecConfig,
+}
+
+impl Machine {
+    /// Lowers `program` with `layout` (which must have been built for it). Fails only for a
+    /// layout of another program, `or`/`branch` nested beyond the 64-bit power stack, or a
+    /// program too large for 31-bit indices.
+    pub fn new(
+        program: &Program,
+        layout: Layout,
+        config: &ExecConfig,
+    ) -> Result<Machine, LowerError> {
+        let code = lower::lower(program, &layout)?;
+        Ok(Machine {
+            main_first: program.main().rungs.start,
+            ops: code.ops,
+            consts: code.consts,
+            fors: code.fors,
+            rung_op: code.rung_op,
+            for_of_head: code.for_of_head,
+            pou_entry: code.pou_entry,
+            vars: program
+                .vars
+                .iter()
+                .map(|v| VarInfo {
+                    ty: v.ty,
+                    class: v.class,
+                })
+                .collect(),
+            inits: program.vars.iter().map(|v| v.init).collect(),
+            layout,
+            config: *config,
+        })
+    }
+
+    /// The layout the machine was built with.
+    pub fn layout(&self) -> &Layout {
+        &self.layout
+    }
+
+    /// The configuration the machine was built with.
+    pub fn config(&self) -> &ExecConfig {
+        &self.config
+    }
+
+    /// Number of slots a store must have.
+    pub fn slot_count(&self) -> u32 {
+        self.layout.slot_count()
+    }
+
+    /// Number of lowered instructions (rung markers included).
+    pub fn instruction_count(&self) -> usize {
+        self.ops.len()
+    }
+
+    /// The state at load: declared initial values, instances zero, padding zero.
+    pub fn initial_state(&self) -> State {
+        let mut slots = vec![0u64; self.layout.slot_count() as usize];
+        for (v, info) in self.vars.iter().enumerate() {
+            if !matches!(info.ty, Type::Fb(_)) {
+                slots[self.layout.start(VarId(v as u32)) as usize] = encode(self.inits[v]);
+            }
+        }
+        State { slots }
+    }
+
+    /// The slot of a variable or instance field.
+    pub fn slot_of(&self, r: VarRef) -> u32 {
+        self.layout.start(r.var) + r.field.map_or(0, field_offset)
+    }
+
+    /// Writes input values (normally of input variables; any scalar variable is accepted, which
+    /// lets tests force values).
+    ///
+    /// # Panics
+    /// If a variable is an instance, or a value's type is not the variable's type.
+    pub fn set_inputs(&self, state: &mut State, inputs: &[(VarId, Value)]) {
+        for &(var, value) in inputs {
+            let ty = self.vars[var.index()].ty;
+            assert!(
+                value.ty() == ty,
+                "input {} is {ty}, given {value} ({})",
+                var.0,
+                value.ty()
+            );
+            state.slots[self.layout.start(var) as usize] = encode(value);
+        }
+    }
+
+    /// The per-scan context of scan `scan` (time `scan × cycle_ms`, no iterations yet).
+    pub fn context<'f>(&self, scan: u64, faults: &'f mut Vec<Fault>) -> ScanCtx<'f> {
+        ScanCtx {
+            scan,
+            now: (scan as i64).wrapping_mul(self.config.cycle_ms as i64),
+            iterations: 0,
+            faults,
+        }
+    }
+
+    /// Runs scan number `scan` (0-based) on `state`: the whole main program from its first rung.
+    /// Faults are appended to `faults`.
+    ///
+    /// # Panics
+    /// If `state` has fewer slots than [`Machine::slot_count`].
+    pub fn run_scan(&self, state: &mut State, scan: u64, faults: &mut Vec<Fault>) {
+        assert!(
+            state.slots.len() >= self.layout.slot_count() as usize,
+            "state too small for this machine"
+        );
+        let mut ctx = self.context(scan, faults);
+        self.exec(
+            &mut state.slots[..],
+            &mut ctx,
+            self.pou_entry[0] as usize,
+            self.main_first,
+            &everywhere,
+        );
+    }
+
+    /// [`set_inputs`](Self::set_inputs) then [`run_scan`](Self::run_scan).
+    pub fn scan(
+        &self,
+        state: &mut State,
+        scan: u64,
+        inputs: &[(VarId, Value)],
+        faults: &mut Vec<Fault>,
+    ) {
+        self.set_inputs(state, inputs);
+        self.run_scan(state, scan, faults);
+    }
+
+    /// Runs from the start of main-program rung `start` for as long as control stays at rungs for
+    /// which `inside` holds (called at every rung start, including `start`; subroutines called on
+    /// the way run whole, without consulting it), and returns where control left to.
+    pub fn run_from<S, F>(
+        &self,
+        store: &mut S,
+        ctx: &mut ScanCtx<'_>,
+        start: RungId,
+        inside: F,
+    ) -> Exit
+    where
+        S: Store + ?Sized,
+        F: Fn(RungId) -> bool,
+    {
+        self.resume(store, ctx, Exit::Rung(start), inside)
+    }
+
+    /// Like [`run_from`](Self::run_from), starting where an earlier run left: at a rung, at a FOR
+    /// test (without the head rung's conditions), or nowhere (`Exit::Stop` returns `Stop`).
+    pub fn resume<S, F>(&self, store: &mut S, ctx: &mut ScanCtx<'_>, at: Exit, inside: F) -> Exit
+    where
+        S: Store + ?Sized,
+        F: Fn(RungId) -> bool,
+    {
+        let (pc, rung) = match at {
+            Exit::Stop => return Exit::Stop,
+            Exit::Rung(r) => (self.rung_op[r.index()], r.0),
+            Exit::ForTest(h) => {
+                let f = self.for_of_head[h.index()];
+                assert!(f != u32::MAX, "rung {} is not a FOR head", h.0);
+                if !inside(h) {
+                    return at;
+                }
+                (self.fors[f as usize].test, h.0)
+            }
+        };
+        match self.exec(store, ctx, pc as usize, rung, &inside) {
+            Flow::Return | Flow::Stop => Exit::Stop,
+            Flow::Rung(r) => Exit::Rung(RungId(r)),
+            Flow::ForTest(h) => Exit::ForTest(RungId(h)),
+        }
+    }
+
+    /// The value of a variable: its scalar value, or an instance's readable fields.
+    pub fn value(&self, state: &State, var: VarId) -> VarValue {
+        let range = self.layout.slots_of(var);
+        VarValue::from_slots(
+            self.vars[var.index()].ty,
+            &state.slots[range.start as usize..range.end as usize],
+        )
+    }
+
+    /// The output variables and their values, in declaration order.
+    pub fn outputs(&self, state: &State) -> Vec<(VarId, VarValue)> {
+        (0..self.vars.len() as u32)
+            .map(VarId)
+            .filter(|v| self.vars[v.index()].class == VarClass::Output)
+            .map(|v| (v, self.value(state, v)))
+            .collect()
+    }
+}
