@@ -141,7 +141,13 @@ pub fn summarise(costs: &[u64], preds: &[Vec<u32>], levels: &[u32]) -> CostSumma
         bottom[t] = costs[t] + successors(t).iter().map(|&s| bottom[s as usize]).max().unwrap_or(0);
     }
     let cores = [1u32, 2, 4, 8];
-    let makespan = cores.iter().map(|&p| (p, list_schedule(costs, preds, &successors, &bottom, p as usize))).collect();
+    // One core runs everything back to back: its makespan is the work. The others are simulated,
+    // in parallel (they are independent).
+    use rayon::prelude::*;
+    let makespan = cores
+        .par_iter()
+        .map(|&p| (p, if p == 1 { work } else { list_schedule(costs, preds, &successors, &bottom, p as usize) }))
+        .collect();
     let groups = super::levels::group_by_level(levels);
     let level_makespan = cores
         .iter()
@@ -164,7 +170,7 @@ fn lpt(jobs: impl Iterator<Item = u64>, p: usize) -> u64 {
 
 /// Greedy list scheduling: whenever a core is free, it takes the ready task with the highest
 /// bottom level (ties: earlier task).
-fn list_schedule<'a>(costs: &[u64], preds: &[Vec<u32>], successors: &dyn Fn(usize) -> &'a [u32], bottom: &[u64], p: usize) -> u64 {
+fn list_schedule<'a>(costs: &[u64], preds: &[Vec<u32>], successors: &(dyn Fn(usize) -> &'a [u32] + Sync), bottom: &[u64], p: usize) -> u64 {
     let n = costs.len();
     let mut waiting: Vec<u32> = preds.iter().map(|ps| ps.len() as u32).collect();
     let mut ready: BinaryHeap<(u64, Reverse<u32>)> = (0..n).filter(|&t| waiting[t] == 0).map(|t| (bottom[t], Reverse(t as u32))).collect();

@@ -79,32 +79,39 @@ pub struct Analysis {
     pub warnings: Vec<Warning>,
 }
 
-/// Runs every analysis on `p`.
+/// Runs every analysis on `p`. The paper's views and the combined schedule are independent once
+/// the accesses and the CFG are known, so they are computed on two threads (rayon).
 pub fn analyse(p: &Program) -> Analysis {
     let acc = accesses(p);
-    let data = data_dependences(&acc.reads, &acc.writes);
-    let data_lv = data_levels(&acc.reads, &acc.writes);
     let cfg = control_flow_graph(p);
-    let pairs: Vec<(u32, u32)> = cfg.edges.iter().map(|e| (e.from, e.to)).collect();
-    let pdom = post_dominators(cfg.node_count(), &pairs, cfg.stop());
-    let reachable = cfg.reachable();
-    let control = control_dependences(&pairs, &pdom, |a| reachable[a as usize]);
-    let paper_control = paper_control_view(p, &control);
     let n = p.rungs.len();
-    let cv_edges: Vec<(u32, u32)> = paper_control.iter().map(|d| (d.from.0, d.to.0)).filter(|(a, b)| a != b).collect();
-    let control_lv = levels::asap_levels(n, &cv_edges);
-    let schedule = combined_schedule(p, &cfg, &acc);
-    let base = cost::rung_costs(p);
-    let mut rung_costs = base.clone();
-    for pou in 0..p.pous.len() {
-        let pou = PouId(pou as u32);
-        for (r, m) in p.pou_rungs(pou).zip(cost::multipliers(p, pou)) {
-            rung_costs[r.index()] = base[r.index()] * m;
+    let paper = || {
+        let (data, data_lv) = rayon::join(|| data_dependences(&acc.reads, &acc.writes), || data_levels(&acc.reads, &acc.writes));
+        let pairs: Vec<(u32, u32)> = cfg.edges.iter().map(|e| (e.from, e.to)).collect();
+        let pdom = post_dominators(cfg.node_count(), &pairs, cfg.stop());
+        let reachable = cfg.reachable();
+        let control = control_dependences(&pairs, &pdom, |a| reachable[a as usize]);
+        let paper_control = paper_control_view(p, &control);
+        let cv_edges: Vec<(u32, u32)> = paper_control.iter().map(|d| (d.from.0, d.to.0)).filter(|(a, b)| a != b).collect();
+        let control_lv = levels::asap_levels(n, &cv_edges);
+        (data, data_lv, pdom, control, paper_control, control_lv)
+    };
+    let combined = || {
+        let schedule = combined_schedule(p, &cfg, &acc);
+        let base = cost::rung_costs(p);
+        let mut rung_costs = base.clone();
+        for pou in 0..p.pous.len() {
+            let pou = PouId(pou as u32);
+            for (r, m) in p.pou_rungs(pou).zip(cost::multipliers(p, pou)) {
+                rung_costs[r.index()] = base[r.index()] * m;
+            }
         }
-    }
-    let task_costs: Vec<u64> = schedule.tasks.iter().map(|t| t.rungs.iter().map(|r| rung_costs[r.index()]).sum()).collect();
-    let task_levels: Vec<u32> = schedule.tasks.iter().map(|t| t.level).collect();
-    let cost = cost::summarise(&task_costs, &schedule.preds, &task_levels);
+        let task_costs: Vec<u64> = schedule.tasks.iter().map(|t| t.rungs.iter().map(|r| rung_costs[r.index()]).sum()).collect();
+        let task_levels: Vec<u32> = schedule.tasks.iter().map(|t| t.level).collect();
+        let cost = cost::summarise(&task_costs, &schedule.preds, &task_levels);
+        (schedule, rung_costs, cost)
+    };
+    let ((data, data_lv, pdom, control, paper_control, control_lv), (schedule, rung_costs, cost)) = rayon::join(paper, combined);
     let mut warnings = Vec::new();
     if !schedule.unreachable.is_empty() {
         warnings.push(Warning::Unreachable(schedule.unreachable.clone()));

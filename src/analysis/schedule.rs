@@ -131,15 +131,34 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
             indeg[cb as usize] += 1;
         }
     }
-    let comp_graph = Csr::from_edges(comp_count, &comp_edges);
     let first = |c: u32| sccs.members(c)[0];
-    let mut heap: BinaryHeap<Reverse<(u32, u32)>> = (0..comp_count as u32)
-        .filter(|&c| comp_is_task[c as usize] && indeg[c as usize] == 0)
-        .map(|c| Reverse((first(c), c)))
-        .collect();
+    // Task order: components by first rung when that is topological (every condensed edge goes
+    // forward in program order — the usual case, O(V)); otherwise Kahn's algorithm preferring
+    // the earliest first rung (O(V log V)).
+    let forward = comp_edges.iter().all(|&(a, b)| first(a) < first(b));
+    let order: Vec<u32> = if forward {
+        main.clone().filter(|&r| reach[r as usize] && first(sccs.component_of(r)) == r).map(|r| sccs.component_of(r)).collect()
+    } else {
+        let comp_graph = Csr::from_edges(comp_count, &comp_edges);
+        let mut heap: BinaryHeap<Reverse<(u32, u32)>> = (0..comp_count as u32)
+            .filter(|&c| comp_is_task[c as usize] && indeg[c as usize] == 0)
+            .map(|c| Reverse((first(c), c)))
+            .collect();
+        let mut order = Vec::new();
+        while let Some(Reverse((_, c))) = heap.pop() {
+            order.push(c);
+            for &d in comp_graph.successors(c) {
+                indeg[d as usize] -= 1;
+                if indeg[d as usize] == 0 {
+                    heap.push(Reverse((first(d), d)));
+                }
+            }
+        }
+        order
+    };
     let mut task_of_comp = vec![u32::MAX; comp_count];
-    let mut tasks: Vec<Task> = Vec::new();
-    while let Some(Reverse((_, c))) = heap.pop() {
+    let mut tasks: Vec<Task> = Vec::with_capacity(order.len());
+    for c in order {
         task_of_comp[c as usize] = tasks.len() as u32;
         let members = sccs.members(c);
         tasks.push(Task {
@@ -149,12 +168,6 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
             guard: Vec::new(),
             level: 0,
         });
-        for &d in comp_graph.successors(c) {
-            indeg[d as usize] -= 1;
-            if indeg[d as usize] == 0 {
-                heap.push(Reverse((first(d), d)));
-            }
-        }
     }
     let mut task_of: Vec<Option<u32>> = vec![None; p.rungs.len()];
     for r in main.clone() {
@@ -217,7 +230,10 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
     let mut leveller = Leveller::new(var_count);
     let mut preds: Vec<Vec<u32>> = vec![Vec::new(); t as usize];
     let mut last_writer: Vec<u32> = vec![u32::MAX; var_count];
-    let mut readers: Vec<Vec<u32>> = vec![Vec::new(); var_count];
+    // Readers of each variable since its last write, as linked lists in one flat array:
+    // `first_reader[x]` → (task, next) in `reader_nodes`.
+    let mut first_reader: Vec<u32> = vec![u32::MAX; var_count];
+    let mut reader_nodes: Vec<(u32, u32)> = Vec::new();
     let mut reads = Vec::new();
     let mut writes = Vec::new();
     for i in 0..t as usize {
@@ -227,10 +243,12 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
             reads.extend_from_slice(acc.ins(r));
             writes.extend_from_slice(acc.outs(r));
         }
-        reads.sort_unstable();
-        reads.dedup();
-        writes.sort_unstable();
-        writes.dedup();
+        if tasks[i].rungs.len() > 1 {
+            reads.sort_unstable();
+            reads.dedup();
+            writes.sort_unstable();
+            writes.dedup();
+        }
         let mut ps: Vec<u32> = tasks[i].guard.iter().map(|g| g.controller).collect();
         if tasks[i].entries.len() > 1 {
             ps.extend_from_slice(&entry_preds[i]);
@@ -244,7 +262,14 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
             if last_writer[x.index()] != u32::MAX {
                 ps.push(last_writer[x.index()]);
             }
-            ps.extend(readers[x.index()].drain(..).filter(|&r| r as usize != i));
+            let mut node = first_reader[x.index()];
+            while node != u32::MAX {
+                let (r, next) = reader_nodes[node as usize];
+                if r as usize != i {
+                    ps.push(r);
+                }
+                node = next;
+            }
         }
         ps.sort_unstable();
         ps.dedup();
@@ -252,11 +277,12 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
         let level = leveller.place(&reads, &writes, floor);
         tasks[i].level = level;
         for &x in &reads {
-            readers[x.index()].push(i as u32);
+            reader_nodes.push((i as u32, first_reader[x.index()]));
+            first_reader[x.index()] = reader_nodes.len() as u32 - 1;
         }
         for &x in &writes {
             last_writer[x.index()] = i as u32;
-            readers[x.index()].clear();
+            first_reader[x.index()] = u32::MAX;
         }
         ps.retain(|&q| (q as usize) < i);
         preds[i] = ps;
