@@ -103,19 +103,7 @@ impl Cfg {
     }
     /// Nodes reachable from START.
     pub fn reachable(&self) -> Vec<bool> {
-        let g = self.graph();
-        let mut seen = vec![false; self.node_count()];
-        let mut stack = vec![self.start()];
-        seen[self.start() as usize] = true;
-        while let Some(n) = stack.pop() {
-            for &s in g.successors(n) {
-                if !seen[s as usize] {
-                    seen[s as usize] = true;
-                    stack.push(s);
-                }
-            }
-        }
-        seen
+        crate::graph::reachable(&self.graph(), self.start())
     }
 }
 

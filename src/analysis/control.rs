@@ -19,7 +19,7 @@
 //! path meets A itself (a loop), A is included; a self loop A→A makes A depend on itself. Each dependence keeps the edge that causes it.
 //! Cost: O(E + |CD|).
 
-use crate::graph::{dominators, strongly_connected_components, Csr, DominatorTree};
+use crate::graph::{dominators, reachable, strongly_connected_components, Csr, DominatorTree};
 
 /// The post-dominator tree of a graph.
 #[derive(Clone, Debug)]
@@ -54,20 +54,7 @@ pub fn post_dominators(node_count: usize, edges: &[(u32, u32)], stop: u32) -> Po
     let forward = Csr::from_edges(node_count, edges);
     let mut reverse = forward.reversed();
     // Which nodes reach STOP?
-    let mut reaches = vec![false; node_count];
-    let mark = |reverse: &Csr, reaches: &mut Vec<bool>, from: u32| {
-        let mut stack = vec![from];
-        reaches[from as usize] = true;
-        while let Some(n) = stack.pop() {
-            for &p in reverse.successors(n) {
-                if !reaches[p as usize] {
-                    reaches[p as usize] = true;
-                    stack.push(p);
-                }
-            }
-        }
-    };
-    mark(&reverse, &mut reaches, stop);
+    let reaches = reachable(&reverse, stop);
     let mut virtual_edges = Vec::new();
     let mut endless = Vec::new();
     if reaches.iter().any(|r| !r) {
@@ -93,11 +80,7 @@ pub fn post_dominators(node_count: usize, edges: &[(u32, u32)], stop: u32) -> Po
         let mut all = edges.to_vec();
         all.extend_from_slice(&virtual_edges);
         reverse = Csr::from_edges(node_count, &all).reversed();
-        debug_assert!({
-            let mut all_reach = vec![false; node_count];
-            mark(&reverse, &mut all_reach, stop);
-            all_reach.iter().all(|&r| r)
-        });
+        debug_assert!(reachable(&reverse, stop).iter().all(|&r| r));
     }
     PostDominators { tree: dominators(&reverse, stop), virtual_edges, endless }
 }

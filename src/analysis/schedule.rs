@@ -98,17 +98,7 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
         .map(|e| (e.from, e.to))
         .collect();
     let g = Csr::from_edges(n, &edges);
-    let mut reach = vec![false; n];
-    let mut stack = vec![start];
-    reach[start as usize] = true;
-    while let Some(v) = stack.pop() {
-        for &s in g.successors(v) {
-            if !reach[s as usize] {
-                reach[s as usize] = true;
-                stack.push(s);
-            }
-        }
-    }
+    let reach = crate::graph::reachable(&g, start);
     let unreachable: Vec<RungId> = main.clone().filter(|&r| !reach[r as usize]).map(RungId).collect();
     let live_edges: Vec<(u32, u32)> = edges.iter().copied().filter(|&(a, _)| reach[a as usize]).collect();
     let live = Csr::from_edges(n, &live_edges);

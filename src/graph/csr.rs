@@ -166,6 +166,23 @@ pub(crate) fn shift_right(offsets: &mut [u32]) {
     offsets[0] = 0;
 }
 
+/// The nodes reachable from `from` (itself included), by an iterative depth-first search.
+/// O(V + E).
+pub fn reachable(g: &Csr, from: u32) -> Vec<bool> {
+    let mut seen = vec![false; g.node_count()];
+    let mut stack = vec![from];
+    seen[from as usize] = true;
+    while let Some(n) = stack.pop() {
+        for &s in g.successors(n) {
+            if !seen[s as usize] {
+                seen[s as usize] = true;
+                stack.push(s);
+            }
+        }
+    }
+    seen
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -15,6 +15,6 @@ pub mod csr;
 pub mod dominators;
 pub mod scc;
 
-pub use csr::Csr;
+pub use csr::{reachable, Csr};
 pub use dominators::{dominators, DominatorTree};
 pub use scc::{strongly_connected_components, Sccs};
