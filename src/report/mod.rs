@@ -163,11 +163,18 @@ pub(crate) fn differences(p: &Program, a: &Analysis) -> Vec<Difference> {
 
 /// Human text of a warning.
 pub(crate) fn warning_text(p: &Program, w: &Warning) -> String {
-    let ids = |rs: &[RungId]| rs.iter().map(|r| p.rung(*r).id.as_str()).collect::<Vec<_>>().join(", ");
+    let ids = |rs: &[RungId]| {
+        let list = rs.iter().map(|r| p.rung(*r).id.as_str()).collect::<Vec<_>>().join(", ");
+        if rs.len() == 1 {
+            format!("rung {list}")
+        } else {
+            format!("rungs {list}")
+        }
+    };
     match w {
-        Warning::Unreachable(rs) => format!("rungs {} can never run (no path from the start of the scan reaches them)", ids(rs)),
+        Warning::Unreachable(rs) => format!("{} can never run (no path from the start of the scan reaches it)", ids(rs)),
         Warning::Endless(rs) => format!(
-            "rungs {} can never reach the end of the scan (an endless loop); the post-dominator tree treats the last of them as an exit",
+            "{} can never reach the end of the scan (an endless loop); the post-dominator tree treats the last of them as an exit",
             ids(rs)
         ),
         Warning::Uncalled(pou) => format!("subroutine {} is never called", p.pou(*pou).name),
