@@ -83,31 +83,45 @@ impl Accesses {
 pub fn accesses(p: &Program) -> Accesses {
     // Summaries of called subroutines, callees first (the call graph is acyclic).
     let mut summary: Vec<(Vec<VarId>, Vec<VarId>)> = vec![(Vec::new(), Vec::new()); p.pous.len()];
-    let mut reads_of: Vec<Vec<VarId>> = vec![Vec::new(); p.rungs.len()];
-    let mut writes_of: Vec<Vec<VarId>> = vec![Vec::new(); p.rungs.len()];
+    // Per rung, in POU order; rungs are stored in listing order afterwards.
+    let mut per_rung: Vec<(u32, u32, u32, u32)> = vec![(0, 0, 0, 0); p.rungs.len()];
+    let (mut all_reads, mut all_writes) = (Vec::new(), Vec::new());
     let mut reads = Vec::new();
     let mut writes = Vec::new();
     for pou in callee_first_order(p) {
         let is_sub = pou.index() != 0;
-        let (mut all_r, mut all_w) = (Vec::new(), Vec::new());
+        let (mut sub_r, mut sub_w) = (Vec::new(), Vec::new());
         for r in p.pou_rungs(pou) {
             one_rung(p, r, &summary, &mut reads, &mut writes);
             if is_sub {
-                all_r.extend_from_slice(&reads);
-                all_w.extend_from_slice(&writes);
+                sub_r.extend_from_slice(&reads);
+                sub_w.extend_from_slice(&writes);
             }
-            reads_of[r.index()] = reads.clone();
-            writes_of[r.index()] = writes.clone();
+            let (rs, ws) = (all_reads.len() as u32, all_writes.len() as u32);
+            all_reads.extend_from_slice(&reads);
+            all_writes.extend_from_slice(&writes);
+            per_rung[r.index()] = (rs, all_reads.len() as u32, ws, all_writes.len() as u32);
         }
         if is_sub {
-            for l in [&mut all_r, &mut all_w] {
+            for l in [&mut sub_r, &mut sub_w] {
                 l.sort_unstable();
                 l.dedup();
             }
-            summary[pou.index()] = (all_r, all_w);
+            summary[pou.index()] = (sub_r, sub_w);
         }
     }
-    Accesses { reads: VarSets::from_sorted(&reads_of), writes: VarSets::from_sorted(&writes_of) }
+    // Main first in listing order, and the callee-first order puts main last: re-lay in rung order.
+    let gather = |all: &[VarId], range: fn(&(u32, u32, u32, u32)) -> (u32, u32)| {
+        let mut s = VarSets { offsets: Vec::with_capacity(per_rung.len() + 1), vars: Vec::with_capacity(all.len()) };
+        s.offsets.push(0);
+        for r in &per_rung {
+            let (a, b) = range(r);
+            s.vars.extend_from_slice(&all[a as usize..b as usize]);
+            s.offsets.push(s.vars.len() as u32);
+        }
+        s
+    };
+    Accesses { reads: gather(&all_reads, |r| (r.0, r.1)), writes: gather(&all_writes, |r| (r.2, r.3)) }
 }
 
 /// The sorted IN and OUT of one rung, into `reads` and `writes` (cleared first).

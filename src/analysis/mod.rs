@@ -82,8 +82,7 @@ pub struct Analysis {
 /// Runs every analysis on `p`. The paper's views and the combined schedule are independent once
 /// the accesses and the CFG are known, so they are computed on two threads (rayon).
 pub fn analyse(p: &Program) -> Analysis {
-    let acc = accesses(p);
-    let cfg = control_flow_graph(p);
+    let (acc, cfg) = rayon::join(|| accesses(p), || control_flow_graph(p));
     let n = p.rungs.len();
     let paper = || {
         let (data, data_lv) = rayon::join(|| data_dependences(&acc.reads, &acc.writes), || data_levels(&acc.reads, &acc.writes));
