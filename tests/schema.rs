@@ -1,0 +1,46 @@
+//! The shipped JSON Schema (`plc-deps schema`) agrees with the reader: every program the project
+//! ships or generates validates, and every malformed shape the reader rejects, the schema
+//! rejects too.
+
+use std::path::PathBuf;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn validator() -> jsonschema::Validator {
+    let schema: serde_json::Value = serde_json::from_str(plc_deps::app::PROGRAM_SCHEMA).unwrap();
+    jsonschema::draft202012::new(&schema).expect("the schema is valid Draft 2020-12")
+}
+
+fn json(path: &std::path::Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+#[test]
+fn shipped_and_generated_programs_validate() {
+    let v = validator();
+    let mut checked = 0;
+    for entry in std::fs::read_dir(root().join("analyses")).unwrap() {
+        let path = entry.unwrap().path().join("program.json");
+        if path.is_file() {
+            let doc = json(&path);
+            let errors: Vec<String> = v.iter_errors(&doc).map(|e| format!("{} at {}", e, e.instance_path())).collect();
+            assert!(errors.is_empty(), "{}: {errors:?}", path.display());
+            checked += 1;
+        }
+    }
+    assert!(checked >= 5);
+    let config = plc_deps::gen::GenConfig { rungs: 2000, width: 50, seed: 3, timers: true, loops: true, jumps: true, calls: true };
+    let doc: serde_json::Value = serde_json::from_str(&plc_deps::gen::generate_string(&config)).unwrap();
+    assert!(v.is_valid(&doc));
+}
+
+#[test]
+fn malformed_shapes_are_rejected_by_the_schema_too() {
+    let v = validator();
+    for name in ["unknown-field", "unknown-element", "unknown-type", "not-an-object", "time-needs-literal"] {
+        let doc = json(&root().join(format!("tests/errors/{name}.json")));
+        assert!(!v.is_valid(&doc), "{name} should not validate");
+    }
+}
