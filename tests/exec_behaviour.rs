@@ -559,6 +559,45 @@ fn set_reset_latch_and_seal_in() {
 }
 
 #[test]
+fn long_series_of_contacts_with_negations() {
+    // 1 to 8 contacts in a row (fused into 2-, 3- and 4–6-contact instructions), every third one
+    // negated: the coil is the AND of them all, for every input combination.
+    for n in 1..=8usize {
+        let vars: Vec<String> = (0..n)
+            .map(|i| format!(r#"{{"name": "x{i}", "type": "BOOL", "class": "input"}}"#))
+            .chain([r#"{"name": "y", "type": "BOOL", "class": "output"}"#.to_string()])
+            .collect();
+        let ld: Vec<String> = (0..n)
+            .map(|i| {
+                format!(
+                    r#"{{"contact": "x{i}"{}}}"#,
+                    if i % 3 == 2 {
+                        r#", "negated": true"#
+                    } else {
+                        ""
+                    }
+                )
+            })
+            .chain([r#"{"coil": "y"}"#.to_string()])
+            .collect();
+        let json = format!(
+            r#"{{"program": "series", "vars": [{}], "rungs": [{{"id": "R1", "ld": [{}]}}]}}"#,
+            vars.join(","),
+            ld.join(",")
+        );
+        let mut s = Sim::new(&json);
+        for bits in 0..1u32 << n {
+            let inputs: Vec<(VarId, Value)> = (0..n)
+                .map(|i| (VarId(i as u32), Value::Bool(bits >> i & 1 != 0)))
+                .collect();
+            s.step_values(&inputs);
+            let expected = (0..n).all(|i| (bits >> i & 1 != 0) != (i % 3 == 2));
+            assert_eq!(s.bool("y"), expected, "{n} contacts, inputs {bits:b}");
+        }
+    }
+}
+
+#[test]
 fn or_and_branch_power_flow() {
     let mut s = Sim::new(
         r#"{
@@ -828,10 +867,13 @@ fn loop_cap_ends_an_endless_backward_jump() {
         },
     );
     s.step(&[]);
-    // R1 runs once, then once more after each of the 1000 allowed jumps; jump 1001 faults.
+    // R1 runs once, then once more after each of the 1000 allowed jumps; jump 1001 is refused
+    // (a fault) and the scan goes on after R2, as if the loop had ended.
     assert_eq!(s.int("n"), 1001);
-    assert!(!s.bool("after"));
+    assert!(s.bool("after"));
     assert_eq!(s.faults, vec![s.fault(0, "R2", FaultKind::LoopCap)]);
+    assert_eq!(s.m.loop_count(&s.st, s.rung("R2")), Some(1001));
+    assert_eq!(s.m.loop_count(&s.st, s.rung("R1")), None);
     s.step(&[]); // the cap is per scan
     assert_eq!(s.int("n"), 2002);
     assert_eq!(s.faults[1], s.fault(1, "R2", FaultKind::LoopCap));
@@ -842,7 +884,77 @@ fn loop_cap_default_is_100_000() {
     let mut s = Sim::new(ENDLESS_JUMP);
     s.step(&[]);
     assert_eq!(s.int("n"), 100_001);
+    assert!(s.bool("after"));
     assert_eq!(s.faults, vec![s.fault(0, "R2", FaultKind::LoopCap)]);
+}
+
+#[test]
+fn loop_cap_is_per_rung_and_faults_once_per_rung_and_scan() {
+    // Two loop-back rungs in one loop: when R2 is refused, control falls to R3, which loops back
+    // on its own budget; R2 is then refused again (silently) until R3 is refused too. A refused
+    // jump acts as an unpowered one: the coil after it in R3 gets no power (`tail` FALSE).
+    let mut s = Sim::with(
+        r#"{
+      "program": "two_backs",
+      "vars": [{"name": "n", "type": "DINT"}, {"name": "m", "type": "DINT"},
+               {"name": "tail", "type": "BOOL", "init": true}, {"name": "after", "type": "BOOL"}],
+      "rungs": [
+        {"id": "R1", "label": "L", "ld": [{"op": "ADD", "in": ["n", 1], "out": "n"}]},
+        {"id": "R2", "ld": [{"jmp": "L"}]},
+        {"id": "R3", "ld": [{"op": "ADD", "in": ["m", 1], "out": "m"}, {"jmp": "L"}, {"coil": "tail"}]},
+        {"id": "R4", "ld": [{"coil": "after"}]}
+      ]
+    }"#,
+        ExecConfig {
+            cycle_ms: 10,
+            loop_cap: 10,
+        },
+    );
+    s.step(&[]);
+    // R1 runs 1 + 10 (R2's loop-backs) + 10 (R3's) times; R3 runs 11 times.
+    assert_eq!((s.int("n"), s.int("m")), (21, 11));
+    assert!(!s.bool("tail") && s.bool("after"));
+    assert_eq!(
+        s.faults,
+        vec![
+            s.fault(0, "R2", FaultKind::LoopCap),
+            s.fault(0, "R3", FaultKind::LoopCap)
+        ]
+    );
+    assert_eq!(s.m.loop_count(&s.st, s.rung("R2")), Some(21));
+    assert_eq!(s.m.loop_count(&s.st, s.rung("R3")), Some(11));
+}
+
+#[test]
+fn loop_cap_of_a_subroutine_counts_over_all_its_calls() {
+    let mut s = Sim::with(
+        r#"{
+      "program": "sub_loop",
+      "vars": [{"name": "k", "type": "DINT"}, {"name": "after", "type": "BOOL"}],
+      "rungs": [
+        {"id": "R1", "ld": [{"call": "S"}]},
+        {"id": "R2", "ld": [{"call": "S"}]},
+        {"id": "R3", "ld": [{"coil": "after"}]}
+      ],
+      "subroutines": {"S": {"rungs": [
+        {"id": "S1", "label": "L", "ld": [{"op": "ADD", "in": ["k", 1], "out": "k"}]},
+        {"id": "S2", "ld": [{"compare": "LT", "a": "k", "b": 1000}, {"jmp": "L"}]}
+      ]}}
+    }"#,
+        ExecConfig {
+            cycle_ms: 10,
+            loop_cap: 5,
+        },
+    );
+    s.step(&[]);
+    // First call: S1 runs 6 times (5 loop-backs, the 6th refused). Second call: S1 runs once,
+    // S2's budget is spent: refused again, silently.
+    assert_eq!(s.int("k"), 7);
+    assert!(s.bool("after"));
+    assert_eq!(s.faults, vec![s.fault(0, "S2", FaultKind::LoopCap)]);
+    s.step(&[]);
+    assert_eq!(s.int("k"), 14);
+    assert_eq!(s.faults.len(), 2);
 }
 
 #[test]
@@ -864,6 +976,7 @@ fn loop_cap_ends_an_endless_for_loop() {
         },
     );
     s.step(&[]);
+    // 1000 NEXTs loop back; the 1001st is refused: no increment, on past the NEXT.
     assert_eq!((s.int("k"), s.int("i")), (1001, 1000));
     assert_eq!(s.faults, vec![s.fault(0, "R3", FaultKind::LoopCap)]);
 }
@@ -923,6 +1036,7 @@ fn run_from_reports_where_control_leaves_a_region() {
     let mut ctx = m.context(0, &mut faults);
     let r = RungId;
     let store = &mut st.slots[..];
+    m.begin_scan(store);
     assert_eq!(
         m.run_from(store, &mut ctx, r(0), |x| x == r(0)),
         Exit::Rung(r(1))
@@ -932,7 +1046,6 @@ fn run_from_reports_where_control_leaves_a_region() {
         m.run_from(store, &mut ctx, r(1), |x| x == r(1) || x == r(2)),
         Exit::Rung(r(3))
     );
-    assert_eq!(ctx.iterations, 2);
     assert_eq!(
         m.run_from(store, &mut ctx, r(3), |x| x == r(3)),
         Exit::Rung(r(4))
@@ -955,8 +1068,12 @@ fn run_from_reports_where_control_leaves_a_region() {
     );
     assert_eq!(m.run_from(store, &mut ctx, r(7), |_| true), Exit::Stop);
     assert_eq!(m.resume(store, &mut ctx, Exit::Stop, |_| true), Exit::Stop);
-    assert_eq!(ctx.iterations, 4);
     assert!(faults.is_empty());
+    // R2 jumped back twice, the NEXT looped back twice.
+    assert_eq!(
+        (m.loop_count(&st, r(2)), m.loop_count(&st, r(6))),
+        (Some(2), Some(2))
+    );
     let v = |n: &str| m.value(&st, s.id(n));
     assert_eq!(v("idx"), VarValue::Scalar(Value::Int(3)));
     assert_eq!(v("done"), VarValue::Scalar(Value::Bool(true)));
@@ -1022,6 +1139,7 @@ fn scan_by_schedule(
 ) -> Vec<Fault> {
     use plc_deps::analysis::schedule::Successor;
     let mut faults = Vec::new();
+    m.begin_scan(&mut st.slots[..]);
     let mut ctx = m.context(scan, &mut faults);
     let n = sched.tasks.len();
     let mut exit: Vec<Option<Exit>> = vec![None; n];

@@ -201,7 +201,8 @@ impl Layout {
         self.starts[var.index()]
     }
 
-    /// Total number of slots (the length of a state's slot array).
+    /// Total number of slots of the variables (a machine adds its loop counters after them:
+    /// the length of a state's slot array is [`Machine::slot_count`](super::Machine::slot_count)).
     pub fn slot_count(&self) -> u32 {
         self.total
     }

@@ -68,10 +68,21 @@
 //!   - Elements in rungs that control skips (jumped over, loop not entered, subroutine not called)
 //!     are not evaluated at all in that scan: their timers do not see IN, their edge memories and
 //!     counters' previous CU keep their values.
-//! - **Iteration cap** ([`ExecConfig::loop_cap`], default 100 000 per scan): every NEXT and every
-//!   taken backward jump (to the same rung or an earlier one, in any POU) counts one iteration.
-//!   The iteration that would exceed the cap is not performed: the scan ends at once and
-//!   [`FaultKind::LoopCap`] is recorded on the rung of that NEXT or jump. A scan never hangs.
+//! - **Iteration cap** ([`ExecConfig::loop_cap`], default 100 000): a *loop-back rung* is a NEXT
+//!   rung or a rung holding a backward jump (to itself or an earlier rung of its POU). Each
+//!   loop-back rung may loop back (NEXT: back to the FOR test; a taken backward jump: to its
+//!   target) at most `loop_cap` times per scan, counted in a hidden counter slot of its own that
+//!   [`Machine::begin_scan`] zeroes at the start of every scan (a subroutine's loop-back rungs
+//!   count over all its calls in the scan). A refused loop-back is not performed and control
+//!   goes on as if the loop had ended there: a refused NEXT does not increment the index and
+//!   continues at the rung after the NEXT (the loop's exit); a refused backward jump is not taken
+//!   and acts as a jump without power: the power after it in its series is FALSE and the rest of
+//!   the rung is evaluated as usual (then the next rung, or the rung's other transfers). The
+//!   first refusal of a rung in a scan records
+//!   [`FaultKind::LoopCap`] on that rung; further refusals of the same rung in the same scan
+//!   (control can come back through another loop-back rung) are silent. The rule is local to one
+//!   rung and deterministic, so a parallel scan reproduces it exactly; a scan performs at most
+//!   `loop_cap` × (number of loop-back rungs) loop-backs and never hangs.
 //! - **Faults** are data ([`Fault`]: scan, rung, kind), appended to a caller-owned `Vec` (no
 //!   allocation when there are none, or when its capacity is reused).
 //!
@@ -79,18 +90,26 @@
 //! The model is lowered once ([`Machine::new`]) into a flat array of 16-byte instructions over a
 //! flat array of `u64` slots; a scan walks it with no allocation, hashing or strings. Contacts on
 //! BOOLs and coils are a load, an and (xor for negation) and a store; `or`/`branch` keep their
-//! saved powers in a 64-bit register. The slot of each variable comes from a [`Layout`], so a
+//! saved powers in a 64-bit register. The cost of an interpreter is its dispatches, and above
+//! all the mispredicted ones, so consecutive contacts are fused (up to six in one instruction
+//! when their slots fit in 16 bits) and every output (coil, negated coil, set, reset) is one
+//! instruction computed without a branch: a typical rung is three uniform dispatches (rung,
+//! contacts, output). The slot of each variable comes from a [`Layout`], so a
 //! parallel executor can permute and pad variables. Memory is accessed through the [`Store`]
 //! trait, monomorphised, so the same interpreter runs on a plain `[u64]` and on a shared store.
 //!
 //! For the parallel executor (tasks of `analysis::schedule`): [`Machine::run_from`] runs from a
 //! rung while control stays in a region (`inside`) and reports where it left ([`Exit`]);
-//! [`Machine::run_scan`] is `run_from(first main rung, everywhere)`. Per-scan context (time,
-//! scan index, iteration counter, fault sink) is explicit in [`ScanCtx`].
+//! [`Machine::run_scan`] is [`begin_scan`](Machine::begin_scan) then `run_from(first main rung,
+//! everywhere)`. Per-scan context (time, scan index, fault sink) is explicit in [`ScanCtx`]; the
+//! loop counters are slots of the store, after the layout's (one 64-byte line each), so a loop
+//! task's counter lives with the data it runs on. [`parallel`] runs the combined schedule on
+//! several threads, bit-identical to [`Machine::run_scan`].
 #![warn(missing_docs)]
 
 mod layout;
 mod lower;
+pub mod parallel;
 mod run;
 mod store;
 mod value;
@@ -109,12 +128,12 @@ use run::{everywhere, Flow};
 pub struct ExecConfig {
     /// Virtual scan period: scan `k` runs at `k × cycle_ms` ms.
     pub cycle_ms: u32,
-    /// Loop iterations (NEXTs plus taken backward jumps) allowed per scan.
+    /// Loop-backs allowed per loop-back rung (a NEXT, or a rung with a backward jump) per scan.
     pub loop_cap: u32,
 }
 
 impl Default for ExecConfig {
-    /// 10 ms cycle, 100 000 iterations.
+    /// 10 ms cycle, 100 000 loop-backs per loop-back rung and scan.
     fn default() -> Self {
         ExecConfig {
             cycle_ms: 10,
@@ -135,7 +154,7 @@ pub struct State {
 pub enum FaultKind {
     /// An integer DIV or MOD by zero (the result was 0).
     DivByZero,
-    /// The scan hit the iteration cap and was ended.
+    /// A loop-back rung was refused a loop-back past the iteration cap (the loop was left there).
     LoopCap,
 }
 
@@ -169,7 +188,7 @@ pub enum Exit {
     /// happens when the region is a task of the combined schedule: a FOR head and its NEXT are
     /// always in the same loop task.)
     ForTest(RungId),
-    /// The scan is over: the main program ended (last rung, RET, END) or the loop cap hit.
+    /// The scan is over: the main program ended (last rung, RET, END).
     Stop,
 }
 
@@ -180,8 +199,6 @@ pub struct ScanCtx<'f> {
     pub scan: u64,
     /// Virtual time of the scan, ms.
     pub now: i64,
-    /// Loop iterations counted so far with this context (see [`ExecConfig::loop_cap`]).
-    pub iterations: u64,
     /// Where faults are appended.
     pub faults: &'f mut Vec<Fault>,
 }
@@ -202,6 +219,8 @@ pub struct Machine {
     rung_op: Vec<u32>,
     for_of_head: Vec<u32>,
     pou_entry: Vec<u32>,
+    counters: Vec<(u32, u32)>,
+    slot_count: u32,
     main_first: u32,
     vars: Vec<VarInfo>,
     inits: Vec<Value>,
@@ -227,6 +246,8 @@ impl Machine {
             rung_op: code.rung_op,
             for_of_head: code.for_of_head,
             pou_entry: code.pou_entry,
+            counters: code.counters,
+            slot_count: code.slot_count,
             vars: program
                 .vars
                 .iter()
@@ -251,9 +272,35 @@ impl Machine {
         &self.config
     }
 
-    /// Number of slots a store must have.
+    /// Number of slots a store must have: the layout's, then (if the program has loop-back
+    /// rungs) the loop counters, one per 8-slot line from the layout's total rounded up to 8.
     pub fn slot_count(&self) -> u32 {
-        self.layout.slot_count()
+        self.slot_count
+    }
+
+    /// The loop-back rungs (NEXT rungs and rungs with a backward jump, any POU) with their
+    /// counter slots, in rung order.
+    pub fn loop_counters(&self) -> impl ExactSizeIterator<Item = (RungId, u32)> + '_ {
+        self.counters.iter().map(|&(r, slot)| (RungId(r), slot))
+    }
+
+    /// How many times loop-back rung `rung` looped back (or was refused) in the current scan of
+    /// `state`; `None` if it is not a loop-back rung.
+    pub fn loop_count(&self, state: &State, rung: RungId) -> Option<u64> {
+        self.counters
+            .iter()
+            .find(|&&(r, _)| r == rung.0)
+            .map(|&(_, slot)| state.slots[slot as usize])
+    }
+
+    /// Starts a scan on `store`: zeroes the loop counters. [`run_scan`](Self::run_scan) does it
+    /// itself; a caller that runs a scan piecewise with [`run_from`](Self::run_from) /
+    /// [`resume`](Self::resume) calls it once before the scan's first piece.
+    #[inline]
+    pub fn begin_scan<S: Store + ?Sized>(&self, store: &mut S) {
+        for &(_, slot) in &self.counters {
+            store.set(slot, 0);
+        }
     }
 
     /// Number of lowered instructions (rung markers included).
@@ -263,7 +310,7 @@ impl Machine {
 
     /// The state at load: declared initial values, instances zero, padding zero.
     pub fn initial_state(&self) -> State {
-        let mut slots = vec![0u64; self.layout.slot_count() as usize];
+        let mut slots = vec![0u64; self.slot_count as usize];
         for (v, info) in self.vars.iter().enumerate() {
             if !matches!(info.ty, Type::Fb(_)) {
                 slots[self.layout.start(VarId(v as u32)) as usize] = encode(self.inits[v]);
@@ -283,6 +330,14 @@ impl Machine {
     /// # Panics
     /// If a variable is an instance, or a value's type is not the variable's type.
     pub fn set_inputs(&self, state: &mut State, inputs: &[(VarId, Value)]) {
+        self.set_inputs_in(&mut state.slots, inputs);
+    }
+
+    /// [`set_inputs`](Self::set_inputs) on a bare slot array (a state's `slots`).
+    ///
+    /// # Panics
+    /// As `set_inputs`.
+    pub fn set_inputs_in(&self, slots: &mut [u64], inputs: &[(VarId, Value)]) {
         for &(var, value) in inputs {
             let ty = self.vars[var.index()].ty;
             assert!(
@@ -291,16 +346,15 @@ impl Machine {
                 var.0,
                 value.ty()
             );
-            state.slots[self.layout.start(var) as usize] = encode(value);
+            slots[self.layout.start(var) as usize] = encode(value);
         }
     }
 
-    /// The per-scan context of scan `scan` (time `scan × cycle_ms`, no iterations yet).
+    /// The per-scan context of scan `scan` (time `scan × cycle_ms`).
     pub fn context<'f>(&self, scan: u64, faults: &'f mut Vec<Fault>) -> ScanCtx<'f> {
         ScanCtx {
             scan,
             now: (scan as i64).wrapping_mul(self.config.cycle_ms as i64),
-            iterations: 0,
             faults,
         }
     }
@@ -312,9 +366,10 @@ impl Machine {
     /// If `state` has fewer slots than [`Machine::slot_count`].
     pub fn run_scan(&self, state: &mut State, scan: u64, faults: &mut Vec<Fault>) {
         assert!(
-            state.slots.len() >= self.layout.slot_count() as usize,
+            state.slots.len() >= self.slot_count as usize,
             "state too small for this machine"
         );
+        self.begin_scan(&mut state.slots[..]);
         let mut ctx = self.context(scan, faults);
         self.exec(
             &mut state.slots[..],
@@ -382,10 +437,15 @@ impl Machine {
 
     /// The value of a variable: its scalar value, or an instance's readable fields.
     pub fn value(&self, state: &State, var: VarId) -> VarValue {
+        self.value_in(&state.slots, var)
+    }
+
+    /// [`value`](Self::value) on a bare slot array (a state's `slots`).
+    pub fn value_in(&self, slots: &[u64], var: VarId) -> VarValue {
         let range = self.layout.slots_of(var);
         VarValue::from_slots(
             self.vars[var.index()].ty,
-            &state.slots[range.start as usize..range.end as usize],
+            &slots[range.start as usize..range.end as usize],
         )
     }
 

@@ -10,7 +10,7 @@ use crate::model::{ArithOp, CmpOp, RungId, TimerKind};
 pub(crate) enum Flow {
     /// The POU ended (last rung done, or RET taken).
     Return,
-    /// The scan ends (END, or the loop cap).
+    /// The scan ends (END).
     Stop,
     /// Control reached the start of a rung outside the region.
     Rung(u32),
@@ -112,6 +112,14 @@ impl Machine {
                     let bits = st.get(a) | st.get(b) << 1 | st.get(c) << 2;
                     p &= ((bits ^ neg as u64) == 7) as u64;
                 }
+                Op::ContactN { n, neg, s: sl } => {
+                    let mut bits = 0u64;
+                    for (k, &x) in sl.iter().enumerate() {
+                        bits |= st.get(x as u32) << k;
+                    }
+                    let mask = (1u64 << n) - 1;
+                    p &= (((bits ^ neg as u64) & mask) == mask) as u64;
+                }
                 Op::Rising { slot, mem } => {
                     let v = st.get(slot);
                     p &= v & !st.get(mem) & 1;
@@ -147,15 +155,12 @@ impl Machine {
                     p = s & 1;
                     s >>= 1;
                 }
-                Op::Coil { slot, neg } => st.set(slot, p ^ neg as u64),
-                Op::Set { slot } => {
-                    if p != 0 {
-                        st.set(slot, 1);
-                    }
-                }
-                Op::Reset { slot } => {
-                    if p != 0 {
-                        st.set(slot, 0);
+                Op::Coil { slot, neg } => {
+                    // Powered: bit 0 of the mode. Unpowered: bit 2, or no write (set/reset).
+                    let (on, keep, off) =
+                        (neg as u64 & 1, (neg as u64 >> 1) & 1, (neg as u64 >> 2) & 1);
+                    if (p | (keep ^ 1)) != 0 {
+                        st.set(slot, (p & on) | ((p ^ 1) & off));
                     }
                 }
                 Op::Timer { kind, inst, pt } => {
@@ -204,12 +209,14 @@ impl Machine {
                         pc = to as usize;
                     }
                 }
-                Op::JmpBack { to } => {
+                Op::JmpBack { to, ctr } => {
                     if p != 0 {
-                        if !self.count_iteration(ctx, rung) {
-                            return Flow::Stop;
+                        if self.loop_back(st, ctx, ctr, rung) {
+                            pc = to as usize;
+                        } else {
+                            // Refused: the jump acts as if it had no power.
+                            p = 0;
                         }
-                        pc = to as usize;
                     }
                 }
                 Op::Ret => {
@@ -244,10 +251,11 @@ impl Machine {
                     }
                 }
                 Op::Next { f } => {
-                    if !self.count_iteration(ctx, rung) {
-                        return Flow::Stop;
-                    }
                     let l = &self.fors[f as usize];
+                    if !self.loop_back(st, ctx, l.ctr, rung) {
+                        pc = l.exit as usize;
+                        continue;
+                    }
                     st.set(l.var, wrap(l.num, (st.get(l.var) as i64).wrapping_add(1)));
                     if !inside(RungId(l.head)) {
                         return Flow::ForTest(l.head);
@@ -260,20 +268,31 @@ impl Machine {
         }
     }
 
-    /// Counts one loop iteration; past the cap records the fault and returns false.
+    /// Counts one loop-back of `rung` in its counter slot `ctr`; returns whether it may loop back.
+    /// The first refused loop-back of a scan records [`FaultKind::LoopCap`]; later ones (control
+    /// can come back through another loop-back rung) are refused silently.
     #[inline]
-    fn count_iteration(&self, ctx: &mut ScanCtx<'_>, rung: u32) -> bool {
-        ctx.iterations += 1;
-        if ctx.iterations > self.config.loop_cap as u64 {
+    fn loop_back<S: Store + ?Sized>(
+        &self,
+        st: &mut S,
+        ctx: &mut ScanCtx<'_>,
+        ctr: u32,
+        rung: u32,
+    ) -> bool {
+        let c = st.get(ctr).wrapping_add(1);
+        st.set(ctr, c);
+        let cap = self.config.loop_cap as u64;
+        if c <= cap {
+            return true;
+        }
+        if c == cap + 1 {
             ctx.faults.push(Fault {
                 scan: ctx.scan,
                 rung: RungId(rung),
                 kind: FaultKind::LoopCap,
             });
-            false
-        } else {
-            true
         }
+        false
     }
 }
 

@@ -1,0 +1,431 @@
+//! Differential property test of the parallel scan: for thousands of random programs (every
+//! element kind, forward and backward jumps, FOR loops, calls, timers, counters, set/reset,
+//! edges; `tests/common`) and random input sequences, the parallel executor with 1, 2 and 4
+//! workers leaves exactly the sequential scan's slot array — and the same faults, in the same
+//! order — after every scan. The sequential reference runs on the same (padded) layout, so the
+//! full slot arrays compare directly, loop counters and hidden state included.
+//!
+//! The plans are forced to be as parallel as possible (every level a parallel phase, or the cost
+//! model with free barriers) and alternate contiguous and LPT slicing, so that barriers,
+//! decisions, guards, multi-entry loops and runs of tasks are all exercised; a small loop cap
+//! makes the cap's refusals frequent. One thread pool serves every case.
+
+mod common;
+
+use plc_deps::analysis::analyse;
+use plc_deps::exec::parallel::{ParallelMachine, PlanConfig, ScanDriver, Slicing, Strategy};
+use plc_deps::exec::{ExecConfig, Fault, FaultKind, Machine};
+use plc_deps::model::{Program, Value, VarClass, VarId};
+use std::time::Duration;
+
+const PROGRAMS: u64 = 2000;
+const SCANS: u64 = 30;
+const THREADS: [usize; 3] = [1, 2, 4];
+
+/// Records the state and faults after every scan; writes inputs from a table.
+struct Recorder<'a> {
+    inputs: &'a [Vec<(VarId, Value)>],
+    states: Vec<Vec<u64>>,
+    faults: Vec<Vec<Fault>>,
+}
+
+impl ScanDriver for Recorder<'_> {
+    fn before_scan(&mut self, m: &Machine, scan: u64, slots: &mut [u64]) {
+        m.set_inputs_in(slots, &self.inputs[scan as usize]);
+    }
+    fn after_scan(&mut self, _: &Machine, _: u64, slots: &[u64], faults: &[Fault], _: Duration) {
+        self.states.push(slots.to_vec());
+        self.faults.push(faults.to_vec());
+    }
+}
+
+/// Random inputs per scan: the BOOL inputs and the INT input `k` (often 0: DIV/MOD faults).
+fn input_table(p: &Program, seed: u64, scans: u64) -> Vec<Vec<(VarId, Value)>> {
+    let mut rng = common::Rng::new(seed ^ 0xABCD);
+    let inputs: Vec<VarId> = (0..p.vars.len() as u32)
+        .map(VarId)
+        .filter(|&v| p.var(v).class == VarClass::Input)
+        .collect();
+    (0..scans)
+        .map(|_| {
+            let mut row = Vec::new();
+            for &v in &inputs {
+                if rng.chance(20) {
+                    continue; // sometimes an input keeps its value
+                }
+                let value = match p.var(v).ty {
+                    plc_deps::model::Type::Bool => Value::Bool(rng.chance(50)),
+                    plc_deps::model::Type::Int => Value::Int(rng.below(9) as i16 - 3),
+                    plc_deps::model::Type::Dint => Value::Dint(rng.below(9) as i32 - 3),
+                    plc_deps::model::Type::Real => Value::Real(rng.below(9) as f32 * 0.5),
+                    _ => Value::Time(rng.below(100) as i32),
+                };
+                row.push((v, value));
+            }
+            row
+        })
+        .collect()
+}
+
+#[derive(Default)]
+struct Stats {
+    cases: u64,
+    parallel_cases: u64,
+    parallel_phases: u64,
+    loop_cap_faults: u64,
+    div_faults: u64,
+}
+
+/// Runs one program under one plan configuration and compares every scan.
+#[allow(clippy::too_many_arguments)]
+fn check(
+    p: &Program,
+    label: &str,
+    config: &PlanConfig,
+    exec: &ExecConfig,
+    scans: u64,
+    seed: u64,
+    pool: &rayon::ThreadPool,
+    stats: &mut Stats,
+) {
+    let inputs = input_table(p, seed, scans);
+    check_with(p, label, config, exec, &inputs, pool, stats)
+}
+
+fn check_with(
+    p: &Program,
+    label: &str,
+    config: &PlanConfig,
+    exec: &ExecConfig,
+    inputs: &[Vec<(VarId, Value)>],
+    pool: &rayon::ThreadPool,
+    stats: &mut Stats,
+) {
+    let scans = inputs.len() as u64;
+    let a = analyse(p);
+    let par = ParallelMachine::new(p, &a, exec, config).unwrap_or_else(|e| panic!("{label}: {e}"));
+    if let Err(e) = par.verify(p, &a) {
+        panic!("{label}: unsafe plan: {e}\n{}", par.explain(p));
+    }
+    let seq = Machine::new(p, par.machine().layout().clone(), exec).unwrap();
+    let mut rec = Recorder {
+        inputs,
+        states: Vec::new(),
+        faults: Vec::new(),
+    };
+    let mut state = par.initial_state();
+    par.run(Some(pool), &mut state, 0..scans, &mut rec);
+    assert_eq!(
+        rec.states.len() as u64,
+        scans,
+        "{label}: one callback per scan"
+    );
+    let mut s = seq.initial_state();
+    assert_eq!(s.slots, par.initial_state().slots);
+    stats.cases += 1;
+    if par.plan().sequential().is_none() {
+        stats.parallel_cases += 1;
+        stats.parallel_phases += par.plan().parallel_phases() as u64;
+    }
+    for scan in 0..scans {
+        let mut faults = Vec::new();
+        seq.scan(&mut s, scan, &inputs[scan as usize], &mut faults);
+        let got = &rec.states[scan as usize];
+        if got != &s.slots {
+            let slot = got.iter().zip(&s.slots).position(|(a, b)| a != b).unwrap();
+            let var = (0..p.vars.len() as u32)
+                .map(VarId)
+                .find(|&v| seq.layout().slots_of(v).contains(&(slot as u32)));
+            panic!(
+                "{label}: state differs after scan {scan} at slot {slot} ({}): par {:#x}, seq {:#x}\n{}",
+                var.map_or("loop counter or padding".to_string(), |v| p.var(v).name.clone()),
+                got[slot],
+                s.slots[slot],
+                par.explain(p)
+            );
+        }
+        assert_eq!(
+            rec.faults[scan as usize], faults,
+            "{label}: faults of scan {scan}"
+        );
+        stats.loop_cap_faults += faults
+            .iter()
+            .filter(|f| f.kind == FaultKind::LoopCap)
+            .count() as u64;
+        stats.div_faults += faults
+            .iter()
+            .filter(|f| f.kind == FaultKind::DivByZero)
+            .count() as u64;
+    }
+}
+
+fn configs(threads: usize, seed: u64) -> PlanConfig {
+    let mut c = PlanConfig::new(threads);
+    match seed % 4 {
+        0 => {
+            c.strategy = Strategy::AllParallel;
+            c.slicing = Slicing::Contiguous;
+        }
+        1 => {
+            c.strategy = Strategy::AllParallel;
+            c.slicing = Slicing::Lpt;
+        }
+        2 => {
+            // The cost model with free barriers and items: parallel wherever a level has two tasks,
+            // sequential phases in between.
+            c.barrier_cost = 0;
+            c.item_cost = 0;
+            c.slicing = Slicing::Auto;
+        }
+        _ => {
+            c.strategy = Strategy::AllParallel;
+            c.slicing = Slicing::Auto;
+        }
+    }
+    c
+}
+
+fn pool() -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(3)
+        .build()
+        .unwrap()
+}
+
+#[test]
+fn parallel_scan_equals_sequential_scan_on_random_programs() {
+    let pool = pool();
+    let exec = ExecConfig {
+        cycle_ms: 10,
+        loop_cap: 12,
+    };
+    let mut stats = Stats::default();
+    let mut loaded = 0;
+    for seed in 0..PROGRAMS {
+        let json = common::random_program(seed, 24);
+        let Ok(p) = plc_deps::read::program_from_json(&json) else {
+            continue;
+        };
+        loaded += 1;
+        for threads in THREADS {
+            let config = configs(threads, seed + threads as u64);
+            let label = format!(
+                "seed {seed}, {threads} threads, {:?}/{:?}",
+                config.strategy, config.slicing
+            );
+            check(&p, &label, &config, &exec, SCANS, seed, &pool, &mut stats);
+        }
+    }
+    eprintln!(
+        "{loaded} programs, {} cases ({} with parallel phases, {} parallel phases), faults: {} loop-cap, {} div-by-zero",
+        stats.cases, stats.parallel_cases, stats.parallel_phases, stats.loop_cap_faults, stats.div_faults
+    );
+    assert!(
+        loaded >= PROGRAMS * 3 / 4,
+        "only {loaded} random programs loaded"
+    );
+    assert!(
+        stats.parallel_cases >= stats.cases / 2,
+        "too few parallel plans: {} of {}",
+        stats.parallel_cases,
+        stats.cases
+    );
+    assert!(
+        stats.loop_cap_faults > 0 && stats.div_faults > 0,
+        "faults are exercised"
+    );
+}
+
+#[test]
+fn parallel_scan_equals_sequential_scan_on_generated_programs() {
+    // Larger programs of the generator with every knob on (timers, counters, FOR loops, forward
+    // jumps, END, calls), under the default cost model and forced parallelism.
+    let pool = pool();
+    let exec = ExecConfig::default();
+    let mut stats = Stats::default();
+    for (rungs, width, seed) in [(600, 40, 1), (2000, 100, 2), (300, 300, 3), (1500, 8, 4)] {
+        let json = plc_deps::gen::generate_string(&plc_deps::gen::GenConfig::all_features(
+            rungs, width, seed,
+        ));
+        let p = plc_deps::read::program_from_json(&json).unwrap();
+        for threads in [2, 4] {
+            for config in [
+                PlanConfig::new(threads),
+                configs(threads, 0),
+                configs(threads, 1),
+                configs(threads, 2),
+            ] {
+                let label = format!(
+                    "gen {rungs}/{width}/{seed}, {threads} threads, {:?}/{:?}",
+                    config.strategy, config.slicing
+                );
+                check(&p, &label, &config, &exec, 60, seed, &pool, &mut stats);
+            }
+        }
+    }
+    // The default cost model finds these levels too small for 2 cores; the others are parallel.
+    assert!(
+        stats.parallel_cases >= stats.cases * 3 / 4,
+        "{} of {} parallel",
+        stats.parallel_cases,
+        stats.cases
+    );
+}
+
+#[test]
+fn worked_examples_with_their_inputs_under_forced_parallel_plans() {
+    let pool = pool();
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("analyses");
+    let mut stats = Stats::default();
+    for dir in [
+        "example-a",
+        "example-b",
+        "conveyor",
+        "mixing-station",
+        "packaging-line",
+    ] {
+        let p = plc_deps::read::program_from_json(
+            &std::fs::read_to_string(root.join(dir).join("program.json")).unwrap(),
+        )
+        .unwrap();
+        let table = plc_deps::runcmd::load_inputs(&p, &root.join(dir).join("inputs.csv")).unwrap();
+        // The committed inputs, then the rows again: 2 × 20–50 scans.
+        let inputs: Vec<Vec<(VarId, Value)>> = table
+            .rows
+            .iter()
+            .chain(table.rows.iter())
+            .cloned()
+            .collect();
+        for exec in [
+            ExecConfig {
+                cycle_ms: 1000,
+                loop_cap: 100_000,
+            },
+            ExecConfig {
+                cycle_ms: 10,
+                loop_cap: 2,
+            },
+        ] {
+            for threads in [2, 4] {
+                for k in 0..4 {
+                    let config = configs(threads, k);
+                    let label = format!(
+                        "{dir}, {threads} threads, {:?}/{:?}, cap {}",
+                        config.strategy, config.slicing, exec.loop_cap
+                    );
+                    check_with(&p, &label, &config, &exec, &inputs, &pool, &mut stats);
+                }
+            }
+        }
+    }
+    assert!(
+        stats.parallel_cases >= stats.cases / 2,
+        "{} of {} parallel",
+        stats.parallel_cases,
+        stats.cases
+    );
+}
+
+#[test]
+fn wide_program_gets_a_parallel_plan_and_a_chain_falls_back() {
+    let wide = plc_deps::gen::generate_string(&plc_deps::gen::GenConfig {
+        rungs: 4000,
+        width: 200,
+        ..Default::default()
+    });
+    let p = plc_deps::read::program_from_json(&wide).unwrap();
+    let a = analyse(&p);
+    let par = ParallelMachine::new(&p, &a, &ExecConfig::default(), &PlanConfig::new(2)).unwrap();
+    let plan = par.plan();
+    assert!(plan.sequential().is_none(), "{}", par.explain(&p));
+    assert_eq!(
+        plan.parallel_phases(),
+        a.schedule.levels.len(),
+        "every level of a wide program pays"
+    );
+    assert!(par.explain(&p).contains("contiguous"));
+    // A chain: each rung reads the previous rung's coil; no level has two tasks.
+    let chain = chain_program(50);
+    let p = plc_deps::read::program_from_json(&chain).unwrap();
+    let a = analyse(&p);
+    let par = ParallelMachine::new(&p, &a, &ExecConfig::default(), &PlanConfig::new(2)).unwrap();
+    assert!(par.plan().sequential().is_some(), "{}", par.explain(&p));
+    assert_eq!(par.machine().layout(), &plc_deps::exec::Layout::dense(&p));
+}
+
+/// `n` rungs, rung i reads the coil of rung i − 1 (and an input).
+fn chain_program(n: usize) -> String {
+    let mut vars = vec![serde_json::json!({"name": "go", "type": "BOOL", "class": "input"})];
+    let mut rungs = Vec::new();
+    for i in 0..n {
+        vars.push(serde_json::json!({"name": format!("c{i}"), "type": "BOOL", "class": if i + 1 == n { "output" } else { "memory" }}));
+        let prev = if i == 0 {
+            "go".to_string()
+        } else {
+            format!("c{}", i - 1)
+        };
+        rungs.push(serde_json::json!({"id": format!("R{i}"), "ld": [{"contact": prev}, {"contact": "go"}, {"coil": format!("c{i}")}]}));
+    }
+    serde_json::json!({"program": "chain", "vars": vars, "rungs": rungs}).to_string()
+}
+
+#[test]
+fn unconditional_backward_jump_whose_refusal_leaves_the_cfg_runs_sequentially() {
+    // R2 jumps back unconditionally: the CFG has no way from it to R3, but after a refusal of the
+    // cap control goes on to R3. The plan must not rely on the schedule then.
+    let json = r#"{
+      "program": "endless",
+      "vars": [{"name": "n", "type": "DINT"}, {"name": "a", "type": "BOOL", "class": "input"},
+               {"name": "x", "type": "BOOL"}, {"name": "after", "type": "BOOL"}],
+      "rungs": [
+        {"id": "R0", "ld": [{"contact": "a"}, {"coil": "x"}]},
+        {"id": "R1", "label": "L", "ld": [{"op": "ADD", "in": ["n", 1], "out": "n"}]},
+        {"id": "R2", "ld": [{"jmp": "L"}]},
+        {"id": "R3", "ld": [{"contact": "x"}, {"coil": "after"}]}
+      ]
+    }"#;
+    let p = plc_deps::read::program_from_json(json).unwrap();
+    let a = analyse(&p);
+    let exec = ExecConfig {
+        cycle_ms: 10,
+        loop_cap: 7,
+    };
+    let mut config = PlanConfig::new(2);
+    config.strategy = Strategy::AllParallel;
+    let par = ParallelMachine::new(&p, &a, &exec, &config).unwrap();
+    let why = par.plan().sequential().expect("sequential fallback");
+    assert!(why.contains("rung R2") && why.contains("R3"), "{why}");
+    let mut stats = Stats::default();
+    check(&p, "endless", &config, &exec, 5, 7, &pool(), &mut stats);
+    assert_eq!(stats.loop_cap_faults, 5);
+}
+
+#[test]
+fn one_scan_at_a_time_equals_a_run() {
+    let json = plc_deps::gen::generate_string(&plc_deps::gen::GenConfig::all_features(800, 50, 9));
+    let p = plc_deps::read::program_from_json(&json).unwrap();
+    let a = analyse(&p);
+    let pool = pool();
+    let par = ParallelMachine::new(&p, &a, &ExecConfig::default(), &PlanConfig::new(2)).unwrap();
+    let inputs = input_table(&p, 9, 40);
+    let mut rec = Recorder {
+        inputs: &inputs,
+        states: Vec::new(),
+        faults: Vec::new(),
+    };
+    let mut whole = par.initial_state();
+    par.run(Some(&pool), &mut whole, 0..40, &mut rec);
+    let mut single = par.initial_state();
+    for scan in 0..40u64 {
+        let mut faults = Vec::new();
+        par.scan(
+            Some(&pool),
+            &mut single,
+            scan,
+            &inputs[scan as usize],
+            &mut faults,
+        );
+        assert_eq!(single.slots, rec.states[scan as usize]);
+        assert_eq!(faults, rec.faults[scan as usize]);
+    }
+}

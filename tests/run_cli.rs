@@ -1,0 +1,493 @@
+//! `plc-deps run` as a user meets it: the JSON report's keys, inputs from CSV and JSON (values
+//! held between rows and after the last one), the trace file, `--mode both` on programs with
+//! jumps, loops and calls, faults, and bad input: one located error, exit code 2, no output file.
+
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn run(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_plc-deps"))
+        .current_dir(root())
+        .args(args)
+        .output()
+        .expect("run plc-deps")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("plc-deps-run-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+fn write(name: &str, text: &str) -> String {
+    let path = tmp(name);
+    std::fs::write(&path, text).unwrap();
+    path.to_str().unwrap().to_owned()
+}
+
+fn json_of(out: &Output) -> Value {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("JSON on stdout")
+}
+
+/// A failing run: exit code 2, one `error:` line on stderr containing `needle`, nothing on stdout.
+fn fails(args: &[&str], needle: &str) -> String {
+    let out = run(args);
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+    assert!(out.stdout.is_empty(), "{args:?}: nothing on stdout");
+    assert_eq!(stderr.lines().count(), 1, "{args:?}: one line: {stderr}");
+    assert!(stderr.starts_with("error: "), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(
+        stderr.contains(needle),
+        "{args:?}: expected {needle:?} in {stderr}"
+    );
+    stderr
+}
+
+/// Inputs `a` (BOOL), `n` (INT), `t` (TIME); outputs copy them; a TON on `a`.
+const ECHO: &str = r#"{
+  "program": "echo",
+  "vars": [
+    {"name": "a", "type": "BOOL", "class": "input"},
+    {"name": "n", "type": "INT", "class": "input"},
+    {"name": "t", "type": "TIME", "class": "input"},
+    {"name": "q", "type": "BOOL", "class": "output"},
+    {"name": "m", "type": "INT", "class": "output"},
+    {"name": "u", "type": "TIME", "class": "output"},
+    {"name": "rise", "type": "DINT", "class": "output"},
+    {"name": "T1", "type": "TON"}
+  ],
+  "rungs": [
+    {"id": "R1", "ld": [{"contact": "a"}, {"coil": "q"}]},
+    {"id": "R2", "ld": [{"move": "n", "to": "m"}]},
+    {"id": "R3", "ld": [{"move": "t", "to": "u"}]},
+    {"id": "R4", "ld": [{"contact": "a", "edge": "rising"}, {"op": "ADD", "in": ["rise", 1], "out": "rise"}]},
+    {"id": "R5", "ld": [{"contact": "a"}, {"ton": "T1", "pt": "T#30ms"}]}
+  ]
+}"#;
+
+#[test]
+fn json_report_has_the_normative_keys() {
+    let out = run(&[
+        "run",
+        "analyses/conveyor/program.json",
+        "--scans",
+        "30",
+        "--format",
+        "json",
+        "--threads",
+        "2",
+    ]);
+    let j = json_of(&out);
+    for key in [
+        "scans",
+        "outputs",
+        "state",
+        "faults",
+        "modes",
+        "identical",
+        "first_difference",
+    ] {
+        assert!(j.get(key).is_some(), "key {key} in {j}");
+    }
+    assert_eq!(j["scans"], 30);
+    assert_eq!(j["identical"], true);
+    assert!(j["first_difference"].is_null());
+    assert!(j["faults"].as_array().unwrap().is_empty());
+    for mode in ["seq", "par"] {
+        let m = &j["modes"][mode];
+        assert!(m["scans_per_s"].as_f64().unwrap() > 0.0, "{m}");
+        assert!(m["ns_per_scan"].as_f64().unwrap() > 0.0, "{m}");
+    }
+    // State: every declared variable, BOOLs as booleans, instances as objects of their fields,
+    // no hidden edge memories; outputs are the output variables.
+    let state = j["state"].as_object().unwrap();
+    let program: Value = serde_json::from_str(
+        &std::fs::read_to_string(root().join("analyses/conveyor/program.json")).unwrap(),
+    )
+    .unwrap();
+    let declared: Vec<&str> = program["vars"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        state.keys().map(String::as_str).collect::<Vec<_>>(),
+        declared,
+        "state holds the declared variables, in order"
+    );
+    assert!(!state.keys().any(|k| k.contains(':')), "no edge memories");
+    for (name, v) in state {
+        let ty = program["vars"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|x| x["name"] == name.as_str())
+            .unwrap()["type"]
+            .as_str()
+            .unwrap();
+        match ty {
+            "BOOL" => assert!(v.is_boolean(), "{name}: {v}"),
+            "TON" | "TOF" | "TP" => assert!(
+                v["Q"].is_boolean() && v["ET"].is_number() && v["PT"].is_number(),
+                "{name}: {v}"
+            ),
+            "CTU" | "CTD" => assert!(
+                v["Q"].is_boolean() && v["CV"].is_number() && v["PV"].is_number(),
+                "{name}: {v}"
+            ),
+            _ => assert!(v.is_number(), "{name}: {v}"),
+        }
+    }
+    let outputs = j["outputs"].as_object().unwrap();
+    assert!(!outputs.is_empty());
+    for (name, v) in outputs {
+        assert_eq!(&state[name], v);
+    }
+}
+
+#[test]
+fn csv_inputs_hold_their_last_value_and_the_trace_shows_every_scan() {
+    let program = write("echo.json", ECHO);
+    let inputs = write(
+        "echo.csv",
+        "a,n,t\ntrue,5,T#1s\n,7,\nfalse,,250\n\n  1 , -3 ,\n",
+    );
+    let trace = tmp("echo-trace.csv");
+    let out = run(&[
+        "run",
+        &program,
+        "--inputs",
+        &inputs,
+        "--scans",
+        "6",
+        "--mode",
+        "seq",
+        "--format",
+        "json",
+        "--trace",
+        trace.to_str().unwrap(),
+    ]);
+    let j = json_of(&out);
+    // The last row (scan 3) set a and n; scans 4 and 5 hold them; t held since scan 2.
+    assert_eq!(
+        j["outputs"],
+        serde_json::json!({"q": true, "m": -3, "u": 250, "rise": 2})
+    );
+    assert!(j["identical"].is_null());
+    assert!(j["modes"].get("par").is_none());
+    let text = std::fs::read_to_string(&trace).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines[0], "scan,time_ms,a,n,t,q,m,u,rise,T1.Q,T1.ET,T1.PT");
+    assert_eq!(lines.len(), 7);
+    assert_eq!(lines[1], "0,0,1,5,1000,1,5,1000,1,0,0,30");
+    assert_eq!(lines[2], "1,10,1,7,1000,1,7,1000,1,0,10,30");
+    assert_eq!(lines[3], "2,20,0,7,250,0,7,250,1,0,0,30");
+    assert_eq!(lines[4], "3,30,1,-3,250,1,-3,250,2,0,0,30");
+    assert_eq!(lines[6], "5,50,1,-3,250,1,-3,250,2,0,20,30");
+    // A chosen subset, fields included.
+    let out = run(&[
+        "run",
+        &program,
+        "--inputs",
+        &inputs,
+        "--trace",
+        trace.to_str().unwrap(),
+        "--trace-vars",
+        "rise,T1.Q,T1",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&trace).unwrap();
+    assert_eq!(
+        text.lines().next().unwrap(),
+        "scan,time_ms,rise,T1.Q,T1.Q,T1.ET,T1.PT"
+    );
+    assert_eq!(text.lines().count(), 5, "scans default to the input rows");
+}
+
+#[test]
+fn json_inputs_give_the_same_run_as_csv() {
+    let program = write("echo2.json", ECHO);
+    let csv = write("echo2.csv", "a,n,t\ntrue,5,T#1s\n,7,\nfalse,,250\n1,-3,\n");
+    let json = write(
+        "echo2-inputs.json",
+        r#"[{"a": true, "n": 5, "t": "T#1s"}, {"n": 7}, {"a": false, "t": 250}, {"a": true, "n": -3, "t": null}]"#,
+    );
+    let a = json_of(&run(&[
+        "run", &program, "--inputs", &csv, "--scans", "9", "--format", "json",
+    ]));
+    let b = json_of(&run(&[
+        "run", &program, "--inputs", &json, "--scans", "9", "--format", "json",
+    ]));
+    assert_eq!(a["state"], b["state"]);
+    assert_eq!(a["identical"], true);
+    assert_eq!(b["identical"], true);
+}
+
+#[test]
+fn both_modes_are_identical_on_programs_with_jumps_loops_and_calls() {
+    let gen = tmp("gen-all.json");
+    let out = run(&[
+        "gen",
+        "--rungs",
+        "3000",
+        "--width",
+        "300",
+        "--timers",
+        "--loops",
+        "--jumps",
+        "--calls",
+        "--seed",
+        "5",
+        "-o",
+        gen.to_str().unwrap(),
+    ]);
+    assert!(out.status.success());
+    for threads in ["1", "2", "3"] {
+        let j = json_of(&run(&[
+            "run",
+            gen.to_str().unwrap(),
+            "--scans",
+            "150",
+            "--threads",
+            threads,
+            "--format",
+            "json",
+            "--explain",
+        ]));
+        assert_eq!(
+            j["identical"], true,
+            "{threads} threads: {}",
+            j["first_difference"]
+        );
+        assert_eq!(j["plan"]["threads"], threads.parse::<u64>().unwrap());
+    }
+    for dir in [
+        "example-a",
+        "example-b",
+        "conveyor",
+        "mixing-station",
+        "packaging-line",
+    ] {
+        let program = format!("analyses/{dir}/program.json");
+        let j = json_of(&run(&[
+            "run", &program, "--scans", "200", "--format", "json",
+        ]));
+        assert_eq!(j["identical"], true, "{dir}");
+    }
+}
+
+#[test]
+fn text_report_and_explain() {
+    let wide = tmp("wide.json");
+    assert!(run(&[
+        "gen",
+        "--rungs",
+        "4000",
+        "--width",
+        "400",
+        "-o",
+        wide.to_str().unwrap()
+    ])
+    .status
+    .success());
+    let out = run(&[
+        "run",
+        wide.to_str().unwrap(),
+        "--scans",
+        "50",
+        "--threads",
+        "2",
+        "--explain",
+    ]);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    for needle in [
+        "parallel plan: 2 worker(s)",
+        "level   1:",
+        "parallel (contiguous",
+        "padding:",
+        "outputs after scan 49:",
+        "faults: none",
+        "seq ",
+        "par ",
+        "identical: yes",
+    ] {
+        assert!(text.contains(needle), "{needle:?} in\n{text}");
+    }
+    assert!(out.stderr.is_empty(), "quiet when stderr is not a terminal");
+}
+
+#[test]
+fn faults_are_reported_with_scan_rung_and_kind() {
+    let program = write(
+        "faulty.json",
+        r#"{"program": "faulty",
+        "vars": [{"name": "d", "type": "INT", "class": "input"}, {"name": "x", "type": "INT", "class": "output"}, {"name": "i", "type": "INT"}],
+        "rungs": [
+          {"id": "DIV", "ld": [{"op": "DIV", "in": [10, "d"], "out": "x"}]},
+          {"id": "L", "label": "back", "ld": [{"op": "ADD", "in": ["i", 1], "out": "i"}]},
+          {"id": "J", "ld": [{"compare": "GT", "a": "i", "b": 0}, {"jmp": "back"}]}
+        ]}"#,
+    );
+    let inputs = write("faulty.csv", "d\n0\n5\n0\n");
+    let j = json_of(&run(&[
+        "run",
+        &program,
+        "--inputs",
+        &inputs,
+        "--loop-cap",
+        "50",
+        "--format",
+        "json",
+    ]));
+    let faults = j["faults"].as_array().unwrap();
+    assert_eq!(
+        faults[0],
+        serde_json::json!({"scan": 0, "rung": "DIV", "kind": "div-by-zero"})
+    );
+    assert_eq!(
+        faults[1],
+        serde_json::json!({"scan": 0, "rung": "J", "kind": "loop-cap"})
+    );
+    assert_eq!(
+        faults[2],
+        serde_json::json!({"scan": 1, "rung": "J", "kind": "loop-cap"})
+    );
+    assert_eq!(faults.len(), 5);
+    assert_eq!(j["fault_count"], 5);
+    assert_eq!(j["identical"], true);
+    let text =
+        String::from_utf8(run(&["run", &program, "--inputs", &inputs, "--loop-cap", "50"]).stdout)
+            .unwrap();
+    assert!(text.contains("scan 0: rung DIV: div-by-zero"), "{text}");
+}
+
+#[test]
+fn bad_input_is_one_located_error_with_exit_code_2_and_no_output_file() {
+    let program = write("echo3.json", ECHO);
+    let trace = tmp("never.csv");
+    let out_file = tmp("never.json");
+    let t = trace.to_str().unwrap();
+    let o = out_file.to_str().unwrap();
+    let csv = |name: &str, text: &str| write(name, text);
+    let unknown = csv("unknown.csv", "a,temp\n1,2\n");
+    fails(
+        &["run", &program, "--inputs", &unknown, "--trace", t, "-o", o],
+        &format!("{unknown}:1:3: unknown input variable `temp`"),
+    );
+    let not_input = csv("notinput.csv", "a,q\n1,1\n");
+    fails(
+        &["run", &program, "--inputs", &not_input],
+        &format!("{not_input}:1:3: `q` is not an input variable"),
+    );
+    let bad_value = csv("badvalue.csv", "a,n\n1,2\n0,70000\n");
+    fails(
+        &["run", &program, "--inputs", &bad_value, "--trace", t],
+        &format!("{bad_value}:3:3: scan 1, column `n`: `70000` is not an INT"),
+    );
+    let bad_bool = csv("badbool.csv", "a\nyes\n");
+    fails(
+        &["run", &program, "--inputs", &bad_bool],
+        &format!("{bad_bool}:2:1: scan 0, column `a`: `yes` is not a BOOL"),
+    );
+    let too_many = csv("toomany.csv", "a\n1,2\n");
+    fails(
+        &["run", &program, "--inputs", &too_many],
+        &format!("{too_many}:2:3: 2 values in a row"),
+    );
+    let bad_json = csv("bad.json", "[{\"a\": true},\n {\"a\": tru}]");
+    fails(
+        &["run", &program, "--inputs", &bad_json, "-o", o],
+        &format!("{bad_json}:2:"),
+    );
+    let json_key = csv("key.json", "[{\"a\": true},\n {\"nope\": 1}]");
+    fails(
+        &["run", &program, "--inputs", &json_key],
+        &format!("{json_key}:2:"),
+    );
+    fails(
+        &["run", &program, "--inputs", &json_key],
+        "scan 1: unknown input variable `nope`",
+    );
+    let json_type = csv("type.json", "[{\"n\": true}]");
+    fails(
+        &["run", &program, "--inputs", &json_type],
+        "scan 0, input `n`: true is not an INT",
+    );
+    let not_array = csv("obj.json", "{\"a\": true}");
+    fails(
+        &["run", &program, "--inputs", &not_array],
+        "an array with one object of input values per scan",
+    );
+    fails(
+        &["run", &program, "--threads", "0", "--trace", t],
+        "--threads must be at least 1",
+    );
+    fails(
+        &["run", &program, "--cycle", "10"],
+        "--cycle 10: not a TIME",
+    );
+    fails(&["run", &program, "--cycle", "fast"], "not a TIME");
+    fails(&["run", &program, "--cycle", "T#0ms"], "positive");
+    fails(
+        &["run", &program, "--scans", "0"],
+        "--scans must be at least 1",
+    );
+    fails(
+        &["run", &program, "--trace", t, "--trace-vars", "a,zz"],
+        "unknown variable `zz`",
+    );
+    fails(
+        &["run", &program, "--trace", t, "--trace-vars", "T1.CV"],
+        "T1 has no field CV",
+    );
+    let broken = csv("broken.json", "{\"program\": \"x\", \"vars\": [");
+    fails(&["run", &broken, "-o", o], &format!("{broken}:1:"));
+    assert!(!trace.exists(), "no trace file after an error");
+    assert!(!out_file.exists(), "no output file after an error");
+    // Missing files are I/O errors (exit code 1), as for `report`.
+    let out = run(&["run", &program, "--inputs", "no/such/inputs.csv"]);
+    assert_eq!(out.status.code(), Some(1));
+}
+
+#[test]
+fn output_file_is_written_whole() {
+    let program = write("echo4.json", ECHO);
+    let out_file = tmp("report.json");
+    let out = run(&[
+        "run",
+        &program,
+        "--scans",
+        "5",
+        "--format",
+        "json",
+        "-o",
+        out_file.to_str().unwrap(),
+    ]);
+    assert!(out.status.success());
+    assert!(out.stdout.is_empty());
+    let j: Value = serde_json::from_str(&std::fs::read_to_string(&out_file).unwrap()).unwrap();
+    assert_eq!(j["scans"], 5);
+}
+
+#[allow(dead_code)]
+fn exists(p: &Path) -> bool {
+    p.exists()
+}
