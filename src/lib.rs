@@ -5,9 +5,11 @@
 //! (text, JSON, DOT). [`graph`] holds the generic graph algorithms the analyses use.
 pub mod analysis;
 pub mod exec;
+pub mod fbd;
 pub mod app;
 pub mod graph;
 pub mod model;
 pub mod read;
 pub mod report;
+pub mod runcmd;
 pub mod gen;

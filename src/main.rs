@@ -36,6 +36,17 @@ enum Command {
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
+    /// Print each FBD network's execution order and conditional fragment tree (seed 000).
+    Order {
+        /// The program (JSON program format with FBD bodies, see docs/fbd.md).
+        file: PathBuf,
+        /// Output format.
+        #[arg(long, value_enum, default_value_t = FormatArg::Text)]
+        format: FormatArg,
+        /// Write to this file instead of standard output.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
     /// Print the JSON Schema of the program format.
     Schema {
         /// Write to this file instead of standard output.
@@ -69,6 +80,58 @@ enum Command {
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
+    /// Run the PLC scan cycle on virtual time: sequentially, in parallel, or both (checked equal).
+    Run {
+        /// The program (JSON program format, see docs/format.md).
+        file: PathBuf,
+        /// Number of scans [default: the rows of --inputs, or 1000].
+        #[arg(long)]
+        scans: Option<u64>,
+        /// Input values per scan: CSV (header of input names, one row per scan) or JSON
+        /// (`[{"start": true, "temp": 40}, ...]`); see docs/scan.md.
+        #[arg(long)]
+        inputs: Option<PathBuf>,
+        /// Virtual scan period, a TIME (scan k runs at k × cycle).
+        #[arg(long, default_value = "10ms")]
+        cycle: String,
+        /// Workers of the parallel executor [default: the number of cores].
+        #[arg(long)]
+        threads: Option<usize>,
+        /// Which executors run.
+        #[arg(long, value_enum, default_value_t = ModeArg::Both)]
+        mode: ModeArg,
+        /// Write the traced variables after every scan to this CSV file.
+        #[arg(long)]
+        trace: Option<PathBuf>,
+        /// Variables to trace (comma-separated; instance fields as T1.Q) [default: all].
+        #[arg(long, value_delimiter = ',')]
+        trace_vars: Option<Vec<String>>,
+        /// Output format.
+        #[arg(long, value_enum, default_value_t = RunFormatArg::Text)]
+        format: RunFormatArg,
+        /// Explain the parallel plan: levels, costs, slices, merges and padding.
+        #[arg(long)]
+        explain: bool,
+        /// Loop-backs allowed per loop-back rung and scan (the iteration cap).
+        #[arg(long, default_value_t = 100_000)]
+        loop_cap: u32,
+        /// Write the report to this file instead of standard output.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
+}
+
+#[derive(Copy, Clone, ValueEnum)]
+enum ModeArg {
+    Seq,
+    Par,
+    Both,
+}
+
+#[derive(Copy, Clone, ValueEnum)]
+enum RunFormatArg {
+    Text,
+    Json,
 }
 
 #[derive(Copy, Clone, ValueEnum)]
@@ -104,6 +167,14 @@ fn run(cli: Cli) -> Result<(), CliError> {
             };
             app::report(&config)
         }
+        Command::Order { file, format, output } => {
+            let format = match format {
+                FormatArg::Text => app::OrderFormat::Text,
+                FormatArg::Json => app::OrderFormat::Json,
+                FormatArg::Dot => app::OrderFormat::Dot,
+            };
+            app::order(&app::OrderConfig { input: file, format, output })
+        }
         Command::Schema { output } => app::write_output(output.as_deref(), app::PROGRAM_SCHEMA),
         Command::Gen { rungs, width, seed, timers, loops, jumps, calls, output } => {
             if rungs == 0 || width == 0 {
@@ -111,6 +182,31 @@ fn run(cli: Cli) -> Result<(), CliError> {
             }
             let config = plc_deps::gen::GenConfig { rungs, width, seed, timers, loops, jumps, calls };
             app::write_output_with(output.as_deref(), |w| plc_deps::gen::write_program(&config, w))
+        }
+        Command::Run { file, scans, inputs, cycle, threads, mode, trace, trace_vars, format, explain, loop_cap, output } => {
+            use plc_deps::runcmd::{self, RunConfig, RunFormat, RunMode};
+            let mut config = RunConfig::new(file);
+            config.scans = scans;
+            config.inputs = inputs;
+            config.cycle_ms = runcmd::parse_cycle(&cycle)?;
+            if let Some(t) = threads {
+                config.threads = t;
+            }
+            config.mode = match mode {
+                ModeArg::Seq => RunMode::Seq,
+                ModeArg::Par => RunMode::Par,
+                ModeArg::Both => RunMode::Both,
+            };
+            config.trace = trace;
+            config.trace_vars = trace_vars;
+            config.format = match format {
+                RunFormatArg::Text => RunFormat::Text,
+                RunFormatArg::Json => RunFormat::Json,
+            };
+            config.explain = explain;
+            config.loop_cap = loop_cap;
+            config.output = output;
+            runcmd::run(&config)
         }
     }
 }

@@ -1,6 +1,11 @@
 //! Data-driven worked examples: every `analyses/*/program.json` has its committed reports
 //! (`report.txt`, `report.json`) beside it. This test regenerates them all and fails on any
-//! difference; `UPDATE_EXPECT=1 cargo test --test analyses` re-blesses them.
+//! difference; `UPDATE_EXPECT=1 cargo test --test analyses` re-blesses them. Examples written in
+//! FBD also have `order.txt` and `order.json` (`plc-deps order`).
+//!
+//! An example with an `inputs.csv` also has its committed `run.json`: the JSON of
+//! `plc-deps run program.json --inputs inputs.csv --cycle 1s --threads 2 --mode both
+//! --format json` with the timing fields zeroed (`runcmd::run_json_deterministic`).
 
 use plc_deps::app::{render_report, ReportFormat};
 use plc_deps::read::program_from_json;
@@ -42,11 +47,31 @@ fn every_worked_example_matches_its_committed_reports() {
     let dirs = examples();
     assert!(dirs.len() >= 5, "expected the worked examples in analyses/, found {}", dirs.len());
     let mut failures = Vec::new();
+    let mut runs = 0;
     for dir in dirs {
         let text = std::fs::read_to_string(dir.join("program.json")).expect("read program");
         let program = program_from_json(&text).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
         check(&dir.join("report.txt"), &render_report(&program, ReportFormat::Text, View::All), &mut failures);
         check(&dir.join("report.json"), &render_report(&program, ReportFormat::Json, View::All), &mut failures);
+        let (_, fbd) = plc_deps::read::program_and_fbd_from_json(&text).expect("loaded above");
+        if !fbd.pous.is_empty() {
+            // FBD examples also commit `plc-deps order` (text and JSON).
+            check(&dir.join("order.txt"), &plc_deps::app::render_order(&program, &fbd, plc_deps::app::OrderFormat::Text), &mut failures);
+            check(&dir.join("order.json"), &plc_deps::app::render_order(&program, &fbd, plc_deps::app::OrderFormat::Json), &mut failures);
+        }
+        if dir.join("inputs.csv").is_file() {
+            runs += 1;
+            let mut c = plc_deps::runcmd::RunConfig::new(dir.join("program.json"));
+            c.inputs = Some(dir.join("inputs.csv"));
+            c.cycle_ms = 1000;
+            c.threads = 2;
+            c.mode = plc_deps::runcmd::RunMode::Both;
+            let run = plc_deps::runcmd::run_json_deterministic(&c).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
+            let doc: serde_json::Value = serde_json::from_str(&run).expect("run JSON");
+            assert_eq!(doc["identical"], true, "{}: {}", dir.display(), doc["first_difference"]);
+            check(&dir.join("run.json"), &run, &mut failures);
+        }
     }
+    assert!(runs >= 5, "expected inputs.csv beside the five worked examples, found {runs}");
     assert!(failures.is_empty(), "{}\n(re-bless with UPDATE_EXPECT=1 if the change is intended)", failures.join("\n"));
 }

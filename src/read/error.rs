@@ -13,10 +13,18 @@ pub struct Location {
     pub rung: Option<String>,
     /// JSON path from the document root, e.g. `rungs[2].ld[1].or[0][0]`.
     pub path: String,
+    /// For an error in an FBD network: the network id and, if the error is in a block, its id.
+    pub network: Option<(String, Option<u32>)>,
 }
 
 impl fmt::Display for Location {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if let Some((network, block)) = &self.network {
+            return match block {
+                Some(b) => write!(f, "network {network} block {b} at {}", self.path),
+                None => write!(f, "network {network} at {}", self.path),
+            };
+        }
         match &self.rung {
             Some(r) => write!(f, "rung {r} at {}", self.path),
             None => write!(f, "at {}", if self.path.is_empty() { "top level" } else { &self.path }),
@@ -84,12 +92,55 @@ pub enum Invalid {
     Recursion { name: String, chain: String },
     #[error("the program has no rungs")]
     Empty,
+    // ---- FBD bodies and function blocks (docs/fbd.md)
+    #[error("unknown op `{op}` (expected {names} or a function block)", names = crate::fbd::OP_NAMES)]
+    UnknownOp { op: String },
+    #[error("{op} has no {dir} `{pin}` ({dir}s: {pins})")]
+    UnknownPin { op: String, dir: &'static str, pin: String, pins: String },
+    #[error("{op} takes {expected}, found {found}")]
+    PinCount { op: String, expected: String, found: usize },
+    #[error("{op} needs its input `{pin}` connected")]
+    Unconnected { op: String, pin: String },
+    #[error("block id {id} is used twice in this POU (first at {first})")]
+    DuplicateBlock { id: u32, first: String },
+    #[error("no block {id} in network {network}")]
+    UndefinedBlock { id: u32, network: String },
+    #[error("network id `{id}` is used twice (first at {first})")]
+    DuplicateNetwork { id: String, first: String },
+    #[error("label `{label}` is used twice in {pou} (first on network {first})")]
+    DuplicateNetworkLabel { label: String, pou: String, first: String },
+    #[error("blocks {blocks} form a cycle of arcs; feed the value back through a variable instead (one block writes it, the other reads it)")]
+    Cycle { blocks: String },
+    #[error("block {block} (fragment {fragment}) {how} block {dep} (fragment {dep_fragment}), a fragment that is neither its own nor an ancestor of it: block {dep} may not have run when block {block} runs")]
+    FragmentRule { block: u32, fragment: String, how: &'static str, dep: u32, dep_fragment: String },
+    #[error("fragment {fragment} cannot run as one block: the arcs {arcs} leave it and come back (a control arc from several sources orders a block after the fragment, and the fragment depends on that block)")]
+    FragmentSplit { fragment: String, arcs: String },
+    #[error("function block `{name}` contains an instance of itself (through {chain})")]
+    FbRecursion { name: String, chain: String },
+    #[error("`{name}` is declared, but the FBD body needs it for a hidden variable (names `_<block>_<pin>` and `_run_<network>_<fragment>` are reserved in FBD POUs)")]
+    HiddenClash { name: String },
+    #[error("TIME variable `{var}` is accumulated (TSTART/TSTOP) in {first} and in {second}; accumulate it in one POU only")]
+    AccumulatedTwice { var: String, first: String, second: String },
+    #[error("`{name}` is a function block instance; read its outputs as `{name}.OUTPUT`")]
+    InstanceValue { name: String },
+    #[error("`{instance}` ({fb}) has no input or output `{member}` (members: {members})")]
+    UnknownMember { instance: String, fb: String, member: String, members: String },
+    #[error("unknown type `{name}` (expected BOOL, INT, DINT, REAL, TIME, TON, TOF, TP, CTU, CTD or a function block: {fbs})")]
+    UnknownTypeOrFb { name: String, fbs: String },
 }
 
 impl LoadError {
     pub(crate) fn invalid(rung: Option<&str>, path: &str, kind: Invalid) -> LoadError {
         LoadError::Invalid {
-            location: Location { rung: rung.map(str::to_owned), path: path.to_owned() },
+            location: Location { rung: rung.map(str::to_owned), path: path.to_owned(), network: None },
+            kind,
+        }
+    }
+
+    /// An error in FBD network `network` (in block `block`, if given).
+    pub(crate) fn fbd(network: &str, block: Option<u32>, path: &str, kind: Invalid) -> LoadError {
+        LoadError::Invalid {
+            location: Location { rung: None, path: path.to_owned(), network: Some((network.to_owned(), block)) },
             kind,
         }
     }

@@ -8,9 +8,13 @@
 
 use super::error::{Invalid, LoadError};
 use super::operand::{self, Untyped};
+use crate::fbd::lower::{Env, InstanceRef, Names};
+use crate::fbd::read::FbSig;
+use crate::fbd::{Fbd, FbdPou, FbdPouKind, LoweredCopy};
 use crate::model::*;
 use serde_json::{Map, Value as Json};
-use std::collections::HashMap;
+use std::borrow::Cow;
+use std::collections::{HashMap, HashSet};
 
 type Result<T> = std::result::Result<T, LoadError>;
 
@@ -28,17 +32,26 @@ pub(crate) fn kind_of(v: &Json) -> String {
 
 /// Builds a program from an already parsed JSON document.
 pub fn program_from_value(doc: &Json) -> Result<Program> {
+    program_and_fbd_from_value(doc).map(|(p, _)| p)
+}
+
+/// Builds a program from an already parsed JSON document, and returns with it its FBD bodies
+/// (networks, orders, fragment trees, and where each copy was lowered to).
+pub fn program_and_fbd_from_value(doc: &Json) -> Result<(Program, Fbd)> {
     let top = object(doc, "", None, "the program")?;
-    check_keys(top, &["program", "vars", "rungs", "subroutines", "comment"], "the program", "", None)?;
+    check_keys(top, &["program", "vars", "rungs", "fbd", "subroutines", "function_blocks", "comment"], "the program", "", None)?;
     let name = string(required(top, "program", "the program", "", None)?, "program", None)?.to_owned();
     let mut b = Builder::default();
-    b.pous.push(PouDraft { name: name.clone(), kind: PouKind::Main, path: String::new(), rungs: Vec::new() });
-    b.locals.push(HashMap::new());
-    if let Some(vars) = top.get("vars") {
-        b.declare_vars(vars, "vars", None)?;
+    if let Some(fbs) = top.get("function_blocks") {
+        b.function_block_types(fbs)?;
     }
-    let main_rungs = array(required(top, "rungs", "the program", "", None)?, "rungs", None)?;
-    b.pous[0].rungs = main_rungs.iter().collect();
+    b.pous.push(PouDraft::new(name.clone(), PouKind::Main, String::new()));
+    b.locals.push(HashMap::new());
+    b.local_instances.push(HashMap::new());
+    if let Some(vars) = top.get("vars") {
+        b.declare_vars(vars, "vars", None, false)?;
+    }
+    b.body(0, top, "", "the program")?;
     if let Some(subs) = top.get("subroutines") {
         let subs = object(subs, "subroutines", None, "the subroutines")?;
         for (sname, body) in subs {
@@ -51,18 +64,42 @@ pub fn program_from_value(doc: &Json) -> Result<Program> {
                 }));
             }
             let body = object(body, &path, None, "a subroutine")?;
-            check_keys(body, &["vars", "rungs", "comment"], "a subroutine", &path, None)?;
+            check_keys(body, &["vars", "rungs", "fbd", "comment"], "a subroutine", &path, None)?;
             let pou = PouId(b.pous.len() as u32);
             b.locals.push(HashMap::new());
+            b.local_instances.push(HashMap::new());
             if let Some(vars) = body.get("vars") {
-                b.declare_vars(vars, &format!("{path}.vars"), Some((pou, sname)))?;
+                b.declare_vars(vars, &format!("{path}.vars"), Some((pou, format!("{sname}:"))), false)?;
             }
-            let rungs_path = format!("{path}.rungs");
-            let rungs = array(required(body, "rungs", "a subroutine", &path, None)?, &rungs_path, None)?;
-            b.pous.push(PouDraft { name: sname.clone(), kind: PouKind::Subroutine, path: rungs_path, rungs: rungs.iter().collect() });
+            b.pous.push(PouDraft::new(sname.clone(), PouKind::Subroutine, format!("{path}.rungs")));
+            b.body(pou.index(), body, &path, "a subroutine")?;
         }
     }
-    b.build(name)
+    // Instances of user function blocks: one POU each, after the subroutines.
+    let top_level: Vec<usize> = std::mem::take(&mut b.pending);
+    for i in top_level {
+        b.expand(i, &mut Vec::new())?;
+    }
+    b.lower_fbd()?;
+    let mut bodies = std::mem::take(&mut b.fbd_bodies);
+    let program = b.build(name)?;
+    for body in &mut bodies {
+        for copy in &mut body.copies {
+            let start = program.pou(copy.pou).rungs.start;
+            for r in &mut copy.networks {
+                *r = r.start + start..r.end + start;
+            }
+            for blocks in &mut copy.blocks {
+                for r in blocks.iter_mut() {
+                    r.0 += start;
+                }
+            }
+        }
+    }
+    // Main program and subroutines first, then function block types (each in file order).
+    let (mut pous, fbs): (Vec<FbdPou>, Vec<FbdPou>) = bodies.into_iter().partition(|p| p.kind != FbdPouKind::FunctionBlock);
+    pous.extend(fbs);
+    Ok((program, Fbd { pous }))
 }
 
 struct PouDraft<'a> {
@@ -71,20 +108,80 @@ struct PouDraft<'a> {
     /// JSON path of the rung array ("" means top-level `rungs`).
     path: String,
     rungs: Vec<&'a Json>,
+    /// Index into `Builder::fbd_bodies` when the body is FBD.
+    fbd: Option<usize>,
+    /// An FBD body after lowering (jump targets relative to the POU).
+    lowered: Option<Vec<Rung>>,
+    /// Prepended to rung ids (`G1:` for the POU of function block instance `G1`).
+    prefix: String,
+    /// Prepended to the names of hidden variables of an FBD body (`SBR:`, `G1.`).
+    var_prefix: String,
+    /// False for instances of function blocks: `call` cannot name them.
+    callable: bool,
+}
+
+impl<'a> PouDraft<'a> {
+    fn new(name: String, kind: PouKind, path: String) -> PouDraft<'a> {
+        let var_prefix = if kind == PouKind::Main { String::new() } else { format!("{name}:") };
+        PouDraft { name, kind, path, rungs: Vec::new(), fbd: None, lowered: None, prefix: String::new(), var_prefix, callable: true }
+    }
+}
+
+/// A user function block type: its declarations and body.
+struct FbType<'a> {
+    name: String,
+    path: String,
+    inputs: Option<&'a Json>,
+    outputs: Option<&'a Json>,
+    vars: Option<&'a Json>,
+    /// The ladder body, or the index of the FBD body in `Builder::fbd_bodies`.
+    rungs: Option<&'a [Json]>,
+    fbd: Option<usize>,
+    sig: FbSig,
+}
+
+/// An instance of a user function block type.
+struct InstanceDraft {
+    /// `G1`, `SBR:G1`, `G1.INNER`.
+    display: String,
+    fb: String,
+    /// JSON path of its declaration.
+    path: String,
+    pou: Option<PouId>,
+    inputs: Vec<(String, VarId)>,
+    outputs: Vec<(String, VarId)>,
 }
 
 #[derive(Default)]
 struct Builder<'a> {
     vars: Vec<Var>,
+    /// Display names of all variables, built when the first hidden FBD variable is made (its
+    /// name must not clash).
+    var_names: Option<HashSet<String>>,
     globals: HashMap<String, VarId>,
     /// Per POU: its local variables.
     locals: Vec<HashMap<String, VarId>>,
+    /// Program-wide and per-POU instances of user function blocks (index into `instances`).
+    global_instances: HashMap<String, usize>,
+    local_instances: Vec<HashMap<String, usize>>,
+    instances: Vec<InstanceDraft>,
+    /// Instances declared but not yet given their POU.
+    pending: Vec<usize>,
+    fb_types: Vec<FbType<'a>>,
+    fb_index: HashMap<String, usize>,
+    /// FBD bodies in reading order (function block types first, as they are read first).
+    fbd_bodies: Vec<FbdPou>,
+    /// TIME variables accumulated by TSTART/TSTOP, with the POU that does it.
+    accumulated: HashMap<VarId, PouId>,
     pous: Vec<PouDraft<'a>>,
     /// Per POU: label → rung.
     labels: Vec<HashMap<String, RungId>>,
     /// Per rung, during element resolution: number of edge contacts so far.
     edge_count: u32,
 }
+
+/// A ladder rung after pass 1: its id, its JSON object and its (prefixed) id text.
+type RungHead<'a> = (RungId, &'a Map<String, Json>, String);
 
 /// What may appear in a series, by where the series is.
 #[derive(Copy, Clone, PartialEq, Eq)]
@@ -103,7 +200,11 @@ struct Scope<'s> {
 }
 
 impl<'a> Builder<'a> {
-    fn declare_vars(&mut self, vars: &Json, path: &str, scope: Option<(PouId, &str)>) -> Result<()> {
+    /// Declares the variables of a scope: the program's (`scope` None) or a POU's, whose display
+    /// names get the prefix (`SBR:`, or `G1.` for an instance). `elementary`: only BOOL, INT,
+    /// DINT, REAL, TIME (inputs and outputs of function blocks). Variables of a user function block
+    /// type are instances: recorded in `pending`, given their POU by [`Self::expand`].
+    fn declare_vars(&mut self, vars: &Json, path: &str, scope: Option<(PouId, String)>, elementary: bool) -> Result<()> {
         for (i, v) in array(vars, path, None)?.iter().enumerate() {
             let p = format!("{path}[{i}]");
             let o = object(v, &p, None, "a variable")?;
@@ -111,8 +212,22 @@ impl<'a> Builder<'a> {
             let name = string(required(o, "name", "a variable", &p, None)?, &format!("{p}.name"), None)?;
             check_name(name, &format!("{p}.name"), None)?;
             let tname = string(required(o, "type", "a variable", &p, None)?, &format!("{p}.type"), None)?;
-            let ty = Type::parse(tname)
-                .ok_or_else(|| LoadError::invalid(None, &format!("{p}.type"), Invalid::UnknownType { name: tname.into() }))?;
+            let user_fb = Type::parse(tname).is_none() && self.fb_index.contains_key(tname);
+            let ty = match Type::parse(tname) {
+                Some(t) => t,
+                None if user_fb => Type::Fb(FbKind::Ton), // placeholder: instances are not variables
+                None if !self.fb_types.is_empty() => {
+                    let fbs = self.fb_types.iter().map(|f| f.name.as_str()).collect::<Vec<_>>().join(", ");
+                    return Err(LoadError::invalid(None, &format!("{p}.type"), Invalid::UnknownTypeOrFb { name: tname.into(), fbs }));
+                }
+                None => return Err(LoadError::invalid(None, &format!("{p}.type"), Invalid::UnknownType { name: tname.into() })),
+            };
+            if elementary && matches!(ty, Type::Fb(_)) {
+                return Err(LoadError::invalid(None, &format!("{p}.type"), Invalid::Misplaced {
+                    what: "a function block type",
+                    place: "as an input or output of a function block (declare the instance in `vars`)",
+                }));
+            }
             let class = match o.get("class") {
                 None => VarClass::Memory,
                 Some(c) => match string(c, &format!("{p}.class"), None)? {
@@ -152,34 +267,231 @@ impl<'a> Builder<'a> {
                     }
                 }
             };
-            let table = match scope {
-                None => &mut self.globals,
-                Some((p, _)) => &mut self.locals[p.index()],
+            let (table, instances) = match &scope {
+                None => (&mut self.globals, &mut self.global_instances),
+                Some((p, _)) => (&mut self.locals[p.index()], &mut self.local_instances[p.index()]),
             };
-            if table.contains_key(name) {
+            if table.contains_key(name) || instances.contains_key(name) {
                 return Err(LoadError::invalid(None, &format!("{p}.name"), Invalid::DuplicateVar { name: name.into() }));
+            }
+            let display = match &scope {
+                None => name.to_owned(),
+                Some((_, prefix)) => format!("{prefix}{name}"),
+            };
+            if user_fb {
+                let idx = self.instances.len();
+                instances.insert(name.to_owned(), idx);
+                self.instances.push(InstanceDraft { display, fb: tname.to_owned(), path: p, pou: None, inputs: Vec::new(), outputs: Vec::new() });
+                self.pending.push(idx);
+                continue;
             }
             let id = VarId(self.vars.len() as u32);
             table.insert(name.to_owned(), id);
-            let display = match scope {
-                None => name.to_owned(),
-                Some((_, pou)) => format!("{pou}:{name}"),
-            };
-            self.vars.push(Var { name: display, ty, class, init, scope: scope.map(|(p, _)| p), hidden: false });
+            self.vars.push(Var { name: display, ty, class, init, scope: scope.as_ref().map(|(p, _)| *p), hidden: false });
         }
         Ok(())
     }
 
+    /// Reads `function_blocks`: names and pins first (bodies may use each other), then each
+    /// type's declarations (checked on a scratch scope), its body and, for FBD, its networks.
+    fn function_block_types(&mut self, fbs: &'a Json) -> Result<()> {
+        let fbs = object(fbs, "function_blocks", None, "the function blocks")?;
+        for (fname, body) in fbs {
+            let path = format!("function_blocks.{fname}");
+            check_name(fname, &path, None)?;
+            if Type::parse(fname).is_some() {
+                return Err(LoadError::invalid(None, &path, Invalid::Misplaced { what: "a function block named like a standard type", place: "(rename it)" }));
+            }
+            let o = object(body, &path, None, "a function block")?;
+            check_keys(o, &["vars", "inputs", "outputs", "fbd", "rungs", "comment"], "a function block", &path, None)?;
+            let names = |k: &str| -> Vec<String> {
+                o.get(k).and_then(Json::as_array).into_iter().flatten().filter_map(|v| v.get("name").and_then(Json::as_str).map(str::to_owned)).collect()
+            };
+            let sig = FbSig { inputs: names("inputs"), outputs: names("outputs") };
+            self.fb_index.insert(fname.clone(), self.fb_types.len());
+            self.fb_types.push(FbType { name: fname.clone(), path, inputs: o.get("inputs"), outputs: o.get("outputs"), vars: o.get("vars"), rungs: None, fbd: None, sig });
+        }
+        // Declarations on a scratch scope (rolled back), and which types each type instantiates.
+        let mut uses: Vec<Vec<(usize, String)>> = Vec::new();
+        for f in 0..self.fb_types.len() {
+            let (vars_mark, inst_mark) = (self.vars.len(), self.instances.len());
+            let scratch = PouId(self.locals.len() as u32);
+            self.locals.push(HashMap::new());
+            self.local_instances.push(HashMap::new());
+            let (path, prefix) = (self.fb_types[f].path.clone(), format!("{}.", self.fb_types[f].name));
+            let decls = [("inputs", self.fb_types[f].inputs, true), ("outputs", self.fb_types[f].outputs, true), ("vars", self.fb_types[f].vars, false)];
+            for (key, decl, elementary) in decls {
+                if let Some(d) = decl {
+                    self.declare_vars(d, &format!("{path}.{key}"), Some((scratch, prefix.clone())), elementary)?;
+                }
+            }
+            uses.push(self.instances[inst_mark..].iter().map(|i| (self.fb_index[&i.fb], i.path.clone())).collect());
+            self.vars.truncate(vars_mark);
+            self.instances.truncate(inst_mark);
+            self.pending.clear();
+            self.locals.pop();
+            self.local_instances.pop();
+        }
+        // No type may contain itself (directly or through others).
+        for start in 0..self.fb_types.len() {
+            let mut seen = vec![false; self.fb_types.len()];
+            seen[start] = true;
+            let mut stack: Vec<(usize, usize)> = vec![(start, 0)];
+            while let Some(&mut (f, ref mut i)) = stack.last_mut() {
+                if let Some((g, p)) = uses[f].get(*i) {
+                    *i += 1;
+                    if *g == start {
+                        let mut chain: Vec<&str> = stack.iter().map(|&(x, _)| self.fb_types[x].name.as_str()).collect();
+                        chain.push(&self.fb_types[start].name);
+                        return Err(LoadError::invalid(None, p, Invalid::FbRecursion { name: self.fb_types[start].name.clone(), chain: chain.join(" → ") }));
+                    }
+                    if !seen[*g] {
+                        seen[*g] = true;
+                        stack.push((*g, 0));
+                    }
+                } else {
+                    stack.pop();
+                }
+            }
+        }
+        // Bodies.
+        for f in 0..self.fb_types.len() {
+            let path = self.fb_types[f].path.clone();
+            let o = fbs[&self.fb_types[f].name].as_object().expect("checked above");
+            match (o.get("rungs"), o.get("fbd")) {
+                (Some(_), Some(_)) => {
+                    return Err(LoadError::invalid(None, &format!("{path}.fbd"), Invalid::Misplaced { what: "`fbd`", place: "together with `rungs` (a body is one of them)" }))
+                }
+                (Some(r), None) => self.fb_types[f].rungs = Some(array(r, &format!("{path}.rungs"), None)?),
+                (None, Some(j)) => {
+                    let index = &self.fb_index;
+                    let types = &self.fb_types;
+                    let sig = |n: &str| index.get(n).map(|&i| types[i].sig.clone());
+                    let body = crate::fbd::read::read_body(j, &format!("{path}.fbd"), &self.fb_types[f].name, FbdPouKind::FunctionBlock, &sig)?;
+                    self.fb_types[f].fbd = Some(self.fbd_bodies.len());
+                    self.fbd_bodies.push(body);
+                }
+                (None, None) => return Err(LoadError::invalid(None, &path, Invalid::MissingField { field: "fbd` or `rungs", what: "a function block" })),
+            }
+        }
+        Ok(())
+    }
+
+    /// The body of POU `pou`: `rungs` (ladder) or `fbd`.
+    fn body(&mut self, pou: usize, o: &'a Map<String, Json>, path: &str, what: &'static str) -> Result<()> {
+        let at = |k: &str| if path.is_empty() { k.to_owned() } else { format!("{path}.{k}") };
+        match (o.get("rungs"), o.get("fbd")) {
+            (Some(_), Some(_)) => Err(LoadError::invalid(None, &at("fbd"), Invalid::Misplaced { what: "`fbd`", place: "together with `rungs` (a body is one of them)" })),
+            (None, Some(j)) => {
+                let kind = if pou == 0 { FbdPouKind::Main } else { FbdPouKind::Subroutine };
+                let index = &self.fb_index;
+                let types = &self.fb_types;
+                let sig = |n: &str| index.get(n).map(|&i| types[i].sig.clone());
+                let body = crate::fbd::read::read_body(j, &at("fbd"), &self.pous[pou].name, kind, &sig)?;
+                self.pous[pou].fbd = Some(self.fbd_bodies.len());
+                self.fbd_bodies.push(body);
+                Ok(())
+            }
+            (r, None) => {
+                let r = r.ok_or_else(|| LoadError::invalid(None, path, Invalid::MissingField { field: "rungs", what }))?;
+                self.pous[pou].rungs = array(r, &at("rungs"), None)?.iter().collect();
+                Ok(())
+            }
+        }
+    }
+
+    /// Gives instance `idx` its POU: the function block's variables declared as `G1.name`, its
+    /// body (ladder rungs now, FBD lowered later), nested instances right after it.
+    fn expand(&mut self, idx: usize, stack: &mut Vec<String>) -> Result<()> {
+        let f = self.fb_index[&self.instances[idx].fb];
+        let (display, ipath) = (self.instances[idx].display.clone(), self.instances[idx].path.clone());
+        if stack.contains(&self.fb_types[f].name) {
+            let mut chain = stack.clone();
+            chain.push(self.fb_types[f].name.clone());
+            return Err(LoadError::invalid(None, &ipath, Invalid::FbRecursion { name: self.fb_types[f].name.clone(), chain: chain.join(" → ") }));
+        }
+        if self.pous.iter().any(|p| p.name == display) {
+            return Err(LoadError::invalid(None, &format!("{ipath}.name"), Invalid::Misplaced {
+                what: "a function block instance named like the program or a subroutine",
+                place: "(rename one of them)",
+            }));
+        }
+        let pou = PouId(self.pous.len() as u32);
+        let t = &self.fb_types[f];
+        let (path, inputs, outputs, vars, rungs, fbd) = (t.path.clone(), t.inputs, t.outputs, t.vars, t.rungs, t.fbd);
+        let mut draft = PouDraft::new(display.clone(), PouKind::Subroutine, format!("{path}.rungs"));
+        draft.rungs = rungs.map(|r| r.iter().collect()).unwrap_or_default();
+        draft.fbd = fbd;
+        draft.prefix = format!("{display}:");
+        draft.var_prefix = format!("{display}.");
+        draft.callable = false;
+        self.pous.push(draft);
+        self.locals.push(HashMap::new());
+        self.local_instances.push(HashMap::new());
+        let mark = self.pending.len();
+        let prefix = format!("{display}.");
+        for (key, decl, elementary) in [("inputs", inputs, true), ("outputs", outputs, true), ("vars", vars, false)] {
+            if let Some(d) = decl {
+                self.declare_vars(d, &format!("{path}.{key}"), Some((pou, prefix.clone())), elementary)?;
+            }
+        }
+        let locals = &self.locals[pou.index()];
+        let pins = |names: &[String]| names.iter().map(|n| (n.clone(), locals[n])).collect::<Vec<_>>();
+        let (ins, outs) = (pins(&self.fb_types[f].sig.inputs), pins(&self.fb_types[f].sig.outputs));
+        let inst = &mut self.instances[idx];
+        inst.pou = Some(pou);
+        inst.inputs = ins;
+        inst.outputs = outs;
+        stack.push(self.fb_types[f].name.clone());
+        let nested: Vec<usize> = self.pending.drain(mark..).collect();
+        for n in nested {
+            self.expand(n, stack)?;
+        }
+        stack.pop();
+        Ok(())
+    }
+
+    /// Lowers every FBD body: the main program's and subroutines' once, a function block type's
+    /// once per instance.
+    fn lower_fbd(&mut self) -> Result<()> {
+        let mut bodies = std::mem::take(&mut self.fbd_bodies);
+        for pou in 0..self.pous.len() {
+            let Some(i) = self.pous[pou].fbd else { continue };
+            let draft = &self.pous[pou];
+            let names = Names { pou: draft.name.clone(), rung_prefix: draft.prefix.clone(), var_prefix: draft.var_prefix.clone() };
+            let pid = PouId(pou as u32);
+            let lowered = crate::fbd::lower::lower(&bodies[i], &mut PouEnv { b: self, pou: pid }, &names, pid)?;
+            bodies[i].copies.push(LoweredCopy {
+                pou: pid,
+                networks: lowered.networks,
+                blocks: lowered.blocks.into_iter().map(|bs| bs.into_iter().map(RungId).collect()).collect(),
+            });
+            self.pous[pou].lowered = Some(lowered.rungs);
+        }
+        self.fbd_bodies = bodies;
+        Ok(())
+    }
+
     fn build(mut self, name: String) -> Result<Program> {
-        if self.pous[0].rungs.is_empty() {
+        if self.pous[0].fbd.is_none() && self.pous[0].rungs.is_empty() {
             return Err(LoadError::invalid(None, "rungs", Invalid::Empty));
         }
-        // Pass 1: rung ids and labels.
-        let mut ids: HashMap<&str, String> = HashMap::new();
-        let mut heads: Vec<(RungId, &'a Map<String, Json>, String, PouId)> = Vec::new();
+        // Pass 1: rung ids and labels (lowered FBD bodies: ids only, their labels are resolved).
+        let mut ids: HashMap<Cow<'_, str>, String> = HashMap::new();
+        let mut heads: Vec<Vec<RungHead<'a>>> = Vec::new();
         let mut next_id = 0u32;
-        for (pi, pou) in self.pous.iter().enumerate() {
+        for pou in &self.pous {
             let mut labels = HashMap::new();
+            let mut pou_heads = Vec::new();
+            if let Some(lowered) = &pou.lowered {
+                for r in lowered {
+                    if let Some(first) = ids.get(r.id.as_str()) {
+                        return Err(LoadError::invalid(Some(&r.id), &r.path, Invalid::DuplicateRung { id: r.id.clone(), first: first.clone() }));
+                    }
+                    ids.insert(Cow::Borrowed(r.id.as_str()), r.path.clone());
+                    next_id += 1;
+                }
+            }
             for (i, r) in pou.rungs.iter().enumerate() {
                 let path = rung_path(&pou.path, i);
                 let o = object(r, &path, None, "a rung")?;
@@ -191,51 +503,101 @@ impl<'a> Builder<'a> {
                         found: format!("\"{id}\""),
                     }));
                 }
-                if let Some(first) = ids.get(id) {
-                    return Err(LoadError::invalid(Some(id), &format!("{path}.id"), Invalid::DuplicateRung { id: id.into(), first: first.clone() }));
+                let key: Cow<'_, str> = if pou.prefix.is_empty() { Cow::Borrowed(id) } else { Cow::Owned(format!("{}{id}", pou.prefix)) };
+                let id = key.to_string();
+                if let Some(first) = ids.get(key.as_ref()) {
+                    return Err(LoadError::invalid(Some(&id), &format!("{path}.id"), Invalid::DuplicateRung { id: id.clone(), first: first.clone() }));
                 }
-                ids.insert(id, path.clone());
+                ids.insert(key, path.clone());
                 let rid = RungId(next_id);
                 next_id += 1;
                 if let Some(l) = o.get("label") {
                     let lp = format!("{path}.label");
-                    let l = string(l, &lp, Some(id))?;
-                    check_name(l, &lp, Some(id))?;
+                    let l = string(l, &lp, Some(&id))?;
+                    check_name(l, &lp, Some(&id))?;
                     if let Some(prev) = labels.insert(l.to_owned(), rid) {
-                        let first = heads[prev.index()].2.clone();
-                        return Err(LoadError::invalid(Some(id), &lp, Invalid::DuplicateLabel { label: l.into(), pou: pou.name.clone(), first }));
+                        let first = pou_heads.iter().find(|h: &&RungHead| h.0 == prev).map(|h| h.2.clone()).unwrap_or_default();
+                        return Err(LoadError::invalid(Some(&id), &lp, Invalid::DuplicateLabel { label: l.into(), pou: pou.name.clone(), first }));
                     }
                 }
-                heads.push((rid, o, id.to_owned(), PouId(pi as u32)));
+                pou_heads.push((rid, o, id));
             }
+            heads.push(pou_heads);
             self.labels.push(labels);
         }
         // Pass 2: elements.
-        let mut rungs = Vec::with_capacity(heads.len());
+        let mut rungs = Vec::with_capacity(next_id as usize);
         let mut pous = Vec::with_capacity(self.pous.len());
         let mut start = 0u32;
         for pou in &self.pous {
-            let end = start + pou.rungs.len() as u32;
+            let end = start + pou.rungs.len() as u32 + pou.lowered.as_ref().map_or(0, |l| l.len() as u32);
             pous.push(Pou { name: pou.name.clone(), kind: pou.kind, rungs: start..end });
             start = end;
         }
-        for (rid, o, id, pou) in &heads {
-            let path = rung_path(&self.pous[pou.index()].path, (rid.0 - pous[pou.index()].rungs.start) as usize);
-            let ldp = format!("{path}.ld");
-            let ld = array(required(o, "ld", "a rung", &path, Some(id))?, &ldp, Some(id))?;
-            self.edge_count = 0;
-            let scope = Scope { pou: *pou, rung_id: id };
-            let series = self.series(ld, &ldp, Place::Top, &scope)?;
-            let label = o.get("label").and_then(Json::as_str).map(str::to_owned);
-            let comment = match o.get("comment") {
-                None => None,
-                Some(c) => Some(string(c, &format!("{path}.comment"), Some(id))?.to_owned()),
-            };
-            rungs.push(Rung { id: id.clone(), label, comment, pou: *pou, series, path });
+        for (pi, pou_heads) in heads.iter().enumerate() {
+            let pou = PouId(pi as u32);
+            if let Some(lowered) = self.pous[pi].lowered.take() {
+                let offset = pous[pi].rungs.start;
+                for mut r in lowered {
+                    r.pou = pou;
+                    relocate_jumps(&mut r.series, offset);
+                    rungs.push(r);
+                }
+            }
+            for (rid, o, id) in pou_heads {
+                let path = rung_path(&self.pous[pi].path, (rid.0 - pous[pi].rungs.start) as usize);
+                let ldp = format!("{path}.ld");
+                let ld = array(required(o, "ld", "a rung", &path, Some(id))?, &ldp, Some(id))?;
+                self.edge_count = 0;
+                let scope = Scope { pou, rung_id: id };
+                let series = self.series(ld, &ldp, Place::Top, &scope)?;
+                let label = o.get("label").and_then(Json::as_str).map(str::to_owned);
+                let comment = match o.get("comment") {
+                    None => None,
+                    Some(c) => Some(string(c, &format!("{path}.comment"), Some(id))?.to_owned()),
+                };
+                rungs.push(Rung { id: id.clone(), label, comment, pou, series, path });
+            }
         }
         let mut program = Program { name, vars: self.vars, pous, rungs };
         super::structure::check(&mut program)?;
         Ok(program)
+    }
+
+    /// A name a block or element writes, in the scope of `pou`: not an input, not a field, not
+    /// a member or an instance.
+    fn writable_name(&self, text: &str, pou: PouId, what: &'static str) -> std::result::Result<VarId, Invalid> {
+        let (r, t) = self.lookup(text, pou)?;
+        let var = &self.vars[r.var.index()];
+        let fail = |why| Err(Invalid::NotWritable { what, var: text.to_owned(), why });
+        if r.field.is_some() {
+            return fail("instance fields are written only by their function block");
+        }
+        if text.contains('.') {
+            return fail("it belongs to a function block instance (only the instance writes it)");
+        }
+        if var.class == VarClass::Input {
+            return fail("it is an input (inputs are written by the scan, not the program)");
+        }
+        if matches!(t, Type::Fb(_)) {
+            return fail("it is a function block instance");
+        }
+        Ok(r.var)
+    }
+
+    /// A member (input or output) of user function block instance `i`, read as `G1.NAME`.
+    fn member(&self, i: usize, base: &str, field: Option<&str>) -> std::result::Result<(VarRef, Type), Invalid> {
+        let inst = &self.instances[i];
+        let Some(f) = field else { return Err(Invalid::InstanceValue { name: base.to_owned() }) };
+        match inst.inputs.iter().chain(&inst.outputs).find(|(n, _)| n == f) {
+            Some(&(_, v)) => Ok((VarRef { var: v, field: None }, self.vars[v.index()].ty)),
+            None => Err(Invalid::UnknownMember {
+                instance: base.to_owned(),
+                fb: inst.fb.clone(),
+                member: f.to_owned(),
+                members: inst.inputs.iter().chain(&inst.outputs).map(|(n, _)| n.as_str()).collect::<Vec<_>>().join(", "),
+            }),
+        }
     }
 
     fn series(&mut self, items: &[Json], path: &str, place: Place, s: &Scope) -> Result<Series> {
@@ -410,7 +772,7 @@ impl<'a> Builder<'a> {
                 let pou = self
                     .pous
                     .iter()
-                    .position(|p| p.kind == PouKind::Subroutine && p.name == name)
+                    .position(|p| p.kind == PouKind::Subroutine && p.callable && p.name == name)
                     .ok_or_else(|| err("call", Invalid::UndefinedSubroutine { name: name.into() }))?;
                 Element::Call { pou: PouId(pou as u32) }
             }
@@ -455,11 +817,21 @@ impl<'a> Builder<'a> {
             Some((b, f)) => (b, Some(f)),
             None => (text, None),
         };
-        let id = self.locals[pou.index()]
-            .get(base)
-            .or_else(|| self.globals.get(base))
-            .copied()
-            .ok_or_else(|| Invalid::UndefinedVar { name: base.to_owned() })?;
+        let id = match self.locals[pou.index()].get(base) {
+            Some(&id) => id,
+            None => {
+                if let Some(&i) = self.local_instances[pou.index()].get(base) {
+                    return self.member(i, base, field);
+                }
+                match self.globals.get(base) {
+                    Some(&id) => id,
+                    None => match self.global_instances.get(base) {
+                        Some(&i) => return self.member(i, base, field),
+                        None => return Err(Invalid::UndefinedVar { name: base.to_owned() }),
+                    },
+                }
+            }
+        };
         operand::field_ref(id, text, self.vars[id.index()].ty, field)
     }
 
@@ -494,22 +866,13 @@ impl<'a> Builder<'a> {
 
     /// A variable that an element writes: not an input, not a field, of type `ty` if given.
     fn writable(&self, v: &Json, path: &str, s: &Scope, what: &'static str, ty: Option<Type>) -> Result<VarId> {
-        let (r, t) = self.var_ref(v, path, s)?;
-        let var = &self.vars[r.var.index()];
-        let fail = |why| Err(LoadError::invalid(Some(s.rung_id), path, Invalid::NotWritable { what, var: display_json(v), why }));
-        if r.field.is_some() {
-            return fail("instance fields are written only by their function block");
-        }
-        if var.class == VarClass::Input {
-            return fail("it is an input (inputs are written by the scan, not the program)");
-        }
-        if matches!(t, Type::Fb(_)) {
-            return fail("it is a function block instance");
-        }
+        let text = string(v, path, Some(s.rung_id))?;
+        let id = self.writable_name(text, s.pou, what).map_err(|k| LoadError::invalid(Some(s.rung_id), path, k))?;
+        let var = &self.vars[id.index()];
         if let Some(ty) = ty {
-            expect_type(t, ty, what, &var.name).map_err(|k| LoadError::invalid(Some(s.rung_id), path, k))?;
+            expect_type(var.ty, ty, what, &var.name).map_err(|k| LoadError::invalid(Some(s.rung_id), path, k))?;
         }
-        Ok(r.var)
+        Ok(id)
     }
 
     fn instance(&self, v: &Json, path: &str, s: &Scope, fb: FbKind) -> Result<VarId> {
@@ -523,6 +886,92 @@ impl<'a> Builder<'a> {
             }));
         }
         Ok(r.var)
+    }
+}
+
+/// The lowering's view of one POU's scope.
+struct PouEnv<'b, 'a> {
+    b: &'b mut Builder<'a>,
+    pou: PouId,
+}
+
+impl Env for PouEnv<'_, '_> {
+    fn lookup(&self, text: &str) -> std::result::Result<(VarRef, Type), Invalid> {
+        self.b.lookup(text, self.pou)
+    }
+
+    fn writable(&self, text: &str, what: &'static str) -> std::result::Result<VarId, Invalid> {
+        self.b.writable_name(text, self.pou, what)
+    }
+
+    fn instance(&self, text: &str) -> std::result::Result<InstanceRef, Invalid> {
+        let b = &*self.b;
+        let user = |i: usize| {
+            let inst = &b.instances[i];
+            InstanceRef::User { pou: inst.pou.expect("expanded before lowering"), fb: inst.fb.clone(), inputs: inst.inputs.clone(), outputs: inst.outputs.clone() }
+        };
+        let var = |id: VarId| match b.vars[id.index()].ty {
+            Type::Fb(k) => InstanceRef::Builtin(id, k),
+            t => InstanceRef::Other(t),
+        };
+        let pou = self.pou.index();
+        if !text.contains('.') {
+            if let Some(&id) = b.locals[pou].get(text) {
+                return Ok(var(id));
+            }
+            if let Some(&i) = b.local_instances[pou].get(text) {
+                return Ok(user(i));
+            }
+            if let Some(&id) = b.globals.get(text) {
+                return Ok(var(id));
+            }
+            if let Some(&i) = b.global_instances.get(text) {
+                return Ok(user(i));
+            }
+        }
+        let (_, t) = b.lookup(text, self.pou)?;
+        Ok(InstanceRef::Other(t))
+    }
+
+    fn var(&self, v: VarId) -> &Var {
+        &self.b.vars[v.index()]
+    }
+
+    fn hidden(&mut self, name: String, ty: Type) -> std::result::Result<VarId, Invalid> {
+        let b = &mut *self.b;
+        let names = b.var_names.get_or_insert_with(|| b.vars.iter().map(|v| v.name.clone()).collect());
+        if !names.insert(name.clone()) {
+            return Err(Invalid::HiddenClash { name });
+        }
+        let id = VarId(self.b.vars.len() as u32);
+        let scope = if self.pou.index() == 0 { None } else { Some(self.pou) };
+        self.b.vars.push(Var { name, ty, class: VarClass::Memory, init: ty.zero(), scope, hidden: true });
+        Ok(id)
+    }
+
+    fn claim_accumulator(&mut self, v: VarId) -> std::result::Result<(), Invalid> {
+        match self.b.accumulated.get(&v) {
+            Some(&other) if other != self.pou => Err(Invalid::AccumulatedTwice {
+                var: self.b.vars[v.index()].name.clone(),
+                first: self.b.pous[other.index()].name.clone(),
+                second: self.b.pous[self.pou.index()].name.clone(),
+            }),
+            _ => {
+                self.b.accumulated.insert(v, self.pou);
+                Ok(())
+            }
+        }
+    }
+}
+
+/// Makes the POU-relative jump targets of a lowered rung absolute.
+fn relocate_jumps(series: &mut Series, offset: u32) {
+    for e in series {
+        match e {
+            Element::Jmp { target, .. } => target.0 += offset,
+            Element::Or(bs) | Element::Branch(bs) => bs.iter_mut().for_each(|b| relocate_jumps(b, offset)),
+            _ => {}
+        }
     }
 }
 

@@ -7,11 +7,11 @@
 
 mod error;
 mod json;
-mod operand;
+pub(crate) mod operand;
 mod structure;
 
 pub use error::{Invalid, LoadError, Location};
-pub use json::program_from_value;
+pub use json::{program_and_fbd_from_value, program_from_value};
 
 use crate::model::Program;
 
@@ -23,6 +23,17 @@ pub fn program_from_json(text: &str) -> Result<Program, LoadError> {
         message: strip_position(&e.to_string()),
     })?;
     program_from_value(&value)
+}
+
+/// Parses and checks a program given as JSON text, and returns with it the FBD bodies it was
+/// written in (before lowering: their networks, execution orders and fragment trees).
+pub fn program_and_fbd_from_json(text: &str) -> Result<(Program, crate::fbd::Fbd), LoadError> {
+    let value: serde_json::Value = serde_json::from_str(text).map_err(|e| LoadError::Syntax {
+        line: e.line(),
+        column: e.column(),
+        message: strip_position(&e.to_string()),
+    })?;
+    program_and_fbd_from_value(&value)
 }
 
 /// serde_json appends " at line L column C"; the location is carried separately.

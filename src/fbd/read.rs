@@ -1,0 +1,926 @@
+//! The FBD parts of the JSON program format → [`FbdPou`] (structure only).
+//!
+//! Checks every field, the op and its pins, block ids (unique in the POU), arcs (`{"from": ID}`
+//! names a block of the same network and one of its outputs), control arcs and labels, then
+//! plans every network ([`super::plan`]: order, cycles, fragments). Operands stay JSON: they are
+//! resolved and typed by the lowering, once per POU (per instance for a function block type).
+//! Errors carry the network id, the block id and the JSON path.
+
+use super::model::*;
+use crate::read::{Invalid, LoadError};
+use serde_json::{Map, Value as Json};
+use std::collections::HashMap;
+
+type Result<T> = std::result::Result<T, LoadError>;
+
+/// The pins of a user function block type (declared `inputs` and `outputs`, in order).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct FbSig {
+    pub inputs: Vec<String>,
+    pub outputs: Vec<String>,
+}
+
+const NETWORK_KEYS: &[&str] = &["id", "label", "comment", "blocks"];
+const BLOCK_KEYS: &[&str] = &[
+    "id", "op", "in", "out", "instance", "cond", "after", "label", "comment",
+];
+
+/// Reads an `fbd` object (`{"networks": [...]}`) at `path` and plans its networks.
+/// `sig` gives the pins of a user function block type by name.
+pub(crate) fn read_body(
+    v: &Json,
+    path: &str,
+    name: &str,
+    kind: FbdPouKind,
+    sig: &dyn Fn(&str) -> Option<FbSig>,
+) -> Result<FbdPou> {
+    let top = v.as_object().ok_or_else(|| {
+        LoadError::invalid(
+            None,
+            path,
+            Invalid::Shape {
+                expected: "an object (an FBD body: {\"networks\": [...]})",
+                found: kind_of(v),
+            },
+        )
+    })?;
+    if let Some(k) = top
+        .keys()
+        .find(|k| !["networks", "comment"].contains(&k.as_str()))
+    {
+        return Err(LoadError::invalid(
+            None,
+            &format!("{path}.{k}"),
+            Invalid::UnknownField {
+                field: k.clone(),
+                what: "an FBD body",
+                allowed: "networks, comment".into(),
+            },
+        ));
+    }
+    let np = format!("{path}.networks");
+    let nets = top.get("networks").ok_or_else(|| {
+        LoadError::invalid(
+            None,
+            path,
+            Invalid::MissingField {
+                field: "networks",
+                what: "an FBD body",
+            },
+        )
+    })?;
+    let nets = nets.as_array().ok_or_else(|| {
+        LoadError::invalid(
+            None,
+            &np,
+            Invalid::Shape {
+                expected: "an array",
+                found: kind_of(nets),
+            },
+        )
+    })?;
+    if nets.is_empty() && kind == FbdPouKind::Main {
+        return Err(LoadError::invalid(
+            None,
+            &np,
+            Invalid::Shape {
+                expected: "at least one network",
+                found: "an empty array".into(),
+            },
+        ));
+    }
+    let mut networks = Vec::with_capacity(nets.len());
+    let mut ids: HashMap<String, String> = HashMap::new();
+    let mut labels: HashMap<String, String> = HashMap::new();
+    let mut block_ids: HashMap<u32, String> = HashMap::new();
+    for (i, n) in nets.iter().enumerate() {
+        let p = format!("{np}[{i}]");
+        let net = network(n, &p, sig, &mut block_ids)?;
+        if let Some(first) = ids.insert(net.id.clone(), p.clone()) {
+            return Err(LoadError::fbd(
+                &net.id,
+                None,
+                &format!("{p}.id"),
+                Invalid::DuplicateNetwork {
+                    id: net.id.clone(),
+                    first,
+                },
+            ));
+        }
+        if let Some(l) = &net.label {
+            if let Some(first) = labels.insert(l.clone(), net.id.clone()) {
+                return Err(LoadError::fbd(
+                    &net.id,
+                    None,
+                    &format!("{p}.label"),
+                    Invalid::DuplicateNetworkLabel {
+                        label: l.clone(),
+                        pou: name.to_owned(),
+                        first,
+                    },
+                ));
+            }
+        }
+        networks.push(net);
+    }
+    // Jump targets resolve within the POU.
+    for net in &networks {
+        for b in &net.blocks {
+            if let Some(l) = &b.label {
+                if !labels.contains_key(l) {
+                    return Err(LoadError::fbd(
+                        &net.id,
+                        Some(b.id),
+                        &format!("{}.label", b.path),
+                        Invalid::UndefinedLabel {
+                            label: l.clone(),
+                            pou: name.to_owned(),
+                        },
+                    ));
+                }
+            }
+        }
+    }
+    let plans = networks
+        .iter()
+        .map(super::plan)
+        .collect::<Result<Vec<_>>>()?;
+    Ok(FbdPou {
+        name: name.to_owned(),
+        kind,
+        path: path.to_owned(),
+        networks,
+        plans,
+        copies: Vec::new(),
+    })
+}
+
+/// A block as first read: its JSON and its op, before arcs are resolved.
+struct Draft<'v> {
+    id: u32,
+    op: Op,
+    o: &'v Map<String, Json>,
+    path: String,
+}
+
+fn network(
+    v: &Json,
+    path: &str,
+    sig: &dyn Fn(&str) -> Option<FbSig>,
+    block_ids: &mut HashMap<u32, String>,
+) -> Result<Network> {
+    let o = v.as_object().ok_or_else(|| {
+        LoadError::invalid(
+            None,
+            path,
+            Invalid::Shape {
+                expected: "an object (a network)",
+                found: kind_of(v),
+            },
+        )
+    })?;
+    let id = match o.get("id") {
+        None => {
+            return Err(LoadError::invalid(
+                None,
+                path,
+                Invalid::MissingField {
+                    field: "id",
+                    what: "a network",
+                },
+            ))
+        }
+        Some(Json::String(s))
+            if !s.is_empty() && !s.chars().any(|c| c.is_whitespace() || c == '"') =>
+        {
+            s.clone()
+        }
+        Some(Json::String(s)) => {
+            return Err(LoadError::invalid(
+                None,
+                &format!("{path}.id"),
+                Invalid::Shape {
+                    expected: "a network id without spaces or quotes",
+                    found: format!("\"{s}\""),
+                },
+            ))
+        }
+        Some(other) => {
+            return Err(LoadError::invalid(
+                None,
+                &format!("{path}.id"),
+                Invalid::Shape {
+                    expected: "a string",
+                    found: kind_of(other),
+                },
+            ))
+        }
+    };
+    let e = |p: String, k: Invalid| LoadError::fbd(&id, None, &p, k);
+    check_keys(o, NETWORK_KEYS, "a network", path).map_err(|(p, k)| e(p, k))?;
+    let label = match o.get("label") {
+        None => None,
+        Some(l) => Some(
+            name(l)
+                .map_err(|k| e(format!("{path}.label"), k))?
+                .to_owned(),
+        ),
+    };
+    let comment = match o.get("comment") {
+        None => None,
+        Some(c) => Some(
+            string(c)
+                .map_err(|k| e(format!("{path}.comment"), k))?
+                .to_owned(),
+        ),
+    };
+    let bp = format!("{path}.blocks");
+    let items = o.get("blocks").ok_or_else(|| {
+        e(
+            path.to_owned(),
+            Invalid::MissingField {
+                field: "blocks",
+                what: "a network",
+            },
+        )
+    })?;
+    let items = items.as_array().ok_or_else(|| {
+        e(
+            bp.clone(),
+            Invalid::Shape {
+                expected: "an array",
+                found: kind_of(items),
+            },
+        )
+    })?;
+    if items.is_empty() {
+        return Err(e(
+            bp,
+            Invalid::Shape {
+                expected: "at least one block",
+                found: "an empty array".into(),
+            },
+        ));
+    }
+    // Pass 1: ids and ops.
+    let mut drafts = Vec::with_capacity(items.len());
+    for (i, item) in items.iter().enumerate() {
+        let p = format!("{bp}[{i}]");
+        let o = item.as_object().ok_or_else(|| {
+            e(
+                p.clone(),
+                Invalid::Shape {
+                    expected: "an object (a block)",
+                    found: kind_of(item),
+                },
+            )
+        })?;
+        let bid = match o.get("id") {
+            None => {
+                return Err(e(
+                    p,
+                    Invalid::MissingField {
+                        field: "id",
+                        what: "a block",
+                    },
+                ))
+            }
+            Some(j) => j
+                .as_u64()
+                .filter(|&n| n <= u32::MAX as u64)
+                .ok_or_else(|| {
+                    e(
+                        format!("{p}.id"),
+                        Invalid::Shape {
+                            expected: "a block id (a whole number, 0 or more)",
+                            found: kind_of(j),
+                        },
+                    )
+                })? as u32,
+        };
+        let be = |q: String, k: Invalid| LoadError::fbd(&id, Some(bid), &q, k);
+        if let Some(first) = block_ids.insert(bid, p.clone()) {
+            return Err(be(
+                format!("{p}.id"),
+                Invalid::DuplicateBlock { id: bid, first },
+            ));
+        }
+        check_keys(o, BLOCK_KEYS, "a block", &p).map_err(|(q, k)| be(q, k))?;
+        let opj = o.get("op").ok_or_else(|| {
+            be(
+                p.clone(),
+                Invalid::MissingField {
+                    field: "op",
+                    what: "a block",
+                },
+            )
+        })?;
+        let opname = string(opj).map_err(|k| be(format!("{p}.op"), k))?;
+        let op = match Op::parse(opname) {
+            Some(op) => op,
+            None if sig(opname).is_some() => Op::Call(opname.to_owned()),
+            None => {
+                return Err(be(
+                    format!("{p}.op"),
+                    Invalid::UnknownOp {
+                        op: opname.to_owned(),
+                    },
+                ))
+            }
+        };
+        drafts.push(Draft {
+            id: bid,
+            op,
+            o,
+            path: p,
+        });
+    }
+    drafts.sort_by_key(|d| d.id);
+    let index: HashMap<u32, BlockId> = drafts
+        .iter()
+        .enumerate()
+        .map(|(i, d)| (d.id, BlockId(i as u32)))
+        .collect();
+    let outputs_of = |d: &Draft| -> Vec<String> {
+        match &d.op {
+            Op::Call(fb) => sig(fb).map(|s| s.outputs).unwrap_or_default(),
+            op => op.output_pins().iter().map(|s| s.to_string()).collect(),
+        }
+    };
+    let out_pins: Vec<Vec<String>> = drafts.iter().map(outputs_of).collect();
+    // Pass 2: pins, arcs, the rest.
+    let mut blocks = Vec::with_capacity(drafts.len());
+    for d in &drafts {
+        let be = |q: String, k: Invalid| LoadError::fbd(&id, Some(d.id), &q, k);
+        let p = &d.path;
+        let o = d.o;
+        let arc = |j: &Json, q: String| -> Result<Input> {
+            input(j, &q, &id, d.id, &index, &drafts, &out_pins)
+        };
+        // Inputs.
+        let declared: Option<Vec<String>> = match &d.op {
+            Op::Call(fb) => Some(sig(fb).map(|s| s.inputs).unwrap_or_default()),
+            _ => None,
+        };
+        if matches!(d.op, Op::Jmp | Op::Ret) && o.contains_key("in") {
+            return Err(be(
+                format!("{p}.in"),
+                Invalid::Misplaced {
+                    what: "`in`",
+                    place: "on a JMP or RET (its condition is `cond`)",
+                },
+            ));
+        }
+        let mut inputs: Vec<InputPin> = Vec::new();
+        match o.get("in") {
+            None => {
+                let pins = declared.clone().unwrap_or_else(|| d.op.input_pins(0));
+                if declared.is_none() && !pins.is_empty() {
+                    return Err(be(
+                        p.clone(),
+                        Invalid::MissingField {
+                            field: "in",
+                            what: "a block with inputs",
+                        },
+                    ));
+                }
+                inputs = pins
+                    .into_iter()
+                    .map(|n| InputPin {
+                        name: n,
+                        input: None,
+                        path: p.clone(),
+                    })
+                    .collect();
+            }
+            Some(Json::Array(list)) => {
+                let pins = declared
+                    .clone()
+                    .unwrap_or_else(|| d.op.input_pins(list.len()));
+                let fits = if declared.is_some() {
+                    list.len() <= pins.len()
+                } else {
+                    list.len() == pins.len()
+                };
+                if !fits {
+                    return Err(be(
+                        format!("{p}.in"),
+                        Invalid::PinCount {
+                            op: d.op.name().to_owned(),
+                            expected: pin_count_text(&d.op, &pins),
+                            found: list.len(),
+                        },
+                    ));
+                }
+                for (i, pin) in pins.into_iter().enumerate() {
+                    let q = format!("{p}.in[{i}]");
+                    let conn = match list.get(i) {
+                        Some(j) => Some(arc(j, q.clone())?),
+                        None => None,
+                    };
+                    inputs.push(InputPin {
+                        name: pin,
+                        input: conn,
+                        path: if conn_is_given(list.len(), i) {
+                            q
+                        } else {
+                            format!("{p}.in")
+                        },
+                    });
+                }
+            }
+            Some(Json::Object(map)) => {
+                let pins = match &declared {
+                    Some(pins) => pins.clone(),
+                    None if d.op.extensible() => {
+                        // IN1..INn, n = the highest given.
+                        let mut n = 0;
+                        for k in map.keys() {
+                            match k
+                                .strip_prefix("IN")
+                                .and_then(|x| x.parse::<usize>().ok())
+                                .filter(|&x| x >= 1 && format!("IN{x}") == *k)
+                            {
+                                Some(x) => n = n.max(x),
+                                None => {
+                                    return Err(be(
+                                        format!("{p}.in.{k}"),
+                                        Invalid::UnknownPin {
+                                            op: d.op.name().to_owned(),
+                                            dir: "input",
+                                            pin: k.clone(),
+                                            pins: "IN1, IN2, …".into(),
+                                        },
+                                    ))
+                                }
+                            }
+                        }
+                        d.op.input_pins(n)
+                    }
+                    None => d.op.input_pins(0),
+                };
+                for k in map.keys() {
+                    if !pins.contains(k) {
+                        return Err(be(
+                            format!("{p}.in.{k}"),
+                            Invalid::UnknownPin {
+                                op: d.op.name().to_owned(),
+                                dir: "input",
+                                pin: k.clone(),
+                                pins: list_or_none(&pins),
+                            },
+                        ));
+                    }
+                }
+                for pin in pins {
+                    let q = format!("{p}.in.{pin}");
+                    let conn = match map.get(&pin) {
+                        Some(j) => Some(arc(j, q.clone())?),
+                        None => None,
+                    };
+                    let path = if conn.is_some() { q } else { format!("{p}.in") };
+                    inputs.push(InputPin {
+                        name: pin,
+                        input: conn,
+                        path,
+                    });
+                }
+            }
+            Some(other) => {
+                return Err(be(
+                    format!("{p}.in"),
+                    Invalid::Shape {
+                        expected: "an array of inputs or an object {PIN: input}",
+                        found: kind_of(other),
+                    },
+                ))
+            }
+        }
+        if declared.is_none() {
+            if let Some(pin) = inputs.iter().find(|x| x.input.is_none()) {
+                return Err(be(
+                    format!("{p}.in"),
+                    Invalid::Unconnected {
+                        op: d.op.name().to_owned(),
+                        pin: pin.name.clone(),
+                    },
+                ));
+            }
+        }
+        // Outputs.
+        let pins = &out_pins[index[&d.id].index()];
+        let mut outputs: Vec<OutputPin> = pins
+            .iter()
+            .map(|n| OutputPin {
+                name: n.clone(),
+                vars: Vec::new(),
+            })
+            .collect();
+        if let Some(out) = o.get("out") {
+            let op_ = d.op.name().to_owned();
+            if pins.is_empty() {
+                return Err(be(
+                    format!("{p}.out"),
+                    Invalid::Misplaced {
+                        what: "`out`",
+                        place: "on a block without outputs",
+                    },
+                ));
+            }
+            match out {
+                Json::String(s) => outputs[0].vars.push((
+                    var_name(s).map_err(|k| be(format!("{p}.out"), k))?,
+                    format!("{p}.out"),
+                )),
+                Json::Array(list) => {
+                    if list.len() > pins.len() {
+                        return Err(be(
+                            format!("{p}.out"),
+                            Invalid::PinCount {
+                                op: op_,
+                                expected: format!(
+                                    "at most {} output{} ({})",
+                                    pins.len(),
+                                    if pins.len() == 1 { "" } else { "s" },
+                                    pins.join(", ")
+                                ),
+                                found: list.len(),
+                            },
+                        ));
+                    }
+                    for (i, j) in list.iter().enumerate() {
+                        match j {
+                            Json::Null => {}
+                            Json::String(s) => outputs[i].vars.push((
+                                var_name(s).map_err(|k| be(format!("{p}.out[{i}]"), k))?,
+                                format!("{p}.out[{i}]"),
+                            )),
+                            other => {
+                                return Err(be(
+                                    format!("{p}.out[{i}]"),
+                                    Invalid::Shape {
+                                        expected: "a variable name or null",
+                                        found: kind_of(other),
+                                    },
+                                ))
+                            }
+                        }
+                    }
+                }
+                Json::Object(map) => {
+                    for (k, j) in map {
+                        let q = format!("{p}.out.{k}");
+                        let i = pins.iter().position(|x| x == k).ok_or_else(|| {
+                            be(
+                                q.clone(),
+                                Invalid::UnknownPin {
+                                    op: op_.clone(),
+                                    dir: "output",
+                                    pin: k.clone(),
+                                    pins: pins.join(", "),
+                                },
+                            )
+                        })?;
+                        match j {
+                            Json::String(s) => outputs[i]
+                                .vars
+                                .push((var_name(s).map_err(|kd| be(q.clone(), kd))?, q.clone())),
+                            Json::Array(vs) => {
+                                for (m, v) in vs.iter().enumerate() {
+                                    let s = v.as_str().ok_or_else(|| {
+                                        be(
+                                            format!("{q}[{m}]"),
+                                            Invalid::Shape {
+                                                expected: "a variable name",
+                                                found: kind_of(v),
+                                            },
+                                        )
+                                    })?;
+                                    outputs[i].vars.push((
+                                        var_name(s).map_err(|kd| be(format!("{q}[{m}]"), kd))?,
+                                        format!("{q}[{m}]"),
+                                    ));
+                                }
+                            }
+                            other => {
+                                return Err(be(
+                                    q,
+                                    Invalid::Shape {
+                                        expected: "a variable name or an array of them",
+                                        found: kind_of(other),
+                                    },
+                                ))
+                            }
+                        }
+                    }
+                }
+                other => {
+                    return Err(be(
+                        format!("{p}.out"),
+                        Invalid::Shape {
+                            expected: "a variable name, an array or an object {PIN: variable}",
+                            found: kind_of(other),
+                        },
+                    ))
+                }
+            }
+        }
+        // Instance, label, condition, control arcs.
+        let instance = match (o.get("instance"), d.op.needs_instance()) {
+            (Some(j), true) => Some(
+                var_name(string(j).map_err(|k| be(format!("{p}.instance"), k))?)
+                    .map_err(|k| be(format!("{p}.instance"), k))?,
+            ),
+            (None, true) => {
+                return Err(be(
+                    p.clone(),
+                    Invalid::MissingField {
+                        field: "instance",
+                        what: "a timer, counter or function block",
+                    },
+                ))
+            }
+            (Some(_), false) => {
+                return Err(be(
+                    format!("{p}.instance"),
+                    Invalid::Misplaced {
+                        what: "`instance`",
+                        place: "on this block (only timers, counters and function blocks have one)",
+                    },
+                ))
+            }
+            (None, false) => None,
+        };
+        let label = match (o.get("label"), d.op == Op::Jmp) {
+            (Some(l), true) => Some(name(l).map_err(|k| be(format!("{p}.label"), k))?.to_owned()),
+            (None, true) => {
+                return Err(be(
+                    p.clone(),
+                    Invalid::MissingField {
+                        field: "label",
+                        what: "a JMP",
+                    },
+                ))
+            }
+            (Some(_), false) => {
+                return Err(be(
+                    format!("{p}.label"),
+                    Invalid::Misplaced {
+                        what: "`label`",
+                        place: "on a block other than JMP (label the network)",
+                    },
+                ))
+            }
+            (None, false) => None,
+        };
+        let cond = match o.get("cond") {
+            None => None,
+            Some(j) => Some(arc(j, format!("{p}.cond"))?),
+        };
+        let mut after = Vec::new();
+        if let Some(a) = o.get("after") {
+            let q = format!("{p}.after");
+            let list = a.as_array().ok_or_else(|| {
+                be(
+                    q.clone(),
+                    Invalid::Shape {
+                        expected: "an array of block ids",
+                        found: kind_of(a),
+                    },
+                )
+            })?;
+            for (i, j) in list.iter().enumerate() {
+                let qi = format!("{q}[{i}]");
+                let src = j
+                    .as_u64()
+                    .filter(|&n| n <= u32::MAX as u64)
+                    .ok_or_else(|| {
+                        be(
+                            qi.clone(),
+                            Invalid::Shape {
+                                expected: "a block id",
+                                found: kind_of(j),
+                            },
+                        )
+                    })? as u32;
+                let b = *index.get(&src).ok_or_else(|| {
+                    be(
+                        qi,
+                        Invalid::UndefinedBlock {
+                            id: src,
+                            network: id.clone(),
+                        },
+                    )
+                })?;
+                after.push(b);
+            }
+            after.sort_unstable();
+            after.dedup();
+        }
+        let comment = match o.get("comment") {
+            None => None,
+            Some(c) => Some(
+                string(c)
+                    .map_err(|k| be(format!("{p}.comment"), k))?
+                    .to_owned(),
+            ),
+        };
+        blocks.push(Block {
+            id: d.id,
+            op: d.op.clone(),
+            path: p.clone(),
+            inputs,
+            outputs,
+            instance,
+            label,
+            cond,
+            after,
+            comment,
+        });
+    }
+    Ok(Network {
+        id,
+        label,
+        comment,
+        path: path.to_owned(),
+        blocks,
+    })
+}
+
+/// An INPUT: an operand, or `{"from": ID}` / `{"from": ID, "pin": "Q"}`.
+fn input(
+    j: &Json,
+    path: &str,
+    network: &str,
+    block: u32,
+    index: &HashMap<u32, BlockId>,
+    drafts: &[Draft],
+    out_pins: &[Vec<String>],
+) -> Result<Input> {
+    let e = |q: String, k: Invalid| LoadError::fbd(network, Some(block), &q, k);
+    match j {
+        Json::Object(o) => {
+            if let Some(k) = o.keys().find(|k| !["from", "pin"].contains(&k.as_str())) {
+                return Err(e(
+                    format!("{path}.{k}"),
+                    Invalid::UnknownField {
+                        field: k.clone(),
+                        what: "an arc",
+                        allowed: "from, pin".into(),
+                    },
+                ));
+            }
+            let from = o.get("from").ok_or_else(|| {
+                e(
+                    path.to_owned(),
+                    Invalid::MissingField {
+                        field: "from",
+                        what: "an arc",
+                    },
+                )
+            })?;
+            let src = from
+                .as_u64()
+                .filter(|&n| n <= u32::MAX as u64)
+                .ok_or_else(|| {
+                    e(
+                        format!("{path}.from"),
+                        Invalid::Shape {
+                            expected: "a block id",
+                            found: kind_of(from),
+                        },
+                    )
+                })? as u32;
+            let b = *index.get(&src).ok_or_else(|| {
+                e(
+                    format!("{path}.from"),
+                    Invalid::UndefinedBlock {
+                        id: src,
+                        network: network.to_owned(),
+                    },
+                )
+            })?;
+            let pins = &out_pins[b.index()];
+            let opname = drafts[b.index()].op.name().to_owned();
+            let pin = match o.get("pin") {
+                None if pins.is_empty() => {
+                    return Err(e(
+                        format!("{path}.from"),
+                        Invalid::UnknownPin {
+                            op: format!("block {src} ({opname})"),
+                            dir: "output",
+                            pin: "(any)".into(),
+                            pins: "none".into(),
+                        },
+                    ))
+                }
+                None => 0,
+                Some(pj) => {
+                    let pn = string(pj).map_err(|k| e(format!("{path}.pin"), k))?;
+                    pins.iter().position(|x| x == pn).ok_or_else(|| {
+                        e(
+                            format!("{path}.pin"),
+                            Invalid::UnknownPin {
+                                op: format!("block {src} ({opname})"),
+                                dir: "output",
+                                pin: pn.to_owned(),
+                                pins: list_or_none(pins),
+                            },
+                        )
+                    })? as u32
+                }
+            };
+            Ok(Input::Arc { from: b, pin })
+        }
+        Json::String(_) | Json::Number(_) | Json::Bool(_) => Ok(Input::Operand(j.clone())),
+        other => Err(e(
+            path.to_owned(),
+            Invalid::Shape {
+                expected: "an operand or an arc {\"from\": BLOCK}",
+                found: kind_of(other),
+            },
+        )),
+    }
+}
+
+fn conn_is_given(given: usize, i: usize) -> bool {
+    i < given
+}
+
+fn pin_count_text(op: &Op, pins: &[String]) -> String {
+    if matches!(op, Op::Call(_)) {
+        format!("at most {} inputs ({})", pins.len(), list_or_none(pins))
+    } else if op.extensible() {
+        "two or more inputs".into()
+    } else if pins.len() == 1 {
+        format!("one input ({})", pins[0])
+    } else {
+        format!("{} inputs ({})", pins.len(), pins.join(", "))
+    }
+}
+
+fn list_or_none(pins: &[String]) -> String {
+    if pins.is_empty() {
+        "none".into()
+    } else {
+        pins.join(", ")
+    }
+}
+
+pub(crate) fn kind_of(v: &Json) -> String {
+    match v {
+        Json::Null => "null".into(),
+        Json::Bool(b) => format!("boolean {b}"),
+        Json::Number(n) => format!("number {n}"),
+        Json::String(s) => format!("string \"{s}\""),
+        Json::Array(_) => "an array".into(),
+        Json::Object(_) => "an object".into(),
+    }
+}
+
+fn string(v: &Json) -> std::result::Result<&str, Invalid> {
+    v.as_str().ok_or_else(|| Invalid::Shape {
+        expected: "a string",
+        found: kind_of(v),
+    })
+}
+
+/// A name (labels): letters, digits and `_`, not starting with a digit.
+fn name(v: &Json) -> std::result::Result<&str, Invalid> {
+    let s = string(v)?;
+    if valid_name(s) {
+        Ok(s)
+    } else {
+        Err(Invalid::BadName { name: s.to_owned() })
+    }
+}
+
+/// A variable a block writes or runs on; resolved (and refused, with the reason) by the lowering.
+fn var_name(s: &str) -> std::result::Result<String, Invalid> {
+    Ok(s.to_owned())
+}
+
+pub(crate) fn valid_name(s: &str) -> bool {
+    let mut chars = s.chars();
+    matches!(chars.next(), Some(c) if c.is_ascii_alphabetic() || c == '_')
+        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
+}
+
+fn check_keys(
+    o: &Map<String, Json>,
+    allowed: &[&str],
+    what: &'static str,
+    path: &str,
+) -> std::result::Result<(), (String, Invalid)> {
+    match o.keys().find(|k| !allowed.contains(&k.as_str())) {
+        None => Ok(()),
+        Some(k) => Err((
+            format!("{path}.{k}"),
+            Invalid::UnknownField {
+                field: k.clone(),
+                what,
+                allowed: allowed.join(", "),
+            },
+        )),
+    }
+}
