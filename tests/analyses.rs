@@ -3,9 +3,10 @@
 //! difference; `UPDATE_EXPECT=1 cargo test --test analyses` re-blesses them. Examples written in
 //! FBD also have `order.txt` and `order.json` (`plc-deps order`).
 //!
-//! An example with an `inputs.csv` also has its committed `run.json`: the JSON of
-//! `plc-deps run program.json --inputs inputs.csv --cycle 1s --threads 2 --mode both
-//! --format json` with the timing fields zeroed (`runcmd::run_json_deterministic`).
+//! Every example also has its committed `run.json`: the JSON of `plc-deps run program.json
+//! --inputs inputs.csv --cycle 1s --threads 2 --mode both --format json` (or, for a program
+//! without `inputs.csv`, `--scans 450 --cycle 10ms`) with the timing fields zeroed
+//! (`runcmd::run_json_deterministic`).
 
 use plc_deps::app::{render_report, ReportFormat};
 use plc_deps::read::program_from_json;
@@ -59,11 +60,18 @@ fn every_worked_example_matches_its_committed_reports() {
             check(&dir.join("order.txt"), &plc_deps::app::render_order(&program, &fbd, plc_deps::app::OrderFormat::Text), &mut failures);
             check(&dir.join("order.json"), &plc_deps::app::render_order(&program, &fbd, plc_deps::app::OrderFormat::Json), &mut failures);
         }
-        if dir.join("inputs.csv").is_file() {
+        {
             runs += 1;
             let mut c = plc_deps::runcmd::RunConfig::new(dir.join("program.json"));
-            c.inputs = Some(dir.join("inputs.csv"));
-            c.cycle_ms = 1000;
+            if dir.join("inputs.csv").is_file() {
+                c.inputs = Some(dir.join("inputs.csv"));
+                c.cycle_ms = 1000;
+            } else {
+                // Programs without inputs (KASKAD 2-5) run 450 scans of 10 ms: long enough for
+                // the 1 s and 2 s generators of KASKAD 4 and 5 to toggle.
+                c.scans = Some(450);
+                c.cycle_ms = 10;
+            }
             c.threads = 2;
             c.mode = plc_deps::runcmd::RunMode::Both;
             let run = plc_deps::runcmd::run_json_deterministic(&c).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
@@ -72,6 +80,6 @@ fn every_worked_example_matches_its_committed_reports() {
             check(&dir.join("run.json"), &run, &mut failures);
         }
     }
-    assert!(runs >= 5, "expected inputs.csv beside the five worked examples, found {runs}");
+    assert!(runs >= 11, "expected every worked example to run, found {runs}");
     assert!(failures.is_empty(), "{}\n(re-bless with UPDATE_EXPECT=1 if the change is intended)", failures.join("\n"));
 }
