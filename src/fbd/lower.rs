@@ -104,6 +104,9 @@ pub(crate) fn lower(fbd: &FbdPou, env: &mut dyn Env, names: &Names, pou: PouId) 
     for (net, plan) in fbd.networks.iter().zip(&fbd.plans) {
         let start = cx.rungs.len() as u32;
         let block_rungs = cx.network(net, plan, &labels, &mut jumps)?;
+        for rung in &mut cx.rungs[start as usize..] {
+            rung.network = Some(net.id.clone());
+        }
         networks.push(start..cx.rungs.len() as u32);
         blocks.push(block_rungs);
     }
@@ -236,6 +239,7 @@ impl Cx<'_> {
             pou: self.pou,
             series,
             path: path.to_owned(),
+            network: None,
         });
         self.rungs.len() - 1
     }

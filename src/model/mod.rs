@@ -106,6 +106,9 @@ pub struct Rung {
     pub series: Series,
     /// The JSON path of this rung in its file (`rungs[3]`, `subroutines.SBR_0.rungs[0]`).
     pub path: String,
+    /// For a rung lowered from an FBD block (or a fragment guard of it): the id of its network.
+    /// The rungs of one network are contiguous.
+    pub network: Option<String>,
 }
 
 /// A series of elements; power flows through them in order.

@@ -556,7 +556,7 @@ impl<'a> Builder<'a> {
                     None => None,
                     Some(c) => Some(string(c, &format!("{path}.comment"), Some(id))?.to_owned()),
                 };
-                rungs.push(Rung { id: id.clone(), label, comment, pou, series, path });
+                rungs.push(Rung { id: id.clone(), label, comment, pou, series, path, network: None });
             }
         }
         let mut program = Program { name, vars: self.vars, pous, rungs };

@@ -145,7 +145,19 @@ pub fn render_json(p: &Program, a: &Analysis) -> String {
             })
         })
         .collect();
-    let report = json!({
+    let networks: Vec<Json> = networks(p, a)
+        .into_iter()
+        .map(|n| {
+            json!({
+                "pou": p.pou(n.pou).name,
+                "id": n.id,
+                "rungs": n.rungs.iter().map(|&r| id(r)).collect::<Vec<_>>(),
+                "in": n.ins.iter().map(|&v| var(v)).collect::<Vec<_>>(),
+                "out": n.outs.iter().map(|&v| var(v)).collect::<Vec<_>>(),
+            })
+        })
+        .collect();
+    let mut report = json!({
         "program": p.name,
         "rungs": rungs,
         "dependences": dependences,
@@ -170,6 +182,9 @@ pub fn render_json(p: &Program, a: &Analysis) -> String {
         "differences": differences,
         "warnings": a.warnings.iter().map(|w| warning_text(p, w)).collect::<Vec<_>>(),
     });
+    if !networks.is_empty() {
+        report["networks"] = Json::Array(networks);
+    }
     let mut out = serde_json::to_string_pretty(&report).expect("JSON values always serialise");
     out.push('\n');
     out

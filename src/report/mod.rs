@@ -161,6 +161,39 @@ pub(crate) fn differences(p: &Program, a: &Analysis) -> Vec<Difference> {
     out
 }
 
+/// An FBD network of the program: its (contiguous) rungs and the union of their IN and OUT.
+pub(crate) struct Network {
+    pub pou: PouId,
+    pub id: String,
+    pub rungs: Vec<RungId>,
+    pub ins: Vec<VarId>,
+    pub outs: Vec<VarId>,
+}
+
+/// The FBD networks, in program order (empty for a pure ladder program).
+pub(crate) fn networks(p: &Program, a: &Analysis) -> Vec<Network> {
+    let mut out: Vec<Network> = Vec::new();
+    for r in p.rung_ids() {
+        let rung = p.rung(r);
+        let Some(net) = &rung.network else { continue };
+        let same = out.last().is_some_and(|n| n.pou == rung.pou && &n.id == net && n.rungs.last().is_some_and(|l| l.0 + 1 == r.0));
+        if !same {
+            out.push(Network { pou: rung.pou, id: net.clone(), rungs: Vec::new(), ins: Vec::new(), outs: Vec::new() });
+        }
+        let n = out.last_mut().expect("pushed above");
+        n.rungs.push(r);
+        n.ins.extend_from_slice(a.accesses.ins(r));
+        n.outs.extend_from_slice(a.accesses.outs(r));
+    }
+    for n in &mut out {
+        for l in [&mut n.ins, &mut n.outs] {
+            l.sort_unstable();
+            l.dedup();
+        }
+    }
+    out
+}
+
 /// Human text of a warning.
 pub(crate) fn warning_text(p: &Program, w: &Warning) -> String {
     let ids = |rs: &[RungId]| {

@@ -151,6 +151,20 @@ pub fn render_text(p: &Program, a: &Analysis, view: View) -> String {
     }
     t.render(&mut o);
 
+    let nets = networks(p, a);
+    if !nets.is_empty() {
+        o.push_str("\nFBD networks (IN/OUT: the union over the network's block rungs)\n");
+        let mut t = Table::new(&["network", "pou", "rungs", "IN", "OUT"]);
+        for n in &nets {
+            let v = |vs: &[VarId]| if vs.is_empty() { "-".to_string() } else { join(vs.iter().map(|&x| p.var(x).name.as_str()), " ") };
+            let first = id(n.rungs[0]);
+            let last = id(*n.rungs.last().expect("a network has rungs"));
+            let span = if n.rungs.len() == 1 { first.to_owned() } else { format!("{first} .. {last} ({})", n.rungs.len()) };
+            t.row(vec![n.id.clone(), p.pou(n.pou).name.clone(), span, v(&n.ins), v(&n.outs)]);
+        }
+        t.render(&mut o);
+    }
+
     let n_of = |k: DepKind| a.data.iter().filter(|d| d.kind == k).count();
     let _ = writeln!(
         o,
