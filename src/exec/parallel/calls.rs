@@ -1,0 +1,139 @@
+//! Facts about calls and loop-backs the planner and the verifier need: the call closure of each
+//! POU, the subroutines a rung calls, loop-back rungs, and whether a refused loop-back of the main
+//! program can continue along an edge the schedule does not know.
+
+use super::plan::NONE;
+use crate::analysis::{Analysis, EdgeKind};
+use crate::model::{Element, PouId, Program, RungId};
+
+/// Subroutines (transitively) called from each POU, and whether each POU has loop-back rungs.
+pub(super) fn call_closure(p: &Program) -> Vec<Vec<u32>> {
+    let direct: Vec<Vec<u32>> = (0..p.pous.len())
+        .map(|pou| {
+            let mut calls = Vec::new();
+            for r in p.pou_rungs(PouId(pou as u32)) {
+                crate::model::walk_elements(&p.rung(r).series, &mut |e| {
+                    if let Element::Call { pou } = e {
+                        calls.push(pou.0);
+                    }
+                });
+            }
+            calls.sort_unstable();
+            calls.dedup();
+            calls
+        })
+        .collect();
+    let mut closure: Vec<Option<Vec<u32>>> = vec![None; p.pous.len()];
+    fn visit(pou: usize, direct: &[Vec<u32>], closure: &mut Vec<Option<Vec<u32>>>) -> Vec<u32> {
+        if let Some(c) = &closure[pou] {
+            return c.clone();
+        }
+        let mut all = Vec::new();
+        for &c in &direct[pou] {
+            all.push(c);
+            all.extend(visit(c as usize, direct, closure));
+        }
+        all.sort_unstable();
+        all.dedup();
+        closure[pou] = Some(all.clone());
+        all
+    }
+    (0..p.pous.len())
+        .map(|pou| visit(pou, &direct, &mut closure))
+        .collect()
+}
+
+/// Subroutines called (transitively) from a rung.
+pub(super) fn rung_callees(p: &Program, closure: &[Vec<u32>], r: RungId) -> Vec<u32> {
+    let mut out = Vec::new();
+    crate::model::walk_elements(&p.rung(r).series, &mut |e| {
+        if let Element::Call { pou } = e {
+            out.push(pou.0);
+            out.extend_from_slice(&closure[pou.index()]);
+        }
+    });
+    out.sort_unstable();
+    out.dedup();
+    out
+}
+
+/// Whether rung `r` holds a loop-back (a NEXT, or a backward jump).
+pub(super) fn is_loop_back(p: &Program, r: RungId) -> bool {
+    let mut found = false;
+    crate::model::walk_elements(&p.rung(r).series, &mut |e| match e {
+        Element::Next { .. } => found = true,
+        Element::Jmp { target, .. } if target.0 <= r.0 => found = true,
+        _ => {}
+    });
+    found
+}
+
+/// The first main-program rung whose loop-cap refusal could lead where the schedule does not
+/// expect control to go, with the reason; `None` if there is none.
+pub(super) fn uncovered_refusal(p: &Program, a: &Analysis, task_of: &[u32]) -> Option<String> {
+    let n = p.rungs.len() as u32;
+    let stop = a.cfg.stop();
+    // Live CFG edges of the main program, by (task of source, target node).
+    let mut edges: std::collections::HashSet<(u32, u32)> = std::collections::HashSet::new();
+    for e in &a.cfg.edges {
+        if matches!(e.kind, EdgeKind::Call | EdgeKind::Return)
+            || e.from >= n
+            || task_of[e.from as usize] == NONE
+        {
+            continue;
+        }
+        edges.insert((task_of[e.from as usize], e.to));
+    }
+    let main = p.main().rungs.clone();
+    let mut found = Vec::new();
+    for r in main.clone() {
+        let t = task_of[r as usize];
+        if t == NONE {
+            continue;
+        }
+        let rung = p.rung(RungId(r));
+        let next = if r + 1 < main.end { r + 1 } else { stop };
+        let targets: Vec<u32> = match rung.series.last() {
+            // A refused NEXT goes on to the rung after it: the FOR head's loop exit, which is in
+            // the same task; checked like the others all the same.
+            Some(Element::Next { .. }) => vec![next],
+            _ => {
+                found.clear();
+                crate::analysis::cfg::transfers(&rung.series, &mut found);
+                let unconditional_back = found.iter().any(|&(tr, always)| {
+                    always && matches!(tr, crate::analysis::cfg::Transfer::Jump(x) if x.0 <= r)
+                });
+                if !unconditional_back {
+                    continue; // a conditional backward jump's "not taken" paths are CFG edges
+                }
+                // After a refusal the rest of the rung runs: any of its transfers, or onwards.
+                let mut ts = vec![next];
+                crate::model::walk_elements(&rung.series, &mut |e| match e {
+                    Element::Jmp { target, .. } => ts.push(target.0),
+                    Element::Ret | Element::End => ts.push(stop),
+                    _ => {}
+                });
+                ts
+            }
+        };
+        for x in targets {
+            let covered = if x == stop {
+                edges.contains(&(t, stop))
+            } else {
+                task_of[x as usize] == t || (task_of[x as usize] != NONE && edges.contains(&(t, x)))
+            };
+            if !covered {
+                let to = if x == stop {
+                    "the end of the scan".to_string()
+                } else {
+                    format!("rung {}", p.rung(RungId(x)).id)
+                };
+                return Some(format!(
+                    "rung {} loops back unconditionally; if the iteration cap refuses it, control goes on to {to}, a way the schedule does not know",
+                    rung.id
+                ));
+            }
+        }
+    }
+    None
+}

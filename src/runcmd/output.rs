@@ -1,0 +1,208 @@
+//! Rendering a run's report: the text report, the JSON report (normative keys: docs/scan.md)
+//! and its deterministic form for `analyses/*/run.json`.
+
+use super::engine::RunReport;
+use super::{run_report, RunConfig};
+use crate::app::CliError;
+use crate::exec::{FaultKind, VarValue};
+use crate::model::Value;
+use serde_json::{json, Map, Value as Json};
+use std::fmt::Write as _;
+
+/// JSON of a scalar value as `state` shows it (BOOL true/false, numbers, TIME ms).
+pub(super) fn value_json(v: VarValue) -> Json {
+    v.to_json()
+}
+
+/// Text of a value (BOOL TRUE/FALSE, TIME T#…ms, instances as their fields).
+fn value_text(v: VarValue) -> String {
+    match v {
+        VarValue::Scalar(Value::Real(f)) => format!("{f}"),
+        VarValue::Scalar(x) => x.to_string(),
+        VarValue::Timer { q, et, pt } => format!(
+            "Q={} ET=T#{et}ms PT=T#{pt}ms",
+            if q { "TRUE" } else { "FALSE" }
+        ),
+        VarValue::Counter { q, cv, pv } => {
+            format!("Q={} CV={cv} PV={pv}", if q { "TRUE" } else { "FALSE" })
+        }
+    }
+}
+
+/// The JSON report (normative keys: docs/scan.md). `deterministic` zeroes the timing fields, so
+/// that the same run always gives the same bytes (the committed `analyses/*/run.json`).
+pub fn render_json(r: &RunReport, deterministic: bool) -> String {
+    let mut doc = Map::new();
+    doc.insert("program".into(), json!(r.program));
+    doc.insert("scans".into(), json!(r.scans));
+    doc.insert("cycle_ms".into(), json!(r.cycle_ms));
+    doc.insert("threads".into(), json!(r.threads));
+    doc.insert(
+        "outputs".into(),
+        Json::Object(
+            r.outputs
+                .iter()
+                .map(|(n, v)| (n.clone(), value_json(*v)))
+                .collect(),
+        ),
+    );
+    doc.insert(
+        "state".into(),
+        Json::Object(
+            r.state
+                .iter()
+                .map(|(n, v)| (n.clone(), value_json(*v)))
+                .collect(),
+        ),
+    );
+    doc.insert(
+        "faults".into(),
+        json!(r
+            .faults
+            .iter()
+            .map(|(s, rung, k)| json!({"scan": s, "rung": rung, "kind": k.name()}))
+            .collect::<Vec<_>>()),
+    );
+    doc.insert("fault_count".into(), json!(r.fault_count));
+    let mut modes = Map::new();
+    for &(name, total) in &r.modes {
+        let (ns, per_s, rungs_per_s) = if deterministic || total.is_zero() {
+            (json!(0), json!(0), json!(0))
+        } else {
+            let ns = total.as_nanos() as f64 / r.scans as f64;
+            let per_s = 1e9 / ns;
+            (
+                json!((ns * 10.0).round() / 10.0),
+                json!(per_s.round()),
+                json!((per_s * r.rungs as f64).round()),
+            )
+        };
+        modes.insert(
+            name.into(),
+            json!({"scans_per_s": per_s, "ns_per_scan": ns, "rungs_per_s": rungs_per_s}),
+        );
+    }
+    doc.insert("modes".into(), Json::Object(modes));
+    let speedup = match (
+        r.modes.iter().find(|m| m.0 == "seq"),
+        r.modes.iter().find(|m| m.0 == "par"),
+    ) {
+        (Some(s), Some(p)) if !deterministic && !p.1.is_zero() => {
+            json!((s.1.as_secs_f64() / p.1.as_secs_f64() * 1000.0).round() / 1000.0)
+        }
+        (Some(_), Some(_)) => json!(0),
+        _ => Json::Null,
+    };
+    doc.insert("speedup".into(), speedup);
+    doc.insert("identical".into(), json!(r.identical));
+    doc.insert(
+        "first_difference".into(),
+        r.first_difference.clone().unwrap_or(Json::Null),
+    );
+    if let Some((_, plan)) = &r.explain {
+        doc.insert("plan".into(), plan.clone());
+    }
+    let mut s = serde_json::to_string_pretty(&Json::Object(doc)).expect("JSON");
+    s.push('\n');
+    s
+}
+
+fn time_text(ns: f64) -> String {
+    if ns >= 1e9 {
+        format!("{:.2} s", ns / 1e9)
+    } else if ns >= 1e6 {
+        format!("{:.2} ms", ns / 1e6)
+    } else if ns >= 1e3 {
+        format!("{:.2} µs", ns / 1e3)
+    } else {
+        format!("{ns:.0} ns")
+    }
+}
+
+/// The text report.
+pub fn render_text(r: &RunReport) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "program {}: {} scans, cycle {} ms, {} thread(s)",
+        r.program, r.scans, r.cycle_ms, r.threads
+    );
+    if let Some((text, _)) = &r.explain {
+        s.push('\n');
+        s.push_str(text);
+        s.push('\n');
+    }
+    let _ = writeln!(s, "outputs after scan {}:", r.scans - 1);
+    if r.outputs.is_empty() {
+        let _ = writeln!(s, "  (no output variables)");
+    }
+    let width = r.outputs.iter().map(|(n, _)| n.len()).max().unwrap_or(0);
+    for (n, v) in &r.outputs {
+        let _ = writeln!(s, "  {n:<width$}  {}", value_text(*v));
+    }
+    if r.fault_count == 0 {
+        let _ = writeln!(s, "faults: none");
+    } else {
+        let count = |k: FaultKind| r.faults.iter().filter(|f| f.2 == k).count();
+        let _ = writeln!(
+            s,
+            "faults: {}{} (listed: {} div-by-zero, {} loop-cap)",
+            r.fault_count,
+            if r.fault_count as usize > r.faults.len() {
+                format!(", the first {} listed", r.faults.len())
+            } else {
+                String::new()
+            },
+            count(FaultKind::DivByZero),
+            count(FaultKind::LoopCap)
+        );
+        for (scan, rung, kind) in r.faults.iter().take(20) {
+            let _ = writeln!(s, "  scan {scan}: rung {rung}: {}", kind.name());
+        }
+        if r.faults.len() > 20 {
+            let _ = writeln!(s, "  ... ({} more in --format json)", r.fault_count - 20);
+        }
+    }
+    let _ = writeln!(s, "speed:");
+    let seq_total = r.modes.iter().find(|m| m.0 == "seq").map(|m| m.1);
+    for &(name, total) in &r.modes {
+        let ns = total.as_nanos() as f64 / r.scans as f64;
+        let per_s = if ns > 0.0 { 1e9 / ns } else { 0.0 };
+        let _ = write!(
+            s,
+            "  {name}  {:>12.0} scans/s  {:>10}/scan  {:>8.1} M rungs/s",
+            per_s,
+            time_text(ns),
+            per_s * r.rungs as f64 / 1e6
+        );
+        if let (Some(st), "par") = (seq_total, name) {
+            if !total.is_zero() {
+                let _ = write!(s, "  ({:.2}x seq)", st.as_secs_f64() / total.as_secs_f64());
+            }
+        }
+        s.push('\n');
+    }
+    match (r.identical, &r.first_difference) {
+        (Some(true), _) => {
+            let _ = writeln!(
+                s,
+                "identical: yes, seq == par after every scan (full state and faults)"
+            );
+        }
+        (Some(false), Some(d)) => {
+            let _ = writeln!(s, "identical: NO, first difference: {d}");
+        }
+        _ => {}
+    }
+    s
+}
+
+/// The deterministic JSON of a run (timing fields zero): what `analyses/*/run.json` holds.
+pub fn run_json_deterministic(c: &RunConfig) -> Result<String, CliError> {
+    let c = RunConfig {
+        progress: false,
+        trace: None,
+        ..c.clone()
+    };
+    Ok(render_json(&run_report(&c)?, true))
+}

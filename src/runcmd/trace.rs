@@ -1,0 +1,148 @@
+//! The `--trace` CSV: the traced columns (`--trace-vars`), the header and one line per scan.
+
+use crate::app::CliError;
+use crate::exec::Machine;
+use crate::model::{Field, Program, Type, Value, VarId, VarRef};
+use std::io::Write;
+
+/// The CSV cell of one traced slot: BOOL 1/0, integers and TIME (ms) as numbers, REAL shortest.
+pub(super) fn cell(ty: Type, bits: u64) -> String {
+    match crate::exec::decode(ty, bits) {
+        Value::Bool(b) => (if b { "1" } else { "0" }).to_string(),
+        Value::Int(i) => i.to_string(),
+        Value::Dint(i) | Value::Time(i) => i.to_string(),
+        Value::Real(f) => format!("{f}"),
+    }
+}
+
+pub(super) struct Trace<'a> {
+    pub(super) out: &'a mut dyn Write,
+    pub(super) cols: Vec<(u32, Type)>,
+    pub(super) line: String,
+    pub(super) error: Option<std::io::Error>,
+}
+
+/// Resolves `--trace-vars` (names, or instance fields `T1.Q`) to (header, variable, type)
+/// columns; `None`: every variable but the hidden edge memories, instances as their Q/ET/PT or
+/// Q/CV/PV fields.
+pub(super) fn trace_columns(
+    p: &Program,
+    vars: Option<&[String]>,
+) -> Result<Vec<(String, VarRef, Type)>, CliError> {
+    let fields_of = |v: VarId| -> Vec<(Field, Type)> {
+        match p.var(v).ty {
+            Type::Fb(crate::model::FbKind::Ctu | crate::model::FbKind::Ctd) => vec![
+                (Field::Q, Type::Bool),
+                (Field::Cv, Type::Int),
+                (Field::Pv, Type::Int),
+            ],
+            Type::Fb(_) => vec![
+                (Field::Q, Type::Bool),
+                (Field::Et, Type::Time),
+                (Field::Pt, Type::Time),
+            ],
+            _ => vec![],
+        }
+    };
+    let mut cols = Vec::new();
+    let mut add = |v: VarId, field: Option<(Field, Type)>| {
+        let name = &p.var(v).name;
+        match field {
+            Some((f, ty)) => cols.push((
+                format!("{name}.{}", f.name()),
+                VarRef {
+                    var: v,
+                    field: Some(f),
+                },
+                ty,
+            )),
+            None => cols.push((
+                name.clone(),
+                VarRef {
+                    var: v,
+                    field: None,
+                },
+                p.var(v).ty,
+            )),
+        }
+    };
+    match vars {
+        None => {
+            for v in (0..p.vars.len() as u32)
+                .map(VarId)
+                .filter(|&v| !p.var(v).hidden)
+            {
+                let fields = fields_of(v);
+                if fields.is_empty() {
+                    add(v, None);
+                } else {
+                    for f in fields {
+                        add(v, Some(f));
+                    }
+                }
+            }
+        }
+        Some(names) => {
+            for raw in names {
+                let name = raw.trim();
+                let (base, field) = match name.split_once('.') {
+                    Some((b, f)) => (b, Some(f)),
+                    None => (name, None),
+                };
+                let Some(v) = p
+                    .vars
+                    .iter()
+                    .position(|x| x.name == base)
+                    .map(|i| VarId(i as u32))
+                else {
+                    return Err(CliError::Usage(format!(
+                        "--trace-vars: unknown variable `{name}`"
+                    )));
+                };
+                let fields = fields_of(v);
+                match field {
+                    None if fields.is_empty() => add(v, None),
+                    None => {
+                        for f in fields {
+                            add(v, Some(f));
+                        }
+                    }
+                    Some(f) => match fields
+                        .iter()
+                        .find(|(x, _)| x.name().eq_ignore_ascii_case(f))
+                    {
+                        Some(&ft) => add(v, Some(ft)),
+                        None => {
+                            return Err(CliError::Usage(format!(
+                                "--trace-vars: `{name}`: {base} has no field {f}"
+                            )))
+                        }
+                    },
+                }
+            }
+        }
+    }
+    Ok(cols)
+}
+
+impl<'a> Trace<'a> {
+    pub(super) fn new(
+        m: &Machine,
+        cols: &[(String, VarRef, Type)],
+        out: &'a mut dyn Write,
+    ) -> Trace<'a> {
+        let mut line = String::from("scan,time_ms");
+        for (name, _, _) in cols {
+            line.push(',');
+            line.push_str(name);
+        }
+        line.push('\n');
+        let error = out.write_all(line.as_bytes()).err();
+        Trace {
+            out,
+            cols: cols.iter().map(|&(_, r, t)| (m.slot_of(r), t)).collect(),
+            line,
+            error,
+        }
+    }
+}
