@@ -8,20 +8,7 @@
 use crate::model::{ArithOp, CmpOp, PouId, RungId, TimerKind};
 use std::ops::Range;
 
-macro_rules! index_type {
-    ($(#[$m:meta])* $name:ident) => {
-        $(#[$m])*
-        #[derive(Copy, Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-        pub struct $name(pub u32);
-        impl $name {
-            /// The index into the owning `Vec`.
-            #[inline]
-            pub fn index(self) -> usize {
-                self.0 as usize
-            }
-        }
-    };
-}
+use crate::model::index_type;
 
 index_type!(
     /// A block of one network: index into [`Network::blocks`] (blocks sorted by id).

@@ -37,6 +37,9 @@ macro_rules! index_type {
     };
 }
 
+/// Typed dense indices are declared the same way everywhere (also by `crate::fbd`).
+pub(crate) use index_type;
+
 index_type!(
     /// A variable: index into [`Program::vars`].
     VarId
