@@ -6,10 +6,19 @@
 //! resolved and typed by the lowering, once per POU (per instance for a function block type).
 //! Errors carry the network id, the block id and the JSON path.
 
+mod input;
+mod util;
+
 use super::model::*;
 use crate::read::{Invalid, LoadError};
 use serde_json::{Map, Value as Json};
 use std::collections::HashMap;
+
+use input::input;
+pub(crate) use util::kind_of;
+#[allow(unused_imports)] // reachable at its old path, though only the reader uses it
+pub(crate) use util::valid_name;
+use util::{check_keys, conn_is_given, list_or_none, name, pin_count_text, string, var_name};
 
 type Result<T> = std::result::Result<T, LoadError>;
 
@@ -745,182 +754,4 @@ fn network(
         path: path.to_owned(),
         blocks,
     })
-}
-
-/// An INPUT: an operand, or `{"from": ID}` / `{"from": ID, "pin": "Q"}`.
-fn input(
-    j: &Json,
-    path: &str,
-    network: &str,
-    block: u32,
-    index: &HashMap<u32, BlockId>,
-    drafts: &[Draft],
-    out_pins: &[Vec<String>],
-) -> Result<Input> {
-    let e = |q: String, k: Invalid| LoadError::fbd(network, Some(block), &q, k);
-    match j {
-        Json::Object(o) => {
-            if let Some(k) = o.keys().find(|k| !["from", "pin"].contains(&k.as_str())) {
-                return Err(e(
-                    format!("{path}.{k}"),
-                    Invalid::UnknownField {
-                        field: k.clone(),
-                        what: "an arc",
-                        allowed: "from, pin".into(),
-                    },
-                ));
-            }
-            let from = o.get("from").ok_or_else(|| {
-                e(
-                    path.to_owned(),
-                    Invalid::MissingField {
-                        field: "from",
-                        what: "an arc",
-                    },
-                )
-            })?;
-            let src = from
-                .as_u64()
-                .filter(|&n| n <= u32::MAX as u64)
-                .ok_or_else(|| {
-                    e(
-                        format!("{path}.from"),
-                        Invalid::Shape {
-                            expected: "a block id",
-                            found: kind_of(from),
-                        },
-                    )
-                })? as u32;
-            let b = *index.get(&src).ok_or_else(|| {
-                e(
-                    format!("{path}.from"),
-                    Invalid::UndefinedBlock {
-                        id: src,
-                        network: network.to_owned(),
-                    },
-                )
-            })?;
-            let pins = &out_pins[b.index()];
-            let opname = drafts[b.index()].op.name().to_owned();
-            let pin = match o.get("pin") {
-                None if pins.is_empty() => {
-                    return Err(e(
-                        format!("{path}.from"),
-                        Invalid::UnknownPin {
-                            op: format!("block {src} ({opname})"),
-                            dir: "output",
-                            pin: "(any)".into(),
-                            pins: "none".into(),
-                        },
-                    ))
-                }
-                None => 0,
-                Some(pj) => {
-                    let pn = string(pj).map_err(|k| e(format!("{path}.pin"), k))?;
-                    pins.iter().position(|x| x == pn).ok_or_else(|| {
-                        e(
-                            format!("{path}.pin"),
-                            Invalid::UnknownPin {
-                                op: format!("block {src} ({opname})"),
-                                dir: "output",
-                                pin: pn.to_owned(),
-                                pins: list_or_none(pins),
-                            },
-                        )
-                    })? as u32
-                }
-            };
-            Ok(Input::Arc { from: b, pin })
-        }
-        Json::String(_) | Json::Number(_) | Json::Bool(_) => Ok(Input::Operand(j.clone())),
-        other => Err(e(
-            path.to_owned(),
-            Invalid::Shape {
-                expected: "an operand or an arc {\"from\": BLOCK}",
-                found: kind_of(other),
-            },
-        )),
-    }
-}
-
-fn conn_is_given(given: usize, i: usize) -> bool {
-    i < given
-}
-
-fn pin_count_text(op: &Op, pins: &[String]) -> String {
-    if matches!(op, Op::Call(_)) {
-        format!("at most {} inputs ({})", pins.len(), list_or_none(pins))
-    } else if op.extensible() {
-        "two or more inputs".into()
-    } else if pins.len() == 1 {
-        format!("one input ({})", pins[0])
-    } else {
-        format!("{} inputs ({})", pins.len(), pins.join(", "))
-    }
-}
-
-fn list_or_none(pins: &[String]) -> String {
-    if pins.is_empty() {
-        "none".into()
-    } else {
-        pins.join(", ")
-    }
-}
-
-pub(crate) fn kind_of(v: &Json) -> String {
-    match v {
-        Json::Null => "null".into(),
-        Json::Bool(b) => format!("boolean {b}"),
-        Json::Number(n) => format!("number {n}"),
-        Json::String(s) => format!("string \"{s}\""),
-        Json::Array(_) => "an array".into(),
-        Json::Object(_) => "an object".into(),
-    }
-}
-
-fn string(v: &Json) -> std::result::Result<&str, Invalid> {
-    v.as_str().ok_or_else(|| Invalid::Shape {
-        expected: "a string",
-        found: kind_of(v),
-    })
-}
-
-/// A name (labels): letters, digits and `_`, not starting with a digit.
-fn name(v: &Json) -> std::result::Result<&str, Invalid> {
-    let s = string(v)?;
-    if valid_name(s) {
-        Ok(s)
-    } else {
-        Err(Invalid::BadName { name: s.to_owned() })
-    }
-}
-
-/// A variable a block writes or runs on; resolved (and refused, with the reason) by the lowering.
-fn var_name(s: &str) -> std::result::Result<String, Invalid> {
-    Ok(s.to_owned())
-}
-
-pub(crate) fn valid_name(s: &str) -> bool {
-    let mut chars = s.chars();
-    matches!(chars.next(), Some(c) if c.is_ascii_alphabetic() || c == '_')
-        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
-}
-
-fn check_keys(
-    o: &Map<String, Json>,
-    allowed: &[&str],
-    what: &'static str,
-    path: &str,
-) -> std::result::Result<(), (String, Invalid)> {
-    match o.keys().find(|k| !allowed.contains(&k.as_str())) {
-        None => Ok(()),
-        Some(k) => Err((
-            format!("{path}.{k}"),
-            Invalid::UnknownField {
-                field: k.clone(),
-                what,
-                allowed: allowed.join(", "),
-            },
-        )),
-    }
 }

@@ -1,0 +1,159 @@
+//! Block inputs and outputs: values of connected inputs (arcs, variables, constants) typed
+//! on use, the variables an output is written to, hidden temps for outputs arcs read.
+
+use super::{var_op, Cx, Net, Result, Val};
+use crate::fbd::model::*;
+use crate::model::*;
+use crate::read::operand::{self, Untyped};
+use crate::read::{Invalid, LoadError};
+
+impl Cx<'_> {
+    pub(super) fn val(
+        &self,
+        nx: &Net,
+        input: &Input,
+        path: &str,
+        block: Option<u32>,
+    ) -> Result<Val> {
+        match input {
+            Input::Arc { from, pin } => {
+                let src = nx.net.block(*from);
+                let (o, t) = nx.values[from.index()][*pin as usize]
+                    .expect("arcs come from blocks lowered earlier");
+                Ok(Val::Typed(
+                    o,
+                    t,
+                    format!("{}.{}", src.id, src.outputs[*pin as usize].name),
+                ))
+            }
+            Input::Operand(j) => {
+                let env = &*self.env;
+                let u = operand::parse(j, &|n| env.lookup(n))
+                    .map_err(|k| LoadError::fbd(&nx.net.id, block, path, k))?;
+                let text = match j {
+                    serde_json::Value::String(s) => s.clone(),
+                    other => other.to_string(),
+                };
+                Ok(match u {
+                    Untyped::Var(r, t) => Val::Typed(Operand::Var(r), t, text),
+                    other => Val::Const(other, text),
+                })
+            }
+        }
+    }
+
+    pub(super) fn coerce(
+        &self,
+        nx: &Net,
+        v: &Val,
+        ty: Type,
+        what: &'static str,
+        path: &str,
+        block: Option<u32>,
+    ) -> Result<Operand> {
+        let e = |k| LoadError::fbd(&nx.net.id, block, path, k);
+        match v {
+            Val::Typed(o, t, text) if *t != ty => {
+                let _ = o;
+                Err(e(Invalid::Type {
+                    what,
+                    expected: ty.to_string(),
+                    operand: text.clone(),
+                    found: t.to_string(),
+                }))
+            }
+            Val::Typed(o, _, _) => Ok(*o),
+            Val::Const(u, text) => operand::typed(u, ty, what, text).map_err(e),
+        }
+    }
+
+    pub(super) fn bool_input(
+        &self,
+        nx: &mut Net,
+        block: Option<u32>,
+        input: &Input,
+        path: &str,
+        what: &'static str,
+    ) -> Result<Operand> {
+        let v = self.val(nx, input, path, block)?;
+        self.coerce(nx, &v, Type::Bool, what, path, block)
+    }
+
+    /// The variables output pin `pin` of `b` is written to, type-checked against `ty`.
+    pub(super) fn out_vars(
+        &self,
+        nx: &Net,
+        b: BlockId,
+        pin: usize,
+        ty: Option<Type>,
+    ) -> Result<Vec<VarId>> {
+        let blk = nx.net.block(b);
+        let mut out = Vec::new();
+        for (name, path) in &blk.outputs[pin].vars {
+            let e = |k| LoadError::fbd(&nx.net.id, Some(blk.id), path, k);
+            let v = self.env.writable(name, "a block output").map_err(e)?;
+            let vt = self.env.var(v).ty;
+            if let Some(ty) = ty {
+                if vt != ty {
+                    return Err(e(Invalid::Type {
+                        what: "a block output",
+                        expected: ty.to_string(),
+                        operand: name.clone(),
+                        found: vt.to_string(),
+                    }));
+                }
+            }
+            out.push(v);
+        }
+        Ok(out)
+    }
+
+    /// A hidden temp `_<block>_<pin>` for output `pin` of `b`, which arcs read from now on.
+    pub(super) fn temp(&mut self, nx: &mut Net, b: BlockId, pin: usize, ty: Type) -> Result<VarId> {
+        let blk = nx.net.block(b);
+        let name = format!(
+            "{}_{}_{}",
+            self.names.var_prefix, blk.id, blk.outputs[pin].name
+        );
+        let t = self
+            .env
+            .hidden(name, ty)
+            .map_err(|k| LoadError::fbd(&nx.net.id, Some(blk.id), &blk.path, k))?;
+        nx.values[b.index()][pin] = Some((var_op(t), ty));
+        Ok(t)
+    }
+
+    /// Where a function-like block computes output `pin`: a temp when an arc reads it, when no
+    /// variable takes it, or when the first variable is also an input of a block computed in
+    /// several steps (`avoid`); otherwise the first variable. Returns it and the other variables.
+    pub(super) fn dest(
+        &mut self,
+        nx: &mut Net,
+        b: BlockId,
+        pin: usize,
+        ty: Type,
+        avoid: &[Operand],
+    ) -> Result<(VarId, Vec<VarId>)> {
+        let vars = self.out_vars(nx, b, pin, Some(ty))?;
+        let aliased = |v: VarId| avoid.iter().any(|o| o.var() == Some(v));
+        if nx.used[b.index()][pin] || vars.is_empty() || aliased(vars[0]) {
+            let t = self.temp(nx, b, pin, ty)?;
+            Ok((t, vars))
+        } else {
+            Ok((vars[0], vars[1..].to_vec()))
+        }
+    }
+
+    pub(super) fn typed_all(
+        &self,
+        nx: &Net,
+        vals: &[(Val, &str)],
+        ty: Type,
+        what: &'static str,
+        id: Option<u32>,
+    ) -> Result<Vec<Operand>> {
+        vals.iter()
+            .map(|(v, p)| self.coerce(nx, v, ty, what, p, id))
+            .collect()
+    }
+}

@@ -1,0 +1,232 @@
+//! Name resolution and operand typing: variables (locals first, then program variables),
+//! members of function block instances, writable targets, typed operands and instances.
+
+use super::elements::Scope;
+use super::util::{display_json, expect_type, string};
+use super::{Builder, Result};
+use crate::model::*;
+use crate::read::error::{Invalid, LoadError};
+use crate::read::operand::{self, Untyped};
+use serde_json::Value as Json;
+
+impl<'a> Builder<'a> {
+    /// A name a block or element writes, in the scope of `pou`: not an input, not a field, not
+    /// a member or an instance.
+    pub(super) fn writable_name(
+        &self,
+        text: &str,
+        pou: PouId,
+        what: &'static str,
+    ) -> std::result::Result<VarId, Invalid> {
+        let (r, t) = self.lookup(text, pou)?;
+        let var = &self.vars[r.var.index()];
+        let fail = |why| {
+            Err(Invalid::NotWritable {
+                what,
+                var: text.to_owned(),
+                why,
+            })
+        };
+        if r.field.is_some() {
+            return fail("instance fields are written only by their function block");
+        }
+        if text.contains('.') {
+            return fail("it belongs to a function block instance (only the instance writes it)");
+        }
+        if var.class == VarClass::Input {
+            return fail("it is an input (inputs are written by the scan, not the program)");
+        }
+        if matches!(t, Type::Fb(_)) {
+            return fail("it is a function block instance");
+        }
+        Ok(r.var)
+    }
+
+    /// A member (input or output) of user function block instance `i`, read as `G1.NAME`.
+    pub(super) fn member(
+        &self,
+        i: usize,
+        base: &str,
+        field: Option<&str>,
+    ) -> std::result::Result<(VarRef, Type), Invalid> {
+        let inst = &self.instances[i];
+        let Some(f) = field else {
+            return Err(Invalid::InstanceValue {
+                name: base.to_owned(),
+            });
+        };
+        match inst
+            .inputs
+            .iter()
+            .chain(&inst.outputs)
+            .find(|(n, _)| n == f)
+        {
+            Some(&(_, v)) => Ok((
+                VarRef {
+                    var: v,
+                    field: None,
+                },
+                self.vars[v.index()].ty,
+            )),
+            None => Err(Invalid::UnknownMember {
+                instance: base.to_owned(),
+                fb: inst.fb.clone(),
+                member: f.to_owned(),
+                members: inst
+                    .inputs
+                    .iter()
+                    .chain(&inst.outputs)
+                    .map(|(n, _)| n.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            }),
+        }
+    }
+
+    pub(super) fn lookup(
+        &self,
+        text: &str,
+        pou: PouId,
+    ) -> std::result::Result<(VarRef, Type), Invalid> {
+        let (base, field) = match text.split_once('.') {
+            Some((b, f)) => (b, Some(f)),
+            None => (text, None),
+        };
+        let id = match self.locals[pou.index()].get(base) {
+            Some(&id) => id,
+            None => {
+                if let Some(&i) = self.local_instances[pou.index()].get(base) {
+                    return self.member(i, base, field);
+                }
+                match self.globals.get(base) {
+                    Some(&id) => id,
+                    None => match self.global_instances.get(base) {
+                        Some(&i) => return self.member(i, base, field),
+                        None => {
+                            return Err(Invalid::UndefinedVar {
+                                name: base.to_owned(),
+                            })
+                        }
+                    },
+                }
+            }
+        };
+        operand::field_ref(id, text, self.vars[id.index()].ty, field)
+    }
+
+    pub(super) fn var_ref(&self, v: &Json, path: &str, s: &Scope) -> Result<(VarRef, Type)> {
+        let text = string(v, path, Some(s.rung_id))?;
+        self.lookup(text, s.pou)
+            .map_err(|k| LoadError::invalid(Some(s.rung_id), path, k))
+    }
+
+    pub(super) fn untyped(&self, v: &Json, path: &str, s: &Scope) -> Result<Untyped> {
+        operand::parse(v, &|n| self.lookup(n, s.pou))
+            .map_err(|k| LoadError::invalid(Some(s.rung_id), path, k))
+    }
+
+    pub(super) fn operand_of(
+        &self,
+        v: &Json,
+        path: &str,
+        s: &Scope,
+        ty: Type,
+        what: &'static str,
+    ) -> Result<Operand> {
+        let u = self.untyped(v, path, s)?;
+        operand::typed(&u, ty, what, &display_json(v))
+            .map_err(|k| LoadError::invalid(Some(s.rung_id), path, k))
+    }
+
+    /// Two operands of one numeric type (the type of whichever fixes one).
+    pub(super) fn numeric_pair(
+        &self,
+        a: &Json,
+        b: &Json,
+        path: &str,
+        s: &Scope,
+        what: &'static str,
+        accept: fn(Type) -> bool,
+    ) -> Result<(Operand, Operand)> {
+        let (pa, pb) = (format!("{path}.a"), format!("{path}.b"));
+        let ua = self.untyped(a, &pa, s)?;
+        let ub = self.untyped(b, &pb, s)?;
+        let ty = ua
+            .ty()
+            .or(ub.ty())
+            .unwrap_or_else(|| operand::default_type(&ua).max_numeric(operand::default_type(&ub)));
+        if !ty.is_numeric() || !accept(ty) {
+            let (p, j) = if ua.ty().is_some() {
+                (&pa, a)
+            } else {
+                (&pb, b)
+            };
+            return Err(LoadError::invalid(
+                Some(s.rung_id),
+                p,
+                Invalid::Type {
+                    what,
+                    expected: "INT, DINT, REAL or TIME".into(),
+                    operand: display_json(j),
+                    found: ty.to_string(),
+                },
+            ));
+        }
+        let oa = operand::typed(&ua, ty, what, &display_json(a))
+            .map_err(|k| LoadError::invalid(Some(s.rung_id), &pa, k))?;
+        let ob = operand::typed(&ub, ty, what, &display_json(b))
+            .map_err(|k| LoadError::invalid(Some(s.rung_id), &pb, k))?;
+        Ok((oa, ob))
+    }
+
+    /// A variable that an element writes: not an input, not a field, of type `ty` if given.
+    pub(super) fn writable(
+        &self,
+        v: &Json,
+        path: &str,
+        s: &Scope,
+        what: &'static str,
+        ty: Option<Type>,
+    ) -> Result<VarId> {
+        let text = string(v, path, Some(s.rung_id))?;
+        let id = self
+            .writable_name(text, s.pou, what)
+            .map_err(|k| LoadError::invalid(Some(s.rung_id), path, k))?;
+        let var = &self.vars[id.index()];
+        if let Some(ty) = ty {
+            expect_type(var.ty, ty, what, &var.name)
+                .map_err(|k| LoadError::invalid(Some(s.rung_id), path, k))?;
+        }
+        Ok(id)
+    }
+
+    pub(super) fn instance(&self, v: &Json, path: &str, s: &Scope, fb: FbKind) -> Result<VarId> {
+        let (r, t) = self.var_ref(v, path, s)?;
+        if r.field.is_some() || t != Type::Fb(fb) {
+            return Err(LoadError::invalid(
+                Some(s.rung_id),
+                path,
+                Invalid::Type {
+                    what: "this box",
+                    expected: format!("a {} instance", Type::Fb(fb)),
+                    operand: display_json(v),
+                    found: t.to_string(),
+                },
+            ));
+        }
+        Ok(r.var)
+    }
+}
+
+trait MaxNumeric {
+    fn max_numeric(self, other: Type) -> Type;
+}
+impl MaxNumeric for Type {
+    fn max_numeric(self, other: Type) -> Type {
+        if self == Type::Real || other == Type::Real {
+            Type::Real
+        } else {
+            self
+        }
+    }
+}
