@@ -11,6 +11,7 @@ pub(crate) mod operand;
 mod structure;
 
 pub use error::{Invalid, LoadError, Location};
+pub(crate) use json::kind_of;
 pub use json::{program_and_fbd_from_value, program_from_value};
 
 use crate::model::Program;

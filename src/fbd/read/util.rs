@@ -29,16 +29,8 @@ pub(super) fn list_or_none(pins: &[String]) -> String {
     }
 }
 
-pub(crate) fn kind_of(v: &Json) -> String {
-    match v {
-        Json::Null => "null".into(),
-        Json::Bool(b) => format!("boolean {b}"),
-        Json::Number(n) => format!("number {n}"),
-        Json::String(s) => format!("string \"{s}\""),
-        Json::Array(_) => "an array".into(),
-        Json::Object(_) => "an object".into(),
-    }
-}
+/// The ladder reader's description of a JSON value's kind, shared so both readers say the same.
+pub(crate) use crate::read::kind_of;
 
 pub(super) fn string(v: &Json) -> std::result::Result<&str, Invalid> {
     v.as_str().ok_or_else(|| Invalid::Shape {
