@@ -149,11 +149,15 @@ fn paper_control_view(p: &Program, control: &[ControlDependence]) -> Vec<PaperCo
         .filter(|d| d.controller < n && d.dependent < n)
         .map(|d| PaperControl { from: RungId(d.controller), to: RungId(d.dependent), cause: ControlCause::Branch { edge: d.edge } })
         .collect();
-    // Box rungs per instance, in order; then each field read pairs with earlier box rungs.
-    let mut boxes: Vec<Vec<RungId>> = vec![Vec::new(); p.vars.len()];
+    // Box rungs per instance (a linked list, newest first, in one flat array: most variables are
+    // not instances); then each field read pairs with the earlier box rungs.
+    let mut last_box: Vec<u32> = vec![u32::MAX; p.vars.len()];
+    let mut box_nodes: Vec<(RungId, u32)> = Vec::new();
+    let mut field_reads: Vec<VarId> = Vec::new();
+    let mut own_boxes: Vec<VarId> = Vec::new();
     for r in p.rung_ids() {
-        let mut field_reads: Vec<VarId> = Vec::new();
-        let mut own_boxes: Vec<VarId> = Vec::new();
+        field_reads.clear();
+        own_boxes.clear();
         walk_elements(&p.rung(r).series, &mut |e| match e {
             Element::Timer { instance, .. } | Element::Ctu { instance, .. } | Element::Ctd { instance, .. } => own_boxes.push(*instance),
             Element::Contact { var, .. } if var.field.is_some() => field_reads.push(var.var),
@@ -178,13 +182,18 @@ fn paper_control_view(p: &Program, control: &[ControlDependence]) -> Vec<PaperCo
         field_reads.sort_unstable();
         field_reads.dedup();
         for &v in &field_reads {
-            for &s in &boxes[v.index()] {
+            let mut node = last_box[v.index()];
+            while node != u32::MAX {
+                let (s, next) = box_nodes[node as usize];
                 out.push(PaperControl { from: s, to: r, cause: ControlCause::Instance { var: v } });
+                node = next;
             }
         }
-        for v in own_boxes {
-            if boxes[v.index()].last() != Some(&r) {
-                boxes[v.index()].push(r);
+        for &v in &own_boxes {
+            let head = last_box[v.index()];
+            if head == u32::MAX || box_nodes[head as usize].0 != r {
+                box_nodes.push((r, head));
+                last_box[v.index()] = box_nodes.len() as u32 - 1;
             }
         }
     }
