@@ -15,7 +15,15 @@ use plc_deps::model::Program;
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 fn program(rungs: usize) -> Program {
-    let config = GenConfig { rungs, width: 1000, seed: 42, timers: true, loops: true, jumps: true, calls: false };
+    let config = GenConfig {
+        rungs,
+        width: 1000,
+        seed: 42,
+        timers: true,
+        loops: true,
+        jumps: true,
+        calls: false,
+    };
     plc_deps::read::program_from_json(&generate_string(&config)).expect("generated programs load")
 }
 
@@ -24,7 +32,9 @@ fn analysis(c: &mut Criterion) {
     group.sample_size(10);
     for rungs in [100_000usize, 1_000_000] {
         let p = program(rungs);
-        group.bench_with_input(BenchmarkId::from_parameter(rungs), &p, |b, p| b.iter(|| analyse(p)));
+        group.bench_with_input(BenchmarkId::from_parameter(rungs), &p, |b, p| {
+            b.iter(|| analyse(p))
+        });
     }
     group.finish();
 }
@@ -35,9 +45,16 @@ fn dependences_vs_pairwise(c: &mut Criterion) {
     let mut group = c.benchmark_group("data dependences 20k rungs");
     group.sample_size(10);
     group.bench_function("per variable (pairs + levels)", |b| {
-        b.iter(|| (data_dependences(&acc.reads, &acc.writes), data_levels(&acc.reads, &acc.writes)))
+        b.iter(|| {
+            (
+                data_dependences(&acc.reads, &acc.writes),
+                data_levels(&acc.reads, &acc.writes),
+            )
+        })
     });
-    group.bench_function("pairwise definition", |b| b.iter(|| data_dependences_pairwise(&acc.reads, &acc.writes)));
+    group.bench_function("pairwise definition", |b| {
+        b.iter(|| data_dependences_pairwise(&acc.reads, &acc.writes))
+    });
     group.finish();
 }
 

@@ -11,6 +11,10 @@ fn main() {
     for _ in 0..n {
         let t = std::time::Instant::now();
         let a = plc_deps::analysis::analyse(&p);
-        eprintln!("analyse: {:?} ({} levels)", t.elapsed(), a.schedule.levels.len());
+        eprintln!(
+            "analyse: {:?} ({} levels)",
+            t.elapsed(),
+            a.schedule.levels.len()
+        );
     }
 }

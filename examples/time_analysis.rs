@@ -34,9 +34,18 @@ fn main() {
     eprintln!("control dependences: {:?} ({})", t.elapsed(), cd.len());
     let t = Instant::now();
     let s = combined_schedule(&p, &cfg, &acc);
-    eprintln!("combined schedule: {:?} ({} levels)", t.elapsed(), s.levels.len());
+    eprintln!(
+        "combined schedule: {:?} ({} levels)",
+        t.elapsed(),
+        s.levels.len()
+    );
     eprintln!("steps total: {:?}", all.elapsed());
     let t = Instant::now();
     let a = analyse(&p);
-    eprintln!("analyse: {:?} ({} data deps, {} levels combined)", t.elapsed(), a.data.len(), a.schedule.levels.len());
+    eprintln!(
+        "analyse: {:?} ({} data deps, {} levels combined)",
+        t.elapsed(),
+        a.data.len(),
+        a.schedule.levels.len()
+    );
 }

@@ -38,8 +38,14 @@ impl CliError {
 
 /// Reads and checks a program file.
 pub fn load_program(path: &Path) -> Result<Program, CliError> {
-    let text = std::fs::read_to_string(path).map_err(|e| CliError::Io { path: path.display().to_string(), message: e.to_string() })?;
-    program_from_json(&text).map_err(|error| CliError::Load { file: path.display().to_string(), error })
+    let text = std::fs::read_to_string(path).map_err(|e| CliError::Io {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    })?;
+    program_from_json(&text).map_err(|error| CliError::Load {
+        file: path.display().to_string(),
+        error,
+    })
 }
 
 /// Writes `contents` to `out` (atomically) or to standard output.
@@ -50,7 +56,10 @@ pub fn write_output(out: Option<&Path>, contents: &str) -> Result<(), CliError> 
 /// Streams output produced by `write` to `out` or to standard output. A file is written under a
 /// temporary name beside `out` and renamed into place only when `write` succeeded, so a failure
 /// never leaves a partial file.
-pub fn write_output_with(out: Option<&Path>, write: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>) -> Result<(), CliError> {
+pub fn write_output_with(
+    out: Option<&Path>,
+    write: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>,
+) -> Result<(), CliError> {
     use std::io::Write;
     match out {
         None => {
@@ -60,9 +69,18 @@ pub fn write_output_with(out: Option<&Path>, write: impl FnOnce(&mut dyn std::io
             Ok(())
         }
         Some(path) => {
-            let io = |e: std::io::Error| CliError::Io { path: path.display().to_string(), message: e.to_string() };
+            let io = |e: std::io::Error| CliError::Io {
+                path: path.display().to_string(),
+                message: e.to_string(),
+            };
             let mut tmp: PathBuf = path.to_path_buf();
-            let name = format!(".{}.tmp-{}", path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default(), std::process::id());
+            let name = format!(
+                ".{}.tmp-{}",
+                path.file_name()
+                    .map(|n| n.to_string_lossy().into_owned())
+                    .unwrap_or_default(),
+                std::process::id()
+            );
             tmp.set_file_name(name);
             let result = std::fs::File::create(&tmp).and_then(|f| {
                 let mut w = std::io::BufWriter::new(f);
@@ -143,8 +161,15 @@ pub fn render_order(p: &Program, fbd: &crate::fbd::Fbd, format: OrderFormat) -> 
 /// a fragment-rule violation is a load error naming the blocks (exit code 2).
 pub fn order(c: &OrderConfig) -> Result<(), CliError> {
     let path = &c.input;
-    let text = std::fs::read_to_string(path).map_err(|e| CliError::Io { path: path.display().to_string(), message: e.to_string() })?;
-    let (p, fbd) = crate::read::program_and_fbd_from_json(&text).map_err(|error| CliError::Load { file: path.display().to_string(), error })?;
+    let text = std::fs::read_to_string(path).map_err(|e| CliError::Io {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    })?;
+    let (p, fbd) =
+        crate::read::program_and_fbd_from_json(&text).map_err(|error| CliError::Load {
+            file: path.display().to_string(),
+            error,
+        })?;
     write_output(c.output.as_deref(), &render_order(&p, &fbd, c.format))
 }
 

@@ -150,7 +150,12 @@ enum ViewArg {
 
 fn run(cli: Cli) -> Result<(), CliError> {
     match cli.command {
-        Command::Report { file, format, view, output } => {
+        Command::Report {
+            file,
+            format,
+            view,
+            output,
+        } => {
             let config = ReportConfig {
                 input: file,
                 format: match format {
@@ -167,23 +172,65 @@ fn run(cli: Cli) -> Result<(), CliError> {
             };
             app::report(&config)
         }
-        Command::Order { file, format, output } => {
+        Command::Order {
+            file,
+            format,
+            output,
+        } => {
             let format = match format {
                 FormatArg::Text => app::OrderFormat::Text,
                 FormatArg::Json => app::OrderFormat::Json,
                 FormatArg::Dot => app::OrderFormat::Dot,
             };
-            app::order(&app::OrderConfig { input: file, format, output })
+            app::order(&app::OrderConfig {
+                input: file,
+                format,
+                output,
+            })
         }
         Command::Schema { output } => app::write_output(output.as_deref(), app::PROGRAM_SCHEMA),
-        Command::Gen { rungs, width, seed, timers, loops, jumps, calls, output } => {
+        Command::Gen {
+            rungs,
+            width,
+            seed,
+            timers,
+            loops,
+            jumps,
+            calls,
+            output,
+        } => {
             if rungs == 0 || width == 0 {
-                return Err(CliError::Usage("--rungs and --width must be at least 1".into()));
+                return Err(CliError::Usage(
+                    "--rungs and --width must be at least 1".into(),
+                ));
             }
-            let config = plc_deps::gen::GenConfig { rungs, width, seed, timers, loops, jumps, calls };
-            app::write_output_with(output.as_deref(), |w| plc_deps::gen::write_program(&config, w))
+            let config = plc_deps::gen::GenConfig {
+                rungs,
+                width,
+                seed,
+                timers,
+                loops,
+                jumps,
+                calls,
+            };
+            app::write_output_with(output.as_deref(), |w| {
+                plc_deps::gen::write_program(&config, w)
+            })
         }
-        Command::Run { file, scans, inputs, cycle, threads, mode, trace, trace_vars, format, explain, loop_cap, output } => {
+        Command::Run {
+            file,
+            scans,
+            inputs,
+            cycle,
+            threads,
+            mode,
+            trace,
+            trace_vars,
+            format,
+            explain,
+            loop_cap,
+            output,
+        } => {
             use plc_deps::runcmd::{self, RunConfig, RunFormat, RunMode};
             let mut config = RunConfig::new(file);
             config.scans = scans;

@@ -32,7 +32,11 @@ fn check(path: &Path, actual: &str, failures: &mut Vec<String>) {
     }
     let expected = std::fs::read_to_string(path).unwrap_or_default();
     if expected != actual {
-        let line = expected.lines().zip(actual.lines()).position(|(a, b)| a != b).unwrap_or_else(|| expected.lines().count().min(actual.lines().count()));
+        let line = expected
+            .lines()
+            .zip(actual.lines())
+            .position(|(a, b)| a != b)
+            .unwrap_or_else(|| expected.lines().count().min(actual.lines().count()));
         failures.push(format!(
             "{} differs at line {}:\n  committed: {:?}\n  now:       {:?}",
             path.display(),
@@ -46,19 +50,39 @@ fn check(path: &Path, actual: &str, failures: &mut Vec<String>) {
 #[test]
 fn every_worked_example_matches_its_committed_reports() {
     let dirs = examples();
-    assert!(dirs.len() >= 5, "expected the worked examples in analyses/, found {}", dirs.len());
+    assert!(
+        dirs.len() >= 5,
+        "expected the worked examples in analyses/, found {}",
+        dirs.len()
+    );
     let mut failures = Vec::new();
     let mut runs = 0;
     for dir in dirs {
         let text = std::fs::read_to_string(dir.join("program.json")).expect("read program");
         let program = program_from_json(&text).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
-        check(&dir.join("report.txt"), &render_report(&program, ReportFormat::Text, View::All), &mut failures);
-        check(&dir.join("report.json"), &render_report(&program, ReportFormat::Json, View::All), &mut failures);
+        check(
+            &dir.join("report.txt"),
+            &render_report(&program, ReportFormat::Text, View::All),
+            &mut failures,
+        );
+        check(
+            &dir.join("report.json"),
+            &render_report(&program, ReportFormat::Json, View::All),
+            &mut failures,
+        );
         let (_, fbd) = plc_deps::read::program_and_fbd_from_json(&text).expect("loaded above");
         if !fbd.pous.is_empty() {
             // FBD examples also commit `plc-deps order` (text and JSON).
-            check(&dir.join("order.txt"), &plc_deps::app::render_order(&program, &fbd, plc_deps::app::OrderFormat::Text), &mut failures);
-            check(&dir.join("order.json"), &plc_deps::app::render_order(&program, &fbd, plc_deps::app::OrderFormat::Json), &mut failures);
+            check(
+                &dir.join("order.txt"),
+                &plc_deps::app::render_order(&program, &fbd, plc_deps::app::OrderFormat::Text),
+                &mut failures,
+            );
+            check(
+                &dir.join("order.json"),
+                &plc_deps::app::render_order(&program, &fbd, plc_deps::app::OrderFormat::Json),
+                &mut failures,
+            );
         }
         {
             runs += 1;
@@ -74,12 +98,26 @@ fn every_worked_example_matches_its_committed_reports() {
             }
             c.threads = 2;
             c.mode = plc_deps::runcmd::RunMode::Both;
-            let run = plc_deps::runcmd::run_json_deterministic(&c).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
+            let run = plc_deps::runcmd::run_json_deterministic(&c)
+                .unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
             let doc: serde_json::Value = serde_json::from_str(&run).expect("run JSON");
-            assert_eq!(doc["identical"], true, "{}: {}", dir.display(), doc["first_difference"]);
+            assert_eq!(
+                doc["identical"],
+                true,
+                "{}: {}",
+                dir.display(),
+                doc["first_difference"]
+            );
             check(&dir.join("run.json"), &run, &mut failures);
         }
     }
-    assert!(runs >= 11, "expected every worked example to run, found {runs}");
-    assert!(failures.is_empty(), "{}\n(re-bless with UPDATE_EXPECT=1 if the change is intended)", failures.join("\n"));
+    assert!(
+        runs >= 11,
+        "expected every worked example to run, found {runs}"
+    );
+    assert!(
+        failures.is_empty(),
+        "{}\n(re-bless with UPDATE_EXPECT=1 if the change is intended)",
+        failures.join("\n")
+    );
 }

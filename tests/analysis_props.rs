@@ -6,19 +6,30 @@
 mod common;
 
 use plc_deps::analysis::accesses::VarSets;
-use plc_deps::analysis::{analyse, control_dependences, data_dependences, data_levels, post_dominators};
 use plc_deps::analysis::dependences::data_dependences_pairwise;
 use plc_deps::analysis::levels::asap_levels;
+use plc_deps::analysis::{
+    analyse, control_dependences, data_dependences, data_levels, post_dominators,
+};
 use plc_deps::model::VarId;
 use proptest::prelude::*;
 
 fn var_sets() -> impl Strategy<Value = (VarSets, VarSets)> {
     (1usize..40).prop_flat_map(|n| {
         let set = proptest::collection::vec(0u32..8, 0..4);
-        (proptest::collection::vec(set.clone(), n), proptest::collection::vec(set, n)).prop_map(|(r, w)| {
-            let f = |l: Vec<Vec<u32>>| VarSets::from_lists(l.into_iter().map(|s| s.into_iter().map(VarId).collect::<Vec<_>>()));
-            (f(r), f(w))
-        })
+        (
+            proptest::collection::vec(set.clone(), n),
+            proptest::collection::vec(set, n),
+        )
+            .prop_map(|(r, w)| {
+                let f = |l: Vec<Vec<u32>>| {
+                    VarSets::from_lists(
+                        l.into_iter()
+                            .map(|s| s.into_iter().map(VarId).collect::<Vec<_>>()),
+                    )
+                };
+                (f(r), f(w))
+            })
     })
 }
 
@@ -114,15 +125,25 @@ proptest! {
 
 /// Checks the combined schedule's safety conditions pairwise on one program.
 fn check_schedule(text: &str) -> Result<bool, TestCaseError> {
-    let Ok(p) = plc_deps::read::program_from_json(text) else { return Ok(false) };
+    let Ok(p) = plc_deps::read::program_from_json(text) else {
+        return Ok(false);
+    };
     let a = analyse(&p);
     let s = &a.schedule;
     let task_acc: Vec<(Vec<VarId>, Vec<VarId>)> = s
         .tasks
         .iter()
         .map(|t| {
-            let mut r: Vec<VarId> = t.rungs.iter().flat_map(|&x| a.accesses.ins(x).iter().copied()).collect();
-            let mut w: Vec<VarId> = t.rungs.iter().flat_map(|&x| a.accesses.outs(x).iter().copied()).collect();
+            let mut r: Vec<VarId> = t
+                .rungs
+                .iter()
+                .flat_map(|&x| a.accesses.ins(x).iter().copied())
+                .collect();
+            let mut w: Vec<VarId> = t
+                .rungs
+                .iter()
+                .flat_map(|&x| a.accesses.outs(x).iter().copied())
+                .collect();
             r.sort();
             w.sort();
             (r, w)
@@ -134,7 +155,12 @@ fn check_schedule(text: &str) -> Result<bool, TestCaseError> {
             let (ri, wi) = &task_acc[i];
             let (rj, wj) = &task_acc[j];
             if meets(wi, rj) || meets(ri, wj) || meets(wi, wj) {
-                prop_assert!(s.tasks[i].level < s.tasks[j].level, "tasks {:?} and {:?} conflict but are not ordered", s.tasks[i].rungs, s.tasks[j].rungs);
+                prop_assert!(
+                    s.tasks[i].level < s.tasks[j].level,
+                    "tasks {:?} and {:?} conflict but are not ordered",
+                    s.tasks[i].rungs,
+                    s.tasks[j].rungs
+                );
             }
         }
         for g in &s.tasks[j].guard {
@@ -152,14 +178,21 @@ fn check_schedule(text: &str) -> Result<bool, TestCaseError> {
     for e in &a.cfg.edges {
         if main.contains(&e.from) && main.contains(&e.to) {
             if let (Some(x), Some(y)) = (s.task_of[e.from as usize], s.task_of[e.to as usize]) {
-                prop_assert!(x <= y, "edge {} → {} goes backwards between tasks", e.from, e.to);
+                prop_assert!(
+                    x <= y,
+                    "edge {} → {} goes backwards between tasks",
+                    e.from,
+                    e.to
+                );
             }
         }
     }
     // Levels are ASAP: every task above level 0 has a predecessor exactly one level below.
     for (t, task) in s.tasks.iter().enumerate() {
         if task.level > 0 {
-            prop_assert!(s.preds[t].iter().any(|&q| s.tasks[q as usize].level + 1 == task.level));
+            prop_assert!(s.preds[t]
+                .iter()
+                .any(|&q| s.tasks[q as usize].level + 1 == task.level));
         }
     }
     Ok(true)

@@ -17,7 +17,11 @@ fn root() -> PathBuf {
 }
 
 fn run(args: &[&str]) -> Output {
-    bin().current_dir(root()).args(args).output().expect("run plc-deps")
+    bin()
+        .current_dir(root())
+        .args(args)
+        .output()
+        .expect("run plc-deps")
 }
 
 fn tmp(name: &str) -> PathBuf {
@@ -37,8 +41,16 @@ fn every_bad_program_gives_one_located_error_and_exit_code_2() {
     assert!(cases.len() >= 15);
     let mut failures = Vec::new();
     for case in cases {
-        let rel = case.strip_prefix(root()).unwrap().to_str().unwrap().to_owned();
-        let out_file = tmp(&format!("{}.txt", case.file_stem().unwrap().to_str().unwrap()));
+        let rel = case
+            .strip_prefix(root())
+            .unwrap()
+            .to_str()
+            .unwrap()
+            .to_owned();
+        let out_file = tmp(&format!(
+            "{}.txt",
+            case.file_stem().unwrap().to_str().unwrap()
+        ));
         let out = run(&["report", &rel, "-o", out_file.to_str().unwrap()]);
         let stderr = String::from_utf8(out.stderr).unwrap();
         assert_eq!(out.status.code(), Some(2), "{rel}: {stderr}");
@@ -67,18 +79,46 @@ fn missing_file_is_an_io_error() {
 #[test]
 fn report_writes_the_output_file_whole() {
     let out_file = tmp("example-b.json");
-    let out = run(&["report", "analyses/example-b/program.json", "--format", "json", "-o", out_file.to_str().unwrap()]);
+    let out = run(&[
+        "report",
+        "analyses/example-b/program.json",
+        "--format",
+        "json",
+        "-o",
+        out_file.to_str().unwrap(),
+    ]);
     assert!(out.status.success());
     assert!(out.stdout.is_empty());
     let written = std::fs::read_to_string(&out_file).unwrap();
-    assert_eq!(written, std::fs::read_to_string(root().join("analyses/example-b/report.json")).unwrap());
+    assert_eq!(
+        written,
+        std::fs::read_to_string(root().join("analyses/example-b/report.json")).unwrap()
+    );
 }
 
 #[test]
 fn views_select_what_the_text_shows() {
-    let paper = String::from_utf8(run(&["report", "analyses/example-b/program.json", "--view", "paper"]).stdout).unwrap();
+    let paper = String::from_utf8(
+        run(&[
+            "report",
+            "analyses/example-b/program.json",
+            "--view",
+            "paper",
+        ])
+        .stdout,
+    )
+    .unwrap();
     assert!(paper.contains("paper control view") && !paper.contains("combined (correct)"));
-    let combined = String::from_utf8(run(&["report", "analyses/example-b/program.json", "--view", "combined"]).stdout).unwrap();
+    let combined = String::from_utf8(
+        run(&[
+            "report",
+            "analyses/example-b/program.json",
+            "--view",
+            "combined",
+        ])
+        .stdout,
+    )
+    .unwrap();
     assert!(!combined.contains("paper control view") && combined.contains("combined (correct)"));
 }
 
@@ -93,14 +133,23 @@ fn schema_is_json_and_describes_every_element_kind() {
         .iter()
         .map(|v| v["required"][0].as_str().unwrap().to_owned())
         .collect();
-    for k in ["contact", "compare", "or", "coil", "set", "reset", "branch", "ton", "tof", "tp", "ctu", "ctd", "move", "op", "jmp", "ret", "end", "call", "for", "next"] {
+    for k in [
+        "contact", "compare", "or", "coil", "set", "reset", "branch", "ton", "tof", "tp", "ctu",
+        "ctd", "move", "op", "jmp", "ret", "end", "call", "for", "next",
+    ] {
         assert!(kinds.iter().any(|x| x == k), "schema lacks {k}");
     }
 }
 
 #[test]
 fn dot_renders_with_graphviz_without_warnings() {
-    for example in ["example-a", "example-b", "conveyor", "mixing-station", "packaging-line"] {
+    for example in [
+        "example-a",
+        "example-b",
+        "conveyor",
+        "mixing-station",
+        "packaging-line",
+    ] {
         for view in ["all", "paper"] {
             let program = format!("analyses/{example}/program.json");
             let out = run(&["report", &program, "--format", "dot", "--view", view]);
@@ -116,7 +165,11 @@ fn dot_renders_with_graphviz_without_warnings() {
             dot.stdin.as_ref().unwrap().write_all(&out.stdout).unwrap();
             let res = dot.wait_with_output().unwrap();
             assert!(res.status.success(), "{example}: dot failed");
-            assert!(res.stderr.is_empty(), "{example} ({view}): dot warned: {}", String::from_utf8_lossy(&res.stderr));
+            assert!(
+                res.stderr.is_empty(),
+                "{example} ({view}): dot warned: {}",
+                String::from_utf8_lossy(&res.stderr)
+            );
             assert!(String::from_utf8_lossy(&res.stdout).contains("<svg"));
         }
     }
@@ -125,10 +178,40 @@ fn dot_renders_with_graphviz_without_warnings() {
 #[test]
 fn generated_programs_load_and_report() {
     let file = tmp("gen.json");
-    let out = run(&["gen", "--rungs", "300", "--width", "20", "--seed", "7", "--timers", "--loops", "--jumps", "--calls", "-o", file.to_str().unwrap()]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = run(&[
+        "gen",
+        "--rungs",
+        "300",
+        "--width",
+        "20",
+        "--seed",
+        "7",
+        "--timers",
+        "--loops",
+        "--jumps",
+        "--calls",
+        "-o",
+        file.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let out = run(&["report", file.to_str().unwrap(), "--format", "json"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert_eq!(r["rungs"].as_array().unwrap().iter().filter(|x| !x["pou"].as_str().unwrap().starts_with("SBR")).count(), 300);
+    assert_eq!(
+        r["rungs"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|x| !x["pou"].as_str().unwrap().starts_with("SBR"))
+            .count(),
+        300
+    );
 }

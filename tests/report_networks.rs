@@ -7,23 +7,34 @@ use serde_json::Value;
 use std::collections::BTreeSet;
 
 fn report(name: &str) -> Value {
-    let path = format!("{}/analyses/{name}/program.json", env!("CARGO_MANIFEST_DIR"));
+    let path = format!(
+        "{}/analyses/{name}/program.json",
+        env!("CARGO_MANIFEST_DIR")
+    );
     let p = program_from_json(&std::fs::read_to_string(path).unwrap()).unwrap();
     serde_json::from_str(&render_report(&p, ReportFormat::Json, View::All)).unwrap()
 }
 
 fn names(v: &Value) -> BTreeSet<String> {
-    v.as_array().unwrap().iter().map(|x| x.as_str().unwrap().to_owned()).collect()
+    v.as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_str().unwrap().to_owned())
+        .collect()
 }
 
 #[test]
 fn network_in_out_is_the_union_of_its_blocks() {
     let r = report("example-c");
-    let nets = r["networks"].as_array().expect("FBD programs have networks");
+    let nets = r["networks"]
+        .as_array()
+        .expect("FBD programs have networks");
     let n1 = nets.iter().find(|n| n["id"] == "N1").unwrap();
     let rungs = names(&n1["rungs"]);
     // The network's rungs are its eight blocks plus the fragment guards and landing rungs.
-    for b in ["N1.3", "N1.4", "N1.8", "N1.10", "N1.27", "N1.24", "N1.15", "N1.17"] {
+    for b in [
+        "N1.3", "N1.4", "N1.8", "N1.10", "N1.27", "N1.24", "N1.15", "N1.17",
+    ] {
         assert!(rungs.contains(b), "{b} missing from {rungs:?}");
     }
     let (mut ins, mut outs) = (BTreeSet::new(), BTreeSet::new());

@@ -26,14 +26,23 @@ fn endless_loop_is_a_warning_with_a_sound_tree() {
             ]}"#,
     );
     let warnings = j["warnings"].as_array().unwrap();
-    assert!(warnings.iter().any(|w| w.as_str().unwrap().starts_with("rungs R2, R3 can never reach the end of the scan")), "{warnings:?}");
+    assert!(
+        warnings.iter().any(|w| w
+            .as_str()
+            .unwrap()
+            .starts_with("rungs R2, R3 can never reach the end of the scan")),
+        "{warnings:?}"
+    );
     assert!(text.contains("warning: rungs R2, R3 can never reach the end of the scan"));
     // The tree treats R3 (the loop's last rung) as the loop's exit: R2 → R3 → STOP.
     assert_eq!(j["ipdom"]["R2"], "R3");
     assert_eq!(j["ipdom"]["R3"], "STOP");
     assert_eq!(j["ipdom"]["R1"], "STOP");
     // The loop is one task, guarded by R1's decision; R4 runs only when R1 jumps.
-    assert_eq!(j["levels"]["combined"], json!([["R1"], [["R2", "R3"]], ["R4"]]));
+    assert_eq!(
+        j["levels"]["combined"],
+        json!([["R1"], [["R2", "R3"]], ["R4"]])
+    );
 }
 
 #[test]
@@ -50,7 +59,12 @@ fn unreachable_rungs_and_uncalled_subroutines_are_reported() {
     );
     assert_eq!(j["schedule"]["unreachable"], json!(["R2"]));
     assert_eq!(j["levels"]["combined"], json!([["R1", "R3"]]));
-    let warnings: Vec<&str> = j["warnings"].as_array().unwrap().iter().map(|w| w.as_str().unwrap()).collect();
+    let warnings: Vec<&str> = j["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|w| w.as_str().unwrap())
+        .collect();
     assert_eq!(
         warnings,
         vec![

@@ -25,21 +25,39 @@ fn shipped_and_generated_programs_validate() {
         let path = entry.unwrap().path().join("program.json");
         if path.is_file() {
             let doc = json(&path);
-            let errors: Vec<String> = v.iter_errors(&doc).map(|e| format!("{} at {}", e, e.instance_path())).collect();
+            let errors: Vec<String> = v
+                .iter_errors(&doc)
+                .map(|e| format!("{} at {}", e, e.instance_path()))
+                .collect();
             assert!(errors.is_empty(), "{}: {errors:?}", path.display());
             checked += 1;
         }
     }
     assert!(checked >= 5);
-    let config = plc_deps::gen::GenConfig { rungs: 2000, width: 50, seed: 3, timers: true, loops: true, jumps: true, calls: true };
-    let doc: serde_json::Value = serde_json::from_str(&plc_deps::gen::generate_string(&config)).unwrap();
+    let config = plc_deps::gen::GenConfig {
+        rungs: 2000,
+        width: 50,
+        seed: 3,
+        timers: true,
+        loops: true,
+        jumps: true,
+        calls: true,
+    };
+    let doc: serde_json::Value =
+        serde_json::from_str(&plc_deps::gen::generate_string(&config)).unwrap();
     assert!(v.is_valid(&doc));
 }
 
 #[test]
 fn malformed_shapes_are_rejected_by_the_schema_too() {
     let v = validator();
-    for name in ["unknown-field", "unknown-element", "unknown-type", "not-an-object", "time-needs-literal"] {
+    for name in [
+        "unknown-field",
+        "unknown-element",
+        "unknown-type",
+        "not-an-object",
+        "time-needs-literal",
+    ] {
         let doc = json(&root().join(format!("tests/errors/{name}.json")));
         assert!(!v.is_valid(&doc), "{name} should not validate");
     }

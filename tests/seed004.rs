@@ -6,7 +6,10 @@ use plc_deps::report::View;
 use serde_json::{json, Value};
 
 fn report(name: &str) -> Value {
-    let path = format!("{}/analyses/{name}/program.json", env!("CARGO_MANIFEST_DIR"));
+    let path = format!(
+        "{}/analyses/{name}/program.json",
+        env!("CARGO_MANIFEST_DIR")
+    );
     let p = program_from_json(&std::fs::read_to_string(path).unwrap()).unwrap();
     serde_json::from_str(&render_report(&p, ReportFormat::Json, View::All)).unwrap()
 }
@@ -17,12 +20,19 @@ fn deps(r: &Value, kind: &str) -> Vec<(String, String)> {
         .unwrap()
         .iter()
         .filter(|d| d["kind"] == kind)
-        .map(|d| (d["from"].as_str().unwrap().to_owned(), d["to"].as_str().unwrap().to_owned()))
+        .map(|d| {
+            (
+                d["from"].as_str().unwrap().to_owned(),
+                d["to"].as_str().unwrap().to_owned(),
+            )
+        })
         .collect()
 }
 
 fn pairs(v: &[(&str, &str)]) -> Vec<(String, String)> {
-    v.iter().map(|(a, b)| (a.to_string(), b.to_string())).collect()
+    v.iter()
+        .map(|(a, b)| (a.to_string(), b.to_string()))
+        .collect()
 }
 
 #[test]
@@ -32,11 +42,17 @@ fn example_a_dependences_levels_and_cycles() {
     assert_eq!(deps(&r, "flow"), pairs(&[("R2", "R4"), ("R3", "R4")]));
     assert_eq!(deps(&r, "anti"), pairs(&[]));
     assert_eq!(deps(&r, "control"), pairs(&[]));
-    assert_eq!(r["levels"]["data"], json!([["R1", "R2", "R5"], ["R3"], ["R4"]]));
+    assert_eq!(
+        r["levels"]["data"],
+        json!([["R1", "R2", "R5"], ["R3"], ["R4"]])
+    );
     assert_eq!(r["cycles"]["before"], 5);
     assert_eq!(r["cycles"]["data"], 3);
     // No control flow to respect: the combined schedule is the data view.
-    assert_eq!(r["levels"]["combined"], json!([["R1", "R2", "R5"], ["R3"], ["R4"]]));
+    assert_eq!(
+        r["levels"]["combined"],
+        json!([["R1", "R2", "R5"], ["R3"], ["R4"]])
+    );
 }
 
 #[test]
@@ -50,24 +66,47 @@ fn example_b_ipdoms_control_dependences_levels_and_cycles() {
     assert_eq!(
         deps(&r, "control"),
         pairs(&[
-            ("R1", "R2"), ("R1", "R3"), ("R1", "R4"),
-            ("R3", "R5"), ("R3", "R6"), ("R3", "R7"), ("R3", "R8"),
+            ("R1", "R2"),
+            ("R1", "R3"),
+            ("R1", "R4"),
+            ("R3", "R5"),
+            ("R3", "R6"),
+            ("R3", "R7"),
+            ("R3", "R8"),
             ("R6", "R7"),
-            ("R10", "R11"), ("R10", "R12"),
+            ("R10", "R11"),
+            ("R10", "R12"),
         ])
     );
     assert_eq!(
         r["levels"]["control"],
-        json!([["R1", "R9", "R10"], ["R2", "R3", "R4", "R11", "R12"], ["R5", "R6", "R8"], ["R7"]])
+        json!([
+            ["R1", "R9", "R10"],
+            ["R2", "R3", "R4", "R11", "R12"],
+            ["R5", "R6", "R8"],
+            ["R7"]
+        ])
     );
     assert_eq!(r["cycles"]["before"], 12);
     assert_eq!(r["cycles"]["control"], 4);
     // The correct schedule keeps the loop R3..R8 whole and waits for R1's jump decision.
-    assert_eq!(r["levels"]["combined"], json!([["R1", "R9", "R10"], ["R2", "R4"], [["R3", "R5", "R6", "R7", "R8"]]]));
+    assert_eq!(
+        r["levels"]["combined"],
+        json!([
+            ["R1", "R9", "R10"],
+            ["R2", "R4"],
+            [["R3", "R5", "R6", "R7", "R8"]]
+        ])
+    );
     assert_eq!(r["cycles"]["combined"], 3);
     // CFG edge labels where rungs branch.
     let edges = r["cfg"]["edges"].as_array().unwrap();
-    let labelled = |from: &str, to: &str| edges.iter().find(|e| e["from"] == from && e["to"] == to).map(|e| e["label"].clone());
+    let labelled = |from: &str, to: &str| {
+        edges
+            .iter()
+            .find(|e| e["from"] == from && e["to"] == to)
+            .map(|e| e["label"].clone())
+    };
     assert_eq!(labelled("R1", "R9"), Some(json!("T")));
     assert_eq!(labelled("R1", "R2"), Some(json!("F")));
     assert_eq!(labelled("R3", "R5"), Some(json!("T")));

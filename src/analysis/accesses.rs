@@ -26,7 +26,10 @@ pub struct VarSets {
 impl VarSets {
     /// Builds from one list per unit (each is sorted and deduplicated here).
     pub fn from_lists<I: IntoIterator<Item = Vec<VarId>>>(lists: I) -> VarSets {
-        let mut s = VarSets { offsets: vec![0], vars: Vec::new() };
+        let mut s = VarSets {
+            offsets: vec![0],
+            vars: Vec::new(),
+        };
         for mut l in lists {
             l.sort_unstable();
             l.dedup();
@@ -38,7 +41,10 @@ impl VarSets {
     /// Builds from lists that are already sorted and duplicate-free.
     pub fn from_sorted(lists: &[Vec<VarId>]) -> VarSets {
         let total = lists.iter().map(Vec::len).sum();
-        let mut s = VarSets { offsets: Vec::with_capacity(lists.len() + 1), vars: Vec::with_capacity(total) };
+        let mut s = VarSets {
+            offsets: Vec::with_capacity(lists.len() + 1),
+            vars: Vec::with_capacity(total),
+        };
         s.offsets.push(0);
         for l in lists {
             debug_assert!(l.windows(2).all(|w| w[0] < w[1]));
@@ -112,7 +118,10 @@ pub fn accesses(p: &Program) -> Accesses {
     }
     // Main first in listing order, and the callee-first order puts main last: re-lay in rung order.
     let gather = |all: &[VarId], range: fn(&(u32, u32, u32, u32)) -> (u32, u32)| {
-        let mut s = VarSets { offsets: Vec::with_capacity(per_rung.len() + 1), vars: Vec::with_capacity(all.len()) };
+        let mut s = VarSets {
+            offsets: Vec::with_capacity(per_rung.len() + 1),
+            vars: Vec::with_capacity(all.len()),
+        };
         s.offsets.push(0);
         for r in &per_rung {
             let (a, b) = range(r);
@@ -121,18 +130,32 @@ pub fn accesses(p: &Program) -> Accesses {
         }
         s
     };
-    Accesses { reads: gather(&all_reads, |r| (r.0, r.1)), writes: gather(&all_writes, |r| (r.2, r.3)) }
+    Accesses {
+        reads: gather(&all_reads, |r| (r.0, r.1)),
+        writes: gather(&all_writes, |r| (r.2, r.3)),
+    }
 }
 
 /// The sorted IN and OUT of one rung, into `reads` and `writes` (cleared first).
-fn one_rung(p: &Program, r: RungId, summary: &[(Vec<VarId>, Vec<VarId>)], reads: &mut Vec<VarId>, writes: &mut Vec<VarId>) {
+fn one_rung(
+    p: &Program,
+    r: RungId,
+    summary: &[(Vec<VarId>, Vec<VarId>)],
+    reads: &mut Vec<VarId>,
+    writes: &mut Vec<VarId>,
+) {
     reads.clear();
     writes.clear();
-    rung_accesses(&p.rung(r).series, reads, writes, &mut |callee, reads, writes| {
-        let (sr, sw) = &summary[callee.index()];
-        reads.extend_from_slice(sr);
-        writes.extend_from_slice(sw);
-    });
+    rung_accesses(
+        &p.rung(r).series,
+        reads,
+        writes,
+        &mut |callee, reads, writes| {
+            let (sr, sw) = &summary[callee.index()];
+            reads.extend_from_slice(sr);
+            writes.extend_from_slice(sw);
+        },
+    );
     if let Some(Element::Next { head }) = p.rung(r).series.last() {
         if let Some(Element::For { var, .. }) = p.rung(*head).series.last() {
             reads.push(*var);
@@ -209,13 +232,24 @@ pub(crate) fn rung_accesses(
                     rung_accesses(b, reads, writes, call);
                 }
             }
-            Element::Coil { var, .. } | Element::Set(var) | Element::Reset(var) => writes.push(*var),
+            Element::Coil { var, .. } | Element::Set(var) | Element::Reset(var) => {
+                writes.push(*var)
+            }
             Element::Timer { instance, pt, .. } => {
                 reads.push(*instance);
                 writes.push(*instance);
                 operand(pt, reads);
             }
-            Element::Ctu { instance, pv, reset: other } | Element::Ctd { instance, pv, load: other } => {
+            Element::Ctu {
+                instance,
+                pv,
+                reset: other,
+            }
+            | Element::Ctd {
+                instance,
+                pv,
+                load: other,
+            } => {
                 reads.push(*instance);
                 writes.push(*instance);
                 operand(pv, reads);

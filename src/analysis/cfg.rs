@@ -122,7 +122,11 @@ pub(crate) fn transfers(series: &[Element], out: &mut Vec<(Transfer, bool)>) -> 
     fn walk(series: &[Element], mut always: bool, out: &mut Vec<(Transfer, bool)>) -> (bool, bool) {
         for e in series {
             match e {
-                Element::Contact { .. } | Element::Compare { .. } | Element::Timer { .. } | Element::Ctu { .. } | Element::Ctd { .. } => always = false,
+                Element::Contact { .. }
+                | Element::Compare { .. }
+                | Element::Timer { .. }
+                | Element::Ctu { .. }
+                | Element::Ctd { .. } => always = false,
                 Element::Or(bs) => {
                     let mut any = false;
                     for b in bs {
@@ -158,7 +162,13 @@ pub(crate) fn transfers(series: &[Element], out: &mut Vec<(Transfer, bool)>) -> 
                     }
                 }
                 Element::Call { pou } => out.push((Transfer::Call(*pou), always)),
-                Element::Coil { .. } | Element::Set(_) | Element::Reset(_) | Element::Move { .. } | Element::Arith { .. } | Element::For { .. } | Element::Next { .. } => {}
+                Element::Coil { .. }
+                | Element::Set(_)
+                | Element::Reset(_)
+                | Element::Move { .. }
+                | Element::Arith { .. }
+                | Element::For { .. }
+                | Element::Next { .. } => {}
             }
         }
         (always, false)
@@ -193,34 +203,81 @@ pub fn control_flow_graph(p: &Program) -> Cfg {
             }
         }
     }
-    let uncalled: Vec<PouId> = (1..p.pous.len()).filter(|&i| callers[i].is_empty()).map(|i| PouId(i as u32)).collect();
-    let mut edges = vec![CfgEdge { from: start, to: 0, label: None, kind: EdgeKind::Entry }];
+    let uncalled: Vec<PouId> = (1..p.pous.len())
+        .filter(|&i| callers[i].is_empty())
+        .map(|i| PouId(i as u32))
+        .collect();
+    let mut edges = vec![CfgEdge {
+        from: start,
+        to: 0,
+        label: None,
+        kind: EdgeKind::Entry,
+    }];
     // Edges from `from` to the exit of `pou`.
     let exit = |edges: &mut Vec<CfgEdge>, from: u32, pou: PouId, label, kind| {
         if pou.index() == 0 || callers[pou.index()].is_empty() {
-            edges.push(CfgEdge { from, to: stop, label, kind });
+            edges.push(CfgEdge {
+                from,
+                to: stop,
+                label,
+                kind,
+            });
         } else {
             for &c in &callers[pou.index()] {
-                edges.push(CfgEdge { from, to: c, label, kind: if kind == EdgeKind::Fallthrough { EdgeKind::Return } else { kind } });
+                edges.push(CfgEdge {
+                    from,
+                    to: c,
+                    label,
+                    kind: if kind == EdgeKind::Fallthrough {
+                        EdgeKind::Return
+                    } else {
+                        kind
+                    },
+                });
             }
         }
     };
     for r in p.rung_ids() {
         let rung = p.rung(r);
         let pou = p.pou(rung.pou);
-        let next = if r.0 + 1 < pou.rungs.end { Some(r.0 + 1) } else { None };
+        let next = if r.0 + 1 < pou.rungs.end {
+            Some(r.0 + 1)
+        } else {
+            None
+        };
         match rung.series.last() {
             Some(Element::For { next: nx, .. }) => {
-                edges.push(CfgEdge { from: r.0, to: r.0 + 1, label: Some(Branch::T), kind: EdgeKind::LoopEnter });
+                edges.push(CfgEdge {
+                    from: r.0,
+                    to: r.0 + 1,
+                    label: Some(Branch::T),
+                    kind: EdgeKind::LoopEnter,
+                });
                 if nx.0 + 1 < pou.rungs.end {
-                    edges.push(CfgEdge { from: r.0, to: nx.0 + 1, label: Some(Branch::F), kind: EdgeKind::LoopExit });
+                    edges.push(CfgEdge {
+                        from: r.0,
+                        to: nx.0 + 1,
+                        label: Some(Branch::F),
+                        kind: EdgeKind::LoopExit,
+                    });
                 } else {
-                    exit(&mut edges, r.0, rung.pou, Some(Branch::F), EdgeKind::LoopExit);
+                    exit(
+                        &mut edges,
+                        r.0,
+                        rung.pou,
+                        Some(Branch::F),
+                        EdgeKind::LoopExit,
+                    );
                 }
                 continue;
             }
             Some(Element::Next { head }) => {
-                edges.push(CfgEdge { from: r.0, to: head.0, label: None, kind: EdgeKind::LoopBack });
+                edges.push(CfgEdge {
+                    from: r.0,
+                    to: head.0,
+                    label: None,
+                    kind: EdgeKind::LoopBack,
+                });
                 continue;
             }
             _ => {}
@@ -228,16 +285,37 @@ pub fn control_flow_graph(p: &Program) -> Cfg {
         found.clear();
         let terminated = transfers(&rung.series, &mut found);
         let conditional = found.iter().any(|(_, always)| !always) || terminated && found.len() > 1;
-        let label = |always: bool| if always && !conditional { None } else { Some(Branch::T) };
+        let label = |always: bool| {
+            if always && !conditional {
+                None
+            } else {
+                Some(Branch::T)
+            }
+        };
         for &(t, always) in &found {
             match t {
-                Transfer::Jump(target) => edges.push(CfgEdge { from: r.0, to: target.0, label: label(always), kind: EdgeKind::Jump }),
-                Transfer::End => edges.push(CfgEdge { from: r.0, to: stop, label: label(always), kind: EdgeKind::End }),
+                Transfer::Jump(target) => edges.push(CfgEdge {
+                    from: r.0,
+                    to: target.0,
+                    label: label(always),
+                    kind: EdgeKind::Jump,
+                }),
+                Transfer::End => edges.push(CfgEdge {
+                    from: r.0,
+                    to: stop,
+                    label: label(always),
+                    kind: EdgeKind::End,
+                }),
                 Transfer::Ret => exit(&mut edges, r.0, rung.pou, label(always), EdgeKind::Ret),
                 Transfer::Call(c) => {
                     let callee = p.pou(c);
                     if !callee.rungs.is_empty() {
-                        edges.push(CfgEdge { from: r.0, to: callee.rungs.start, label: label(always), kind: EdgeKind::Call });
+                        edges.push(CfgEdge {
+                            from: r.0,
+                            to: callee.rungs.start,
+                            label: label(always),
+                            kind: EdgeKind::Call,
+                        });
                     }
                 }
             }
@@ -245,10 +323,19 @@ pub fn control_flow_graph(p: &Program) -> Cfg {
         if !terminated {
             let fl = if conditional { Some(Branch::F) } else { None };
             match next {
-                Some(nx) => edges.push(CfgEdge { from: r.0, to: nx, label: fl, kind: EdgeKind::Fallthrough }),
+                Some(nx) => edges.push(CfgEdge {
+                    from: r.0,
+                    to: nx,
+                    label: fl,
+                    kind: EdgeKind::Fallthrough,
+                }),
                 None => exit(&mut edges, r.0, rung.pou, fl, EdgeKind::Fallthrough),
             }
         }
     }
-    Cfg { rungs: n, edges, uncalled }
+    Cfg {
+        rungs: n,
+        edges,
+        uncalled,
+    }
 }

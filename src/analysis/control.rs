@@ -59,7 +59,11 @@ pub fn post_dominators(node_count: usize, edges: &[(u32, u32)], stop: u32) -> Po
     let mut endless = Vec::new();
     if reaches.iter().any(|r| !r) {
         // Sink components of the subgraph of nodes that cannot reach STOP.
-        let sub: Vec<(u32, u32)> = edges.iter().copied().filter(|&(a, b)| !reaches[a as usize] && !reaches[b as usize]).collect();
+        let sub: Vec<(u32, u32)> = edges
+            .iter()
+            .copied()
+            .filter(|&(a, b)| !reaches[a as usize] && !reaches[b as usize])
+            .collect();
         let g = Csr::from_edges(node_count, &sub);
         let sccs = strongly_connected_components(&g);
         let mut has_exit = vec![false; sccs.len()];
@@ -82,7 +86,11 @@ pub fn post_dominators(node_count: usize, edges: &[(u32, u32)], stop: u32) -> Po
         reverse = Csr::from_edges(node_count, &all).reversed();
         debug_assert!(reachable(&reverse, stop).iter().all(|&r| r));
     }
-    PostDominators { tree: dominators(&reverse, stop), virtual_edges, endless }
+    PostDominators {
+        tree: dominators(&reverse, stop),
+        virtual_edges,
+        endless,
+    }
 }
 
 /// `dependent` is control dependent on `controller` because of CFG edge `edge`.
@@ -96,7 +104,11 @@ pub struct ControlDependence {
 
 /// Control dependences by the Ferrante–Ottenstein–Warren walk, for the edges whose source
 /// `include(source)` accepts. Sorted by (controller, dependent, edge).
-pub fn control_dependences(edges: &[(u32, u32)], pdom: &PostDominators, include: impl Fn(u32) -> bool) -> Vec<ControlDependence> {
+pub fn control_dependences(
+    edges: &[(u32, u32)],
+    pdom: &PostDominators,
+    include: impl Fn(u32) -> bool,
+) -> Vec<ControlDependence> {
     let mut out = Vec::new();
     for (i, &(a, b)) in edges.iter().enumerate() {
         if !include(a) {
@@ -105,7 +117,11 @@ pub fn control_dependences(edges: &[(u32, u32)], pdom: &PostDominators, include:
         if a == b {
             // A self loop: the rung decides whether it runs again (the walk below would stop at
             // once, since every node post-dominates itself).
-            out.push(ControlDependence { controller: a, dependent: a, edge: i as u32 });
+            out.push(ControlDependence {
+                controller: a,
+                dependent: a,
+                edge: i as u32,
+            });
             continue;
         }
         if pdom.post_dominates(b, a) {
@@ -117,7 +133,11 @@ pub fn control_dependences(edges: &[(u32, u32)], pdom: &PostDominators, include:
             if Some(n) == stop_at {
                 break;
             }
-            out.push(ControlDependence { controller: a, dependent: n, edge: i as u32 });
+            out.push(ControlDependence {
+                controller: a,
+                dependent: n,
+                edge: i as u32,
+            });
             x = pdom.immediate(n);
         }
     }
@@ -132,8 +152,23 @@ mod tests {
     /// Example B of seed 004 as a bare graph (nodes 0..=11 are R1..R12, 12 START, 13 STOP).
     fn example_b() -> Vec<(u32, u32)> {
         vec![
-            (12, 0), (0, 8), (0, 1), (1, 2), (2, 4), (2, 3), (4, 5), (5, 6), (6, 7), (7, 2),
-            (3, 8), (8, 9), (9, 10), (9, 11), (10, 9), (11, 9), (9, 13),
+            (12, 0),
+            (0, 8),
+            (0, 1),
+            (1, 2),
+            (2, 4),
+            (2, 3),
+            (4, 5),
+            (5, 6),
+            (6, 7),
+            (7, 2),
+            (3, 8),
+            (8, 9),
+            (9, 10),
+            (9, 11),
+            (10, 9),
+            (11, 9),
+            (9, 13),
         ]
     }
 
@@ -143,11 +178,43 @@ mod tests {
         let pd = post_dominators(14, &edges, 13);
         let ipdom: Vec<Option<u32>> = (0..14).map(|n| pd.immediate(n)).collect();
         // START→R1, R1→R9, R2→R3, R3→R4, R4→R9, R5→R6, R6→R7, R7→R8, R8→R3, R9→R10, R10→STOP, R11→R10, R12→R10
-        assert_eq!(ipdom, vec![Some(8), Some(2), Some(3), Some(8), Some(5), Some(6), Some(7), Some(2), Some(9), Some(13), Some(9), Some(9), Some(0), None]);
+        assert_eq!(
+            ipdom,
+            vec![
+                Some(8),
+                Some(2),
+                Some(3),
+                Some(8),
+                Some(5),
+                Some(6),
+                Some(7),
+                Some(2),
+                Some(9),
+                Some(13),
+                Some(9),
+                Some(9),
+                Some(0),
+                None
+            ]
+        );
         let cd = control_dependences(&edges, &pd, |_| true);
-        let pairs: std::collections::BTreeSet<(u32, u32)> = cd.iter().map(|d| (d.controller, d.dependent)).collect();
-        let want: std::collections::BTreeSet<(u32, u32)> =
-            [(0, 1), (0, 2), (0, 3), (2, 4), (2, 5), (2, 6), (2, 7), (2, 2), (9, 10), (9, 11), (9, 9)].into_iter().collect();
+        let pairs: std::collections::BTreeSet<(u32, u32)> =
+            cd.iter().map(|d| (d.controller, d.dependent)).collect();
+        let want: std::collections::BTreeSet<(u32, u32)> = [
+            (0, 1),
+            (0, 2),
+            (0, 3),
+            (2, 4),
+            (2, 5),
+            (2, 6),
+            (2, 7),
+            (2, 2),
+            (9, 10),
+            (9, 11),
+            (9, 9),
+        ]
+        .into_iter()
+        .collect();
         assert_eq!(pairs, want);
     }
 

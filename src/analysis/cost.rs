@@ -20,7 +20,12 @@ pub fn rung_costs(p: &Program) -> Vec<u64> {
     // Callee-first: a POU's total is needed by its callers. POUs have no cycles.
     let mut total: Vec<Option<u64>> = vec![None; p.pous.len()];
     let mut cost = vec![0u64; p.rungs.len()];
-    fn pou_total(p: &Program, pou: PouId, total: &mut Vec<Option<u64>>, cost: &mut Vec<u64>) -> u64 {
+    fn pou_total(
+        p: &Program,
+        pou: PouId,
+        total: &mut Vec<Option<u64>>,
+        cost: &mut Vec<u64>,
+    ) -> u64 {
         if let Some(t) = total[pou.index()] {
             return t;
         }
@@ -41,7 +46,11 @@ pub fn rung_costs(p: &Program) -> Vec<u64> {
             cost[r.index()] = series_cost(&p.rung(r).series, &totals);
         }
         let mult = multipliers(p, pou);
-        let t = p.pou_rungs(pou).zip(mult).map(|(r, m)| cost[r.index()] * m).sum();
+        let t = p
+            .pou_rungs(pou)
+            .zip(mult)
+            .map(|(r, m)| cost[r.index()] * m)
+            .sum();
         total[pou.index()] = Some(t);
         t
     }
@@ -55,7 +64,9 @@ fn series_cost(series: &[Element], pou_totals: &[u64]) -> u64 {
     series
         .iter()
         .map(|e| match e {
-            Element::Or(bs) | Element::Branch(bs) => 1 + bs.iter().map(|b| series_cost(b, pou_totals)).sum::<u64>(),
+            Element::Or(bs) | Element::Branch(bs) => {
+                1 + bs.iter().map(|b| series_cost(b, pou_totals)).sum::<u64>()
+            }
             Element::Move { .. } | Element::Arith { .. } | Element::For { .. } => 2,
             Element::Timer { .. } | Element::Ctu { .. } | Element::Ctd { .. } => 4,
             Element::Call { pou } => 1 + pou_totals[pou.index()],
@@ -113,7 +124,11 @@ pub fn summarise(costs: &[u64], preds: &[Vec<u32>], levels: &[u32]) -> CostSumma
     let work = costs.iter().sum();
     let mut finish = vec![0u64; n];
     for t in 0..n {
-        let start = preds[t].iter().map(|&p| finish[p as usize]).max().unwrap_or(0);
+        let start = preds[t]
+            .iter()
+            .map(|&p| finish[p as usize])
+            .max()
+            .unwrap_or(0);
         finish[t] = start + costs[t];
     }
     let span = finish.iter().copied().max().unwrap_or(0);
@@ -138,7 +153,12 @@ pub fn summarise(costs: &[u64], preds: &[Vec<u32>], levels: &[u32]) -> CostSumma
     let successors = |t: usize| &succ[succ_count[t] as usize..succ_count[t + 1] as usize];
     let mut bottom = vec![0u64; n];
     for t in (0..n).rev() {
-        bottom[t] = costs[t] + successors(t).iter().map(|&s| bottom[s as usize]).max().unwrap_or(0);
+        bottom[t] = costs[t]
+            + successors(t)
+                .iter()
+                .map(|&s| bottom[s as usize])
+                .max()
+                .unwrap_or(0);
     }
     let cores = [1u32, 2, 4, 8];
     // One core runs everything back to back: its makespan is the work. The others are simulated,
@@ -146,14 +166,36 @@ pub fn summarise(costs: &[u64], preds: &[Vec<u32>], levels: &[u32]) -> CostSumma
     use rayon::prelude::*;
     let makespan = cores
         .par_iter()
-        .map(|&p| (p, if p == 1 { work } else { list_schedule(costs, preds, &successors, &bottom, p as usize) }))
+        .map(|&p| {
+            (
+                p,
+                if p == 1 {
+                    work
+                } else {
+                    list_schedule(costs, preds, &successors, &bottom, p as usize)
+                },
+            )
+        })
         .collect();
     let groups = super::levels::group_by_level(levels);
     let level_makespan = cores
         .iter()
-        .map(|&p| (p, groups.iter().map(|g| lpt(g.iter().map(|&t| costs[t as usize]), p as usize)).sum()))
+        .map(|&p| {
+            (
+                p,
+                groups
+                    .iter()
+                    .map(|g| lpt(g.iter().map(|&t| costs[t as usize]), p as usize))
+                    .sum(),
+            )
+        })
         .collect();
-    CostSummary { work, span, makespan, level_makespan }
+    CostSummary {
+        work,
+        span,
+        makespan,
+        level_makespan,
+    }
 }
 
 /// Longest-processing-time-first makespan of independent jobs on `p` machines.
@@ -170,10 +212,19 @@ fn lpt(jobs: impl Iterator<Item = u64>, p: usize) -> u64 {
 
 /// Greedy list scheduling: whenever a core is free, it takes the ready task with the highest
 /// bottom level (ties: earlier task).
-fn list_schedule<'a>(costs: &[u64], preds: &[Vec<u32>], successors: &(dyn Fn(usize) -> &'a [u32] + Sync), bottom: &[u64], p: usize) -> u64 {
+fn list_schedule<'a>(
+    costs: &[u64],
+    preds: &[Vec<u32>],
+    successors: &(dyn Fn(usize) -> &'a [u32] + Sync),
+    bottom: &[u64],
+    p: usize,
+) -> u64 {
     let n = costs.len();
     let mut waiting: Vec<u32> = preds.iter().map(|ps| ps.len() as u32).collect();
-    let mut ready: BinaryHeap<(u64, Reverse<u32>)> = (0..n).filter(|&t| waiting[t] == 0).map(|t| (bottom[t], Reverse(t as u32))).collect();
+    let mut ready: BinaryHeap<(u64, Reverse<u32>)> = (0..n)
+        .filter(|&t| waiting[t] == 0)
+        .map(|t| (bottom[t], Reverse(t as u32)))
+        .collect();
     // Running tasks by finish time.
     let mut running: BinaryHeap<Reverse<(u64, u32)>> = BinaryHeap::new();
     let mut now = 0u64;
@@ -189,7 +240,9 @@ fn list_schedule<'a>(costs: &[u64], preds: &[Vec<u32>], successors: &(dyn Fn(usi
                 None => break,
             }
         }
-        let Some(Reverse((f, t))) = running.pop() else { break };
+        let Some(Reverse((f, t))) = running.pop() else {
+            break;
+        };
         now = f;
         end = end.max(f);
         idle += 1;

@@ -52,7 +52,13 @@ pub struct DataDependence {
 }
 
 fn var_count(reads: &VarSets, writes: &VarSets) -> usize {
-    let max = |s: &VarSets| (0..s.len()).flat_map(|i| s.list(i).iter()).map(|v| v.index() + 1).max().unwrap_or(0);
+    let max = |s: &VarSets| {
+        (0..s.len())
+            .flat_map(|i| s.list(i).iter())
+            .map(|v| v.index() + 1)
+            .max()
+            .unwrap_or(0)
+    };
     max(reads).max(max(writes))
 }
 
@@ -103,15 +109,30 @@ pub fn data_dependences(reads: &VarSets, writes: &VarSets) -> Vec<DataDependence
         let tu = t as u32;
         for &x in reads.list(t) {
             for &s in writers.before(x, tu) {
-                out.push(DataDependence { from: s, to: tu, kind: DepKind::Flow, var: x });
+                out.push(DataDependence {
+                    from: s,
+                    to: tu,
+                    kind: DepKind::Flow,
+                    var: x,
+                });
             }
         }
         for &x in writes.list(t) {
             for &s in readers.before(x, tu) {
-                out.push(DataDependence { from: s, to: tu, kind: DepKind::Anti, var: x });
+                out.push(DataDependence {
+                    from: s,
+                    to: tu,
+                    kind: DepKind::Anti,
+                    var: x,
+                });
             }
             for &s in writers.before(x, tu) {
-                out.push(DataDependence { from: s, to: tu, kind: DepKind::Output, var: x });
+                out.push(DataDependence {
+                    from: s,
+                    to: tu,
+                    kind: DepKind::Output,
+                    var: x,
+                });
             }
         }
         out[start..].sort_unstable();
@@ -128,7 +149,12 @@ pub fn data_dependences_pairwise(reads: &VarSets, writes: &VarSets) -> Vec<DataD
             let mut add = |kind, a: &[VarId], b: &[VarId]| {
                 for &x in a {
                     if b.contains(&x) {
-                        out.push(DataDependence { from: s as u32, to: t as u32, kind, var: x });
+                        out.push(DataDependence {
+                            from: s as u32,
+                            to: t as u32,
+                            kind,
+                            var: x,
+                        });
                     }
                 }
             };
@@ -160,7 +186,9 @@ pub struct Leveller {
 
 impl Leveller {
     pub fn new(var_count: usize) -> Leveller {
-        Leveller { vars: vec![VarState::default(); var_count] }
+        Leveller {
+            vars: vec![VarState::default(); var_count],
+        }
     }
 
     /// Levels the next unit with IN `reads`, OUT `writes` and lower bound `floor`.
@@ -189,7 +217,9 @@ impl Leveller {
 /// ASAP levels (0-based) of the data dependences alone, in O(accesses).
 pub fn data_levels(reads: &VarSets, writes: &VarSets) -> Vec<u32> {
     let mut l = Leveller::new(var_count(reads, writes));
-    (0..reads.len()).map(|i| l.place(reads.list(i), writes.list(i), 0)).collect()
+    (0..reads.len())
+        .map(|i| l.place(reads.list(i), writes.list(i), 0))
+        .collect()
 }
 
 #[cfg(test)]
@@ -197,7 +227,11 @@ mod tests {
     use super::*;
 
     fn sets(lists: &[&[u32]]) -> VarSets {
-        VarSets::from_lists(lists.iter().map(|l| l.iter().map(|&v| VarId(v)).collect::<Vec<_>>()))
+        VarSets::from_lists(
+            lists
+                .iter()
+                .map(|l| l.iter().map(|&v| VarId(v)).collect::<Vec<_>>()),
+        )
     }
 
     /// Example A of seed 004: R2 δo R3, R2 δf R4, R3 δf R4; levels {R1,R2,R5} {R3} {R4}.
@@ -208,7 +242,14 @@ mod tests {
         let writes = sets(&[&[1], &[3], &[3], &[5], &[7]]);
         let deps = data_dependences(&reads, &writes);
         let pairs: Vec<_> = deps.iter().map(|d| (d.from, d.to, d.kind)).collect();
-        assert_eq!(pairs, vec![(1, 2, DepKind::Output), (1, 3, DepKind::Flow), (2, 3, DepKind::Flow)]);
+        assert_eq!(
+            pairs,
+            vec![
+                (1, 2, DepKind::Output),
+                (1, 3, DepKind::Flow),
+                (2, 3, DepKind::Flow)
+            ]
+        );
         assert_eq!(data_levels(&reads, &writes), vec![0, 0, 1, 2, 0]);
         assert_eq!(deps, data_dependences_pairwise(&reads, &writes));
     }

@@ -26,7 +26,9 @@ pub fn asap_levels(n: usize, edges: &[(u32, u32)]) -> Vec<u32> {
             }
         }
     }
-    (0..n as u32).map(|v| level[sccs.component_of(v) as usize]).collect()
+    (0..n as u32)
+        .map(|v| level[sccs.component_of(v) as usize])
+        .collect()
 }
 
 /// Groups node indices by level: `groups[l]` lists the nodes at level `l`, ascending.
@@ -46,9 +48,18 @@ mod tests {
     #[test]
     fn chain_diamond_cycle() {
         assert_eq!(asap_levels(3, &[(0, 1), (1, 2)]), vec![0, 1, 2]);
-        assert_eq!(asap_levels(4, &[(0, 1), (0, 2), (1, 3), (2, 3)]), vec![0, 1, 1, 2]);
+        assert_eq!(
+            asap_levels(4, &[(0, 1), (0, 2), (1, 3), (2, 3)]),
+            vec![0, 1, 1, 2]
+        );
         // 1 and 2 form a cycle; 3 after them; self edge on 0 ignored.
-        assert_eq!(asap_levels(4, &[(0, 0), (0, 1), (1, 2), (2, 1), (2, 3)]), vec![0, 1, 1, 2]);
-        assert_eq!(group_by_level(&[0, 1, 1, 2]), vec![vec![0], vec![1, 2], vec![3]]);
+        assert_eq!(
+            asap_levels(4, &[(0, 0), (0, 1), (1, 2), (2, 1), (2, 3)]),
+            vec![0, 1, 1, 2]
+        );
+        assert_eq!(
+            group_by_level(&[0, 1, 1, 2]),
+            vec![vec![0], vec![1, 2], vec![3]]
+        );
     }
 }

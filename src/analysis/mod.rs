@@ -85,13 +85,20 @@ pub fn analyse(p: &Program) -> Analysis {
     let (acc, cfg) = rayon::join(|| accesses(p), || control_flow_graph(p));
     let n = p.rungs.len();
     let paper = || {
-        let (data, data_lv) = rayon::join(|| data_dependences(&acc.reads, &acc.writes), || data_levels(&acc.reads, &acc.writes));
+        let (data, data_lv) = rayon::join(
+            || data_dependences(&acc.reads, &acc.writes),
+            || data_levels(&acc.reads, &acc.writes),
+        );
         let pairs: Vec<(u32, u32)> = cfg.edges.iter().map(|e| (e.from, e.to)).collect();
         let pdom = post_dominators(cfg.node_count(), &pairs, cfg.stop());
         let reachable = cfg.reachable();
         let control = control_dependences(&pairs, &pdom, |a| reachable[a as usize]);
         let paper_control = paper_control_view(p, &control);
-        let cv_edges: Vec<(u32, u32)> = paper_control.iter().map(|d| (d.from.0, d.to.0)).filter(|(a, b)| a != b).collect();
+        let cv_edges: Vec<(u32, u32)> = paper_control
+            .iter()
+            .map(|d| (d.from.0, d.to.0))
+            .filter(|(a, b)| a != b)
+            .collect();
         let control_lv = levels::asap_levels(n, &cv_edges);
         (data, data_lv, pdom, control, paper_control, control_lv)
     };
@@ -105,18 +112,27 @@ pub fn analyse(p: &Program) -> Analysis {
                 rung_costs[r.index()] = base[r.index()] * m;
             }
         }
-        let task_costs: Vec<u64> = schedule.tasks.iter().map(|t| t.rungs.iter().map(|r| rung_costs[r.index()]).sum()).collect();
+        let task_costs: Vec<u64> = schedule
+            .tasks
+            .iter()
+            .map(|t| t.rungs.iter().map(|r| rung_costs[r.index()]).sum())
+            .collect();
         let task_levels: Vec<u32> = schedule.tasks.iter().map(|t| t.level).collect();
         let cost = cost::summarise(&task_costs, &schedule.preds, &task_levels);
         (schedule, rung_costs, cost)
     };
-    let ((data, data_lv, pdom, control, paper_control, control_lv), (schedule, rung_costs, cost)) = rayon::join(paper, combined);
+    let ((data, data_lv, pdom, control, paper_control, control_lv), (schedule, rung_costs, cost)) =
+        rayon::join(paper, combined);
     let mut warnings = Vec::new();
     if !schedule.unreachable.is_empty() {
         warnings.push(Warning::Unreachable(schedule.unreachable.clone()));
     }
     for region in &pdom.endless {
-        let rungs: Vec<RungId> = region.iter().filter(|&&v| (v as usize) < n).map(|&v| RungId(v)).collect();
+        let rungs: Vec<RungId> = region
+            .iter()
+            .filter(|&&v| (v as usize) < n)
+            .map(|&v| RungId(v))
+            .collect();
         if !rungs.is_empty() {
             warnings.push(Warning::Endless(rungs));
         }
@@ -147,7 +163,11 @@ fn paper_control_view(p: &Program, control: &[ControlDependence]) -> Vec<PaperCo
     let mut out: Vec<PaperControl> = control
         .iter()
         .filter(|d| d.controller < n && d.dependent < n)
-        .map(|d| PaperControl { from: RungId(d.controller), to: RungId(d.dependent), cause: ControlCause::Branch { edge: d.edge } })
+        .map(|d| PaperControl {
+            from: RungId(d.controller),
+            to: RungId(d.dependent),
+            cause: ControlCause::Branch { edge: d.edge },
+        })
         .collect();
     // Box rungs per instance (a linked list, newest first, in one flat array: most variables are
     // not instances); then each field read pairs with the earlier box rungs.
@@ -159,7 +179,9 @@ fn paper_control_view(p: &Program, control: &[ControlDependence]) -> Vec<PaperCo
         field_reads.clear();
         own_boxes.clear();
         walk_elements(&p.rung(r).series, &mut |e| match e {
-            Element::Timer { instance, .. } | Element::Ctu { instance, .. } | Element::Ctd { instance, .. } => own_boxes.push(*instance),
+            Element::Timer { instance, .. }
+            | Element::Ctu { instance, .. }
+            | Element::Ctd { instance, .. } => own_boxes.push(*instance),
             Element::Contact { var, .. } if var.field.is_some() => field_reads.push(var.var),
             Element::Compare { a, b, .. } | Element::Arith { a, b, .. } => {
                 for o in [a, b] {
@@ -185,7 +207,11 @@ fn paper_control_view(p: &Program, control: &[ControlDependence]) -> Vec<PaperCo
             let mut node = last_box[v.index()];
             while node != u32::MAX {
                 let (s, next) = box_nodes[node as usize];
-                out.push(PaperControl { from: s, to: r, cause: ControlCause::Instance { var: v } });
+                out.push(PaperControl {
+                    from: s,
+                    to: r,
+                    cause: ControlCause::Instance { var: v },
+                });
                 node = next;
             }
         }

@@ -94,13 +94,23 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
     let edges: Vec<(u32, u32)> = cfg
         .edges
         .iter()
-        .filter(|e| !matches!(e.kind, EdgeKind::Call | EdgeKind::Return) && in_main(e.from) && in_main(e.to))
+        .filter(|e| {
+            !matches!(e.kind, EdgeKind::Call | EdgeKind::Return) && in_main(e.from) && in_main(e.to)
+        })
         .map(|e| (e.from, e.to))
         .collect();
     let g = Csr::from_edges(n, &edges);
     let reach = crate::graph::reachable(&g, start);
-    let unreachable: Vec<RungId> = main.clone().filter(|&r| !reach[r as usize]).map(RungId).collect();
-    let live_edges: Vec<(u32, u32)> = edges.iter().copied().filter(|&(a, _)| reach[a as usize]).collect();
+    let unreachable: Vec<RungId> = main
+        .clone()
+        .filter(|&r| !reach[r as usize])
+        .map(RungId)
+        .collect();
+    let live_edges: Vec<(u32, u32)> = edges
+        .iter()
+        .copied()
+        .filter(|&(a, _)| reach[a as usize])
+        .collect();
     let live = Csr::from_edges(n, &live_edges);
     let sccs = strongly_connected_components(&live);
 
@@ -127,7 +137,10 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
     // the earliest first rung (O(V log V)).
     let forward = comp_edges.iter().all(|&(a, b)| first(a) < first(b));
     let order: Vec<u32> = if forward {
-        main.clone().filter(|&r| reach[r as usize] && first(sccs.component_of(r)) == r).map(|r| sccs.component_of(r)).collect()
+        main.clone()
+            .filter(|&r| reach[r as usize] && first(sccs.component_of(r)) == r)
+            .map(|r| sccs.component_of(r))
+            .collect()
     } else {
         let comp_graph = Csr::from_edges(comp_count, &comp_edges);
         let mut heap: BinaryHeap<Reverse<(u32, u32)>> = (0..comp_count as u32)
@@ -200,7 +213,13 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
     let endless: Vec<Vec<RungId>> = pdom
         .endless
         .iter()
-        .map(|region| region.iter().filter(|&&c| c < t).flat_map(|&c| tasks[c as usize].rungs.iter().copied()).collect())
+        .map(|region| {
+            region
+                .iter()
+                .filter(|&&c| c < t)
+                .flat_map(|&c| tasks[c as usize].rungs.iter().copied())
+                .collect()
+        })
         .filter(|r: &Vec<RungId>| !r.is_empty())
         .collect();
     for d in control_dependences(&cedges, &pdom, |_| true) {
@@ -208,8 +227,15 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
         if a == cstart || d.dependent >= t || d.dependent == a {
             continue;
         }
-        let successor = if b == cstop { Successor::Stop } else { Successor::Task(b) };
-        let guard = Guard { controller: a, successor };
+        let successor = if b == cstop {
+            Successor::Stop
+        } else {
+            Successor::Task(b)
+        };
+        let guard = Guard {
+            controller: a,
+            successor,
+        };
         let task = &mut tasks[d.dependent as usize];
         if !task.guard.contains(&guard) {
             task.guard.push(guard);
@@ -263,7 +289,12 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
         }
         ps.sort_unstable();
         ps.dedup();
-        let floor = ps.iter().filter(|&&q| (q as usize) < i).map(|&q| tasks[q as usize].level + 1).max().unwrap_or(0);
+        let floor = ps
+            .iter()
+            .filter(|&&q| (q as usize) < i)
+            .map(|&q| tasks[q as usize].level + 1)
+            .max()
+            .unwrap_or(0);
         let level = leveller.place(&reads, &writes, floor);
         tasks[i].level = level;
         for &x in &reads {
@@ -289,5 +320,12 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
         task.entries.sort_unstable();
         task.guard.sort_unstable();
     }
-    Schedule { tasks, task_of, levels, unreachable, preds, endless }
+    Schedule {
+        tasks,
+        task_of,
+        levels,
+        unreachable,
+        preds,
+        endless,
+    }
 }

@@ -207,7 +207,11 @@ pub(super) fn write_series<W: Write>(w: &mut W, series: &[Elem]) -> io::Result<(
     w.write_all(b"]")
 }
 
-pub(super) fn write_branches<W: Write>(w: &mut W, key: &str, branches: &[Vec<Elem>]) -> io::Result<()> {
+pub(super) fn write_branches<W: Write>(
+    w: &mut W,
+    key: &str,
+    branches: &[Vec<Elem>],
+) -> io::Result<()> {
     write!(w, "{{\"{key}\":[")?;
     for (i, s) in branches.iter().enumerate() {
         if i > 0 {
@@ -264,4 +268,3 @@ pub(super) fn write_elem<W: Write>(w: &mut W, e: &Elem) -> io::Result<()> {
         Elem::Next => w.write_all(b"{\"next\":true}"),
     }
 }
-

@@ -201,7 +201,10 @@ impl Generator {
         let n = cfg.rungs;
         let lanes = cfg.width.clamp(1, n.max(1));
         let stages = n.div_ceil(lanes);
-        let phases = (stages.saturating_sub(8)..stages).map(|s| phase(s) + 1).max().unwrap_or(0);
+        let phases = (stages.saturating_sub(8)..stages)
+            .map(|s| phase(s) + 1)
+            .max()
+            .unwrap_or(0);
         let inputs = (lanes / 8).max(8);
         let outputs = lanes.div_ceil(16);
         let mut g = Generator {

@@ -135,15 +135,32 @@ pub enum Element {
     /// Output branches: each series receives the same power (LPS/LRD/LPP); power out is unchanged.
     Branch(Vec<Series>),
     /// TON/TOF/TP instance call; power in is IN, power out is Q.
-    Timer { kind: TimerKind, instance: VarId, pt: Operand },
+    Timer {
+        kind: TimerKind,
+        instance: VarId,
+        pt: Operand,
+    },
     /// Up counter; power in is CU, power out is Q.
-    Ctu { instance: VarId, pv: Operand, reset: Operand },
+    Ctu {
+        instance: VarId,
+        pv: Operand,
+        reset: Operand,
+    },
     /// Down counter; power in is CD, power out is Q.
-    Ctd { instance: VarId, pv: Operand, load: Operand },
+    Ctd {
+        instance: VarId,
+        pv: Operand,
+        load: Operand,
+    },
     /// MOVE box: when powered, `to := from`; power out = power in (ENO).
     Move { from: Operand, to: VarId },
     /// Arithmetic box: when powered, `out := a op b`; power out = power in (ENO).
-    Arith { op: ArithOp, a: Operand, b: Operand, out: VarId },
+    Arith {
+        op: ArithOp,
+        a: Operand,
+        b: Operand,
+        out: VarId,
+    },
     /// Jump, taken when powered, to the rung that carries the label.
     Jmp { label: String, target: RungId },
     /// Return: when powered, ends this POU for this scan.
@@ -154,7 +171,12 @@ pub enum Element {
     Call { pou: PouId },
     /// FOR head (last element of its rung). When powered: `var := from`, then loop while
     /// `var <= to`; the body is the rungs up to `next`.
-    For { var: VarId, from: Operand, to: Operand, next: RungId },
+    For {
+        var: VarId,
+        from: Operand,
+        to: Operand,
+        next: RungId,
+    },
     /// NEXT (alone in its rung): `var += 1` and back to the FOR head's test.
     Next { head: RungId },
 }
@@ -166,8 +188,12 @@ pub enum ContactKind {
     Negated,
     /// Passes power for one evaluation when the BOOL went FALSE→TRUE since the contact's last
     /// evaluation; `memory` is the hidden variable holding the previous value.
-    Rising { memory: VarId },
-    Falling { memory: VarId },
+    Rising {
+        memory: VarId,
+    },
+    Falling {
+        memory: VarId,
+    },
 }
 
 impl Program {

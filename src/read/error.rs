@@ -27,7 +27,15 @@ impl fmt::Display for Location {
         }
         match &self.rung {
             Some(r) => write!(f, "rung {r} at {}", self.path),
-            None => write!(f, "at {}", if self.path.is_empty() { "top level" } else { &self.path }),
+            None => write!(
+                f,
+                "at {}",
+                if self.path.is_empty() {
+                    "top level"
+                } else {
+                    &self.path
+                }
+            ),
         }
     }
 }
@@ -37,7 +45,11 @@ impl fmt::Display for Location {
 pub enum LoadError {
     /// The file is not JSON (serde_json's message, with line and column).
     #[error("{line}:{column}: {message}")]
-    Syntax { line: usize, column: usize, message: String },
+    Syntax {
+        line: usize,
+        column: usize,
+        message: String,
+    },
     /// The JSON is well formed but the program is not valid.
     #[error("{location}: {kind}")]
     Invalid { location: Location, kind: Invalid },
@@ -47,41 +59,74 @@ pub enum LoadError {
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum Invalid {
     #[error("expected {expected}, found {found}")]
-    Shape { expected: &'static str, found: String },
+    Shape {
+        expected: &'static str,
+        found: String,
+    },
     #[error("missing field `{field}` in {what}")]
-    MissingField { field: &'static str, what: &'static str },
+    MissingField {
+        field: &'static str,
+        what: &'static str,
+    },
     #[error("unknown field `{field}` in {what} (allowed: {allowed})")]
-    UnknownField { field: String, what: &'static str, allowed: String },
+    UnknownField {
+        field: String,
+        what: &'static str,
+        allowed: String,
+    },
     #[error("unknown element {{{keys}}} (an element has one of the keys contact, compare, or, coil, set, reset, branch, ton, tof, tp, ctu, ctd, move, op, jmp, ret, end, call, for, next)")]
     UnknownElement { keys: String },
     #[error("`{name}` is not a valid name (letters, digits and _, not starting with a digit)")]
     BadName { name: String },
-    #[error("unknown type `{name}` (expected BOOL, INT, DINT, REAL, TIME, TON, TOF, TP, CTU or CTD)")]
+    #[error(
+        "unknown type `{name}` (expected BOOL, INT, DINT, REAL, TIME, TON, TOF, TP, CTU or CTD)"
+    )]
     UnknownType { name: String },
     #[error("variable `{name}` is declared twice")]
     DuplicateVar { name: String },
     #[error("rung id `{id}` is used twice (first at {first})")]
     DuplicateRung { id: String, first: String },
     #[error("label `{label}` is used twice in {pou} (first on rung {first})")]
-    DuplicateLabel { label: String, pou: String, first: String },
+    DuplicateLabel {
+        label: String,
+        pou: String,
+        first: String,
+    },
     #[error("undefined variable `{name}`")]
     UndefinedVar { name: String },
     #[error("`{var}` of type {ty} has no field `{field}` (fields: {fields})")]
-    UnknownFieldOf { var: String, ty: String, field: String, fields: &'static str },
+    UnknownFieldOf {
+        var: String,
+        ty: String,
+        field: String,
+        fields: &'static str,
+    },
     #[error("undefined label `{label}` in {pou}")]
     UndefinedLabel { label: String, pou: String },
     #[error("undefined subroutine `{name}`")]
     UndefinedSubroutine { name: String },
     #[error("{what} needs {expected}, but `{operand}` is {found}")]
-    Type { what: &'static str, expected: String, operand: String, found: String },
+    Type {
+        what: &'static str,
+        expected: String,
+        operand: String,
+        found: String,
+    },
     #[error("{what} cannot write `{var}`: {why}")]
-    NotWritable { what: &'static str, var: String, why: &'static str },
+    NotWritable {
+        what: &'static str,
+        var: String,
+        why: &'static str,
+    },
     #[error("constant {value} does not fit {ty}")]
     Range { value: String, ty: String },
     #[error("`{text}` is not a valid TIME literal (write e.g. \"T#1s\", \"T#250ms\")")]
     BadTime { text: String },
     #[error("{what} is not allowed {place}")]
-    Misplaced { what: &'static str, place: &'static str },
+    Misplaced {
+        what: &'static str,
+        place: &'static str,
+    },
     #[error("NEXT without a FOR")]
     NextWithoutFor,
     #[error("FOR without a NEXT")]
@@ -96,9 +141,18 @@ pub enum Invalid {
     #[error("unknown op `{op}` (expected {names} or a function block)", names = crate::fbd::OP_NAMES)]
     UnknownOp { op: String },
     #[error("{op} has no {dir} `{pin}` ({dir}s: {pins})")]
-    UnknownPin { op: String, dir: &'static str, pin: String, pins: String },
+    UnknownPin {
+        op: String,
+        dir: &'static str,
+        pin: String,
+        pins: String,
+    },
     #[error("{op} takes {expected}, found {found}")]
-    PinCount { op: String, expected: String, found: usize },
+    PinCount {
+        op: String,
+        expected: String,
+        found: usize,
+    },
     #[error("{op} needs its input `{pin}` connected")]
     Unconnected { op: String, pin: String },
     #[error("block id {id} is used twice in this POU (first at {first})")]
@@ -108,11 +162,21 @@ pub enum Invalid {
     #[error("network id `{id}` is used twice (first at {first})")]
     DuplicateNetwork { id: String, first: String },
     #[error("label `{label}` is used twice in {pou} (first on network {first})")]
-    DuplicateNetworkLabel { label: String, pou: String, first: String },
+    DuplicateNetworkLabel {
+        label: String,
+        pou: String,
+        first: String,
+    },
     #[error("blocks {blocks} form a cycle of arcs; feed the value back through a variable instead (one block writes it, the other reads it)")]
     Cycle { blocks: String },
     #[error("block {block} (fragment {fragment}) {how} block {dep} (fragment {dep_fragment}), a fragment that is neither its own nor an ancestor of it: block {dep} may not have run when block {block} runs")]
-    FragmentRule { block: u32, fragment: String, how: &'static str, dep: u32, dep_fragment: String },
+    FragmentRule {
+        block: u32,
+        fragment: String,
+        how: &'static str,
+        dep: u32,
+        dep_fragment: String,
+    },
     #[error("fragment {fragment} cannot run as one block: the arcs {arcs} leave it and come back (a control arc from several sources orders a block after the fragment, and the fragment depends on that block)")]
     FragmentSplit { fragment: String, arcs: String },
     #[error("function block `{name}` contains an instance of itself (through {chain})")]
@@ -120,11 +184,20 @@ pub enum Invalid {
     #[error("`{name}` is declared, but the FBD body needs it for a hidden variable (names `_<block>_<pin>` and `_run_<network>_<fragment>` are reserved in FBD POUs)")]
     HiddenClash { name: String },
     #[error("TIME variable `{var}` is accumulated (TSTART/TSTOP) in {first} and in {second}; accumulate it in one POU only")]
-    AccumulatedTwice { var: String, first: String, second: String },
+    AccumulatedTwice {
+        var: String,
+        first: String,
+        second: String,
+    },
     #[error("`{name}` is a function block instance; read its outputs as `{name}.OUTPUT`")]
     InstanceValue { name: String },
     #[error("`{instance}` ({fb}) has no input or output `{member}` (members: {members})")]
-    UnknownMember { instance: String, fb: String, member: String, members: String },
+    UnknownMember {
+        instance: String,
+        fb: String,
+        member: String,
+        members: String,
+    },
     #[error("unknown type `{name}` (expected BOOL, INT, DINT, REAL, TIME, TON, TOF, TP, CTU, CTD or a function block: {fbs})")]
     UnknownTypeOrFb { name: String, fbs: String },
 }
@@ -132,7 +205,11 @@ pub enum Invalid {
 impl LoadError {
     pub(crate) fn invalid(rung: Option<&str>, path: &str, kind: Invalid) -> LoadError {
         LoadError::Invalid {
-            location: Location { rung: rung.map(str::to_owned), path: path.to_owned(), network: None },
+            location: Location {
+                rung: rung.map(str::to_owned),
+                path: path.to_owned(),
+                network: None,
+            },
             kind,
         }
     }
@@ -140,7 +217,11 @@ impl LoadError {
     /// An error in FBD network `network` (in block `block`, if given).
     pub(crate) fn fbd(network: &str, block: Option<u32>, path: &str, kind: Invalid) -> LoadError {
         LoadError::Invalid {
-            location: Location { rung: None, path: path.to_owned(), network: Some((network.to_owned(), block)) },
+            location: Location {
+                rung: None,
+                path: path.to_owned(),
+                network: Some((network.to_owned(), block)),
+            },
             kind,
         }
     }
@@ -157,8 +238,15 @@ mod tests {
             "rungs[2].ld[0]",
             Invalid::UndefinedVar { name: "X".into() },
         );
-        assert_eq!(e.to_string(), "rung R3 at rungs[2].ld[0]: undefined variable `X`");
-        let e = LoadError::Syntax { line: 3, column: 7, message: "expected `,`".into() };
+        assert_eq!(
+            e.to_string(),
+            "rung R3 at rungs[2].ld[0]: undefined variable `X`"
+        );
+        let e = LoadError::Syntax {
+            line: 3,
+            column: 7,
+            message: "expected `,`".into(),
+        };
         assert_eq!(e.to_string(), "3:7: expected `,`");
     }
 }

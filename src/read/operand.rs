@@ -63,7 +63,12 @@ pub(crate) fn parse(
 }
 
 /// Gives `u` the type `ty`, checking that it has it (or, for numbers, fits it).
-pub(crate) fn typed(u: &Untyped, ty: Type, what: &'static str, text: &str) -> Result<Operand, Invalid> {
+pub(crate) fn typed(
+    u: &Untyped,
+    ty: Type,
+    what: &'static str,
+    text: &str,
+) -> Result<Operand, Invalid> {
     let mismatch = |found: String| Invalid::Type {
         what,
         expected: ty.to_string(),
@@ -76,7 +81,10 @@ pub(crate) fn typed(u: &Untyped, ty: Type, what: &'static str, text: &str) -> Re
         (Untyped::Bool(b), Type::Bool) => Ok(Operand::Const(Value::Bool(*b))),
         (Untyped::Time(ms), Type::Time) => match i32::try_from(*ms) {
             Ok(v) => Ok(Operand::Const(Value::Time(v))),
-            Err(_) => Err(Invalid::Range { value: text.to_owned(), ty: "TIME".into() }),
+            Err(_) => Err(Invalid::Range {
+                value: text.to_owned(),
+                ty: "TIME".into(),
+            }),
         },
         (Untyped::Number(x, integral), Type::Int | Type::Dint) => {
             let range = if ty == Type::Int {
@@ -87,7 +95,10 @@ pub(crate) fn typed(u: &Untyped, ty: Type, what: &'static str, text: &str) -> Re
             if !*integral {
                 Err(mismatch("a REAL constant".into()))
             } else if !range.contains(x) {
-                Err(Invalid::Range { value: text.to_owned(), ty: ty.to_string() })
+                Err(Invalid::Range {
+                    value: text.to_owned(),
+                    ty: ty.to_string(),
+                })
             } else if ty == Type::Int {
                 Ok(Operand::Const(Value::Int(*x as i16)))
             } else {
@@ -126,7 +137,13 @@ pub(crate) fn field_ref(
     match (ty, field) {
         (_, None) => Ok((VarRef { var, field: None }, ty)),
         (Type::Fb(fb), Some(f)) => match Field::lookup(fb, f) {
-            Some((field, fty)) => Ok((VarRef { var, field: Some(field) }, fty)),
+            Some((field, fty)) => Ok((
+                VarRef {
+                    var,
+                    field: Some(field),
+                },
+                fty,
+            )),
             None => Err(Invalid::UnknownFieldOf {
                 var: name.to_owned(),
                 ty: ty.to_string(),

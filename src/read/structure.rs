@@ -31,11 +31,14 @@ fn pair_loops(p: &mut Program) -> Result<(), LoadError> {
             match last_top(p.rung(r)) {
                 Some(Element::For { .. }) => stack.push(r),
                 Some(Element::Next { .. }) => {
-                    let head = stack.pop().ok_or_else(|| err(p, r, ".ld[0]", Invalid::NextWithoutFor))?;
+                    let head = stack
+                        .pop()
+                        .ok_or_else(|| err(p, r, ".ld[0]", Invalid::NextWithoutFor))?;
                     if let Some(Element::Next { head: h }) = p.rungs[r.index()].series.last_mut() {
                         *h = head;
                     }
-                    if let Some(Element::For { next, .. }) = p.rungs[head.index()].series.last_mut() {
+                    if let Some(Element::For { next, .. }) = p.rungs[head.index()].series.last_mut()
+                    {
                         *next = r;
                     }
                 }
@@ -44,7 +47,12 @@ fn pair_loops(p: &mut Program) -> Result<(), LoadError> {
         }
         if let Some(head) = stack.pop() {
             let n = p.rung(head).series.len();
-            return Err(err(p, head, &format!(".ld[{}]", n - 1), Invalid::ForWithoutNext));
+            return Err(err(
+                p,
+                head,
+                &format!(".ld[{}]", n - 1),
+                Invalid::ForWithoutNext,
+            ));
         }
     }
     Ok(())
@@ -78,12 +86,24 @@ fn check_jumps(p: &Program) -> Result<(), LoadError> {
                     if !encloses(head, r) && bad.is_none() {
                         bad = Some((label.clone(), head));
                     }
-                    h = if head.0 == 0 { None } else { body[head.index()] };
+                    h = if head.0 == 0 {
+                        None
+                    } else {
+                        body[head.index()]
+                    };
                 }
             }
         });
         if let Some((label, head)) = bad {
-            return Err(err(p, r, ".ld", Invalid::JumpIntoLoop { label, head: p.rung(head).id.clone() }));
+            return Err(err(
+                p,
+                r,
+                ".ld",
+                Invalid::JumpIntoLoop {
+                    label,
+                    head: p.rung(head).id.clone(),
+                },
+            ));
         }
     }
     Ok(())
@@ -123,10 +143,24 @@ fn check_recursion(p: &Program) -> Result<(), LoadError> {
                         stack.push((callee.index(), 0));
                     }
                     Colour::Grey => {
-                        let start = stack.iter().position(|&(q, _)| q == callee.index()).unwrap_or(0);
-                        let mut chain: Vec<&str> = stack[start..].iter().map(|&(q, _)| p.pous[q].name.as_str()).collect();
+                        let start = stack
+                            .iter()
+                            .position(|&(q, _)| q == callee.index())
+                            .unwrap_or(0);
+                        let mut chain: Vec<&str> = stack[start..]
+                            .iter()
+                            .map(|&(q, _)| p.pous[q].name.as_str())
+                            .collect();
                         chain.push(&p.pou(callee).name);
-                        return Err(err(p, rung, ".ld", Invalid::Recursion { name: p.pou(callee).name.clone(), chain: chain.join(" → ") }));
+                        return Err(err(
+                            p,
+                            rung,
+                            ".ld",
+                            Invalid::Recursion {
+                                name: p.pou(callee).name.clone(),
+                                chain: chain.join(" → "),
+                            },
+                        ));
                     }
                     Colour::Black => {}
                 }

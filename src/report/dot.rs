@@ -24,8 +24,14 @@ pub fn render_dot(p: &Program, a: &Analysis, view: View) -> String {
     let groups: Vec<Vec<RungId>> = if view == View::Paper {
         rung_groups(&a.data_levels)
     } else {
-        let mut g: Vec<Vec<RungId>> = combined_groups(a).into_iter().map(|l| l.into_iter().flatten().collect()).collect();
-        let others: Vec<RungId> = p.rung_ids().filter(|r| a.schedule.task_of[r.index()].is_none()).collect();
+        let mut g: Vec<Vec<RungId>> = combined_groups(a)
+            .into_iter()
+            .map(|l| l.into_iter().flatten().collect())
+            .collect();
+        let others: Vec<RungId> = p
+            .rung_ids()
+            .filter(|r| a.schedule.task_of[r.index()].is_none())
+            .collect();
         if !others.is_empty() {
             g.push(others);
         }
@@ -43,14 +49,38 @@ pub fn render_dot(p: &Program, a: &Analysis, view: View) -> String {
         let _ = writeln!(o, "  \"level {}\" -> \"level {}\" [style=invis];", l, l + 1);
     }
     if view != View::Paper {
-        for (i, t) in a.schedule.tasks.iter().enumerate().filter(|(_, t)| t.is_loop) {
-            let _ = writeln!(o, "  subgraph \"cluster_loop{}\" {{ label=\"loop task\"; style=dashed; {} }}", i, t.rungs.iter().map(|&r| format!("{};", id(r))).collect::<Vec<_>>().join(" "));
+        for (i, t) in a
+            .schedule
+            .tasks
+            .iter()
+            .enumerate()
+            .filter(|(_, t)| t.is_loop)
+        {
+            let _ = writeln!(
+                o,
+                "  subgraph \"cluster_loop{}\" {{ label=\"loop task\"; style=dashed; {} }}",
+                i,
+                t.rungs
+                    .iter()
+                    .map(|&r| format!("{};", id(r)))
+                    .collect::<Vec<_>>()
+                    .join(" ")
+            );
         }
     }
     for r in p.rung_ids() {
         let rung = p.rung(r);
-        let pou = if rung.pou.index() == 0 { String::new() } else { format!("\\n({})", p.pou(rung.pou).name) };
-        let _ = writeln!(o, "  {} [label={}];", id(r), quote(&format!("{}{}", rung.id, pou)).replace("\\\\n", "\\n"));
+        let pou = if rung.pou.index() == 0 {
+            String::new()
+        } else {
+            format!("\\n({})", p.pou(rung.pou).name)
+        };
+        let _ = writeln!(
+            o,
+            "  {} [label={}];",
+            id(r),
+            quote(&format!("{}{}", rung.id, pou)).replace("\\\\n", "\\n")
+        );
     }
     for d in &a.data {
         let style = match d.kind {
@@ -59,10 +89,22 @@ pub fn render_dot(p: &Program, a: &Analysis, view: View) -> String {
             DepKind::Output => "color=red, style=dotted",
             DepKind::Control => "color=darkgreen, style=bold",
         };
-        let _ = writeln!(o, "  {} -> {} [label={}, {}];", id(RungId(d.from)), id(RungId(d.to)), quote(&format!("{} {}", d.kind.name(), p.var(d.var).name)), style);
+        let _ = writeln!(
+            o,
+            "  {} -> {} [label={}, {}];",
+            id(RungId(d.from)),
+            id(RungId(d.to)),
+            quote(&format!("{} {}", d.kind.name(), p.var(d.var).name)),
+            style
+        );
     }
     for (f, t, _) in paper_control_pairs(a) {
-        let _ = writeln!(o, "  {} -> {} [label=\"control\", color=darkgreen, style=bold];", id(f), id(t));
+        let _ = writeln!(
+            o,
+            "  {} -> {} [label=\"control\", color=darkgreen, style=bold];",
+            id(f),
+            id(t)
+        );
     }
     o.push_str("  legend [shape=note, style=\"\", label=\"flow: black, solid\\lanti: blue, dashed\\loutput: red, dotted\\lcontrol: green, bold\\l\"];\n");
     o.push_str("}\n");

@@ -28,8 +28,14 @@ pub fn render_json(p: &Program, a: &Analysis) -> String {
             if let Some(l) = &rung.label {
                 o.insert("label".into(), l.as_str().into());
             }
-            o.insert("in".into(), a.accesses.ins(r).iter().map(|&v| var(v)).collect());
-            o.insert("out".into(), a.accesses.outs(r).iter().map(|&v| var(v)).collect());
+            o.insert(
+                "in".into(),
+                a.accesses.ins(r).iter().map(|&v| var(v)).collect(),
+            );
+            o.insert(
+                "out".into(),
+                a.accesses.outs(r).iter().map(|&v| var(v)).collect(),
+            );
             o.insert("cost".into(), a.rung_costs[r.index()].into());
             Json::Object(o)
         })
@@ -88,14 +94,23 @@ pub fn render_json(p: &Program, a: &Analysis) -> String {
         }
     }
     let groups = |levels: &[u32]| -> Json {
-        rung_groups(levels).into_iter().map(|g| g.into_iter().map(id).collect::<Json>()).collect()
+        rung_groups(levels)
+            .into_iter()
+            .map(|g| g.into_iter().map(id).collect::<Json>())
+            .collect()
     };
     let combined: Json = combined_groups(a)
         .into_iter()
         .map(|level| {
             level
                 .into_iter()
-                .map(|task| if task.len() == 1 { id(task[0]) } else { task.into_iter().map(id).collect() })
+                .map(|task| {
+                    if task.len() == 1 {
+                        id(task[0])
+                    } else {
+                        task.into_iter().map(id).collect()
+                    }
+                })
                 .collect::<Json>()
         })
         .collect();

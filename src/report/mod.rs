@@ -47,7 +47,10 @@ pub(crate) fn paper_control_pairs(a: &Analysis) -> Vec<(RungId, RungId, ControlC
         if d.from == d.to {
             continue;
         }
-        if out.last().is_some_and(|&(f, t, _)| f == d.from && t == d.to) {
+        if out
+            .last()
+            .is_some_and(|&(f, t, _)| f == d.from && t == d.to)
+        {
             continue;
         }
         out.push((d.from, d.to, d.cause));
@@ -57,14 +60,22 @@ pub(crate) fn paper_control_pairs(a: &Analysis) -> Vec<(RungId, RungId, ControlC
 
 /// Rungs the paper's control view finds control dependent on themselves (loop heads, calls).
 pub(crate) fn self_controlled(a: &Analysis) -> Vec<RungId> {
-    let mut v: Vec<RungId> = a.paper_control.iter().filter(|d| d.from == d.to).map(|d| d.from).collect();
+    let mut v: Vec<RungId> = a
+        .paper_control
+        .iter()
+        .filter(|d| d.from == d.to)
+        .map(|d| d.from)
+        .collect();
     v.dedup();
     v
 }
 
 /// Level groups (0-based level → rung ids in program order) from per-rung levels.
 pub(crate) fn rung_groups(levels: &[u32]) -> Vec<Vec<RungId>> {
-    crate::analysis::levels::group_by_level(levels).into_iter().map(|g| g.into_iter().map(RungId).collect()).collect()
+    crate::analysis::levels::group_by_level(levels)
+        .into_iter()
+        .map(|g| g.into_iter().map(RungId).collect())
+        .collect()
 }
 
 /// Level groups of the combined schedule: each task's rungs, tasks ordered by first rung.
@@ -73,7 +84,10 @@ pub(crate) fn combined_groups(a: &Analysis) -> Vec<Vec<Vec<RungId>>> {
         .levels
         .iter()
         .map(|level| {
-            let mut tasks: Vec<Vec<RungId>> = level.iter().map(|&t| a.schedule.tasks[t as usize].rungs.clone()).collect();
+            let mut tasks: Vec<Vec<RungId>> = level
+                .iter()
+                .map(|&t| a.schedule.tasks[t as usize].rungs.clone())
+                .collect();
             tasks.sort_unstable_by_key(|t| t[0]);
             tasks
         })
@@ -93,7 +107,11 @@ pub(crate) struct Difference {
 /// One entry per rung whose combined placement differs from a paper view.
 pub(crate) fn differences(p: &Program, a: &Analysis) -> Vec<Difference> {
     let s = &a.schedule;
-    let ids = |rs: &mut dyn Iterator<Item = RungId>| rs.map(|r| p.rung(r).id.clone()).collect::<Vec<_>>().join(", ");
+    let ids = |rs: &mut dyn Iterator<Item = RungId>| {
+        rs.map(|r| p.rung(r).id.clone())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
     let mut callers: Vec<Vec<RungId>> = vec![Vec::new(); p.pous.len()];
     for e in &a.cfg.edges {
         if e.kind == crate::analysis::EdgeKind::Call {
@@ -110,14 +128,23 @@ pub(crate) fn differences(p: &Program, a: &Analysis) -> Vec<Difference> {
             let reason = if rung.pou.index() != 0 {
                 let c = &callers[rung.pou.index()];
                 if c.is_empty() {
-                    format!("in subroutine {}, which nothing calls", p.pou(rung.pou).name)
+                    format!(
+                        "in subroutine {}, which nothing calls",
+                        p.pou(rung.pou).name
+                    )
                 } else {
                     format!("in subroutine {}: runs inside the calling rung's task ({}), not as a unit of its own", p.pou(rung.pou).name, ids(&mut c.iter().copied()))
                 }
             } else {
                 "can never run (unreachable from the start of the scan)".to_string()
             };
-            out.push(Difference { rung: r, data_level: dl, control_level: cl, combined_level: None, reasons: vec![reason] });
+            out.push(Difference {
+                rung: r,
+                data_level: dl,
+                control_level: cl,
+                combined_level: None,
+                reasons: vec![reason],
+            });
             continue;
         };
         let task = &s.tasks[t as usize];
@@ -127,7 +154,10 @@ pub(crate) fn differences(p: &Program, a: &Analysis) -> Vec<Difference> {
         }
         let mut reasons = Vec::new();
         if task.is_loop {
-            reasons.push(format!("part of the loop {{{}}}, kept whole as one sequential task", ids(&mut task.rungs.iter().copied())));
+            reasons.push(format!(
+                "part of the loop {{{}}}, kept whole as one sequential task",
+                ids(&mut task.rungs.iter().copied())
+            ));
         }
         let controllers: Vec<u32> = task.guard.iter().map(|g| g.controller).collect();
         if level > dl && !controllers.is_empty() {
@@ -136,7 +166,11 @@ pub(crate) fn differences(p: &Program, a: &Analysis) -> Vec<Difference> {
                 ids(&mut controllers.iter().map(|&c| s.head(c)))
             ));
         }
-        let data_preds: Vec<u32> = s.preds[t as usize].iter().copied().filter(|q| !controllers.contains(q)).collect();
+        let data_preds: Vec<u32> = s.preds[t as usize]
+            .iter()
+            .copied()
+            .filter(|q| !controllers.contains(q))
+            .collect();
         if level > cl && !data_preds.is_empty() {
             reasons.push(format!(
                 "must follow {} (data), which the control view ignores",
@@ -144,7 +178,10 @@ pub(crate) fn differences(p: &Program, a: &Analysis) -> Vec<Difference> {
             ));
         }
         if level < cl {
-            let instance = a.paper_control.iter().any(|d| d.to == r && matches!(d.cause, ControlCause::Instance { .. }));
+            let instance = a
+                .paper_control
+                .iter()
+                .any(|d| d.to == r && matches!(d.cause, ControlCause::Instance { .. }));
             if instance {
                 reasons.push("reads a timer or counter: the paper counts that as a control dependence, here it is the data dependence on the instance".into());
             }
@@ -156,7 +193,13 @@ pub(crate) fn differences(p: &Program, a: &Analysis) -> Vec<Difference> {
                 "levelled from the combined dependences".into()
             });
         }
-        out.push(Difference { rung: r, data_level: dl, control_level: cl, combined_level: Some(level), reasons });
+        out.push(Difference {
+            rung: r,
+            data_level: dl,
+            control_level: cl,
+            combined_level: Some(level),
+            reasons,
+        });
     }
     out
 }
@@ -176,9 +219,17 @@ pub(crate) fn networks(p: &Program, a: &Analysis) -> Vec<Network> {
     for r in p.rung_ids() {
         let rung = p.rung(r);
         let Some(net) = &rung.network else { continue };
-        let same = out.last().is_some_and(|n| n.pou == rung.pou && &n.id == net && n.rungs.last().is_some_and(|l| l.0 + 1 == r.0));
+        let same = out.last().is_some_and(|n| {
+            n.pou == rung.pou && &n.id == net && n.rungs.last().is_some_and(|l| l.0 + 1 == r.0)
+        });
         if !same {
-            out.push(Network { pou: rung.pou, id: net.clone(), rungs: Vec::new(), ins: Vec::new(), outs: Vec::new() });
+            out.push(Network {
+                pou: rung.pou,
+                id: net.clone(),
+                rungs: Vec::new(),
+                ins: Vec::new(),
+                outs: Vec::new(),
+            });
         }
         let n = out.last_mut().expect("pushed above");
         n.rungs.push(r);
@@ -197,7 +248,11 @@ pub(crate) fn networks(p: &Program, a: &Analysis) -> Vec<Network> {
 /// Human text of a warning.
 pub(crate) fn warning_text(p: &Program, w: &Warning) -> String {
     let ids = |rs: &[RungId]| {
-        let list = rs.iter().map(|r| p.rung(*r).id.as_str()).collect::<Vec<_>>().join(", ");
+        let list = rs
+            .iter()
+            .map(|r| p.rung(*r).id.as_str())
+            .collect::<Vec<_>>()
+            .join(", ");
         if rs.len() == 1 {
             format!("rung {list}")
         } else {

@@ -13,7 +13,9 @@ struct Table {
 
 impl Table {
     fn new(header: &[&str]) -> Table {
-        Table { rows: vec![header.iter().map(|h| h.to_string()).collect()] }
+        Table {
+            rows: vec![header.iter().map(|h| h.to_string()).collect()],
+        }
     }
     fn row(&mut self, cells: Vec<String>) {
         self.rows.push(cells);
@@ -59,25 +61,53 @@ pub fn render_text(p: &Program, a: &Analysis, view: View) -> String {
         p.name,
         m,
         if m == 1 { "" } else { "s" },
-        if main == m { String::new() } else { format!(" ({main} in the main program, {} in subroutines)", m - main) }
+        if main == m {
+            String::new()
+        } else {
+            format!(" ({main} in the main program, {} in subroutines)", m - main)
+        }
     );
     let count = |levels: &[u32]| levels.iter().map(|&l| l as usize + 1).max().unwrap_or(0);
-    let (nd, nc, nk) = (count(&a.data_levels), count(&a.control_levels), a.schedule.levels.len());
-    let pct = |n: usize| if m == 0 { 0.0 } else { 100.0 * (m as f64 - n as f64) / m as f64 };
+    let (nd, nc, nk) = (
+        count(&a.data_levels),
+        count(&a.control_levels),
+        a.schedule.levels.len(),
+    );
+    let pct = |n: usize| {
+        if m == 0 {
+            0.0
+        } else {
+            100.0 * (m as f64 - n as f64) / m as f64
+        }
+    };
 
     o.push_str("\nScan cycles (one rung per cycle before; one level per cycle after)\n");
     let mut t = Table::new(&["schedule", "cycles", "saved"]);
     t.row(vec!["sequential".into(), m.to_string(), String::new()]);
     if paper {
-        t.row(vec!["paper data view".into(), nd.to_string(), format!("{:.0} %", pct(nd))]);
-        t.row(vec!["paper control view".into(), nc.to_string(), format!("{:.0} %", pct(nc))]);
+        t.row(vec![
+            "paper data view".into(),
+            nd.to_string(),
+            format!("{:.0} %", pct(nd)),
+        ]);
+        t.row(vec![
+            "paper control view".into(),
+            nc.to_string(),
+            format!("{:.0} %", pct(nc)),
+        ]);
     }
     if combined {
-        t.row(vec!["combined (correct)".into(), nk.to_string(), format!("{:.0} %", pct(nk))]);
+        t.row(vec![
+            "combined (correct)".into(),
+            nk.to_string(),
+            format!("{:.0} %", pct(nk)),
+        ]);
     }
     t.render(&mut o);
 
-    o.push_str("\nLevels (rungs in one level may run at the same time; {…} is a loop run as one task)\n");
+    o.push_str(
+        "\nLevels (rungs in one level may run at the same time; {…} is a loop run as one task)\n",
+    );
     let data_g = rung_groups(&a.data_levels);
     let ctrl_g = rung_groups(&a.control_levels);
     let comb_g = combined_groups(a);
@@ -89,8 +119,16 @@ pub fn render_text(p: &Program, a: &Analysis, view: View) -> String {
         header.push("combined");
     }
     let mut t = Table::new(&header);
-    let rows = if paper { data_g.len().max(ctrl_g.len()) } else { 0 }.max(if combined { comb_g.len() } else { 0 });
-    let names = |g: Option<&Vec<RungId>>| g.map(|g| join(g.iter().map(|&r| id(r)), " ")).unwrap_or_default();
+    let rows = if paper {
+        data_g.len().max(ctrl_g.len())
+    } else {
+        0
+    }
+    .max(if combined { comb_g.len() } else { 0 });
+    let names = |g: Option<&Vec<RungId>>| {
+        g.map(|g| join(g.iter().map(|&r| id(r)), " "))
+            .unwrap_or_default()
+    };
     for l in 0..rows {
         let mut row = vec![(l + 1).to_string()];
         if paper {
@@ -130,9 +168,21 @@ pub fn render_text(p: &Program, a: &Analysis, view: View) -> String {
             c.span,
             ratio(c.work, c.span)
         );
-        let mut t = Table::new(&["cores", "makespan", "speed-up", "level by level", "speed-up"]);
+        let mut t = Table::new(&[
+            "cores",
+            "makespan",
+            "speed-up",
+            "level by level",
+            "speed-up",
+        ]);
         for ((cores, ms), (_, lm)) in c.makespan.iter().zip(&c.level_makespan) {
-            t.row(vec![cores.to_string(), ms.to_string(), format!("{:.2}", ratio(c.work, *ms)), lm.to_string(), format!("{:.2}", ratio(c.work, *lm))]);
+            t.row(vec![
+                cores.to_string(),
+                ms.to_string(),
+                format!("{:.2}", ratio(c.work, *ms)),
+                lm.to_string(),
+                format!("{:.2}", ratio(c.work, *lm)),
+            ]);
         }
         t.render(&mut o);
     }
@@ -140,7 +190,13 @@ pub fn render_text(p: &Program, a: &Analysis, view: View) -> String {
     o.push_str("\nRungs (IN: may read, OUT: may write; calls include their subroutine)\n");
     let mut t = Table::new(&["rung", "pou", "IN", "OUT", "cost"]);
     for r in p.rung_ids() {
-        let v = |vs: &[VarId]| if vs.is_empty() { "-".to_string() } else { join(vs.iter().map(|&x| p.var(x).name.as_str()), " ") };
+        let v = |vs: &[VarId]| {
+            if vs.is_empty() {
+                "-".to_string()
+            } else {
+                join(vs.iter().map(|&x| p.var(x).name.as_str()), " ")
+            }
+        };
         t.row(vec![
             id(r).into(),
             p.pou(p.rung(r).pou).name.clone(),
@@ -156,11 +212,27 @@ pub fn render_text(p: &Program, a: &Analysis, view: View) -> String {
         o.push_str("\nFBD networks (IN/OUT: the union over the network's block rungs)\n");
         let mut t = Table::new(&["network", "pou", "rungs", "IN", "OUT"]);
         for n in &nets {
-            let v = |vs: &[VarId]| if vs.is_empty() { "-".to_string() } else { join(vs.iter().map(|&x| p.var(x).name.as_str()), " ") };
+            let v = |vs: &[VarId]| {
+                if vs.is_empty() {
+                    "-".to_string()
+                } else {
+                    join(vs.iter().map(|&x| p.var(x).name.as_str()), " ")
+                }
+            };
             let first = id(n.rungs[0]);
             let last = id(*n.rungs.last().expect("a network has rungs"));
-            let span = if n.rungs.len() == 1 { first.to_owned() } else { format!("{first} .. {last} ({})", n.rungs.len()) };
-            t.row(vec![n.id.clone(), p.pou(n.pou).name.clone(), span, v(&n.ins), v(&n.outs)]);
+            let span = if n.rungs.len() == 1 {
+                first.to_owned()
+            } else {
+                format!("{first} .. {last} ({})", n.rungs.len())
+            };
+            t.row(vec![
+                n.id.clone(),
+                p.pou(n.pou).name.clone(),
+                span,
+                v(&n.ins),
+                v(&n.outs),
+            ]);
         }
         t.render(&mut o);
     }
@@ -180,7 +252,12 @@ pub fn render_text(p: &Program, a: &Analysis, view: View) -> String {
         let mut sorted = a.data.clone();
         sorted.sort_unstable_by_key(|d| (d.from, d.to, d.kind, d.var));
         for d in sorted {
-            t.row(vec![id(RungId(d.from)).into(), id(RungId(d.to)).into(), dep_kind_name(d.kind).into(), p.var(d.var).name.clone()]);
+            t.row(vec![
+                id(RungId(d.from)).into(),
+                id(RungId(d.to)).into(),
+                dep_kind_name(d.kind).into(),
+                p.var(d.var).name.clone(),
+            ]);
         }
         t.render(&mut o);
     }
@@ -195,9 +272,18 @@ pub fn render_text(p: &Program, a: &Analysis, view: View) -> String {
             let why = match cause {
                 ControlCause::Branch { edge } => {
                     let e = &a.cfg.edges[*edge as usize];
-                    format!("edge {} → {}{} ({})", node_name(p, e.from), node_name(p, e.to), label_suffix(e.label), e.kind.name())
+                    format!(
+                        "edge {} → {}{} ({})",
+                        node_name(p, e.from),
+                        node_name(p, e.to),
+                        label_suffix(e.label),
+                        e.kind.name()
+                    )
                 }
-                ControlCause::Instance { var } => format!("reads {} (timer/counter, counted as control by the paper)", p.var(*var).name),
+                ControlCause::Instance { var } => format!(
+                    "reads {} (timer/counter, counted as control by the paper)",
+                    p.var(*var).name
+                ),
             };
             t.row(vec![id(*f).into(), id(*to).into(), why]);
         }
@@ -205,33 +291,61 @@ pub fn render_text(p: &Program, a: &Analysis, view: View) -> String {
     }
     let selfs = self_controlled(a);
     if !selfs.is_empty() {
-        let _ = writeln!(o, "  control dependent on themselves (loop heads, calls; ignored for levels): {}", join(selfs.iter().map(|&r| id(r)), " "));
+        let _ = writeln!(
+            o,
+            "  control dependent on themselves (loop heads, calls; ignored for levels): {}",
+            join(selfs.iter().map(|&r| id(r)), " ")
+        );
     }
 
     o.push_str("\nControl-flow graph\n");
     let mut t = Table::new(&["from", "to", "label", "kind"]);
     for e in &a.cfg.edges {
-        t.row(vec![node_name(p, e.from).into(), node_name(p, e.to).into(), label_suffix(e.label).trim().trim_matches(['(', ')']).into(), e.kind.name().into()]);
+        t.row(vec![
+            node_name(p, e.from).into(),
+            node_name(p, e.to).into(),
+            label_suffix(e.label).trim().trim_matches(['(', ')']).into(),
+            e.kind.name().into(),
+        ]);
     }
     t.render(&mut o);
 
     o.push_str("\nPost-dominator tree (ipdom = immediate post-dominator; the root is STOP)\n");
     let mut t = Table::new(&["node", "ipdom", "children"]);
-    for n in std::iter::once(a.cfg.start()).chain(0..m as u32).chain(std::iter::once(a.cfg.stop())) {
-        let ip = a.post_dominators.immediate(n).map(|d| node_name(p, d).to_owned()).unwrap_or_else(|| "-".into());
-        let kids = join(a.post_dominators.children(n).iter().map(|&k| node_name(p, k)), " ");
+    for n in std::iter::once(a.cfg.start())
+        .chain(0..m as u32)
+        .chain(std::iter::once(a.cfg.stop()))
+    {
+        let ip = a
+            .post_dominators
+            .immediate(n)
+            .map(|d| node_name(p, d).to_owned())
+            .unwrap_or_else(|| "-".into());
+        let kids = join(
+            a.post_dominators
+                .children(n)
+                .iter()
+                .map(|&k| node_name(p, k)),
+            " ",
+        );
         t.row(vec![node_name(p, n).into(), ip, kids]);
     }
     t.render(&mut o);
 
     if combined {
         let s = &a.schedule;
-        o.push_str("\nCombined schedule tasks (a task runs when its guard holds; \"always\" otherwise)\n");
+        o.push_str(
+            "\nCombined schedule tasks (a task runs when its guard holds; \"always\" otherwise)\n",
+        );
         let mut t = Table::new(&["level", "task", "guard"]);
         for (l, level) in s.levels.iter().enumerate() {
             for &ti in level {
                 let task = &s.tasks[ti as usize];
-                let name = if task.rungs.len() == 1 { id(task.rungs[0]).to_owned() } else { format!("{{{}}}", join(task.rungs.iter().map(|&r| id(r)), " ")) };
+                let name = if task.rungs.len() == 1 {
+                    id(task.rungs[0]).to_owned()
+                } else {
+                    format!("{{{}}}", join(task.rungs.iter().map(|&r| id(r)), " "))
+                };
                 let guard = if task.guard.is_empty() {
                     "always".to_string()
                 } else {
@@ -262,7 +376,9 @@ pub fn render_text(p: &Program, a: &Analysis, view: View) -> String {
                         id(d.rung).into(),
                         (d.data_level + 1).to_string(),
                         (d.control_level + 1).to_string(),
-                        d.combined_level.map(|l| (l + 1).to_string()).unwrap_or_else(|| "-".into()),
+                        d.combined_level
+                            .map(|l| (l + 1).to_string())
+                            .unwrap_or_else(|| "-".into()),
                         d.reasons.join("; "),
                     ]);
                 }

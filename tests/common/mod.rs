@@ -80,11 +80,23 @@ fn condition(rng: &mut Rng, depth: u32) -> Value {
     match rng.below(if depth > 1 { 8 } else { 10 }) {
         0..=3 => json!({"contact": bool_read(rng)}),
         4 => json!({"contact": bool_read(rng), "negated": true}),
-        5 => json!({"contact": bool_read(rng), "edge": if rng.chance(50) { "rising" } else { "falling" }}),
-        6 | 7 => json!({"compare": rng.pick(&["EQ", "NE", "LT", "LE", "GT", "GE"]), "a": int_operand(rng), "b": int_operand(rng)}),
+        5 => {
+            json!({"contact": bool_read(rng), "edge": if rng.chance(50) { "rising" } else { "falling" }})
+        }
+        6 | 7 => {
+            json!({"compare": rng.pick(&["EQ", "NE", "LT", "LE", "GT", "GE"]), "a": int_operand(rng), "b": int_operand(rng)})
+        }
         _ => {
             let n = 2 + rng.below(2);
-            let branches: Vec<Value> = (0..n).map(|_| Value::Array((0..1 + rng.below(2)).map(|_| condition(rng, depth + 1)).collect())).collect();
+            let branches: Vec<Value> = (0..n)
+                .map(|_| {
+                    Value::Array(
+                        (0..1 + rng.below(2))
+                            .map(|_| condition(rng, depth + 1))
+                            .collect(),
+                    )
+                })
+                .collect();
             json!({"or": branches})
         }
     }
@@ -104,7 +116,9 @@ fn action(rng: &mut Rng, labels: &[String], subs: &[String], depth: u32) -> Valu
         9 => json!({"ctu": "c0", "pv": 3, "reset": bool_read(rng)}),
         10 => json!({"ctd": "c1", "pv": 2, "load": bool_read(rng)}),
         11 => json!({"move": int_operand(rng), "to": rng.pick(INTS)}),
-        12 => json!({"op": rng.pick(&["ADD", "SUB", "MUL", "DIV", "MOD"]), "in": [int_operand(rng), int_operand(rng)], "out": rng.pick(INTS)}),
+        12 => {
+            json!({"op": rng.pick(&["ADD", "SUB", "MUL", "DIV", "MOD"]), "in": [int_operand(rng), int_operand(rng)], "out": rng.pick(INTS)})
+        }
         13 => json!({"op": rng.pick(&["ADD", "MUL", "DIV"]), "in": ["r", 1.5], "out": "r"}),
         14 if !labels.is_empty() => json!({"jmp": rng.pick(labels)}),
         14 | 15 if !subs.is_empty() => json!({"call": rng.pick(subs)}),
@@ -124,13 +138,27 @@ fn action(rng: &mut Rng, labels: &[String], subs: &[String], depth: u32) -> Valu
 }
 
 /// Rungs of one POU: `prefix` names them, `subs` are callable subroutines.
-fn rungs(rng: &mut Rng, prefix: &str, count: usize, subs: &[String], main: bool, loops: bool) -> Vec<Value> {
-    let labels: Vec<String> = (0..count).filter(|i| i % 3 == 1).map(|i| format!("{prefix}L{i}")).collect();
+fn rungs(
+    rng: &mut Rng,
+    prefix: &str,
+    count: usize,
+    subs: &[String],
+    main: bool,
+    loops: bool,
+) -> Vec<Value> {
+    let labels: Vec<String> = (0..count)
+        .filter(|i| i % 3 == 1)
+        .map(|i| format!("{prefix}L{i}"))
+        .collect();
     let mut out = Vec::new();
     let mut i = 0;
     while i < count {
         let id = format!("{prefix}{i}");
-        let label = if i % 3 == 1 { Some(format!("{prefix}L{i}")) } else { None };
+        let label = if i % 3 == 1 {
+            Some(format!("{prefix}L{i}"))
+        } else {
+            None
+        };
         let mut series: Vec<Value> = (0..rng.below(3)).map(|_| condition(rng, 0)).collect();
         // A FOR/NEXT block of 1–2 body rungs with a constant bound.
         if loops && main && rng.chance(8) && i + 3 < count && label.is_none() {
@@ -150,7 +178,11 @@ fn rungs(rng: &mut Rng, prefix: &str, count: usize, subs: &[String], main: bool,
             series.push(action(rng, &labels, subs, 0));
         }
         if rng.chance(4) {
-            series.push(if main && rng.chance(50) { json!({"end": true}) } else { json!({"ret": true}) });
+            series.push(if main && rng.chance(50) {
+                json!({"end": true})
+            } else {
+                json!({"ret": true})
+            });
         }
         let mut r = json!({"id": id, "ld": series});
         if let Some(l) = label {
@@ -179,5 +211,6 @@ pub fn random_program(seed: u64, max_rungs: usize) -> String {
     }
     let count = 1 + rng.below(max_rungs as u64) as usize;
     let main = rungs(&mut rng, "R", count, &names, true, true);
-    json!({"program": "random", "vars": vars(), "rungs": main, "subroutines": subroutines}).to_string()
+    json!({"program": "random", "vars": vars(), "rungs": main, "subroutines": subroutines})
+        .to_string()
 }
