@@ -12,32 +12,16 @@
 
 mod common;
 
+use common::Recorder;
+
 use plc_deps::analysis::analyse;
-use plc_deps::exec::parallel::{ParallelMachine, PlanConfig, ScanDriver, Slicing, Strategy};
-use plc_deps::exec::{ExecConfig, Fault, FaultKind, Machine};
+use plc_deps::exec::parallel::{ParallelMachine, PlanConfig, Slicing, Strategy};
+use plc_deps::exec::{ExecConfig, FaultKind, Machine};
 use plc_deps::model::{Program, Value, VarClass, VarId};
-use std::time::Duration;
 
 const PROGRAMS: u64 = 2000;
 const SCANS: u64 = 30;
 const THREADS: [usize; 3] = [1, 2, 4];
-
-/// Records the state and faults after every scan; writes inputs from a table.
-struct Recorder<'a> {
-    inputs: &'a [Vec<(VarId, Value)>],
-    states: Vec<Vec<u64>>,
-    faults: Vec<Vec<Fault>>,
-}
-
-impl ScanDriver for Recorder<'_> {
-    fn before_scan(&mut self, m: &Machine, scan: u64, slots: &mut [u64]) {
-        m.set_inputs_in(slots, &self.inputs[scan as usize]);
-    }
-    fn after_scan(&mut self, _: &Machine, _: u64, slots: &[u64], faults: &[Fault], _: Duration) {
-        self.states.push(slots.to_vec());
-        self.faults.push(faults.to_vec());
-    }
-}
 
 /// Random inputs per scan: the BOOL inputs and the INT input `k` (often 0: DIV/MOD faults).
 fn input_table(p: &Program, seed: u64, scans: u64) -> Vec<Vec<(VarId, Value)>> {

@@ -9,37 +9,17 @@
 //! constants only, typed DINT, feeding an INT) are refused by the reader; the test counts them
 //! and requires most programs to load.
 
+mod common;
+
+use common::{Recorder, Rng};
 use plc_deps::analysis::analyse;
-use plc_deps::exec::parallel::{ParallelMachine, PlanConfig, ScanDriver, Slicing, Strategy};
-use plc_deps::exec::{ExecConfig, Fault, Machine};
+use plc_deps::exec::parallel::{ParallelMachine, PlanConfig, Slicing, Strategy};
+use plc_deps::exec::{ExecConfig, Machine};
 use plc_deps::model::{Program, Type, Value, VarClass, VarId};
 use serde_json::{json, Value as Json};
-use std::time::Duration;
 
 const PROGRAMS: u64 = 400;
 const SCANS: u64 = 25;
-
-/// splitmix64.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n.max(1)
-    }
-    fn chance(&mut self, percent: u64) -> bool {
-        self.below(100) < percent
-    }
-    fn pick<'a, T>(&mut self, items: &'a [T]) -> &'a T {
-        &items[self.below(items.len() as u64) as usize]
-    }
-}
 
 #[derive(Copy, Clone, PartialEq)]
 enum Ty {
@@ -309,7 +289,7 @@ fn body(rng: &mut Rng, s: &Scope, networks: usize) -> Json {
 }
 
 fn random_fbd_program(seed: u64) -> String {
-    let mut rng = Rng(seed ^ 0x5EED_F00D);
+    let mut rng = Rng::new(seed ^ 0x5EED_F00D);
     let main = Scope {
         bools_read: vec!["i0", "i1", "b0", "b1", "q", "t0.Q", "c0.Q", "f0.Q"],
         bools_write: vec!["b0", "b1", "q"],
@@ -363,24 +343,8 @@ fn random_fbd_program(seed: u64) -> String {
     .to_string()
 }
 
-struct Recorder<'a> {
-    inputs: &'a [Vec<(VarId, Value)>],
-    states: Vec<Vec<u64>>,
-    faults: Vec<Vec<Fault>>,
-}
-
-impl ScanDriver for Recorder<'_> {
-    fn before_scan(&mut self, m: &Machine, scan: u64, slots: &mut [u64]) {
-        m.set_inputs_in(slots, &self.inputs[scan as usize]);
-    }
-    fn after_scan(&mut self, _: &Machine, _: u64, slots: &[u64], faults: &[Fault], _: Duration) {
-        self.states.push(slots.to_vec());
-        self.faults.push(faults.to_vec());
-    }
-}
-
 fn input_table(p: &Program, seed: u64) -> Vec<Vec<(VarId, Value)>> {
-    let mut rng = Rng(seed ^ 0xABCD);
+    let mut rng = Rng::new(seed ^ 0xABCD);
     let inputs: Vec<VarId> = (0..p.vars.len() as u32)
         .map(VarId)
         .filter(|&v| p.var(v).class == VarClass::Input)

@@ -3,7 +3,29 @@
 //! from a seed, so a failing case is reproducible and printable.
 #![allow(dead_code)]
 
+use plc_deps::exec::parallel::ScanDriver;
+use plc_deps::exec::{Fault, Machine};
+use plc_deps::model::{Value as PlcValue, VarId};
 use serde_json::{json, Value};
+use std::time::Duration;
+
+/// A scan driver for differential tests: writes each scan's inputs from a table and records the
+/// full state and the faults after every scan.
+pub struct Recorder<'a> {
+    pub inputs: &'a [Vec<(VarId, PlcValue)>],
+    pub states: Vec<Vec<u64>>,
+    pub faults: Vec<Vec<Fault>>,
+}
+
+impl ScanDriver for Recorder<'_> {
+    fn before_scan(&mut self, m: &Machine, scan: u64, slots: &mut [u64]) {
+        m.set_inputs_in(slots, &self.inputs[scan as usize]);
+    }
+    fn after_scan(&mut self, _: &Machine, _: u64, slots: &[u64], faults: &[Fault], _: Duration) {
+        self.states.push(slots.to_vec());
+        self.faults.push(faults.to_vec());
+    }
+}
 
 /// A small deterministic PRNG (splitmix64).
 pub struct Rng(u64);
