@@ -5,30 +5,11 @@
 //! `tests/errors/NAME.json` holds a bad program and `NAME.err` the exact error text
 //! (`UPDATE_EXPECT=1` re-blesses).
 
+mod common;
+
+use common::cli::*;
+
 use std::path::PathBuf;
-use std::process::{Command, Output};
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_plc-deps"))
-}
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn run(args: &[&str]) -> Output {
-    bin()
-        .current_dir(root())
-        .args(args)
-        .output()
-        .expect("run plc-deps")
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("plc-deps-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
 
 #[test]
 fn every_bad_program_gives_one_located_error_and_exit_code_2() {
@@ -154,23 +135,7 @@ fn dot_renders_with_graphviz_without_warnings() {
             let program = format!("analyses/{example}/program.json");
             let out = run(&["report", &program, "--format", "dot", "--view", view]);
             assert!(out.status.success());
-            let dot = Command::new("dot")
-                .arg("-Tsvg")
-                .stdin(std::process::Stdio::piped())
-                .stdout(std::process::Stdio::piped())
-                .stderr(std::process::Stdio::piped())
-                .spawn()
-                .expect("Graphviz `dot` is installed (.ci/run installs it)");
-            use std::io::Write;
-            dot.stdin.as_ref().unwrap().write_all(&out.stdout).unwrap();
-            let res = dot.wait_with_output().unwrap();
-            assert!(res.status.success(), "{example}: dot failed");
-            assert!(
-                res.stderr.is_empty(),
-                "{example} ({view}): dot warned: {}",
-                String::from_utf8_lossy(&res.stderr)
-            );
-            assert!(String::from_utf8_lossy(&res.stdout).contains("<svg"));
+            graphviz(&out.stdout, &format!("{example} ({view})"));
         }
     }
 }

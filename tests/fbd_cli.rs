@@ -2,9 +2,11 @@
 //! renders cleanly (also the report's DOT of FBD programs), and cycles and fragment-rule
 //! violations as one located error with exit code 2 and no output file.
 
+mod common;
+
+use common::cli::*;
+
 use serde_json::Value;
-use std::path::PathBuf;
-use std::process::{Command, Output};
 
 const FBD_EXAMPLES: &[&str] = &[
     "example-c",
@@ -14,24 +16,6 @@ const FBD_EXAMPLES: &[&str] = &[
     "kaskad-4",
     "kaskad-5",
 ];
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_plc-deps"))
-        .current_dir(root())
-        .args(args)
-        .output()
-        .expect("run plc-deps")
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("plc-deps-fbd-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
 
 fn keys(v: &Value) -> Vec<&str> {
     let mut k: Vec<&str> = v
@@ -211,26 +195,6 @@ fn a_fragment_rule_violation_is_exit_code_2_naming_blocks_and_fragments() {
         e.contains("block 12 (fragment F(3)) reads an output of block 9 (fragment F(4))"),
         "{e}"
     );
-}
-
-fn graphviz(dot: &[u8], what: &str) {
-    let child = Command::new("dot")
-        .arg("-Tsvg")
-        .stdin(std::process::Stdio::piped())
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .expect("Graphviz `dot` is installed (.ci/run installs it)");
-    use std::io::Write;
-    child.stdin.as_ref().unwrap().write_all(dot).unwrap();
-    let res = child.wait_with_output().unwrap();
-    assert!(res.status.success(), "{what}: dot failed");
-    assert!(
-        res.stderr.is_empty(),
-        "{what}: dot warned: {}",
-        String::from_utf8_lossy(&res.stderr)
-    );
-    assert!(String::from_utf8_lossy(&res.stdout).contains("<svg"));
 }
 
 #[test]

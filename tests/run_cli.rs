@@ -2,27 +2,13 @@
 //! held between rows and after the last one), the trace file, `--mode both` on programs with
 //! jumps, loops and calls, faults, and bad input: one located error, exit code 2, no output file.
 
+mod common;
+
+use common::cli::*;
+
 use serde_json::Value;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_plc-deps"))
-        .current_dir(root())
-        .args(args)
-        .output()
-        .expect("run plc-deps")
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("plc-deps-run-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
+use std::path::Path;
+use std::process::Output;
 
 fn write(name: &str, text: &str) -> String {
     let path = tmp(name);

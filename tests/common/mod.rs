@@ -3,6 +3,8 @@
 //! from a seed, so a failing case is reproducible and printable.
 #![allow(dead_code)]
 
+pub mod cli;
+
 use plc_deps::exec::parallel::ScanDriver;
 use plc_deps::exec::{Fault, Machine};
 use plc_deps::model::{Value as PlcValue, VarId};
