@@ -29,20 +29,9 @@ pub(crate) fn everywhere(_: RungId) -> bool {
 const PREV_IN: u64 = 1;
 const ACTIVE: u64 = 2; // TON: timing since IN rose; TOF: timing since IN fell; TP: pulsing.
 
+/// `a OP b` for integers (as `i64`) and REAL (`f32`, IEEE: NaN compares false except NE).
 #[inline(always)]
-fn cmp_int(op: CmpOp, a: i64, b: i64) -> bool {
-    match op {
-        CmpOp::Eq => a == b,
-        CmpOp::Ne => a != b,
-        CmpOp::Lt => a < b,
-        CmpOp::Le => a <= b,
-        CmpOp::Gt => a > b,
-        CmpOp::Ge => a >= b,
-    }
-}
-
-#[inline(always)]
-fn cmp_real(op: CmpOp, a: f32, b: f32) -> bool {
+fn compare<T: PartialOrd>(op: CmpOp, a: T, b: T) -> bool {
     match op {
         CmpOp::Eq => a == b,
         CmpOp::Ne => a != b,
@@ -131,14 +120,14 @@ impl Machine {
                     st.set(mem, v);
                 }
                 Op::CmpInt { op, a, b } => {
-                    p &= cmp_int(op, self.src(st, a) as i64, self.src(st, b) as i64) as u64
+                    p &= compare(op, self.src(st, a) as i64, self.src(st, b) as i64) as u64
                 }
                 Op::CmpReal { op, a, b } => {
                     let (a, b) = (
                         f32::from_bits(self.src(st, a) as u32),
                         f32::from_bits(self.src(st, b) as u32),
                     );
-                    p &= cmp_real(op, a, b) as u64;
+                    p &= compare(op, a, b) as u64;
                 }
                 Op::OrOpen => s = (s << 2) | (p << 1),
                 Op::OrNext => {

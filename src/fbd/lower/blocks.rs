@@ -33,22 +33,7 @@ impl Cx<'_> {
         }
         let series = match &blk.op {
             Op::Compare(c) => {
-                let ty = numeric_type(&vals, None);
-                if !ty.is_numeric() {
-                    let (v, p) = vals
-                        .iter()
-                        .find(|(v, _)| v.ty().is_some())
-                        .unwrap_or(&vals[0]);
-                    return Err(e(
-                        p,
-                        Invalid::Type {
-                            what: "a comparison",
-                            expected: "INT, DINT, REAL or TIME".into(),
-                            operand: v.text().to_owned(),
-                            found: ty.to_string(),
-                        },
-                    ));
-                }
+                let ty = numeric(&vals, None, "a comparison").map_err(|(p, k)| e(p, k))?;
                 let a = self.coerce(nx, &vals[0].0, ty, "a comparison", vals[0].1, id)?;
                 let bb = self.coerce(nx, &vals[1].0, ty, "a comparison", vals[1].1, id)?;
                 let (d, rest) = self.dest(nx, b, 0, Type::Bool, &[])?;
@@ -234,22 +219,7 @@ impl Cx<'_> {
                     .out_vars(nx, b, 0, None)?
                     .first()
                     .map(|&v| self.env.var(v).ty);
-                let ty = numeric_type(&vals, out_ty);
-                if !ty.is_numeric() {
-                    let (v, p) = vals
-                        .iter()
-                        .find(|(v, _)| v.ty().is_some())
-                        .unwrap_or(&vals[0]);
-                    return Err(e(
-                        p,
-                        Invalid::Type {
-                            what: "this block",
-                            expected: "INT, DINT, REAL or TIME".into(),
-                            operand: v.text().to_owned(),
-                            found: ty.to_string(),
-                        },
-                    ));
-                }
+                let ty = numeric(&vals, out_ty, "this block").map_err(|(p, k)| e(p, k))?;
                 let ops = self.typed_all(nx, &vals, ty, blk.op.name_static(), id)?;
                 let (d, rest) = self.dest(nx, b, 0, ty, &ops)?;
                 let dv = var_op(d);
@@ -467,6 +437,32 @@ fn numeric_type(vals: &[(Val, &str)], fallback: Option<Type>) -> Type {
     } else {
         Type::Dint
     }
+}
+
+/// The numeric type of the inputs (see [`numeric_type`]), or the error naming the input that
+/// fixed a non-numeric type (its pin path and the kind).
+fn numeric<'v>(
+    vals: &[(Val, &'v str)],
+    fallback: Option<Type>,
+    what: &'static str,
+) -> std::result::Result<Type, (&'v str, Invalid)> {
+    let ty = numeric_type(vals, fallback);
+    if ty.is_numeric() {
+        return Ok(ty);
+    }
+    let (v, p) = vals
+        .iter()
+        .find(|(v, _)| v.ty().is_some())
+        .unwrap_or(&vals[0]);
+    Err((
+        p,
+        Invalid::Type {
+            what,
+            expected: "INT, DINT, REAL or TIME".into(),
+            operand: v.text().to_owned(),
+            found: ty.to_string(),
+        },
+    ))
 }
 
 impl Op {
