@@ -5,10 +5,12 @@
 //! the whole output is ready (written to a temporary file beside it, then renamed), so a failure
 //! never leaves a half-written file.
 
-use crate::analysis::analyse;
+use crate::analysis::{analyse, analyse_with, Analysis, AnalysisConfig, DependenceListing, Listed};
 use crate::model::Program;
 use crate::read::{program_from_json, LoadError};
-use crate::report::{render_dot, render_json, render_text, View};
+use crate::report::{
+    document, render_dot, render_json, render_text, Rows, TextOptions, View, DOT_MAX_RUNGS,
+};
 use std::path::{Path, PathBuf};
 
 /// An error of a command, with what the user needs to find its cause.
@@ -111,25 +113,79 @@ pub enum ReportFormat {
 pub struct ReportConfig {
     pub input: PathBuf,
     pub format: ReportFormat,
+    /// The levellings text and DOT show.
     pub view: View,
+    /// Rows per section of the text report.
+    pub rows: Rows,
+    /// Which data dependences are listed.
+    pub analysis: AnalysisConfig,
     pub output: Option<PathBuf>,
 }
 
-/// Renders the report of a loaded program.
-pub fn render_report(p: &Program, format: ReportFormat, view: View) -> String {
-    let a = analyse(p);
+/// Writes the report of `p` (analysed as `analysis` says) in `format`.
+pub fn write_report(
+    p: &Program,
+    a: &Analysis,
+    format: ReportFormat,
+    text: &TextOptions,
+    out: &mut impl std::io::Write,
+) -> std::io::Result<()> {
+    let doc = document(p, a);
     match format {
-        ReportFormat::Text => render_text(p, &a, view),
-        ReportFormat::Json => render_json(p, &a),
-        ReportFormat::Dot => render_dot(p, &a, view),
+        ReportFormat::Text => render_text(&doc, text, out),
+        ReportFormat::Json => render_json(&doc, out),
+        ReportFormat::Dot => render_dot(&doc, text.view, out),
     }
 }
 
-/// `plc-deps report`.
+/// Renders the report of a loaded program with the default options (a convenience for tests
+/// and small programs: the command streams instead).
+pub fn render_report(p: &Program, format: ReportFormat, view: View) -> String {
+    let a = analyse(p);
+    let mut out = Vec::new();
+    let text = TextOptions {
+        view,
+        ..TextOptions::default()
+    };
+    write_report(p, &a, format, &text, &mut out).expect("writing to memory cannot fail");
+    String::from_utf8(out).expect("reports are UTF-8")
+}
+
+/// `plc-deps report`. Warnings go to standard error as well as into the report.
 pub fn report(c: &ReportConfig) -> Result<(), CliError> {
     let p = load_program(&c.input)?;
-    let out = render_report(&p, c.format, c.view);
-    write_output(c.output.as_deref(), &out)
+    if c.format == ReportFormat::Dot && p.rungs.len() > DOT_MAX_RUNGS {
+        return Err(CliError::Usage(format!(
+            "{}: {} rungs are too many to draw ({} at most): Graphviz cannot lay out a graph this size usefully; use the text or JSON report",
+            c.input.display(),
+            p.rungs.len(),
+            DOT_MAX_RUNGS
+        )));
+    }
+    let a = analyse_with(&p, &c.analysis);
+    for w in &a.warnings {
+        eprintln!(
+            "warning: {}: {}",
+            c.input.display(),
+            crate::report::warning_text(&p, w)
+        );
+    }
+    if a.listed == Listed::Direct && c.analysis.dependences != DependenceListing::Direct {
+        eprintln!(
+            "warning: {}: {} data dependence pairs are more than --max-pairs allows; listing the {} direct ones (they imply the rest; --dependences all lists every pair)",
+            c.input.display(),
+            a.counts.total(),
+            a.data.len()
+        );
+    }
+    let text = TextOptions {
+        view: c.view,
+        rows: c.rows,
+    };
+    write_output_with(c.output.as_deref(), |w| {
+        let mut w = w;
+        write_report(&p, &a, c.format, &text, &mut w)
+    })
 }
 
 /// Output format of `order`.

@@ -7,8 +7,9 @@
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 use clap::{Parser, Subcommand, ValueEnum};
+use plc_deps::analysis::{AnalysisConfig, DependenceListing};
 use plc_deps::app::{self, CliError, ReportConfig, ReportFormat};
-use plc_deps::report::View;
+use plc_deps::report::{Rows, View};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -29,9 +30,21 @@ enum Command {
         /// Output format.
         #[arg(long, value_enum, default_value_t = FormatArg::Text)]
         format: FormatArg,
-        /// Which levellings the text and DOT outputs show (JSON always has all of them).
-        #[arg(long, value_enum, default_value_t = ViewArg::All)]
-        view: ViewArg,
+        /// Which levellings the output shows (JSON always has all of them) [default: all for
+        /// text, combined for DOT, which draws one levelling].
+        #[arg(long, value_enum)]
+        view: Option<ViewArg>,
+        /// Print every row of every text section (by default each shows its first rows).
+        #[arg(long)]
+        full: bool,
+        /// Which data dependences are listed: every pair of the definition, or only the direct
+        /// ones (last writer → reader, reader → next writer, writer → next writer), which imply
+        /// the rest [default: all up to --max-pairs, direct beyond].
+        #[arg(long, value_enum)]
+        dependences: Option<DependencesArg>,
+        /// The most data dependence pairs listed before the report lists the direct ones instead.
+        #[arg(long, default_value_t = plc_deps::analysis::DEFAULT_MAX_PAIRS)]
+        max_pairs: u64,
         /// Write to this file instead of standard output.
         #[arg(short, long)]
         output: Option<PathBuf>,
@@ -148,25 +161,53 @@ enum ViewArg {
     All,
 }
 
+#[derive(Copy, Clone, ValueEnum)]
+enum DependencesArg {
+    All,
+    Direct,
+}
+
 fn run(cli: Cli) -> Result<(), CliError> {
     match cli.command {
         Command::Report {
             file,
             format,
             view,
+            full,
+            dependences,
+            max_pairs,
             output,
         } => {
+            let format = match format {
+                FormatArg::Text => ReportFormat::Text,
+                FormatArg::Json => ReportFormat::Json,
+                FormatArg::Dot => ReportFormat::Dot,
+            };
+            let view = match (view, format) {
+                (Some(ViewArg::Paper), _) => View::Paper,
+                (Some(ViewArg::Combined), _) | (None, ReportFormat::Dot) => View::Combined,
+                (Some(ViewArg::All), ReportFormat::Dot) => {
+                    return Err(CliError::Usage(
+                        "--view all: the DOT report draws one levelling; use --view combined (the default) or --view paper".into(),
+                    ))
+                }
+                (Some(ViewArg::All), _) | (None, _) => View::All,
+            };
             let config = ReportConfig {
                 input: file,
-                format: match format {
-                    FormatArg::Text => ReportFormat::Text,
-                    FormatArg::Json => ReportFormat::Json,
-                    FormatArg::Dot => ReportFormat::Dot,
+                format,
+                view,
+                rows: if full {
+                    Rows::All
+                } else {
+                    Rows::First(plc_deps::report::text::DEFAULT_ROWS)
                 },
-                view: match view {
-                    ViewArg::Paper => View::Paper,
-                    ViewArg::Combined => View::Combined,
-                    ViewArg::All => View::All,
+                analysis: AnalysisConfig {
+                    dependences: match dependences {
+                        Some(DependencesArg::All) => DependenceListing::All,
+                        Some(DependencesArg::Direct) => DependenceListing::Direct,
+                        None => DependenceListing::UpTo(max_pairs),
+                    },
                 },
                 output,
             };

@@ -131,13 +131,62 @@ fn dot_renders_with_graphviz_without_warnings() {
         "mixing-station",
         "packaging-line",
     ] {
-        for view in ["all", "paper"] {
+        for view in ["combined", "paper"] {
             let program = format!("analyses/{example}/program.json");
             let out = run(&["report", &program, "--format", "dot", "--view", view]);
             assert!(out.status.success());
             graphviz(&out.stdout, &format!("{example} ({view})"));
         }
     }
+}
+
+/// The DOT report ranks by the levels the schedule has, puts subroutine rungs beside the
+/// ranks, and draws every dependence between two rungs as one edge.
+#[test]
+fn dot_ranks_are_the_schedule_levels_and_edges_are_merged() {
+    let out = run(&[
+        "report",
+        "analyses/example-b/program.json",
+        "--format",
+        "dot",
+    ]);
+    assert!(out.status.success());
+    let dot = String::from_utf8(out.stdout).unwrap();
+    // Example B's combined schedule has 3 levels; R11 and R12 run inside R10's task.
+    assert!(dot.contains("{ rank=same; \"level 3\"; \"R3\"; \"R5\"; \"R6\"; \"R7\"; \"R8\"; }"));
+    assert!(!dot.contains("level 4"), "{dot}");
+    assert!(dot.contains("subgraph \"cluster_sub0\" { label=\"subroutine SBR_A (runs inside its caller's task)\"; style=dotted; \"R11\"; }"));
+    // R2 → R5: flow and output on idx, one edge in both colours.
+    let r2_r5: Vec<&str> = dot
+        .lines()
+        .filter(|l| l.starts_with("  \"R2\" -> \"R5\""))
+        .collect();
+    assert_eq!(
+        r2_r5,
+        ["  \"R2\" -> \"R5\" [label=\"flow idx\\noutput idx\", color=\"black:red\"];"]
+    );
+    let paper = run(&[
+        "report",
+        "analyses/example-b/program.json",
+        "--format",
+        "dot",
+        "--view",
+        "paper",
+    ]);
+    let paper = String::from_utf8(paper.stdout).unwrap();
+    assert!(paper.contains("\"data level 3\""), "{paper}");
+    assert_ne!(dot, paper);
+    // One graph cannot show every levelling.
+    let all = run(&[
+        "report",
+        "analyses/example-b/program.json",
+        "--format",
+        "dot",
+        "--view",
+        "all",
+    ]);
+    assert_eq!(all.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&all.stderr).contains("draws one levelling"));
 }
 
 #[test]

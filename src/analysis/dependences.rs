@@ -140,6 +140,120 @@ pub fn data_dependences(reads: &VarSets, writes: &VarSets) -> Vec<DataDependence
     out
 }
 
+/// How many pairs of each data kind the every-pair definition gives, in total and per variable.
+///
+/// Computed without listing a single pair, in O(accesses · log accesses): for each access, the
+/// number of earlier conflicting accesses of its variable is a binary search in the per-variable
+/// index. A hot variable written by k rungs has k(k−1)/2 output pairs, so these counts are what a
+/// report can always afford even when the pairs themselves are too many to list.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct DependenceCounts {
+    pub flow: u64,
+    pub anti: u64,
+    pub output: u64,
+    /// Per variable with at least one pair: (variable, flow, anti, output), by variable id.
+    pub by_var: Vec<(VarId, u64, u64, u64)>,
+}
+
+impl DependenceCounts {
+    /// All data pairs together.
+    pub fn total(&self) -> u64 {
+        self.flow + self.anti + self.output
+    }
+}
+
+/// Counts the pairs [`data_dependences`] would list, per kind and per variable.
+pub fn dependence_counts(reads: &VarSets, writes: &VarSets) -> DependenceCounts {
+    let vars = var_count(reads, writes);
+    let readers = ByVar::new(reads, vars);
+    let writers = ByVar::new(writes, vars);
+    let mut per = vec![(0u64, 0u64, 0u64); vars];
+    for t in 0..reads.len() {
+        let tu = t as u32;
+        for &x in reads.list(t) {
+            per[x.index()].0 += writers.before(x, tu).len() as u64;
+        }
+        for &x in writes.list(t) {
+            per[x.index()].1 += readers.before(x, tu).len() as u64;
+            per[x.index()].2 += writers.before(x, tu).len() as u64;
+        }
+    }
+    let mut c = DependenceCounts::default();
+    for (x, &(f, a, o)) in per.iter().enumerate() {
+        c.flow += f;
+        c.anti += a;
+        c.output += o;
+        if f + a + o > 0 {
+            c.by_var.push((VarId(x as u32), f, a, o));
+        }
+    }
+    c
+}
+
+/// The *direct* data dependences: per variable, last writer → reader (flow), each reader since
+/// the last write → the next writer (anti), writer → next writer (output). Sorted like
+/// [`data_dependences`], and a subset of it.
+///
+/// Every pair of the full definition is implied by a path of direct pairs (a writer reaches a
+/// later writer through the chain of output pairs between them, and a later reader through that
+/// chain and the last writer's flow pair; a reader reaches a later writer through its anti pair
+/// and the output chain), so any schedule that respects the direct pairs respects them all, and
+/// ASAP levels over the direct pairs equal [`data_levels`]. Their number is at most the number
+/// of accesses, O(accesses) to compute, where the full list can be quadratic in the writers of a
+/// hot variable.
+pub fn direct_dependences(reads: &VarSets, writes: &VarSets) -> Vec<DataDependence> {
+    let vars = var_count(reads, writes);
+    let mut last_writer: Vec<Option<u32>> = vec![None; vars];
+    // Readers since the last write of each variable, as linked lists through `reader_links`.
+    let mut readers_head: Vec<Option<u32>> = vec![None; vars];
+    let mut reader_links: Vec<(u32, Option<u32>)> = Vec::new();
+    let mut out = Vec::new();
+    for t in 0..reads.len() {
+        let start = out.len();
+        let tu = t as u32;
+        for &x in reads.list(t) {
+            if let Some(s) = last_writer[x.index()] {
+                out.push(DataDependence {
+                    from: s,
+                    to: tu,
+                    kind: DepKind::Flow,
+                    var: x,
+                });
+            }
+        }
+        for &x in writes.list(t) {
+            let mut node = readers_head[x.index()].take();
+            while let Some(i) = node {
+                let (s, next) = reader_links[i as usize];
+                out.push(DataDependence {
+                    from: s,
+                    to: tu,
+                    kind: DepKind::Anti,
+                    var: x,
+                });
+                node = next;
+            }
+            if let Some(s) = last_writer[x.index()] {
+                out.push(DataDependence {
+                    from: s,
+                    to: tu,
+                    kind: DepKind::Output,
+                    var: x,
+                });
+            }
+            last_writer[x.index()] = Some(tu);
+        }
+        for &x in reads.list(t) {
+            if writes.list(t).binary_search(&x).is_err() {
+                reader_links.push((tu, readers_head[x.index()]));
+                readers_head[x.index()] = Some(reader_links.len() as u32 - 1);
+            }
+        }
+        out[start..].sort_unstable();
+    }
+    out
+}
+
 /// The definition applied literally: every ordered pair of units, every variable. O(n² · |vars|).
 pub fn data_dependences_pairwise(reads: &VarSets, writes: &VarSets) -> Vec<DataDependence> {
     let n = reads.len();

@@ -24,7 +24,10 @@ pub use accesses::{accesses, Accesses, VarSets};
 pub use cfg::{control_flow_graph, Branch, Cfg, CfgEdge, EdgeKind};
 pub use control::{control_dependences, post_dominators, ControlDependence, PostDominators};
 pub use cost::CostSummary;
-pub use dependences::{data_dependences, data_levels, DataDependence, DepKind};
+pub use dependences::{
+    data_dependences, data_levels, dependence_counts, direct_dependences, DataDependence, DepKind,
+    DependenceCounts,
+};
 pub use schedule::{combined_schedule, Guard, Schedule, Successor, Task};
 
 /// A control dependence of the paper's control view.
@@ -56,12 +59,52 @@ pub enum Warning {
     Uncalled(PouId),
 }
 
+/// Which data dependences an [`Analysis`] lists (levels and schedule never depend on it).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum DependenceListing {
+    /// Every pair of the paper's definition.
+    All,
+    /// Only the direct pairs ([`direct_dependences`]), linear in the accesses.
+    Direct,
+    /// Every pair while there are at most this many, the direct ones beyond.
+    UpTo(u64),
+}
+
+/// What [`analyse_with`] computes.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub struct AnalysisConfig {
+    pub dependences: DependenceListing,
+}
+
+/// The default limit of listed pairs: beyond it the report lists the direct ones.
+pub const DEFAULT_MAX_PAIRS: u64 = 2_000_000;
+
+impl Default for AnalysisConfig {
+    fn default() -> Self {
+        AnalysisConfig {
+            dependences: DependenceListing::UpTo(DEFAULT_MAX_PAIRS),
+        }
+    }
+}
+
+/// Which data dependences [`Analysis::data`] holds.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum Listed {
+    All,
+    Direct,
+}
+
 /// Everything `plc-deps report` shows.
 #[derive(Clone, Debug)]
 pub struct Analysis {
     pub accesses: Accesses,
-    /// Data dependences between rungs in listing order (unit index = `RungId`).
+    /// Data dependences between rungs in listing order (unit index = `RungId`): every pair, or
+    /// the direct ones (see `listed`).
     pub data: Vec<DataDependence>,
+    /// Which pairs `data` holds.
+    pub listed: Listed,
+    /// How many pairs of each kind the every-pair definition gives.
+    pub counts: DependenceCounts,
     /// Paper data view: level per rung (0-based).
     pub data_levels: Vec<u32>,
     pub cfg: Cfg,
@@ -79,14 +122,41 @@ pub struct Analysis {
     pub warnings: Vec<Warning>,
 }
 
+/// Runs every analysis on `p` with the default [`AnalysisConfig`].
+pub fn analyse(p: &Program) -> Analysis {
+    analyse_with(p, &AnalysisConfig::default())
+}
+
+/// The data dependences to list, and which kind of list that is.
+fn listed_dependences(
+    acc: &Accesses,
+    counts: &DependenceCounts,
+    listing: DependenceListing,
+) -> (Vec<DataDependence>, Listed) {
+    let all = match listing {
+        DependenceListing::All => true,
+        DependenceListing::Direct => false,
+        DependenceListing::UpTo(max) => counts.total() <= max,
+    };
+    if all {
+        (data_dependences(&acc.reads, &acc.writes), Listed::All)
+    } else {
+        (direct_dependences(&acc.reads, &acc.writes), Listed::Direct)
+    }
+}
+
 /// Runs every analysis on `p`. The paper's views and the combined schedule are independent once
 /// the accesses and the CFG are known, so they are computed on two threads (rayon).
-pub fn analyse(p: &Program) -> Analysis {
+pub fn analyse_with(p: &Program, config: &AnalysisConfig) -> Analysis {
     let (acc, cfg) = rayon::join(|| accesses(p), || control_flow_graph(p));
     let n = p.rungs.len();
     let paper = || {
-        let (data, data_lv) = rayon::join(
-            || data_dependences(&acc.reads, &acc.writes),
+        let ((counts, (data, listed)), data_lv) = rayon::join(
+            || {
+                let counts = dependence_counts(&acc.reads, &acc.writes);
+                let data = listed_dependences(&acc, &counts, config.dependences);
+                (counts, data)
+            },
             || data_levels(&acc.reads, &acc.writes),
         );
         let pairs: Vec<(u32, u32)> = cfg.edges.iter().map(|e| (e.from, e.to)).collect();
@@ -100,7 +170,16 @@ pub fn analyse(p: &Program) -> Analysis {
             .filter(|(a, b)| a != b)
             .collect();
         let control_lv = levels::asap_levels(n, &cv_edges);
-        (data, data_lv, pdom, control, paper_control, control_lv)
+        (
+            data,
+            listed,
+            counts,
+            data_lv,
+            pdom,
+            control,
+            paper_control,
+            control_lv,
+        )
     };
     let combined = || {
         let schedule = combined_schedule(p, &cfg, &acc);
@@ -121,8 +200,10 @@ pub fn analyse(p: &Program) -> Analysis {
         let cost = cost::summarise(&task_costs, &schedule.preds, &task_levels);
         (schedule, rung_costs, cost)
     };
-    let ((data, data_lv, pdom, control, paper_control, control_lv), (schedule, rung_costs, cost)) =
-        rayon::join(paper, combined);
+    let (
+        (data, listed, counts, data_lv, pdom, control, paper_control, control_lv),
+        (schedule, rung_costs, cost),
+    ) = rayon::join(paper, combined);
     let mut warnings = Vec::new();
     if !schedule.unreachable.is_empty() {
         warnings.push(Warning::Unreachable(schedule.unreachable.clone()));
@@ -143,6 +224,8 @@ pub fn analyse(p: &Program) -> Analysis {
     Analysis {
         accesses: acc,
         data,
+        listed,
+        counts,
         data_levels: data_lv,
         cfg,
         post_dominators: pdom,

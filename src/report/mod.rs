@@ -1,20 +1,25 @@
-//! Outputs of `plc-deps report`: the analysis rendered as text (for people), JSON (for tools,
-//! normative keys, docs/report.md) and DOT (for Graphviz).
+//! `plc-deps report`: the analysis as one [`Report`] document ([`document`]), rendered as text
+//! (for people, bounded at any program size), JSON (for tools; the document's serde keys are the
+//! normative keys of docs/report.md) and DOT (for Graphviz).
 //!
-//! Renderers take the program and its [`Analysis`] and return a `String`; they never print, so
-//! the caller writes the output file whole or not at all. Shared naming and the explanation of
-//! the differences between the paper's views and the combined schedule live here, so that every
-//! format says the same thing.
+//! The document is built once from the model and its [`Analysis`]; renderers write it to an
+//! `impl Write` and never print, so the caller decides where output goes and writes an output
+//! file whole or not at all. Adding a renderer touches no other renderer. The naming shared by
+//! every format and the explanation of where the combined schedule differs from the paper's
+//! views (Zhao & Yan, 2012) live here and in `explain`.
 
+pub mod document;
 mod dot;
+mod explain;
 mod json;
-mod text;
+pub mod text;
 
-pub use dot::render_dot;
+pub use document::{document, Report};
+pub use dot::{render_dot, MAX_RUNGS as DOT_MAX_RUNGS};
 pub use json::render_json;
-pub use text::render_text;
+pub use text::{render_text, Rows, TextOptions};
 
-use crate::analysis::{Analysis, ControlCause, DepKind, Warning};
+use crate::analysis::{Analysis, ControlCause, Warning};
 use crate::model::*;
 
 /// Which levellings a text or DOT report shows (JSON always carries all of them).
@@ -94,116 +99,6 @@ pub(crate) fn combined_groups(a: &Analysis) -> Vec<Vec<Vec<RungId>>> {
         .collect()
 }
 
-/// How the combined schedule places one rung differently from the paper's views, and why.
-pub(crate) struct Difference {
-    pub rung: RungId,
-    pub data_level: u32,
-    pub control_level: u32,
-    /// `None` for rungs that are not units of the combined schedule.
-    pub combined_level: Option<u32>,
-    pub reasons: Vec<String>,
-}
-
-/// One entry per rung whose combined placement differs from a paper view.
-pub(crate) fn differences(p: &Program, a: &Analysis) -> Vec<Difference> {
-    let s = &a.schedule;
-    let ids = |rs: &mut dyn Iterator<Item = RungId>| {
-        rs.map(|r| p.rung(r).id.clone())
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
-    let mut callers: Vec<Vec<RungId>> = vec![Vec::new(); p.pous.len()];
-    for e in &a.cfg.edges {
-        if e.kind == crate::analysis::EdgeKind::Call {
-            let pou = p.rungs[e.to as usize].pou;
-            callers[pou.index()].push(RungId(e.from));
-        }
-    }
-    let mut out = Vec::new();
-    for r in p.rung_ids() {
-        let dl = a.data_levels[r.index()];
-        let cl = a.control_levels[r.index()];
-        let rung = p.rung(r);
-        let Some(t) = s.task_of[r.index()] else {
-            let reason = if rung.pou.index() != 0 {
-                let c = &callers[rung.pou.index()];
-                if c.is_empty() {
-                    format!(
-                        "in subroutine {}, which nothing calls",
-                        p.pou(rung.pou).name
-                    )
-                } else {
-                    format!("in subroutine {}: runs inside the calling rung's task ({}), not as a unit of its own", p.pou(rung.pou).name, ids(&mut c.iter().copied()))
-                }
-            } else {
-                "can never run (unreachable from the start of the scan)".to_string()
-            };
-            out.push(Difference {
-                rung: r,
-                data_level: dl,
-                control_level: cl,
-                combined_level: None,
-                reasons: vec![reason],
-            });
-            continue;
-        };
-        let task = &s.tasks[t as usize];
-        let level = task.level;
-        if level == dl && level == cl && !task.is_loop {
-            continue;
-        }
-        let mut reasons = Vec::new();
-        if task.is_loop {
-            reasons.push(format!(
-                "part of the loop {{{}}}, kept whole as one sequential task",
-                ids(&mut task.rungs.iter().copied())
-            ));
-        }
-        let controllers: Vec<u32> = task.guard.iter().map(|g| g.controller).collect();
-        if level > dl && !controllers.is_empty() {
-            reasons.push(format!(
-                "runs only if {} decides so (control), which the data view ignores",
-                ids(&mut controllers.iter().map(|&c| s.head(c)))
-            ));
-        }
-        let data_preds: Vec<u32> = s.preds[t as usize]
-            .iter()
-            .copied()
-            .filter(|q| !controllers.contains(q))
-            .collect();
-        if level > cl && !data_preds.is_empty() {
-            reasons.push(format!(
-                "must follow {} (data), which the control view ignores",
-                ids(&mut data_preds.iter().take(4).map(|&c| s.head(c)))
-            ));
-        }
-        if level < cl {
-            let instance = a
-                .paper_control
-                .iter()
-                .any(|d| d.to == r && matches!(d.cause, ControlCause::Instance { .. }));
-            if instance {
-                reasons.push("reads a timer or counter: the paper counts that as a control dependence, here it is the data dependence on the instance".into());
-            }
-        }
-        if reasons.is_empty() {
-            reasons.push(if level > dl.max(cl) {
-                "both kinds of dependence together put it later than either view alone".into()
-            } else {
-                "levelled from the combined dependences".into()
-            });
-        }
-        out.push(Difference {
-            rung: r,
-            data_level: dl,
-            control_level: cl,
-            combined_level: Some(level),
-            reasons,
-        });
-    }
-    out
-}
-
 /// An FBD network of the program: its (contiguous) rungs and the union of their IN and OUT.
 pub(crate) struct Network {
     pub pou: PouId,
@@ -246,7 +141,7 @@ pub(crate) fn networks(p: &Program, a: &Analysis) -> Vec<Network> {
 }
 
 /// Human text of a warning.
-pub(crate) fn warning_text(p: &Program, w: &Warning) -> String {
+pub fn warning_text(p: &Program, w: &Warning) -> String {
     let ids = |rs: &[RungId]| {
         let list = rs
             .iter()
@@ -267,8 +162,4 @@ pub(crate) fn warning_text(p: &Program, w: &Warning) -> String {
         ),
         Warning::Uncalled(pou) => format!("subroutine {} is never called", p.pou(*pou).name),
     }
-}
-
-pub(crate) fn dep_kind_name(k: DepKind) -> &'static str {
-    k.name()
 }

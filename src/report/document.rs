@@ -1,0 +1,538 @@
+//! The report document: everything `plc-deps report` says about a program, built once from the
+//! model and its [`Analysis`], rendered by every output format.
+//!
+//! The structs here are the JSON report: their `#[derive(Serialize)]` field names are its keys,
+//! which are normative (docs/report.md; add fields, never rename or drop one). Sections whose
+//! size grows with the program (rungs, dependences, CFG edges, post-dominators, tasks,
+//! differences) are [`Lazy`] lists: each entry is made when a renderer asks for it, so a
+//! million-rung report costs no second copy of the analysis, and a renderer that shows only the
+//! first rows (the text report) only makes those. Everything small is built eagerly.
+//!
+//! Fields marked `#[serde(skip)]` are for the human renderers (text, DOT) and are not part of
+//! the JSON contract. Nothing here writes output: renderers do (`text`, `json`, `dot`).
+
+use super::explain::Explainer;
+use crate::analysis::{Analysis, Branch, ControlCause, Listed, Successor};
+use crate::model::*;
+use serde::ser::{Serialize, SerializeMap, Serializer};
+
+/// A list whose entries are made on demand from the analysis, serialised as a JSON array.
+pub struct Lazy<'a, T> {
+    len: usize,
+    make: Box<dyn Fn() -> Box<dyn Iterator<Item = T> + 'a> + 'a>,
+}
+
+impl<'a, T: 'a> Lazy<'a, T> {
+    fn new<I: Iterator<Item = T> + 'a>(len: usize, make: impl Fn() -> I + 'a) -> Self {
+        Lazy {
+            len,
+            make: Box::new(move || Box::new(make())),
+        }
+    }
+    /// Number of entries.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+    /// True if there are no entries.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+    /// The entries, in order.
+    pub fn iter(&self) -> Box<dyn Iterator<Item = T> + 'a> {
+        (self.make)()
+    }
+}
+
+impl<'a, T: Serialize + 'a> Serialize for Lazy<'a, T> {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_seq(self.iter())
+    }
+}
+
+/// The whole report.
+#[derive(serde::Serialize)]
+pub struct Report<'a> {
+    pub program: &'a str,
+    pub rungs: Lazy<'a, RungEntry<'a>>,
+    /// Data dependences (every pair, or the direct ones: see `dependences_listed`), then the
+    /// paper's control dependences, one per (from, to) pair.
+    pub dependences: Lazy<'a, DependenceEntry<'a>>,
+    /// `"all"` or `"direct"`: which data pairs `dependences` lists.
+    pub dependences_listed: &'static str,
+    /// Pair counts of the every-pair definition, whichever pairs are listed.
+    pub dependence_counts: DependenceCounts<'a>,
+    pub self_control: Vec<&'a str>,
+    pub cfg: CfgSection<'a>,
+    pub ipdom: Ipdom<'a>,
+    pub levels: Levels<'a>,
+    pub cycles: Cycles,
+    pub cost: Cost,
+    pub schedule: ScheduleSection<'a>,
+    /// The loops of the combined schedule, each named once by its first rung.
+    pub loops: Vec<LoopEntry<'a>>,
+    pub differences: Lazy<'a, DifferenceEntry>,
+    pub warnings: Vec<String>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub networks: Vec<NetworkEntry<'a>>,
+    /// For the human renderers.
+    #[serde(skip)]
+    pub summary: Summary,
+    #[serde(skip)]
+    pub post_dominator_tree: Lazy<'a, TreeNode<'a>>,
+    #[serde(skip)]
+    pub control_count: usize,
+}
+
+/// Sizes the text report's headline needs.
+pub struct Summary {
+    /// All rungs (main program and subroutines).
+    pub rungs: usize,
+    /// Rungs of the main program.
+    pub main_rungs: usize,
+}
+
+#[derive(serde::Serialize)]
+pub struct RungEntry<'a> {
+    pub id: &'a str,
+    pub pou: &'a str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub label: Option<&'a str>,
+    #[serde(rename = "in")]
+    pub ins: Vec<&'a str>,
+    pub out: Vec<&'a str>,
+    pub cost: u64,
+}
+
+/// A dependence: a data pair with its variable, or a control pair with its cause.
+#[derive(serde::Serialize)]
+#[serde(untagged)]
+pub enum DependenceEntry<'a> {
+    Data {
+        kind: &'static str,
+        from: &'a str,
+        to: &'a str,
+        var: &'a str,
+    },
+    Control {
+        kind: &'static str,
+        from: &'a str,
+        to: &'a str,
+        cause: &'static str,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        edge: Option<EdgeRef<'a>>,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        var: Option<&'a str>,
+    },
+}
+
+/// A CFG edge named by its end points (in a control dependence: the edge that causes it).
+#[derive(serde::Serialize)]
+pub struct EdgeRef<'a> {
+    pub from: &'a str,
+    pub to: &'a str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub label: Option<&'static str>,
+    #[serde(skip)]
+    pub kind: &'static str,
+}
+
+#[derive(serde::Serialize)]
+pub struct DependenceCounts<'a> {
+    pub flow: u64,
+    pub anti: u64,
+    pub output: u64,
+    pub control: u64,
+    /// Per variable with at least one data pair.
+    pub by_var: Lazy<'a, VarCount<'a>>,
+}
+
+#[derive(serde::Serialize)]
+pub struct VarCount<'a> {
+    pub var: &'a str,
+    pub flow: u64,
+    pub anti: u64,
+    pub output: u64,
+}
+
+#[derive(serde::Serialize)]
+pub struct CfgSection<'a> {
+    pub edges: Lazy<'a, CfgEdgeEntry<'a>>,
+}
+
+#[derive(serde::Serialize)]
+pub struct CfgEdgeEntry<'a> {
+    pub from: &'a str,
+    pub to: &'a str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub label: Option<&'static str>,
+    pub kind: &'static str,
+}
+
+/// Immediate post-dominator of START and of every rung that has one, as a JSON object.
+pub struct Ipdom<'a>(Lazy<'a, (&'a str, &'a str)>);
+
+impl Serialize for Ipdom<'_> {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let mut m = s.serialize_map(None)?;
+        for (k, v) in self.0.iter() {
+            m.serialize_entry(k, v)?;
+        }
+        m.end()
+    }
+}
+
+/// A node of the post-dominator tree with its children (text report only).
+pub struct TreeNode<'a> {
+    pub node: &'a str,
+    pub ipdom: Option<&'a str>,
+    pub children: Vec<&'a str>,
+}
+
+#[derive(serde::Serialize)]
+pub struct Levels<'a> {
+    pub data: Vec<Vec<&'a str>>,
+    pub control: Vec<Vec<&'a str>>,
+    pub combined: Vec<Vec<TaskName<'a>>>,
+}
+
+/// A task in a level: one rung, or the rungs of one loop task.
+#[derive(serde::Serialize)]
+#[serde(untagged)]
+pub enum TaskName<'a> {
+    Rung(&'a str),
+    Loop(Vec<&'a str>),
+}
+
+#[derive(serde::Serialize)]
+pub struct Cycles {
+    pub before: usize,
+    pub data: usize,
+    pub control: usize,
+    pub combined: usize,
+}
+
+#[derive(serde::Serialize)]
+pub struct Cost {
+    pub work: u64,
+    pub span: u64,
+    pub ideal_speedup: f64,
+    pub makespan: PerCores,
+    pub level_makespan: PerCores,
+}
+
+/// Makespan per number of cores, as a JSON object keyed by the core count.
+pub struct PerCores(pub Vec<(u32, u64)>);
+
+impl Serialize for PerCores {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let mut m = s.serialize_map(Some(self.0.len()))?;
+        for (p, v) in &self.0 {
+            m.serialize_entry(&p.to_string(), v)?;
+        }
+        m.end()
+    }
+}
+
+#[derive(serde::Serialize)]
+pub struct ScheduleSection<'a> {
+    pub tasks: Lazy<'a, TaskEntry<'a>>,
+    pub unreachable: Vec<&'a str>,
+}
+
+#[derive(serde::Serialize)]
+pub struct TaskEntry<'a> {
+    pub rungs: Vec<&'a str>,
+    #[serde(rename = "loop")]
+    pub is_loop: bool,
+    pub level: u32,
+    pub entries: Vec<&'a str>,
+    pub guard: Vec<GuardEntry<'a>>,
+}
+
+#[derive(serde::Serialize)]
+pub struct GuardEntry<'a> {
+    pub controller: &'a str,
+    pub successor: &'a str,
+}
+
+#[derive(serde::Serialize)]
+pub struct LoopEntry<'a> {
+    /// The loop's name: its first rung.
+    pub head: &'a str,
+    pub rungs: Vec<&'a str>,
+}
+
+#[derive(serde::Serialize)]
+pub struct DifferenceEntry {
+    pub rung: String,
+    pub data_level: u32,
+    pub control_level: u32,
+    pub combined_level: Option<u32>,
+    pub reasons: Vec<String>,
+}
+
+#[derive(serde::Serialize)]
+pub struct NetworkEntry<'a> {
+    pub pou: &'a str,
+    pub id: &'a str,
+    pub rungs: Vec<&'a str>,
+    #[serde(rename = "in")]
+    pub ins: Vec<&'a str>,
+    pub out: Vec<&'a str>,
+}
+
+fn label_name(b: Option<Branch>) -> Option<&'static str> {
+    b.map(|b| match b {
+        Branch::T => "T",
+        Branch::F => "F",
+    })
+}
+
+fn round3(x: f64) -> f64 {
+    (x * 1000.0).round() / 1000.0
+}
+
+/// Builds the report document of `p` from its analysis `a`.
+pub fn document<'a>(p: &'a Program, a: &'a Analysis) -> Report<'a> {
+    let id = move |r: RungId| p.rung(r).id.as_str();
+    let var = move |v: VarId| p.var(v).name.as_str();
+    let names = move |vs: &[VarId]| vs.iter().map(|&v| var(v)).collect::<Vec<_>>();
+    let node = move |n: u32| super::node_name(p, n);
+    let edge_ref = move |i: u32| {
+        let e = &a.cfg.edges[i as usize];
+        EdgeRef {
+            from: node(e.from),
+            to: node(e.to),
+            label: label_name(e.label),
+            kind: e.kind.name(),
+        }
+    };
+
+    let rungs = Lazy::new(p.rungs.len(), move || {
+        p.rung_ids().map(move |r| {
+            let rung = p.rung(r);
+            RungEntry {
+                id: id(r),
+                pou: p.pou(rung.pou).name.as_str(),
+                label: rung.label.as_deref(),
+                ins: names(a.accesses.ins(r)),
+                out: names(a.accesses.outs(r)),
+                cost: a.rung_costs[r.index()],
+            }
+        })
+    });
+
+    let control_pairs = super::paper_control_pairs(a);
+    let control_count = control_pairs.len();
+    let control_pairs = std::rc::Rc::new(control_pairs);
+    let dependences = {
+        let pairs = control_pairs.clone();
+        Lazy::new(a.data.len() + pairs.len(), move || {
+            let data = a.data.iter().map(move |d| DependenceEntry::Data {
+                kind: d.kind.name(),
+                from: id(RungId(d.from)),
+                to: id(RungId(d.to)),
+                var: var(d.var),
+            });
+            let pairs = pairs.clone();
+            let control = (0..pairs.len()).map(move |i| {
+                let (from, to, cause) = pairs[i];
+                let (cause, edge, v) = match cause {
+                    ControlCause::Branch { edge } => ("branch", Some(edge_ref(edge)), None),
+                    ControlCause::Instance { var: v } => ("instance", None, Some(var(v))),
+                };
+                DependenceEntry::Control {
+                    kind: "control",
+                    from: id(from),
+                    to: id(to),
+                    cause,
+                    edge,
+                    var: v,
+                }
+            });
+            data.chain(control)
+        })
+    };
+
+    let counts = &a.counts;
+    let dependence_counts = DependenceCounts {
+        flow: counts.flow,
+        anti: counts.anti,
+        output: counts.output,
+        control: control_count as u64,
+        by_var: Lazy::new(counts.by_var.len(), move || {
+            counts
+                .by_var
+                .iter()
+                .map(move |&(v, flow, anti, output)| VarCount {
+                    var: var(v),
+                    flow,
+                    anti,
+                    output,
+                })
+        }),
+    };
+
+    let edges = Lazy::new(a.cfg.edges.len(), move || {
+        a.cfg.edges.iter().map(move |e| CfgEdgeEntry {
+            from: node(e.from),
+            to: node(e.to),
+            label: label_name(e.label),
+            kind: e.kind.name(),
+        })
+    });
+
+    let m = p.rungs.len() as u32;
+    let ipdom = Ipdom(Lazy::new(0, move || {
+        std::iter::once(a.cfg.start())
+            .chain(0..m)
+            .filter_map(move |n| a.post_dominators.immediate(n).map(|d| (node(n), node(d))))
+    }));
+    let post_dominator_tree = Lazy::new(m as usize + 2, move || {
+        std::iter::once(a.cfg.start())
+            .chain(0..m)
+            .chain(std::iter::once(a.cfg.stop()))
+            .map(move |n| TreeNode {
+                node: node(n),
+                ipdom: a.post_dominators.immediate(n).map(node),
+                children: a
+                    .post_dominators
+                    .children(n)
+                    .iter()
+                    .map(|&k| node(k))
+                    .collect(),
+            })
+    });
+
+    let groups = |levels: &[u32]| -> Vec<Vec<&'a str>> {
+        super::rung_groups(levels)
+            .into_iter()
+            .map(|g| g.into_iter().map(id).collect())
+            .collect()
+    };
+    let combined = super::combined_groups(a)
+        .into_iter()
+        .map(|level| {
+            level
+                .into_iter()
+                .map(|task| {
+                    if task.len() == 1 {
+                        TaskName::Rung(id(task[0]))
+                    } else {
+                        TaskName::Loop(task.into_iter().map(id).collect())
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    let levels = Levels {
+        data: groups(&a.data_levels),
+        control: groups(&a.control_levels),
+        combined,
+    };
+    let count = |levels: &[u32]| levels.iter().map(|&l| l as usize + 1).max().unwrap_or(0);
+    let s = &a.schedule;
+    let cycles = Cycles {
+        before: p.rungs.len(),
+        data: count(&a.data_levels),
+        control: count(&a.control_levels),
+        combined: s.levels.len(),
+    };
+    let c = &a.cost;
+    let cost = Cost {
+        work: c.work,
+        span: c.span,
+        ideal_speedup: if c.span == 0 {
+            0.0
+        } else {
+            round3(c.work as f64 / c.span as f64)
+        },
+        makespan: PerCores(c.makespan.clone()),
+        level_makespan: PerCores(c.level_makespan.clone()),
+    };
+    let tasks = Lazy::new(s.tasks.len(), move || {
+        s.tasks.iter().map(move |t| TaskEntry {
+            rungs: t.rungs.iter().map(|&r| id(r)).collect(),
+            is_loop: t.is_loop,
+            level: t.level + 1,
+            entries: t.entries.iter().map(|&r| id(r)).collect(),
+            guard: t
+                .guard
+                .iter()
+                .map(|g| GuardEntry {
+                    controller: id(s.head(g.controller)),
+                    successor: match g.successor {
+                        Successor::Task(x) => id(s.head(x)),
+                        Successor::Stop => "STOP",
+                    },
+                })
+                .collect(),
+        })
+    });
+    let loops = s
+        .tasks
+        .iter()
+        .filter(|t| t.is_loop)
+        .map(|t| LoopEntry {
+            head: id(t.rungs[0]),
+            rungs: t.rungs.iter().map(|&r| id(r)).collect(),
+        })
+        .collect();
+
+    let explainer = std::rc::Rc::new(Explainer::new(p, a));
+    let differing = explainer.differing();
+    let differences = {
+        let differing = std::rc::Rc::new(differing);
+        Lazy::new(differing.len(), move || {
+            let explainer = explainer.clone();
+            let differing = differing.clone();
+            (0..differing.len()).map(move |i| explainer.difference(differing[i]))
+        })
+    };
+
+    let networks = super::networks(p, a)
+        .into_iter()
+        .map(|n| NetworkEntry {
+            pou: p.pou(n.pou).name.as_str(),
+            id: p.rung(n.rungs[0]).network.as_deref().unwrap_or_default(),
+            rungs: n.rungs.iter().map(|&r| id(r)).collect(),
+            ins: names(&n.ins),
+            out: names(&n.outs),
+        })
+        .collect();
+
+    Report {
+        program: &p.name,
+        rungs,
+        dependences,
+        dependences_listed: match a.listed {
+            Listed::All => "all",
+            Listed::Direct => "direct",
+        },
+        dependence_counts,
+        self_control: super::self_controlled(a).into_iter().map(id).collect(),
+        cfg: CfgSection { edges },
+        ipdom,
+        levels,
+        cycles,
+        cost,
+        schedule: ScheduleSection {
+            tasks,
+            unreachable: s.unreachable.iter().map(|&r| id(r)).collect(),
+        },
+        loops,
+        differences,
+        warnings: a
+            .warnings
+            .iter()
+            .map(|w| super::warning_text(p, w))
+            .collect(),
+        networks,
+        summary: Summary {
+            rungs: p.rungs.len(),
+            main_rungs: p.main().rungs.len(),
+        },
+        post_dominator_tree,
+        control_count,
+    }
+}
