@@ -9,7 +9,8 @@ use plc_deps::analysis::accesses::VarSets;
 use plc_deps::analysis::dependences::data_dependences_pairwise;
 use plc_deps::analysis::levels::asap_levels;
 use plc_deps::analysis::{
-    analyse, control_dependences, data_dependences, data_levels, post_dominators,
+    analyse, analyse_with, control_dependences, data_dependences, data_levels, dependence_counts,
+    direct_dependences, post_dominators, AnalysisConfig, DepKind, DependenceListing, Listed,
 };
 use plc_deps::model::VarId;
 use proptest::prelude::*;
@@ -44,6 +45,51 @@ proptest! {
         // Levels: ASAP over every pair (reference) == O(accesses) levelling.
         let edges: Vec<(u32, u32)> = brute.iter().map(|d| (d.from, d.to)).collect();
         prop_assert_eq!(data_levels(&reads, &writes), asap_levels(reads.len(), &edges));
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(3000))]
+
+    /// The direct pairs are pairs of the definition, imply every other pair (each pair of the
+    /// definition is a path of direct pairs), give the same ASAP levels, and the counts equal
+    /// the lengths of the full list.
+    #[test]
+    fn direct_dependences_imply_every_pair_and_keep_the_levels((reads, writes) in var_sets()) {
+        let all = data_dependences_pairwise(&reads, &writes);
+        let direct = direct_dependences(&reads, &writes);
+        let mut sorted_all = all.clone();
+        sorted_all.sort_unstable();
+        for d in &direct {
+            prop_assert!(sorted_all.binary_search(d).is_ok(), "{:?} is not a dependence", d);
+        }
+        let n = reads.len();
+        // Reachability over the direct pairs (units are in order, so one forward pass each).
+        let mut succ = vec![Vec::new(); n];
+        for d in &direct {
+            succ[d.from as usize].push(d.to as usize);
+        }
+        for s in 0..n {
+            let mut reach = vec![false; n];
+            reach[s] = true;
+            for u in s..n {
+                if reach[u] {
+                    for &v in &succ[u] {
+                        reach[v] = true;
+                    }
+                }
+            }
+            for d in all.iter().filter(|d| d.from as usize == s) {
+                prop_assert!(reach[d.to as usize], "{:?} is not implied by the direct pairs", d);
+            }
+        }
+        let edges: Vec<(u32, u32)> = direct.iter().map(|d| (d.from, d.to)).collect();
+        prop_assert_eq!(data_levels(&reads, &writes), asap_levels(n, &edges));
+        let c = dependence_counts(&reads, &writes);
+        let of = |k: DepKind| all.iter().filter(|d| d.kind == k).count() as u64;
+        prop_assert_eq!((c.flow, c.anti, c.output), (of(DepKind::Flow), of(DepKind::Anti), of(DepKind::Output)));
+        let per_var: u64 = c.by_var.iter().map(|&(_, f, a, o)| f + a + o).sum();
+        prop_assert_eq!(per_var, all.len() as u64);
     }
 }
 
@@ -206,5 +252,33 @@ proptest! {
         let text = common::random_program(seed, 24);
         let loaded = check_schedule(&text)?;
         prop_assume!(loaded);
+    }
+
+    /// Listing every pair or only the direct ones changes nothing but the list.
+    #[test]
+    fn levels_and_schedule_do_not_depend_on_the_listing(seed in any::<u64>()) {
+        let text = common::random_program(seed, 24);
+        let Ok(p) = plc_deps::read::program_from_json(&text) else {
+            return Err(TestCaseError::reject("not a valid program"));
+        };
+        let cfg = |dependences| AnalysisConfig { dependences };
+        let all = analyse_with(&p, &cfg(DependenceListing::All));
+        let direct = analyse_with(&p, &cfg(DependenceListing::Direct));
+        prop_assert_eq!(all.listed, Listed::All);
+        prop_assert_eq!(direct.listed, Listed::Direct);
+        prop_assert_eq!(&all.data_levels, &direct.data_levels);
+        prop_assert_eq!(&all.control_levels, &direct.control_levels);
+        let tasks = |a: &plc_deps::analysis::Analysis| -> Vec<(Vec<u32>, u32)> {
+            a.schedule.tasks.iter().map(|t| (t.rungs.iter().map(|r| r.0).collect(), t.level)).collect()
+        };
+        prop_assert_eq!(tasks(&all), tasks(&direct));
+        prop_assert_eq!(&all.counts, &direct.counts);
+        prop_assert!(direct.data.len() <= all.data.len());
+        // UpTo picks all below the limit and direct above it.
+        let total = all.counts.total();
+        prop_assert_eq!(analyse_with(&p, &cfg(DependenceListing::UpTo(total))).listed, Listed::All);
+        if total > 0 {
+            prop_assert_eq!(analyse_with(&p, &cfg(DependenceListing::UpTo(total - 1))).listed, Listed::Direct);
+        }
     }
 }
