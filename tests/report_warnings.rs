@@ -74,3 +74,86 @@ fn unreachable_rungs_and_uncalled_subroutines_are_reported() {
     );
     assert!(text.contains("warning: subroutine S is never called"));
 }
+
+#[test]
+fn empty_rungs_and_rungs_without_effect_are_warnings() {
+    let (j, text) = report(
+        r#"{"program": "p",
+            "vars": [{"name": "a", "type": "BOOL", "class": "input"}, {"name": "y", "type": "BOOL"}],
+            "rungs": [
+              {"id": "R1", "ld": []},
+              {"id": "R2", "ld": [{"contact": "a"}]},
+              {"id": "R3", "ld": [{"contact": "a"}, {"coil": "y"}]}
+            ]}"#,
+    );
+    let warnings: Vec<&str> = j["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|w| w.as_str().unwrap())
+        .collect();
+    assert_eq!(
+        warnings,
+        vec![
+            "rung R1 is empty (no elements)",
+            "rung R2 has no effect: nothing is written and control is not transferred"
+        ]
+    );
+    assert!(text.contains("warning: rung R1 is empty (no elements)"));
+}
+
+/// The CLI prints warnings on standard error too, and the endless-loop warning says what
+/// `run` does: it leaves the loop after the loop cap with a loop-cap fault.
+#[test]
+fn warnings_go_to_stderr_and_the_endless_loop_warning_agrees_with_run() {
+    let file = std::env::temp_dir().join(format!("plc-deps-endless-{}.json", std::process::id()));
+    std::fs::write(
+        &file,
+        r#"{"program": "p",
+            "vars": [{"name": "a", "type": "BOOL", "class": "input"}, {"name": "y", "type": "BOOL"}],
+            "rungs": [
+              {"id": "R1", "ld": [{"contact": "a"}, {"jmp": "L4"}]},
+              {"id": "R2", "label": "L2", "ld": [{"coil": "y"}]},
+              {"id": "R3", "ld": [{"jmp": "L2"}]},
+              {"id": "R4", "label": "L4", "ld": [{"contact": "y"}, {"coil": "y"}]}
+            ]}"#,
+    )
+    .unwrap();
+    let bin = env!("CARGO_BIN_EXE_plc-deps");
+    let out = std::process::Command::new(bin)
+        .args(["report", file.to_str().unwrap(), "--format", "json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        stderr.contains("warning: ")
+            && stderr.contains("rungs R2, R3 can never reach the end of the scan")
+            && stderr.contains("leaves the loop after --loop-cap loop-backs with a loop-cap fault"),
+        "{stderr}"
+    );
+    let run = std::process::Command::new(bin)
+        .args([
+            "run",
+            file.to_str().unwrap(),
+            "--scans",
+            "2",
+            "--loop-cap",
+            "5",
+            "--mode",
+            "seq",
+            "--format",
+            "json",
+        ])
+        .output()
+        .unwrap();
+    let j: Value = serde_json::from_slice(&run.stdout).unwrap();
+    let faults = j["faults"].as_array().unwrap();
+    assert!(
+        faults
+            .iter()
+            .any(|f| f["rung"] == "R3" && f["kind"] == "loop-cap"),
+        "{faults:?}"
+    );
+    let _ = std::fs::remove_file(&file);
+}

@@ -57,6 +57,42 @@ pub enum Warning {
     Endless(Vec<RungId>),
     /// A subroutine nothing calls.
     Uncalled(PouId),
+    /// Rungs with no elements at all (written by the user, not FBD lowering).
+    Empty(Vec<RungId>),
+    /// Rungs that write nothing and transfer no control: they have no effect on the scan.
+    NoEffect(Vec<RungId>),
+}
+
+/// Rungs of the user's ladder program that are empty or have no effect. Rungs lowered from FBD
+/// are left out: their empty landing rungs belong to the lowering.
+fn idle_rungs(p: &Program, acc: &Accesses) -> (Vec<RungId>, Vec<RungId>) {
+    let (mut empty, mut no_effect) = (Vec::new(), Vec::new());
+    for r in p.rung_ids() {
+        let rung = p.rung(r);
+        if rung.network.is_some() {
+            continue;
+        }
+        if rung.series.is_empty() {
+            empty.push(r);
+            continue;
+        }
+        let mut transfers = false;
+        walk_elements(&rung.series, &mut |e| {
+            transfers |= matches!(
+                e,
+                Element::Jmp { .. }
+                    | Element::Ret
+                    | Element::End
+                    | Element::Call { .. }
+                    | Element::For { .. }
+                    | Element::Next { .. }
+            )
+        });
+        if !transfers && acc.outs(r).is_empty() {
+            no_effect.push(r);
+        }
+    }
+    (empty, no_effect)
 }
 
 /// Which data dependences an [`Analysis`] lists (levels and schedule never depend on it).
@@ -220,6 +256,13 @@ pub fn analyse_with(p: &Program, config: &AnalysisConfig) -> Analysis {
     }
     for &pou in &cfg.uncalled {
         warnings.push(Warning::Uncalled(pou));
+    }
+    let (empty, no_effect) = idle_rungs(p, &acc);
+    if !empty.is_empty() {
+        warnings.push(Warning::Empty(empty));
+    }
+    if !no_effect.is_empty() {
+        warnings.push(Warning::NoEffect(no_effect));
     }
     Analysis {
         accesses: acc,

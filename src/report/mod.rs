@@ -142,12 +142,17 @@ pub(crate) fn networks(p: &Program, a: &Analysis) -> Vec<Network> {
 
 /// Human text of a warning.
 pub fn warning_text(p: &Program, w: &Warning) -> String {
+    // At most ten ids: a warning is one line even about a million rungs.
     let ids = |rs: &[RungId]| {
-        let list = rs
+        let mut list = rs
             .iter()
+            .take(10)
             .map(|r| p.rung(*r).id.as_str())
             .collect::<Vec<_>>()
             .join(", ");
+        if rs.len() > 10 {
+            list.push_str(&format!(" … (+{} more)", text::thousands(rs.len() - 10)));
+        }
         if rs.len() == 1 {
             format!("rung {list}")
         } else {
@@ -157,9 +162,15 @@ pub fn warning_text(p: &Program, w: &Warning) -> String {
     match w {
         Warning::Unreachable(rs) => format!("{} can never run (no path from the start of the scan reaches it)", ids(rs)),
         Warning::Endless(rs) => format!(
-            "{} can never reach the end of the scan (an endless loop); the post-dominator tree treats the last of them as an exit",
+            "{} can never reach the end of the scan (an endless loop): the post-dominator tree treats the last of them as an exit, and `plc-deps run` leaves the loop after --loop-cap loop-backs with a loop-cap fault",
             ids(rs)
         ),
         Warning::Uncalled(pou) => format!("subroutine {} is never called", p.pou(*pou).name),
+        Warning::Empty(rs) => format!("{} {} empty (no elements)", ids(rs), if rs.len() == 1 { "is" } else { "are" }),
+        Warning::NoEffect(rs) => format!(
+            "{} {} no effect: nothing is written and control is not transferred",
+            ids(rs),
+            if rs.len() == 1 { "has" } else { "have" }
+        ),
     }
 }
