@@ -1,7 +1,7 @@
 //! Speed of the analysis (parse excluded) on generated programs, and the per-variable data
 //! dependence method against the pairwise definition.
 //!
-//! Targets (issue 2): a 1,000,000-rung program analysed in under 1 s on the 2-core machine; growth
+//! Targets: a 1,000,000-rung program analysed in under 1 s on the 2-core machine; growth
 //! from 100k to 1M within 12×; at 20k rungs the dependence computation at least 100× faster than
 //! the pairwise method. `cargo bench --bench analysis`.
 

@@ -49,7 +49,7 @@ enum Command {
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
-    /// Print each FBD network's execution order and conditional fragment tree (seed 000).
+    /// Print each FBD network's execution order and conditional fragment tree (the FBD text-generation paper).
     Order {
         /// The program (JSON program format with FBD bodies, see docs/fbd.md).
         file: PathBuf,

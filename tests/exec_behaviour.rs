@@ -104,7 +104,7 @@ impl Sim {
     }
 }
 
-// ---------------------------------------------------------------- KASKAD (seed 003)
+// ---------------------------------------------------------------- KASKAD (the KASKAD-SAU manual)
 
 /// Example 2 with FOR/NEXT: the loop body adds 1 to Count ten times; after the loop idx holds
 /// the first value that failed the test (10), copied to `after`; then idx := 0.
@@ -1090,7 +1090,7 @@ fn run_from_reports_where_control_leaves_a_region() {
     assert_eq!(whole, st);
 }
 
-/// Seed 004's example B (as in analyses/example-b.json): a conditional jump, a backward-jump
+/// Zhao & Yan's Example B (as in analyses/example-b.json): a conditional jump, a backward-jump
 /// loop holding a timer, and two calls.
 const EXAMPLE_B: &str = r#"{
   "program": "example_b",

@@ -1,4 +1,4 @@
-//! The FBD worked examples in `analyses/` (seed 000's Example C, seed 003's KASKAD 1–5): their
+//! The FBD worked examples in `analyses/` (Example C of the FBD text-generation paper, KASKAD 1–5 of the KASKAD-SAU manual): their
 //! order and fragment trees, and their behaviour on the scan interpreter, with the numbers
 //! computed by hand from the seeds (comments give the computation).
 
@@ -82,7 +82,7 @@ fn ids(p: &FbdPou, net: usize, bs: &[plc_deps::fbd::BlockId]) -> Vec<u32> {
     bs.iter().map(|b| p.networks[net].block(*b).id).collect()
 }
 
-// ---------------------------------------------------------------- Example C (seed 000)
+// ---------------------------------------------------------------- Example C (the FBD text-generation paper)
 
 #[test]
 fn example_c_order_and_fragment_tree_are_the_seeds() {
@@ -201,7 +201,7 @@ fn example_c_runs_like_the_seeds_c_for_var1_0_1_2() {
     );
 }
 
-// ---------------------------------------------------------------- KASKAD 1–5 (seed 003)
+// ---------------------------------------------------------------- KASKAD 1–5 (the KASKAD-SAU manual)
 
 #[test]
 fn kaskad_1_average_of_three() {

@@ -1,4 +1,4 @@
-//! IN and OUT sets of every rung (seed 004, §2 "data dependence": IN(S), OUT(S)).
+//! IN and OUT sets of every rung (Zhao & Yan, 2012, §2 "data dependence": IN(S), OUT(S)).
 //!
 //! A rung's IN holds every variable it may read, OUT every variable it may write, including the
 //! implicit state the paper's examples leave out:

@@ -1,4 +1,4 @@
-//! The control-flow graph of a program (seed 004, §2 "control dependence": CFG ⟨V, E, T/F,
+//! The control-flow graph of a program (Zhao & Yan, 2012, §2 "control dependence": CFG ⟨V, E, T/F,
 //! START, STOP⟩).
 //!
 //! One node per rung (node `i` is `RungId(i)`) plus START (`rung count`) and STOP (`+ 1`).

@@ -1,4 +1,4 @@
-//! Post-dominators and control dependences (seed 004, §2; Ferrante, Ottenstein & Warren 1987,
+//! Post-dominators and control dependences (Zhao & Yan, 2012, §2; Ferrante, Ottenstein & Warren 1987,
 //! "The program dependence graph and its use in optimization").
 //!
 //! Definitions, for a graph with exit node STOP: Y post-dominates X if every path from X to STOP
@@ -149,7 +149,7 @@ pub fn control_dependences(
 mod tests {
     use super::*;
 
-    /// Example B of seed 004 as a bare graph (nodes 0..=11 are R1..R12, 12 START, 13 STOP).
+    /// Zhao & Yan's Example B as a bare graph (nodes 0..=11 are R1..R12, 12 START, 13 STOP).
     fn example_b() -> Vec<(u32, u32)> {
         vec![
             (12, 0),

@@ -1,4 +1,4 @@
-//! Flow, anti and output data dependences between units in sequential order (seed 004, §2,
+//! Flow, anti and output data dependences between units in sequential order (Zhao & Yan, 2012, §2,
 //! Definition 1), and their ASAP levels.
 //!
 //! For units S before T and a variable x:
@@ -348,7 +348,7 @@ mod tests {
         )
     }
 
-    /// Example A of seed 004: R2 δo R3, R2 δf R4, R3 δf R4; levels {R1,R2,R5} {R3} {R4}.
+    /// Zhao & Yan's Example A: R2 δo R3, R2 δf R4, R3 δf R4; levels {R1,R2,R5} {R3} {R4}.
     #[test]
     fn example_a() {
         // vars: 0 I0, 1 Q1, 2 A, 3 X, 4 B, 5 Y, 6 C, 7 Z

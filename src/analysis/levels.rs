@@ -1,4 +1,4 @@
-//! ASAP levelling of a dependence graph (seed 004, §3: "rungs with no dependence are level L1; a
+//! ASAP levelling of a dependence graph (Zhao & Yan, 2012, §3: "rungs with no dependence are level L1; a
 //! rung depending on rungs at levels Li, Lj is at level max(i, j) + 1").
 //!
 //! [`asap_levels`] works on any edge list, in any order, with cycles: the nodes of a strongly

@@ -1,4 +1,4 @@
-//! The analyses of seed 004, each a plain function from the model (or an earlier result) to a
+//! The analyses of Zhao & Yan (2012), each a plain function from the model (or an earlier result) to a
 //! result value, and [`analyse`], which runs them all in order.
 //!
 //! - [`accesses`]: IN/OUT per rung;

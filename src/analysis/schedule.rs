@@ -1,5 +1,5 @@
 //! The combined schedule: data and control dependences together, loops kept whole — the
-//! levelling that a parallel scan can actually run (the correction to seed 004's two views).
+//! levelling that a parallel scan can actually run (the correction to Zhao & Yan's two views).
 //!
 //! Units are *tasks* of the main program: a rung, or a loop — a strongly connected part of the
 //! main program's CFG (FOR/NEXT, backward jumps) — run sequentially as one task. Calls are not

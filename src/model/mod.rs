@@ -15,7 +15,7 @@
 //!   an ordinary variable for the analyses and the scan.
 //!
 //! It deliberately carries no analysis results: those are separate values computed from it.
-//! Element semantics follow IEC 61131-3 (LD, §4.2) and the S7-200 shapes of seed 004.
+//! Element semantics follow IEC 61131-3 (LD, §4.2) and the S7-200 shapes of Zhao & Yan (2012).
 
 mod types;
 pub use types::*;

@@ -1,4 +1,4 @@
-//! Seed 004's worked examples, number by number (see ../shared/SEEDS.md, "004").
+//! Zhao & Yan's worked examples (Example A and B), number by number.
 
 use plc_deps::app::{render_report, ReportFormat};
 use plc_deps::read::program_from_json;
