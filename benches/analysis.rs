@@ -8,8 +8,8 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use plc_deps::analysis::dependences::data_dependences_pairwise;
 use plc_deps::analysis::{accesses, analyse, data_dependences, data_levels};
-use plc_deps::gen::{generate_string, GenConfig};
 use plc_deps::model::Program;
+use plc_deps::synth::{generate_string, GenConfig};
 
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;

@@ -204,7 +204,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
                     "--rungs and --width must be at least 1".into(),
                 ));
             }
-            let config = plc_deps::gen::GenConfig {
+            let config = plc_deps::synth::GenConfig {
                 rungs,
                 width,
                 seed,
@@ -214,7 +214,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
                 calls,
             };
             app::write_output_with(output.as_deref(), |w| {
-                plc_deps::gen::write_program(&config, w)
+                plc_deps::synth::write_program(&config, w)
             })
         }
         Command::Run {

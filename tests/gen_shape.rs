@@ -1,7 +1,7 @@
-//! Shape and validity of the synthetic program generator (`plc_deps::gen`), checked on the JSON
+//! Shape and validity of the synthetic program generator (`plc_deps::synth`), checked on the JSON
 //! text alone (serde_json), independently of the crate's reader.
 
-use plc_deps::gen::{generate_string, phase, write_program, GenConfig};
+use plc_deps::synth::{generate_string, phase, write_program, GenConfig};
 use proptest::prelude::*;
 use serde_json::{Map, Value};
 use std::collections::{BTreeMap, HashMap, HashSet};
