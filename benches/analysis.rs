@@ -23,6 +23,7 @@ fn program(rungs: usize) -> Program {
         loops: true,
         jumps: true,
         calls: false,
+        ..Default::default()
     };
     plc_deps::read::program_from_json(&generate_string(&config)).expect("generated programs load")
 }

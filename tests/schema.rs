@@ -42,6 +42,7 @@ fn shipped_and_generated_programs_validate() {
         loops: true,
         jumps: true,
         calls: true,
+        ..Default::default()
     };
     let doc: serde_json::Value =
         serde_json::from_str(&plc_deps::synth::generate_string(&config)).unwrap();

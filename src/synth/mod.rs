@@ -71,16 +71,18 @@
 //! interpreter should use wrapping arithmetic. `rungs = 0` gives an empty (invalid) program.
 
 mod emit;
+mod hot;
 mod program;
 mod rung;
 mod subs;
 
 use emit::*;
+use hot::{HotDuty, HotPlan};
 use std::io::{self, Write};
 use subs::SubPlan;
 
 /// Shape knobs for [`write_program`]; see the module documentation for the exact shape.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct GenConfig {
     /// Number of rungs of the main program (subroutine rungs come on top, with `calls`).
     pub rungs: usize,
@@ -97,6 +99,12 @@ pub struct GenConfig {
     pub jumps: bool,
     /// 2–4 subroutines, called from about 1 in 500 rungs.
     pub calls: bool,
+    /// With `loops`: every FOR block has exactly this many body rungs (at least 1), and the
+    /// first block starts at the first rung where it fits. `None`: 2–4 body rungs at random.
+    pub for_body: Option<usize>,
+    /// `Some(F)` with `0 < F ≤ 1`: about `F * rungs` main rungs also set the global BOOL `FAULT`
+    /// and about a tenth as many read it (spread evenly; see the module documentation).
+    pub hot_fraction: Option<f64>,
 }
 
 impl Default for GenConfig {
@@ -110,6 +118,8 @@ impl Default for GenConfig {
             loops: false,
             jumps: false,
             calls: false,
+            for_body: None,
+            hot_fraction: None,
         }
     }
 }
@@ -125,21 +135,59 @@ impl GenConfig {
             loops: true,
             jumps: true,
             calls: true,
+            for_body: None,
+            hot_fraction: None,
+        }
+    }
+
+    /// Checks what [`write_program`] needs: `rungs ≥ 1` (a program has at least one rung),
+    /// `for_body ≥ 1`, and `0 < hot_fraction ≤ 1`. `width` is clamped, never refused.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        if self.rungs == 0 {
+            return Err(ConfigError::NoRungs);
+        }
+        if self.for_body == Some(0) {
+            return Err(ConfigError::EmptyForBody);
+        }
+        match self.hot_fraction {
+            Some(f) if !(f > 0.0 && f <= 1.0) => Err(ConfigError::HotFraction(f)),
+            _ => Ok(()),
         }
     }
 }
 
+/// Why [`GenConfig::validate`] refuses a config.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ConfigError {
+    /// `rungs = 0`.
+    #[error("rungs must be at least 1 (a program has at least one rung)")]
+    NoRungs,
+    /// `for_body = Some(0)`.
+    #[error("for_body must be at least 1")]
+    EmptyForBody,
+    /// `hot_fraction` outside `(0, 1]` (or NaN).
+    #[error("hot_fraction must be in (0, 1], not {0}")]
+    HotFraction(f64),
+}
+
 /// Writes the program JSON for `config` to `out` (buffered internally; flushed at the end).
+/// An invalid config ([`GenConfig::validate`]) is an [`io::ErrorKind::InvalidInput`] error and
+/// writes nothing.
 pub fn write_program<W: Write>(config: &GenConfig, out: W) -> io::Result<()> {
+    config
+        .validate()
+        .map_err(|e| io::Error::new(io::ErrorKind::InvalidInput, e))?;
     let mut w = io::BufWriter::with_capacity(1 << 16, out);
     Generator::new(config).write(&mut w)?;
     w.flush()
 }
 
-/// [`write_program`] into a `String`.
+/// [`write_program`] into a `String`. Panics on an invalid config ([`GenConfig::validate`]).
 pub fn generate_string(config: &GenConfig) -> String {
     let mut buf = Vec::new();
-    write_program(config, &mut buf).expect("writing to a Vec cannot fail");
+    if let Err(e) = write_program(config, &mut buf) {
+        panic!("{config:?}: {e}");
+    }
     String::from_utf8(buf).expect("the generator writes ASCII only")
 }
 
@@ -168,4 +216,8 @@ struct Generator {
     labels: usize,
     conds: Vec<Elem>,
     tail: Vec<Elem>,
+    /// The hot variable's slots (`hot_fraction`).
+    hot: Option<HotPlan>,
+    /// What the rung being built does with the hot variable.
+    duty: HotDuty,
 }

@@ -4,7 +4,7 @@
 //! subroutines (`super::subs`).
 
 use super::emit::*;
-use super::{phase, GenConfig, Generator};
+use super::{phase, GenConfig, Generator, HotDuty, HotPlan};
 use std::io::{self, Write};
 
 /// What a main rung slot is.
@@ -45,6 +45,8 @@ impl Generator {
             labels: 0,
             conds: Vec::with_capacity(8),
             tail: Vec::with_capacity(4),
+            hot: cfg.hot_fraction.map(|f| HotPlan::new(n, f, cfg.seed)),
+            duty: HotDuty::default(),
         };
         g.has_end = cfg.jumps && n >= 3 && g.q_of(n - 1).is_none();
         if cfg.calls {
@@ -139,6 +141,9 @@ impl Generator {
         for k in 0..self.subs.len() {
             var(w, Name::Sr(k), "BOOL", "memory", None)?;
         }
+        if self.hot.is_some() {
+            var(w, Name::Hot, "BOOL", "memory", None)?;
+        }
         Ok(())
     }
 
@@ -169,11 +174,29 @@ impl Generator {
         w.write_all(b"]}")
     }
 
+    /// With a fixed FOR body length, the first block starts at the first rung (not a `Q` writer)
+    /// where it fits, so that a program of `n ≥ for_body + 2` rungs (`+ 1` with an end rung)
+    /// always has one.
+    fn eager_for(&self, r: usize, blocks: usize, usable: usize) -> bool {
+        match self.cfg.for_body {
+            Some(b) if blocks == 0 => {
+                self.q_of(r).is_none() && self.next_fits(r + b.max(1) + 1, usable)
+            }
+            _ => false,
+        }
+    }
+
+    /// A FOR block's NEXT rung can go at `next`: before the end rung (if any), not a `Q` writer.
+    fn next_fits(&self, next: usize, usable: usize) -> bool {
+        next < usable && self.q_of(next).is_none()
+    }
+
     fn write_main<W: Write>(&mut self, w: &mut W) -> io::Result<()> {
         let n = self.n;
         let usable = if self.has_end { n - 1 } else { n };
         let mut pending: Option<(usize, usize)> = None; // (target rung, label)
         let mut in_for: Option<(usize, usize)> = None; // (next rung, k)
+        let mut blocks = 0usize; // FOR blocks started
         for r in 0..n {
             let (s, j) = (r / self.lanes, r % self.lanes);
             if j == 0 && s > 0 {
@@ -197,13 +220,20 @@ impl Generator {
                 }
             } else if self.has_end && r == n - 1 {
                 Kind::End
-            } else if self.cfg.loops && self.rng.one_in(200) {
-                let body = self.rng.range(2, 4);
+            } else if self.cfg.loops
+                && ((pending.is_none() && self.eager_for(r, blocks, usable))
+                    || self.rng.one_in(200))
+            {
+                let body = match self.cfg.for_body {
+                    Some(b) => b.max(1),
+                    None => self.rng.range(2, 4),
+                };
                 let next = r + body + 1;
-                if pending.is_none() && !is_q && next < usable && self.q_of(next).is_none() {
+                if pending.is_none() && !is_q && self.next_fits(next, usable) {
                     // One index per lane: a block's index is local to it, as in real programs.
                     let k = r % self.lanes;
                     in_for = Some((next, k));
+                    blocks += 1;
                     Kind::ForHead(k)
                 } else {
                     Kind::Normal
@@ -226,6 +256,10 @@ impl Generator {
             };
             self.conds.clear();
             self.tail.clear();
+            let can_carry = matches!(kind, Kind::Normal | Kind::Body(_));
+            if let Some(hot) = &mut self.hot {
+                self.duty = hot.duty(r, can_carry);
+            }
             match kind {
                 Kind::Normal => self.normal_rung(r, None),
                 Kind::Body(k) => self.normal_rung(r, Some(k)),

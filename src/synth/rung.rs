@@ -85,6 +85,9 @@ impl Generator {
         let (s, j) = (r / self.lanes, r % self.lanes);
         let p = phase(s);
         self.conditions(s, j);
+        if self.duty.read {
+            self.conds.push(contact(Name::Hot, true));
+        }
         let extra_path = self.boxes(s, j, body);
         self.output(r, j, p, extra_path);
     }
@@ -295,6 +298,22 @@ impl Generator {
                     negated: false,
                 },
             });
+        }
+        if self.duty.write {
+            self.set_hot();
+        }
+    }
+
+    /// Adds `{"set": "FAULT"}` as an extra path of the output (made a `branch` if it is not one).
+    fn set_hot(&mut self) {
+        let set = vec![Elem::Set(Name::Hot)];
+        match self.tail.pop() {
+            Some(Elem::Branch(mut paths)) => {
+                paths.push(set);
+                self.tail.push(Elem::Branch(paths));
+            }
+            Some(out) => self.tail.push(Elem::Branch(vec![vec![out], set])),
+            None => self.tail.push(Elem::Set(Name::Hot)),
         }
     }
 
