@@ -18,7 +18,8 @@
 //!   and phase `p ≤ max phase(s) for s < S` (a few carry a non-zero `init`); with `timers`, `T{j}_{p}` timer
 //!   instances (TON mostly, TOF or TP for some `(j, p)`, fixed by `(5j + 3p) % 8`: 0 → TOF,
 //!   1 → TP, else TON) and `C{j}_{p}` counter instances (CTU if `j + p` is even, else CTD); with
-//!   `loops`, INT FOR indices `i0..i{W-1}` (one per lane); with `calls`, `SR{k}` BOOL results of the subroutines.
+//!   `loops`, INT FOR indices `i0..i{W-1}` (one per lane); with `calls`, `SR{k}` BOOL results of the subroutines;
+//!   with `hot_fraction`, the BOOL `FAULT`.
 //! * **Normal rung** (stage `s`, lane `j`, phase `p = phase(s) = (s / 8) * 4 + s % 4`): a series
 //!   of conditions, optional boxes, then one output writing the lane's own `M{j}_{p}` (memory is
 //!   recycled every 4 stages within each section of 8 stages, so each variable has at most two
@@ -50,6 +51,12 @@
 //!   `{"op": "ADD", "in": ["N{j}_{p}", "i{k}"], "out": "N{j}_{p}"}` before their output) and a
 //!   `[{"next": true}]` rung. Blocks are not nested. Header, body and NEXT rungs all count in
 //!   `n` and occupy their stage/lane slots (header and NEXT write no `M`).
+//!   With `for_body = N` (`--for-body N`, which needs `--loops`; `N ≥ 1`) every block has
+//!   exactly `N` body rungs, and the first block starts at the first rung where it fits
+//!   (header not a `Q` writer, NEXT before the end rung and not a `Q` writer), so a program
+//!   with room for one block has one (e.g. `--rungs 10000 --loops --for-body 4000`: rungs 0 and 4001
+//!   are headers of 4,000-rung bodies); further blocks start as above. A block that does not fit
+//!   is not made.
 //! * **`jumps`**: 1 in 100 rungs (outside FOR bodies, at most one jump pending at a time, no
 //!   FOR block starting while one is) is a jump rung: 2–3 conditions then `{"jmp": "L{m}"}`,
 //!   skipping the next 1–5 rungs; the target rung carries `"label": "L{m}"` (labels numbered
@@ -65,10 +72,29 @@
 //!   `SR{k}` through a `branch`. Some subroutines call `SBR_{k+1}` (so calls form an acyclic
 //!   chain), have a conditional `{"ret": true}` rung (SBR_0 always does), and, with `jumps`,
 //!   a forward jump from their first rung.
+//! * **`hot_fraction = F`** (`--hot-fraction F`, `0 < F ≤ 1`): a hot variable, the global BOOL
+//!   `FAULT` (declared last), set by `k_w = clamp(round(F n), 1, n)` main rungs and read by
+//!   `k_r = max(1, k_w / 10)`. Slot `i` of `k` is rung `(i n + off) / k` (evenly spread; the
+//!   offset `off < k` comes from the seed through its own generator stream, so every rung that
+//!   has no slot is byte-identical to the program without `hot_fraction`). A writer's output gets
+//!   an extra path `[{"set": "FAULT"}]` (the output becomes a `branch` if it is not one); a reader
+//!   gets `{"contact": "FAULT", "negated": true}` after its other conditions. Only normal and FOR
+//!   body rungs carry slots; a slot on a header, NEXT, jump, call or end rung is owed to the next
+//!   normal rung that has none of its own, so the counts are exact unless slots are still owed
+//!   after the last normal rung. `--rungs 100000 --hot-fraction 0.05` gives 5,000 writers of
+//!   `FAULT` 20 rungs apart and 500 readers: about 12.5 million output pairs (and 2.5 million
+//!   flow and anti pairs) under the every-pair definition of the dependences, against a few per
+//!   rung for the rest of the program.
 //!
 //! With every knob on and a few thousand rungs, every element kind of the format appears.
 //! INT arithmetic is not bounded: over many scans accumulators may wrap (16-bit INT), so an
-//! interpreter should use wrapping arithmetic. `rungs = 0` gives an empty (invalid) program.
+//! interpreter should use wrapping arithmetic.
+//!
+//! `rungs = 0` is refused (a program has at least one rung), as are `for_body = 0` and a
+//! `hot_fraction` outside `(0, 1]`: `GenConfig::validate` says why, `write_program` returns an
+//! `InvalidInput` error without writing anything, and `plc-deps gen --rungs 0` exits with status 2
+//! and `error: --rungs must be at least 1 (a program has at least one rung)`. The CLI also refuses
+//! `--width 0` (the library clamps `width` to at least 1).
 
 mod emit;
 mod hot;
