@@ -7,7 +7,7 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use plc_deps::analysis::analyse;
 use plc_deps::app::{write_report, ReportFormat};
-use plc_deps::gen::{generate_string, GenConfig};
+use plc_deps::synth::{generate_string, GenConfig};
 use plc_deps::model::Program;
 use plc_deps::report::TextOptions;
 use std::io::{self, Write};
@@ -24,6 +24,7 @@ fn program(rungs: usize) -> Program {
         loops: true,
         jumps: true,
         calls: false,
+        ..Default::default()
     };
     plc_deps::read::program_from_json(&generate_string(&config)).expect("generated programs load")
 }

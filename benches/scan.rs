@@ -17,7 +17,7 @@ use serde_json::json;
 use std::time::{Duration, Instant};
 
 fn generated(rungs: usize, width: usize) -> Program {
-    let text = plc_deps::gen::generate_string(&plc_deps::gen::GenConfig {
+    let text = plc_deps::synth::generate_string(&plc_deps::synth::GenConfig {
         rungs,
         width,
         seed: 1,

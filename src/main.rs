@@ -68,7 +68,7 @@ enum Command {
     },
     /// Generate a synthetic program (shape documented in docs/gen.md).
     Gen {
-        /// Number of rungs of the main program.
+        /// Number of rungs of the main program (at least 1).
         #[arg(long)]
         rungs: usize,
         /// Rungs per stage: the program has about rungs / width data levels.
@@ -77,12 +77,21 @@ enum Command {
         /// Seed of the pseudo-random choices (same seed, same program).
         #[arg(long, default_value_t = 1)]
         seed: u64,
-        /// Add timers (TON boxes and reads of their Q).
+        /// Add timer boxes (TON, TOF, TP), counter boxes (CTU, CTD), and reads of their Q and of
+        /// the counters' CV.
         #[arg(long)]
         timers: bool,
-        /// Add FOR/NEXT loops.
+        /// Add FOR/NEXT loops (about 1 in 200 rungs starts one).
         #[arg(long)]
         loops: bool,
+        /// With --loops: every FOR body has exactly N rungs (at least 1), and the first loop
+        /// starts as early as it fits (default: 2 to 4 body rungs).
+        #[arg(long, value_name = "N", requires = "loops")]
+        for_body: Option<usize>,
+        /// A hot variable: about F * rungs main rungs (0 < F <= 1) also set the BOOL FAULT and
+        /// a tenth as many read it, spread evenly over the program.
+        #[arg(long, value_name = "F")]
+        hot_fraction: Option<f64>,
         /// Add conditional forward jumps.
         #[arg(long)]
         jumps: bool,
@@ -238,14 +247,14 @@ fn run(cli: Cli) -> Result<(), CliError> {
             loops,
             jumps,
             calls,
+            for_body,
+            hot_fraction,
             output,
         } => {
-            if rungs == 0 || width == 0 {
-                return Err(CliError::Usage(
-                    "--rungs and --width must be at least 1".into(),
-                ));
+            if width == 0 {
+                return Err(CliError::Usage("--width must be at least 1".into()));
             }
-            let config = plc_deps::gen::GenConfig {
+            let config = plc_deps::synth::GenConfig {
                 rungs,
                 width,
                 seed,
@@ -253,9 +262,25 @@ fn run(cli: Cli) -> Result<(), CliError> {
                 loops,
                 jumps,
                 calls,
+                for_body,
+                hot_fraction,
             };
+            if let Err(e) = config.validate() {
+                use plc_deps::synth::ConfigError;
+                return Err(CliError::Usage(match e {
+                    ConfigError::NoRungs => {
+                        "--rungs must be at least 1 (a program has at least one rung)".into()
+                    }
+                    ConfigError::EmptyForBody => "--for-body must be at least 1".into(),
+                    ConfigError::HotFraction(f) => {
+                        format!(
+                            "--hot-fraction must be in (0, 1] (a fraction of the rungs), not {f}"
+                        )
+                    }
+                }));
+            }
             app::write_output_with(output.as_deref(), |w| {
-                plc_deps::gen::write_program(&config, w)
+                plc_deps::synth::write_program(&config, w)
             })
         }
         Command::Run {

@@ -228,7 +228,7 @@ fn parallel_scan_equals_sequential_scan_on_generated_programs() {
     let exec = ExecConfig::default();
     let mut stats = Stats::default();
     for (rungs, width, seed) in [(600, 40, 1), (2000, 100, 2), (300, 300, 3), (1500, 8, 4)] {
-        let json = plc_deps::gen::generate_string(&plc_deps::gen::GenConfig::all_features(
+        let json = plc_deps::synth::generate_string(&plc_deps::synth::GenConfig::all_features(
             rungs, width, seed,
         ));
         let p = plc_deps::read::program_from_json(&json).unwrap();
@@ -312,7 +312,7 @@ fn worked_examples_with_their_inputs_under_forced_parallel_plans() {
 
 #[test]
 fn wide_program_gets_a_parallel_plan_and_a_chain_falls_back() {
-    let wide = plc_deps::gen::generate_string(&plc_deps::gen::GenConfig {
+    let wide = plc_deps::synth::generate_string(&plc_deps::synth::GenConfig {
         rungs: 4000,
         width: 200,
         ..Default::default()
@@ -386,7 +386,8 @@ fn unconditional_backward_jump_whose_refusal_leaves_the_cfg_runs_sequentially() 
 
 #[test]
 fn one_scan_at_a_time_equals_a_run() {
-    let json = plc_deps::gen::generate_string(&plc_deps::gen::GenConfig::all_features(800, 50, 9));
+    let json =
+        plc_deps::synth::generate_string(&plc_deps::synth::GenConfig::all_features(800, 50, 9));
     let p = plc_deps::read::program_from_json(&json).unwrap();
     let a = analyse(&p);
     let pool = pool();

@@ -1,7 +1,7 @@
-//! Shape and validity of the synthetic program generator (`plc_deps::gen`), checked on the JSON
+//! Shape and validity of the synthetic program generator (`plc_deps::synth`), checked on the JSON
 //! text alone (serde_json), independently of the crate's reader.
 
-use plc_deps::gen::{generate_string, phase, write_program, GenConfig};
+use plc_deps::synth::{generate_string, phase, write_program, GenConfig};
 use proptest::prelude::*;
 use serde_json::{Map, Value};
 use std::collections::{BTreeMap, HashMap, HashSet};
@@ -503,6 +503,8 @@ fn cfg(rungs: usize, width: usize, seed: u64, on: bool) -> GenConfig {
         loops: on,
         jumps: on,
         calls: on,
+        for_body: None,
+        hot_fraction: None,
     }
 }
 
@@ -531,6 +533,8 @@ fn valid_and_exact_counts_over_many_shapes() {
                         loops: mask & 2 != 0,
                         jumps: mask & 4 != 0,
                         calls: mask & 8 != 0,
+                        for_body: None,
+                        hot_fraction: None,
                     };
                     let stats = check(&c);
                     if c.calls {
@@ -725,7 +729,7 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
     #[test]
     fn random_configs_are_valid(rungs in 1usize..400, width in 0usize..70, seed in any::<u64>(), mask in 0u8..16) {
-        let c = GenConfig { rungs, width, seed, timers: mask & 1 != 0, loops: mask & 2 != 0, jumps: mask & 4 != 0, calls: mask & 8 != 0 };
+        let c = GenConfig { rungs, width, seed, timers: mask & 1 != 0, loops: mask & 2 != 0, jumps: mask & 4 != 0, calls: mask & 8 != 0, for_body: None, hot_fraction: None };
         let text = generate_string(&c);
         let stats = validate(&text).map_err(|e| TestCaseError::fail(format!("{c:?}: {e}")))?;
         prop_assert_eq!(stats.main_rungs, rungs);
@@ -797,5 +801,216 @@ fn million_rungs_stream() {
             sink.bytes as f64 / 1e6,
             sink.bytes as f64 / sink.rungs as f64,
         );
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Hot variable and fixed FOR bodies
+
+/// Main rungs (index, rung) that write / read `name`.
+fn rungs_touching(v: &Value, name: &str) -> (Vec<usize>, Vec<usize>) {
+    let (mut writers, mut readers) = (Vec::new(), Vec::new());
+    for (i, rung) in v["rungs"].as_array().unwrap().iter().enumerate() {
+        let (mut reads, mut writes) = (Vec::new(), Vec::new());
+        collect(&rung["ld"], &mut reads, &mut writes);
+        if writes.iter().any(|x| x == name) {
+            writers.push(i);
+        }
+        if reads.iter().any(|x| x == name) {
+            readers.push(i);
+        }
+    }
+    (writers, readers)
+}
+
+/// Body lengths of the main program's FOR blocks (header and NEXT excluded).
+fn for_bodies(v: &Value) -> Vec<usize> {
+    let (mut open, mut bodies) = (Vec::new(), Vec::new());
+    for (i, rung) in v["rungs"].as_array().unwrap().iter().enumerate() {
+        let last = rung["ld"].as_array().unwrap().last().unwrap();
+        if last.get("for").is_some() {
+            open.push(i);
+        } else if last.get("next").is_some() {
+            bodies.push(i - open.pop().unwrap() - 1);
+        }
+    }
+    bodies
+}
+
+fn loads(text: &str, c: &GenConfig) {
+    if let Err(e) = plc_deps::read::program_from_json(text) {
+        panic!("{c:?}: the reader refuses the program: {e}");
+    }
+}
+
+/// 100,000 rungs with `hot_fraction` 0.05: exactly 5,000 rungs set `FAULT` (always through
+/// `set`), 500 read it, evenly spread; every other rung is the rung of the program without it.
+#[test]
+fn hot_variable_has_the_asked_number_of_writers() {
+    let n = 100_000;
+    let off = GenConfig {
+        seed: 5,
+        ..cfg(n, 100, 5, false)
+    };
+    let hot = GenConfig {
+        hot_fraction: Some(0.05),
+        ..off.clone()
+    };
+    let text = generate_string(&hot);
+    let stats = validate(&text).unwrap_or_else(|e| panic!("{hot:?}: {e}"));
+    assert_eq!(stats.main_rungs, n);
+    loads(&text, &hot);
+    let v: Value = serde_json::from_str(&text).unwrap();
+    let fault: Vec<&Value> = v["vars"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|d| d["name"] == "FAULT")
+        .collect();
+    assert_eq!(fault.len(), 1);
+    assert_eq!(fault[0]["type"], "BOOL");
+    let (writers, readers) = rungs_touching(&v, "FAULT");
+    assert_eq!(writers.len(), 5_000);
+    assert_eq!(readers.len(), 500);
+    assert_eq!(text.matches(r#"{"set":"FAULT"}"#).count(), 5_000);
+    // Evenly spread: consecutive writers 20 rungs apart (readers 200).
+    assert!(writers.windows(2).all(|w| w[1] - w[0] == 20), "{writers:?}");
+    assert!(readers.windows(2).all(|w| w[1] - w[0] == 200));
+    // The hot variable changes nothing else.
+    let plain: Value = serde_json::from_str(&generate_string(&off)).unwrap();
+    let (a, b) = (
+        v["rungs"].as_array().unwrap(),
+        plain["rungs"].as_array().unwrap(),
+    );
+    for i in 0..n {
+        if writers.binary_search(&i).is_err() && readers.binary_search(&i).is_err() {
+            assert_eq!(a[i], b[i], "rung {i}");
+        }
+    }
+}
+
+#[test]
+fn hot_variable_with_every_knob() {
+    for (n, f, seed) in [(20_000usize, 0.05, 1u64), (3_000, 0.5, 2), (500, 0.001, 3)] {
+        let c = GenConfig {
+            hot_fraction: Some(f),
+            ..GenConfig::all_features(n, 64, seed)
+        };
+        let text = generate_string(&c);
+        validate(&text).unwrap_or_else(|e| panic!("{c:?}: {e}"));
+        loads(&text, &c);
+        let v: Value = serde_json::from_str(&text).unwrap();
+        let (writers, readers) = rungs_touching(&v, "FAULT");
+        let want = ((f * n as f64).round() as usize).clamp(1, n);
+        // Slots on header/NEXT/jump/call rungs are owed to the next normal rungs; only slots
+        // still owed after the last normal rung (a NEXT, the end rung) are lost.
+        assert!(
+            (want.saturating_sub(2)..=want).contains(&writers.len()),
+            "{c:?}: {} writers, want {want}",
+            writers.len()
+        );
+        assert!(!readers.is_empty());
+        assert_eq!(text, generate_string(&c), "deterministic");
+    }
+}
+
+/// A 4,000-rung FOR body; the blocks are otherwise as without `for_body`.
+#[test]
+fn fixed_for_body_length() {
+    let c = GenConfig {
+        loops: true,
+        for_body: Some(4_000),
+        ..cfg(10_000, 100, 11, false)
+    };
+    let text = generate_string(&c);
+    validate(&text).unwrap_or_else(|e| panic!("{c:?}: {e}"));
+    loads(&text, &c);
+    let v: Value = serde_json::from_str(&text).unwrap();
+    let bodies = for_bodies(&v);
+    assert!(!bodies.is_empty(), "no FOR block");
+    assert!(bodies.iter().all(|&b| b == 4_000), "{bodies:?}");
+    // The first block starts at rung 0 (the first place it fits).
+    assert!(v["rungs"][0]["ld"].as_array().unwrap().last().unwrap()["for"].is_object());
+    // Every knob on, small bodies and too-long ones (no block fits: none is made).
+    for (n, body) in [(5_000usize, 1usize), (5_000, 37), (2_000, 1_990), (50, 60)] {
+        let c = GenConfig {
+            for_body: Some(body),
+            hot_fraction: Some(0.1),
+            ..GenConfig::all_features(n, 40, 3)
+        };
+        let text = generate_string(&c);
+        validate(&text).unwrap_or_else(|e| panic!("{c:?}: {e}"));
+        loads(&text, &c);
+        let bodies = for_bodies(&serde_json::from_str(&text).unwrap());
+        assert!(bodies.iter().all(|&b| b == body), "{c:?}: {bodies:?}");
+        assert_eq!(bodies.is_empty(), body + 3 > n, "{c:?}: {bodies:?}");
+    }
+}
+
+#[test]
+fn invalid_configs_are_refused() {
+    let bad = [
+        cfg(0, 10, 1, false),
+        GenConfig {
+            for_body: Some(0),
+            ..cfg(10, 10, 1, true)
+        },
+        GenConfig {
+            hot_fraction: Some(0.0),
+            ..cfg(10, 10, 1, false)
+        },
+        GenConfig {
+            hot_fraction: Some(1.5),
+            ..cfg(10, 10, 1, false)
+        },
+        GenConfig {
+            hot_fraction: Some(f64::NAN),
+            ..cfg(10, 10, 1, false)
+        },
+    ];
+    for c in bad {
+        assert!(c.validate().is_err(), "{c:?}");
+        let mut buf = Vec::new();
+        let e = write_program(&c, &mut buf).unwrap_err();
+        assert_eq!(e.kind(), io::ErrorKind::InvalidInput, "{c:?}");
+        assert!(buf.is_empty(), "{c:?}: wrote {} bytes", buf.len());
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+    #[test]
+    fn random_hot_and_for_body_configs_are_valid(
+        rungs in 1usize..400,
+        width in 0usize..70,
+        seed in any::<u64>(),
+        mask in 0u8..16,
+        body in proptest::option::of(1usize..40),
+        hot in proptest::option::of(0.0001f64..=1.0),
+    ) {
+        let c = GenConfig {
+            rungs, width, seed,
+            timers: mask & 1 != 0, loops: mask & 2 != 0 || body.is_some(), jumps: mask & 4 != 0, calls: mask & 8 != 0,
+            for_body: body,
+            hot_fraction: hot,
+        };
+        let text = generate_string(&c);
+        let stats = validate(&text).map_err(|e| TestCaseError::fail(format!("{c:?}: {e}")))?;
+        prop_assert_eq!(stats.main_rungs, rungs);
+        let v: Value = serde_json::from_str(&text).unwrap();
+        if let Some(b) = body {
+            prop_assert!(for_bodies(&v).iter().all(|&x| x == b));
+        }
+        if let Some(f) = hot {
+            let want = ((f * rungs as f64).round() as usize).clamp(1, rungs);
+            let (writers, _) = rungs_touching(&v, "FAULT");
+            // Only slots owed by rungs that cannot carry one (header, NEXT, jump, call, end)
+            // can be lost.
+            let structural = v["rungs"].as_array().unwrap().iter().filter(|r| {
+                let last = r["ld"].as_array().unwrap().last().unwrap();
+                ["for", "next", "jmp", "call", "end"].iter().any(|k| last.get(*k).is_some())
+            }).count();
+            prop_assert!(writers.len() <= want && writers.len() + structural >= want, "{:?}: {} writers, want {}", c, writers.len(), want);
+        }
     }
 }

@@ -34,7 +34,7 @@ fn shipped_and_generated_programs_validate() {
         }
     }
     assert!(checked >= 5);
-    let config = plc_deps::gen::GenConfig {
+    let config = plc_deps::synth::GenConfig {
         rungs: 2000,
         width: 50,
         seed: 3,
@@ -42,9 +42,10 @@ fn shipped_and_generated_programs_validate() {
         loops: true,
         jumps: true,
         calls: true,
+        ..Default::default()
     };
     let doc: serde_json::Value =
-        serde_json::from_str(&plc_deps::gen::generate_string(&config)).unwrap();
+        serde_json::from_str(&plc_deps::synth::generate_string(&config)).unwrap();
     assert!(v.is_valid(&doc));
 }
 

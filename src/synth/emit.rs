@@ -55,6 +55,8 @@ pub(super) enum Name {
     Sr(usize),
     Sb(usize, usize),
     Sn(usize),
+    /// The hot variable `FAULT` (`hot_fraction`).
+    Hot,
 }
 
 impl fmt::Display for Name {
@@ -70,6 +72,7 @@ impl fmt::Display for Name {
             Name::Sr(k) => write!(f, "SR{k}"),
             Name::Sb(k, i) => write!(f, "S{k}_B{i}"),
             Name::Sn(k) => write!(f, "S{k}_N"),
+            Name::Hot => f.write_str("FAULT"),
         }
     }
 }
