@@ -7,9 +7,9 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use plc_deps::analysis::analyse;
 use plc_deps::app::{write_report, ReportFormat};
-use plc_deps::synth::{generate_string, GenConfig};
 use plc_deps::model::Program;
 use plc_deps::report::TextOptions;
+use plc_deps::synth::{generate_string, GenConfig};
 use std::io::{self, Write};
 
 #[global_allocator]

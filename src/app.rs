@@ -6,10 +6,12 @@
 //! never leaves a half-written file.
 
 use crate::analysis::{analyse, analyse_with, Analysis, AnalysisConfig, DependenceListing, Listed};
+use crate::fbd::Fbd;
 use crate::model::Program;
 use crate::read::{program_from_json, LoadError};
 use crate::report::{
-    document, render_dot, render_json, render_text, Rows, TextOptions, View, DOT_MAX_RUNGS,
+    document_with, fbd_parts, render_dot, render_json, render_text, FbdParts, Rows, TextOptions,
+    View, DOT_MAX_RUNGS,
 };
 use std::path::{Path, PathBuf};
 
@@ -45,6 +47,18 @@ pub fn load_program(path: &Path) -> Result<Program, CliError> {
         message: e.to_string(),
     })?;
     program_from_json(&text).map_err(|error| CliError::Load {
+        file: path.display().to_string(),
+        error,
+    })
+}
+
+/// Reads and checks a program file, with its FBD bodies as written.
+pub fn load_program_and_fbd(path: &Path) -> Result<(Program, Fbd), CliError> {
+    let text = std::fs::read_to_string(path).map_err(|e| CliError::Io {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    })?;
+    crate::read::program_and_fbd_from_json(&text).map_err(|error| CliError::Load {
         file: path.display().to_string(),
         error,
     })
@@ -122,15 +136,16 @@ pub struct ReportConfig {
     pub output: Option<PathBuf>,
 }
 
-/// Writes the report of `p` (analysed as `analysis` says) in `format`.
+/// Writes the report of `p` (with `fbd`, what its FBD lowering made) in `format`.
 pub fn write_report(
     p: &Program,
     a: &Analysis,
+    fbd: Option<&FbdParts>,
     format: ReportFormat,
     text: &TextOptions,
     out: &mut impl std::io::Write,
 ) -> std::io::Result<()> {
-    let doc = document(p, a);
+    let doc = document_with(p, a, fbd);
     match format {
         ReportFormat::Text => render_text(&doc, text, out),
         ReportFormat::Json => render_json(&doc, out),
@@ -138,22 +153,25 @@ pub fn write_report(
     }
 }
 
-/// Renders the report of a loaded program with the default options (a convenience for tests
-/// and small programs: the command streams instead).
-pub fn render_report(p: &Program, format: ReportFormat, view: View) -> String {
+/// Renders the report of a loaded program and its FBD bodies with the default options (a
+/// convenience for tests and small programs: the command streams instead).
+pub fn render_report(p: &Program, fbd: &Fbd, format: ReportFormat, view: View) -> String {
     let a = analyse(p);
+    let parts = fbd_parts(p, fbd);
     let mut out = Vec::new();
     let text = TextOptions {
         view,
         ..TextOptions::default()
     };
-    write_report(p, &a, format, &text, &mut out).expect("writing to memory cannot fail");
+    write_report(p, &a, parts.as_ref(), format, &text, &mut out)
+        .expect("writing to memory cannot fail");
     String::from_utf8(out).expect("reports are UTF-8")
 }
 
 /// `plc-deps report`. Warnings go to standard error as well as into the report.
 pub fn report(c: &ReportConfig) -> Result<(), CliError> {
-    let p = load_program(&c.input)?;
+    let (p, fbd) = load_program_and_fbd(&c.input)?;
+    let parts = fbd_parts(&p, &fbd);
     if c.format == ReportFormat::Dot && p.rungs.len() > DOT_MAX_RUNGS {
         return Err(CliError::Usage(format!(
             "{}: {} rungs are too many to draw ({} at most): Graphviz cannot lay out a graph this size usefully; use the text or JSON report",
@@ -174,8 +192,8 @@ pub fn report(c: &ReportConfig) -> Result<(), CliError> {
         eprintln!(
             "warning: {}: {} data dependence pairs are more than --max-pairs allows; listing the {} direct ones (they imply the rest; --dependences all lists every pair)",
             c.input.display(),
-            a.counts.total(),
-            a.data.len()
+            crate::report::text::thousands(a.counts.total() as usize),
+            crate::report::text::thousands(a.data.len())
         );
     }
     let text = TextOptions {
@@ -184,7 +202,7 @@ pub fn report(c: &ReportConfig) -> Result<(), CliError> {
     };
     write_output_with(c.output.as_deref(), |w| {
         let mut w = w;
-        write_report(&p, &a, c.format, &text, &mut w)
+        write_report(&p, &a, parts.as_ref(), c.format, &text, &mut w)
     })
 }
 

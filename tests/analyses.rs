@@ -9,7 +9,6 @@
 //! (`runcmd::run_json_deterministic`).
 
 use plc_deps::app::{render_report, ReportFormat};
-use plc_deps::read::program_from_json;
 use plc_deps::report::View;
 use std::path::{Path, PathBuf};
 
@@ -59,18 +58,18 @@ fn every_worked_example_matches_its_committed_reports() {
     let mut runs = 0;
     for dir in dirs {
         let text = std::fs::read_to_string(dir.join("program.json")).expect("read program");
-        let program = program_from_json(&text).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
+        let (program, fbd) = plc_deps::read::program_and_fbd_from_json(&text)
+            .unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
         check(
             &dir.join("report.txt"),
-            &render_report(&program, ReportFormat::Text, View::All),
+            &render_report(&program, &fbd, ReportFormat::Text, View::All),
             &mut failures,
         );
         check(
             &dir.join("report.json"),
-            &render_report(&program, ReportFormat::Json, View::All),
+            &render_report(&program, &fbd, ReportFormat::Json, View::All),
             &mut failures,
         );
-        let (_, fbd) = plc_deps::read::program_and_fbd_from_json(&text).expect("loaded above");
         if !fbd.pous.is_empty() {
             // FBD examples also commit `plc-deps order` (text and JSON).
             check(

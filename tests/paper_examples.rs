@@ -1,7 +1,7 @@
 //! Zhao & Yan's worked examples (Example A and B), number by number.
 
 use plc_deps::app::{render_report, ReportFormat};
-use plc_deps::read::program_from_json;
+use plc_deps::read::program_and_fbd_from_json;
 use plc_deps::report::View;
 use serde_json::{json, Value};
 
@@ -10,8 +10,8 @@ fn report(name: &str) -> Value {
         "{}/analyses/{name}/program.json",
         env!("CARGO_MANIFEST_DIR")
     );
-    let p = program_from_json(&std::fs::read_to_string(path).unwrap()).unwrap();
-    serde_json::from_str(&render_report(&p, ReportFormat::Json, View::All)).unwrap()
+    let (p, fbd) = program_and_fbd_from_json(&std::fs::read_to_string(path).unwrap()).unwrap();
+    serde_json::from_str(&render_report(&p, &fbd, ReportFormat::Json, View::All)).unwrap()
 }
 
 fn deps(r: &Value, kind: &str) -> Vec<(String, String)> {

@@ -1,7 +1,7 @@
 //! FBD programs get per-network IN/OUT in the report: the union over the network's block rungs.
 
 use plc_deps::app::{render_report, ReportFormat};
-use plc_deps::read::program_from_json;
+use plc_deps::read::program_and_fbd_from_json;
 use plc_deps::report::View;
 use serde_json::Value;
 use std::collections::BTreeSet;
@@ -11,8 +11,8 @@ fn report(name: &str) -> Value {
         "{}/analyses/{name}/program.json",
         env!("CARGO_MANIFEST_DIR")
     );
-    let p = program_from_json(&std::fs::read_to_string(path).unwrap()).unwrap();
-    serde_json::from_str(&render_report(&p, ReportFormat::Json, View::All)).unwrap()
+    let (p, fbd) = program_and_fbd_from_json(&std::fs::read_to_string(path).unwrap()).unwrap();
+    serde_json::from_str(&render_report(&p, &fbd, ReportFormat::Json, View::All)).unwrap()
 }
 
 fn names(v: &Value) -> BTreeSet<String> {

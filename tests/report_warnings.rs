@@ -2,14 +2,14 @@
 //! a rung nothing reaches, a subroutine nothing calls.
 
 use plc_deps::app::{render_report, ReportFormat};
-use plc_deps::read::program_from_json;
+use plc_deps::read::program_and_fbd_from_json;
 use plc_deps::report::View;
 use serde_json::{json, Value};
 
 fn report(text: &str) -> (Value, String) {
-    let p = program_from_json(text).unwrap();
-    let j = serde_json::from_str(&render_report(&p, ReportFormat::Json, View::All)).unwrap();
-    (j, render_report(&p, ReportFormat::Text, View::All))
+    let (p, fbd) = program_and_fbd_from_json(text).unwrap();
+    let j = serde_json::from_str(&render_report(&p, &fbd, ReportFormat::Json, View::All)).unwrap();
+    (j, render_report(&p, &fbd, ReportFormat::Text, View::All))
 }
 
 #[test]

@@ -12,6 +12,7 @@
 //! the JSON contract. Nothing here writes output: renderers do (`text`, `json`, `dot`).
 
 use super::explain::Explainer;
+use super::{FbdParts, RungPart};
 use crate::analysis::{Analysis, Branch, ControlCause, Listed, Successor};
 use crate::model::*;
 use serde::ser::{Serialize, SerializeMap, Serializer};
@@ -74,6 +75,12 @@ pub struct Report<'a> {
     pub warnings: Vec<String>,
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub networks: Vec<NetworkEntry<'a>>,
+    /// For programs with FBD bodies: the program as written, in blocks and networks.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fbd: Option<FbdSection<'a>>,
+    /// The levels without the lowering's empty landing rungs (what the text report shows).
+    #[serde(skip)]
+    pub shown_levels: Option<Levels<'a>>,
     /// For the human renderers.
     #[serde(skip)]
     pub summary: Summary,
@@ -81,6 +88,17 @@ pub struct Report<'a> {
     pub post_dominator_tree: Lazy<'a, TreeNode<'a>>,
     #[serde(skip)]
     pub control_count: usize,
+}
+
+/// An FBD program as written: its blocks and networks, and the rungs its lowering added.
+#[derive(serde::Serialize)]
+pub struct FbdSection<'a> {
+    pub blocks: usize,
+    pub networks: usize,
+    /// Rungs that test a conditional fragment's condition.
+    pub fragment_guards: Vec<&'a str>,
+    /// The empty rungs a fragment's guard jumps to.
+    pub fragment_ends: Vec<&'a str>,
 }
 
 /// Sizes the text report's headline needs.
@@ -294,6 +312,11 @@ fn round3(x: f64) -> f64 {
 
 /// Builds the report document of `p` from its analysis `a`.
 pub fn document<'a>(p: &'a Program, a: &'a Analysis) -> Report<'a> {
+    document_with(p, a, None)
+}
+
+/// Builds the report document; `fbd` says which rungs the FBD lowering made.
+pub fn document_with<'a>(p: &'a Program, a: &'a Analysis, fbd: Option<&'a FbdParts>) -> Report<'a> {
     let id = move |r: RungId| p.rung(r).id.as_str();
     let var = move |v: VarId| p.var(v).name.as_str();
     let names = move |vs: &[VarId]| vs.iter().map(|&v| var(v)).collect::<Vec<_>>();
@@ -501,6 +524,48 @@ pub fn document<'a>(p: &'a Program, a: &'a Analysis) -> Report<'a> {
         })
         .collect();
 
+    let of_part = |part: RungPart| -> Vec<&'a str> {
+        fbd.map(|f| {
+            p.rung_ids()
+                .filter(|r| f.parts[r.index()] == part)
+                .map(id)
+                .collect()
+        })
+        .unwrap_or_default()
+    };
+    let fbd_section = fbd.map(|f| FbdSection {
+        blocks: f.blocks,
+        networks: f.networks,
+        fragment_guards: of_part(RungPart::FragmentGuard),
+        fragment_ends: of_part(RungPart::FragmentEnd),
+    });
+    let shown_levels = fbd.map(|f| {
+        let landings = landing_names(p, f);
+        let shown = |r: &&'a str| !landings.contains(r);
+        let keep = |g: &Vec<Vec<&'a str>>| -> Vec<Vec<&'a str>> {
+            g.iter()
+                .map(|l| l.iter().copied().filter(shown).collect())
+                .collect()
+        };
+        Levels {
+            data: keep(&levels.data),
+            control: keep(&levels.control),
+            combined: levels
+                .combined
+                .iter()
+                .map(|l| {
+                    l.iter()
+                        .filter(|t| !matches!(t, TaskName::Rung(x) if !shown(x)))
+                        .map(|t| match t {
+                            TaskName::Rung(x) => TaskName::Rung(x),
+                            TaskName::Loop(xs) => TaskName::Loop(xs.clone()),
+                        })
+                        .collect()
+                })
+                .collect(),
+        }
+    });
+
     Report {
         program: &p.name,
         rungs,
@@ -528,6 +593,8 @@ pub fn document<'a>(p: &'a Program, a: &'a Analysis) -> Report<'a> {
             .map(|w| super::warning_text(p, w))
             .collect(),
         networks,
+        fbd: fbd_section,
+        shown_levels,
         summary: Summary {
             rungs: p.rungs.len(),
             main_rungs: p.main().rungs.len(),
@@ -535,4 +602,12 @@ pub fn document<'a>(p: &'a Program, a: &'a Analysis) -> Report<'a> {
         post_dominator_tree,
         control_count,
     }
+}
+
+/// The ids of the lowering's landing rungs.
+fn landing_names<'a>(p: &'a Program, f: &FbdParts) -> std::collections::HashSet<&'a str> {
+    p.rung_ids()
+        .filter(|r| f.parts[r.index()] == RungPart::FragmentEnd)
+        .map(|r| p.rung(r).id.as_str())
+        .collect()
 }

@@ -14,7 +14,7 @@ mod explain;
 mod json;
 pub mod text;
 
-pub use document::{document, Report};
+pub use document::{document, document_with, Report};
 pub use dot::{render_dot, MAX_RUNGS as DOT_MAX_RUNGS};
 pub use json::render_json;
 pub use text::{render_text, Rows, TextOptions};
@@ -173,4 +173,63 @@ pub fn warning_text(p: &Program, w: &Warning) -> String {
             if rs.len() == 1 { "has" } else { "have" }
         ),
     }
+}
+
+/// What a rung of the lowered program is to the user who wrote the program.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum RungPart {
+    /// A ladder rung as written.
+    Ladder,
+    /// An FBD block (one rung per block).
+    Block,
+    /// The test of a conditional fragment, made by the lowering (`N1.F(3)`).
+    FragmentGuard,
+    /// The empty rung a fragment's guard jumps to, made by the lowering (`N1.F(3).end`).
+    FragmentEnd,
+}
+
+/// The FBD bodies of a program as the user wrote them: how many blocks and networks, and what
+/// each rung of the lowered program is.
+#[derive(Clone, Debug)]
+pub struct FbdParts {
+    /// Blocks as written (a function block type's body counted once).
+    pub blocks: usize,
+    /// Networks as written.
+    pub networks: usize,
+    /// Per rung of the lowered program.
+    pub parts: Vec<RungPart>,
+}
+
+/// The blocks, networks and rung parts of `p`'s FBD bodies `fbd` (`None` for a ladder program).
+pub fn fbd_parts(p: &Program, fbd: &crate::fbd::Fbd) -> Option<FbdParts> {
+    if fbd.pous.is_empty() {
+        return None;
+    }
+    let mut parts = vec![RungPart::Ladder; p.rungs.len()];
+    for pou in &fbd.pous {
+        for copy in &pou.copies {
+            for (range, blocks) in copy.networks.iter().zip(&copy.blocks) {
+                for r in range.clone() {
+                    parts[r as usize] = if p.rungs[r as usize].series.is_empty() {
+                        RungPart::FragmentEnd
+                    } else {
+                        RungPart::FragmentGuard
+                    };
+                }
+                for r in blocks {
+                    parts[r.index()] = RungPart::Block;
+                }
+            }
+        }
+    }
+    Some(FbdParts {
+        blocks: fbd
+            .pous
+            .iter()
+            .flat_map(|u| &u.networks)
+            .map(|n| n.blocks.len())
+            .sum(),
+        networks: fbd.pous.iter().map(|u| u.networks.len()).sum(),
+        parts,
+    })
 }

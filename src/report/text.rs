@@ -228,7 +228,30 @@ pub fn render_text(r: &Report, o: &TextOptions, out: &mut impl Write) -> io::Res
     let combined = o.view != View::Paper;
     let s = &r.summary;
     let m = s.rungs;
-    if s.main_rungs == m {
+    if let Some(f) = &r.fbd {
+        let lowering = f.fragment_guards.len() + f.fragment_ends.len();
+        writeln!(
+            out,
+            "{}: {} in {} ({} after lowering{})",
+            r.program,
+            plural(f.blocks, "block", "blocks"),
+            plural(f.networks, "network", "networks"),
+            plural(m, "rung", "rungs"),
+            if lowering == 0 {
+                String::new()
+            } else {
+                format!(
+                    " with {} and {}; the levels below leave the landing rungs out",
+                    plural(f.fragment_guards.len(), "fragment guard", "fragment guards"),
+                    plural(
+                        f.fragment_ends.len(),
+                        "empty landing rung",
+                        "empty landing rungs"
+                    )
+                )
+            }
+        )?;
+    } else if s.main_rungs == m {
         writeln!(out, "{}: {}", r.program, plural(m, "rung", "rungs"))?;
     } else {
         writeln!(
@@ -310,7 +333,7 @@ fn levels(
         out,
         "\nLevels (rungs in one level may run at the same time; {{…}} is a loop run as one task)"
     )?;
-    let l = &r.levels;
+    let l = r.shown_levels.as_ref().unwrap_or(&r.levels);
     let mut header = vec!["level"];
     if paper {
         header.extend(["paper data view", "paper control view"]);
