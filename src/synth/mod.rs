@@ -54,8 +54,8 @@
 //!   With `for_body = N` (`--for-body N`, which needs `--loops`; `N ≥ 1`) every block has
 //!   exactly `N` body rungs, and the first block starts at the first rung where it fits
 //!   (header not a `Q` writer, NEXT before the end rung and not a `Q` writer), so a program
-//!   with room for one block has one (e.g. `--rungs 10000 --loops --for-body 4000`: rungs 0 and 4001
-//!   are headers of 4,000-rung bodies); further blocks start as above. A block that does not fit
+//!   with room for one block has one (e.g. `--rungs 10000 --loops --for-body 4000`: rung 0 heads a
+//!   4,000-rung body closed by the NEXT rung 4001); further blocks start as above. A block that does not fit
 //!   is not made.
 //! * **`jumps`**: 1 in 100 rungs (outside FOR bodies, at most one jump pending at a time, no
 //!   FOR block starting while one is) is a jump rung: 2–3 conditions then `{"jmp": "L{m}"}`,
