@@ -24,7 +24,7 @@ struct Cli {
 enum Command {
     /// Analyse a program: dependences, control flow, post-dominators, levels, cycles, cost.
     Report {
-        /// The program (JSON program format, see docs/format.md).
+        /// The program (JSON program format, see docs/format.md; `-`: standard input).
         file: PathBuf,
         /// Output format.
         #[arg(long, value_enum, default_value_t = FormatArg::Text)]
@@ -38,7 +38,8 @@ enum Command {
     },
     /// Print each FBD network's execution order and conditional fragment tree (seed 000).
     Order {
-        /// The program (JSON program format with FBD bodies, see docs/fbd.md).
+        /// The program (JSON program format with FBD bodies, see docs/fbd.md; `-`: standard
+        /// input).
         file: PathBuf,
         /// Output format.
         #[arg(long, value_enum, default_value_t = FormatArg::Text)]
@@ -82,7 +83,7 @@ enum Command {
     },
     /// Run the PLC scan cycle on virtual time: sequentially, in parallel, or both (checked equal).
     Run {
-        /// The program (JSON program format, see docs/format.md).
+        /// The program (JSON program format, see docs/format.md; `-`: standard input).
         file: PathBuf,
         /// Number of scans [default: the rows of --inputs, or 1000].
         #[arg(long)]
@@ -258,8 +259,18 @@ fn run(cli: Cli) -> Result<(), CliError> {
     }
 }
 
+/// On SIGINT or SIGTERM: remove the temporary files being written (an output or trace file in
+/// the making) and exit with 130, so a stopped command leaves nothing behind.
+fn remove_temp_files_on_signal() {
+    let _ = ctrlc::set_handler(|| {
+        app::remove_temp_files();
+        std::process::exit(130);
+    });
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    remove_temp_files_on_signal();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

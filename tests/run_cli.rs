@@ -448,9 +448,15 @@ fn bad_input_is_one_located_error_with_exit_code_2_and_no_output_file() {
     fails(&["run", &broken, "-o", o], &format!("{broken}:1:"));
     assert!(!trace.exists(), "no trace file after an error");
     assert!(!out_file.exists(), "no output file after an error");
-    // Missing files are I/O errors (exit code 1), as for `report`.
-    let out = run(&["run", &program, "--inputs", "no/such/inputs.csv"]);
-    assert_eq!(out.status.code(), Some(1));
+    // Missing files are I/O errors naming the file's role (exit code 2), as for `report`.
+    fails(
+        &["run", &program, "--inputs", "no/such/inputs.csv"],
+        "cannot read --inputs no/such/inputs.csv: No such file or directory",
+    );
+    fails(
+        &["run", "no/such/program.json"],
+        "cannot read the program no/such/program.json: No such file or directory",
+    );
 }
 
 #[test]

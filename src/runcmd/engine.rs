@@ -212,10 +212,7 @@ pub(super) fn prepare(c: &RunConfig) -> Result<Prepared, CliError> {
                     .num_threads(c.threads - 1)
                     .thread_name(|i| format!("plc-worker-{}", i + 1))
                     .build()
-                    .map_err(|e| CliError::Io {
-                        path: "thread pool".into(),
-                        message: e.to_string(),
-                    })?,
+                    .map_err(|e| CliError::Threads(e.to_string()))?,
             )
         }
         _ => None,

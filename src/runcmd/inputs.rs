@@ -1,7 +1,7 @@
 //! The per-scan input values of `plc-deps run`: the CSV and JSON inputs files, parsed and
 //! checked against the program, with errors naming the file, line and column.
 
-use crate::app::CliError;
+use crate::app::{read_text, CliError, FileRole};
 use crate::model::{parse_time_literal, Program, Type, Value, VarClass, VarId};
 use serde_json::Value as Json;
 use std::path::Path;
@@ -298,12 +298,10 @@ fn describe_json(v: &Json) -> String {
     }
 }
 
-/// Reads an inputs file (JSON if it ends in `.json`, CSV otherwise).
+/// Reads an inputs file (JSON if it ends in `.json`, CSV otherwise; see [`read_text`] for what
+/// is refused before parsing).
 pub fn load_inputs(p: &Program, path: &Path) -> Result<InputTable, CliError> {
-    let text = std::fs::read_to_string(path).map_err(|e| CliError::Io {
-        path: path.display().to_string(),
-        message: e.to_string(),
-    })?;
+    let text = read_text(path, FileRole::Inputs)?;
     let file = path.display().to_string();
     if path
         .extension()
