@@ -264,6 +264,11 @@ fn run(cli: Cli) -> Result<(), CliError> {
 fn remove_temp_files_on_signal() {
     let _ = ctrlc::set_handler(|| {
         app::remove_temp_files();
+        use std::io::{IsTerminal, Write};
+        if std::io::stderr().is_terminal() {
+            // Clear a progress line, so the shell's prompt starts on a clean line.
+            let _ = write!(std::io::stderr(), "\r\x1b[2K");
+        }
         std::process::exit(130);
     });
 }

@@ -84,6 +84,18 @@ fn bad_files_are_refused_before_parsing_with_the_file_and_the_byte_offset() {
         error_line(&run(&["report", folder]), "folder"),
         format!("error: cannot read the program {folder}: it is a folder, not a file")
     );
+    // Over the 2 GiB limit: refused on its size (a sparse file, never read).
+    let huge = dir.join("huge.json");
+    std::fs::File::create(&huge)
+        .unwrap()
+        .set_len(3 << 30)
+        .unwrap();
+    let h = huge.to_str().unwrap();
+    assert_eq!(
+        error_line(&run(&["report", h]), "huge"),
+        format!("error: cannot read the program {h}: the file is larger than the limit of 2 GiB (3221225472 bytes)")
+    );
+    std::fs::remove_file(&huge).unwrap();
     for cmd in ["report", "order", "run"] {
         let out = run(&[cmd, &binary]);
         assert!(error_line(&out, cmd).contains("a NUL byte at offset 4"));

@@ -9,7 +9,8 @@
 //!   is dropped, so fast phases show nothing.
 //! - [`Progress::bar`]`(name, len, unit)`: `len` steps (scans). A bar with the count, the rate
 //!   (`scans/s`) and the time left, also after half a second; call [`Bar::inc`] once per step
-//!   (cheap: the shared bar is updated every 64 steps) and drop or [`Bar::finish`] it at the end.
+//!   (cheap: it looks at the clock once per batch of steps, the batch sized to about 50 ms, and
+//!   only then updates the shared bar) and drop or [`Bar::finish`] it at the end.
 //!
 //! ```no_run
 //! use plc_deps::runcmd::Progress;
@@ -39,8 +40,10 @@ use std::time::Duration;
 const SHOW_AFTER: Duration = Duration::from_millis(500);
 /// How often a shown phase is redrawn (spinner, elapsed time, rate) even without progress.
 const REDRAW: Duration = Duration::from_millis(100);
-/// Steps of a [`Bar`] between updates of the shared bar.
-const BATCH: u64 = 64;
+/// Steps of a [`Bar`] between updates of the shared bar: at most this many, fewer when steps
+/// are slow, so that the shared bar moves about every [`FLUSH_EVERY`].
+const MAX_BATCH: u64 = 1024;
+const FLUSH_EVERY: Duration = Duration::from_millis(50);
 
 /// Progress on standard error, shown or hidden for the whole command.
 #[derive(Copy, Clone, Debug)]
@@ -97,7 +100,10 @@ impl Progress {
             shared: Delayed::start(self.shown, Some(len), style, name),
             done: 0,
             flushed: 0,
+            batch: 1,
+            last_flush: std::time::Instant::now(),
             len,
+            shown: self.shown,
         }
     }
 }
@@ -157,7 +163,11 @@ pub struct Bar {
     shared: Delayed,
     done: u64,
     flushed: u64,
+    /// Steps between looks at the clock (1 ..= MAX_BATCH).
+    batch: u64,
+    last_flush: std::time::Instant,
     len: u64,
+    shown: bool,
 }
 
 impl Bar {
@@ -165,10 +175,23 @@ impl Bar {
     #[inline]
     pub fn inc(&mut self) {
         self.done += 1;
-        if self.done - self.flushed >= BATCH || self.done == self.len {
-            self.flushed = self.done;
-            self.shared.bar.set_position(self.done);
+        if self.shown && (self.done - self.flushed >= self.batch || self.done == self.len) {
+            self.flush();
         }
+    }
+
+    #[cold]
+    fn flush(&mut self) {
+        let now = std::time::Instant::now();
+        let took = now.duration_since(self.last_flush);
+        if took < FLUSH_EVERY / 2 {
+            self.batch = (self.batch * 2).min(MAX_BATCH);
+        } else if took > FLUSH_EVERY * 2 {
+            self.batch = (self.batch / 2).max(1);
+        }
+        self.last_flush = now;
+        self.flushed = self.done;
+        self.shared.bar.set_position(self.done);
     }
 
     /// Steps done so far.
@@ -178,4 +201,44 @@ impl Bar {
 
     /// Ends the phase (the same as dropping the guard).
     pub fn finish(self) {}
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hidden_progress_starts_no_thread_and_still_counts() {
+        let p = Progress::new(false);
+        assert!(!p.is_shown());
+        let phase = p.phase("reading");
+        assert!(phase.0.helper.is_none());
+        drop(phase);
+        let mut bar = p.bar("seq", 10, "scans");
+        assert!(bar.shared.helper.is_none());
+        for _ in 0..10 {
+            bar.inc();
+        }
+        assert_eq!(bar.done(), 10);
+        bar.finish();
+    }
+
+    #[test]
+    fn a_short_phase_is_never_drawn() {
+        // Shown, but over before SHOW_AFTER: the helper thread ends without drawing.
+        let p = Progress::new(true);
+        let phase = p.phase("quick");
+        assert!(phase.0.bar.is_hidden());
+        drop(phase);
+        let mut bar = p.bar("seq", 3, "scans");
+        bar.inc();
+        assert!(bar.shared.bar.is_hidden());
+        bar.inc();
+        bar.inc();
+        assert_eq!(
+            bar.shared.bar.position(),
+            3,
+            "the last step is always flushed"
+        );
+    }
 }
