@@ -416,3 +416,54 @@ pub fn order(c: &OrderConfig) -> Result<(), CliError> {
 
 /// The JSON Schema of the program format (`plc-deps schema`).
 pub const PROGRAM_SCHEMA: &str = include_str!("../schema/program.schema.json");
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn io_errors_name_the_file_keep_their_source_and_exit_with_2() {
+        use std::error::Error;
+        let e = CliError::io(
+            FileRole::Trace,
+            Path::new("t.csv"),
+            std::io::Error::from_raw_os_error(2),
+        );
+        assert_eq!(
+            e.to_string(),
+            "cannot write --trace t.csv: No such file or directory"
+        );
+        let source = e.source().expect("the io::Error is the source");
+        assert!(source.downcast_ref::<std::io::Error>().is_some());
+        assert_eq!(e.exit_code(), 2);
+        assert_eq!(CliError::Usage("x".into()).exit_code(), 2);
+    }
+
+    #[test]
+    fn text_is_utf8_without_nul_and_loses_its_byte_order_mark() {
+        assert_eq!(utf8_text(b"\xef\xbb\xbf{}".to_vec()).unwrap(), "{}");
+        assert_eq!(utf8_text("é".as_bytes().to_vec()).unwrap(), "é");
+        assert_eq!(
+            utf8_text(b"ab\xc3".to_vec()).unwrap_err(),
+            "not UTF-8 text (byte 0xc3 at offset 2 is not valid UTF-8)"
+        );
+        assert_eq!(
+            utf8_text(b"a\0\xff".to_vec()).unwrap_err(),
+            "binary data, not text (a NUL byte at offset 1)"
+        );
+        assert_eq!(
+            utf8_text(b"\xff\0".to_vec()).unwrap_err(),
+            "not UTF-8 text (byte 0xff at offset 0 is not valid UTF-8)"
+        );
+    }
+
+    #[test]
+    fn temporary_names_sit_beside_the_file() {
+        let t = temp_name(Path::new("out/r.json"));
+        assert_eq!(
+            t,
+            PathBuf::from(format!("out/.r.json.tmp-{}", std::process::id()))
+        );
+        assert_eq!(folder_of(Path::new("r.json")), Path::new("."));
+    }
+}

@@ -454,11 +454,16 @@ fn a_fault_of_every_scan_is_one_summary_line_and_an_endless_loop_ends_at_the_cap
 }
 
 #[test]
-fn trace_vars_without_trace_is_a_usage_error() {
+fn trace_vars_without_trace_and_stdin_twice_are_usage_errors() {
     let program = write("echo-tv.json", ECHO);
     fails(
         &["run", &program, "--trace-vars", "a"],
         "--trace-vars chooses the columns of the trace file: give --trace FILE too",
+    );
+    let out = run_stdin(&["run", "-", "--inputs", "-"], ECHO.as_bytes());
+    assert_eq!(
+        error_line(&out, "stdin twice"),
+        "error: the program and --inputs cannot both be read from standard input (-)"
     );
 }
 

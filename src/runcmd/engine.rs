@@ -217,6 +217,11 @@ fn check_arguments(c: &RunConfig) -> Result<(), CliError> {
             "--trace-vars chooses the columns of the trace file: give --trace FILE too".into(),
         ));
     }
+    if c.input.as_os_str() == "-" && c.inputs.as_ref().is_some_and(|i| i.as_os_str() == "-") {
+        return Err(CliError::Usage(
+            "the program and --inputs cannot both be read from standard input (-)".into(),
+        ));
+    }
     if let (Some(o), Some(t)) = (&c.output, &c.trace) {
         if o == t {
             return Err(CliError::Usage(format!(
