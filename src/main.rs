@@ -92,7 +92,7 @@ enum Command {
         /// (`[{"start": true, "temp": 40}, ...]`); see docs/scan.md.
         #[arg(long)]
         inputs: Option<PathBuf>,
-        /// Virtual scan period, a TIME (scan k runs at k × cycle).
+        /// Virtual scan period, a TIME of whole milliseconds (scan k runs at k × cycle).
         #[arg(long, default_value = "10ms")]
         cycle: String,
         /// Workers of the parallel executor [default: the number of cores].
@@ -101,10 +101,12 @@ enum Command {
         /// Which executors run.
         #[arg(long, value_enum, default_value_t = ModeArg::Both)]
         mode: ModeArg,
-        /// Write the traced variables after every scan to this CSV file.
+        /// Write the traced variables after every scan to this CSV file (checked before the
+        /// first scan, complete or not at all).
         #[arg(long)]
         trace: Option<PathBuf>,
-        /// Variables to trace (comma-separated; instance fields as T1.Q) [default: all].
+        /// Variables to trace with --trace (comma-separated; instance fields as T1.Q; each
+        /// column once) [default: all].
         #[arg(long, value_delimiter = ',')]
         trace_vars: Option<Vec<String>>,
         /// Output format.

@@ -361,8 +361,11 @@ pub(super) fn execute(
     // pays for cold caches and branch predictors (or for the other mode's warm ones).
     let warm = scans.min(WARM_UP);
     let mut seq = pr.seq.as_ref().map(|m| {
-        let mut st = m.initial_state();
-        run_sequential(m, &mut st, 0..warm, &mut Inputs(inputs));
+        {
+            let _phase = progress.phase("seq: warm-up scans");
+            let mut st = m.initial_state();
+            run_sequential(m, &mut st, 0..warm, &mut Inputs(inputs));
+        }
         let t = match (&pr.trace_cols, trace.take()) {
             (Some(cols), Some(out)) => Some(Trace::new(m, cols, out)),
             _ => None,
@@ -374,8 +377,11 @@ pub(super) fn execute(
         Pass::of(d, st.slots)
     });
     let par = run_par.map(|pm| {
-        let mut st = pm.initial_state();
-        pm.run(pr.pool.as_ref(), &mut st, 0..warm, &mut Inputs(inputs));
+        {
+            let _phase = progress.phase("par: warm-up scans");
+            let mut st = pm.initial_state();
+            pm.run(pr.pool.as_ref(), &mut st, 0..warm, &mut Inputs(inputs));
+        }
         let m = pm.machine();
         let t = match (&pr.trace_cols, trace.take()) {
             (Some(cols), Some(out)) => Some(Trace::new(m, cols, out)),

@@ -57,13 +57,13 @@ pub enum RunFormat {
 /// A validated `plc-deps run` invocation.
 #[derive(Clone, Debug)]
 pub struct RunConfig {
-    /// The program file.
+    /// The program file (`-`: standard input).
     pub input: PathBuf,
     /// Number of scans; `None`: the number of input rows (at least 1), or 1000 without inputs.
     pub scans: Option<u64>,
     /// Input values per scan (CSV or JSON, by extension: `.json` is JSON, anything else CSV).
     pub inputs: Option<PathBuf>,
-    /// Virtual scan period, ms (at least 1).
+    /// Virtual scan period, whole ms (at least 1).
     pub cycle_ms: u32,
     /// Workers of the parallel executor (at least 1).
     pub threads: usize,
