@@ -4,6 +4,13 @@
 //! here returns a [`CliError`] instead of printing or exiting, and writes an output file only when
 //! the whole output is ready (written to a temporary file beside it, then renamed), so a failure
 //! never leaves a half-written file.
+//!
+//! Files are read by [`read_text`]: `-` is standard input, a folder, a file over
+//! [`MAX_INPUT_BYTES`], binary data (a NUL byte) or text that is not UTF-8 is refused before
+//! parsing (naming the byte offset), and a UTF-8 byte-order mark is dropped. Output paths can be
+//! checked before any work with [`check_output_path`]. Temporary files in the making are listed
+//! in a registry that [`remove_temp_files`] empties (the binary calls it on SIGINT/SIGTERM), so a
+//! stopped command leaves none behind. Nothing here prints.
 
 use crate::analysis::{analyse, analyse_with, Analysis, AnalysisConfig, DependenceListing, Listed};
 use crate::fbd::Fbd;
@@ -13,7 +20,48 @@ use crate::report::{
     document_with, fbd_parts, render_dot, render_json, render_text, FbdParts, Rows, TextOptions,
     View, DOT_MAX_RUNGS,
 };
+use std::io::Read;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+/// Which file of a command an I/O error is about (the name the user gave it).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum FileRole {
+    /// The program (`FILE` argument, `-` for standard input).
+    Program,
+    /// `--inputs` of `run`.
+    Inputs,
+    /// `-o`.
+    Output,
+    /// `--trace` of `run`.
+    Trace,
+}
+
+impl FileRole {
+    fn verb(self) -> &'static str {
+        match self {
+            FileRole::Program | FileRole::Inputs => "read",
+            FileRole::Output | FileRole::Trace => "write",
+        }
+    }
+    fn what(self) -> &'static str {
+        match self {
+            FileRole::Program => "the program",
+            FileRole::Inputs => "--inputs",
+            FileRole::Output => "-o",
+            FileRole::Trace => "--trace",
+        }
+    }
+}
+
+/// An I/O error's text without the `(os error N)` suffix of the standard library.
+fn io_reason(e: &std::io::Error) -> String {
+    let s = e.to_string();
+    match (s.rfind(" (os error "), s.ends_with(')')) {
+        (Some(i), true) => s[..i].to_string(),
+        _ => s,
+    }
+}
 
 /// An error of a command, with what the user needs to find its cause.
 #[derive(Debug, thiserror::Error)]
@@ -22,46 +70,234 @@ pub enum CliError {
     /// errors, `file: rung R at path: message` for the others.
     #[error("{file}{}{error}", if matches!(error, LoadError::Syntax { .. }) { ":" } else { ": " })]
     Load { file: String, error: LoadError },
-    /// A file could not be read or written.
-    #[error("{path}: {message}")]
-    Io { path: String, message: String },
+    /// A file could not be read or written: `cannot read the program P: reason`,
+    /// `cannot write -o P: reason` (see [`FileRole`]).
+    #[error("cannot {} {} {path}: {}", role.verb(), role.what(), io_reason(source))]
+    Io {
+        role: FileRole,
+        path: String,
+        #[source]
+        source: std::io::Error,
+    },
     /// An argument is not valid.
     #[error("{0}")]
     Usage(String),
+    /// The worker threads of the parallel executor could not be started.
+    #[error("cannot start the worker threads: {0}")]
+    Threads(String),
 }
 
 impl CliError {
-    /// Exit code: 2 for bad input (program, arguments), 1 for I/O failures.
+    /// Exit code: 2 for every error (bad program, arguments, files). Exit code 1 is reserved
+    /// for a run that faulted or whose modes differed.
     pub fn exit_code(&self) -> u8 {
-        match self {
-            CliError::Load { .. } | CliError::Usage(_) => 2,
-            CliError::Io { .. } => 1,
+        2
+    }
+
+    /// An I/O error about `path` in `role`.
+    pub fn io(role: FileRole, path: &Path, source: std::io::Error) -> CliError {
+        CliError::Io {
+            role,
+            path: display_name(path),
+            source,
         }
     }
 }
 
-/// Reads and checks a program file.
-pub fn load_program(path: &Path) -> Result<Program, CliError> {
-    let text = std::fs::read_to_string(path).map_err(|e| CliError::Io {
-        path: path.display().to_string(),
-        message: e.to_string(),
-    })?;
-    program_from_json(&text).map_err(|error| CliError::Load {
-        file: path.display().to_string(),
-        error,
+/// Largest file (or standard input) read whole: 2 GiB. Larger ones are refused before reading.
+pub const MAX_INPUT_BYTES: u64 = 2 << 30;
+
+/// How a path is named in messages: `<stdin>` for `-`.
+fn display_name(path: &Path) -> String {
+    if is_stdin(path) {
+        "<stdin>".to_string()
+    } else {
+        path.display().to_string()
+    }
+}
+
+fn is_stdin(path: &Path) -> bool {
+    path.as_os_str() == "-"
+}
+
+fn invalid(kind: std::io::ErrorKind, message: String) -> std::io::Error {
+    std::io::Error::new(kind, message)
+}
+
+/// The bytes as UTF-8 text without a leading byte-order mark, or why not: the byte offset of
+/// the first NUL byte (binary data) or of the first byte that is not UTF-8, whichever is first.
+fn utf8_text(bytes: Vec<u8>) -> Result<String, String> {
+    let nul = bytes.iter().position(|&b| b == 0);
+    let text = match String::from_utf8(bytes) {
+        Ok(text) => text,
+        Err(e) => {
+            let at = e.utf8_error().valid_up_to();
+            if nul.is_none_or(|n| n > at) {
+                let byte = e.as_bytes()[at];
+                return Err(format!(
+                    "not UTF-8 text (byte 0x{byte:02x} at offset {at} is not valid UTF-8)"
+                ));
+            }
+            String::new() // the NUL comes first
+        }
+    };
+    if let Some(n) = nul {
+        return Err(format!("binary data, not text (a NUL byte at offset {n})"));
+    }
+    Ok(match text.strip_prefix('\u{feff}') {
+        Some(rest) => rest.to_string(),
+        None => text,
     })
 }
 
-/// Reads and checks a program file, with its FBD bodies as written.
+/// Reads a whole text file (`-`: standard input) for `role`, refusing folders, files over
+/// [`MAX_INPUT_BYTES`] (checked on the metadata, before reading), binary data and text that is
+/// not UTF-8; a UTF-8 byte-order mark is dropped.
+pub fn read_text(path: &Path, role: FileRole) -> Result<String, CliError> {
+    use std::io::ErrorKind;
+    let err = |e| CliError::io(role, path, e);
+    let too_large = |len: u64| {
+        err(invalid(
+            ErrorKind::FileTooLarge,
+            format!(
+                "the file is larger than the limit of {} GiB{}",
+                MAX_INPUT_BYTES >> 30,
+                if len > MAX_INPUT_BYTES {
+                    format!(" ({len} bytes)")
+                } else {
+                    String::new()
+                }
+            ),
+        ))
+    };
+    let bytes = if is_stdin(path) {
+        let mut bytes = Vec::new();
+        std::io::stdin()
+            .lock()
+            .take(MAX_INPUT_BYTES + 1)
+            .read_to_end(&mut bytes)
+            .map_err(err)?;
+        if bytes.len() as u64 > MAX_INPUT_BYTES {
+            return Err(too_large(0));
+        }
+        bytes
+    } else {
+        let meta = std::fs::metadata(path).map_err(err)?;
+        if meta.is_dir() {
+            return Err(err(invalid(
+                ErrorKind::IsADirectory,
+                "it is a folder, not a file".into(),
+            )));
+        }
+        if meta.len() > MAX_INPUT_BYTES {
+            return Err(too_large(meta.len()));
+        }
+        std::fs::read(path).map_err(err)?
+    };
+    utf8_text(bytes).map_err(|m| err(invalid(ErrorKind::InvalidData, m)))
+}
+
+/// Reads a program's text (`-`: standard input; see [`read_text`]) and the name that errors
+/// about it use (`<stdin>` for `-`).
+pub fn read_program_text(path: &Path) -> Result<(String, String), CliError> {
+    Ok((display_name(path), read_text(path, FileRole::Program)?))
+}
+
+/// Reads and checks a program file (`-`: standard input).
+pub fn load_program(path: &Path) -> Result<Program, CliError> {
+    let (file, text) = read_program_text(path)?;
+    program_from_json(&text).map_err(|error| CliError::Load { file, error })
+}
+
+/// Reads and checks a program file (`-`: standard input), with its FBD bodies as written.
 pub fn load_program_and_fbd(path: &Path) -> Result<(Program, Fbd), CliError> {
-    let text = std::fs::read_to_string(path).map_err(|e| CliError::Io {
-        path: path.display().to_string(),
-        message: e.to_string(),
-    })?;
-    crate::read::program_and_fbd_from_json(&text).map_err(|error| CliError::Load {
-        file: path.display().to_string(),
-        error,
-    })
+    let (file, text) = read_program_text(path)?;
+    crate::read::program_and_fbd_from_json(&text).map_err(|error| CliError::Load { file, error })
+}
+
+/// Checks, before any work, that an output file can be written at `path`: not a folder, in a
+/// folder that exists and lets us create a file (probed with the temporary name, then removed).
+pub fn check_output_path(path: &Path, role: FileRole) -> Result<(), CliError> {
+    if path.is_dir() {
+        return Err(CliError::io(
+            role,
+            path,
+            invalid(
+                std::io::ErrorKind::IsADirectory,
+                "it is a folder, not a file".into(),
+            ),
+        ));
+    }
+    let tmp = temp_name(path);
+    let probe = std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(&tmp);
+    match probe {
+        Ok(f) => {
+            drop(f);
+            let _ = std::fs::remove_file(&tmp);
+            Ok(())
+        }
+        // Our own leftover (same process id) cannot be: create_new failed on someone else's.
+        Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => Ok(()),
+        Err(e) => Err(output_error(path, role, e)),
+    }
+}
+
+/// The error of creating a file at `path`: a missing folder is named as such.
+fn output_error(path: &Path, role: FileRole, e: std::io::Error) -> CliError {
+    let folder = folder_of(path);
+    let e = if !folder.is_dir() {
+        let what = if folder.exists() {
+            format!("{} is not a folder", folder.display())
+        } else {
+            format!("the folder {} does not exist", folder.display())
+        };
+        invalid(e.kind(), what)
+    } else {
+        e
+    };
+    CliError::io(role, path, e)
+}
+
+/// The folder a file at `path` goes in (`.` for a bare name).
+fn folder_of(path: &Path) -> &Path {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    }
+}
+
+/// The temporary name beside `path`: `.NAME.tmp-PID`.
+fn temp_name(path: &Path) -> PathBuf {
+    let mut tmp = path.to_path_buf();
+    tmp.set_file_name(format!(
+        ".{}.tmp-{}",
+        path.file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default(),
+        std::process::id()
+    ));
+    tmp
+}
+
+/// Temporary files being written now (removed by [`remove_temp_files`] on a signal).
+static TEMP_FILES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+fn temp_files() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    TEMP_FILES.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Removes every temporary file in the making and keeps the registry locked, so that no new one
+/// is started and none is renamed into place: call it only right before exiting (the binary
+/// does on SIGINT/SIGTERM).
+pub fn remove_temp_files() {
+    let files = temp_files();
+    for f in files.iter() {
+        let _ = std::fs::remove_file(f);
+    }
+    std::mem::forget(files);
 }
 
 /// Writes `contents` to `out` (atomically) or to standard output.
@@ -84,34 +320,40 @@ pub fn write_output_with(
             let _ = write(&mut stdout).and_then(|_| stdout.flush());
             Ok(())
         }
-        Some(path) => {
-            let io = |e: std::io::Error| CliError::Io {
-                path: path.display().to_string(),
-                message: e.to_string(),
-            };
-            let mut tmp: PathBuf = path.to_path_buf();
-            let name = format!(
-                ".{}.tmp-{}",
-                path.file_name()
-                    .map(|n| n.to_string_lossy().into_owned())
-                    .unwrap_or_default(),
-                std::process::id()
-            );
-            tmp.set_file_name(name);
-            let result = std::fs::File::create(&tmp).and_then(|f| {
-                let mut w = std::io::BufWriter::new(f);
-                write(&mut w)?;
-                w.flush()
-            });
-            match result.and_then(|_| std::fs::rename(&tmp, path)) {
-                Ok(()) => Ok(()),
-                Err(e) => {
-                    let _ = std::fs::remove_file(&tmp);
-                    Err(io(e))
-                }
-            }
-        }
+        Some(path) => write_file_as(path, FileRole::Output, write),
     }
+}
+
+/// Writes the file `path` (for `role`, which errors name) from `write`: under a temporary name
+/// beside it, registered for removal on a signal, then renamed into place; on any error the
+/// temporary file is removed and nothing is left.
+pub fn write_file_as(
+    path: &Path,
+    role: FileRole,
+    write: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>,
+) -> Result<(), CliError> {
+    use std::io::Write;
+    let tmp = temp_name(path);
+    temp_files().push(tmp.clone());
+    let unregister = |tmp: &Path| temp_files().retain(|t| t != tmp);
+    let file = match std::fs::File::create(&tmp) {
+        Ok(f) => f,
+        Err(e) => {
+            unregister(&tmp);
+            return Err(output_error(path, role, e));
+        }
+    };
+    let mut w = std::io::BufWriter::new(file);
+    let result = write(&mut w).and_then(|_| w.flush());
+    drop(w);
+    let mut files = temp_files();
+    let result = result.and_then(|_| std::fs::rename(&tmp, path));
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    files.retain(|t| *t != tmp);
+    drop(files);
+    result.map_err(|e| CliError::io(role, path, e))
 }
 
 /// Output format of `report`.
@@ -234,18 +476,62 @@ pub fn render_order(p: &Program, fbd: &crate::fbd::Fbd, format: OrderFormat) -> 
 /// `plc-deps order`: each FBD network's execution order and fragment tree. A cycle of arcs or
 /// a fragment-rule violation is a load error naming the blocks (exit code 2).
 pub fn order(c: &OrderConfig) -> Result<(), CliError> {
-    let path = &c.input;
-    let text = std::fs::read_to_string(path).map_err(|e| CliError::Io {
-        path: path.display().to_string(),
-        message: e.to_string(),
-    })?;
-    let (p, fbd) =
-        crate::read::program_and_fbd_from_json(&text).map_err(|error| CliError::Load {
-            file: path.display().to_string(),
-            error,
-        })?;
+    let (file, text) = read_program_text(&c.input)?;
+    let (p, fbd) = crate::read::program_and_fbd_from_json(&text)
+        .map_err(|error| CliError::Load { file, error })?;
     write_output(c.output.as_deref(), &render_order(&p, &fbd, c.format))
 }
 
 /// The JSON Schema of the program format (`plc-deps schema`).
 pub const PROGRAM_SCHEMA: &str = include_str!("../schema/program.schema.json");
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn io_errors_name_the_file_keep_their_source_and_exit_with_2() {
+        use std::error::Error;
+        let e = CliError::io(
+            FileRole::Trace,
+            Path::new("t.csv"),
+            std::io::Error::from_raw_os_error(2),
+        );
+        assert_eq!(
+            e.to_string(),
+            "cannot write --trace t.csv: No such file or directory"
+        );
+        let source = e.source().expect("the io::Error is the source");
+        assert!(source.downcast_ref::<std::io::Error>().is_some());
+        assert_eq!(e.exit_code(), 2);
+        assert_eq!(CliError::Usage("x".into()).exit_code(), 2);
+    }
+
+    #[test]
+    fn text_is_utf8_without_nul_and_loses_its_byte_order_mark() {
+        assert_eq!(utf8_text(b"\xef\xbb\xbf{}".to_vec()).unwrap(), "{}");
+        assert_eq!(utf8_text("é".as_bytes().to_vec()).unwrap(), "é");
+        assert_eq!(
+            utf8_text(b"ab\xc3".to_vec()).unwrap_err(),
+            "not UTF-8 text (byte 0xc3 at offset 2 is not valid UTF-8)"
+        );
+        assert_eq!(
+            utf8_text(b"a\0\xff".to_vec()).unwrap_err(),
+            "binary data, not text (a NUL byte at offset 1)"
+        );
+        assert_eq!(
+            utf8_text(b"\xff\0".to_vec()).unwrap_err(),
+            "not UTF-8 text (byte 0xff at offset 0 is not valid UTF-8)"
+        );
+    }
+
+    #[test]
+    fn temporary_names_sit_beside_the_file() {
+        let t = temp_name(Path::new("out/r.json"));
+        assert_eq!(
+            t,
+            PathBuf::from(format!("out/.r.json.tmp-{}", std::process::id()))
+        );
+        assert_eq!(folder_of(Path::new("r.json")), Path::new("."));
+    }
+}

@@ -25,7 +25,7 @@ struct Cli {
 enum Command {
     /// Analyse a program: dependences, control flow, post-dominators, levels, cycles, cost.
     Report {
-        /// The program (JSON program format, see docs/format.md).
+        /// The program (JSON program format, see docs/format.md; `-`: standard input).
         file: PathBuf,
         /// Output format.
         #[arg(long, value_enum, default_value_t = FormatArg::Text)]
@@ -51,7 +51,8 @@ enum Command {
     },
     /// Print each FBD network's execution order and conditional fragment tree (the FBD text-generation paper).
     Order {
-        /// The program (JSON program format with FBD bodies, see docs/fbd.md).
+        /// The program (JSON program format with FBD bodies, see docs/fbd.md; `-`: standard
+        /// input).
         file: PathBuf,
         /// Output format.
         #[arg(long, value_enum, default_value_t = FormatArg::Text)]
@@ -104,7 +105,7 @@ enum Command {
     },
     /// Run the PLC scan cycle on virtual time: sequentially, in parallel, or both (checked equal).
     Run {
-        /// The program (JSON program format, see docs/format.md).
+        /// The program (JSON program format, see docs/format.md; `-`: standard input).
         file: PathBuf,
         /// Number of scans [default: the rows of --inputs, or 1000].
         #[arg(long)]
@@ -113,7 +114,7 @@ enum Command {
         /// (`[{"start": true, "temp": 40}, ...]`); see docs/scan.md.
         #[arg(long)]
         inputs: Option<PathBuf>,
-        /// Virtual scan period, a TIME (scan k runs at k × cycle).
+        /// Virtual scan period, a TIME of whole milliseconds (scan k runs at k × cycle).
         #[arg(long, default_value = "10ms")]
         cycle: String,
         /// Workers of the parallel executor [default: the number of cores].
@@ -122,10 +123,12 @@ enum Command {
         /// Which executors run.
         #[arg(long, value_enum, default_value_t = ModeArg::Both)]
         mode: ModeArg,
-        /// Write the traced variables after every scan to this CSV file.
+        /// Write the traced variables after every scan to this CSV file (checked before the
+        /// first scan, complete or not at all).
         #[arg(long)]
         trace: Option<PathBuf>,
-        /// Variables to trace (comma-separated; instance fields as T1.Q) [default: all].
+        /// Variables to trace with --trace (comma-separated; instance fields as T1.Q; each
+        /// column once) [default: all].
         #[arg(long, value_delimiter = ',')]
         trace_vars: Option<Vec<String>>,
         /// Output format.
@@ -324,8 +327,23 @@ fn run(cli: Cli) -> Result<(), CliError> {
     }
 }
 
+/// On SIGINT or SIGTERM: remove the temporary files being written (an output or trace file in
+/// the making) and exit with 130, so a stopped command leaves nothing behind.
+fn remove_temp_files_on_signal() {
+    let _ = ctrlc::set_handler(|| {
+        app::remove_temp_files();
+        use std::io::{IsTerminal, Write};
+        if std::io::stderr().is_terminal() {
+            // Clear a progress line, so the shell's prompt starts on a clean line.
+            let _ = write!(std::io::stderr(), "\r\x1b[2K");
+        }
+        std::process::exit(130);
+    });
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    remove_temp_files_on_signal();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

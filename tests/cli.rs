@@ -50,11 +50,114 @@ fn every_bad_program_gives_one_located_error_and_exit_code_2() {
 }
 
 #[test]
-fn missing_file_is_an_io_error() {
+fn missing_file_is_an_io_error_with_exit_code_2() {
     let out = run(&["report", "no/such/file.json"]);
-    assert_eq!(out.status.code(), Some(1));
-    let stderr = String::from_utf8(out.stderr).unwrap();
-    assert!(stderr.starts_with("error: no/such/file.json: "), "{stderr}");
+    assert_eq!(
+        error_line(&out, "missing"),
+        "error: cannot read the program no/such/file.json: No such file or directory"
+    );
+}
+
+#[test]
+fn bad_files_are_refused_before_parsing_with_the_file_and_the_byte_offset() {
+    let dir = tmp("bad-files");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = |name: &str, bytes: &[u8]| {
+        let p = dir.join(name);
+        std::fs::write(&p, bytes).unwrap();
+        p.to_str().unwrap().to_owned()
+    };
+    let latin1 = file("latin1.json", b"{\"program\": \"caf\xe9\"}");
+    assert_eq!(
+        error_line(&run(&["report", &latin1]), "latin-1"),
+        format!(
+            "error: cannot read the program {latin1}: not UTF-8 text (byte 0xe9 at offset 16 is not valid UTF-8)"
+        )
+    );
+    let binary = file("binary.json", b"PK\x03\x04\x00\x00\xff");
+    assert_eq!(
+        error_line(&run(&["report", &binary]), "binary"),
+        format!("error: cannot read the program {binary}: binary data, not text (a NUL byte at offset 4)")
+    );
+    let folder = dir.to_str().unwrap();
+    assert_eq!(
+        error_line(&run(&["report", folder]), "folder"),
+        format!("error: cannot read the program {folder}: it is a folder, not a file")
+    );
+    // Over the 2 GiB limit: refused on its size (a sparse file, never read).
+    let huge = dir.join("huge.json");
+    std::fs::File::create(&huge)
+        .unwrap()
+        .set_len(3 << 30)
+        .unwrap();
+    let h = huge.to_str().unwrap();
+    assert_eq!(
+        error_line(&run(&["report", h]), "huge"),
+        format!("error: cannot read the program {h}: the file is larger than the limit of 2 GiB (3221225472 bytes)")
+    );
+    std::fs::remove_file(&huge).unwrap();
+    for cmd in ["report", "order", "run"] {
+        let out = run(&[cmd, &binary]);
+        assert!(error_line(&out, cmd).contains("a NUL byte at offset 4"));
+    }
+}
+
+#[test]
+fn a_byte_order_mark_is_accepted_and_dash_reads_standard_input() {
+    let program = std::fs::read(root().join("analyses/example-b/program.json")).unwrap();
+    let expected = run(&["report", "analyses/example-b/program.json"]);
+    assert!(expected.status.success());
+    let mut with_bom = b"\xef\xbb\xbf".to_vec();
+    with_bom.extend_from_slice(&program);
+    let bom = tmp("bom.json");
+    std::fs::write(&bom, &with_bom).unwrap();
+    let from_bom = run(&["report", bom.to_str().unwrap()]);
+    assert!(
+        from_bom.status.success(),
+        "{}",
+        String::from_utf8_lossy(&from_bom.stderr)
+    );
+    assert_eq!(from_bom.stdout, expected.stdout);
+    let from_stdin = run_stdin(&["report", "-"], &with_bom);
+    assert!(from_stdin.status.success());
+    assert_eq!(from_stdin.stdout, expected.stdout);
+    let order = run(&["order", "analyses/example-b/program.json"]);
+    assert_eq!(run_stdin(&["order", "-"], &program).stdout, order.stdout);
+    let out = run_stdin(&["run", "-", "--scans", "3", "--format", "json"], &program);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // Errors about standard input name it `<stdin>`.
+    let out = run_stdin(&["report", "-"], b"{\"program\": ");
+    assert!(error_line(&out, "stdin").starts_with("error: <stdin>:1:"));
+    let out = run_stdin(&["report", "-"], b"\xff");
+    assert_eq!(
+        error_line(&out, "stdin"),
+        "error: cannot read the program <stdin>: not UTF-8 text (byte 0xff at offset 0 is not valid UTF-8)"
+    );
+}
+
+#[test]
+fn an_output_folder_that_does_not_exist_is_an_error_naming_it() {
+    let out = run(&[
+        "report",
+        "analyses/example-b/program.json",
+        "-o",
+        "no/such/dir/r.txt",
+    ]);
+    assert_eq!(
+        error_line(&out, "-o"),
+        "error: cannot write -o no/such/dir/r.txt: the folder no/such/dir does not exist"
+    );
+    let folder = tmp("out-folder");
+    std::fs::create_dir_all(&folder).unwrap();
+    let f = folder.to_str().unwrap();
+    let out = run(&["schema", "-o", f]);
+    assert!(error_line(&out, "folder").starts_with(&format!("error: cannot write -o {f}: ")));
+    assert!(temp_files_in(&folder).is_empty());
+    assert!(temp_files_in(folder.parent().unwrap()).is_empty());
 }
 
 #[test]

@@ -192,7 +192,7 @@ fn csv_inputs_hold_their_last_value_and_the_trace_shows_every_scan() {
         "--trace",
         trace.to_str().unwrap(),
         "--trace-vars",
-        "rise,T1.Q,T1",
+        "rise,T1.Q,T1,rise",
     ]);
     assert!(
         out.status.success(),
@@ -202,7 +202,8 @@ fn csv_inputs_hold_their_last_value_and_the_trace_shows_every_scan() {
     let text = std::fs::read_to_string(&trace).unwrap();
     assert_eq!(
         text.lines().next().unwrap(),
-        "scan,time_ms,rise,T1.Q,T1.Q,T1.ET,T1.PT"
+        "scan,time_ms,rise,T1.Q,T1.ET,T1.PT",
+        "each column once, where it was first asked for"
     );
     assert_eq!(text.lines().count(), 5, "scans default to the input rows");
 }
@@ -359,10 +360,264 @@ fn faults_are_reported_with_scan_rung_and_kind() {
     assert_eq!(faults.len(), 5);
     assert_eq!(j["fault_count"], 5);
     assert_eq!(j["identical"], true);
+    assert_eq!(
+        j["fault_summary"],
+        serde_json::json!([
+            {"rung": "DIV", "kind": "div-by-zero", "count": 2, "first_scan": 0, "last_scan": 2},
+            {"rung": "J", "kind": "loop-cap", "count": 3, "first_scan": 0, "last_scan": 2}
+        ])
+    );
     let text =
         String::from_utf8(run(&["run", &program, "--inputs", &inputs, "--loop-cap", "50"]).stdout)
             .unwrap();
-    assert!(text.contains("scan 0: rung DIV: div-by-zero"), "{text}");
+    assert!(
+        text.contains(
+            "faults: 5 (2 distinct faults)\n  rung DIV: div-by-zero, 2 times, scans 0 to 2\n  rung J: loop-cap, 3 times, scans 0 to 2\n"
+        ),
+        "{text}"
+    );
+}
+
+/// A DIV by zero in every scan and an endless backward jump (`L: … jmp L`, unconditional).
+const ALWAYS_FAULTY: &str = r#"{"program": "always",
+    "vars": [{"name": "d", "type": "INT", "class": "input"}, {"name": "x", "type": "INT", "class": "output"}, {"name": "i", "type": "DINT", "class": "output"}],
+    "rungs": [
+      {"id": "DIV", "ld": [{"op": "DIV", "in": [10, "d"], "out": "x"}]},
+      {"id": "L", "label": "again", "ld": [{"op": "ADD", "in": ["i", 1], "out": "i"}, {"jmp": "again"}]}
+    ]}"#;
+
+#[test]
+fn a_fault_of_every_scan_is_one_summary_line_and_an_endless_loop_ends_at_the_cap() {
+    let program = write("always.json", ALWAYS_FAULTY);
+    let out = run(&["run", &program, "--loop-cap", "10"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    let faults: Vec<&str> = text
+        .lines()
+        .skip_while(|l| !l.starts_with("faults:"))
+        .take_while(|l| !l.starts_with("speed:"))
+        .collect();
+    assert_eq!(
+        faults,
+        [
+            "faults: 2000 (2 distinct faults)",
+            "  rung DIV: div-by-zero, 1000 times, scans 0 to 999",
+            "  rung L: loop-cap, 1000 times, scans 0 to 999",
+        ],
+        "{text}"
+    );
+    // The endless loop runs `--loop-cap` loop-backs (11 passes) per scan, then the scan ends.
+    let j = json_of(&run(&[
+        "run",
+        &program,
+        "--loop-cap",
+        "10",
+        "--scans",
+        "3",
+        "--format",
+        "json",
+    ]));
+    assert_eq!(j["outputs"]["i"], 33);
+    assert_eq!(j["fault_count"], 6);
+    assert_eq!(j["faults"].as_array().unwrap().len(), 6);
+    assert_eq!(j["fault_summary"][1]["count"], 3);
+    assert_eq!(j["identical"], true);
+    let one = run(&["run", &program, "--loop-cap", "10", "--scans", "1"]);
+    let text = String::from_utf8(one.stdout).unwrap();
+    assert!(
+        text.starts_with("program always: 1 scan, cycle 10 ms, "),
+        "{text}"
+    );
+    assert!(
+        text.contains("  rung L: loop-cap, once, in scan 0\n"),
+        "{text}"
+    );
+    let one = run(&[
+        "run",
+        &program,
+        "--scans",
+        "1",
+        "--threads",
+        "1",
+        "--mode",
+        "seq",
+    ]);
+    let text = String::from_utf8(one.stdout).unwrap();
+    assert!(
+        text.starts_with("program always: 1 scan, cycle 10 ms, 1 thread\n"),
+        "{text}"
+    );
+}
+
+#[test]
+fn trace_vars_without_trace_and_stdin_twice_are_usage_errors() {
+    let program = write("echo-tv.json", ECHO);
+    fails(
+        &["run", &program, "--trace-vars", "a"],
+        "--trace-vars chooses the columns of the trace file: give --trace FILE too",
+    );
+    let out = run_stdin(&["run", "-", "--inputs", "-"], ECHO.as_bytes());
+    assert_eq!(
+        error_line(&out, "stdin twice"),
+        "error: the program and --inputs cannot both be read from standard input (-)"
+    );
+}
+
+#[test]
+fn an_inputs_file_without_rows_is_a_warning_and_the_run_goes_on() {
+    let program = write("echo-empty.json", ECHO);
+    for (name, text) in [
+        ("empty.csv", ""),
+        ("header-only.csv", "a,n\n"),
+        ("empty.json", "[]"),
+    ] {
+        let inputs = write(name, text);
+        let out = run(&["run", &program, "--inputs", &inputs, "--format", "json"]);
+        assert_eq!(
+            String::from_utf8(out.stderr.clone()).unwrap(),
+            format!(
+                "warning: --inputs {inputs} has no rows: every input keeps its initial value; \
+                 running 1 scan (give --scans N for more)\n"
+            )
+        );
+        assert_eq!(json_of(&out)["scans"], 1);
+        let out = run(&["run", &program, "--inputs", &inputs, "--scans", "4"]);
+        assert!(out.status.success());
+        assert_eq!(
+            String::from_utf8(out.stderr).unwrap(),
+            format!(
+                "warning: --inputs {inputs} has no rows: every input keeps its initial value\n"
+            )
+        );
+    }
+}
+
+#[test]
+fn time_below_a_millisecond_is_refused_not_rounded() {
+    let program = write("echo-time.json", ECHO);
+    fails(
+        &["run", &program, "--cycle", "0.5ms"],
+        "--cycle 0.5ms: not a whole number of milliseconds (TIME counts milliseconds)",
+    );
+    fails(
+        &["run", &program, "--cycle", "T#1.0005s"],
+        "not a whole number of milliseconds",
+    );
+    assert!(
+        run(&["run", &program, "--cycle", "1.5ms", "--scans", "1"])
+            .status
+            .code()
+            == Some(2)
+    );
+    assert!(run(&["run", &program, "--cycle", "0.002s", "--scans", "1"])
+        .status
+        .success());
+    let inputs = write("subms.csv", "t\nT#0.4ms\n");
+    fails(
+        &["run", &program, "--inputs", &inputs],
+        &format!(
+            "{inputs}:2:1: scan 0, column `t`: `T#0.4ms` is not a whole number of milliseconds"
+        ),
+    );
+    let literal = write("subms.json", &ECHO.replace("T#30ms", "T#0.4ms"));
+    let out = run(&["run", &literal]);
+    assert!(error_line(&out, "literal").contains("`T#0.4ms`"));
+}
+
+#[test]
+fn output_and_trace_paths_are_checked_before_the_first_scan() {
+    let program = write("echo-paths.json", ECHO);
+    let start = std::time::Instant::now();
+    fails(
+        &[
+            "run",
+            &program,
+            "--scans",
+            "1000000000",
+            "-o",
+            "no/such/dir/r.json",
+        ],
+        "cannot write -o no/such/dir/r.json: the folder no/such/dir does not exist",
+    );
+    fails(
+        &[
+            "run",
+            &program,
+            "--scans",
+            "1000000000",
+            "--trace",
+            "no/such/t.csv",
+        ],
+        "cannot write --trace no/such/t.csv: the folder no/such does not exist",
+    );
+    let dir = tmp("paths-dir");
+    std::fs::create_dir_all(&dir).unwrap();
+    let d = dir.to_str().unwrap();
+    fails(
+        &["run", &program, "--scans", "1000000000", "--trace", d],
+        &format!("cannot write --trace {d}: it is a folder, not a file"),
+    );
+    let same = tmp("same.csv");
+    let same = same.to_str().unwrap();
+    fails(
+        &["run", &program, "--trace", same, "-o", same],
+        "-o and --trace name the same file",
+    );
+    assert!(start.elapsed().as_secs() < 20, "no scan ran");
+    assert!(temp_files_in(&dir).is_empty());
+    assert!(temp_files_in(dir.parent().unwrap()).is_empty());
+}
+
+/// Sends `signal` to a running `plc-deps run` with `--trace` and `-o` once it has started, and
+/// checks that it exits with 130 leaving neither the files nor their temporary files.
+fn stopped_by(signal: &str) {
+    let program = write(&format!("echo-{signal}.json"), ECHO);
+    let dir = tmp(&format!("signal-{signal}"));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (trace, report) = (dir.join("t.csv"), dir.join("r.json"));
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_plc-deps"))
+        .args([
+            "run",
+            &program,
+            "--scans",
+            "100000000",
+            "--trace",
+            trace.to_str().unwrap(),
+            "-o",
+            report.to_str().unwrap(),
+        ])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Wait until the trace's temporary file exists: the scans are running.
+    let t0 = std::time::Instant::now();
+    while temp_files_in(&dir).is_empty() {
+        assert!(t0.elapsed().as_secs() < 30, "the run did not start");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let kill = std::process::Command::new("kill")
+        .args([&format!("-{signal}"), &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(130), "{signal}");
+    assert!(
+        temp_files_in(&dir).is_empty(),
+        "{signal}: {:?}",
+        temp_files_in(&dir)
+    );
+    assert!(!trace.exists() && !report.exists(), "{signal}");
+}
+
+#[test]
+fn a_run_stopped_by_sigint_or_sigterm_leaves_no_file() {
+    stopped_by("INT");
+    stopped_by("TERM");
 }
 
 #[test]
@@ -448,9 +703,15 @@ fn bad_input_is_one_located_error_with_exit_code_2_and_no_output_file() {
     fails(&["run", &broken, "-o", o], &format!("{broken}:1:"));
     assert!(!trace.exists(), "no trace file after an error");
     assert!(!out_file.exists(), "no output file after an error");
-    // Missing files are I/O errors (exit code 1), as for `report`.
-    let out = run(&["run", &program, "--inputs", "no/such/inputs.csv"]);
-    assert_eq!(out.status.code(), Some(1));
+    // Missing files are I/O errors naming the file's role (exit code 2), as for `report`.
+    fails(
+        &["run", &program, "--inputs", "no/such/inputs.csv"],
+        "cannot read --inputs no/such/inputs.csv: No such file or directory",
+    );
+    fails(
+        &["run", "no/such/program.json"],
+        "cannot read the program no/such/program.json: No such file or directory",
+    );
 }
 
 #[test]

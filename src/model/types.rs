@@ -281,6 +281,12 @@ impl ArithOp {
 }
 
 /// Parses an IEC TIME literal (`T#1s`, `T#250ms`, `TIME#1m30s`, `T#1.5s`) into milliseconds.
+///
+/// `None` for exactly two reasons: the text is not a TIME literal, or its value is not a whole
+/// number of milliseconds (`T#0.5ms`, `T#1.0005s`): TIME counts milliseconds, and a fraction
+/// would be lost silently. (IEC 61131-3 allows finer literals; this executor does not.) The
+/// arithmetic is exact (decimal digits, not floating point); a value beyond the `i64` range
+/// saturates, so callers check the range they need.
 pub fn parse_time_literal(s: &str) -> Option<i64> {
     let rest = s
         .strip_prefix("T#")
@@ -294,31 +300,55 @@ pub fn parse_time_literal(s: &str) -> Option<i64> {
     if rest.is_empty() {
         return None;
     }
-    let mut total = 0f64;
+    // The value in units of 10^-FRAC ms; more fractional digits than FRAC can never add up to
+    // whole milliseconds (a unit is at most 2^10 · 3^3 · 5^5 ms), so they are refused.
+    const FRAC: u32 = 12;
+    let mut total: i128 = 0;
+    let mut saturated = false;
     while !rest.is_empty() {
         let num_len = rest
             .find(|c: char| !(c.is_ascii_digit() || c == '.' || c == '_'))
             .unwrap_or(rest.len());
-        if num_len == 0 {
+        let number = rest[..num_len].replace('_', "");
+        rest = &rest[num_len..];
+        if number.matches('.').count() > 1 || !number.bytes().any(|b| b.is_ascii_digit()) {
             return None;
         }
-        let number: f64 = rest[..num_len].replace('_', "").parse().ok()?;
-        rest = &rest[num_len..];
+        let (int, frac) = number.split_once('.').unwrap_or((&number, ""));
+        let frac = frac.trim_end_matches('0');
         let unit_len = rest
             .find(|c: char| c.is_ascii_digit() || c == '.')
             .unwrap_or(rest.len());
-        let factor = match rest[..unit_len].to_ascii_lowercase().as_str() {
-            "d" => 86_400_000.0,
-            "h" => 3_600_000.0,
-            "m" => 60_000.0,
-            "s" => 1000.0,
-            "ms" => 1.0,
+        let factor: i128 = match rest[..unit_len].to_ascii_lowercase().as_str() {
+            "d" => 86_400_000,
+            "h" => 3_600_000,
+            "m" => 60_000,
+            "s" => 1000,
+            "ms" => 1,
             _ => return None,
         };
         rest = &rest[unit_len..];
-        total += number * factor;
+        if frac.len() > FRAC as usize {
+            return None;
+        }
+        let digits = format!("{int}{frac}{}", "0".repeat(FRAC as usize - frac.len()));
+        let part = digits
+            .parse::<i128>()
+            .ok()
+            .and_then(|d| d.checked_mul(factor));
+        match part.and_then(|p| total.checked_add(p)) {
+            Some(t) => total = t,
+            None => saturated = true,
+        }
     }
-    let ms = total.round() as i64;
+    let unit = 10i128.pow(FRAC);
+    if saturated {
+        return Some(if neg { i64::MIN } else { i64::MAX });
+    }
+    if total % unit != 0 {
+        return None;
+    }
+    let ms = i64::try_from(total / unit).unwrap_or(i64::MAX);
     Some(if neg { -ms } else { ms })
 }
 
@@ -336,5 +366,25 @@ mod tests {
         assert_eq!(parse_time_literal("T#"), None);
         assert_eq!(parse_time_literal("T#5x"), None);
         assert_eq!(parse_time_literal("5s"), None);
+        assert_eq!(parse_time_literal("T#0.001s"), Some(1));
+        assert_eq!(parse_time_literal("T#1.250_0s"), Some(1250));
+        assert_eq!(parse_time_literal("T#0.1s0.2s"), Some(300));
+        assert_eq!(parse_time_literal("T#1_000ms"), Some(1000));
+        assert_eq!(parse_time_literal("T#.5s"), Some(500));
+        assert_eq!(parse_time_literal("T#2.ms"), Some(2));
+        assert_eq!(parse_time_literal("T#0.00001d"), Some(864));
+        assert_eq!(parse_time_literal("T#0.000001d"), None, "86.4 ms");
+        // Not a whole number of milliseconds: refused, never rounded.
+        assert_eq!(parse_time_literal("T#0.4ms"), None);
+        assert_eq!(parse_time_literal("T#0.5ms"), None);
+        assert_eq!(parse_time_literal("T#1.0005s"), None);
+        assert_eq!(parse_time_literal("T#0.0000000000001s"), None);
+        assert_eq!(parse_time_literal("T#1.2.3s"), None);
+        assert_eq!(parse_time_literal("T#.s"), None);
+        assert_eq!(parse_time_literal("T#_s"), None);
+        assert_eq!(
+            parse_time_literal("T#99999999999999999999999999999999999999999d"),
+            Some(i64::MAX)
+        );
     }
 }

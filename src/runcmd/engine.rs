@@ -1,18 +1,20 @@
-//! The run itself: everything validated before the first scan, then the warm-up and the timed
-//! sequential and parallel passes, with the per-scan bookkeeping (digests, faults, trace,
-//! progress) and the report they add up to.
+//! The run itself: everything validated before the first scan (arguments, output and trace
+//! paths, program, inputs, trace variables), then the warm-up and the timed sequential and
+//! parallel passes, with the per-scan bookkeeping (digests, faults and their summary, trace,
+//! progress) and the report they add up to. It prints nothing: warnings are returned as data.
 
 use super::compare::{canonical_slots, digest, first_difference};
 use super::inputs::{load_inputs, InputTable};
-use super::progress::Progress;
+use super::progress::{Bar, Progress};
 use super::trace::{cell, trace_columns, Trace};
-use super::{RunConfig, RunMode};
+use super::{RunConfig, RunMode, RunWarning};
 use crate::analysis::analyse;
-use crate::app::{load_program, CliError};
+use crate::app::{check_output_path, load_program, CliError, FileRole};
 use crate::exec::parallel::{run_sequential, ParallelMachine, PlanConfig, ScanDriver};
 use crate::exec::{ExecConfig, Fault, FaultKind, Layout, Machine, VarValue};
 use crate::model::{Program, Type, VarClass, VarId, VarRef};
 use serde_json::Value as Json;
+use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::io::Write;
 use std::time::Duration;
@@ -36,6 +38,8 @@ pub struct RunReport {
     /// The first faults (at most 1000) and the total.
     pub faults: Vec<(u64, String, FaultKind)>,
     pub fault_count: u64,
+    /// Every distinct fault (rung and kind), in the order of their first occurrence.
+    pub fault_summary: Vec<FaultSummary>,
     /// Per mode: (name, total scan time).
     pub modes: Vec<(&'static str, Duration)>,
     /// `Some` when both modes ran.
@@ -43,6 +47,37 @@ pub struct RunReport {
     pub first_difference: Option<Json>,
     /// The parallel plan (text, JSON) when asked for.
     pub explain: Option<(String, Json)>,
+}
+
+/// One distinct fault of a run: a rung and a kind, how often, and the first and last scan.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct FaultSummary {
+    pub rung: String,
+    pub kind: FaultKind,
+    pub count: u64,
+    pub first_scan: u64,
+    pub last_scan: u64,
+}
+
+/// Counts every fault by (rung, kind), in the order of first occurrence.
+#[derive(Default)]
+struct FaultTally {
+    index: HashMap<(u32, FaultKind), usize>,
+    /// (rung, kind, count, first scan, last scan)
+    rows: Vec<(u32, FaultKind, u64, u64, u64)>,
+}
+
+impl FaultTally {
+    fn add(&mut self, f: &Fault) {
+        let rows = &mut self.rows;
+        let i = *self.index.entry((f.rung.0, f.kind)).or_insert_with(|| {
+            rows.push((f.rung.0, f.kind, 0, f.scan, f.scan));
+            rows.len() - 1
+        });
+        let row = &mut self.rows[i];
+        row.2 += 1;
+        row.4 = f.scan;
+    }
 }
 
 /// Per-scan bookkeeping shared by both modes.
@@ -56,8 +91,9 @@ struct Driver<'a> {
     total: Duration,
     faults: Vec<(u64, u32, FaultKind)>,
     fault_count: u64,
+    tally: FaultTally,
     trace: Option<Trace<'a>>,
-    progress: &'a mut Progress,
+    bar: Bar,
 }
 
 impl<'a> Driver<'a> {
@@ -67,7 +103,7 @@ impl<'a> Driver<'a> {
         digests: Vec<u128>,
         check: bool,
         trace: Option<Trace<'a>>,
-        progress: &'a mut Progress,
+        bar: Bar,
     ) -> Driver<'a> {
         Driver {
             inputs,
@@ -78,8 +114,9 @@ impl<'a> Driver<'a> {
             total: Duration::ZERO,
             faults: Vec::new(),
             fault_count: 0,
+            tally: FaultTally::default(),
             trace,
-            progress,
+            bar,
         }
     }
 }
@@ -111,6 +148,7 @@ impl ScanDriver for Driver<'_> {
             if self.faults.len() < FAULTS_KEPT {
                 self.faults.push((f.scan, f.rung.0, f.kind));
             }
+            self.tally.add(f);
         }
         if let Some(t) = &mut self.trace {
             if t.error.is_none() {
@@ -130,7 +168,7 @@ impl ScanDriver for Driver<'_> {
                 }
             }
         }
-        self.progress.tick();
+        self.bar.inc();
     }
 }
 
@@ -159,9 +197,12 @@ pub(super) struct Prepared {
     par: Option<ParallelMachine>,
     pool: Option<rayon::ThreadPool>,
     trace_cols: Option<Vec<(String, VarRef, Type)>>,
+    /// What the user should know before the run starts.
+    pub(super) warnings: Vec<RunWarning>,
 }
 
-pub(super) fn prepare(c: &RunConfig) -> Result<Prepared, CliError> {
+/// Checks the arguments alone, before any file is touched.
+fn check_arguments(c: &RunConfig) -> Result<(), CliError> {
     if c.threads == 0 {
         return Err(CliError::Usage("--threads must be at least 1".into()));
     }
@@ -171,9 +212,45 @@ pub(super) fn prepare(c: &RunConfig) -> Result<Prepared, CliError> {
     if c.scans == Some(0) {
         return Err(CliError::Usage("--scans must be at least 1".into()));
     }
-    let p = load_program(&c.input)?;
+    if c.trace_vars.is_some() && c.trace.is_none() {
+        return Err(CliError::Usage(
+            "--trace-vars chooses the columns of the trace file: give --trace FILE too".into(),
+        ));
+    }
+    if c.input.as_os_str() == "-" && c.inputs.as_ref().is_some_and(|i| i.as_os_str() == "-") {
+        return Err(CliError::Usage(
+            "the program and --inputs cannot both be read from standard input (-)".into(),
+        ));
+    }
+    if let (Some(o), Some(t)) = (&c.output, &c.trace) {
+        if o == t {
+            return Err(CliError::Usage(format!(
+                "-o and --trace name the same file {}",
+                o.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
+pub(super) fn prepare(c: &RunConfig, progress: &Progress) -> Result<Prepared, CliError> {
+    check_arguments(c)?;
+    if let Some(o) = &c.output {
+        check_output_path(o, FileRole::Output)?;
+    }
+    if let Some(t) = &c.trace {
+        check_output_path(t, FileRole::Trace)?;
+    }
+    let p = {
+        let _phase = progress.phase(&format!("reading {}", c.input.display()));
+        load_program(&c.input)?
+    };
+    let mut warnings = Vec::new();
     let inputs = match &c.inputs {
-        Some(path) => load_inputs(&p, path)?,
+        Some(path) => {
+            let _phase = progress.phase(&format!("reading {}", path.display()));
+            load_inputs(&p, path)?
+        }
         None => InputTable::default(),
     };
     let scans = c.scans.unwrap_or(if c.inputs.is_some() {
@@ -181,10 +258,18 @@ pub(super) fn prepare(c: &RunConfig) -> Result<Prepared, CliError> {
     } else {
         1000
     });
+    if let (Some(path), true) = (&c.inputs, inputs.rows.is_empty()) {
+        warnings.push(RunWarning::NoInputRows {
+            file: path.display().to_string(),
+            scans,
+            scans_given: c.scans.is_some(),
+        });
+    }
     let trace_cols = match &c.trace {
         Some(_) => Some(trace_columns(&p, c.trace_vars.as_deref())?),
         None => None,
     };
+    let _phase = progress.phase("preparing the executors");
     let exec = ExecConfig {
         cycle_ms: c.cycle_ms,
         loop_cap: c.loop_cap,
@@ -212,10 +297,7 @@ pub(super) fn prepare(c: &RunConfig) -> Result<Prepared, CliError> {
                     .num_threads(c.threads - 1)
                     .thread_name(|i| format!("plc-worker-{}", i + 1))
                     .build()
-                    .map_err(|e| CliError::Io {
-                        path: "thread pool".into(),
-                        message: e.to_string(),
-                    })?,
+                    .map_err(|e| CliError::Threads(e.to_string()))?,
             )
         }
         _ => None,
@@ -228,7 +310,35 @@ pub(super) fn prepare(c: &RunConfig) -> Result<Prepared, CliError> {
         par,
         pool,
         trace_cols,
+        warnings,
     })
+}
+
+/// What one pass (one mode) leaves for the report.
+struct Pass {
+    total: Duration,
+    digests: Vec<u128>,
+    first_mismatch: Option<u64>,
+    faults: Vec<(u64, u32, FaultKind)>,
+    fault_count: u64,
+    tally: FaultTally,
+    trace_error: Option<std::io::Error>,
+    slots: Vec<u64>,
+}
+
+impl Pass {
+    fn of(d: Driver<'_>, slots: Vec<u64>) -> Pass {
+        Pass {
+            total: d.total,
+            digests: d.digests,
+            first_mismatch: d.first_mismatch,
+            faults: d.faults,
+            fault_count: d.fault_count,
+            tally: d.tally,
+            trace_error: d.trace.and_then(|t| t.error),
+            slots,
+        }
+    }
 }
 
 /// Runs the prepared scans; `trace` receives the trace CSV (from the sequential run, or from the
@@ -237,126 +347,151 @@ pub(super) fn execute(
     pr: &Prepared,
     c: &RunConfig,
     trace: Option<&mut dyn Write>,
+    progress: &Progress,
 ) -> (RunReport, Option<std::io::Error>) {
-    let (p, inputs, scans) = (&pr.p, &pr.inputs, pr.scans);
+    let (inputs, scans) = (&pr.inputs, pr.scans);
     // The parallel machine may exist only for --explain.
     let run_par = if c.mode == RunMode::Seq {
         None
     } else {
         pr.par.as_ref()
     };
-    let passes = pr.seq.is_some() as u64 + run_par.is_some() as u64;
-    let mut progress = Progress::new(c.progress, scans * passes);
     let mut trace = trace;
-    let mut modes = Vec::new();
-    let mut digests = Vec::new();
-    let mut report_state: Option<(Vec<u64>, bool)> = None; // (slots, of the parallel machine)
-    let (mut faults, mut fault_count, mut first_mismatch, mut trace_error) =
-        (Vec::new(), 0, None, None);
     // Untimed warm-up scans on a throwaway state before each timed pass, so that neither mode
     // pays for cold caches and branch predictors (or for the other mode's warm ones).
     let warm = scans.min(WARM_UP);
-    if let Some(m) = &pr.seq {
-        let mut st = m.initial_state();
-        run_sequential(m, &mut st, 0..warm, &mut Inputs(inputs));
-        progress.label = "seq";
-        let progress = &mut progress;
+    let mut seq = pr.seq.as_ref().map(|m| {
+        {
+            let _phase = progress.phase("seq: warm-up scans");
+            let mut st = m.initial_state();
+            run_sequential(m, &mut st, 0..warm, &mut Inputs(inputs));
+        }
         let t = match (&pr.trace_cols, trace.take()) {
             (Some(cols), Some(out)) => Some(Trace::new(m, cols, out)),
             _ => None,
         };
-        let mut d = Driver::new(inputs, m, Vec::new(), false, t, progress);
+        let bar = progress.bar("seq", scans, "scans");
+        let mut d = Driver::new(inputs, m, Vec::new(), false, t, bar);
         let mut st = m.initial_state();
         run_sequential(m, &mut st, 0..scans, &mut d);
-        modes.push(("seq", d.total));
-        digests = std::mem::take(&mut d.digests);
-        faults = std::mem::take(&mut d.faults);
-        fault_count = d.fault_count;
-        trace_error = d.trace.and_then(|t| t.error);
-        report_state = Some((st.slots, false));
-    }
-    if let Some(pm) = run_par {
-        let mut st = pm.initial_state();
-        pm.run(pr.pool.as_ref(), &mut st, 0..warm, &mut Inputs(inputs));
-        progress.label = "par";
-        let progress = &mut progress;
+        Pass::of(d, st.slots)
+    });
+    let par = run_par.map(|pm| {
+        {
+            let _phase = progress.phase("par: warm-up scans");
+            let mut st = pm.initial_state();
+            pm.run(pr.pool.as_ref(), &mut st, 0..warm, &mut Inputs(inputs));
+        }
         let m = pm.machine();
         let t = match (&pr.trace_cols, trace.take()) {
             (Some(cols), Some(out)) => Some(Trace::new(m, cols, out)),
             _ => None,
         };
-        let check = pr.seq.is_some();
-        let mut d = Driver::new(inputs, m, std::mem::take(&mut digests), check, t, progress);
+        let check = seq.is_some();
+        let digests = seq.as_mut().map(|s| std::mem::take(&mut s.digests));
+        let bar = progress.bar("par", scans, "scans");
+        let mut d = Driver::new(inputs, m, digests.unwrap_or_default(), check, t, bar);
         let mut st = pm.initial_state();
         pm.run(pr.pool.as_ref(), &mut st, 0..scans, &mut d);
-        modes.push(("par", d.total));
-        first_mismatch = d.first_mismatch;
-        if !check {
-            faults = std::mem::take(&mut d.faults);
-            fault_count = d.fault_count;
-            trace_error = d.trace.and_then(|t| t.error);
-            report_state = Some((st.slots, true));
-        }
-    }
-    progress.finish();
-    let (identical, first_difference) = match (&pr.seq, run_par) {
-        (Some(s), Some(pm)) => match first_mismatch {
+        Pass::of(d, st.slots)
+    });
+    let (identical, first_difference) = match (&pr.seq, run_par, &par) {
+        (Some(s), Some(pm), Some(pass)) => match pass.first_mismatch {
             None => (Some(true), None),
-            Some(k) => (
-                Some(false),
-                Some(self::first_difference(
-                    p,
-                    s,
-                    pm,
-                    pr.pool.as_ref(),
-                    inputs,
-                    k,
-                )),
-            ),
+            Some(k) => {
+                let _phase = progress.phase("replaying both modes to the first difference");
+                (
+                    Some(false),
+                    Some(self::first_difference(
+                        &pr.p,
+                        s,
+                        pm,
+                        pr.pool.as_ref(),
+                        inputs,
+                        k,
+                    )),
+                )
+            }
         },
         _ => (None, None),
     };
-    let (slots, on_par) = report_state.expect("one mode ran");
-    let m: &Machine = if on_par {
-        pr.par.as_ref().expect("par").machine()
-    } else {
-        pr.seq.as_ref().expect("seq")
+    let mut modes = Vec::new();
+    modes.extend(seq.as_ref().map(|s| ("seq", s.total)));
+    modes.extend(par.as_ref().map(|p| ("par", p.total)));
+    // The report (faults, trace, state) comes from the sequential run when it ran.
+    let (pass, m) = match (seq, par) {
+        (Some(s), _) => (s, pr.seq.as_ref().expect("seq")),
+        (None, Some(p)) => (p, pr.par.as_ref().expect("par").machine()),
+        (None, None) => unreachable!("one mode ran"),
     };
+    let explain = if c.explain {
+        pr.par
+            .as_ref()
+            .map(|pm| (pm.explain(&pr.p), pm.explain_json()))
+    } else {
+        None
+    };
+    let extra = (modes, identical, first_difference, explain);
+    let mut pass = pass;
+    let trace_error = pass.trace_error.take();
+    (report(pr, c, m, pass, extra), trace_error)
+}
+
+type Extra = (
+    Vec<(&'static str, Duration)>,
+    Option<bool>,
+    Option<Json>,
+    Option<(String, Json)>,
+);
+
+/// The report of a run from the pass it shows.
+fn report(pr: &Prepared, c: &RunConfig, m: &Machine, pass: Pass, extra: Extra) -> RunReport {
+    let p = &pr.p;
+    let (modes, identical, first_difference, explain) = extra;
+    let slots = &pass.slots;
     let visible: Vec<VarId> = (0..p.vars.len() as u32)
         .map(VarId)
         .filter(|&v| !p.var(v).hidden)
         .collect();
     let state: Vec<(String, VarValue)> = visible
         .iter()
-        .map(|&v| (p.var(v).name.clone(), m.value_in(&slots, v)))
+        .map(|&v| (p.var(v).name.clone(), m.value_in(slots, v)))
         .collect();
     let outputs = visible
         .iter()
         .filter(|&&v| p.var(v).class == VarClass::Output)
-        .map(|&v| (p.var(v).name.clone(), m.value_in(&slots, v)))
+        .map(|&v| (p.var(v).name.clone(), m.value_in(slots, v)))
         .collect();
-    let explain = if c.explain {
-        pr.par.as_ref().map(|pm| (pm.explain(p), pm.explain_json()))
-    } else {
-        None
-    };
-    let report = RunReport {
+    let rung_id = |r: u32| p.rungs[r as usize].id.clone();
+    RunReport {
         program: p.name.clone(),
-        scans,
+        scans: pr.scans,
         cycle_ms: c.cycle_ms,
         threads: c.threads,
         rungs: p.main().rungs.len(),
         outputs,
         state,
-        faults: faults
+        faults: pass
+            .faults
             .into_iter()
-            .map(|(s, r, k)| (s, p.rungs[r as usize].id.clone(), k))
+            .map(|(s, r, k)| (s, rung_id(r), k))
             .collect(),
-        fault_count,
+        fault_count: pass.fault_count,
+        fault_summary: pass
+            .tally
+            .rows
+            .into_iter()
+            .map(|(r, kind, count, first_scan, last_scan)| FaultSummary {
+                rung: rung_id(r),
+                kind,
+                count,
+                first_scan,
+                last_scan,
+            })
+            .collect(),
         modes,
         identical,
         first_difference,
         explain,
-    };
-    (report, trace_error)
+    }
 }

@@ -1,7 +1,8 @@
 //! The per-scan input values of `plc-deps run`: the CSV and JSON inputs files, parsed and
 //! checked against the program, with errors naming the file, line and column.
 
-use crate::app::CliError;
+use super::{count, time_refusal};
+use crate::app::{read_text, CliError, FileRole};
 use crate::model::{parse_time_literal, Program, Type, Value, VarClass, VarId};
 use serde_json::Value as Json;
 use std::path::Path;
@@ -79,7 +80,11 @@ fn parse_value(ty: Type, s: &str) -> Result<Value, String> {
                 Some(ms) if ms >= i32::MIN as i64 && ms <= i32::MAX as i64 => {
                     Value::Time(ms as i32)
                 }
-                _ => {
+                Some(_) => return Err(format!("`{t}` is out of the range of TIME (32-bit ms)")),
+                None if t.contains('#') => {
+                    return Err(format!("`{t}` is {}", time_refusal(t)));
+                }
+                None => {
                     return Err(format!(
                         "`{t}` is not a TIME (milliseconds or a literal like T#1s)"
                     ))
@@ -172,9 +177,9 @@ pub fn parse_inputs_csv(p: &Program, text: &str, file: &str) -> Result<InputTabl
                 line,
                 fields[columns.len()].0,
                 format!(
-                    "{} values in a row, the header has {} columns",
-                    fields.len(),
-                    columns.len()
+                    "{} in a row, the header has {}",
+                    count(fields.len() as u64, "value", "values"),
+                    count(columns.len() as u64, "column", "columns")
                 ),
             ));
         }
@@ -298,12 +303,10 @@ fn describe_json(v: &Json) -> String {
     }
 }
 
-/// Reads an inputs file (JSON if it ends in `.json`, CSV otherwise).
+/// Reads an inputs file (JSON if it ends in `.json`, CSV otherwise; see [`read_text`] for what
+/// is refused before parsing).
 pub fn load_inputs(p: &Program, path: &Path) -> Result<InputTable, CliError> {
-    let text = std::fs::read_to_string(path).map_err(|e| CliError::Io {
-        path: path.display().to_string(),
-        message: e.to_string(),
-    })?;
+    let text = read_text(path, FileRole::Inputs)?;
     let file = path.display().to_string();
     if path
         .extension()

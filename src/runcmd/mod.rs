@@ -3,9 +3,11 @@
 //! every scan's full state was identical. The format of the inputs, the trace and the JSON report
 //! is documented in docs/scan.md.
 //!
-//! Everything is validated before the first scan (program, inputs, trace variables, arguments);
-//! a problem is one [`CliError`] naming the file, line and column (exit code 2), and no output
-//! file is written.
+//! Everything is validated before the first scan (arguments, the `-o` and `--trace` paths,
+//! program, inputs, trace variables); a problem is one [`CliError`] naming the file, line and
+//! column (exit code 2), and no output file is written. Warnings ([`RunWarning`]) are data,
+//! printed by [`run`] on standard error before the first scan; progress ([`Progress`]) is shown
+//! on standard error when it is a terminal.
 //!
 //! With `--mode both` the sequential run and the parallel run are timed separately, one after the
 //! other, each with nothing else in its timed region (inputs, tracing, checking and progress are
@@ -19,15 +21,15 @@ mod compare;
 mod engine;
 mod inputs;
 mod output;
-mod progress;
+pub mod progress;
 mod trace;
 
-pub use engine::RunReport;
+pub use engine::{FaultSummary, RunReport};
 pub use inputs::{load_inputs, parse_inputs_csv, parse_inputs_json, InputTable};
 pub use output::{render_json, render_text, run_json_deterministic};
 pub use progress::Progress;
 
-use crate::app::{write_output, write_output_with, CliError};
+use crate::app::{write_file_as, write_output, CliError, FileRole};
 use crate::exec::ExecConfig;
 use crate::model::parse_time_literal;
 use engine::{execute, prepare};
@@ -55,13 +57,13 @@ pub enum RunFormat {
 /// A validated `plc-deps run` invocation.
 #[derive(Clone, Debug)]
 pub struct RunConfig {
-    /// The program file.
+    /// The program file (`-`: standard input).
     pub input: PathBuf,
     /// Number of scans; `None`: the number of input rows (at least 1), or 1000 without inputs.
     pub scans: Option<u64>,
     /// Input values per scan (CSV or JSON, by extension: `.json` is JSON, anything else CSV).
     pub inputs: Option<PathBuf>,
-    /// Virtual scan period, ms (at least 1).
+    /// Virtual scan period, whole ms (at least 1).
     pub cycle_ms: u32,
     /// Workers of the parallel executor (at least 1).
     pub threads: usize,
@@ -77,7 +79,8 @@ pub struct RunConfig {
     pub loop_cap: u32,
     /// Write the report here instead of standard output.
     pub output: Option<PathBuf>,
-    /// Show a progress bar on standard error (when it is a terminal and the run takes > 1 s).
+    /// Show progress on standard error (default: when it is a terminal); a phase appears once it
+    /// has taken half a second.
     pub progress: bool,
 }
 
@@ -103,8 +106,44 @@ impl RunConfig {
     }
 }
 
+/// Something the user should know about a run that still runs (printed as `warning: …`).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum RunWarning {
+    /// The `--inputs` file has no rows: every input keeps its initial value.
+    #[error(
+        "--inputs {file} has no rows: every input keeps its initial value{}",
+        if *scans_given { String::new() } else {
+            format!("; running {} (give --scans N for more)", count(*scans, "scan", "scans"))
+        }
+    )]
+    NoInputRows {
+        file: String,
+        scans: u64,
+        scans_given: bool,
+    },
+}
+
+/// `n` and the noun in the singular or plural (`1 scan`, `2 scans`).
+pub(crate) fn count(n: u64, one: &str, many: &str) -> String {
+    format!("{n} {}", if n == 1 { one } else { many })
+}
+
+/// Why a TIME text is refused: not a TIME at all, or not a whole number of milliseconds (the
+/// two reasons `parse_time_literal` refuses one; with every digit made 0 the second parses).
+pub(crate) fn time_refusal(literal: &str) -> &'static str {
+    let zeroed: String = literal
+        .chars()
+        .map(|c| if c.is_ascii_digit() { '0' } else { c })
+        .collect();
+    if parse_time_literal(&zeroed).is_some() {
+        "not a whole number of milliseconds (TIME counts milliseconds)"
+    } else {
+        "not a TIME"
+    }
+}
+
 /// Parses `--cycle`: a TIME literal with or without its `T#` prefix (`10ms`, `T#1s`, `1.5s`),
-/// positive and at most 24 days (32-bit milliseconds).
+/// a whole number of milliseconds, positive and at most 24 days (32-bit milliseconds).
 pub fn parse_cycle(s: &str) -> Result<u32, CliError> {
     let t = s.trim();
     let literal = if t.to_ascii_uppercase().starts_with("T#")
@@ -120,32 +159,46 @@ pub fn parse_cycle(s: &str) -> Result<u32, CliError> {
             "--cycle {s}: the cycle must be a positive TIME of at most T#24d (e.g. 10ms, T#1s)"
         ))),
         None => Err(CliError::Usage(format!(
-            "--cycle {s}: not a TIME (e.g. 10ms, T#250ms, 1s)"
+            "--cycle {s}: {} (e.g. 10ms, T#250ms, 1s)",
+            time_refusal(&literal)
         ))),
     }
 }
 
 /// Checks and loads everything a run needs, runs it, and returns the report (the trace file, if
-/// any, is written whole, or not at all).
+/// any, is written whole, or not at all). Quiet: no progress, warnings dropped.
 pub fn run_report(c: &RunConfig) -> Result<RunReport, CliError> {
-    let pr = prepare(c)?;
+    run_report_with(c, &Progress::new(false), &mut |_| {})
+}
+
+/// [`run_report`] with progress, and `warn` called with each warning before the first scan.
+pub fn run_report_with(
+    c: &RunConfig,
+    progress: &Progress,
+    warn: &mut dyn FnMut(&RunWarning),
+) -> Result<RunReport, CliError> {
+    let pr = prepare(c, progress)?;
+    for w in &pr.warnings {
+        warn(w);
+    }
     match &c.trace {
         Some(path) => {
             let mut result = None;
-            write_output_with(Some(path), |w| {
-                let (r, err) = execute(&pr, c, Some(w));
+            write_file_as(path, FileRole::Trace, |w| {
+                let (r, err) = execute(&pr, c, Some(w), progress);
                 result = Some(r);
                 err.map_or(Ok(()), Err)
             })?;
             Ok(result.expect("the run finished"))
         }
-        None => Ok(execute(&pr, c, None).0),
+        None => Ok(execute(&pr, c, None, progress).0),
     }
 }
 
-/// `plc-deps run`.
+/// `plc-deps run`: warnings on standard error, the report on standard output or `-o`.
 pub fn run(c: &RunConfig) -> Result<(), CliError> {
-    let r = run_report(c)?;
+    let progress = Progress::new(c.progress);
+    let r = run_report_with(c, &progress, &mut |w| eprintln!("warning: {w}"))?;
     let out = match c.format {
         RunFormat::Text => render_text(&r),
         RunFormat::Json => render_json(&r, false),
@@ -165,5 +218,14 @@ mod tests {
         assert!(parse_cycle("0ms").is_err());
         assert!(parse_cycle("-5ms").is_err());
         assert!(parse_cycle("T#25d").is_err());
+        assert_eq!(
+            parse_cycle("0.5ms").unwrap_err().to_string(),
+            "--cycle 0.5ms: not a whole number of milliseconds (TIME counts milliseconds) \
+             (e.g. 10ms, T#250ms, 1s)"
+        );
+        assert_eq!(
+            parse_cycle("fast").unwrap_err().to_string(),
+            "--cycle fast: not a TIME (e.g. 10ms, T#250ms, 1s)"
+        );
     }
 }

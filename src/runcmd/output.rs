@@ -2,9 +2,9 @@
 //! and its deterministic form for `analyses/*/run.json`.
 
 use super::engine::RunReport;
-use super::{run_report, RunConfig};
+use super::{count, run_report, RunConfig};
 use crate::app::CliError;
-use crate::exec::{FaultKind, VarValue};
+use crate::exec::VarValue;
 use crate::model::Value;
 use serde_json::{json, Map, Value as Json};
 use std::fmt::Write as _;
@@ -64,6 +64,17 @@ pub fn render_json(r: &RunReport, deterministic: bool) -> String {
             .collect::<Vec<_>>()),
     );
     doc.insert("fault_count".into(), json!(r.fault_count));
+    doc.insert(
+        "fault_summary".into(),
+        json!(r
+            .fault_summary
+            .iter()
+            .map(
+                |f| json!({"rung": f.rung, "kind": f.kind.name(), "count": f.count,
+                "first_scan": f.first_scan, "last_scan": f.last_scan})
+            )
+            .collect::<Vec<_>>()),
+    );
     let mut modes = Map::new();
     for &(name, total) in &r.modes {
         let (ns, per_s, rungs_per_s) = if deterministic || total.is_zero() {
@@ -119,13 +130,54 @@ fn time_text(ns: f64) -> String {
     }
 }
 
+/// Distinct faults listed in the text report (all of them are in the JSON).
+const DISTINCT_FAULTS_SHOWN: usize = 50;
+
+/// The faults of the text report: the total, then one line per distinct fault (rung and kind)
+/// with its count and its first and last scan.
+fn write_faults(s: &mut String, r: &RunReport) {
+    if r.fault_count == 0 {
+        let _ = writeln!(s, "faults: none");
+        return;
+    }
+    let distinct = r.fault_summary.len() as u64;
+    let _ = writeln!(
+        s,
+        "faults: {} ({})",
+        r.fault_count,
+        count(distinct, "distinct fault", "distinct faults")
+    );
+    for f in r.fault_summary.iter().take(DISTINCT_FAULTS_SHOWN) {
+        let when = if f.count == 1 {
+            format!("once, in scan {}", f.first_scan)
+        } else {
+            format!(
+                "{} times, scans {} to {}",
+                f.count, f.first_scan, f.last_scan
+            )
+        };
+        let _ = writeln!(s, "  rung {}: {}, {when}", f.rung, f.kind.name());
+    }
+    if r.fault_summary.len() > DISTINCT_FAULTS_SHOWN {
+        let more = (r.fault_summary.len() - DISTINCT_FAULTS_SHOWN) as u64;
+        let _ = writeln!(
+            s,
+            "  ... and {} more (fault_summary in --format json)",
+            count(more, "distinct fault", "distinct faults")
+        );
+    }
+}
+
 /// The text report.
 pub fn render_text(r: &RunReport) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "program {}: {} scans, cycle {} ms, {} thread(s)",
-        r.program, r.scans, r.cycle_ms, r.threads
+        "program {}: {}, cycle {} ms, {}",
+        r.program,
+        count(r.scans, "scan", "scans"),
+        r.cycle_ms,
+        count(r.threads as u64, "thread", "threads")
     );
     if let Some((text, _)) = &r.explain {
         s.push('\n');
@@ -140,29 +192,7 @@ pub fn render_text(r: &RunReport) -> String {
     for (n, v) in &r.outputs {
         let _ = writeln!(s, "  {n:<width$}  {}", value_text(*v));
     }
-    if r.fault_count == 0 {
-        let _ = writeln!(s, "faults: none");
-    } else {
-        let count = |k: FaultKind| r.faults.iter().filter(|f| f.2 == k).count();
-        let _ = writeln!(
-            s,
-            "faults: {}{} (listed: {} div-by-zero, {} loop-cap)",
-            r.fault_count,
-            if r.fault_count as usize > r.faults.len() {
-                format!(", the first {} listed", r.faults.len())
-            } else {
-                String::new()
-            },
-            count(FaultKind::DivByZero),
-            count(FaultKind::LoopCap)
-        );
-        for (scan, rung, kind) in r.faults.iter().take(20) {
-            let _ = writeln!(s, "  scan {scan}: rung {rung}: {}", kind.name());
-        }
-        if r.faults.len() > 20 {
-            let _ = writeln!(s, "  ... ({} more in --format json)", r.fault_count - 20);
-        }
-    }
+    write_faults(&mut s, r);
     let _ = writeln!(s, "speed:");
     let seq_total = r.modes.iter().find(|m| m.0 == "seq").map(|m| m.1);
     for &(name, total) in &r.modes {

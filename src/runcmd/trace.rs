@@ -23,7 +23,7 @@ pub(super) struct Trace<'a> {
 }
 
 /// Resolves `--trace-vars` (names, or instance fields `T1.Q`) to (header, variable, type)
-/// columns; `None`: every variable but the hidden edge memories, instances as their Q/ET/PT or
+/// columns, each once (in the order first asked for); `None`: every variable but the hidden edge memories, instances as their Q/ET/PT or
 /// Q/CV/PV fields.
 pub(super) fn trace_columns(
     p: &Program,
@@ -122,6 +122,9 @@ pub(super) fn trace_columns(
             }
         }
     }
+    // A column asked for twice (`T1.Q,T1`) is written once, where it was first asked for.
+    let mut seen = std::collections::HashSet::new();
+    cols.retain(|(_, r, _)| seen.insert(*r));
     Ok(cols)
 }
 

@@ -1,4 +1,5 @@
-//! Running the `plc-deps` binary from tests: the checkout root, a run, a scratch file, and the
+//! Running the `plc-deps` binary from tests: the checkout root, a run (with or without standard
+//! input), the one-line error of a failure, scratch files and leftover temporary files, and the
 //! Graphviz check that DOT output renders without warnings.
 
 use std::path::PathBuf;
@@ -16,6 +17,46 @@ pub fn run(args: &[&str]) -> Output {
         .args(args)
         .output()
         .expect("run plc-deps")
+}
+
+/// Runs `plc-deps ARGS` in the checkout with `stdin` as its standard input.
+pub fn run_stdin(args: &[&str], stdin: &[u8]) -> Output {
+    use std::io::Write;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_plc-deps"))
+        .current_dir(root())
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run plc-deps");
+    let mut input = child.stdin.take().unwrap();
+    // A command that fails early may close its standard input before reading it all.
+    let _ = input.write_all(stdin);
+    drop(input);
+    child.wait_with_output().expect("run plc-deps")
+}
+
+/// The single `error: ` line of a failed command with exit code 2 and nothing on stdout.
+pub fn error_line(out: &Output, what: &str) -> String {
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(out.status.code(), Some(2), "{what}: {stderr}");
+    assert!(out.stdout.is_empty(), "{what}: nothing on stdout");
+    assert_eq!(stderr.lines().count(), 1, "{what}: one line: {stderr}");
+    assert!(stderr.starts_with("error: "), "{what}: {stderr}");
+    stderr.trim_end().to_string()
+}
+
+/// The files of a folder whose name contains `.tmp-` (leftover temporary files).
+pub fn temp_files_in(dir: &std::path::Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .map(|d| {
+            d.filter_map(|e| e.ok())
+                .map(|e| e.file_name().to_string_lossy().into_owned())
+                .filter(|n| n.contains(".tmp-"))
+                .collect()
+        })
+        .unwrap_or_default()
 }
 
 /// A path for a scratch file of this test process.
