@@ -6,7 +6,7 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use plc_deps::analysis::analyse;
-use plc_deps::app::{write_report, ReportFormat};
+use plc_deps::cmd::report::{write_report, ReportFormat};
 use plc_deps::model::Program;
 use plc_deps::report::TextOptions;
 use plc_deps::synth::{generate_string, GenConfig};

@@ -4,12 +4,11 @@
 //! program) → [`analysis`] (plain functions from the model to result values) → [`report`]
 //! (text, JSON, DOT). [`graph`] holds the generic graph algorithms the analyses use.
 pub mod analysis;
-pub mod app;
+pub mod cmd;
 pub mod exec;
 pub mod fbd;
 pub mod graph;
 pub mod model;
 pub mod read;
 pub mod report;
-pub mod runcmd;
 pub mod synth;

@@ -1,5 +1,5 @@
 //! The `plc-deps` command line: parses arguments into validated configurations and calls the
-//! library (`plc_deps::app`). Nothing else happens here.
+//! library (`plc_deps::cmd`). Nothing else happens here.
 
 // mimalloc: the analyses allocate many small vectors right after the loader frees a large JSON
 // tree; glibc's malloc spends seconds consolidating that heap at 1M rungs, mimalloc does not.
@@ -8,7 +8,8 @@ static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use plc_deps::analysis::{AnalysisConfig, DependenceListing};
-use plc_deps::app::{self, CliError, ReportConfig, ReportFormat};
+use plc_deps::cmd::report::{ReportConfig, ReportFormat};
+use plc_deps::cmd::{self, CliError};
 use plc_deps::report::{Rows, View};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -223,7 +224,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
                 },
                 output,
             };
-            app::report(&config)
+            cmd::report::report(&config)
         }
         Command::Order {
             file,
@@ -231,17 +232,19 @@ fn run(cli: Cli) -> Result<(), CliError> {
             output,
         } => {
             let format = match format {
-                FormatArg::Text => app::OrderFormat::Text,
-                FormatArg::Json => app::OrderFormat::Json,
-                FormatArg::Dot => app::OrderFormat::Dot,
+                FormatArg::Text => cmd::order::OrderFormat::Text,
+                FormatArg::Json => cmd::order::OrderFormat::Json,
+                FormatArg::Dot => cmd::order::OrderFormat::Dot,
             };
-            app::order(&app::OrderConfig {
+            cmd::order::order(&cmd::order::OrderConfig {
                 input: file,
                 format,
                 output,
             })
         }
-        Command::Schema { output } => app::write_output(output.as_deref(), app::PROGRAM_SCHEMA),
+        Command::Schema { output } => {
+            cmd::io::write_output(output.as_deref(), cmd::schema::PROGRAM_SCHEMA)
+        }
         Command::Gen {
             rungs,
             width,
@@ -254,9 +257,6 @@ fn run(cli: Cli) -> Result<(), CliError> {
             hot_fraction,
             output,
         } => {
-            if width == 0 {
-                return Err(CliError::Usage("--width must be at least 1".into()));
-            }
             let config = plc_deps::synth::GenConfig {
                 rungs,
                 width,
@@ -268,23 +268,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
                 for_body,
                 hot_fraction,
             };
-            if let Err(e) = config.validate() {
-                use plc_deps::synth::ConfigError;
-                return Err(CliError::Usage(match e {
-                    ConfigError::NoRungs => {
-                        "--rungs must be at least 1 (a program has at least one rung)".into()
-                    }
-                    ConfigError::EmptyForBody => "--for-body must be at least 1".into(),
-                    ConfigError::HotFraction(f) => {
-                        format!(
-                            "--hot-fraction must be in (0, 1] (a fraction of the rungs), not {f}"
-                        )
-                    }
-                }));
-            }
-            app::write_output_with(output.as_deref(), |w| {
-                plc_deps::synth::write_program(&config, w)
-            })
+            cmd::gen::gen(&cmd::gen::GenCommand { config, output })
         }
         Command::Run {
             file,
@@ -300,11 +284,11 @@ fn run(cli: Cli) -> Result<(), CliError> {
             loop_cap,
             output,
         } => {
-            use plc_deps::runcmd::{self, RunConfig, RunFormat, RunMode};
+            use plc_deps::cmd::run::{self, RunConfig, RunFormat, RunMode};
             let mut config = RunConfig::new(file);
             config.scans = scans;
             config.inputs = inputs;
-            config.cycle_ms = runcmd::parse_cycle(&cycle)?;
+            config.cycle_ms = run::parse_cycle(&cycle)?;
             if let Some(t) = threads {
                 config.threads = t;
             }
@@ -322,7 +306,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
             config.explain = explain;
             config.loop_cap = loop_cap;
             config.output = output;
-            runcmd::run(&config)
+            run::run(&config)
         }
     }
 }
@@ -331,7 +315,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
 /// the making) and exit with 130, so a stopped command leaves nothing behind.
 fn remove_temp_files_on_signal() {
     let _ = ctrlc::set_handler(|| {
-        app::remove_temp_files();
+        cmd::io::remove_temp_files();
         use std::io::{IsTerminal, Write};
         if std::io::stderr().is_terminal() {
             // Clear a progress line, so the shell's prompt starts on a clean line.

@@ -8,7 +8,7 @@
 //! without `inputs.csv`, `--scans 450 --cycle 10ms`) with the timing fields zeroed
 //! (`runcmd::run_json_deterministic`).
 
-use plc_deps::app::{render_report, ReportFormat};
+use plc_deps::cmd::report::{render_report, ReportFormat};
 use plc_deps::report::View;
 use std::path::{Path, PathBuf};
 
@@ -74,18 +74,26 @@ fn every_worked_example_matches_its_committed_reports() {
             // FBD examples also commit `plc-deps order` (text and JSON).
             check(
                 &dir.join("order.txt"),
-                &plc_deps::app::render_order(&program, &fbd, plc_deps::app::OrderFormat::Text),
+                &plc_deps::cmd::order::render_order(
+                    &program,
+                    &fbd,
+                    plc_deps::cmd::order::OrderFormat::Text,
+                ),
                 &mut failures,
             );
             check(
                 &dir.join("order.json"),
-                &plc_deps::app::render_order(&program, &fbd, plc_deps::app::OrderFormat::Json),
+                &plc_deps::cmd::order::render_order(
+                    &program,
+                    &fbd,
+                    plc_deps::cmd::order::OrderFormat::Json,
+                ),
                 &mut failures,
             );
         }
         {
             runs += 1;
-            let mut c = plc_deps::runcmd::RunConfig::new(dir.join("program.json"));
+            let mut c = plc_deps::cmd::run::RunConfig::new(dir.join("program.json"));
             if dir.join("inputs.csv").is_file() {
                 c.inputs = Some(dir.join("inputs.csv"));
                 c.cycle_ms = 1000;
@@ -96,8 +104,8 @@ fn every_worked_example_matches_its_committed_reports() {
                 c.cycle_ms = 10;
             }
             c.threads = 2;
-            c.mode = plc_deps::runcmd::RunMode::Both;
-            let run = plc_deps::runcmd::run_json_deterministic(&c)
+            c.mode = plc_deps::cmd::run::RunMode::Both;
+            let run = plc_deps::cmd::run::run_json_deterministic(&c)
                 .unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
             let doc: serde_json::Value = serde_json::from_str(&run).expect("run JSON");
             assert_eq!(

@@ -272,7 +272,8 @@ fn worked_examples_with_their_inputs_under_forced_parallel_plans() {
             &std::fs::read_to_string(root.join(dir).join("program.json")).unwrap(),
         )
         .unwrap();
-        let table = plc_deps::runcmd::load_inputs(&p, &root.join(dir).join("inputs.csv")).unwrap();
+        let table =
+            plc_deps::cmd::run::load_inputs(&p, &root.join(dir).join("inputs.csv")).unwrap();
         // The committed inputs, then the rows again: 2 × 20–50 scans.
         let inputs: Vec<Vec<(VarId, Value)>> = table
             .rows

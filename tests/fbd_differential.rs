@@ -527,7 +527,7 @@ fn fbd_worked_examples_under_forced_parallel_plans() {
         // Inputs from the committed table when there is one, 450 scans (past KASKAD 5's toggle
         // at scan 401), on a 10 ms cycle.
         let table = match root.join(dir).join("inputs.csv") {
-            f if f.is_file() => plc_deps::runcmd::load_inputs(&p, &f).unwrap().rows,
+            f if f.is_file() => plc_deps::cmd::run::load_inputs(&p, &f).unwrap().rows,
             _ => Vec::new(),
         };
         let scans = 450u64;

@@ -1,6 +1,6 @@
 //! Zhao & Yan's worked examples (Example A and B), number by number.
 
-use plc_deps::app::{render_report, ReportFormat};
+use plc_deps::cmd::report::{render_report, ReportFormat};
 use plc_deps::read::program_and_fbd_from_json;
 use plc_deps::report::View;
 use serde_json::{json, Value};

@@ -1,6 +1,6 @@
 //! FBD programs get per-network IN/OUT in the report: the union over the network's block rungs.
 
-use plc_deps::app::{render_report, ReportFormat};
+use plc_deps::cmd::report::{render_report, ReportFormat};
 use plc_deps::read::program_and_fbd_from_json;
 use plc_deps::report::View;
 use serde_json::Value;

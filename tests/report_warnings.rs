@@ -1,7 +1,7 @@
 //! Programs the analysis must not get wrong quietly: an endless jump loop (no path to STOP),
 //! a rung nothing reaches, a subroutine nothing calls.
 
-use plc_deps::app::{render_report, ReportFormat};
+use plc_deps::cmd::report::{render_report, ReportFormat};
 use plc_deps::read::program_and_fbd_from_json;
 use plc_deps::report::View;
 use serde_json::{json, Value};

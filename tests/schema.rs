@@ -9,7 +9,8 @@ fn root() -> PathBuf {
 }
 
 fn validator() -> jsonschema::Validator {
-    let schema: serde_json::Value = serde_json::from_str(plc_deps::app::PROGRAM_SCHEMA).unwrap();
+    let schema: serde_json::Value =
+        serde_json::from_str(plc_deps::cmd::schema::PROGRAM_SCHEMA).unwrap();
     jsonschema::draft202012::new(&schema).expect("the schema is valid Draft 2020-12")
 }
 

@@ -2,7 +2,7 @@
 //! checked against the program, with errors naming the file, line and column.
 
 use super::{count, time_refusal};
-use crate::app::{read_text, CliError, FileRole};
+use crate::cmd::io::{read_text, CliError, FileRole};
 use crate::model::{parse_time_literal, Program, Type, Value, VarClass, VarId};
 use serde_json::Value as Json;
 use std::path::Path;

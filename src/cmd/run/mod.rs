@@ -21,15 +21,15 @@ mod compare;
 mod engine;
 mod inputs;
 mod output;
-pub mod progress;
+
 mod trace;
 
+pub use crate::cmd::progress::Progress;
 pub use engine::{FaultSummary, RunReport};
 pub use inputs::{load_inputs, parse_inputs_csv, parse_inputs_json, InputTable};
 pub use output::{render_json, render_text, run_json_deterministic};
-pub use progress::Progress;
 
-use crate::app::{write_file_as, write_output, CliError, FileRole};
+use crate::cmd::io::{write_file_as, write_output, CliError, FileRole};
 use crate::exec::ExecConfig;
 use crate::model::parse_time_literal;
 use engine::{execute, prepare};

@@ -1,25 +1,18 @@
-//! The commands behind the binary, as library functions over validated configurations.
-//!
-//! `main.rs` turns command-line arguments into these configs and calls one function; everything
-//! here returns a [`CliError`] instead of printing or exiting, and writes an output file only when
-//! the whole output is ready (written to a temporary file beside it, then renamed), so a failure
-//! never leaves a half-written file.
+//! The commands' files: reading a program or an input file (standard input for `-`), checking
+//! output paths before any work, and writing outputs atomically.
 //!
 //! Files are read by [`read_text`]: `-` is standard input, a folder, a file over
 //! [`MAX_INPUT_BYTES`], binary data (a NUL byte) or text that is not UTF-8 is refused before
 //! parsing (naming the byte offset), and a UTF-8 byte-order mark is dropped. Output paths can be
-//! checked before any work with [`check_output_path`]. Temporary files in the making are listed
-//! in a registry that [`remove_temp_files`] empties (the binary calls it on SIGINT/SIGTERM), so a
+//! checked before any work with [`check_output_path`]. An output file is written under a
+//! temporary name beside it and renamed into place only when the whole output is ready, so a
+//! failure never leaves a half-written file; temporary files in the making are listed in a
+//! registry that [`remove_temp_files`] empties (the binary calls it on SIGINT/SIGTERM), so a
 //! stopped command leaves none behind. Nothing here prints.
 
-use crate::analysis::{analyse, analyse_with, Analysis, AnalysisConfig, DependenceListing, Listed};
 use crate::fbd::Fbd;
 use crate::model::Program;
 use crate::read::{program_from_json, LoadError};
-use crate::report::{
-    document_with, fbd_parts, render_dot, render_json, render_text, FbdParts, Rows, TextOptions,
-    View, DOT_MAX_RUNGS,
-};
 use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
@@ -355,135 +348,6 @@ pub fn write_file_as(
     drop(files);
     result.map_err(|e| CliError::io(role, path, e))
 }
-
-/// Output format of `report`.
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
-pub enum ReportFormat {
-    Text,
-    Json,
-    Dot,
-}
-
-/// A validated `plc-deps report` invocation.
-#[derive(Clone, Debug)]
-pub struct ReportConfig {
-    pub input: PathBuf,
-    pub format: ReportFormat,
-    /// The levellings text and DOT show.
-    pub view: View,
-    /// Rows per section of the text report.
-    pub rows: Rows,
-    /// Which data dependences are listed.
-    pub analysis: AnalysisConfig,
-    pub output: Option<PathBuf>,
-}
-
-/// Writes the report of `p` (with `fbd`, what its FBD lowering made) in `format`.
-pub fn write_report(
-    p: &Program,
-    a: &Analysis,
-    fbd: Option<&FbdParts>,
-    format: ReportFormat,
-    text: &TextOptions,
-    out: &mut impl std::io::Write,
-) -> std::io::Result<()> {
-    let doc = document_with(p, a, fbd);
-    match format {
-        ReportFormat::Text => render_text(&doc, text, out),
-        ReportFormat::Json => render_json(&doc, out),
-        ReportFormat::Dot => render_dot(&doc, text.view, out),
-    }
-}
-
-/// Renders the report of a loaded program and its FBD bodies with the default options (a
-/// convenience for tests and small programs: the command streams instead).
-pub fn render_report(p: &Program, fbd: &Fbd, format: ReportFormat, view: View) -> String {
-    let a = analyse(p);
-    let parts = fbd_parts(p, fbd);
-    let mut out = Vec::new();
-    let text = TextOptions {
-        view,
-        ..TextOptions::default()
-    };
-    write_report(p, &a, parts.as_ref(), format, &text, &mut out)
-        .expect("writing to memory cannot fail");
-    String::from_utf8(out).expect("reports are UTF-8")
-}
-
-/// `plc-deps report`. Warnings go to standard error as well as into the report.
-pub fn report(c: &ReportConfig) -> Result<(), CliError> {
-    let (p, fbd) = load_program_and_fbd(&c.input)?;
-    let parts = fbd_parts(&p, &fbd);
-    if c.format == ReportFormat::Dot && p.rungs.len() > DOT_MAX_RUNGS {
-        return Err(CliError::Usage(format!(
-            "{}: {} rungs are too many to draw ({} at most): Graphviz cannot lay out a graph this size usefully; use the text or JSON report",
-            c.input.display(),
-            p.rungs.len(),
-            DOT_MAX_RUNGS
-        )));
-    }
-    let a = analyse_with(&p, &c.analysis);
-    for w in &a.warnings {
-        eprintln!(
-            "warning: {}: {}",
-            c.input.display(),
-            crate::report::warning_text(&p, w)
-        );
-    }
-    if a.listed == Listed::Direct && c.analysis.dependences != DependenceListing::Direct {
-        eprintln!(
-            "warning: {}: {} data dependence pairs are more than --max-pairs allows; listing the {} direct ones (they imply the rest; --dependences all lists every pair)",
-            c.input.display(),
-            crate::report::text::thousands(a.counts.total() as usize),
-            crate::report::text::thousands(a.data.len())
-        );
-    }
-    let text = TextOptions {
-        view: c.view,
-        rows: c.rows,
-    };
-    write_output_with(c.output.as_deref(), |w| {
-        let mut w = w;
-        write_report(&p, &a, parts.as_ref(), c.format, &text, &mut w)
-    })
-}
-
-/// Output format of `order`.
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
-pub enum OrderFormat {
-    Text,
-    Json,
-    Dot,
-}
-
-/// A validated `plc-deps order` invocation.
-#[derive(Clone, Debug)]
-pub struct OrderConfig {
-    pub input: PathBuf,
-    pub format: OrderFormat,
-    pub output: Option<PathBuf>,
-}
-
-/// Renders the execution order and fragment trees of a program's FBD networks.
-pub fn render_order(p: &Program, fbd: &crate::fbd::Fbd, format: OrderFormat) -> String {
-    match format {
-        OrderFormat::Text => crate::fbd::render_order_text(p, fbd),
-        OrderFormat::Json => crate::fbd::render_order_json(p, fbd),
-        OrderFormat::Dot => crate::fbd::render_order_dot(p, fbd),
-    }
-}
-
-/// `plc-deps order`: each FBD network's execution order and fragment tree. A cycle of arcs or
-/// a fragment-rule violation is a load error naming the blocks (exit code 2).
-pub fn order(c: &OrderConfig) -> Result<(), CliError> {
-    let (file, text) = read_program_text(&c.input)?;
-    let (p, fbd) = crate::read::program_and_fbd_from_json(&text)
-        .map_err(|error| CliError::Load { file, error })?;
-    write_output(c.output.as_deref(), &render_order(&p, &fbd, c.format))
-}
-
-/// The JSON Schema of the program format (`plc-deps schema`).
-pub const PROGRAM_SCHEMA: &str = include_str!("../schema/program.schema.json");
 
 #[cfg(test)]
 mod tests {

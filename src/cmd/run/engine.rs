@@ -5,11 +5,11 @@
 
 use super::compare::{canonical_slots, digest, first_difference};
 use super::inputs::{load_inputs, InputTable};
-use super::progress::{Bar, Progress};
 use super::trace::{cell, trace_columns, Trace};
 use super::{RunConfig, RunMode, RunWarning};
 use crate::analysis::analyse;
-use crate::app::{check_output_path, load_program, CliError, FileRole};
+use crate::cmd::io::{check_output_path, load_program, CliError, FileRole};
+use crate::cmd::progress::{Bar, Progress};
 use crate::exec::parallel::{run_sequential, ParallelMachine, PlanConfig, ScanDriver};
 use crate::exec::{ExecConfig, Fault, FaultKind, Layout, Machine, VarValue};
 use crate::model::{Program, Type, VarClass, VarId, VarRef};

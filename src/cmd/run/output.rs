@@ -3,7 +3,7 @@
 
 use super::engine::RunReport;
 use super::{count, run_report, RunConfig};
-use crate::app::CliError;
+use crate::cmd::io::CliError;
 use crate::exec::VarValue;
 use crate::model::Value;
 use serde_json::{json, Map, Value as Json};

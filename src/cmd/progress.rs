@@ -13,7 +13,7 @@
 //!   only then updates the shared bar) and drop or [`Bar::finish`] it at the end.
 //!
 //! ```no_run
-//! use plc_deps::runcmd::Progress;
+//! use plc_deps::cmd::progress::Progress;
 //! let progress = Progress::stderr(); // hidden unless standard error is a terminal
 //! let text = {
 //!     let _phase = progress.phase("reading prog.json");

@@ -1,6 +1,6 @@
 //! The `--trace` CSV: the traced columns (`--trace-vars`), the header and one line per scan.
 
-use crate::app::CliError;
+use crate::cmd::io::CliError;
 use crate::exec::Machine;
 use crate::model::{Field, Program, Type, Value, VarId, VarRef};
 use std::io::Write;

@@ -1,0 +1,33 @@
+//! `plc-deps gen`: a synthetic program (shape in docs/gen.md) for benchmarks and tests, written
+//! to standard output or atomically to `-o`.
+
+use super::io::write_output_with;
+use super::CliError;
+use crate::synth::{write_program, ConfigError, GenConfig};
+use std::path::PathBuf;
+
+/// A `plc-deps gen` invocation.
+#[derive(Clone, Debug)]
+pub struct GenCommand {
+    pub config: GenConfig,
+    pub output: Option<PathBuf>,
+}
+
+/// `plc-deps gen`: checks the shape, then writes the program.
+pub fn gen(c: &GenCommand) -> Result<(), CliError> {
+    if c.config.width == 0 {
+        return Err(CliError::Usage("--width must be at least 1".into()));
+    }
+    if let Err(e) = c.config.validate() {
+        return Err(CliError::Usage(match e {
+            ConfigError::NoRungs => {
+                "--rungs must be at least 1 (a program has at least one rung)".into()
+            }
+            ConfigError::EmptyForBody => "--for-body must be at least 1".into(),
+            ConfigError::HotFraction(f) => {
+                format!("--hot-fraction must be in (0, 1] (a fraction of the rungs), not {f}")
+            }
+        }));
+    }
+    write_output_with(c.output.as_deref(), |w| write_program(&c.config, w))
+}

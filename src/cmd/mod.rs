@@ -1,0 +1,17 @@
+//! The commands behind the binary, one module each, as library functions over validated
+//! configurations: [`report`], [`order`], [`run`], [`schema`], [`gen`].
+//!
+//! `main.rs` turns command-line arguments into these configs and calls one function; everything
+//! here returns a [`CliError`] (rendered once, by `main`) instead of printing an error or
+//! exiting. [`io`] reads inputs and writes outputs (atomically, never half-written);
+//! [`progress`] shows long phases on a terminal. This is the top layer: nothing below imports it.
+
+pub mod gen;
+pub mod io;
+pub mod order;
+pub mod progress;
+pub mod report;
+pub mod run;
+pub mod schema;
+
+pub use io::{CliError, FileRole};

@@ -1,0 +1,41 @@
+//! `plc-deps order`: each FBD network's execution order and conditional fragment tree, as
+//! text, JSON or DOT (the renderers are in `crate::report::order`).
+
+use super::io::{read_program_text, write_output};
+use super::CliError;
+use crate::model::Program;
+use std::path::PathBuf;
+
+/// Output format of `order`.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum OrderFormat {
+    Text,
+    Json,
+    Dot,
+}
+
+/// A validated `plc-deps order` invocation.
+#[derive(Clone, Debug)]
+pub struct OrderConfig {
+    pub input: PathBuf,
+    pub format: OrderFormat,
+    pub output: Option<PathBuf>,
+}
+
+/// Renders the execution order and fragment trees of a program's FBD networks.
+pub fn render_order(p: &Program, fbd: &crate::fbd::Fbd, format: OrderFormat) -> String {
+    match format {
+        OrderFormat::Text => crate::fbd::render_order_text(p, fbd),
+        OrderFormat::Json => crate::fbd::render_order_json(p, fbd),
+        OrderFormat::Dot => crate::fbd::render_order_dot(p, fbd),
+    }
+}
+
+/// `plc-deps order`: each FBD network's execution order and fragment tree. A cycle of arcs or
+/// a fragment-rule violation is a load error naming the blocks (exit code 2).
+pub fn order(c: &OrderConfig) -> Result<(), CliError> {
+    let (file, text) = read_program_text(&c.input)?;
+    let (p, fbd) = crate::read::program_and_fbd_from_json(&text)
+        .map_err(|error| CliError::Load { file, error })?;
+    write_output(c.output.as_deref(), &render_order(&p, &fbd, c.format))
+}

@@ -1,0 +1,118 @@
+//! `plc-deps report`: load, analyse, build the report document, render it (text, JSON or DOT)
+//! to standard output or atomically to `-o`. Warnings go to standard error as well as into the
+//! report. Long phases show progress on a terminal.
+
+use super::io::{check_output_path, load_program_and_fbd, write_output_with, FileRole};
+use super::progress::Progress;
+use super::CliError;
+use crate::analysis::{analyse, analyse_with, Analysis, AnalysisConfig, DependenceListing, Listed};
+use crate::fbd::Fbd;
+use crate::model::Program;
+use crate::report::{
+    document_with, fbd_parts, render_dot, render_json, render_text, FbdParts, Rows, TextOptions,
+    View, DOT_MAX_RUNGS,
+};
+use std::path::PathBuf;
+
+/// Output format of `report`.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum ReportFormat {
+    Text,
+    Json,
+    Dot,
+}
+
+/// A validated `plc-deps report` invocation.
+#[derive(Clone, Debug)]
+pub struct ReportConfig {
+    pub input: PathBuf,
+    pub format: ReportFormat,
+    /// The levellings text and DOT show.
+    pub view: View,
+    /// Rows per section of the text report.
+    pub rows: Rows,
+    /// Which data dependences are listed.
+    pub analysis: AnalysisConfig,
+    pub output: Option<PathBuf>,
+}
+
+/// Writes the report of `p` (with `fbd`, what its FBD lowering made) in `format`.
+pub fn write_report(
+    p: &Program,
+    a: &Analysis,
+    fbd: Option<&FbdParts>,
+    format: ReportFormat,
+    text: &TextOptions,
+    out: &mut impl std::io::Write,
+) -> std::io::Result<()> {
+    let doc = document_with(p, a, fbd);
+    match format {
+        ReportFormat::Text => render_text(&doc, text, out),
+        ReportFormat::Json => render_json(&doc, out),
+        ReportFormat::Dot => render_dot(&doc, text.view, out),
+    }
+}
+
+/// Renders the report of a loaded program and its FBD bodies with the default options (a
+/// convenience for tests and small programs: the command streams instead).
+pub fn render_report(p: &Program, fbd: &Fbd, format: ReportFormat, view: View) -> String {
+    let a = analyse(p);
+    let parts = fbd_parts(p, fbd);
+    let mut out = Vec::new();
+    let text = TextOptions {
+        view,
+        ..TextOptions::default()
+    };
+    write_report(p, &a, parts.as_ref(), format, &text, &mut out)
+        .expect("writing to memory cannot fail");
+    String::from_utf8(out).expect("reports are UTF-8")
+}
+
+/// `plc-deps report`. Warnings go to standard error as well as into the report.
+pub fn report(c: &ReportConfig) -> Result<(), CliError> {
+    if let Some(out) = &c.output {
+        check_output_path(out, FileRole::Output)?;
+    }
+    let progress = Progress::stderr();
+    let (p, fbd) = {
+        let _phase = progress.phase("reading the program");
+        load_program_and_fbd(&c.input)?
+    };
+    let parts = fbd_parts(&p, &fbd);
+    if c.format == ReportFormat::Dot && p.rungs.len() > DOT_MAX_RUNGS {
+        return Err(CliError::Usage(format!(
+            "{}: {} rungs are too many to draw ({} at most): Graphviz cannot lay out a graph this size usefully; use the text or JSON report",
+            c.input.display(),
+            p.rungs.len(),
+            DOT_MAX_RUNGS
+        )));
+    }
+    let a = {
+        let _phase = progress.phase("analysing");
+        analyse_with(&p, &c.analysis)
+    };
+    for w in &a.warnings {
+        eprintln!(
+            "warning: {}: {}",
+            c.input.display(),
+            crate::report::warning_text(&p, w)
+        );
+    }
+    if a.listed == Listed::Direct && c.analysis.dependences != DependenceListing::Direct {
+        eprintln!(
+            "warning: {}: {} data dependence pairs are more than --max-pairs allows; listing the {} direct ones (they imply the rest; --dependences all lists every pair)",
+            c.input.display(),
+            crate::report::text::thousands(a.counts.total() as usize),
+            crate::report::text::thousands(a.data.len())
+        );
+    }
+    let text = TextOptions {
+        view: c.view,
+        rows: c.rows,
+    };
+    let _phase = progress.phase("writing the report");
+    write_output_with(c.output.as_deref(), |w| {
+        let mut w = w;
+        write_report(&p, &a, parts.as_ref(), c.format, &text, &mut w)
+    })
+}
