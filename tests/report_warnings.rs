@@ -129,7 +129,9 @@ fn warnings_go_to_stderr_and_the_endless_loop_warning_agrees_with_run() {
     assert!(
         stderr.contains("warning: ")
             && stderr.contains("rungs R2, R3 can never reach the end of the scan")
-            && stderr.contains("leaves the loop after --loop-cap loop-backs with a loop-cap fault"),
+            && stderr.contains(
+                "leaves the loop after --loop-cap loop-backs of each loop-back rung per scan"
+            ),
         "{stderr}"
     );
     let run = std::process::Command::new(bin)

@@ -306,7 +306,7 @@ fn text_report_and_explain() {
     assert!(out.status.success());
     let text = String::from_utf8(out.stdout).unwrap();
     for needle in [
-        "parallel plan: 2 worker(s)",
+        "parallel plan: 2 workers",
         "level   1:",
         "parallel (contiguous",
         "padding:",

@@ -162,7 +162,7 @@ pub fn warning_text(p: &Program, w: &Warning) -> String {
     match w {
         Warning::Unreachable(rs) => format!("{} can never run (no path from the start of the scan reaches it)", ids(rs)),
         Warning::Endless(rs) => format!(
-            "{} can never reach the end of the scan (an endless loop): the post-dominator tree treats the last of them as an exit, and `plc-deps run` leaves the loop after --loop-cap loop-backs with a loop-cap fault",
+            "{} can never reach the end of the scan (an endless loop): the post-dominator tree treats the last of them as an exit, and `plc-deps run` leaves the loop after --loop-cap loop-backs of each loop-back rung per scan (default 100,000) with a loop-cap fault in every scan",
             ids(rs)
         ),
         Warning::Uncalled(pou) => format!("subroutine {} is never called", p.pou(*pou).name),

@@ -10,8 +10,8 @@ impl ParallelMachine {
         let plan = &self.plan;
         let c = &plan.config;
         let mut s = String::new();
-        let _ = writeln!(s, "parallel plan: {} worker(s), {} levels, cost model: barrier {} steps, item {} steps, strategy {:?}, slicing {:?}",
-            plan.threads, plan.levels.len(), c.barrier_cost, c.item_cost, c.strategy, c.slicing);
+        let _ = writeln!(s, "parallel plan: {}, {}, cost model: barrier {} steps, item {} steps, strategy {:?}, slicing {:?}",
+            count(plan.threads, "worker"), count(plan.levels.len(), "level"), c.barrier_cost, c.item_cost, c.strategy, c.slicing);
         let (seq, est) = plan.estimates();
         let _ = writeln!(
             s,
@@ -26,10 +26,10 @@ impl ParallelMachine {
         } else {
             let _ = writeln!(
                 s,
-                "decision: {} phases per scan ({} parallel), {} barriers per scan",
-                plan.phase_count(),
+                "decision: {} per scan ({} parallel), {} per scan",
+                count(plan.phase_count(), "phase"),
                 plan.parallel_phases(),
-                plan.barriers_per_scan()
+                count(plan.barriers_per_scan(), "barrier")
             );
         }
         let shown = plan.levels.len().min(500);
@@ -41,15 +41,21 @@ impl ParallelMachine {
             };
             let _ = write!(
                 s,
-                "  level {:>3}: {:>6} tasks, cost {:>8}, {kind}",
+                "  level {:>3}: {:>6} task{}, cost {:>8}, {kind}",
                 l + 1,
                 lp.tasks,
+                if lp.tasks == 1 { " " } else { "s" },
                 lp.cost
             );
             if let (true, Some(m)) = (lp.parallel, lp.makespan) {
                 let _ = write!(s, " ({}, makespan {m}):", lp.slicing);
                 for (w, (tasks, items, cost)) in lp.workers.iter().enumerate() {
-                    let _ = write!(s, " w{w} {tasks} tasks/{items} items/{cost}");
+                    let _ = write!(
+                        s,
+                        " w{w} {}/{}/{cost}",
+                        count(*tasks, "task"),
+                        count(*items, "item")
+                    );
                     if w + 1 < lp.workers.len() {
                         s.push(',');
                     }
@@ -114,4 +120,10 @@ impl ParallelMachine {
             })).collect::<Vec<_>>(),
         })
     }
+}
+
+/// `1 task`, `2 tasks`.
+fn count(n: impl TryInto<u64>, one: &str) -> String {
+    let n: u64 = n.try_into().unwrap_or(u64::MAX);
+    format!("{n} {one}{}", if n == 1 { "" } else { "s" })
 }
