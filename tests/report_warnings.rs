@@ -6,6 +6,26 @@ use plc_deps::read::program_and_fbd_from_json;
 use plc_deps::report::View;
 use serde_json::{json, Value};
 
+/// R2 and R3 jump to each other forever once R1 lets control in; R4 is after the loop.
+const ENDLESS: &str = r#"{"program": "p",
+            "vars": [{"name": "a", "type": "BOOL", "class": "input"}, {"name": "y", "type": "BOOL"}],
+            "rungs": [
+              {"id": "R1", "ld": [{"contact": "a"}, {"jmp": "L4"}]},
+              {"id": "R2", "label": "L2", "ld": [{"coil": "y"}]},
+              {"id": "R3", "ld": [{"jmp": "L2"}]},
+              {"id": "R4", "label": "L4", "ld": [{"contact": "y"}, {"coil": "y"}]}
+            ]}"#;
+
+/// The warnings of a report, as texts.
+fn warning_texts(j: &Value) -> Vec<&str> {
+    j["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|w| w.as_str().unwrap())
+        .collect()
+}
+
 fn report(text: &str) -> (Value, String) {
     let (p, fbd) = program_and_fbd_from_json(text).unwrap();
     let j = serde_json::from_str(&render_report(&p, &fbd, ReportFormat::Json, View::All)).unwrap();
@@ -15,16 +35,7 @@ fn report(text: &str) -> (Value, String) {
 #[test]
 fn endless_loop_is_a_warning_with_a_sound_tree() {
     // R2 and R3 jump to each other forever once R1 lets control in; R4 is after the loop.
-    let (j, text) = report(
-        r#"{"program": "p",
-            "vars": [{"name": "a", "type": "BOOL", "class": "input"}, {"name": "y", "type": "BOOL"}],
-            "rungs": [
-              {"id": "R1", "ld": [{"contact": "a"}, {"jmp": "L4"}]},
-              {"id": "R2", "label": "L2", "ld": [{"coil": "y"}]},
-              {"id": "R3", "ld": [{"jmp": "L2"}]},
-              {"id": "R4", "label": "L4", "ld": [{"contact": "y"}, {"coil": "y"}]}
-            ]}"#,
-    );
+    let (j, text) = report(ENDLESS);
     let warnings = j["warnings"].as_array().unwrap();
     assert!(
         warnings.iter().any(|w| w
@@ -59,12 +70,7 @@ fn unreachable_rungs_and_uncalled_subroutines_are_reported() {
     );
     assert_eq!(j["schedule"]["unreachable"], json!(["R2"]));
     assert_eq!(j["levels"]["combined"], json!([["R1", "R3"]]));
-    let warnings: Vec<&str> = j["warnings"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|w| w.as_str().unwrap())
-        .collect();
+    let warnings = warning_texts(&j);
     assert_eq!(
         warnings,
         vec![
@@ -86,12 +92,7 @@ fn empty_rungs_and_rungs_without_effect_are_warnings() {
               {"id": "R3", "ld": [{"contact": "a"}, {"coil": "y"}]}
             ]}"#,
     );
-    let warnings: Vec<&str> = j["warnings"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|w| w.as_str().unwrap())
-        .collect();
+    let warnings = warning_texts(&j);
     assert_eq!(
         warnings,
         vec![
@@ -107,18 +108,7 @@ fn empty_rungs_and_rungs_without_effect_are_warnings() {
 #[test]
 fn warnings_go_to_stderr_and_the_endless_loop_warning_agrees_with_run() {
     let file = std::env::temp_dir().join(format!("plc-deps-endless-{}.json", std::process::id()));
-    std::fs::write(
-        &file,
-        r#"{"program": "p",
-            "vars": [{"name": "a", "type": "BOOL", "class": "input"}, {"name": "y", "type": "BOOL"}],
-            "rungs": [
-              {"id": "R1", "ld": [{"contact": "a"}, {"jmp": "L4"}]},
-              {"id": "R2", "label": "L2", "ld": [{"coil": "y"}]},
-              {"id": "R3", "ld": [{"jmp": "L2"}]},
-              {"id": "R4", "label": "L4", "ld": [{"contact": "y"}, {"coil": "y"}]}
-            ]}"#,
-    )
-    .unwrap();
+    std::fs::write(&file, ENDLESS).unwrap();
     let bin = env!("CARGO_BIN_EXE_plc-deps");
     let out = std::process::Command::new(bin)
         .args(["report", file.to_str().unwrap(), "--format", "json"])
