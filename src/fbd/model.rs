@@ -223,7 +223,7 @@ pub enum Op {
 }
 
 /// The op names of the format, as the error message lists them.
-pub const OP_NAMES: &str = "EQ, NE, LT, LE, GT, GE, ADD, SUB, MUL, DIV, MOD, AND, OR, XOR, NOT, MOVE, SEL, MAX, MIN, LIMIT, TON, TOF, TP, CTU, CTD, JMP, RET, TSTART, TSTOP";
+pub use crate::diag::OP_NAMES;
 
 impl Op {
     /// A built-in op by its name (user function blocks are resolved by the reader).

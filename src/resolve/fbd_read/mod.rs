@@ -2,15 +2,15 @@
 //!
 //! Checks every field, the op and its pins, block ids (unique in the POU), arcs (`{"from": ID}`
 //! names a block of the same network and one of its outputs), control arcs and labels, then
-//! plans every network ([`super::plan`]: order, cycles, fragments). Operands stay JSON: they are
+//! plans every network ([`crate::fbd::plan`]: order, cycles, fragments). Operands stay JSON: they are
 //! resolved and typed by the lowering, once per POU (per instance for a function block type).
 //! Errors carry the network id, the block id and the JSON path.
 
 mod input;
 mod util;
 
-use super::model::*;
-use crate::read::{Invalid, LoadError};
+use crate::diag::{Invalid, LoadError};
+use crate::fbd::model::*;
 use serde_json::{Map, Value as Json};
 use std::collections::HashMap;
 
@@ -152,7 +152,7 @@ pub(crate) fn read_body(
     }
     let plans = networks
         .iter()
-        .map(super::plan)
+        .map(crate::fbd::plan)
         .collect::<Result<Vec<_>>>()?;
     Ok(FbdPou {
         name: name.to_owned(),

@@ -6,7 +6,7 @@
 //! may nest but not recurse (the call graph is acyclic, which also keeps every CALL's access
 //! summary finite).
 
-use super::error::{Invalid, LoadError};
+use crate::diag::{Invalid, LoadError};
 use crate::model::*;
 
 pub(crate) fn check(p: &mut Program) -> Result<(), LoadError> {
