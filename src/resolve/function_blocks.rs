@@ -2,13 +2,13 @@
 //! recursion, bodies) and expanding each instance into its own POU.
 
 use super::util::check_name;
+use super::util::FastMap;
 use super::{Builder, FbType, PouDraft, Result};
 use crate::diag::{Invalid, LoadError};
 use crate::fbd::FbdPouKind;
 use crate::model::*;
 use crate::resolve::fbd_read::FbSig;
 use crate::syntax;
-use std::collections::HashMap;
 
 impl<'a> Builder<'a> {
     /// Reads `function_blocks`: names and pins first (bodies may use each other), then each
@@ -60,8 +60,8 @@ impl<'a> Builder<'a> {
         for f in 0..self.fb_types.len() {
             let (vars_mark, inst_mark) = (self.vars.len(), self.instances.len());
             let scratch = PouId(self.locals.len() as u32);
-            self.locals.push(HashMap::new());
-            self.local_instances.push(HashMap::new());
+            self.locals.push(FastMap::default());
+            self.local_instances.push(FastMap::default());
             let (path, prefix) = (
                 self.fb_types[f].path.clone(),
                 format!("{}.", self.fb_types[f].name),
@@ -188,8 +188,8 @@ impl<'a> Builder<'a> {
         draft.var_prefix = format!("{display}.");
         draft.callable = false;
         self.pous.push(draft);
-        self.locals.push(HashMap::new());
-        self.local_instances.push(HashMap::new());
+        self.locals.push(FastMap::default());
+        self.local_instances.push(FastMap::default());
         let mark = self.pending.len();
         let prefix = format!("{display}.");
         for (key, decl, elementary) in [

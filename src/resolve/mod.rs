@@ -36,7 +36,7 @@ use crate::model::*;
 use crate::syntax;
 use fbd_read::FbSig;
 use std::borrow::Cow;
-use std::collections::{HashMap, HashSet};
+use util::{FastMap, FastSet};
 
 use elements::{Place, Scope};
 use lowering::relocate_jumps;
@@ -162,25 +162,25 @@ struct Builder<'a> {
     vars: Vec<Var>,
     /// Display names of all variables, built when the first hidden FBD variable is made (its
     /// name must not clash).
-    var_names: Option<HashSet<String>>,
-    globals: HashMap<String, VarId>,
+    var_names: Option<FastSet<String>>,
+    globals: FastMap<String, VarId>,
     /// Per POU: its local variables.
-    locals: Vec<HashMap<String, VarId>>,
+    locals: Vec<FastMap<String, VarId>>,
     /// Program-wide and per-POU instances of user function blocks (index into `instances`).
-    global_instances: HashMap<String, usize>,
-    local_instances: Vec<HashMap<String, usize>>,
+    global_instances: FastMap<String, usize>,
+    local_instances: Vec<FastMap<String, usize>>,
     instances: Vec<InstanceDraft>,
     /// Instances declared but not yet given their POU.
     pending: Vec<usize>,
     fb_types: Vec<FbType<'a>>,
-    fb_index: HashMap<String, usize>,
+    fb_index: FastMap<String, usize>,
     /// FBD bodies in reading order (function block types first, as they are read first).
     fbd_bodies: Vec<FbdPou>,
     /// TIME variables accumulated by TSTART/TSTOP, with the POU that does it.
-    accumulated: HashMap<VarId, PouId>,
+    accumulated: FastMap<VarId, PouId>,
     pous: Vec<PouDraft<'a>>,
     /// Per POU: label → rung.
-    labels: Vec<HashMap<String, RungId>>,
+    labels: Vec<FastMap<String, RungId>>,
     /// Per rung, during element resolution: number of edge contacts so far.
     edge_count: u32,
 }
@@ -227,8 +227,8 @@ impl<'a> Builder<'a> {
         let name = syn.name.to_string();
         self.pous
             .push(PouDraft::new(name.clone(), PouKind::Main, String::new()));
-        self.locals.push(HashMap::new());
-        self.local_instances.push(HashMap::new());
+        self.locals.push(FastMap::default());
+        self.local_instances.push(FastMap::default());
         self.declare_vars(&syn.vars, "vars", None, false);
         if let Some(body) = &syn.body {
             let r = self.body(0, body, "");
@@ -252,8 +252,8 @@ impl<'a> Builder<'a> {
                 continue;
             }
             let pou = PouId(self.pous.len() as u32);
-            self.locals.push(HashMap::new());
-            self.local_instances.push(HashMap::new());
+            self.locals.push(FastMap::default());
+            self.local_instances.push(FastMap::default());
             self.declare_vars(
                 &sub.vars,
                 &format!("{path}.vars"),
@@ -339,7 +339,7 @@ impl<'a> Builder<'a> {
             });
             start = end;
         }
-        for (pi, pou_heads) in heads.iter().enumerate() {
+        for (pi, pou_heads) in heads.into_iter().enumerate() {
             let pou = PouId(pi as u32);
             if let Some(lowered) = self.pous[pi].lowered.take() {
                 let offset = pous[pi].rungs.start;
@@ -352,7 +352,7 @@ impl<'a> Builder<'a> {
             for (rid, syn, id) in pou_heads {
                 let path = rung_path(&self.pous[pi].path, (rid.0 - pous[pi].rungs.start) as usize);
                 self.edge_count = 0;
-                let scope = Scope { pou, rung_id: id };
+                let scope = Scope { pou, rung_id: &id };
                 let base = At::base(&path);
                 let ld = base.key("ld");
                 let series = match self.series(&syn.ld, &ld, Place::Top, &scope) {
@@ -364,7 +364,7 @@ impl<'a> Builder<'a> {
                     }
                 };
                 rungs.push(Rung {
-                    id: id.clone(),
+                    id,
                     label: syn.label.as_ref().map(|l| l.to_string()),
                     comment: syn.comment.as_ref().map(|c| c.to_string()),
                     pou,
@@ -388,31 +388,47 @@ impl<'a> Builder<'a> {
     /// Pass 1: rung ids (program-wide) and labels (per POU); lowered FBD bodies: ids only, their
     /// labels are resolved. Returns the ladder rungs of each POU and the number of rungs.
     fn rung_heads(&mut self) -> (Vec<Vec<RungHead<'a>>>, u32) {
-        let mut ids: HashMap<Cow<'a, str>, String> = HashMap::new();
+        // Where each id was first used: (POU, index of its rung) for ladder rungs, the path of
+        // lowered rungs; rendered only for a duplicate.
+        let mut ids: FastMap<Cow<'a, str>, (usize, Option<usize>)> = FastMap::default();
+        let first_path = |pous: &[PouDraft], (pou, i): (usize, Option<usize>)| match i {
+            Some(i) => rung_path(&pous[pou].path, i),
+            None => String::new(),
+        };
         let mut heads: Vec<Vec<RungHead<'a>>> = Vec::new();
         let mut next_id = 0u32;
         let mut errors = Vec::new();
-        for pou in &self.pous {
-            let mut labels = HashMap::new();
+        for (pi, pou) in self.pous.iter().enumerate() {
+            let mut labels = FastMap::default();
             let mut pou_heads = Vec::with_capacity(pou.rungs.len());
             if let Some(lowered) = &pou.lowered {
                 for r in lowered {
-                    if let Some(first) = ids.get(r.id.as_str()) {
+                    if let Some(&first) = ids.get(r.id.as_str()) {
+                        let first = match first {
+                            (p, None) => self.pous[p]
+                                .lowered
+                                .iter()
+                                .flatten()
+                                .find(|x| x.id == r.id)
+                                .map(|x| x.path.clone())
+                                .unwrap_or_default(),
+                            other => first_path(&self.pous, other),
+                        };
                         errors.push(LoadError::invalid(
                             Some(&r.id),
                             &r.path,
                             Invalid::DuplicateRung {
                                 id: r.id.clone(),
-                                first: first.clone(),
+                                first,
                             },
                         ));
                     }
-                    ids.insert(Cow::Owned(r.id.clone()), r.path.clone());
+                    ids.insert(Cow::Owned(r.id.clone()), (pi, None));
                     next_id += 1;
                 }
             }
             for (i, r) in pou.rungs.iter().enumerate() {
-                let position = r.origin.line_column(self.text);
+                let position = || r.origin.line_column(self.text);
                 let path = || rung_path(&pou.path, i);
                 let key: Cow<'a, str> = if pou.prefix.is_empty() {
                     match &r.id {
@@ -427,30 +443,40 @@ impl<'a> Builder<'a> {
                     let rung = r.problem_in_rung.then_some(id.as_str());
                     let e =
                         LoadError::invalid(rung, &format!("{}{}", path(), p.at), p.kind.clone());
-                    errors.push(e.at_position(position));
+                    errors.push(e.at_position(position()));
                     continue;
                 }
-                if let Some(first) = ids.get(key.as_ref()) {
+                if let Some(&first) = ids.get(key.as_ref()) {
+                    let first = match first {
+                        (p, None) => self.pous[p]
+                            .lowered
+                            .iter()
+                            .flatten()
+                            .find(|x| x.id == id)
+                            .map(|x| x.path.clone())
+                            .unwrap_or_default(),
+                        other => first_path(&self.pous, other),
+                    };
                     errors.push(
                         LoadError::invalid(
                             Some(&id),
                             &format!("{}.id", path()),
                             Invalid::DuplicateRung {
                                 id: id.clone(),
-                                first: first.clone(),
+                                first,
                             },
                         )
-                        .at_position(position),
+                        .at_position(position()),
                     );
                     continue;
                 }
-                ids.insert(key, path());
+                ids.insert(key, (pi, Some(i)));
                 let rid = RungId(next_id);
                 next_id += 1;
                 if let Some(l) = &r.label {
                     let lp = format!("{}.label", path());
                     if let Err(e) = check_name(l, &lp, Some(&id)) {
-                        errors.push(e.at_position(position));
+                        errors.push(e.at_position(position()));
                     } else if let Some(prev) = labels.insert(l.to_string(), rid) {
                         let first = pou_heads
                             .iter()
@@ -467,7 +493,7 @@ impl<'a> Builder<'a> {
                                     first,
                                 },
                             )
-                            .at_position(position),
+                            .at_position(position()),
                         );
                     }
                 }
