@@ -111,9 +111,9 @@ impl<'a> Builder<'a> {
                 };
                 Element::Contact { var, kind }
             }
-            S::Compare { op, a, b } => {
-                let (a, b) = self.numeric_pair(a, b, at, s, "a comparison", |_| true)?;
-                Element::Compare { op: *op, a, b }
+            S::Compare(c) => {
+                let (a, b) = self.numeric_pair(&c.a, &c.b, at, s, "a comparison", |_| true)?;
+                Element::Compare { op: c.op, a, b }
             }
             S::Or(bs) => Element::Or(self.branches(bs, &key("or"), Place::Or, s)?),
             S::Branch(bs) => {
@@ -136,44 +136,40 @@ impl<'a> Builder<'a> {
                 "a reset coil",
                 Some(Type::Bool),
             )?),
-            S::Timer { kind, instance, pt } => {
-                let instance = self.instance(instance, &key(kind.name()), s, kind.fb())?;
-                let pt = self.operand_of(pt, &key("pt"), s, Type::Time, "a timer's PT")?;
+            S::Timer(t) => {
+                let instance = self.instance(&t.instance, &key(t.kind.name()), s, t.kind.fb())?;
+                let pt = self.operand_of(&t.pt, &key("pt"), s, Type::Time, "a timer's PT")?;
                 Element::Timer {
-                    kind: *kind,
+                    kind: t.kind,
                     instance,
                     pt,
                 }
             }
-            S::Ctu {
-                instance,
-                pv,
-                reset,
-            } => {
-                let instance = self.instance(instance, &key("ctu"), s, FbKind::Ctu)?;
-                let pv = self.operand_of(pv, &key("pv"), s, Type::Int, "a counter's PV")?;
+            S::Counter(c) if !c.down => {
+                let instance = self.instance(&c.instance, &key("ctu"), s, FbKind::Ctu)?;
+                let pv = self.operand_of(&c.pv, &key("pv"), s, Type::Int, "a counter's PV")?;
                 let reset =
-                    self.operand_of(reset, &key("reset"), s, Type::Bool, "a counter's reset")?;
+                    self.operand_of(&c.aux, &key("reset"), s, Type::Bool, "a counter's reset")?;
                 Element::Ctu {
                     instance,
                     pv,
                     reset,
                 }
             }
-            S::Ctd { instance, pv, load } => {
-                let instance = self.instance(instance, &key("ctd"), s, FbKind::Ctd)?;
-                let pv = self.operand_of(pv, &key("pv"), s, Type::Int, "a counter's PV")?;
+            S::Counter(c) => {
+                let instance = self.instance(&c.instance, &key("ctd"), s, FbKind::Ctd)?;
+                let pv = self.operand_of(&c.pv, &key("pv"), s, Type::Int, "a counter's PV")?;
                 let load =
-                    self.operand_of(load, &key("load"), s, Type::Bool, "a counter's load")?;
+                    self.operand_of(&c.aux, &key("load"), s, Type::Bool, "a counter's load")?;
                 Element::Ctd { instance, pv, load }
             }
-            S::Move { from, to } => {
-                let to = self.writable(to, &key("to"), s, "a move", None)?;
+            S::Move(m) => {
+                let to = self.writable(&m.to, &key("to"), s, "a move", None)?;
                 let ty = self.vars[to.index()].ty;
-                let from = self.operand_of(from, &key("move"), s, ty, "a move")?;
+                let from = self.operand_of(&m.from, &key("move"), s, ty, "a move")?;
                 Element::Move { from, to }
             }
-            S::Arith { op, a, b, out } => self.arith(*op, a, b, out, at, s)?,
+            S::Arith(x) => self.arith(x.op, &x.a, &x.b, &x.out, at, s)?,
             S::Jmp(label) => {
                 let target = *self.labels[s.pou.index()]
                     .get(label.as_ref())
@@ -223,7 +219,8 @@ impl<'a> Builder<'a> {
                     pou: PouId(pou as u32),
                 }
             }
-            S::For { var, from, to } => {
+            S::For(f) => {
+                let (var, from, to) = (&f.var, &f.from, &f.to);
                 let fp = key("for");
                 let var = self.writable(var, &fp.key("var"), s, "a FOR", None)?;
                 let ty = self.vars[var.index()].ty;

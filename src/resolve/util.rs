@@ -115,9 +115,14 @@ impl std::hash::Hasher for FxHasher {
     fn write_usize(&mut self, i: usize) {
         self.add(i as u64);
     }
+    /// With a final mix (MurmurHash3's): the multiply leaves the low bits, which pick the
+    /// bucket, poorly mixed, and ids like `R1`…`R1000000` would collide.
     #[inline]
     fn finish(&self) -> u64 {
-        self.hash
+        let mut h = self.hash;
+        h ^= h >> 33;
+        h = h.wrapping_mul(0xff51_afd7_ed55_8ccd);
+        h ^ (h >> 33)
     }
 }
 

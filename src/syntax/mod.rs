@@ -214,7 +214,8 @@ pub struct Rung<'a> {
 pub type Series<'a> = Vec<Element<'a>>;
 
 /// A ladder element as written (IEC 61131-3 8.2: contacts, coils, function block and function
-/// calls; the control elements of S7-200: jumps, return, end, calls, FOR/NEXT).
+/// calls; the control elements of S7-200: jumps, return, end, calls, FOR/NEXT). Kinds with
+/// operands are boxed, so that the common contacts and coils take 32 bytes.
 #[derive(Clone, Debug)]
 pub enum Element<'a> {
     Contact {
@@ -222,11 +223,7 @@ pub enum Element<'a> {
         negated: bool,
         edge: Option<Edge>,
     },
-    Compare {
-        op: CmpOp,
-        a: Scalar<'a>,
-        b: Scalar<'a>,
-    },
+    Compare(Box<Compare<'a>>),
     Or(Vec<Series<'a>>),
     Coil {
         var: Text<'a>,
@@ -235,44 +232,69 @@ pub enum Element<'a> {
     Set(Text<'a>),
     Reset(Text<'a>),
     Branch(Vec<Series<'a>>),
-    Timer {
-        kind: TimerKind,
-        instance: Text<'a>,
-        pt: Scalar<'a>,
-    },
-    Ctu {
-        instance: Text<'a>,
-        pv: Scalar<'a>,
-        reset: Scalar<'a>,
-    },
-    Ctd {
-        instance: Text<'a>,
-        pv: Scalar<'a>,
-        load: Scalar<'a>,
-    },
-    Move {
-        from: Scalar<'a>,
-        to: Text<'a>,
-    },
-    Arith {
-        op: ArithOp,
-        a: Scalar<'a>,
-        b: Scalar<'a>,
-        out: Text<'a>,
-    },
+    Timer(Box<Timer<'a>>),
+    /// CTU (`load` false: `aux` is R) or CTD (`aux` is LD).
+    Counter(Box<Counter<'a>>),
+    Move(Box<Move<'a>>),
+    Arith(Box<Arith<'a>>),
     Jmp(Text<'a>),
     Ret,
     End,
     Call(Text<'a>),
-    For {
-        var: Text<'a>,
-        from: Scalar<'a>,
-        to: Scalar<'a>,
-    },
+    For(Box<For<'a>>),
     Next,
-    /// The element is malformed. `in_element`: `at` is relative to the element (else the
-    /// problem is the series itself, e.g. an element that is not an object).
+    /// The element is malformed (`at` is relative to the element).
     Invalid(Box<Problem>),
+}
+
+/// `{"compare": OP, "a": A, "b": B}`.
+#[derive(Clone, Debug)]
+pub struct Compare<'a> {
+    pub op: CmpOp,
+    pub a: Scalar<'a>,
+    pub b: Scalar<'a>,
+}
+
+/// `{"ton": T, "pt": PT}` and TOF, TP.
+#[derive(Clone, Debug)]
+pub struct Timer<'a> {
+    pub kind: TimerKind,
+    pub instance: Text<'a>,
+    pub pt: Scalar<'a>,
+}
+
+/// `{"ctu": C, "pv": PV, "reset": R}` or `{"ctd": C, "pv": PV, "load": LD}`.
+#[derive(Clone, Debug)]
+pub struct Counter<'a> {
+    pub down: bool,
+    pub instance: Text<'a>,
+    pub pv: Scalar<'a>,
+    /// R of a CTU, LD of a CTD.
+    pub aux: Scalar<'a>,
+}
+
+/// `{"move": FROM, "to": TO}`.
+#[derive(Clone, Debug)]
+pub struct Move<'a> {
+    pub from: Scalar<'a>,
+    pub to: Text<'a>,
+}
+
+/// `{"op": OP, "in": [A, B], "out": OUT}`.
+#[derive(Clone, Debug)]
+pub struct Arith<'a> {
+    pub op: ArithOp,
+    pub a: Scalar<'a>,
+    pub b: Scalar<'a>,
+    pub out: Text<'a>,
+}
+
+/// `{"for": {"var": V, "from": A, "to": B}}`.
+#[derive(Clone, Debug)]
+pub struct For<'a> {
+    pub var: Text<'a>,
+    pub from: Scalar<'a>,
+    pub to: Scalar<'a>,
 }
 
 /// The edge of an edge contact.
@@ -296,7 +318,10 @@ impl<'a> Element<'a> {
     pub fn is_condition(&self) -> bool {
         matches!(
             self,
-            Element::Contact { .. } | Element::Compare { .. } | Element::Or(_)
+            Element::Contact { .. } | Element::Compare(_) | Element::Or(_)
         )
     }
 }
+
+// The common elements stay small: a million-rung program holds millions of them.
+const _: () = assert!(std::mem::size_of::<Element>() <= 32);

@@ -4,7 +4,7 @@
 
 use super::ladder::{arith_op, cmp_op, edge, timer_kind, ForSlots, Slot};
 use crate::diag::Invalid;
-use crate::syntax::{Element, Problem, Scalar, Text};
+use crate::syntax::{self, Element, Problem, Scalar, Text};
 
 type Slots<'de> = Vec<(Text<'de>, Slot<'de>)>;
 
@@ -180,7 +180,7 @@ pub(super) fn classify(slots: Slots<'_>) -> R<Element<'_>> {
             })?;
             let a = f.operand("a")?;
             let b = f.operand("b")?;
-            Element::Compare { op, a, b }
+            Element::Compare(Box::new(syntax::Compare { op, a, b }))
         }
         "or" => Element::Or(f.branches("or")?),
         "branch" => Element::Branch(f.branches("branch")?),
@@ -194,32 +194,38 @@ pub(super) fn classify(slots: Slots<'_>) -> R<Element<'_>> {
         "ton" | "tof" | "tp" => {
             let instance = f.string(key)?;
             let pt = f.operand("pt")?;
-            Element::Timer {
+            Element::Timer(Box::new(syntax::Timer {
                 kind: timer_kind(key).unwrap_or(crate::model::TimerKind::Ton),
                 instance,
                 pt,
-            }
+            }))
         }
         "ctu" => {
             let instance = f.string("ctu")?;
             let pv = f.operand("pv")?;
-            let reset = f.operand("reset")?;
-            Element::Ctu {
+            let aux = f.operand("reset")?;
+            Element::Counter(Box::new(syntax::Counter {
+                down: false,
                 instance,
                 pv,
-                reset,
-            }
+                aux,
+            }))
         }
         "ctd" => {
             let instance = f.string("ctd")?;
             let pv = f.operand("pv")?;
-            let load = f.operand("load")?;
-            Element::Ctd { instance, pv, load }
+            let aux = f.operand("load")?;
+            Element::Counter(Box::new(syntax::Counter {
+                down: true,
+                instance,
+                pv,
+                aux,
+            }))
         }
         "move" => {
             let to = f.string("to")?;
             let from = f.operand("move")?;
-            Element::Move { from, to }
+            Element::Move(Box::new(syntax::Move { from, to }))
         }
         "op" => arith(&mut f)?,
         "jmp" => Element::Jmp(f.string("jmp")?),
@@ -295,7 +301,7 @@ fn arith<'de>(f: &mut Fields<'de>) -> R<Element<'de>> {
             },
         )
     })?;
-    Ok(Element::Arith { op, a, b, out })
+    Ok(Element::Arith(Box::new(syntax::Arith { op, a, b, out })))
 }
 
 fn for_loop<'de>(f: &mut Fields<'de>) -> R<Element<'de>> {
@@ -336,5 +342,5 @@ fn for_loop<'de>(f: &mut Fields<'de>) -> R<Element<'de>> {
     };
     let from = get("from")?;
     let to = get("to")?;
-    Ok(Element::For { var, from, to })
+    Ok(Element::For(Box::new(syntax::For { var, from, to })))
 }
