@@ -70,3 +70,24 @@ fn at_most_twenty_errors_are_reported() {
     let text = format!(r#"{{"program": "p", "rungs": [{}]}}"#, rungs.join(","));
     assert_eq!(err(&text).diagnostics().len(), plc_deps::diag::MAX_ERRORS);
 }
+
+#[test]
+fn instances_map_to_their_function_block_type_and_pou() {
+    let text = r#"{"program": "p",
+      "vars": [{"name": "G1", "type": "GEN"}, {"name": "G2", "type": "GEN"}, {"name": "R", "type": "INT"}],
+      "rungs": [{"id": "R1", "ld": [{"move": "G2.OUT", "to": "R"}]}],
+      "function_blocks": {"GEN": {"inputs": [{"name": "IN", "type": "INT"}],
+        "outputs": [{"name": "OUT", "type": "INT"}],
+        "rungs": [{"id": "B1", "ld": [{"move": "IN", "to": "OUT"}]}]}}}"#;
+    let (p, fbd) = plc_deps::read::program_and_fbd_from_json(text).expect("loads");
+    let names: Vec<(&str, &str)> = fbd
+        .instances
+        .iter()
+        .map(|i| (i.name.as_str(), i.fb.as_str()))
+        .collect();
+    assert_eq!(names, [("G1", "GEN"), ("G2", "GEN")]);
+    for i in &fbd.instances {
+        assert_eq!(p.pou(i.pou).name, i.name);
+        assert_eq!(p.var(i.outputs[0].1).name, format!("{}.OUT", i.name));
+    }
+}

@@ -67,6 +67,21 @@ pub fn resolve(text: &str, syn: &syntax::Program<'_>) -> Result<(Program, Fbd)> 
     b.collect(r);
     b.phase_end()?;
     let mut bodies = std::mem::take(&mut b.fbd_bodies);
+    // Copied: the ladder rungs still read instance members through `b.instances`.
+    let mut instances: Vec<crate::fbd::FbInstance> = b
+        .instances
+        .iter()
+        .filter_map(|i| {
+            Some(crate::fbd::FbInstance {
+                pou: i.pou?,
+                name: i.display.clone(),
+                fb: i.fb.clone(),
+                inputs: i.inputs.clone(),
+                outputs: i.outputs.clone(),
+            })
+        })
+        .collect();
+    instances.sort_by_key(|i| i.pou);
     let program = b.build(syn.name.to_string())?;
     for body in &mut bodies {
         for copy in &mut body.copies {
@@ -86,7 +101,7 @@ pub fn resolve(text: &str, syn: &syntax::Program<'_>) -> Result<(Program, Fbd)> 
         .into_iter()
         .partition(|p| p.kind != FbdPouKind::FunctionBlock);
     pous.extend(fbs);
-    Ok((program, Fbd { pous }))
+    Ok((program, Fbd { pous, instances }))
 }
 
 struct PouDraft<'a> {
