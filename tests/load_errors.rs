@@ -91,3 +91,18 @@ fn instances_map_to_their_function_block_type_and_pou() {
         assert_eq!(p.var(i.outputs[0].1).name, format!("{}.OUT", i.name));
     }
 }
+
+#[test]
+fn every_unpaired_for_and_next_is_reported() {
+    let text = r#"{"program": "p", "vars": [{"name": "i", "type": "INT"}], "rungs": [
+        {"id": "R1", "ld": [{"next": true}]},
+        {"id": "R2", "ld": [{"for": {"var": "i", "from": 1, "to": 2}}]},
+        {"id": "R3", "ld": [{"for": {"var": "i", "from": 1, "to": 2}}]}
+    ]}"#;
+    assert_eq!(
+        err(text).to_string(),
+        "rung R1 at rungs[0].ld[0]: NEXT without a FOR\n\
+         rung R2 at rungs[1].ld[0]: FOR without a NEXT\n\
+         rung R3 at rungs[2].ld[0]: FOR without a NEXT"
+    );
+}
