@@ -60,8 +60,9 @@ fn io_reason(e: &std::io::Error) -> String {
 #[derive(Debug, thiserror::Error)]
 pub enum CliError {
     /// The program file is not a valid program: `file:line:column: message` for syntax
-    /// errors, `file: rung R at path: message` for the others.
-    #[error("{file}{}{error}", if matches!(error, LoadError::Syntax { .. }) { ":" } else { ": " })]
+    /// errors, `file: rung R at path: message` for the others (one line per error when there
+    /// are several, each naming the file).
+    #[error("{}", error.in_file(file))]
     Load { file: String, error: LoadError },
     /// A file could not be read or written: `cannot read the program P: reason`,
     /// `cannot write -o P: reason` (see [`FileRole`]).

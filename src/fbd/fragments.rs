@@ -29,7 +29,7 @@
 //! Cost: O((V + E) log V + E·depth).
 
 use super::model::*;
-use crate::read::{Invalid, LoadError};
+use crate::diag::{Invalid, LoadError};
 use std::cmp::Reverse;
 use std::collections::{BinaryHeap, HashMap};
 

@@ -4,27 +4,27 @@
 //!
 //! - [`model`]: networks, blocks (dense [`BlockId`] indices, sorted by the user's id), arcs, and
 //!   the [`Plan`] of a network (execution order, fragment tree);
-//! - `read`: the FBD parts of the JSON program format (structure, located errors); the program
-//!   reader (`crate::read`) calls it for every `"fbd"` body;
 //! - [`order`]: depth-first topological sort, O(V + E), ties by block id, cycles reported;
-//! - [`fragments`]: the conditional fragment tree, the seed's rule, the regrouped order;
-//! - `lower`: blocks → ladder rungs (one rung per block, `if` blocks for fragments);
+//! - [`fragments`]: the conditional fragment tree, the rule of conditional fragments, the
+//!   regrouped order;
 //! - [`render`]: `plc-deps order` as text, JSON and DOT.
 //!
-//! The format and every lowering rule are in docs/fbd.md.
+//! Only the model and the pure algorithms live here: reading FBD bodies and lowering them into
+//! rungs is the resolver's (`crate::resolve`), which calls [`plan`]. The format and every
+//! lowering rule are in docs/fbd.md.
 
 pub mod fragments;
-pub(crate) mod lower;
 pub mod model;
 pub mod order;
-pub(crate) mod read;
 pub mod render;
 
-pub use lower::ACCUMULATE_PT_MS;
+/// The longest time an accumulation (TSTART/TSTOP) can run (the TIME range): the PT of its
+/// hidden TON.
+pub const ACCUMULATE_PT_MS: i32 = i32::MAX;
 pub use model::*;
 pub use render::{render_order_dot, render_order_json, render_order_text};
 
-use crate::read::{Invalid, LoadError};
+use crate::diag::{Invalid, LoadError};
 
 /// Orders `net` and builds its fragment tree: a cycle of arcs or a block that depends on a
 /// fragment that is neither its own nor an ancestor is an error naming the blocks.

@@ -5,7 +5,7 @@
 //! [`BlockId`] (the index), so "ties by block id" is "ties by index". Operands are kept as the JSON
 //! the file wrote: a function block type's body is read once and resolved once per instance.
 
-use crate::model::{ArithOp, CmpOp, PouId, RungId, TimerKind};
+use crate::model::{ArithOp, CmpOp, PouId, RungId, TimerKind, VarId};
 use std::ops::Range;
 
 use crate::model::index_type;
@@ -24,6 +24,22 @@ index_type!(
 #[derive(Clone, Debug, Default)]
 pub struct Fbd {
     pub pous: Vec<FbdPou>,
+    /// Every instance of a user function block type (with an FBD or a ladder body), in the order
+    /// their POUs follow the subroutines: the instance → type map.
+    pub instances: Vec<FbInstance>,
+}
+
+/// One instance of a user function block type and the POU it was expanded into.
+#[derive(Clone, Debug)]
+pub struct FbInstance {
+    /// `G1`, `SBR:G1` (declared in a subroutine), `G1.INNER` (nested): also its POU's name.
+    pub name: String,
+    /// The function block type.
+    pub fb: String,
+    pub pou: PouId,
+    /// Its input and output variables by pin name, in declaration order.
+    pub inputs: Vec<(String, VarId)>,
+    pub outputs: Vec<(String, VarId)>,
 }
 
 /// What an FBD body belongs to.
@@ -223,7 +239,7 @@ pub enum Op {
 }
 
 /// The op names of the format, as the error message lists them.
-pub const OP_NAMES: &str = "EQ, NE, LT, LE, GT, GE, ADD, SUB, MUL, DIV, MOD, AND, OR, XOR, NOT, MOVE, SEL, MAX, MIN, LIMIT, TON, TOF, TP, CTU, CTD, JMP, RET, TSTART, TSTOP";
+pub use crate::diag::OP_NAMES;
 
 impl Op {
     /// A built-in op by its name (user function blocks are resolved by the reader).

@@ -1,45 +1,194 @@
-//! The JSON program format → [`Program`]: field checks, name resolution, type checks.
+//! The JSON program format (docs/format.md, docs/fbd.md) → [`syntax::Program`], streamed.
 //!
-//! Follows docs/format.md (normative). Every object is checked for unknown fields; every name is
-//! resolved (subroutine locals first, then program variables); every operand is typed. Errors name
-//! the rung id and the JSON path. Structural rules checked here: unique rung ids (program-wide)
-//! and labels (per POU), FOR/NEXT nesting, no jump into a FOR body, no recursive calls, `end` in
-//! the main program only, no writes to inputs or to instance fields.
+//! Two passes over the text, neither of which builds a `serde_json::Value` tree of the document:
+//! the first reads the program object with serde, keeping each part it will look at later as a
+//! `&RawValue` (a slice of the text: syntax is fully checked here, so a syntax error is always
+//! reported first, with line and column); the second reads each part — variables, each rung, each
+//! element — with streaming visitors into the syntax types. The byte offset of a raw part in the
+//! text is its [`Origin`]. Every visitor accepts any JSON value: a value of the wrong shape or an
+//! unknown field becomes a [`Problem`] at the node (a path suffix relative to it), so reading
+//! never stops at the first one. A UTF-8 byte-order mark at the start of the text is skipped.
+//!
+//! Deliberately not here: names, types, ids, labels and every other rule that needs more than
+//! one node (`crate::resolve`).
 
-mod elements;
-mod function_blocks;
-mod lowering;
-mod names;
-mod util;
-mod vars;
+mod element;
+mod ladder;
+mod scalar;
 
-use super::error::{Invalid, LoadError};
-use crate::fbd::read::FbSig;
-use crate::fbd::{Fbd, FbdPou, FbdPouKind};
-use crate::model::*;
-use serde_json::{Map, Value as Json};
-use std::borrow::Cow;
-use std::collections::{HashMap, HashSet};
+use crate::diag::{Invalid, LoadError};
+use crate::syntax::{self, Body, Origin, Problem, Scalar, Text, Var, VarClass};
+use ladder::RungDe;
+use scalar::{parse_raw, AnyScalar, Container};
+use serde::de::{IgnoredAny, MapAccess, SeqAccess};
+use serde_json::value::RawValue;
 
-use elements::{Place, Scope};
-use lowering::relocate_jumps;
-pub(crate) use util::kind_of;
-use util::{array, check_keys, check_name, object, required, rung_path, string};
-
-type Result<T> = std::result::Result<T, LoadError>;
-
-/// Builds a program from an already parsed JSON document.
-pub fn program_from_value(doc: &Json) -> Result<Program> {
-    program_and_fbd_from_value(doc).map(|(p, _)| p)
+/// Reads a program file's text into the surface syntax. Only syntax errors fail here.
+pub fn parse(text: &str) -> Result<syntax::Program<'_>, LoadError> {
+    let body = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let top: Container = serde_json::from_str(body).map_err(|e| syntax_error(body, &e))?;
+    let mut r = Reader {
+        base: text.as_ptr() as usize,
+        program: syntax::Program::default(),
+    };
+    match top {
+        Container::Object(entries) => r.program_object(entries)?,
+        Container::Array(_) => r.problem("", shape("a JSON object (the program)", &Scalar::Array)),
+        Container::Other(s) => r.problem("", shape("a JSON object (the program)", &s)),
+    }
+    Ok(r.program)
 }
 
-/// Builds a program from an already parsed JSON document, and returns with it its FBD bodies
-/// (networks, orders, fragment trees, and where each copy was lowered to).
-pub fn program_and_fbd_from_value(doc: &Json) -> Result<(Program, Fbd)> {
-    let top = object(doc, "", None, "the program")?;
-    check_keys(
-        top,
-        &[
+fn syntax_error(text: &str, e: &serde_json::Error) -> LoadError {
+    let message = e.to_string();
+    let message = match message.rfind(" at line ") {
+        Some(i) => message[..i].to_owned(),
+        None => message,
+    };
+    if text.trim().is_empty() {
+        return LoadError::Syntax {
+            line: e.line().max(1),
+            column: 1,
+            message: "the file is empty (expected a JSON object, the program)".into(),
+        };
+    }
+    LoadError::Syntax {
+        line: e.line(),
+        // serde_json counts the column of an error at the start of a line as 0.
+        column: e.column().max(1),
+        message,
+    }
+}
+
+fn shape(expected: &'static str, found: &Scalar) -> Invalid {
+    Invalid::Shape {
+        expected,
+        found: found.kind(),
+    }
+}
+
+fn join(path: &str, key: &str) -> String {
+    if path.is_empty() {
+        key.to_owned()
+    } else {
+        format!("{path}.{key}")
+    }
+}
+
+/// A raw part, parsed. The first pass checked its syntax, so an error is a visitor's bug: it is
+/// still reported as located data, never a panic.
+fn raw<'de, T: serde::Deserialize<'de>>(v: &'de RawValue, path: &str) -> Result<T, LoadError> {
+    parse_raw(v).map_err(|e| {
+        LoadError::invalid(
+            None,
+            path,
+            Invalid::Shape {
+                expected: "a value the reader can read",
+                found: e.to_string(),
+            },
+        )
+    })
+}
+
+/// Drains an array, for "found an array" messages.
+pub(super) fn scalar_of_seq<'de, A: SeqAccess<'de>>(mut seq: A) -> Result<Scalar<'de>, A::Error> {
+    while seq.next_element::<IgnoredAny>()?.is_some() {}
+    Ok(Scalar::Array)
+}
+
+/// Drains an object, for "found an object" messages.
+pub(super) fn scalar_of_map<'de, A: MapAccess<'de>>(mut map: A) -> Result<Scalar<'de>, A::Error> {
+    while map.next_entry::<IgnoredAny, IgnoredAny>()?.is_some() {}
+    Ok(Scalar::Object)
+}
+
+type Entries<'de> = Vec<(Text<'de>, &'de RawValue)>;
+
+struct Reader<'de> {
+    /// Address of the start of the whole text (offsets are relative to it).
+    base: usize,
+    program: syntax::Program<'de>,
+}
+
+fn get<'e, 'de>(entries: &'e Entries<'de>, key: &str) -> Option<&'de RawValue> {
+    entries.iter().find(|(k, _)| k == key).map(|(_, v)| *v)
+}
+
+impl<'de> Reader<'de> {
+    fn origin(&self, v: &RawValue) -> Origin {
+        Origin::at(v.get().as_ptr() as usize - self.base)
+    }
+
+    fn problem(&mut self, path: &str, kind: Invalid) {
+        self.program.problems.push(Problem {
+            at: path.to_owned(),
+            kind,
+        });
+    }
+
+    fn unknown_keys(&mut self, e: &Entries, allowed: &[&str], what: &'static str, path: &str) {
+        if let Some((k, _)) = e.iter().find(|(k, _)| !allowed.contains(&k.as_ref())) {
+            let kind = Invalid::UnknownField {
+                field: k.to_string(),
+                what,
+                allowed: allowed.join(", "),
+            };
+            self.problem(&join(path, k), kind);
+        }
+    }
+
+    /// A string field; `None` (with a problem) when it is not a string.
+    fn string(&mut self, v: &'de RawValue, path: &str) -> Result<Option<Text<'de>>, LoadError> {
+        match raw::<AnyScalar>(v, path)?.0 {
+            Scalar::Str(s) => Ok(Some(s)),
+            other => {
+                self.problem(path, shape("a string", &other));
+                Ok(None)
+            }
+        }
+    }
+
+    /// An object of raw parts; `None` (with a problem) when it is not an object.
+    fn object(
+        &mut self,
+        v: &'de RawValue,
+        path: &str,
+        expected: &'static str,
+    ) -> Result<Option<Entries<'de>>, LoadError> {
+        match raw::<Container>(v, path)? {
+            Container::Object(e) => Ok(Some(e)),
+            Container::Array(_) => {
+                self.problem(path, shape(expected, &Scalar::Array));
+                Ok(None)
+            }
+            Container::Other(s) => {
+                self.problem(path, shape(expected, &s));
+                Ok(None)
+            }
+        }
+    }
+
+    /// An array of raw parts; `None` (with a problem) when it is not an array.
+    fn array(
+        &mut self,
+        v: &'de RawValue,
+        path: &str,
+    ) -> Result<Option<Vec<&'de RawValue>>, LoadError> {
+        match raw::<Container>(v, path)? {
+            Container::Array(a) => Ok(Some(a)),
+            Container::Object(_) => {
+                self.problem(path, shape("an array", &Scalar::Object));
+                Ok(None)
+            }
+            Container::Other(s) => {
+                self.problem(path, shape("an array", &s));
+                Ok(None)
+            }
+        }
+    }
+
+    fn program_object(&mut self, top: Entries<'de>) -> Result<(), LoadError> {
+        const KEYS: &[&str] = &[
             "program",
             "vars",
             "rungs",
@@ -47,401 +196,263 @@ pub fn program_and_fbd_from_value(doc: &Json) -> Result<(Program, Fbd)> {
             "subroutines",
             "function_blocks",
             "comment",
-        ],
-        "the program",
-        "",
-        None,
-    )?;
-    let name = string(
-        required(top, "program", "the program", "", None)?,
-        "program",
-        None,
-    )?
-    .to_owned();
-    let mut b = Builder::default();
-    if let Some(fbs) = top.get("function_blocks") {
-        b.function_block_types(fbs)?;
-    }
-    b.pous
-        .push(PouDraft::new(name.clone(), PouKind::Main, String::new()));
-    b.locals.push(HashMap::new());
-    b.local_instances.push(HashMap::new());
-    if let Some(vars) = top.get("vars") {
-        b.declare_vars(vars, "vars", None, false)?;
-    }
-    b.body(0, top, "", "the program")?;
-    if let Some(subs) = top.get("subroutines") {
-        let subs = object(subs, "subroutines", None, "the subroutines")?;
-        for (sname, body) in subs {
-            let path = format!("subroutines.{sname}");
-            check_name(sname, &path, None)?;
-            if sname == &name {
-                return Err(LoadError::invalid(
-                    None,
-                    &path,
-                    Invalid::Misplaced {
-                        what: "a subroutine named like the program",
-                        place: "(rename one of them)",
-                    },
-                ));
+        ];
+        self.unknown_keys(&top, KEYS, "the program", "");
+        match get(&top, "program") {
+            None => self.problem(
+                "",
+                Invalid::MissingField {
+                    field: "program",
+                    what: "the program",
+                },
+            ),
+            Some(v) => {
+                if let Some(s) = self.string(v, "program")? {
+                    self.program.name = s;
+                }
             }
-            let body = object(body, &path, None, "a subroutine")?;
-            check_keys(
-                body,
+        }
+        if let Some(c) = get(&top, "comment") {
+            self.program.comment = match raw::<AnyScalar>(c, "comment")?.0 {
+                Scalar::Str(s) => Some(s),
+                _ => None,
+            };
+        }
+        if let Some(fbs) = get(&top, "function_blocks") {
+            self.function_blocks(fbs)?;
+        }
+        if let Some(vars) = get(&top, "vars") {
+            self.program.vars = self.vars(vars, "vars")?;
+        }
+        self.program.body = self.body(&top, "", "the program")?;
+        if let Some(subs) = get(&top, "subroutines") {
+            self.subroutines(subs)?;
+        }
+        Ok(())
+    }
+
+    fn subroutines(&mut self, subs: &'de RawValue) -> Result<(), LoadError> {
+        let Some(entries) = self.object(subs, "subroutines", "an object of subroutines")? else {
+            return Ok(());
+        };
+        for (name, v) in entries {
+            let path = format!("subroutines.{name}");
+            let origin = self.origin(v);
+            let Some(o) = self.object(v, &path, "an object (a subroutine)")? else {
+                continue;
+            };
+            self.unknown_keys(
+                &o,
                 &["vars", "rungs", "fbd", "comment"],
                 "a subroutine",
                 &path,
-                None,
-            )?;
-            let pou = PouId(b.pous.len() as u32);
-            b.locals.push(HashMap::new());
-            b.local_instances.push(HashMap::new());
-            if let Some(vars) = body.get("vars") {
-                b.declare_vars(
-                    vars,
-                    &format!("{path}.vars"),
-                    Some((pou, format!("{sname}:"))),
-                    false,
-                )?;
-            }
-            b.pous.push(PouDraft::new(
-                sname.clone(),
-                PouKind::Subroutine,
-                format!("{path}.rungs"),
-            ));
-            b.body(pou.index(), body, &path, "a subroutine")?;
+            );
+            let vars = match get(&o, "vars") {
+                Some(vs) => self.vars(vs, &format!("{path}.vars"))?,
+                None => Vec::new(),
+            };
+            let body = self.body(&o, &path, "a subroutine")?;
+            self.program.subroutines.push(syntax::Subroutine {
+                origin,
+                name,
+                vars,
+                body,
+            });
         }
+        Ok(())
     }
-    // Instances of user function blocks: one POU each, after the subroutines.
-    let top_level: Vec<usize> = std::mem::take(&mut b.pending);
-    for i in top_level {
-        b.expand(i, &mut Vec::new())?;
-    }
-    b.lower_fbd()?;
-    let mut bodies = std::mem::take(&mut b.fbd_bodies);
-    let program = b.build(name)?;
-    for body in &mut bodies {
-        for copy in &mut body.copies {
-            let start = program.pou(copy.pou).rungs.start;
-            for r in &mut copy.networks {
-                *r = r.start + start..r.end + start;
-            }
-            for blocks in &mut copy.blocks {
-                for r in blocks.iter_mut() {
-                    r.0 += start;
-                }
-            }
-        }
-    }
-    // Main program and subroutines first, then function block types (each in file order).
-    let (mut pous, fbs): (Vec<FbdPou>, Vec<FbdPou>) = bodies
-        .into_iter()
-        .partition(|p| p.kind != FbdPouKind::FunctionBlock);
-    pous.extend(fbs);
-    Ok((program, Fbd { pous }))
-}
 
-struct PouDraft<'a> {
-    name: String,
-    kind: PouKind,
-    /// JSON path of the rung array ("" means top-level `rungs`).
-    path: String,
-    rungs: Vec<&'a Json>,
-    /// Index into `Builder::fbd_bodies` when the body is FBD.
-    fbd: Option<usize>,
-    /// An FBD body after lowering (jump targets relative to the POU).
-    lowered: Option<Vec<Rung>>,
-    /// Prepended to rung ids (`G1:` for the POU of function block instance `G1`).
-    prefix: String,
-    /// Prepended to the names of hidden variables of an FBD body (`SBR:`, `G1.`).
-    var_prefix: String,
-    /// False for instances of function blocks: `call` cannot name them.
-    callable: bool,
-}
-
-impl<'a> PouDraft<'a> {
-    fn new(name: String, kind: PouKind, path: String) -> PouDraft<'a> {
-        let var_prefix = if kind == PouKind::Main {
-            String::new()
-        } else {
-            format!("{name}:")
+    fn function_blocks(&mut self, fbs: &'de RawValue) -> Result<(), LoadError> {
+        let Some(entries) = self.object(fbs, "function_blocks", "an object")? else {
+            return Ok(());
         };
-        PouDraft {
-            name,
-            kind,
-            path,
-            rungs: Vec::new(),
-            fbd: None,
-            lowered: None,
-            prefix: String::new(),
-            var_prefix,
-            callable: true,
+        for (name, v) in entries {
+            let path = format!("function_blocks.{name}");
+            let origin = self.origin(v);
+            let Some(o) = self.object(v, &path, "an object")? else {
+                continue;
+            };
+            self.unknown_keys(
+                &o,
+                &["vars", "inputs", "outputs", "fbd", "rungs", "comment"],
+                "a function block",
+                &path,
+            );
+            let decl = |r: &mut Self, key: &str| match get(&o, key) {
+                Some(vs) => r.vars(vs, &format!("{path}.{key}")),
+                None => Ok(Vec::new()),
+            };
+            let inputs = decl(self, "inputs")?;
+            let outputs = decl(self, "outputs")?;
+            let vars = decl(self, "vars")?;
+            let body = if get(&o, "rungs").is_none() && get(&o, "fbd").is_none() {
+                self.problem(
+                    &path,
+                    Invalid::MissingField {
+                        field: "fbd` or `rungs",
+                        what: "a function block",
+                    },
+                );
+                None
+            } else {
+                self.body(&o, &path, "a function block")?
+            };
+            self.program.function_blocks.push(syntax::FunctionBlock {
+                origin,
+                name,
+                inputs,
+                outputs,
+                vars,
+                body,
+            });
         }
+        Ok(())
     }
-}
 
-/// A user function block type: its declarations and body.
-struct FbType<'a> {
-    name: String,
-    path: String,
-    inputs: Option<&'a Json>,
-    outputs: Option<&'a Json>,
-    vars: Option<&'a Json>,
-    /// The ladder body, or the index of the FBD body in `Builder::fbd_bodies`.
-    rungs: Option<&'a [Json]>,
-    fbd: Option<usize>,
-    sig: FbSig,
-}
-
-/// An instance of a user function block type.
-struct InstanceDraft {
-    /// `G1`, `SBR:G1`, `G1.INNER`.
-    display: String,
-    fb: String,
-    /// JSON path of its declaration.
-    path: String,
-    pou: Option<PouId>,
-    inputs: Vec<(String, VarId)>,
-    outputs: Vec<(String, VarId)>,
-}
-
-#[derive(Default)]
-struct Builder<'a> {
-    vars: Vec<Var>,
-    /// Display names of all variables, built when the first hidden FBD variable is made (its
-    /// name must not clash).
-    var_names: Option<HashSet<String>>,
-    globals: HashMap<String, VarId>,
-    /// Per POU: its local variables.
-    locals: Vec<HashMap<String, VarId>>,
-    /// Program-wide and per-POU instances of user function blocks (index into `instances`).
-    global_instances: HashMap<String, usize>,
-    local_instances: Vec<HashMap<String, usize>>,
-    instances: Vec<InstanceDraft>,
-    /// Instances declared but not yet given their POU.
-    pending: Vec<usize>,
-    fb_types: Vec<FbType<'a>>,
-    fb_index: HashMap<String, usize>,
-    /// FBD bodies in reading order (function block types first, as they are read first).
-    fbd_bodies: Vec<FbdPou>,
-    /// TIME variables accumulated by TSTART/TSTOP, with the POU that does it.
-    accumulated: HashMap<VarId, PouId>,
-    pous: Vec<PouDraft<'a>>,
-    /// Per POU: label → rung.
-    labels: Vec<HashMap<String, RungId>>,
-    /// Per rung, during element resolution: number of edge contacts so far.
-    edge_count: u32,
-}
-
-/// A ladder rung after pass 1: its id, its JSON object and its (prefixed) id text.
-type RungHead<'a> = (RungId, &'a Map<String, Json>, String);
-
-impl<'a> Builder<'a> {
-    /// The body of POU `pou`: `rungs` (ladder) or `fbd`.
+    /// The body of a POU: `rungs` or `fbd`, not both.
     fn body(
         &mut self,
-        pou: usize,
-        o: &'a Map<String, Json>,
+        o: &Entries<'de>,
         path: &str,
         what: &'static str,
-    ) -> Result<()> {
-        let at = |k: &str| {
-            if path.is_empty() {
-                k.to_owned()
-            } else {
-                format!("{path}.{k}")
+    ) -> Result<Option<Body<'de>>, LoadError> {
+        match (get(o, "rungs"), get(o, "fbd")) {
+            (Some(_), Some(_)) => {
+                self.problem(
+                    &join(path, "fbd"),
+                    Invalid::Misplaced {
+                        what: "`fbd`",
+                        place: "together with `rungs` (a body is one of them)",
+                    },
+                );
+                Ok(None)
             }
-        };
-        match (o.get("rungs"), o.get("fbd")) {
-            (Some(_), Some(_)) => Err(LoadError::invalid(
-                None,
-                &at("fbd"),
-                Invalid::Misplaced {
-                    what: "`fbd`",
-                    place: "together with `rungs` (a body is one of them)",
-                },
-            )),
-            (None, Some(j)) => {
-                let kind = if pou == 0 {
-                    FbdPouKind::Main
-                } else {
-                    FbdPouKind::Subroutine
+            (None, Some(f)) => Ok(Some(Body::Fbd(syntax::FbdBody {
+                origin: self.origin(f),
+                text: f.get(),
+            }))),
+            (Some(r), None) => {
+                let rp = join(path, "rungs");
+                let Some(items) = self.array(r, &rp)? else {
+                    return Ok(None);
                 };
-                let index = &self.fb_index;
-                let types = &self.fb_types;
-                let sig = |n: &str| index.get(n).map(|&i| types[i].sig.clone());
-                let body =
-                    crate::fbd::read::read_body(j, &at("fbd"), &self.pous[pou].name, kind, &sig)?;
-                self.pous[pou].fbd = Some(self.fbd_bodies.len());
-                self.fbd_bodies.push(body);
-                Ok(())
+                let mut rungs = Vec::with_capacity(items.len());
+                for item in items {
+                    let RungDe(mut rung) = raw(item, &rp)?;
+                    rung.origin = self.origin(item);
+                    rungs.push(rung);
+                }
+                Ok(Some(Body::Rungs(rungs)))
             }
-            (r, None) => {
-                let r = r.ok_or_else(|| {
-                    LoadError::invalid(
-                        None,
-                        path,
-                        Invalid::MissingField {
-                            field: "rungs",
-                            what,
-                        },
-                    )
-                })?;
-                self.pous[pou].rungs = array(r, &at("rungs"), None)?.iter().collect();
-                Ok(())
+            (None, None) => {
+                self.problem(
+                    path,
+                    Invalid::MissingField {
+                        field: "rungs",
+                        what,
+                    },
+                );
+                Ok(None)
             }
         }
     }
 
-    fn build(mut self, name: String) -> Result<Program> {
-        if self.pous[0].fbd.is_none() && self.pous[0].rungs.is_empty() {
-            return Err(LoadError::invalid(None, "rungs", Invalid::Empty));
-        }
-        // Pass 1: rung ids and labels (lowered FBD bodies: ids only, their labels are resolved).
-        let mut ids: HashMap<Cow<'_, str>, String> = HashMap::new();
-        let mut heads: Vec<Vec<RungHead<'a>>> = Vec::new();
-        let mut next_id = 0u32;
-        for pou in &self.pous {
-            let mut labels = HashMap::new();
-            let mut pou_heads = Vec::new();
-            if let Some(lowered) = &pou.lowered {
-                for r in lowered {
-                    if let Some(first) = ids.get(r.id.as_str()) {
-                        return Err(LoadError::invalid(
-                            Some(&r.id),
-                            &r.path,
-                            Invalid::DuplicateRung {
-                                id: r.id.clone(),
-                                first: first.clone(),
-                            },
-                        ));
-                    }
-                    ids.insert(Cow::Borrowed(r.id.as_str()), r.path.clone());
-                    next_id += 1;
-                }
-            }
-            for (i, r) in pou.rungs.iter().enumerate() {
-                let path = rung_path(&pou.path, i);
-                let o = object(r, &path, None, "a rung")?;
-                check_keys(o, &["id", "label", "comment", "ld"], "a rung", &path, None)?;
-                let id = string(
-                    required(o, "id", "a rung", &path, None)?,
-                    &format!("{path}.id"),
-                    None,
-                )?;
-                if id.is_empty() || id.chars().any(|c| c.is_whitespace() || c == '"') {
-                    return Err(LoadError::invalid(
-                        None,
-                        &format!("{path}.id"),
-                        Invalid::Shape {
-                            expected: "a rung id without spaces or quotes",
-                            found: format!("\"{id}\""),
-                        },
-                    ));
-                }
-                let key: Cow<'_, str> = if pou.prefix.is_empty() {
-                    Cow::Borrowed(id)
-                } else {
-                    Cow::Owned(format!("{}{id}", pou.prefix))
-                };
-                let id = key.to_string();
-                if let Some(first) = ids.get(key.as_ref()) {
-                    return Err(LoadError::invalid(
-                        Some(&id),
-                        &format!("{path}.id"),
-                        Invalid::DuplicateRung {
-                            id: id.clone(),
-                            first: first.clone(),
-                        },
-                    ));
-                }
-                ids.insert(key, path.clone());
-                let rid = RungId(next_id);
-                next_id += 1;
-                if let Some(l) = o.get("label") {
-                    let lp = format!("{path}.label");
-                    let l = string(l, &lp, Some(&id))?;
-                    check_name(l, &lp, Some(&id))?;
-                    if let Some(prev) = labels.insert(l.to_owned(), rid) {
-                        let first = pou_heads
-                            .iter()
-                            .find(|h: &&RungHead| h.0 == prev)
-                            .map(|h| h.2.clone())
-                            .unwrap_or_default();
-                        return Err(LoadError::invalid(
-                            Some(&id),
-                            &lp,
-                            Invalid::DuplicateLabel {
-                                label: l.into(),
-                                pou: pou.name.clone(),
-                                first,
-                            },
-                        ));
-                    }
-                }
-                pou_heads.push((rid, o, id));
-            }
-            heads.push(pou_heads);
-            self.labels.push(labels);
-        }
-        // Pass 2: elements.
-        let mut rungs = Vec::with_capacity(next_id as usize);
-        let mut pous = Vec::with_capacity(self.pous.len());
-        let mut start = 0u32;
-        for pou in &self.pous {
-            let end =
-                start + pou.rungs.len() as u32 + pou.lowered.as_ref().map_or(0, |l| l.len() as u32);
-            pous.push(Pou {
-                name: pou.name.clone(),
-                kind: pou.kind,
-                rungs: start..end,
-            });
-            start = end;
-        }
-        for (pi, pou_heads) in heads.iter().enumerate() {
-            let pou = PouId(pi as u32);
-            if let Some(lowered) = self.pous[pi].lowered.take() {
-                let offset = pous[pi].rungs.start;
-                for mut r in lowered {
-                    r.pou = pou;
-                    relocate_jumps(&mut r.series, offset);
-                    rungs.push(r);
-                }
-            }
-            for (rid, o, id) in pou_heads {
-                let path = rung_path(&self.pous[pi].path, (rid.0 - pous[pi].rungs.start) as usize);
-                let ldp = format!("{path}.ld");
-                let ld = array(
-                    required(o, "ld", "a rung", &path, Some(id))?,
-                    &ldp,
-                    Some(id),
-                )?;
-                self.edge_count = 0;
-                let scope = Scope { pou, rung_id: id };
-                let series = self.series(ld, &ldp, Place::Top, &scope)?;
-                let label = o.get("label").and_then(Json::as_str).map(str::to_owned);
-                let comment = match o.get("comment") {
-                    None => None,
-                    Some(c) => Some(string(c, &format!("{path}.comment"), Some(id))?.to_owned()),
-                };
-                rungs.push(Rung {
-                    id: id.clone(),
-                    label,
-                    comment,
-                    pou,
-                    series,
-                    path,
-                    network: None,
-                });
-            }
-        }
-        let mut program = Program {
-            name,
-            vars: self.vars,
-            pous,
-            rungs,
+    fn vars(&mut self, v: &'de RawValue, path: &str) -> Result<Vec<Var<'de>>, LoadError> {
+        let Some(items) = self.array(v, path)? else {
+            return Ok(Vec::new());
         };
-        super::structure::check(&mut program)?;
-        Ok(program)
+        let mut out = Vec::with_capacity(items.len());
+        for item in items {
+            out.push(self.var(item, path)?);
+        }
+        Ok(out)
+    }
+
+    fn var(&mut self, v: &'de RawValue, path: &str) -> Result<Var<'de>, LoadError> {
+        let mut var = Var {
+            origin: self.origin(v),
+            name: Text::Borrowed(""),
+            ty: Text::Borrowed(""),
+            class: VarClass::Default,
+            init: None,
+            problem: None,
+        };
+        let entries = match raw::<Container>(v, path)? {
+            Container::Object(e) => e,
+            Container::Array(_) => {
+                var.problem = Some(Problem::new(
+                    "",
+                    shape("an object (a variable)", &Scalar::Array),
+                ));
+                return Ok(var);
+            }
+            Container::Other(s) => {
+                var.problem = Some(Problem::new("", shape("an object (a variable)", &s)));
+                return Ok(var);
+            }
+        };
+        let allowed = ["name", "type", "class", "init", "comment"];
+        let mut problem = entries
+            .iter()
+            .find(|(k, _)| !allowed.contains(&k.as_ref()))
+            .map(|(k, _)| {
+                Problem::new(
+                    format!(".{k}"),
+                    Invalid::UnknownField {
+                        field: k.to_string(),
+                        what: "a variable",
+                        allowed: allowed.join(", "),
+                    },
+                )
+            });
+        let text = |key: &'static str, problem: &mut Option<Box<Problem>>| {
+            let found = match get(&entries, key) {
+                None => {
+                    let kind = Invalid::MissingField {
+                        field: key,
+                        what: "a variable",
+                    };
+                    problem.get_or_insert_with(|| Problem::new("", kind));
+                    return Ok(Text::Borrowed(""));
+                }
+                Some(j) => raw::<AnyScalar>(j, path)?.0,
+            };
+            match found {
+                Scalar::Str(s) => Ok(s),
+                other => {
+                    problem.get_or_insert_with(|| {
+                        Problem::new(format!(".{key}"), shape("a string", &other))
+                    });
+                    Ok(Text::Borrowed(""))
+                }
+            }
+        };
+        var.name = text("name", &mut problem)?;
+        var.ty = text("type", &mut problem)?;
+        if let Some(c) = get(&entries, "class") {
+            var.class = match raw::<AnyScalar>(c, path)?.0 {
+                Scalar::Str(s) if s == "input" => VarClass::Input,
+                Scalar::Str(s) if s == "output" => VarClass::Output,
+                Scalar::Str(s) if s == "memory" => VarClass::Memory,
+                Scalar::Str(s) => {
+                    let kind = Invalid::Shape {
+                        expected: "\"input\", \"output\" or \"memory\"",
+                        found: format!("\"{s}\""),
+                    };
+                    problem.get_or_insert_with(|| Problem::new(".class", kind));
+                    VarClass::Default
+                }
+                other => {
+                    problem
+                        .get_or_insert_with(|| Problem::new(".class", shape("a string", &other)));
+                    VarClass::Default
+                }
+            };
+        }
+        if let Some(i) = get(&entries, "init") {
+            var.init = Some(raw::<AnyScalar>(i, path)?.0);
+        }
+        var.problem = problem;
+        Ok(var)
     }
 }

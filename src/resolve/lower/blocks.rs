@@ -2,10 +2,10 @@
 //! timers, counters, jumps, TSTART/TSTOP) as ladder elements. docs/fbd.md gives each rung.
 
 use super::{condition, contact, steps, var_op, Cx, Net, Result, Val, ACCUMULATE_PT_MS};
+use crate::diag::{Invalid, LoadError};
 use crate::fbd::model::*;
 use crate::model::*;
-use crate::read::operand;
-use crate::read::{Invalid, LoadError};
+use crate::resolve::operand;
 use std::collections::HashMap;
 
 impl Cx<'_> {

@@ -2,10 +2,10 @@
 //! on use, the variables an output is written to, hidden temps for outputs arcs read.
 
 use super::{var_op, Cx, Net, Result, Val};
+use crate::diag::{Invalid, LoadError};
 use crate::fbd::model::*;
 use crate::model::*;
-use crate::read::operand::{self, Untyped};
-use crate::read::{Invalid, LoadError};
+use crate::resolve::operand::{self, Untyped};
 
 impl Cx<'_> {
     pub(super) fn val(
@@ -28,7 +28,7 @@ impl Cx<'_> {
             }
             Input::Operand(j) => {
                 let env = &*self.env;
-                let u = operand::parse(j, &|n| env.lookup(n))
+                let u = operand::parse_json(j, &|n| env.lookup(n))
                     .map_err(|k| LoadError::fbd(&nx.net.id, block, path, k))?;
                 let text = match j {
                     serde_json::Value::String(s) => s.clone(),

@@ -1,24 +1,27 @@
 //! User function blocks: reading the `function_blocks` types (signatures, declarations, no
 //! recursion, bodies) and expanding each instance into its own POU.
 
-use super::util::{array, check_keys, check_name, object};
+use super::util::check_name;
+use super::util::FastMap;
 use super::{Builder, FbType, PouDraft, Result};
-use crate::fbd::read::FbSig;
+use crate::diag::{Invalid, LoadError};
 use crate::fbd::FbdPouKind;
 use crate::model::*;
-use crate::read::error::{Invalid, LoadError};
-use serde_json::Value as Json;
-use std::collections::HashMap;
+use crate::resolve::fbd_read::FbSig;
+use crate::syntax;
 
 impl<'a> Builder<'a> {
     /// Reads `function_blocks`: names and pins first (bodies may use each other), then each
     /// type's declarations (checked on a scratch scope), its body and, for FBD, its networks.
-    pub(super) fn function_block_types(&mut self, fbs: &'a Json) -> Result<()> {
-        let fbs = object(fbs, "function_blocks", None, "the function blocks")?;
-        for (fname, body) in fbs {
-            let path = format!("function_blocks.{fname}");
-            check_name(fname, &path, None)?;
-            if Type::parse(fname).is_some() {
+    pub(super) fn function_block_types(
+        &mut self,
+        fbs: &'a [syntax::FunctionBlock<'a>],
+    ) -> Result<()> {
+        let mut bodies = Vec::with_capacity(fbs.len());
+        for fb in fbs {
+            let path = format!("function_blocks.{}", fb.name);
+            check_name(&fb.name, &path, None)?;
+            if Type::parse(&fb.name).is_some() {
                 return Err(LoadError::invalid(
                     None,
                     &path,
@@ -28,45 +31,37 @@ impl<'a> Builder<'a> {
                     },
                 ));
             }
-            let o = object(body, &path, None, "a function block")?;
-            check_keys(
-                o,
-                &["vars", "inputs", "outputs", "fbd", "rungs", "comment"],
-                "a function block",
-                &path,
-                None,
-            )?;
-            let names = |k: &str| -> Vec<String> {
-                o.get(k)
-                    .and_then(Json::as_array)
-                    .into_iter()
-                    .flatten()
-                    .filter_map(|v| v.get("name").and_then(Json::as_str).map(str::to_owned))
+            let names = |vs: &[syntax::Var]| -> Vec<String> {
+                vs.iter()
+                    .filter(|v| v.problem.is_none())
+                    .map(|v| v.name.to_string())
                     .collect()
             };
             let sig = FbSig {
-                inputs: names("inputs"),
-                outputs: names("outputs"),
+                inputs: names(&fb.inputs),
+                outputs: names(&fb.outputs),
             };
-            self.fb_index.insert(fname.clone(), self.fb_types.len());
+            self.fb_index
+                .insert(fb.name.to_string(), self.fb_types.len());
             self.fb_types.push(FbType {
-                name: fname.clone(),
+                name: fb.name.to_string(),
                 path,
-                inputs: o.get("inputs"),
-                outputs: o.get("outputs"),
-                vars: o.get("vars"),
+                inputs: &fb.inputs,
+                outputs: &fb.outputs,
+                vars: &fb.vars,
                 rungs: None,
                 fbd: None,
                 sig,
             });
+            bodies.push(&fb.body);
         }
         // Declarations on a scratch scope (rolled back), and which types each type instantiates.
         let mut uses: Vec<Vec<(usize, String)>> = Vec::new();
         for f in 0..self.fb_types.len() {
             let (vars_mark, inst_mark) = (self.vars.len(), self.instances.len());
             let scratch = PouId(self.locals.len() as u32);
-            self.locals.push(HashMap::new());
-            self.local_instances.push(HashMap::new());
+            self.locals.push(FastMap::default());
+            self.local_instances.push(FastMap::default());
             let (path, prefix) = (
                 self.fb_types[f].path.clone(),
                 format!("{}.", self.fb_types[f].name),
@@ -77,19 +72,17 @@ impl<'a> Builder<'a> {
                 ("vars", self.fb_types[f].vars, false),
             ];
             for (key, decl, elementary) in decls {
-                if let Some(d) = decl {
-                    self.declare_vars(
-                        d,
-                        &format!("{path}.{key}"),
-                        Some((scratch, prefix.clone())),
-                        elementary,
-                    )?;
-                }
+                self.declare_vars(
+                    decl,
+                    &format!("{path}.{key}"),
+                    Some((scratch, prefix.clone())),
+                    elementary,
+                );
             }
             uses.push(
                 self.instances[inst_mark..]
                     .iter()
-                    .map(|i| (self.fb_index[&i.fb], i.path.clone()))
+                    .filter_map(|i| Some((*self.fb_index.get(&i.fb)?, i.path.clone())))
                     .collect(),
             );
             self.vars.truncate(vars_mark);
@@ -131,48 +124,17 @@ impl<'a> Builder<'a> {
             }
         }
         // Bodies.
-        for f in 0..self.fb_types.len() {
+        for (f, body) in bodies.into_iter().enumerate() {
             let path = self.fb_types[f].path.clone();
-            let o = fbs[&self.fb_types[f].name]
-                .as_object()
-                .expect("checked above");
-            match (o.get("rungs"), o.get("fbd")) {
-                (Some(_), Some(_)) => {
-                    return Err(LoadError::invalid(
-                        None,
-                        &format!("{path}.fbd"),
-                        Invalid::Misplaced {
-                            what: "`fbd`",
-                            place: "together with `rungs` (a body is one of them)",
-                        },
-                    ))
-                }
-                (Some(r), None) => {
-                    self.fb_types[f].rungs = Some(array(r, &format!("{path}.rungs"), None)?)
-                }
-                (None, Some(j)) => {
-                    let index = &self.fb_index;
-                    let types = &self.fb_types;
-                    let sig = |n: &str| index.get(n).map(|&i| types[i].sig.clone());
-                    let body = crate::fbd::read::read_body(
-                        j,
-                        &format!("{path}.fbd"),
-                        &self.fb_types[f].name,
-                        FbdPouKind::FunctionBlock,
-                        &sig,
-                    )?;
+            match body {
+                None => {} // reported by the reader
+                Some(syntax::Body::Rungs(r)) => self.fb_types[f].rungs = Some(r),
+                Some(syntax::Body::Fbd(j)) => {
+                    let name = self.fb_types[f].name.clone();
+                    let body =
+                        self.read_fbd(j, &format!("{path}.fbd"), &name, FbdPouKind::FunctionBlock)?;
                     self.fb_types[f].fbd = Some(self.fbd_bodies.len());
                     self.fbd_bodies.push(body);
-                }
-                (None, None) => {
-                    return Err(LoadError::invalid(
-                        None,
-                        &path,
-                        Invalid::MissingField {
-                            field: "fbd` or `rungs",
-                            what: "a function block",
-                        },
-                    ))
                 }
             }
         }
@@ -182,7 +144,9 @@ impl<'a> Builder<'a> {
     /// Gives instance `idx` its POU: the function block's variables declared as `G1.name`, its
     /// body (ladder rungs now, FBD lowered later), nested instances right after it.
     pub(super) fn expand(&mut self, idx: usize, stack: &mut Vec<String>) -> Result<()> {
-        let f = self.fb_index[&self.instances[idx].fb];
+        let Some(&f) = self.fb_index.get(&self.instances[idx].fb) else {
+            return Ok(()); // declared only for user types (checked when declared)
+        };
         let (display, ipath) = (
             self.instances[idx].display.clone(),
             self.instances[idx].path.clone(),
@@ -218,14 +182,14 @@ impl<'a> Builder<'a> {
             PouKind::Subroutine,
             format!("{path}.rungs"),
         );
-        draft.rungs = rungs.map(|r| r.iter().collect()).unwrap_or_default();
+        draft.rungs = rungs.unwrap_or_default();
         draft.fbd = fbd;
         draft.prefix = format!("{display}:");
         draft.var_prefix = format!("{display}.");
         draft.callable = false;
         self.pous.push(draft);
-        self.locals.push(HashMap::new());
-        self.local_instances.push(HashMap::new());
+        self.locals.push(FastMap::default());
+        self.local_instances.push(FastMap::default());
         let mark = self.pending.len();
         let prefix = format!("{display}.");
         for (key, decl, elementary) in [
@@ -233,20 +197,19 @@ impl<'a> Builder<'a> {
             ("outputs", outputs, true),
             ("vars", vars, false),
         ] {
-            if let Some(d) = decl {
-                self.declare_vars(
-                    d,
-                    &format!("{path}.{key}"),
-                    Some((pou, prefix.clone())),
-                    elementary,
-                )?;
-            }
+            self.declare_vars(
+                decl,
+                &format!("{path}.{key}"),
+                Some((pou, prefix.clone())),
+                elementary,
+            );
         }
+        self.phase_end()?;
         let locals = &self.locals[pou.index()];
         let pins = |names: &[String]| {
             names
                 .iter()
-                .map(|n| (n.clone(), locals[n]))
+                .filter_map(|n| Some((n.clone(), *locals.get(n)?)))
                 .collect::<Vec<_>>()
         };
         let (ins, outs) = (

@@ -26,17 +26,16 @@ mod instances;
 mod pins;
 mod time;
 
-use super::model::*;
+use crate::diag::{Invalid, LoadError};
+use crate::fbd::model::*;
 use crate::model::*;
-use crate::read::operand::Untyped;
-use crate::read::{Invalid, LoadError};
+use crate::resolve::operand::Untyped;
 use std::collections::HashMap;
 use std::ops::Range;
 
 type Result<T> = std::result::Result<T, LoadError>;
 
-/// The longest time an accumulation can run (the TIME range): the PT of its hidden TON.
-pub const ACCUMULATE_PT_MS: i32 = i32::MAX;
+pub use crate::fbd::ACCUMULATE_PT_MS;
 
 /// What the lowering needs from the reader: names resolved in the POU's scope, new hidden
 /// variables.

@@ -2,9 +2,9 @@
 //! fields), and calls of user function block instances (each its own POU).
 
 use super::{field_op, steps, var_op, Cx, InstanceRef, Net, Result};
+use crate::diag::{Invalid, LoadError};
 use crate::fbd::model::*;
 use crate::model::*;
-use crate::read::{Invalid, LoadError};
 
 impl Cx<'_> {
     pub(super) fn builtin_instance(&self, nx: &Net, b: BlockId, fb: FbKind) -> Result<VarId> {

@@ -6,13 +6,30 @@
 //! may nest but not recurse (the call graph is acyclic, which also keeps every CALL's access
 //! summary finite).
 
-use super::error::{Invalid, LoadError};
+use crate::diag::{Invalid, LoadError};
 use crate::model::*;
 
+/// Every structural problem, in program order (loops and jumps per rung, then the first
+/// recursive call chain); jumps are checked only when the loops pair.
 pub(crate) fn check(p: &mut Program) -> Result<(), LoadError> {
-    pair_loops(p)?;
-    check_jumps(p)?;
-    check_recursion(p)
+    let mut errors = Vec::new();
+    pair_loops(p, &mut errors);
+    if errors.is_empty() {
+        check_jumps(p, &mut errors);
+    }
+    if let Err(e) = check_recursion(p) {
+        errors.push(e);
+    }
+    let diagnostics = errors
+        .into_iter()
+        .filter_map(|e| e.into_diagnostics().ok())
+        .flatten()
+        .take(crate::diag::MAX_ERRORS)
+        .collect();
+    match LoadError::from_diagnostics(diagnostics) {
+        None => Ok(()),
+        Some(e) => Err(e),
+    }
 }
 
 fn err(p: &Program, r: RungId, suffix: &str, kind: Invalid) -> LoadError {
@@ -24,16 +41,17 @@ fn last_top(rung: &Rung) -> Option<&Element> {
     rung.series.last()
 }
 
-fn pair_loops(p: &mut Program) -> Result<(), LoadError> {
+fn pair_loops(p: &mut Program, errors: &mut Vec<LoadError>) {
     for pou in 0..p.pous.len() {
         let mut stack: Vec<RungId> = Vec::new();
         for r in p.pou_rungs(PouId(pou as u32)) {
             match last_top(p.rung(r)) {
                 Some(Element::For { .. }) => stack.push(r),
                 Some(Element::Next { .. }) => {
-                    let head = stack
-                        .pop()
-                        .ok_or_else(|| err(p, r, ".ld[0]", Invalid::NextWithoutFor))?;
+                    let Some(head) = stack.pop() else {
+                        errors.push(err(p, r, ".ld[0]", Invalid::NextWithoutFor));
+                        continue;
+                    };
                     if let Some(Element::Next { head: h }) = p.rungs[r.index()].series.last_mut() {
                         *h = head;
                     }
@@ -45,21 +63,21 @@ fn pair_loops(p: &mut Program) -> Result<(), LoadError> {
                 _ => {}
             }
         }
-        if let Some(head) = stack.pop() {
+        // Unclosed heads, in program order.
+        for head in stack {
             let n = p.rung(head).series.len();
-            return Err(err(
+            errors.push(err(
                 p,
                 head,
-                &format!(".ld[{}]", n - 1),
+                &format!(".ld[{}]", n.saturating_sub(1)),
                 Invalid::ForWithoutNext,
             ));
         }
     }
-    Ok(())
 }
 
 /// Jumps may leave loop bodies but not enter them.
-fn check_jumps(p: &Program) -> Result<(), LoadError> {
+fn check_jumps(p: &Program, errors: &mut Vec<LoadError>) {
     // body[r] = innermost FOR head whose body (head+1 ..= next) holds r.
     let mut body: Vec<Option<RungId>> = vec![None; p.rungs.len()];
     for r in p.rung_ids() {
@@ -95,7 +113,7 @@ fn check_jumps(p: &Program) -> Result<(), LoadError> {
             }
         });
         if let Some((label, head)) = bad {
-            return Err(err(
+            errors.push(err(
                 p,
                 r,
                 ".ld",
@@ -106,7 +124,6 @@ fn check_jumps(p: &Program) -> Result<(), LoadError> {
             ));
         }
     }
-    Ok(())
 }
 
 fn check_recursion(p: &Program) -> Result<(), LoadError> {

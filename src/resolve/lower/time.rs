@@ -2,9 +2,9 @@
 //! accumulates, one rung per variable at the start of the POU.
 
 use super::{contact, field_op, var_op, Acc, Cx, Result, ACCUMULATE_PT_MS};
+use crate::diag::{Invalid, LoadError};
 use crate::fbd::model::*;
 use crate::model::*;
-use crate::read::{Invalid, LoadError};
 
 impl Cx<'_> {
     /// The update rungs of every TIME variable this body accumulates, first use first.
@@ -94,7 +94,7 @@ impl Cx<'_> {
             Some(Input::Operand(j)) => {
                 return Err(e(Invalid::Shape {
                     expected: "a TIME variable",
-                    found: crate::fbd::read::kind_of(j),
+                    found: crate::resolve::util::kind_of(j),
                 }))
             }
             _ => {

@@ -1,11 +1,11 @@
-//! FBD bodies in the program reader: lowering each body into ladder rungs (once per POU that
+//! FBD bodies in the resolver: lowering each body into ladder rungs (once per POU that
 //! runs it), through the lowering's view of a POU's scope ([`Env`]).
 
+use super::lower::{Env, InstanceRef, Names};
 use super::{Builder, Result};
-use crate::fbd::lower::{Env, InstanceRef, Names};
+use crate::diag::Invalid;
 use crate::fbd::LoweredCopy;
 use crate::model::*;
-use crate::read::error::Invalid;
 
 impl<'a> Builder<'a> {
     /// Lowers every FBD body: the main program's and subroutines' once, a function block type's
@@ -23,12 +23,8 @@ impl<'a> Builder<'a> {
                 var_prefix: draft.var_prefix.clone(),
             };
             let pid = PouId(pou as u32);
-            let lowered = crate::fbd::lower::lower(
-                &bodies[i],
-                &mut PouEnv { b: self, pou: pid },
-                &names,
-                pid,
-            )?;
+            let lowered =
+                super::lower::lower(&bodies[i], &mut PouEnv { b: self, pou: pid }, &names, pid)?;
             bodies[i].copies.push(LoweredCopy {
                 pou: pid,
                 networks: lowered.networks,

@@ -2,9 +2,9 @@
 //! (guard rung, landing rung), compound fragments tested through their run flags.
 
 use super::{condition, contact, set_jump_target, Cx, Net, Result};
+use crate::diag::LoadError;
 use crate::fbd::model::*;
 use crate::model::*;
-use crate::read::LoadError;
 use std::collections::HashMap;
 
 impl Cx<'_> {

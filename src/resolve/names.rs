@@ -2,12 +2,13 @@
 //! members of function block instances, writable targets, typed operands and instances.
 
 use super::elements::Scope;
-use super::util::{display_json, expect_type, string};
+use super::operand::{self, Untyped};
+use super::path::At;
+use super::util::expect_type;
 use super::{Builder, Result};
+use crate::diag::{Invalid, LoadError};
 use crate::model::*;
-use crate::read::error::{Invalid, LoadError};
-use crate::read::operand::{self, Untyped};
-use serde_json::Value as Json;
+use crate::syntax::Scalar;
 
 impl<'a> Builder<'a> {
     /// A name a block or element writes, in the scope of `pou`: not an input, not a field, not
@@ -114,41 +115,40 @@ impl<'a> Builder<'a> {
         operand::field_ref(id, text, self.vars[id.index()].ty, field)
     }
 
-    pub(super) fn var_ref(&self, v: &Json, path: &str, s: &Scope) -> Result<(VarRef, Type)> {
-        let text = string(v, path, Some(s.rung_id))?;
+    pub(super) fn var_ref(&self, text: &str, at: &At, s: &Scope) -> Result<(VarRef, Type)> {
         self.lookup(text, s.pou)
-            .map_err(|k| LoadError::invalid(Some(s.rung_id), path, k))
+            .map_err(|k| LoadError::invalid(Some(s.rung_id), &at.with(""), k))
     }
 
-    pub(super) fn untyped(&self, v: &Json, path: &str, s: &Scope) -> Result<Untyped> {
+    pub(super) fn untyped(&self, v: &Scalar, at: &At, s: &Scope) -> Result<Untyped> {
         operand::parse(v, &|n| self.lookup(n, s.pou))
-            .map_err(|k| LoadError::invalid(Some(s.rung_id), path, k))
+            .map_err(|k| LoadError::invalid(Some(s.rung_id), &at.with(""), k))
     }
 
     pub(super) fn operand_of(
         &self,
-        v: &Json,
-        path: &str,
+        v: &Scalar,
+        at: &At,
         s: &Scope,
         ty: Type,
         what: &'static str,
     ) -> Result<Operand> {
-        let u = self.untyped(v, path, s)?;
-        operand::typed(&u, ty, what, &display_json(v))
-            .map_err(|k| LoadError::invalid(Some(s.rung_id), path, k))
+        let u = self.untyped(v, at, s)?;
+        operand::typed(&u, ty, what, &v.display())
+            .map_err(|k| LoadError::invalid(Some(s.rung_id), &at.with(""), k))
     }
 
     /// Two operands of one numeric type (the type of whichever fixes one).
     pub(super) fn numeric_pair(
         &self,
-        a: &Json,
-        b: &Json,
-        path: &str,
+        a: &Scalar,
+        b: &Scalar,
+        at: &At,
         s: &Scope,
         what: &'static str,
         accept: fn(Type) -> bool,
     ) -> Result<(Operand, Operand)> {
-        let (pa, pb) = (format!("{path}.a"), format!("{path}.b"));
+        let (pa, pb) = (at.key("a"), at.key("b"));
         let ua = self.untyped(a, &pa, s)?;
         let ub = self.untyped(b, &pb, s)?;
         let ty = ua
@@ -163,53 +163,52 @@ impl<'a> Builder<'a> {
             };
             return Err(LoadError::invalid(
                 Some(s.rung_id),
-                p,
+                &p.with(""),
                 Invalid::Type {
                     what,
                     expected: "INT, DINT, REAL or TIME".into(),
-                    operand: display_json(j),
+                    operand: j.display(),
                     found: ty.to_string(),
                 },
             ));
         }
-        let oa = operand::typed(&ua, ty, what, &display_json(a))
-            .map_err(|k| LoadError::invalid(Some(s.rung_id), &pa, k))?;
-        let ob = operand::typed(&ub, ty, what, &display_json(b))
-            .map_err(|k| LoadError::invalid(Some(s.rung_id), &pb, k))?;
+        let oa = operand::typed(&ua, ty, what, &a.display())
+            .map_err(|k| LoadError::invalid(Some(s.rung_id), &pa.with(""), k))?;
+        let ob = operand::typed(&ub, ty, what, &b.display())
+            .map_err(|k| LoadError::invalid(Some(s.rung_id), &pb.with(""), k))?;
         Ok((oa, ob))
     }
 
     /// A variable that an element writes: not an input, not a field, of type `ty` if given.
     pub(super) fn writable(
         &self,
-        v: &Json,
-        path: &str,
+        text: &str,
+        at: &At,
         s: &Scope,
         what: &'static str,
         ty: Option<Type>,
     ) -> Result<VarId> {
-        let text = string(v, path, Some(s.rung_id))?;
         let id = self
             .writable_name(text, s.pou, what)
-            .map_err(|k| LoadError::invalid(Some(s.rung_id), path, k))?;
+            .map_err(|k| LoadError::invalid(Some(s.rung_id), &at.with(""), k))?;
         let var = &self.vars[id.index()];
         if let Some(ty) = ty {
             expect_type(var.ty, ty, what, &var.name)
-                .map_err(|k| LoadError::invalid(Some(s.rung_id), path, k))?;
+                .map_err(|k| LoadError::invalid(Some(s.rung_id), &at.with(""), k))?;
         }
         Ok(id)
     }
 
-    pub(super) fn instance(&self, v: &Json, path: &str, s: &Scope, fb: FbKind) -> Result<VarId> {
-        let (r, t) = self.var_ref(v, path, s)?;
+    pub(super) fn instance(&self, text: &str, at: &At, s: &Scope, fb: FbKind) -> Result<VarId> {
+        let (r, t) = self.var_ref(text, at, s)?;
         if r.field.is_some() || t != Type::Fb(fb) {
             return Err(LoadError::invalid(
                 Some(s.rung_id),
-                path,
+                &at.with(""),
                 Invalid::Type {
                     what: "this box",
                     expected: format!("a {} instance", Type::Fb(fb)),
-                    operand: display_json(v),
+                    operand: text.to_owned(),
                     found: t.to_string(),
                 },
             ));

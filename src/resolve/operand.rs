@@ -1,11 +1,12 @@
-//! Operand resolution and typing for the JSON reader.
+//! Operand resolution and typing for the resolver.
 //!
 //! An OPERAND is a variable name or field (`"N"`, `"T1.Q"`), a JSON number or boolean, or a
 //! TIME literal string. Numbers have no type of their own: they take the type the context needs
 //! (the other compare operand, the box's output), and must fit it.
 
-use super::error::Invalid;
+use crate::diag::Invalid;
 use crate::model::{parse_time_literal, Field, Operand, Type, Value, VarRef};
+use crate::syntax::Scalar;
 use serde_json::Value as Json;
 
 /// An operand before its constant (if any) is given a type.
@@ -31,24 +32,26 @@ impl Untyped {
 
 /// Parses an operand; `lookup` resolves a variable name to its reference and type.
 pub(crate) fn parse(
-    json: &Json,
+    s: &Scalar,
     lookup: &dyn Fn(&str) -> Result<(VarRef, Type), Invalid>,
 ) -> Result<Untyped, Invalid> {
-    match json {
-        Json::Bool(b) => Ok(Untyped::Bool(*b)),
-        Json::Number(n) => {
+    match s {
+        Scalar::Bool(b) => Ok(Untyped::Bool(*b)),
+        Scalar::Number(n) => {
             if let Some(i) = n.as_i64() {
                 Ok(Untyped::Number(i as f64, true))
             } else {
                 Ok(Untyped::Number(n.as_f64().unwrap_or(f64::NAN), false))
             }
         }
-        Json::String(s) => {
+        Scalar::Str(s) => {
             let upper = s.to_ascii_uppercase();
             if upper.starts_with("T#") || upper.starts_with("TIME#") {
                 match parse_time_literal(s) {
                     Some(ms) => Ok(Untyped::Time(ms)),
-                    None => Err(Invalid::BadTime { text: s.clone() }),
+                    None => Err(Invalid::BadTime {
+                        text: s.to_string(),
+                    }),
                 }
             } else {
                 let (r, t) = lookup(s)?;
@@ -57,9 +60,29 @@ pub(crate) fn parse(
         }
         other => Err(Invalid::Shape {
             expected: "an operand (variable name, number, boolean or TIME literal)",
-            found: super::json::kind_of(other),
+            found: other.kind(),
         }),
     }
+}
+
+/// A JSON leaf as a [`Scalar`] (FBD operands are kept as JSON values in the FBD model).
+pub(crate) fn scalar_of(j: &Json) -> Scalar<'_> {
+    match j {
+        Json::Null => Scalar::Null,
+        Json::Bool(b) => Scalar::Bool(*b),
+        Json::Number(n) => Scalar::Number(n.clone()),
+        Json::String(s) => Scalar::Str(std::borrow::Cow::Borrowed(s)),
+        Json::Array(_) => Scalar::Array,
+        Json::Object(_) => Scalar::Object,
+    }
+}
+
+/// [`parse`] of an operand kept as JSON.
+pub(crate) fn parse_json(
+    j: &Json,
+    lookup: &dyn Fn(&str) -> Result<(VarRef, Type), Invalid>,
+) -> Result<Untyped, Invalid> {
+    parse(&scalar_of(j), lookup)
 }
 
 /// Gives `u` the type `ty`, checking that it has it (or, for numbers, fits it).

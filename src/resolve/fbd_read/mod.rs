@@ -2,15 +2,15 @@
 //!
 //! Checks every field, the op and its pins, block ids (unique in the POU), arcs (`{"from": ID}`
 //! names a block of the same network and one of its outputs), control arcs and labels, then
-//! plans every network ([`super::plan`]: order, cycles, fragments). Operands stay JSON: they are
+//! plans every network ([`crate::fbd::plan`]: order, cycles, fragments). Operands stay JSON: they are
 //! resolved and typed by the lowering, once per POU (per instance for a function block type).
 //! Errors carry the network id, the block id and the JSON path.
 
 mod input;
 mod util;
 
-use super::model::*;
-use crate::read::{Invalid, LoadError};
+use crate::diag::{Invalid, LoadError};
+use crate::fbd::model::*;
 use serde_json::{Map, Value as Json};
 use std::collections::HashMap;
 
@@ -152,7 +152,7 @@ pub(crate) fn read_body(
     }
     let plans = networks
         .iter()
-        .map(super::plan)
+        .map(crate::fbd::plan)
         .collect::<Result<Vec<_>>>()?;
     Ok(FbdPou {
         name: name.to_owned(),
@@ -358,17 +358,55 @@ fn network(
     };
     let out_pins: Vec<Vec<String>> = drafts.iter().map(outputs_of).collect();
     // Pass 2: pins, arcs, the rest.
-    let mut blocks = Vec::with_capacity(drafts.len());
-    for d in &drafts {
-        let be = |q: String, k: Invalid| LoadError::fbd(&id, Some(d.id), &q, k);
+    let net = Net {
+        id: &id,
+        index: &index,
+        drafts: &drafts,
+        out_pins: &out_pins,
+        sig,
+    };
+    let blocks = drafts
+        .iter()
+        .map(|d| net.block(d))
+        .collect::<Result<Vec<_>>>()?;
+    Ok(Network {
+        id,
+        label,
+        comment,
+        path: path.to_owned(),
+        blocks,
+    })
+}
+
+/// One network being read: what every block of it needs to resolve its arcs.
+struct Net<'n, 'v> {
+    id: &'n str,
+    index: &'n HashMap<u32, BlockId>,
+    drafts: &'n [Draft<'v>],
+    out_pins: &'n [Vec<String>],
+    sig: &'n dyn Fn(&str) -> Option<FbSig>,
+}
+
+impl Net<'_, '_> {
+    /// A block: its input pins, its output pins, then instance, label, condition, control arcs.
+    fn block(&self, d: &Draft) -> Result<Block> {
+        let inputs = self.inputs(d)?;
+        let outputs = self.outputs(d)?;
+        self.rest(d, inputs, outputs)
+    }
+
+    /// The input pins: by position or by name; every input of a built-in op connected.
+    fn inputs(&self, d: &Draft) -> Result<Vec<InputPin>> {
+        let id = self.id;
+        let be = |q: String, k: Invalid| LoadError::fbd(id, Some(d.id), &q, k);
         let p = &d.path;
         let o = d.o;
+        let (index, drafts, out_pins) = (self.index, self.drafts, self.out_pins);
         let arc = |j: &Json, q: String| -> Result<Input> {
-            input(j, &q, &id, d.id, &index, &drafts, &out_pins)
+            input(j, &q, id, d.id, index, drafts, out_pins)
         };
-        // Inputs.
         let declared: Option<Vec<String>> = match &d.op {
-            Op::Call(fb) => Some(sig(fb).map(|s| s.inputs).unwrap_or_default()),
+            Op::Call(fb) => Some((self.sig)(fb).map(|s| s.inputs).unwrap_or_default()),
             _ => None,
         };
         if matches!(d.op, Op::Jmp | Op::Ret) && o.contains_key("in") {
@@ -516,7 +554,16 @@ fn network(
                 ));
             }
         }
-        // Outputs.
+        Ok(inputs)
+    }
+
+    /// The output pins and the variables each is written to.
+    fn outputs(&self, d: &Draft) -> Result<Vec<OutputPin>> {
+        let id = self.id;
+        let be = |q: String, k: Invalid| LoadError::fbd(id, Some(d.id), &q, k);
+        let p = &d.path;
+        let o = d.o;
+        let (index, out_pins) = (self.index, self.out_pins);
         let pins = &out_pins[index[&d.id].index()];
         let mut outputs: Vec<OutputPin> = pins
             .iter()
@@ -634,7 +681,19 @@ fn network(
                 }
             }
         }
-        // Instance, label, condition, control arcs.
+        Ok(outputs)
+    }
+
+    /// Instance, label, condition, control arcs and comment.
+    fn rest(&self, d: &Draft, inputs: Vec<InputPin>, outputs: Vec<OutputPin>) -> Result<Block> {
+        let id = self.id;
+        let be = |q: String, k: Invalid| LoadError::fbd(id, Some(d.id), &q, k);
+        let p = &d.path;
+        let o = d.o;
+        let (index, drafts, out_pins) = (self.index, self.drafts, self.out_pins);
+        let arc = |j: &Json, q: String| -> Result<Input> {
+            input(j, &q, id, d.id, index, drafts, out_pins)
+        };
         let instance = match (o.get("instance"), d.op.needs_instance()) {
             (Some(j), true) => Some(
                 var_name(string(j).map_err(|k| be(format!("{p}.instance"), k))?)
@@ -717,7 +776,7 @@ fn network(
                         qi,
                         Invalid::UndefinedBlock {
                             id: src,
-                            network: id.clone(),
+                            network: id.to_owned(),
                         },
                     )
                 })?;
@@ -734,7 +793,7 @@ fn network(
                     .to_owned(),
             ),
         };
-        blocks.push(Block {
+        Ok(Block {
             id: d.id,
             op: d.op.clone(),
             path: p.clone(),
@@ -745,13 +804,6 @@ fn network(
             cond,
             after,
             comment,
-        });
+        })
     }
-    Ok(Network {
-        id,
-        label,
-        comment,
-        path: path.to_owned(),
-        blocks,
-    })
 }

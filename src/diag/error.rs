@@ -1,10 +1,16 @@
 //! Load errors: what can be wrong with a program file, and where.
 //!
-//! Errors are data: a [`LoadError`] carries a [`Location`] (rung id and JSON path, or line and
-//! column for syntax errors) and a kind; rendering happens only in `Display`, in one place per kind.
-//! The file name is not part of the error: the caller that opened the file adds it.
+//! Errors are data: a [`LoadError`] carries one or more [`Diagnostic`]s (each a [`Location`] —
+//! rung id and JSON path, network and block — and an [`Invalid`] kind), or line and column for
+//! syntax errors; rendering happens only in `Display`, in one place per kind. The file name is
+//! not part of the error: the caller that opened the file adds it ([`LoadError::in_file`]).
 
+use super::Diagnostic;
 use std::fmt;
+
+/// The op names of the FBD format, as the unknown-op message lists them (re-exported by
+/// `crate::fbd`).
+pub const OP_NAMES: &str = "EQ, NE, LT, LE, GT, GE, ADD, SUB, MUL, DIV, MOD, AND, OR, XOR, NOT, MOVE, SEL, MAX, MIN, LIMIT, TON, TOF, TP, CTU, CTD, JMP, RET, TSTART, TSTOP";
 
 /// Where in the program file an error is.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -15,6 +21,9 @@ pub struct Location {
     pub path: String,
     /// For an error in an FBD network: the network id and, if the error is in a block, its id.
     pub network: Option<(String, Option<u32>)>,
+    /// Line and column (1-based) in the file of the innermost node that knows them (a rung, a
+    /// variable, a network, a block); not part of `Display`, which stays the path.
+    pub position: Option<(u32, u32)>,
 }
 
 impl fmt::Display for Location {
@@ -41,22 +50,46 @@ impl fmt::Display for Location {
 }
 
 /// Everything that makes a program file unusable.
-#[derive(Debug, thiserror::Error, PartialEq)]
+#[derive(Debug, PartialEq)]
 pub enum LoadError {
-    /// The file is not JSON (serde_json's message, with line and column).
-    #[error("{line}:{column}: {message}")]
+    /// The file is not JSON (serde_json's message, with line and column, both 1-based).
     Syntax {
         line: usize,
         column: usize,
         message: String,
     },
-    /// The JSON is well formed but the program is not valid.
-    #[error("{location}: {kind}")]
-    Invalid { location: Location, kind: Invalid },
+    /// The JSON is well formed but the program is not valid: one problem.
+    Invalid(Box<Diagnostic>),
+    /// Several problems, in program order (at most [`super::MAX_ERRORS`]).
+    Several(Vec<Diagnostic>),
+}
+
+impl std::error::Error for LoadError {}
+
+impl fmt::Display for LoadError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            LoadError::Syntax {
+                line,
+                column,
+                message,
+            } => write!(f, "{line}:{column}: {message}"),
+            LoadError::Invalid(d) => write!(f, "{d}"),
+            LoadError::Several(ds) => {
+                for (i, d) in ds.iter().enumerate() {
+                    if i > 0 {
+                        writeln!(f)?;
+                    }
+                    write!(f, "{d}")?;
+                }
+                Ok(())
+            }
+        }
+    }
 }
 
 /// The ways a well-formed JSON document can fail to be a valid program.
-#[derive(Debug, thiserror::Error, PartialEq)]
+#[derive(Clone, Debug, thiserror::Error, PartialEq)]
 pub enum Invalid {
     #[error("expected {expected}, found {found}")]
     Shape {
@@ -138,7 +171,7 @@ pub enum Invalid {
     #[error("the program has no rungs")]
     Empty,
     // ---- FBD bodies and function blocks (docs/fbd.md)
-    #[error("unknown op `{op}` (expected {names} or a function block)", names = crate::fbd::OP_NAMES)]
+    #[error("unknown op `{op}` (expected {names} or a function block)", names = OP_NAMES)]
     UnknownOp { op: String },
     #[error("{op} has no {dir} `{pin}` ({dir}s: {pins})")]
     UnknownPin {
@@ -204,25 +237,93 @@ pub enum Invalid {
 
 impl LoadError {
     pub(crate) fn invalid(rung: Option<&str>, path: &str, kind: Invalid) -> LoadError {
-        LoadError::Invalid {
-            location: Location {
+        LoadError::Invalid(Box::new(Diagnostic::error(
+            Location {
                 rung: rung.map(str::to_owned),
                 path: path.to_owned(),
                 network: None,
+                position: None,
             },
             kind,
-        }
+        )))
     }
 
     /// An error in FBD network `network` (in block `block`, if given).
     pub(crate) fn fbd(network: &str, block: Option<u32>, path: &str, kind: Invalid) -> LoadError {
-        LoadError::Invalid {
-            location: Location {
+        LoadError::Invalid(Box::new(Diagnostic::error(
+            Location {
                 rung: None,
                 path: path.to_owned(),
                 network: Some((network.to_owned(), block)),
+                position: None,
             },
             kind,
+        )))
+    }
+
+    /// The problems, in program order (none for a syntax error).
+    pub fn diagnostics(&self) -> &[Diagnostic] {
+        match self {
+            LoadError::Syntax { .. } => &[],
+            LoadError::Invalid(d) => std::slice::from_ref(d),
+            LoadError::Several(ds) => ds,
+        }
+    }
+
+    /// One error or several: `Several` only when there are two or more.
+    pub(crate) fn from_diagnostics(mut ds: Vec<Diagnostic>) -> Option<LoadError> {
+        match ds.len() {
+            0 => None,
+            1 => ds.pop().map(|d| LoadError::Invalid(Box::new(d))),
+            _ => Some(LoadError::Several(ds)),
+        }
+    }
+
+    /// The diagnostics of `self` appended to `out` (a syntax error cannot be).
+    pub(crate) fn into_diagnostics(self) -> Result<Vec<Diagnostic>, LoadError> {
+        match self {
+            LoadError::Syntax { .. } => Err(self),
+            LoadError::Invalid(d) => Ok(vec![*d]),
+            LoadError::Several(ds) => Ok(ds),
+        }
+    }
+
+    /// Renders every problem as `FILE:LINE:COLUMN: message` (syntax) or `FILE: LOCATION: message`,
+    /// one per line, each line after the first prefixed `error: ` like the first one is by the
+    /// command line.
+    pub fn in_file<'e>(&'e self, file: &'e str) -> impl fmt::Display + 'e {
+        InFile { error: self, file }
+    }
+
+    /// Adds the line and column of the node the error is in, where it has none yet.
+    pub(crate) fn at_position(mut self, position: Option<(u32, u32)>) -> LoadError {
+        if let LoadError::Invalid(d) = &mut self {
+            if d.location.position.is_none() {
+                d.location.position = position;
+            }
+        }
+        self
+    }
+}
+
+struct InFile<'e> {
+    error: &'e LoadError,
+    file: &'e str,
+}
+
+impl fmt::Display for InFile<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.error {
+            LoadError::Syntax { .. } => write!(f, "{}:{}", self.file, self.error),
+            other => {
+                for (i, d) in other.diagnostics().iter().enumerate() {
+                    if i > 0 {
+                        write!(f, "\nerror: ")?;
+                    }
+                    write!(f, "{}: {d}", self.file)?;
+                }
+                Ok(())
+            }
         }
     }
 }
@@ -241,6 +342,11 @@ mod tests {
         assert_eq!(
             e.to_string(),
             "rung R3 at rungs[2].ld[0]: undefined variable `X`"
+        );
+        let two = LoadError::Several(vec![e.diagnostics()[0].clone(), e.diagnostics()[0].clone()]);
+        assert_eq!(
+            two.in_file("p.json").to_string(),
+            "p.json: rung R3 at rungs[2].ld[0]: undefined variable `X`\nerror: p.json: rung R3 at rungs[2].ld[0]: undefined variable `X`"
         );
         let e = LoadError::Syntax {
             line: 3,

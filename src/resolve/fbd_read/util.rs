@@ -1,8 +1,8 @@
 //! Small helpers of the FBD reader: JSON kinds and strings, names, unknown-field checks, and
 //! the texts of pin-count messages.
 
+use crate::diag::Invalid;
 use crate::fbd::model::*;
-use crate::read::Invalid;
 use serde_json::{Map, Value as Json};
 
 pub(super) fn conn_is_given(given: usize, i: usize) -> bool {
@@ -30,7 +30,7 @@ pub(super) fn list_or_none(pins: &[String]) -> String {
 }
 
 /// The ladder reader's description of a JSON value's kind, shared so both readers say the same.
-pub(crate) use crate::read::kind_of;
+pub(crate) use crate::resolve::util::kind_of;
 
 pub(super) fn string(v: &Json) -> std::result::Result<&str, Invalid> {
     v.as_str().ok_or_else(|| Invalid::Shape {

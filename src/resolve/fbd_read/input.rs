@@ -4,8 +4,8 @@
 
 use super::util::{kind_of, list_or_none, string};
 use super::{Draft, Result};
+use crate::diag::{Invalid, LoadError};
 use crate::fbd::model::*;
-use crate::read::{Invalid, LoadError};
 use serde_json::Value as Json;
 use std::collections::HashMap;
 

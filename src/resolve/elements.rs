@@ -1,0 +1,303 @@
+//! Ladder elements: one syntax element → [`Element`] (contacts, coils, boxes, jumps, calls,
+//! FOR/NEXT), series and branches with the placement rules of each kind (IEC 61131-3 8.2; the
+//! S7-200 FOR/NEXT shape: FOR last in its rung, NEXT alone in its rung).
+
+use super::path::At;
+use super::util::expect_type;
+use super::{Builder, Result};
+use crate::diag::{Invalid, LoadError};
+use crate::model::*;
+use crate::syntax::{self, Edge};
+
+/// What may appear in a series, by where the series is.
+#[derive(Copy, Clone, PartialEq, Eq)]
+pub(super) enum Place {
+    /// The rung's own series.
+    Top,
+    /// A branch of `branch` (an output path).
+    Branch,
+    /// A branch of `or` (conditions only).
+    Or,
+}
+
+pub(super) struct Scope<'s> {
+    pub(super) pou: PouId,
+    pub(super) rung_id: &'s str,
+}
+
+impl<'a> Builder<'a> {
+    pub(super) fn series(
+        &mut self,
+        items: &[syntax::Element],
+        at: &At,
+        place: Place,
+        s: &Scope,
+    ) -> Result<Series> {
+        let mut out = Vec::with_capacity(items.len());
+        for (i, item) in items.iter().enumerate() {
+            let p = at.index(i);
+            let misplaced = |what: &'static str, place: &'static str| {
+                Err(LoadError::invalid(
+                    Some(s.rung_id),
+                    &p.with(""),
+                    Invalid::Misplaced { what, place },
+                ))
+            };
+            // Placement first only where the old element had no errors of its own to report.
+            let e = self.element(item, &p, s)?;
+            match (&e, place) {
+                (Element::For { .. }, Place::Top) if i + 1 == items.len() => {}
+                (Element::For { .. }, _) => {
+                    return misplaced("`for`", "except as the last element of a rung")
+                }
+                (Element::Next { .. }, Place::Top) if items.len() == 1 => {}
+                (Element::Next { .. }, _) => {
+                    return misplaced("`next`", "except alone in its rung")
+                }
+                (Element::Contact { .. } | Element::Compare { .. } | Element::Or(_), _) => {}
+                (_, Place::Or) => {
+                    return misplaced(
+                        "this element",
+                        "inside `or` (only contact, compare and or are)",
+                    )
+                }
+                _ => {}
+            }
+            out.push(e);
+        }
+        Ok(out)
+    }
+
+    fn branches(
+        &mut self,
+        branches: &[syntax::Series],
+        at: &At,
+        place: Place,
+        s: &Scope,
+    ) -> Result<Vec<Series>> {
+        let mut out = Vec::with_capacity(branches.len());
+        for (i, b) in branches.iter().enumerate() {
+            out.push(self.series(b, &at.index(i), place, s)?);
+        }
+        Ok(out)
+    }
+
+    pub(super) fn element(&mut self, e: &syntax::Element, at: &At, s: &Scope) -> Result<Element> {
+        use syntax::Element as S;
+        let rid = Some(s.rung_id);
+        let err =
+            |k: &str, kind: Invalid| LoadError::invalid(rid, &at.with(&format!(".{k}")), kind);
+        let key = |k: &'static str| at.key(k);
+        Ok(match e {
+            S::Invalid(p) => return Err(LoadError::invalid(rid, &at.with(&p.at), p.kind.clone())),
+            S::Contact { var, negated, edge } => {
+                let (var, ty) = self.var_ref(var, &key("contact"), s)?;
+                expect_type(
+                    ty,
+                    Type::Bool,
+                    "a contact",
+                    &self.vars[var.var.index()].name,
+                )
+                .map_err(|k| err("contact", k))?;
+                let kind = match (edge, negated) {
+                    (None, true) => ContactKind::Negated,
+                    (None, false) => ContactKind::Normal,
+                    (Some(Edge::Rising), _) => ContactKind::Rising {
+                        memory: self.edge_memory(s),
+                    },
+                    (Some(Edge::Falling), _) => ContactKind::Falling {
+                        memory: self.edge_memory(s),
+                    },
+                };
+                Element::Contact { var, kind }
+            }
+            S::Compare(c) => {
+                let (a, b) = self.numeric_pair(&c.a, &c.b, at, s, "a comparison", |_| true)?;
+                Element::Compare { op: c.op, a, b }
+            }
+            S::Or(bs) => Element::Or(self.branches(bs, &key("or"), Place::Or, s)?),
+            S::Branch(bs) => {
+                Element::Branch(self.branches(bs, &key("branch"), Place::Branch, s)?)
+            }
+            S::Coil { var, negated } => {
+                let var = self.writable(var, &key("coil"), s, "a coil", Some(Type::Bool))?;
+                Element::Coil {
+                    var,
+                    negated: *negated,
+                }
+            }
+            S::Set(v) => {
+                Element::Set(self.writable(v, &key("set"), s, "a set coil", Some(Type::Bool))?)
+            }
+            S::Reset(v) => Element::Reset(self.writable(
+                v,
+                &key("reset"),
+                s,
+                "a reset coil",
+                Some(Type::Bool),
+            )?),
+            S::Timer(t) => {
+                let instance = self.instance(&t.instance, &key(t.kind.name()), s, t.kind.fb())?;
+                let pt = self.operand_of(&t.pt, &key("pt"), s, Type::Time, "a timer's PT")?;
+                Element::Timer {
+                    kind: t.kind,
+                    instance,
+                    pt,
+                }
+            }
+            S::Counter(c) if !c.down => {
+                let instance = self.instance(&c.instance, &key("ctu"), s, FbKind::Ctu)?;
+                let pv = self.operand_of(&c.pv, &key("pv"), s, Type::Int, "a counter's PV")?;
+                let reset =
+                    self.operand_of(&c.aux, &key("reset"), s, Type::Bool, "a counter's reset")?;
+                Element::Ctu {
+                    instance,
+                    pv,
+                    reset,
+                }
+            }
+            S::Counter(c) => {
+                let instance = self.instance(&c.instance, &key("ctd"), s, FbKind::Ctd)?;
+                let pv = self.operand_of(&c.pv, &key("pv"), s, Type::Int, "a counter's PV")?;
+                let load =
+                    self.operand_of(&c.aux, &key("load"), s, Type::Bool, "a counter's load")?;
+                Element::Ctd { instance, pv, load }
+            }
+            S::Move(m) => {
+                let to = self.writable(&m.to, &key("to"), s, "a move", None)?;
+                let ty = self.vars[to.index()].ty;
+                let from = self.operand_of(&m.from, &key("move"), s, ty, "a move")?;
+                Element::Move { from, to }
+            }
+            S::Arith(x) => self.arith(x.op, &x.a, &x.b, &x.out, at, s)?,
+            S::Jmp(label) => {
+                let target = *self.labels[s.pou.index()]
+                    .get(label.as_ref())
+                    .ok_or_else(|| {
+                        err(
+                            "jmp",
+                            Invalid::UndefinedLabel {
+                                label: label.to_string(),
+                                pou: self.pous[s.pou.index()].name.clone(),
+                            },
+                        )
+                    })?;
+                Element::Jmp {
+                    label: label.to_string(),
+                    target,
+                }
+            }
+            S::Ret => Element::Ret,
+            S::End => {
+                if s.pou != PouId(0) {
+                    return Err(err(
+                        "end",
+                        Invalid::Misplaced {
+                            what: "`end`",
+                            place: "in a subroutine (use `ret`)",
+                        },
+                    ));
+                }
+                Element::End
+            }
+            // Paired with its FOR by the structural checks.
+            S::Next => Element::Next { head: RungId(0) },
+            S::Call(name) => {
+                let pou = self
+                    .pous
+                    .iter()
+                    .position(|p| p.kind == PouKind::Subroutine && p.callable && p.name == *name)
+                    .ok_or_else(|| {
+                        err(
+                            "call",
+                            Invalid::UndefinedSubroutine {
+                                name: name.to_string(),
+                            },
+                        )
+                    })?;
+                Element::Call {
+                    pou: PouId(pou as u32),
+                }
+            }
+            S::For(f) => {
+                let (var, from, to) = (&f.var, &f.from, &f.to);
+                let fp = key("for");
+                let var = self.writable(var, &fp.key("var"), s, "a FOR", None)?;
+                let ty = self.vars[var.index()].ty;
+                if !matches!(ty, Type::Int | Type::Dint) {
+                    return Err(LoadError::invalid(
+                        rid,
+                        &fp.with(".var"),
+                        Invalid::Type {
+                            what: "a FOR index",
+                            expected: "INT or DINT".into(),
+                            operand: self.vars[var.index()].name.clone(),
+                            found: ty.to_string(),
+                        },
+                    ));
+                }
+                let from = self.operand_of(from, &fp.key("from"), s, ty, "a FOR bound")?;
+                let to = self.operand_of(to, &fp.key("to"), s, ty, "a FOR bound")?;
+                // The NEXT is found by the structural checks.
+                Element::For {
+                    var,
+                    from,
+                    to,
+                    next: RungId(0),
+                }
+            }
+        })
+    }
+
+    fn arith(
+        &mut self,
+        op: ArithOp,
+        a: &syntax::Scalar,
+        b: &syntax::Scalar,
+        out: &str,
+        at: &At,
+        s: &Scope,
+    ) -> Result<Element> {
+        let out = self.writable(out, &at.key("out"), s, "an arithmetic box", None)?;
+        let ty = self.vars[out.index()].ty;
+        let ok = match op {
+            ArithOp::Add | ArithOp::Sub => ty.is_numeric(),
+            ArithOp::Mul | ArithOp::Div => matches!(ty, Type::Int | Type::Dint | Type::Real),
+            ArithOp::Mod => matches!(ty, Type::Int | Type::Dint),
+        };
+        if !ok {
+            return Err(LoadError::invalid(
+                Some(s.rung_id),
+                &at.with(".out"),
+                Invalid::Type {
+                    what: "this arithmetic box",
+                    expected: if op == ArithOp::Mod {
+                        "INT or DINT".into()
+                    } else {
+                        "a numeric type".into()
+                    },
+                    operand: self.vars[out.index()].name.clone(),
+                    found: ty.to_string(),
+                },
+            ));
+        }
+        let inp = at.key("in");
+        let a = self.operand_of(a, &inp.index(0), s, ty, "an arithmetic box")?;
+        let b = self.operand_of(b, &inp.index(1), s, ty, "an arithmetic box")?;
+        Ok(Element::Arith { op, a, b, out })
+    }
+
+    pub(super) fn edge_memory(&mut self, s: &Scope) -> VarId {
+        self.edge_count += 1;
+        let id = VarId(self.vars.len() as u32);
+        self.vars.push(Var {
+            name: format!("{}:edge{}", s.rung_id, self.edge_count),
+            ty: Type::Bool,
+            class: VarClass::Memory,
+            init: Value::Bool(false),
+            scope: None,
+            hidden: true,
+        });
+        id
+    }
+}

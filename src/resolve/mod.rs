@@ -1,0 +1,525 @@
+//! The resolver: surface syntax ([`crate::syntax`]) → the model ([`crate::model::Program`] and
+//! the FBD bodies [`crate::fbd::Fbd`]).
+//!
+//! One place for every rule that needs more than one node (docs/format.md, docs/fbd.md):
+//! declarations (names, types, classes, initial values; IEC 61131-3 6.5), name resolution
+//! (subroutine or instance locals first, then program variables), operand typing, unique rung ids
+//! (program-wide) and labels (per POU), FOR/NEXT nesting, no jump into a FOR body, no recursive
+//! calls, `end` in the main program only, no writes to inputs or instance fields, FBD networks
+//! (ids, arcs, labels; order and fragments by the pure algorithms of `crate::fbd`), user function
+//! block types (no type containing itself) expanded into one POU per instance, and the lowering
+//! of FBD bodies into rungs ([`lower`]).
+//!
+//! Errors are collected, in program order, up to [`MAX_ERRORS`], phase by phase: the reader's
+//! problems and the declarations; instances and FBD lowering; rung ids and labels; elements (the
+//! first problem of each rung); loops, jumps and calls. A phase with errors ends the resolution
+//! (later phases would only report their consequences). Paths are rendered only for errors.
+//! Nothing is half-built: a program either resolves whole or not at all.
+
+mod elements;
+pub(crate) mod fbd_read;
+mod function_blocks;
+pub(crate) mod lower;
+mod lowering;
+mod names;
+pub(crate) mod operand;
+mod path;
+mod structure;
+pub(crate) mod util;
+mod vars;
+
+pub use lower::ACCUMULATE_PT_MS;
+
+use crate::diag::{Diagnostic, Invalid, LoadError, MAX_ERRORS};
+use crate::fbd::{Fbd, FbdPou, FbdPouKind};
+use crate::model::*;
+use crate::syntax;
+use fbd_read::FbSig;
+use std::borrow::Cow;
+use util::{FastMap, FastSet};
+
+use elements::{Place, Scope};
+use lowering::relocate_jumps;
+use path::At;
+use util::{check_name, rung_path};
+
+type Result<T> = std::result::Result<T, LoadError>;
+
+/// Resolves a program read from `text` (the text gives the line and column of nodes for errors).
+pub fn resolve(text: &str, syn: &syntax::Program<'_>) -> Result<(Program, Fbd)> {
+    let mut b = Builder {
+        text,
+        ..Builder::default()
+    };
+    for p in &syn.problems {
+        b.report(LoadError::invalid(None, &p.at, p.kind.clone()));
+    }
+    b.declarations(syn);
+    b.phase_end()?;
+    // Instances of user function blocks: one POU each, after the subroutines.
+    let top_level: Vec<usize> = std::mem::take(&mut b.pending);
+    for i in top_level {
+        let r = b.expand(i, &mut Vec::new());
+        b.collect(r);
+    }
+    b.phase_end()?;
+    let r = b.lower_fbd();
+    b.collect(r);
+    b.phase_end()?;
+    let mut bodies = std::mem::take(&mut b.fbd_bodies);
+    // Copied: the ladder rungs still read instance members through `b.instances`.
+    let mut instances: Vec<crate::fbd::FbInstance> = b
+        .instances
+        .iter()
+        .filter_map(|i| {
+            Some(crate::fbd::FbInstance {
+                pou: i.pou?,
+                name: i.display.clone(),
+                fb: i.fb.clone(),
+                inputs: i.inputs.clone(),
+                outputs: i.outputs.clone(),
+            })
+        })
+        .collect();
+    instances.sort_by_key(|i| i.pou);
+    let program = b.build(syn.name.to_string())?;
+    for body in &mut bodies {
+        for copy in &mut body.copies {
+            let start = program.pou(copy.pou).rungs.start;
+            for r in &mut copy.networks {
+                *r = r.start + start..r.end + start;
+            }
+            for blocks in &mut copy.blocks {
+                for r in blocks.iter_mut() {
+                    r.0 += start;
+                }
+            }
+        }
+    }
+    // Main program and subroutines first, then function block types (each in file order).
+    let (mut pous, fbs): (Vec<FbdPou>, Vec<FbdPou>) = bodies
+        .into_iter()
+        .partition(|p| p.kind != FbdPouKind::FunctionBlock);
+    pous.extend(fbs);
+    Ok((program, Fbd { pous, instances }))
+}
+
+struct PouDraft<'a> {
+    name: String,
+    kind: PouKind,
+    /// JSON path of the rung array ("" means top-level `rungs`).
+    path: String,
+    rungs: &'a [syntax::Rung<'a>],
+    /// Index into `Builder::fbd_bodies` when the body is FBD.
+    fbd: Option<usize>,
+    /// An FBD body after lowering (jump targets relative to the POU).
+    lowered: Option<Vec<Rung>>,
+    /// Prepended to rung ids (`G1:` for the POU of function block instance `G1`).
+    prefix: String,
+    /// Prepended to the names of hidden variables of an FBD body (`SBR:`, `G1.`).
+    var_prefix: String,
+    /// False for instances of function blocks: `call` cannot name them.
+    callable: bool,
+}
+
+impl<'a> PouDraft<'a> {
+    fn new(name: String, kind: PouKind, path: String) -> PouDraft<'a> {
+        let var_prefix = if kind == PouKind::Main {
+            String::new()
+        } else {
+            format!("{name}:")
+        };
+        PouDraft {
+            name,
+            kind,
+            path,
+            rungs: &[],
+            fbd: None,
+            lowered: None,
+            prefix: String::new(),
+            var_prefix,
+            callable: true,
+        }
+    }
+}
+
+/// A user function block type: its declarations and body.
+struct FbType<'a> {
+    name: String,
+    path: String,
+    inputs: &'a [syntax::Var<'a>],
+    outputs: &'a [syntax::Var<'a>],
+    vars: &'a [syntax::Var<'a>],
+    /// The ladder body, or the index of the FBD body in `Builder::fbd_bodies`.
+    rungs: Option<&'a [syntax::Rung<'a>]>,
+    fbd: Option<usize>,
+    sig: FbSig,
+}
+
+/// An instance of a user function block type.
+struct InstanceDraft {
+    /// `G1`, `SBR:G1`, `G1.INNER`.
+    display: String,
+    fb: String,
+    /// JSON path of its declaration.
+    path: String,
+    pou: Option<PouId>,
+    inputs: Vec<(String, VarId)>,
+    outputs: Vec<(String, VarId)>,
+}
+
+/// A program-wide rule (ids, labels, names) is kept per POU; every table is indexed by POU.
+#[derive(Default)]
+struct Builder<'a> {
+    text: &'a str,
+    /// Problems found so far, in program order (at most [`MAX_ERRORS`]).
+    errors: Vec<Diagnostic>,
+    vars: Vec<Var>,
+    /// Display names of all variables, built when the first hidden FBD variable is made (its
+    /// name must not clash).
+    var_names: Option<FastSet<String>>,
+    globals: FastMap<String, VarId>,
+    /// Per POU: its local variables.
+    locals: Vec<FastMap<String, VarId>>,
+    /// Program-wide and per-POU instances of user function blocks (index into `instances`).
+    global_instances: FastMap<String, usize>,
+    local_instances: Vec<FastMap<String, usize>>,
+    instances: Vec<InstanceDraft>,
+    /// Instances declared but not yet given their POU.
+    pending: Vec<usize>,
+    fb_types: Vec<FbType<'a>>,
+    fb_index: FastMap<String, usize>,
+    /// FBD bodies in reading order (function block types first, as they are read first).
+    fbd_bodies: Vec<FbdPou>,
+    /// TIME variables accumulated by TSTART/TSTOP, with the POU that does it.
+    accumulated: FastMap<VarId, PouId>,
+    pous: Vec<PouDraft<'a>>,
+    /// Per POU: label → rung.
+    labels: Vec<FastMap<String, RungId>>,
+    /// Per rung, during element resolution: number of edge contacts so far.
+    edge_count: u32,
+}
+
+/// A ladder rung after pass 1: its id, its syntax and its (prefixed) id text.
+type RungHead<'a> = (RungId, &'a syntax::Rung<'a>, String);
+
+impl<'a> Builder<'a> {
+    /// Records the problems of `e` (up to [`MAX_ERRORS`]).
+    fn report(&mut self, e: LoadError) {
+        if let Ok(ds) = e.into_diagnostics() {
+            let room = MAX_ERRORS.saturating_sub(self.errors.len());
+            self.errors.extend(ds.into_iter().take(room));
+        }
+    }
+
+    fn collect<T>(&mut self, r: Result<T>) -> Option<T> {
+        match r {
+            Ok(v) => Some(v),
+            Err(e) => {
+                self.report(e);
+                None
+            }
+        }
+    }
+
+    /// Ends a phase: the errors so far, if any.
+    fn phase_end(&mut self) -> Result<()> {
+        match LoadError::from_diagnostics(std::mem::take(&mut self.errors)) {
+            None => Ok(()),
+            Some(e) => Err(e),
+        }
+    }
+
+    fn position(&self, origin: syntax::Origin) -> Option<(u32, u32)> {
+        origin.line_column(self.text)
+    }
+
+    /// Function block types, the program's variables, the main body, then each subroutine with
+    /// its variables and body, in file order.
+    fn declarations(&mut self, syn: &'a syntax::Program<'a>) {
+        let r = self.function_block_types(&syn.function_blocks);
+        self.collect(r);
+        let name = syn.name.to_string();
+        self.pous
+            .push(PouDraft::new(name.clone(), PouKind::Main, String::new()));
+        self.locals.push(FastMap::default());
+        self.local_instances.push(FastMap::default());
+        self.declare_vars(&syn.vars, "vars", None, false);
+        if let Some(body) = &syn.body {
+            let r = self.body(0, body, "");
+            self.collect(r);
+        }
+        for sub in &syn.subroutines {
+            let path = format!("subroutines.{}", sub.name);
+            let r = check_name(&sub.name, &path, None);
+            if self.collect(r).is_none() {
+                continue;
+            }
+            if sub.name == name {
+                self.report(LoadError::invalid(
+                    None,
+                    &path,
+                    Invalid::Misplaced {
+                        what: "a subroutine named like the program",
+                        place: "(rename one of them)",
+                    },
+                ));
+                continue;
+            }
+            let pou = PouId(self.pous.len() as u32);
+            self.locals.push(FastMap::default());
+            self.local_instances.push(FastMap::default());
+            self.declare_vars(
+                &sub.vars,
+                &format!("{path}.vars"),
+                Some((pou, format!("{}:", sub.name))),
+                false,
+            );
+            self.pous.push(PouDraft::new(
+                sub.name.to_string(),
+                PouKind::Subroutine,
+                format!("{path}.rungs"),
+            ));
+            if let Some(body) = &sub.body {
+                let r = self.body(pou.index(), body, &path);
+                self.collect(r);
+            }
+        }
+    }
+
+    /// The body of POU `pou`: rungs (kept for pass 1) or FBD (read and planned now).
+    fn body(&mut self, pou: usize, body: &'a syntax::Body<'a>, path: &str) -> Result<()> {
+        match body {
+            syntax::Body::Rungs(rungs) => {
+                self.pous[pou].rungs = rungs;
+                Ok(())
+            }
+            syntax::Body::Fbd(f) => {
+                let kind = if pou == 0 {
+                    FbdPouKind::Main
+                } else {
+                    FbdPouKind::Subroutine
+                };
+                let at = util::join(path, "fbd");
+                let fbd = self.read_fbd(f, &at, &self.pous[pou].name.clone(), kind)?;
+                self.pous[pou].fbd = Some(self.fbd_bodies.len());
+                self.fbd_bodies.push(fbd);
+                Ok(())
+            }
+        }
+    }
+
+    /// Reads and plans an FBD body.
+    fn read_fbd(
+        &self,
+        f: &syntax::FbdBody,
+        path: &str,
+        name: &str,
+        kind: FbdPouKind,
+    ) -> Result<FbdPou> {
+        let index = &self.fb_index;
+        let types = &self.fb_types;
+        let sig = |n: &str| index.get(n).map(|&i| types[i].sig.clone());
+        let json: serde_json::Value = serde_json::from_str(f.text).map_err(|e| {
+            LoadError::invalid(
+                None,
+                path,
+                Invalid::Shape {
+                    expected: "an FBD body",
+                    found: e.to_string(),
+                },
+            )
+        })?;
+        fbd_read::read_body(&json, path, name, kind, &sig)
+            .map_err(|e| e.at_position(self.position(f.origin)))
+    }
+
+    fn build(mut self, name: String) -> Result<Program> {
+        if self.pous[0].fbd.is_none() && self.pous[0].rungs.is_empty() {
+            return Err(LoadError::invalid(None, "rungs", Invalid::Empty));
+        }
+        let (heads, next_id) = self.rung_heads();
+        self.phase_end()?;
+        // Pass 2: elements.
+        let mut rungs = Vec::with_capacity(next_id as usize);
+        let mut pous = Vec::with_capacity(self.pous.len());
+        let mut start = 0u32;
+        for pou in &self.pous {
+            let end =
+                start + pou.rungs.len() as u32 + pou.lowered.as_ref().map_or(0, |l| l.len() as u32);
+            pous.push(Pou {
+                name: pou.name.clone(),
+                kind: pou.kind,
+                rungs: start..end,
+            });
+            start = end;
+        }
+        for (pi, pou_heads) in heads.into_iter().enumerate() {
+            let pou = PouId(pi as u32);
+            if let Some(lowered) = self.pous[pi].lowered.take() {
+                let offset = pous[pi].rungs.start;
+                for mut r in lowered {
+                    r.pou = pou;
+                    relocate_jumps(&mut r.series, offset);
+                    rungs.push(r);
+                }
+            }
+            for (rid, syn, id) in pou_heads {
+                let path = rung_path(&self.pous[pi].path, (rid.0 - pous[pi].rungs.start) as usize);
+                self.edge_count = 0;
+                let scope = Scope { pou, rung_id: &id };
+                let base = At::base(&path);
+                let ld = base.key("ld");
+                let series = match self.series(&syn.ld, &ld, Place::Top, &scope) {
+                    Ok(s) => s,
+                    Err(e) => {
+                        let e = e.at_position(self.position(syn.origin));
+                        self.report(e);
+                        Vec::new()
+                    }
+                };
+                rungs.push(Rung {
+                    id,
+                    label: syn.label.as_ref().map(|l| l.to_string()),
+                    comment: syn.comment.as_ref().map(|c| c.to_string()),
+                    pou,
+                    series,
+                    path,
+                    network: None,
+                });
+            }
+        }
+        self.phase_end()?;
+        let mut program = Program {
+            name,
+            vars: self.vars,
+            pous,
+            rungs,
+        };
+        structure::check(&mut program)?;
+        Ok(program)
+    }
+
+    /// Pass 1: rung ids (program-wide) and labels (per POU); lowered FBD bodies: ids only, their
+    /// labels are resolved. Returns the ladder rungs of each POU and the number of rungs.
+    fn rung_heads(&mut self) -> (Vec<Vec<RungHead<'a>>>, u32) {
+        // Where each id was first used: (POU, index of its rung) for ladder rungs, the path of
+        // lowered rungs; rendered only for a duplicate.
+        let mut ids: FastMap<Cow<'a, str>, (usize, Option<usize>)> = FastMap::default();
+        let first_path = |pous: &[PouDraft], (pou, i): (usize, Option<usize>)| match i {
+            Some(i) => rung_path(&pous[pou].path, i),
+            None => String::new(),
+        };
+        let mut heads: Vec<Vec<RungHead<'a>>> = Vec::new();
+        let mut next_id = 0u32;
+        let mut errors = Vec::new();
+        for (pi, pou) in self.pous.iter().enumerate() {
+            let mut labels = FastMap::default();
+            let mut pou_heads = Vec::with_capacity(pou.rungs.len());
+            if let Some(lowered) = &pou.lowered {
+                for r in lowered {
+                    if let Some(&first) = ids.get(r.id.as_str()) {
+                        let first = match first {
+                            (p, None) => self.pous[p]
+                                .lowered
+                                .iter()
+                                .flatten()
+                                .find(|x| x.id == r.id)
+                                .map(|x| x.path.clone())
+                                .unwrap_or_default(),
+                            other => first_path(&self.pous, other),
+                        };
+                        errors.push(LoadError::invalid(
+                            Some(&r.id),
+                            &r.path,
+                            Invalid::DuplicateRung {
+                                id: r.id.clone(),
+                                first,
+                            },
+                        ));
+                    }
+                    ids.insert(Cow::Owned(r.id.clone()), (pi, None));
+                    next_id += 1;
+                }
+            }
+            for (i, r) in pou.rungs.iter().enumerate() {
+                let position = || r.origin.line_column(self.text);
+                let path = || rung_path(&pou.path, i);
+                let key: Cow<'a, str> = if pou.prefix.is_empty() {
+                    match &r.id {
+                        Cow::Borrowed(s) => Cow::Borrowed(s),
+                        Cow::Owned(s) => Cow::Owned(s.clone()),
+                    }
+                } else {
+                    Cow::Owned(format!("{}{}", pou.prefix, r.id))
+                };
+                let id = key.to_string();
+                if let Some(p) = &r.problem {
+                    let rung = r.problem_in_rung.then_some(id.as_str());
+                    let e =
+                        LoadError::invalid(rung, &format!("{}{}", path(), p.at), p.kind.clone());
+                    errors.push(e.at_position(position()));
+                    continue;
+                }
+                if let Some(&first) = ids.get(key.as_ref()) {
+                    let first = match first {
+                        (p, None) => self.pous[p]
+                            .lowered
+                            .iter()
+                            .flatten()
+                            .find(|x| x.id == id)
+                            .map(|x| x.path.clone())
+                            .unwrap_or_default(),
+                        other => first_path(&self.pous, other),
+                    };
+                    errors.push(
+                        LoadError::invalid(
+                            Some(&id),
+                            &format!("{}.id", path()),
+                            Invalid::DuplicateRung {
+                                id: id.clone(),
+                                first,
+                            },
+                        )
+                        .at_position(position()),
+                    );
+                    continue;
+                }
+                ids.insert(key, (pi, Some(i)));
+                let rid = RungId(next_id);
+                next_id += 1;
+                if let Some(l) = &r.label {
+                    let lp = format!("{}.label", path());
+                    if let Err(e) = check_name(l, &lp, Some(&id)) {
+                        errors.push(e.at_position(position()));
+                    } else if let Some(prev) = labels.insert(l.to_string(), rid) {
+                        let first = pou_heads
+                            .iter()
+                            .find(|h: &&RungHead| h.0 == prev)
+                            .map(|h| h.2.clone())
+                            .unwrap_or_default();
+                        errors.push(
+                            LoadError::invalid(
+                                Some(&id),
+                                &lp,
+                                Invalid::DuplicateLabel {
+                                    label: l.to_string(),
+                                    pou: pou.name.clone(),
+                                    first,
+                                },
+                            )
+                            .at_position(position()),
+                        );
+                    }
+                }
+                pou_heads.push((rid, r, id));
+            }
+            heads.push(pou_heads);
+            self.labels.push(labels);
+        }
+        for e in errors {
+            self.report(e);
+        }
+        (heads, next_id)
+    }
+}

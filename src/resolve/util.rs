@@ -1,0 +1,133 @@
+//! Small helpers of the resolver: names, paths, type expectations, and the description of a
+//! JSON value's kind (FBD bodies are still walked as JSON values).
+
+use super::Result;
+use crate::diag::{Invalid, LoadError};
+use crate::model::Type;
+use serde_json::Value as Json;
+
+/// A short description of a JSON value's kind, for error messages.
+pub(crate) fn kind_of(v: &Json) -> String {
+    match v {
+        Json::Null => "null".into(),
+        Json::Bool(b) => format!("boolean {b}"),
+        Json::Number(n) => format!("number {n}"),
+        Json::String(s) => format!("string \"{s}\""),
+        Json::Array(_) => "an array".into(),
+        Json::Object(_) => "an object".into(),
+    }
+}
+
+/// `path.key`, or `key` at the top level.
+pub(super) fn join(path: &str, key: &str) -> String {
+    if path.is_empty() {
+        key.to_owned()
+    } else {
+        format!("{path}.{key}")
+    }
+}
+
+pub(super) fn rung_path(pou_path: &str, i: usize) -> String {
+    if pou_path.is_empty() {
+        format!("rungs[{i}]")
+    } else {
+        format!("{pou_path}[{i}]")
+    }
+}
+
+pub(super) fn expect_type(
+    found: Type,
+    expected: Type,
+    what: &'static str,
+    name: &str,
+) -> std::result::Result<(), Invalid> {
+    if found == expected {
+        Ok(())
+    } else {
+        Err(Invalid::Type {
+            what,
+            expected: expected.to_string(),
+            operand: name.to_owned(),
+            found: found.to_string(),
+        })
+    }
+}
+
+pub(super) fn check_name(name: &str, path: &str, rung: Option<&str>) -> Result<()> {
+    let mut chars = name.chars();
+    let ok = matches!(chars.next(), Some(c) if c.is_ascii_alphabetic() || c == '_')
+        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_');
+    if ok {
+        Ok(())
+    } else {
+        Err(LoadError::invalid(
+            rung,
+            path,
+            Invalid::BadName { name: name.into() },
+        ))
+    }
+}
+
+/// A fast, non-cryptographic hasher for the resolver's name tables (the multiply-rotate hash of
+/// Firefox and rustc): names come from one trusted file, and SipHash's resistance to chosen
+/// collisions is not worth its cost on millions of lookups.
+#[derive(Default, Clone, Copy)]
+pub(crate) struct FxHasher {
+    hash: u64,
+}
+
+impl FxHasher {
+    #[inline]
+    fn add(&mut self, word: u64) {
+        self.hash = (self.hash.rotate_left(5) ^ word).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+}
+
+impl std::hash::Hasher for FxHasher {
+    #[inline]
+    fn write(&mut self, bytes: &[u8]) {
+        let mut chunks = bytes.chunks_exact(8);
+        for c in &mut chunks {
+            let mut w = [0u8; 8];
+            w.copy_from_slice(c);
+            self.add(u64::from_le_bytes(w));
+        }
+        let rest = chunks.remainder();
+        if !rest.is_empty() {
+            let mut w = [0u8; 8];
+            w[..rest.len()].copy_from_slice(rest);
+            self.add(u64::from_le_bytes(w));
+        }
+    }
+    #[inline]
+    fn write_u8(&mut self, i: u8) {
+        self.add(i as u64);
+    }
+    #[inline]
+    fn write_u32(&mut self, i: u32) {
+        self.add(i as u64);
+    }
+    #[inline]
+    fn write_u64(&mut self, i: u64) {
+        self.add(i);
+    }
+    #[inline]
+    fn write_usize(&mut self, i: usize) {
+        self.add(i as u64);
+    }
+    /// With a final mix (MurmurHash3's): the multiply leaves the low bits, which pick the
+    /// bucket, poorly mixed, and ids like `R1`…`R1000000` would collide.
+    #[inline]
+    fn finish(&self) -> u64 {
+        let mut h = self.hash;
+        h ^= h >> 33;
+        h = h.wrapping_mul(0xff51_afd7_ed55_8ccd);
+        h ^ (h >> 33)
+    }
+}
+
+/// A `HashMap` with [`FxHasher`].
+pub(crate) type FastMap<K, V> =
+    std::collections::HashMap<K, V, std::hash::BuildHasherDefault<FxHasher>>;
+/// A `HashSet` with [`FxHasher`].
+pub(crate) type FastSet<K> = std::collections::HashSet<K, std::hash::BuildHasherDefault<FxHasher>>;

@@ -1,0 +1,185 @@
+//! Variable declarations (`vars`, and a function block's `inputs`/`outputs`/`vars`): names,
+//! types, classes, initial values; instances of user function blocks are recorded for later.
+
+use super::util::check_name;
+use super::{Builder, InstanceDraft, Result};
+use crate::diag::{Invalid, LoadError};
+use crate::model::*;
+use crate::resolve::operand;
+use crate::syntax;
+
+impl<'a> Builder<'a> {
+    /// Declares the variables of a scope: the program's (`scope` None) or a POU's, whose display
+    /// names get the prefix (`SBR:`, or `G1.` for an instance). `elementary`: only BOOL, INT,
+    /// DINT, REAL, TIME (inputs and outputs of function blocks). Variables of a user function block
+    /// type are instances: recorded in `pending`, given their POU by [`Self::expand`]. Every
+    /// declaration's problem is reported; the others are still declared.
+    pub(super) fn declare_vars(
+        &mut self,
+        vars: &[syntax::Var],
+        path: &str,
+        scope: Option<(PouId, String)>,
+        elementary: bool,
+    ) {
+        for (i, v) in vars.iter().enumerate() {
+            let p = format!("{path}[{i}]");
+            let r = self.declare_var(v, p, &scope, elementary);
+            if let Err(e) = r {
+                self.report(e.at_position(v.origin.line_column(self.text)));
+            }
+        }
+    }
+
+    fn declare_var(
+        &mut self,
+        v: &syntax::Var,
+        p: String,
+        scope: &Option<(PouId, String)>,
+        elementary: bool,
+    ) -> Result<()> {
+        if let Some(problem) = &v.problem {
+            return Err(LoadError::invalid(
+                None,
+                &format!("{p}{}", problem.at),
+                problem.kind.clone(),
+            ));
+        }
+        let name: &str = &v.name;
+        check_name(name, &format!("{p}.name"), None)?;
+        let tname: &str = &v.ty;
+        let user_fb = Type::parse(tname).is_none() && self.fb_index.contains_key(tname);
+        let ty = match Type::parse(tname) {
+            Some(t) => t,
+            None if user_fb => Type::Fb(FbKind::Ton), // placeholder: instances are not variables
+            None if !self.fb_types.is_empty() => {
+                let fbs = self
+                    .fb_types
+                    .iter()
+                    .map(|f| f.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ");
+                return Err(LoadError::invalid(
+                    None,
+                    &format!("{p}.type"),
+                    Invalid::UnknownTypeOrFb {
+                        name: tname.into(),
+                        fbs,
+                    },
+                ));
+            }
+            None => {
+                return Err(LoadError::invalid(
+                    None,
+                    &format!("{p}.type"),
+                    Invalid::UnknownType { name: tname.into() },
+                ))
+            }
+        };
+        if elementary && matches!(ty, Type::Fb(_)) {
+            return Err(LoadError::invalid(
+                None,
+                &format!("{p}.type"),
+                Invalid::Misplaced {
+                    what: "a function block type",
+                    place:
+                        "as an input or output of a function block (declare the instance in `vars`)",
+                },
+            ));
+        }
+        let class = match v.class {
+            syntax::VarClass::Input => VarClass::Input,
+            syntax::VarClass::Output => VarClass::Output,
+            syntax::VarClass::Memory | syntax::VarClass::Default => VarClass::Memory,
+        };
+        if matches!(ty, Type::Fb(_)) && class != VarClass::Memory {
+            return Err(LoadError::invalid(
+                None,
+                &format!("{p}.class"),
+                Invalid::Misplaced {
+                    what: "an input or output class",
+                    place: "on a function block instance",
+                },
+            ));
+        }
+        let init = match &v.init {
+            None => ty.zero(),
+            Some(_) if matches!(ty, Type::Fb(_)) => {
+                return Err(LoadError::invalid(
+                    None,
+                    &format!("{p}.init"),
+                    Invalid::Misplaced {
+                        what: "`init`",
+                        place: "on a function block instance",
+                    },
+                ))
+            }
+            Some(j) => {
+                let ip = format!("{p}.init");
+                let u = operand::parse(j, &|n| {
+                    Err(Invalid::Shape {
+                        expected: "a constant",
+                        found: format!("name \"{n}\""),
+                    })
+                })
+                .map_err(|k| LoadError::invalid(None, &ip, k))?;
+                match operand::typed(&u, ty, "the initial value", &j.json()) {
+                    Ok(Operand::Const(v)) => v,
+                    Ok(Operand::Var(_)) => {
+                        return Err(LoadError::invalid(
+                            None,
+                            &ip,
+                            Invalid::Shape {
+                                expected: "a constant",
+                                found: j.kind(),
+                            },
+                        ))
+                    }
+                    Err(k) => return Err(LoadError::invalid(None, &ip, k)),
+                }
+            }
+        };
+        let (table, instances) = match scope {
+            None => (&mut self.globals, &mut self.global_instances),
+            Some((p, _)) => (
+                &mut self.locals[p.index()],
+                &mut self.local_instances[p.index()],
+            ),
+        };
+        if table.contains_key(name) || instances.contains_key(name) {
+            return Err(LoadError::invalid(
+                None,
+                &format!("{p}.name"),
+                Invalid::DuplicateVar { name: name.into() },
+            ));
+        }
+        let display = match scope {
+            None => name.to_owned(),
+            Some((_, prefix)) => format!("{prefix}{name}"),
+        };
+        if user_fb {
+            let idx = self.instances.len();
+            instances.insert(name.to_owned(), idx);
+            self.instances.push(InstanceDraft {
+                display,
+                fb: tname.to_owned(),
+                path: p.clone(),
+                pou: None,
+                inputs: Vec::new(),
+                outputs: Vec::new(),
+            });
+            self.pending.push(idx);
+            return Ok(());
+        }
+        let id = VarId(self.vars.len() as u32);
+        table.insert(name.to_owned(), id);
+        self.vars.push(Var {
+            name: display,
+            ty,
+            class,
+            init,
+            scope: scope.as_ref().map(|(p, _)| *p),
+            hidden: false,
+        });
+        Ok(())
+    }
+}

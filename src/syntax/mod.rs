@@ -1,0 +1,327 @@
+//! The surface syntax: what a program file says, before any name is resolved.
+//!
+//! Plain, format-neutral types for IEC 61131-3 program organisation units (clause 6.6: the
+//! program, function block types, subroutines called like functions), their variable
+//! declarations (6.5), ladder rungs with their series/parallel element trees (clause 8.2, LD) and
+//! FBD bodies (8.3) kept as written. A reader (today `crate::read::json`; a PLCopen XML or STL
+//! reader would fill the same types) produces them; `crate::resolve` turns them into the model.
+//!
+//! Invariants: every string borrows from the source text where it can (`Cow`); every node that
+//! has a place of its own in the file (POU, variable, rung, FBD body) carries an [`Origin`] — a
+//! byte offset, 4 bytes — from which line and column are computed only when an error is reported.
+//! A node's JSON path is its position in this tree (`rungs[2].ld[1].or[0][0]` is rung 2, element
+//! 1, branch 0, element 0): the resolver renders it from the indices it walks, only on error, so
+//! a million rungs cost no path strings. What the reader found malformed stays in the tree as a
+//! [`Problem`] (where, relative to the node, and what), so that errors come out in program order
+//! with the rung id known, and reading goes on after the first one.
+//!
+//! Deliberately not here: name resolution, types of operands, structural rules (those are the
+//! resolver's), and anything JSON-specific beyond [`Scalar`] (a leaf as written, for messages).
+
+use crate::diag::Invalid;
+use crate::model::{ArithOp, CmpOp, TimerKind};
+use std::borrow::Cow;
+
+/// A string of the source text (borrowed unless it had escapes).
+pub type Text<'a> = Cow<'a, str>;
+
+/// Where a node starts in the source text: a byte offset (none for nodes made up by a reader).
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
+pub struct Origin {
+    pub offset: Option<u32>,
+}
+
+impl Origin {
+    pub const NONE: Origin = Origin { offset: None };
+
+    pub fn at(offset: usize) -> Origin {
+        Origin {
+            offset: u32::try_from(offset).ok(),
+        }
+    }
+
+    /// 1-based line and column (in characters) of the node in `text`.
+    pub fn line_column(self, text: &str) -> Option<(u32, u32)> {
+        let offset = self.offset? as usize;
+        let before = text.get(..offset)?;
+        let line = before.bytes().filter(|&b| b == b'\n').count() + 1;
+        let start = before.rfind('\n').map_or(0, |i| i + 1);
+        let column = before[start..].chars().count() + 1;
+        Some((line as u32, column as u32))
+    }
+}
+
+/// Something the reader found malformed: where (a path suffix relative to the node that holds
+/// it, e.g. `.negated`, `.in[1]`, or "" for the node itself) and what.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Problem {
+    pub at: String,
+    pub kind: Invalid,
+}
+
+impl Problem {
+    pub fn new(at: impl Into<String>, kind: Invalid) -> Box<Problem> {
+        Box::new(Problem {
+            at: at.into(),
+            kind,
+        })
+    }
+}
+
+/// A leaf value as the file wrote it: operands, initial values, and the "found …" of messages.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Scalar<'a> {
+    Null,
+    Bool(bool),
+    Number(serde_json::Number),
+    Str(Text<'a>),
+    /// An array or object where a leaf was expected (its contents are not kept).
+    Array,
+    Object,
+}
+
+impl Scalar<'_> {
+    /// A short description of the value's kind, for messages (`number 5`, `an array`).
+    pub fn kind(&self) -> String {
+        match self {
+            Scalar::Null => "null".into(),
+            Scalar::Bool(b) => format!("boolean {b}"),
+            Scalar::Number(n) => format!("number {n}"),
+            Scalar::Str(s) => format!("string \"{s}\""),
+            Scalar::Array => "an array".into(),
+            Scalar::Object => "an object".into(),
+        }
+    }
+
+    /// The value as messages quote an operand: strings bare, the rest as JSON.
+    pub fn display(&self) -> String {
+        match self {
+            Scalar::Str(s) => s.to_string(),
+            other => other.json(),
+        }
+    }
+
+    /// The value as JSON text.
+    pub fn json(&self) -> String {
+        match self {
+            Scalar::Null => "null".into(),
+            Scalar::Bool(b) => b.to_string(),
+            Scalar::Number(n) => n.to_string(),
+            Scalar::Str(s) => serde_json::Value::String(s.to_string()).to_string(),
+            Scalar::Array => "[…]".into(),
+            Scalar::Object => "{…}".into(),
+        }
+    }
+
+    pub fn as_str(&self) -> Option<&str> {
+        match self {
+            Scalar::Str(s) => Some(s),
+            _ => None,
+        }
+    }
+
+    pub fn into_owned(self) -> Scalar<'static> {
+        match self {
+            Scalar::Null => Scalar::Null,
+            Scalar::Bool(b) => Scalar::Bool(b),
+            Scalar::Number(n) => Scalar::Number(n),
+            Scalar::Str(s) => Scalar::Str(Cow::Owned(s.into_owned())),
+            Scalar::Array => Scalar::Array,
+            Scalar::Object => Scalar::Object,
+        }
+    }
+}
+
+/// A whole program file.
+#[derive(Clone, Debug, Default)]
+pub struct Program<'a> {
+    pub name: Text<'a>,
+    pub comment: Option<Text<'a>>,
+    /// The program-wide variables.
+    pub vars: Vec<Var<'a>>,
+    /// The main program's body (`None`: the file has none, a problem is recorded).
+    pub body: Option<Body<'a>>,
+    pub subroutines: Vec<Subroutine<'a>>,
+    pub function_blocks: Vec<FunctionBlock<'a>>,
+    /// Problems of the program object itself and of its non-rung parts, with absolute paths.
+    pub problems: Vec<Problem>,
+}
+
+/// A POU's body: ladder rungs or an FBD body.
+#[derive(Clone, Debug)]
+pub enum Body<'a> {
+    Rungs(Vec<Rung<'a>>),
+    Fbd(FbdBody<'a>),
+}
+
+/// A subroutine (called by `call`; IEC 61131-3 would make it a function without result).
+#[derive(Clone, Debug)]
+pub struct Subroutine<'a> {
+    pub origin: Origin,
+    pub name: Text<'a>,
+    pub vars: Vec<Var<'a>>,
+    pub body: Option<Body<'a>>,
+}
+
+/// A user function block type (IEC 61131-3 6.6.3): its interface, its own data and its body.
+#[derive(Clone, Debug)]
+pub struct FunctionBlock<'a> {
+    pub origin: Origin,
+    pub name: Text<'a>,
+    pub inputs: Vec<Var<'a>>,
+    pub outputs: Vec<Var<'a>>,
+    pub vars: Vec<Var<'a>>,
+    pub body: Option<Body<'a>>,
+}
+
+/// A variable declaration as written (the type is a name: resolved against the standard types and
+/// the file's function block types).
+#[derive(Clone, Debug)]
+pub struct Var<'a> {
+    pub origin: Origin,
+    pub name: Text<'a>,
+    pub ty: Text<'a>,
+    pub class: VarClass,
+    pub init: Option<Scalar<'a>>,
+    /// Something malformed in the declaration (then the fields may be defaults).
+    pub problem: Option<Box<Problem>>,
+}
+
+/// The declared class of a variable (`class`); `Memory` when absent.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum VarClass {
+    Input,
+    Output,
+    Memory,
+    /// No `class` given.
+    Default,
+}
+
+/// A ladder rung.
+#[derive(Clone, Debug)]
+pub struct Rung<'a> {
+    pub origin: Origin,
+    pub id: Text<'a>,
+    pub label: Option<Text<'a>>,
+    pub comment: Option<Text<'a>>,
+    pub ld: Series<'a>,
+    /// Something malformed in the rung object; `problem_in_rung`: the message names the rung id.
+    pub problem: Option<Box<Problem>>,
+    pub problem_in_rung: bool,
+}
+
+/// A series of elements, power flowing left to right.
+pub type Series<'a> = Vec<Element<'a>>;
+
+/// A ladder element as written (IEC 61131-3 8.2: contacts, coils, function block and function
+/// calls; the control elements of S7-200: jumps, return, end, calls, FOR/NEXT). Kinds with
+/// operands are boxed, so that the common contacts and coils take 32 bytes.
+#[derive(Clone, Debug)]
+pub enum Element<'a> {
+    Contact {
+        var: Text<'a>,
+        negated: bool,
+        edge: Option<Edge>,
+    },
+    Compare(Box<Compare<'a>>),
+    Or(Vec<Series<'a>>),
+    Coil {
+        var: Text<'a>,
+        negated: bool,
+    },
+    Set(Text<'a>),
+    Reset(Text<'a>),
+    Branch(Vec<Series<'a>>),
+    Timer(Box<Timer<'a>>),
+    /// CTU (`load` false: `aux` is R) or CTD (`aux` is LD).
+    Counter(Box<Counter<'a>>),
+    Move(Box<Move<'a>>),
+    Arith(Box<Arith<'a>>),
+    Jmp(Text<'a>),
+    Ret,
+    End,
+    Call(Text<'a>),
+    For(Box<For<'a>>),
+    Next,
+    /// The element is malformed (`at` is relative to the element).
+    Invalid(Box<Problem>),
+}
+
+/// `{"compare": OP, "a": A, "b": B}`.
+#[derive(Clone, Debug)]
+pub struct Compare<'a> {
+    pub op: CmpOp,
+    pub a: Scalar<'a>,
+    pub b: Scalar<'a>,
+}
+
+/// `{"ton": T, "pt": PT}` and TOF, TP.
+#[derive(Clone, Debug)]
+pub struct Timer<'a> {
+    pub kind: TimerKind,
+    pub instance: Text<'a>,
+    pub pt: Scalar<'a>,
+}
+
+/// `{"ctu": C, "pv": PV, "reset": R}` or `{"ctd": C, "pv": PV, "load": LD}`.
+#[derive(Clone, Debug)]
+pub struct Counter<'a> {
+    pub down: bool,
+    pub instance: Text<'a>,
+    pub pv: Scalar<'a>,
+    /// R of a CTU, LD of a CTD.
+    pub aux: Scalar<'a>,
+}
+
+/// `{"move": FROM, "to": TO}`.
+#[derive(Clone, Debug)]
+pub struct Move<'a> {
+    pub from: Scalar<'a>,
+    pub to: Text<'a>,
+}
+
+/// `{"op": OP, "in": [A, B], "out": OUT}`.
+#[derive(Clone, Debug)]
+pub struct Arith<'a> {
+    pub op: ArithOp,
+    pub a: Scalar<'a>,
+    pub b: Scalar<'a>,
+    pub out: Text<'a>,
+}
+
+/// `{"for": {"var": V, "from": A, "to": B}}`.
+#[derive(Clone, Debug)]
+pub struct For<'a> {
+    pub var: Text<'a>,
+    pub from: Scalar<'a>,
+    pub to: Scalar<'a>,
+}
+
+/// The edge of an edge contact.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum Edge {
+    Rising,
+    Falling,
+}
+
+/// An FBD body as written. Today the JSON reader keeps it as the text of its `fbd` value and
+/// `crate::resolve` reads networks from it (FBD bodies are small next to ladder programs).
+#[derive(Clone, Debug)]
+pub struct FbdBody<'a> {
+    pub origin: Origin,
+    /// The JSON text of the body (`{"networks": [...]}`).
+    pub text: &'a str,
+}
+
+impl<'a> Element<'a> {
+    /// True for the conditions (allowed inside `or`).
+    pub fn is_condition(&self) -> bool {
+        matches!(
+            self,
+            Element::Contact { .. } | Element::Compare(_) | Element::Or(_)
+        )
+    }
+}
+
+// The common elements stay small: a million-rung program holds millions of them.
+const _: () = assert!(std::mem::size_of::<Element>() <= 32);
