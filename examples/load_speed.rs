@@ -1,7 +1,7 @@
 //! Load speed and memory of the reader and resolver alone, on a file:
-//! `PLC_LOAD_FILE=/tmp/g1m.json cargo test --release --test load_speed -- --ignored --nocapture`
-//! (run the test binary under `/usr/bin/time -v` for the peak memory). Ignored by default: it
-//! needs a generated file (`plc-deps gen --rungs 1000000 --width 5000 -o /tmp/g1m.json`).
+//! `cargo run --release --example load_speed -- /tmp/g1m.json 3` (run the built example under
+//! `/usr/bin/time -v` for the peak memory), after
+//! `plc-deps gen --rungs 1000000 --width 5000 -o /tmp/g1m.json`.
 
 // The command line's allocator, so that the figures are the command line's.
 #[global_allocator]
@@ -9,18 +9,14 @@ static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 use std::time::Instant;
 
-#[test]
-#[ignore]
-fn load_file() {
-    let Ok(path) = std::env::var("PLC_LOAD_FILE") else {
-        eprintln!("set PLC_LOAD_FILE");
-        return;
+fn main() {
+    let mut args = std::env::args().skip(1);
+    let Some(path) = args.next() else {
+        eprintln!("usage: load_speed FILE [RUNS]");
+        std::process::exit(2);
     };
     let text = std::fs::read_to_string(&path).expect("read the file");
-    let runs: usize = std::env::var("PLC_LOAD_RUNS")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(1);
+    let runs: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(1);
     for _ in 0..runs {
         let t = Instant::now();
         let syntax = plc_deps::read::json::parse(&text).expect("parses");
