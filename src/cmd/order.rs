@@ -25,9 +25,9 @@ pub struct OrderConfig {
 /// Renders the execution order and fragment trees of a program's FBD networks.
 pub fn render_order(p: &Program, fbd: &crate::fbd::Fbd, format: OrderFormat) -> String {
     match format {
-        OrderFormat::Text => crate::fbd::render_order_text(p, fbd),
-        OrderFormat::Json => crate::fbd::render_order_json(p, fbd),
-        OrderFormat::Dot => crate::fbd::render_order_dot(p, fbd),
+        OrderFormat::Text => crate::report::order::render_order_text(p, fbd),
+        OrderFormat::Json => crate::report::order::render_order_json(p, fbd),
+        OrderFormat::Dot => crate::report::order::render_order_dot(p, fbd),
     }
 }
 

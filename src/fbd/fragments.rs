@@ -1,4 +1,4 @@
-//! Conditional fragments of a network (seed 000) and the regrouped execution order.
+//! Conditional fragments of a network (the FBD text-generation paper) and the regrouped execution order.
 //!
 //! Blocks are taken in topological order. A block's *data fragment* FD is the deepest fragment
 //! among those of the blocks it depends on: its data arcs, its conditional arc and a control arc
@@ -14,7 +14,7 @@
 //! - any other block joins FD.
 //!
 //! Then the rule: a block may depend (data arc, conditional arc, one-source control arc) only on
-//! blocks of its own fragment or of its ancestors; otherwise the generator of seed 000 refuses the
+//! blocks of its own fragment or of its ancestors; otherwise the paper's generator refuses the
 //! network, naming both blocks and fragments.
 //!
 //! Regrouping: inside each fragment, its own blocks and its child fragments (each as one item)

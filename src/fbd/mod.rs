@@ -1,5 +1,5 @@
 //! Function block diagrams (FBD): a first-class input, read into their own model, ordered and
-//! split into conditional fragments (seed 000), then lowered into the ladder model so that the
+//! split into conditional fragments (the FBD text-generation paper), then lowered into the ladder model so that the
 //! analyses, `plc-deps report`, the interpreter and the parallel executor work on them unchanged.
 //!
 //! - [`model`]: networks, blocks (dense [`BlockId`] indices, sorted by the user's id), arcs, and
@@ -7,22 +7,20 @@
 //! - [`order`]: depth-first topological sort, O(V + E), ties by block id, cycles reported;
 //! - [`fragments`]: the conditional fragment tree, the rule of conditional fragments, the
 //!   regrouped order;
-//! - [`render`]: `plc-deps order` as text, JSON and DOT.
 //!
 //! Only the model and the pure algorithms live here: reading FBD bodies and lowering them into
-//! rungs is the resolver's (`crate::resolve`), which calls [`plan`]. The format and every
+//! rungs is the resolver's (`crate::resolve`), which calls [`plan`]; `plc-deps order` renders
+//! them (`crate::report::order`). The format and every
 //! lowering rule are in docs/fbd.md.
 
 pub mod fragments;
 pub mod model;
 pub mod order;
-pub mod render;
 
 /// The longest time an accumulation (TSTART/TSTOP) can run (the TIME range): the PT of its
 /// hidden TON.
 pub const ACCUMULATE_PT_MS: i32 = i32::MAX;
 pub use model::*;
-pub use render::{render_order_dot, render_order_json, render_order_text};
 
 use crate::diag::{Invalid, LoadError};
 

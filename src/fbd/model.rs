@@ -349,7 +349,7 @@ impl Op {
     }
 }
 
-/// The execution order and conditional fragments of one network (seed 000).
+/// The execution order and conditional fragments of one network (the FBD text-generation paper).
 #[derive(Clone, Debug)]
 pub struct Plan {
     /// The depth-first topological order (before regrouping).

@@ -1,4 +1,4 @@
-//! Execution order of a network: depth-first topological sort (seed 000), O(V + E).
+//! Execution order of a network: depth-first topological sort (the FBD text-generation paper), O(V + E).
 //!
 //! The search runs on the *predecessor* graph (a block's inputs first), so a block is placed
 //! when the processing of all blocks it depends on has ended — the seed's "no element runs before

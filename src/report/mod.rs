@@ -12,6 +12,7 @@ pub mod document;
 mod dot;
 mod explain;
 mod json;
+pub mod order;
 pub mod text;
 
 pub use document::{document, document_with, Report};

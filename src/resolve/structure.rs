@@ -1,7 +1,7 @@
 //! Structural checks that need the whole resolved program: FOR/NEXT pairing and nesting, no jump
 //! into a FOR body from outside it, no recursive subroutine calls.
 //!
-//! S7-200 rules (seed 004's instruction set): FOR/NEXT pairs nest like brackets inside one POU;
+//! S7-200 rules (the instruction set of Zhao & Yan's S7-200 examples): FOR/NEXT pairs nest like brackets inside one POU;
 //! a jump may leave a loop body but not enter one (the loop head would be bypassed); subroutines
 //! may nest but not recurse (the call graph is acyclic, which also keeps every CALL's access
 //! summary finite).

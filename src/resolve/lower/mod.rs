@@ -7,7 +7,7 @@
 //! subroutine, `G1.` in an instance), written once per run of the block, so arcs are ordinary
 //! flow dependences. Timers and counters are read through their instance (`T1.Q`, `T1.ET`).
 //!
-//! A conditional fragment becomes an `if` block as seed 000 generates it: a guard rung
+//! A conditional fragment becomes an `if` block as the FBD text-generation paper generates it: a guard rung
 //! `<network>.<fragment>` = `[contact cond negated, jmp <landing>]` before its body and an empty
 //! landing rung `<network>.<fragment>.end` after it, so the CFG's control dependences inside a
 //! network are exactly the fragment tree. A compound fragment tests a hidden run flag

@@ -4,8 +4,8 @@
 //! IN/OUT of blocks and networks come from `analysis::accesses` on the lowered program: the
 //! rung a block became (per instance, for a function block type).
 
-use super::model::*;
 use crate::analysis::{accesses, Accesses};
+use crate::fbd::*;
 use crate::model::{Program, RungId, VarId};
 use serde_json::{json, Value as Json};
 use std::fmt::Write;
@@ -14,7 +14,7 @@ use std::fmt::Write;
 pub fn render_order_text(p: &Program, fbd: &Fbd) -> String {
     let acc = accesses(p);
     let mut o = String::new();
-    let _ = writeln!(o, "{}: FBD execution order (depth-first topological sort, ties by block id; conditional fragments of seed 000)", p.name);
+    let _ = writeln!(o, "{}: FBD execution order (depth-first topological sort, ties by block id; conditional fragments as in the FBD text-generation paper)", p.name);
     if fbd.pous.is_empty() {
         let _ = writeln!(o, "\nno FBD bodies (the program is ladder only)");
         return o;
