@@ -88,6 +88,10 @@ pub struct Report<'a> {
     pub post_dominator_tree: Lazy<'a, TreeNode<'a>>,
     #[serde(skip)]
     pub control_count: usize,
+    /// The tasks level by level (sequential order inside a level), as the text report lists
+    /// them.
+    #[serde(skip)]
+    pub tasks_by_level: Lazy<'a, TaskEntry<'a>>,
 }
 
 /// An FBD program as written: its blocks and networks, and the rungs its lowering added.
@@ -473,24 +477,28 @@ pub fn document_with<'a>(p: &'a Program, a: &'a Analysis, fbd: Option<&'a FbdPar
         makespan: PerCores(c.makespan.clone()),
         level_makespan: PerCores(c.level_makespan.clone()),
     };
-    let tasks = Lazy::new(s.tasks.len(), move || {
-        s.tasks.iter().map(move |t| TaskEntry {
-            rungs: t.rungs.iter().map(|&r| id(r)).collect(),
-            is_loop: t.is_loop,
-            level: t.level + 1,
-            entries: t.entries.iter().map(|&r| id(r)).collect(),
-            guard: t
-                .guard
-                .iter()
-                .map(|g| GuardEntry {
-                    controller: id(s.head(g.controller)),
-                    successor: match g.successor {
-                        Successor::Task(x) => id(s.head(x)),
-                        Successor::Stop => "STOP",
-                    },
-                })
-                .collect(),
-        })
+    let task_entry = move |t: &'a crate::analysis::Task| TaskEntry {
+        rungs: t.rungs.iter().map(|&r| id(r)).collect(),
+        is_loop: t.is_loop,
+        level: t.level + 1,
+        entries: t.entries.iter().map(|&r| id(r)).collect(),
+        guard: t
+            .guard
+            .iter()
+            .map(|g| GuardEntry {
+                controller: id(s.head(g.controller)),
+                successor: match g.successor {
+                    Successor::Task(x) => id(s.head(x)),
+                    Successor::Stop => "STOP",
+                },
+            })
+            .collect(),
+    };
+    let tasks = Lazy::new(s.tasks.len(), move || s.tasks.iter().map(task_entry));
+    let order = std::rc::Rc::new(s.levels.concat());
+    let tasks_by_level = Lazy::new(s.tasks.len(), move || {
+        let order = order.clone();
+        (0..order.len()).map(move |i| task_entry(&s.tasks[order[i] as usize]))
     });
     let loops = s
         .tasks
@@ -601,6 +609,7 @@ pub fn document_with<'a>(p: &'a Program, a: &'a Analysis, fbd: Option<&'a FbdPar
         },
         post_dominator_tree,
         control_count,
+        tasks_by_level,
     }
 }
 

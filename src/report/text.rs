@@ -626,9 +626,7 @@ fn tasks(r: &Report, o: &TextOptions, out: &mut impl Write) -> io::Result<()> {
         "\nCombined schedule tasks (a task runs when its guard holds; \"always\" otherwise)"
     )?;
     let mut t = Table::new(&["level", "task", "guard"]);
-    // Listed level by level, as the levels are (tasks are stored in sequential order).
-    let mut all: Vec<_> = r.schedule.tasks.iter().collect();
-    all.sort_by_key(|t| t.level);
+    let all = &r.tasks_by_level;
     let shown = all.len().min(o.limit());
     for task in all.iter().take(shown) {
         let guard = if task.guard.is_empty() {
