@@ -431,32 +431,7 @@ pub fn document_with<'a>(p: &'a Program, a: &'a Analysis, fbd: Option<&'a FbdPar
             })
     });
 
-    let groups = |levels: &[u32]| -> Vec<Vec<&'a str>> {
-        super::rung_groups(levels)
-            .into_iter()
-            .map(|g| g.into_iter().map(id).collect())
-            .collect()
-    };
-    let combined = super::combined_groups(a)
-        .into_iter()
-        .map(|level| {
-            level
-                .into_iter()
-                .map(|task| {
-                    if task.len() == 1 {
-                        TaskName::Rung(id(task[0]))
-                    } else {
-                        TaskName::Loop(task.into_iter().map(id).collect())
-                    }
-                })
-                .collect()
-        })
-        .collect();
-    let levels = Levels {
-        data: groups(&a.data_levels),
-        control: groups(&a.control_levels),
-        combined,
-    };
+    let levels = levels_of(p, a);
     let count = |levels: &[u32]| levels.iter().map(|&l| l as usize + 1).max().unwrap_or(0);
     let s = &a.schedule;
     let cycles = Cycles {
@@ -465,18 +440,7 @@ pub fn document_with<'a>(p: &'a Program, a: &'a Analysis, fbd: Option<&'a FbdPar
         control: count(&a.control_levels),
         combined: s.levels.len(),
     };
-    let c = &a.cost;
-    let cost = Cost {
-        work: c.work,
-        span: c.span,
-        ideal_speedup: if c.span == 0 {
-            0.0
-        } else {
-            round3(c.work as f64 / c.span as f64)
-        },
-        makespan: PerCores(c.makespan.clone()),
-        level_makespan: PerCores(c.level_makespan.clone()),
-    };
+    let cost = cost_of(a);
     let task_entry = move |t: &'a crate::analysis::Task| TaskEntry {
         rungs: t.rungs.iter().map(|&r| id(r)).collect(),
         is_loop: t.is_loop,
@@ -532,47 +496,7 @@ pub fn document_with<'a>(p: &'a Program, a: &'a Analysis, fbd: Option<&'a FbdPar
         })
         .collect();
 
-    let of_part = |part: RungPart| -> Vec<&'a str> {
-        fbd.map(|f| {
-            p.rung_ids()
-                .filter(|r| f.parts[r.index()] == part)
-                .map(id)
-                .collect()
-        })
-        .unwrap_or_default()
-    };
-    let fbd_section = fbd.map(|f| FbdSection {
-        blocks: f.blocks,
-        networks: f.networks,
-        fragment_guards: of_part(RungPart::FragmentGuard),
-        fragment_ends: of_part(RungPart::FragmentEnd),
-    });
-    let shown_levels = fbd.map(|f| {
-        let landings = landing_names(p, f);
-        let shown = |r: &&'a str| !landings.contains(r);
-        let keep = |g: &Vec<Vec<&'a str>>| -> Vec<Vec<&'a str>> {
-            g.iter()
-                .map(|l| l.iter().copied().filter(shown).collect())
-                .collect()
-        };
-        Levels {
-            data: keep(&levels.data),
-            control: keep(&levels.control),
-            combined: levels
-                .combined
-                .iter()
-                .map(|l| {
-                    l.iter()
-                        .filter(|t| !matches!(t, TaskName::Rung(x) if !shown(x)))
-                        .map(|t| match t {
-                            TaskName::Rung(x) => TaskName::Rung(x),
-                            TaskName::Loop(xs) => TaskName::Loop(xs.clone()),
-                        })
-                        .collect()
-                })
-                .collect(),
-        }
-    });
+    let (fbd_section, shown_levels) = fbd_of(p, fbd, &levels);
 
     Report {
         program: &p.name,
@@ -619,4 +543,104 @@ fn landing_names<'a>(p: &'a Program, f: &FbdParts) -> std::collections::HashSet<
         .filter(|r| f.parts[r.index()] == RungPart::FragmentEnd)
         .map(|r| p.rung(r).id.as_str())
         .collect()
+}
+
+/// The three levellings, rung ids per level (a loop task of the combined schedule as one list).
+fn levels_of<'a>(p: &'a Program, a: &'a Analysis) -> Levels<'a> {
+    let id = move |r: RungId| p.rung(r).id.as_str();
+    let groups = |levels: &[u32]| -> Vec<Vec<&'a str>> {
+        super::rung_groups(levels)
+            .into_iter()
+            .map(|g| g.into_iter().map(id).collect())
+            .collect()
+    };
+    let combined = super::combined_groups(a)
+        .into_iter()
+        .map(|level| {
+            level
+                .into_iter()
+                .map(|task| {
+                    if task.len() == 1 {
+                        TaskName::Rung(id(task[0]))
+                    } else {
+                        TaskName::Loop(task.into_iter().map(id).collect())
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    let levels = Levels {
+        data: groups(&a.data_levels),
+        control: groups(&a.control_levels),
+        combined,
+    };
+    levels
+}
+
+/// The cost model's figures of the combined schedule.
+fn cost_of(a: &Analysis) -> Cost {
+    let c = &a.cost;
+    let cost = Cost {
+        work: c.work,
+        span: c.span,
+        ideal_speedup: if c.span == 0 {
+            0.0
+        } else {
+            round3(c.work as f64 / c.span as f64)
+        },
+        makespan: PerCores(c.makespan.clone()),
+        level_makespan: PerCores(c.level_makespan.clone()),
+    };
+    cost
+}
+
+/// The FBD section and the levels without the lowering's landing rungs (`None` without FBD).
+fn fbd_of<'a>(
+    p: &'a Program,
+    fbd: Option<&'a FbdParts>,
+    levels: &Levels<'a>,
+) -> (Option<FbdSection<'a>>, Option<Levels<'a>>) {
+    let id = move |r: RungId| p.rung(r).id.as_str();
+    let of_part = |part: RungPart| -> Vec<&'a str> {
+        fbd.map(|f| {
+            p.rung_ids()
+                .filter(|r| f.parts[r.index()] == part)
+                .map(id)
+                .collect()
+        })
+        .unwrap_or_default()
+    };
+    let fbd_section = fbd.map(|f| FbdSection {
+        blocks: f.blocks,
+        networks: f.networks,
+        fragment_guards: of_part(RungPart::FragmentGuard),
+        fragment_ends: of_part(RungPart::FragmentEnd),
+    });
+    let shown_levels = fbd.map(|f| {
+        let landings = landing_names(p, f);
+        let shown = |r: &&'a str| !landings.contains(r);
+        let keep = |g: &Vec<Vec<&'a str>>| -> Vec<Vec<&'a str>> {
+            g.iter()
+                .map(|l| l.iter().copied().filter(shown).collect())
+                .collect()
+        };
+        Levels {
+            data: keep(&levels.data),
+            control: keep(&levels.control),
+            combined: levels
+                .combined
+                .iter()
+                .map(|l| {
+                    l.iter()
+                        .filter(|t| !matches!(t, TaskName::Rung(x) if !shown(x)))
+                        .map(|t| match t {
+                            TaskName::Rung(x) => TaskName::Rung(x),
+                            TaskName::Loop(xs) => TaskName::Loop(xs.clone()),
+                        })
+                        .collect()
+                })
+                .collect(),
+        }
+    });
+    (fbd_section, shown_levels)
 }
