@@ -694,52 +694,38 @@ impl Net<'_, '_> {
         let arc = |j: &Json, q: String| -> Result<Input> {
             input(j, &q, id, d.id, index, drafts, out_pins)
         };
-        let instance = match (o.get("instance"), d.op.needs_instance()) {
-            (Some(j), true) => Some(
+        let instance = match only_if(
+            o,
+            "instance",
+            d.op.needs_instance(),
+            FieldRule {
+                needed_by: "a timer, counter or function block",
+                quoted: "`instance`",
+                misplaced: "on this block (only timers, counters and function blocks have one)",
+            },
+            p,
+            &be,
+        )? {
+            Some(j) => Some(
                 var_name(string(j).map_err(|k| be(format!("{p}.instance"), k))?)
                     .map_err(|k| be(format!("{p}.instance"), k))?,
             ),
-            (None, true) => {
-                return Err(be(
-                    p.clone(),
-                    Invalid::MissingField {
-                        field: "instance",
-                        what: "a timer, counter or function block",
-                    },
-                ))
-            }
-            (Some(_), false) => {
-                return Err(be(
-                    format!("{p}.instance"),
-                    Invalid::Misplaced {
-                        what: "`instance`",
-                        place: "on this block (only timers, counters and function blocks have one)",
-                    },
-                ))
-            }
-            (None, false) => None,
+            None => None,
         };
-        let label = match (o.get("label"), d.op == Op::Jmp) {
-            (Some(l), true) => Some(name(l).map_err(|k| be(format!("{p}.label"), k))?.to_owned()),
-            (None, true) => {
-                return Err(be(
-                    p.clone(),
-                    Invalid::MissingField {
-                        field: "label",
-                        what: "a JMP",
-                    },
-                ))
-            }
-            (Some(_), false) => {
-                return Err(be(
-                    format!("{p}.label"),
-                    Invalid::Misplaced {
-                        what: "`label`",
-                        place: "on a block other than JMP (label the network)",
-                    },
-                ))
-            }
-            (None, false) => None,
+        let label = match only_if(
+            o,
+            "label",
+            d.op == Op::Jmp,
+            FieldRule {
+                needed_by: "a JMP",
+                quoted: "`label`",
+                misplaced: "on a block other than JMP (label the network)",
+            },
+            p,
+            &be,
+        )? {
+            Some(l) => Some(name(l).map_err(|k| be(format!("{p}.label"), k))?.to_owned()),
+            None => None,
         };
         let cond = match o.get("cond") {
             None => None,
@@ -805,5 +791,45 @@ impl Net<'_, '_> {
             after,
             comment,
         })
+    }
+}
+
+/// How messages name a field that only some blocks have.
+struct FieldRule {
+    /// The blocks that need it (`a JMP`).
+    needed_by: &'static str,
+    /// The field as quoted in a message (`` `label` ``).
+    quoted: &'static str,
+    /// Where it does not belong.
+    misplaced: &'static str,
+}
+
+/// A block field that exactly the blocks `needed` holds for have: missing where needed, or
+/// present where not, is an error.
+fn only_if<'v>(
+    o: &'v Map<String, Json>,
+    field: &'static str,
+    needed: bool,
+    rule: FieldRule,
+    path: &str,
+    be: &impl Fn(String, Invalid) -> LoadError,
+) -> Result<Option<&'v Json>> {
+    match (o.get(field), needed) {
+        (Some(j), true) => Ok(Some(j)),
+        (None, true) => Err(be(
+            path.to_owned(),
+            Invalid::MissingField {
+                field,
+                what: rule.needed_by,
+            },
+        )),
+        (Some(_), false) => Err(be(
+            format!("{path}.{field}"),
+            Invalid::Misplaced {
+                what: rule.quoted,
+                place: rule.misplaced,
+            },
+        )),
+        (None, false) => Ok(None),
     }
 }
