@@ -332,3 +332,28 @@ fn generated_programs_load_and_report() {
         300
     );
 }
+
+/// A program too big for Graphviz is refused before anything is written.
+#[test]
+fn dot_of_a_big_program_is_refused_with_a_message() {
+    let file = tmp("big-dot.json");
+    let path = file.to_str().unwrap();
+    let out = run(&["gen", "--rungs", "2500", "-o", path]);
+    assert!(out.status.success());
+    let dot = tmp("big.dot");
+    let out = run(&[
+        "report",
+        path,
+        "--format",
+        "dot",
+        "-o",
+        dot.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("2,500 rungs are too many to draw (2,000 at most)"),
+        "{stderr}"
+    );
+    assert!(!dot.exists(), "no DOT file is written");
+}

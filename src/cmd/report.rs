@@ -83,8 +83,8 @@ pub fn report(c: &ReportConfig) -> Result<(), CliError> {
         return Err(CliError::Usage(format!(
             "{}: {} rungs are too many to draw ({} at most): Graphviz cannot lay out a graph this size usefully; use the text or JSON report",
             c.input.display(),
-            p.rungs.len(),
-            DOT_MAX_RUNGS
+            crate::report::text::thousands(p.rungs.len()),
+            crate::report::text::thousands(DOT_MAX_RUNGS)
         )));
     }
     let a = {
