@@ -46,11 +46,15 @@ pub fn write_report(
     out: &mut impl std::io::Write,
 ) -> std::io::Result<()> {
     let doc = document_with(p, a, fbd);
+    // The renderers make many small writes: a buffer of a known type here keeps each of them a
+    // copy into memory, whatever `out` is (a `dyn Write` file costs a call per write).
+    let mut out = std::io::BufWriter::with_capacity(1 << 20, out);
     match format {
-        ReportFormat::Text => render_text(&doc, text, out),
-        ReportFormat::Json => render_json(&doc, out),
-        ReportFormat::Dot => render_dot(&doc, text.view, out),
-    }
+        ReportFormat::Text => render_text(&doc, text, &mut out),
+        ReportFormat::Json => render_json(&doc, &mut out),
+        ReportFormat::Dot => render_dot(&doc, text.view, &mut out),
+    }?;
+    std::io::Write::flush(&mut out)
 }
 
 /// Renders the report of a loaded program and its FBD bodies with the default options (a
