@@ -1,17 +1,11 @@
 //! Zhao & Yan's worked examples (Example A and B), number by number.
 
-use plc_deps::cmd::report::{render_report, ReportFormat};
-use plc_deps::read::program_and_fbd_from_json;
-use plc_deps::report::View;
+mod common;
+
 use serde_json::{json, Value};
 
 fn report(name: &str) -> Value {
-    let path = format!(
-        "{}/analyses/{name}/program.json",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    let (p, fbd) = program_and_fbd_from_json(&std::fs::read_to_string(path).unwrap()).unwrap();
-    serde_json::from_str(&render_report(&p, &fbd, ReportFormat::Json, View::All)).unwrap()
+    common::example_report(name)
 }
 
 fn deps(r: &Value, kind: &str) -> Vec<(String, String)> {

@@ -1,18 +1,12 @@
 //! FBD programs get per-network IN/OUT in the report: the union over the network's block rungs.
 
-use plc_deps::cmd::report::{render_report, ReportFormat};
-use plc_deps::read::program_and_fbd_from_json;
-use plc_deps::report::View;
+mod common;
+
 use serde_json::Value;
 use std::collections::BTreeSet;
 
 fn report(name: &str) -> Value {
-    let path = format!(
-        "{}/analyses/{name}/program.json",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    let (p, fbd) = program_and_fbd_from_json(&std::fs::read_to_string(path).unwrap()).unwrap();
-    serde_json::from_str(&render_report(&p, &fbd, ReportFormat::Json, View::All)).unwrap()
+    common::example_report(name)
 }
 
 fn names(v: &Value) -> BTreeSet<String> {

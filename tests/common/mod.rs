@@ -238,3 +238,16 @@ pub fn random_program(seed: u64, max_rungs: usize) -> String {
     json!({"program": "random", "vars": vars(), "rungs": main, "subroutines": subroutines})
         .to_string()
 }
+
+/// The JSON report of the worked example `analyses/NAME`, parsed.
+pub fn example_report(name: &str) -> serde_json::Value {
+    use plc_deps::cmd::report::{render_report, ReportFormat};
+    let path = format!(
+        "{}/analyses/{name}/program.json",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let text = std::fs::read_to_string(path).unwrap();
+    let (p, fbd) = plc_deps::read::program_and_fbd_from_json(&text).unwrap();
+    let json = render_report(&p, &fbd, ReportFormat::Json, plc_deps::report::View::All);
+    serde_json::from_str(&json).unwrap()
+}
