@@ -218,7 +218,7 @@ pub struct Levels<'a> {
 }
 
 /// A task in a level: one rung, or the rungs of one loop task.
-#[derive(serde::Serialize)]
+#[derive(Clone, serde::Serialize)]
 #[serde(untagged)]
 pub enum TaskName<'a> {
     Rung(&'a str),
@@ -410,11 +410,12 @@ pub fn document_with<'a>(p: &'a Program, a: &'a Analysis, fbd: Option<&'a FbdPar
     });
 
     let m = p.rungs.len() as u32;
-    let ipdom = Ipdom(Lazy::new(0, move || {
+    let with_ipdom = move || {
         std::iter::once(a.cfg.start())
             .chain(0..m)
             .filter_map(move |n| a.post_dominators.immediate(n).map(|d| (node(n), node(d))))
-    }));
+    };
+    let ipdom = Ipdom(Lazy::new(with_ipdom().count(), with_ipdom));
     let post_dominator_tree = Lazy::new(m as usize + 2, move || {
         std::iter::once(a.cfg.start())
             .chain(0..m)
@@ -633,10 +634,7 @@ fn fbd_of<'a>(
                 .map(|l| {
                     l.iter()
                         .filter(|t| !matches!(t, TaskName::Rung(x) if !shown(x)))
-                        .map(|t| match t {
-                            TaskName::Rung(x) => TaskName::Rung(x),
-                            TaskName::Loop(xs) => TaskName::Loop(xs.clone()),
-                        })
+                        .cloned()
                         .collect()
                 })
                 .collect(),
