@@ -6,7 +6,7 @@
 //! (`plc_deps::gen`) with every knob on, so the timers, loops, jumps and calls are read too.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use plc_deps::gen::{generate_string, GenConfig};
+use plc_deps::synth::{generate_string, GenConfig};
 
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
@@ -20,6 +20,7 @@ fn text(rungs: usize) -> String {
         loops: true,
         jumps: true,
         calls: true,
+        ..GenConfig::default()
     })
 }
 

@@ -10,7 +10,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use plc_deps::analysis::{AnalysisConfig, DependenceListing};
 use plc_deps::cmd::report::{ReportConfig, ReportFormat};
 use plc_deps::cmd::{self, CliError};
-use plc_deps::report::{Rows, View};
+use plc_deps::report::{Rows, Selection, View};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -46,6 +46,12 @@ enum Command {
         /// The most data dependence pairs listed before the report lists the direct ones instead.
         #[arg(long, default_value_t = plc_deps::analysis::DEFAULT_MAX_PAIRS)]
         max_pairs: u64,
+        /// DOT only: draw the rungs of this POU (the program, a subroutine or an FB instance).
+        #[arg(long, conflicts_with = "rungs")]
+        pou: Option<String>,
+        /// DOT only: draw the rungs from FIRST to LAST in file order (`R10..R50`, or one id).
+        #[arg(long, value_name = "FIRST..LAST")]
+        rungs: Option<String>,
         /// Write to this file instead of standard output.
         #[arg(short, long)]
         output: Option<PathBuf>,
@@ -189,6 +195,8 @@ fn run(cli: Cli) -> Result<(), CliError> {
             full,
             dependences,
             max_pairs,
+            pou,
+            rungs,
             output,
         } => {
             let format = match format {
@@ -196,6 +204,25 @@ fn run(cli: Cli) -> Result<(), CliError> {
                 FormatArg::Json => ReportFormat::Json,
                 FormatArg::Dot => ReportFormat::Dot,
             };
+            let selection = match (pou, rungs) {
+                (Some(name), _) => Selection::Pou(name),
+                (None, Some(range)) => match range.split_once("..") {
+                    Some((first, last)) => Selection::Rungs {
+                        first: first.trim().to_owned(),
+                        last: last.trim().to_owned(),
+                    },
+                    None => Selection::Rungs {
+                        first: range.trim().to_owned(),
+                        last: range.trim().to_owned(),
+                    },
+                },
+                (None, None) => Selection::Whole,
+            };
+            if selection != Selection::Whole && format != ReportFormat::Dot {
+                return Err(CliError::Usage(
+                    "--pou and --rungs choose what the DOT report draws; add --format dot (the text and JSON reports cover the whole program)".into(),
+                ));
+            }
             let view = match (view, format) {
                 (Some(ViewArg::Paper), _) => View::Paper,
                 (Some(ViewArg::Combined), _) | (None, ReportFormat::Dot) => View::Combined,
@@ -222,6 +249,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
                         None => DependenceListing::UpTo(max_pairs),
                     },
                 },
+                selection,
                 output,
             };
             cmd::report::report(&config)

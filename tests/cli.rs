@@ -357,3 +357,78 @@ fn dot_of_a_big_program_is_refused_with_a_message() {
     );
     assert!(!dot.exists(), "no DOT file is written");
 }
+
+/// A big program is drawn a part at a time: a rung range or a POU, with the far ends of the
+/// edges that leave the part drawn grey, levels numbered as in the whole schedule.
+#[test]
+fn dot_draws_a_selection_of_a_big_program() {
+    let file = tmp("big-dot-selection.json");
+    let path = file.to_str().unwrap();
+    let out = run(&["gen", "--rungs", "2500", "--width", "40", "-o", path]);
+    assert!(out.status.success());
+    let out = run(&["report", path, "--format", "dot", "--rungs", "R100..R140"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    graphviz(&out.stdout, "R100..R140 of 2,500 rungs");
+    let dot = String::from_utf8(out.stdout).unwrap();
+    assert!(dot.contains("label=\"41 of 2,500 rungs drawn;"), "{dot}");
+    let drawn: Vec<&str> = dot
+        .lines()
+        .filter(|l| l.contains(" [label=\"R"))
+        .map(|l| l.trim().split(' ').next().unwrap().trim_matches('"'))
+        .collect();
+    let expected: Vec<String> = (100..=140).map(|i| format!("R{i}")).collect();
+    assert_eq!(drawn, expected);
+    // Every edge has a drawn end; every other end is a grey node.
+    for l in dot.lines().filter(|l| l.contains(" -> \"R")) {
+        let ends: Vec<&str> = l.trim().split(" [").next().unwrap().split(" -> ").collect();
+        let inside = |x: &str| expected.iter().any(|e| format!("\"{e}\"") == x);
+        assert!(ends.iter().any(|x| inside(x)), "{l}");
+        for x in ends.iter().filter(|x| !inside(x)) {
+            assert!(
+                dot.contains(&format!("  {x} [style=\"rounded,dashed\", color=grey")),
+                "{x} of {l}"
+            );
+        }
+    }
+    // Example B's subroutine: its one rung, and its caller in grey.
+    let out = run(&[
+        "report",
+        "analyses/example-b/program.json",
+        "--format",
+        "dot",
+        "--pou",
+        "SBR_A",
+    ]);
+    assert!(out.status.success());
+    let dot = String::from_utf8(out.stdout).unwrap();
+    assert!(dot.contains("  \"R11\" [label=\"R11\\n(SBR_A)\"];"), "{dot}");
+    assert!(dot.contains("  \"R10\" [style=\"rounded,dashed\", color=grey, fontcolor=grey];"));
+    assert!(!dot.contains("rank=same"), "R11 runs inside R10's task, at no level: {dot}");
+}
+
+/// A selection that names nothing, runs backwards, is too big, or is given to a report that
+/// is not DOT is a usage error, exit code 2, no output file.
+#[test]
+fn dot_selection_errors_are_clear() {
+    let file = tmp("big-dot-selection-errors.json");
+    let path = file.to_str().unwrap();
+    assert!(run(&["gen", "--rungs", "2500", "-o", path]).status.success());
+    let b = "analyses/example-b/program.json";
+    let big = format!("error: {path}: the selection has 2,400 rungs, too many to draw (2,000 at most); choose a shorter --rungs range");
+    let cases: [(&[&str], &str); 5] = [
+        (&["report", b, "--format", "dot", "--pou", "X"], "error: analyses/example-b/program.json: --pou: no POU `X` in the program (POUs: example_b, SBR_A, SBR_B)"),
+        (&["report", b, "--format", "dot", "--rungs", "R5..R2"], "error: analyses/example-b/program.json: --rungs R5..R2: `R2` comes before `R5` in the program"),
+        (&["report", b, "--format", "dot", "--rungs", "R5..R99"], "error: analyses/example-b/program.json: --rungs: no rung `R99` in the program"),
+        (&["report", b, "--rungs", "R5"], "error: --pou and --rungs choose what the DOT report draws; add --format dot (the text and JSON reports cover the whole program)"),
+        (&["report", path, "--format", "dot", "--rungs", "R1..R2400"], &big),
+    ];
+    for (args, expected) in cases {
+        let mut args = args.to_vec();
+        let out_file = tmp("selection-error.dot");
+        let o = out_file.to_str().unwrap().to_owned();
+        args.extend(["-o", &o]);
+        let out = run(&args);
+        assert_eq!(error_line(&out, expected), expected);
+        assert!(!out_file.exists());
+    }
+}

@@ -9,9 +9,10 @@ use crate::analysis::{analyse, analyse_with, Analysis, AnalysisConfig, Dependenc
 use crate::fbd::Fbd;
 use crate::model::Program;
 use crate::report::{
-    document_with, fbd_parts, render_dot, render_json, render_text, FbdParts, Rows, TextOptions,
-    View, DOT_MAX_RUNGS,
+    document_with, fbd_parts, render_dot, render_json, render_text, select_rungs, FbdParts, Rows,
+    Selection, TextOptions, View, DOT_MAX_RUNGS,
 };
+use std::collections::HashSet;
 use std::path::PathBuf;
 
 /// Output format of `report`.
@@ -33,16 +34,20 @@ pub struct ReportConfig {
     pub rows: Rows,
     /// Which data dependences are listed.
     pub analysis: AnalysisConfig,
+    /// The rungs the DOT report draws (only `Selection::Whole` for text and JSON).
+    pub selection: Selection,
     pub output: Option<PathBuf>,
 }
 
-/// Writes the report of `p` (with `fbd`, what its FBD lowering made) in `format`.
+/// Writes the report of `p` (with `fbd`, what its FBD lowering made) in `format`; the DOT report
+/// draws only the rungs in `drawn` when it is given.
 pub fn write_report(
     p: &Program,
     a: &Analysis,
     fbd: Option<&FbdParts>,
     format: ReportFormat,
     text: &TextOptions,
+    drawn: Option<&HashSet<String>>,
     out: &mut impl std::io::Write,
 ) -> std::io::Result<()> {
     let doc = document_with(p, a, fbd);
@@ -52,7 +57,7 @@ pub fn write_report(
     match format {
         ReportFormat::Text => render_text(&doc, text, &mut out),
         ReportFormat::Json => render_json(&doc, &mut out),
-        ReportFormat::Dot => render_dot(&doc, text.view, &mut out),
+        ReportFormat::Dot => render_dot(&doc, text.view, drawn, &mut out),
     }?;
     std::io::Write::flush(&mut out)
 }
@@ -67,7 +72,7 @@ pub fn render_report(p: &Program, fbd: &Fbd, format: ReportFormat, view: View) -
         view,
         ..TextOptions::default()
     };
-    write_report(p, &a, parts.as_ref(), format, &text, &mut out)
+    write_report(p, &a, parts.as_ref(), format, &text, None, &mut out)
         .expect("writing to memory cannot fail");
     String::from_utf8(out).expect("reports are UTF-8")
 }
@@ -83,14 +88,7 @@ pub fn report(c: &ReportConfig) -> Result<(), CliError> {
         load_program_and_fbd(&c.input)?
     };
     let parts = fbd_parts(&p, &fbd);
-    if c.format == ReportFormat::Dot && p.rungs.len() > DOT_MAX_RUNGS {
-        return Err(CliError::Usage(format!(
-            "{}: {} rungs are too many to draw ({} at most): Graphviz cannot lay out a graph this size usefully; use the text or JSON report",
-            c.input.display(),
-            crate::report::text::thousands(p.rungs.len()),
-            crate::report::text::thousands(DOT_MAX_RUNGS)
-        )));
-    }
+    let drawn = dot_selection(c, &p)?;
     let a = {
         let _phase = progress.phase("analysing");
         analyse_with(&p, &c.analysis)
@@ -117,6 +115,31 @@ pub fn report(c: &ReportConfig) -> Result<(), CliError> {
     let _phase = progress.phase("writing the report");
     write_output_with(c.output.as_deref(), |w| {
         let mut w = w;
-        write_report(&p, &a, parts.as_ref(), c.format, &text, &mut w)
+        write_report(&p, &a, parts.as_ref(), c.format, &text, drawn.as_ref(), &mut w)
     })
+}
+
+/// The rungs the DOT report of `p` draws (`None`: all), refused above [`DOT_MAX_RUNGS`].
+fn dot_selection(c: &ReportConfig, p: &Program) -> Result<Option<HashSet<String>>, CliError> {
+    use crate::report::text::thousands;
+    if c.format != ReportFormat::Dot {
+        return Ok(None);
+    }
+    let drawn = select_rungs(p, &c.selection)
+        .map_err(|e| CliError::Usage(format!("{}: {e}", c.input.display())))?;
+    match &drawn {
+        None if p.rungs.len() > DOT_MAX_RUNGS => Err(CliError::Usage(format!(
+            "{}: {} rungs are too many to draw ({} at most): Graphviz cannot lay out a graph this size usefully; draw a part with --pou NAME or --rungs FIRST..LAST, or use the text or JSON report",
+            c.input.display(),
+            thousands(p.rungs.len()),
+            thousands(DOT_MAX_RUNGS)
+        ))),
+        Some(s) if s.len() > DOT_MAX_RUNGS => Err(CliError::Usage(format!(
+            "{}: the selection has {} rungs, too many to draw ({} at most); choose a shorter --rungs range",
+            c.input.display(),
+            thousands(s.len()),
+            thousands(DOT_MAX_RUNGS)
+        ))),
+        _ => Ok(drawn),
+    }
 }

@@ -9,12 +9,19 @@
 //! dashed blue, output dotted red, control bold green; an edge of several kinds is drawn in all
 //! their colours). Output renders with `dot` without warnings (tested).
 //!
-//! Graphviz cannot lay out a graph of tens of thousands of nodes usefully: the command refuses a
-//! program above [`MAX_RUNGS`] rungs before rendering (docs/report.md).
+//! Graphviz cannot lay out a graph of tens of thousands of nodes usefully: the command refuses to
+//! draw more than [`MAX_RUNGS`] rungs before rendering (docs/report.md). A bigger program is drawn
+//! a part at a time ([`Selection`]: one POU, or a range of rungs in file order): levels keep the
+//! numbers of the whole schedule, and the far end of an edge that leaves the selection is drawn as
+//! a grey dashed node outside the ranks, so what the part depends on stays visible.
+//!
+//! Deliberately not here: layout (Graphviz's), and which rungs exist (the selection is resolved
+//! against the program by [`select_rungs`] before anything is rendered).
 
 use super::document::{DependenceEntry, Report, TaskName};
 use super::View;
-use std::collections::HashMap;
+use crate::model::Program;
+use std::collections::{HashMap, HashSet};
 use std::io::{self, Write};
 
 /// The largest program the DOT report draws.
@@ -22,6 +29,52 @@ pub const MAX_RUNGS: usize = 2000;
 
 fn quote(s: &str) -> String {
     format!("\"{}\"", s.replace('\\', "\\\\").replace('"', "\\\""))
+}
+
+/// The part of a program the DOT report draws.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub enum Selection {
+    /// Every rung.
+    #[default]
+    Whole,
+    /// The rungs of one POU (the program, a subroutine, a function block instance).
+    Pou(String),
+    /// The rungs from `first` to `last` in file order, both included (`last` = `first` for one).
+    Rungs { first: String, last: String },
+}
+
+/// The ids of the rungs `selection` names in `p`, in file order; `None` for the whole program.
+/// An unknown POU or rung id, or a range whose end comes before its start, is an error message.
+pub fn select_rungs(p: &Program, selection: &Selection) -> Result<Option<HashSet<String>>, String> {
+    let position = |id: &str| {
+        p.rungs
+            .iter()
+            .position(|r| r.id == id)
+            .ok_or_else(|| format!("--rungs: no rung `{id}` in the program"))
+    };
+    let range = match selection {
+        Selection::Whole => return Ok(None),
+        Selection::Pou(name) => match p.pous.iter().find(|u| u.name == *name) {
+            Some(u) => u.rungs.start as usize..u.rungs.end as usize,
+            None => {
+                let names: Vec<&str> = p.pous.iter().map(|u| u.name.as_str()).collect();
+                return Err(format!(
+                    "--pou: no POU `{name}` in the program (POUs: {})",
+                    names.join(", ")
+                ));
+            }
+        },
+        Selection::Rungs { first, last } => {
+            let (a, b) = (position(first)?, position(last)?);
+            if b < a {
+                return Err(format!(
+                    "--rungs {first}..{last}: `{last}` comes before `{first}` in the program"
+                ));
+            }
+            a..b + 1
+        }
+    };
+    Ok(Some(p.rungs[range].iter().map(|r| r.id.clone()).collect()))
 }
 
 /// One drawn edge: every dependence between two rungs.
@@ -33,18 +86,26 @@ struct Edge<'a> {
     kinds: Vec<&'static str>,
 }
 
-fn merged_edges<'a>(r: &Report<'a>) -> Vec<Edge<'a>> {
+/// The edges with at least one end that `drawn` keeps.
+fn merged_edges<'a>(r: &Report<'a>, drawn: impl Fn(&str) -> bool) -> Vec<Edge<'a>> {
     let mut edges: Vec<Edge<'a>> = Vec::new();
     let mut index: HashMap<(&'a str, &'a str), usize> = HashMap::new();
     for d in r.dependences.iter() {
-        let (kind, from, to, label) = match d {
+        let (kind, from, to, var) = match d {
             DependenceEntry::Data {
                 kind,
                 from,
                 to,
                 var,
-            } => (kind, from, to, format!("{kind} {var}")),
-            DependenceEntry::Control { kind, from, to, .. } => (kind, from, to, "control".into()),
+            } => (kind, from, to, Some(var)),
+            DependenceEntry::Control { kind, from, to, .. } => (kind, from, to, None),
+        };
+        if !drawn(from) && !drawn(to) {
+            continue;
+        }
+        let label = match var {
+            Some(var) => format!("{kind} {var}"),
+            None => "control".into(),
         };
         let i = *index.entry((from, to)).or_insert_with(|| {
             edges.push(Edge {
@@ -86,13 +147,33 @@ fn style(kinds: &[&str]) -> String {
     format!("color=\"{}\"{line}", colours.join(":"))
 }
 
-/// Writes the dependence graph ranked by `view` (`View::All` draws the combined schedule).
-pub fn render_dot(r: &Report, view: View, out: &mut impl Write) -> io::Result<()> {
+/// Writes the dependence graph ranked by `view` (`View::All` draws the combined schedule), of
+/// every rung or only of those in `only` (from [`select_rungs`]).
+pub fn render_dot(
+    r: &Report,
+    view: View,
+    only: Option<&HashSet<String>>,
+    out: &mut impl Write,
+) -> io::Result<()> {
+    let drawn = |x: &str| only.is_none_or(|s| s.contains(x));
     writeln!(out, "digraph {} {{", quote(r.program))?;
     out.write_all(b"  graph [rankdir=TB, newrank=true, nodesep=0.3, ranksep=0.5];\n")?;
+    if let Some(s) = only {
+        writeln!(
+            out,
+            "  graph [labelloc=t, label={}];",
+            quote(&format!(
+                "{} of {} rungs drawn; grey dashed: the far end of an edge leaving them",
+                super::text::thousands(s.len()),
+                super::text::thousands(r.summary.rungs)
+            ))
+        )?;
+    }
     out.write_all(b"  node [shape=box, style=rounded, fontname=\"Helvetica\"];\n")?;
     out.write_all(b"  edge [fontname=\"Helvetica\", fontsize=10];\n")?;
-    let rungs: Vec<_> = r.rungs.iter().collect();
+    let all_rungs: Vec<_> = r.rungs.iter().collect();
+    let main = all_rungs.first().map(|e| e.pou).unwrap_or_default();
+    let rungs: Vec<_> = all_rungs.into_iter().filter(|e| drawn(e.id)).collect();
     let (groups, what): (Vec<Vec<&str>>, &str) = if view == View::Paper {
         (r.levels.data.clone(), "data level")
     } else {
@@ -111,25 +192,38 @@ pub fn render_dot(r: &Report, view: View, out: &mut impl Write) -> io::Result<()
             .collect();
         (g, "level")
     };
+    // Levels keep the whole schedule's numbers; a level with no drawn rung is left out.
+    let mut shown_levels = Vec::new();
     for (l, g) in groups.iter().enumerate() {
+        if !g.iter().any(|x| drawn(x)) {
+            continue;
+        }
+        shown_levels.push(l + 1);
         writeln!(out, "  \"{what} {}\" [shape=plaintext, style=\"\"];", l + 1)?;
         write!(out, "  {{ rank=same; \"{what} {}\";", l + 1)?;
-        for x in g {
+        for x in g.iter().filter(|x| drawn(x)) {
             write!(out, " {};", quote(x))?;
         }
         out.write_all(b" }\n")?;
     }
-    for l in 1..groups.len() {
+    for w in shown_levels.windows(2) {
         writeln!(
             out,
             "  \"{what} {}\" -> \"{what} {}\" [style=invis];",
-            l,
-            l + 1
+            w[0], w[1]
         )?;
     }
     if view != View::Paper {
         for (i, lp) in r.loops.iter().enumerate() {
-            let members: Vec<String> = lp.rungs.iter().map(|x| format!("{};", quote(x))).collect();
+            let members: Vec<String> = lp
+                .rungs
+                .iter()
+                .filter(|x| drawn(x))
+                .map(|x| format!("{};", quote(x)))
+                .collect();
+            if members.is_empty() {
+                continue;
+            }
             writeln!(
                 out,
                 "  subgraph \"cluster_loop{i}\" {{ label=\"loop task\"; style=dashed; {} }}",
@@ -137,7 +231,6 @@ pub fn render_dot(r: &Report, view: View, out: &mut impl Write) -> io::Result<()
             )?;
         }
         // Subroutine rungs run inside their caller's task; unreachable rungs never run.
-        let main = rungs.first().map(|e| e.pou).unwrap_or_default();
         let mut pous: Vec<(&str, Vec<&str>)> = Vec::new();
         for e in rungs.iter().filter(|e| e.pou != main) {
             match pous.iter_mut().find(|(p, _)| *p == e.pou) {
@@ -154,13 +247,9 @@ pub fn render_dot(r: &Report, view: View, out: &mut impl Write) -> io::Result<()
                 members.join(" ")
             )?;
         }
-        if !r.schedule.unreachable.is_empty() {
-            let members: Vec<String> = r
-                .schedule
-                .unreachable
-                .iter()
-                .map(|x| format!("{};", quote(x)))
-                .collect();
+        let never: Vec<&&str> = r.schedule.unreachable.iter().filter(|x| drawn(x)).collect();
+        if !never.is_empty() {
+            let members: Vec<String> = never.iter().map(|x| format!("{};", quote(x))).collect();
             writeln!(
                 out,
                 "  subgraph \"cluster_never\" {{ label=\"never runs\"; style=dotted; {} }}",
@@ -168,7 +257,6 @@ pub fn render_dot(r: &Report, view: View, out: &mut impl Write) -> io::Result<()
             )?;
         }
     }
-    let main = rungs.first().map(|e| e.pou).unwrap_or_default();
     for e in &rungs {
         let label = if e.pou == main {
             quote(e.id)
@@ -177,7 +265,19 @@ pub fn render_dot(r: &Report, view: View, out: &mut impl Write) -> io::Result<()
         };
         writeln!(out, "  {} [label={}];", quote(e.id), label)?;
     }
-    for e in merged_edges(r) {
+    let edges = merged_edges(r, drawn);
+    let mut elsewhere = HashSet::new();
+    for x in edges.iter().flat_map(|e| [e.from, e.to]) {
+        if drawn(x) || !elsewhere.insert(x) {
+            continue;
+        }
+        writeln!(
+            out,
+            "  {} [style=\"rounded,dashed\", color=grey, fontcolor=grey];",
+            quote(x)
+        )?;
+    }
+    for e in edges {
         writeln!(
             out,
             "  {} -> {} [label={}, {}];",

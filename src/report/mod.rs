@@ -16,7 +16,7 @@ pub mod order;
 pub mod text;
 
 pub use document::{document, document_with, Report};
-pub use dot::{render_dot, MAX_RUNGS as DOT_MAX_RUNGS};
+pub use dot::{render_dot, select_rungs, Selection, MAX_RUNGS as DOT_MAX_RUNGS};
 pub use json::render_json;
 pub use text::{render_text, Rows, TextOptions};
 
