@@ -52,7 +52,16 @@ fn writing(c: &mut Criterion) {
             group.bench_with_input(BenchmarkId::from_parameter(name), &format, |b, &format| {
                 b.iter(|| {
                     let mut sink = Sink(0);
-                    write_report(&p, &a, None, format, &TextOptions::default(), None, &mut sink).unwrap();
+                    write_report(
+                        &p,
+                        &a,
+                        None,
+                        format,
+                        &TextOptions::default(),
+                        None,
+                        &mut sink,
+                    )
+                    .unwrap();
                     sink.0
                 })
             });

@@ -1184,12 +1184,21 @@ fn scan_by_schedule(
     faults
 }
 
+/// Also when the iteration cap refuses loop-backs (caps 1–3 cut Example B's loop short: a refusal
+/// at R8 goes on to R9 and skips R4, which the schedule must know).
 #[test]
 fn schedule_driven_scan_equals_sequential_scan() {
-    for json in [EXAMPLE_B, KASKAD_FOR, KASKAD_POST, KASKAD_PRE] {
+    for (json, loop_cap) in [EXAMPLE_B, KASKAD_FOR, KASKAD_POST, KASKAD_PRE]
+        .into_iter()
+        .flat_map(|j| [100_000, 1, 2, 3].map(|c| (j, c)))
+    {
         let p = plc_deps::read::program_from_json(json).unwrap();
         let sched = plc_deps::analysis::analyse(&p).schedule;
-        let m = Machine::new(&p, Layout::dense(&p), &ExecConfig::default()).unwrap();
+        let config = ExecConfig {
+            loop_cap,
+            ..ExecConfig::default()
+        };
+        let m = Machine::new(&p, Layout::dense(&p), &config).unwrap();
         let (mut a, mut b) = (m.initial_state(), m.initial_state());
         let inputs: Vec<VarId> = (0..p.vars.len() as u32)
             .map(VarId)
@@ -1209,7 +1218,11 @@ fn schedule_driven_scan_equals_sequential_scan() {
             m.scan(&mut a, scan, &vals, &mut fa);
             m.set_inputs(&mut b, &vals);
             let fb = scan_by_schedule(&m, &p, &sched, &mut b, scan);
-            assert_eq!(a, b, "{}: states differ after scan {scan}", p.name);
+            assert_eq!(
+                a, b,
+                "{} (cap {loop_cap}): states differ after scan {scan}",
+                p.name
+            );
             assert_eq!(fa, fb);
         }
     }

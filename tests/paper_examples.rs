@@ -83,16 +83,19 @@ fn example_b_ipdoms_control_dependences_levels_and_cycles() {
     );
     assert_eq!(r["cycles"]["before"], 12);
     assert_eq!(r["cycles"]["control"], 4);
-    // The correct schedule keeps the loop R3..R8 whole and waits for R1's jump decision.
+    // The correct schedule keeps the loop R3..R8 whole and waits for R1's jump decision. R4
+    // runs only if the loop is left through R3: when the iteration cap refuses R8's jump,
+    // control goes on to R9 and R4 is skipped, so R4 waits for the loop task.
     assert_eq!(
         r["levels"]["combined"],
         json!([
             ["R1", "R9", "R10"],
-            ["R2", "R4"],
-            [["R3", "R5", "R6", "R7", "R8"]]
+            ["R2"],
+            [["R3", "R5", "R6", "R7", "R8"]],
+            ["R4"]
         ])
     );
-    assert_eq!(r["cycles"]["combined"], 3);
+    assert_eq!(r["cycles"]["combined"], 4);
     // CFG edge labels where rungs branch.
     let edges = r["cfg"]["edges"].as_array().unwrap();
     let labelled = |from: &str, to: &str| {
@@ -105,4 +108,13 @@ fn example_b_ipdoms_control_dependences_levels_and_cycles() {
     assert_eq!(labelled("R1", "R2"), Some(json!("F")));
     assert_eq!(labelled("R3", "R5"), Some(json!("T")));
     assert_eq!(labelled("R3", "R4"), Some(json!("F")));
+    // R8's unconditional backward jump, and where a refusal by the iteration cap goes; the
+    // paper's post-dominators and control dependences (above) do not see that edge.
+    assert_eq!(labelled("R8", "R3"), Some(json!("T")));
+    assert_eq!(labelled("R8", "R9"), Some(json!("F")));
+    let refused: Vec<_> = edges.iter().filter(|e| e["kind"] == "refused").collect();
+    assert_eq!(
+        refused,
+        [&json!({"from": "R8", "to": "R9", "label": "F", "kind": "refused"})]
+    );
 }

@@ -47,6 +47,9 @@ pub enum EdgeKind {
     LoopEnter,
     LoopExit,
     LoopBack,
+    /// From a rung whose loop-back is an unconditional backward jump, on past it: the way the
+    /// scan goes when the iteration cap refuses the jump (it then acts as a jump without power).
+    Refused,
 }
 
 impl EdgeKind {
@@ -62,6 +65,7 @@ impl EdgeKind {
             EdgeKind::LoopEnter => "loop-enter",
             EdgeKind::LoopExit => "loop-exit",
             EdgeKind::LoopBack => "loop-back",
+            EdgeKind::Refused => "refused",
         }
     }
 }
@@ -105,6 +109,13 @@ impl Cfg {
     pub fn reachable(&self) -> Vec<bool> {
         crate::graph::reachable(&self.graph(), self.start())
     }
+    /// The indices in [`Cfg::edges`] of the edges of the paper's CFG: every edge but the
+    /// iteration cap's [`EdgeKind::Refused`] ones (the paper's programs have no iteration cap).
+    pub fn paper_edges(&self) -> Vec<u32> {
+        (0..self.edges.len() as u32)
+            .filter(|&i| self.edges[i as usize].kind != EdgeKind::Refused)
+            .collect()
+    }
 }
 
 /// A control transfer found in a rung, in evaluation order.
@@ -119,70 +130,99 @@ pub(crate) enum Transfer {
 /// The control transfers of a series, each with "power is constantly TRUE here"; stops after
 /// the first unconditional jump, ret or end. Returns whether such a terminator was found.
 pub(crate) fn transfers(series: &[Element], out: &mut Vec<(Transfer, bool)>) -> bool {
-    fn walk(series: &[Element], mut always: bool, out: &mut Vec<(Transfer, bool)>) -> (bool, bool) {
-        for e in series {
-            match e {
-                Element::Contact { .. }
-                | Element::Compare { .. }
-                | Element::Timer { .. }
-                | Element::Ctu { .. }
-                | Element::Ctd { .. } => always = false,
-                Element::Or(bs) => {
-                    let mut any = false;
-                    for b in bs {
-                        let (a, _) = walk_conditions(b, always);
-                        any |= a;
-                    }
-                    always = any;
+    transfers_refusing(series, None, out)
+}
+
+/// [`transfers`] of rung `refused`'s series when the iteration cap refuses its backward jumps
+/// (those to `refused` itself or an earlier rung): each is listed, as it may be taken before
+/// the cap is reached, and then acts as a jump without power, so the walk goes on past it with
+/// power no longer constantly TRUE.
+fn transfers_refusing(
+    series: &[Element],
+    refused: Option<RungId>,
+    out: &mut Vec<(Transfer, bool)>,
+) -> bool {
+    walk_series(series, true, refused, out).1
+}
+
+/// One series of [`transfers_refusing`] entered with power `always` (constantly TRUE or not):
+/// returns the power after it and whether it ended in an unconditional transfer.
+fn walk_series(
+    series: &[Element],
+    mut always: bool,
+    refused: Option<RungId>,
+    out: &mut Vec<(Transfer, bool)>,
+) -> (bool, bool) {
+    let walk = |series: &[Element], always: bool, out: &mut Vec<(Transfer, bool)>| {
+        walk_series(series, always, refused, out)
+    };
+    let back = |target: RungId| refused.is_some_and(|r| target.0 <= r.0);
+    for e in series {
+        match e {
+            Element::Contact { .. }
+            | Element::Compare { .. }
+            | Element::Timer { .. }
+            | Element::Ctu { .. }
+            | Element::Ctd { .. } => always = false,
+            Element::Or(bs) => {
+                let mut any = false;
+                for b in bs {
+                    let (a, _) = walk_conditions(b, always);
+                    any |= a;
                 }
-                Element::Branch(bs) => {
-                    for b in bs {
-                        let (_, stopped) = walk(b, always, out);
-                        if stopped {
-                            return (always, true);
-                        }
-                    }
-                }
-                Element::Jmp { target, .. } => {
-                    out.push((Transfer::Jump(*target), always));
-                    if always {
-                        return (always, true);
-                    }
-                }
-                Element::Ret => {
-                    out.push((Transfer::Ret, always));
-                    if always {
-                        return (always, true);
-                    }
-                }
-                Element::End => {
-                    out.push((Transfer::End, always));
-                    if always {
-                        return (always, true);
-                    }
-                }
-                Element::Call { pou } => out.push((Transfer::Call(*pou), always)),
-                Element::Coil { .. }
-                | Element::Set(_)
-                | Element::Reset(_)
-                | Element::Move { .. }
-                | Element::Arith { .. }
-                | Element::For { .. }
-                | Element::Next { .. } => {}
+                always = any;
             }
-        }
-        (always, false)
-    }
-    fn walk_conditions(series: &[Element], mut always: bool) -> (bool, ()) {
-        for e in series {
-            match e {
-                Element::Or(bs) => always = always && bs.iter().any(|b| walk_conditions(b, true).0),
-                _ => always = false,
+            Element::Branch(bs) => {
+                for b in bs {
+                    let (_, stopped) = walk(b, always, out);
+                    if stopped {
+                        return (always, true);
+                    }
+                }
             }
+            Element::Jmp { target, .. } if back(*target) => {
+                out.push((Transfer::Jump(*target), always));
+                always = false;
+            }
+            Element::Jmp { target, .. } => {
+                out.push((Transfer::Jump(*target), always));
+                if always {
+                    return (always, true);
+                }
+            }
+            Element::Ret => {
+                out.push((Transfer::Ret, always));
+                if always {
+                    return (always, true);
+                }
+            }
+            Element::End => {
+                out.push((Transfer::End, always));
+                if always {
+                    return (always, true);
+                }
+            }
+            Element::Call { pou } => out.push((Transfer::Call(*pou), always)),
+            Element::Coil { .. }
+            | Element::Set(_)
+            | Element::Reset(_)
+            | Element::Move { .. }
+            | Element::Arith { .. }
+            | Element::For { .. }
+            | Element::Next { .. } => {}
         }
-        (always, ())
     }
-    walk(series, true, out).1
+    (always, false)
+}
+
+fn walk_conditions(series: &[Element], mut always: bool) -> (bool, ()) {
+    for e in series {
+        match e {
+            Element::Or(bs) => always = always && bs.iter().any(|b| walk_conditions(b, true).0),
+            _ => always = false,
+        }
+    }
+    (always, ())
 }
 
 /// Builds the CFG of a program.
@@ -283,8 +323,17 @@ pub fn control_flow_graph(p: &Program) -> Cfg {
             _ => {}
         }
         found.clear();
-        let terminated = transfers(&rung.series, &mut found);
-        let conditional = found.iter().any(|(_, always)| !always) || terminated && found.len() > 1;
+        let mut terminated = transfers(&rung.series, &mut found);
+        // An unconditional backward jump ends the rung only until the iteration cap refuses it:
+        // then the rest of the rung runs, and control may go on past it.
+        let capped =
+            terminated && matches!(found.last(), Some(&(Transfer::Jump(t), true)) if t.0 <= r.0);
+        if capped {
+            found.clear();
+            terminated = transfers_refusing(&rung.series, Some(r), &mut found);
+        }
+        let conditional =
+            capped || found.iter().any(|(_, always)| !always) || terminated && found.len() > 1;
         let label = |always: bool| {
             if always && !conditional {
                 None
@@ -322,14 +371,19 @@ pub fn control_flow_graph(p: &Program) -> Cfg {
         }
         if !terminated {
             let fl = if conditional { Some(Branch::F) } else { None };
+            let kind = if capped {
+                EdgeKind::Refused
+            } else {
+                EdgeKind::Fallthrough
+            };
             match next {
                 Some(nx) => edges.push(CfgEdge {
                     from: r.0,
                     to: nx,
                     label: fl,
-                    kind: EdgeKind::Fallthrough,
+                    kind,
                 }),
-                None => exit(&mut edges, r.0, rung.pou, fl, EdgeKind::Fallthrough),
+                None => exit(&mut edges, r.0, rung.pou, fl, kind),
             }
         }
     }

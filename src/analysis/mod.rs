@@ -195,10 +195,22 @@ pub fn analyse_with(p: &Program, config: &AnalysisConfig) -> Analysis {
             },
             || data_levels(&acc.reads, &acc.writes),
         );
-        let pairs: Vec<(u32, u32)> = cfg.edges.iter().map(|e| (e.from, e.to)).collect();
+        // The paper's views are computed on the paper's CFG; the combined schedule (below)
+        // also knows where the iteration cap can send control.
+        let paper_edges = cfg.paper_edges();
+        let pairs: Vec<(u32, u32)> = paper_edges
+            .iter()
+            .map(|&i| (cfg.edges[i as usize].from, cfg.edges[i as usize].to))
+            .collect();
         let pdom = post_dominators(cfg.node_count(), &pairs, cfg.stop());
-        let reachable = cfg.reachable();
-        let control = control_dependences(&pairs, &pdom, |a| reachable[a as usize]);
+        let reachable = crate::graph::reachable(
+            &crate::graph::Csr::from_edges(cfg.node_count(), &pairs),
+            cfg.start(),
+        );
+        let mut control = control_dependences(&pairs, &pdom, |a| reachable[a as usize]);
+        for d in &mut control {
+            d.edge = paper_edges[d.edge as usize]; // an index into `cfg.edges`
+        }
         let paper_control = paper_control_view(p, &control);
         let cv_edges: Vec<(u32, u32)> = paper_control
             .iter()

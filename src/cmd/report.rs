@@ -115,7 +115,15 @@ pub fn report(c: &ReportConfig) -> Result<(), CliError> {
     let _phase = progress.phase("writing the report");
     write_output_with(c.output.as_deref(), |w| {
         let mut w = w;
-        write_report(&p, &a, parts.as_ref(), c.format, &text, drawn.as_ref(), &mut w)
+        write_report(
+            &p,
+            &a,
+            parts.as_ref(),
+            c.format,
+            &text,
+            drawn.as_ref(),
+            &mut w,
+        )
     })
 }
 
