@@ -26,8 +26,8 @@ fn main() {
     let cfg = control_flow_graph(&p);
     eprintln!("cfg: {:?}", t.elapsed());
     let t = Instant::now();
-    let pairs: Vec<(u32, u32)> = cfg.edges.iter().map(|e| (e.from, e.to)).collect();
-    let pd = post_dominators(cfg.node_count(), &pairs, cfg.stop());
+    let pairs: Vec<(u32, u32)> = cfg.edges.iter().map(|e| (e.from.0, e.to.0)).collect();
+    let pd = post_dominators(cfg.node_count(), &pairs, cfg.stop().0);
     eprintln!("post-dominators: {:?}", t.elapsed());
     let t = Instant::now();
     let cd = control_dependences(&pairs, &pd, |_| true);

@@ -210,7 +210,7 @@ fn check_schedule(text: &str) -> Result<bool, TestCaseError> {
             }
         }
         for g in &s.tasks[j].guard {
-            prop_assert!(s.tasks[g.controller as usize].level < s.tasks[j].level);
+            prop_assert!(s.task(g.controller).level < s.tasks[j].level);
         }
     }
     // Every main rung is in one task or unreachable; every CFG cycle of the main program stays
@@ -222,13 +222,13 @@ fn check_schedule(text: &str) -> Result<bool, TestCaseError> {
         prop_assert!(in_task != unreachable);
     }
     for e in &a.cfg.edges {
-        if main.contains(&e.from) && main.contains(&e.to) {
-            if let (Some(x), Some(y)) = (s.task_of[e.from as usize], s.task_of[e.to as usize]) {
+        if main.contains(&e.from.0) && main.contains(&e.to.0) {
+            if let (Some(x), Some(y)) = (s.task_of[e.from.0 as usize], s.task_of[e.to.0 as usize]) {
                 prop_assert!(
                     x <= y,
                     "edge {} → {} goes backwards between tasks",
-                    e.from,
-                    e.to
+                    e.from.0,
+                    e.to.0
                 );
             }
         }
@@ -238,7 +238,7 @@ fn check_schedule(text: &str) -> Result<bool, TestCaseError> {
         if task.level > 0 {
             prop_assert!(s.preds[t]
                 .iter()
-                .any(|&q| s.tasks[q as usize].level + 1 == task.level));
+                .any(|&q| s.task(q).level + 1 == task.level));
         }
     }
     Ok(true)

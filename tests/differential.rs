@@ -377,7 +377,7 @@ fn unconditional_backward_jump_refusal_is_a_cfg_edge_and_runs_in_parallel() {
         .edges
         .iter()
         .filter(|e| e.kind == plc_deps::analysis::EdgeKind::Refused)
-        .map(|e| (e.from, e.to))
+        .map(|e| (e.from.0, e.to.0))
         .collect();
     assert_eq!(refused, [(2, 3)]);
     let exec = ExecConfig {

@@ -1151,12 +1151,12 @@ fn scan_by_schedule(
     };
     for level in &sched.levels {
         for &t in level {
-            let task = &sched.tasks[t as usize];
+            let task = sched.task(t);
             let runs = task.guard.is_empty()
                 || task
                     .guard
                     .iter()
-                    .any(|g| exit[g.controller as usize].map(successor) == Some(g.successor));
+                    .any(|g| exit[g.controller.index()].map(successor) == Some(g.successor));
             if !runs {
                 continue;
             }
@@ -1173,12 +1173,12 @@ fn scan_by_schedule(
                         .collect();
                     match entered.as_slice() {
                         [e] => *e,
-                        other => panic!("{}: task {t} entered from {other:?}", p.name),
+                        other => panic!("{}: task {t:?} entered from {other:?}", p.name),
                     }
                 }
             };
             let inside = |r: RungId| sched.task_of[r.index()] == Some(t);
-            exit[t as usize] = Some(m.resume(&mut st.slots[..], &mut ctx, at, inside));
+            exit[t.index()] = Some(m.resume(&mut st.slots[..], &mut ctx, at, inside));
         }
     }
     faults

@@ -70,11 +70,28 @@ impl EdgeKind {
     }
 }
 
+crate::model::index_type!(
+    /// A CFG node: rung `i` of [`Program::rungs`] is node `i`; START and STOP follow
+    /// ([`Cfg::start`], [`Cfg::stop`]).
+    CfgNode
+);
+
+impl From<RungId> for CfgNode {
+    fn from(r: RungId) -> CfgNode {
+        CfgNode(r.0)
+    }
+}
+
+crate::model::index_type!(
+    /// A CFG edge: index into [`Cfg::edges`].
+    CfgEdgeId
+);
+
 /// One CFG edge.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
 pub struct CfgEdge {
-    pub from: u32,
-    pub to: u32,
+    pub from: CfgNode,
+    pub to: CfgNode,
     pub label: Option<Branch>,
     pub kind: EdgeKind,
 }
@@ -91,29 +108,38 @@ pub struct Cfg {
 }
 
 impl Cfg {
-    pub fn start(&self) -> u32 {
-        self.rungs
+    pub fn start(&self) -> CfgNode {
+        CfgNode(self.rungs)
     }
-    pub fn stop(&self) -> u32 {
-        self.rungs + 1
+    pub fn stop(&self) -> CfgNode {
+        CfgNode(self.rungs + 1)
     }
     pub fn node_count(&self) -> usize {
         self.rungs as usize + 2
     }
-    /// Successor adjacency of the whole graph.
+    /// The rung a node stands for; `None` for START and STOP.
+    pub fn rung(&self, n: CfgNode) -> Option<RungId> {
+        (n.0 < self.rungs).then_some(RungId(n.0))
+    }
+    /// The edge with index `e`.
+    pub fn edge(&self, e: CfgEdgeId) -> &CfgEdge {
+        &self.edges[e.index()]
+    }
+    /// Successor adjacency of the whole graph (nodes as [`CfgNode`] numbers).
     pub fn graph(&self) -> Csr {
-        let pairs: Vec<(u32, u32)> = self.edges.iter().map(|e| (e.from, e.to)).collect();
+        let pairs: Vec<(u32, u32)> = self.edges.iter().map(|e| (e.from.0, e.to.0)).collect();
         Csr::from_edges(self.node_count(), &pairs)
     }
     /// Nodes reachable from START.
     pub fn reachable(&self) -> Vec<bool> {
-        crate::graph::reachable(&self.graph(), self.start())
+        crate::graph::reachable(&self.graph(), self.start().0)
     }
     /// The indices in [`Cfg::edges`] of the edges of the paper's CFG: every edge but the
     /// iteration cap's [`EdgeKind::Refused`] ones (the paper's programs have no iteration cap).
-    pub fn paper_edges(&self) -> Vec<u32> {
+    pub fn paper_edges(&self) -> Vec<CfgEdgeId> {
         (0..self.edges.len() as u32)
-            .filter(|&i| self.edges[i as usize].kind != EdgeKind::Refused)
+            .map(CfgEdgeId)
+            .filter(|&e| self.edge(e).kind != EdgeKind::Refused)
             .collect()
     }
 }
@@ -248,8 +274,8 @@ pub fn control_flow_graph(p: &Program) -> Cfg {
         .map(|i| PouId(i as u32))
         .collect();
     let mut edges = vec![CfgEdge {
-        from: start,
-        to: 0,
+        from: CfgNode(start),
+        to: CfgNode(0),
         label: None,
         kind: EdgeKind::Entry,
     }];
@@ -257,16 +283,16 @@ pub fn control_flow_graph(p: &Program) -> Cfg {
     let exit = |edges: &mut Vec<CfgEdge>, from: u32, pou: PouId, label, kind| {
         if pou.index() == 0 || callers[pou.index()].is_empty() {
             edges.push(CfgEdge {
-                from,
-                to: stop,
+                from: CfgNode(from),
+                to: CfgNode(stop),
                 label,
                 kind,
             });
         } else {
             for &c in &callers[pou.index()] {
                 edges.push(CfgEdge {
-                    from,
-                    to: c,
+                    from: CfgNode(from),
+                    to: CfgNode(c),
                     label,
                     kind: if kind == EdgeKind::Fallthrough {
                         EdgeKind::Return
@@ -288,15 +314,15 @@ pub fn control_flow_graph(p: &Program) -> Cfg {
         match rung.series.last() {
             Some(Element::For { next: nx, .. }) => {
                 edges.push(CfgEdge {
-                    from: r.0,
-                    to: r.0 + 1,
+                    from: CfgNode(r.0),
+                    to: CfgNode(r.0 + 1),
                     label: Some(Branch::T),
                     kind: EdgeKind::LoopEnter,
                 });
                 if nx.0 + 1 < pou.rungs.end {
                     edges.push(CfgEdge {
-                        from: r.0,
-                        to: nx.0 + 1,
+                        from: CfgNode(r.0),
+                        to: CfgNode(nx.0 + 1),
                         label: Some(Branch::F),
                         kind: EdgeKind::LoopExit,
                     });
@@ -313,8 +339,8 @@ pub fn control_flow_graph(p: &Program) -> Cfg {
             }
             Some(Element::Next { head }) => {
                 edges.push(CfgEdge {
-                    from: r.0,
-                    to: head.0,
+                    from: CfgNode(r.0),
+                    to: CfgNode(head.0),
                     label: None,
                     kind: EdgeKind::LoopBack,
                 });
@@ -344,14 +370,14 @@ pub fn control_flow_graph(p: &Program) -> Cfg {
         for &(t, always) in &found {
             match t {
                 Transfer::Jump(target) => edges.push(CfgEdge {
-                    from: r.0,
-                    to: target.0,
+                    from: CfgNode(r.0),
+                    to: CfgNode(target.0),
                     label: label(always),
                     kind: EdgeKind::Jump,
                 }),
                 Transfer::End => edges.push(CfgEdge {
-                    from: r.0,
-                    to: stop,
+                    from: CfgNode(r.0),
+                    to: CfgNode(stop),
                     label: label(always),
                     kind: EdgeKind::End,
                 }),
@@ -360,8 +386,8 @@ pub fn control_flow_graph(p: &Program) -> Cfg {
                     let callee = p.pou(c);
                     if !callee.rungs.is_empty() {
                         edges.push(CfgEdge {
-                            from: r.0,
-                            to: callee.rungs.start,
+                            from: CfgNode(r.0),
+                            to: CfgNode(callee.rungs.start),
                             label: label(always),
                             kind: EdgeKind::Call,
                         });
@@ -378,8 +404,8 @@ pub fn control_flow_graph(p: &Program) -> Cfg {
             };
             match next {
                 Some(nx) => edges.push(CfgEdge {
-                    from: r.0,
-                    to: nx,
+                    from: CfgNode(r.0),
+                    to: CfgNode(nx),
                     label: fl,
                     kind,
                 }),

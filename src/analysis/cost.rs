@@ -11,6 +11,7 @@
 //! W/S bounds the speed-up of any schedule; the makespan for P cores comes from list scheduling
 //! (highest bottom level first, Graham 1969 / Coffman) on the same DAG, O((V + E) log V) each.
 
+use super::schedule::TaskId;
 use crate::model::*;
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
@@ -119,14 +120,14 @@ pub struct CostSummary {
 
 /// Computes W, S and makespans; `preds[t]` are the tasks `t` must wait for (all earlier in the
 /// task order), `levels` the task levels.
-pub fn summarise(costs: &[u64], preds: &[Vec<u32>], levels: &[u32]) -> CostSummary {
+pub fn summarise(costs: &[u64], preds: &[Vec<TaskId>], levels: &[u32]) -> CostSummary {
     let n = costs.len();
     let work = costs.iter().sum();
     let mut finish = vec![0u64; n];
     for t in 0..n {
         let start = preds[t]
             .iter()
-            .map(|&p| finish[p as usize])
+            .map(|&p| finish[p.index()])
             .max()
             .unwrap_or(0);
         finish[t] = start + costs[t];
@@ -136,7 +137,7 @@ pub fn summarise(costs: &[u64], preds: &[Vec<u32>], levels: &[u32]) -> CostSumma
     let mut succ_count = vec![0u32; n + 1];
     for ps in preds {
         for &p in ps {
-            succ_count[p as usize + 1] += 1;
+            succ_count[p.index() + 1] += 1;
         }
     }
     for i in 0..n {
@@ -146,8 +147,8 @@ pub fn summarise(costs: &[u64], preds: &[Vec<u32>], levels: &[u32]) -> CostSumma
     let mut fill = succ_count.clone();
     for (t, ps) in preds.iter().enumerate() {
         for &p in ps {
-            succ[fill[p as usize] as usize] = t as u32;
-            fill[p as usize] += 1;
+            succ[fill[p.index()] as usize] = t as u32;
+            fill[p.index()] += 1;
         }
     }
     let successors = |t: usize| &succ[succ_count[t] as usize..succ_count[t + 1] as usize];
@@ -214,7 +215,7 @@ fn lpt(jobs: impl Iterator<Item = u64>, p: usize) -> u64 {
 /// bottom level (ties: earlier task).
 fn list_schedule<'a>(
     costs: &[u64],
-    preds: &[Vec<u32>],
+    preds: &[Vec<TaskId>],
     successors: &(dyn Fn(usize) -> &'a [u32] + Sync),
     bottom: &[u64],
     p: usize,
@@ -278,7 +279,7 @@ mod tests {
     fn figures_of_a_small_dag() {
         // 0 → 2, 1 → 2, 3 independent; costs 2, 3, 1, 4.
         let costs = [2, 3, 1, 4];
-        let preds = vec![vec![], vec![], vec![0, 1], vec![]];
+        let preds = vec![vec![], vec![], vec![TaskId(0), TaskId(1)], vec![]];
         let s = summarise(&costs, &preds, &[0, 0, 1, 0]);
         assert_eq!(s.work, 10);
         assert_eq!(s.span, 4);

@@ -21,7 +21,7 @@ pub mod schedule;
 
 use crate::model::*;
 pub use accesses::{accesses, Accesses, VarSets};
-pub use cfg::{control_flow_graph, Branch, Cfg, CfgEdge, EdgeKind};
+pub use cfg::{control_flow_graph, Branch, Cfg, CfgEdge, CfgEdgeId, CfgNode, EdgeKind};
 pub use control::{control_dependences, post_dominators, ControlDependence, PostDominators};
 pub use cost::CostSummary;
 pub use dependences::{
@@ -42,7 +42,7 @@ pub struct PaperControl {
 #[derive(Copy, Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum ControlCause {
     /// FOW control dependence through CFG edge `edge` (an index into `Cfg::edges`).
-    Branch { edge: u32 },
+    Branch { edge: CfgEdgeId },
     /// The rung reads a field of a timer or counter instance whose box is on `from` (the paper
     /// counts these as control dependences).
     Instance { var: VarId },
@@ -200,16 +200,16 @@ pub fn analyse_with(p: &Program, config: &AnalysisConfig) -> Analysis {
         let paper_edges = cfg.paper_edges();
         let pairs: Vec<(u32, u32)> = paper_edges
             .iter()
-            .map(|&i| (cfg.edges[i as usize].from, cfg.edges[i as usize].to))
+            .map(|&e| (cfg.edge(e).from.0, cfg.edge(e).to.0))
             .collect();
-        let pdom = post_dominators(cfg.node_count(), &pairs, cfg.stop());
+        let pdom = post_dominators(cfg.node_count(), &pairs, cfg.stop().0);
         let reachable = crate::graph::reachable(
             &crate::graph::Csr::from_edges(cfg.node_count(), &pairs),
-            cfg.start(),
+            cfg.start().0,
         );
         let mut control = control_dependences(&pairs, &pdom, |a| reachable[a as usize]);
         for d in &mut control {
-            d.edge = paper_edges[d.edge as usize]; // an index into `cfg.edges`
+            d.edge = paper_edges[d.edge as usize].0; // an index into `cfg.edges`
         }
         let paper_control = paper_control_view(p, &control);
         let cv_edges: Vec<(u32, u32)> = paper_control
@@ -304,13 +304,15 @@ fn paper_control_view(p: &Program, control: &[ControlDependence]) -> Vec<PaperCo
         .map(|d| PaperControl {
             from: RungId(d.controller),
             to: RungId(d.dependent),
-            cause: ControlCause::Branch { edge: d.edge },
+            cause: ControlCause::Branch {
+                edge: CfgEdgeId(d.edge),
+            },
         })
         .collect();
     // Box rungs per instance (a linked list, newest first, in one flat array: most variables are
     // not instances); then each field read pairs with the earlier box rungs.
-    let mut last_box: Vec<u32> = vec![u32::MAX; p.vars.len()];
-    let mut box_nodes: Vec<(RungId, u32)> = Vec::new();
+    let mut last_box: Vec<Option<u32>> = vec![None; p.vars.len()];
+    let mut box_nodes: Vec<(RungId, Option<u32>)> = Vec::new();
     let mut field_reads: Vec<VarId> = Vec::new();
     let mut own_boxes: Vec<VarId> = Vec::new();
     for r in p.rung_ids() {
@@ -343,8 +345,8 @@ fn paper_control_view(p: &Program, control: &[ControlDependence]) -> Vec<PaperCo
         field_reads.dedup();
         for &v in &field_reads {
             let mut node = last_box[v.index()];
-            while node != u32::MAX {
-                let (s, next) = box_nodes[node as usize];
+            while let Some(at) = node {
+                let (s, next) = box_nodes[at as usize];
                 out.push(PaperControl {
                     from: s,
                     to: r,
@@ -355,9 +357,9 @@ fn paper_control_view(p: &Program, control: &[ControlDependence]) -> Vec<PaperCo
         }
         for &v in &own_boxes {
             let head = last_box[v.index()];
-            if head == u32::MAX || box_nodes[head as usize].0 != r {
+            if head.is_none_or(|h| box_nodes[h as usize].0 != r) {
                 box_nodes.push((r, head));
-                last_box[v.index()] = box_nodes.len() as u32 - 1;
+                last_box[v.index()] = Some(box_nodes.len() as u32 - 1);
             }
         }
     }

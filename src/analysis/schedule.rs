@@ -31,17 +31,22 @@ use crate::model::*;
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
+crate::model::index_type!(
+    /// A task of the combined schedule: index into [`Schedule::tasks`].
+    TaskId
+);
+
 /// Where control goes after a task: another task or the end of the scan.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Successor {
-    Task(u32),
+    Task(TaskId),
     Stop,
 }
 
 /// One disjunct of a guard: task `controller` ran and left towards `successor`.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct Guard {
-    pub controller: u32,
+    pub controller: TaskId,
     pub successor: Successor,
 }
 
@@ -66,21 +71,25 @@ pub struct Schedule {
     /// Tasks in sequential order.
     pub tasks: Vec<Task>,
     /// Task of each rung (main-program rungs that run; `None` otherwise).
-    pub task_of: Vec<Option<u32>>,
+    pub task_of: Vec<Option<TaskId>>,
     /// Task indices per level, in sequential order.
-    pub levels: Vec<Vec<u32>>,
+    pub levels: Vec<Vec<TaskId>>,
     /// Main-program rungs that can never run.
     pub unreachable: Vec<RungId>,
     /// For each task, the earlier tasks it must wait for (data and control), deduplicated.
-    pub preds: Vec<Vec<u32>>,
+    pub preds: Vec<Vec<TaskId>>,
     /// Regions of the main program that can never reach the end of the scan.
     pub endless: Vec<Vec<RungId>>,
 }
 
 impl Schedule {
+    /// Task `t`.
+    pub fn task(&self, t: TaskId) -> &Task {
+        &self.tasks[t.index()]
+    }
     /// The first rung of task `t` (its name in reports).
-    pub fn head(&self, t: u32) -> RungId {
-        self.tasks[t as usize].rungs[0]
+    pub fn head(&self, t: TaskId) -> RungId {
+        self.task(t).rungs[0]
     }
 }
 
@@ -88,16 +97,18 @@ impl Schedule {
 pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
     let main = p.main().rungs.clone();
     let n = cfg.node_count();
-    let (start, stop) = (cfg.start(), cfg.stop());
+    let (start, stop) = (cfg.start().0, cfg.stop().0);
     let in_main = |v: u32| main.contains(&v) || v == start || v == stop;
     // The main program's own CFG: no call or return edges.
     let edges: Vec<(u32, u32)> = cfg
         .edges
         .iter()
         .filter(|e| {
-            !matches!(e.kind, EdgeKind::Call | EdgeKind::Return) && in_main(e.from) && in_main(e.to)
+            !matches!(e.kind, EdgeKind::Call | EdgeKind::Return)
+                && in_main(e.from.0)
+                && in_main(e.to.0)
         })
-        .map(|e| (e.from, e.to))
+        .map(|e| (e.from.0, e.to.0))
         .collect();
     let g = Csr::from_edges(n, &edges);
     let reach = crate::graph::reachable(&g, start);
@@ -159,10 +170,10 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
         }
         order
     };
-    let mut task_of_comp = vec![u32::MAX; comp_count];
+    let mut task_of_comp: Vec<Option<TaskId>> = vec![None; comp_count];
     let mut tasks: Vec<Task> = Vec::with_capacity(order.len());
     for c in order {
-        task_of_comp[c as usize] = tasks.len() as u32;
+        task_of_comp[c as usize] = Some(TaskId(tasks.len() as u32));
         let members = sccs.members(c);
         tasks.push(Task {
             rungs: members.iter().map(|&m| RungId(m)).collect(),
@@ -172,10 +183,10 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
             level: 0,
         });
     }
-    let mut task_of: Vec<Option<u32>> = vec![None; p.rungs.len()];
+    let mut task_of: Vec<Option<TaskId>> = vec![None; p.rungs.len()];
     for r in main.clone() {
         if reach[r as usize] {
-            task_of[r as usize] = Some(task_of_comp[sccs.component_of(r) as usize]);
+            task_of[r as usize] = task_of_comp[sccs.component_of(r) as usize];
         }
     }
     // Condensed CFG over tasks: nodes 0..t, START = t, STOP = t + 1.
@@ -187,7 +198,7 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
         } else if v == stop {
             cstop
         } else {
-            task_of[v as usize].expect("live rung")
+            task_of[v as usize].expect("live rung").0
         }
     };
     let mut cedges: Vec<(u32, u32)> = Vec::new();
@@ -230,10 +241,10 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
         let successor = if b == cstop {
             Successor::Stop
         } else {
-            Successor::Task(b)
+            Successor::Task(TaskId(b))
         };
         let guard = Guard {
-            controller: a,
+            controller: TaskId(a),
             successor,
         };
         let task = &mut tasks[d.dependent as usize];
@@ -244,12 +255,12 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
     // Levels: data (over task accesses in task order) and control floors.
     let var_count = p.vars.len();
     let mut leveller = Leveller::new(var_count);
-    let mut preds: Vec<Vec<u32>> = vec![Vec::new(); t as usize];
-    let mut last_writer: Vec<u32> = vec![u32::MAX; var_count];
+    let mut preds: Vec<Vec<TaskId>> = vec![Vec::new(); t as usize];
+    let mut last_writer: Vec<Option<u32>> = vec![None; var_count];
     // Readers of each variable since its last write, as linked lists in one flat array:
     // `first_reader[x]` → (task, next) in `reader_nodes`.
-    let mut first_reader: Vec<u32> = vec![u32::MAX; var_count];
-    let mut reader_nodes: Vec<(u32, u32)> = Vec::new();
+    let mut first_reader: Vec<Option<u32>> = vec![None; var_count];
+    let mut reader_nodes: Vec<(u32, Option<u32>)> = Vec::new();
     let mut reads = Vec::new();
     let mut writes = Vec::new();
     for i in 0..t as usize {
@@ -265,22 +276,18 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
             writes.sort_unstable();
             writes.dedup();
         }
-        let mut ps: Vec<u32> = tasks[i].guard.iter().map(|g| g.controller).collect();
+        let mut ps: Vec<u32> = tasks[i].guard.iter().map(|g| g.controller.0).collect();
         if tasks[i].entries.len() > 1 {
             ps.extend_from_slice(&entry_preds[i]);
         }
         for &x in &reads {
-            if last_writer[x.index()] != u32::MAX {
-                ps.push(last_writer[x.index()]);
-            }
+            ps.extend(last_writer[x.index()]);
         }
         for &x in &writes {
-            if last_writer[x.index()] != u32::MAX {
-                ps.push(last_writer[x.index()]);
-            }
+            ps.extend(last_writer[x.index()]);
             let mut node = first_reader[x.index()];
-            while node != u32::MAX {
-                let (r, next) = reader_nodes[node as usize];
+            while let Some(at) = node {
+                let (r, next) = reader_nodes[at as usize];
                 if r as usize != i {
                     ps.push(r);
                 }
@@ -299,22 +306,25 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
         tasks[i].level = level;
         for &x in &reads {
             reader_nodes.push((i as u32, first_reader[x.index()]));
-            first_reader[x.index()] = reader_nodes.len() as u32 - 1;
+            first_reader[x.index()] = Some(reader_nodes.len() as u32 - 1);
         }
         for &x in &writes {
-            last_writer[x.index()] = i as u32;
-            first_reader[x.index()] = u32::MAX;
+            last_writer[x.index()] = Some(i as u32);
+            first_reader[x.index()] = None;
         }
-        ps.retain(|&q| (q as usize) < i);
-        preds[i] = ps;
+        preds[i] = ps
+            .into_iter()
+            .filter(|&q| (q as usize) < i)
+            .map(TaskId)
+            .collect();
     }
-    let mut levels: Vec<Vec<u32>> = Vec::new();
+    let mut levels: Vec<Vec<TaskId>> = Vec::new();
     for (i, task) in tasks.iter().enumerate() {
         let l = task.level as usize;
         if levels.len() <= l {
             levels.resize(l + 1, Vec::new());
         }
-        levels[l].push(i as u32);
+        levels[l].push(TaskId(i as u32));
     }
     for task in &mut tasks {
         task.entries.sort_unstable();

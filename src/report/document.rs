@@ -13,7 +13,7 @@
 
 use super::explain::Explainer;
 use super::{FbdParts, RungPart};
-use crate::analysis::{Analysis, Branch, ControlCause, Listed, Successor};
+use crate::analysis::{Analysis, Branch, CfgEdgeId, ControlCause, Listed, Successor};
 use crate::model::*;
 use serde::ser::{Serialize, SerializeMap, Serializer};
 
@@ -325,11 +325,11 @@ pub fn document_with<'a>(p: &'a Program, a: &'a Analysis, fbd: Option<&'a FbdPar
     let var = move |v: VarId| p.var(v).name.as_str();
     let names = move |vs: &[VarId]| vs.iter().map(|&v| var(v)).collect::<Vec<_>>();
     let node = move |n: u32| super::node_name(p, n);
-    let edge_ref = move |i: u32| {
-        let e = &a.cfg.edges[i as usize];
+    let edge_ref = move |i: CfgEdgeId| {
+        let e = a.cfg.edge(i);
         EdgeRef {
-            from: node(e.from),
-            to: node(e.to),
+            from: node(e.from.0),
+            to: node(e.to.0),
             label: label_name(e.label),
             kind: e.kind.name(),
         }
@@ -402,8 +402,8 @@ pub fn document_with<'a>(p: &'a Program, a: &'a Analysis, fbd: Option<&'a FbdPar
 
     let edges = Lazy::new(a.cfg.edges.len(), move || {
         a.cfg.edges.iter().map(move |e| CfgEdgeEntry {
-            from: node(e.from),
-            to: node(e.to),
+            from: node(e.from.0),
+            to: node(e.to.0),
             label: label_name(e.label),
             kind: e.kind.name(),
         })
@@ -411,15 +411,15 @@ pub fn document_with<'a>(p: &'a Program, a: &'a Analysis, fbd: Option<&'a FbdPar
 
     let m = p.rungs.len() as u32;
     let with_ipdom = move || {
-        std::iter::once(a.cfg.start())
+        std::iter::once(a.cfg.start().0)
             .chain(0..m)
             .filter_map(move |n| a.post_dominators.immediate(n).map(|d| (node(n), node(d))))
     };
     let ipdom = Ipdom(Lazy::new(with_ipdom().count(), with_ipdom));
     let post_dominator_tree = Lazy::new(m as usize + 2, move || {
-        std::iter::once(a.cfg.start())
+        std::iter::once(a.cfg.start().0)
             .chain(0..m)
-            .chain(std::iter::once(a.cfg.stop()))
+            .chain(std::iter::once(a.cfg.stop().0))
             .map(move |n| TreeNode {
                 node: node(n),
                 ipdom: a.post_dominators.immediate(n).map(node),
@@ -463,7 +463,7 @@ pub fn document_with<'a>(p: &'a Program, a: &'a Analysis, fbd: Option<&'a FbdPar
     let order = std::rc::Rc::new(s.levels.concat());
     let tasks_by_level = Lazy::new(s.tasks.len(), move || {
         let order = order.clone();
-        (0..order.len()).map(move |i| task_entry(&s.tasks[order[i] as usize]))
+        (0..order.len()).map(move |i| task_entry(s.task(order[i])))
     });
     let loops = s
         .tasks

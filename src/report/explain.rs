@@ -7,7 +7,7 @@
 //! members are listed in the report's `loops`, not repeated in every member's reason.
 
 use super::document::DifferenceEntry;
-use crate::analysis::{Analysis, ControlCause, EdgeKind};
+use crate::analysis::{schedule::TaskId, Analysis, ControlCause, EdgeKind};
 use crate::model::*;
 
 /// Precomputed context for explaining differences.
@@ -25,8 +25,8 @@ impl<'a> Explainer<'a> {
         let mut callers: Vec<Vec<RungId>> = vec![Vec::new(); p.pous.len()];
         for e in &a.cfg.edges {
             if e.kind == EdgeKind::Call {
-                let pou = p.rungs[e.to as usize].pou;
-                callers[pou.index()].push(RungId(e.from));
+                let pou = p.rungs[e.to.0 as usize].pou;
+                callers[pou.index()].push(RungId(e.from.0));
             }
         }
         let mut instance_read = vec![false; p.rungs.len()];
@@ -51,7 +51,7 @@ impl<'a> Explainer<'a> {
             .filter(|r| match s.task_of[r.index()] {
                 None => true,
                 Some(t) => {
-                    let task = &s.tasks[t as usize];
+                    let task = s.task(t);
                     task.is_loop
                         || task.level != a.data_levels[r.index()]
                         || task.level != a.control_levels[r.index()]
@@ -99,7 +99,7 @@ impl<'a> Explainer<'a> {
             };
             return entry(None, vec![reason]);
         };
-        let task = &s.tasks[t as usize];
+        let task = s.task(t);
         let level = task.level;
         let mut reasons = Vec::new();
         if task.is_loop {
@@ -108,14 +108,14 @@ impl<'a> Explainer<'a> {
                 p.rung(task.rungs[0]).id
             ));
         }
-        let controllers: Vec<u32> = task.guard.iter().map(|g| g.controller).collect();
+        let controllers: Vec<TaskId> = task.guard.iter().map(|g| g.controller).collect();
         if level > dl && !controllers.is_empty() {
             reasons.push(format!(
                 "runs only if {} decides so (control), which the data view ignores",
                 self.ids(controllers.iter().map(|&c| s.head(c)))
             ));
         }
-        let data_preds: Vec<u32> = s.preds[t as usize]
+        let data_preds: Vec<TaskId> = s.preds[t.index()]
             .iter()
             .copied()
             .filter(|q| !controllers.contains(q))

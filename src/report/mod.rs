@@ -92,7 +92,7 @@ pub(crate) fn combined_groups(a: &Analysis) -> Vec<Vec<Vec<RungId>>> {
         .map(|level| {
             let mut tasks: Vec<Vec<RungId>> = level
                 .iter()
-                .map(|&t| a.schedule.tasks[t as usize].rungs.clone())
+                .map(|&t| a.schedule.task(t).rungs.clone())
                 .collect();
             tasks.sort_unstable_by_key(|t| t[0]);
             tasks

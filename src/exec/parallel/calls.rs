@@ -72,17 +72,17 @@ pub(super) fn is_loop_back(p: &Program, r: RungId) -> bool {
 /// expect control to go, with the reason; `None` if there is none.
 pub(super) fn uncovered_refusal(p: &Program, a: &Analysis, task_of: &[u32]) -> Option<String> {
     let n = p.rungs.len() as u32;
-    let stop = a.cfg.stop();
+    let stop = a.cfg.stop().0;
     // Live CFG edges of the main program, by (task of source, target node).
     let mut edges: std::collections::HashSet<(u32, u32)> = std::collections::HashSet::new();
     for e in &a.cfg.edges {
         if matches!(e.kind, EdgeKind::Call | EdgeKind::Return)
-            || e.from >= n
-            || task_of[e.from as usize] == NONE
+            || e.from.0 >= n
+            || task_of[e.from.0 as usize] == NONE
         {
             continue;
         }
-        edges.insert((task_of[e.from as usize], e.to));
+        edges.insert((task_of[e.from.0 as usize], e.to.0));
     }
     let main = p.main().rungs.clone();
     let mut found = Vec::new();

@@ -209,7 +209,11 @@ impl ParallelMachine {
             }
             (reads, writes)
         };
-        let name = |t: u32| p.rung(sched.head(t)).id.clone();
+        let name = |t: u32| {
+            p.rung(sched.head(crate::analysis::schedule::TaskId(t)))
+                .id
+                .clone()
+        };
         for (pi, ph) in self.plan.phases.iter().enumerate() {
             if !ph.parallel {
                 continue;

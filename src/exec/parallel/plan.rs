@@ -5,7 +5,7 @@
 use super::calls::{call_closure, is_loop_back, rung_callees, uncovered_refusal};
 use super::config::{PlanConfig, Slicing, Strategy};
 use super::tasks::{contiguous, lpt, Tasks};
-use crate::analysis::{Analysis, EdgeKind, Successor};
+use crate::analysis::{schedule::TaskId, Analysis, EdgeKind, Successor};
 use crate::model::{PouId, Program, VarId};
 use std::collections::HashMap;
 use std::ops::Range;
@@ -111,29 +111,35 @@ impl Plan {
         let sched = &a.schedule;
         let nt = sched.tasks.len();
         let threads = config.threads.max(1);
+        // Task numbers as plain indices, the way this planner works with them.
+        let sched_levels: Vec<Vec<u32>> = sched
+            .levels
+            .iter()
+            .map(|l| l.iter().map(|t| t.0).collect())
+            .collect();
         let mut task_of_rung = vec![NONE; p.rungs.len()];
         for (r, t) in sched.task_of.iter().enumerate() {
             if let Some(t) = t {
-                task_of_rung[r] = *t;
+                task_of_rung[r] = t.0;
             }
         }
         // Condensed successors and entry predecessors from the main program's live CFG edges.
         let n = p.rungs.len() as u32;
-        let stop = a.cfg.stop();
+        let stop = a.cfg.stop().0;
         let mut succs: Vec<Vec<u32>> = vec![Vec::new(); nt];
         let mut entry_preds: Vec<Vec<u32>> = vec![Vec::new(); nt];
         for e in &a.cfg.edges {
-            if matches!(e.kind, EdgeKind::Call | EdgeKind::Return) || e.from >= n {
+            if matches!(e.kind, EdgeKind::Call | EdgeKind::Return) || e.from.0 >= n {
                 continue;
             }
-            let ta = task_of_rung[e.from as usize];
+            let ta = task_of_rung[e.from.0 as usize];
             if ta == NONE {
                 continue;
             }
-            let tb = if e.to == stop {
+            let tb = if e.to.0 == stop {
                 STOP
-            } else if e.to < n {
-                task_of_rung[e.to as usize]
+            } else if e.to.0 < n {
+                task_of_rung[e.to.0 as usize]
             } else {
                 continue;
             };
@@ -155,7 +161,7 @@ impl Plan {
                 needs_decision[q as usize] = true;
             }
             for g in &sched.tasks[t].guard {
-                needs_decision[g.controller as usize] = true;
+                needs_decision[g.controller.index()] = true;
             }
         }
         let only_succ: Vec<u32> = succs
@@ -194,7 +200,7 @@ impl Plan {
             .map(|pou| p.pou_rungs(PouId(pou as u32)).any(|r| is_loop_back(p, r)))
             .collect();
         let mut level_conflict: Vec<Option<String>> = vec![None; sched.levels.len()];
-        for (l, level) in sched.levels.iter().enumerate() {
+        for (l, level) in sched_levels.iter().enumerate() {
             let mut user: HashMap<u32, u32> = HashMap::new();
             'level: for &t in level {
                 let mut pous: Vec<u32> = Vec::new();
@@ -211,8 +217,8 @@ impl Plan {
                     if let Some(&other) = user.get(&c) {
                         level_conflict[l] = Some(format!(
                             "tasks {} and {} both call {}, whose loop counters they would share",
-                            p.rung(sched.head(other)).id,
-                            p.rung(sched.head(t)).id,
+                            p.rung(sched.head(TaskId(other))).id,
+                            p.rung(sched.head(TaskId(t))).id,
                             p.pous[c as usize].name
                         ));
                         break 'level;
@@ -225,7 +231,7 @@ impl Plan {
         // Per level: sequential cost, parallel slices and makespan.
         let mut level_plans = Vec::with_capacity(sched.levels.len());
         let mut level_slices: Vec<Option<Vec<Vec<u32>>>> = Vec::with_capacity(sched.levels.len());
-        for (l, level) in sched.levels.iter().enumerate() {
+        for (l, level) in sched_levels.iter().enumerate() {
             let weights: Vec<u64> = level.iter().map(|&t| info.cost[t as usize]).collect();
             let c: u64 = weights.iter().sum();
             let mut lp = LevelPlan {
@@ -413,7 +419,7 @@ impl Plan {
                     l += 1;
                 }
                 let mut tasks: Vec<u32> =
-                    sched.levels[start..l].iter().flatten().copied().collect();
+                    sched_levels[start..l].iter().flatten().copied().collect();
                 tasks.sort_unstable();
                 let barrier_before = start > 0; // after a P phase
                 plan.phases.push(Phase {
@@ -458,11 +464,10 @@ impl Plan {
                     let g0 = plan.guards.len() as u32;
                     for g in &task.guard {
                         let succ = match g.successor {
-                            Successor::Task(s) => s,
+                            Successor::Task(s) => s.0,
                             Successor::Stop => STOP,
                         };
-                        plan.guards
-                            .push((slot_of_task[g.controller as usize], succ));
+                        plan.guards.push((slot_of_task[g.controller.index()], succ));
                     }
                     it.guard = g0..plan.guards.len() as u32;
                     if task.entries.len() > 1 {
