@@ -217,7 +217,7 @@ pub struct Machine {
     consts: Vec<u64>,
     fors: Vec<ForLoop>,
     rung_op: Vec<u32>,
-    for_of_head: Vec<u32>,
+    for_of_head: Vec<Option<u32>>,
     pou_entry: Vec<u32>,
     counters: Vec<(u32, u32)>,
     slot_count: u32,
@@ -420,8 +420,9 @@ impl Machine {
             Exit::Stop => return Exit::Stop,
             Exit::Rung(r) => (self.rung_op[r.index()], r.0),
             Exit::ForTest(h) => {
-                let f = self.for_of_head[h.index()];
-                assert!(f != u32::MAX, "rung {} is not a FOR head", h.0);
+                let Some(f) = self.for_of_head[h.index()] else {
+                    panic!("rung {} is not a FOR head", h.0);
+                };
                 if !inside(h) {
                     return at;
                 }

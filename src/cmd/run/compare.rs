@@ -2,7 +2,6 @@
 //! into a 128-bit digest, and the exact lockstep replay that names the first difference.
 
 use super::inputs::InputTable;
-use super::output::value_json;
 use crate::exec::parallel::ParallelMachine;
 use crate::exec::{Fault, FaultKind, Machine};
 use crate::model::{Program, VarId};
@@ -79,7 +78,7 @@ pub(super) fn first_difference(
                     let w = seq.layout().slots_of(v).len();
                     if i < k + w {
                         let (va, vb) = (seq.value(&a, v), par.machine().value(&b, v));
-                        let mut d = json!({"scan": scan, "variable": p.var(v).name, "seq": value_json(va), "par": value_json(vb)});
+                        let mut d = json!({"scan": scan, "variable": p.var(v).name, "seq": va.to_json(), "par": vb.to_json()});
                         if va == vb {
                             d["detail"] = json!(format!("internal slot {} of the instance", i - k));
                         }

@@ -6,7 +6,7 @@
 use super::compare::{canonical_slots, digest, first_difference};
 use super::inputs::{load_inputs, InputTable};
 use super::trace::{cell, trace_columns, Trace};
-use super::{RunConfig, RunMode, RunWarning};
+use super::config::{RunConfig, RunMode, RunWarning};
 use crate::analysis::analyse;
 use crate::cmd::io::{check_output_path, load_program, CliError, FileRole};
 use crate::cmd::progress::{Bar, Progress};

@@ -1,18 +1,12 @@
 //! Rendering a run's report: the text report, the JSON report (normative keys: docs/scan.md)
 //! and its deterministic form for `analyses/*/run.json`.
 
+use super::config::count;
 use super::engine::RunReport;
-use super::{count, run_report, RunConfig};
-use crate::cmd::io::CliError;
 use crate::exec::VarValue;
 use crate::model::Value;
 use serde_json::{json, Map, Value as Json};
 use std::fmt::Write as _;
-
-/// JSON of a scalar value as `state` shows it (BOOL true/false, numbers, TIME ms).
-pub(super) fn value_json(v: VarValue) -> Json {
-    v.to_json()
-}
 
 /// Text of a value (BOOL TRUE/FALSE, TIME T#…ms, instances as their fields).
 fn value_text(v: VarValue) -> String {
@@ -42,7 +36,7 @@ pub fn render_json(r: &RunReport, deterministic: bool) -> String {
         Json::Object(
             r.outputs
                 .iter()
-                .map(|(n, v)| (n.clone(), value_json(*v)))
+                .map(|(n, v)| (n.clone(), VarValue::to_json(&*v)))
                 .collect(),
         ),
     );
@@ -51,7 +45,7 @@ pub fn render_json(r: &RunReport, deterministic: bool) -> String {
         Json::Object(
             r.state
                 .iter()
-                .map(|(n, v)| (n.clone(), value_json(*v)))
+                .map(|(n, v)| (n.clone(), VarValue::to_json(&*v)))
                 .collect(),
         ),
     );
@@ -225,14 +219,4 @@ pub fn render_text(r: &RunReport) -> String {
         _ => {}
     }
     s
-}
-
-/// The deterministic JSON of a run (timing fields zero): what `analyses/*/run.json` holds.
-pub fn run_json_deterministic(c: &RunConfig) -> Result<String, CliError> {
-    let c = RunConfig {
-        progress: false,
-        trace: None,
-        ..c.clone()
-    };
-    Ok(render_json(&run_report(&c)?, true))
 }

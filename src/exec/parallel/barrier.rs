@@ -1,6 +1,9 @@
 //! The spinning barrier the workers meet at between the phases of a scan.
+//!
+//! Invariant: every worker calls [`SpinBarrier::wait`] the same number of times per run, with
+//! its own epoch counter; it depends only on the padding below it and knows nothing of plans.
 
-use super::shared::Padded;
+use super::pad::Padded;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 /// A spinning barrier for a fixed set of workers: each worker publishes the number of barriers

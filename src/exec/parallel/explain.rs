@@ -1,6 +1,7 @@
-//! `plc-deps run --explain`: the plan in words and as JSON.
+//! `plc-deps run --explain`: the plan in words and as JSON. The top of the parallel module:
+//! it reads the machine and its plan and changes nothing.
 
-use super::ParallelMachine;
+use super::machine::ParallelMachine;
 use crate::model::Program;
 use std::fmt::Write as _;
 
@@ -71,7 +72,7 @@ impl ParallelMachine {
         }
         if plan.sequential.is_none() {
             for (i, ph) in plan.phases.iter().enumerate() {
-                if !ph.parallel && ph.levels.len() > 1 {
+                if !ph.is_parallel() && ph.levels.len() > 1 {
                     let _ = writeln!(s, "  phase {}: levels {}..={} merged into one sequential phase (worker 0, task order)", i + 1, ph.levels.start + 1, ph.levels.end);
                 }
             }
@@ -80,7 +81,7 @@ impl ParallelMachine {
             let _ = writeln!(
                 s,
                 "padding: {} variable groups on 64-byte lines (one per set of (phase, worker) writers); {} slots for {} of data, {} loop counters (a line each), {} decision slots",
-                plan.groups.len(),
+                self.layout_groups,
                 m.layout().slot_count(),
                 dense,
                 m.loop_counters().len(),
@@ -107,7 +108,7 @@ impl ParallelMachine {
             "parallel_phases": plan.parallel_phases(),
             "barriers_per_scan": plan.barriers_per_scan(),
             "slots": self.machine.slot_count(),
-            "layout_groups": plan.groups.len(),
+            "layout_groups": self.layout_groups,
             "decision_slots": plan.decision_slots,
             "levels": plan.levels.iter().map(|lp| json!({
                 "tasks": lp.tasks,
