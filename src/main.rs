@@ -74,8 +74,15 @@ enum Command {
         #[arg(long)]
         rungs: usize,
         /// Rungs per stage: the program has about rungs / width data levels.
-        #[arg(long, default_value_t = 100)]
+        #[arg(long, default_value_t = 100, conflicts_with = "levels")]
         width: usize,
+        /// Data levels instead of --width: width = ceil(rungs / levels) (at least 1).
+        #[arg(long, value_name = "L")]
+        levels: Option<usize>,
+        /// Which lanes of the previous stage a rung reads: 3-5 nearby ones (local) or 3-6 drawn
+        /// at random from the whole stage (random).
+        #[arg(long, value_enum, default_value_t = ReadsArg::Local)]
+        reads: ReadsArg,
         /// Seed of the pseudo-random choices (same seed, same program).
         #[arg(long, default_value_t = 1)]
         seed: u64,
@@ -145,6 +152,12 @@ enum Command {
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
+}
+
+#[derive(Copy, Clone, ValueEnum)]
+enum ReadsArg {
+    Local,
+    Random,
 }
 
 #[derive(Copy, Clone, ValueEnum)]
@@ -248,6 +261,8 @@ fn run(cli: Cli) -> Result<(), CliError> {
         Command::Gen {
             rungs,
             width,
+            levels,
+            reads,
             seed,
             timers,
             loops,
@@ -267,8 +282,16 @@ fn run(cli: Cli) -> Result<(), CliError> {
                 calls,
                 for_body,
                 hot_fraction,
+                reads: match reads {
+                    ReadsArg::Local => plc_deps::synth::Reads::Local,
+                    ReadsArg::Random => plc_deps::synth::Reads::Random,
+                },
             };
-            cmd::gen::gen(&cmd::gen::GenCommand { config, output })
+            cmd::gen::gen(&cmd::gen::GenCommand {
+                config,
+                levels,
+                output,
+            })
         }
         Command::Run {
             file,
