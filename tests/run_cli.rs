@@ -263,7 +263,11 @@ fn both_modes_are_identical_on_programs_with_jumps_loops_and_calls() {
             "{threads} threads: {}",
             j["first_difference"]
         );
-        assert_eq!(j["plan"]["threads"], threads.parse::<u64>().unwrap());
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get()) as u64;
+        let asked: u64 = threads.parse().unwrap();
+        assert_eq!(j["threads"], asked);
+        assert_eq!(j["workers"], asked.min(cores));
+        assert_eq!(j["plan"]["threads"], asked.min(cores), "planned for the cores that exist");
     }
     for dir in [
         "example-a",
@@ -278,6 +282,36 @@ fn both_modes_are_identical_on_programs_with_jumps_loops_and_calls() {
         ]));
         assert_eq!(j["identical"], true, "{dir}");
     }
+}
+
+#[test]
+fn more_threads_than_cores_is_a_warning_and_plans_for_the_cores() {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let threads = (cores + 6).to_string();
+    let out = run(&[
+        "run",
+        "analyses/example-a/program.json",
+        "--scans",
+        "30",
+        "--threads",
+        &threads,
+        "--format",
+        "json",
+        "--explain",
+    ]);
+    assert!(out.status.success());
+    let err = String::from_utf8(out.stderr).unwrap();
+    let plural = if cores == 1 { "core" } else { "cores" };
+    assert!(
+        err.contains(&format!(
+            "warning: --threads {threads} is more than the {cores} {plural} of this machine"
+        )),
+        "{err}"
+    );
+    let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(j["workers"], cores as u64);
+    assert_eq!(j["plan"]["threads"], cores as u64);
+    assert_eq!(j["identical"], true);
 }
 
 #[test]

@@ -81,6 +81,13 @@ impl RunConfig {
 /// Something the user should know about a run that still runs (printed as `warning: …`).
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum RunWarning {
+    /// More `--threads` than cores: the plan is made for the cores that exist.
+    #[error(
+        "--threads {threads} is more than the {cores} {} of this machine: planning for {cores} {}",
+        if *cores == 1 { "core" } else { "cores" },
+        if *cores == 1 { "worker" } else { "workers" }
+    )]
+    Oversubscribed { threads: usize, cores: usize },
     /// The `--inputs` file has no rows: every input keeps its initial value.
     #[error(
         "--inputs {file} has no rows: every input keeps its initial value{}",

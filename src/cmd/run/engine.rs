@@ -29,6 +29,8 @@ pub struct RunReport {
     pub scans: u64,
     pub cycle_ms: u32,
     pub threads: usize,
+    /// Workers the parallel executor was planned for: `threads`, at most the cores.
+    pub workers: usize,
     /// Main-program rungs (for the rung-execution rate).
     pub rungs: usize,
     /// Output variables after the last scan.
@@ -196,6 +198,7 @@ pub(super) struct Prepared {
     seq: Option<Machine>,
     par: Option<ParallelMachine>,
     pool: Option<rayon::ThreadPool>,
+    workers: usize,
     trace_cols: Option<Vec<(String, VarRef, Type)>>,
     /// What the user should know before the run starts.
     pub(super) warnings: Vec<RunWarning>,
@@ -281,20 +284,28 @@ pub(super) fn prepare(c: &RunConfig, progress: &Progress) -> Result<Prepared, Cl
     } else {
         None
     };
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let workers = c.threads.min(cores);
+    if c.threads > cores && c.mode != RunMode::Seq {
+        warnings.push(RunWarning::Oversubscribed {
+            threads: c.threads,
+            cores,
+        });
+    }
     let par = if c.mode != RunMode::Seq || c.explain {
         let a = analyse(&p);
         Some(
-            ParallelMachine::new(&p, &a, &exec, &PlanConfig::new(c.threads))
+            ParallelMachine::new(&p, &a, &exec, &PlanConfig::new(workers))
                 .map_err(lower_error)?,
         )
     } else {
         None
     };
     let pool = match &par {
-        Some(pm) if c.mode != RunMode::Seq && pm.plan().sequential().is_none() && c.threads > 1 => {
+        Some(pm) if c.mode != RunMode::Seq && pm.plan().sequential().is_none() && workers > 1 => {
             Some(
                 rayon::ThreadPoolBuilder::new()
-                    .num_threads(c.threads - 1)
+                    .num_threads(workers - 1)
                     .thread_name(|i| format!("plc-worker-{}", i + 1))
                     .build()
                     .map_err(|e| CliError::Threads(e.to_string()))?,
@@ -309,6 +320,7 @@ pub(super) fn prepare(c: &RunConfig, progress: &Progress) -> Result<Prepared, Cl
         seq,
         par,
         pool,
+        workers,
         trace_cols,
         warnings,
     })
@@ -468,6 +480,7 @@ fn report(pr: &Prepared, c: &RunConfig, m: &Machine, pass: Pass, extra: Extra) -
         scans: pr.scans,
         cycle_ms: c.cycle_ms,
         threads: c.threads,
+        workers: pr.workers,
         rungs: p.main().rungs.len(),
         outputs,
         state,

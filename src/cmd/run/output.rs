@@ -31,6 +31,7 @@ pub fn render_json(r: &RunReport, deterministic: bool) -> String {
     doc.insert("scans".into(), json!(r.scans));
     doc.insert("cycle_ms".into(), json!(r.cycle_ms));
     doc.insert("threads".into(), json!(r.threads));
+    doc.insert("workers".into(), json!(r.workers));
     doc.insert(
         "outputs".into(),
         Json::Object(
@@ -167,11 +168,16 @@ pub fn render_text(r: &RunReport) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "program {}: {}, cycle {} ms, {}",
+        "program {}: {}, cycle {} ms, {}{}",
         r.program,
         count(r.scans, "scan", "scans"),
         r.cycle_ms,
-        count(r.threads as u64, "thread", "threads")
+        count(r.threads as u64, "thread", "threads"),
+        if r.workers != r.threads {
+            format!(" (planned for {})", count(r.workers as u64, "worker", "workers"))
+        } else {
+            String::new()
+        }
     );
     if let Some((text, _)) = &r.explain {
         s.push('\n');

@@ -253,6 +253,7 @@ impl ParallelMachine {
         mut driver: Option<&mut D>,
     ) {
         let body = std::panic::AssertUnwindSafe(|| {
+            sh.barrier.register(w);
             let mut store = sh.slots;
             let mut epoch = 0u64;
             let mut scratch: Vec<Fault> = Vec::new();
