@@ -142,9 +142,15 @@ enum Command {
         /// Output format.
         #[arg(long, value_enum, default_value_t = RunFormatArg::Text)]
         format: RunFormatArg,
-        /// Explain the parallel plan: levels, costs, slices, merges and padding.
+        /// Explain the parallel plan: levels, costs, slices, merges and padding, and what the
+        /// run chose (measured times, switches).
         #[arg(long)]
         explain: bool,
+        /// Which plans the parallel executor may use: measured among the sequential walk and
+        /// the levelled plans (auto), the cost model's choice (model), always the sequential
+        /// walk (seq), always the levelled plan (par).
+        #[arg(long, value_enum, default_value_t = PlanArg::Auto)]
+        plan: PlanArg,
         /// Loop-backs allowed per loop-back rung and scan (the iteration cap).
         #[arg(long, default_value_t = 100_000)]
         loop_cap: u32,
@@ -152,6 +158,14 @@ enum Command {
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
+}
+
+#[derive(Copy, Clone, ValueEnum)]
+enum PlanArg {
+    Auto,
+    Model,
+    Seq,
+    Par,
 }
 
 #[derive(Copy, Clone, ValueEnum)]
@@ -304,6 +318,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
             trace_vars,
             format,
             explain,
+            plan,
             loop_cap,
             output,
         } => {
@@ -327,6 +342,12 @@ fn run(cli: Cli) -> Result<(), CliError> {
                 RunFormatArg::Json => RunFormat::Json,
             };
             config.explain = explain;
+            config.plan = match plan {
+                PlanArg::Auto => plc_deps::exec::parallel::PlanKind::Auto,
+                PlanArg::Model => plc_deps::exec::parallel::PlanKind::Model,
+                PlanArg::Seq => plc_deps::exec::parallel::PlanKind::Seq,
+                PlanArg::Par => plc_deps::exec::parallel::PlanKind::Par,
+            };
             config.loop_cap = loop_cap;
             config.output = output;
             run::run(&config)

@@ -3,6 +3,7 @@
 //! uses. The bottom of the command: it depends on nothing else in it.
 
 use crate::cmd::io::CliError;
+use crate::exec::parallel::PlanKind;
 use crate::exec::ExecConfig;
 use crate::model::parse_time_literal;
 use std::io::IsTerminal;
@@ -47,6 +48,8 @@ pub struct RunConfig {
     pub format: RunFormat,
     /// Describe the parallel plan.
     pub explain: bool,
+    /// Which plans the parallel executor may use (default: measured, `auto`).
+    pub plan: PlanKind,
     /// Loop-backs per loop-back rung and scan.
     pub loop_cap: u32,
     /// Write the report here instead of standard output.
@@ -71,6 +74,7 @@ impl RunConfig {
             trace_vars: None,
             format: RunFormat::Text,
             explain: false,
+            plan: PlanKind::Auto,
             loop_cap: ExecConfig::default().loop_cap,
             output: None,
             progress: std::io::stderr().is_terminal(),
@@ -88,6 +92,9 @@ pub enum RunWarning {
         if *cores == 1 { "worker" } else { "workers" }
     )]
     Oversubscribed { threads: usize, cores: usize },
+    /// A parallel plan failed its check against the lowered code and is not used.
+    #[error("{0}")]
+    PlanDropped(String),
     /// The `--inputs` file has no rows: every input keeps its initial value.
     #[error(
         "--inputs {file} has no rows: every input keeps its initial value{}",

@@ -18,17 +18,17 @@
 //! first difference (variable and both values).
 
 // Bottom to top; each module uses only the ones before it.
-mod config;
-mod inputs;
-mod trace;
 mod compare;
+mod config;
 mod engine;
+mod inputs;
 mod output;
+mod trace;
 
 pub use crate::cmd::progress::Progress;
+pub use config::{parse_cycle, RunConfig, RunFormat, RunMode, RunWarning};
 pub use engine::{FaultSummary, RunReport};
 pub use inputs::{load_inputs, parse_inputs_csv, parse_inputs_json, InputTable};
-pub use config::{parse_cycle, RunConfig, RunFormat, RunMode, RunWarning};
 pub use output::{render_json, render_text};
 
 use crate::cmd::io::{write_file_as, write_output, CliError, FileRole};

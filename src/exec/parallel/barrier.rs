@@ -14,8 +14,10 @@ use std::thread::Thread;
 
 /// Spin-loop hints before a waiter starts yielding (a few µs: what a balanced phase needs).
 const SPINS: u32 = 1 << 11;
-/// `yield_now` calls before a waiter parks (lets a descheduled worker on the same core run).
-const YIELDS: u32 = 8;
+/// How long a waiter yields before it parks: long enough to cover worker 0's work between two
+/// scans (the driver's digest of a large state) without a wake-up latency, short enough that a
+/// descheduled worker costs the others a sleep, not a time slice of spinning.
+const YIELD_FOR: std::time::Duration = std::time::Duration::from_micros(200);
 
 /// One worker's seat: the barriers it has reached, whether it is parked, and its thread.
 #[derive(Debug, Default)]
@@ -76,10 +78,15 @@ impl SpinBarrier {
     #[inline]
     fn wait_for(&self, w: usize, other: &Seat, e: u64) -> bool {
         let mut spins = 0u32;
+        let mut yielding: Option<std::time::Instant> = None;
         while other.epoch.load(Ordering::Acquire) < e {
             if spins < SPINS {
                 std::hint::spin_loop();
-            } else if spins < SPINS + YIELDS {
+            } else if yielding
+                .get_or_insert_with(std::time::Instant::now)
+                .elapsed()
+                < YIELD_FOR
+            {
                 std::thread::yield_now();
             } else {
                 if self.poisoned.load(Ordering::SeqCst) {
@@ -87,8 +94,7 @@ impl SpinBarrier {
                 }
                 let me = &self.seats[w].0;
                 me.parked.store(true, Ordering::SeqCst);
-                if other.epoch.load(Ordering::SeqCst) < e && !self.poisoned.load(Ordering::SeqCst)
-                {
+                if other.epoch.load(Ordering::SeqCst) < e && !self.poisoned.load(Ordering::SeqCst) {
                     // A registered worker is woken by `unpark`; an unregistered one (a caller
                     // that skipped `register`) still wakes up: park_timeout bounds its sleep.
                     if me.thread.get().is_some() {

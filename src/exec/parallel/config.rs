@@ -50,12 +50,12 @@ pub struct Measure {
 }
 
 impl Default for Measure {
-    /// 4 scans per probe, re-measure after 64 scans doubling up to 2048, windows of 32 scans,
+    /// 4 scans per probe, re-measure after 128 scans doubling up to 2048, windows of 32 scans,
     /// every 8th scan timed.
     fn default() -> Self {
         Measure {
             probe_scans: 4,
-            min_interval: 64,
+            min_interval: 128,
             max_interval: 2048,
             chunk: 32,
             sample_every: 8,

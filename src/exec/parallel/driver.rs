@@ -46,4 +46,3 @@ pub fn run_sequential<D: ScanDriver + ?Sized>(
         driver.after_scan(machine, scan, &state.slots, &faults, elapsed);
     }
 }
-

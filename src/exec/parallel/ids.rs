@@ -109,6 +109,9 @@ mod tests {
         ] {
             assert_eq!(Decision::unpack(d.pack()), d);
         }
-        assert_ne!(Decision::Rung(RungId(3)).pack(), Decision::ForTest(RungId(3)).pack());
+        assert_ne!(
+            Decision::Rung(RungId(3)).pack(),
+            Decision::ForTest(RungId(3)).pack()
+        );
     }
 }

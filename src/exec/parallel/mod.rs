@@ -52,7 +52,8 @@
 //! # Modules, bottom to top
 //! Each depends only on the ones above it in this list: `ids` (typed indices and decisions),
 //! `config`, `pad`, `calls` (call closures, loop-backs), `tasks` (task facts, items, slicing),
-//! `plan` (phases on the cost model: the planning), `driver` (the per-scan callbacks and the
+//! `plan` (phases on the cost model: the planning), `check` (a plan against the lowered code),
+//! `choice` (the measured choice among candidates), `driver` (the per-scan callbacks and the
 //! sequential loop), `barrier`, `shared` (lock-free shared memory), `machine` (the running
 //! machine), `explain`.
 //!
@@ -66,6 +67,8 @@
 
 mod barrier;
 mod calls;
+mod check;
+mod choice;
 mod config;
 mod driver;
 mod explain;
@@ -77,9 +80,11 @@ mod shared;
 mod tasks;
 
 pub use barrier::SpinBarrier;
-pub use config::{PlanConfig, Slicing, Strategy};
+pub use choice::{Chooser, Switch, Window};
+pub use config::{Measure, PlanConfig, PlanKind, Slicing, Strategy};
 pub use driver::{run_sequential, ScanDriver};
+pub use explain::{ns_text, run_log_json};
 pub use ids::{Decision, DecisionSlot, Next, TaskId};
-pub use machine::ParallelMachine;
+pub use machine::{Candidate, ParallelMachine, RunLog};
 pub use plan::{LevelPlan, Plan};
 pub use shared::SharedSlots;

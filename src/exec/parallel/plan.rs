@@ -11,11 +11,11 @@
 //! against the lowered code (see `check`).
 
 use super::calls::{call_closure, is_loop_back, rung_callees, uncovered_refusal};
-use super::config::{PlanConfig, Slicing, Strategy};
+use super::config::{PlanConfig, PlanKind, Slicing, Strategy};
 use super::ids::{DecisionSlot, Next, TaskId};
 use super::tasks::{contiguous, lpt, Item, Tasks};
 use crate::analysis::{Analysis, EdgeKind, Successor};
-use crate::model::{PouId, Program, VarId};
+use crate::model::{PouId, Program, RungId, VarId};
 use std::collections::HashMap;
 use std::ops::Range;
 
@@ -23,7 +23,7 @@ use std::ops::Range;
 pub(super) const DECISION_LINE: usize = 16;
 
 /// Whether a phase runs on all workers or on worker 0 alone.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub(super) enum PhaseKind {
     /// One slice of items per worker.
     Parallel(Vec<Vec<Item>>),
@@ -32,7 +32,7 @@ pub(super) enum PhaseKind {
 }
 
 /// One phase of a scan.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub(super) struct Phase {
     pub(super) kind: PhaseKind,
     /// The levels it runs.
@@ -100,6 +100,8 @@ pub struct Plan {
     pub(super) levels: Vec<LevelPlan>,
     /// Task of each rung (main-program rungs that run).
     pub(super) task_of_rung: Vec<Option<TaskId>>,
+    /// The rungs of each task (the schedule's).
+    pub(super) task_rungs: Vec<Vec<RungId>>,
     /// Guard disjuncts: (decision slot of the controller, where it must have led).
     pub(super) guards: Vec<(DecisionSlot, Next)>,
     /// Decision slots of entry predecessors.
@@ -130,13 +132,25 @@ impl Plan {
             Some(why)
         } else if config.strategy == Strategy::Sequential {
             Some("sequential strategy requested".into())
+        } else if config.kind == PlanKind::Seq {
+            Some("the sequential walk was asked for (--plan seq)".into())
         } else if threads == 1 && config.strategy != Strategy::AllParallel {
             Some("one worker".into())
         } else if !any_parallel {
             Some("no level saves more than the barriers it needs".into())
-        } else if config.strategy == Strategy::Auto && est_plan + b > est_sequential {
+        } else if config.strategy == Strategy::Auto
+            && config.kind == PlanKind::Model
+            && est_plan + b > est_sequential
+        {
             Some(format!(
                 "the best plan ({est_plan} steps per scan with barriers) does not beat the sequential scan ({est_sequential} steps) by a barrier"
+            ))
+        } else if config.strategy == Strategy::Auto
+            && config.kind == PlanKind::Auto
+            && est_plan >= est_sequential
+        {
+            Some(format!(
+                "the cost model sees no gain to measure ({est_plan} steps per scan with barriers, sequential {est_sequential})"
             ))
         } else {
             None
@@ -150,6 +164,7 @@ impl Plan {
             end_barrier: false,
             levels: level_plans,
             task_of_rung,
+            task_rungs: sched.tasks.iter().map(|t| t.rungs.clone()).collect(),
             guards: Vec::new(),
             entry_slots: Vec::new(),
             decision_slots: 0,
@@ -196,7 +211,10 @@ impl Plan {
             }
         }
         self.decision_slots = next;
-        let slot = |t: TaskId| slot_of_task[t.index()].expect("a task read by a later guard or entry has a decision slot");
+        let slot = |t: TaskId| {
+            slot_of_task[t.index()]
+                .expect("a task read by a later guard or entry has a decision slot")
+        };
         let (guards, entry_slots) = (&mut self.guards, &mut self.entry_slots);
         for ph in &mut self.phases {
             let slices: Vec<&mut Vec<Item>> = match &mut ph.kind {

@@ -22,7 +22,7 @@ pub(super) enum Region {
 
 /// One call into the interpreter: a run of tasks `first..=last`, or one guarded or
 /// multi-entry task.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub(super) struct Item {
     pub(super) first: TaskId,
     pub(super) last: TaskId,
