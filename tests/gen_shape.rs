@@ -536,7 +536,11 @@ fn valid_and_exact_counts_over_many_shapes() {
                         calls: mask & 8 != 0,
                         for_body: None,
                         hot_fraction: None,
-                        reads: if seed % 2 == 1 { Reads::Random } else { Reads::Local },
+                        reads: if seed % 2 == 1 {
+                            Reads::Random
+                        } else {
+                            Reads::Local
+                        },
                     };
                     let stats = check(&c);
                     if c.calls {
@@ -661,7 +665,11 @@ fn random_reads_layout() {
         let (mut reads, mut writes) = (Vec::new(), Vec::new());
         collect(&rung["ld"], &mut reads, &mut writes);
         let ms: Vec<&String> = writes.iter().filter(|x| x.starts_with('M')).collect();
-        assert_eq!(ms, vec![&format!("M{j}_{}", phase(s))], "rung {r} writes {writes:?}");
+        assert_eq!(
+            ms,
+            vec![&format!("M{j}_{}", phase(s))],
+            "rung {r} writes {writes:?}"
+        );
         let mut lanes = HashSet::new();
         for x in reads.iter().filter(|x| x.starts_with('M')) {
             assert!(s > 0, "stage 0 rung {r} reads {x}");
