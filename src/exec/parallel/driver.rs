@@ -6,7 +6,7 @@ use crate::exec::{Fault, Machine, State};
 use std::ops::Range;
 use std::time::{Duration, Instant};
 
-/// What a caller of [`ParallelMachine::run`] (or [`run_sequential`]) does around each scan. Both
+/// What a caller of [`ParallelMachine::run`](super::ParallelMachine::run) (or [`run_sequential`]) does around each scan. Both
 /// methods are called on the calling thread, with exclusive access to the state.
 pub trait ScanDriver {
     /// Before scan `scan`: write its inputs (`Machine::set_inputs_in`).

@@ -1,13 +1,13 @@
 //! The parallel scan: the combined schedule (`analysis::schedule`) run level by level on several
 //! threads, with a result identical — every slot and every fault, every scan — to
-//! [`Machine::run_scan`].
+//! [`Machine::run_scan`](crate::exec::Machine::run_scan).
 //!
 //! # Shape
 //! Granularity decides everything: a rung of 6 contacts and a coil costs about 3.5 ns, a level
 //! of a thousand of them a few µs, so the executor must not pay a thread wake-up per level. The
 //! workers are therefore entered **once per run** (one [`rayon::ThreadPool::in_place_scope`]
 //! around all scans: the calling thread is worker 0, the pool supplies the others) and meet at a
-//! spinning barrier ([`SpinBarrier`]) between the *phases* of every scan:
+//! barrier ([`SpinBarrier`]: spin, yield, then park) between the *phases* of every scan:
 //!
 //! - a **parallel phase** is one level of the schedule, cut statically into one *slice* per
 //!   worker, balanced on the cost model (`Analysis::rung_costs`): contiguous runs of tasks
@@ -20,8 +20,10 @@
 //! The choice is a small dynamic programme over the levels (each level parallel or sequential,
 //! a barrier at every change and between parallel levels; sequential levels next to each other
 //! share their barriers): it minimises the modelled scan time `Σ parallel makespans + Σ
-//! sequential costs + barriers × barrier_cost`, and the plan is used only if it beats the plain
-//! sequential scan by more than one barrier. `plc-deps run --explain` prints the decisions.
+//! sequential costs + barriers × barrier_cost`. With [`PlanKind::Model`] the plan is used only
+//! if it beats the plain sequential scan by more than one barrier; with [`PlanKind::Auto`] the
+//! run measures the sequential walk and the levelled plans on its first scans and keeps the
+//! fastest, re-measuring as it goes (`choice`). `plc-deps run --explain` prints the decisions.
 //!
 //! Per scan: worker 0 writes the inputs and zeroes the loop counters; barrier; every phase (a
 //! barrier before a parallel phase and after it); worker 0 then merges the faults (into the
@@ -31,11 +33,12 @@
 //! - Tasks of one level never touch a variable that another task of the level writes (the
 //!   schedule's guarantee), and the loop counters of main-program loops belong to one task
 //!   each; a level whose tasks may share a subroutine's loop counters is run sequentially.
-//!   `ParallelMachine::verify` checks, slot by slot, that no slot written by a worker in a
-//!   parallel phase is read or written by another worker of that phase (debug builds check it at
-//!   construction).
+//!   Every plan is checked when it is built, in every build, against the lowered instructions'
+//!   actual slot accesses (`check`): no slot written by a worker in a parallel phase is read or
+//!   written by another worker of that phase, and no two workers write one 64-byte line; a plan
+//!   that fails is not run.
 //! - Control: after a task runs, the slot of its *decision* records where control left (the rung
-//!   it went to, or STOP); a task that does not run records NOT_RUN. A task runs iff its guard is
+//!   it went to, or the end of the scan); a task that does not run records [`Decision::NotRun`]. A task runs iff its guard is
 //!   empty or one of its disjuncts holds (`decision(controller)` leads to `successor`); a loop
 //!   task with several entries is entered at the rung its predecessor's decision names (the
 //!   schedule places it after all its predecessors). Decisions are read only in later phases.
@@ -60,7 +63,7 @@
 //! # Memory
 //! The state is one slot array shared by all workers without locks ([`SharedSlots`]: a raw
 //! pointer; disjointness is the schedule's guarantee above, ordering comes from the barrier's
-//! release/acquire). Its layout ([`Layout::from_groups`], 8-slot = 64-byte lines) groups the
+//! release/acquire). Its layout ([`Layout::from_groups`](crate::exec::Layout::from_groups), 8-slot = 64-byte lines) groups the
 //! variables by the set of (phase, worker) pairs that write them, so two workers never write the
 //! same cache line in one phase; loop counters have a line each; decisions and fault buffers are
 //! padded per worker.
