@@ -1,5 +1,8 @@
 //! Scan speed: the sequential interpreter and the parallel executor, per scan, on
-//! - `gen --rungs 20000 --width 1000` (20 levels of ~1000 rungs of 4–6 contacts and an output),
+//! - `gen --rungs 20000 --width 1000` (20 levels of ~1000 rungs of 4–6 contacts and an output,
+//!   each reading nearby lanes of the level before: the "local" shape),
+//! - `gen --rungs 20000 --levels 20 --reads random` (the same, each rung reading 3–6 variables
+//!   drawn at random from the whole level before),
 //! - a 50-rung chain (each rung reads the previous rung's coil: no parallelism; the parallel
 //!   executor must fall back to the sequential scan),
 //! - 20,000 uniform rungs of 6 contacts and a coil on 64 inputs (the interpreter's best case).
@@ -10,17 +13,18 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use plc_deps::analysis::analyse;
-use plc_deps::exec::parallel::{ParallelMachine, PlanConfig, ScanDriver};
+use plc_deps::exec::parallel::{ParallelMachine, PlanConfig, PlanKind, ScanDriver};
 use plc_deps::exec::{ExecConfig, Fault, Layout, Machine};
 use plc_deps::model::Program;
 use serde_json::json;
 use std::time::{Duration, Instant};
 
-fn generated(rungs: usize, width: usize) -> Program {
+fn generated(rungs: usize, width: usize, reads: plc_deps::synth::Reads) -> Program {
     let text = plc_deps::synth::generate_string(&plc_deps::synth::GenConfig {
         rungs,
         width,
         seed: 1,
+        reads,
         ..Default::default()
     });
     plc_deps::read::program_from_json(&text).expect("generated program loads")
@@ -92,7 +96,16 @@ fn bench_program(c: &mut Criterion, name: &str, p: &Program) {
     let a = analyse(p);
     let exec = ExecConfig::default();
     let seq = Machine::new(p, Layout::dense(p), &exec).expect("lowers");
-    let par = ParallelMachine::new(p, &a, &exec, &PlanConfig::new(2)).expect("lowers");
+    let par = ParallelMachine::new(
+        p,
+        &a,
+        &exec,
+        &PlanConfig {
+            kind: PlanKind::Auto,
+            ..PlanConfig::new(2)
+        },
+    )
+    .expect("lowers");
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build()
@@ -108,17 +121,17 @@ fn bench_program(c: &mut Criterion, name: &str, p: &Program) {
             scan += 1;
         })
     });
-    let label = if par.plan().sequential().is_some() {
+    let label = if par.sequential_reason().is_some() {
         "par-fallback"
     } else {
-        "par-2"
+        "par-auto-2"
     };
     g.bench_function(BenchmarkId::new(label, rungs), |b| {
         let mut st = par.initial_state();
         let mut scan = 0;
         b.iter_custom(|iters| {
             let t = Instant::now();
-            par.run(Some(&pool), &mut st, scan..scan + iters, &mut Nothing);
+            let _ = par.run(Some(&pool), &mut st, scan..scan + iters, &mut Nothing);
             scan += iters;
             t.elapsed()
         })
@@ -127,7 +140,13 @@ fn bench_program(c: &mut Criterion, name: &str, p: &Program) {
 }
 
 fn scan(c: &mut Criterion) {
-    bench_program(c, "gen-20000x1000", &generated(20_000, 1000));
+    use plc_deps::synth::Reads;
+    bench_program(c, "gen-20000x1000", &generated(20_000, 1000, Reads::Local));
+    bench_program(
+        c,
+        "random-reads-20000x20-levels",
+        &generated(20_000, 1000, Reads::Random),
+    );
     bench_program(c, "chain-50", &chain(50));
     bench_program(c, "uniform-6-contacts-20000", &uniform(20_000));
 }

@@ -80,8 +80,15 @@ enum Command {
         #[arg(long)]
         rungs: usize,
         /// Rungs per stage: the program has about rungs / width data levels.
-        #[arg(long, default_value_t = 100)]
+        #[arg(long, default_value_t = 100, conflicts_with = "levels")]
         width: usize,
+        /// Data levels instead of --width: width = ceil(rungs / levels) (at least 1).
+        #[arg(long, value_name = "L")]
+        levels: Option<usize>,
+        /// Which lanes of the previous stage a rung reads: 3-5 nearby ones (local) or 3-6 drawn
+        /// at random from the whole stage (random).
+        #[arg(long, value_enum, default_value_t = ReadsArg::Local)]
+        reads: ReadsArg,
         /// Seed of the pseudo-random choices (same seed, same program).
         #[arg(long, default_value_t = 1)]
         seed: u64,
@@ -141,9 +148,15 @@ enum Command {
         /// Output format.
         #[arg(long, value_enum, default_value_t = RunFormatArg::Text)]
         format: RunFormatArg,
-        /// Explain the parallel plan: levels, costs, slices, merges and padding.
+        /// Explain the parallel plan: levels, costs, slices, merges and padding, and what the
+        /// run chose (measured times, switches).
         #[arg(long)]
         explain: bool,
+        /// Which plans the parallel executor may use: measured among the sequential walk and
+        /// the levelled plans (auto), the cost model's choice (model), always the sequential
+        /// walk (seq), always the levelled plan (par).
+        #[arg(long, value_enum, default_value_t = PlanArg::Auto)]
+        plan: PlanArg,
         /// Loop-backs allowed per loop-back rung and scan (the iteration cap).
         #[arg(long, default_value_t = 100_000)]
         loop_cap: u32,
@@ -151,6 +164,20 @@ enum Command {
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
+}
+
+#[derive(Copy, Clone, ValueEnum)]
+enum PlanArg {
+    Auto,
+    Model,
+    Seq,
+    Par,
+}
+
+#[derive(Copy, Clone, ValueEnum)]
+enum ReadsArg {
+    Local,
+    Random,
 }
 
 #[derive(Copy, Clone, ValueEnum)]
@@ -276,6 +303,8 @@ fn run(cli: Cli) -> Result<(), CliError> {
         Command::Gen {
             rungs,
             width,
+            levels,
+            reads,
             seed,
             timers,
             loops,
@@ -295,8 +324,16 @@ fn run(cli: Cli) -> Result<(), CliError> {
                 calls,
                 for_body,
                 hot_fraction,
+                reads: match reads {
+                    ReadsArg::Local => plc_deps::synth::Reads::Local,
+                    ReadsArg::Random => plc_deps::synth::Reads::Random,
+                },
             };
-            cmd::gen::gen(&cmd::gen::GenCommand { config, output })
+            cmd::gen::gen(&cmd::gen::GenCommand {
+                config,
+                levels,
+                output,
+            })
         }
         Command::Run {
             file,
@@ -309,6 +346,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
             trace_vars,
             format,
             explain,
+            plan,
             loop_cap,
             output,
         } => {
@@ -332,6 +370,12 @@ fn run(cli: Cli) -> Result<(), CliError> {
                 RunFormatArg::Json => RunFormat::Json,
             };
             config.explain = explain;
+            config.plan = match plan {
+                PlanArg::Auto => plc_deps::exec::parallel::PlanKind::Auto,
+                PlanArg::Model => plc_deps::exec::parallel::PlanKind::Model,
+                PlanArg::Seq => plc_deps::exec::parallel::PlanKind::Seq,
+                PlanArg::Par => plc_deps::exec::parallel::PlanKind::Par,
+            };
             config.loop_cap = loop_cap;
             config.output = output;
             run::run(&config)

@@ -15,7 +15,9 @@ mod common;
 use common::Recorder;
 
 use plc_deps::analysis::analyse;
-use plc_deps::exec::parallel::{ParallelMachine, PlanConfig, Slicing, Strategy};
+use plc_deps::exec::parallel::{
+    Candidate, Measure, ParallelMachine, PlanConfig, PlanKind, Slicing, Strategy,
+};
 use plc_deps::exec::{ExecConfig, FaultKind, Machine};
 use plc_deps::model::{Program, Value, VarClass, VarId};
 
@@ -58,6 +60,9 @@ struct Stats {
     parallel_phases: u64,
     loop_cap_faults: u64,
     div_faults: u64,
+    /// Cases where the run mixed the sequential walk and a levelled plan.
+    mixed_runs: u64,
+    switches: u64,
 }
 
 /// Runs one program under one plan configuration and compares every scan.
@@ -98,7 +103,22 @@ fn check_with(
         faults: Vec::new(),
     };
     let mut state = par.initial_state();
-    par.run(Some(pool), &mut state, 0..scans, &mut rec);
+    let log = par.run(Some(pool), &mut state, 0..scans, &mut rec);
+    assert_eq!(
+        log.scans_on.iter().sum::<u64>(),
+        scans,
+        "{label}: every scan on a candidate"
+    );
+    let on = |seq: bool| -> u64 {
+        (0..log.candidates.len())
+            .filter(|&i| (par.candidates()[i] == Candidate::Sequential) == seq)
+            .map(|i| log.scans_on[i])
+            .sum()
+    };
+    if on(true) > 0 && on(false) > 0 {
+        stats.mixed_runs += 1;
+    }
+    stats.switches += log.switches.len() as u64;
     assert_eq!(
         rec.states.len() as u64,
         scans,
@@ -217,6 +237,67 @@ fn parallel_scan_equals_sequential_scan_on_random_programs() {
     assert!(
         stats.loop_cap_faults > 0 && stats.div_faults > 0,
         "faults are exercised"
+    );
+}
+
+/// Measuring that re-measures every few scans: the run switches between the sequential walk
+/// and the levelled plans all the time, whichever is faster.
+fn restless() -> Measure {
+    Measure {
+        probe_scans: 1,
+        min_interval: 1,
+        max_interval: 3,
+        chunk: 2,
+        sample_every: 1,
+    }
+}
+
+#[test]
+fn every_plan_kind_with_up_to_eight_workers_equals_the_sequential_scan() {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(7)
+        .build()
+        .unwrap();
+    let exec = ExecConfig {
+        cycle_ms: 10,
+        loop_cap: 12,
+    };
+    let mut stats = Stats::default();
+    for seed in 0..400u64 {
+        let json = common::random_program(seed + 50_000, 24);
+        let Ok(p) = plc_deps::read::program_from_json(&json) else {
+            continue;
+        };
+        for threads in [2, 8] {
+            for kind in [
+                PlanKind::Seq,
+                PlanKind::Model,
+                PlanKind::Par,
+                PlanKind::Auto,
+            ] {
+                let mut config = configs(threads, seed);
+                config.kind = kind;
+                if kind == PlanKind::Auto {
+                    config.measure = restless();
+                }
+                let label = format!(
+                    "seed {seed}, {threads} threads, --plan {}, {:?}/{:?}",
+                    kind.name(),
+                    config.strategy,
+                    config.slicing
+                );
+                check(&p, &label, &config, &exec, SCANS, seed, &pool, &mut stats);
+            }
+        }
+    }
+    eprintln!(
+        "{} cases, {} mixing the sequential walk and a levelled plan, {} switches",
+        stats.cases, stats.mixed_runs, stats.switches
+    );
+    assert!(
+        stats.mixed_runs >= 100,
+        "switching is exercised: {}",
+        stats.mixed_runs
     );
 }
 

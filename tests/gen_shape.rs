@@ -1,7 +1,7 @@
 //! Shape and validity of the synthetic program generator (`plc_deps::synth`), checked on the JSON
 //! text alone (serde_json), independently of the crate's reader.
 
-use plc_deps::synth::{generate_string, phase, write_program, GenConfig};
+use plc_deps::synth::{generate_string, phase, write_program, GenConfig, Reads};
 use proptest::prelude::*;
 use serde_json::{Map, Value};
 use std::collections::{BTreeMap, HashMap, HashSet};
@@ -505,6 +505,7 @@ fn cfg(rungs: usize, width: usize, seed: u64, on: bool) -> GenConfig {
         calls: on,
         for_body: None,
         hot_fraction: None,
+        reads: Reads::Local,
     }
 }
 
@@ -535,6 +536,11 @@ fn valid_and_exact_counts_over_many_shapes() {
                         calls: mask & 8 != 0,
                         for_body: None,
                         hot_fraction: None,
+                        reads: if seed % 2 == 1 {
+                            Reads::Random
+                        } else {
+                            Reads::Local
+                        },
                     };
                     let stats = check(&c);
                     if c.calls {
@@ -642,6 +648,47 @@ fn deterministic_and_seed_sensitive() {
     }
 }
 
+/// `--reads random`: normal rung (s, j) still writes `M{j}_{phase(s)}`, and reads 3–6 distinct
+/// `M{l}_{phase(s-1)}` of any lanes, far ones included.
+#[test]
+fn random_reads_layout() {
+    let (n, w) = (4000usize, 50usize);
+    let c = GenConfig {
+        reads: Reads::Random,
+        ..cfg(n, w, 3, false)
+    };
+    let v: Value = serde_json::from_str(&generate_string(&c)).unwrap();
+    let mut far = 0;
+    let mut counts = [0usize; 7];
+    for (r, rung) in v["rungs"].as_array().unwrap().iter().enumerate() {
+        let (s, j) = (r / w, r % w);
+        let (mut reads, mut writes) = (Vec::new(), Vec::new());
+        collect(&rung["ld"], &mut reads, &mut writes);
+        let ms: Vec<&String> = writes.iter().filter(|x| x.starts_with('M')).collect();
+        assert_eq!(
+            ms,
+            vec![&format!("M{j}_{}", phase(s))],
+            "rung {r} writes {writes:?}"
+        );
+        let mut lanes = HashSet::new();
+        for x in reads.iter().filter(|x| x.starts_with('M')) {
+            assert!(s > 0, "stage 0 rung {r} reads {x}");
+            let (lane, ph) = x[1..].split_once('_').unwrap();
+            let (lane, ph): (usize, usize) = (lane.parse().unwrap(), ph.parse().unwrap());
+            assert_eq!(ph, phase(s - 1), "rung {r} (stage {s}) reads {x}");
+            let d = (lane + w - j) % w;
+            far += (d > 2 && d < w - 2) as usize;
+            assert!(lanes.insert(lane), "rung {r} reads lane {lane} twice");
+        }
+        if s > 0 {
+            assert!((3..=6).contains(&lanes.len()), "rung {r} reads {reads:?}");
+            counts[lanes.len()] += 1;
+        }
+    }
+    assert!(far > n, "most reads are far: {far}");
+    assert!(counts[3] > 0 && counts[6] > 0, "3 to 6 reads: {counts:?}");
+}
+
 /// The documented stage/lane layout: normal rung (s, j) writes `M{j}_{phase(s)}` and reads only
 /// inputs (stage 0) or `M{l}_{phase(s-1)}` with `l` within 2 lanes of `j` (mod W).
 #[test]
@@ -729,7 +776,7 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
     #[test]
     fn random_configs_are_valid(rungs in 1usize..400, width in 0usize..70, seed in any::<u64>(), mask in 0u8..16) {
-        let c = GenConfig { rungs, width, seed, timers: mask & 1 != 0, loops: mask & 2 != 0, jumps: mask & 4 != 0, calls: mask & 8 != 0, for_body: None, hot_fraction: None };
+        let c = GenConfig { rungs, width, seed, timers: mask & 1 != 0, loops: mask & 2 != 0, jumps: mask & 4 != 0, calls: mask & 8 != 0, for_body: None, hot_fraction: None, reads: Default::default() };
         let text = generate_string(&c);
         let stats = validate(&text).map_err(|e| TestCaseError::fail(format!("{c:?}: {e}")))?;
         prop_assert_eq!(stats.main_rungs, rungs);
@@ -993,6 +1040,7 @@ proptest! {
             timers: mask & 1 != 0, loops: mask & 2 != 0 || body.is_some(), jumps: mask & 4 != 0, calls: mask & 8 != 0,
             for_body: body,
             hot_fraction: hot,
+            reads: if seed % 3 == 0 { Reads::Random } else { Reads::Local },
         };
         let text = generate_string(&c);
         let stats = validate(&text).map_err(|e| TestCaseError::fail(format!("{c:?}: {e}")))?;

@@ -263,7 +263,15 @@ fn both_modes_are_identical_on_programs_with_jumps_loops_and_calls() {
             "{threads} threads: {}",
             j["first_difference"]
         );
-        assert_eq!(j["plan"]["threads"], threads.parse::<u64>().unwrap());
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get()) as u64;
+        let asked: u64 = threads.parse().unwrap();
+        assert_eq!(j["threads"], asked);
+        assert_eq!(j["workers"], asked.min(cores));
+        assert_eq!(
+            j["plan"]["threads"],
+            asked.min(cores),
+            "planned for the cores that exist"
+        );
     }
     for dir in [
         "example-a",
@@ -278,6 +286,141 @@ fn both_modes_are_identical_on_programs_with_jumps_loops_and_calls() {
         ]));
         assert_eq!(j["identical"], true, "{dir}");
     }
+}
+
+#[test]
+fn a_sequential_walk_says_so_instead_of_a_ratio_and_every_ratio_its_scans() {
+    let one = write(
+        "one_rung.json",
+        r#"{"program": "one", "vars": [{"name": "a", "type": "BOOL", "class": "input"},
+            {"name": "q", "type": "BOOL", "class": "output"}],
+            "rungs": [{"id": "R1", "ld": [{"contact": "a"}, {"coil": "q"}]}]}"#,
+    );
+    let out = run(&["run", &one, "--scans", "100", "--threads", "2"]);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    let par = text
+        .lines()
+        .find(|l| l.trim_start().starts_with("par "))
+        .unwrap();
+    assert!(par.contains("  sequential fallback ("), "{par}");
+    assert!(!par.contains("x seq"), "{par}");
+    let wide = tmp("wide_plans.json");
+    assert!(run(&[
+        "gen",
+        "--rungs",
+        "2000",
+        "--levels",
+        "4",
+        "--reads",
+        "random",
+        "-o",
+        wide.to_str().unwrap()
+    ])
+    .status
+    .success());
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    for (plan, candidates, fallback) in [
+        (
+            "seq",
+            vec!["seq"],
+            Some("the sequential walk was asked for (--plan seq)"),
+        ),
+        ("par", vec!["par"], None),
+    ] {
+        let j = json_of(&run(&[
+            "run",
+            wide.to_str().unwrap(),
+            "--scans",
+            "40",
+            "--threads",
+            "2",
+            "--plan",
+            plan,
+            "--format",
+            "json",
+        ]));
+        assert_eq!(j["identical"], true, "--plan {plan}");
+        assert_eq!(j["plan_kind"], plan);
+        assert_eq!(j["speedup_scans"], 40);
+        if cores >= 2 {
+            assert_eq!(
+                j["plan_run"]["candidates"],
+                serde_json::json!(candidates),
+                "--plan {plan}"
+            );
+            assert_eq!(j["plan_run"]["scans"][candidates[0]], 40);
+            assert_eq!(
+                j["sequential_fallback"],
+                serde_json::json!(fallback),
+                "--plan {plan}"
+            );
+        }
+    }
+    if cores >= 2 {
+        let out = run(&[
+            "run",
+            wide.to_str().unwrap(),
+            "--scans",
+            "40",
+            "--threads",
+            "2",
+            "--plan",
+            "par",
+        ]);
+        let text = String::from_utf8(out.stdout).unwrap();
+        let par = text
+            .lines()
+            .find(|l| l.trim_start().starts_with("par "))
+            .unwrap();
+        assert!(par.contains("x seq over 40 scans)"), "{par}");
+        let out = run(&[
+            "run",
+            wide.to_str().unwrap(),
+            "--scans",
+            "40",
+            "--threads",
+            "2",
+            "--explain",
+        ]);
+        let text = String::from_utf8(out.stdout).unwrap();
+        assert!(text.contains("plan kind: auto ("), "{text}");
+        assert!(text.contains("candidates: seq, par"), "{text}");
+        assert!(
+            text.contains("plan choice (--plan auto) over 40 scans:"),
+            "{text}"
+        );
+    }
+}
+
+#[test]
+fn more_threads_than_cores_is_a_warning_and_plans_for_the_cores() {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let threads = (cores + 6).to_string();
+    let out = run(&[
+        "run",
+        "analyses/example-a/program.json",
+        "--scans",
+        "30",
+        "--threads",
+        &threads,
+        "--format",
+        "json",
+        "--explain",
+    ]);
+    assert!(out.status.success());
+    let err = String::from_utf8(out.stderr).unwrap();
+    let plural = if cores == 1 { "core" } else { "cores" };
+    assert!(
+        err.contains(&format!(
+            "warning: --threads {threads} is more than the {cores} {plural} of this machine"
+        )),
+        "{err}"
+    );
+    let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(j["workers"], cores as u64);
+    assert_eq!(j["plan"]["threads"], cores as u64);
+    assert_eq!(j["identical"], true);
 }
 
 #[test]

@@ -10,11 +10,24 @@ use std::path::PathBuf;
 #[derive(Clone, Debug)]
 pub struct GenCommand {
     pub config: GenConfig,
+    /// `--levels L`: replaces `config.width` by `ceil(rungs / L)`.
+    pub levels: Option<usize>,
     pub output: Option<PathBuf>,
 }
 
 /// `plc-deps gen`: checks the shape, then writes the program.
 pub fn gen(c: &GenCommand) -> Result<(), CliError> {
+    let mut config = c.config.clone();
+    match c.levels {
+        Some(0) => return Err(CliError::Usage("--levels must be at least 1".into())),
+        Some(l) => config.width = config.rungs.div_ceil(l).max(1),
+        None => {}
+    }
+    let c = &GenCommand {
+        config,
+        levels: None,
+        output: c.output.clone(),
+    };
     if c.config.width == 0 {
         return Err(CliError::Usage("--width must be at least 1".into()));
     }

@@ -152,8 +152,8 @@ pub(crate) struct Code {
     pub fors: Vec<ForLoop>,
     /// Instruction index of each rung's `Rung` marker.
     pub rung_op: Vec<u32>,
-    /// For each rung: the index into `fors` if it is a FOR head, else `u32::MAX`.
-    pub for_of_head: Vec<u32>,
+    /// For each rung: the index into `fors` if it is a FOR head.
+    pub for_of_head: Vec<Option<u32>>,
     /// Instruction index of each POU's first instruction.
     pub pou_entry: Vec<u32>,
     /// Loop-back rungs (a NEXT, or a rung with a backward jump) and their counter slots, in rung
@@ -220,7 +220,7 @@ pub(crate) fn lower(p: &Program, layout: &Layout) -> Result<Code, LowerError> {
             consts: Vec::new(),
             fors: Vec::new(),
             rung_op: vec![0; p.rungs.len()],
-            for_of_head: vec![u32::MAX; p.rungs.len()],
+            for_of_head: vec![None; p.rungs.len()],
             pou_entry: Vec::with_capacity(p.pous.len()),
             counters: Vec::new(),
             slot_count: 0,
@@ -546,14 +546,15 @@ impl Lowerer<'_> {
                     head: rung.0,
                     ctr: 0,
                 });
-                self.code.for_of_head[rung.index()] = f as u32;
+                self.code.for_of_head[rung.index()] = Some(f as u32);
                 self.for_nexts.push((f, *next));
                 self.push(Op::For { f: f as u32 });
                 self.push(Op::ForTest { f: f as u32 });
             }
             Element::Next { head } => {
                 // FOR heads come before their NEXT, so the head is already lowered.
-                let f = self.code.for_of_head[head.index()];
+                let f = self.code.for_of_head[head.index()]
+                    .expect("the model puts a FOR head before its NEXT");
                 let ctr = self.counter(rung);
                 self.code.fors[f as usize].ctr = ctr;
                 self.push(Op::Next { f });

@@ -106,7 +106,9 @@
 //! task's counter lives with the data it runs on. [`parallel`] runs the combined schedule on
 //! several threads, bit-identical to [`Machine::run_scan`].
 #![warn(missing_docs)]
+#![warn(clippy::undocumented_unsafe_blocks)]
 
+mod access;
 mod layout;
 mod lower;
 pub mod parallel;
@@ -217,7 +219,7 @@ pub struct Machine {
     consts: Vec<u64>,
     fors: Vec<ForLoop>,
     rung_op: Vec<u32>,
-    for_of_head: Vec<u32>,
+    for_of_head: Vec<Option<u32>>,
     pou_entry: Vec<u32>,
     counters: Vec<(u32, u32)>,
     slot_count: u32,
@@ -365,14 +367,23 @@ impl Machine {
     /// # Panics
     /// If `state` has fewer slots than [`Machine::slot_count`].
     pub fn run_scan(&self, state: &mut State, scan: u64, faults: &mut Vec<Fault>) {
+        self.run_scan_in(&mut state.slots, scan, faults)
+    }
+
+    /// [`run_scan`](Self::run_scan) on a bare slot array (a state's `slots`).
+    ///
+    /// # Panics
+    /// If `slots` has fewer than [`Machine::slot_count`] slots.
+    #[inline]
+    pub fn run_scan_in(&self, slots: &mut [u64], scan: u64, faults: &mut Vec<Fault>) {
         assert!(
-            state.slots.len() >= self.slot_count as usize,
+            slots.len() >= self.slot_count as usize,
             "state too small for this machine"
         );
-        self.begin_scan(&mut state.slots[..]);
+        self.begin_scan(slots);
         let mut ctx = self.context(scan, faults);
         self.exec(
-            &mut state.slots[..],
+            slots,
             &mut ctx,
             self.pou_entry[0] as usize,
             self.main_first,
@@ -420,8 +431,9 @@ impl Machine {
             Exit::Stop => return Exit::Stop,
             Exit::Rung(r) => (self.rung_op[r.index()], r.0),
             Exit::ForTest(h) => {
-                let f = self.for_of_head[h.index()];
-                assert!(f != u32::MAX, "rung {} is not a FOR head", h.0);
+                let Some(f) = self.for_of_head[h.index()] else {
+                    panic!("rung {} is not a FOR head", h.0);
+                };
                 if !inside(h) {
                     return at;
                 }

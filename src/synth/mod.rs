@@ -28,7 +28,11 @@
 //!   - Stage 0 reads inputs only: 4–6 distinct `I..` contacts (1 in 6 negated, 1 in 25 with a
 //!     rising/falling edge).
 //!   - Stage `s ≥ 1` reads 3–5 of the variables `M{l}_{phase(s-1)}` written by stage `s-1` in the
-//!     nearby lanes `l ∈ j-2..=j+2` (mod W, distinct; 1 in 4 negated), one input contact half
+//!     nearby lanes `l ∈ j-2..=j+2` (mod W, distinct; 1 in 4 negated) — with
+//!     `reads = Random` (`--reads random`) instead 3–6 distinct lanes `l` drawn uniformly from
+//!     `0..W` (all of them if `W < 6`; the timer, counter and compare reads below come from these
+//!     lanes, a `move`'s source stays a nearby `N`; header, jump and call rungs read 2–3 of
+//!     them the same way) —, one input contact half
 //!     of the time (or as many as needed to reach 4 conditions), and now and then: the `.Q` of a
 //!     nearby timer of stage `s-1` (`timers`), the `.Q` or `.CV ≥ 3` of a nearby counter of
 //!     stage `s-1` (`timers`), an INT `compare` of `N{l}_{phase(s-1)}` with a constant (1 in 30;
@@ -131,6 +135,20 @@ pub struct GenConfig {
     /// `Some(F)` with `0 < F ≤ 1`: about `F * rungs` main rungs also set the global BOOL `FAULT`
     /// and about a tenth as many read it (spread evenly; see the module documentation).
     pub hot_fraction: Option<f64>,
+    /// Where a rung's conditions come from in the previous stage (see [`Reads`]).
+    pub reads: Reads,
+}
+
+/// Which lanes of the previous stage a rung reads.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Reads {
+    /// 3–5 of the nearby lanes `j-2..=j+2` (the default: producers and consumers stay close,
+    /// as in real programs laid out by function).
+    #[default]
+    Local,
+    /// 3–6 distinct lanes drawn uniformly from all `W` lanes (fewer when `W` is smaller): the
+    /// values a level reads are spread over the whole level before it.
+    Random,
 }
 
 impl Default for GenConfig {
@@ -146,6 +164,7 @@ impl Default for GenConfig {
             calls: false,
             for_body: None,
             hot_fraction: None,
+            reads: Reads::Local,
         }
     }
 }
@@ -163,6 +182,7 @@ impl GenConfig {
             calls: true,
             for_body: None,
             hot_fraction: None,
+            reads: Reads::Local,
         }
     }
 

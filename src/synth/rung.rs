@@ -4,7 +4,7 @@
 //! byte-identical for a given config). It does not decide where rungs go (`super::program`).
 
 use super::emit::*;
-use super::{phase, Generator};
+use super::{phase, Generator, Reads};
 
 /// Per-lane facts about the previous / current stage.
 const F_TIMER: u8 = 1;
@@ -14,6 +14,43 @@ const F_INT: u8 = 4;
 const CMP_OPS: [&str; 6] = ["EQ", "NE", "LT", "LE", "GT", "GE"];
 
 impl Generator {
+    /// The lanes of the previous stage a rung of lane `j` may read, in a random order, and how
+    /// many it reads at most: nearby lanes (at most 5), or random ones (at most 6).
+    fn sources(&mut self, j: usize) -> ([usize; 6], usize, usize) {
+        match self.cfg.reads {
+            Reads::Local => {
+                let (lanes, len) = self.nearby(j);
+                let mut out = [0usize; 6];
+                out[..5].copy_from_slice(&lanes);
+                (out, len, 5)
+            }
+            Reads::Random => {
+                let w = self.lanes;
+                let mut out = [0usize; 6];
+                let len = w.min(6);
+                if w <= 6 {
+                    for (k, o) in out.iter_mut().enumerate().take(len) {
+                        *o = k;
+                    }
+                    for i in (1..len).rev() {
+                        let k = self.rng.below(i + 1);
+                        out.swap(i, k);
+                    }
+                } else {
+                    let mut n = 0;
+                    while n < len {
+                        let l = self.rng.below(w);
+                        if !out[..n].contains(&l) {
+                            out[n] = l;
+                            n += 1;
+                        }
+                    }
+                }
+                (out, len, 6)
+            }
+        }
+    }
+
     /// Distinct lanes among `j-2..=j+2` (mod W), in a random order.
     fn nearby(&mut self, j: usize) -> ([usize; 5], usize) {
         let w = self.lanes;
@@ -67,7 +104,7 @@ impl Generator {
             }
         } else {
             let pp = phase(s - 1);
-            let (lanes, len) = self.nearby(j);
+            let (lanes, len, _) = self.sources(j);
             for &l in lanes.iter().take(count.min(len)) {
                 let neg = self.rng.one_in(4);
                 self.conds.push(contact(Name::M(l, pp), neg));
@@ -105,8 +142,8 @@ impl Generator {
             }
         } else {
             let pp = phase(s - 1);
-            let (lanes, len) = self.nearby(j);
-            let take = self.rng.range(3, 5).min(len);
+            let (lanes, len, most) = self.sources(j);
+            let take = self.rng.range(3, most).min(len);
             for &l in &lanes[..take] {
                 let neg = self.rng.one_in(4);
                 self.conds.push(contact(Name::M(l, pp), neg));

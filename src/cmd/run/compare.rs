@@ -2,8 +2,7 @@
 //! into a 128-bit digest, and the exact lockstep replay that names the first difference.
 
 use super::inputs::InputTable;
-use super::output::value_json;
-use crate::exec::parallel::ParallelMachine;
+use crate::exec::parallel::{ParallelMachine, RunLog};
 use crate::exec::{Fault, FaultKind, Machine};
 use crate::model::{Program, VarId};
 use serde_json::{json, Value as Json};
@@ -55,6 +54,7 @@ pub(super) fn first_difference(
     seq: &Machine,
     par: &ParallelMachine,
     pool: Option<&rayon::ThreadPool>,
+    log: &RunLog,
     inputs: &InputTable,
     until: u64,
 ) -> Json {
@@ -66,7 +66,15 @@ pub(super) fn first_difference(
     for scan in 0..=until {
         let (mut fa, mut fb) = (Vec::new(), Vec::new());
         seq.scan(&mut a, scan, inputs.at(scan), &mut fa);
-        par.scan(pool, &mut b, scan, inputs.at(scan), &mut fb);
+        // The candidate the run used for this scan: the replay repeats the run exactly.
+        par.scan_on(
+            log.candidate_at(scan),
+            pool,
+            &mut b,
+            scan,
+            inputs.at(scan),
+            &mut fb,
+        );
         if let Some(i) = cs
             .iter()
             .zip(&cp)
@@ -79,7 +87,7 @@ pub(super) fn first_difference(
                     let w = seq.layout().slots_of(v).len();
                     if i < k + w {
                         let (va, vb) = (seq.value(&a, v), par.machine().value(&b, v));
-                        let mut d = json!({"scan": scan, "variable": p.var(v).name, "seq": value_json(va), "par": value_json(vb)});
+                        let mut d = json!({"scan": scan, "variable": p.var(v).name, "seq": va.to_json(), "par": vb.to_json()});
                         if va == vb {
                             d["detail"] = json!(format!("internal slot {} of the instance", i - k));
                         }
@@ -139,12 +147,13 @@ mod tests {
             &PlanConfig::new(1),
         )
         .unwrap();
-        let d = first_difference(&p, &seq, &par, None, &InputTable::default(), 5);
+        let log = RunLog::default();
+        let d = first_difference(&p, &seq, &par, None, &log, &InputTable::default(), 5);
         assert_eq!(
             d,
             json!({"scan": 1, "variable": "T1", "seq": {"Q": false, "ET": 10, "PT": 1000}, "par": {"Q": false, "ET": 20, "PT": 1000}})
         );
-        let d = first_difference(&p, &seq, &par, None, &InputTable::default(), 0);
+        let d = first_difference(&p, &seq, &par, None, &log, &InputTable::default(), 0);
         assert_eq!(d["variable"], Json::Null, "no difference in scan 0: {d}");
     }
 

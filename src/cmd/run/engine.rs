@@ -4,13 +4,15 @@
 //! progress) and the report they add up to. It prints nothing: warnings are returned as data.
 
 use super::compare::{canonical_slots, digest, first_difference};
+use super::config::{RunConfig, RunMode, RunWarning};
 use super::inputs::{load_inputs, InputTable};
 use super::trace::{cell, trace_columns, Trace};
-use super::{RunConfig, RunMode, RunWarning};
 use crate::analysis::analyse;
 use crate::cmd::io::{check_output_path, load_program, CliError, FileRole};
 use crate::cmd::progress::{Bar, Progress};
-use crate::exec::parallel::{run_sequential, ParallelMachine, PlanConfig, ScanDriver};
+use crate::exec::parallel::{
+    run_sequential, Candidate, ParallelMachine, PlanConfig, PlanKind, RunLog, ScanDriver,
+};
 use crate::exec::{ExecConfig, Fault, FaultKind, Layout, Machine, VarValue};
 use crate::model::{Program, Type, VarClass, VarId, VarRef};
 use serde_json::Value as Json;
@@ -29,6 +31,8 @@ pub struct RunReport {
     pub scans: u64,
     pub cycle_ms: u32,
     pub threads: usize,
+    /// Workers the parallel executor was planned for: `threads`, at most the cores.
+    pub workers: usize,
     /// Main-program rungs (for the rung-execution rate).
     pub rungs: usize,
     /// Output variables after the last scan.
@@ -42,6 +46,12 @@ pub struct RunReport {
     pub fault_summary: Vec<FaultSummary>,
     /// Per mode: (name, total scan time).
     pub modes: Vec<(&'static str, Duration)>,
+    /// Which plans the parallel executor could use.
+    pub plan_kind: PlanKind,
+    /// What the parallel pass ran (when it ran).
+    pub plan_run: Option<RunLog>,
+    /// `Some(why)` when every scan of the parallel pass was the sequential walk.
+    pub sequential_fallback: Option<String>,
     /// `Some` when both modes ran.
     pub identical: Option<bool>,
     pub first_difference: Option<Json>,
@@ -196,6 +206,7 @@ pub(super) struct Prepared {
     seq: Option<Machine>,
     par: Option<ParallelMachine>,
     pool: Option<rayon::ThreadPool>,
+    workers: usize,
     trace_cols: Option<Vec<(String, VarRef, Type)>>,
     /// What the user should know before the run starts.
     pub(super) warnings: Vec<RunWarning>,
@@ -281,20 +292,46 @@ pub(super) fn prepare(c: &RunConfig, progress: &Progress) -> Result<Prepared, Cl
     } else {
         None
     };
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let workers = c.threads.min(cores);
+    if c.threads > cores && c.mode != RunMode::Seq {
+        warnings.push(RunWarning::Oversubscribed {
+            threads: c.threads,
+            cores,
+        });
+    }
     let par = if c.mode != RunMode::Seq || c.explain {
         let a = analyse(&p);
         Some(
-            ParallelMachine::new(&p, &a, &exec, &PlanConfig::new(c.threads))
-                .map_err(lower_error)?,
+            ParallelMachine::new(
+                &p,
+                &a,
+                &exec,
+                &PlanConfig {
+                    kind: c.plan,
+                    ..PlanConfig::new(workers)
+                },
+            )
+            .map_err(lower_error)?,
         )
     } else {
         None
     };
+    if let Some(pm) = &par {
+        warnings.extend(pm.warnings().iter().cloned().map(RunWarning::PlanDropped));
+    }
     let pool = match &par {
-        Some(pm) if c.mode != RunMode::Seq && pm.plan().sequential().is_none() && c.threads > 1 => {
+        Some(pm)
+            if c.mode != RunMode::Seq
+                && workers > 1
+                && pm
+                    .candidates()
+                    .iter()
+                    .any(|k| matches!(k, Candidate::Levelled(_))) =>
+        {
             Some(
                 rayon::ThreadPoolBuilder::new()
-                    .num_threads(c.threads - 1)
+                    .num_threads(workers - 1)
                     .thread_name(|i| format!("plc-worker-{}", i + 1))
                     .build()
                     .map_err(|e| CliError::Threads(e.to_string()))?,
@@ -309,6 +346,7 @@ pub(super) fn prepare(c: &RunConfig, progress: &Progress) -> Result<Prepared, Cl
         seq,
         par,
         pool,
+        workers,
         trace_cols,
         warnings,
     })
@@ -324,10 +362,12 @@ struct Pass {
     tally: FaultTally,
     trace_error: Option<std::io::Error>,
     slots: Vec<u64>,
+    /// What the parallel executor ran.
+    log: Option<RunLog>,
 }
 
 impl Pass {
-    fn of(d: Driver<'_>, slots: Vec<u64>) -> Pass {
+    fn of(d: Driver<'_>, slots: Vec<u64>, log: Option<RunLog>) -> Pass {
         Pass {
             total: d.total,
             digests: d.digests,
@@ -337,6 +377,7 @@ impl Pass {
             tally: d.tally,
             trace_error: d.trace.and_then(|t| t.error),
             slots,
+            log,
         }
     }
 }
@@ -374,7 +415,7 @@ pub(super) fn execute(
         let mut d = Driver::new(inputs, m, Vec::new(), false, t, bar);
         let mut st = m.initial_state();
         run_sequential(m, &mut st, 0..scans, &mut d);
-        Pass::of(d, st.slots)
+        Pass::of(d, st.slots, None)
     });
     let par = run_par.map(|pm| {
         {
@@ -392,8 +433,8 @@ pub(super) fn execute(
         let bar = progress.bar("par", scans, "scans");
         let mut d = Driver::new(inputs, m, digests.unwrap_or_default(), check, t, bar);
         let mut st = pm.initial_state();
-        pm.run(pr.pool.as_ref(), &mut st, 0..scans, &mut d);
-        Pass::of(d, st.slots)
+        let log = pm.run(pr.pool.as_ref(), &mut st, 0..scans, &mut d);
+        Pass::of(d, st.slots, Some(log))
     });
     let (identical, first_difference) = match (&pr.seq, run_par, &par) {
         (Some(s), Some(pm), Some(pass)) => match pass.first_mismatch {
@@ -407,6 +448,7 @@ pub(super) fn execute(
                         s,
                         pm,
                         pr.pool.as_ref(),
+                        pass.log.as_ref().expect("the parallel pass logs its plans"),
                         inputs,
                         k,
                     )),
@@ -415,6 +457,7 @@ pub(super) fn execute(
         },
         _ => (None, None),
     };
+    let plan_run = par.as_ref().and_then(|p| p.log.clone());
     let mut modes = Vec::new();
     modes.extend(seq.as_ref().map(|s| ("seq", s.total)));
     modes.extend(par.as_ref().map(|p| ("par", p.total)));
@@ -425,29 +468,82 @@ pub(super) fn execute(
         (None, None) => unreachable!("one mode ran"),
     };
     let explain = if c.explain {
-        pr.par
-            .as_ref()
-            .map(|pm| (pm.explain(&pr.p), pm.explain_json()))
+        pr.par.as_ref().map(|pm| {
+            let (mut text, mut json) = (pm.explain(&pr.p), pm.explain_json());
+            if let Some(log) = &plan_run {
+                text.push('\n');
+                text.push_str(&pm.explain_run(log));
+                json["run"] = crate::exec::parallel::run_log_json(log, false);
+            }
+            (text, json)
+        })
     } else {
         None
     };
-    let extra = (modes, identical, first_difference, explain);
+    let sequential_fallback = match (run_par, &plan_run) {
+        (Some(pm), Some(log)) => fallback_reason(pm, log),
+        _ => None,
+    };
+    let extra = Extra {
+        modes,
+        identical,
+        first_difference,
+        explain,
+        plan_run,
+        sequential_fallback,
+    };
     let mut pass = pass;
     let trace_error = pass.trace_error.take();
     (report(pr, c, m, pass, extra), trace_error)
 }
 
-type Extra = (
-    Vec<(&'static str, Duration)>,
-    Option<bool>,
-    Option<Json>,
-    Option<(String, Json)>,
-);
+/// What the report adds to the pass it shows.
+struct Extra {
+    modes: Vec<(&'static str, Duration)>,
+    identical: Option<bool>,
+    first_difference: Option<Json>,
+    explain: Option<(String, Json)>,
+    plan_run: Option<RunLog>,
+    sequential_fallback: Option<String>,
+}
+
+/// `Some(why)` when every scan of the parallel pass ran the sequential walk.
+fn fallback_reason(pm: &ParallelMachine, log: &RunLog) -> Option<String> {
+    let parallel_scans: u64 = (0..log.candidates.len())
+        .filter(|&i| !pm.is_sequential(i))
+        .map(|i| log.scans_on[i])
+        .sum();
+    if parallel_scans > 0 {
+        return None;
+    }
+    Some(match pm.sequential_reason() {
+        Some(why) => why.to_string(),
+        None => {
+            let times: Vec<String> = log
+                .candidates
+                .iter()
+                .zip(&log.estimates)
+                .filter_map(|(n, e)| e.map(|ns| format!("{n} {ns} ns")))
+                .collect();
+            format!(
+                "measured per scan: {}; the sequential walk was fastest",
+                times.join(", ")
+            )
+        }
+    })
+}
 
 /// The report of a run from the pass it shows.
 fn report(pr: &Prepared, c: &RunConfig, m: &Machine, pass: Pass, extra: Extra) -> RunReport {
     let p = &pr.p;
-    let (modes, identical, first_difference, explain) = extra;
+    let Extra {
+        modes,
+        identical,
+        first_difference,
+        explain,
+        plan_run,
+        sequential_fallback,
+    } = extra;
     let slots = &pass.slots;
     let visible: Vec<VarId> = (0..p.vars.len() as u32)
         .map(VarId)
@@ -468,6 +564,7 @@ fn report(pr: &Prepared, c: &RunConfig, m: &Machine, pass: Pass, extra: Extra) -
         scans: pr.scans,
         cycle_ms: c.cycle_ms,
         threads: c.threads,
+        workers: pr.workers,
         rungs: p.main().rungs.len(),
         outputs,
         state,
@@ -490,6 +587,9 @@ fn report(pr: &Prepared, c: &RunConfig, m: &Machine, pass: Pass, extra: Extra) -
             })
             .collect(),
         modes,
+        plan_kind: c.plan,
+        plan_run,
+        sequential_fallback,
         identical,
         first_difference,
         explain,

@@ -1,7 +1,7 @@
 //! The per-scan input values of `plc-deps run`: the CSV and JSON inputs files, parsed and
 //! checked against the program, with errors naming the file, line and column.
 
-use super::{count, time_refusal};
+use super::config::{count, time_refusal};
 use crate::cmd::io::{read_text, CliError, FileRole};
 use crate::model::{parse_time_literal, Program, Type, Value, VarClass, VarId};
 use serde_json::Value as Json;

@@ -17,153 +17,22 @@
 //! On the first mismatch both runs are replayed in lockstep, exactly, up to that scan to name the
 //! first difference (variable and both values).
 
+// Bottom to top; each module uses only the ones before it.
 mod compare;
+mod config;
 mod engine;
 mod inputs;
 mod output;
-
 mod trace;
 
 pub use crate::cmd::progress::Progress;
+pub use config::{parse_cycle, RunConfig, RunFormat, RunMode, RunWarning};
 pub use engine::{FaultSummary, RunReport};
 pub use inputs::{load_inputs, parse_inputs_csv, parse_inputs_json, InputTable};
-pub use output::{render_json, render_text, run_json_deterministic};
+pub use output::{render_json, render_text};
 
 use crate::cmd::io::{write_file_as, write_output, CliError, FileRole};
-use crate::exec::ExecConfig;
-use crate::model::parse_time_literal;
 use engine::{execute, prepare};
-use std::io::IsTerminal;
-use std::path::PathBuf;
-
-/// Which executors `run` uses.
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
-pub enum RunMode {
-    /// The sequential interpreter only.
-    Seq,
-    /// The parallel executor only.
-    Par,
-    /// Both, timed separately, every scan checked seq == par.
-    Both,
-}
-
-/// Output format of `run`.
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
-pub enum RunFormat {
-    Text,
-    Json,
-}
-
-/// A validated `plc-deps run` invocation.
-#[derive(Clone, Debug)]
-pub struct RunConfig {
-    /// The program file (`-`: standard input).
-    pub input: PathBuf,
-    /// Number of scans; `None`: the number of input rows (at least 1), or 1000 without inputs.
-    pub scans: Option<u64>,
-    /// Input values per scan (CSV or JSON, by extension: `.json` is JSON, anything else CSV).
-    pub inputs: Option<PathBuf>,
-    /// Virtual scan period, whole ms (at least 1).
-    pub cycle_ms: u32,
-    /// Workers of the parallel executor (at least 1).
-    pub threads: usize,
-    pub mode: RunMode,
-    /// Write the chosen variables after every scan to this CSV file.
-    pub trace: Option<PathBuf>,
-    /// The traced variables (names or instance fields `T1.Q`); `None`: every variable.
-    pub trace_vars: Option<Vec<String>>,
-    pub format: RunFormat,
-    /// Describe the parallel plan.
-    pub explain: bool,
-    /// Loop-backs per loop-back rung and scan.
-    pub loop_cap: u32,
-    /// Write the report here instead of standard output.
-    pub output: Option<PathBuf>,
-    /// Show progress on standard error (default: when it is a terminal); a phase appears once it
-    /// has taken half a second.
-    pub progress: bool,
-}
-
-impl RunConfig {
-    /// Defaults for a program file: all scans of the inputs (or 1000), 10 ms, one worker per
-    /// core, both modes, text, progress on a terminal.
-    pub fn new(input: impl Into<PathBuf>) -> RunConfig {
-        RunConfig {
-            input: input.into(),
-            scans: None,
-            inputs: None,
-            cycle_ms: 10,
-            threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
-            mode: RunMode::Both,
-            trace: None,
-            trace_vars: None,
-            format: RunFormat::Text,
-            explain: false,
-            loop_cap: ExecConfig::default().loop_cap,
-            output: None,
-            progress: std::io::stderr().is_terminal(),
-        }
-    }
-}
-
-/// Something the user should know about a run that still runs (printed as `warning: …`).
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-pub enum RunWarning {
-    /// The `--inputs` file has no rows: every input keeps its initial value.
-    #[error(
-        "--inputs {file} has no rows: every input keeps its initial value{}",
-        if *scans_given { String::new() } else {
-            format!("; running {} (give --scans N for more)", count(*scans, "scan", "scans"))
-        }
-    )]
-    NoInputRows {
-        file: String,
-        scans: u64,
-        scans_given: bool,
-    },
-}
-
-/// `n` and the noun in the singular or plural (`1 scan`, `2 scans`).
-pub(crate) fn count(n: u64, one: &str, many: &str) -> String {
-    format!("{n} {}", if n == 1 { one } else { many })
-}
-
-/// Why a TIME text is refused: not a TIME at all, or not a whole number of milliseconds (the
-/// two reasons `parse_time_literal` refuses one; with every digit made 0 the second parses).
-pub(crate) fn time_refusal(literal: &str) -> &'static str {
-    let zeroed: String = literal
-        .chars()
-        .map(|c| if c.is_ascii_digit() { '0' } else { c })
-        .collect();
-    if parse_time_literal(&zeroed).is_some() {
-        "not a whole number of milliseconds (TIME counts milliseconds)"
-    } else {
-        "not a TIME"
-    }
-}
-
-/// Parses `--cycle`: a TIME literal with or without its `T#` prefix (`10ms`, `T#1s`, `1.5s`),
-/// a whole number of milliseconds, positive and at most 24 days (32-bit milliseconds).
-pub fn parse_cycle(s: &str) -> Result<u32, CliError> {
-    let t = s.trim();
-    let literal = if t.to_ascii_uppercase().starts_with("T#")
-        || t.to_ascii_uppercase().starts_with("TIME#")
-    {
-        t.to_string()
-    } else {
-        format!("T#{t}")
-    };
-    match parse_time_literal(&literal) {
-        Some(ms) if ms >= 1 && ms <= i32::MAX as i64 => Ok(ms as u32),
-        Some(_) => Err(CliError::Usage(format!(
-            "--cycle {s}: the cycle must be a positive TIME of at most T#24d (e.g. 10ms, T#1s)"
-        ))),
-        None => Err(CliError::Usage(format!(
-            "--cycle {s}: {} (e.g. 10ms, T#250ms, 1s)",
-            time_refusal(&literal)
-        ))),
-    }
-}
 
 /// Checks and loads everything a run needs, runs it, and returns the report (the trace file, if
 /// any, is written whole, or not at all). Quiet: no progress, warnings dropped.
@@ -206,26 +75,12 @@ pub fn run(c: &RunConfig) -> Result<(), CliError> {
     write_output(c.output.as_deref(), &out)
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    #[test]
-    fn cycles() {
-        assert_eq!(parse_cycle("10ms").unwrap(), 10);
-        assert_eq!(parse_cycle("T#1.5s").unwrap(), 1500);
-        assert_eq!(parse_cycle("time#1m").unwrap(), 60_000);
-        assert!(parse_cycle("10").is_err());
-        assert!(parse_cycle("0ms").is_err());
-        assert!(parse_cycle("-5ms").is_err());
-        assert!(parse_cycle("T#25d").is_err());
-        assert_eq!(
-            parse_cycle("0.5ms").unwrap_err().to_string(),
-            "--cycle 0.5ms: not a whole number of milliseconds (TIME counts milliseconds) \
-             (e.g. 10ms, T#250ms, 1s)"
-        );
-        assert_eq!(
-            parse_cycle("fast").unwrap_err().to_string(),
-            "--cycle fast: not a TIME (e.g. 10ms, T#250ms, 1s)"
-        );
-    }
+/// The deterministic JSON of a run (timing fields zero): what `analyses/*/run.json` holds.
+pub fn run_json_deterministic(c: &RunConfig) -> Result<String, CliError> {
+    let c = RunConfig {
+        progress: false,
+        trace: None,
+        ..c.clone()
+    };
+    Ok(render_json(&run_report(&c)?, true))
 }

@@ -1,18 +1,13 @@
 //! Rendering a run's report: the text report, the JSON report (normative keys: docs/scan.md)
 //! and its deterministic form for `analyses/*/run.json`.
 
+use super::config::count;
 use super::engine::RunReport;
-use super::{count, run_report, RunConfig};
-use crate::cmd::io::CliError;
+use crate::exec::parallel::run_log_json;
 use crate::exec::VarValue;
 use crate::model::Value;
 use serde_json::{json, Map, Value as Json};
 use std::fmt::Write as _;
-
-/// JSON of a scalar value as `state` shows it (BOOL true/false, numbers, TIME ms).
-pub(super) fn value_json(v: VarValue) -> Json {
-    v.to_json()
-}
 
 /// Text of a value (BOOL TRUE/FALSE, TIME T#…ms, instances as their fields).
 fn value_text(v: VarValue) -> String {
@@ -37,12 +32,13 @@ pub fn render_json(r: &RunReport, deterministic: bool) -> String {
     doc.insert("scans".into(), json!(r.scans));
     doc.insert("cycle_ms".into(), json!(r.cycle_ms));
     doc.insert("threads".into(), json!(r.threads));
+    doc.insert("workers".into(), json!(r.workers));
     doc.insert(
         "outputs".into(),
         Json::Object(
             r.outputs
                 .iter()
-                .map(|(n, v)| (n.clone(), value_json(*v)))
+                .map(|(n, v)| (n.clone(), VarValue::to_json(v)))
                 .collect(),
         ),
     );
@@ -51,7 +47,7 @@ pub fn render_json(r: &RunReport, deterministic: bool) -> String {
         Json::Object(
             r.state
                 .iter()
-                .map(|(n, v)| (n.clone(), value_json(*v)))
+                .map(|(n, v)| (n.clone(), VarValue::to_json(v)))
                 .collect(),
         ),
     );
@@ -105,6 +101,19 @@ pub fn render_json(r: &RunReport, deterministic: bool) -> String {
         _ => Json::Null,
     };
     doc.insert("speedup".into(), speedup);
+    let both = r.modes.len() == 2;
+    doc.insert(
+        "speedup_scans".into(),
+        if both { json!(r.scans) } else { Json::Null },
+    );
+    doc.insert("plan_kind".into(), json!(r.plan_kind.name()));
+    doc.insert("sequential_fallback".into(), json!(r.sequential_fallback));
+    doc.insert(
+        "plan_run".into(),
+        r.plan_run
+            .as_ref()
+            .map_or(Json::Null, |log| run_log_json(log, deterministic)),
+    );
     doc.insert("identical".into(), json!(r.identical));
     doc.insert(
         "first_difference".into(),
@@ -168,16 +177,45 @@ fn write_faults(s: &mut String, r: &RunReport) {
     }
 }
 
+/// `; 40 of them sequential, 2 switches` when the parallel pass mixed candidates.
+fn mix_text(r: &RunReport) -> String {
+    let Some(log) = &r.plan_run else {
+        return String::new();
+    };
+    let seq: u64 = log
+        .candidates
+        .iter()
+        .zip(&log.scans_on)
+        .filter(|(n, _)| n.as_str() == "seq")
+        .map(|(_, &k)| k)
+        .sum();
+    if seq == 0 && log.switches.is_empty() {
+        return String::new();
+    }
+    format!(
+        "; {seq} of them on the sequential walk, {}",
+        count(log.switches.len() as u64, "switch", "switches")
+    )
+}
+
 /// The text report.
 pub fn render_text(r: &RunReport) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "program {}: {}, cycle {} ms, {}",
+        "program {}: {}, cycle {} ms, {}{}",
         r.program,
         count(r.scans, "scan", "scans"),
         r.cycle_ms,
-        count(r.threads as u64, "thread", "threads")
+        count(r.threads as u64, "thread", "threads"),
+        if r.workers != r.threads {
+            format!(
+                " (planned for {})",
+                count(r.workers as u64, "worker", "workers")
+            )
+        } else {
+            String::new()
+        }
     );
     if let Some((text, _)) = &r.explain {
         s.push('\n');
@@ -206,8 +244,20 @@ pub fn render_text(r: &RunReport) -> String {
             per_s * r.rungs as f64 / 1e6
         );
         if let (Some(st), "par") = (seq_total, name) {
-            if !total.is_zero() {
-                let _ = write!(s, "  ({:.2}x seq)", st.as_secs_f64() / total.as_secs_f64());
+            match &r.sequential_fallback {
+                Some(why) => {
+                    let _ = write!(s, "  sequential fallback ({why})");
+                }
+                None if !total.is_zero() => {
+                    let _ = write!(
+                        s,
+                        "  ({:.2}x seq over {}{})",
+                        st.as_secs_f64() / total.as_secs_f64(),
+                        count(r.scans, "scan", "scans"),
+                        mix_text(r)
+                    );
+                }
+                None => {}
             }
         }
         s.push('\n');
@@ -225,14 +275,4 @@ pub fn render_text(r: &RunReport) -> String {
         _ => {}
     }
     s
-}
-
-/// The deterministic JSON of a run (timing fields zero): what `analyses/*/run.json` holds.
-pub fn run_json_deterministic(c: &RunConfig) -> Result<String, CliError> {
-    let c = RunConfig {
-        progress: false,
-        trace: None,
-        ..c.clone()
-    };
-    Ok(render_json(&run_report(&c)?, true))
 }

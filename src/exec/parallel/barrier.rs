@@ -1,14 +1,39 @@
-//! The spinning barrier the workers meet at between the phases of a scan.
+//! The barrier the workers meet at between the phases of a scan: spin briefly, then yield, then
+//! park, so that it is fast when every worker owns a core and costs no scheduler time slice per
+//! barrier when one does not (another process on the core, or more workers than cores).
+//!
+//! Invariants: every worker calls [`SpinBarrier::wait`] the same number of times per run, with
+//! its own epoch counter, and [`SpinBarrier::register`]s its thread before its first wait. It
+//! depends only on the padding below it and knows nothing of plans. Parking uses
+//! `std::thread::park`/`unpark` (a futex on Linux): no crate is needed for one flag per worker.
 
-use super::shared::Padded;
+use super::pad::Padded;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::OnceLock;
+use std::thread::Thread;
 
-/// A spinning barrier for a fixed set of workers: each worker publishes the number of barriers
-/// it has reached in its own cache line and waits until every other worker has reached as many
-/// (no shared counter to fight over: one line transfer per worker pair). Spins with
-/// `spin_loop`, then yields, so that it behaves when there are more workers than cores.
+/// Spin-loop hints before a waiter starts yielding (a few µs: what a balanced phase needs).
+const SPINS: u32 = 1 << 11;
+/// How long a waiter yields before it parks: long enough to cover worker 0's work between two
+/// scans (the driver's digest of a large state) without a wake-up latency, short enough that a
+/// descheduled worker costs the others a sleep, not a time slice of spinning.
+const YIELD_FOR: std::time::Duration = std::time::Duration::from_micros(200);
+
+/// One worker's seat: the barriers it has reached, whether it is parked, and its thread.
+#[derive(Debug, Default)]
+struct Seat {
+    epoch: AtomicU64,
+    parked: AtomicBool,
+    thread: OnceLock<Thread>,
+}
+
+/// A barrier for a fixed set of workers: each worker publishes the number of barriers it has
+/// reached in its own cache line and waits until every other worker has reached as many (no
+/// shared counter to fight over: one line transfer per worker pair). A waiter spins, then
+/// yields, then parks; an arriving worker unparks the workers parked on it.
+#[derive(Debug)]
 pub struct SpinBarrier {
-    epochs: Box<[Padded<AtomicU64>]>,
+    seats: Box<[Padded<Seat>]>,
     poisoned: AtomicBool,
 }
 
@@ -16,9 +41,14 @@ impl SpinBarrier {
     /// A barrier for `n` workers.
     pub fn new(n: usize) -> SpinBarrier {
         SpinBarrier {
-            epochs: (0..n).map(|_| Padded(AtomicU64::new(0))).collect(),
+            seats: (0..n).map(|_| Padded(Seat::default())).collect(),
             poisoned: AtomicBool::new(false),
         }
+    }
+
+    /// Worker `w` runs on the calling thread (call once, before its first [`wait`](Self::wait)).
+    pub fn register(&self, w: usize) {
+        let _ = self.seats[w].0.thread.set(std::thread::current());
     }
 
     /// Worker `w` arrives (its count in `epoch`) and waits for all; false if a worker panicked.
@@ -26,29 +56,130 @@ impl SpinBarrier {
     pub fn wait(&self, w: usize, epoch: &mut u64) -> bool {
         *epoch += 1;
         let e = *epoch;
-        self.epochs[w].0.store(e, Ordering::Release);
-        for (i, other) in self.epochs.iter().enumerate() {
-            if i == w {
-                continue;
-            }
-            let mut spins = 0u32;
-            while other.0.load(Ordering::Acquire) < e {
-                if spins < 2000 {
-                    spins += 1;
-                    std::hint::spin_loop();
-                } else {
-                    if self.poisoned.load(Ordering::Relaxed) {
-                        return false;
-                    }
-                    std::thread::yield_now();
+        // SeqCst store, then SeqCst loads of the parked flags; a parking waiter stores its flag
+        // then loads the epochs (SeqCst): one of the two sees the other, no wake-up is lost.
+        self.seats[w].0.epoch.store(e, Ordering::SeqCst);
+        for (i, seat) in self.seats.iter().enumerate() {
+            if i != w && seat.0.parked.load(Ordering::SeqCst) {
+                if let Some(t) = seat.0.thread.get() {
+                    t.unpark();
                 }
             }
+        }
+        for (i, other) in self.seats.iter().enumerate() {
+            if i != w && !self.wait_for(w, &other.0, e) {
+                return false;
+            }
+        }
+        true
+    }
+
+    /// Waits until `other` has reached barrier `e`; false if the barrier was poisoned.
+    #[inline]
+    fn wait_for(&self, w: usize, other: &Seat, e: u64) -> bool {
+        let mut spins = 0u32;
+        let mut yielding: Option<std::time::Instant> = None;
+        while other.epoch.load(Ordering::Acquire) < e {
+            if spins < SPINS {
+                std::hint::spin_loop();
+            } else if yielding
+                .get_or_insert_with(std::time::Instant::now)
+                .elapsed()
+                < YIELD_FOR
+            {
+                std::thread::yield_now();
+            } else {
+                if self.poisoned.load(Ordering::SeqCst) {
+                    return false;
+                }
+                let me = &self.seats[w].0;
+                me.parked.store(true, Ordering::SeqCst);
+                if other.epoch.load(Ordering::SeqCst) < e && !self.poisoned.load(Ordering::SeqCst) {
+                    // A registered worker is woken by `unpark`; an unregistered one (a caller
+                    // that skipped `register`) still wakes up: park_timeout bounds its sleep.
+                    if me.thread.get().is_some() {
+                        std::thread::park();
+                    } else {
+                        std::thread::park_timeout(std::time::Duration::from_micros(50));
+                    }
+                }
+                me.parked.store(false, Ordering::SeqCst);
+            }
+            spins = spins.saturating_add(1);
         }
         true
     }
 
     /// Releases every waiter for good (a worker panicked).
     pub fn poison(&self) {
-        self.poisoned.store(true, Ordering::Relaxed);
+        self.poisoned.store(true, Ordering::SeqCst);
+        for seat in self.seats.iter() {
+            if let Some(t) = seat.0.thread.get() {
+                t.unpark();
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::atomic::AtomicUsize;
+
+    /// More workers than cores, many barriers: every worker sees every other's writes of the
+    /// previous phase (the counter is exact), and nothing hangs.
+    #[test]
+    fn oversubscribed_workers_meet_at_every_barrier() {
+        let n = 8;
+        let b = SpinBarrier::new(n);
+        let counter = AtomicUsize::new(0);
+        std::thread::scope(|s| {
+            for w in 0..n {
+                let (b, counter) = (&b, &counter);
+                s.spawn(move || {
+                    b.register(w);
+                    let mut epoch = 0;
+                    for round in 0..200 {
+                        counter.fetch_add(1, Ordering::Relaxed);
+                        assert!(b.wait(w, &mut epoch));
+                        assert_eq!(counter.load(Ordering::Relaxed), (round + 1) * n);
+                        assert!(b.wait(w, &mut epoch));
+                    }
+                });
+            }
+        });
+        assert_eq!(counter.load(Ordering::Relaxed), 200 * n);
+    }
+
+    /// A worker that arrives late (asleep for a while) wakes the parked ones.
+    #[test]
+    fn a_late_worker_unparks_the_waiters() {
+        let b = SpinBarrier::new(2);
+        std::thread::scope(|s| {
+            s.spawn(|| {
+                b.register(1);
+                let mut e = 0;
+                std::thread::sleep(std::time::Duration::from_millis(30));
+                assert!(b.wait(1, &mut e));
+            });
+            b.register(0);
+            let mut e = 0;
+            assert!(b.wait(0, &mut e));
+            assert!(b.seats[1].0.epoch.load(Ordering::SeqCst) >= 1);
+        });
+    }
+
+    #[test]
+    fn poison_releases_a_parked_waiter() {
+        let b = SpinBarrier::new(2);
+        std::thread::scope(|s| {
+            s.spawn(|| {
+                std::thread::sleep(std::time::Duration::from_millis(20));
+                b.poison();
+            });
+            b.register(0);
+            let mut e = 0;
+            assert!(!b.wait(0, &mut e));
+        });
     }
 }

@@ -1,8 +1,11 @@
-//! Facts about calls and loop-backs the planner and the verifier need: the call closure of each
-//! POU, the subroutines a rung calls, loop-back rungs, and whether a refused loop-back of the main
+//! Facts about calls and loop-backs the planner needs: the call closure of each POU, the
+//! subroutines a rung calls, loop-back rungs, and whether a refused loop-back of the main
 //! program can continue along an edge the schedule does not know.
+//!
+//! Pure functions of the program and its analysis (CALL/SBR and JMP/LBL as sources of control
+//! dependence, Zhao & Yan); depends only on the typed indices below it. It does not plan.
 
-use super::plan::NONE;
+use super::ids::TaskId;
 use crate::analysis::{Analysis, EdgeKind};
 use crate::model::{Element, PouId, Program, RungId};
 
@@ -70,27 +73,29 @@ pub(super) fn is_loop_back(p: &Program, r: RungId) -> bool {
 
 /// The first main-program rung whose loop-cap refusal could lead where the schedule does not
 /// expect control to go, with the reason; `None` if there is none.
-pub(super) fn uncovered_refusal(p: &Program, a: &Analysis, task_of: &[u32]) -> Option<String> {
+pub(super) fn uncovered_refusal(
+    p: &Program,
+    a: &Analysis,
+    task_of: &[Option<TaskId>],
+) -> Option<String> {
     let n = p.rungs.len() as u32;
     let stop = a.cfg.stop().0;
     // Live CFG edges of the main program, by (task of source, target node).
-    let mut edges: std::collections::HashSet<(u32, u32)> = std::collections::HashSet::new();
+    let mut edges: std::collections::HashSet<(TaskId, u32)> = std::collections::HashSet::new();
     for e in &a.cfg.edges {
-        if matches!(e.kind, EdgeKind::Call | EdgeKind::Return)
-            || e.from.0 >= n
-            || task_of[e.from.0 as usize] == NONE
-        {
+        if matches!(e.kind, EdgeKind::Call | EdgeKind::Return) || e.from.0 >= n {
             continue;
         }
-        edges.insert((task_of[e.from.0 as usize], e.to.0));
+        if let Some(t) = task_of[e.from.0 as usize] {
+            edges.insert((t, e.to.0));
+        }
     }
     let main = p.main().rungs.clone();
     let mut found = Vec::new();
     for r in main.clone() {
-        let t = task_of[r as usize];
-        if t == NONE {
+        let Some(t) = task_of[r as usize] else {
             continue;
-        }
+        };
         let rung = p.rung(RungId(r));
         let next = if r + 1 < main.end { r + 1 } else { stop };
         let targets: Vec<u32> = match rung.series.last() {
@@ -120,7 +125,10 @@ pub(super) fn uncovered_refusal(p: &Program, a: &Analysis, task_of: &[u32]) -> O
             let covered = if x == stop {
                 edges.contains(&(t, stop))
             } else {
-                task_of[x as usize] == t || (task_of[x as usize] != NONE && edges.contains(&(t, x)))
+                match task_of[x as usize] {
+                    Some(tx) => tx == t || edges.contains(&(t, x)),
+                    None => false,
+                }
             };
             if !covered {
                 let to = if x == stop {

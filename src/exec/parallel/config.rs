@@ -1,5 +1,67 @@
-//! The parameters of the parallel plan: worker count, modelled barrier and item costs, and how
-//! levels become phases and parallel levels become slices.
+//! The parameters of the parallel plan: worker count, modelled barrier and item costs, how
+//! levels become phases and parallel levels become slices, which candidate plans a run may use
+//! ([`PlanKind`]) and how the measured choice among them re-measures ([`Measure`]).
+//! Plain data at the bottom of the parallel module; nothing here decides anything.
+
+/// Which plans a run may use.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum PlanKind {
+    /// Measured: the sequential walk and the levelled plans (contiguous and LPT slicing) that
+    /// the cost model says may gain are timed on the run's first scans, the fastest runs, and
+    /// the choice is re-measured as the run goes (`plc-deps run --plan auto`, the default).
+    Auto,
+    /// The cost model decides, once, with no measurement (the levelled plan if it beats the
+    /// sequential scan by a modelled barrier, else the sequential walk).
+    Model,
+    /// Always the sequential walk.
+    Seq,
+    /// Always the levelled plan of the cost model's phases, even if the model says it does not
+    /// pay (the sequential walk only when no level can run in parallel at all).
+    Par,
+}
+
+impl PlanKind {
+    /// `auto`, `model`, `seq`, `par`.
+    pub fn name(self) -> &'static str {
+        match self {
+            PlanKind::Auto => "auto",
+            PlanKind::Model => "model",
+            PlanKind::Seq => "seq",
+            PlanKind::Par => "par",
+        }
+    }
+}
+
+/// How the measured choice ([`PlanKind::Auto`]) measures, in scans.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub struct Measure {
+    /// Scans timed per candidate and measurement (the first warms its caches up).
+    pub probe_scans: u64,
+    /// Scans on the chosen candidate before the first re-measurement, and after a switch.
+    pub min_interval: u64,
+    /// The longest stretch between re-measurements (the interval doubles while the choice
+    /// holds).
+    pub max_interval: u64,
+    /// Scans per window while a parallel candidate runs (the machine looks at the scan times
+    /// after each window, to re-measure when they jump).
+    pub chunk: u64,
+    /// Time every `sample_every`-th scan while nothing else times them.
+    pub sample_every: u64,
+}
+
+impl Default for Measure {
+    /// 4 scans per probe, re-measure after 128 scans doubling up to 2048, windows of 32 scans,
+    /// every 8th scan timed.
+    fn default() -> Self {
+        Measure {
+            probe_scans: 4,
+            min_interval: 128,
+            max_interval: 2048,
+            chunk: 32,
+            sample_every: 8,
+        }
+    }
+}
 
 /// How levels are turned into phases.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
@@ -39,6 +101,11 @@ pub struct PlanConfig {
     pub strategy: Strategy,
     /// How parallel levels are sliced.
     pub slicing: Slicing,
+    /// Which plans a run may use (the library's default is [`PlanKind::Model`]: one plan,
+    /// decided by the model; `plc-deps run` defaults to [`PlanKind::Auto`]).
+    pub kind: PlanKind,
+    /// How [`PlanKind::Auto`] measures.
+    pub measure: Measure,
 }
 
 impl PlanConfig {
@@ -52,6 +119,8 @@ impl PlanConfig {
             item_cost: 12,
             strategy: Strategy::Auto,
             slicing: Slicing::Auto,
+            kind: PlanKind::Model,
+            measure: Measure::default(),
         }
     }
 }

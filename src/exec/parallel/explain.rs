@@ -1,15 +1,32 @@
-//! `plc-deps run --explain`: the plan in words and as JSON.
+//! `plc-deps run --explain`: the plan in words and as JSON. The top of the parallel module:
+//! it reads the machine and its plan and changes nothing.
 
-use super::ParallelMachine;
+use super::machine::{Candidate, ParallelMachine, RunLog};
 use crate::model::Program;
+use serde_json::json;
 use std::fmt::Write as _;
 
 impl ParallelMachine {
-    /// `plc-deps run --explain`: the plan in words.
+    /// `plc-deps run --explain`: the plan in words (the primary plan; the candidates of a
+    /// measured choice are listed first).
     pub fn explain(&self, p: &Program) -> String {
-        let plan = &self.plan;
+        let plan = &self.plans[0];
         let c = &plan.config;
         let mut s = String::new();
+        let names: Vec<&str> = self.names.iter().map(String::as_str).collect();
+        let _ = writeln!(
+            s,
+            "plan kind: {} ({}: {})",
+            self.kind.name(),
+            count(names.len(), "candidate"),
+            names.join(", ")
+        );
+        if let Some(why) = self.sequential_reason() {
+            let _ = writeln!(s, "every scan runs the sequential walk: {why}");
+        }
+        for w in &self.warnings {
+            let _ = writeln!(s, "warning: {w}");
+        }
         let _ = writeln!(s, "parallel plan: {}, {}, cost model: barrier {} steps, item {} steps, strategy {:?}, slicing {:?}",
             count(plan.threads, "worker"), count(plan.levels.len(), "level"), c.barrier_cost, c.item_cost, c.strategy, c.slicing);
         let (seq, est) = plan.estimates();
@@ -71,7 +88,7 @@ impl ParallelMachine {
         }
         if plan.sequential.is_none() {
             for (i, ph) in plan.phases.iter().enumerate() {
-                if !ph.parallel && ph.levels.len() > 1 {
+                if !ph.is_parallel() && ph.levels.len() > 1 {
                     let _ = writeln!(s, "  phase {}: levels {}..={} merged into one sequential phase (worker 0, task order)", i + 1, ph.levels.start + 1, ph.levels.end);
                 }
             }
@@ -80,7 +97,7 @@ impl ParallelMachine {
             let _ = writeln!(
                 s,
                 "padding: {} variable groups on 64-byte lines (one per set of (phase, worker) writers); {} slots for {} of data, {} loop counters (a line each), {} decision slots",
-                plan.groups.len(),
+                self.layout_groups,
                 m.layout().slot_count(),
                 dense,
                 m.loop_counters().len(),
@@ -92,12 +109,53 @@ impl ParallelMachine {
         s
     }
 
+    /// What a run chose, in words: the candidates' measured times, the scans each ran, and
+    /// every switch (`plc-deps run --explain`, after the run).
+    pub fn explain_run(&self, log: &RunLog) -> String {
+        let mut s = String::new();
+        let total: u64 = log.scans_on.iter().sum();
+        let _ = writeln!(
+            s,
+            "plan choice (--plan {}) over {}:",
+            self.kind.name(),
+            count(total, "scan")
+        );
+        for (i, name) in log.candidates.iter().enumerate() {
+            let est = log.estimates[i].map_or("not measured".to_string(), |ns| {
+                format!("measured {} per scan", ns_text(ns))
+            });
+            let _ = writeln!(s, "  {name}: {}, {est}", count(log.scans_on[i], "scan"));
+        }
+        if log.switches.is_empty() {
+            let _ = writeln!(
+                s,
+                "  no switch: {} ran throughout",
+                log.candidates[log.last]
+            );
+        }
+        for sw in &log.switches {
+            let _ = writeln!(
+                s,
+                "  switch at scan {}: {} -> {} ({})",
+                sw.scan, log.candidates[sw.from], log.candidates[sw.to], sw.why
+            );
+        }
+        s
+    }
+
+    /// Whether candidate `i` is the sequential walk.
+    pub fn is_sequential(&self, i: usize) -> bool {
+        self.candidates[i] == Candidate::Sequential
+    }
+
     /// The plan as JSON (`plc-deps run --explain --format json`).
     pub fn explain_json(&self) -> serde_json::Value {
-        use serde_json::json;
-        let plan = &self.plan;
+        let plan = &self.plans[0];
         let (seq, est) = plan.estimates();
         json!({
+            "kind": self.kind.name(),
+            "candidates": self.names,
+            "sequential_fallback": self.sequential_reason(),
             "threads": plan.threads,
             "sequential": plan.sequential,
             "barrier_cost": plan.config.barrier_cost,
@@ -107,7 +165,7 @@ impl ParallelMachine {
             "parallel_phases": plan.parallel_phases(),
             "barriers_per_scan": plan.barriers_per_scan(),
             "slots": self.machine.slot_count(),
-            "layout_groups": plan.groups.len(),
+            "layout_groups": self.layout_groups,
             "decision_slots": plan.decision_slots,
             "levels": plan.levels.iter().map(|lp| json!({
                 "tasks": lp.tasks,
@@ -120,6 +178,40 @@ impl ParallelMachine {
             })).collect::<Vec<_>>(),
         })
     }
+}
+
+/// A time in ns as text (`850 ns`, `12.3 µs`, `4.56 ms`).
+pub fn ns_text(ns: u64) -> String {
+    let f = ns as f64;
+    if f >= 1e6 {
+        format!("{:.2} ms", f / 1e6)
+    } else if f >= 1e3 {
+        format!("{:.1} µs", f / 1e3)
+    } else {
+        format!("{ns} ns")
+    }
+}
+
+/// The run log as JSON (the `plan_run` of `plc-deps run --format json`); `deterministic`
+/// zeroes what depends on timing (measured times; scans per candidate and switches when there
+/// is more than one candidate).
+pub fn run_log_json(log: &RunLog, deterministic: bool) -> serde_json::Value {
+    let timed = deterministic && log.candidates.len() > 1;
+    json!({
+        "candidates": log.candidates,
+        "scans": log.candidates.iter().zip(&log.scans_on)
+            .map(|(n, &k)| (n.clone(), json!(if timed { 0 } else { k })))
+            .collect::<serde_json::Map<_, _>>(),
+        "ns_per_scan": log.candidates.iter().zip(&log.estimates)
+            .map(|(n, e)| (n.clone(), if deterministic { json!(0) } else { json!(e) }))
+            .collect::<serde_json::Map<_, _>>(),
+        "last": if timed { serde_json::Value::Null } else { json!(log.candidates[log.last]) },
+        "switches": if timed { Vec::new() } else {
+            log.switches.iter().map(|s| json!({
+                "scan": s.scan, "from": log.candidates[s.from], "to": log.candidates[s.to], "why": s.why,
+            })).collect::<Vec<_>>()
+        },
+    })
 }
 
 /// `1 task`, `2 tasks`.

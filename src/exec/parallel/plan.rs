@@ -1,65 +1,71 @@
-//! The static plan: the schedule's levels turned into phases and per-worker slices of items
-//! (the dynamic programme over the levels, contiguous or LPT slicing, decision slots, guards and
-//! entries), the layout groups, and the plan's accessors.
+//! The static plan of one candidate: the schedule's levels turned into phases and per-worker
+//! slices of items (a dynamic programme over the levels on the cost model, contiguous or LPT
+//! slicing), the decision slots, guards and entries that carry control between tasks, and the
+//! variables each (phase, worker) writes (the layout's padding groups).
+//!
+//! Follows Zhao & Yan's data levelling (levels run one after another, the rungs of a level in
+//! parallel) on the *combined* schedule: data and control dependences together, loops kept whole.
+//! Invariants: every task of the schedule is in exactly one phase; in a parallel phase each
+//! worker's items are ascending in task order; a task has a decision slot iff a later guard or
+//! entry reads it. It does not measure anything (see `choice`) and does not check the plan
+//! against the lowered code (see `check`).
 
 use super::calls::{call_closure, is_loop_back, rung_callees, uncovered_refusal};
-use super::config::{PlanConfig, Slicing, Strategy};
-use super::tasks::{contiguous, lpt, Tasks};
-use crate::analysis::{schedule::TaskId, Analysis, EdgeKind, Successor};
-use crate::model::{PouId, Program, VarId};
+use super::config::{PlanConfig, PlanKind, Slicing, Strategy};
+use super::ids::{DecisionSlot, Next, TaskId};
+use super::tasks::{contiguous, lpt, Item, Tasks};
+use crate::analysis::{Analysis, EdgeKind, Successor};
+use crate::model::{PouId, Program, RungId, VarId};
 use std::collections::HashMap;
 use std::ops::Range;
 
-pub(super) const NONE: u32 = u32::MAX;
-/// Decision value: the task did not run this scan.
-pub(super) const NOT_RUN: u32 = u32::MAX;
-/// Decision value: control left to the end of the scan.
-pub(super) const STOP: u32 = u32::MAX - 1;
-/// Decision value flag: control left to the FOR test of this head rung (never for tasks of the
-/// combined schedule, but encoded exactly anyway).
-pub(super) const FOR_TEST: u32 = 1 << 31;
 /// Decision slots per 64-byte line.
 pub(super) const DECISION_LINE: usize = 16;
 
-/// Which rungs a walk of the interpreter may visit.
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
-pub(super) enum Region {
-    /// Rungs `lo..hi` (the run's rungs are exactly this range).
-    Rungs(u32, u32),
-    /// Rungs whose task is in `lo..=hi`.
-    Tasks(u32, u32),
-}
-
-/// One call into the interpreter: a run of tasks `first..=last`, or one guarded or
-/// multi-entry task.
-#[derive(Clone, Debug)]
-pub(super) struct Item {
-    pub(super) first: u32,
-    pub(super) last: u32,
-    /// The entry rung (single-entry tasks).
-    pub(super) start: u32,
-    pub(super) region: Region,
-    /// Guard disjuncts: range into `Plan::guards`; empty: always runs.
-    pub(super) guard: Range<u32>,
-    /// Entry predecessors' decision slots (multi-entry loop tasks): range into
-    /// `Plan::entry_slots`; empty: enter at `start`.
-    pub(super) entries: Range<u32>,
-    /// Decision slot of `last`, or NONE.
-    pub(super) decision: u32,
-    /// Modelled cost (tasks + item overhead).
-    pub(super) cost: u64,
+/// Whether a phase runs on all workers or on worker 0 alone.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(super) enum PhaseKind {
+    /// One slice of items per worker.
+    Parallel(Vec<Vec<Item>>),
+    /// Worker 0 runs these items, in task order.
+    Sequential(Vec<Item>),
 }
 
 /// One phase of a scan.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub(super) struct Phase {
-    pub(super) parallel: bool,
+    pub(super) kind: PhaseKind,
     /// The levels it runs.
     pub(super) levels: Range<usize>,
     /// Meet at the barrier before running it.
     pub(super) barrier_before: bool,
-    /// Items per worker (a sequential phase has only worker 0's).
-    pub(super) slices: Vec<Vec<Item>>,
+}
+
+impl Phase {
+    /// The items worker `w` runs in this phase.
+    #[inline]
+    pub(super) fn items_of(&self, w: usize) -> &[Item] {
+        match &self.kind {
+            PhaseKind::Parallel(slices) => slices.get(w).map_or(&[], |s| s.as_slice()),
+            PhaseKind::Sequential(items) if w == 0 => items,
+            PhaseKind::Sequential(_) => &[],
+        }
+    }
+
+    pub(super) fn is_parallel(&self) -> bool {
+        matches!(self.kind, PhaseKind::Parallel(_))
+    }
+
+    /// Every (worker, item) of the phase.
+    pub(super) fn all_items(&self) -> impl Iterator<Item = (usize, &Item)> {
+        let slices: Vec<(usize, &[Item])> = match &self.kind {
+            PhaseKind::Parallel(s) => s.iter().map(|v| v.as_slice()).enumerate().collect(),
+            PhaseKind::Sequential(items) => vec![(0, items.as_slice())],
+        };
+        slices
+            .into_iter()
+            .flat_map(|(w, items)| items.iter().map(move |it| (w, it)))
+    }
 }
 
 /// What the plan decided for one level (for `--explain`).
@@ -81,8 +87,8 @@ pub struct LevelPlan {
     pub reason: String,
 }
 
-/// A static plan: phases, slices, decision slots and the padded layout. Built once per program
-/// and thread count by [`ParallelMachine::new`](super::ParallelMachine::new).
+/// A static plan: phases, slices, decision slots and the variables each (phase, worker) writes.
+/// Built once per program, thread count and configuration.
 #[derive(Clone, Debug)]
 pub struct Plan {
     pub(super) threads: usize,
@@ -92,15 +98,17 @@ pub struct Plan {
     pub(super) phases: Vec<Phase>,
     pub(super) end_barrier: bool,
     pub(super) levels: Vec<LevelPlan>,
-    /// Task of each rung (main-program rungs that run), else NONE.
-    pub(super) task_of_rung: Vec<u32>,
-    /// Guard disjuncts: (decision slot of the controller, successor task or STOP).
-    pub(super) guards: Vec<(u32, u32)>,
+    /// Task of each rung (main-program rungs that run).
+    pub(super) task_of_rung: Vec<Option<TaskId>>,
+    /// The rungs of each task (the schedule's).
+    pub(super) task_rungs: Vec<Vec<RungId>>,
+    /// Guard disjuncts: (decision slot of the controller, where it must have led).
+    pub(super) guards: Vec<(DecisionSlot, Next)>,
     /// Decision slots of entry predecessors.
-    pub(super) entry_slots: Vec<u32>,
+    pub(super) entry_slots: Vec<DecisionSlot>,
     pub(super) decision_slots: usize,
-    /// Layout groups (variables written by one (phase, worker) set).
-    pub(super) groups: Vec<Vec<VarId>>,
+    /// Per variable: the (phase, worker) pairs of parallel phases that write it.
+    pub(super) write_keys: Vec<Vec<(u32, u32)>>,
     /// Modelled scan costs: sequential, and this plan's.
     pub(super) est_sequential: u64,
     pub(super) est_plan: u64,
@@ -109,271 +117,44 @@ pub struct Plan {
 impl Plan {
     pub(super) fn build(p: &Program, a: &Analysis, config: &PlanConfig) -> Plan {
         let sched = &a.schedule;
-        let nt = sched.tasks.len();
         let threads = config.threads.max(1);
-        // Task numbers as plain indices, the way this planner works with them.
-        let sched_levels: Vec<Vec<u32>> = sched
-            .levels
-            .iter()
-            .map(|l| l.iter().map(|t| t.0).collect())
-            .collect();
-        let mut task_of_rung = vec![NONE; p.rungs.len()];
-        for (r, t) in sched.task_of.iter().enumerate() {
-            if let Some(t) = t {
-                task_of_rung[r] = t.0;
-            }
-        }
-        // Condensed successors and entry predecessors from the main program's live CFG edges.
-        let n = p.rungs.len() as u32;
-        let stop = a.cfg.stop().0;
-        let mut succs: Vec<Vec<u32>> = vec![Vec::new(); nt];
-        let mut entry_preds: Vec<Vec<u32>> = vec![Vec::new(); nt];
-        for e in &a.cfg.edges {
-            if matches!(e.kind, EdgeKind::Call | EdgeKind::Return) || e.from.0 >= n {
-                continue;
-            }
-            let ta = task_of_rung[e.from.0 as usize];
-            if ta == NONE {
-                continue;
-            }
-            let tb = if e.to.0 == stop {
-                STOP
-            } else if e.to.0 < n {
-                task_of_rung[e.to.0 as usize]
-            } else {
-                continue;
-            };
-            if tb == ta || tb == NONE {
-                continue;
-            }
-            succs[ta as usize].push(tb);
-            if tb != STOP && sched.tasks[tb as usize].entries.len() > 1 {
-                entry_preds[tb as usize].push(ta);
-            }
-        }
-        let mut needs_decision = vec![false; nt];
-        for t in 0..nt {
-            succs[t].sort_unstable();
-            succs[t].dedup();
-            entry_preds[t].sort_unstable();
-            entry_preds[t].dedup();
-            for &q in &entry_preds[t] {
-                needs_decision[q as usize] = true;
-            }
-            for g in &sched.tasks[t].guard {
-                needs_decision[g.controller.index()] = true;
-            }
-        }
-        let only_succ: Vec<u32> = succs
-            .iter()
-            .map(|s| {
-                if s.len() == 1 && s[0] != STOP {
-                    s[0]
-                } else {
-                    NONE
-                }
-            })
-            .collect();
-        let cost: Vec<u64> = sched
-            .tasks
-            .iter()
-            .map(|t| {
-                t.rungs
-                    .iter()
-                    .map(|r| a.rung_costs[r.index()])
-                    .sum::<u64>()
-                    .max(1)
-            })
-            .collect();
-        let info = Tasks {
-            a,
-            cost,
-            only_succ,
-            needs_decision,
-            entry_preds,
-        };
+        let task_of_rung: Vec<Option<TaskId>> = sched.task_of.clone();
+        let info = task_facts(p, a, &task_of_rung);
         let est_sequential: u64 = info.cost.iter().sum();
-
-        // Levels that must not run in parallel: tasks sharing a subroutine's loop counters.
-        let closure = call_closure(p);
-        let pou_loops: Vec<bool> = (0..p.pous.len())
-            .map(|pou| p.pou_rungs(PouId(pou as u32)).any(|r| is_loop_back(p, r)))
-            .collect();
-        let mut level_conflict: Vec<Option<String>> = vec![None; sched.levels.len()];
-        for (l, level) in sched_levels.iter().enumerate() {
-            let mut user: HashMap<u32, u32> = HashMap::new();
-            'level: for &t in level {
-                let mut pous: Vec<u32> = Vec::new();
-                for &r in &sched.tasks[t as usize].rungs {
-                    pous.extend(
-                        rung_callees(p, &closure, r)
-                            .into_iter()
-                            .filter(|&c| pou_loops[c as usize]),
-                    );
-                }
-                pous.sort_unstable();
-                pous.dedup();
-                for c in pous {
-                    if let Some(&other) = user.get(&c) {
-                        level_conflict[l] = Some(format!(
-                            "tasks {} and {} both call {}, whose loop counters they would share",
-                            p.rung(sched.head(TaskId(other))).id,
-                            p.rung(sched.head(TaskId(t))).id,
-                            p.pous[c as usize].name
-                        ));
-                        break 'level;
-                    }
-                    user.insert(c, t);
-                }
-            }
-        }
-
-        // Per level: sequential cost, parallel slices and makespan.
-        let mut level_plans = Vec::with_capacity(sched.levels.len());
-        let mut level_slices: Vec<Option<Vec<Vec<u32>>>> = Vec::with_capacity(sched.levels.len());
-        for (l, level) in sched_levels.iter().enumerate() {
-            let weights: Vec<u64> = level.iter().map(|&t| info.cost[t as usize]).collect();
-            let c: u64 = weights.iter().sum();
-            let mut lp = LevelPlan {
-                tasks: level.len(),
-                cost: c,
-                parallel: false,
-                makespan: None,
-                slicing: "",
-                workers: Vec::new(),
-                reason: String::new(),
-            };
-            let forced = config.strategy == Strategy::AllParallel;
-            if let Some(why) = &level_conflict[l] {
-                lp.reason = why.clone();
-                level_slices.push(None);
-            } else if (threads == 1 || level.len() < 2) && !forced {
-                lp.reason = if threads == 1 {
-                    "one worker".into()
-                } else {
-                    "a single task".into()
-                };
-                level_slices.push(None);
-            } else {
-                let slice_cost = |s: &[u32]| -> (usize, u64) {
-                    let items = info.items(s, config.item_cost);
-                    (items.len(), items.iter().map(|i| i.cost).sum())
-                };
-                let contig: Vec<Vec<u32>> = contiguous(&weights, threads)
-                    .into_iter()
-                    .map(|r| level[r].to_vec())
-                    .collect();
-                let by_lpt = lpt(level, &weights, threads);
-                let ms = |sl: &[Vec<u32>]| sl.iter().map(|s| slice_cost(s).1).max().unwrap_or(0);
-                let (m_c, m_l) = (ms(&contig), ms(&by_lpt));
-                let (mut slices, name, m) = match config.slicing {
-                    Slicing::Contiguous => (contig, "contiguous", m_c),
-                    Slicing::Lpt => (by_lpt, "lpt", m_l),
-                    Slicing::Auto if m_l < m_c => (by_lpt, "lpt", m_l),
-                    Slicing::Auto => (contig, "contiguous", m_c),
-                };
-                slices.resize(threads, Vec::new());
-                lp.makespan = Some(m);
-                lp.slicing = name;
-                lp.workers = slices
-                    .iter()
-                    .map(|s| {
-                        let (items, cost) = slice_cost(s);
-                        (s.len(), items, cost)
-                    })
-                    .collect();
-                level_slices.push(Some(slices));
-            }
-            level_plans.push(lp);
-        }
-
-        // Phases: each level parallel (P) or sequential (S); a barrier between any two phases,
-        // before a leading P and after a trailing P; adjacent S levels form one phase.
+        let level_conflict = level_conflicts(p, a);
+        let (mut level_plans, mut level_slices) =
+            slice_levels(a, &info, config, threads, &level_conflict);
+        let (choice, est_plan) = choose_phases(&level_plans, config);
+        let any_parallel = choice.contains(&true);
         let b = config.barrier_cost;
-        let nl = sched.levels.len();
-        const INF: u64 = u64::MAX / 4;
-        // best[l][s], s = 0 (S) or 1 (P); from[l][s] = state of level l - 1.
-        let mut best = vec![[INF; 2]; nl];
-        let mut from = vec![[0usize; 2]; nl];
-        for l in 0..nl {
-            let c_s = level_plans[l].cost + config.item_cost;
-            let c_p = match (config.strategy, level_plans[l].makespan) {
-                (Strategy::Sequential, _) | (_, None) => INF,
-                (_, Some(m)) => m,
-            };
-            for s in 0..2 {
-                let own = if s == 0 { c_s } else { c_p };
-                if own >= INF {
-                    continue;
-                }
-                if l == 0 {
-                    best[0][s] = own + if s == 1 { b } else { 0 };
-                    continue;
-                }
-                for prev in 0..2 {
-                    let barrier = if prev == 1 || s == 1 { b } else { 0 };
-                    let v = best[l - 1][prev].saturating_add(own + barrier);
-                    if v < best[l][s] {
-                        best[l][s] = v;
-                        from[l][s] = prev;
-                    }
-                }
-            }
-            if config.strategy == Strategy::AllParallel && best[l][1] < INF {
-                best[l][0] = INF; // force P wherever possible
-            }
-        }
-        let mut choice = vec![0usize; nl];
-        let mut est_plan = 0;
-        if nl > 0 {
-            let end = |s: usize| best[nl - 1][s].saturating_add(if s == 1 { b } else { 0 });
-            let mut s = if end(1) < end(0) { 1 } else { 0 };
-            est_plan = end(s);
-            for l in (0..nl).rev() {
-                choice[l] = s;
-                s = from[l][s];
-            }
-        }
-        let any_parallel = choice.contains(&1);
         let sequential = if let Some(why) = uncovered_refusal(p, a, &task_of_rung) {
             Some(why)
         } else if config.strategy == Strategy::Sequential {
             Some("sequential strategy requested".into())
-        } else if threads == 1 && config.strategy == Strategy::Auto {
+        } else if config.kind == PlanKind::Seq {
+            Some("the sequential walk was asked for (--plan seq)".into())
+        } else if threads == 1 && config.strategy != Strategy::AllParallel {
             Some("one worker".into())
         } else if !any_parallel {
             Some("no level saves more than the barriers it needs".into())
-        } else if config.strategy == Strategy::Auto && est_plan + b > est_sequential {
+        } else if config.strategy == Strategy::Auto
+            && config.kind == PlanKind::Model
+            && est_plan + b > est_sequential
+        {
             Some(format!(
                 "the best plan ({est_plan} steps per scan with barriers) does not beat the sequential scan ({est_sequential} steps) by a barrier"
+            ))
+        } else if config.strategy == Strategy::Auto
+            && config.kind == PlanKind::Auto
+            && est_plan >= est_sequential
+        {
+            Some(format!(
+                "the cost model sees no gain to measure ({est_plan} steps per scan with barriers, sequential {est_sequential})"
             ))
         } else {
             None
         };
-        for (l, lp) in level_plans.iter_mut().enumerate() {
-            lp.parallel = sequential.is_none() && choice[l] == 1;
-            if lp.reason.is_empty() {
-                lp.reason = match (lp.parallel, lp.makespan) {
-                    (true, Some(m)) => format!(
-                        "saves {} steps, more than a barrier ({b})",
-                        lp.cost.saturating_sub(m)
-                    ),
-                    (false, Some(m)) if sequential.is_some() => {
-                        format!("the whole program runs sequentially (makespan {m})")
-                    }
-                    (false, Some(m)) if lp.cost.saturating_sub(m) <= b => format!(
-                        "saves {} steps, not more than a barrier ({b}): sequential",
-                        lp.cost.saturating_sub(m)
-                    ),
-                    (false, Some(m)) => format!(
-                        "saves {} steps, less than the barriers it would add between its \
-                         neighbours (barrier {b}): sequential",
-                        lp.cost.saturating_sub(m)
-                    ),
-                    _ => String::new(),
-                };
-            }
-        }
+        explain_levels(&mut level_plans, &choice, sequential.is_some(), b);
         let mut plan = Plan {
             threads,
             config: *config,
@@ -382,10 +163,11 @@ impl Plan {
             end_barrier: false,
             levels: level_plans,
             task_of_rung,
+            task_rungs: sched.tasks.iter().map(|t| t.rungs.clone()).collect(),
             guards: Vec::new(),
             entry_slots: Vec::new(),
             decision_slots: 0,
-            groups: Vec::new(),
+            write_keys: vec![Vec::new(); p.vars.len()],
             est_sequential,
             est_plan: if any_parallel {
                 est_plan
@@ -396,54 +178,30 @@ impl Plan {
         if plan.sequential.is_some() {
             return plan;
         }
+        plan.phases = phases(a, &info, config, &choice, &mut level_slices);
+        plan.end_barrier = plan.phases.last().is_some_and(Phase::is_parallel);
+        plan.place_decisions(a, &info);
+        plan.write_keys = write_keys(p, a, &plan.phases);
+        plan
+    }
 
-        // Phases and their items.
-        let mut l = 0;
-        while l < nl {
-            if choice[l] == 1 {
-                let slices = level_slices[l].take().expect("parallel level has slices");
-                let items = slices
-                    .iter()
-                    .map(|s| info.items(s, config.item_cost))
-                    .collect();
-                plan.phases.push(Phase {
-                    parallel: true,
-                    levels: l..l + 1,
-                    barrier_before: true,
-                    slices: items,
-                });
-                l += 1;
-            } else {
-                let start = l;
-                while l < nl && choice[l] == 0 {
-                    l += 1;
-                }
-                let mut tasks: Vec<u32> =
-                    sched_levels[start..l].iter().flatten().copied().collect();
-                tasks.sort_unstable();
-                let barrier_before = start > 0; // after a P phase
-                plan.phases.push(Phase {
-                    parallel: false,
-                    levels: start..l,
-                    barrier_before,
-                    slices: vec![info.items(&tasks, config.item_cost)],
-                });
-            }
-        }
-        plan.end_barrier = plan.phases.last().is_some_and(|ph| ph.parallel);
-
-        // Decision slots, grouped per (phase, worker) and padded to a line.
-        let mut slot_of_task = vec![NONE; nt];
+    /// Decision slots, grouped per (phase, worker) and padded to a line; then each item's
+    /// decision, guard and entries.
+    fn place_decisions(&mut self, a: &Analysis, info: &Tasks<'_>) {
+        let sched = &a.schedule;
+        let mut slot_of_task: Vec<Option<DecisionSlot>> = vec![None; sched.tasks.len()];
         let mut next = 0usize;
-        for ph in &plan.phases {
-            for slice in &ph.slices {
+        for ph in &self.phases {
+            let slices: Vec<&[Item]> = match &ph.kind {
+                PhaseKind::Parallel(s) => s.iter().map(|v| v.as_slice()).collect(),
+                PhaseKind::Sequential(items) => vec![items.as_slice()],
+            };
+            for slice in slices {
                 let before = next;
-                for it in slice {
-                    for t in it.first..=it.last {
-                        if info.needs_decision[t as usize] {
-                            slot_of_task[t as usize] = next as u32;
-                            next += 1;
-                        }
+                for t in slice.iter().flat_map(Item::tasks) {
+                    if info.needs_decision[t.index()] {
+                        slot_of_task[t.index()] = Some(DecisionSlot(next as u32));
+                        next += 1;
                     }
                 }
                 if next > before {
@@ -451,77 +209,42 @@ impl Plan {
                 }
             }
         }
-        plan.decision_slots = next;
-        for ph in &mut plan.phases {
-            for slice in &mut ph.slices {
-                for it in slice {
-                    debug_assert!(
-                        (it.first..it.last).all(|t| slot_of_task[t as usize] == NONE),
-                        "only the last task of a run decides"
-                    );
-                    it.decision = slot_of_task[it.last as usize];
-                    let task = &sched.tasks[it.first as usize];
-                    let g0 = plan.guards.len() as u32;
-                    for g in &task.guard {
-                        let succ = match g.successor {
-                            Successor::Task(s) => s.0,
-                            Successor::Stop => STOP,
-                        };
-                        plan.guards.push((slot_of_task[g.controller.index()], succ));
+        self.decision_slots = next;
+        let slot = |t: TaskId| {
+            slot_of_task[t.index()]
+                .expect("a task read by a later guard or entry has a decision slot")
+        };
+        let (guards, entry_slots) = (&mut self.guards, &mut self.entry_slots);
+        for ph in &mut self.phases {
+            let slices: Vec<&mut Vec<Item>> = match &mut ph.kind {
+                PhaseKind::Parallel(s) => s.iter_mut().collect(),
+                PhaseKind::Sequential(items) => vec![items],
+            };
+            for it in slices.into_iter().flatten() {
+                debug_assert!(
+                    (it.first.0..it.last.0).all(|t| slot_of_task[t as usize].is_none()),
+                    "only the last task of a run decides"
+                );
+                it.decision = slot_of_task[it.last.index()];
+                let task = &sched.tasks[it.first.index()];
+                let g0 = guards.len() as u32;
+                for g in &task.guard {
+                    let succ = match g.successor {
+                        Successor::Task(s) => Next::Task(s),
+                        Successor::Stop => Next::Stop,
+                    };
+                    guards.push((slot(g.controller), succ));
+                }
+                it.guard = g0..guards.len() as u32;
+                if task.entries.len() > 1 {
+                    let e0 = entry_slots.len() as u32;
+                    for &q in &info.entry_preds[it.first.index()] {
+                        entry_slots.push(slot(q));
                     }
-                    it.guard = g0..plan.guards.len() as u32;
-                    if task.entries.len() > 1 {
-                        let e0 = plan.entry_slots.len() as u32;
-                        for &q in &info.entry_preds[it.first as usize] {
-                            plan.entry_slots.push(slot_of_task[q as usize]);
-                        }
-                        it.entries = e0..plan.entry_slots.len() as u32;
-                    }
+                    it.entries = e0..entry_slots.len() as u32;
                 }
             }
         }
-
-        // Layout groups: variables keyed by the (phase, worker) pairs that write them.
-        let mut key_of: Vec<Vec<(u32, u32)>> = vec![Vec::new(); p.vars.len()];
-        for (pi, ph) in plan.phases.iter().enumerate() {
-            if !ph.parallel {
-                continue;
-            }
-            for (w, slice) in ph.slices.iter().enumerate() {
-                for it in slice {
-                    for t in it.first..=it.last {
-                        for r in &sched.tasks[t as usize].rungs {
-                            for &v in a.accesses.outs(*r) {
-                                let key = &mut key_of[v.index()];
-                                if key.last() != Some(&(pi as u32, w as u32)) {
-                                    key.push((pi as u32, w as u32));
-                                }
-                            }
-                        }
-                    }
-                }
-            }
-        }
-        let mut group_of: HashMap<&[(u32, u32)], usize> = HashMap::new();
-        let mut order: Vec<(u32, u32, usize)> = Vec::new(); // (first pair, group) for ordering
-        let mut groups: Vec<Vec<VarId>> = Vec::new();
-        for (v, key) in key_of.iter().enumerate() {
-            if key.is_empty() {
-                continue;
-            }
-            let g = *group_of.entry(key.as_slice()).or_insert_with(|| {
-                groups.push(Vec::new());
-                order.push((key[0].0, key[0].1, groups.len() - 1));
-                groups.len() - 1
-            });
-            groups[g].push(VarId(v as u32));
-        }
-        order.sort_unstable();
-        plan.groups = order
-            .into_iter()
-            .map(|(_, _, g)| std::mem::take(&mut groups[g]))
-            .collect();
-        plan
     }
 
     /// The number of workers.
@@ -546,7 +269,7 @@ impl Plan {
 
     /// Number of parallel phases per scan.
     pub fn parallel_phases(&self) -> usize {
-        self.phases.iter().filter(|p| p.parallel).count()
+        self.phases.iter().filter(|p| p.is_parallel()).count()
     }
 
     /// Barriers per scan.
@@ -563,4 +286,369 @@ impl Plan {
     pub fn config(&self) -> &PlanConfig {
         &self.config
     }
+}
+
+/// Costs, only successors, decisions and entry predecessors of the tasks, from the main
+/// program's live CFG edges condensed to tasks.
+fn task_facts<'a>(p: &Program, a: &'a Analysis, task_of: &[Option<TaskId>]) -> Tasks<'a> {
+    let sched = &a.schedule;
+    let nt = sched.tasks.len();
+    let n = p.rungs.len() as u32;
+    let stop = a.cfg.stop().0;
+    let mut succs: Vec<Vec<Next>> = vec![Vec::new(); nt];
+    let mut entry_preds: Vec<Vec<TaskId>> = vec![Vec::new(); nt];
+    for e in &a.cfg.edges {
+        if matches!(e.kind, EdgeKind::Call | EdgeKind::Return) || e.from.0 >= n {
+            continue;
+        }
+        let Some(ta) = task_of[e.from.0 as usize] else {
+            continue;
+        };
+        let tb = if e.to.0 == stop {
+            Next::Stop
+        } else if e.to.0 < n {
+            match task_of[e.to.0 as usize] {
+                Some(tb) if tb != ta => Next::Task(tb),
+                _ => continue,
+            }
+        } else {
+            continue;
+        };
+        succs[ta.index()].push(tb);
+        if let Next::Task(tb) = tb {
+            if sched.tasks[tb.index()].entries.len() > 1 {
+                entry_preds[tb.index()].push(ta);
+            }
+        }
+    }
+    let mut needs_decision = vec![false; nt];
+    for t in 0..nt {
+        succs[t].sort_unstable();
+        succs[t].dedup();
+        entry_preds[t].sort_unstable();
+        entry_preds[t].dedup();
+        for &q in &entry_preds[t] {
+            needs_decision[q.index()] = true;
+        }
+        for g in &sched.tasks[t].guard {
+            needs_decision[g.controller.index()] = true;
+        }
+    }
+    let only_succ = succs
+        .iter()
+        .map(|s| match s.as_slice() {
+            [Next::Task(t)] => Some(*t),
+            _ => None,
+        })
+        .collect();
+    let cost = sched
+        .tasks
+        .iter()
+        .map(|t| {
+            t.rungs
+                .iter()
+                .map(|r| a.rung_costs[r.index()])
+                .sum::<u64>()
+                .max(1)
+        })
+        .collect();
+    Tasks {
+        a,
+        cost,
+        only_succ,
+        needs_decision,
+        entry_preds,
+    }
+}
+
+/// Per level: why it must not run in parallel (tasks sharing a subroutine's loop counters).
+fn level_conflicts(p: &Program, a: &Analysis) -> Vec<Option<String>> {
+    let sched = &a.schedule;
+    let closure = call_closure(p);
+    let pou_loops: Vec<bool> = (0..p.pous.len())
+        .map(|pou| p.pou_rungs(PouId(pou as u32)).any(|r| is_loop_back(p, r)))
+        .collect();
+    let mut level_conflict: Vec<Option<String>> = vec![None; sched.levels.len()];
+    for (l, level) in sched.levels.iter().enumerate() {
+        let mut user: HashMap<u32, TaskId> = HashMap::new();
+        'level: for &t in level {
+            let mut pous: Vec<u32> = Vec::new();
+            for &r in &sched.task(t).rungs {
+                pous.extend(
+                    rung_callees(p, &closure, r)
+                        .into_iter()
+                        .filter(|&c| pou_loops[c as usize]),
+                );
+            }
+            pous.sort_unstable();
+            pous.dedup();
+            for c in pous {
+                if let Some(&other) = user.get(&c) {
+                    level_conflict[l] = Some(format!(
+                        "tasks {} and {} both call {}, whose loop counters they would share",
+                        p.rung(sched.head(other)).id,
+                        p.rung(sched.head(t)).id,
+                        p.pous[c as usize].name
+                    ));
+                    break 'level;
+                }
+                user.insert(c, t);
+            }
+        }
+    }
+    level_conflict
+}
+
+/// Per level: its plan for `--explain`, and its parallel slices (`None`: it cannot run in
+/// parallel).
+#[allow(clippy::type_complexity)]
+fn slice_levels(
+    a: &Analysis,
+    info: &Tasks<'_>,
+    config: &PlanConfig,
+    threads: usize,
+    level_conflict: &[Option<String>],
+) -> (Vec<LevelPlan>, Vec<Option<Vec<Vec<TaskId>>>>) {
+    let sched = &a.schedule;
+    let mut level_plans = Vec::with_capacity(sched.levels.len());
+    let mut level_slices = Vec::with_capacity(sched.levels.len());
+    for (l, level) in sched.levels.iter().enumerate() {
+        let level: Vec<TaskId> = level.clone();
+        let weights: Vec<u64> = level.iter().map(|t| info.cost[t.index()]).collect();
+        let mut lp = LevelPlan {
+            tasks: level.len(),
+            cost: weights.iter().sum(),
+            parallel: false,
+            makespan: None,
+            slicing: "",
+            workers: Vec::new(),
+            reason: String::new(),
+        };
+        let forced = config.strategy == Strategy::AllParallel;
+        if let Some(why) = &level_conflict[l] {
+            lp.reason = why.clone();
+            level_slices.push(None);
+        } else if (threads == 1 || level.len() < 2) && !forced {
+            lp.reason = if threads == 1 {
+                "one worker".into()
+            } else {
+                "a single task".into()
+            };
+            level_slices.push(None);
+        } else {
+            let slice_cost = |s: &[TaskId]| -> (usize, u64) {
+                let items = info.items(s, config.item_cost);
+                (items.len(), items.iter().map(|i| i.cost).sum())
+            };
+            let contig: Vec<Vec<TaskId>> = contiguous(&weights, threads)
+                .into_iter()
+                .map(|r| level[r].to_vec())
+                .collect();
+            let by_lpt = lpt(&level, &weights, threads);
+            let ms = |sl: &[Vec<TaskId>]| sl.iter().map(|s| slice_cost(s).1).max().unwrap_or(0);
+            let (m_c, m_l) = (ms(&contig), ms(&by_lpt));
+            let (mut slices, name, m) = match config.slicing {
+                Slicing::Contiguous => (contig, "contiguous", m_c),
+                Slicing::Lpt => (by_lpt, "lpt", m_l),
+                Slicing::Auto if m_l < m_c => (by_lpt, "lpt", m_l),
+                Slicing::Auto => (contig, "contiguous", m_c),
+            };
+            slices.resize(threads, Vec::new());
+            lp.makespan = Some(m);
+            lp.slicing = name;
+            lp.workers = slices
+                .iter()
+                .map(|s| {
+                    let (items, cost) = slice_cost(s);
+                    (s.len(), items, cost)
+                })
+                .collect();
+            level_slices.push(Some(slices));
+        }
+        level_plans.push(lp);
+    }
+    (level_plans, level_slices)
+}
+
+/// Each level parallel (true) or sequential: the dynamic programme minimising the modelled scan
+/// (a barrier between any two phases, before a leading parallel phase and after a trailing one;
+/// adjacent sequential levels form one phase). Returns the choice and its modelled cost.
+fn choose_phases(level_plans: &[LevelPlan], config: &PlanConfig) -> (Vec<bool>, u64) {
+    let b = config.barrier_cost;
+    let nl = level_plans.len();
+    const INF: u64 = u64::MAX / 4;
+    // best[l][s], s = 0 (S) or 1 (P); from[l][s] = state of level l - 1.
+    let mut best = vec![[INF; 2]; nl];
+    let mut from = vec![[0usize; 2]; nl];
+    for l in 0..nl {
+        let c_s = level_plans[l].cost + config.item_cost;
+        let c_p = match (config.strategy, level_plans[l].makespan) {
+            (Strategy::Sequential, _) | (_, None) => INF,
+            (_, Some(m)) => m,
+        };
+        for s in 0..2 {
+            let own = if s == 0 { c_s } else { c_p };
+            if own >= INF {
+                continue;
+            }
+            if l == 0 {
+                best[0][s] = own + if s == 1 { b } else { 0 };
+                continue;
+            }
+            for prev in 0..2 {
+                let barrier = if prev == 1 || s == 1 { b } else { 0 };
+                let v = best[l - 1][prev].saturating_add(own + barrier);
+                if v < best[l][s] {
+                    best[l][s] = v;
+                    from[l][s] = prev;
+                }
+            }
+        }
+        if config.strategy == Strategy::AllParallel && best[l][1] < INF {
+            best[l][0] = INF; // force P wherever possible
+        }
+    }
+    let mut choice = vec![false; nl];
+    let mut est_plan = 0;
+    if nl > 0 {
+        let end = |s: usize| best[nl - 1][s].saturating_add(if s == 1 { b } else { 0 });
+        let mut s = if end(1) < end(0) { 1 } else { 0 };
+        est_plan = end(s);
+        for l in (0..nl).rev() {
+            choice[l] = s == 1;
+            s = from[l][s];
+        }
+    }
+    (choice, est_plan)
+}
+
+/// The reasons `--explain` gives for each level.
+fn explain_levels(levels: &mut [LevelPlan], choice: &[bool], sequential: bool, b: u64) {
+    for (l, lp) in levels.iter_mut().enumerate() {
+        lp.parallel = !sequential && choice[l];
+        if !lp.reason.is_empty() {
+            continue;
+        }
+        lp.reason = match (lp.parallel, lp.makespan) {
+            (true, Some(m)) => format!(
+                "saves {} steps, more than a barrier ({b})",
+                lp.cost.saturating_sub(m)
+            ),
+            (false, Some(m)) if sequential => {
+                format!("the whole program runs sequentially (makespan {m})")
+            }
+            (false, Some(m)) if lp.cost.saturating_sub(m) <= b => format!(
+                "saves {} steps, not more than a barrier ({b}): sequential",
+                lp.cost.saturating_sub(m)
+            ),
+            (false, Some(m)) => format!(
+                "saves {} steps, less than the barriers it would add between its \
+                 neighbours (barrier {b}): sequential",
+                lp.cost.saturating_sub(m)
+            ),
+            _ => String::new(),
+        };
+    }
+}
+
+/// The phases and their items.
+fn phases(
+    a: &Analysis,
+    info: &Tasks<'_>,
+    config: &PlanConfig,
+    choice: &[bool],
+    level_slices: &mut [Option<Vec<Vec<TaskId>>>],
+) -> Vec<Phase> {
+    let sched = &a.schedule;
+    let nl = choice.len();
+    let mut out = Vec::new();
+    let mut l = 0;
+    while l < nl {
+        if choice[l] {
+            let slices = level_slices[l].take().expect("a parallel level has slices");
+            let items = slices
+                .iter()
+                .map(|s| info.items(s, config.item_cost))
+                .collect();
+            out.push(Phase {
+                kind: PhaseKind::Parallel(items),
+                levels: l..l + 1,
+                barrier_before: true,
+            });
+            l += 1;
+        } else {
+            let start = l;
+            while l < nl && !choice[l] {
+                l += 1;
+            }
+            let mut tasks: Vec<TaskId> = sched.levels[start..l].iter().flatten().copied().collect();
+            tasks.sort_unstable();
+            out.push(Phase {
+                kind: PhaseKind::Sequential(info.items(&tasks, config.item_cost)),
+                levels: start..l,
+                barrier_before: start > 0, // after a parallel phase
+            });
+        }
+    }
+    out
+}
+
+/// Per variable: the (phase, worker) pairs of parallel phases whose tasks write it.
+fn write_keys(p: &Program, a: &Analysis, phases: &[Phase]) -> Vec<Vec<(u32, u32)>> {
+    let sched = &a.schedule;
+    let mut key_of: Vec<Vec<(u32, u32)>> = vec![Vec::new(); p.vars.len()];
+    for (pi, ph) in phases.iter().enumerate() {
+        if !ph.is_parallel() {
+            continue;
+        }
+        for (w, it) in ph.all_items() {
+            for t in it.tasks() {
+                for r in &sched.tasks[t.index()].rungs {
+                    for &v in a.accesses.outs(*r) {
+                        let key = &mut key_of[v.index()];
+                        if key.last() != Some(&(pi as u32, w as u32)) {
+                            key.push((pi as u32, w as u32));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    key_of
+}
+
+/// Layout groups for several plans run on one state: variables keyed by every (plan, phase,
+/// worker) that writes them, one group per distinct key, groups ordered by their first writer.
+/// Variables of different groups never share a line once the layout aligns each group.
+pub(super) fn layout_groups(plans: &[&Plan], vars: usize) -> Vec<Vec<VarId>> {
+    let mut group_of: HashMap<Vec<(u32, u32, u32)>, usize> = HashMap::new();
+    let mut order: Vec<((u32, u32, u32), usize)> = Vec::new();
+    let mut groups: Vec<Vec<VarId>> = Vec::new();
+    for v in 0..vars {
+        let key: Vec<(u32, u32, u32)> = plans
+            .iter()
+            .enumerate()
+            .flat_map(|(c, plan)| {
+                plan.write_keys
+                    .get(v)
+                    .into_iter()
+                    .flatten()
+                    .map(move |&(ph, w)| (c as u32, ph, w))
+            })
+            .collect();
+        let Some(&first) = key.first() else {
+            continue;
+        };
+        let g = *group_of.entry(key).or_insert_with(|| {
+            groups.push(Vec::new());
+            order.push((first, groups.len() - 1));
+            groups.len() - 1
+        });
+        groups[g].push(VarId(v as u32));
+    }
+    order.sort_unstable();
+    order
+        .into_iter()
+        .map(|(_, g)| std::mem::take(&mut groups[g]))
+        .collect()
 }

@@ -1,19 +1,18 @@
 //! Memory shared by the workers without locks: the slot array ([`SharedSlots`]), the padded
-//! per-worker fault buffers and decisions. Every `unsafe` here rests on the plan's discipline,
-//! stated in its `// SAFETY:` comment.
+//! per-worker fault buffers and the decision cells. Every `unsafe` here rests on the plan's
+//! discipline (no slot written by one worker in a phase is read or written by another; checked
+//! against the lowered code by `check`), stated in its `// SAFETY:` comment. Depends on the
+//! barrier, padding and typed indices below it; it does not run anything.
 
 use super::barrier::SpinBarrier;
+use super::ids::{Decision, DecisionSlot};
+use super::pad::Padded;
 use crate::exec::{Fault, Store};
 use std::cell::UnsafeCell;
-use std::sync::atomic::AtomicU32;
-
-/// Pads its content to its own 128-byte block (two cache lines: also keeps the adjacent-line
-/// prefetcher from coupling neighbours).
-#[repr(align(128))]
-pub(super) struct Padded<T>(pub(super) T);
+use std::sync::atomic::{AtomicU32, Ordering};
 
 /// The slot array shared by all workers, without locks.
-#[derive(Copy, Clone)]
+#[derive(Copy, Clone, Debug)]
 pub struct SharedSlots {
     pub(super) ptr: *mut u64,
     pub(super) len: usize,
@@ -21,9 +20,9 @@ pub struct SharedSlots {
 
 // SAFETY: a `SharedSlots` is only created by `ParallelMachine::run` from the `&mut State` it
 // holds for the whole run, and used by the workers under the plan's discipline: in a parallel
-// phase, no slot written by one worker is read or written by another (checked by
-// `ParallelMachine::verify`, from the schedule's guarantee), so there are no data races; between
-// phases the barrier's release/acquire orders all accesses.
+// phase, no slot written by one worker is read or written by another (checked at plan time
+// against the lowered instructions' accesses), so there are no data races; between phases the
+// barrier's release/acquire orders all accesses.
 unsafe impl Send for SharedSlots {}
 // SAFETY: as above.
 unsafe impl Sync for SharedSlots {}
@@ -58,9 +57,34 @@ impl Store for SharedSlots {
 /// (the key of the sequential order).
 pub(super) type FaultBuffer = Padded<UnsafeCell<Vec<(u32, Fault)>>>;
 
+/// The decisions of one run, one cell per decision slot (lines of them per (phase, worker)).
+pub(super) struct Decisions(Box<[AtomicU32]>);
+
+impl Decisions {
+    pub(super) fn new(n: usize) -> Decisions {
+        Decisions(
+            (0..n)
+                .map(|_| AtomicU32::new(Decision::NotRun.pack()))
+                .collect(),
+        )
+    }
+
+    /// Relaxed: written in an earlier phase, ordered by the barrier in between.
+    #[inline]
+    pub(super) fn get(&self, s: DecisionSlot) -> Decision {
+        Decision::unpack(self.0[s.index()].load(Ordering::Relaxed))
+    }
+
+    /// Relaxed: read only in later phases, after a barrier.
+    #[inline]
+    pub(super) fn set(&self, s: DecisionSlot, d: Decision) {
+        self.0[s.index()].store(d.pack(), Ordering::Relaxed)
+    }
+}
+
 pub(super) struct Shared<'a> {
     pub(super) slots: SharedSlots,
-    pub(super) decisions: &'a [AtomicU32],
+    pub(super) decisions: &'a Decisions,
     pub(super) faults: &'a [FaultBuffer],
     pub(super) barrier: SpinBarrier,
 }

@@ -1,42 +1,88 @@
-//! What the planner knows about the tasks (costs, chains into runs, decisions, entries) and how
-//! a parallel level is cut into slices: contiguous runs balanced by cost, or LPT.
+//! What the planner knows about the tasks (costs, chains into runs, decisions, entries), the
+//! unit of work a worker runs ([`Item`]), and how a parallel level is cut into slices:
+//! contiguous runs balanced by cost, or LPT (longest processing time first).
+//!
+//! Invariants: an item's tasks are consecutive in task order and, when more than one, each leads
+//! only to the next (one walk of the interpreter visits exactly them, in the sequential order).
+//! Depends only on the analysis and the typed indices; it does not choose phases (see `plan`).
 
-use super::plan::{Item, Region, NONE};
+use super::ids::{DecisionSlot, TaskId};
 use crate::analysis::Analysis;
+use crate::model::RungId;
 use std::ops::Range;
+
+/// Which rungs a walk of the interpreter may visit.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub(super) enum Region {
+    /// Rungs `lo..hi` (the run's rungs are exactly this range).
+    Rungs(u32, u32),
+    /// Rungs whose task is in `lo..=hi`.
+    Tasks(TaskId, TaskId),
+}
+
+/// One call into the interpreter: a run of tasks `first..=last`, or one guarded or
+/// multi-entry task.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(super) struct Item {
+    pub(super) first: TaskId,
+    pub(super) last: TaskId,
+    /// The entry rung (single-entry tasks).
+    pub(super) start: RungId,
+    pub(super) region: Region,
+    /// Guard disjuncts: range into `Plan::guards`; empty: always runs.
+    pub(super) guard: Range<u32>,
+    /// Entry predecessors' decision slots (multi-entry loop tasks): range into
+    /// `Plan::entry_slots`; empty: enter at `start`.
+    pub(super) entries: Range<u32>,
+    /// Decision slot of `last`, if a later task reads where control left it.
+    pub(super) decision: Option<DecisionSlot>,
+    /// Modelled cost (tasks + item overhead).
+    pub(super) cost: u64,
+}
+
+impl Item {
+    /// The tasks of the item, in order.
+    pub(super) fn tasks(&self) -> impl Iterator<Item = TaskId> {
+        (self.first.0..=self.last.0).map(TaskId)
+    }
+}
 
 /// Facts about the tasks the planner needs.
 pub(super) struct Tasks<'a> {
     pub(super) a: &'a Analysis,
     pub(super) cost: Vec<u64>,
-    /// The only condensed successor (task index), if there is exactly one and it is a task.
-    pub(super) only_succ: Vec<u32>,
+    /// The only condensed successor, if there is exactly one and it is a task.
+    pub(super) only_succ: Vec<Option<TaskId>>,
     pub(super) needs_decision: Vec<bool>,
     /// Tasks with a CFG edge into each multi-entry task.
-    pub(super) entry_preds: Vec<Vec<u32>>,
+    pub(super) entry_preds: Vec<Vec<TaskId>>,
 }
 
 impl Tasks<'_> {
-    pub(super) fn unguarded_single(&self, t: u32) -> bool {
-        let task = &self.a.schedule.tasks[t as usize];
+    pub(super) fn unguarded_single(&self, t: TaskId) -> bool {
+        let task = &self.a.schedule.tasks[t.index()];
         task.guard.is_empty() && task.entries.len() == 1
     }
 
     /// Whether `t` and `t + 1` can be one walk.
-    pub(super) fn chains(&self, t: u32) -> bool {
-        self.only_succ[t as usize] == t + 1
-            && !self.needs_decision[t as usize]
-            && self.unguarded_single(t + 1)
+    pub(super) fn chains(&self, t: TaskId) -> bool {
+        let next = TaskId(t.0 + 1);
+        self.only_succ[t.index()] == Some(next)
+            && !self.needs_decision[t.index()]
+            && self.unguarded_single(next)
     }
 
     /// The items of a slice (tasks ascending).
-    pub(super) fn items(&self, tasks: &[u32], item_cost: u64) -> Vec<Item> {
+    pub(super) fn items(&self, tasks: &[TaskId], item_cost: u64) -> Vec<Item> {
         let mut out = Vec::new();
         let mut i = 0;
         while i < tasks.len() {
             let mut j = i;
             if self.unguarded_single(tasks[i]) {
-                while j + 1 < tasks.len() && tasks[j + 1] == tasks[j] + 1 && self.chains(tasks[j]) {
+                while j + 1 < tasks.len()
+                    && tasks[j + 1].0 == tasks[j].0 + 1
+                    && self.chains(tasks[j])
+                {
                     j += 1;
                 }
             }
@@ -46,10 +92,10 @@ impl Tasks<'_> {
         out
     }
 
-    pub(super) fn item(&self, first: u32, last: u32, item_cost: u64) -> Item {
+    fn item(&self, first: TaskId, last: TaskId, item_cost: u64) -> Item {
         let sched = &self.a.schedule;
         let (mut lo, mut hi, mut count) = (u32::MAX, 0u32, 0u64);
-        for t in first..=last {
+        for t in first.0..=last.0 {
             for r in &sched.tasks[t as usize].rungs {
                 lo = lo.min(r.0);
                 hi = hi.max(r.0 + 1);
@@ -61,16 +107,19 @@ impl Tasks<'_> {
         } else {
             Region::Tasks(first, last)
         };
-        let task = &sched.tasks[first as usize];
+        let task = &sched.tasks[first.index()];
         Item {
             first,
             last,
-            start: task.entries[0].0,
+            start: task.entries[0],
             region,
             guard: 0..0,
             entries: 0..0,
-            decision: NONE,
-            cost: (first..=last).map(|t| self.cost[t as usize]).sum::<u64>() + item_cost,
+            decision: None,
+            cost: (first.0..=last.0)
+                .map(|t| self.cost[t as usize])
+                .sum::<u64>()
+                + item_cost,
         }
     }
 }
@@ -106,7 +155,7 @@ pub(super) fn contiguous(weights: &[u64], p: usize) -> Vec<Range<usize>> {
 }
 
 /// LPT: tasks (with weights) to `p` workers; each worker's tasks ascending.
-pub(super) fn lpt(tasks: &[u32], weights: &[u64], p: usize) -> Vec<Vec<u32>> {
+pub(super) fn lpt(tasks: &[TaskId], weights: &[u64], p: usize) -> Vec<Vec<TaskId>> {
     let mut order: Vec<usize> = (0..tasks.len()).collect();
     order.sort_by(|&a, &b| weights[b].cmp(&weights[a]).then(a.cmp(&b)));
     let mut load = vec![0u64; p];
@@ -120,4 +169,23 @@ pub(super) fn lpt(tasks: &[u32], weights: &[u64], p: usize) -> Vec<Vec<u32>> {
         s.sort_unstable();
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    #[test]
+    fn contiguous_balances_the_heaviest_part() {
+        assert_eq!(contiguous(&[1, 1, 1, 1], 2), vec![0..2, 2..4]);
+        assert_eq!(contiguous(&[5, 1, 1, 1, 1, 1], 2), vec![0..1, 1..6]);
+        assert_eq!(contiguous(&[3], 4), vec![0..1]);
+    }
+    #[test]
+    fn lpt_gives_each_task_to_the_least_loaded_worker() {
+        let t: Vec<TaskId> = (0..4).map(TaskId).collect();
+        assert_eq!(
+            lpt(&t, &[5, 4, 3, 3], 2),
+            vec![vec![TaskId(0), TaskId(3)], vec![TaskId(1), TaskId(2)]]
+        );
+    }
 }

@@ -1,0 +1,157 @@
+//! The plan check run on every plan at plan time, in release builds too: from the *lowered
+//! instructions'* actual slot reads and writes (`Machine::rung_accesses`), not from the access
+//! sets the plan was built from, every parallel phase must satisfy
+//! - no slot written by one worker is read or written by another worker (no data race), and
+//! - no two workers write one 64-byte line (8 slots) of the state (no false sharing of writes:
+//!   the layout's padding did its job).
+//!
+//! A plan that fails is not run: `ParallelMachine::new` drops it with a warning and the run
+//! falls back to the sequential walk. Depends on the plan and the interpreter below it; it does
+//! not fix plans.
+
+use super::plan::Plan;
+use crate::exec::Machine;
+use crate::model::RungId;
+
+/// Slots per 64-byte line.
+const LINE: u32 = 8;
+
+/// Who touched a slot or a line last: (phase, worker).
+type Owner = Option<(u32, u32)>;
+
+/// Checks `plan` against `machine`'s lowered code; the error names the phase, the workers and
+/// the slot.
+pub(super) fn check_plan(machine: &Machine, plan: &Plan) -> Result<(), String> {
+    let n = machine.slot_count() as usize;
+    let mut slot_writer: Vec<Owner> = vec![None; n];
+    let mut line_writer: Vec<Owner> = vec![None; n.div_ceil(LINE as usize)];
+    let (mut reads, mut writes) = (Vec::new(), Vec::new());
+    // Per worker of a phase: the slots it reads (checked once all writers are known).
+    let mut read_by: Vec<Vec<u32>> = Vec::new();
+    for (pi, ph) in plan.phases.iter().enumerate() {
+        if !ph.is_parallel() {
+            continue;
+        }
+        let pi = pi as u32;
+        read_by.iter_mut().for_each(Vec::clear);
+        for (w, it) in ph.all_items() {
+            if read_by.len() <= w {
+                read_by.resize(w + 1, Vec::new());
+            }
+            for r in item_rungs(plan, it) {
+                reads.clear();
+                writes.clear();
+                machine.rung_accesses(r, &mut reads, &mut writes);
+                read_by[w].extend_from_slice(&reads);
+                let w = w as u32;
+                for &s in &writes {
+                    let Some(slot) = slot_writer.get_mut(s as usize) else {
+                        return Err(format!("rung {} writes slot {s}, past the state", r.0));
+                    };
+                    match *slot {
+                        Some((p, w2)) if p == pi && w2 != w => {
+                            return Err(format!(
+                                "phase {pi}: slot {s} written by workers {w2} and {w}"
+                            ))
+                        }
+                        _ => *slot = Some((pi, w)),
+                    }
+                    let line = &mut line_writer[(s / LINE) as usize];
+                    match *line {
+                        Some((p, w2)) if p == pi && w2 != w => {
+                            return Err(format!(
+                                "phase {pi}: workers {w2} and {w} both write the line of slot {s}"
+                            ))
+                        }
+                        _ => *line = Some((pi, w)),
+                    }
+                }
+            }
+        }
+        for (w, slots) in read_by.iter().enumerate() {
+            for &s in slots {
+                if let Some(Some((p, w2))) = slot_writer.get(s as usize) {
+                    if *p == pi && *w2 != w as u32 {
+                        return Err(format!(
+                            "phase {pi}: slot {s} written by worker {w2} and read by worker {w}"
+                        ));
+                    }
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The rungs of an item's tasks.
+fn item_rungs<'a>(plan: &'a Plan, it: &'a super::tasks::Item) -> impl Iterator<Item = RungId> + 'a {
+    it.tasks()
+        .flat_map(move |t| plan.task_rungs[t.index()].iter().copied())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::exec::parallel::config::{PlanConfig, Strategy};
+    use crate::exec::{ExecConfig, Layout};
+
+    /// Two independent rungs writing two BOOLs: a parallel level of two tasks.
+    fn program() -> crate::model::Program {
+        crate::read::program_from_json(
+            r#"{"program": "p", "vars": [
+                {"name": "a", "type": "BOOL", "class": "input"},
+                {"name": "b", "type": "BOOL", "class": "input"},
+                {"name": "x", "type": "BOOL", "class": "output"},
+                {"name": "y", "type": "BOOL", "class": "output"}],
+              "rungs": [{"id": "R1", "ld": [{"contact": "a"}, {"coil": "x"}]},
+                        {"id": "R2", "ld": [{"contact": "b"}, {"coil": "y"}]}]}"#,
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn a_padded_layout_passes_and_a_dense_one_fails_on_the_shared_line() {
+        let p = program();
+        let a = crate::analysis::analyse(&p);
+        let config = PlanConfig {
+            strategy: Strategy::AllParallel,
+            ..PlanConfig::new(2)
+        };
+        let plan = Plan::build(&p, &a, &config);
+        assert_eq!(plan.parallel_phases(), 1);
+        let groups = super::super::plan::layout_groups(&[&plan], p.vars.len());
+        let padded = Machine::new(
+            &p,
+            Layout::from_groups(&p, &groups, 8).unwrap(),
+            &ExecConfig::default(),
+        )
+        .unwrap();
+        assert_eq!(check_plan(&padded, &plan), Ok(()));
+        // x and y on one line, written by workers 0 and 1 in phase 0.
+        let dense = Machine::new(&p, Layout::dense(&p), &ExecConfig::default()).unwrap();
+        assert_eq!(
+            check_plan(&dense, &plan),
+            Err("phase 0: workers 0 and 1 both write the line of slot 3".into())
+        );
+    }
+
+    #[test]
+    fn two_workers_writing_one_slot_fail() {
+        let p = program();
+        let a = crate::analysis::analyse(&p);
+        let mut plan = Plan::build(
+            &p,
+            &a,
+            &PlanConfig {
+                strategy: Strategy::AllParallel,
+                ..PlanConfig::new(2)
+            },
+        );
+        // Pretend R2 reads x: give task 1 the rungs of both tasks (R1 then writes x on worker 0
+        // and worker 1 both).
+        plan.task_rungs[1] = vec![RungId(0), RungId(1)];
+        let m = Machine::new(&p, Layout::dense(&p), &ExecConfig::default()).unwrap();
+        let e = check_plan(&m, &plan).unwrap_err();
+        assert_eq!(e, "phase 0: slot 2 written by workers 0 and 1");
+    }
+}

@@ -1,0 +1,761 @@
+//! The running machine: a [`ParallelMachine`] (a [`Machine`] on one padded layout shared by its
+//! candidate plans, the plans, and the candidates a run chooses from) and its runs: the workers
+//! entered once per run; worker 0 (the calling thread) asks the measured choice (`choice`)
+//! which candidate runs the next window of scans, runs sequential windows alone while the
+//! others sleep at the window barrier, and runs parallel windows with them, meeting at the
+//! barrier between phases.
+//!
+//! Invariants: worker 0 alone talks to the driver and the chooser, between barriers; every
+//! candidate works on the same state layout, so a switch between scans needs no copy; the
+//! results are those of [`Machine::run_scan`], slot for slot and fault for fault, whichever
+//! candidates ran. It does not plan (`plan`) nor check plans (`check`); it runs what
+//! [`ParallelMachine::new`] kept.
+
+use super::barrier::SpinBarrier;
+use super::check::check_plan;
+use super::choice::{Chooser, Switch, Window};
+use super::config::{Measure, PlanConfig, PlanKind, Slicing};
+use super::driver::{run_sequential, ScanDriver};
+use super::ids::{Decision, Next};
+use super::pad::Padded;
+use super::plan::{layout_groups, Plan};
+use super::shared::{Decisions, FaultBuffer, Shared, SharedSlots};
+use super::tasks::{Item, Region};
+use crate::analysis::Analysis;
+use crate::exec::{ExecConfig, Exit, Fault, Layout, LowerError, Machine, ScanCtx, State};
+use crate::model::{Program, RungId, VarId};
+use std::cell::UnsafeCell;
+use std::ops::Range;
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::time::{Duration, Instant};
+
+/// One way to run a scan.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum Candidate {
+    /// The sequential walk ([`Machine::run_scan`]) on worker 0.
+    Sequential,
+    /// The levelled plan `plans[i]` on all workers.
+    Levelled(usize),
+}
+
+/// What a run did: which candidates ran how many scans, their last measured times, and every
+/// switch between them.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct RunLog {
+    /// Candidate names (`seq`, `par`, `par-contiguous`, `par-lpt`), by candidate index.
+    pub candidates: Vec<String>,
+    /// Scans run on each candidate.
+    pub scans_on: Vec<u64>,
+    /// The last measured ns per scan of each candidate (`None`: never measured).
+    pub estimates: Vec<Option<u64>>,
+    /// Every change of the running candidate.
+    pub switches: Vec<Switch>,
+    /// The candidate that ran last.
+    pub last: usize,
+    /// Runs of scans on one candidate: (first scan, candidate), ascending.
+    pub segments: Vec<(u64, usize)>,
+}
+
+impl RunLog {
+    /// The candidate that ran scan `scan` (the first if the log does not cover it).
+    pub fn candidate_at(&self, scan: u64) -> usize {
+        match self.segments.partition_point(|&(s, _)| s <= scan) {
+            0 => 0,
+            i => self.segments[i - 1].1,
+        }
+    }
+
+    fn push_segment(&mut self, first: u64, candidate: usize) {
+        if self.segments.last().map(|s| s.1) != Some(candidate) {
+            self.segments.push((first, candidate));
+        }
+    }
+}
+
+/// A program lowered for the parallel scan: a [`Machine`] on the candidates' common padded
+/// layout, the plans, and the candidates a run chooses from. Immutable and `Sync`.
+#[derive(Debug)]
+pub struct ParallelMachine {
+    pub(super) machine: Machine,
+    /// `plans[0]` is the primary plan ([`plan`](Self::plan)).
+    pub(super) plans: Vec<Plan>,
+    pub(super) candidates: Vec<Candidate>,
+    pub(super) names: Vec<String>,
+    pub(super) kind: PlanKind,
+    pub(super) measure: Measure,
+    /// Padding groups of the layout (for `--explain`).
+    pub(super) layout_groups: usize,
+    /// Why plans were dropped (a failed check), for the user.
+    pub(super) warnings: Vec<String>,
+}
+
+/// The window the workers run next, published by worker 0 before the window barrier.
+struct WindowCell {
+    plan: AtomicUsize,
+    first: AtomicU64,
+    /// 0: the run is over.
+    scans: AtomicU64,
+}
+
+impl ParallelMachine {
+    /// Plans `program` (analysed as `analysis`) for `config.threads` workers: the candidate
+    /// plans of `config.kind`, each checked against the lowered instructions' slot accesses
+    /// (a plan that fails is dropped with a warning, see [`warnings`](Self::warnings)), lowered
+    /// on one layout padded for all of them.
+    pub fn new(
+        program: &Program,
+        analysis: &Analysis,
+        exec: &ExecConfig,
+        config: &PlanConfig,
+    ) -> Result<ParallelMachine, LowerError> {
+        let mut plans = candidate_plans(program, analysis, config);
+        let levelled: Vec<&Plan> = plans.iter().filter(|p| p.sequential.is_none()).collect();
+        let (layout, groups) = if levelled.is_empty() {
+            (Layout::dense(program), 0)
+        } else {
+            let groups = layout_groups(&levelled, program.vars.len());
+            let layout =
+                Layout::from_groups(program, &groups, 8).expect("groups hold each variable once");
+            (layout, groups.len())
+        };
+        let machine = Machine::new(program, layout, exec)?;
+        let mut warnings = Vec::new();
+        for plan in &mut plans {
+            if plan.sequential.is_some() {
+                continue;
+            }
+            if let Err(e) = check_plan(&machine, plan) {
+                warnings.push(format!(
+                    "the parallel plan failed its check against the lowered code ({e}); running sequentially instead"
+                ));
+                plan.sequential = Some(format!("the plan failed its check: {e}"));
+            }
+        }
+        let mut candidates = Vec::new();
+        if config.kind == PlanKind::Auto || plans.iter().all(|p| p.sequential.is_some()) {
+            candidates.push(Candidate::Sequential);
+        }
+        let levelled = plans.iter().filter(|p| p.sequential.is_none()).count();
+        let mut names: Vec<String> = candidates.iter().map(|_| "seq".to_string()).collect();
+        for (i, plan) in plans.iter().enumerate() {
+            if plan.sequential.is_none() {
+                candidates.push(Candidate::Levelled(i));
+                names.push(if levelled > 1 {
+                    format!("par-{}", slicing_name(plan.config.slicing))
+                } else {
+                    "par".to_string()
+                });
+            }
+        }
+        Ok(ParallelMachine {
+            machine,
+            plans,
+            candidates,
+            names,
+            kind: config.kind,
+            measure: config.measure,
+            layout_groups: groups,
+            warnings,
+        })
+    }
+
+    /// The machine (on the plans' layout).
+    pub fn machine(&self) -> &Machine {
+        &self.machine
+    }
+
+    /// The primary plan: the cost model's (of [`PlanKind::Model`]), or the first levelled
+    /// candidate.
+    pub fn plan(&self) -> &Plan {
+        &self.plans[0]
+    }
+
+    /// Every plan built (levelled or not).
+    pub fn plans(&self) -> &[Plan] {
+        &self.plans
+    }
+
+    /// The candidates a run chooses from (one for every kind but [`PlanKind::Auto`]).
+    pub fn candidates(&self) -> &[Candidate] {
+        &self.candidates
+    }
+
+    /// The name of candidate `i`.
+    pub fn candidate_name(&self, i: usize) -> &str {
+        &self.names[i]
+    }
+
+    /// Which plans a run may use.
+    pub fn kind(&self) -> PlanKind {
+        self.kind
+    }
+
+    /// `Some(why)` when every run is the sequential walk.
+    pub fn sequential_reason(&self) -> Option<&str> {
+        match self.candidates.as_slice() {
+            [Candidate::Sequential] => Some(
+                self.plans
+                    .iter()
+                    .find_map(|p| p.sequential.as_deref())
+                    .unwrap_or("sequential plan requested"),
+            ),
+            _ => None,
+        }
+    }
+
+    /// Plans dropped because they failed their check, in words.
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+
+    /// The state at load.
+    pub fn initial_state(&self) -> State {
+        self.machine.initial_state()
+    }
+
+    /// Checks every levelled plan against the lowered instructions' slot accesses (what
+    /// [`new`](Self::new) did); the analysis is not needed and not used.
+    pub fn verify(&self, _p: &Program, _a: &Analysis) -> Result<(), String> {
+        for plan in &self.plans {
+            if plan.sequential.is_none() {
+                check_plan(&self.machine, plan)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// One scan on the first candidate (enters the workers for this scan only; use
+    /// [`run`](Self::run) for many).
+    pub fn scan(
+        &self,
+        pool: Option<&rayon::ThreadPool>,
+        state: &mut State,
+        scan: u64,
+        inputs: &[(VarId, crate::model::Value)],
+        faults: &mut Vec<Fault>,
+    ) {
+        self.scan_on(0, pool, state, scan, inputs, faults)
+    }
+
+    /// One scan on candidate `candidate` (e.g. the one a [`RunLog`] says ran that scan).
+    pub fn scan_on(
+        &self,
+        candidate: usize,
+        pool: Option<&rayon::ThreadPool>,
+        state: &mut State,
+        scan: u64,
+        inputs: &[(VarId, crate::model::Value)],
+        faults: &mut Vec<Fault>,
+    ) {
+        struct One<'a> {
+            inputs: &'a [(VarId, crate::model::Value)],
+            faults: &'a mut Vec<Fault>,
+        }
+        impl ScanDriver for One<'_> {
+            fn before_scan(&mut self, m: &Machine, _: u64, slots: &mut [u64]) {
+                m.set_inputs_in(slots, self.inputs);
+            }
+            fn after_scan(
+                &mut self,
+                _: &Machine,
+                _: u64,
+                _: &[u64],
+                faults: &[Fault],
+                _: Duration,
+            ) {
+                self.faults.extend_from_slice(faults);
+            }
+            fn wants_time(&self) -> bool {
+                false
+            }
+        }
+        let mut one = One { inputs, faults };
+        self.run_with(pool, state, scan..scan + 1, &mut one, Some(candidate));
+    }
+
+    /// Runs scans `scans` on `state`, choosing among the candidates as [`PlanKind`] says, and
+    /// tells which ran when. The workers are entered once for all of them: the calling thread
+    /// is worker 0 and `pool` supplies the others (it needs at least `threads − 1` threads, and
+    /// may be `None` for one thread or when every candidate is sequential).
+    ///
+    /// # Panics
+    /// If the pool is too small, if called from one of the pool's threads, or if `state` is not
+    /// a state of this machine.
+    pub fn run<D: ScanDriver + ?Sized>(
+        &self,
+        pool: Option<&rayon::ThreadPool>,
+        state: &mut State,
+        scans: Range<u64>,
+        driver: &mut D,
+    ) -> RunLog {
+        self.run_with(pool, state, scans, driver, None)
+    }
+
+    fn run_with<D: ScanDriver + ?Sized>(
+        &self,
+        pool: Option<&rayon::ThreadPool>,
+        state: &mut State,
+        scans: Range<u64>,
+        driver: &mut D,
+        only: Option<usize>,
+    ) -> RunLog {
+        assert_eq!(
+            state.slots.len(),
+            self.machine.slot_count() as usize,
+            "state of another machine"
+        );
+        let allowed: Vec<usize> = match only {
+            Some(c) => vec![c],
+            None => (0..self.candidates.len()).collect(),
+        };
+        let mut log = RunLog {
+            candidates: self.names.clone(),
+            scans_on: vec![0; self.candidates.len()],
+            estimates: vec![None; self.candidates.len()],
+            switches: Vec::new(),
+            last: allowed[0],
+            segments: Vec::new(),
+        };
+        let threads = self
+            .plans
+            .iter()
+            .filter(|p| p.sequential.is_none())
+            .map(|p| p.threads)
+            .max();
+        let threads = match (threads, allowed.as_slice()) {
+            (Some(t), _)
+                if allowed
+                    .iter()
+                    .any(|&c| self.candidates[c] != Candidate::Sequential) =>
+            {
+                t
+            }
+            _ => {
+                log.scans_on[allowed[0]] = scans.end.saturating_sub(scans.start);
+                log.push_segment(scans.start, allowed[0]);
+                run_sequential(&self.machine, state, scans, driver);
+                return log;
+            }
+        };
+        let decision_slots = self
+            .plans
+            .iter()
+            .map(|p| p.decision_slots)
+            .max()
+            .unwrap_or(0);
+        let decisions = Decisions::new(decision_slots);
+        let faults: Vec<FaultBuffer> = (0..threads)
+            .map(|_| Padded(UnsafeCell::new(Vec::new())))
+            .collect();
+        let shared = Shared {
+            slots: SharedSlots {
+                ptr: state.slots.as_mut_ptr(),
+                len: state.slots.len(),
+            },
+            decisions: &decisions,
+            faults: &faults,
+            barrier: SpinBarrier::new(threads),
+        };
+        let window = WindowCell {
+            plan: AtomicUsize::new(0),
+            first: AtomicU64::new(0),
+            scans: AtomicU64::new(0),
+        };
+        let (shared, window) = (&shared, &window);
+        let mut chooser = Chooser::new(allowed.len(), self.measure, scans.start);
+        if threads == 1 {
+            self.leader(
+                shared,
+                window,
+                scans,
+                driver,
+                &mut chooser,
+                &allowed,
+                &mut log,
+            );
+        } else {
+            let pool = pool.expect("a thread pool for more than one worker");
+            assert!(
+                pool.current_thread_index().is_none(),
+                "run the parallel executor from outside its pool (worker 0 is the calling thread)"
+            );
+            assert!(
+                pool.current_num_threads() >= threads - 1,
+                "the pool has {} threads, {} workers need {}",
+                pool.current_num_threads(),
+                threads,
+                threads - 1
+            );
+            pool.in_place_scope(|s| {
+                for w in 1..threads {
+                    s.spawn(move |_| self.follower(w, shared, window));
+                }
+                self.leader(
+                    shared,
+                    window,
+                    scans,
+                    driver,
+                    &mut chooser,
+                    &allowed,
+                    &mut log,
+                );
+            });
+        }
+        for (i, &c) in allowed.iter().enumerate() {
+            log.estimates[c] = chooser.estimates()[i];
+        }
+        log.switches = chooser
+            .switches()
+            .iter()
+            .map(|s| Switch {
+                from: allowed[s.from],
+                to: allowed[s.to],
+                ..s.clone()
+            })
+            .collect();
+        log.last = allowed[chooser.current()];
+        log
+    }
+
+    /// Worker 0: chooses, runs sequential windows alone and parallel windows with the others,
+    /// then releases them.
+    #[allow(clippy::too_many_arguments)]
+    fn leader<D: ScanDriver + ?Sized>(
+        &self,
+        sh: &Shared<'_>,
+        window: &WindowCell,
+        scans: Range<u64>,
+        driver: &mut D,
+        chooser: &mut Chooser,
+        allowed: &[usize],
+        log: &mut RunLog,
+    ) {
+        let body = std::panic::AssertUnwindSafe(|| {
+            sh.barrier.register(0);
+            let mut epoch = 0u64;
+            let mut times: Vec<u64> = Vec::new();
+            let mut bufs = Buffers::default();
+            let mut scan = scans.start;
+            while scan < scans.end {
+                let win = chooser.next();
+                let n = win.scans.min(scans.end - scan);
+                let c = allowed[win.candidate];
+                log.scans_on[c] += n;
+                log.push_segment(scan, c);
+                times.clear();
+                let timing = Timing {
+                    all: win.timed || driver.wants_time(),
+                    every: self.measure.sample_every.max(1),
+                };
+                match self.candidates[c] {
+                    Candidate::Sequential => {
+                        self.sequential_window(sh, scan..scan + n, driver, timing, &mut times)
+                    }
+                    Candidate::Levelled(i) => {
+                        window.plan.store(i, Ordering::Relaxed);
+                        window.first.store(scan, Ordering::Relaxed);
+                        window.scans.store(n, Ordering::Relaxed);
+                        if !sh.barrier.wait(0, &mut epoch) {
+                            return;
+                        }
+                        let plan = &self.plans[i];
+                        let d = Some((&mut *driver, timing, &mut times));
+                        if !self.plan_scans(0, plan, sh, scan..scan + n, &mut epoch, d, &mut bufs) {
+                            return;
+                        }
+                    }
+                }
+                chooser.record(Window { scans: n, ..win }, &times);
+                scan += n;
+            }
+            window.scans.store(0, Ordering::Relaxed);
+            sh.barrier.wait(0, &mut epoch);
+        });
+        if let Err(panic) = std::panic::catch_unwind(body) {
+            sh.barrier.poison();
+            std::panic::resume_unwind(panic);
+        }
+    }
+
+    /// Workers 1..: wait for a window, run their part of it, until the run is over.
+    fn follower(&self, w: usize, sh: &Shared<'_>, window: &WindowCell) {
+        let body = std::panic::AssertUnwindSafe(|| {
+            sh.barrier.register(w);
+            let mut epoch = 0u64;
+            let mut bufs = Buffers::default();
+            loop {
+                if !sh.barrier.wait(w, &mut epoch) {
+                    return;
+                }
+                // Relaxed: written by worker 0 before the barrier just passed.
+                let n = window.scans.load(Ordering::Relaxed);
+                if n == 0 {
+                    return;
+                }
+                let first = window.first.load(Ordering::Relaxed);
+                let plan = &self.plans[window.plan.load(Ordering::Relaxed)];
+                if !self.plan_scans::<NoDriver>(
+                    w,
+                    plan,
+                    sh,
+                    first..first + n,
+                    &mut epoch,
+                    None,
+                    &mut bufs,
+                ) {
+                    return;
+                }
+            }
+        });
+        if let Err(panic) = std::panic::catch_unwind(body) {
+            sh.barrier.poison();
+            std::panic::resume_unwind(panic);
+        }
+    }
+
+    /// Worker 0 alone runs `scans` as the sequential walk on the shared slots.
+    fn sequential_window<D: ScanDriver + ?Sized>(
+        &self,
+        sh: &Shared<'_>,
+        scans: Range<u64>,
+        driver: &mut D,
+        timing: Timing,
+        times: &mut Vec<u64>,
+    ) {
+        // SAFETY: the other workers wait at the window barrier (or have not started) and touch
+        // no slot until worker 0 reaches it: worker 0 has the slots to itself for this window.
+        let slots = unsafe { std::slice::from_raw_parts_mut(sh.slots.ptr, sh.slots.len) };
+        let mut faults = Vec::new();
+        for scan in scans {
+            driver.before_scan(&self.machine, scan, slots);
+            faults.clear();
+            let t0 = timing.wants(scan).then(Instant::now);
+            self.machine.run_scan_in(slots, scan, &mut faults);
+            let elapsed = t0.map(|t| t.elapsed()).unwrap_or_default();
+            if t0.is_some() {
+                times.push(elapsed.as_nanos() as u64);
+            }
+            driver.after_scan(&self.machine, scan, slots, &faults, elapsed);
+        }
+    }
+
+    /// Worker `w`'s part of `scans` on `plan`; worker 0 also talks to the driver. False if a
+    /// worker panicked.
+    #[allow(clippy::too_many_arguments)]
+    fn plan_scans<D: ScanDriver + ?Sized>(
+        &self,
+        w: usize,
+        plan: &Plan,
+        sh: &Shared<'_>,
+        scans: Range<u64>,
+        epoch: &mut u64,
+        mut driver: Option<(&mut D, Timing, &mut Vec<u64>)>,
+        b: &mut Buffers,
+    ) -> bool {
+        let mut store = sh.slots;
+        for scan in scans {
+            let mut t0 = None;
+            if let Some((d, timing, _)) = driver.as_mut() {
+                // SAFETY: the other workers wait at the next barrier (or have not started):
+                // worker 0 has the slots to itself until it reaches that barrier.
+                let slots = unsafe { std::slice::from_raw_parts_mut(sh.slots.ptr, sh.slots.len) };
+                d.before_scan(&self.machine, scan, slots);
+                t0 = timing.wants(scan).then(Instant::now);
+                self.machine.begin_scan(&mut store);
+            }
+            let mut ctx = self.machine.context(scan, &mut b.scratch);
+            for ph in &plan.phases {
+                if ph.barrier_before && !sh.barrier.wait(w, epoch) {
+                    return false;
+                }
+                for it in ph.items_of(w) {
+                    self.run_item(plan, it, &mut store, &mut ctx, sh);
+                    if !ctx.faults.is_empty() {
+                        // SAFETY: only worker `w` touches its fault buffer during a scan;
+                        // worker 0 reads it after the scan's last barrier.
+                        let buf = unsafe { &mut *sh.faults[w].0.get() };
+                        buf.extend(ctx.faults.drain(..).map(|f| (it.first.0, f)));
+                    }
+                }
+            }
+            if plan.end_barrier && !sh.barrier.wait(w, epoch) {
+                return false;
+            }
+            if let Some((d, _, times)) = driver.as_mut() {
+                let elapsed = t0.map(|t| t.elapsed()).unwrap_or_default();
+                if t0.is_some() {
+                    times.push(elapsed.as_nanos() as u64);
+                }
+                // Every other worker has passed the scan's last barrier and waits at the next
+                // one: worker 0 has the buffers and slots to itself.
+                b.merged.clear();
+                for f in sh.faults.iter() {
+                    // SAFETY: as above; no other reference to the buffer exists now.
+                    let buf = unsafe { &mut *f.0.get() };
+                    b.merged.append(buf);
+                }
+                b.merged.sort_by_key(|&(t, _)| t); // stable: a task's faults keep their order
+                b.out.clear();
+                b.out.extend(b.merged.iter().map(|&(_, f)| f));
+                // SAFETY: as above: nobody writes the slots until worker 0 reaches the next
+                // barrier, after the driver returned.
+                let slots = unsafe { std::slice::from_raw_parts(sh.slots.ptr, sh.slots.len) };
+                d.after_scan(&self.machine, scan, slots, &b.out, elapsed);
+            }
+        }
+        true
+    }
+
+    /// Where a decision leads: the task holding the rung control went to, or the end of the
+    /// scan; `None` if the task did not run.
+    #[inline]
+    fn successor_of(plan: &Plan, d: Decision) -> Option<Next> {
+        match d {
+            Decision::NotRun => None,
+            Decision::Stop => Some(Next::Stop),
+            Decision::Rung(r) | Decision::ForTest(r) => {
+                plan.task_of_rung[r.index()].map(Next::Task)
+            }
+        }
+    }
+
+    /// Where item `it` starts this scan; `None` if the sequential scan would not run it.
+    #[inline]
+    fn entry(plan: &Plan, it: &Item, sh: &Shared<'_>) -> Option<Exit> {
+        if !it.guard.is_empty() {
+            let holds = plan.guards[it.guard.start as usize..it.guard.end as usize]
+                .iter()
+                .any(|&(slot, succ)| {
+                    Self::successor_of(plan, sh.decisions.get(slot)) == Some(succ)
+                });
+            if !holds {
+                return None;
+            }
+        }
+        if it.entries.is_empty() {
+            return Some(Exit::Rung(it.start));
+        }
+        let mut at = None;
+        for &slot in &plan.entry_slots[it.entries.start as usize..it.entries.end as usize] {
+            let d = sh.decisions.get(slot);
+            if Self::successor_of(plan, d) == Some(Next::Task(it.first)) {
+                debug_assert!(at.is_none(), "task {} entered twice", it.first.0);
+                at = match d {
+                    Decision::ForTest(h) => Some(Exit::ForTest(h)),
+                    Decision::Rung(r) => Some(Exit::Rung(r)),
+                    Decision::Stop | Decision::NotRun => at,
+                };
+            }
+        }
+        // None: no predecessor led here, so the sequential scan does not run it either.
+        at
+    }
+
+    #[inline]
+    fn run_item(
+        &self,
+        plan: &Plan,
+        it: &Item,
+        store: &mut SharedSlots,
+        ctx: &mut ScanCtx<'_>,
+        sh: &Shared<'_>,
+    ) {
+        let Some(at) = Self::entry(plan, it, sh) else {
+            if let Some(slot) = it.decision {
+                sh.decisions.set(slot, Decision::NotRun);
+            }
+            return;
+        };
+        let exit = match it.region {
+            Region::Rungs(lo, hi) => self
+                .machine
+                .resume(store, ctx, at, |r| lo <= r.0 && r.0 < hi),
+            Region::Tasks(lo, hi) => {
+                let task_of = &plan.task_of_rung;
+                self.machine.resume(store, ctx, at, |r: RungId| {
+                    task_of[r.index()].is_some_and(|t| lo <= t && t <= hi)
+                })
+            }
+        };
+        if let Some(slot) = it.decision {
+            let d = match exit {
+                Exit::Stop => Decision::Stop,
+                Exit::Rung(r) => Decision::Rung(r),
+                Exit::ForTest(h) => Decision::ForTest(h),
+            };
+            sh.decisions.set(slot, d);
+        }
+    }
+}
+
+/// Which scans of a window worker 0 times.
+#[derive(Copy, Clone, Debug)]
+struct Timing {
+    /// Every scan (a probe, or a driver that wants every scan timed).
+    all: bool,
+    /// Otherwise every `every`-th scan.
+    every: u64,
+}
+
+impl Timing {
+    #[inline]
+    fn wants(self, scan: u64) -> bool {
+        self.all || scan.is_multiple_of(self.every)
+    }
+}
+
+/// Per-worker scratch buffers, kept across windows.
+#[derive(Default)]
+struct Buffers {
+    scratch: Vec<Fault>,
+    merged: Vec<(u32, Fault)>,
+    out: Vec<Fault>,
+}
+
+/// The driver type of workers that have none.
+struct NoDriver;
+
+impl ScanDriver for NoDriver {
+    fn before_scan(&mut self, _: &Machine, _: u64, _: &mut [u64]) {}
+    fn after_scan(&mut self, _: &Machine, _: u64, _: &[u64], _: &[Fault], _: Duration) {}
+}
+
+fn slicing_name(s: Slicing) -> &'static str {
+    match s {
+        Slicing::Auto => "auto",
+        Slicing::Contiguous => "contiguous",
+        Slicing::Lpt => "lpt",
+    }
+}
+
+/// The plans of `config.kind`: the model's plan (model, seq, par), or the levelled plans of
+/// the model's phases under both slicings (auto, when slicing is left to the planner; one
+/// plan when both slicings give the same phases).
+fn candidate_plans(p: &Program, a: &Analysis, config: &PlanConfig) -> Vec<Plan> {
+    if config.kind != PlanKind::Auto || config.slicing != Slicing::Auto {
+        return vec![Plan::build(p, a, config)];
+    }
+    let contiguous = Plan::build(
+        p,
+        a,
+        &PlanConfig {
+            slicing: Slicing::Contiguous,
+            ..*config
+        },
+    );
+    let lpt = Plan::build(
+        p,
+        a,
+        &PlanConfig {
+            slicing: Slicing::Lpt,
+            ..*config
+        },
+    );
+    if lpt.sequential.is_some() || lpt.phases == contiguous.phases {
+        vec![contiguous]
+    } else if contiguous.sequential.is_some() {
+        vec![lpt]
+    } else {
+        vec![contiguous, lpt]
+    }
+}
