@@ -320,17 +320,11 @@ impl<'a> Builder<'a> {
         let index = &self.fb_index;
         let types = &self.fb_types;
         let sig = |n: &str| index.get(n).map(|&i| types[i].sig.clone());
-        let json: serde_json::Value = serde_json::from_str(f.text).map_err(|e| {
-            LoadError::invalid(
-                None,
-                path,
-                Invalid::Shape {
-                    expected: "an FBD body",
-                    found: e.to_string(),
-                },
-            )
-        })?;
-        fbd_read::read_body(&json, path, name, kind, &sig)
+        let cx = fbd_read::Context {
+            text: self.text,
+            sig: &sig,
+        };
+        fbd_read::read_body(f, path, name, kind, &cx)
             .map_err(|e| e.at_position(self.position(f.origin)))
     }
 

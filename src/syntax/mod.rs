@@ -18,9 +18,13 @@
 //! Deliberately not here: name resolution, types of operands, structural rules (those are the
 //! resolver's), and anything JSON-specific beyond [`Scalar`] (a leaf as written, for messages).
 
+pub mod fbd;
+
 use crate::diag::Invalid;
 use crate::model::{ArithOp, CmpOp, TimerKind};
 use std::borrow::Cow;
+
+pub use fbd::FbdBody;
 
 /// A string of the source text (borrowed unless it had escapes).
 pub type Text<'a> = Cow<'a, str>;
@@ -302,15 +306,6 @@ pub struct For<'a> {
 pub enum Edge {
     Rising,
     Falling,
-}
-
-/// An FBD body as written. Today the JSON reader keeps it as the text of its `fbd` value and
-/// `crate::resolve` reads networks from it (FBD bodies are small next to ladder programs).
-#[derive(Clone, Debug)]
-pub struct FbdBody<'a> {
-    pub origin: Origin,
-    /// The JSON text of the body (`{"networks": [...]}`).
-    pub text: &'a str,
 }
 
 impl<'a> Element<'a> {

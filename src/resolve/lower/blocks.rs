@@ -22,13 +22,12 @@ impl Cx<'_> {
         let e = |path: &str, k| LoadError::fbd(&net.id, id, path, k);
         // The connected inputs, in pin order.
         let mut vals: Vec<(Val, &str)> = Vec::with_capacity(blk.inputs.len());
-        if !matches!(blk.op, Op::TStart | Op::TStop | Op::Call(_)) {
+        if !matches!(blk.op, Op::TStart | Op::TStop | Op::Call { .. }) {
+            // Built-in ops have every input connected (checked by the reader).
             for pin in &blk.inputs {
-                let input = pin
-                    .input
-                    .as_ref()
-                    .expect("built-in ops have every input connected");
-                vals.push((self.val(nx, input, &pin.path, id)?, pin.path.as_str()));
+                if let Some(input) = &pin.input {
+                    vals.push((self.val(nx, input, &pin.path, id)?, pin.path.as_str()));
+                }
             }
         }
         let series = match &blk.op {
@@ -276,8 +275,8 @@ impl Cx<'_> {
                 s.extend(moves(d, &rest));
                 s
             }
-            Op::Timer(kind) => {
-                let inst = self.builtin_instance(nx, b, kind.fb())?;
+            Op::Timer { kind, instance } => {
+                let inst = self.builtin_instance(nx, b, kind.fb(), instance)?;
                 let inp = self.coerce(nx, &vals[0].0, Type::Bool, "a timer's IN", vals[0].1, id)?;
                 let pt = self.coerce(nx, &vals[1].0, Type::Time, "a timer's PT", vals[1].1, id)?;
                 let mut first = condition(inp, false);
@@ -294,13 +293,13 @@ impl Cx<'_> {
                     first,
                 )?
             }
-            Op::Ctu | Op::Ctd => {
-                let fb = if blk.op == Op::Ctu {
+            Op::Ctu { instance } | Op::Ctd { instance } => {
+                let fb = if matches!(blk.op, Op::Ctu { .. }) {
                     FbKind::Ctu
                 } else {
                     FbKind::Ctd
                 };
-                let inst = self.builtin_instance(nx, b, fb)?;
+                let inst = self.builtin_instance(nx, b, fb, instance)?;
                 let c = self.coerce(
                     nx,
                     &vals[0].0,
@@ -344,7 +343,7 @@ impl Cx<'_> {
                     first,
                 )?
             }
-            Op::Jmp | Op::Ret => {
+            Op::Jmp { .. } | Op::Ret => {
                 let mut s = match &blk.cond {
                     Some(c) => {
                         let o = self.bool_input(
@@ -358,19 +357,18 @@ impl Cx<'_> {
                     }
                     None => Vec::new(),
                 };
-                if blk.op == Op::Jmp {
-                    let label = blk.label.clone().expect("a JMP has a label");
+                if let Op::Jmp { label } = &blk.op {
                     if !labels.contains_key(label.as_str()) {
                         return Err(e(
                             &format!("{}.label", blk.path),
                             Invalid::UndefinedLabel {
-                                label,
+                                label: label.clone(),
                                 pou: self.names.pou.clone(),
                             },
                         ));
                     }
                     s.push(Element::Jmp {
-                        label,
+                        label: label.clone(),
                         target: RungId(u32::MAX),
                     });
                 } else {
@@ -407,7 +405,7 @@ impl Cx<'_> {
                     vec![Element::Reset(a.acc), contact(acc, false), timer]
                 }
             }
-            Op::Call(fb) => self.call(nx, b, fb)?,
+            Op::Call { fb, instance } => self.call(nx, b, fb, instance)?,
         };
         Ok(series)
     }

@@ -111,9 +111,11 @@ impl Cx<'_> {
                         series,
                         &blk.path,
                     );
-                    if blk.op == Op::Jmp {
-                        let target = labels[blk.label.as_deref().expect("a JMP has a label")];
-                        jumps.push((r, target));
+                    if let Op::Jmp { label } = &blk.op {
+                        // Checked by the block's lowering: the label is defined.
+                        if let Some(&target) = labels.get(label.as_str()) {
+                            jumps.push((r, target));
+                        }
                     }
                     block_rung[b.index()] = r as u32;
                 }

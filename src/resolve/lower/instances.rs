@@ -7,10 +7,15 @@ use crate::fbd::model::*;
 use crate::model::*;
 
 impl Cx<'_> {
-    pub(super) fn builtin_instance(&self, nx: &Net, b: BlockId, fb: FbKind) -> Result<VarId> {
+    pub(super) fn builtin_instance(
+        &self,
+        nx: &Net,
+        b: BlockId,
+        fb: FbKind,
+        name: &str,
+    ) -> Result<VarId> {
         let blk = nx.net.block(b);
         let path = format!("{}.instance", blk.path);
-        let name = blk.instance.as_deref().expect("checked by the reader");
         let e = |k| LoadError::fbd(&nx.net.id, Some(blk.id), &path, k);
         match self.env.instance(name).map_err(e)? {
             InstanceRef::Builtin(v, k) if k == fb => Ok(v),
@@ -47,12 +52,17 @@ impl Cx<'_> {
     }
 
     /// A user function block call: inputs moved into the instance, `call`, outputs moved out.
-    pub(super) fn call(&mut self, nx: &mut Net, b: BlockId, fb: &str) -> Result<Series> {
+    pub(super) fn call(
+        &mut self,
+        nx: &mut Net,
+        b: BlockId,
+        fb: &str,
+        name: &str,
+    ) -> Result<Series> {
         let net = nx.net;
         let blk = net.block(b);
         let id = Some(blk.id);
         let path = format!("{}.instance", blk.path);
-        let name = blk.instance.as_deref().expect("checked by the reader");
         let e = |k| LoadError::fbd(&net.id, id, &path, k);
         let (pou, inputs, outputs) = match self.env.instance(name).map_err(e)? {
             InstanceRef::User {

@@ -5,7 +5,9 @@ use super::{var_op, Cx, Net, Result, Val};
 use crate::diag::{Invalid, LoadError};
 use crate::fbd::model::*;
 use crate::model::*;
-use crate::resolve::operand::{self, Untyped};
+use crate::resolve::operand;
+use crate::syntax::Scalar;
+use std::borrow::Cow;
 
 impl Cx<'_> {
     pub(super) fn val(
@@ -26,18 +28,18 @@ impl Cx<'_> {
                     format!("{}.{}", src.id, src.outputs[*pin as usize].name),
                 ))
             }
-            Input::Operand(j) => {
-                let env = &*self.env;
-                let u = operand::parse_json(j, &|n| env.lookup(n))
+            Input::Variable(name) => {
+                let (r, t) = self
+                    .env
+                    .lookup(name)
                     .map_err(|k| LoadError::fbd(&nx.net.id, block, path, k))?;
-                let text = match j {
-                    serde_json::Value::String(s) => s.clone(),
-                    other => other.to_string(),
-                };
-                Ok(match u {
-                    Untyped::Var(r, t) => Val::Typed(Operand::Var(r), t, text),
-                    other => Val::Const(other, text),
-                })
+                Ok(Val::Typed(Operand::Var(r), t, name.clone()))
+            }
+            Input::Constant(c) => {
+                let env = &*self.env;
+                let u = operand::parse(&constant_scalar(c), &|n| env.lookup(n))
+                    .map_err(|k| LoadError::fbd(&nx.net.id, block, path, k))?;
+                Ok(Val::Const(u, c.text()))
             }
         }
     }
@@ -155,5 +157,14 @@ impl Cx<'_> {
         vals.iter()
             .map(|(v, p)| self.coerce(nx, v, ty, what, p, id))
             .collect()
+    }
+}
+
+/// A constant as the operand parser reads it.
+pub(super) fn constant_scalar(c: &Constant) -> Scalar<'_> {
+    match c {
+        Constant::Bool(b) => Scalar::Bool(*b),
+        Constant::Number(n) => Scalar::Number(n.clone()),
+        Constant::Time(s) => Scalar::Str(Cow::Borrowed(s)),
     }
 }
