@@ -29,6 +29,8 @@ pub struct Fbd {
     /// Every instance of a user function block type (with an FBD or a ladder body), in the order
     /// their POUs follow the subroutines: the instance → type map.
     pub instances: Vec<FbInstance>,
+    /// Every user function block type, in file order.
+    pub types: Vec<super::types::FbType>,
 }
 
 /// One instance of a user function block type and the POU it was expanded into.
@@ -36,8 +38,9 @@ pub struct Fbd {
 pub struct FbInstance {
     /// `G1`, `SBR:G1` (declared in a subroutine), `G1.INNER` (nested): also its POU's name.
     pub name: String,
-    /// The function block type.
+    /// The function block type (its name and its index).
     pub fb: String,
+    pub ty: super::types::FbTypeId,
     pub pou: PouId,
     /// Its input and output variables by pin name, in declaration order.
     pub inputs: Vec<(String, VarId)>,
@@ -270,20 +273,32 @@ pub enum Op {
     /// LIMIT(MN, IN, MX).
     Limit,
     /// TON TOF TP on `instance`: inputs IN, PT; outputs Q, ET.
-    Timer { kind: TimerKind, instance: String },
+    Timer {
+        kind: TimerKind,
+        instance: String,
+    },
     /// CTU (CU, R, PV) on `instance`; outputs Q, CV.
-    Ctu { instance: String },
+    Ctu {
+        instance: String,
+    },
     /// CTD (CD, LD, PV) on `instance`; outputs Q, CV.
-    Ctd { instance: String },
+    Ctd {
+        instance: String,
+    },
     /// Jump to the network labelled `label` when `cond` holds (always without `cond`).
-    Jmp { label: String },
+    Jmp {
+        label: String,
+    },
     /// Return from the POU when `cond` holds (always without `cond`).
     Ret,
     /// Start / stop accumulating elapsed time in a TIME variable (KASKAD's TIMER_CONTROL).
     TStart,
     TStop,
     /// A call of user function block type `fb` on `instance`.
-    Call { fb: String, instance: String },
+    Call {
+        fb: String,
+        instance: String,
+    },
 }
 
 /// The op names of the format, as the error message lists them.

@@ -158,7 +158,9 @@ impl FbdReader {
         net.id = match get(&e, "id") {
             None => Err(missing("id", "a network")),
             Some(id) => match self.scalar(id)? {
-                Scalar::Str(s) if s.is_empty() || s.chars().any(|c| c.is_whitespace() || c == '"') => {
+                Scalar::Str(s)
+                    if s.is_empty() || s.chars().any(|c| c.is_whitespace() || c == '"') =>
+                {
                     Err(problem(
                         ".id",
                         Invalid::Shape {
@@ -220,10 +222,7 @@ impl FbdReader {
             Some(id) => {
                 let s = self.scalar(id)?;
                 block_id(&s).ok_or_else(|| {
-                    problem(
-                        ".id",
-                        shape("a block id (a whole number, 0 or more)", &s),
-                    )
+                    problem(".id", shape("a block id (a whole number, 0 or more)", &s))
                 })
             }
         };
@@ -312,7 +311,10 @@ impl FbdReader {
         })
     }
 
-    fn out_var<'de>(&self, v: &'de RawValue) -> Result<std::result::Result<OutVar<'de>, Scalar<'de>>> {
+    fn out_var<'de>(
+        &self,
+        v: &'de RawValue,
+    ) -> Result<std::result::Result<OutVar<'de>, Scalar<'de>>> {
         Ok(match self.scalar(v)? {
             Scalar::Str(name) => Ok(OutVar {
                 origin: self.origin(v),
@@ -371,10 +373,7 @@ impl FbdReader {
                 let mut vars = Vec::with_capacity(items.len());
                 for (m, item) in items.into_iter().enumerate() {
                     vars.push(self.out_var(item)?.map_err(|other| {
-                        problem(
-                            format!(".out.{pin}[{m}]"),
-                            shape("a variable name", &other),
-                        )
+                        problem(format!(".out.{pin}[{m}]"), shape("a variable name", &other))
                     }));
                 }
                 Ok(Targets::Many(vars))
@@ -393,8 +392,9 @@ impl FbdReader {
                 for (i, item) in items.into_iter().enumerate() {
                     let s = self.scalar(item)?;
                     ids.push(
-                        block_id(&s)
-                            .ok_or_else(|| problem(format!(".after[{i}]"), shape("a block id", &s))),
+                        block_id(&s).ok_or_else(|| {
+                            problem(format!(".after[{i}]"), shape("a block id", &s))
+                        }),
                     );
                 }
                 Ok(ids)

@@ -315,7 +315,9 @@ impl Net<'_, '_, '_> {
                         Ok(syn::Targets::Many(vs)) => {
                             for (m, v) in vs.iter().enumerate() {
                                 let v = v.as_ref().map_err(|e| self.problem(d, e, p))?;
-                                outputs[i].vars.push((v.name.to_string(), format!("{q}[{m}]")));
+                                outputs[i]
+                                    .vars
+                                    .push((v.name.to_string(), format!("{q}[{m}]")));
                             }
                         }
                     }

@@ -86,12 +86,16 @@ pub(crate) fn read_body(
     let mut block_ids: HashMap<u32, String> = HashMap::new();
     for (i, n) in body.networks.iter().enumerate() {
         let p = format!("{np}[{i}]");
-        let net = network(n, &p, cx, &mut block_ids)
-            .map_err(|e| e.at_position(cx.position(n.origin)))?;
-        let e = |q: String, k| LoadError::fbd(&net.id, None, &q, k).at_position(cx.position(n.origin));
+        let net =
+            network(n, &p, cx, &mut block_ids).map_err(|e| e.at_position(cx.position(n.origin)))?;
+        let e =
+            |q: String, k| LoadError::fbd(&net.id, None, &q, k).at_position(cx.position(n.origin));
         if let Some(first) = ids.insert(net.id.clone(), p.clone()) {
             let id = net.id.clone();
-            return Err(e(format!("{p}.id"), Invalid::DuplicateNetwork { id, first }));
+            return Err(e(
+                format!("{p}.id"),
+                Invalid::DuplicateNetwork { id, first },
+            ));
         }
         if let Some(l) = &net.label {
             if let Some(first) = labels.insert(l.clone(), net.id.clone()) {
@@ -162,7 +166,9 @@ fn network(
         None => None,
         Some(Err(p)) => return Err(reported(p, path, e)),
         Some(Ok(l)) if !valid_name(l) => {
-            let kind = Invalid::BadName { name: l.to_string() };
+            let kind = Invalid::BadName {
+                name: l.to_string(),
+            };
             return Err(e(&format!("{path}.label"), kind));
         }
         Some(Ok(l)) => Some(l.to_string()),
@@ -177,7 +183,8 @@ fn network(
     let mut drafts = Vec::with_capacity(items.len());
     for (i, b) in items.iter().enumerate() {
         let p = format!("{path}.blocks[{i}]");
-        let d = draft(b, p, &id, cx, block_ids).map_err(|e| e.at_position(cx.position(b.origin)))?;
+        let d =
+            draft(b, p, &id, cx, block_ids).map_err(|e| e.at_position(cx.position(b.origin)))?;
         drafts.push(d);
     }
     drafts.sort_by_key(|d| d.id);
@@ -228,11 +235,18 @@ fn draft<'s, 'a>(
 ) -> Result<Draft<'s, 'a>> {
     let id = match &b.id {
         Ok(id) => *id,
-        Err(p) => return Err(reported(p, &path, |q, k| LoadError::fbd(network, None, q, k))),
+        Err(p) => {
+            return Err(reported(p, &path, |q, k| {
+                LoadError::fbd(network, None, q, k)
+            }))
+        }
     };
     let be = |q: &str, k| LoadError::fbd(network, Some(id), q, k);
     if let Some(first) = block_ids.insert(id, path.clone()) {
-        return Err(be(&format!("{path}.id"), Invalid::DuplicateBlock { id, first }));
+        return Err(be(
+            &format!("{path}.id"),
+            Invalid::DuplicateBlock { id, first },
+        ));
     }
     if let Some(p) = &b.problem {
         return Err(reported(p, &path, be));

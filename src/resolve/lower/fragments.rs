@@ -4,18 +4,19 @@
 use super::{condition, contact, set_jump_target, Cx, Net, Result};
 use crate::diag::LoadError;
 use crate::fbd::model::*;
+use crate::fbd::types::TypedNetwork;
 use crate::model::*;
 use std::collections::HashMap;
 
 impl Cx<'_> {
-    /// Lowers one network; returns the rung of each block.
+    /// Lowers one network; returns the rung of each block and the network's typed form.
     pub(super) fn network(
         &mut self,
         net: &Network,
         plan: &Plan,
         labels: &HashMap<&str, usize>,
         jumps: &mut Vec<(usize, usize)>,
-    ) -> Result<Vec<u32>> {
+    ) -> Result<(Vec<u32>, TypedNetwork<VarRef>)> {
         let n = net.blocks.len();
         let mut used: Vec<Vec<bool>> = net
             .blocks
@@ -39,7 +40,12 @@ impl Cx<'_> {
             .iter()
             .map(|b| vec![None; b.outputs.len()])
             .collect();
-        let mut nx = Net { net, used, values };
+        let mut nx = Net {
+            net,
+            used,
+            values,
+            constants: HashMap::new(),
+        };
         let rp = self.names.rung_prefix.clone();
         let e_net = |k| LoadError::fbd(&net.id, None, &net.path, k);
         // Run flags of compound fragments: reset first, set inside each source fragment.
@@ -140,6 +146,6 @@ impl Cx<'_> {
         if first_rung.comment.is_none() {
             first_rung.comment = net.comment.clone();
         }
-        Ok(block_rung)
+        Ok((block_rung, self.typed_network(&nx)))
     }
 }

@@ -1,7 +1,7 @@
 //! Function block instances in a network: built-in timers and counters (read through their
 //! fields), and calls of user function block instances (each its own POU).
 
-use super::{field_op, steps, var_op, Cx, InstanceRef, Net, Result};
+use super::{field_op, steps, var_op, Cx, InstanceRef, Net, PinSlot, Result};
 use crate::diag::{Invalid, LoadError};
 use crate::fbd::model::*;
 use crate::model::*;
@@ -81,10 +81,10 @@ impl Cx<'_> {
             }
         };
         let mut s = Vec::new();
-        for (pin, (_, var)) in blk.inputs.iter().zip(&inputs) {
+        for (i, (pin, (_, var))) in blk.inputs.iter().zip(&inputs).enumerate() {
             if let Some(input) = &pin.input {
                 let ty = self.env.var(*var).ty;
-                let v = self.val(nx, input, &pin.path, id)?;
+                let v = self.val(nx, input, &pin.path, id, Some(PinSlot(b, i)))?;
                 let from = self.coerce(nx, &v, ty, "a function block input", &pin.path, id)?;
                 s.push(Element::Move { from, to: *var });
             }

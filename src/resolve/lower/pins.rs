@@ -1,7 +1,7 @@
 //! Block inputs and outputs: values of connected inputs (arcs, variables, constants) typed
 //! on use, the variables an output is written to, hidden temps for outputs arcs read.
 
-use super::{var_op, Cx, Net, Result, Val};
+use super::{var_op, Cx, Net, PinSlot, Result, Val};
 use crate::diag::{Invalid, LoadError};
 use crate::fbd::model::*;
 use crate::model::*;
@@ -10,12 +10,14 @@ use crate::syntax::Scalar;
 use std::borrow::Cow;
 
 impl Cx<'_> {
+    /// The value connected to an input (`slot`: the input pin, when it is one).
     pub(super) fn val(
         &self,
         nx: &Net,
         input: &Input,
         path: &str,
         block: Option<u32>,
+        slot: Option<PinSlot>,
     ) -> Result<Val> {
         match input {
             Input::Arc { from, pin } => {
@@ -39,14 +41,15 @@ impl Cx<'_> {
                 let env = &*self.env;
                 let u = operand::parse(&constant_scalar(c), &|n| env.lookup(n))
                     .map_err(|k| LoadError::fbd(&nx.net.id, block, path, k))?;
-                Ok(Val::Const(u, c.text()))
+                Ok(Val::Const(u, c.text(), slot))
             }
         }
     }
 
+    /// `v` as an operand of type `ty` (a constant recorded for its pin).
     pub(super) fn coerce(
         &self,
-        nx: &Net,
+        nx: &mut Net,
         v: &Val,
         ty: Type,
         what: &'static str,
@@ -55,17 +58,20 @@ impl Cx<'_> {
     ) -> Result<Operand> {
         let e = |k| LoadError::fbd(&nx.net.id, block, path, k);
         match v {
-            Val::Typed(o, t, text) if *t != ty => {
-                let _ = o;
-                Err(e(Invalid::Type {
-                    what,
-                    expected: ty.to_string(),
-                    operand: text.clone(),
-                    found: t.to_string(),
-                }))
-            }
+            Val::Typed(_, t, text) if *t != ty => Err(e(Invalid::Type {
+                what,
+                expected: ty.to_string(),
+                operand: text.clone(),
+                found: t.to_string(),
+            })),
             Val::Typed(o, _, _) => Ok(*o),
-            Val::Const(u, text) => operand::typed(u, ty, what, text).map_err(e),
+            Val::Const(u, text, slot) => {
+                let o = operand::typed(u, ty, what, text).map_err(e)?;
+                if let (Operand::Const(value), Some(slot)) = (o, slot) {
+                    nx.constants.insert(*slot, value);
+                }
+                Ok(o)
+            }
         }
     }
 
@@ -77,7 +83,7 @@ impl Cx<'_> {
         path: &str,
         what: &'static str,
     ) -> Result<Operand> {
-        let v = self.val(nx, input, path, block)?;
+        let v = self.val(nx, input, path, block, None)?;
         self.coerce(nx, &v, Type::Bool, what, path, block)
     }
 
@@ -148,7 +154,7 @@ impl Cx<'_> {
 
     pub(super) fn typed_all(
         &self,
-        nx: &Net,
+        nx: &mut Net,
         vals: &[(Val, &str)],
         ty: Type,
         what: &'static str,
