@@ -102,23 +102,7 @@ pub fn fragments(net: &Network, topological: Vec<BlockId>) -> Result<Plan, LoadE
             match conditional.get(&key) {
                 Some(&f) => f,
                 None => {
-                    let (base, condition) = match cond {
-                        Input::Arc { from, pin } => {
-                            let src = net.block(*from);
-                            let pin_name = &src.outputs[*pin as usize].name;
-                            let base = if *pin == 0 {
-                                format!("F({})", src.id)
-                            } else {
-                                format!("F({}.{pin_name})", src.id)
-                            };
-                            (base, format!("{}.{pin_name}", src.id))
-                        }
-                        Input::Variable(v) => (format!("F({v})"), v.clone()),
-                        Input::Constant(c) => {
-                            let text = c.text();
-                            (format!("F({text})"), text)
-                        }
-                    };
+                    let (base, condition) = conditional_name(net, cond);
                     let f = t.add(
                         unique(&mut names, base),
                         fd,
@@ -315,6 +299,28 @@ fn split_error(
             arcs: arcs.join(", "),
         },
     )
+}
+
+/// The name (`F(3)`, `F(5.ET)`, `F(Var)`) and the condition text of the fragment conditional
+/// on `cond`.
+fn conditional_name(net: &Network, cond: &Input) -> (String, String) {
+    match cond {
+        Input::Arc { from, pin } => {
+            let src = net.block(*from);
+            let pin_name = &src.outputs[*pin as usize].name;
+            let base = if *pin == 0 {
+                format!("F({})", src.id)
+            } else {
+                format!("F({}.{pin_name})", src.id)
+            };
+            (base, format!("{}.{pin_name}", src.id))
+        }
+        Input::Variable(v) => (format!("F({v})"), v.clone()),
+        Input::Constant(c) => {
+            let text = c.text();
+            (format!("F({text})"), text)
+        }
+    }
 }
 
 fn cond_key(i: &Input) -> String {

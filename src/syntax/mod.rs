@@ -3,7 +3,7 @@
 //! Plain, format-neutral types for IEC 61131-3 program organisation units (clause 6.6: the
 //! program, function block types, subroutines called like functions), their variable
 //! declarations (6.5), ladder rungs with their series/parallel element trees (clause 8.2, LD) and
-//! FBD bodies (8.3) kept as written. A reader (today `crate::read::json`; a PLCopen XML or STL
+//! FBD bodies (8.3, [`fbd`]) kept as written. A reader (today `crate::read::json`; a PLCopen XML or STL
 //! reader would fill the same types) produces them; `crate::resolve` turns them into the model.
 //!
 //! Invariants: every string borrows from the source text where it can (`Cow`); every node that

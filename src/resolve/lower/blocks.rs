@@ -24,10 +24,16 @@ impl Cx<'_> {
         if !matches!(blk.op, Op::TStart | Op::TStop | Op::Call { .. }) {
             // Built-in ops have every input connected (checked by the reader).
             for (i, pin) in blk.inputs.iter().enumerate() {
-                if let Some(input) = &pin.input {
-                    let slot = Some(PinSlot(b, i));
-                    vals.push((self.val(nx, input, &pin.path, id, slot)?, pin.path.as_str()));
-                }
+                let input = pin.input.as_ref().ok_or_else(|| {
+                    let op = blk.op.name().to_owned();
+                    let kind = Invalid::Unconnected {
+                        op,
+                        pin: pin.name.clone(),
+                    };
+                    LoadError::fbd(&net.id, id, &pin.path, kind)
+                })?;
+                let slot = Some(PinSlot(b, i));
+                vals.push((self.val(nx, input, &pin.path, id, slot)?, pin.path.as_str()));
             }
         }
         match &blk.op {
