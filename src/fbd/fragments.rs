@@ -85,7 +85,8 @@ pub fn fragments(net: &Network, topological: Vec<BlockId>) -> Result<Plan, LoadE
                 fd = f;
             }
         }
-        let frag = if b.cond.is_some() && !b.cond_is_own() {
+        let own_cond = b.cond.as_ref().filter(|_| !b.cond_is_own());
+        let frag = if let Some(cond) = own_cond {
             if mc.len() >= 2 {
                 return Err(LoadError::fbd(
                     &net.id,
@@ -97,34 +98,15 @@ pub fn fragments(net: &Network, topological: Vec<BlockId>) -> Result<Plan, LoadE
                     },
                 ));
             }
-            let cond = b.cond.clone().expect("checked");
-            let key = (fd, cond_key(&cond));
+            let key = (fd, cond_key(cond));
             match conditional.get(&key) {
                 Some(&f) => f,
                 None => {
-                    let (base, condition) = match &cond {
-                        Input::Arc { from, pin } => {
-                            let src = net.block(*from);
-                            let pin_name = &src.outputs[*pin as usize].name;
-                            let base = if *pin == 0 {
-                                format!("F({})", src.id)
-                            } else {
-                                format!("F({}.{pin_name})", src.id)
-                            };
-                            (base, format!("{}.{pin_name}", src.id))
-                        }
-                        Input::Operand(j) => {
-                            let text = match j {
-                                serde_json::Value::String(s) => s.clone(),
-                                other => other.to_string(),
-                            };
-                            (format!("F({text})"), text)
-                        }
-                    };
+                    let (base, condition) = conditional_name(net, cond);
                     let f = t.add(
                         unique(&mut names, base),
                         fd,
-                        FragmentKind::Conditional(cond),
+                        FragmentKind::Conditional(cond.clone()),
                         condition,
                     );
                     conditional.insert(key, f);
@@ -319,10 +301,33 @@ fn split_error(
     )
 }
 
+/// The name (`F(3)`, `F(5.ET)`, `F(Var)`) and the condition text of the fragment conditional
+/// on `cond`.
+fn conditional_name(net: &Network, cond: &Input) -> (String, String) {
+    match cond {
+        Input::Arc { from, pin } => {
+            let src = net.block(*from);
+            let pin_name = &src.outputs[*pin as usize].name;
+            let base = if *pin == 0 {
+                format!("F({})", src.id)
+            } else {
+                format!("F({}.{pin_name})", src.id)
+            };
+            (base, format!("{}.{pin_name}", src.id))
+        }
+        Input::Variable(v) => (format!("F({v})"), v.clone()),
+        Input::Constant(c) => {
+            let text = c.text();
+            (format!("F({text})"), text)
+        }
+    }
+}
+
 fn cond_key(i: &Input) -> String {
     match i {
         Input::Arc { from, pin } => format!("#{}:{pin}", from.0),
-        Input::Operand(j) => j.to_string(),
+        Input::Variable(v) => format!("v:{v}"),
+        Input::Constant(c) => format!("c:{}", c.text()),
     }
 }
 

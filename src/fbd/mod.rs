@@ -7,6 +7,7 @@
 //! - [`order`]: depth-first topological sort, O(V + E), ties by block id, cycles reported;
 //! - [`fragments`]: the conditional fragment tree, the rule of conditional fragments, the
 //!   regrouped order;
+//! - [`types`]: user function block types with their interface and typed bodies;
 //!
 //! Only the model and the pure algorithms live here: reading FBD bodies and lowering them into
 //! rungs is the resolver's (`crate::resolve`), which calls [`plan`]; `plc-deps order` renders
@@ -16,11 +17,13 @@
 pub mod fragments;
 pub mod model;
 pub mod order;
+pub mod types;
 
 /// The longest time an accumulation (TSTART/TSTOP) can run (the TIME range): the PT of its
 /// hidden TON.
 pub const ACCUMULATE_PT_MS: i32 = i32::MAX;
 pub use model::*;
+pub use types::*;
 
 use crate::diag::{Invalid, LoadError};
 

@@ -2,8 +2,10 @@
 //! name is resolved), and the plan of each network (execution order and conditional fragments).
 //!
 //! Blocks of a network live in a dense `Vec` sorted by their user id and are addressed by
-//! [`BlockId`] (the index), so "ties by block id" is "ties by index". Operands are kept as the JSON
-//! the file wrote: a function block type's body is read once and resolved once per instance.
+//! [`BlockId`] (the index), so "ties by block id" is "ties by index". What only some ops have (a
+//! timer's instance, a JMP's label, the type of a call) is data of their [`Op`] variant. Operands
+//! are kept by name or as written ([`Input`]): a function block type's body is read once and
+//! resolved once per instance.
 
 use crate::model::{ArithOp, CmpOp, PouId, RungId, TimerKind, VarId};
 use std::ops::Range;
@@ -27,6 +29,8 @@ pub struct Fbd {
     /// Every instance of a user function block type (with an FBD or a ladder body), in the order
     /// their POUs follow the subroutines: the instance → type map.
     pub instances: Vec<FbInstance>,
+    /// Every user function block type, in file order.
+    pub types: Vec<super::types::FbType>,
 }
 
 /// One instance of a user function block type and the POU it was expanded into.
@@ -34,8 +38,9 @@ pub struct Fbd {
 pub struct FbInstance {
     /// `G1`, `SBR:G1` (declared in a subroutine), `G1.INNER` (nested): also its POU's name.
     pub name: String,
-    /// The function block type.
+    /// The function block type (its name and its index).
     pub fb: String,
+    pub ty: super::types::FbTypeId,
     pub pou: PouId,
     /// Its input and output variables by pin name, in declaration order.
     pub inputs: Vec<(String, VarId)>,
@@ -126,6 +131,7 @@ impl Network {
 pub struct Block {
     /// The user's id (an execution number of an FBD editor), unique in its POU.
     pub id: u32,
+    /// The operation, with what only it has (a timer's instance, a JMP's label, …).
     pub op: Op,
     /// JSON path of the block.
     pub path: String,
@@ -133,10 +139,6 @@ pub struct Block {
     pub inputs: Vec<InputPin>,
     /// One entry per output pin.
     pub outputs: Vec<OutputPin>,
-    /// The instance a timer, counter or user function block runs on.
-    pub instance: Option<String>,
-    /// The jump target of a JMP.
-    pub label: Option<String>,
     /// The conditional arc into the control input (for JMP and RET: their condition).
     pub cond: Option<Input>,
     /// Control arcs from these blocks' control outputs (sorted, no duplicates).
@@ -156,7 +158,7 @@ impl Block {
     /// True when `cond` is the block's own condition (JMP, RET) rather than a conditional arc
     /// that opens a fragment.
     pub fn cond_is_own(&self) -> bool {
-        matches!(self.op, Op::Jmp | Op::Ret)
+        matches!(self.op, Op::Jmp { .. } | Op::Ret)
     }
     /// The index of output pin `name`.
     pub fn output_pin(&self, name: &str) -> Option<u32> {
@@ -184,11 +186,14 @@ pub struct OutputPin {
     pub vars: Vec<(String, String)>,
 }
 
-/// What is connected to an input pin or to the control input.
+/// What is connected to an input pin or to the control input. Names and constants stay as
+/// written: a function block type's body is resolved once per instance.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Input {
-    /// An OPERAND as in ladder (variable or field name, number, boolean, TIME literal).
-    Operand(serde_json::Value),
+    /// A variable, a field (`T1.Q`) or a member of a user instance (`G1.RESULT`), by name.
+    Variable(String),
+    /// A constant, typed by the block that reads it.
+    Constant(Constant),
     /// A data arc from output pin `pin` of block `from`.
     Arc { from: BlockId, pin: u32 },
 }
@@ -197,12 +202,57 @@ impl Input {
     pub fn source(&self) -> Option<BlockId> {
         match self {
             Input::Arc { from, .. } => Some(*from),
-            Input::Operand(_) => None,
+            Input::Variable(_) | Input::Constant(_) => None,
         }
     }
 }
 
-/// The operation of a block.
+/// A constant as written, before the block that reads it gives it a type.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Constant {
+    Bool(bool),
+    Number(serde_json::Number),
+    /// A TIME literal (`T#1s`), checked when it is typed.
+    Time(String),
+}
+
+impl Constant {
+    /// The constant as messages and fragment names quote it (`T#1s`, `10`, `true`).
+    pub fn text(&self) -> String {
+        match self {
+            Constant::Bool(b) => b.to_string(),
+            Constant::Number(n) => n.to_string(),
+            Constant::Time(s) => s.clone(),
+        }
+    }
+}
+
+/// The kind of an operation, without its data: what pins and messages depend on.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum OpKind {
+    Compare(CmpOp),
+    Arith(ArithOp),
+    And,
+    Or,
+    Xor,
+    Not,
+    Move,
+    Sel,
+    Max,
+    Min,
+    Limit,
+    Timer(TimerKind),
+    Ctu,
+    Ctd,
+    Jmp,
+    Ret,
+    TStart,
+    TStop,
+    /// A user function block type (its pins are the type's).
+    Call,
+}
+
+/// The operation of a block, with the data only it has.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Op {
     /// EQ NE LT LE GT GE on two numeric inputs; output BOOL.
@@ -222,129 +272,196 @@ pub enum Op {
     Min,
     /// LIMIT(MN, IN, MX).
     Limit,
-    /// TON TOF TP on an instance: inputs IN, PT; outputs Q, ET.
-    Timer(TimerKind),
-    /// CTU (CU, R, PV) and CTD (CD, LD, PV) on an instance; outputs Q, CV.
-    Ctu,
-    Ctd,
+    /// TON TOF TP on `instance`: inputs IN, PT; outputs Q, ET.
+    Timer {
+        kind: TimerKind,
+        instance: String,
+    },
+    /// CTU (CU, R, PV) on `instance`; outputs Q, CV.
+    Ctu {
+        instance: String,
+    },
+    /// CTD (CD, LD, PV) on `instance`; outputs Q, CV.
+    Ctd {
+        instance: String,
+    },
     /// Jump to the network labelled `label` when `cond` holds (always without `cond`).
-    Jmp,
+    Jmp {
+        label: String,
+    },
     /// Return from the POU when `cond` holds (always without `cond`).
     Ret,
     /// Start / stop accumulating elapsed time in a TIME variable (KASKAD's TIMER_CONTROL).
     TStart,
     TStop,
-    /// A call of a user function block type (with an instance of it).
-    Call(String),
+    /// A call of user function block type `fb` on `instance`.
+    Call {
+        fb: String,
+        instance: String,
+    },
 }
 
 /// The op names of the format, as the error message lists them.
 pub use crate::diag::OP_NAMES;
 
-impl Op {
+impl OpKind {
     /// A built-in op by its name (user function blocks are resolved by the reader).
-    pub fn parse(s: &str) -> Option<Op> {
+    pub fn parse(s: &str) -> Option<OpKind> {
         if let Some(c) = CmpOp::parse(s) {
-            return Some(Op::Compare(c));
+            return Some(OpKind::Compare(c));
         }
         if let Some(a) = ArithOp::parse(s) {
-            return Some(Op::Arith(a));
+            return Some(OpKind::Arith(a));
         }
         Some(match s {
-            "AND" => Op::And,
-            "OR" => Op::Or,
-            "XOR" => Op::Xor,
-            "NOT" => Op::Not,
-            "MOVE" => Op::Move,
-            "SEL" => Op::Sel,
-            "MAX" => Op::Max,
-            "MIN" => Op::Min,
-            "LIMIT" => Op::Limit,
-            "TON" => Op::Timer(TimerKind::Ton),
-            "TOF" => Op::Timer(TimerKind::Tof),
-            "TP" => Op::Timer(TimerKind::Tp),
-            "CTU" => Op::Ctu,
-            "CTD" => Op::Ctd,
-            "JMP" => Op::Jmp,
-            "RET" => Op::Ret,
-            "TSTART" => Op::TStart,
-            "TSTOP" => Op::TStop,
+            "AND" => OpKind::And,
+            "OR" => OpKind::Or,
+            "XOR" => OpKind::Xor,
+            "NOT" => OpKind::Not,
+            "MOVE" => OpKind::Move,
+            "SEL" => OpKind::Sel,
+            "MAX" => OpKind::Max,
+            "MIN" => OpKind::Min,
+            "LIMIT" => OpKind::Limit,
+            "TON" => OpKind::Timer(TimerKind::Ton),
+            "TOF" => OpKind::Timer(TimerKind::Tof),
+            "TP" => OpKind::Timer(TimerKind::Tp),
+            "CTU" => OpKind::Ctu,
+            "CTD" => OpKind::Ctd,
+            "JMP" => OpKind::Jmp,
+            "RET" => OpKind::Ret,
+            "TSTART" => OpKind::TStart,
+            "TSTOP" => OpKind::TStop,
             _ => return None,
         })
     }
 
-    pub fn name(&self) -> &str {
-        match self {
-            Op::Compare(c) => c.name(),
-            Op::Arith(a) => a.name(),
-            Op::And => "AND",
-            Op::Or => "OR",
-            Op::Xor => "XOR",
-            Op::Not => "NOT",
-            Op::Move => "MOVE",
-            Op::Sel => "SEL",
-            Op::Max => "MAX",
-            Op::Min => "MIN",
-            Op::Limit => "LIMIT",
-            Op::Timer(TimerKind::Ton) => "TON",
-            Op::Timer(TimerKind::Tof) => "TOF",
-            Op::Timer(TimerKind::Tp) => "TP",
-            Op::Ctu => "CTU",
-            Op::Ctd => "CTD",
-            Op::Jmp => "JMP",
-            Op::Ret => "RET",
-            Op::TStart => "TSTART",
-            Op::TStop => "TSTOP",
-            Op::Call(fb) => fb,
-        }
+    /// The name of a built-in op (`None` for a call: its name is its type's).
+    pub fn name(self) -> Option<&'static str> {
+        Some(match self {
+            OpKind::Compare(c) => c.name(),
+            OpKind::Arith(a) => a.name(),
+            OpKind::And => "AND",
+            OpKind::Or => "OR",
+            OpKind::Xor => "XOR",
+            OpKind::Not => "NOT",
+            OpKind::Move => "MOVE",
+            OpKind::Sel => "SEL",
+            OpKind::Max => "MAX",
+            OpKind::Min => "MIN",
+            OpKind::Limit => "LIMIT",
+            OpKind::Timer(TimerKind::Ton) => "TON",
+            OpKind::Timer(TimerKind::Tof) => "TOF",
+            OpKind::Timer(TimerKind::Tp) => "TP",
+            OpKind::Ctu => "CTU",
+            OpKind::Ctd => "CTD",
+            OpKind::Jmp => "JMP",
+            OpKind::Ret => "RET",
+            OpKind::TStart => "TSTART",
+            OpKind::TStop => "TSTOP",
+            OpKind::Call => return None,
+        })
     }
 
     /// True for ops that take two or more inputs `IN1..INn`.
-    pub fn extensible(&self) -> bool {
+    pub fn extensible(self) -> bool {
         matches!(
             self,
-            Op::Arith(ArithOp::Add | ArithOp::Mul) | Op::And | Op::Or | Op::Xor | Op::Max | Op::Min
+            OpKind::Arith(ArithOp::Add | ArithOp::Mul)
+                | OpKind::And
+                | OpKind::Or
+                | OpKind::Xor
+                | OpKind::Max
+                | OpKind::Min
         )
     }
 
     /// Whether the op needs an `instance`.
-    pub fn needs_instance(&self) -> bool {
-        matches!(self, Op::Timer(_) | Op::Ctu | Op::Ctd | Op::Call(_))
+    pub fn needs_instance(self) -> bool {
+        matches!(
+            self,
+            OpKind::Timer(_) | OpKind::Ctu | OpKind::Ctd | OpKind::Call
+        )
     }
 
     /// Input pin names of a built-in op given `n` positional inputs (extensible ops: `IN1..INn`).
-    pub fn input_pins(&self, n: usize) -> Vec<String> {
+    pub fn input_pins(self, n: usize) -> Vec<String> {
         let fixed: &[&str] = match self {
-            Op::Compare(_) | Op::Arith(ArithOp::Sub | ArithOp::Div | ArithOp::Mod) => {
+            OpKind::Compare(_) | OpKind::Arith(ArithOp::Sub | ArithOp::Div | ArithOp::Mod) => {
                 &["IN1", "IN2"]
             }
             _ if self.extensible() => return (1..=n.max(2)).map(|i| format!("IN{i}")).collect(),
-            Op::Not | Op::Move | Op::TStart | Op::TStop => &["IN"],
-            Op::Sel => &["G", "IN0", "IN1"],
-            Op::Limit => &["MN", "IN", "MX"],
-            Op::Timer(_) => &["IN", "PT"],
-            Op::Ctu => &["CU", "R", "PV"],
-            Op::Ctd => &["CD", "LD", "PV"],
-            Op::Jmp
-            | Op::Ret
-            | Op::Call(_)
-            | Op::Arith(_)
-            | Op::And
-            | Op::Or
-            | Op::Xor
-            | Op::Max
-            | Op::Min => &[],
+            OpKind::Not | OpKind::Move | OpKind::TStart | OpKind::TStop => &["IN"],
+            OpKind::Sel => &["G", "IN0", "IN1"],
+            OpKind::Limit => &["MN", "IN", "MX"],
+            OpKind::Timer(_) => &["IN", "PT"],
+            OpKind::Ctu => &["CU", "R", "PV"],
+            OpKind::Ctd => &["CD", "LD", "PV"],
+            OpKind::Jmp
+            | OpKind::Ret
+            | OpKind::Call
+            | OpKind::Arith(_)
+            | OpKind::And
+            | OpKind::Or
+            | OpKind::Xor
+            | OpKind::Max
+            | OpKind::Min => &[],
         };
         fixed.iter().map(|s| s.to_string()).collect()
     }
 
     /// Output pin names of a built-in op.
-    pub fn output_pins(&self) -> &'static [&'static str] {
+    pub fn output_pins(self) -> &'static [&'static str] {
         match self {
-            Op::Timer(_) => &["Q", "ET"],
-            Op::Ctu | Op::Ctd => &["Q", "CV"],
-            Op::Jmp | Op::Ret | Op::TStart | Op::TStop | Op::Call(_) => &[],
+            OpKind::Timer(_) => &["Q", "ET"],
+            OpKind::Ctu | OpKind::Ctd => &["Q", "CV"],
+            OpKind::Jmp | OpKind::Ret | OpKind::TStart | OpKind::TStop | OpKind::Call => &[],
             _ => &["OUT"],
+        }
+    }
+}
+
+impl Op {
+    pub fn kind(&self) -> OpKind {
+        match self {
+            Op::Compare(c) => OpKind::Compare(*c),
+            Op::Arith(a) => OpKind::Arith(*a),
+            Op::And => OpKind::And,
+            Op::Or => OpKind::Or,
+            Op::Xor => OpKind::Xor,
+            Op::Not => OpKind::Not,
+            Op::Move => OpKind::Move,
+            Op::Sel => OpKind::Sel,
+            Op::Max => OpKind::Max,
+            Op::Min => OpKind::Min,
+            Op::Limit => OpKind::Limit,
+            Op::Timer { kind, .. } => OpKind::Timer(*kind),
+            Op::Ctu { .. } => OpKind::Ctu,
+            Op::Ctd { .. } => OpKind::Ctd,
+            Op::Jmp { .. } => OpKind::Jmp,
+            Op::Ret => OpKind::Ret,
+            Op::TStart => OpKind::TStart,
+            Op::TStop => OpKind::TStop,
+            Op::Call { .. } => OpKind::Call,
+        }
+    }
+
+    /// The op's name as the file writes it (a call: its function block type).
+    pub fn name(&self) -> &str {
+        match self {
+            Op::Call { fb, .. } => fb,
+            other => other.kind().name().unwrap_or_default(),
+        }
+    }
+
+    /// The instance a timer, counter or user function block runs on.
+    pub fn instance(&self) -> Option<&str> {
+        match self {
+            Op::Timer { instance, .. }
+            | Op::Ctu { instance }
+            | Op::Ctd { instance }
+            | Op::Call { instance, .. } => Some(instance),
+            _ => None,
         }
     }
 }

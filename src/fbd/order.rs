@@ -109,8 +109,6 @@ mod tests {
                     name: "OUT".into(),
                     vars: vec![],
                 }],
-                instance: None,
-                label: None,
                 cond: None,
                 after: vec![],
                 comment: None,

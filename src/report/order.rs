@@ -310,16 +310,14 @@ fn block_label(b: &Block, position: usize) -> String {
 /// `ADD`, `TON T1`, `JMP L2`, `WriteValue WV1`, `TSTART TimeVar`.
 fn op_text(b: &Block) -> String {
     let mut s = b.op.name().to_owned();
-    if let Some(i) = &b.instance {
+    if let Some(i) = b.op.instance() {
         let _ = write!(s, " {i}");
     }
-    if let Some(l) = &b.label {
-        let _ = write!(s, " {l}");
+    if let Op::Jmp { label } = &b.op {
+        let _ = write!(s, " {label}");
     }
     if matches!(b.op, Op::TStart | Op::TStop) {
-        if let Some(Input::Operand(serde_json::Value::String(v))) =
-            b.inputs.first().and_then(|p| p.input.as_ref())
-        {
+        if let Some(Input::Variable(v)) = b.inputs.first().and_then(|p| p.input.as_ref()) {
             let _ = write!(s, " {v}");
         }
     }

@@ -1,11 +1,15 @@
 //! User function blocks: reading the `function_blocks` types (signatures, declarations, no
-//! recursion, bodies) and expanding each instance into its own POU.
+//! recursion, bodies), expanding each instance into its own POU, and what the resolved program
+//! keeps of each type ([`crate::fbd::FbType`]: its interface, and its FBD body in typed form,
+//! variables named relative to the type, taken from the lowering of its first instance —
+//! every instance resolves the same names in the same scopes; IEC 61131-3 6.6.3).
 
 use super::util::check_name;
 use super::util::FastMap;
 use super::{Builder, FbType, PouDraft, Result};
 use crate::diag::{Invalid, LoadError};
-use crate::fbd::FbdPouKind;
+use crate::fbd::types::{self as fbt, FbTypeBody, Pin, TypedBody, TypedRef, TypedVar};
+use crate::fbd::{FbdPou, FbdPouKind};
 use crate::model::*;
 use crate::resolve::fbd_read::FbSig;
 use crate::syntax;
@@ -52,6 +56,14 @@ impl<'a> Builder<'a> {
                 rungs: None,
                 fbd: None,
                 sig,
+                model: fbt::FbType {
+                    name: fb.name.to_string(),
+                    inputs: Vec::new(),
+                    outputs: Vec::new(),
+                    locals: Vec::new(),
+                    nested: Vec::new(),
+                    body: FbTypeBody::Ladder,
+                },
             });
             bodies.push(&fb.body);
         }
@@ -79,6 +91,7 @@ impl<'a> Builder<'a> {
                     elementary,
                 );
             }
+            self.interface(f, scratch);
             uses.push(
                 self.instances[inst_mark..]
                     .iter()
@@ -134,6 +147,10 @@ impl<'a> Builder<'a> {
                     let body =
                         self.read_fbd(j, &format!("{path}.fbd"), &name, FbdPouKind::FunctionBlock)?;
                     self.fb_types[f].fbd = Some(self.fbd_bodies.len());
+                    self.fb_types[f].model.body = FbTypeBody::Fbd {
+                        pou: self.fbd_bodies.len(),
+                        typed: None,
+                    };
                     self.fbd_bodies.push(body);
                 }
             }
@@ -227,5 +244,157 @@ impl<'a> Builder<'a> {
         }
         stack.pop();
         Ok(())
+    }
+}
+
+impl Builder<'_> {
+    /// The interface of type `f` as declared on the scratch scope `pou`, in declaration order
+    /// (declarations with errors are left out: they are reported).
+    fn interface(&mut self, f: usize, pou: PouId) {
+        let (locals, instances) = (
+            &self.locals[pou.index()],
+            &self.local_instances[pou.index()],
+        );
+        let var = |v: &syntax::Var| {
+            let id = *locals.get(v.name.as_ref())?;
+            let var = &self.vars[id.index()];
+            Some(fbt::FbVar {
+                name: v.name.to_string(),
+                ty: var.ty,
+                init: var.init,
+            })
+        };
+        let t = &self.fb_types[f];
+        let inputs = t.inputs.iter().filter_map(var).collect();
+        let outputs = t.outputs.iter().filter_map(var).collect();
+        let locals_ = t.vars.iter().filter_map(var).collect();
+        let nested = t
+            .vars
+            .iter()
+            .filter_map(|v| {
+                let i = *instances.get(v.name.as_ref())?;
+                let ty = *self.fb_index.get(&self.instances[i].fb)?;
+                Some(fbt::Nested {
+                    name: v.name.to_string(),
+                    ty: fbt::FbTypeId(ty as u32),
+                })
+            })
+            .collect();
+        let m = &mut self.fb_types[f].model;
+        (m.inputs, m.outputs, m.locals, m.nested) = (inputs, outputs, locals_, nested);
+    }
+
+    /// Gives the type whose FBD body is `fbd_bodies[body]` its typed form from the lowering of
+    /// its instance `pou` (the first one lowered).
+    pub(super) fn keep_typed_body(&mut self, body: usize, pou: PouId, typed: &TypedBody<VarRef>) {
+        let Some(f) = self.fb_types.iter().position(|t| t.fbd == Some(body)) else {
+            return;
+        };
+        if let FbTypeBody::Fbd { typed: Some(_), .. } = &self.fb_types[f].model.body {
+            return;
+        }
+        let own = self.own_vars(f, pou);
+        let r = |v: &VarRef| TypedRef {
+            var: own.get(&v.var).copied().unwrap_or(TypedVar::Global(v.var)),
+            field: v.field,
+        };
+        let pin = |p: &Pin<VarRef>| match p {
+            Pin::Arc { block, output } => Pin::Arc {
+                block: *block,
+                output: *output,
+            },
+            Pin::Variable(v) => Pin::Variable(r(v)),
+            Pin::Constant(c) => Pin::Constant(*c),
+        };
+        let networks = typed
+            .networks
+            .iter()
+            .map(|n| fbt::TypedNetwork {
+                blocks: n
+                    .blocks
+                    .iter()
+                    .map(|b| fbt::TypedBlock {
+                        inputs: b.inputs.iter().map(|p| p.as_ref().map(pin)).collect(),
+                        cond: b.cond.as_ref().map(pin),
+                        outputs: b
+                            .outputs
+                            .iter()
+                            .map(|vs| vs.iter().map(r).collect())
+                            .collect(),
+                    })
+                    .collect(),
+            })
+            .collect();
+        if let FbTypeBody::Fbd { typed, .. } = &mut self.fb_types[f].model.body {
+            *typed = Some(TypedBody { networks });
+        }
+    }
+
+    /// The variables of instance POU `pou` of type `f`, as the type names them.
+    fn own_vars(&self, f: usize, pou: PouId) -> FastMap<VarId, TypedVar> {
+        let m = &self.fb_types[f].model;
+        let locals = &self.locals[pou.index()];
+        let mut own = FastMap::default();
+        let slots = [
+            (&m.inputs, fbt::Slot::Input as fn(u32) -> fbt::Slot),
+            (&m.outputs, fbt::Slot::Output),
+            (&m.locals, fbt::Slot::Local),
+        ];
+        for (vars, slot) in slots {
+            for (i, v) in vars.iter().enumerate() {
+                if let Some(&id) = locals.get(&v.name) {
+                    own.insert(id, TypedVar::Own(slot(i as u32)));
+                }
+            }
+        }
+        for (n, nested) in m.nested.iter().enumerate() {
+            let Some(&i) = self.local_instances[pou.index()].get(&nested.name) else {
+                continue;
+            };
+            let inst = &self.instances[i];
+            let pins = inst
+                .inputs
+                .iter()
+                .enumerate()
+                .map(|(p, v)| (fbt::Slot::Input(p as u32), v));
+            let outs = inst
+                .outputs
+                .iter()
+                .enumerate()
+                .map(|(p, v)| (fbt::Slot::Output(p as u32), v));
+            for (slot, (_, id)) in pins.chain(outs) {
+                let nested = n as u32;
+                own.insert(*id, TypedVar::Member { nested, slot });
+            }
+        }
+        own
+    }
+
+    /// Every type as the resolved program keeps it; `bodies` are the FBD bodies in reading
+    /// order, which the resolved program lists main program and subroutines first.
+    pub(super) fn fb_type_models(&self, bodies: &[FbdPou]) -> Vec<fbt::FbType> {
+        let is_fb = |p: &FbdPou| p.kind == FbdPouKind::FunctionBlock;
+        let others = bodies.iter().filter(|p| !is_fb(p)).count();
+        let listed = |i: usize| {
+            let before = bodies[..i]
+                .iter()
+                .filter(|p| is_fb(p) == is_fb(&bodies[i]))
+                .count();
+            if is_fb(&bodies[i]) {
+                others + before
+            } else {
+                before
+            }
+        };
+        self.fb_types
+            .iter()
+            .map(|t| {
+                let mut m = t.model.clone();
+                if let FbTypeBody::Fbd { pou, .. } = &mut m.body {
+                    *pou = listed(*pou);
+                }
+                m
+            })
+            .collect()
     }
 }

@@ -4,7 +4,7 @@
 use super::lower::{Env, InstanceRef, Names};
 use super::{Builder, Result};
 use crate::diag::Invalid;
-use crate::fbd::LoweredCopy;
+use crate::fbd::{FbdPouKind, LoweredCopy};
 use crate::model::*;
 
 impl<'a> Builder<'a> {
@@ -25,6 +25,9 @@ impl<'a> Builder<'a> {
             let pid = PouId(pou as u32);
             let lowered =
                 super::lower::lower(&bodies[i], &mut PouEnv { b: self, pou: pid }, &names, pid)?;
+            if bodies[i].kind == FbdPouKind::FunctionBlock {
+                self.keep_typed_body(i, pid, &lowered.typed);
+            }
             bodies[i].copies.push(LoweredCopy {
                 pou: pid,
                 networks: lowered.networks,

@@ -76,12 +76,14 @@ pub fn resolve(text: &str, syn: &syntax::Program<'_>) -> Result<(Program, Fbd)> 
                 pou: i.pou?,
                 name: i.display.clone(),
                 fb: i.fb.clone(),
+                ty: crate::fbd::FbTypeId(*b.fb_index.get(&i.fb)? as u32),
                 inputs: i.inputs.clone(),
                 outputs: i.outputs.clone(),
             })
         })
         .collect();
     instances.sort_by_key(|i| i.pou);
+    let types = b.fb_type_models(&bodies);
     let program = b.build(syn.name.to_string())?;
     for body in &mut bodies {
         for copy in &mut body.copies {
@@ -101,7 +103,14 @@ pub fn resolve(text: &str, syn: &syntax::Program<'_>) -> Result<(Program, Fbd)> 
         .into_iter()
         .partition(|p| p.kind != FbdPouKind::FunctionBlock);
     pous.extend(fbs);
-    Ok((program, Fbd { pous, instances }))
+    Ok((
+        program,
+        Fbd {
+            pous,
+            instances,
+            types,
+        },
+    ))
 }
 
 struct PouDraft<'a> {
@@ -154,6 +163,9 @@ struct FbType<'a> {
     rungs: Option<&'a [syntax::Rung<'a>]>,
     fbd: Option<usize>,
     sig: FbSig,
+    /// What the resolved program keeps of the type (its body's typed form once an instance
+    /// of it is lowered).
+    model: crate::fbd::FbType,
 }
 
 /// An instance of a user function block type.
@@ -320,17 +332,11 @@ impl<'a> Builder<'a> {
         let index = &self.fb_index;
         let types = &self.fb_types;
         let sig = |n: &str| index.get(n).map(|&i| types[i].sig.clone());
-        let json: serde_json::Value = serde_json::from_str(f.text).map_err(|e| {
-            LoadError::invalid(
-                None,
-                path,
-                Invalid::Shape {
-                    expected: "an FBD body",
-                    found: e.to_string(),
-                },
-            )
-        })?;
-        fbd_read::read_body(&json, path, name, kind, &sig)
+        let cx = fbd_read::Context {
+            text: self.text,
+            sig: &sig,
+        };
+        fbd_read::read_body(f, path, name, kind, &cx)
             .map_err(|e| e.at_position(self.position(f.origin)))
     }
 

@@ -7,7 +7,6 @@
 use crate::diag::Invalid;
 use crate::model::{parse_time_literal, Field, Operand, Type, Value, VarRef};
 use crate::syntax::Scalar;
-use serde_json::Value as Json;
 
 /// An operand before its constant (if any) is given a type.
 #[derive(Clone, Debug)]
@@ -63,26 +62,6 @@ pub(crate) fn parse(
             found: other.kind(),
         }),
     }
-}
-
-/// A JSON leaf as a [`Scalar`] (FBD operands are kept as JSON values in the FBD model).
-pub(crate) fn scalar_of(j: &Json) -> Scalar<'_> {
-    match j {
-        Json::Null => Scalar::Null,
-        Json::Bool(b) => Scalar::Bool(*b),
-        Json::Number(n) => Scalar::Number(n.clone()),
-        Json::String(s) => Scalar::Str(std::borrow::Cow::Borrowed(s)),
-        Json::Array(_) => Scalar::Array,
-        Json::Object(_) => Scalar::Object,
-    }
-}
-
-/// [`parse`] of an operand kept as JSON.
-pub(crate) fn parse_json(
-    j: &Json,
-    lookup: &dyn Fn(&str) -> Result<(VarRef, Type), Invalid>,
-) -> Result<Untyped, Invalid> {
-    parse(&scalar_of(j), lookup)
 }
 
 /// Gives `u` the type `ty`, checking that it has it (or, for numbers, fits it).

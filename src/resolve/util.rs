@@ -1,22 +1,8 @@
-//! Small helpers of the resolver: names, paths, type expectations, and the description of a
-//! JSON value's kind (FBD bodies are still walked as JSON values).
+//! Small helpers of the resolver: names, paths, type expectations.
 
 use super::Result;
 use crate::diag::{Invalid, LoadError};
 use crate::model::Type;
-use serde_json::Value as Json;
-
-/// A short description of a JSON value's kind, for error messages.
-pub(crate) fn kind_of(v: &Json) -> String {
-    match v {
-        Json::Null => "null".into(),
-        Json::Bool(b) => format!("boolean {b}"),
-        Json::Number(n) => format!("number {n}"),
-        Json::String(s) => format!("string \"{s}\""),
-        Json::Array(_) => "an array".into(),
-        Json::Object(_) => "an object".into(),
-    }
-}
 
 /// `path.key`, or `key` at the top level.
 pub(super) fn join(path: &str, key: &str) -> String {

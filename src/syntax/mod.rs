@@ -3,7 +3,7 @@
 //! Plain, format-neutral types for IEC 61131-3 program organisation units (clause 6.6: the
 //! program, function block types, subroutines called like functions), their variable
 //! declarations (6.5), ladder rungs with their series/parallel element trees (clause 8.2, LD) and
-//! FBD bodies (8.3) kept as written. A reader (today `crate::read::json`; a PLCopen XML or STL
+//! FBD bodies (8.3, [`fbd`]) kept as written. A reader (today `crate::read::json`; a PLCopen XML or STL
 //! reader would fill the same types) produces them; `crate::resolve` turns them into the model.
 //!
 //! Invariants: every string borrows from the source text where it can (`Cow`); every node that
@@ -18,9 +18,13 @@
 //! Deliberately not here: name resolution, types of operands, structural rules (those are the
 //! resolver's), and anything JSON-specific beyond [`Scalar`] (a leaf as written, for messages).
 
+pub mod fbd;
+
 use crate::diag::Invalid;
 use crate::model::{ArithOp, CmpOp, TimerKind};
 use std::borrow::Cow;
+
+pub use fbd::FbdBody;
 
 /// A string of the source text (borrowed unless it had escapes).
 pub type Text<'a> = Cow<'a, str>;
@@ -302,15 +306,6 @@ pub struct For<'a> {
 pub enum Edge {
     Rising,
     Falling,
-}
-
-/// An FBD body as written. Today the JSON reader keeps it as the text of its `fbd` value and
-/// `crate::resolve` reads networks from it (FBD bodies are small next to ladder programs).
-#[derive(Clone, Debug)]
-pub struct FbdBody<'a> {
-    pub origin: Origin,
-    /// The JSON text of the body (`{"networks": [...]}`).
-    pub text: &'a str,
 }
 
 impl<'a> Element<'a> {

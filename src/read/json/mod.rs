@@ -13,6 +13,7 @@
 //! one node (`crate::resolve`).
 
 mod element;
+mod fbd;
 mod ladder;
 mod scalar;
 
@@ -327,10 +328,7 @@ impl<'de> Reader<'de> {
                 );
                 Ok(None)
             }
-            (None, Some(f)) => Ok(Some(Body::Fbd(syntax::FbdBody {
-                origin: self.origin(f),
-                text: f.get(),
-            }))),
+            (None, Some(f)) => Ok(Some(Body::Fbd(fbd::body(self.base, f)?))),
             (Some(r), None) => {
                 let rp = join(path, "rungs");
                 let Some(items) = self.array(r, &rp)? else {

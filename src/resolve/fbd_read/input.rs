@@ -1,106 +1,90 @@
-//! One INPUT of a block: an operand (kept as JSON for the lowering), or an arc
-//! `{"from": ID}` / `{"from": ID, "pin": "Q"}` resolved to a block of the same network and
+//! One INPUT of a block: a variable or a constant (kept as written for the lowering), or an
+//! arc `{"from": ID}` / `{"from": ID, "pin": "Q"}` resolved to a block of the same network and
 //! one of its outputs.
 
-use super::util::{kind_of, list_or_none, string};
+use super::block::Net;
+use super::util::list_or_none;
 use super::{Draft, Result};
-use crate::diag::{Invalid, LoadError};
+use crate::diag::Invalid;
 use crate::fbd::model::*;
-use serde_json::Value as Json;
-use std::collections::HashMap;
+use crate::syntax::fbd as syn;
+use crate::syntax::Scalar;
 
-/// An INPUT: an operand, or `{"from": ID}` / `{"from": ID, "pin": "Q"}`.
-pub(super) fn input(
-    j: &Json,
-    path: &str,
-    network: &str,
-    block: u32,
-    index: &HashMap<u32, BlockId>,
-    drafts: &[Draft],
-    out_pins: &[Vec<String>],
-) -> Result<Input> {
-    let e = |q: String, k: Invalid| LoadError::fbd(network, Some(block), &q, k);
-    match j {
-        Json::Object(o) => {
-            if let Some(k) = o.keys().find(|k| !["from", "pin"].contains(&k.as_str())) {
-                return Err(e(
-                    format!("{path}.{k}"),
-                    Invalid::UnknownField {
-                        field: k.clone(),
-                        what: "an arc",
-                        allowed: "from, pin".into(),
+impl Net<'_, '_, '_> {
+    /// The input `j` of block `d`, at `path`.
+    pub(super) fn input(&self, d: &Draft, j: &syn::Input, path: &str) -> Result<Input> {
+        match &j.from {
+            syn::Connection::Invalid(e) => Err(self.problem(d, e, path)),
+            syn::Connection::Variable(name) => Ok(Input::Variable(name.to_string())),
+            syn::Connection::Constant(c) => match c {
+                Scalar::Bool(b) => Ok(Input::Constant(Constant::Bool(*b))),
+                Scalar::Number(n) => Ok(Input::Constant(Constant::Number(n.clone()))),
+                Scalar::Str(s) => Ok(Input::Constant(Constant::Time(s.to_string()))),
+                other => Err(self.err(
+                    d,
+                    path,
+                    Invalid::Shape {
+                        expected: "an operand or an arc {\"from\": BLOCK}",
+                        found: other.kind(),
                     },
-                ));
+                )),
+            },
+            syn::Connection::Arc { block, pin } => self.arc(d, *block, pin.as_ref(), path),
+        }
+    }
+
+    /// An arc from output `pin` (the first when `None`) of block `src`.
+    fn arc(
+        &self,
+        d: &Draft,
+        src: u32,
+        pin: Option<&syn::Read<crate::syntax::Text>>,
+        path: &str,
+    ) -> Result<Input> {
+        let from_path = format!("{path}.from");
+        let b = *self.index.get(&src).ok_or_else(|| {
+            self.err(
+                d,
+                &from_path,
+                Invalid::UndefinedBlock {
+                    id: src,
+                    network: self.id.to_owned(),
+                },
+            )
+        })?;
+        let pins = &self.out_pins[b.index()];
+        let op = format!("block {src} ({})", self.drafts[b.index()].op);
+        let pin = match pin {
+            None if pins.is_empty() => {
+                return Err(self.err(
+                    d,
+                    &from_path,
+                    Invalid::UnknownPin {
+                        op,
+                        dir: "output",
+                        pin: "(any)".into(),
+                        pins: "none".into(),
+                    },
+                ))
             }
-            let from = o.get("from").ok_or_else(|| {
-                e(
-                    path.to_owned(),
-                    Invalid::MissingField {
-                        field: "from",
-                        what: "an arc",
-                    },
-                )
-            })?;
-            let src = from
-                .as_u64()
-                .filter(|&n| n <= u32::MAX as u64)
-                .ok_or_else(|| {
-                    e(
-                        format!("{path}.from"),
-                        Invalid::Shape {
-                            expected: "a block id",
-                            found: kind_of(from),
-                        },
-                    )
-                })? as u32;
-            let b = *index.get(&src).ok_or_else(|| {
-                e(
-                    format!("{path}.from"),
-                    Invalid::UndefinedBlock {
-                        id: src,
-                        network: network.to_owned(),
-                    },
-                )
-            })?;
-            let pins = &out_pins[b.index()];
-            let opname = drafts[b.index()].op.name().to_owned();
-            let pin = match o.get("pin") {
-                None if pins.is_empty() => {
-                    return Err(e(
-                        format!("{path}.from"),
+            None => 0,
+            Some(Err(e)) => return Err(self.problem(d, e, path)),
+            Some(Ok(name)) => match pins.iter().position(|x| x == name) {
+                Some(i) => i as u32,
+                None => {
+                    return Err(self.err(
+                        d,
+                        &format!("{path}.pin"),
                         Invalid::UnknownPin {
-                            op: format!("block {src} ({opname})"),
+                            op,
                             dir: "output",
-                            pin: "(any)".into(),
-                            pins: "none".into(),
+                            pin: name.to_string(),
+                            pins: list_or_none(pins),
                         },
                     ))
                 }
-                None => 0,
-                Some(pj) => {
-                    let pn = string(pj).map_err(|k| e(format!("{path}.pin"), k))?;
-                    pins.iter().position(|x| x == pn).ok_or_else(|| {
-                        e(
-                            format!("{path}.pin"),
-                            Invalid::UnknownPin {
-                                op: format!("block {src} ({opname})"),
-                                dir: "output",
-                                pin: pn.to_owned(),
-                                pins: list_or_none(pins),
-                            },
-                        )
-                    })? as u32
-                }
-            };
-            Ok(Input::Arc { from: b, pin })
-        }
-        Json::String(_) | Json::Number(_) | Json::Bool(_) => Ok(Input::Operand(j.clone())),
-        other => Err(e(
-            path.to_owned(),
-            Invalid::Shape {
-                expected: "an operand or an arc {\"from\": BLOCK}",
-                found: kind_of(other),
             },
-        )),
+        };
+        Ok(Input::Arc { from: b, pin })
     }
 }

@@ -1,10 +1,17 @@
-//! The FBD parts of the JSON program format → [`FbdPou`] (structure only).
+//! FBD bodies as written ([`crate::syntax::fbd`]) → [`FbdPou`] (structure only).
 //!
-//! Checks every field, the op and its pins, block ids (unique in the POU), arcs (`{"from": ID}`
-//! names a block of the same network and one of its outputs), control arcs and labels, then
-//! plans every network ([`crate::fbd::plan`]: order, cycles, fragments). Operands stay JSON: they are
-//! resolved and typed by the lowering, once per POU (per instance for a function block type).
-//! Errors carry the network id, the block id and the JSON path.
+//! Checks what needs more than one node: block ids (unique in the POU), ops (built-in or a user
+//! function block type), pins against the op, arcs (`{"from": ID}` names a block of the same
+//! network and one of its outputs), control arcs, labels (valid names, unique, defined), and
+//! reports what the reader found malformed at the point where these rules reach it; then plans
+//! every network ([`crate::fbd::plan`]: order, cycles, fragments). Operands stay names and
+//! constants as written: they are resolved and typed by the lowering, once per POU (per instance
+//! for a function block type). docs/fbd.md is the format.
+//!
+//! One error per body, the first in this order: the body, then each network in file order —
+//! its id, fields and blocks' ids and ops (file order), then every block's pins and fields (in
+//! block id order) — then labels, then plans. Errors carry the network id, the block id, the
+//! JSON path and the line and column of the innermost network or block.
 
 mod block;
 mod input;
@@ -12,14 +19,12 @@ mod util;
 
 use crate::diag::{Invalid, LoadError};
 use crate::fbd::model::*;
-use serde_json::{Map, Value as Json};
+use crate::syntax::fbd as syn;
+use crate::syntax::{Origin, Problem};
 use std::collections::HashMap;
 
 use block::Net;
-pub(crate) use util::kind_of;
-#[allow(unused_imports)] // reachable at its old path, though only the reader uses it
 pub(crate) use util::valid_name;
-use util::{check_keys, name, string};
 
 pub(super) type Result<T> = std::result::Result<T, LoadError>;
 
@@ -30,68 +35,44 @@ pub(crate) struct FbSig {
     pub outputs: Vec<String>,
 }
 
-const NETWORK_KEYS: &[&str] = &["id", "label", "comment", "blocks"];
-const BLOCK_KEYS: &[&str] = &[
-    "id", "op", "in", "out", "instance", "cond", "after", "label", "comment",
-];
+/// What every network of a body is read against.
+pub(crate) struct Context<'c> {
+    /// The program text (for the line and column of errors).
+    pub text: &'c str,
+    /// The pins of a user function block type by name.
+    pub sig: &'c dyn Fn(&str) -> Option<FbSig>,
+}
 
-/// Reads an `fbd` object (`{"networks": [...]}`) at `path` and plans its networks.
-/// `sig` gives the pins of a user function block type by name.
+impl Context<'_> {
+    fn position(&self, origin: Origin) -> Option<(u32, u32)> {
+        origin.line_column(self.text)
+    }
+}
+
+/// A problem the reader recorded, as an error at `path` (the path of the node that holds it).
+pub(super) fn reported(
+    p: &Problem,
+    path: &str,
+    place: impl FnOnce(&str, Invalid) -> LoadError,
+) -> LoadError {
+    place(&format!("{path}{}", p.at), p.kind.clone())
+}
+
+/// Reads the FBD body `body` at `path` of POU `name` and plans its networks.
 pub(crate) fn read_body(
-    v: &Json,
+    body: &syn::FbdBody,
     path: &str,
     name: &str,
     kind: FbdPouKind,
-    sig: &dyn Fn(&str) -> Option<FbSig>,
+    cx: &Context,
 ) -> Result<FbdPou> {
-    let top = v.as_object().ok_or_else(|| {
-        LoadError::invalid(
-            None,
-            path,
-            Invalid::Shape {
-                expected: "an object (an FBD body: {\"networks\": [...]})",
-                found: kind_of(v),
-            },
-        )
-    })?;
-    if let Some(k) = top
-        .keys()
-        .find(|k| !["networks", "comment"].contains(&k.as_str()))
-    {
-        return Err(LoadError::invalid(
-            None,
-            &format!("{path}.{k}"),
-            Invalid::UnknownField {
-                field: k.clone(),
-                what: "an FBD body",
-                allowed: "networks, comment".into(),
-            },
-        ));
+    let plain = |p: &str, k| LoadError::invalid(None, p, k);
+    if let Some(p) = &body.problem {
+        return Err(reported(p, path, plain));
     }
     let np = format!("{path}.networks");
-    let nets = top.get("networks").ok_or_else(|| {
-        LoadError::invalid(
-            None,
-            path,
-            Invalid::MissingField {
-                field: "networks",
-                what: "an FBD body",
-            },
-        )
-    })?;
-    let nets = nets.as_array().ok_or_else(|| {
-        LoadError::invalid(
-            None,
-            &np,
-            Invalid::Shape {
-                expected: "an array",
-                found: kind_of(nets),
-            },
-        )
-    })?;
-    if nets.is_empty() && kind == FbdPouKind::Main {
-        return Err(LoadError::invalid(
-            None,
+    if body.networks.is_empty() && kind == FbdPouKind::Main {
+        return Err(plain(
             &np,
             Invalid::Shape {
                 expected: "at least one network",
@@ -99,36 +80,28 @@ pub(crate) fn read_body(
             },
         ));
     }
-    let mut networks = Vec::with_capacity(nets.len());
+    let mut networks = Vec::with_capacity(body.networks.len());
     let mut ids: HashMap<String, String> = HashMap::new();
     let mut labels: HashMap<String, String> = HashMap::new();
     let mut block_ids: HashMap<u32, String> = HashMap::new();
-    for (i, n) in nets.iter().enumerate() {
+    for (i, n) in body.networks.iter().enumerate() {
         let p = format!("{np}[{i}]");
-        let net = network(n, &p, sig, &mut block_ids)?;
+        let net =
+            network(n, &p, cx, &mut block_ids).map_err(|e| e.at_position(cx.position(n.origin)))?;
+        let e =
+            |q: String, k| LoadError::fbd(&net.id, None, &q, k).at_position(cx.position(n.origin));
         if let Some(first) = ids.insert(net.id.clone(), p.clone()) {
-            return Err(LoadError::fbd(
-                &net.id,
-                None,
-                &format!("{p}.id"),
-                Invalid::DuplicateNetwork {
-                    id: net.id.clone(),
-                    first,
-                },
+            let id = net.id.clone();
+            return Err(e(
+                format!("{p}.id"),
+                Invalid::DuplicateNetwork { id, first },
             ));
         }
         if let Some(l) = &net.label {
             if let Some(first) = labels.insert(l.clone(), net.id.clone()) {
-                return Err(LoadError::fbd(
-                    &net.id,
-                    None,
-                    &format!("{p}.label"),
-                    Invalid::DuplicateNetworkLabel {
-                        label: l.clone(),
-                        pou: name.to_owned(),
-                        first,
-                    },
-                ));
+                let (label, pou) = (l.clone(), name.to_owned());
+                let kind = Invalid::DuplicateNetworkLabel { label, pou, first };
+                return Err(e(format!("{p}.label"), kind));
             }
         }
         networks.push(net);
@@ -136,14 +109,14 @@ pub(crate) fn read_body(
     // Jump targets resolve within the POU.
     for net in &networks {
         for b in &net.blocks {
-            if let Some(l) = &b.label {
-                if !labels.contains_key(l) {
+            if let Op::Jmp { label } = &b.op {
+                if !labels.contains_key(label) {
                     return Err(LoadError::fbd(
                         &net.id,
                         Some(b.id),
                         &format!("{}.label", b.path),
                         Invalid::UndefinedLabel {
-                            label: l.clone(),
+                            label: label.clone(),
                             pou: name.to_owned(),
                         },
                     ));
@@ -165,185 +138,54 @@ pub(crate) fn read_body(
     })
 }
 
-/// A block as first read: its JSON and its op, before arcs are resolved.
-pub(super) struct Draft<'v> {
+/// A block as first read: its id and the kind of its op, before its pins and arcs are resolved.
+pub(super) struct Draft<'s, 'a> {
     pub(super) id: u32,
-    pub(super) op: Op,
-    pub(super) o: &'v Map<String, Json>,
+    pub(super) kind: OpKind,
+    /// The op's name: a built-in op's, or the user function block type's.
+    pub(super) op: &'s str,
+    pub(super) syn: &'s syn::Block<'a>,
     pub(super) path: String,
 }
 
 fn network(
-    v: &Json,
+    n: &syn::Network,
     path: &str,
-    sig: &dyn Fn(&str) -> Option<FbSig>,
+    cx: &Context,
     block_ids: &mut HashMap<u32, String>,
 ) -> Result<Network> {
-    let o = v.as_object().ok_or_else(|| {
-        LoadError::invalid(
-            None,
-            path,
-            Invalid::Shape {
-                expected: "an object (a network)",
-                found: kind_of(v),
-            },
-        )
-    })?;
-    let id = match o.get("id") {
-        None => {
-            return Err(LoadError::invalid(
-                None,
-                path,
-                Invalid::MissingField {
-                    field: "id",
-                    what: "a network",
-                },
-            ))
-        }
-        Some(Json::String(s))
-            if !s.is_empty() && !s.chars().any(|c| c.is_whitespace() || c == '"') =>
-        {
-            s.clone()
-        }
-        Some(Json::String(s)) => {
-            return Err(LoadError::invalid(
-                None,
-                &format!("{path}.id"),
-                Invalid::Shape {
-                    expected: "a network id without spaces or quotes",
-                    found: format!("\"{s}\""),
-                },
-            ))
-        }
-        Some(other) => {
-            return Err(LoadError::invalid(
-                None,
-                &format!("{path}.id"),
-                Invalid::Shape {
-                    expected: "a string",
-                    found: kind_of(other),
-                },
-            ))
-        }
+    let id = match &n.id {
+        Ok(id) => id.to_string(),
+        Err(p) => return Err(reported(p, path, |q, k| LoadError::invalid(None, q, k))),
     };
-    let e = |p: String, k: Invalid| LoadError::fbd(&id, None, &p, k);
-    check_keys(o, NETWORK_KEYS, "a network", path).map_err(|(p, k)| e(p, k))?;
-    let label = match o.get("label") {
-        None => None,
-        Some(l) => Some(
-            name(l)
-                .map_err(|k| e(format!("{path}.label"), k))?
-                .to_owned(),
-        ),
-    };
-    let comment = match o.get("comment") {
-        None => None,
-        Some(c) => Some(
-            string(c)
-                .map_err(|k| e(format!("{path}.comment"), k))?
-                .to_owned(),
-        ),
-    };
-    let bp = format!("{path}.blocks");
-    let items = o.get("blocks").ok_or_else(|| {
-        e(
-            path.to_owned(),
-            Invalid::MissingField {
-                field: "blocks",
-                what: "a network",
-            },
-        )
-    })?;
-    let items = items.as_array().ok_or_else(|| {
-        e(
-            bp.clone(),
-            Invalid::Shape {
-                expected: "an array",
-                found: kind_of(items),
-            },
-        )
-    })?;
-    if items.is_empty() {
-        return Err(e(
-            bp,
-            Invalid::Shape {
-                expected: "at least one block",
-                found: "an empty array".into(),
-            },
-        ));
+    let e = |q: &str, k| LoadError::fbd(&id, None, q, k);
+    if let Some(p) = &n.problem {
+        return Err(reported(p, path, e));
     }
+    let label = match &n.label {
+        None => None,
+        Some(Err(p)) => return Err(reported(p, path, e)),
+        Some(Ok(l)) if !valid_name(l) => {
+            let kind = Invalid::BadName {
+                name: l.to_string(),
+            };
+            return Err(e(&format!("{path}.label"), kind));
+        }
+        Some(Ok(l)) => Some(l.to_string()),
+    };
+    let comment = match &n.comment {
+        None => None,
+        Some(Err(p)) => return Err(reported(p, path, e)),
+        Some(Ok(c)) => Some(c.to_string()),
+    };
+    let items = n.blocks.as_ref().map_err(|p| reported(p, path, e))?;
     // Pass 1: ids and ops.
     let mut drafts = Vec::with_capacity(items.len());
-    for (i, item) in items.iter().enumerate() {
-        let p = format!("{bp}[{i}]");
-        let o = item.as_object().ok_or_else(|| {
-            e(
-                p.clone(),
-                Invalid::Shape {
-                    expected: "an object (a block)",
-                    found: kind_of(item),
-                },
-            )
-        })?;
-        let bid = match o.get("id") {
-            None => {
-                return Err(e(
-                    p,
-                    Invalid::MissingField {
-                        field: "id",
-                        what: "a block",
-                    },
-                ))
-            }
-            Some(j) => j
-                .as_u64()
-                .filter(|&n| n <= u32::MAX as u64)
-                .ok_or_else(|| {
-                    e(
-                        format!("{p}.id"),
-                        Invalid::Shape {
-                            expected: "a block id (a whole number, 0 or more)",
-                            found: kind_of(j),
-                        },
-                    )
-                })? as u32,
-        };
-        let be = |q: String, k: Invalid| LoadError::fbd(&id, Some(bid), &q, k);
-        if let Some(first) = block_ids.insert(bid, p.clone()) {
-            return Err(be(
-                format!("{p}.id"),
-                Invalid::DuplicateBlock { id: bid, first },
-            ));
-        }
-        check_keys(o, BLOCK_KEYS, "a block", &p).map_err(|(q, k)| be(q, k))?;
-        let opj = o.get("op").ok_or_else(|| {
-            be(
-                p.clone(),
-                Invalid::MissingField {
-                    field: "op",
-                    what: "a block",
-                },
-            )
-        })?;
-        let opname = string(opj).map_err(|k| be(format!("{p}.op"), k))?;
-        let op = match Op::parse(opname) {
-            Some(op) => op,
-            None if sig(opname).is_some() => Op::Call(opname.to_owned()),
-            None => {
-                return Err(be(
-                    format!("{p}.op"),
-                    Invalid::UnknownOp {
-                        op: opname.to_owned(),
-                    },
-                ))
-            }
-        };
-        drafts.push(Draft {
-            id: bid,
-            op,
-            o,
-            path: p,
-        });
+    for (i, b) in items.iter().enumerate() {
+        let p = format!("{path}.blocks[{i}]");
+        let d =
+            draft(b, p, &id, cx, block_ids).map_err(|e| e.at_position(cx.position(b.origin)))?;
+        drafts.push(d);
     }
     drafts.sort_by_key(|d| d.id);
     let index: HashMap<u32, BlockId> = drafts
@@ -351,24 +193,28 @@ fn network(
         .enumerate()
         .map(|(i, d)| (d.id, BlockId(i as u32)))
         .collect();
-    let outputs_of = |d: &Draft| -> Vec<String> {
-        match &d.op {
-            Op::Call(fb) => sig(fb).map(|s| s.outputs).unwrap_or_default(),
-            op => op.output_pins().iter().map(|s| s.to_string()).collect(),
-        }
-    };
-    let out_pins: Vec<Vec<String>> = drafts.iter().map(outputs_of).collect();
-    // Pass 2: pins, arcs, the rest.
+    let out_pins: Vec<Vec<String>> = drafts
+        .iter()
+        .map(|d| match d.kind {
+            OpKind::Call => (cx.sig)(d.op).map(|s| s.outputs).unwrap_or_default(),
+            k => k.output_pins().iter().map(|s| s.to_string()).collect(),
+        })
+        .collect();
+    // Pass 2: pins, arcs, the rest (in block id order).
     let net = Net {
         id: &id,
         index: &index,
         drafts: &drafts,
         out_pins: &out_pins,
-        sig,
+        sig: cx.sig,
     };
     let blocks = drafts
         .iter()
-        .map(|d| net.block(d))
+        .enumerate()
+        .map(|(i, d)| {
+            net.block(BlockId(i as u32), d)
+                .map_err(|e| e.at_position(cx.position(d.syn.origin)))
+        })
         .collect::<Result<Vec<_>>>()?;
     Ok(Network {
         id,
@@ -376,5 +222,49 @@ fn network(
         comment,
         path: path.to_owned(),
         blocks,
+    })
+}
+
+/// Pass 1 of one block: its id (unique in the POU) and its op.
+fn draft<'s, 'a>(
+    b: &'s syn::Block<'a>,
+    path: String,
+    network: &str,
+    cx: &Context,
+    block_ids: &mut HashMap<u32, String>,
+) -> Result<Draft<'s, 'a>> {
+    let id = match &b.id {
+        Ok(id) => *id,
+        Err(p) => {
+            return Err(reported(p, &path, |q, k| {
+                LoadError::fbd(network, None, q, k)
+            }))
+        }
+    };
+    let be = |q: &str, k| LoadError::fbd(network, Some(id), q, k);
+    if let Some(first) = block_ids.insert(id, path.clone()) {
+        return Err(be(
+            &format!("{path}.id"),
+            Invalid::DuplicateBlock { id, first },
+        ));
+    }
+    if let Some(p) = &b.problem {
+        return Err(reported(p, &path, be));
+    }
+    let op: &str = b.op.as_ref().map_err(|p| reported(p, &path, be))?;
+    let kind = match OpKind::parse(op) {
+        Some(k) => k,
+        None if (cx.sig)(op).is_some() => OpKind::Call,
+        None => {
+            let kind = Invalid::UnknownOp { op: op.to_owned() };
+            return Err(be(&format!("{path}.op"), kind));
+        }
+    };
+    Ok(Draft {
+        id,
+        kind,
+        op,
+        syn: b,
+        path,
     })
 }

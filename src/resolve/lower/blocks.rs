@@ -1,7 +1,7 @@
 //! One block → its rung series: every standard FBD op (logic, compare, arithmetic, selection,
 //! timers, counters, jumps, TSTART/TSTOP) as ladder elements. docs/fbd.md gives each rung.
 
-use super::{condition, contact, steps, var_op, Cx, Net, Result, Val, ACCUMULATE_PT_MS};
+use super::{condition, contact, steps, var_op, Cx, Net, PinSlot, Result, Val, ACCUMULATE_PT_MS};
 use crate::diag::{Invalid, LoadError};
 use crate::fbd::model::*;
 use crate::model::*;
@@ -19,397 +19,490 @@ impl Cx<'_> {
         let net = nx.net;
         let blk = net.block(b);
         let id = Some(blk.id);
-        let e = |path: &str, k| LoadError::fbd(&net.id, id, path, k);
         // The connected inputs, in pin order.
         let mut vals: Vec<(Val, &str)> = Vec::with_capacity(blk.inputs.len());
-        if !matches!(blk.op, Op::TStart | Op::TStop | Op::Call(_)) {
-            for pin in &blk.inputs {
-                let input = pin
-                    .input
-                    .as_ref()
-                    .expect("built-in ops have every input connected");
-                vals.push((self.val(nx, input, &pin.path, id)?, pin.path.as_str()));
+        if !matches!(blk.op, Op::TStart | Op::TStop | Op::Call { .. }) {
+            // Built-in ops have every input connected (checked by the reader).
+            for (i, pin) in blk.inputs.iter().enumerate() {
+                let input = pin.input.as_ref().ok_or_else(|| {
+                    let op = blk.op.name().to_owned();
+                    let kind = Invalid::Unconnected {
+                        op,
+                        pin: pin.name.clone(),
+                    };
+                    LoadError::fbd(&net.id, id, &pin.path, kind)
+                })?;
+                let slot = Some(PinSlot(b, i));
+                vals.push((self.val(nx, input, &pin.path, id, slot)?, pin.path.as_str()));
             }
         }
-        let series = match &blk.op {
-            Op::Compare(c) => {
-                let ty = numeric(&vals, None, "a comparison").map_err(|(p, k)| e(p, k))?;
-                let a = self.coerce(nx, &vals[0].0, ty, "a comparison", vals[0].1, id)?;
-                let bb = self.coerce(nx, &vals[1].0, ty, "a comparison", vals[1].1, id)?;
-                let (d, rest) = self.dest(nx, b, 0, Type::Bool, &[])?;
-                let mut s = vec![
-                    Element::Compare { op: *c, a, b: bb },
-                    Element::Coil {
-                        var: d,
-                        negated: false,
+        match &blk.op {
+            Op::Compare(c) => self.compare(nx, b, &vals, *c),
+            Op::Arith(op) => self.arith(nx, b, &vals, *op),
+            Op::And | Op::Or | Op::Not => self.logic(nx, b, &vals),
+            Op::Xor => self.xor(nx, b, &vals),
+            Op::Move => self.move_block(nx, b, &vals),
+            Op::Sel => self.sel(nx, b, &vals),
+            Op::Max | Op::Min | Op::Limit => self.extreme(nx, b, &vals),
+            Op::Timer { kind, instance } => self.timer(nx, b, &vals, *kind, instance),
+            Op::Ctu { instance } | Op::Ctd { instance } => self.counter(nx, b, &vals, instance),
+            Op::Jmp { .. } | Op::Ret => self.jump(nx, b, labels),
+            Op::TStart | Op::TStop => self.accumulate(nx, b),
+            Op::Call { fb, instance } => self.call(nx, b, fb, instance),
+        }
+    }
+
+    /// EQ … GE: `[compare OP a b, coil d]`.
+    fn compare(
+        &mut self,
+        nx: &mut Net,
+        b: BlockId,
+        vals: &[(Val, &str)],
+        c: CmpOp,
+    ) -> Result<Series> {
+        let net = nx.net;
+        let blk = net.block(b);
+        let id = Some(blk.id);
+        let e = |path: &str, k| LoadError::fbd(&net.id, id, path, k);
+        let ty = numeric(&vals, None, "a comparison").map_err(|(p, k)| e(p, k))?;
+        let a = self.coerce(nx, &vals[0].0, ty, "a comparison", vals[0].1, id)?;
+        let bb = self.coerce(nx, &vals[1].0, ty, "a comparison", vals[1].1, id)?;
+        let (d, rest) = self.dest(nx, b, 0, Type::Bool, &[])?;
+        let mut s = vec![
+            Element::Compare { op: c, a, b: bb },
+            Element::Coil {
+                var: d,
+                negated: false,
+            },
+        ];
+        s.extend(rest.into_iter().map(|v| Element::Coil {
+            var: v,
+            negated: false,
+        }));
+        Ok(s)
+    }
+
+    /// ADD … MOD: `[op a b → d]`, n inputs: `[op a b → d, op d c → d, …]`.
+    fn arith(
+        &mut self,
+        nx: &mut Net,
+        b: BlockId,
+        vals: &[(Val, &str)],
+        op: ArithOp,
+    ) -> Result<Series> {
+        let net = nx.net;
+        let blk = net.block(b);
+        let id = Some(blk.id);
+        let e = |path: &str, k| LoadError::fbd(&net.id, id, path, k);
+        let out_ty = self
+            .out_vars(nx, b, 0, None)?
+            .first()
+            .map(|&v| self.env.var(v).ty);
+        let ty = numeric_type(&vals, out_ty);
+        let ok = match op {
+            ArithOp::Add | ArithOp::Sub => ty.is_numeric(),
+            ArithOp::Mul | ArithOp::Div => {
+                matches!(ty, Type::Int | Type::Dint | Type::Real)
+            }
+            ArithOp::Mod => matches!(ty, Type::Int | Type::Dint),
+        };
+        if !ok {
+            let (v, p) = vals
+                .iter()
+                .find(|(v, _)| v.ty().is_some())
+                .unwrap_or(&vals[0]);
+            return Err(e(
+                p,
+                Invalid::Type {
+                    what: "this arithmetic block",
+                    expected: if op == ArithOp::Mod {
+                        "INT or DINT".into()
+                    } else {
+                        "a numeric type".into()
                     },
-                ];
-                s.extend(rest.into_iter().map(|v| Element::Coil {
-                    var: v,
-                    negated: false,
-                }));
-                s
-            }
-            Op::Arith(op) => {
-                let out_ty = self
-                    .out_vars(nx, b, 0, None)?
-                    .first()
-                    .map(|&v| self.env.var(v).ty);
-                let ty = numeric_type(&vals, out_ty);
-                let ok = match op {
-                    ArithOp::Add | ArithOp::Sub => ty.is_numeric(),
-                    ArithOp::Mul | ArithOp::Div => {
-                        matches!(ty, Type::Int | Type::Dint | Type::Real)
-                    }
-                    ArithOp::Mod => matches!(ty, Type::Int | Type::Dint),
-                };
-                if !ok {
-                    let (v, p) = vals
-                        .iter()
-                        .find(|(v, _)| v.ty().is_some())
-                        .unwrap_or(&vals[0]);
-                    return Err(e(
-                        p,
-                        Invalid::Type {
-                            what: "this arithmetic block",
-                            expected: if *op == ArithOp::Mod {
-                                "INT or DINT".into()
-                            } else {
-                                "a numeric type".into()
-                            },
-                            operand: v.text().to_owned(),
-                            found: ty.to_string(),
-                        },
-                    ));
-                }
-                let ops = self.typed_all(nx, &vals, ty, "an arithmetic block", id)?;
-                let avoid: &[Operand] = if ops.len() > 2 { &ops[2..] } else { &[] };
-                let (d, rest) = self.dest(nx, b, 0, ty, avoid)?;
-                let mut s = vec![Element::Arith {
-                    op: *op,
-                    a: ops[0],
-                    b: ops[1],
-                    out: d,
-                }];
-                for o in &ops[2..] {
-                    s.push(Element::Arith {
-                        op: *op,
-                        a: var_op(d),
-                        b: *o,
-                        out: d,
-                    });
-                }
-                s.extend(moves(d, &rest));
-                s
-            }
-            Op::And | Op::Or | Op::Not => {
-                let ops = self.typed_all(nx, &vals, Type::Bool, "a logic block", id)?;
-                let (d, rest) = self.dest(nx, b, 0, Type::Bool, &[])?;
-                let mut s: Series = match blk.op {
-                    Op::And => ops.iter().flat_map(|o| condition(*o, false)).collect(),
-                    Op::Or => vec![Element::Or(
-                        ops.iter().map(|o| condition(*o, false)).collect(),
-                    )],
-                    _ => condition(ops[0], true),
-                };
-                s.push(Element::Coil {
+                    operand: v.text().to_owned(),
+                    found: ty.to_string(),
+                },
+            ));
+        }
+        let ops = self.typed_all(nx, &vals, ty, "an arithmetic block", id)?;
+        let avoid: &[Operand] = if ops.len() > 2 { &ops[2..] } else { &[] };
+        let (d, rest) = self.dest(nx, b, 0, ty, avoid)?;
+        let mut s = vec![Element::Arith {
+            op,
+            a: ops[0],
+            b: ops[1],
+            out: d,
+        }];
+        for o in &ops[2..] {
+            s.push(Element::Arith {
+                op,
+                a: var_op(d),
+                b: *o,
+                out: d,
+            });
+        }
+        s.extend(moves(d, &rest));
+        Ok(s)
+    }
+
+    /// AND (contacts in series), OR (in parallel), NOT (a negated contact), then coils.
+    fn logic(&mut self, nx: &mut Net, b: BlockId, vals: &[(Val, &str)]) -> Result<Series> {
+        let net = nx.net;
+        let blk = net.block(b);
+        let id = Some(blk.id);
+        let ops = self.typed_all(nx, &vals, Type::Bool, "a logic block", id)?;
+        let (d, rest) = self.dest(nx, b, 0, Type::Bool, &[])?;
+        let mut s: Series = match blk.op {
+            Op::And => ops.iter().flat_map(|o| condition(*o, false)).collect(),
+            Op::Or => vec![Element::Or(
+                ops.iter().map(|o| condition(*o, false)).collect(),
+            )],
+            _ => condition(ops[0], true),
+        };
+        s.push(Element::Coil {
+            var: d,
+            negated: false,
+        });
+        s.extend(rest.into_iter().map(|v| Element::Coil {
+            var: v,
+            negated: false,
+        }));
+        Ok(s)
+    }
+
+    /// XOR: `[or [[a, b negated], [a negated, b]], coil d]`, one such step per further input.
+    fn xor(&mut self, nx: &mut Net, b: BlockId, vals: &[(Val, &str)]) -> Result<Series> {
+        let net = nx.net;
+        let blk = net.block(b);
+        let id = Some(blk.id);
+        let ops = self.typed_all(nx, &vals, Type::Bool, "a logic block", id)?;
+        let (d, rest) = self.dest(
+            nx,
+            b,
+            0,
+            Type::Bool,
+            if ops.len() > 2 { &ops[2..] } else { &[] },
+        )?;
+        let xor = |a: Operand, bb: Operand| -> Series {
+            let mut l = condition(a, false);
+            l.extend(condition(bb, true));
+            let mut r = condition(a, true);
+            r.extend(condition(bb, false));
+            vec![
+                Element::Or(vec![l, r]),
+                Element::Coil {
                     var: d,
                     negated: false,
-                });
-                s.extend(rest.into_iter().map(|v| Element::Coil {
-                    var: v,
-                    negated: false,
-                }));
-                s
-            }
-            Op::Xor => {
-                let ops = self.typed_all(nx, &vals, Type::Bool, "a logic block", id)?;
-                let (d, rest) = self.dest(
-                    nx,
-                    b,
-                    0,
-                    Type::Bool,
-                    if ops.len() > 2 { &ops[2..] } else { &[] },
-                )?;
-                let xor = |a: Operand, bb: Operand| -> Series {
-                    let mut l = condition(a, false);
-                    l.extend(condition(bb, true));
-                    let mut r = condition(a, true);
-                    r.extend(condition(bb, false));
-                    vec![
-                        Element::Or(vec![l, r]),
-                        Element::Coil {
-                            var: d,
-                            negated: false,
-                        },
-                    ]
-                };
-                let mut parts = vec![xor(ops[0], ops[1])];
-                for o in &ops[2..] {
-                    parts.push(xor(var_op(d), *o));
-                }
-                let mut s = steps(parts);
-                s.extend(rest.into_iter().map(|v| Element::Coil {
-                    var: v,
-                    negated: false,
-                }));
-                s
-            }
-            Op::Move => {
-                let out_ty = self
-                    .out_vars(nx, b, 0, None)?
-                    .first()
-                    .map(|&v| self.env.var(v).ty);
-                let ty = vals[0]
-                    .0
-                    .ty()
-                    .or(out_ty)
-                    .unwrap_or_else(|| match &vals[0].0 {
-                        Val::Const(u, _) => operand::default_type(u),
-                        Val::Typed(_, t, _) => *t,
-                    });
-                if matches!(ty, Type::Fb(_)) {
-                    return Err(e(
-                        vals[0].1,
-                        Invalid::Type {
-                            what: "MOVE",
-                            expected: "a value (BOOL, INT, DINT, REAL or TIME)".into(),
-                            operand: vals[0].0.text().to_owned(),
-                            found: ty.to_string(),
-                        },
-                    ));
-                }
-                let a = self.coerce(nx, &vals[0].0, ty, "MOVE", vals[0].1, id)?;
-                let (d, rest) = self.dest(nx, b, 0, ty, &[])?;
-                let mut s = vec![Element::Move { from: a, to: d }];
-                s.extend(moves(d, &rest));
-                s
-            }
-            Op::Sel => {
-                let g = self.coerce(nx, &vals[0].0, Type::Bool, "SEL's G", vals[0].1, id)?;
-                let out_ty = self
-                    .out_vars(nx, b, 0, None)?
-                    .first()
-                    .map(|&v| self.env.var(v).ty);
-                let ty = numeric_type(&vals[1..], out_ty);
-                if matches!(ty, Type::Fb(_)) {
-                    return Err(e(
-                        vals[1].1,
-                        Invalid::Type {
-                            what: "SEL",
-                            expected: "a value (BOOL, INT, DINT, REAL or TIME)".into(),
-                            operand: vals[1].0.text().to_owned(),
-                            found: ty.to_string(),
-                        },
-                    ));
-                }
-                let in0 = self.coerce(nx, &vals[1].0, ty, "SEL", vals[1].1, id)?;
-                let in1 = self.coerce(nx, &vals[2].0, ty, "SEL", vals[2].1, id)?;
-                let (d, rest) = self.dest(nx, b, 0, ty, &[g, in1])?;
-                let mut parts = vec![vec![Element::Move { from: in0, to: d }]];
-                let mut second = condition(g, false);
-                second.push(Element::Move { from: in1, to: d });
-                parts.push(second);
-                let mut s = steps(parts);
-                s.extend(moves(d, &rest));
-                s
-            }
-            Op::Max | Op::Min | Op::Limit => {
-                let out_ty = self
-                    .out_vars(nx, b, 0, None)?
-                    .first()
-                    .map(|&v| self.env.var(v).ty);
-                let ty = numeric(&vals, out_ty, "this block").map_err(|(p, k)| e(p, k))?;
-                let ops = self.typed_all(nx, &vals, ty, blk.op.name_static(), id)?;
-                let (d, rest) = self.dest(nx, b, 0, ty, &ops)?;
-                let dv = var_op(d);
-                let cmp_move = |op: CmpOp, x: Operand| {
-                    vec![
-                        Element::Compare { op, a: x, b: dv },
-                        Element::Move { from: x, to: d },
-                    ]
-                };
-                let parts: Vec<Series> = match blk.op {
-                    Op::Limit => vec![
-                        vec![Element::Move {
-                            from: ops[1],
-                            to: d,
-                        }],
-                        vec![
-                            Element::Compare {
-                                op: CmpOp::Lt,
-                                a: dv,
-                                b: ops[0],
-                            },
-                            Element::Move {
-                                from: ops[0],
-                                to: d,
-                            },
-                        ],
-                        vec![
-                            Element::Compare {
-                                op: CmpOp::Gt,
-                                a: dv,
-                                b: ops[2],
-                            },
-                            Element::Move {
-                                from: ops[2],
-                                to: d,
-                            },
-                        ],
-                    ],
-                    _ => {
-                        let c = if blk.op == Op::Max {
-                            CmpOp::Gt
-                        } else {
-                            CmpOp::Lt
-                        };
-                        std::iter::once(vec![Element::Move {
-                            from: ops[0],
-                            to: d,
-                        }])
-                        .chain(ops[1..].iter().map(|&x| cmp_move(c, x)))
-                        .collect()
-                    }
-                };
-                let mut s = steps(parts);
-                s.extend(moves(d, &rest));
-                s
-            }
-            Op::Timer(kind) => {
-                let inst = self.builtin_instance(nx, b, kind.fb())?;
-                let inp = self.coerce(nx, &vals[0].0, Type::Bool, "a timer's IN", vals[0].1, id)?;
-                let pt = self.coerce(nx, &vals[1].0, Type::Time, "a timer's PT", vals[1].1, id)?;
-                let mut first = condition(inp, false);
-                first.push(Element::Timer {
-                    kind: *kind,
-                    instance: inst,
-                    pt,
-                });
-                self.instance_outputs(
-                    nx,
-                    b,
-                    inst,
-                    [(Field::Q, Type::Bool), (Field::Et, Type::Time)],
-                    first,
-                )?
-            }
-            Op::Ctu | Op::Ctd => {
-                let fb = if blk.op == Op::Ctu {
-                    FbKind::Ctu
-                } else {
-                    FbKind::Ctd
-                };
-                let inst = self.builtin_instance(nx, b, fb)?;
-                let c = self.coerce(
-                    nx,
-                    &vals[0].0,
-                    Type::Bool,
-                    "a counter's input",
-                    vals[0].1,
-                    id,
-                )?;
-                let r = self.coerce(
-                    nx,
-                    &vals[1].0,
-                    Type::Bool,
-                    if fb == FbKind::Ctu {
-                        "a counter's reset"
-                    } else {
-                        "a counter's load"
-                    },
-                    vals[1].1,
-                    id,
-                )?;
-                let pv = self.coerce(nx, &vals[2].0, Type::Int, "a counter's PV", vals[2].1, id)?;
-                let mut first = condition(c, false);
-                first.push(if fb == FbKind::Ctu {
-                    Element::Ctu {
-                        instance: inst,
-                        pv,
-                        reset: r,
-                    }
-                } else {
-                    Element::Ctd {
-                        instance: inst,
-                        pv,
-                        load: r,
-                    }
-                });
-                self.instance_outputs(
-                    nx,
-                    b,
-                    inst,
-                    [(Field::Q, Type::Bool), (Field::Cv, Type::Int)],
-                    first,
-                )?
-            }
-            Op::Jmp | Op::Ret => {
-                let mut s = match &blk.cond {
-                    Some(c) => {
-                        let o = self.bool_input(
-                            nx,
-                            id,
-                            c,
-                            &format!("{}.cond", blk.path),
-                            "a condition",
-                        )?;
-                        condition(o, false)
-                    }
-                    None => Vec::new(),
-                };
-                if blk.op == Op::Jmp {
-                    let label = blk.label.clone().expect("a JMP has a label");
-                    if !labels.contains_key(label.as_str()) {
-                        return Err(e(
-                            &format!("{}.label", blk.path),
-                            Invalid::UndefinedLabel {
-                                label,
-                                pou: self.names.pou.clone(),
-                            },
-                        ));
-                    }
-                    s.push(Element::Jmp {
-                        label,
-                        target: RungId(u32::MAX),
-                    });
-                } else {
-                    s.push(Element::Ret);
-                }
-                s
-            }
-            Op::TStart | Op::TStop => {
-                let v = self.accumulated_var(net, blk)?;
-                let a = &self.accumulators[&v];
-                let acc = VarRef {
-                    var: a.acc,
-                    field: None,
-                };
-                let pt = Operand::Const(Value::Time(ACCUMULATE_PT_MS));
-                let timer = Element::Timer {
-                    kind: TimerKind::Ton,
-                    instance: a.timer,
-                    pt,
-                };
-                if blk.op == Op::TStart {
-                    vec![Element::Branch(vec![
-                        vec![
-                            contact(acc, true),
-                            Element::Set(a.acc),
-                            Element::Move {
-                                from: Operand::Const(Value::Time(0)),
-                                to: a.last,
-                            },
-                        ],
-                        vec![contact(acc, false), timer],
-                    ])]
-                } else {
-                    vec![Element::Reset(a.acc), contact(acc, false), timer]
-                }
-            }
-            Op::Call(fb) => self.call(nx, b, fb)?,
+                },
+            ]
         };
-        Ok(series)
+        let mut parts = vec![xor(ops[0], ops[1])];
+        for o in &ops[2..] {
+            parts.push(xor(var_op(d), *o));
+        }
+        let mut s = steps(parts);
+        s.extend(rest.into_iter().map(|v| Element::Coil {
+            var: v,
+            negated: false,
+        }));
+        Ok(s)
+    }
+
+    /// MOVE: `[move a → d]`.
+    fn move_block(&mut self, nx: &mut Net, b: BlockId, vals: &[(Val, &str)]) -> Result<Series> {
+        let net = nx.net;
+        let blk = net.block(b);
+        let id = Some(blk.id);
+        let e = |path: &str, k| LoadError::fbd(&net.id, id, path, k);
+        let out_ty = self
+            .out_vars(nx, b, 0, None)?
+            .first()
+            .map(|&v| self.env.var(v).ty);
+        let ty = vals[0]
+            .0
+            .ty()
+            .or(out_ty)
+            .unwrap_or_else(|| match &vals[0].0 {
+                Val::Const(u, ..) => operand::default_type(u),
+                Val::Typed(_, t, _) => *t,
+            });
+        if matches!(ty, Type::Fb(_)) {
+            return Err(e(
+                vals[0].1,
+                Invalid::Type {
+                    what: "MOVE",
+                    expected: "a value (BOOL, INT, DINT, REAL or TIME)".into(),
+                    operand: vals[0].0.text().to_owned(),
+                    found: ty.to_string(),
+                },
+            ));
+        }
+        let a = self.coerce(nx, &vals[0].0, ty, "MOVE", vals[0].1, id)?;
+        let (d, rest) = self.dest(nx, b, 0, ty, &[])?;
+        let mut s = vec![Element::Move { from: a, to: d }];
+        s.extend(moves(d, &rest));
+        Ok(s)
+    }
+
+    /// SEL: `branch [[move IN0 → d], [contact G, move IN1 → d]]`.
+    fn sel(&mut self, nx: &mut Net, b: BlockId, vals: &[(Val, &str)]) -> Result<Series> {
+        let net = nx.net;
+        let blk = net.block(b);
+        let id = Some(blk.id);
+        let e = |path: &str, k| LoadError::fbd(&net.id, id, path, k);
+        let g = self.coerce(nx, &vals[0].0, Type::Bool, "SEL's G", vals[0].1, id)?;
+        let out_ty = self
+            .out_vars(nx, b, 0, None)?
+            .first()
+            .map(|&v| self.env.var(v).ty);
+        let ty = numeric_type(&vals[1..], out_ty);
+        if matches!(ty, Type::Fb(_)) {
+            return Err(e(
+                vals[1].1,
+                Invalid::Type {
+                    what: "SEL",
+                    expected: "a value (BOOL, INT, DINT, REAL or TIME)".into(),
+                    operand: vals[1].0.text().to_owned(),
+                    found: ty.to_string(),
+                },
+            ));
+        }
+        let in0 = self.coerce(nx, &vals[1].0, ty, "SEL", vals[1].1, id)?;
+        let in1 = self.coerce(nx, &vals[2].0, ty, "SEL", vals[2].1, id)?;
+        let (d, rest) = self.dest(nx, b, 0, ty, &[g, in1])?;
+        let mut parts = vec![vec![Element::Move { from: in0, to: d }]];
+        let mut second = condition(g, false);
+        second.push(Element::Move { from: in1, to: d });
+        parts.push(second);
+        let mut s = steps(parts);
+        s.extend(moves(d, &rest));
+        Ok(s)
+    }
+
+    /// MAX, MIN (a move, then a compare and move per further input) and LIMIT.
+    fn extreme(&mut self, nx: &mut Net, b: BlockId, vals: &[(Val, &str)]) -> Result<Series> {
+        let net = nx.net;
+        let blk = net.block(b);
+        let id = Some(blk.id);
+        let e = |path: &str, k| LoadError::fbd(&net.id, id, path, k);
+        let out_ty = self
+            .out_vars(nx, b, 0, None)?
+            .first()
+            .map(|&v| self.env.var(v).ty);
+        let ty = numeric(&vals, out_ty, "this block").map_err(|(p, k)| e(p, k))?;
+        let ops = self.typed_all(nx, &vals, ty, blk.op.name_static(), id)?;
+        let (d, rest) = self.dest(nx, b, 0, ty, &ops)?;
+        let dv = var_op(d);
+        let cmp_move = |op: CmpOp, x: Operand| {
+            vec![
+                Element::Compare { op, a: x, b: dv },
+                Element::Move { from: x, to: d },
+            ]
+        };
+        let parts: Vec<Series> = match blk.op {
+            Op::Limit => vec![
+                vec![Element::Move {
+                    from: ops[1],
+                    to: d,
+                }],
+                vec![
+                    Element::Compare {
+                        op: CmpOp::Lt,
+                        a: dv,
+                        b: ops[0],
+                    },
+                    Element::Move {
+                        from: ops[0],
+                        to: d,
+                    },
+                ],
+                vec![
+                    Element::Compare {
+                        op: CmpOp::Gt,
+                        a: dv,
+                        b: ops[2],
+                    },
+                    Element::Move {
+                        from: ops[2],
+                        to: d,
+                    },
+                ],
+            ],
+            _ => {
+                let c = if blk.op == Op::Max {
+                    CmpOp::Gt
+                } else {
+                    CmpOp::Lt
+                };
+                std::iter::once(vec![Element::Move {
+                    from: ops[0],
+                    to: d,
+                }])
+                .chain(ops[1..].iter().map(|&x| cmp_move(c, x)))
+                .collect()
+            }
+        };
+        let mut s = steps(parts);
+        s.extend(moves(d, &rest));
+        Ok(s)
+    }
+
+    /// TON, TOF, TP: `[contact IN, ton T pt]`, outputs read through the instance.
+    fn timer(
+        &mut self,
+        nx: &mut Net,
+        b: BlockId,
+        vals: &[(Val, &str)],
+        kind: TimerKind,
+        instance: &str,
+    ) -> Result<Series> {
+        let net = nx.net;
+        let blk = net.block(b);
+        let id = Some(blk.id);
+        let inst = self.builtin_instance(nx, b, kind.fb(), instance)?;
+        let inp = self.coerce(nx, &vals[0].0, Type::Bool, "a timer's IN", vals[0].1, id)?;
+        let pt = self.coerce(nx, &vals[1].0, Type::Time, "a timer's PT", vals[1].1, id)?;
+        let mut first = condition(inp, false);
+        first.push(Element::Timer {
+            kind,
+            instance: inst,
+            pt,
+        });
+        self.instance_outputs(
+            nx,
+            b,
+            inst,
+            [(Field::Q, Type::Bool), (Field::Et, Type::Time)],
+            first,
+        )
+    }
+
+    /// CTU, CTD: `[contact CU, ctu C pv R]` / `[contact CD, ctd C pv LD]`.
+    fn counter(
+        &mut self,
+        nx: &mut Net,
+        b: BlockId,
+        vals: &[(Val, &str)],
+        instance: &str,
+    ) -> Result<Series> {
+        let net = nx.net;
+        let blk = net.block(b);
+        let id = Some(blk.id);
+        let fb = if matches!(blk.op, Op::Ctu { .. }) {
+            FbKind::Ctu
+        } else {
+            FbKind::Ctd
+        };
+        let inst = self.builtin_instance(nx, b, fb, instance)?;
+        let c = self.coerce(
+            nx,
+            &vals[0].0,
+            Type::Bool,
+            "a counter's input",
+            vals[0].1,
+            id,
+        )?;
+        let r = self.coerce(
+            nx,
+            &vals[1].0,
+            Type::Bool,
+            if fb == FbKind::Ctu {
+                "a counter's reset"
+            } else {
+                "a counter's load"
+            },
+            vals[1].1,
+            id,
+        )?;
+        let pv = self.coerce(nx, &vals[2].0, Type::Int, "a counter's PV", vals[2].1, id)?;
+        let mut first = condition(c, false);
+        first.push(if fb == FbKind::Ctu {
+            Element::Ctu {
+                instance: inst,
+                pv,
+                reset: r,
+            }
+        } else {
+            Element::Ctd {
+                instance: inst,
+                pv,
+                load: r,
+            }
+        });
+        self.instance_outputs(
+            nx,
+            b,
+            inst,
+            [(Field::Q, Type::Bool), (Field::Cv, Type::Int)],
+            first,
+        )
+    }
+
+    /// JMP and RET: `[contact cond, jmp <label>]` / `[contact cond, ret]`.
+    fn jump(&mut self, nx: &mut Net, b: BlockId, labels: &HashMap<&str, usize>) -> Result<Series> {
+        let net = nx.net;
+        let blk = net.block(b);
+        let id = Some(blk.id);
+        let e = |path: &str, k| LoadError::fbd(&net.id, id, path, k);
+        let mut s = match &blk.cond {
+            Some(c) => {
+                let o = self.bool_input(nx, id, c, &format!("{}.cond", blk.path), "a condition")?;
+                condition(o, false)
+            }
+            None => Vec::new(),
+        };
+        if let Op::Jmp { label } = &blk.op {
+            if !labels.contains_key(label.as_str()) {
+                return Err(e(
+                    &format!("{}.label", blk.path),
+                    Invalid::UndefinedLabel {
+                        label: label.clone(),
+                        pou: self.names.pou.clone(),
+                    },
+                ));
+            }
+            s.push(Element::Jmp {
+                label: label.clone(),
+                target: RungId(u32::MAX),
+            });
+        } else {
+            s.push(Element::Ret);
+        }
+        Ok(s)
+    }
+
+    /// TSTART and TSTOP (module docs of the lowering).
+    fn accumulate(&mut self, nx: &mut Net, b: BlockId) -> Result<Series> {
+        let net = nx.net;
+        let blk = net.block(b);
+        let v = self.accumulated_var(net, blk)?;
+        let a = &self.accumulators[&v];
+        let acc = VarRef {
+            var: a.acc,
+            field: None,
+        };
+        let pt = Operand::Const(Value::Time(ACCUMULATE_PT_MS));
+        let timer = Element::Timer {
+            kind: TimerKind::Ton,
+            instance: a.timer,
+            pt,
+        };
+        Ok(if blk.op == Op::TStart {
+            vec![Element::Branch(vec![
+                vec![
+                    contact(acc, true),
+                    Element::Set(a.acc),
+                    Element::Move {
+                        from: Operand::Const(Value::Time(0)),
+                        to: a.last,
+                    },
+                ],
+                vec![contact(acc, false), timer],
+            ])]
+        } else {
+            vec![Element::Reset(a.acc), contact(acc, false), timer]
+        })
     }
 }
 
@@ -431,7 +524,7 @@ fn numeric_type(vals: &[(Val, &str)], fallback: Option<Type>) -> Type {
     }
     let real = vals
         .iter()
-        .any(|(v, _)| matches!(v, Val::Const(u, _) if operand::default_type(u) == Type::Real));
+        .any(|(v, _)| matches!(v, Val::Const(u, ..) if operand::default_type(u) == Type::Real));
     if real {
         Type::Real
     } else {

@@ -4,18 +4,19 @@
 use super::{condition, contact, set_jump_target, Cx, Net, Result};
 use crate::diag::LoadError;
 use crate::fbd::model::*;
+use crate::fbd::types::TypedNetwork;
 use crate::model::*;
 use std::collections::HashMap;
 
 impl Cx<'_> {
-    /// Lowers one network; returns the rung of each block.
+    /// Lowers one network; returns the rung of each block and the network's typed form.
     pub(super) fn network(
         &mut self,
         net: &Network,
         plan: &Plan,
         labels: &HashMap<&str, usize>,
         jumps: &mut Vec<(usize, usize)>,
-    ) -> Result<Vec<u32>> {
+    ) -> Result<(Vec<u32>, TypedNetwork<VarRef>)> {
         let n = net.blocks.len();
         let mut used: Vec<Vec<bool>> = net
             .blocks
@@ -39,7 +40,12 @@ impl Cx<'_> {
             .iter()
             .map(|b| vec![None; b.outputs.len()])
             .collect();
-        let mut nx = Net { net, used, values };
+        let mut nx = Net {
+            net,
+            used,
+            values,
+            constants: HashMap::new(),
+        };
         let rp = self.names.rung_prefix.clone();
         let e_net = |k| LoadError::fbd(&net.id, None, &net.path, k);
         // Run flags of compound fragments: reset first, set inside each source fragment.
@@ -111,9 +117,11 @@ impl Cx<'_> {
                         series,
                         &blk.path,
                     );
-                    if blk.op == Op::Jmp {
-                        let target = labels[blk.label.as_deref().expect("a JMP has a label")];
-                        jumps.push((r, target));
+                    if let Op::Jmp { label } = &blk.op {
+                        // Checked by the block's lowering: the label is defined.
+                        if let Some(&target) = labels.get(label.as_str()) {
+                            jumps.push((r, target));
+                        }
                     }
                     block_rung[b.index()] = r as u32;
                 }
@@ -138,6 +146,6 @@ impl Cx<'_> {
         if first_rung.comment.is_none() {
             first_rung.comment = net.comment.clone();
         }
-        Ok(block_rung)
+        Ok((block_rung, self.typed_network(&nx)))
     }
 }

@@ -1,16 +1,21 @@
 //! Function block instances in a network: built-in timers and counters (read through their
 //! fields), and calls of user function block instances (each its own POU).
 
-use super::{field_op, steps, var_op, Cx, InstanceRef, Net, Result};
+use super::{field_op, steps, var_op, Cx, InstanceRef, Net, PinSlot, Result};
 use crate::diag::{Invalid, LoadError};
 use crate::fbd::model::*;
 use crate::model::*;
 
 impl Cx<'_> {
-    pub(super) fn builtin_instance(&self, nx: &Net, b: BlockId, fb: FbKind) -> Result<VarId> {
+    pub(super) fn builtin_instance(
+        &self,
+        nx: &Net,
+        b: BlockId,
+        fb: FbKind,
+        name: &str,
+    ) -> Result<VarId> {
         let blk = nx.net.block(b);
         let path = format!("{}.instance", blk.path);
-        let name = blk.instance.as_deref().expect("checked by the reader");
         let e = |k| LoadError::fbd(&nx.net.id, Some(blk.id), &path, k);
         match self.env.instance(name).map_err(e)? {
             InstanceRef::Builtin(v, k) if k == fb => Ok(v),
@@ -47,12 +52,17 @@ impl Cx<'_> {
     }
 
     /// A user function block call: inputs moved into the instance, `call`, outputs moved out.
-    pub(super) fn call(&mut self, nx: &mut Net, b: BlockId, fb: &str) -> Result<Series> {
+    pub(super) fn call(
+        &mut self,
+        nx: &mut Net,
+        b: BlockId,
+        fb: &str,
+        name: &str,
+    ) -> Result<Series> {
         let net = nx.net;
         let blk = net.block(b);
         let id = Some(blk.id);
         let path = format!("{}.instance", blk.path);
-        let name = blk.instance.as_deref().expect("checked by the reader");
         let e = |k| LoadError::fbd(&net.id, id, &path, k);
         let (pou, inputs, outputs) = match self.env.instance(name).map_err(e)? {
             InstanceRef::User {
@@ -71,10 +81,10 @@ impl Cx<'_> {
             }
         };
         let mut s = Vec::new();
-        for (pin, (_, var)) in blk.inputs.iter().zip(&inputs) {
+        for (i, (pin, (_, var))) in blk.inputs.iter().zip(&inputs).enumerate() {
             if let Some(input) = &pin.input {
                 let ty = self.env.var(*var).ty;
-                let v = self.val(nx, input, &pin.path, id)?;
+                let v = self.val(nx, input, &pin.path, id, Some(PinSlot(b, i)))?;
                 let from = self.coerce(nx, &v, ty, "a function block input", &pin.path, id)?;
                 s.push(Element::Move { from, to: *var });
             }

@@ -25,9 +25,11 @@ mod fragments;
 mod instances;
 mod pins;
 mod time;
+mod typed;
 
 use crate::diag::{Invalid, LoadError};
 use crate::fbd::model::*;
+use crate::fbd::types::TypedBody;
 use crate::model::*;
 use crate::resolve::operand::Untyped;
 use std::collections::HashMap;
@@ -85,6 +87,8 @@ pub(crate) struct Lowered {
     pub networks: Vec<Range<u32>>,
     /// Per network, per block: its rung (POU-relative).
     pub blocks: Vec<Vec<u32>>,
+    /// The body with typed pins, variables as this POU's scope resolves them.
+    pub typed: TypedBody<VarRef>,
 }
 
 /// Lowers `fbd` in the scope `env` gives.
@@ -106,9 +110,11 @@ pub(crate) fn lower(fbd: &FbdPou, env: &mut dyn Env, names: &Names, pou: PouId) 
     let mut jumps: Vec<(usize, usize)> = Vec::new();
     let mut networks = Vec::with_capacity(fbd.networks.len());
     let mut blocks = Vec::with_capacity(fbd.networks.len());
+    let mut typed = Vec::with_capacity(fbd.networks.len());
     for (net, plan) in fbd.networks.iter().zip(&fbd.plans) {
         let start = cx.rungs.len() as u32;
-        let block_rungs = cx.network(net, plan, &labels, &mut jumps)?;
+        let (block_rungs, typed_net) = cx.network(net, plan, &labels, &mut jumps)?;
+        typed.push(typed_net);
         for rung in &mut cx.rungs[start as usize..] {
             rung.network = Some(net.id.clone());
         }
@@ -123,6 +129,7 @@ pub(crate) fn lower(fbd: &FbdPou, env: &mut dyn Env, names: &Names, pou: PouId) 
         rungs: cx.rungs,
         networks,
         blocks,
+        typed: TypedBody { networks: typed },
     })
 }
 
@@ -147,23 +154,28 @@ struct Cx<'e> {
     accumulators: HashMap<VarId, Acc>,
 }
 
-/// A value connected to an input: typed (variable or arc), or a constant waiting for its type.
+/// A value connected to an input: typed (variable or arc), or a constant waiting for its type
+/// (with the input pin it is connected to, whose typed value the lowering records).
 #[derive(Clone)]
 enum Val {
     Typed(Operand, Type, String),
-    Const(Untyped, String),
+    Const(Untyped, String, Option<PinSlot>),
 }
+
+/// Input pin `.1` of block `.0`.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
+struct PinSlot(BlockId, usize);
 
 impl Val {
     fn ty(&self) -> Option<Type> {
         match self {
             Val::Typed(_, t, _) => Some(*t),
-            Val::Const(u, _) => u.ty(),
+            Val::Const(u, ..) => u.ty(),
         }
     }
     fn text(&self) -> &str {
         match self {
-            Val::Typed(_, _, s) | Val::Const(_, s) => s,
+            Val::Typed(_, _, s) | Val::Const(_, s, _) => s,
         }
     }
 }
@@ -175,6 +187,8 @@ struct Net<'n> {
     used: Vec<Vec<bool>>,
     /// Per block, per output pin: the operand an arc reads.
     values: Vec<Vec<Option<(Operand, Type)>>>,
+    /// The constants connected to input pins, as typed by their blocks.
+    constants: HashMap<PinSlot, Value>,
 }
 
 fn never() -> Element {

@@ -1,19 +1,23 @@
 //! Block inputs and outputs: values of connected inputs (arcs, variables, constants) typed
 //! on use, the variables an output is written to, hidden temps for outputs arcs read.
 
-use super::{var_op, Cx, Net, Result, Val};
+use super::{var_op, Cx, Net, PinSlot, Result, Val};
 use crate::diag::{Invalid, LoadError};
 use crate::fbd::model::*;
 use crate::model::*;
-use crate::resolve::operand::{self, Untyped};
+use crate::resolve::operand;
+use crate::syntax::Scalar;
+use std::borrow::Cow;
 
 impl Cx<'_> {
+    /// The value connected to an input (`slot`: the input pin, when it is one).
     pub(super) fn val(
         &self,
         nx: &Net,
         input: &Input,
         path: &str,
         block: Option<u32>,
+        slot: Option<PinSlot>,
     ) -> Result<Val> {
         match input {
             Input::Arc { from, pin } => {
@@ -26,25 +30,26 @@ impl Cx<'_> {
                     format!("{}.{}", src.id, src.outputs[*pin as usize].name),
                 ))
             }
-            Input::Operand(j) => {
-                let env = &*self.env;
-                let u = operand::parse_json(j, &|n| env.lookup(n))
+            Input::Variable(name) => {
+                let (r, t) = self
+                    .env
+                    .lookup(name)
                     .map_err(|k| LoadError::fbd(&nx.net.id, block, path, k))?;
-                let text = match j {
-                    serde_json::Value::String(s) => s.clone(),
-                    other => other.to_string(),
-                };
-                Ok(match u {
-                    Untyped::Var(r, t) => Val::Typed(Operand::Var(r), t, text),
-                    other => Val::Const(other, text),
-                })
+                Ok(Val::Typed(Operand::Var(r), t, name.clone()))
+            }
+            Input::Constant(c) => {
+                let env = &*self.env;
+                let u = operand::parse(&constant_scalar(c), &|n| env.lookup(n))
+                    .map_err(|k| LoadError::fbd(&nx.net.id, block, path, k))?;
+                Ok(Val::Const(u, c.text(), slot))
             }
         }
     }
 
+    /// `v` as an operand of type `ty` (a constant recorded for its pin).
     pub(super) fn coerce(
         &self,
-        nx: &Net,
+        nx: &mut Net,
         v: &Val,
         ty: Type,
         what: &'static str,
@@ -53,17 +58,20 @@ impl Cx<'_> {
     ) -> Result<Operand> {
         let e = |k| LoadError::fbd(&nx.net.id, block, path, k);
         match v {
-            Val::Typed(o, t, text) if *t != ty => {
-                let _ = o;
-                Err(e(Invalid::Type {
-                    what,
-                    expected: ty.to_string(),
-                    operand: text.clone(),
-                    found: t.to_string(),
-                }))
-            }
+            Val::Typed(_, t, text) if *t != ty => Err(e(Invalid::Type {
+                what,
+                expected: ty.to_string(),
+                operand: text.clone(),
+                found: t.to_string(),
+            })),
             Val::Typed(o, _, _) => Ok(*o),
-            Val::Const(u, text) => operand::typed(u, ty, what, text).map_err(e),
+            Val::Const(u, text, slot) => {
+                let o = operand::typed(u, ty, what, text).map_err(e)?;
+                if let (Operand::Const(value), Some(slot)) = (o, slot) {
+                    nx.constants.insert(*slot, value);
+                }
+                Ok(o)
+            }
         }
     }
 
@@ -75,7 +83,7 @@ impl Cx<'_> {
         path: &str,
         what: &'static str,
     ) -> Result<Operand> {
-        let v = self.val(nx, input, path, block)?;
+        let v = self.val(nx, input, path, block, None)?;
         self.coerce(nx, &v, Type::Bool, what, path, block)
     }
 
@@ -146,7 +154,7 @@ impl Cx<'_> {
 
     pub(super) fn typed_all(
         &self,
-        nx: &Net,
+        nx: &mut Net,
         vals: &[(Val, &str)],
         ty: Type,
         what: &'static str,
@@ -155,5 +163,14 @@ impl Cx<'_> {
         vals.iter()
             .map(|(v, p)| self.coerce(nx, v, ty, what, p, id))
             .collect()
+    }
+}
+
+/// A constant as the operand parser reads it.
+pub(super) fn constant_scalar(c: &Constant) -> Scalar<'_> {
+    match c {
+        Constant::Bool(b) => Scalar::Bool(*b),
+        Constant::Number(n) => Scalar::Number(n.clone()),
+        Constant::Time(s) => Scalar::Str(Cow::Borrowed(s)),
     }
 }

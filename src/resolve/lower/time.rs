@@ -90,11 +90,11 @@ impl Cx<'_> {
         let pin = &blk.inputs[0];
         let e = |k| LoadError::fbd(&net.id, Some(blk.id), &pin.path, k);
         let text = match &pin.input {
-            Some(Input::Operand(serde_json::Value::String(s))) => s.as_str(),
-            Some(Input::Operand(j)) => {
+            Some(Input::Variable(s)) | Some(Input::Constant(Constant::Time(s))) => s.as_str(),
+            Some(Input::Constant(c)) => {
                 return Err(e(Invalid::Shape {
                     expected: "a TIME variable",
-                    found: crate::resolve::util::kind_of(j),
+                    found: super::pins::constant_scalar(c).kind(),
                 }))
             }
             _ => {
