@@ -4,7 +4,7 @@
 use super::util::check_name;
 use super::util::FastMap;
 use super::{Builder, FbType, PouDraft, Result};
-use crate::diag::{Invalid, LoadError};
+use crate::diag::{Invalid, LoadError, Origin};
 use crate::fbd::FbdPouKind;
 use crate::model::*;
 use crate::resolve::fbd_read::FbSig;
@@ -20,7 +20,7 @@ impl<'a> Builder<'a> {
         let mut bodies = Vec::with_capacity(fbs.len());
         for fb in fbs {
             let path = format!("function_blocks.{}", fb.name);
-            check_name(&fb.name, &path, None)?;
+            check_name(&fb.name, &path, None).map_err(|e| e.at(fb.origin))?;
             if Type::parse(&fb.name).is_some() {
                 return Err(LoadError::invalid(
                     None,
@@ -29,12 +29,13 @@ impl<'a> Builder<'a> {
                         what: "a function block named like a standard type",
                         place: "(rename it)",
                     },
-                ));
+                )
+                .at(fb.origin));
             }
             let names = |vs: &[syntax::Var]| -> Vec<String> {
                 vs.iter()
                     .filter(|v| v.problem.is_none())
-                    .map(|v| v.name.to_string())
+                    .map(|v| v.name.value.to_string())
                     .collect()
             };
             let sig = FbSig {
@@ -56,7 +57,7 @@ impl<'a> Builder<'a> {
             bodies.push(&fb.body);
         }
         // Declarations on a scratch scope (rolled back), and which types each type instantiates.
-        let mut uses: Vec<Vec<(usize, String)>> = Vec::new();
+        let mut uses: Vec<Vec<(usize, String, Origin)>> = Vec::new();
         for f in 0..self.fb_types.len() {
             let (vars_mark, inst_mark) = (self.vars.len(), self.instances.len());
             let scratch = PouId(self.locals.len() as u32);
@@ -82,7 +83,7 @@ impl<'a> Builder<'a> {
             uses.push(
                 self.instances[inst_mark..]
                     .iter()
-                    .filter_map(|i| Some((*self.fb_index.get(&i.fb)?, i.path.clone())))
+                    .filter_map(|i| Some((*self.fb_index.get(&i.fb)?, i.path.clone(), i.origin)))
                     .collect(),
             );
             self.vars.truncate(vars_mark);
@@ -97,7 +98,7 @@ impl<'a> Builder<'a> {
             seen[start] = true;
             let mut stack: Vec<(usize, usize)> = vec![(start, 0)];
             while let Some(&mut (f, ref mut i)) = stack.last_mut() {
-                if let Some((g, p)) = uses[f].get(*i) {
+                if let Some((g, p, origin)) = uses[f].get(*i) {
                     *i += 1;
                     if *g == start {
                         let mut chain: Vec<&str> = stack
@@ -112,7 +113,8 @@ impl<'a> Builder<'a> {
                                 name: self.fb_types[start].name.clone(),
                                 chain: chain.join(" → "),
                             },
-                        ));
+                        )
+                        .at(*origin));
                     }
                     if !seen[*g] {
                         seen[*g] = true;
@@ -135,6 +137,7 @@ impl<'a> Builder<'a> {
                         self.read_fbd(j, &format!("{path}.fbd"), &name, FbdPouKind::FunctionBlock)?;
                     self.fb_types[f].fbd = Some(self.fbd_bodies.len());
                     self.fbd_bodies.push(body);
+                    self.fbd_origins.push(j.origin);
                 }
             }
         }
@@ -147,9 +150,10 @@ impl<'a> Builder<'a> {
         let Some(&f) = self.fb_index.get(&self.instances[idx].fb) else {
             return Ok(()); // declared only for user types (checked when declared)
         };
-        let (display, ipath) = (
+        let (display, ipath, iorigin) = (
             self.instances[idx].display.clone(),
             self.instances[idx].path.clone(),
+            self.instances[idx].origin,
         );
         if stack.contains(&self.fb_types[f].name) {
             let mut chain = stack.clone();
@@ -161,7 +165,8 @@ impl<'a> Builder<'a> {
                     name: self.fb_types[f].name.clone(),
                     chain: chain.join(" → "),
                 },
-            ));
+            )
+            .at(iorigin));
         }
         if self.pous.iter().any(|p| p.name == display) {
             return Err(LoadError::invalid(
@@ -171,7 +176,8 @@ impl<'a> Builder<'a> {
                     what: "a function block instance named like the program or a subroutine",
                     place: "(rename one of them)",
                 },
-            ));
+            )
+            .at(self.instances[idx].name_origin));
         }
         let pou = PouId(self.pous.len() as u32);
         let t = &self.fb_types[f];

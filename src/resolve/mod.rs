@@ -45,14 +45,16 @@ use util::{check_name, rung_path};
 
 type Result<T> = std::result::Result<T, LoadError>;
 
-/// Resolves a program read from `text` (the text gives the line and column of nodes for errors).
+/// Resolves a program read from `text` (the text gives the line and column of nodes for errors,
+/// computed only when there are errors).
 pub fn resolve(text: &str, syn: &syntax::Program<'_>) -> Result<(Program, Fbd)> {
-    let mut b = Builder {
-        text,
-        ..Builder::default()
-    };
+    resolve_syntax(syn).map_err(|e| e.locate(text))
+}
+
+fn resolve_syntax(syn: &syntax::Program<'_>) -> Result<(Program, Fbd)> {
+    let mut b = Builder::default();
     for p in &syn.problems {
-        b.report(LoadError::invalid(None, &p.at, p.kind.clone()));
+        b.report(LoadError::invalid(None, &p.at, p.kind.clone()).at(p.origin));
     }
     b.declarations(syn);
     b.phase_end()?;
@@ -82,7 +84,7 @@ pub fn resolve(text: &str, syn: &syntax::Program<'_>) -> Result<(Program, Fbd)> 
         })
         .collect();
     instances.sort_by_key(|i| i.pou);
-    let program = b.build(syn.name.to_string())?;
+    let program = b.build(syn.name.to_string(), syn.origin)?;
     for body in &mut bodies {
         for copy in &mut body.copies {
             let start = program.pou(copy.pou).rungs.start;
@@ -163,6 +165,9 @@ struct InstanceDraft {
     fb: String,
     /// JSON path of its declaration.
     path: String,
+    /// Where its declaration and its name start.
+    origin: syntax::Origin,
+    name_origin: syntax::Origin,
     pou: Option<PouId>,
     inputs: Vec<(String, VarId)>,
     outputs: Vec<(String, VarId)>,
@@ -171,7 +176,6 @@ struct InstanceDraft {
 /// A program-wide rule (ids, labels, names) is kept per POU; every table is indexed by POU.
 #[derive(Default)]
 struct Builder<'a> {
-    text: &'a str,
     /// Problems found so far, in program order (at most [`MAX_ERRORS`]).
     errors: Vec<Diagnostic>,
     vars: Vec<Var>,
@@ -189,8 +193,10 @@ struct Builder<'a> {
     pending: Vec<usize>,
     fb_types: Vec<FbType<'a>>,
     fb_index: FastMap<String, usize>,
-    /// FBD bodies in reading order (function block types first, as they are read first).
+    /// FBD bodies in reading order (function block types first, as they are read first), and
+    /// where each starts in the text.
     fbd_bodies: Vec<FbdPou>,
+    fbd_origins: Vec<syntax::Origin>,
     /// TIME variables accumulated by TSTART/TSTOP, with the POU that does it.
     accumulated: FastMap<VarId, PouId>,
     pous: Vec<PouDraft<'a>>,
@@ -230,10 +236,6 @@ impl<'a> Builder<'a> {
         }
     }
 
-    fn position(&self, origin: syntax::Origin) -> Option<(u32, u32)> {
-        origin.line_column(self.text)
-    }
-
     /// Function block types, the program's variables, the main body, then each subroutine with
     /// its variables and body, in file order.
     fn declarations(&mut self, syn: &'a syntax::Program<'a>) {
@@ -251,19 +253,22 @@ impl<'a> Builder<'a> {
         }
         for sub in &syn.subroutines {
             let path = format!("subroutines.{}", sub.name);
-            let r = check_name(&sub.name, &path, None);
+            let r = check_name(&sub.name, &path, None).map_err(|e| e.at(sub.origin));
             if self.collect(r).is_none() {
                 continue;
             }
             if sub.name == name {
-                self.report(LoadError::invalid(
-                    None,
-                    &path,
-                    Invalid::Misplaced {
-                        what: "a subroutine named like the program",
-                        place: "(rename one of them)",
-                    },
-                ));
+                self.report(
+                    LoadError::invalid(
+                        None,
+                        &path,
+                        Invalid::Misplaced {
+                            what: "a subroutine named like the program",
+                            place: "(rename one of them)",
+                        },
+                    )
+                    .at(sub.origin),
+                );
                 continue;
             }
             let pou = PouId(self.pous.len() as u32);
@@ -304,6 +309,7 @@ impl<'a> Builder<'a> {
                 let fbd = self.read_fbd(f, &at, &self.pous[pou].name.clone(), kind)?;
                 self.pous[pou].fbd = Some(self.fbd_bodies.len());
                 self.fbd_bodies.push(fbd);
+                self.fbd_origins.push(f.origin);
                 Ok(())
             }
         }
@@ -329,19 +335,22 @@ impl<'a> Builder<'a> {
                     found: e.to_string(),
                 },
             )
+            .at(f.origin)
         })?;
-        fbd_read::read_body(&json, path, name, kind, &sig)
-            .map_err(|e| e.at_position(self.position(f.origin)))
+        fbd_read::read_body(&json, path, name, kind, &sig).map_err(|e| e.at(f.origin))
     }
 
-    fn build(mut self, name: String) -> Result<Program> {
+    fn build(mut self, name: String, origin: syntax::Origin) -> Result<Program> {
         if self.pous[0].fbd.is_none() && self.pous[0].rungs.is_empty() {
-            return Err(LoadError::invalid(None, "rungs", Invalid::Empty));
+            return Err(LoadError::invalid(None, "rungs", Invalid::Empty).at(origin));
         }
         let (heads, next_id) = self.rung_heads();
         self.phase_end()?;
         // Pass 2: elements.
         let mut rungs = Vec::with_capacity(next_id as usize);
+        // The syntax of each ladder rung (none for rungs lowered from FBD), for the places of
+        // structural errors.
+        let mut places: Vec<Option<&syntax::Rung>> = Vec::with_capacity(next_id as usize);
         let mut pous = Vec::with_capacity(self.pous.len());
         let mut start = 0u32;
         for pou in &self.pous {
@@ -362,6 +371,7 @@ impl<'a> Builder<'a> {
                     r.pou = pou;
                     relocate_jumps(&mut r.series, offset);
                     rungs.push(r);
+                    places.push(None);
                 }
             }
             for (rid, syn, id) in pou_heads {
@@ -373,14 +383,14 @@ impl<'a> Builder<'a> {
                 let series = match self.series(&syn.ld, &ld, Place::Top, &scope) {
                     Ok(s) => s,
                     Err(e) => {
-                        let e = e.at_position(self.position(syn.origin));
-                        self.report(e);
+                        self.report(e.at(syn.origin));
                         Vec::new()
                     }
                 };
+                places.push(Some(syn));
                 rungs.push(Rung {
                     id,
-                    label: syn.label.as_ref().map(|l| l.to_string()),
+                    label: syn.label.as_ref().map(|l| l.value.to_string()),
                     comment: syn.comment.as_ref().map(|c| c.to_string()),
                     pou,
                     series,
@@ -396,7 +406,7 @@ impl<'a> Builder<'a> {
             pous,
             rungs,
         };
-        structure::check(&mut program)?;
+        structure::check(&mut program, &places)?;
         Ok(program)
     }
 
@@ -443,22 +453,21 @@ impl<'a> Builder<'a> {
                 }
             }
             for (i, r) in pou.rungs.iter().enumerate() {
-                let position = || r.origin.line_column(self.text);
                 let path = || rung_path(&pou.path, i);
                 let key: Cow<'a, str> = if pou.prefix.is_empty() {
-                    match &r.id {
+                    match &r.id.value {
                         Cow::Borrowed(s) => Cow::Borrowed(s),
                         Cow::Owned(s) => Cow::Owned(s.clone()),
                     }
                 } else {
-                    Cow::Owned(format!("{}{}", pou.prefix, r.id))
+                    Cow::Owned(format!("{}{}", pou.prefix, r.id.value))
                 };
                 let id = key.to_string();
                 if let Some(p) = &r.problem {
                     let rung = r.problem_in_rung.then_some(id.as_str());
                     let e =
                         LoadError::invalid(rung, &format!("{}{}", path(), p.at), p.kind.clone());
-                    errors.push(e.at_position(position()));
+                    errors.push(e.at(p.origin).at(r.origin));
                     continue;
                 }
                 if let Some(&first) = ids.get(key.as_ref()) {
@@ -481,7 +490,7 @@ impl<'a> Builder<'a> {
                                 first,
                             },
                         )
-                        .at_position(position()),
+                        .at(r.id.origin),
                     );
                     continue;
                 }
@@ -490,9 +499,9 @@ impl<'a> Builder<'a> {
                 next_id += 1;
                 if let Some(l) = &r.label {
                     let lp = format!("{}.label", path());
-                    if let Err(e) = check_name(l, &lp, Some(&id)) {
-                        errors.push(e.at_position(position()));
-                    } else if let Some(prev) = labels.insert(l.to_string(), rid) {
+                    if let Err(e) = check_name(l.as_str(), &lp, Some(&id)) {
+                        errors.push(e.at(l.origin));
+                    } else if let Some(prev) = labels.insert(l.value.to_string(), rid) {
                         let first = pou_heads
                             .iter()
                             .find(|h: &&RungHead| h.0 == prev)
@@ -503,12 +512,12 @@ impl<'a> Builder<'a> {
                                 Some(&id),
                                 &lp,
                                 Invalid::DuplicateLabel {
-                                    label: l.to_string(),
+                                    label: l.value.to_string(),
                                     pou: pou.name.clone(),
                                     first,
                                 },
                             )
-                            .at_position(position()),
+                            .at(l.origin),
                         );
                     }
                 }

@@ -25,7 +25,7 @@ impl<'a> Builder<'a> {
             let p = format!("{path}[{i}]");
             let r = self.declare_var(v, p, &scope, elementary);
             if let Err(e) = r {
-                self.report(e.at_position(v.origin.line_column(self.text)));
+                self.report(e.at(v.origin));
             }
         }
     }
@@ -42,11 +42,12 @@ impl<'a> Builder<'a> {
                 None,
                 &format!("{p}{}", problem.at),
                 problem.kind.clone(),
-            ));
+            )
+            .at(problem.origin));
         }
-        let name: &str = &v.name;
-        check_name(name, &format!("{p}.name"), None)?;
-        let tname: &str = &v.ty;
+        let name: &str = v.name.as_str();
+        check_name(name, &format!("{p}.name"), None).map_err(|e| e.at(v.name.origin))?;
+        let tname: &str = v.ty.as_str();
         let user_fb = Type::parse(tname).is_none() && self.fb_index.contains_key(tname);
         let ty = match Type::parse(tname) {
             Some(t) => t,
@@ -65,14 +66,16 @@ impl<'a> Builder<'a> {
                         name: tname.into(),
                         fbs,
                     },
-                ));
+                )
+                .at(v.ty.origin));
             }
             None => {
                 return Err(LoadError::invalid(
                     None,
                     &format!("{p}.type"),
                     Invalid::UnknownType { name: tname.into() },
-                ))
+                )
+                .at(v.ty.origin))
             }
         };
         if elementary && matches!(ty, Type::Fb(_)) {
@@ -84,9 +87,10 @@ impl<'a> Builder<'a> {
                     place:
                         "as an input or output of a function block (declare the instance in `vars`)",
                 },
-            ));
+            )
+            .at(v.ty.origin));
         }
-        let class = match v.class {
+        let class = match v.class.value {
             syntax::VarClass::Input => VarClass::Input,
             syntax::VarClass::Output => VarClass::Output,
             syntax::VarClass::Memory | syntax::VarClass::Default => VarClass::Memory,
@@ -99,11 +103,12 @@ impl<'a> Builder<'a> {
                     what: "an input or output class",
                     place: "on a function block instance",
                 },
-            ));
+            )
+            .at(v.class.origin));
         }
         let init = match &v.init {
             None => ty.zero(),
-            Some(_) if matches!(ty, Type::Fb(_)) => {
+            Some(j) if matches!(ty, Type::Fb(_)) => {
                 return Err(LoadError::invalid(
                     None,
                     &format!("{p}.init"),
@@ -111,30 +116,29 @@ impl<'a> Builder<'a> {
                         what: "`init`",
                         place: "on a function block instance",
                     },
-                ))
+                )
+                .at(j.origin))
             }
-            Some(j) => {
+            Some(init) => {
                 let ip = format!("{p}.init");
+                let j = &init.value;
+                let fail = |k| LoadError::invalid(None, &ip, k).at(init.origin);
                 let u = operand::parse(j, &|n| {
                     Err(Invalid::Shape {
                         expected: "a constant",
                         found: format!("name \"{n}\""),
                     })
                 })
-                .map_err(|k| LoadError::invalid(None, &ip, k))?;
+                .map_err(fail)?;
                 match operand::typed(&u, ty, "the initial value", &j.json()) {
                     Ok(Operand::Const(v)) => v,
                     Ok(Operand::Var(_)) => {
-                        return Err(LoadError::invalid(
-                            None,
-                            &ip,
-                            Invalid::Shape {
-                                expected: "a constant",
-                                found: j.kind(),
-                            },
-                        ))
+                        return Err(fail(Invalid::Shape {
+                            expected: "a constant",
+                            found: j.kind(),
+                        }))
                     }
-                    Err(k) => return Err(LoadError::invalid(None, &ip, k)),
+                    Err(k) => return Err(fail(k)),
                 }
             }
         };
@@ -150,7 +154,8 @@ impl<'a> Builder<'a> {
                 None,
                 &format!("{p}.name"),
                 Invalid::DuplicateVar { name: name.into() },
-            ));
+            )
+            .at(v.name.origin));
         }
         let display = match scope {
             None => name.to_owned(),
@@ -163,6 +168,8 @@ impl<'a> Builder<'a> {
                 display,
                 fb: tname.to_owned(),
                 path: p.clone(),
+                origin: v.origin,
+                name_origin: v.name.origin,
                 pou: None,
                 inputs: Vec::new(),
                 outputs: Vec::new(),
