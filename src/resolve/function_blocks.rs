@@ -1,8 +1,8 @@
 //! User function blocks: reading the `function_blocks` types (signatures, declarations, no
 //! recursion, bodies) and expanding each instance into its own POU.
 
+use super::table::NameTable;
 use super::util::check_name;
-use super::util::FastMap;
 use super::{Builder, FbType, PouDraft, Result};
 use crate::diag::{Invalid, LoadError, Origin};
 use crate::fbd::FbdPouKind;
@@ -20,7 +20,7 @@ impl<'a> Builder<'a> {
         let mut bodies = Vec::with_capacity(fbs.len());
         for fb in fbs {
             let path = format!("function_blocks.{}", fb.name);
-            check_name(&fb.name, &path, None).map_err(|e| e.at(fb.origin))?;
+            check_name(&fb.name, || path.clone(), None).map_err(|e| e.at(fb.origin))?;
             if Type::parse(&fb.name).is_some() {
                 return Err(LoadError::invalid(
                     None,
@@ -61,8 +61,8 @@ impl<'a> Builder<'a> {
         for f in 0..self.fb_types.len() {
             let (vars_mark, inst_mark) = (self.vars.len(), self.instances.len());
             let scratch = PouId(self.locals.len() as u32);
-            self.locals.push(FastMap::default());
-            self.local_instances.push(FastMap::default());
+            self.locals.push(NameTable::default());
+            self.local_instances.push(NameTable::default());
             let (path, prefix) = (
                 self.fb_types[f].path.clone(),
                 format!("{}.", self.fb_types[f].name),
@@ -194,8 +194,8 @@ impl<'a> Builder<'a> {
         draft.var_prefix = format!("{display}.");
         draft.callable = false;
         self.pous.push(draft);
-        self.locals.push(FastMap::default());
-        self.local_instances.push(FastMap::default());
+        self.locals.push(NameTable::default());
+        self.local_instances.push(NameTable::default());
         let mark = self.pending.len();
         let prefix = format!("{display}.");
         for (key, decl, elementary) in [

@@ -25,6 +25,7 @@ mod names;
 pub(crate) mod operand;
 mod path;
 mod structure;
+mod table;
 pub(crate) mod util;
 mod vars;
 
@@ -41,6 +42,7 @@ use util::{FastMap, FastSet};
 use elements::{Place, Scope};
 use lowering::relocate_jumps;
 use path::At;
+use table::NameTable;
 use util::{check_name, rung_path};
 
 type Result<T> = std::result::Result<T, LoadError>;
@@ -182,12 +184,12 @@ struct Builder<'a> {
     /// Display names of all variables, built when the first hidden FBD variable is made (its
     /// name must not clash).
     var_names: Option<FastSet<String>>,
-    globals: FastMap<String, VarId>,
+    globals: NameTable<VarId>,
     /// Per POU: its local variables.
-    locals: Vec<FastMap<String, VarId>>,
+    locals: Vec<NameTable<VarId>>,
     /// Program-wide and per-POU instances of user function blocks (index into `instances`).
-    global_instances: FastMap<String, usize>,
-    local_instances: Vec<FastMap<String, usize>>,
+    global_instances: NameTable<usize>,
+    local_instances: Vec<NameTable<usize>>,
     instances: Vec<InstanceDraft>,
     /// Instances declared but not yet given their POU.
     pending: Vec<usize>,
@@ -244,8 +246,11 @@ impl<'a> Builder<'a> {
         let name = syn.name.to_string();
         self.pous
             .push(PouDraft::new(name.clone(), PouKind::Main, String::new()));
-        self.locals.push(FastMap::default());
-        self.local_instances.push(FastMap::default());
+        self.locals.push(NameTable::default());
+        self.local_instances.push(NameTable::default());
+        // Sized up front: a million variables would otherwise be rehashed and moved twenty times.
+        self.globals.reserve(syn.vars.len());
+        self.vars.reserve(syn.vars.len());
         self.declare_vars(&syn.vars, "vars", None, false);
         if let Some(body) = &syn.body {
             let r = self.body(0, body, "");
@@ -253,7 +258,7 @@ impl<'a> Builder<'a> {
         }
         for sub in &syn.subroutines {
             let path = format!("subroutines.{}", sub.name);
-            let r = check_name(&sub.name, &path, None).map_err(|e| e.at(sub.origin));
+            let r = check_name(&sub.name, || path.clone(), None).map_err(|e| e.at(sub.origin));
             if self.collect(r).is_none() {
                 continue;
             }
@@ -272,8 +277,8 @@ impl<'a> Builder<'a> {
                 continue;
             }
             let pou = PouId(self.pous.len() as u32);
-            self.locals.push(FastMap::default());
-            self.local_instances.push(FastMap::default());
+            self.locals.push(NameTable::default());
+            self.local_instances.push(NameTable::default());
             self.declare_vars(
                 &sub.vars,
                 &format!("{path}.vars"),
@@ -415,7 +420,12 @@ impl<'a> Builder<'a> {
     fn rung_heads(&mut self) -> (Vec<Vec<RungHead<'a>>>, u32) {
         // Where each id was first used: (POU, index of its rung) for ladder rungs, the path of
         // lowered rungs; rendered only for a duplicate.
+        let total = self
+            .pous
+            .iter()
+            .map(|p| p.rungs.len() + p.lowered.as_ref().map_or(0, Vec::len));
         let mut ids: FastMap<Cow<'a, str>, (usize, Option<usize>)> = FastMap::default();
+        ids.reserve(total.sum());
         let first_path = |pous: &[PouDraft], (pou, i): (usize, Option<usize>)| match i {
             Some(i) => rung_path(&pous[pou].path, i),
             None => String::new(),
@@ -499,7 +509,7 @@ impl<'a> Builder<'a> {
                 next_id += 1;
                 if let Some(l) = &r.label {
                     let lp = format!("{}.label", path());
-                    if let Err(e) = check_name(l.as_str(), &lp, Some(&id)) {
+                    if let Err(e) = check_name(l.as_str(), || lp.clone(), Some(&id)) {
                         errors.push(e.at(l.origin));
                     } else if let Some(prev) = labels.insert(l.value.to_string(), rid) {
                         let first = pou_heads

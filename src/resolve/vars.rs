@@ -22,8 +22,9 @@ impl<'a> Builder<'a> {
         elementary: bool,
     ) {
         for (i, v) in vars.iter().enumerate() {
-            let p = format!("{path}[{i}]");
-            let r = self.declare_var(v, p, &scope, elementary);
+            // The declaration's path, rendered only for an error.
+            let p = || format!("{path}[{i}]");
+            let r = self.declare_var(v, &p, &scope, elementary);
             if let Err(e) = r {
                 self.report(e.at(v.origin));
             }
@@ -33,20 +34,20 @@ impl<'a> Builder<'a> {
     fn declare_var(
         &mut self,
         v: &syntax::Var,
-        p: String,
+        p: &dyn Fn() -> String,
         scope: &Option<(PouId, String)>,
         elementary: bool,
     ) -> Result<()> {
         if let Some(problem) = &v.problem {
             return Err(LoadError::invalid(
                 None,
-                &format!("{p}{}", problem.at),
+                &format!("{}{}", p(), problem.at),
                 problem.kind.clone(),
             )
             .at(problem.origin));
         }
         let name: &str = v.name.as_str();
-        check_name(name, &format!("{p}.name"), None).map_err(|e| e.at(v.name.origin))?;
+        check_name(name, || format!("{}.name", p()), None).map_err(|e| e.at(v.name.origin))?;
         let tname: &str = v.ty.as_str();
         let user_fb = Type::parse(tname).is_none() && self.fb_index.contains_key(tname);
         let ty = match Type::parse(tname) {
@@ -61,7 +62,7 @@ impl<'a> Builder<'a> {
                     .join(", ");
                 return Err(LoadError::invalid(
                     None,
-                    &format!("{p}.type"),
+                    &format!("{}.type", p()),
                     Invalid::UnknownTypeOrFb {
                         name: tname.into(),
                         fbs,
@@ -72,7 +73,7 @@ impl<'a> Builder<'a> {
             None => {
                 return Err(LoadError::invalid(
                     None,
-                    &format!("{p}.type"),
+                    &format!("{}.type", p()),
                     Invalid::UnknownType { name: tname.into() },
                 )
                 .at(v.ty.origin))
@@ -81,7 +82,7 @@ impl<'a> Builder<'a> {
         if elementary && matches!(ty, Type::Fb(_)) {
             return Err(LoadError::invalid(
                 None,
-                &format!("{p}.type"),
+                &format!("{}.type", p()),
                 Invalid::Misplaced {
                     what: "a function block type",
                     place:
@@ -98,7 +99,7 @@ impl<'a> Builder<'a> {
         if matches!(ty, Type::Fb(_)) && class != VarClass::Memory {
             return Err(LoadError::invalid(
                 None,
-                &format!("{p}.class"),
+                &format!("{}.class", p()),
                 Invalid::Misplaced {
                     what: "an input or output class",
                     place: "on a function block instance",
@@ -111,7 +112,7 @@ impl<'a> Builder<'a> {
             Some(j) if matches!(ty, Type::Fb(_)) => {
                 return Err(LoadError::invalid(
                     None,
-                    &format!("{p}.init"),
+                    &format!("{}.init", p()),
                     Invalid::Misplaced {
                         what: "`init`",
                         place: "on a function block instance",
@@ -120,7 +121,7 @@ impl<'a> Builder<'a> {
                 .at(j.origin))
             }
             Some(init) => {
-                let ip = format!("{p}.init");
+                let ip = format!("{}.init", p());
                 let j = &init.value;
                 let fail = |k| LoadError::invalid(None, &ip, k).at(init.origin);
                 let u = operand::parse(j, &|n| {
@@ -152,7 +153,7 @@ impl<'a> Builder<'a> {
         if table.contains_key(name) || instances.contains_key(name) {
             return Err(LoadError::invalid(
                 None,
-                &format!("{p}.name"),
+                &format!("{}.name", p()),
                 Invalid::DuplicateVar { name: name.into() },
             )
             .at(v.name.origin));
@@ -163,11 +164,11 @@ impl<'a> Builder<'a> {
         };
         if user_fb {
             let idx = self.instances.len();
-            instances.insert(name.to_owned(), idx);
+            instances.insert(name, idx);
             self.instances.push(InstanceDraft {
                 display,
                 fb: tname.to_owned(),
-                path: p.clone(),
+                path: p(),
                 origin: v.origin,
                 name_origin: v.name.origin,
                 pou: None,
@@ -178,7 +179,7 @@ impl<'a> Builder<'a> {
             return Ok(());
         }
         let id = VarId(self.vars.len() as u32);
-        table.insert(name.to_owned(), id);
+        table.insert(name, id);
         self.vars.push(Var {
             name: display,
             ty,

@@ -69,6 +69,11 @@ impl<'a> Cursor<'a> {
         &self.text[start..self.pos]
     }
 
+    /// Bytes of text after the cursor.
+    pub(super) fn remaining(&self) -> usize {
+        self.text.len() - self.pos
+    }
+
     pub(super) fn offset(&mut self) -> usize {
         self.peek();
         self.pos
