@@ -353,9 +353,10 @@ impl<'a> Builder<'a> {
         self.phase_end()?;
         // Pass 2: elements.
         let mut rungs = Vec::with_capacity(next_id as usize);
-        // The syntax of each ladder rung (none for rungs lowered from FBD), for the places of
-        // structural errors.
-        let mut places: Vec<Option<&syntax::Rung>> = Vec::with_capacity(next_id as usize);
+        // The syntax of each ladder rung and where it is (none for rungs lowered from FBD), for
+        // the paths and places of structural errors.
+        let pou_paths: Vec<String> = self.pous.iter().map(|p| p.path.clone()).collect();
+        let mut places: Vec<Option<structure::Place>> = Vec::with_capacity(next_id as usize);
         let mut pous = Vec::with_capacity(self.pous.len());
         let mut start = 0u32;
         for pou in &self.pous {
@@ -380,10 +381,10 @@ impl<'a> Builder<'a> {
                 }
             }
             for (rid, syn, id) in pou_heads {
-                let path = rung_path(&self.pous[pi].path, (rid.0 - pous[pi].rungs.start) as usize);
+                let index = (rid.0 - pous[pi].rungs.start) as usize;
                 self.edge_count = 0;
                 let scope = Scope { pou, rung_id: &id };
-                let base = At::base(&path);
+                let base = At::rung(&pou_paths[pi], index);
                 let ld = base.key("ld");
                 let series = match self.series(&syn.ld, &ld, Place::Top, &scope) {
                     Ok(s) => s,
@@ -392,14 +393,18 @@ impl<'a> Builder<'a> {
                         Vec::new()
                     }
                 };
-                places.push(Some(syn));
+                places.push(Some(structure::Place {
+                    rung: syn,
+                    pou_path: &pou_paths[pi],
+                    index,
+                }));
                 rungs.push(Rung {
                     id,
                     label: syn.label.as_ref().map(|l| l.value.to_string()),
                     comment: syn.comment.as_ref().map(|c| c.to_string()),
                     pou,
                     series,
-                    path,
+                    block_path: None,
                     network: None,
                 });
             }
@@ -445,13 +450,13 @@ impl<'a> Builder<'a> {
                                 .iter()
                                 .flatten()
                                 .find(|x| x.id == r.id)
-                                .map(|x| x.path.clone())
+                                .and_then(|x| x.block_path.clone())
                                 .unwrap_or_default(),
                             other => first_path(&self.pous, other),
                         };
                         errors.push(LoadError::invalid(
                             Some(&r.id),
-                            &r.path,
+                            r.block_path.as_deref().unwrap_or_default(),
                             Invalid::DuplicateRung {
                                 id: r.id.clone(),
                                 first,
@@ -487,7 +492,7 @@ impl<'a> Builder<'a> {
                             .iter()
                             .flatten()
                             .find(|x| x.id == id)
-                            .map(|x| x.path.clone())
+                            .and_then(|x| x.block_path.clone())
                             .unwrap_or_default(),
                         other => first_path(&self.pous, other),
                     };

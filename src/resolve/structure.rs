@@ -10,13 +10,21 @@ use crate::diag::{Invalid, LoadError, Origin};
 use crate::model::*;
 use crate::syntax;
 
-/// The syntax of each rung (by [`RungId`]; none for rungs lowered from FBD), for the places of
-/// errors.
-type Places<'s, 'a> = &'s [Option<&'a syntax::Rung<'a>>];
+/// A ladder rung's syntax and where it is: rung `index` of the POU whose rung array is at
+/// `pou_path`.
+pub(super) struct Place<'s> {
+    pub(super) rung: &'s syntax::Rung<'s>,
+    pub(super) pou_path: &'s str,
+    pub(super) index: usize,
+}
+
+/// The place of each rung (by [`RungId`]; none for rungs lowered from FBD, whose block path the
+/// model keeps).
+type Places<'s> = &'s [Option<Place<'s>>];
 
 /// Where an error about rung `r` points: its series (`None`) or its element `i`.
 fn place(places: Places, r: RungId, element: Option<usize>) -> Origin {
-    let Some(Some(rung)) = places.get(r.index()) else {
+    let Some(Some(Place { rung, .. })) = places.get(r.index()) else {
         return Origin::NONE;
     };
     let inner = match element {
@@ -30,11 +38,11 @@ fn place(places: Places, r: RungId, element: Option<usize>) -> Origin {
 /// recursive call chain); jumps are checked only when the loops pair.
 pub(crate) fn check(p: &mut Program, places: Places) -> Result<(), LoadError> {
     let mut errors = Vec::new();
-    pair_loops(p, &mut errors);
+    pair_loops(p, places, &mut errors);
     if errors.is_empty() {
-        check_jumps(p, &mut errors);
+        check_jumps(p, places, &mut errors);
     }
-    if let Err(e) = check_recursion(p) {
+    if let Err(e) = check_recursion(p, places) {
         errors.push(e);
     }
     // Each error names its rung and, by its path, the series or an element of it.
@@ -56,13 +64,18 @@ pub(crate) fn check(p: &mut Program, places: Places) -> Result<(), LoadError> {
 /// An error of rung `r` at its series (`element` none) or at one of its top-level elements.
 type Located = (RungId, Option<usize>, LoadError);
 
-fn err(p: &Program, r: RungId, element: Option<usize>, kind: Invalid) -> Located {
+fn err(p: &Program, places: Places, r: RungId, element: Option<usize>, kind: Invalid) -> Located {
     let rung = p.rung(r);
+    let base = match (places.get(r.index()), &rung.block_path) {
+        (Some(Some(at)), _) => super::util::rung_path(at.pou_path, at.index),
+        (_, Some(block)) => block.clone(),
+        (_, None) => String::new(),
+    };
     let suffix = match element {
         None => ".ld".to_owned(),
         Some(i) => format!(".ld[{i}]"),
     };
-    let e = LoadError::invalid(Some(&rung.id), &format!("{}{suffix}", rung.path), kind);
+    let e = LoadError::invalid(Some(&rung.id), &format!("{base}{suffix}"), kind);
     (r, element, e)
 }
 
@@ -70,7 +83,7 @@ fn last_top(rung: &Rung) -> Option<&Element> {
     rung.series.last()
 }
 
-fn pair_loops(p: &mut Program, errors: &mut Vec<Located>) {
+fn pair_loops(p: &mut Program, places: Places, errors: &mut Vec<Located>) {
     for pou in 0..p.pous.len() {
         let mut stack: Vec<RungId> = Vec::new();
         for r in p.pou_rungs(PouId(pou as u32)) {
@@ -78,7 +91,7 @@ fn pair_loops(p: &mut Program, errors: &mut Vec<Located>) {
                 Some(Element::For { .. }) => stack.push(r),
                 Some(Element::Next { .. }) => {
                     let Some(head) = stack.pop() else {
-                        errors.push(err(p, r, Some(0), Invalid::NextWithoutFor));
+                        errors.push(err(p, places, r, Some(0), Invalid::NextWithoutFor));
                         continue;
                     };
                     if let Some(Element::Next { head: h }) = p.rungs[r.index()].series.last_mut() {
@@ -97,6 +110,7 @@ fn pair_loops(p: &mut Program, errors: &mut Vec<Located>) {
             let n = p.rung(head).series.len();
             errors.push(err(
                 p,
+                places,
                 head,
                 Some(n.saturating_sub(1)),
                 Invalid::ForWithoutNext,
@@ -106,7 +120,7 @@ fn pair_loops(p: &mut Program, errors: &mut Vec<Located>) {
 }
 
 /// Jumps may leave loop bodies but not enter them.
-fn check_jumps(p: &Program, errors: &mut Vec<Located>) {
+fn check_jumps(p: &Program, places: Places, errors: &mut Vec<Located>) {
     // body[r] = innermost FOR head whose body (head+1 ..= next) holds r.
     let mut body: Vec<Option<RungId>> = vec![None; p.rungs.len()];
     for r in p.rung_ids() {
@@ -144,6 +158,7 @@ fn check_jumps(p: &Program, errors: &mut Vec<Located>) {
         if let Some((label, head)) = bad {
             errors.push(err(
                 p,
+                places,
                 r,
                 None,
                 Invalid::JumpIntoLoop {
@@ -155,7 +170,7 @@ fn check_jumps(p: &Program, errors: &mut Vec<Located>) {
     }
 }
 
-fn check_recursion(p: &Program) -> Result<(), Located> {
+fn check_recursion(p: &Program, places: Places) -> Result<(), Located> {
     // Callees per POU, with the rung that makes the call.
     let mut calls: Vec<Vec<(PouId, RungId)>> = vec![Vec::new(); p.pous.len()];
     for r in p.rung_ids() {
@@ -200,6 +215,7 @@ fn check_recursion(p: &Program) -> Result<(), Located> {
                         chain.push(&p.pou(callee).name);
                         return Err(err(
                             p,
+                            places,
                             rung,
                             None,
                             Invalid::Recursion {
