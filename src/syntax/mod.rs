@@ -191,7 +191,8 @@ pub struct Var<'a> {
     pub ty: Name<'a>,
     /// The class, with the origin of its value (none when absent).
     pub class: Located<VarClass>,
-    pub init: Option<Operand<'a>>,
+    /// Boxed: most declarations have none, and a million of them are read.
+    pub init: Option<Box<Operand<'a>>>,
     /// Something malformed in the declaration (then the fields may be defaults).
     pub problem: Option<Box<Problem>>,
 }
@@ -211,7 +212,8 @@ pub enum VarClass {
 pub struct Rung<'a> {
     pub origin: Origin,
     pub id: Name<'a>,
-    pub label: Option<Name<'a>>,
+    /// Boxed: few rungs have one.
+    pub label: Option<Box<Name<'a>>>,
     pub comment: Option<Text<'a>>,
     pub ld: Series<'a>,
     /// Where the series (`ld`) starts.
@@ -341,5 +343,7 @@ impl<'a> ElementKind<'a> {
     }
 }
 
-// The common elements stay small: a million-rung program holds millions of them.
+// The common nodes stay small: a million-rung program holds millions of them.
 const _: () = assert!(std::mem::size_of::<Element>() <= 48);
+const _: () = assert!(std::mem::size_of::<Rung>() <= 112);
+const _: () = assert!(std::mem::size_of::<Var>() <= 96);

@@ -128,10 +128,10 @@ impl<'a> Reader<'a> {
         match label {
             None => {}
             Some((Scalar::Str(s), o)) => {
-                r.label = Some(Located {
+                r.label = Some(Box::new(Located {
                     value: s,
                     origin: o,
-                })
+                }))
             }
             Some((other, o)) => fail(problem(".label", o, "a string", &other), true),
         }

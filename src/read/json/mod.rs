@@ -469,10 +469,10 @@ impl<'a> Reader<'a> {
                 "type" => ty = Some((self.c.scalar()?, at)),
                 "class" => class = Some((self.c.scalar()?, at)),
                 "init" => {
-                    var.init = Some(Located {
+                    var.init = Some(Box::new(Located {
                         value: self.c.scalar()?,
                         origin: at,
-                    })
+                    }))
                 }
                 "comment" => self.c.skip()?,
                 _ => {
