@@ -3,7 +3,7 @@
 //!
 //! Target: at least 100 MB/s of program JSON, parse and resolve together. `cargo bench --bench
 //! load`; the `parse` group times the reader alone. The programs are generated in-process
-//! (`plc_deps::gen`) with every knob on, so the timers, loops, jumps and calls are read too.
+//! (`plc_deps::synth`) with every knob on, so the timers, loops, jumps and calls are read too.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use plc_deps::synth::{generate_string, GenConfig};
@@ -12,16 +12,7 @@ use plc_deps::synth::{generate_string, GenConfig};
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 fn text(rungs: usize) -> String {
-    generate_string(&GenConfig {
-        rungs,
-        width: 5000,
-        seed: 42,
-        timers: true,
-        loops: true,
-        jumps: true,
-        calls: true,
-        ..GenConfig::default()
-    })
+    generate_string(&GenConfig::all_features(rungs, 5000, 42))
 }
 
 fn load(c: &mut Criterion) {

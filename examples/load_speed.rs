@@ -1,7 +1,8 @@
 //! Load speed and memory of the reader and resolver alone, on a file:
-//! `cargo run --release --example load_speed -- /tmp/g1m.json 3` (run the built example under
-//! `/usr/bin/time -v` for the peak memory), after
-//! `plc-deps gen --rungs 1000000 --width 5000 -o /tmp/g1m.json`.
+//! `cargo run --release --example load_speed -- /tmp/g1m.json 3`, after
+//! `plc-deps gen --rungs 1000000 --width 5000 -o /tmp/g1m.json`. On Linux it also prints the
+//! peak resident memory (VmHWM) after the text is read, after the first parse and after the first
+//! load, so that what the syntax tree and the model cost beyond the text can be read off.
 
 // The command line's allocator, so that the figures are the command line's.
 #[global_allocator]
@@ -17,12 +18,19 @@ fn main() {
     };
     let text = std::fs::read_to_string(&path).expect("read the file");
     let runs: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(1);
-    for _ in 0..runs {
+    let mut peaks = vec![("text", peak_mb())];
+    for run in 0..runs {
         let t = Instant::now();
         let syntax = plc_deps::read::json::parse(&text).expect("parses");
         let parsed = t.elapsed();
+        if run == 0 {
+            peaks.push(("parsed", peak_mb()));
+        }
         let (p, _) = plc_deps::resolve::resolve(&text, &syntax).expect("resolves");
         let total = t.elapsed();
+        if run == 0 {
+            peaks.push(("loaded", peak_mb()));
+        }
         drop(syntax);
         let mb = text.len() as f64 / 1e6;
         eprintln!(
@@ -32,4 +40,19 @@ fn main() {
         );
         drop(p);
     }
+    let peaks: Vec<String> = peaks
+        .iter()
+        .filter_map(|(at, mb)| Some(format!("{at} {:.0} MB", (*mb)?)))
+        .collect();
+    if !peaks.is_empty() {
+        eprintln!("peak resident memory: {}", peaks.join(", "));
+    }
+}
+
+/// The peak resident memory so far (Linux: VmHWM of /proc/self/status), in MB.
+fn peak_mb() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb / 1000.0)
 }

@@ -24,15 +24,68 @@ fn several_errors_come_in_program_order_each_located() {
     );
     assert_eq!(
         e.in_file("p.json").to_string().lines().nth(1),
-        Some("error: p.json: rung R2 at rungs[1].ld[1].coil: undefined variable `Y`")
+        Some("error: p.json:3:56: rung R2 at rungs[1].ld[1].coil: undefined variable `Y`")
     );
     let d = &e.diagnostics()[0];
     assert_eq!(d.code(), "E0204");
-    assert_eq!(
-        d.location.position,
-        Some((2, 9)),
-        "line and column of rung R1"
-    );
+    // The most precise node: the operand `"X"`, the coil's `"Y"`, the unknown key `"negate"`.
+    let positions: Vec<_> = e
+        .diagnostics()
+        .iter()
+        .map(|d| d.location.position)
+        .collect();
+    assert_eq!(positions, [Some((2, 41)), Some((3, 56)), Some((4, 46))]);
+}
+
+/// Every kind of node an error can name gives its own line and column: a variable's fields, a
+/// rung's id and label, an element, an operand inside a branch, a FOR's fields, a subroutine.
+#[test]
+fn every_error_points_at_its_most_precise_node() {
+    let cases: &[(&str, &str)] = &[
+        (
+            r#"{"program": "p", "vars": [
+  {"name": "A", "type": "WORD"}], "rungs": [{"id": "R1", "ld": [{"ret": true}]}]}"#,
+            "p.json:2:25: at vars[0].type: unknown type `WORD`",
+        ),
+        (
+            r#"{"program": "p", "vars": [{"name": "A", "type": "BOOL", "init": 7}],
+ "rungs": [{"id": "R1", "ld": [{"ret": true}]}]}"#,
+            "p.json:1:65: at vars[0].init: the initial value needs BOOL, but `7` is a number",
+        ),
+        (
+            r#"{"program": "p", "rungs": [{"id": "R1", "ld": [{"ret": true}]},
+  {"id": "R1", "ld": [{"ret": true}]}]}"#,
+            "p.json:2:10: rung R1 at rungs[1].id: rung id `R1` is used twice",
+        ),
+        (
+            r#"{"program": "p", "rungs": [{"id": "R1", "label": "9x", "ld": [{"ret": true}]}]}"#,
+            "p.json:1:50: rung R1 at rungs[0].label: `9x` is not a valid name",
+        ),
+        (
+            r#"{"program": "p", "vars": [{"name": "A", "type": "BOOL"}], "rungs": [
+  {"id": "R1", "ld": [{"or": [[{"contact": "A"}], [{"coil": "A"}]]}]}]}"#,
+            "p.json:2:52: rung R1 at rungs[0].ld[0].or[1][0]: this element is not allowed inside `or`",
+        ),
+        (
+            r#"{"program": "p", "vars": [{"name": "B", "type": "BOOL"}], "rungs": [
+  {"id": "R1", "ld": [{"for": {"var": "B", "from": 1, "to": 2}}]},
+  {"id": "R2", "ld": [{"next": true}]}]}"#,
+            "p.json:2:39: rung R1 at rungs[0].ld[0].for.var: a FOR index needs INT or DINT",
+        ),
+        (
+            r#"{"program": "p", "rungs": [{"id": "R1", "ld": [{"ret": true}]}],
+ "subroutines": {"1S": {"rungs": [{"id": "S", "ld": [{"ret": true}]}]}}}"#,
+            "p.json:2:24: at subroutines.1S: `1S` is not a valid name",
+        ),
+        (
+            r#"{"program": "p", "rungs": [{"id": "R1", "ld": [{"contact": 5, "x": 1}]}]}"#,
+            "p.json:1:63: rung R1 at rungs[0].ld[0].x: unknown field `x` in a contact",
+        ),
+    ];
+    for (text, want) in cases {
+        let got = err(text).in_file("p.json").to_string();
+        assert!(got.starts_with(want), "{got}\n  wanted {want}");
+    }
 }
 
 #[test]

@@ -1,11 +1,12 @@
 //! Load errors: what can be wrong with a program file, and where.
 //!
 //! Errors are data: a [`LoadError`] carries one or more [`Diagnostic`]s (each a [`Location`] —
-//! rung id and JSON path, network and block — and an [`Invalid`] kind), or line and column for
-//! syntax errors; rendering happens only in `Display`, in one place per kind. The file name is
-//! not part of the error: the caller that opened the file adds it ([`LoadError::in_file`]).
+//! rung id and JSON path, network and block, the [`Origin`] of the most precise node — and an
+//! [`Invalid`] kind), or line and column for syntax errors; rendering happens only in `Display`,
+//! in one place per kind. The file name is not part of the error: the caller that opened the file
+//! adds it ([`LoadError::in_file`]), and with it the line and column ([`LoadError::locate`]).
 
-use super::Diagnostic;
+use super::{origin, Diagnostic, Origin};
 use std::fmt;
 
 /// The op names of the FBD format, as the unknown-op message lists them (re-exported by
@@ -21,8 +22,11 @@ pub struct Location {
     pub path: String,
     /// For an error in an FBD network: the network id and, if the error is in a block, its id.
     pub network: Option<(String, Option<u32>)>,
-    /// Line and column (1-based) in the file of the innermost node that knows them (a rung, a
-    /// variable, a network, a block); not part of `Display`, which stays the path.
+    /// Where the most precise node the error names starts in the text (an operand, an element,
+    /// a field, a variable, a rung, an FBD body).
+    pub origin: Origin,
+    /// Line and column (1-based) of `origin`, once [`LoadError::locate`] has computed them; not
+    /// part of `Display` (which stays the path), but of [`LoadError::in_file`].
     pub position: Option<(u32, u32)>,
 }
 
@@ -242,6 +246,7 @@ impl LoadError {
                 rung: rung.map(str::to_owned),
                 path: path.to_owned(),
                 network: None,
+                origin: Origin::NONE,
                 position: None,
             },
             kind,
@@ -255,6 +260,7 @@ impl LoadError {
                 rung: None,
                 path: path.to_owned(),
                 network: Some((network.to_owned(), block)),
+                origin: Origin::NONE,
                 position: None,
             },
             kind,
@@ -288,19 +294,39 @@ impl LoadError {
         }
     }
 
-    /// Renders every problem as `FILE:LINE:COLUMN: message` (syntax) or `FILE: LOCATION: message`,
-    /// one per line, each line after the first prefixed `error: ` like the first one is by the
-    /// command line.
+    /// Renders every problem as `FILE:LINE:COLUMN: message` (syntax), `FILE:LINE:COLUMN:
+    /// LOCATION: message` (located, see [`LoadError::locate`]) or `FILE: LOCATION: message`, one
+    /// per line, each line after the first prefixed `error: ` like the first one is by the command
+    /// line.
     pub fn in_file<'e>(&'e self, file: &'e str) -> impl fmt::Display + 'e {
         InFile { error: self, file }
     }
 
-    /// Adds the line and column of the node the error is in, where it has none yet.
-    pub(crate) fn at_position(mut self, position: Option<(u32, u32)>) -> LoadError {
-        if let LoadError::Invalid(d) = &mut self {
-            if d.location.position.is_none() {
-                d.location.position = position;
-            }
+    /// Gives each problem the origin of the node it is in, where it has none yet (so the
+    /// innermost node that knows its place wins).
+    pub(crate) fn at(mut self, origin: Origin) -> LoadError {
+        let ds: &mut [Diagnostic] = match &mut self {
+            LoadError::Syntax { .. } => return self,
+            LoadError::Invalid(d) => std::slice::from_mut(&mut **d),
+            LoadError::Several(ds) => ds,
+        };
+        for d in ds {
+            d.location.origin = d.location.origin.or(origin);
+        }
+        self
+    }
+
+    /// Computes the line and column of every diagnostic's origin in `text` (the text the
+    /// origins are offsets into), in one pass.
+    pub fn locate(mut self, text: &str) -> LoadError {
+        let ds: &mut [Diagnostic] = match &mut self {
+            LoadError::Syntax { .. } => return self,
+            LoadError::Invalid(d) => std::slice::from_mut(&mut **d),
+            LoadError::Several(ds) => ds,
+        };
+        let origins: Vec<Origin> = ds.iter().map(|d| d.location.origin).collect();
+        for (d, p) in ds.iter_mut().zip(origin::line_columns(text, &origins)) {
+            d.location.position = d.location.position.or(p);
         }
         self
     }
@@ -320,7 +346,10 @@ impl fmt::Display for InFile<'_> {
                     if i > 0 {
                         write!(f, "\nerror: ")?;
                     }
-                    write!(f, "{}: {d}", self.file)?;
+                    match d.location.position {
+                        Some((line, column)) => write!(f, "{}:{line}:{column}: {d}", self.file)?,
+                        None => write!(f, "{}: {d}", self.file)?,
+                    }
                 }
                 Ok(())
             }
@@ -354,5 +383,23 @@ mod tests {
             message: "expected `,`".into(),
         };
         assert_eq!(e.to_string(), "3:7: expected `,`");
+    }
+
+    #[test]
+    fn a_located_error_starts_with_line_and_column_in_its_file() {
+        let text = "{\n  \"rungs\": [\n    {\"id\": \"R1\"}]}";
+        let e = LoadError::invalid(Some("R1"), "rungs[0]", Invalid::Empty)
+            .at(Origin::at(19))
+            .at(Origin::at(0))
+            .locate(text);
+        assert_eq!(e.diagnostics()[0].location.position, Some((3, 5)));
+        assert_eq!(
+            e.in_file("p.json").to_string(),
+            "p.json:3:5: rung R1 at rungs[0]: the program has no rungs"
+        );
+        assert_eq!(
+            e.to_string(),
+            "rung R1 at rungs[0]: the program has no rungs"
+        );
     }
 }

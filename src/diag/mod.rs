@@ -5,12 +5,18 @@
 //! [`MAX_ERRORS`]). A diagnostic is data — a stable code (`E0101`), a severity, the [`Location`]
 //! (rung id, network and block, JSON path, and line and column where the reader knew them), the
 //! [`Invalid`] kind and an optional hint — and is rendered only by `Display`, so the message of
-//! each kind is written in one place. It deliberately knows nothing about files: the caller that
-//! opened the file adds its name ([`LoadError::in_file`]).
+//! each kind is written in one place. Where in the text a problem is, is an [`Origin`] (a byte
+//! offset of the most precise node the producer knew); line and column are computed from the
+//! offsets only when the errors are final ([`LoadError::locate`], one pass over the text for all
+//! of them), so a program that loads pays nothing for them. It deliberately knows nothing about
+//! files: the caller that opened the file adds its name ([`LoadError::in_file`]), and that
+//! rendering (`FILE:LINE:COLUMN: LOCATION: message`) is the only one with line and column.
 
 mod error;
+mod origin;
 
 pub use error::{Invalid, LoadError, Location, OP_NAMES};
+pub use origin::Origin;
 
 use std::fmt;
 

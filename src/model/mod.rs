@@ -107,8 +107,10 @@ pub struct Rung {
     pub comment: Option<String>,
     pub pou: PouId,
     pub series: Series,
-    /// The JSON path of this rung in its file (`rungs[3]`, `subroutines.SBR_0.rungs[0]`).
-    pub path: String,
+    /// For a rung lowered from an FBD block (or a fragment guard of it): the JSON path of what
+    /// it was lowered from (`fbd.networks[0].blocks[2]`). Ladder rungs have none: the resolver
+    /// renders their path (`rungs[3]`) from where they are, only when an error names them.
+    pub block_path: Option<String>,
     /// For a rung lowered from an FBD block (or a fragment guard of it): the id of its network.
     /// The rungs of one network are contiguous.
     pub network: Option<String>,

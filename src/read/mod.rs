@@ -2,9 +2,11 @@
 //! ([`crate::resolve`]) one resolved [`crate::model::Program`] out.
 //!
 //! Only the JSON program format (docs/format.md, docs/fbd.md) exists so far ([`json`]): it
-//! streams the text into the syntax types (syntax errors carry line and column; a byte-order
-//! mark is skipped), the resolver checks and resolves everything else (those errors carry the
-//! rung id and JSON path). Nothing is half-built: a program either loads whole or not at all.
+//! reads the text into the syntax types in one pass (syntax errors carry line and column; a
+//! byte-order mark is skipped), the resolver checks and resolves everything else (those errors
+//! carry the rung id, the JSON path and the byte offset of the most precise node, whose line and
+//! column are computed once the load has failed). Nothing is half-built: a program either loads
+//! whole or not at all.
 
 pub mod json;
 

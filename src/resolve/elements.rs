@@ -5,7 +5,7 @@
 use super::path::At;
 use super::util::expect_type;
 use super::{Builder, Result};
-use crate::diag::{Invalid, LoadError};
+use crate::diag::{Invalid, LoadError, Origin};
 use crate::model::*;
 use crate::syntax::{self, Edge};
 
@@ -41,7 +41,8 @@ impl<'a> Builder<'a> {
                     Some(s.rung_id),
                     &p.with(""),
                     Invalid::Misplaced { what, place },
-                ))
+                )
+                .at(item.origin))
             };
             // Placement first only where the old element had no errors of its own to report.
             let e = self.element(item, &p, s)?;
@@ -83,22 +84,30 @@ impl<'a> Builder<'a> {
     }
 
     pub(super) fn element(&mut self, e: &syntax::Element, at: &At, s: &Scope) -> Result<Element> {
-        use syntax::Element as S;
+        use syntax::ElementKind as S;
         let rid = Some(s.rung_id);
-        let err =
-            |k: &str, kind: Invalid| LoadError::invalid(rid, &at.with(&format!(".{k}")), kind);
+        let err = |k: &str, origin: Origin, kind: Invalid| {
+            LoadError::invalid(rid, &at.with(&format!(".{k}")), kind).at(origin)
+        };
         let key = |k: &'static str| at.key(k);
-        Ok(match e {
-            S::Invalid(p) => return Err(LoadError::invalid(rid, &at.with(&p.at), p.kind.clone())),
-            S::Contact { var, negated, edge } => {
-                let (var, ty) = self.var_ref(var, &key("contact"), s)?;
+        Ok(match &e.kind {
+            S::Invalid(p) => {
+                let err = LoadError::invalid(rid, &at.with(&p.at), p.kind.clone());
+                return Err(err.at(p.origin).at(e.origin));
+            }
+            S::Contact {
+                var: name,
+                negated,
+                edge,
+            } => {
+                let (var, ty) = self.var_ref(name, &key("contact"), s)?;
                 expect_type(
                     ty,
                     Type::Bool,
                     "a contact",
                     &self.vars[var.var.index()].name,
                 )
-                .map_err(|k| err("contact", k))?;
+                .map_err(|k| err("contact", name.origin, k))?;
                 let kind = match (edge, negated) {
                     (None, true) => ContactKind::Negated,
                     (None, false) => ContactKind::Normal,
@@ -172,18 +181,19 @@ impl<'a> Builder<'a> {
             S::Arith(x) => self.arith(x.op, &x.a, &x.b, &x.out, at, s)?,
             S::Jmp(label) => {
                 let target = *self.labels[s.pou.index()]
-                    .get(label.as_ref())
+                    .get(label.as_str())
                     .ok_or_else(|| {
                         err(
                             "jmp",
+                            label.origin,
                             Invalid::UndefinedLabel {
-                                label: label.to_string(),
+                                label: label.value.to_string(),
                                 pou: self.pous[s.pou.index()].name.clone(),
                             },
                         )
                     })?;
                 Element::Jmp {
-                    label: label.to_string(),
+                    label: label.value.to_string(),
                     target,
                 }
             }
@@ -192,6 +202,7 @@ impl<'a> Builder<'a> {
                 if s.pou != PouId(0) {
                     return Err(err(
                         "end",
+                        e.origin,
                         Invalid::Misplaced {
                             what: "`end`",
                             place: "in a subroutine (use `ret`)",
@@ -206,12 +217,15 @@ impl<'a> Builder<'a> {
                 let pou = self
                     .pous
                     .iter()
-                    .position(|p| p.kind == PouKind::Subroutine && p.callable && p.name == *name)
+                    .position(|p| {
+                        p.kind == PouKind::Subroutine && p.callable && p.name == name.as_str()
+                    })
                     .ok_or_else(|| {
                         err(
                             "call",
+                            name.origin,
                             Invalid::UndefinedSubroutine {
-                                name: name.to_string(),
+                                name: name.value.to_string(),
                             },
                         )
                     })?;
@@ -220,9 +234,9 @@ impl<'a> Builder<'a> {
                 }
             }
             S::For(f) => {
-                let (var, from, to) = (&f.var, &f.from, &f.to);
+                let (name, from, to) = (&f.var, &f.from, &f.to);
                 let fp = key("for");
-                let var = self.writable(var, &fp.key("var"), s, "a FOR", None)?;
+                let var = self.writable(name, &fp.key("var"), s, "a FOR", None)?;
                 let ty = self.vars[var.index()].ty;
                 if !matches!(ty, Type::Int | Type::Dint) {
                     return Err(LoadError::invalid(
@@ -234,7 +248,8 @@ impl<'a> Builder<'a> {
                             operand: self.vars[var.index()].name.clone(),
                             found: ty.to_string(),
                         },
-                    ));
+                    )
+                    .at(name.origin));
                 }
                 let from = self.operand_of(from, &fp.key("from"), s, ty, "a FOR bound")?;
                 let to = self.operand_of(to, &fp.key("to"), s, ty, "a FOR bound")?;
@@ -252,13 +267,13 @@ impl<'a> Builder<'a> {
     fn arith(
         &mut self,
         op: ArithOp,
-        a: &syntax::Scalar,
-        b: &syntax::Scalar,
-        out: &str,
+        a: &syntax::Operand,
+        b: &syntax::Operand,
+        name: &syntax::Name,
         at: &At,
         s: &Scope,
     ) -> Result<Element> {
-        let out = self.writable(out, &at.key("out"), s, "an arithmetic box", None)?;
+        let out = self.writable(name, &at.key("out"), s, "an arithmetic box", None)?;
         let ty = self.vars[out.index()].ty;
         let ok = match op {
             ArithOp::Add | ArithOp::Sub => ty.is_numeric(),
@@ -279,7 +294,8 @@ impl<'a> Builder<'a> {
                     operand: self.vars[out.index()].name.clone(),
                     found: ty.to_string(),
                 },
-            ));
+            )
+            .at(name.origin));
         }
         let inp = at.key("in");
         let a = self.operand_of(a, &inp.index(0), s, ty, "an arithmetic box")?;

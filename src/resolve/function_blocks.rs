@@ -4,10 +4,11 @@
 //! variables named relative to the type, taken from the lowering of its first instance —
 //! every instance resolves the same names in the same scopes; IEC 61131-3 6.6.3).
 
+use super::table::NameTable;
 use super::util::check_name;
 use super::util::FastMap;
 use super::{Builder, FbType, PouDraft, Result};
-use crate::diag::{Invalid, LoadError};
+use crate::diag::{Invalid, LoadError, Origin};
 use crate::fbd::types::{self as fbt, FbTypeBody, Pin, TypedBody, TypedRef, TypedVar};
 use crate::fbd::{FbdPou, FbdPouKind};
 use crate::model::*;
@@ -24,7 +25,7 @@ impl<'a> Builder<'a> {
         let mut bodies = Vec::with_capacity(fbs.len());
         for fb in fbs {
             let path = format!("function_blocks.{}", fb.name);
-            check_name(&fb.name, &path, None)?;
+            check_name(&fb.name, || path.clone(), None).map_err(|e| e.at(fb.origin))?;
             if Type::parse(&fb.name).is_some() {
                 return Err(LoadError::invalid(
                     None,
@@ -33,12 +34,13 @@ impl<'a> Builder<'a> {
                         what: "a function block named like a standard type",
                         place: "(rename it)",
                     },
-                ));
+                )
+                .at(fb.origin));
             }
             let names = |vs: &[syntax::Var]| -> Vec<String> {
                 vs.iter()
                     .filter(|v| v.problem.is_none())
-                    .map(|v| v.name.to_string())
+                    .map(|v| v.name.value.to_string())
                     .collect()
             };
             let sig = FbSig {
@@ -68,12 +70,12 @@ impl<'a> Builder<'a> {
             bodies.push(&fb.body);
         }
         // Declarations on a scratch scope (rolled back), and which types each type instantiates.
-        let mut uses: Vec<Vec<(usize, String)>> = Vec::new();
+        let mut uses: Vec<Vec<(usize, String, Origin)>> = Vec::new();
         for f in 0..self.fb_types.len() {
             let (vars_mark, inst_mark) = (self.vars.len(), self.instances.len());
             let scratch = PouId(self.locals.len() as u32);
-            self.locals.push(FastMap::default());
-            self.local_instances.push(FastMap::default());
+            self.locals.push(NameTable::default());
+            self.local_instances.push(NameTable::default());
             let (path, prefix) = (
                 self.fb_types[f].path.clone(),
                 format!("{}.", self.fb_types[f].name),
@@ -95,7 +97,7 @@ impl<'a> Builder<'a> {
             uses.push(
                 self.instances[inst_mark..]
                     .iter()
-                    .filter_map(|i| Some((*self.fb_index.get(&i.fb)?, i.path.clone())))
+                    .filter_map(|i| Some((*self.fb_index.get(&i.fb)?, i.path.clone(), i.origin)))
                     .collect(),
             );
             self.vars.truncate(vars_mark);
@@ -110,7 +112,7 @@ impl<'a> Builder<'a> {
             seen[start] = true;
             let mut stack: Vec<(usize, usize)> = vec![(start, 0)];
             while let Some(&mut (f, ref mut i)) = stack.last_mut() {
-                if let Some((g, p)) = uses[f].get(*i) {
+                if let Some((g, p, origin)) = uses[f].get(*i) {
                     *i += 1;
                     if *g == start {
                         let mut chain: Vec<&str> = stack
@@ -125,7 +127,8 @@ impl<'a> Builder<'a> {
                                 name: self.fb_types[start].name.clone(),
                                 chain: chain.join(" → "),
                             },
-                        ));
+                        )
+                        .at(*origin));
                     }
                     if !seen[*g] {
                         seen[*g] = true;
@@ -152,6 +155,7 @@ impl<'a> Builder<'a> {
                         typed: None,
                     };
                     self.fbd_bodies.push(body);
+                    self.fbd_origins.push(j.origin);
                 }
             }
         }
@@ -164,9 +168,10 @@ impl<'a> Builder<'a> {
         let Some(&f) = self.fb_index.get(&self.instances[idx].fb) else {
             return Ok(()); // declared only for user types (checked when declared)
         };
-        let (display, ipath) = (
+        let (display, ipath, iorigin) = (
             self.instances[idx].display.clone(),
             self.instances[idx].path.clone(),
+            self.instances[idx].origin,
         );
         if stack.contains(&self.fb_types[f].name) {
             let mut chain = stack.clone();
@@ -178,7 +183,8 @@ impl<'a> Builder<'a> {
                     name: self.fb_types[f].name.clone(),
                     chain: chain.join(" → "),
                 },
-            ));
+            )
+            .at(iorigin));
         }
         if self.pous.iter().any(|p| p.name == display) {
             return Err(LoadError::invalid(
@@ -188,7 +194,8 @@ impl<'a> Builder<'a> {
                     what: "a function block instance named like the program or a subroutine",
                     place: "(rename one of them)",
                 },
-            ));
+            )
+            .at(self.instances[idx].name_origin));
         }
         let pou = PouId(self.pous.len() as u32);
         let t = &self.fb_types[f];
@@ -205,8 +212,8 @@ impl<'a> Builder<'a> {
         draft.var_prefix = format!("{display}.");
         draft.callable = false;
         self.pous.push(draft);
-        self.locals.push(FastMap::default());
-        self.local_instances.push(FastMap::default());
+        self.locals.push(NameTable::default());
+        self.local_instances.push(NameTable::default());
         let mark = self.pending.len();
         let prefix = format!("{display}.");
         for (key, decl, elementary) in [
@@ -256,10 +263,10 @@ impl Builder<'_> {
             &self.local_instances[pou.index()],
         );
         let var = |v: &syntax::Var| {
-            let id = *locals.get(v.name.as_ref())?;
+            let id = *locals.get(v.name.value.as_ref())?;
             let var = &self.vars[id.index()];
             Some(fbt::FbVar {
-                name: v.name.to_string(),
+                name: v.name.value.to_string(),
                 ty: var.ty,
                 init: var.init,
             })
@@ -272,10 +279,10 @@ impl Builder<'_> {
             .vars
             .iter()
             .filter_map(|v| {
-                let i = *instances.get(v.name.as_ref())?;
+                let i = *instances.get(v.name.value.as_ref())?;
                 let ty = *self.fb_index.get(&self.instances[i].fb)?;
                 Some(fbt::Nested {
-                    name: v.name.to_string(),
+                    name: v.name.value.to_string(),
                     ty: fbt::FbTypeId(ty as u32),
                 })
             })

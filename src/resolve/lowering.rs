@@ -23,8 +23,10 @@ impl<'a> Builder<'a> {
                 var_prefix: draft.var_prefix.clone(),
             };
             let pid = PouId(pou as u32);
+            let origin = self.fbd_origins[i];
             let lowered =
-                super::lower::lower(&bodies[i], &mut PouEnv { b: self, pou: pid }, &names, pid)?;
+                super::lower::lower(&bodies[i], &mut PouEnv { b: self, pou: pid }, &names, pid)
+                    .map_err(|e| e.at(origin))?;
             if bodies[i].kind == FbdPouKind::FunctionBlock {
                 self.keep_typed_body(i, pid, &lowered.typed);
             }

@@ -13,8 +13,12 @@
 //! Errors are collected, in program order, up to [`MAX_ERRORS`], phase by phase: the reader's
 //! problems and the declarations; instances and FBD lowering; rung ids and labels; elements (the
 //! first problem of each rung); loops, jumps and calls. A phase with errors ends the resolution
-//! (later phases would only report their consequences). Paths are rendered only for errors.
-//! Nothing is half-built: a program either resolves whole or not at all.
+//! (later phases would only report their consequences). Paths are rendered only for errors;
+//! each error gets the origin of the most precise syntax node it names (operand, element, field,
+//! variable, rung, FBD body), and their lines and columns are computed in one pass over the text
+//! when the resolution fails ([`LoadError::locate`]). Names are looked up in [`table`]s that
+//! cost one cache miss a lookup. Nothing is half-built: a program either resolves whole or not
+//! at all.
 
 mod elements;
 pub(crate) mod fbd_read;
@@ -25,6 +29,7 @@ mod names;
 pub(crate) mod operand;
 mod path;
 mod structure;
+mod table;
 pub(crate) mod util;
 mod vars;
 
@@ -41,18 +46,21 @@ use util::{FastMap, FastSet};
 use elements::{Place, Scope};
 use lowering::relocate_jumps;
 use path::At;
+use table::NameTable;
 use util::{check_name, rung_path};
 
 type Result<T> = std::result::Result<T, LoadError>;
 
-/// Resolves a program read from `text` (the text gives the line and column of nodes for errors).
+/// Resolves a program read from `text` (the text gives the line and column of nodes for errors,
+/// computed only when there are errors).
 pub fn resolve(text: &str, syn: &syntax::Program<'_>) -> Result<(Program, Fbd)> {
-    let mut b = Builder {
-        text,
-        ..Builder::default()
-    };
+    resolve_syntax(syn).map_err(|e| e.locate(text))
+}
+
+fn resolve_syntax(syn: &syntax::Program<'_>) -> Result<(Program, Fbd)> {
+    let mut b = Builder::default();
     for p in &syn.problems {
-        b.report(LoadError::invalid(None, &p.at, p.kind.clone()));
+        b.report(LoadError::invalid(None, &p.at, p.kind.clone()).at(p.origin));
     }
     b.declarations(syn);
     b.phase_end()?;
@@ -84,7 +92,7 @@ pub fn resolve(text: &str, syn: &syntax::Program<'_>) -> Result<(Program, Fbd)> 
         .collect();
     instances.sort_by_key(|i| i.pou);
     let types = b.fb_type_models(&bodies);
-    let program = b.build(syn.name.to_string())?;
+    let program = b.build(syn.name.to_string(), syn.origin)?;
     for body in &mut bodies {
         for copy in &mut body.copies {
             let start = program.pou(copy.pou).rungs.start;
@@ -175,6 +183,9 @@ struct InstanceDraft {
     fb: String,
     /// JSON path of its declaration.
     path: String,
+    /// Where its declaration and its name start.
+    origin: syntax::Origin,
+    name_origin: syntax::Origin,
     pou: Option<PouId>,
     inputs: Vec<(String, VarId)>,
     outputs: Vec<(String, VarId)>,
@@ -183,26 +194,27 @@ struct InstanceDraft {
 /// A program-wide rule (ids, labels, names) is kept per POU; every table is indexed by POU.
 #[derive(Default)]
 struct Builder<'a> {
-    text: &'a str,
     /// Problems found so far, in program order (at most [`MAX_ERRORS`]).
     errors: Vec<Diagnostic>,
     vars: Vec<Var>,
     /// Display names of all variables, built when the first hidden FBD variable is made (its
     /// name must not clash).
     var_names: Option<FastSet<String>>,
-    globals: FastMap<String, VarId>,
+    globals: NameTable<VarId>,
     /// Per POU: its local variables.
-    locals: Vec<FastMap<String, VarId>>,
+    locals: Vec<NameTable<VarId>>,
     /// Program-wide and per-POU instances of user function blocks (index into `instances`).
-    global_instances: FastMap<String, usize>,
-    local_instances: Vec<FastMap<String, usize>>,
+    global_instances: NameTable<usize>,
+    local_instances: Vec<NameTable<usize>>,
     instances: Vec<InstanceDraft>,
     /// Instances declared but not yet given their POU.
     pending: Vec<usize>,
     fb_types: Vec<FbType<'a>>,
     fb_index: FastMap<String, usize>,
-    /// FBD bodies in reading order (function block types first, as they are read first).
+    /// FBD bodies in reading order (function block types first, as they are read first), and
+    /// where each starts in the text.
     fbd_bodies: Vec<FbdPou>,
+    fbd_origins: Vec<syntax::Origin>,
     /// TIME variables accumulated by TSTART/TSTOP, with the POU that does it.
     accumulated: FastMap<VarId, PouId>,
     pous: Vec<PouDraft<'a>>,
@@ -242,10 +254,6 @@ impl<'a> Builder<'a> {
         }
     }
 
-    fn position(&self, origin: syntax::Origin) -> Option<(u32, u32)> {
-        origin.line_column(self.text)
-    }
-
     /// Function block types, the program's variables, the main body, then each subroutine with
     /// its variables and body, in file order.
     fn declarations(&mut self, syn: &'a syntax::Program<'a>) {
@@ -254,8 +262,11 @@ impl<'a> Builder<'a> {
         let name = syn.name.to_string();
         self.pous
             .push(PouDraft::new(name.clone(), PouKind::Main, String::new()));
-        self.locals.push(FastMap::default());
-        self.local_instances.push(FastMap::default());
+        self.locals.push(NameTable::default());
+        self.local_instances.push(NameTable::default());
+        // Sized up front: a million variables would otherwise be rehashed and moved twenty times.
+        self.globals.reserve(syn.vars.len());
+        self.vars.reserve(syn.vars.len());
         self.declare_vars(&syn.vars, "vars", None, false);
         if let Some(body) = &syn.body {
             let r = self.body(0, body, "");
@@ -263,24 +274,27 @@ impl<'a> Builder<'a> {
         }
         for sub in &syn.subroutines {
             let path = format!("subroutines.{}", sub.name);
-            let r = check_name(&sub.name, &path, None);
+            let r = check_name(&sub.name, || path.clone(), None).map_err(|e| e.at(sub.origin));
             if self.collect(r).is_none() {
                 continue;
             }
             if sub.name == name {
-                self.report(LoadError::invalid(
-                    None,
-                    &path,
-                    Invalid::Misplaced {
-                        what: "a subroutine named like the program",
-                        place: "(rename one of them)",
-                    },
-                ));
+                self.report(
+                    LoadError::invalid(
+                        None,
+                        &path,
+                        Invalid::Misplaced {
+                            what: "a subroutine named like the program",
+                            place: "(rename one of them)",
+                        },
+                    )
+                    .at(sub.origin),
+                );
                 continue;
             }
             let pou = PouId(self.pous.len() as u32);
-            self.locals.push(FastMap::default());
-            self.local_instances.push(FastMap::default());
+            self.locals.push(NameTable::default());
+            self.local_instances.push(NameTable::default());
             self.declare_vars(
                 &sub.vars,
                 &format!("{path}.vars"),
@@ -316,6 +330,7 @@ impl<'a> Builder<'a> {
                 let fbd = self.read_fbd(f, &at, &self.pous[pou].name.clone(), kind)?;
                 self.pous[pou].fbd = Some(self.fbd_bodies.len());
                 self.fbd_bodies.push(fbd);
+                self.fbd_origins.push(f.origin);
                 Ok(())
             }
         }
@@ -332,22 +347,22 @@ impl<'a> Builder<'a> {
         let index = &self.fb_index;
         let types = &self.fb_types;
         let sig = |n: &str| index.get(n).map(|&i| types[i].sig.clone());
-        let cx = fbd_read::Context {
-            text: self.text,
-            sig: &sig,
-        };
-        fbd_read::read_body(f, path, name, kind, &cx)
-            .map_err(|e| e.at_position(self.position(f.origin)))
+        let cx = fbd_read::Context { sig: &sig };
+        fbd_read::read_body(f, path, name, kind, &cx).map_err(|e| e.at(f.origin))
     }
 
-    fn build(mut self, name: String) -> Result<Program> {
+    fn build(mut self, name: String, origin: syntax::Origin) -> Result<Program> {
         if self.pous[0].fbd.is_none() && self.pous[0].rungs.is_empty() {
-            return Err(LoadError::invalid(None, "rungs", Invalid::Empty));
+            return Err(LoadError::invalid(None, "rungs", Invalid::Empty).at(origin));
         }
         let (heads, next_id) = self.rung_heads();
         self.phase_end()?;
         // Pass 2: elements.
         let mut rungs = Vec::with_capacity(next_id as usize);
+        // The syntax of each ladder rung and where it is (none for rungs lowered from FBD), for
+        // the paths and places of structural errors.
+        let pou_paths: Vec<String> = self.pous.iter().map(|p| p.path.clone()).collect();
+        let mut places: Vec<Option<structure::Place>> = Vec::with_capacity(next_id as usize);
         let mut pous = Vec::with_capacity(self.pous.len());
         let mut start = 0u32;
         for pou in &self.pous {
@@ -368,29 +383,34 @@ impl<'a> Builder<'a> {
                     r.pou = pou;
                     relocate_jumps(&mut r.series, offset);
                     rungs.push(r);
+                    places.push(None);
                 }
             }
             for (rid, syn, id) in pou_heads {
-                let path = rung_path(&self.pous[pi].path, (rid.0 - pous[pi].rungs.start) as usize);
+                let index = (rid.0 - pous[pi].rungs.start) as usize;
                 self.edge_count = 0;
                 let scope = Scope { pou, rung_id: &id };
-                let base = At::base(&path);
+                let base = At::rung(&pou_paths[pi], index);
                 let ld = base.key("ld");
                 let series = match self.series(&syn.ld, &ld, Place::Top, &scope) {
                     Ok(s) => s,
                     Err(e) => {
-                        let e = e.at_position(self.position(syn.origin));
-                        self.report(e);
+                        self.report(e.at(syn.origin));
                         Vec::new()
                     }
                 };
+                places.push(Some(structure::Place {
+                    rung: syn,
+                    pou_path: &pou_paths[pi],
+                    index,
+                }));
                 rungs.push(Rung {
                     id,
-                    label: syn.label.as_ref().map(|l| l.to_string()),
+                    label: syn.label.as_ref().map(|l| l.value.to_string()),
                     comment: syn.comment.as_ref().map(|c| c.to_string()),
                     pou,
                     series,
-                    path,
+                    block_path: None,
                     network: None,
                 });
             }
@@ -402,7 +422,7 @@ impl<'a> Builder<'a> {
             pous,
             rungs,
         };
-        structure::check(&mut program)?;
+        structure::check(&mut program, &places)?;
         Ok(program)
     }
 
@@ -411,7 +431,12 @@ impl<'a> Builder<'a> {
     fn rung_heads(&mut self) -> (Vec<Vec<RungHead<'a>>>, u32) {
         // Where each id was first used: (POU, index of its rung) for ladder rungs, the path of
         // lowered rungs; rendered only for a duplicate.
+        let total = self
+            .pous
+            .iter()
+            .map(|p| p.rungs.len() + p.lowered.as_ref().map_or(0, Vec::len));
         let mut ids: FastMap<Cow<'a, str>, (usize, Option<usize>)> = FastMap::default();
+        ids.reserve(total.sum());
         let first_path = |pous: &[PouDraft], (pou, i): (usize, Option<usize>)| match i {
             Some(i) => rung_path(&pous[pou].path, i),
             None => String::new(),
@@ -431,13 +456,13 @@ impl<'a> Builder<'a> {
                                 .iter()
                                 .flatten()
                                 .find(|x| x.id == r.id)
-                                .map(|x| x.path.clone())
+                                .and_then(|x| x.block_path.clone())
                                 .unwrap_or_default(),
                             other => first_path(&self.pous, other),
                         };
                         errors.push(LoadError::invalid(
                             Some(&r.id),
-                            &r.path,
+                            r.block_path.as_deref().unwrap_or_default(),
                             Invalid::DuplicateRung {
                                 id: r.id.clone(),
                                 first,
@@ -449,22 +474,21 @@ impl<'a> Builder<'a> {
                 }
             }
             for (i, r) in pou.rungs.iter().enumerate() {
-                let position = || r.origin.line_column(self.text);
                 let path = || rung_path(&pou.path, i);
                 let key: Cow<'a, str> = if pou.prefix.is_empty() {
-                    match &r.id {
+                    match &r.id.value {
                         Cow::Borrowed(s) => Cow::Borrowed(s),
                         Cow::Owned(s) => Cow::Owned(s.clone()),
                     }
                 } else {
-                    Cow::Owned(format!("{}{}", pou.prefix, r.id))
+                    Cow::Owned(format!("{}{}", pou.prefix, r.id.value))
                 };
                 let id = key.to_string();
                 if let Some(p) = &r.problem {
                     let rung = r.problem_in_rung.then_some(id.as_str());
                     let e =
                         LoadError::invalid(rung, &format!("{}{}", path(), p.at), p.kind.clone());
-                    errors.push(e.at_position(position()));
+                    errors.push(e.at(p.origin).at(r.origin));
                     continue;
                 }
                 if let Some(&first) = ids.get(key.as_ref()) {
@@ -474,7 +498,7 @@ impl<'a> Builder<'a> {
                             .iter()
                             .flatten()
                             .find(|x| x.id == id)
-                            .map(|x| x.path.clone())
+                            .and_then(|x| x.block_path.clone())
                             .unwrap_or_default(),
                         other => first_path(&self.pous, other),
                     };
@@ -487,7 +511,7 @@ impl<'a> Builder<'a> {
                                 first,
                             },
                         )
-                        .at_position(position()),
+                        .at(r.id.origin),
                     );
                     continue;
                 }
@@ -496,9 +520,9 @@ impl<'a> Builder<'a> {
                 next_id += 1;
                 if let Some(l) = &r.label {
                     let lp = format!("{}.label", path());
-                    if let Err(e) = check_name(l, &lp, Some(&id)) {
-                        errors.push(e.at_position(position()));
-                    } else if let Some(prev) = labels.insert(l.to_string(), rid) {
+                    if let Err(e) = check_name(l.as_str(), || lp.clone(), Some(&id)) {
+                        errors.push(e.at(l.origin));
+                    } else if let Some(prev) = labels.insert(l.value.to_string(), rid) {
                         let first = pou_heads
                             .iter()
                             .find(|h: &&RungHead| h.0 == prev)
@@ -509,12 +533,12 @@ impl<'a> Builder<'a> {
                                 Some(&id),
                                 &lp,
                                 Invalid::DuplicateLabel {
-                                    label: l.to_string(),
+                                    label: l.value.to_string(),
                                     pou: pou.name.clone(),
                                     first,
                                 },
                             )
-                            .at_position(position()),
+                            .at(l.origin),
                         );
                     }
                 }

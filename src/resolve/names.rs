@@ -6,9 +6,14 @@ use super::operand::{self, Untyped};
 use super::path::At;
 use super::util::expect_type;
 use super::{Builder, Result};
-use crate::diag::{Invalid, LoadError};
+use crate::diag::{Invalid, LoadError, Origin};
 use crate::model::*;
-use crate::syntax::Scalar;
+use crate::syntax::{Name, Operand as SynOperand};
+
+/// An error of an element's operand: at the operand's path and origin, in the scope's rung.
+fn fail(s: &Scope, at: &At, origin: Origin, kind: Invalid) -> LoadError {
+    LoadError::invalid(Some(s.rung_id), &at.with(""), kind).at(origin)
+}
 
 impl<'a> Builder<'a> {
     /// A name a block or element writes, in the scope of `pou`: not an input, not a field, not
@@ -115,34 +120,32 @@ impl<'a> Builder<'a> {
         operand::field_ref(id, text, self.vars[id.index()].ty, field)
     }
 
-    pub(super) fn var_ref(&self, text: &str, at: &At, s: &Scope) -> Result<(VarRef, Type)> {
-        self.lookup(text, s.pou)
-            .map_err(|k| LoadError::invalid(Some(s.rung_id), &at.with(""), k))
+    pub(super) fn var_ref(&self, name: &Name, at: &At, s: &Scope) -> Result<(VarRef, Type)> {
+        self.lookup(name.as_str(), s.pou)
+            .map_err(|k| fail(s, at, name.origin, k))
     }
 
-    pub(super) fn untyped(&self, v: &Scalar, at: &At, s: &Scope) -> Result<Untyped> {
-        operand::parse(v, &|n| self.lookup(n, s.pou))
-            .map_err(|k| LoadError::invalid(Some(s.rung_id), &at.with(""), k))
+    pub(super) fn untyped(&self, v: &SynOperand, at: &At, s: &Scope) -> Result<Untyped> {
+        operand::parse(&v.value, &|n| self.lookup(n, s.pou)).map_err(|k| fail(s, at, v.origin, k))
     }
 
     pub(super) fn operand_of(
         &self,
-        v: &Scalar,
+        v: &SynOperand,
         at: &At,
         s: &Scope,
         ty: Type,
         what: &'static str,
     ) -> Result<Operand> {
         let u = self.untyped(v, at, s)?;
-        operand::typed(&u, ty, what, &v.display())
-            .map_err(|k| LoadError::invalid(Some(s.rung_id), &at.with(""), k))
+        operand::typed(&u, ty, what, &v.value.display()).map_err(|k| fail(s, at, v.origin, k))
     }
 
     /// Two operands of one numeric type (the type of whichever fixes one).
     pub(super) fn numeric_pair(
         &self,
-        a: &Scalar,
-        b: &Scalar,
+        a: &SynOperand,
+        b: &SynOperand,
         at: &At,
         s: &Scope,
         what: &'static str,
@@ -161,54 +164,55 @@ impl<'a> Builder<'a> {
             } else {
                 (&pb, b)
             };
-            return Err(LoadError::invalid(
-                Some(s.rung_id),
-                &p.with(""),
+            return Err(fail(
+                s,
+                p,
+                j.origin,
                 Invalid::Type {
                     what,
                     expected: "INT, DINT, REAL or TIME".into(),
-                    operand: j.display(),
+                    operand: j.value.display(),
                     found: ty.to_string(),
                 },
             ));
         }
-        let oa = operand::typed(&ua, ty, what, &a.display())
-            .map_err(|k| LoadError::invalid(Some(s.rung_id), &pa.with(""), k))?;
-        let ob = operand::typed(&ub, ty, what, &b.display())
-            .map_err(|k| LoadError::invalid(Some(s.rung_id), &pb.with(""), k))?;
+        let oa = operand::typed(&ua, ty, what, &a.value.display())
+            .map_err(|k| fail(s, &pa, a.origin, k))?;
+        let ob = operand::typed(&ub, ty, what, &b.value.display())
+            .map_err(|k| fail(s, &pb, b.origin, k))?;
         Ok((oa, ob))
     }
 
     /// A variable that an element writes: not an input, not a field, of type `ty` if given.
     pub(super) fn writable(
         &self,
-        text: &str,
+        name: &Name,
         at: &At,
         s: &Scope,
         what: &'static str,
         ty: Option<Type>,
     ) -> Result<VarId> {
         let id = self
-            .writable_name(text, s.pou, what)
-            .map_err(|k| LoadError::invalid(Some(s.rung_id), &at.with(""), k))?;
+            .writable_name(name.as_str(), s.pou, what)
+            .map_err(|k| fail(s, at, name.origin, k))?;
         let var = &self.vars[id.index()];
         if let Some(ty) = ty {
-            expect_type(var.ty, ty, what, &var.name)
-                .map_err(|k| LoadError::invalid(Some(s.rung_id), &at.with(""), k))?;
+            expect_type(var.ty, ty, what, &var.name).map_err(|k| fail(s, at, name.origin, k))?;
         }
         Ok(id)
     }
 
-    pub(super) fn instance(&self, text: &str, at: &At, s: &Scope, fb: FbKind) -> Result<VarId> {
-        let (r, t) = self.var_ref(text, at, s)?;
+    pub(super) fn instance(&self, name: &Name, at: &At, s: &Scope, fb: FbKind) -> Result<VarId> {
+        let (r, t) = self.var_ref(name, at, s)?;
         if r.field.is_some() || t != Type::Fb(fb) {
-            return Err(LoadError::invalid(
-                Some(s.rung_id),
-                &at.with(""),
+            return Err(fail(
+                s,
+                at,
+                name.origin,
                 Invalid::Type {
                     what: "this box",
                     expected: format!("a {} instance", Type::Fb(fb)),
-                    operand: text.to_owned(),
+                    operand: name.value.to_string(),
                     found: t.to_string(),
                 },
             ));

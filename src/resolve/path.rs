@@ -3,10 +3,11 @@
 
 use std::fmt;
 
-/// One step of a path: the base (a rung's path), an array index or an object key.
+/// One step of a path: the base (rung `index` of the POU whose rung array is at `pou`), an array
+/// index or an object key.
 #[derive(Copy, Clone)]
 enum Seg<'p> {
-    Base(&'p str),
+    Rung { pou: &'p str, index: usize },
     Index(usize),
     Key(&'p str),
 }
@@ -19,10 +20,11 @@ pub(crate) struct At<'p> {
 }
 
 impl<'p> At<'p> {
-    pub(crate) fn base(path: &'p str) -> At<'p> {
+    /// Rung `index` of the POU whose rung array is at `pou` (`""`: the top-level `rungs`).
+    pub(crate) fn rung(pou: &'p str, index: usize) -> At<'p> {
         At {
             parent: None,
-            seg: Seg::Base(path),
+            seg: Seg::Rung { pou, index },
         }
     }
     pub(crate) fn index(&'p self, i: usize) -> At<'p> {
@@ -49,7 +51,8 @@ impl fmt::Display for At<'_> {
             write!(f, "{p}")?;
         }
         match self.seg {
-            Seg::Base(s) => f.write_str(s),
+            Seg::Rung { pou: "", index } => write!(f, "rungs[{index}]"),
+            Seg::Rung { pou, index } => write!(f, "{pou}[{index}]"),
             Seg::Index(i) => write!(f, "[{i}]"),
             Seg::Key(k) => write!(f, ".{k}"),
         }

@@ -6,20 +6,49 @@
 //! may nest but not recurse (the call graph is acyclic, which also keeps every CALL's access
 //! summary finite).
 
-use crate::diag::{Invalid, LoadError};
+use crate::diag::{Invalid, LoadError, Origin};
 use crate::model::*;
+use crate::syntax;
+
+/// A ladder rung's syntax and where it is: rung `index` of the POU whose rung array is at
+/// `pou_path`.
+pub(super) struct Place<'s> {
+    pub(super) rung: &'s syntax::Rung<'s>,
+    pub(super) pou_path: &'s str,
+    pub(super) index: usize,
+}
+
+/// The place of each rung (by [`RungId`]; none for rungs lowered from FBD, whose block path the
+/// model keeps).
+type Places<'s> = &'s [Option<Place<'s>>];
+
+/// Where an error about rung `r` points: its series (`None`) or its element `i`.
+fn place(places: Places, r: RungId, element: Option<usize>) -> Origin {
+    let Some(Some(Place { rung, .. })) = places.get(r.index()) else {
+        return Origin::NONE;
+    };
+    let inner = match element {
+        None => rung.ld_origin,
+        Some(i) => rung.ld.get(i).map_or(Origin::NONE, |e| e.origin),
+    };
+    inner.or(rung.origin)
+}
 
 /// Every structural problem, in program order (loops and jumps per rung, then the first
 /// recursive call chain); jumps are checked only when the loops pair.
-pub(crate) fn check(p: &mut Program) -> Result<(), LoadError> {
+pub(crate) fn check(p: &mut Program, places: Places) -> Result<(), LoadError> {
     let mut errors = Vec::new();
-    pair_loops(p, &mut errors);
+    pair_loops(p, places, &mut errors);
     if errors.is_empty() {
-        check_jumps(p, &mut errors);
+        check_jumps(p, places, &mut errors);
     }
-    if let Err(e) = check_recursion(p) {
+    if let Err(e) = check_recursion(p, places) {
         errors.push(e);
     }
+    // Each error names its rung and, by its path, the series or an element of it.
+    let errors = errors
+        .into_iter()
+        .map(|(r, element, e)| e.at(place(places, r, element)));
     let diagnostics = errors
         .into_iter()
         .filter_map(|e| e.into_diagnostics().ok())
@@ -32,16 +61,29 @@ pub(crate) fn check(p: &mut Program) -> Result<(), LoadError> {
     }
 }
 
-fn err(p: &Program, r: RungId, suffix: &str, kind: Invalid) -> LoadError {
+/// An error of rung `r` at its series (`element` none) or at one of its top-level elements.
+type Located = (RungId, Option<usize>, LoadError);
+
+fn err(p: &Program, places: Places, r: RungId, element: Option<usize>, kind: Invalid) -> Located {
     let rung = p.rung(r);
-    LoadError::invalid(Some(&rung.id), &format!("{}{suffix}", rung.path), kind)
+    let base = match (places.get(r.index()), &rung.block_path) {
+        (Some(Some(at)), _) => super::util::rung_path(at.pou_path, at.index),
+        (_, Some(block)) => block.clone(),
+        (_, None) => String::new(),
+    };
+    let suffix = match element {
+        None => ".ld".to_owned(),
+        Some(i) => format!(".ld[{i}]"),
+    };
+    let e = LoadError::invalid(Some(&rung.id), &format!("{base}{suffix}"), kind);
+    (r, element, e)
 }
 
 fn last_top(rung: &Rung) -> Option<&Element> {
     rung.series.last()
 }
 
-fn pair_loops(p: &mut Program, errors: &mut Vec<LoadError>) {
+fn pair_loops(p: &mut Program, places: Places, errors: &mut Vec<Located>) {
     for pou in 0..p.pous.len() {
         let mut stack: Vec<RungId> = Vec::new();
         for r in p.pou_rungs(PouId(pou as u32)) {
@@ -49,7 +91,7 @@ fn pair_loops(p: &mut Program, errors: &mut Vec<LoadError>) {
                 Some(Element::For { .. }) => stack.push(r),
                 Some(Element::Next { .. }) => {
                     let Some(head) = stack.pop() else {
-                        errors.push(err(p, r, ".ld[0]", Invalid::NextWithoutFor));
+                        errors.push(err(p, places, r, Some(0), Invalid::NextWithoutFor));
                         continue;
                     };
                     if let Some(Element::Next { head: h }) = p.rungs[r.index()].series.last_mut() {
@@ -68,8 +110,9 @@ fn pair_loops(p: &mut Program, errors: &mut Vec<LoadError>) {
             let n = p.rung(head).series.len();
             errors.push(err(
                 p,
+                places,
                 head,
-                &format!(".ld[{}]", n.saturating_sub(1)),
+                Some(n.saturating_sub(1)),
                 Invalid::ForWithoutNext,
             ));
         }
@@ -77,7 +120,7 @@ fn pair_loops(p: &mut Program, errors: &mut Vec<LoadError>) {
 }
 
 /// Jumps may leave loop bodies but not enter them.
-fn check_jumps(p: &Program, errors: &mut Vec<LoadError>) {
+fn check_jumps(p: &Program, places: Places, errors: &mut Vec<Located>) {
     // body[r] = innermost FOR head whose body (head+1 ..= next) holds r.
     let mut body: Vec<Option<RungId>> = vec![None; p.rungs.len()];
     for r in p.rung_ids() {
@@ -115,8 +158,9 @@ fn check_jumps(p: &Program, errors: &mut Vec<LoadError>) {
         if let Some((label, head)) = bad {
             errors.push(err(
                 p,
+                places,
                 r,
-                ".ld",
+                None,
                 Invalid::JumpIntoLoop {
                     label,
                     head: p.rung(head).id.clone(),
@@ -126,7 +170,7 @@ fn check_jumps(p: &Program, errors: &mut Vec<LoadError>) {
     }
 }
 
-fn check_recursion(p: &Program) -> Result<(), LoadError> {
+fn check_recursion(p: &Program, places: Places) -> Result<(), Located> {
     // Callees per POU, with the rung that makes the call.
     let mut calls: Vec<Vec<(PouId, RungId)>> = vec![Vec::new(); p.pous.len()];
     for r in p.rung_ids() {
@@ -171,8 +215,9 @@ fn check_recursion(p: &Program) -> Result<(), LoadError> {
                         chain.push(&p.pou(callee).name);
                         return Err(err(
                             p,
+                            places,
                             rung,
-                            ".ld",
+                            None,
                             Invalid::Recursion {
                                 name: p.pou(callee).name.clone(),
                                 chain: chain.join(" → "),

@@ -39,7 +39,12 @@ pub(super) fn expect_type(
     }
 }
 
-pub(super) fn check_name(name: &str, path: &str, rung: Option<&str>) -> Result<()> {
+/// A valid name, or the error at the path `path` renders (only then).
+pub(super) fn check_name(
+    name: &str,
+    path: impl FnOnce() -> String,
+    rung: Option<&str>,
+) -> Result<()> {
     let mut chars = name.chars();
     let ok = matches!(chars.next(), Some(c) if c.is_ascii_alphabetic() || c == '_')
         && chars.all(|c| c.is_ascii_alphanumeric() || c == '_');
@@ -48,7 +53,7 @@ pub(super) fn check_name(name: &str, path: &str, rung: Option<&str>) -> Result<(
     } else {
         Err(LoadError::invalid(
             rung,
-            path,
+            &path(),
             Invalid::BadName { name: name.into() },
         ))
     }

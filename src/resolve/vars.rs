@@ -22,10 +22,11 @@ impl<'a> Builder<'a> {
         elementary: bool,
     ) {
         for (i, v) in vars.iter().enumerate() {
-            let p = format!("{path}[{i}]");
-            let r = self.declare_var(v, p, &scope, elementary);
+            // The declaration's path, rendered only for an error.
+            let p = || format!("{path}[{i}]");
+            let r = self.declare_var(v, &p, &scope, elementary);
             if let Err(e) = r {
-                self.report(e.at_position(v.origin.line_column(self.text)));
+                self.report(e.at(v.origin));
             }
         }
     }
@@ -33,20 +34,21 @@ impl<'a> Builder<'a> {
     fn declare_var(
         &mut self,
         v: &syntax::Var,
-        p: String,
+        p: &dyn Fn() -> String,
         scope: &Option<(PouId, String)>,
         elementary: bool,
     ) -> Result<()> {
         if let Some(problem) = &v.problem {
             return Err(LoadError::invalid(
                 None,
-                &format!("{p}{}", problem.at),
+                &format!("{}{}", p(), problem.at),
                 problem.kind.clone(),
-            ));
+            )
+            .at(problem.origin));
         }
-        let name: &str = &v.name;
-        check_name(name, &format!("{p}.name"), None)?;
-        let tname: &str = &v.ty;
+        let name: &str = v.name.as_str();
+        check_name(name, || format!("{}.name", p()), None).map_err(|e| e.at(v.name.origin))?;
+        let tname: &str = v.ty.as_str();
         let user_fb = Type::parse(tname).is_none() && self.fb_index.contains_key(tname);
         let ty = match Type::parse(tname) {
             Some(t) => t,
@@ -60,33 +62,36 @@ impl<'a> Builder<'a> {
                     .join(", ");
                 return Err(LoadError::invalid(
                     None,
-                    &format!("{p}.type"),
+                    &format!("{}.type", p()),
                     Invalid::UnknownTypeOrFb {
                         name: tname.into(),
                         fbs,
                     },
-                ));
+                )
+                .at(v.ty.origin));
             }
             None => {
                 return Err(LoadError::invalid(
                     None,
-                    &format!("{p}.type"),
+                    &format!("{}.type", p()),
                     Invalid::UnknownType { name: tname.into() },
-                ))
+                )
+                .at(v.ty.origin))
             }
         };
         if elementary && matches!(ty, Type::Fb(_)) {
             return Err(LoadError::invalid(
                 None,
-                &format!("{p}.type"),
+                &format!("{}.type", p()),
                 Invalid::Misplaced {
                     what: "a function block type",
                     place:
                         "as an input or output of a function block (declare the instance in `vars`)",
                 },
-            ));
+            )
+            .at(v.ty.origin));
         }
-        let class = match v.class {
+        let class = match v.class.value {
             syntax::VarClass::Input => VarClass::Input,
             syntax::VarClass::Output => VarClass::Output,
             syntax::VarClass::Memory | syntax::VarClass::Default => VarClass::Memory,
@@ -94,47 +99,47 @@ impl<'a> Builder<'a> {
         if matches!(ty, Type::Fb(_)) && class != VarClass::Memory {
             return Err(LoadError::invalid(
                 None,
-                &format!("{p}.class"),
+                &format!("{}.class", p()),
                 Invalid::Misplaced {
                     what: "an input or output class",
                     place: "on a function block instance",
                 },
-            ));
+            )
+            .at(v.class.origin));
         }
         let init = match &v.init {
             None => ty.zero(),
-            Some(_) if matches!(ty, Type::Fb(_)) => {
+            Some(j) if matches!(ty, Type::Fb(_)) => {
                 return Err(LoadError::invalid(
                     None,
-                    &format!("{p}.init"),
+                    &format!("{}.init", p()),
                     Invalid::Misplaced {
                         what: "`init`",
                         place: "on a function block instance",
                     },
-                ))
+                )
+                .at(j.origin))
             }
-            Some(j) => {
-                let ip = format!("{p}.init");
+            Some(init) => {
+                let ip = format!("{}.init", p());
+                let j = &init.value;
+                let fail = |k| LoadError::invalid(None, &ip, k).at(init.origin);
                 let u = operand::parse(j, &|n| {
                     Err(Invalid::Shape {
                         expected: "a constant",
                         found: format!("name \"{n}\""),
                     })
                 })
-                .map_err(|k| LoadError::invalid(None, &ip, k))?;
+                .map_err(fail)?;
                 match operand::typed(&u, ty, "the initial value", &j.json()) {
                     Ok(Operand::Const(v)) => v,
                     Ok(Operand::Var(_)) => {
-                        return Err(LoadError::invalid(
-                            None,
-                            &ip,
-                            Invalid::Shape {
-                                expected: "a constant",
-                                found: j.kind(),
-                            },
-                        ))
+                        return Err(fail(Invalid::Shape {
+                            expected: "a constant",
+                            found: j.kind(),
+                        }))
                     }
-                    Err(k) => return Err(LoadError::invalid(None, &ip, k)),
+                    Err(k) => return Err(fail(k)),
                 }
             }
         };
@@ -148,9 +153,10 @@ impl<'a> Builder<'a> {
         if table.contains_key(name) || instances.contains_key(name) {
             return Err(LoadError::invalid(
                 None,
-                &format!("{p}.name"),
+                &format!("{}.name", p()),
                 Invalid::DuplicateVar { name: name.into() },
-            ));
+            )
+            .at(v.name.origin));
         }
         let display = match scope {
             None => name.to_owned(),
@@ -158,11 +164,13 @@ impl<'a> Builder<'a> {
         };
         if user_fb {
             let idx = self.instances.len();
-            instances.insert(name.to_owned(), idx);
+            instances.insert(name, idx);
             self.instances.push(InstanceDraft {
                 display,
                 fb: tname.to_owned(),
-                path: p.clone(),
+                path: p(),
+                origin: v.origin,
+                name_origin: v.name.origin,
                 pou: None,
                 inputs: Vec::new(),
                 outputs: Vec::new(),
@@ -171,7 +179,7 @@ impl<'a> Builder<'a> {
             return Ok(());
         }
         let id = VarId(self.vars.len() as u32);
-        table.insert(name.to_owned(), id);
+        table.insert(name, id);
         self.vars.push(Var {
             name: display,
             ty,

@@ -7,8 +7,9 @@
 //! reader would fill the same types) produces them; `crate::resolve` turns them into the model.
 //!
 //! Invariants: every string borrows from the source text where it can (`Cow`); every node that
-//! has a place of its own in the file (POU, variable, rung, FBD body) carries an [`Origin`] — a
-//! byte offset, 4 bytes — from which line and column are computed only when an error is reported.
+//! an error can name (POU, variable and each of its fields, rung, its id, label and series, each
+//! element and each of its operands, FBD body, each [`Problem`]) carries an [`Origin`] — a byte
+//! offset, 4 bytes — from which line and column are computed only when an error is reported.
 //! A node's JSON path is its position in this tree (`rungs[2].ld[1].or[0][0]` is rung 2, element
 //! 1, branch 0, element 0): the resolver renders it from the indices it walks, only on error, so
 //! a million rungs cost no path strings. What the reader found malformed stays in the tree as a
@@ -29,46 +30,51 @@ pub use fbd::FbdBody;
 /// A string of the source text (borrowed unless it had escapes).
 pub type Text<'a> = Cow<'a, str>;
 
-/// Where a node starts in the source text: a byte offset (none for nodes made up by a reader).
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
-pub struct Origin {
-    pub offset: Option<u32>,
-}
-
-impl Origin {
-    pub const NONE: Origin = Origin { offset: None };
-
-    pub fn at(offset: usize) -> Origin {
-        Origin {
-            offset: u32::try_from(offset).ok(),
-        }
-    }
-
-    /// 1-based line and column (in characters) of the node in `text`.
-    pub fn line_column(self, text: &str) -> Option<(u32, u32)> {
-        let offset = self.offset? as usize;
-        let before = text.get(..offset)?;
-        let line = before.bytes().filter(|&b| b == b'\n').count() + 1;
-        let start = before.rfind('\n').map_or(0, |i| i + 1);
-        let column = before[start..].chars().count() + 1;
-        Some((line as u32, column as u32))
-    }
-}
+pub use crate::diag::Origin;
 
 /// Something the reader found malformed: where (a path suffix relative to the node that holds
-/// it, e.g. `.negated`, `.in[1]`, or "" for the node itself) and what.
+/// it, e.g. `.negated`, `.in[1]`, or "" for the node itself; and the origin of the most precise
+/// node: the value, or the key of an unknown field) and what.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Problem {
     pub at: String,
+    pub origin: Origin,
     pub kind: Invalid,
 }
 
 impl Problem {
-    pub fn new(at: impl Into<String>, kind: Invalid) -> Box<Problem> {
+    pub fn new(at: impl Into<String>, origin: Origin, kind: Invalid) -> Box<Problem> {
         Box::new(Problem {
             at: at.into(),
+            origin,
             kind,
         })
+    }
+}
+
+/// A leaf of the tree with the place it starts.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Located<T> {
+    pub value: T,
+    pub origin: Origin,
+}
+
+/// A name as written (a variable, an instance, a label, a subroutine).
+pub type Name<'a> = Located<Text<'a>>;
+/// An operand as written (a name, a number, a boolean, a TIME literal, or anything found instead).
+pub type Operand<'a> = Located<Scalar<'a>>;
+
+impl<'a> Name<'a> {
+    /// A name made up by a reader (no place in the file).
+    pub fn empty() -> Name<'a> {
+        Located {
+            value: Cow::Borrowed(""),
+            origin: Origin::NONE,
+        }
+    }
+
+    pub fn as_str(&self) -> &str {
+        &self.value
     }
 }
 
@@ -139,6 +145,8 @@ impl Scalar<'_> {
 /// A whole program file.
 #[derive(Clone, Debug, Default)]
 pub struct Program<'a> {
+    /// Where the program object starts.
+    pub origin: Origin,
     pub name: Text<'a>,
     pub comment: Option<Text<'a>>,
     /// The program-wide variables.
@@ -183,10 +191,12 @@ pub struct FunctionBlock<'a> {
 #[derive(Clone, Debug)]
 pub struct Var<'a> {
     pub origin: Origin,
-    pub name: Text<'a>,
-    pub ty: Text<'a>,
-    pub class: VarClass,
-    pub init: Option<Scalar<'a>>,
+    pub name: Name<'a>,
+    pub ty: Name<'a>,
+    /// The class, with the origin of its value (none when absent).
+    pub class: Located<VarClass>,
+    /// Boxed: most declarations have none, and a million of them are read.
+    pub init: Option<Box<Operand<'a>>>,
     /// Something malformed in the declaration (then the fields may be defaults).
     pub problem: Option<Box<Problem>>,
 }
@@ -205,10 +215,13 @@ pub enum VarClass {
 #[derive(Clone, Debug)]
 pub struct Rung<'a> {
     pub origin: Origin,
-    pub id: Text<'a>,
-    pub label: Option<Text<'a>>,
+    pub id: Name<'a>,
+    /// Boxed: few rungs have one.
+    pub label: Option<Box<Name<'a>>>,
     pub comment: Option<Text<'a>>,
     pub ld: Series<'a>,
+    /// Where the series (`ld`) starts.
+    pub ld_origin: Origin,
     /// Something malformed in the rung object; `problem_in_rung`: the message names the rung id.
     pub problem: Option<Box<Problem>>,
     pub problem_in_rung: bool,
@@ -217,34 +230,41 @@ pub struct Rung<'a> {
 /// A series of elements, power flowing left to right.
 pub type Series<'a> = Vec<Element<'a>>;
 
-/// A ladder element as written (IEC 61131-3 8.2: contacts, coils, function block and function
-/// calls; the control elements of S7-200: jumps, return, end, calls, FOR/NEXT). Kinds with
-/// operands are boxed, so that the common contacts and coils take 32 bytes.
+/// A ladder element as written, with where its object starts.
 #[derive(Clone, Debug)]
-pub enum Element<'a> {
+pub struct Element<'a> {
+    pub origin: Origin,
+    pub kind: ElementKind<'a>,
+}
+
+/// The kinds of ladder elements (IEC 61131-3 8.2: contacts, coils, function block and function
+/// calls; the control elements of S7-200: jumps, return, end, calls, FOR/NEXT). Kinds with
+/// several operands are boxed, so that the common contacts and coils stay small.
+#[derive(Clone, Debug)]
+pub enum ElementKind<'a> {
     Contact {
-        var: Text<'a>,
+        var: Name<'a>,
         negated: bool,
         edge: Option<Edge>,
     },
     Compare(Box<Compare<'a>>),
     Or(Vec<Series<'a>>),
     Coil {
-        var: Text<'a>,
+        var: Name<'a>,
         negated: bool,
     },
-    Set(Text<'a>),
-    Reset(Text<'a>),
+    Set(Name<'a>),
+    Reset(Name<'a>),
     Branch(Vec<Series<'a>>),
     Timer(Box<Timer<'a>>),
     /// CTU (`load` false: `aux` is R) or CTD (`aux` is LD).
     Counter(Box<Counter<'a>>),
     Move(Box<Move<'a>>),
     Arith(Box<Arith<'a>>),
-    Jmp(Text<'a>),
+    Jmp(Name<'a>),
     Ret,
     End,
-    Call(Text<'a>),
+    Call(Name<'a>),
     For(Box<For<'a>>),
     Next,
     /// The element is malformed (`at` is relative to the element).
@@ -255,50 +275,50 @@ pub enum Element<'a> {
 #[derive(Clone, Debug)]
 pub struct Compare<'a> {
     pub op: CmpOp,
-    pub a: Scalar<'a>,
-    pub b: Scalar<'a>,
+    pub a: Operand<'a>,
+    pub b: Operand<'a>,
 }
 
 /// `{"ton": T, "pt": PT}` and TOF, TP.
 #[derive(Clone, Debug)]
 pub struct Timer<'a> {
     pub kind: TimerKind,
-    pub instance: Text<'a>,
-    pub pt: Scalar<'a>,
+    pub instance: Name<'a>,
+    pub pt: Operand<'a>,
 }
 
 /// `{"ctu": C, "pv": PV, "reset": R}` or `{"ctd": C, "pv": PV, "load": LD}`.
 #[derive(Clone, Debug)]
 pub struct Counter<'a> {
     pub down: bool,
-    pub instance: Text<'a>,
-    pub pv: Scalar<'a>,
+    pub instance: Name<'a>,
+    pub pv: Operand<'a>,
     /// R of a CTU, LD of a CTD.
-    pub aux: Scalar<'a>,
+    pub aux: Operand<'a>,
 }
 
 /// `{"move": FROM, "to": TO}`.
 #[derive(Clone, Debug)]
 pub struct Move<'a> {
-    pub from: Scalar<'a>,
-    pub to: Text<'a>,
+    pub from: Operand<'a>,
+    pub to: Name<'a>,
 }
 
 /// `{"op": OP, "in": [A, B], "out": OUT}`.
 #[derive(Clone, Debug)]
 pub struct Arith<'a> {
     pub op: ArithOp,
-    pub a: Scalar<'a>,
-    pub b: Scalar<'a>,
-    pub out: Text<'a>,
+    pub a: Operand<'a>,
+    pub b: Operand<'a>,
+    pub out: Name<'a>,
 }
 
 /// `{"for": {"var": V, "from": A, "to": B}}`.
 #[derive(Clone, Debug)]
 pub struct For<'a> {
-    pub var: Text<'a>,
-    pub from: Scalar<'a>,
-    pub to: Scalar<'a>,
+    pub var: Name<'a>,
+    pub from: Operand<'a>,
+    pub to: Operand<'a>,
 }
 
 /// The edge of an edge contact.
@@ -308,15 +328,17 @@ pub enum Edge {
     Falling,
 }
 
-impl<'a> Element<'a> {
+impl<'a> ElementKind<'a> {
     /// True for the conditions (allowed inside `or`).
     pub fn is_condition(&self) -> bool {
         matches!(
             self,
-            Element::Contact { .. } | Element::Compare(_) | Element::Or(_)
+            ElementKind::Contact { .. } | ElementKind::Compare(_) | ElementKind::Or(_)
         )
     }
 }
 
-// The common elements stay small: a million-rung program holds millions of them.
-const _: () = assert!(std::mem::size_of::<Element>() <= 32);
+// The common nodes stay small: a million-rung program holds millions of them.
+const _: () = assert!(std::mem::size_of::<Element>() <= 48);
+const _: () = assert!(std::mem::size_of::<Rung>() <= 112);
+const _: () = assert!(std::mem::size_of::<Var>() <= 96);

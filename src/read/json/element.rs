@@ -1,12 +1,31 @@
 //! Classifying one element object: which kind (by the key it has, in the format's order —
 //! `ctu`/`ctd` before `reset`, since a counter has a `reset` operand), which keys it may have, and
-//! the shape of each field. Names and operands are left to the resolver.
+//! the shape of each field. Names and operands are left to the resolver. The element's keys are
+//! the top of the reader's scratch stack (from `mark` on); they are taken from there.
 
-use super::ladder::{arith_op, cmp_op, edge, timer_kind, ForSlots, Slot};
+use super::ladder::{arith_op, cmp_op, edge, timer_kind, ForSlots};
 use crate::diag::Invalid;
-use crate::syntax::{self, Element, Problem, Scalar, Text};
+use crate::syntax::{
+    self, ElementKind, Located, Name, Operand, Origin, Problem, Scalar, Series, Text,
+};
 
-type Slots<'de> = Vec<(Text<'de>, Slot<'de>)>;
+/// The value of one key of an element object.
+pub(super) enum Slot<'a> {
+    Scalar(Operand<'a>),
+    /// `for`: the object's keys in file order, or the leaf found instead of an object.
+    For(Result<ForSlots<'a>, Scalar<'a>>),
+    Branches(Result<Vec<Series<'a>>, Box<Problem>>),
+    /// `in` of an arithmetic box: the operands, or what was found instead of an array.
+    List(Result<Vec<Operand<'a>>, Scalar<'a>>),
+}
+
+/// One key of an element object: the key and its origin, the value's origin and the value.
+pub(super) struct SlotEntry<'a> {
+    pub(super) key: Text<'a>,
+    pub(super) key_origin: Origin,
+    pub(super) origin: Origin,
+    pub(super) slot: Slot<'a>,
+}
 
 /// Element kind keys, in the order they are recognised, with the keys each kind allows.
 const ELEMENT_KINDS: &[(&str, &[&str])] = &[
@@ -59,9 +78,15 @@ fn element_what(key: &str) -> &'static str {
 
 type R<T> = Result<T, Box<Problem>>;
 
-fn shape(at: impl Into<String>, expected: &'static str, found: &Scalar) -> Box<Problem> {
+fn shape(
+    at: impl Into<String>,
+    origin: Origin,
+    expected: &'static str,
+    found: &Scalar,
+) -> Box<Problem> {
     Problem::new(
         at,
+        origin,
         Invalid::Shape {
             expected,
             found: found.kind(),
@@ -69,154 +94,179 @@ fn shape(at: impl Into<String>, expected: &'static str, found: &Scalar) -> Box<P
     )
 }
 
-/// The fields of one element object, taken out by key.
-struct Fields<'de> {
-    slots: Slots<'de>,
+/// The fields of one element object (`slots[mark..]`), taken out by key.
+struct Fields<'s, 'a> {
+    slots: &'s mut Vec<SlotEntry<'a>>,
+    mark: usize,
     what: &'static str,
+    /// The element's origin.
+    origin: Origin,
 }
 
-impl<'de> Fields<'de> {
-    fn take(&mut self, key: &'static str) -> Option<Slot<'de>> {
-        let i = self.slots.iter().position(|(k, _)| k == key)?;
-        Some(self.slots.swap_remove(i).1)
+impl<'a> Fields<'_, 'a> {
+    /// The value of `key` and its origin.
+    fn take(&mut self, key: &'static str) -> Option<(Slot<'a>, Origin)> {
+        let i = self.slots[self.mark..].iter().position(|s| s.key == key)?;
+        let e = self.slots.swap_remove(self.mark + i);
+        Some((e.slot, e.origin))
     }
-    fn required(&mut self, key: &'static str) -> R<Slot<'de>> {
-        self.take(key).ok_or_else(|| {
-            Problem::new(
-                "",
-                Invalid::MissingField {
-                    field: key,
-                    what: self.what,
-                },
-            )
-        })
+    fn required(&mut self, key: &'static str) -> R<(Slot<'a>, Origin)> {
+        let (what, origin) = (self.what, self.origin);
+        self.take(key)
+            .ok_or_else(|| Problem::new("", origin, Invalid::MissingField { field: key, what }))
     }
     /// A required leaf (operand).
-    fn operand(&mut self, key: &'static str) -> R<Scalar<'de>> {
+    fn operand(&mut self, key: &'static str) -> R<Operand<'a>> {
         match self.required(key)? {
-            Slot::Scalar(s) => Ok(s),
-            _ => Ok(Scalar::Array),
+            (Slot::Scalar(s), _) => Ok(s),
+            (_, origin) => Ok(Located {
+                value: Scalar::Array,
+                origin,
+            }),
         }
     }
     /// A required string.
-    fn string(&mut self, key: &'static str) -> R<Text<'de>> {
-        match self.operand(key)? {
-            Scalar::Str(s) => Ok(s),
-            other => Err(shape(format!(".{key}"), "a string", &other)),
+    fn string(&mut self, key: &'static str) -> R<Name<'a>> {
+        let o = self.operand(key)?;
+        match o.value {
+            Scalar::Str(s) => Ok(Located {
+                value: s,
+                origin: o.origin,
+            }),
+            other => Err(shape(format!(".{key}"), o.origin, "a string", &other)),
         }
     }
     /// An optional `true`/`false`.
     fn boolean(&mut self, key: &'static str) -> R<bool> {
+        let expected = "true or false";
         match self.take(key) {
             None => Ok(false),
-            Some(Slot::Scalar(Scalar::Bool(b))) => Ok(b),
-            Some(Slot::Scalar(other)) => Err(shape(format!(".{key}"), "true or false", &other)),
-            Some(_) => Err(shape(format!(".{key}"), "true or false", &Scalar::Array)),
+            Some((
+                Slot::Scalar(Located {
+                    value: Scalar::Bool(b),
+                    ..
+                }),
+                _,
+            )) => Ok(b),
+            Some((Slot::Scalar(o), _)) => {
+                Err(shape(format!(".{key}"), o.origin, expected, &o.value))
+            }
+            Some((_, origin)) => Err(shape(format!(".{key}"), origin, expected, &Scalar::Array)),
         }
     }
     /// A marker such as `"ret": true`.
     fn flag(&mut self, key: &'static str) -> R<()> {
-        match self.operand(key)? {
+        let o = self.operand(key)?;
+        match o.value {
             Scalar::Bool(true) => Ok(()),
-            other => Err(shape(format!(".{key}"), "true", &other)),
+            other => Err(shape(format!(".{key}"), o.origin, "true", &other)),
         }
     }
-    fn branches(&mut self, key: &'static str) -> R<Vec<crate::syntax::Series<'de>>> {
+    fn branches(&mut self, key: &'static str) -> R<Vec<Series<'a>>> {
         match self.required(key)? {
-            Slot::Branches(Ok(b)) if b.is_empty() => Err(Problem::new(
+            (Slot::Branches(Ok(b)), origin) if b.is_empty() => Err(Problem::new(
                 format!(".{key}"),
+                origin,
                 Invalid::Shape {
                     expected: "at least one branch",
                     found: "an empty array".into(),
                 },
             )),
-            Slot::Branches(Ok(b)) => Ok(b),
-            Slot::Branches(Err(mut p)) => {
+            (Slot::Branches(Ok(b)), _) => Ok(b),
+            (Slot::Branches(Err(mut p)), _) => {
                 p.at = format!(".{key}{}", p.at);
                 Err(p)
             }
-            _ => Err(shape(format!(".{key}"), "an array", &Scalar::Object)),
+            (_, origin) => Err(shape(
+                format!(".{key}"),
+                origin,
+                "an array",
+                &Scalar::Object,
+            )),
         }
     }
 }
 
-/// Which element an object is, with its fields checked for shape.
-pub(super) fn classify(slots: Slots<'_>) -> R<Element<'_>> {
+/// Which element the object whose keys are `slots[mark..]` is (at `origin`), with its fields
+/// checked for shape. The slots it does not take are left for the caller to drop.
+pub(super) fn classify<'a>(
+    slots: &mut Vec<SlotEntry<'a>>,
+    mark: usize,
+    origin: Origin,
+) -> R<ElementKind<'a>> {
+    let own = &slots[mark..];
     let Some(&(key, allowed)) = ELEMENT_KINDS
         .iter()
-        .find(|(k, _)| slots.iter().any(|(q, _)| q == k))
+        .find(|(k, _)| own.iter().any(|s| s.key == *k))
     else {
-        let keys = slots
+        let keys = own
             .iter()
-            .map(|(k, _)| format!("\"{k}\": …"))
+            .map(|s| format!("\"{}\": …", s.key))
             .collect::<Vec<_>>()
             .join(", ");
-        return Err(Problem::new("", Invalid::UnknownElement { keys }));
+        return Err(Problem::new("", origin, Invalid::UnknownElement { keys }));
     };
     let what = element_what(key);
-    if let Some((k, _)) = slots.iter().find(|(k, _)| !allowed.contains(&k.as_ref())) {
+    if let Some(s) = own.iter().find(|s| !allowed.contains(&s.key.as_ref())) {
         return Err(Problem::new(
-            format!(".{k}"),
+            format!(".{}", s.key),
+            s.key_origin,
             Invalid::UnknownField {
-                field: k.to_string(),
+                field: s.key.to_string(),
                 what,
                 allowed: allowed.join(", "),
             },
         ));
     }
-    let mut f = Fields { slots, what };
+    let mut f = Fields {
+        slots,
+        mark,
+        what,
+        origin,
+    };
     Ok(match key {
         "contact" => contact(&mut f)?,
         "compare" => {
             let op = f.string("compare")?;
-            let op = cmp_op(&op).ok_or_else(|| {
+            let op = cmp_op(&op.value).ok_or_else(|| {
                 Problem::new(
                     ".compare",
+                    op.origin,
                     Invalid::Shape {
                         expected: "EQ, NE, LT, LE, GT or GE",
-                        found: format!("\"{op}\""),
+                        found: format!("\"{}\"", op.value),
                     },
                 )
             })?;
             let a = f.operand("a")?;
             let b = f.operand("b")?;
-            Element::Compare(Box::new(syntax::Compare { op, a, b }))
+            ElementKind::Compare(Box::new(syntax::Compare { op, a, b }))
         }
-        "or" => Element::Or(f.branches("or")?),
-        "branch" => Element::Branch(f.branches("branch")?),
+        "or" => ElementKind::Or(f.branches("or")?),
+        "branch" => ElementKind::Branch(f.branches("branch")?),
         "coil" => {
             let var = f.string("coil")?;
             let negated = f.boolean("negated")?;
-            Element::Coil { var, negated }
+            ElementKind::Coil { var, negated }
         }
-        "set" => Element::Set(f.string("set")?),
-        "reset" => Element::Reset(f.string("reset")?),
+        "set" => ElementKind::Set(f.string("set")?),
+        "reset" => ElementKind::Reset(f.string("reset")?),
         "ton" | "tof" | "tp" => {
             let instance = f.string(key)?;
             let pt = f.operand("pt")?;
-            Element::Timer(Box::new(syntax::Timer {
+            ElementKind::Timer(Box::new(syntax::Timer {
                 kind: timer_kind(key).unwrap_or(crate::model::TimerKind::Ton),
                 instance,
                 pt,
             }))
         }
-        "ctu" => {
-            let instance = f.string("ctu")?;
+        "ctu" | "ctd" => {
+            let down = key == "ctd";
+            let instance = f.string(key)?;
             let pv = f.operand("pv")?;
-            let aux = f.operand("reset")?;
-            Element::Counter(Box::new(syntax::Counter {
-                down: false,
-                instance,
-                pv,
-                aux,
-            }))
-        }
-        "ctd" => {
-            let instance = f.string("ctd")?;
-            let pv = f.operand("pv")?;
-            let aux = f.operand("load")?;
-            Element::Counter(Box::new(syntax::Counter {
-                down: true,
+            let aux = f.operand(if down { "load" } else { "reset" })?;
+            ElementKind::Counter(Box::new(syntax::Counter {
+                down,
                 instance,
                 pv,
                 aux,
@@ -225,97 +275,113 @@ pub(super) fn classify(slots: Slots<'_>) -> R<Element<'_>> {
         "move" => {
             let to = f.string("to")?;
             let from = f.operand("move")?;
-            Element::Move(Box::new(syntax::Move { from, to }))
+            ElementKind::Move(Box::new(syntax::Move { from, to }))
         }
         "op" => arith(&mut f)?,
-        "jmp" => Element::Jmp(f.string("jmp")?),
+        "jmp" => ElementKind::Jmp(f.string("jmp")?),
         "ret" => {
             f.flag("ret")?;
-            Element::Ret
+            ElementKind::Ret
         }
         "end" => {
             f.flag("end")?;
-            Element::End
+            ElementKind::End
         }
         "next" => {
             f.flag("next")?;
-            Element::Next
+            ElementKind::Next
         }
-        "call" => Element::Call(f.string("call")?),
+        "call" => ElementKind::Call(f.string("call")?),
         _ => for_loop(&mut f)?,
     })
 }
 
-fn contact<'de>(f: &mut Fields<'de>) -> R<Element<'de>> {
+fn contact<'a>(f: &mut Fields<'_, 'a>) -> R<ElementKind<'a>> {
     let var = f.string("contact")?;
     let negated = f.boolean("negated")?;
     let edge = match f.take("edge") {
         None => None,
-        Some(_) if negated => {
+        Some((_, origin)) if negated => {
             return Err(Problem::new(
                 ".edge",
+                origin,
                 Invalid::Misplaced {
                     what: "`edge`",
                     place: "together with `negated`",
                 },
             ))
         }
-        Some(Slot::Scalar(Scalar::Str(s))) => Some(edge(&s).ok_or_else(|| {
+        Some((
+            Slot::Scalar(Located {
+                value: Scalar::Str(s),
+                origin,
+            }),
+            _,
+        )) => Some(edge(&s).ok_or_else(|| {
             Problem::new(
                 ".edge",
+                origin,
                 Invalid::Shape {
                     expected: "\"rising\" or \"falling\"",
                     found: format!("\"{s}\""),
                 },
             )
         })?),
-        Some(Slot::Scalar(other)) => return Err(shape(".edge", "a string", &other)),
-        Some(_) => return Err(shape(".edge", "a string", &Scalar::Array)),
+        Some((Slot::Scalar(o), _)) => return Err(shape(".edge", o.origin, "a string", &o.value)),
+        Some((_, origin)) => return Err(shape(".edge", origin, "a string", &Scalar::Array)),
     };
-    Ok(Element::Contact { var, negated, edge })
+    Ok(ElementKind::Contact { var, negated, edge })
 }
 
-fn arith<'de>(f: &mut Fields<'de>) -> R<Element<'de>> {
+fn arith<'a>(f: &mut Fields<'_, 'a>) -> R<ElementKind<'a>> {
     let name = f.string("op")?;
-    let op = arith_op(&name).ok_or_else(|| {
+    let op = arith_op(&name.value).ok_or_else(|| {
         Problem::new(
             ".op",
+            name.origin,
             Invalid::Shape {
                 expected: "ADD, SUB, MUL, DIV or MOD",
-                found: format!("\"{name}\""),
+                found: format!("\"{}\"", name.value),
             },
         )
     })?;
     let out = f.string("out")?;
-    let inputs = match f.required("in")? {
-        Slot::List(Ok(list)) => list,
-        Slot::List(Err(found)) => return Err(shape(".in", "an array", &found)),
-        _ => return Err(shape(".in", "an array", &Scalar::Object)),
+    let (inputs, origin) = match f.required("in")? {
+        (Slot::List(Ok(list)), origin) => (list, origin),
+        (Slot::List(Err(found)), origin) => return Err(shape(".in", origin, "an array", &found)),
+        (_, origin) => return Err(shape(".in", origin, "an array", &Scalar::Object)),
     };
-    let [a, b]: [Scalar; 2] = inputs.try_into().map_err(|v: Vec<Scalar>| {
+    let [a, b]: [Operand; 2] = inputs.try_into().map_err(|v: Vec<Operand>| {
         Problem::new(
             ".in",
+            origin,
             Invalid::Shape {
                 expected: "two operands",
                 found: format!("{} operands", v.len()),
             },
         )
     })?;
-    Ok(Element::Arith(Box::new(syntax::Arith { op, a, b, out })))
+    Ok(ElementKind::Arith(Box::new(syntax::Arith {
+        op,
+        a,
+        b,
+        out,
+    })))
 }
 
-fn for_loop<'de>(f: &mut Fields<'de>) -> R<Element<'de>> {
-    let slots: ForSlots<'de> = match f.required("for")? {
-        Slot::For(Ok(slots)) => slots,
-        Slot::For(Err(found)) => return Err(shape(".for", "an object", &found)),
-        _ => return Err(shape(".for", "an object", &Scalar::Array)),
+fn for_loop<'a>(f: &mut Fields<'_, 'a>) -> R<ElementKind<'a>> {
+    let (mut slots, origin) = match f.required("for")? {
+        (Slot::For(Ok(slots)), origin) => (slots, origin),
+        (Slot::For(Err(found)), origin) => return Err(shape(".for", origin, "an object", &found)),
+        (_, origin) => return Err(shape(".for", origin, "an object", &Scalar::Array)),
     };
-    if let Some((k, _)) = slots
+    if let Some((k, key_origin, _)) = slots
         .iter()
-        .find(|(k, _)| !["var", "from", "to"].contains(&k.as_ref()))
+        .find(|(k, _, _)| !["var", "from", "to"].contains(&k.as_ref()))
     {
         return Err(Problem::new(
             format!(".for.{k}"),
+            *key_origin,
             Invalid::UnknownField {
                 field: k.to_string(),
                 what: "a FOR",
@@ -323,24 +389,28 @@ fn for_loop<'de>(f: &mut Fields<'de>) -> R<Element<'de>> {
             },
         ));
     }
-    let mut slots = slots;
-    let mut get = |key: &'static str| -> R<Scalar<'de>> {
-        let i = slots.iter().position(|(k, _)| k == key).ok_or_else(|| {
+    let mut get = |key: &'static str| -> R<Operand<'a>> {
+        let i = slots.iter().position(|(k, _, _)| k == key).ok_or_else(|| {
             Problem::new(
                 ".for",
+                origin,
                 Invalid::MissingField {
                     field: key,
                     what: "a FOR",
                 },
             )
         })?;
-        Ok(slots.swap_remove(i).1)
+        Ok(slots.swap_remove(i).2)
     };
-    let var = match get("var")? {
-        Scalar::Str(s) => s,
-        other => return Err(shape(".for.var", "a string", &other)),
+    let var = get("var")?;
+    let var = match var.value {
+        Scalar::Str(s) => Located {
+            value: s,
+            origin: var.origin,
+        },
+        other => return Err(shape(".for.var", var.origin, "a string", &other)),
     };
     let from = get("from")?;
     let to = get("to")?;
-    Ok(Element::For(Box::new(syntax::For { var, from, to })))
+    Ok(ElementKind::For(Box::new(syntax::For { var, from, to })))
 }

@@ -1,21 +1,22 @@
 //! FBD bodies of the JSON program format (docs/fbd.md) → [`syntax::fbd`], without a value
-//! tree: every node is read from its slice of the text with the reader's visitors
-//! ([`Container`]: an array or object of raw slices, or the leaf found instead; [`AnyScalar`]:
-//! a leaf), so each network, block, input and output variable gets the [`Origin`] of its slice.
+//! tree. The program reader's cursor has already checked the body's syntax (skipping it); this
+//! reader walks it again, one container at a time ([`Container`]: the positions of an array's
+//! items or an object's values, or the leaf found instead), so each network, block, input and
+//! output variable gets the [`Origin`] of its value. FBD bodies are small next to ladder
+//! programs: the second walk costs little.
 //!
 //! Every shape the format allows is checked here, in the order docs/fbd.md lists a node's
 //! fields; what is malformed becomes a [`Problem`] at the part it concerns (see
 //! [`syntax::fbd`]) and reading goes on. Deliberately not here: block ids, ops, arcs, pins,
 //! labels and names (`crate::resolve::fbd_read`).
 
-use super::scalar::{AnyScalar, Container};
-use super::{get, raw, shape, Entries};
-use crate::diag::{Invalid, LoadError};
+use super::cursor::{Cursor, P};
+use super::shape;
+use crate::diag::Invalid;
 use crate::syntax::fbd::*;
 use crate::syntax::{Origin, Problem, Scalar, Text};
-use serde_json::value::RawValue;
 
-type Result<T> = std::result::Result<T, LoadError>;
+type Result<T> = P<T>;
 
 const BODY_KEYS: &[&str] = &["networks", "comment"];
 const NETWORK_KEYS: &[&str] = &["id", "label", "comment", "blocks"];
@@ -24,24 +25,51 @@ const BLOCK_KEYS: &[&str] = &[
 ];
 const ARC_KEYS: &[&str] = &["from", "pin"];
 
-/// Reads the `fbd` value `v`; `base` is the address of the start of the whole text.
-pub(super) fn body<'de>(base: usize, v: &'de RawValue) -> Result<FbdBody<'de>> {
-    FbdReader { base }.body(v)
+/// Reads the `fbd` value at the cursor (which it skips).
+pub(super) fn body<'a>(c: &mut Cursor<'a>) -> P<FbdBody<'a>> {
+    let at = c.offset();
+    c.skip()?;
+    FbdReader { text: c.text() }.body(Raw(at))
 }
 
-struct FbdReader {
-    base: usize,
+/// A value of the text, by the byte offset where it starts.
+#[derive(Copy, Clone)]
+struct Raw(usize);
+
+impl Raw {
+    fn origin(self) -> Origin {
+        Origin::at(self.0)
+    }
 }
 
-/// A problem at `at` (relative to the node that holds it).
-fn problem(at: impl Into<String>, kind: Invalid) -> Box<Problem> {
-    Problem::new(at, kind)
+/// What a place that wants an array or an object found.
+enum Container<'a> {
+    Array(Vec<Raw>),
+    /// Entries in file order (a repeated key keeps its first place and its last value).
+    Object(Vec<(Text<'a>, Raw)>),
+    Other(Scalar<'a>),
 }
 
-fn unknown_key(e: &Entries, allowed: &[&str], what: &'static str) -> Option<Box<Problem>> {
-    let (k, _) = e.iter().find(|(k, _)| !allowed.contains(&k.as_ref()))?;
+type Entries<'a> = Vec<(Text<'a>, Raw)>;
+
+fn get(e: &Entries<'_>, key: &str) -> Option<Raw> {
+    e.iter().find(|(k, _)| k == key).map(|(_, v)| *v)
+}
+
+struct FbdReader<'a> {
+    text: &'a str,
+}
+
+/// A problem at `at` (relative to the node that holds it), whose value starts at `origin`.
+fn problem(at: impl Into<String>, origin: Origin, kind: Invalid) -> Box<Problem> {
+    Problem::new(at, origin, kind)
+}
+
+fn unknown_key(e: &Entries<'_>, allowed: &[&str], what: &'static str) -> Option<Box<Problem>> {
+    let (k, v) = e.iter().find(|(k, _)| !allowed.contains(&k.as_ref()))?;
     Some(problem(
         format!(".{k}"),
+        v.origin(),
         Invalid::UnknownField {
             field: k.to_string(),
             what,
@@ -50,8 +78,8 @@ fn unknown_key(e: &Entries, allowed: &[&str], what: &'static str) -> Option<Box<
     ))
 }
 
-fn missing(field: &'static str, what: &'static str) -> Box<Problem> {
-    problem("", Invalid::MissingField { field, what })
+fn missing(origin: Origin, field: &'static str, what: &'static str) -> Box<Problem> {
+    problem("", origin, Invalid::MissingField { field, what })
 }
 
 /// What a container holds when it is not the expected kind (arrays and objects by kind only).
@@ -71,33 +99,64 @@ fn block_id(s: &Scalar) -> Option<u32> {
     }
 }
 
-impl FbdReader {
-    fn origin(&self, v: &RawValue) -> Origin {
-        Origin::at(v.get().as_ptr() as usize - self.base)
+impl<'a> FbdReader<'a> {
+    /// The array or object at `v` (its items' positions), or the leaf found there.
+    fn container(&self, v: Raw) -> Result<Container<'a>> {
+        let mut c = Cursor::new(self.text, v.0);
+        let mut first = true;
+        match c.peek() {
+            Some(b'[') => {
+                c.begin_array()?;
+                let mut items = Vec::new();
+                while c.item(&mut first)? {
+                    items.push(Raw(c.offset()));
+                    c.skip()?;
+                }
+                Ok(Container::Array(items))
+            }
+            Some(b'{') => {
+                c.begin_object()?;
+                let mut entries: Entries<'a> = Vec::new();
+                while let Some((k, _)) = c.key(&mut first)? {
+                    let at = Raw(c.offset());
+                    c.skip()?;
+                    match entries.iter_mut().find(|(q, _)| *q == k) {
+                        Some(slot) => slot.1 = at,
+                        None => entries.push((k, at)),
+                    }
+                }
+                Ok(Container::Object(entries))
+            }
+            _ => Ok(Container::Other(c.scalar()?)),
+        }
     }
 
-    fn container<'de>(&self, v: &'de RawValue) -> Result<Container<'de>> {
-        raw(v, "fbd")
-    }
-
-    fn scalar<'de>(&self, v: &'de RawValue) -> Result<Scalar<'de>> {
-        Ok(raw::<AnyScalar>(v, "fbd")?.0)
+    /// The leaf at `v` (`Scalar::Array`/`Object` for a container).
+    fn scalar(&self, v: Raw) -> Result<Scalar<'a>> {
+        Ok(match self.container(v)? {
+            Container::Other(s) => s,
+            other => found(other),
+        })
     }
 
     /// An optional string field `key`: `Err` at `.key` when it is not a string.
-    fn text<'de>(&self, e: &Entries<'de>, key: &str) -> Result<Option<Read<Text<'de>>>> {
+    fn text(&self, e: &Entries<'a>, key: &str) -> Result<Option<Read<Text<'a>>>> {
         let Some(v) = get(e, key) else {
             return Ok(None);
         };
         Ok(Some(match self.scalar(v)? {
             Scalar::Str(s) => Ok(s),
-            other => Err(problem(format!(".{key}"), shape("a string", &other))),
+            other => Err(problem(
+                format!(".{key}"),
+                v.origin(),
+                shape("a string", &other),
+            )),
         }))
     }
 
-    fn body<'de>(&self, v: &'de RawValue) -> Result<FbdBody<'de>> {
+    fn body(&self, v: Raw) -> Result<FbdBody<'a>> {
         let mut body = FbdBody {
-            origin: self.origin(v),
+            origin: v.origin(),
             comment: None,
             networks: Vec::new(),
             problem: None,
@@ -106,7 +165,7 @@ impl FbdReader {
             Container::Object(e) => e,
             other => {
                 let expected = "an object (an FBD body: {\"networks\": [...]})";
-                body.problem = Some(problem("", shape(expected, &found(other))));
+                body.problem = Some(problem("", v.origin(), shape(expected, &found(other))));
                 return Ok(body);
             }
         };
@@ -120,7 +179,7 @@ impl FbdReader {
         match get(&e, "networks") {
             None => {
                 body.problem
-                    .get_or_insert_with(|| missing("networks", "an FBD body"));
+                    .get_or_insert_with(|| missing(v.origin(), "networks", "an FBD body"));
             }
             Some(n) => match self.container(n)? {
                 Container::Array(items) => {
@@ -131,7 +190,7 @@ impl FbdReader {
                 }
                 other => {
                     body.problem.get_or_insert_with(|| {
-                        problem(".networks", shape("an array", &found(other)))
+                        problem(".networks", n.origin(), shape("an array", &found(other)))
                     });
                 }
             },
@@ -139,9 +198,9 @@ impl FbdReader {
         Ok(body)
     }
 
-    fn network<'de>(&self, v: &'de RawValue) -> Result<Network<'de>> {
+    fn network(&self, v: Raw) -> Result<Network<'a>> {
         let mut net = Network {
-            origin: self.origin(v),
+            origin: v.origin(),
             id: Ok(Text::Borrowed("")),
             label: None,
             comment: None,
@@ -151,18 +210,23 @@ impl FbdReader {
         let e = match self.container(v)? {
             Container::Object(e) => e,
             other => {
-                net.id = Err(problem("", shape("an object (a network)", &found(other))));
+                net.id = Err(problem(
+                    "",
+                    v.origin(),
+                    shape("an object (a network)", &found(other)),
+                ));
                 return Ok(net);
             }
         };
         net.id = match get(&e, "id") {
-            None => Err(missing("id", "a network")),
+            None => Err(missing(v.origin(), "id", "a network")),
             Some(id) => match self.scalar(id)? {
                 Scalar::Str(s)
                     if s.is_empty() || s.chars().any(|c| c.is_whitespace() || c == '"') =>
                 {
                     Err(problem(
                         ".id",
+                        id.origin(),
                         Invalid::Shape {
                             expected: "a network id without spaces or quotes",
                             found: format!("\"{s}\""),
@@ -170,17 +234,18 @@ impl FbdReader {
                     ))
                 }
                 Scalar::Str(s) => Ok(s),
-                other => Err(problem(".id", shape("a string", &other))),
+                other => Err(problem(".id", id.origin(), shape("a string", &other))),
             },
         };
         net.problem = unknown_key(&e, NETWORK_KEYS, "a network");
         net.label = self.text(&e, "label")?;
         net.comment = self.text(&e, "comment")?;
         net.blocks = match get(&e, "blocks") {
-            None => Err(missing("blocks", "a network")),
+            None => Err(missing(v.origin(), "blocks", "a network")),
             Some(b) => match self.container(b)? {
                 Container::Array(items) if items.is_empty() => Err(problem(
                     ".blocks",
+                    b.origin(),
                     Invalid::Shape {
                         expected: "at least one block",
                         found: "an empty array".into(),
@@ -190,15 +255,19 @@ impl FbdReader {
                     .into_iter()
                     .map(|b| self.block(b))
                     .collect::<Result<_>>()?),
-                other => Err(problem(".blocks", shape("an array", &found(other)))),
+                other => Err(problem(
+                    ".blocks",
+                    b.origin(),
+                    shape("an array", &found(other)),
+                )),
             },
         };
         Ok(net)
     }
 
-    fn block<'de>(&self, v: &'de RawValue) -> Result<Block<'de>> {
+    fn block(&self, v: Raw) -> Result<Block<'a>> {
         let mut b = Block {
-            origin: self.origin(v),
+            origin: v.origin(),
             id: Ok(0),
             op: Ok(Text::Borrowed("")),
             inputs: None,
@@ -213,22 +282,30 @@ impl FbdReader {
         let e = match self.container(v)? {
             Container::Object(e) => e,
             other => {
-                b.id = Err(problem("", shape("an object (a block)", &found(other))));
+                b.id = Err(problem(
+                    "",
+                    v.origin(),
+                    shape("an object (a block)", &found(other)),
+                ));
                 return Ok(b);
             }
         };
         b.id = match get(&e, "id") {
-            None => Err(missing("id", "a block")),
+            None => Err(missing(v.origin(), "id", "a block")),
             Some(id) => {
                 let s = self.scalar(id)?;
                 block_id(&s).ok_or_else(|| {
-                    problem(".id", shape("a block id (a whole number, 0 or more)", &s))
+                    problem(
+                        ".id",
+                        id.origin(),
+                        shape("a block id (a whole number, 0 or more)", &s),
+                    )
                 })
             }
         };
         b.problem = unknown_key(&e, BLOCK_KEYS, "a block");
         b.op = match self.text(&e, "op")? {
-            None => Err(missing("op", "a block")),
+            None => Err(missing(v.origin(), "op", "a block")),
             Some(op) => op,
         };
         if let Some(i) = get(&e, "in") {
@@ -249,7 +326,7 @@ impl FbdReader {
         Ok(b)
     }
 
-    fn inputs<'de>(&self, v: &'de RawValue) -> Result<Read<Inputs<'de>>> {
+    fn inputs(&self, v: Raw) -> Result<Read<Inputs<'a>>> {
         Ok(match self.container(v)? {
             Container::Array(items) => Ok(Inputs::List(
                 items
@@ -265,6 +342,7 @@ impl FbdReader {
             )),
             other => Err(problem(
                 ".in",
+                v.origin(),
                 shape(
                     "an array of inputs or an object {PIN: input}",
                     &found(other),
@@ -274,10 +352,10 @@ impl FbdReader {
     }
 
     /// An INPUT: an arc `{"from": ID, "pin": PIN}`, a variable, or a constant.
-    fn input<'de>(&self, v: &'de RawValue) -> Result<Input<'de>> {
-        let origin = self.origin(v);
+    fn input(&self, v: Raw) -> Result<Input<'a>> {
+        let origin = v.origin();
         let from = match self.container(v)? {
-            Container::Object(e) => self.arc(&e)?,
+            Container::Object(e) => self.arc(&e, origin)?,
             Container::Other(Scalar::Str(s)) if is_time_literal(&s) => {
                 Connection::Constant(Scalar::Str(s))
             }
@@ -285,23 +363,25 @@ impl FbdReader {
             Container::Other(s @ (Scalar::Number(_) | Scalar::Bool(_))) => Connection::Constant(s),
             other => Connection::Invalid(problem(
                 "",
+                origin,
                 shape("an operand or an arc {\"from\": BLOCK}", &found(other)),
             )),
         };
         Ok(Input { origin, from })
     }
 
-    fn arc<'de>(&self, e: &Entries<'de>) -> Result<Connection<'de>> {
+    fn arc(&self, e: &Entries<'a>, origin: Origin) -> Result<Connection<'a>> {
         if let Some(p) = unknown_key(e, ARC_KEYS, "an arc") {
             return Ok(Connection::Invalid(p));
         }
         let Some(from) = get(e, "from") else {
-            return Ok(Connection::Invalid(missing("from", "an arc")));
+            return Ok(Connection::Invalid(missing(origin, "from", "an arc")));
         };
         let s = self.scalar(from)?;
         let Some(block) = block_id(&s) else {
             return Ok(Connection::Invalid(problem(
                 ".from",
+                from.origin(),
                 shape("a block id", &s),
             )));
         };
@@ -311,23 +391,20 @@ impl FbdReader {
         })
     }
 
-    fn out_var<'de>(
-        &self,
-        v: &'de RawValue,
-    ) -> Result<std::result::Result<OutVar<'de>, Scalar<'de>>> {
+    fn out_var(&self, v: Raw) -> Result<std::result::Result<OutVar<'a>, Scalar<'a>>> {
         Ok(match self.scalar(v)? {
             Scalar::Str(name) => Ok(OutVar {
-                origin: self.origin(v),
+                origin: v.origin(),
                 name,
             }),
             other => Err(other),
         })
     }
 
-    fn outputs<'de>(&self, v: &'de RawValue) -> Result<Read<Outputs<'de>>> {
+    fn outputs(&self, v: Raw) -> Result<Read<Outputs<'a>>> {
         Ok(match self.container(v)? {
             Container::Other(Scalar::Str(name)) => Ok(Outputs::First(OutVar {
-                origin: self.origin(v),
+                origin: v.origin(),
                 name,
             })),
             Container::Array(items) => {
@@ -338,6 +415,7 @@ impl FbdReader {
                         Err(Scalar::Null) => Ok(None),
                         Err(other) => Err(problem(
                             format!(".out[{i}]"),
+                            item.origin(),
                             shape("a variable name or null", &other),
                         )),
                     });
@@ -354,6 +432,7 @@ impl FbdReader {
             }
             other => Err(problem(
                 ".out",
+                v.origin(),
                 shape(
                     "a variable name, an array or an object {PIN: variable}",
                     &found(other),
@@ -363,44 +442,52 @@ impl FbdReader {
     }
 
     /// The variables of output pin `pin` in `{PIN: "Var"}` / `{PIN: ["V1", "V2"]}`.
-    fn targets<'de>(&self, v: &'de RawValue, pin: &str) -> Result<Read<Targets<'de>>> {
+    fn targets(&self, v: Raw, pin: &str) -> Result<Read<Targets<'a>>> {
         Ok(match self.container(v)? {
             Container::Other(Scalar::Str(name)) => Ok(Targets::One(OutVar {
-                origin: self.origin(v),
+                origin: v.origin(),
                 name,
             })),
             Container::Array(items) => {
                 let mut vars = Vec::with_capacity(items.len());
                 for (m, item) in items.into_iter().enumerate() {
                     vars.push(self.out_var(item)?.map_err(|other| {
-                        problem(format!(".out.{pin}[{m}]"), shape("a variable name", &other))
+                        problem(
+                            format!(".out.{pin}[{m}]"),
+                            item.origin(),
+                            shape("a variable name", &other),
+                        )
                     }));
                 }
                 Ok(Targets::Many(vars))
             }
             other => Err(problem(
                 format!(".out.{pin}"),
+                v.origin(),
                 shape("a variable name or an array of them", &found(other)),
             )),
         })
     }
 
-    fn after<'de>(&self, v: &'de RawValue) -> Result<Read<Vec<Read<u32>>>> {
+    fn after(&self, v: Raw) -> Result<Read<Vec<Read<u32>>>> {
         Ok(match self.container(v)? {
             Container::Array(items) => {
                 let mut ids = Vec::with_capacity(items.len());
                 for (i, item) in items.into_iter().enumerate() {
                     let s = self.scalar(item)?;
-                    ids.push(
-                        block_id(&s).ok_or_else(|| {
-                            problem(format!(".after[{i}]"), shape("a block id", &s))
-                        }),
-                    );
+                    ids.push(block_id(&s).ok_or_else(|| {
+                        problem(
+                            format!(".after[{i}]"),
+                            item.origin(),
+                            shape("a block id", &s),
+                        )
+                    }));
                 }
                 Ok(ids)
             }
             other => Err(problem(
                 ".after",
+                v.origin(),
                 shape("an array of block ids", &found(other)),
             )),
         })

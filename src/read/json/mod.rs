@@ -1,63 +1,78 @@
-//! The JSON program format (docs/format.md, docs/fbd.md) → [`syntax::Program`], streamed.
+//! The JSON program format (docs/format.md, docs/fbd.md) → [`syntax::Program`], in one pass.
 //!
-//! Two passes over the text, neither of which builds a `serde_json::Value` tree of the document:
-//! the first reads the program object with serde, keeping each part it will look at later as a
-//! `&RawValue` (a slice of the text: syntax is fully checked here, so a syntax error is always
-//! reported first, with line and column); the second reads each part — variables, each rung, each
-//! element — with streaming visitors into the syntax types. The byte offset of a raw part in the
-//! text is its [`Origin`]. Every visitor accepts any JSON value: a value of the wrong shape or an
-//! unknown field becomes a [`Problem`] at the node (a path suffix relative to it), so reading
-//! never stops at the first one. A UTF-8 byte-order mark at the start of the text is skipped.
+//! A hand-written [`cursor::Cursor`] walks the text once, and the readers here and in [`ladder`]
+//! and [`element`] fill the syntax types as they go — no `serde_json::Value` tree, no second look
+//! at any part, strings borrowed from the text, each series collected on a scratch stack and
+//! stored in a `Vec` of its exact size. Every node gets the byte offset of its value (its
+//! [`Origin`]); the key of an unknown field gets its own. Every reader accepts any JSON value: a
+//! value of the wrong shape or an unknown field becomes a [`Problem`] at the node (a path suffix
+//! relative to it, and the origin of the most precise node), so reading never stops at the first
+//! one. The parts of an object are read in file order, each with its own problems, and put
+//! together in the order the format lists them (a repeated key keeps its first place and its
+//! last value). A syntax error stops the reading; its message and place are `serde_json`'s, asked
+//! only then, so they read the same as they always have. A UTF-8 byte-order mark at the start of
+//! the text is skipped (offsets still count it: they are offsets into the text as given).
 //!
 //! Deliberately not here: names, types, ids, labels and every other rule that needs more than
-//! one node (`crate::resolve`).
+//! one node (`crate::resolve`). FBD bodies are read by [`fbd`].
 
+mod cursor;
 mod element;
 mod fbd;
 mod ladder;
-mod scalar;
 
 use crate::diag::{Invalid, LoadError};
-use crate::syntax::{self, Body, Origin, Problem, Scalar, Text, Var, VarClass};
-use ladder::RungDe;
-use scalar::{parse_raw, AnyScalar, Container};
-use serde::de::{IgnoredAny, MapAccess, SeqAccess};
-use serde_json::value::RawValue;
+use crate::syntax::{self, Body, Located, Name, Origin, Problem, Scalar, Text, Var, VarClass};
+use cursor::{Cursor, Fail, P};
+use serde::de::IgnoredAny;
 
 /// Reads a program file's text into the surface syntax. Only syntax errors fail here.
 pub fn parse(text: &str) -> Result<syntax::Program<'_>, LoadError> {
-    let body = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let top: Container = serde_json::from_str(body).map_err(|e| syntax_error(body, &e))?;
-    let mut r = Reader {
-        base: text.as_ptr() as usize,
-        program: syntax::Program::default(),
-    };
-    match top {
-        Container::Object(entries) => r.program_object(entries)?,
-        Container::Array(_) => r.problem("", shape("a JSON object (the program)", &Scalar::Array)),
-        Container::Other(s) => r.problem("", shape("a JSON object (the program)", &s)),
+    let start = if text.starts_with('\u{feff}') { 3 } else { 0 };
+    let mut r = Reader::new(text, start);
+    match r.document() {
+        Ok(program) => Ok(program),
+        Err(Fail) => Err(syntax_error(text, start, r.c.offset())),
     }
-    Ok(r.program)
 }
 
-fn syntax_error(text: &str, e: &serde_json::Error) -> LoadError {
-    let message = e.to_string();
-    let message = match message.rfind(" at line ") {
-        Some(i) => message[..i].to_owned(),
-        None => message,
-    };
-    if text.trim().is_empty() {
-        return LoadError::Syntax {
+/// The syntax error of a text the cursor refused at byte `at`, as `serde_json` words it.
+#[cold]
+fn syntax_error(text: &str, start: usize, at: usize) -> LoadError {
+    let body = &text[start..];
+    // Checked without building values first (a syntax error late in a big file); only what that
+    // accepts (a string that does not decode, say) is read into values to find the error.
+    let checked = serde_json::from_str::<IgnoredAny>(body)
+        .and_then(|_| serde_json::from_str::<serde_json::Value>(body).map(drop));
+    match checked {
+        Err(e) if body.trim().is_empty() => LoadError::Syntax {
             line: e.line().max(1),
             column: 1,
             message: "the file is empty (expected a JSON object, the program)".into(),
-        };
-    }
-    LoadError::Syntax {
-        line: e.line(),
-        // serde_json counts the column of an error at the start of a line as 0.
-        column: e.column().max(1),
-        message,
+        },
+        Err(e) => {
+            let message = e.to_string();
+            let message = match message.rfind(" at line ") {
+                Some(i) => message[..i].to_owned(),
+                None => message,
+            };
+            LoadError::Syntax {
+                line: e.line(),
+                // serde_json counts the column of an error at the start of a line as 0.
+                column: e.column().max(1),
+                message,
+            }
+        }
+        // The cursor refused what serde_json reads: a bug of the cursor, still located.
+        Ok(_) => {
+            let (line, column) = Origin::at(at).line_column(text).unwrap_or((1, 1));
+            LoadError::Syntax {
+                line: line as usize,
+                column: column as usize,
+                message: "the reader cannot read this value (a bug of plc-deps: please report it)"
+                    .into(),
+            }
+        }
     }
 }
 
@@ -76,359 +91,422 @@ fn join(path: &str, key: &str) -> String {
     }
 }
 
-/// A raw part, parsed. The first pass checked its syntax, so an error is a visitor's bug: it is
-/// still reported as located data, never a panic.
-fn raw<'de, T: serde::Deserialize<'de>>(v: &'de RawValue, path: &str) -> Result<T, LoadError> {
-    parse_raw(v).map_err(|e| {
-        LoadError::invalid(
-            None,
-            path,
-            Invalid::Shape {
-                expected: "a value the reader can read",
-                found: e.to_string(),
-            },
-        )
-    })
+fn unknown_field(
+    at: String,
+    origin: Origin,
+    field: &str,
+    what: &'static str,
+    allowed: &[&str],
+) -> Problem {
+    Problem {
+        at,
+        origin,
+        kind: Invalid::UnknownField {
+            field: field.to_owned(),
+            what,
+            allowed: allowed.join(", "),
+        },
+    }
 }
 
-/// Drains an array, for "found an array" messages.
-pub(super) fn scalar_of_seq<'de, A: SeqAccess<'de>>(mut seq: A) -> Result<Scalar<'de>, A::Error> {
-    while seq.next_element::<IgnoredAny>()?.is_some() {}
-    Ok(Scalar::Array)
+/// A part of an object, with the problems found in it (kept apart until the parts are put
+/// together in the format's order).
+struct Part<T> {
+    value: T,
+    problems: Vec<Problem>,
 }
 
-/// Drains an object, for "found an object" messages.
-pub(super) fn scalar_of_map<'de, A: MapAccess<'de>>(mut map: A) -> Result<Scalar<'de>, A::Error> {
-    while map.next_entry::<IgnoredAny, IgnoredAny>()?.is_some() {}
-    Ok(Scalar::Object)
+/// The parts of a POU object (the program, a subroutine, a function block), as read.
+#[derive(Default)]
+struct Parts<'a> {
+    /// The first key that is not allowed (in file order), with its origin.
+    unknown: Option<(Text<'a>, Origin)>,
+    name: Option<(Scalar<'a>, Origin)>,
+    comment: Option<Scalar<'a>>,
+    vars: Option<Part<Vec<Var<'a>>>>,
+    inputs: Option<Part<Vec<Var<'a>>>>,
+    outputs: Option<Part<Vec<Var<'a>>>>,
+    rungs: Option<Part<Option<Vec<syntax::Rung<'a>>>>>,
+    fbd: Option<syntax::FbdBody<'a>>,
+    subroutines: Option<Part<Vec<syntax::Subroutine<'a>>>>,
+    function_blocks: Option<Part<Vec<syntax::FunctionBlock<'a>>>>,
 }
 
-type Entries<'de> = Vec<(Text<'de>, &'de RawValue)>;
+const PROGRAM_KEYS: &[&str] = &[
+    "program",
+    "vars",
+    "rungs",
+    "fbd",
+    "subroutines",
+    "function_blocks",
+    "comment",
+];
+const SUBROUTINE_KEYS: &[&str] = &["vars", "rungs", "fbd", "comment"];
+const FB_KEYS: &[&str] = &["vars", "inputs", "outputs", "fbd", "rungs", "comment"];
+const VAR_KEYS: &[&str] = &["name", "type", "class", "init", "comment"];
 
-struct Reader<'de> {
-    /// Address of the start of the whole text (offsets are relative to it).
-    base: usize,
-    program: syntax::Program<'de>,
+/// The reader: the cursor, the problems of the part being read, and the scratch stacks of
+/// elements and element keys (nested series and elements sit above their parents' entries).
+pub(super) struct Reader<'a> {
+    c: Cursor<'a>,
+    problems: Vec<Problem>,
+    elements: Vec<syntax::Element<'a>>,
+    slots: Vec<element::SlotEntry<'a>>,
 }
 
-fn get<'e, 'de>(entries: &'e Entries<'de>, key: &str) -> Option<&'de RawValue> {
-    entries.iter().find(|(k, _)| k == key).map(|(_, v)| *v)
-}
-
-impl<'de> Reader<'de> {
-    fn origin(&self, v: &RawValue) -> Origin {
-        Origin::at(v.get().as_ptr() as usize - self.base)
+impl<'a> Reader<'a> {
+    fn new(text: &'a str, start: usize) -> Reader<'a> {
+        Reader {
+            c: Cursor::new(text, start),
+            problems: Vec::new(),
+            elements: Vec::with_capacity(64),
+            slots: Vec::with_capacity(16),
+        }
     }
 
-    fn problem(&mut self, path: &str, kind: Invalid) {
-        self.program.problems.push(Problem {
-            at: path.to_owned(),
+    fn problem(&mut self, at: impl Into<String>, origin: Origin, kind: Invalid) {
+        self.problems.push(Problem {
+            at: at.into(),
+            origin,
             kind,
         });
     }
 
-    fn unknown_keys(&mut self, e: &Entries, allowed: &[&str], what: &'static str, path: &str) {
-        if let Some((k, _)) = e.iter().find(|(k, _)| !allowed.contains(&k.as_ref())) {
-            let kind = Invalid::UnknownField {
-                field: k.to_string(),
-                what,
-                allowed: allowed.join(", "),
-            };
-            self.problem(&join(path, k), kind);
-        }
+    /// Reads a part with problems of its own.
+    fn part<T>(&mut self, read: impl FnOnce(&mut Self) -> P<T>) -> P<Part<T>> {
+        let outer = std::mem::take(&mut self.problems);
+        let value = read(self);
+        let problems = std::mem::replace(&mut self.problems, outer);
+        Ok(Part {
+            value: value?,
+            problems,
+        })
     }
 
-    /// A string field; `None` (with a problem) when it is not a string.
-    fn string(&mut self, v: &'de RawValue, path: &str) -> Result<Option<Text<'de>>, LoadError> {
-        match raw::<AnyScalar>(v, path)?.0 {
-            Scalar::Str(s) => Ok(Some(s)),
-            other => {
-                self.problem(path, shape("a string", &other));
-                Ok(None)
-            }
-        }
+    fn document(&mut self) -> P<syntax::Program<'a>> {
+        let origin = self.c.origin();
+        let program = if self.c.peek() == Some(b'{') {
+            self.program_object(origin)?
+        } else {
+            let found = self.c.scalar()?;
+            let mut p = syntax::Program::default();
+            p.problems.push(Problem {
+                at: String::new(),
+                origin,
+                kind: shape("a JSON object (the program)", &found),
+            });
+            p
+        };
+        self.c.end()?;
+        Ok(program)
     }
 
-    /// An object of raw parts; `None` (with a problem) when it is not an object.
-    fn object(
-        &mut self,
-        v: &'de RawValue,
-        path: &str,
-        expected: &'static str,
-    ) -> Result<Option<Entries<'de>>, LoadError> {
-        match raw::<Container>(v, path)? {
-            Container::Object(e) => Ok(Some(e)),
-            Container::Array(_) => {
-                self.problem(path, shape(expected, &Scalar::Array));
-                Ok(None)
+    /// At `{`: the parts of a POU object whose keys may be `allowed`.
+    fn parts(&mut self, path: &str, allowed: &[&str]) -> P<Parts<'a>> {
+        let mut parts = Parts::default();
+        self.c.begin_object()?;
+        let mut first = true;
+        while let Some((key, key_origin)) = self.c.key(&mut first)? {
+            if !allowed.contains(&key.as_ref()) {
+                parts.unknown.get_or_insert((key, key_origin));
+                self.c.skip()?;
+                continue;
             }
-            Container::Other(s) => {
-                self.problem(path, shape(expected, &s));
-                Ok(None)
-            }
-        }
-    }
-
-    /// An array of raw parts; `None` (with a problem) when it is not an array.
-    fn array(
-        &mut self,
-        v: &'de RawValue,
-        path: &str,
-    ) -> Result<Option<Vec<&'de RawValue>>, LoadError> {
-        match raw::<Container>(v, path)? {
-            Container::Array(a) => Ok(Some(a)),
-            Container::Object(_) => {
-                self.problem(path, shape("an array", &Scalar::Object));
-                Ok(None)
-            }
-            Container::Other(s) => {
-                self.problem(path, shape("an array", &s));
-                Ok(None)
+            let origin = self.c.origin();
+            let at = || join(path, &key);
+            match key.as_ref() {
+                "program" => parts.name = Some((self.c.scalar()?, origin)),
+                "comment" => parts.comment = Some(self.c.scalar()?),
+                "vars" => parts.vars = Some(self.part(|r| r.vars(&at()))?),
+                "inputs" => parts.inputs = Some(self.part(|r| r.vars(&at()))?),
+                "outputs" => parts.outputs = Some(self.part(|r| r.vars(&at()))?),
+                "rungs" => parts.rungs = Some(self.part(|r| r.rungs(&at()))?),
+                "subroutines" => parts.subroutines = Some(self.part(|r| r.subroutines())?),
+                "function_blocks" => {
+                    parts.function_blocks = Some(self.part(|r| r.function_blocks())?)
+                }
+                "fbd" => parts.fbd = Some(fbd::body(&mut self.c)?),
+                _ => self.c.skip()?,
             }
         }
+        Ok(parts)
     }
 
-    fn program_object(&mut self, top: Entries<'de>) -> Result<(), LoadError> {
-        const KEYS: &[&str] = &[
-            "program",
-            "vars",
-            "rungs",
-            "fbd",
-            "subroutines",
-            "function_blocks",
-            "comment",
-        ];
-        self.unknown_keys(&top, KEYS, "the program", "");
-        match get(&top, "program") {
-            None => self.problem(
-                "",
-                Invalid::MissingField {
+    fn program_object(&mut self, origin: Origin) -> P<syntax::Program<'a>> {
+        let parts = self.parts("", PROGRAM_KEYS)?;
+        let mut p = syntax::Program {
+            origin,
+            ..syntax::Program::default()
+        };
+        let mut problems = Vec::new();
+        if let Some((k, o)) = &parts.unknown {
+            problems.push(unknown_field(
+                k.to_string(),
+                *o,
+                k,
+                "the program",
+                PROGRAM_KEYS,
+            ));
+        }
+        match parts.name {
+            None => problems.push(Problem {
+                at: String::new(),
+                origin,
+                kind: Invalid::MissingField {
                     field: "program",
                     what: "the program",
                 },
-            ),
-            Some(v) => {
-                if let Some(s) = self.string(v, "program")? {
-                    self.program.name = s;
-                }
-            }
+            }),
+            Some((Scalar::Str(s), _)) => p.name = s,
+            Some((other, o)) => problems.push(Problem {
+                at: "program".into(),
+                origin: o,
+                kind: shape("a string", &other),
+            }),
         }
-        if let Some(c) = get(&top, "comment") {
-            self.program.comment = match raw::<AnyScalar>(c, "comment")?.0 {
-                Scalar::Str(s) => Some(s),
-                _ => None,
-            };
+        if let Some(Scalar::Str(s)) = parts.comment {
+            p.comment = Some(s);
         }
-        if let Some(fbs) = get(&top, "function_blocks") {
-            self.function_blocks(fbs)?;
+        if let Some(fbs) = parts.function_blocks {
+            problems.extend(fbs.problems);
+            p.function_blocks = fbs.value;
         }
-        if let Some(vars) = get(&top, "vars") {
-            self.program.vars = self.vars(vars, "vars")?;
+        if let Some(vars) = parts.vars {
+            problems.extend(vars.problems);
+            p.vars = vars.value;
         }
-        self.program.body = self.body(&top, "", "the program")?;
-        if let Some(subs) = get(&top, "subroutines") {
-            self.subroutines(subs)?;
+        p.body = body(
+            parts.rungs,
+            parts.fbd,
+            "",
+            "the program",
+            origin,
+            &mut problems,
+        );
+        if let Some(subs) = parts.subroutines {
+            problems.extend(subs.problems);
+            p.subroutines = subs.value;
         }
-        Ok(())
+        p.problems = problems;
+        Ok(p)
     }
 
-    fn subroutines(&mut self, subs: &'de RawValue) -> Result<(), LoadError> {
-        let Some(entries) = self.object(subs, "subroutines", "an object of subroutines")? else {
-            return Ok(());
-        };
-        for (name, v) in entries {
-            let path = format!("subroutines.{name}");
-            let origin = self.origin(v);
-            let Some(o) = self.object(v, &path, "an object (a subroutine)")? else {
-                continue;
-            };
-            self.unknown_keys(
-                &o,
-                &["vars", "rungs", "fbd", "comment"],
-                "a subroutine",
-                &path,
-            );
-            let vars = match get(&o, "vars") {
-                Some(vs) => self.vars(vs, &format!("{path}.vars"))?,
-                None => Vec::new(),
-            };
-            let body = self.body(&o, &path, "a subroutine")?;
-            self.program.subroutines.push(syntax::Subroutine {
-                origin,
-                name,
-                vars,
-                body,
-            });
-        }
-        Ok(())
-    }
-
-    fn function_blocks(&mut self, fbs: &'de RawValue) -> Result<(), LoadError> {
-        let Some(entries) = self.object(fbs, "function_blocks", "an object")? else {
-            return Ok(());
-        };
-        for (name, v) in entries {
-            let path = format!("function_blocks.{name}");
-            let origin = self.origin(v);
-            let Some(o) = self.object(v, &path, "an object")? else {
-                continue;
-            };
-            self.unknown_keys(
-                &o,
-                &["vars", "inputs", "outputs", "fbd", "rungs", "comment"],
-                "a function block",
-                &path,
-            );
-            let decl = |r: &mut Self, key: &str| match get(&o, key) {
-                Some(vs) => r.vars(vs, &format!("{path}.{key}")),
-                None => Ok(Vec::new()),
-            };
-            let inputs = decl(self, "inputs")?;
-            let outputs = decl(self, "outputs")?;
-            let vars = decl(self, "vars")?;
-            let body = if get(&o, "rungs").is_none() && get(&o, "fbd").is_none() {
-                self.problem(
-                    &path,
-                    Invalid::MissingField {
-                        field: "fbd` or `rungs",
-                        what: "a function block",
-                    },
-                );
-                None
-            } else {
-                self.body(&o, &path, "a function block")?
-            };
-            self.program.function_blocks.push(syntax::FunctionBlock {
-                origin,
-                name,
-                inputs,
-                outputs,
-                vars,
-                body,
-            });
-        }
-        Ok(())
-    }
-
-    /// The body of a POU: `rungs` or `fbd`, not both.
-    fn body(
+    /// An object of named POU objects (`subroutines`, `function_blocks`); `None` for a value
+    /// that is not an object (the problem recorded). Each entry is read by `read` (at its `{`)
+    /// with its own problems, so that a repeated name keeps its first place and its last value.
+    #[allow(clippy::type_complexity)]
+    fn named<T>(
         &mut self,
-        o: &Entries<'de>,
-        path: &str,
-        what: &'static str,
-    ) -> Result<Option<Body<'de>>, LoadError> {
-        match (get(o, "rungs"), get(o, "fbd")) {
-            (Some(_), Some(_)) => {
-                self.problem(
-                    &join(path, "fbd"),
-                    Invalid::Misplaced {
-                        what: "`fbd`",
-                        place: "together with `rungs` (a body is one of them)",
-                    },
-                );
-                Ok(None)
-            }
-            (None, Some(f)) => Ok(Some(Body::Fbd(fbd::body(self.base, f)?))),
-            (Some(r), None) => {
-                let rp = join(path, "rungs");
-                let Some(items) = self.array(r, &rp)? else {
-                    return Ok(None);
-                };
-                let mut rungs = Vec::with_capacity(items.len());
-                for item in items {
-                    let RungDe(mut rung) = raw(item, &rp)?;
-                    rung.origin = self.origin(item);
-                    rungs.push(rung);
+        container: &'static str,
+        expected: &'static str,
+        entry: &'static str,
+        read: fn(&mut Self, Text<'a>, Origin, &str) -> P<T>,
+    ) -> P<Vec<T>> {
+        let origin = self.c.origin();
+        if self.c.peek() != Some(b'{') {
+            let found = self.c.scalar()?;
+            self.problem(container, origin, shape(expected, &found));
+            return Ok(Vec::new());
+        }
+        let mut entries: Vec<(Text<'a>, Part<Option<T>>)> = Vec::new();
+        self.c.begin_object()?;
+        let mut first = true;
+        while let Some((name, _)) = self.c.key(&mut first)? {
+            let path = format!("{container}.{name}");
+            let origin = self.c.origin();
+            let part = self.part(|r| {
+                if r.c.peek() == Some(b'{') {
+                    read(r, name.clone(), origin, &path).map(Some)
+                } else {
+                    let found = r.c.scalar()?;
+                    r.problem(path.as_str(), origin, shape(entry, &found));
+                    Ok(None)
                 }
-                Ok(Some(Body::Rungs(rungs)))
-            }
-            (None, None) => {
-                self.problem(
-                    path,
-                    Invalid::MissingField {
-                        field: "rungs",
-                        what,
-                    },
-                );
-                Ok(None)
+            })?;
+            match entries.iter_mut().find(|(q, _)| *q == name) {
+                Some(e) => e.1 = part,
+                None => entries.push((name, part)),
             }
         }
-    }
-
-    fn vars(&mut self, v: &'de RawValue, path: &str) -> Result<Vec<Var<'de>>, LoadError> {
-        let Some(items) = self.array(v, path)? else {
-            return Ok(Vec::new());
-        };
-        let mut out = Vec::with_capacity(items.len());
-        for item in items {
-            out.push(self.var(item, path)?);
+        let mut out = Vec::with_capacity(entries.len());
+        for (_, part) in entries {
+            self.problems.extend(part.problems);
+            out.extend(part.value);
         }
         Ok(out)
     }
 
-    fn var(&mut self, v: &'de RawValue, path: &str) -> Result<Var<'de>, LoadError> {
+    fn subroutines(&mut self) -> P<Vec<syntax::Subroutine<'a>>> {
+        self.named(
+            "subroutines",
+            "an object of subroutines",
+            "an object (a subroutine)",
+            |r, name, origin, path| {
+                let parts = r.parts(path, SUBROUTINE_KEYS)?;
+                if let Some((k, o)) = &parts.unknown {
+                    let p = unknown_field(join(path, k), *o, k, "a subroutine", SUBROUTINE_KEYS);
+                    r.problems.push(p);
+                }
+                let vars = r.take(parts.vars);
+                let body = body(
+                    parts.rungs,
+                    parts.fbd,
+                    path,
+                    "a subroutine",
+                    origin,
+                    &mut r.problems,
+                );
+                Ok(syntax::Subroutine {
+                    origin,
+                    name,
+                    vars,
+                    body,
+                })
+            },
+        )
+    }
+
+    fn function_blocks(&mut self) -> P<Vec<syntax::FunctionBlock<'a>>> {
+        self.named(
+            "function_blocks",
+            "an object",
+            "an object",
+            |r, name, origin, path| {
+                let parts = r.parts(path, FB_KEYS)?;
+                if let Some((k, o)) = &parts.unknown {
+                    let p = unknown_field(join(path, k), *o, k, "a function block", FB_KEYS);
+                    r.problems.push(p);
+                }
+                let inputs = r.take(parts.inputs);
+                let outputs = r.take(parts.outputs);
+                let vars = r.take(parts.vars);
+                let body = if parts.rungs.is_none() && parts.fbd.is_none() {
+                    r.problem(
+                        path,
+                        origin,
+                        Invalid::MissingField {
+                            field: "fbd` or `rungs",
+                            what: "a function block",
+                        },
+                    );
+                    None
+                } else {
+                    let what = "a function block";
+                    body(parts.rungs, parts.fbd, path, what, origin, &mut r.problems)
+                };
+                Ok(syntax::FunctionBlock {
+                    origin,
+                    name,
+                    inputs,
+                    outputs,
+                    vars,
+                    body,
+                })
+            },
+        )
+    }
+
+    /// The variables of a part, its problems now recorded.
+    fn take(&mut self, part: Option<Part<Vec<Var<'a>>>>) -> Vec<Var<'a>> {
+        match part {
+            None => Vec::new(),
+            Some(p) => {
+                self.problems.extend(p.problems);
+                p.value
+            }
+        }
+    }
+
+    /// An array of variable declarations at `path`.
+    fn vars(&mut self, path: &str) -> P<Vec<Var<'a>>> {
+        let origin = self.c.origin();
+        if self.c.peek() != Some(b'[') {
+            let found = self.c.scalar()?;
+            self.problem(path, origin, shape("an array", &found));
+            return Ok(Vec::new());
+        }
+        let mut out = Vec::new();
+        self.c.begin_array()?;
+        let mut first = true;
+        while self.c.item(&mut first)? {
+            out.push(self.var()?);
+        }
+        Ok(out)
+    }
+
+    fn var(&mut self) -> P<Var<'a>> {
+        let origin = self.c.origin();
         let mut var = Var {
-            origin: self.origin(v),
-            name: Text::Borrowed(""),
-            ty: Text::Borrowed(""),
-            class: VarClass::Default,
+            origin,
+            name: Name::empty(),
+            ty: Name::empty(),
+            class: Located {
+                value: VarClass::Default,
+                origin: Origin::NONE,
+            },
             init: None,
             problem: None,
         };
-        let entries = match raw::<Container>(v, path)? {
-            Container::Object(e) => e,
-            Container::Array(_) => {
-                var.problem = Some(Problem::new(
-                    "",
-                    shape("an object (a variable)", &Scalar::Array),
-                ));
-                return Ok(var);
-            }
-            Container::Other(s) => {
-                var.problem = Some(Problem::new("", shape("an object (a variable)", &s)));
-                return Ok(var);
-            }
-        };
-        let allowed = ["name", "type", "class", "init", "comment"];
-        let mut problem = entries
-            .iter()
-            .find(|(k, _)| !allowed.contains(&k.as_ref()))
-            .map(|(k, _)| {
-                Problem::new(
-                    format!(".{k}"),
-                    Invalid::UnknownField {
-                        field: k.to_string(),
-                        what: "a variable",
-                        allowed: allowed.join(", "),
-                    },
-                )
-            });
-        let text = |key: &'static str, problem: &mut Option<Box<Problem>>| {
-            let found = match get(&entries, key) {
-                None => {
-                    let kind = Invalid::MissingField {
-                        field: key,
-                        what: "a variable",
-                    };
-                    problem.get_or_insert_with(|| Problem::new("", kind));
-                    return Ok(Text::Borrowed(""));
+        if self.c.peek() != Some(b'{') {
+            let found = self.c.scalar()?;
+            let kind = shape("an object (a variable)", &found);
+            var.problem = Some(Problem::new("", origin, kind));
+            return Ok(var);
+        }
+        let (mut name, mut ty, mut class, mut unknown) = (None, None, None, None);
+        self.c.begin_object()?;
+        let mut first = true;
+        while let Some((key, key_origin)) = self.c.key(&mut first)? {
+            let at = self.c.origin();
+            match key.as_ref() {
+                "name" => name = Some((self.c.scalar()?, at)),
+                "type" => ty = Some((self.c.scalar()?, at)),
+                "class" => class = Some((self.c.scalar()?, at)),
+                "init" => {
+                    var.init = Some(Box::new(Located {
+                        value: self.c.scalar()?,
+                        origin: at,
+                    }))
                 }
-                Some(j) => raw::<AnyScalar>(j, path)?.0,
-            };
-            match found {
-                Scalar::Str(s) => Ok(s),
-                other => {
-                    problem.get_or_insert_with(|| {
-                        Problem::new(format!(".{key}"), shape("a string", &other))
-                    });
-                    Ok(Text::Borrowed(""))
+                "comment" => self.c.skip()?,
+                _ => {
+                    self.c.skip()?;
+                    unknown.get_or_insert((key, key_origin));
                 }
             }
+        }
+        let mut problem = unknown.map(|(k, o)| {
+            Box::new(unknown_field(
+                format!(".{k}"),
+                o,
+                &k,
+                "a variable",
+                VAR_KEYS,
+            ))
+        });
+        let mut text = |found: Option<(Scalar<'a>, Origin)>, key: &'static str| match found {
+            None => {
+                let kind = Invalid::MissingField {
+                    field: key,
+                    what: "a variable",
+                };
+                problem.get_or_insert_with(|| Problem::new("", origin, kind));
+                Name::empty()
+            }
+            Some((Scalar::Str(s), o)) => Located {
+                value: s,
+                origin: o,
+            },
+            Some((other, o)) => {
+                let kind = shape("a string", &other);
+                problem.get_or_insert_with(|| Problem::new(format!(".{key}"), o, kind));
+                Name::empty()
+            }
         };
-        var.name = text("name", &mut problem)?;
-        var.ty = text("type", &mut problem)?;
-        if let Some(c) = get(&entries, "class") {
-            var.class = match raw::<AnyScalar>(c, path)?.0 {
+        var.name = text(name, "name");
+        var.ty = text(ty, "type");
+        if let Some((found, o)) = class {
+            let value = match found {
                 Scalar::Str(s) if s == "input" => VarClass::Input,
                 Scalar::Str(s) if s == "output" => VarClass::Output,
                 Scalar::Str(s) if s == "memory" => VarClass::Memory,
@@ -437,20 +515,58 @@ impl<'de> Reader<'de> {
                         expected: "\"input\", \"output\" or \"memory\"",
                         found: format!("\"{s}\""),
                     };
-                    problem.get_or_insert_with(|| Problem::new(".class", kind));
+                    problem.get_or_insert_with(|| Problem::new(".class", o, kind));
                     VarClass::Default
                 }
                 other => {
-                    problem
-                        .get_or_insert_with(|| Problem::new(".class", shape("a string", &other)));
+                    let kind = shape("a string", &other);
+                    problem.get_or_insert_with(|| Problem::new(".class", o, kind));
                     VarClass::Default
                 }
             };
-        }
-        if let Some(i) = get(&entries, "init") {
-            var.init = Some(raw::<AnyScalar>(i, path)?.0);
+            var.class = Located { value, origin: o };
         }
         var.problem = problem;
         Ok(var)
+    }
+}
+
+/// The body of a POU: `rungs` or `fbd`, not both (`origin`: of the POU object).
+fn body<'a>(
+    rungs: Option<Part<Option<Vec<syntax::Rung<'a>>>>>,
+    fbd: Option<syntax::FbdBody<'a>>,
+    path: &str,
+    what: &'static str,
+    origin: Origin,
+    problems: &mut Vec<Problem>,
+) -> Option<Body<'a>> {
+    match (rungs, fbd) {
+        (Some(_), Some(f)) => {
+            problems.push(Problem {
+                at: join(path, "fbd"),
+                origin: f.origin,
+                kind: Invalid::Misplaced {
+                    what: "`fbd`",
+                    place: "together with `rungs` (a body is one of them)",
+                },
+            });
+            None
+        }
+        (None, Some(f)) => Some(Body::Fbd(f)),
+        (Some(r), None) => {
+            problems.extend(r.problems);
+            r.value.map(Body::Rungs)
+        }
+        (None, None) => {
+            problems.push(Problem {
+                at: path.to_owned(),
+                origin,
+                kind: Invalid::MissingField {
+                    field: "rungs",
+                    what,
+                },
+            });
+            None
+        }
     }
 }

@@ -20,7 +20,7 @@ mod util;
 use crate::diag::{Invalid, LoadError};
 use crate::fbd::model::*;
 use crate::syntax::fbd as syn;
-use crate::syntax::{Origin, Problem};
+use crate::syntax::Problem;
 use std::collections::HashMap;
 
 use block::Net;
@@ -37,16 +37,8 @@ pub(crate) struct FbSig {
 
 /// What every network of a body is read against.
 pub(crate) struct Context<'c> {
-    /// The program text (for the line and column of errors).
-    pub text: &'c str,
     /// The pins of a user function block type by name.
     pub sig: &'c dyn Fn(&str) -> Option<FbSig>,
-}
-
-impl Context<'_> {
-    fn position(&self, origin: Origin) -> Option<(u32, u32)> {
-        origin.line_column(self.text)
-    }
 }
 
 /// A problem the reader recorded, as an error at `path` (the path of the node that holds it).
@@ -86,10 +78,8 @@ pub(crate) fn read_body(
     let mut block_ids: HashMap<u32, String> = HashMap::new();
     for (i, n) in body.networks.iter().enumerate() {
         let p = format!("{np}[{i}]");
-        let net =
-            network(n, &p, cx, &mut block_ids).map_err(|e| e.at_position(cx.position(n.origin)))?;
-        let e =
-            |q: String, k| LoadError::fbd(&net.id, None, &q, k).at_position(cx.position(n.origin));
+        let net = network(n, &p, cx, &mut block_ids).map_err(|e| e.at(n.origin))?;
+        let e = |q: String, k| LoadError::fbd(&net.id, None, &q, k).at(n.origin);
         if let Some(first) = ids.insert(net.id.clone(), p.clone()) {
             let id = net.id.clone();
             return Err(e(
@@ -183,8 +173,7 @@ fn network(
     let mut drafts = Vec::with_capacity(items.len());
     for (i, b) in items.iter().enumerate() {
         let p = format!("{path}.blocks[{i}]");
-        let d =
-            draft(b, p, &id, cx, block_ids).map_err(|e| e.at_position(cx.position(b.origin)))?;
+        let d = draft(b, p, &id, cx, block_ids).map_err(|e| e.at(b.origin))?;
         drafts.push(d);
     }
     drafts.sort_by_key(|d| d.id);
@@ -213,7 +202,7 @@ fn network(
         .enumerate()
         .map(|(i, d)| {
             net.block(BlockId(i as u32), d)
-                .map_err(|e| e.at_position(cx.position(d.syn.origin)))
+                .map_err(|e| e.at(d.syn.origin))
         })
         .collect::<Result<Vec<_>>>()?;
     Ok(Network {

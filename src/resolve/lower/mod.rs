@@ -257,7 +257,7 @@ impl Cx<'_> {
             comment,
             pou: self.pou,
             series,
-            path: path.to_owned(),
+            block_path: Some(path.to_owned()),
             network: None,
         });
         self.rungs.len() - 1
