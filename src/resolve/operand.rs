@@ -44,8 +44,7 @@ pub(crate) fn parse(
             }
         }
         Scalar::Str(s) => {
-            let upper = s.to_ascii_uppercase();
-            if upper.starts_with("T#") || upper.starts_with("TIME#") {
+            if crate::syntax::is_time_literal(s) {
                 match parse_time_literal(s) {
                     Some(ms) => Ok(Untyped::Time(ms)),
                     None => Err(Invalid::BadTime {

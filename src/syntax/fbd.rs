@@ -18,6 +18,7 @@
 //! resolved, names are not checked for spelling or resolved, pins are not counted (all of that
 //! is `crate::resolve::fbd_read`'s).
 
+pub use super::is_time_literal;
 use super::{Origin, Problem, Scalar, Text};
 
 /// A part as read: its value, or what is malformed in it (`at` relative to the node holding it).
@@ -128,12 +129,4 @@ pub enum Targets<'a> {
 pub struct OutVar<'a> {
     pub origin: Origin,
     pub name: Text<'a>,
-}
-
-/// True when an operand string is a TIME literal (`T#…`, `TIME#…`, any case) rather than a name,
-/// as the operand syntax of docs/format.md tells them apart.
-pub fn is_time_literal(s: &str) -> bool {
-    let head = s.get(..5).unwrap_or(s);
-    let upper = head.to_ascii_uppercase();
-    upper.starts_with("T#") || upper.starts_with("TIME#")
 }

@@ -94,10 +94,7 @@ impl Cx<'_> {
         let blk = net.block(b);
         let id = Some(blk.id);
         let e = |path: &str, k| LoadError::fbd(&net.id, id, path, k);
-        let out_ty = self
-            .out_vars(nx, b, 0, None)?
-            .first()
-            .map(|&v| self.env.var(v).ty);
+        let out_ty = self.first_out_type(nx, b)?;
         let ty = numeric_type(&vals, out_ty);
         let ok = match op {
             ArithOp::Add | ArithOp::Sub => ty.is_numeric(),
@@ -215,10 +212,7 @@ impl Cx<'_> {
         let blk = net.block(b);
         let id = Some(blk.id);
         let e = |path: &str, k| LoadError::fbd(&net.id, id, path, k);
-        let out_ty = self
-            .out_vars(nx, b, 0, None)?
-            .first()
-            .map(|&v| self.env.var(v).ty);
+        let out_ty = self.first_out_type(nx, b)?;
         let ty = vals[0]
             .0
             .ty()
@@ -252,10 +246,7 @@ impl Cx<'_> {
         let id = Some(blk.id);
         let e = |path: &str, k| LoadError::fbd(&net.id, id, path, k);
         let g = self.coerce(nx, &vals[0].0, Type::Bool, "SEL's G", vals[0].1, id)?;
-        let out_ty = self
-            .out_vars(nx, b, 0, None)?
-            .first()
-            .map(|&v| self.env.var(v).ty);
+        let out_ty = self.first_out_type(nx, b)?;
         let ty = numeric_type(&vals[1..], out_ty);
         if matches!(ty, Type::Fb(_)) {
             return Err(e(
@@ -286,10 +277,7 @@ impl Cx<'_> {
         let blk = net.block(b);
         let id = Some(blk.id);
         let e = |path: &str, k| LoadError::fbd(&net.id, id, path, k);
-        let out_ty = self
-            .out_vars(nx, b, 0, None)?
-            .first()
-            .map(|&v| self.env.var(v).ty);
+        let out_ty = self.first_out_type(nx, b)?;
         let ty = numeric(&vals, out_ty, "this block").map_err(|(p, k)| e(p, k))?;
         let ops = self.typed_all(nx, &vals, ty, blk.op.name_static(), id)?;
         let (d, rest) = self.dest(nx, b, 0, ty, &ops)?;

@@ -88,6 +88,15 @@ impl Cx<'_> {
     }
 
     /// The variables output pin `pin` of `b` is written to, type-checked against `ty`.
+    /// The type of the first variable block `b`'s first output writes, if it writes one (what
+    /// an untyped input of an overloaded block takes its type from).
+    pub(super) fn first_out_type(&self, nx: &Net, b: BlockId) -> Result<Option<Type>> {
+        Ok(self
+            .out_vars(nx, b, 0, None)?
+            .first()
+            .map(|&v| self.env.var(v).ty))
+    }
+
     pub(super) fn out_vars(
         &self,
         nx: &Net,
