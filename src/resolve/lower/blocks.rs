@@ -75,10 +75,7 @@ impl Cx<'_> {
                 negated: false,
             },
         ];
-        s.extend(rest.into_iter().map(|v| Element::Coil {
-            var: v,
-            negated: false,
-        }));
+        s.extend(coils(&rest));
         Ok(s)
     }
 
@@ -161,10 +158,7 @@ impl Cx<'_> {
             var: d,
             negated: false,
         });
-        s.extend(rest.into_iter().map(|v| Element::Coil {
-            var: v,
-            negated: false,
-        }));
+        s.extend(coils(&rest));
         Ok(s)
     }
 
@@ -199,10 +193,7 @@ impl Cx<'_> {
             parts.push(xor(var_op(d), *o));
         }
         let mut s = steps(parts);
-        s.extend(rest.into_iter().map(|v| Element::Coil {
-            var: v,
-            negated: false,
-        }));
+        s.extend(coils(&rest));
         Ok(s)
     }
 
@@ -494,6 +485,15 @@ impl Cx<'_> {
     }
 }
 
+/// Coils writing the power into each of `to` (a BOOL output's further variables).
+fn coils(to: &[VarId]) -> impl Iterator<Item = Element> + '_ {
+    to.iter().map(|&var| Element::Coil {
+        var,
+        negated: false,
+    })
+}
+
+/// Moves of `from` into each of `to` (a numeric output's further variables).
 fn moves(from: VarId, to: &[VarId]) -> impl Iterator<Item = Element> + '_ {
     to.iter().map(move |&v| Element::Move {
         from: var_op(from),
