@@ -38,7 +38,8 @@ fn several_errors_come_in_program_order_each_located() {
 }
 
 /// Every kind of node an error can name gives its own line and column: a variable's fields, a
-/// rung's id and label, an element, an operand inside a branch, a FOR's fields, a subroutine.
+/// rung's id and label, an element, an operand inside a branch, a FOR's fields, a subroutine,
+/// an FBD block's pin and field.
 #[test]
 fn every_error_points_at_its_most_precise_node() {
     let cases: &[(&str, &str)] = &[
@@ -80,6 +81,20 @@ fn every_error_points_at_its_most_precise_node() {
         (
             r#"{"program": "p", "rungs": [{"id": "R1", "ld": [{"contact": 5, "x": 1}]}]}"#,
             "p.json:1:63: rung R1 at rungs[0].ld[0].x: unknown field `x` in a contact",
+        ),
+        // Found by the FBD lowering, on the model: the pin, not the network or the body.
+        (
+            r#"{"program": "p", "vars": [{"name": "X", "type": "INT"}],
+ "fbd": {"networks": [{"id": "N1", "blocks": [
+   {"id": 1, "op": "GT", "in": ["X", 5]},
+   {"id": 2, "op": "ADD", "in": ["X", {"from": 1}], "out": "X"}]}]}}"#,
+            "p.json:4:39: network N1 block 2 at fbd.networks[0].blocks[1].in[1]: an arithmetic block needs INT",
+        ),
+        (
+            r#"{"program": "p", "vars": [{"name": "X", "type": "INT"}],
+ "fbd": {"networks": [{"id": "N1", "blocks": [
+   {"id": 1, "op": "JMP", "label": "L9", "cond": true}]}]}}"#,
+            "p.json:3:27: network N1 block 1 at fbd.networks[0].blocks[0].label: undefined label `L9`",
         ),
     ];
     for (text, want) in cases {

@@ -316,6 +316,35 @@ impl LoadError {
         self
     }
 
+    /// Moves each problem's origin to the node its path names, where `node_of` (the format's
+    /// path walker: where the node starts, with its key for a member of an object) finds one
+    /// that the origin it has lies before, and computes the line and column of the moved ones:
+    /// for problems found on the model, which keeps every node's path but not always its
+    /// offset. A node starts after every node that contains it, so an origin before the named
+    /// node is a container of it, and one at or after its start is already as precise.
+    pub(crate) fn refine(
+        mut self,
+        text: &str,
+        node_of: impl Fn(&str, &str) -> Option<usize>,
+    ) -> LoadError {
+        let ds: &mut [Diagnostic] = match &mut self {
+            LoadError::Syntax { .. } => return self,
+            LoadError::Invalid(d) => std::slice::from_mut(&mut **d),
+            LoadError::Several(ds) => ds,
+        };
+        for d in ds.iter_mut() {
+            let l = &mut d.location;
+            let Some(start) = node_of(text, &l.path) else {
+                continue;
+            };
+            if l.origin.offset().is_none_or(|o| o < start) {
+                l.origin = Origin::at(start);
+                l.position = None;
+            }
+        }
+        self.locate(text)
+    }
+
     /// Computes the line and column of every diagnostic's origin in `text` (the text the
     /// origins are offsets into), in one pass.
     pub fn locate(mut self, text: &str) -> LoadError {

@@ -5,7 +5,8 @@
 //! reads the text into the syntax types in one pass (syntax errors carry line and column; a
 //! byte-order mark is skipped), the resolver checks and resolves everything else (those errors
 //! carry the rung id, the JSON path and the byte offset of the most precise node, whose line and
-//! column are computed once the load has failed). Nothing is half-built: a program either loads
+//! column are computed once the load has failed; an error found on the model, which has the
+//! path of every node but not always its offset, is placed at the node its path names). Nothing is half-built: a program either loads
 //! whole or not at all.
 
 pub mod json;
@@ -25,6 +26,7 @@ pub fn program_from_json(text: &str) -> Result<Program, LoadError> {
 pub fn program_and_fbd_from_json(text: &str) -> Result<(Program, Fbd), LoadError> {
     let syntax = json::parse(text)?;
     crate::resolve::resolve(text, &syntax)
+        .map_err(|e| e.refine(text, |t, p| json::path_offset(t, p).map(|(start, _)| start)))
 }
 
 /// Builds a program from an already parsed JSON document (tests and benchmarks that build

@@ -20,6 +20,9 @@ mod cursor;
 mod element;
 mod fbd;
 mod ladder;
+mod locate;
+
+pub(crate) use locate::path_offset;
 
 use crate::diag::{Invalid, LoadError};
 use crate::syntax::{self, Body, Located, Name, Origin, Problem, Scalar, Text, Var, VarClass};

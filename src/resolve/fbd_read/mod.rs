@@ -11,7 +11,8 @@
 //! One error per body, the first in this order: the body, then each network in file order —
 //! its id, fields and blocks' ids and ops (file order), then every block's pins and fields (in
 //! block id order) — then labels, then plans. Errors carry the network id, the block id, the
-//! JSON path and the line and column of the innermost network or block.
+//! JSON path and the origin of the innermost network or block; the JSON reader then moves it to
+//! the field or pin the path names (`read::json::path_offset`).
 
 mod block;
 mod input;
