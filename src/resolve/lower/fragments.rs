@@ -64,7 +64,7 @@ impl Cx<'_> {
             }
         }
         let first = self.rungs.len();
-        let mut block_rung = vec![u32::MAX; n];
+        let mut block_rung: Vec<Option<u32>> = vec![None; n];
         let mut guards: Vec<usize> = Vec::new();
         for step in &plan.steps {
             match *step {
@@ -123,7 +123,7 @@ impl Cx<'_> {
                             jumps.push((r, target));
                         }
                     }
-                    block_rung[b.index()] = r as u32;
+                    block_rung[b.index()] = Some(r as u32);
                 }
                 Step::Leave(f) => {
                     let frag = &plan.fragments[f.index()];
@@ -146,6 +146,10 @@ impl Cx<'_> {
         if first_rung.comment.is_none() {
             first_rung.comment = net.comment.clone();
         }
+        let block_rung = block_rung
+            .into_iter()
+            .map(|r| r.expect("a plan's steps hold every block of its network once"))
+            .collect();
         Ok((block_rung, self.typed_network(&nx)))
     }
 }
