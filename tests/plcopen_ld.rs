@@ -6,77 +6,10 @@ mod common;
 use common::cli::{run, run_stdin};
 use serde_json::{json, Value};
 
-const NS: &str = "http://www.plcopen.org/xml/tc6_0201";
+#[path = "plcopen_common/mod.rs"]
+mod px;
 
-/// A project with one program `P` (its variables: `(class, name, type)`) and an LD body.
-pub fn project(vars: &[(&str, &str, &str)], ld: &str) -> String {
-    let mut lists = String::new();
-    for class in ["inputVars", "outputVars", "localVars"] {
-        let vs: Vec<String> = vars
-            .iter()
-            .filter(|v| v.0 == class)
-            .map(|(_, n, t)| {
-                let ty = if ["BOOL", "INT", "DINT", "REAL", "TIME"].contains(t) {
-                    format!("<{t}/>")
-                } else {
-                    format!("<derived name=\"{t}\"/>")
-                };
-                format!("<variable name=\"{n}\"><type>{ty}</type></variable>")
-            })
-            .collect();
-        if !vs.is_empty() {
-            lists.push_str(&format!("<{class}>{}</{class}>\n", vs.concat()));
-        }
-    }
-    format!(
-        r#"<?xml version="1.0" encoding="utf-8"?>
-<project xmlns="{NS}">
-  <fileHeader companyName="t" productName="t" productVersion="1" creationDateTime="2024-01-01T00:00:00"/>
-  <contentHeader name="t"><coordinateInfo><fbd><scaling x="1" y="1"/></fbd><ld><scaling x="1" y="1"/></ld><sfc><scaling x="1" y="1"/></sfc></coordinateInfo></contentHeader>
-  <types><dataTypes/><pous>
-    <pou name="P" pouType="program">
-      <interface>
-{lists}      </interface>
-      <body><LD>
-{ld}
-      </LD></body>
-    </pou>
-  </pous></types>
-  <instances><configurations/></instances>
-</project>
-"#
-    )
-}
-
-fn conn(from: &[u32]) -> String {
-    let c: Vec<String> = from
-        .iter()
-        .map(|r| format!("<connection refLocalId=\"{r}\"/>"))
-        .collect();
-    format!("<connectionPointIn>{}</connectionPointIn>", c.concat())
-}
-
-pub fn rail(id: u32) -> String {
-    format!("<leftPowerRail localId=\"{id}\"><connectionPointOut formalParameter=\"\"/></leftPowerRail>")
-}
-
-pub fn contact(id: u32, var: &str, from: &[u32], attrs: &str) -> String {
-    format!(
-        "<contact localId=\"{id}\" {attrs}>{}<connectionPointOut/><variable>{var}</variable></contact>",
-        conn(from)
-    )
-}
-
-pub fn coil(id: u32, var: &str, from: &[u32], attrs: &str) -> String {
-    format!(
-        "<coil localId=\"{id}\" {attrs}>{}<connectionPointOut/><variable>{var}</variable></coil>",
-        conn(from)
-    )
-}
-
-fn in_var(id: u32, expr: &str) -> String {
-    format!("<inVariable localId=\"{id}\"><connectionPointOut/><expression>{expr}</expression></inVariable>")
-}
+use px::{coil, conn, contact, in_var, project, rail};
 
 /// The JSON report of an XML text (read from standard input).
 fn report(xml: &str) -> Value {
