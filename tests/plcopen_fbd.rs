@@ -125,3 +125,31 @@ fn a_wiring_cycle_is_one_error_naming_the_blocks() {
     );
     assert!(line.starts_with("error: <stdin>:"), "{line}");
 }
+
+#[test]
+fn execution_order_ids_that_disagree_with_the_data_flow_get_a_warning_with_both_orders() {
+    // SEL (5) numbered before ADD (4), which feeds it.
+    let xml = counter()
+        .replace(
+            "localId=\"4\" typeName=\"ADD\"",
+            "localId=\"4\" typeName=\"ADD\" executionOrderId=\"3\"",
+        )
+        .replace(
+            "localId=\"5\" typeName=\"SEL\"",
+            "localId=\"5\" typeName=\"SEL\" executionOrderId=\"1\"",
+        )
+        .replace(
+            "localId=\"8\" typeName=\"GT\"",
+            "localId=\"8\" typeName=\"GT\" executionOrderId=\"2\"",
+        );
+    let out = run_stdin(&["report", "-", "--format", "json"], xml.as_bytes());
+    assert_eq!(out.status.code(), Some(0));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let warnings: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.starts_with("warning: "))
+        .collect();
+    assert_eq!(warnings.len(), 1, "{stderr}");
+    assert!(warnings[0].ends_with("pou P, FBD: the file's executionOrderIds run localIds 5, 8, 4; plc-deps runs them 4, 5, 8 (data flow first, ties by localId; `plc-deps order` shows the whole order)"), "{stderr}");
+    assert!(warnings[0].starts_with("warning: <stdin>:"), "{stderr}");
+}

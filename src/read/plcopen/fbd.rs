@@ -22,7 +22,7 @@
 
 use super::interface::literal;
 use super::wiring::{graph, ElemId, Graph, Source};
-use super::xml::{attr, error, identifier, origin, variable_ref, Note, Tc6, R};
+use super::xml::{attr, error, identifier, origin, variable_ref, ExecOrder, Notes, Tc6, R};
 use crate::syntax::fbd::{Block, Connection, Input, Inputs, Network, OutVar, Outputs, Targets};
 use crate::syntax::FbdBody;
 use roxmltree::Node;
@@ -42,7 +42,7 @@ const FBD_TAGS: &[&str] = &[
 ];
 
 /// Reads FBD body `node` of POU `pou`.
-pub fn body(tc6: Tc6, node: Node, pou: &str, notes: &mut Vec<Note>) -> R<FbdBody<'static>> {
+pub fn body(tc6: Tc6, node: Node, pou: &str, notes: &mut Notes) -> R<FbdBody<'static>> {
     let place = format!("pou {pou}, FBD");
     let g = graph(tc6, node, &place)?;
     let mut ordered = Vec::new();
@@ -67,14 +67,7 @@ pub fn body(tc6: Tc6, node: Node, pou: &str, notes: &mut Vec<Note>) -> R<FbdBody
             }
         }
     }
-    if !ordered.is_empty() {
-        ordered.sort_unstable();
-        let ids: Vec<String> = ordered.iter().map(|(x, l)| format!("{l} (#{x})")).collect();
-        notes.push(Note {
-            origin: origin(node),
-            message: format!("{place}: the file orders localIds {} by executionOrderId; plc-deps orders blocks by their data flow, ties by localId (`plc-deps order` shows it)", ids.join(", ")),
-        });
-    }
+    ordered.sort_unstable();
     let f = Fbd { g: &g, place };
     let mut networks: Vec<Network<'static>> = Vec::new();
     let mut current: Vec<Block<'static>> = Vec::new();
@@ -109,6 +102,16 @@ pub fn body(tc6: Tc6, node: Node, pou: &str, notes: &mut Vec<Note>) -> R<FbdBody
         if let Some(n) = networks.first_mut() {
             n.id = Ok(Cow::Owned(pou.to_owned()));
         }
+    }
+    if !ordered.is_empty() {
+        notes.exec_orders.push(ExecOrder {
+            networks: networks
+                .iter()
+                .filter_map(|n| n.id.as_ref().ok().map(|i| i.to_string()))
+                .collect(),
+            origin: origin(node),
+            ids: ordered,
+        });
     }
     Ok(FbdBody {
         origin: origin(node),

@@ -29,7 +29,7 @@
 use super::ld_block;
 use super::ld_power::{Item, Key, Path, Power};
 use super::wiring::{graph, ElemId, Graph};
-use super::xml::{attr, error, identifier, origin, Note, Tc6, R};
+use super::xml::{attr, error, identifier, origin, Note, Notes, Tc6, R};
 use crate::syntax::{Element, ElementKind, Located, Name, Rung, Series};
 use roxmltree::Node;
 
@@ -51,7 +51,7 @@ const LD_TAGS: &[&str] = &[
 ];
 
 /// Reads LD body `node` of POU `pou` into rungs `<pou>.R1`, `<pou>.R2` … in execution order.
-pub fn rungs(tc6: Tc6, node: Node, pou: &str, notes: &mut Vec<Note>) -> R<Vec<Rung<'static>>> {
+pub fn rungs(tc6: Tc6, node: Node, pou: &str, notes: &mut Notes) -> R<Vec<Rung<'static>>> {
     let place = format!("pou {pou}, LD");
     let g = graph(tc6, node, &place)?;
     for (i, el) in g.elems.iter().enumerate() {
@@ -318,7 +318,7 @@ fn interleave_note(
     rung_of: &[Option<usize>],
     place: &str,
     pou: &str,
-    notes: &mut Vec<Note>,
+    notes: &mut Notes,
 ) {
     let mut seen_last = None;
     for &o in outputs.iter().filter(|o| g.get(**o).tag != "block") {

@@ -14,7 +14,7 @@
 //! several configurations or resources, POUs with actions or transitions outside SFC.
 
 use super::interface::{self, name, Interface, Known};
-use super::xml::{add_data_note, attr, error, identifier, origin, Note, Tc6, R};
+use super::xml::{add_data_note, attr, error, identifier, origin, Note, Notes, Tc6, R};
 use super::{fbd, ld, textual};
 use crate::syntax::{Body, Element, ElementKind, FunctionBlock, Program, Rung, Subroutine, Var};
 use roxmltree::{Document, Node};
@@ -29,7 +29,7 @@ struct ProgramPou {
 }
 
 /// Reads the whole project.
-pub fn program(tc6: Tc6, doc: &Document, notes: &mut Vec<Note>) -> R<Program<'static>> {
+pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static>> {
     let root = doc.root_element();
     add_data_note(tc6, root, notes);
     if let Some(ch) = tc6.child(root, "contentHeader") {
@@ -194,13 +194,7 @@ fn assemble(
 
 /// The body of POU `pou` as syntax: LD rungs, an FBD body, or a textual or SFC body through
 /// its interface.
-fn body(
-    tc6: Tc6,
-    pou: Node,
-    name: &str,
-    iface: &Interface,
-    notes: &mut Vec<Note>,
-) -> R<Body<'static>> {
+fn body(tc6: Tc6, pou: Node, name: &str, iface: &Interface, notes: &mut Notes) -> R<Body<'static>> {
     let place = format!("pou {name}");
     let Some(b) = tc6.child(pou, "body") else {
         return Err(error(
@@ -277,7 +271,7 @@ fn instances<'a, 'i>(
     tc6: Tc6,
     root: Node<'a, 'i>,
     known: &Known,
-    notes: &mut Vec<Note>,
+    notes: &mut Notes,
 ) -> R<(Vec<Var<'static>>, Order<'a, 'i>)> {
     let mut globals = Vec::new();
     let mut order = Vec::new();

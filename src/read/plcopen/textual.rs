@@ -11,7 +11,7 @@
 //! Deliberately not here: parsing ST or IL, SFC steps and transitions (a later step).
 
 use super::interface::name;
-use super::xml::{origin, Note};
+use super::xml::{origin, Note, Notes};
 use crate::model::CmpOp;
 use crate::syntax::{Compare, Element, ElementKind, Located, Move, Rung, Scalar, Var};
 use roxmltree::Node;
@@ -28,7 +28,7 @@ pub fn through_interface(
     reads: &[&Var<'static>],
     writes: &[&Var<'static>],
     externals: &[String],
-    notes: &mut Vec<Note>,
+    notes: &mut Notes,
 ) -> Vec<Rung<'static>> {
     let at = origin(body);
     let mut series = Vec::new();

@@ -52,6 +52,29 @@ pub struct Note {
     pub message: String,
 }
 
+/// The executionOrderIds of an FBD body, to compare with the order plc-deps gives it.
+#[derive(Clone, Debug)]
+pub struct ExecOrder {
+    /// The ids of the body's networks.
+    pub networks: Vec<String>,
+    pub origin: Origin,
+    /// (executionOrderId, localId) of the elements that have one above 0, sorted.
+    pub ids: Vec<(u32, u32)>,
+}
+
+/// What the reader has to say: notes, and the execution orders to check after resolution.
+#[derive(Default)]
+pub struct Notes {
+    pub list: Vec<Note>,
+    pub exec_orders: Vec<ExecOrder>,
+}
+
+impl Notes {
+    pub fn push(&mut self, n: Note) {
+        self.list.push(n);
+    }
+}
+
 /// Parses the text as XML: no DTD (so no entity expansion), at most [`MAX_XML_BYTES`], at most
 /// [`MAX_DEPTH`] levels. Errors are syntax errors with line and column.
 pub fn parse(text: &str) -> R<Document<'_>> {
@@ -261,7 +284,7 @@ pub fn variable_ref(s: &str, n: Node, place: &str) -> R<String> {
 }
 
 /// The `addData` children of `n` as one note (their `data@name`s), if any.
-pub fn add_data_note(tc6: Tc6, n: Node, notes: &mut Vec<Note>) {
+pub fn add_data_note(tc6: Tc6, n: Node, notes: &mut Notes) {
     for a in tc6.children(n, "addData") {
         let names: Vec<&str> = tc6
             .children(a, "data")
