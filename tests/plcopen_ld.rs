@@ -338,3 +338,98 @@ fn a_jump_skips_the_rungs_up_to_its_label() {
     assert_eq!(r["levels"]["control"], json!([["P.R1", "P.R3"], ["P.R2"]]));
     assert_eq!(r["levels"]["combined"], json!([["P.R1", "P.R3"], ["P.R2"]]));
 }
+
+#[test]
+fn counters_compares_and_arithmetic_boxes_in_rungs() {
+    use px::{block, var_in};
+    // R1: Pulse → CTU0(CU, R := Reset contact, PV := 3).Q → Full.
+    // R2: GT(IN1 := N, IN2 := 4).OUT → High.   R3: Go → ADD(EN, N, 1) → N.
+    let ld = [
+        rail(1),
+        contact(2, "Pulse", &[1], "edge=\"rising\""),
+        contact(3, "Reset", &[1], ""),
+        in_var(4, "3"),
+        block(
+            5,
+            "CTU",
+            Some("CTU0"),
+            &[("CU", &[(2, None)]), ("R", &[(3, None)]), ("PV", &[(4, None)])],
+            &["Q", "CV"],
+        ),
+        coil(6, "Full", &[], "").replace(
+            "<connectionPointIn></connectionPointIn>",
+            "<connectionPointIn><connection refLocalId=\"5\" formalParameter=\"Q\"/></connectionPointIn>",
+        ),
+        in_var(7, "N"),
+        in_var(8, "4"),
+        block(8 + 1, "GT", None, &[("IN1", &[(7, None)]), ("IN2", &[(8, None)])], &["OUT"]),
+        coil(10, "High", &[], "").replace(
+            "<connectionPointIn></connectionPointIn>",
+            "<connectionPointIn><connection refLocalId=\"9\" formalParameter=\"OUT\"/></connectionPointIn>",
+        ),
+        contact(11, "Go", &[1], ""),
+        in_var(12, "N"),
+        in_var(13, "1"),
+        block(
+            14,
+            "ADD",
+            None,
+            &[("EN", &[(11, None)]), ("IN1", &[(12, None)]), ("IN2", &[(13, None)])],
+            &["ENO", "OUT"],
+        ),
+        var_in("outVariable", 15, "N", (14, Some("OUT"))),
+    ]
+    .concat();
+    let xml = project(
+        &[
+            ("inputVars", "Pulse", "BOOL"),
+            ("inputVars", "Reset", "BOOL"),
+            ("inputVars", "Go", "BOOL"),
+            ("outputVars", "Full", "BOOL"),
+            ("outputVars", "High", "BOOL"),
+            ("outputVars", "N", "INT"),
+            ("localVars", "CTU0", "CTU"),
+        ],
+        &ld,
+    );
+    let r = report(&xml);
+    assert_eq!(
+        io(&r),
+        vec![
+            (
+                "P.R1".into(),
+                json!(["Pulse", "Reset", "CTU0", "P.R1:edge1"]),
+                json!(["Full", "CTU0", "P.R1:edge1"])
+            ),
+            ("P.R2".into(), json!(["N"]), json!(["High"])),
+            ("P.R3".into(), json!(["Go", "N"]), json!(["N"])),
+        ]
+    );
+    assert_eq!(deps(&r), vec![dep("anti", "P.R2", "P.R3", "N")]);
+    let path = common::cli::tmp("boxes.xml");
+    std::fs::write(&path, &xml).unwrap();
+    let inputs = common::cli::tmp("boxes.csv");
+    // Three rising edges of Pulse; Go on in six scans.
+    std::fs::write(
+        &inputs,
+        "Pulse,Reset,Go\n1,0,1\n0,0,1\n1,0,1\n0,0,1\n1,0,1\n0,0,1\n0,0,0\n",
+    )
+    .unwrap();
+    let out = run(&[
+        "run",
+        path.to_str().unwrap(),
+        "--inputs",
+        inputs.to_str().unwrap(),
+        "--format",
+        "json",
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    // N counts 0..6 (High from the scan that starts with N = 5), CTU0 reaches PV = 3.
+    assert_eq!(v["outputs"], json!({"Full": true, "High": true, "N": 6}));
+}
