@@ -153,3 +153,12 @@ fn execution_order_ids_that_disagree_with_the_data_flow_get_a_warning_with_both_
     assert!(warnings[0].ends_with("pou P, FBD: the file's executionOrderIds run localIds 5, 8, 4; plc-deps runs them 4, 5, 8 (data flow first, ties by localId; `plc-deps order` shows the whole order)"), "{stderr}");
     assert!(warnings[0].starts_with("warning: <stdin>:"), "{stderr}");
 }
+
+#[test]
+fn comments_become_the_network_comment() {
+    let xml =
+        std::fs::read_to_string(common::cli::root().join("tests/plcopen/comment_fbd.xml")).unwrap();
+    let (_, fbd, notes) = plc_deps::read::plcopen::load(&xml).unwrap();
+    assert!(notes.is_empty());
+    assert_eq!(fbd.pous[0].networks[0].comment.as_deref(), Some("Adds one"));
+}

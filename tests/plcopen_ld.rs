@@ -251,9 +251,9 @@ fn a_ton_in_a_rung_times_its_input() {
             conn(&[2]),
             conn(&[3])
         ),
-        format!(
+        (
             "<coil localId=\"5\"><connectionPointIn><connection refLocalId=\"4\" formalParameter=\"Q\"/></connectionPointIn><variable>Done</variable></coil>"
-        ),
+        ).to_string(),
         contact(6, "Done", &[1], ""),
         coil(7, "Lamp", &[6], ""),
     ]

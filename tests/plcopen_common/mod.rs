@@ -78,14 +78,11 @@ pub fn in_var(id: u32, expr: &str) -> String {
     format!("<inVariable localId=\"{id}\"><connectionPointOut/><expression>{expr}</expression></inVariable>")
 }
 
+/// A block's inputs: `(pin, sources)`, a source `(localId, Some(output pin))`.
+pub type Wires<'a> = &'a [(&'a str, &'a [(u32, Option<&'a str>)])];
+
 /// An FBD block: `(pin, sources)` inputs (a source `(localId, Some(pin))`), output pin names.
-pub fn block(
-    id: u32,
-    ty: &str,
-    instance: Option<&str>,
-    inputs: &[(&str, &[(u32, Option<&str>)])],
-    outputs: &[&str],
-) -> String {
+pub fn block(id: u32, ty: &str, instance: Option<&str>, inputs: Wires, outputs: &[&str]) -> String {
     let ins: Vec<String> = inputs
         .iter()
         .map(|(pin, from)| {

@@ -10,7 +10,8 @@
 //! variable it is a MOVE block with the out variable's localId. `jump` and `return` are JMP and
 //! RET blocks whose condition is their input. A `label` starts a new network (networks
 //! `<pou>.N1`, `<pou>.N2` … in file order; one network without labels is `<pou>`).
-//! `connector`/`continuation` pairs are spliced by [`super::wiring`]; comments are skipped.
+//! `connector`/`continuation` pairs are spliced by [`super::wiring`]; the text of the
+//! `comment`s of a network, in file order, is its comment.
 //!
 //! Order: the FBD text-generation paper's depth-first topological sort over the arcs, ties by
 //! localId (docs/fbd.md). Beremiz instead pulls blocks on demand from the out variables in file
@@ -73,6 +74,7 @@ pub fn body(tc6: Tc6, node: Node, pou: &str, notes: &mut Notes) -> R<FbdBody<'st
     let mut current: Vec<Block<'static>> = Vec::new();
     let mut label: Option<(String, Node)> = None;
     let mut labels = 0;
+    let mut comments: Vec<String> = Vec::new();
     for (i, el) in g.elems.iter().enumerate() {
         let e = ElemId(i as u32);
         match el.tag {
@@ -81,10 +83,27 @@ pub fn body(tc6: Tc6, node: Node, pou: &str, notes: &mut Notes) -> R<FbdBody<'st
                 let l = identifier(attr(el.node, "label", &here)?, "label", el.node, &here)?;
                 if !current.is_empty() || label.is_some() {
                     let k = networks.len();
-                    networks.push(network(pou, k, label.take(), std::mem::take(&mut current)));
+                    networks.push(network(
+                        pou,
+                        k,
+                        label.take(),
+                        std::mem::take(&mut current),
+                        std::mem::take(&mut comments),
+                    ));
                 }
                 labels += 1;
                 label = Some((l, el.node));
+            }
+            "comment" => {
+                let t: String = el
+                    .node
+                    .descendants()
+                    .filter(|d| d.is_text())
+                    .filter_map(|d| d.text())
+                    .collect();
+                if !t.trim().is_empty() {
+                    comments.push(t.trim().to_owned());
+                }
             }
             "block" => current.push(f.block(e)?),
             "jump" | "return" => current.push(f.control(e)?),
@@ -97,7 +116,7 @@ pub fn body(tc6: Tc6, node: Node, pou: &str, notes: &mut Notes) -> R<FbdBody<'st
         }
     }
     let k = networks.len();
-    networks.push(network(pou, k, label, current));
+    networks.push(network(pou, k, label, current, comments));
     if labels == 0 {
         if let Some(n) = networks.first_mut() {
             n.id = Ok(Cow::Owned(pou.to_owned()));
@@ -126,6 +145,7 @@ fn network(
     k: usize,
     label: Option<(String, Node)>,
     blocks: Vec<Block<'static>>,
+    comments: Vec<String>,
 ) -> Network<'static> {
     let at = label
         .as_ref()
@@ -134,7 +154,7 @@ fn network(
         origin: at,
         id: Ok(Cow::Owned(format!("{pou}.N{}", k + 1))),
         label: label.map(|(l, _)| Ok(Cow::Owned(l))),
-        comment: None,
+        comment: (!comments.is_empty()).then(|| Ok(Cow::Owned(comments.join("\n")))),
         blocks: Ok(blocks),
         problem: None,
     }
