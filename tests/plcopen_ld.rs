@@ -433,3 +433,50 @@ fn counters_compares_and_arithmetic_boxes_in_rungs() {
     // N counts 0..6 (High from the scan that starts with N = 5), CTU0 reaches PV = 3.
     assert_eq!(v["outputs"], json!({"Full": true, "High": true, "N": 6}));
 }
+
+#[test]
+fn outputs_of_rungs_that_interleave_in_the_file_get_a_warning() {
+    // Coils in file order: X (rung 1), Y (rung 2), Z (rung 1 again, from the same contact A).
+    let ld = [
+        rail(1),
+        contact(2, "A", &[1], ""),
+        coil(3, "X", &[2], ""),
+        contact(4, "B", &[1], ""),
+        coil(5, "Y", &[4], "executionOrderId=\"7\""),
+        coil(6, "Z", &[2], ""),
+    ]
+    .concat();
+    let xml = project(
+        &[
+            ("localVars", "A", "BOOL"),
+            ("localVars", "B", "BOOL"),
+            ("localVars", "X", "BOOL"),
+            ("localVars", "Y", "BOOL"),
+            ("localVars", "Z", "BOOL"),
+        ],
+        &ld,
+    );
+    let out = run_stdin(&["report", "-", "--format", "json"], xml.as_bytes());
+    assert_eq!(out.status.code(), Some(0));
+    let r: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(
+        io(&r),
+        vec![
+            ("P.R1".into(), json!(["A"]), json!(["X", "Z"])),
+            ("P.R2".into(), json!(["B"]), json!(["Y"])),
+        ]
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let warnings: Vec<&str> = stderr
+        .lines()
+        .filter_map(|l| l.strip_prefix("warning: <stdin>:"))
+        .map(|l| l.split_once(": ").unwrap().1)
+        .collect();
+    assert_eq!(
+        warnings,
+        [
+            "pou P, LD: executionOrderId 7 of coil localId 5 is ignored (Beremiz does not read it in LD)",
+            "pou P, LD: coil localId 6 of rung P.R1 comes in the file after outputs of rung P.R2; Beremiz runs the outputs in file order, plc-deps runs each rung whole, in the order of its first output",
+        ]
+    );
+}
