@@ -8,11 +8,12 @@
 //! temporary name beside it and renamed into place only when the whole output is ready, so a
 //! failure never leaves a half-written file; temporary files in the making are listed in a
 //! registry that [`remove_temp_files`] empties (the binary calls it on SIGINT/SIGTERM), so a
-//! stopped command leaves none behind. Nothing here prints.
+//! stopped command leaves none behind. A program is recognised by its content ([`load_text`]:
+//! PLCopen TC6 XML or JSON). Nothing here prints but the PLCopen reader's warnings.
 
 use crate::fbd::Fbd;
 use crate::model::Program;
-use crate::read::{program_from_json, LoadError};
+use crate::read::LoadError;
 use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
@@ -199,14 +200,30 @@ pub fn read_program_text(path: &Path) -> Result<(String, String), CliError> {
 
 /// Reads and checks a program file (`-`: standard input).
 pub fn load_program(path: &Path) -> Result<Program, CliError> {
-    let (file, text) = read_program_text(path)?;
-    program_from_json(&text).map_err(|error| CliError::Load { file, error })
+    load_program_and_fbd(path).map(|(p, _)| p)
 }
 
 /// Reads and checks a program file (`-`: standard input), with its FBD bodies as written.
 pub fn load_program_and_fbd(path: &Path) -> Result<(Program, Fbd), CliError> {
     let (file, text) = read_program_text(path)?;
-    crate::read::program_and_fbd_from_json(&text).map_err(|error| CliError::Load { file, error })
+    load_text(file, &text)
+}
+
+/// Checks a program's text, recognised by its content: PLCopen TC6 XML when it starts with
+/// `<` (the reader's notes go to standard error as warnings), else the JSON format.
+pub fn load_text(file: String, text: &str) -> Result<(Program, Fbd), CliError> {
+    use crate::read::plcopen;
+    if plcopen::looks_like_xml(text) {
+        let (p, f, notes) = plcopen::load(text).map_err(|error| CliError::Load {
+            file: file.clone(),
+            error,
+        })?;
+        for n in &notes {
+            eprintln!("warning: {}", plcopen::note_text(&file, text, n));
+        }
+        return Ok((p, f));
+    }
+    crate::read::program_and_fbd_from_json(text).map_err(|error| CliError::Load { file, error })
 }
 
 /// Checks, before any work, that an output file can be written at `path`: not a folder, in a

@@ -35,7 +35,6 @@ pub fn render_order(p: &Program, fbd: &crate::fbd::Fbd, format: OrderFormat) -> 
 /// a fragment-rule violation is a load error naming the blocks (exit code 2).
 pub fn order(c: &OrderConfig) -> Result<(), CliError> {
     let (file, text) = read_program_text(&c.input)?;
-    let (p, fbd) = crate::read::program_and_fbd_from_json(&text)
-        .map_err(|error| CliError::Load { file, error })?;
+    let (p, fbd) = super::io::load_text(file, &text)?;
     write_output(c.output.as_deref(), &render_order(&p, &fbd, c.format))
 }

@@ -237,6 +237,10 @@ pub enum Invalid {
     },
     #[error("unknown type `{name}` (expected BOOL, INT, DINT, REAL, TIME, TON, TOF, TP, CTU, CTD or a function block: {fbs})")]
     UnknownTypeOrFb { name: String, fbs: String },
+    // ---- PLCopen TC6 XML (docs/plcopen.md)
+    /// What the PLCopen reader cannot take (the message names the element, its localId or name).
+    #[error("{message}")]
+    PlcOpen { message: String },
 }
 
 impl LoadError {

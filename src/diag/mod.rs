@@ -52,7 +52,7 @@ impl Diagnostic {
     }
 
     /// The stable code of the kind: `E01xx` shape of the file, `E02xx` names and types,
-    /// `E03xx` structure (ids, labels, loops, calls), `E04xx` FBD networks and function blocks.
+    /// `E03xx` structure (ids, labels, loops, calls), `E04xx` FBD networks and function blocks, `E05xx` PLCopen TC6 XML.
     pub fn code(&self) -> &'static str {
         self.kind.code()
     }
@@ -114,6 +114,7 @@ impl Invalid {
             FbRecursion { .. } => "E0412",
             HiddenClash { .. } => "E0413",
             AccumulatedTwice { .. } => "E0414",
+            PlcOpen { .. } => "E0501",
         }
     }
 }

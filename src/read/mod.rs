@@ -1,7 +1,8 @@
 //! Readers: program files in → the surface syntax ([`crate::syntax`]) → through the resolver
 //! ([`crate::resolve`]) one resolved [`crate::model::Program`] out.
 //!
-//! Only the JSON program format (docs/format.md, docs/fbd.md) exists so far ([`json`]): it
+//! Two formats: PLCopen TC6 XML ([`plcopen`], docs/plcopen.md) and the JSON program format
+//! (docs/format.md, docs/fbd.md; [`json`]), which
 //! reads the text into the syntax types in one pass (syntax errors carry line and column; a
 //! byte-order mark is skipped), the resolver checks and resolves everything else (those errors
 //! carry the rung id, the JSON path and the byte offset of the most precise node, whose line and
@@ -10,6 +11,7 @@
 //! whole or not at all.
 
 pub mod json;
+pub mod plcopen;
 
 pub use crate::diag::{Invalid, LoadError, Location};
 

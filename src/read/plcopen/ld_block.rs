@@ -1,0 +1,273 @@
+//! Blocks inside LD rungs → the syntax's box elements (IEC 61131-3 8.2.2: function and function
+//! block boxes in ladder; TC6 `block` with `inputVariables`/`outputVariables`).
+//!
+//! A block takes its power from `EN` when it has one, else from its first BOOL input (`IN` of
+//! TON/TOF/TP, `CU` of CTU, `CD` of CTD; functions without `EN` run always, from the rail) and
+//! gives power out on `ENO`, or `Q` (timers, counters), or `OUT` (compares). Its data inputs are
+//! fed by `inVariable`s (a variable or a constant); the result of ADD … MOD and MOVE goes to the
+//! `outVariable` wired to `OUT` (exactly one). A counter's `R`/`LD` may also be a single
+//! contact on the rail (its variable is the operand).
+//!
+//! Deliberately not here (each an error naming the block and its localId): other block types
+//! (standard ones the model lacks, user function blocks and functions in LD), EN/ENO on timers
+//! and counters, outputs other than the power output wired (`ET`, `CV`), a data pin fed by a
+//! block or a contact network.
+
+use super::ld_power::{Item, Key, Path, Power};
+use super::wiring::ElemId;
+use super::xml::{error, origin, variable_ref, R};
+use crate::model::{ArithOp, CmpOp, TimerKind};
+use crate::syntax::{
+    Arith, Compare, Counter, Element, ElementKind, Located, Move, Name, Operand, Scalar, Timer,
+};
+
+/// The block types an LD rung can hold, with their pins.
+enum Spec {
+    Timer(TimerKind),
+    Counter { down: bool },
+    Arith(ArithOp),
+    Move,
+    Compare(CmpOp),
+}
+
+impl Spec {
+    fn of(ty: &str) -> Option<Spec> {
+        Some(match ty {
+            "TON" => Spec::Timer(TimerKind::Ton),
+            "TOF" => Spec::Timer(TimerKind::Tof),
+            "TP" => Spec::Timer(TimerKind::Tp),
+            "CTU" => Spec::Counter { down: false },
+            "CTD" => Spec::Counter { down: true },
+            "MOVE" => Spec::Move,
+            _ => match (ArithOp::parse(ty), CmpOp::parse(ty)) {
+                (Some(op), _) => Spec::Arith(op),
+                (_, Some(op)) => Spec::Compare(op),
+                _ => return None,
+            },
+        })
+    }
+
+    /// (power input, data inputs, power output, the output written to an out variable).
+    fn pins(
+        &self,
+    ) -> (
+        &'static str,
+        &'static [&'static str],
+        &'static str,
+        Option<&'static str>,
+    ) {
+        match self {
+            Spec::Timer(_) => ("IN", &["PT"], "Q", None),
+            Spec::Counter { down: false } => ("CU", &["R", "PV"], "Q", None),
+            Spec::Counter { down: true } => ("CD", &["LD", "PV"], "Q", None),
+            Spec::Arith(_) => ("EN", &["IN1", "IN2"], "ENO", Some("OUT")),
+            Spec::Move => ("EN", &["IN"], "ENO", Some("OUT")),
+            Spec::Compare(_) => ("EN", &["IN1", "IN2"], "OUT", None),
+        }
+    }
+}
+
+const SUPPORTED: &str =
+    "TON, TOF, TP, CTU, CTD, ADD, SUB, MUL, DIV, MOD, MOVE, EQ, NE, LT, LE, GT, GE";
+
+/// True when out variable `e` is the result of an ADD … MOD or MOVE block (part of its box).
+pub fn absorbed(p: &Power, e: ElemId) -> bool {
+    let el = p.g.get(e);
+    let [pin] = el.inputs.as_slice() else {
+        return false;
+    };
+    let [s] = pin.sources.as_slice() else {
+        return false;
+    };
+    let src = p.g.get(s.elem);
+    src.tag == "block"
+        && matches!(
+            src.node.attribute("typeName").and_then(Spec::of),
+            Some(Spec::Arith(_) | Spec::Move)
+        )
+        && s.pin.is_none_or(|p| p == "OUT")
+}
+
+/// The series out of block `e`'s power output (`pin`: the output asked for).
+pub fn power_out(p: &mut Power, e: ElemId, pin: Option<&str>) -> R<Path> {
+    let el = p.g.get(e);
+    let node = el.node;
+    let here = p.at(e);
+    let ty = super::xml::attr(node, "typeName", &here)?;
+    let Some(spec) = Spec::of(ty) else {
+        return Err(error(
+            origin(node),
+            &here,
+            format!("block {ty} (localId {}) is not supported in an LD body yet (supported: {SUPPORTED})", el.local_id),
+        ));
+    };
+    let (power_in, data, power_out, result) = spec.pins();
+    let pin_names: Vec<&str> = el.inputs.iter().filter_map(|p| p.name).collect();
+    for name in &pin_names {
+        if *name != power_in && !data.contains(name) {
+            return Err(error(
+                origin(node),
+                &here,
+                format!("{ty} (localId {}) has the input `{name}`, which plc-deps does not support here (inputs: {power_in}, {})", el.local_id, data.join(", ")),
+            ));
+        }
+    }
+    // Every wired output is the power output or the result.
+    for &(c, _, out_pin) in &p.g.consumers[e.0 as usize] {
+        let first = if result.is_some() { "OUT" } else { power_out };
+        let name = out_pin.unwrap_or(first);
+        if name != power_out && Some(name) != result {
+            return Err(error(
+                origin(p.g.get(c).node),
+                &p.at(c),
+                format!("output `{name}` of {ty} (localId {}) is wired to localId {}: only {power_out} can be wired in LD yet", el.local_id, p.g.get(c).local_id),
+            ));
+        }
+    }
+    if let Some(asked) = pin {
+        if asked != power_out {
+            return Err(error(
+                origin(node),
+                &here,
+                format!("output `{asked}` of {ty} (localId {}) feeds power to an element; only {power_out} can", el.local_id),
+            ));
+        }
+    }
+    let kind = box_kind(p, e, &spec, ty)?;
+    let k = el.inputs.iter().position(|x| x.name == Some(power_in));
+    let mut path = match k {
+        Some(k) if !el.inputs[k].sources.is_empty() => p.input(e, k)?,
+        _ if power_in == "EN" => Vec::new(),
+        _ => {
+            return Err(error(
+                origin(node),
+                &here,
+                format!(
+                    "input {power_in} of {ty} (localId {}) is not connected",
+                    el.local_id
+                ),
+            ))
+        }
+    };
+    path.push(Item {
+        key: Key::Elem(e),
+        element: Element {
+            origin: origin(node),
+            kind,
+        },
+    });
+    Ok(path)
+}
+
+fn box_kind(p: &mut Power, e: ElemId, spec: &Spec, ty: &str) -> R<ElementKind<'static>> {
+    let node = p.g.get(e).node;
+    let here = p.at(e);
+    let instance = || -> R<Name<'static>> {
+        let raw = super::xml::attr(node, "instanceName", &here)?;
+        let n = super::xml::identifier(raw, "instance", node, &here)?;
+        Ok(Located {
+            value: n.into(),
+            origin: origin(node),
+        })
+    };
+    Ok(match *spec {
+        Spec::Timer(kind) => ElementKind::Timer(Box::new(Timer {
+            kind,
+            instance: instance()?,
+            pt: operand(p, e, "PT", ty)?,
+        })),
+        Spec::Counter { down } => ElementKind::Counter(Box::new(Counter {
+            down,
+            instance: instance()?,
+            pv: operand(p, e, "PV", ty)?,
+            aux: operand(p, e, if down { "LD" } else { "R" }, ty)?,
+        })),
+        Spec::Arith(op) => ElementKind::Arith(Box::new(Arith {
+            op,
+            a: operand(p, e, "IN1", ty)?,
+            b: operand(p, e, "IN2", ty)?,
+            out: result(p, e, ty)?,
+        })),
+        Spec::Move => ElementKind::Move(Box::new(Move {
+            from: operand(p, e, "IN", ty)?,
+            to: result(p, e, ty)?,
+        })),
+        Spec::Compare(op) => ElementKind::Compare(Box::new(Compare {
+            op,
+            a: operand(p, e, "IN1", ty)?,
+            b: operand(p, e, "IN2", ty)?,
+        })),
+    })
+}
+
+/// The operand feeding data pin `pin` of block `e`: an inVariable (a variable or a constant), or
+/// a single contact on the rail (its variable), or the rail itself (TRUE).
+fn operand(p: &mut Power, e: ElemId, pin: &str, ty: &str) -> R<Operand<'static>> {
+    let el = p.g.get(e);
+    let here = p.at(e);
+    let Some(input) = el.inputs.iter().find(|x| x.name == Some(pin)) else {
+        return Err(error(
+            origin(el.node),
+            &here,
+            format!("{ty} (localId {}) has no input {pin}", el.local_id),
+        ));
+    };
+    let [s] = input.sources.as_slice() else {
+        return Err(error(
+            origin(input.node),
+            &here,
+            format!(
+                "input {pin} of {ty} (localId {}) needs exactly one connection, found {}",
+                el.local_id,
+                input.sources.len()
+            ),
+        ));
+    };
+    let src = p.g.get(s.elem);
+    let value = match src.tag {
+        "inVariable" => {
+            let text = p.expression(s.elem)?;
+            match super::interface::literal(&text) {
+                Some(v) => v,
+                None => Scalar::Str(variable_ref(&text, src.node, &p.at(s.elem))?.into()),
+            }
+        }
+        "leftPowerRail" => Scalar::Bool(true),
+        "contact"
+            if src.node.attribute("negated").is_none_or(|n| n == "false")
+                && src.node.attribute("edge").is_none_or(|n| n == "none")
+                && p.input(s.elem, 0)?.is_empty() =>
+        {
+            Scalar::Str(p.variable(s.elem)?.value)
+        }
+        other => {
+            return Err(error(
+                s.origin,
+                &here,
+                format!("input {pin} of {ty} (localId {}) is fed by a {other} (localId {}): only a variable, a constant or a single contact on the rail can feed it in LD yet", el.local_id, src.local_id),
+            ))
+        }
+    };
+    Ok(Located {
+        value,
+        origin: s.origin,
+    })
+}
+
+/// The out variable written by the result (`OUT`) of block `e`: exactly one.
+fn result(p: &Power, e: ElemId, ty: &str) -> R<Name<'static>> {
+    let el = p.g.get(e);
+    let outs: Vec<ElemId> = p.g.consumers[e.0 as usize]
+        .iter()
+        .filter(|(_, _, pin)| pin.is_none_or(|x| x == "OUT"))
+        .map(|&(c, _, _)| c)
+        .collect();
+    match outs.as_slice() {
+        [c] if p.g.get(*c).tag == "outVariable" => p.variable(*c),
+        _ => Err(error(
+            origin(el.node),
+            &p.at(e),
+            format!("output OUT of {ty} (localId {}) must be wired to exactly one outVariable, found {} connections", el.local_id, outs.len()),
+        )),
+    }
+}

@@ -1,0 +1,295 @@
+//! Power flow of an LD body: for each element, the series of elements that brings power to it
+//! from the left rail, with parallel joins recovered as `or` groups (IEC 61131-3 8.2; TC6
+//! `ldObjects`).
+//!
+//! A pin's power is the OR of its connections (Beremiz's `ComputeExpression`: several
+//! `connection`s in one `connectionPointIn` are a wired OR). The series of the sources are
+//! compared element by element from the rail: their common prefix is kept once, and what
+//! follows it becomes the branches of one `or` — the series-parallel decomposition of the
+//! wiring. A branch must hold conditions only (contacts, compares, nested `or`s): a coil or a
+//! block inside a parallel branch, or a wiring that is not series-parallel and would need it,
+//! is one error naming the localIds. Two branches that are the same series make the `or`
+//! moot and are an error too, rather than a dropped read.
+//!
+//! Invariants: every element's series is computed once ([`Power::out`] memoises it); a loop in
+//! the wiring is an error naming its localIds; nothing is dropped.
+//!
+//! Deliberately not here: which elements end a rung and in what order rungs run (`super::ld`),
+//! what blocks become (`super::ld_block`).
+
+use super::ld_block;
+use super::wiring::{ElemId, Graph, Source};
+use super::xml::{error, origin, variable_ref, R};
+use crate::diag::Origin;
+use crate::syntax::{Edge, Element, ElementKind, Series};
+use std::collections::HashMap;
+
+/// What identifies an element of a path: two paths share a prefix when their keys agree.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub enum Key {
+    Elem(ElemId),
+    /// An `or` of these sources (sorted).
+    Or(Vec<ElemId>),
+}
+
+/// One element of a path from the left rail.
+#[derive(Clone, Debug)]
+pub struct Item {
+    pub key: Key,
+    pub element: Element<'static>,
+}
+
+/// A series from the left rail to an element's output.
+pub type Path = Vec<Item>;
+
+/// The power computation of one body.
+pub struct Power<'g, 'a, 'i> {
+    pub g: &'g Graph<'a, 'i>,
+    /// `pou Main, LD` (for errors).
+    pub place: String,
+    memo: HashMap<ElemId, Path>,
+    visiting: Vec<bool>,
+}
+
+impl<'g, 'a, 'i> Power<'g, 'a, 'i> {
+    pub fn new(g: &'g Graph<'a, 'i>, place: String) -> Self {
+        Power {
+            g,
+            place,
+            memo: HashMap::new(),
+            visiting: vec![false; g.elems.len()],
+        }
+    }
+
+    pub fn at(&self, e: ElemId) -> String {
+        self.g.place(&self.place, e)
+    }
+
+    /// The series that brings power out of `e` (through its output pin `pin`).
+    pub fn out(&mut self, e: ElemId, pin: Option<&str>) -> R<Path> {
+        if let Some(p) = self.memo.get(&e) {
+            return Ok(p.clone());
+        }
+        if self.visiting[e.0 as usize] {
+            return Err(error(
+                origin(self.g.get(e).node),
+                &self.at(e),
+                format!(
+                    "the power wiring through localId {} forms a loop",
+                    self.g.get(e).local_id
+                ),
+            ));
+        }
+        self.visiting[e.0 as usize] = true;
+        let path = self.compute(e, pin);
+        self.visiting[e.0 as usize] = false;
+        let path = path?;
+        self.memo.insert(e, path.clone());
+        Ok(path)
+    }
+
+    fn compute(&mut self, e: ElemId, pin: Option<&str>) -> R<Path> {
+        let el = self.g.get(e);
+        let node = el.node;
+        let here = self.at(e);
+        let item = |kind| Item {
+            key: Key::Elem(e),
+            element: Element {
+                origin: origin(node),
+                kind,
+            },
+        };
+        match el.tag {
+            "leftPowerRail" => Ok(Vec::new()),
+            "contact" => {
+                let var = self.variable(e)?;
+                let negated = super::xml::flag(node, "negated", &here)?;
+                let edge = match node.attribute("edge") {
+                    None | Some("none") => None,
+                    Some("rising") => Some(Edge::Rising),
+                    Some("falling") => Some(Edge::Falling),
+                    Some(o) => {
+                        return Err(error(origin(node), &here, format!("unknown edge `{o}`")))
+                    }
+                };
+                if negated && edge.is_some() {
+                    return Err(error(
+                        origin(node),
+                        &here,
+                        "a contact both negated and edge-qualified is not supported (Beremiz would ignore the edge)",
+                    ));
+                }
+                let mut p = self.input(e, 0)?;
+                p.push(item(ElementKind::Contact { var, negated, edge }));
+                Ok(p)
+            }
+            "coil" | "outVariable" => {
+                let kind = self.coil(e)?;
+                let mut p = self.input(e, 0)?;
+                p.push(item(kind));
+                Ok(p)
+            }
+            "inVariable" => {
+                let text = self.expression(e)?;
+                if text.trim().eq_ignore_ascii_case("TRUE") {
+                    return Ok(Vec::new());
+                }
+                let var = crate::syntax::Located {
+                    value: variable_ref(&text, node, &here)?.into(),
+                    origin: origin(node),
+                };
+                Ok(vec![item(ElementKind::Contact {
+                    var,
+                    negated: false,
+                    edge: None,
+                })])
+            }
+            "block" => ld_block::power_out(self, e, pin),
+            other => Err(error(
+                origin(node),
+                &here,
+                format!("a {other} cannot bring power to an element in LD"),
+            )),
+        }
+    }
+
+    /// The coil (or an out variable fed by power) as an element.
+    pub fn coil(&self, e: ElemId) -> R<ElementKind<'static>> {
+        let node = self.g.get(e).node;
+        let here = self.at(e);
+        let var = self.variable(e)?;
+        let negated = super::xml::flag(node, "negated", &here)?;
+        let storage = node.attribute("storage").unwrap_or("none");
+        if !matches!(node.attribute("edge"), None | Some("none")) {
+            return Err(error(
+                origin(node),
+                &here,
+                "edge-qualified coils are not supported yet",
+            ));
+        }
+        match (storage, negated) {
+            ("none", _) => Ok(ElementKind::Coil { var, negated }),
+            ("set", false) => Ok(ElementKind::Set(var)),
+            ("reset", false) => Ok(ElementKind::Reset(var)),
+            ("set" | "reset", true) => Err(error(
+                origin(node),
+                &here,
+                "a set or reset coil that is also negated is not supported (Beremiz would ignore the storage)",
+            )),
+            (o, _) => Err(error(origin(node), &here, format!("unknown storage `{o}`"))),
+        }
+    }
+
+    /// The variable a contact, coil or variable element names.
+    pub fn variable(&self, e: ElemId) -> R<crate::syntax::Name<'static>> {
+        let el = self.g.get(e);
+        let text = self.expression(e)?;
+        Ok(crate::syntax::Located {
+            value: variable_ref(&text, el.node, &self.at(e))?.into(),
+            origin: origin(el.node),
+        })
+    }
+
+    /// The text of an element's `variable` (contacts, coils) or `expression` (variables).
+    pub fn expression(&self, e: ElemId) -> R<String> {
+        let el = self.g.get(e);
+        let tag = if matches!(el.tag, "contact" | "coil") {
+            "variable"
+        } else {
+            "expression"
+        };
+        el.node
+            .children()
+            .find(|c| c.is_element() && c.tag_name().name() == tag)
+            .and_then(|c| c.text())
+            .map(str::to_owned)
+            .ok_or_else(|| {
+                error(
+                    origin(el.node),
+                    &self.at(e),
+                    format!("the {} has no `{tag}`", el.tag),
+                )
+            })
+    }
+
+    /// The power into input pin `k` of `e`: the OR of its connections.
+    pub fn input(&mut self, e: ElemId, k: usize) -> R<Path> {
+        let el = self.g.get(e);
+        let sources: Vec<Source> = el
+            .inputs
+            .get(k)
+            .map(|p| p.sources.clone())
+            .unwrap_or_default();
+        match sources.len() {
+            0 => Err(error(
+                origin(el.inputs.get(k).map_or(el.node, |p| p.node)),
+                &self.at(e),
+                format!(
+                    "{} localId {} is not connected on its left (an element without power does nothing; remove it or wire it)",
+                    el.tag, el.local_id
+                ),
+            )),
+            1 => self.out(sources[0].elem, sources[0].pin),
+            _ => self.join(e, &sources),
+        }
+    }
+
+    /// Several sources into one pin: their common prefix, then an `or` of the rest.
+    fn join(&mut self, e: ElemId, sources: &[Source]) -> R<Path> {
+        let mut paths = Vec::with_capacity(sources.len());
+        for s in sources {
+            paths.push(self.out(s.elem, s.pin)?);
+        }
+        let common = (0..)
+            .take_while(|&i| {
+                paths
+                    .iter()
+                    .all(|p| p.get(i).map(|x| &x.key) == paths[0].get(i).map(|x| &x.key))
+            })
+            .count();
+        let mut branches: Vec<Series<'static>> = Vec::with_capacity(paths.len());
+        for (p, s) in paths.iter().zip(sources) {
+            let rest = &p[common..];
+            if rest.is_empty() {
+                return Err(self.not_sp(e, sources, "one of its connections is the same power as the others up to this point, so the parallel branch would be TRUE and its contacts never matter"));
+            }
+            if let Some(bad) = rest.iter().find(|x| !x.element.kind.is_condition()) {
+                let what = match &bad.key {
+                    Key::Elem(b) => format!("localId {}", self.g.get(*b).local_id),
+                    Key::Or(_) => "an element".into(),
+                };
+                let _ = s;
+                return Err(self.not_sp(e, sources, &format!("the parallel branch through {what} holds an output or a block, which a parallel (OR) branch cannot")));
+            }
+            branches.push(rest.iter().map(|x| x.element.clone()).collect());
+        }
+        let mut keys: Vec<ElemId> = sources.iter().map(|s| s.elem).collect();
+        keys.sort_unstable();
+        let mut out: Path = paths.swap_remove(0);
+        out.truncate(common);
+        out.push(Item {
+            key: Key::Or(keys),
+            element: Element {
+                origin: sources.first().map_or(Origin::NONE, |s| s.origin),
+                kind: ElementKind::Or(branches),
+            },
+        });
+        Ok(out)
+    }
+
+    fn not_sp(&self, e: ElemId, sources: &[Source], why: &str) -> crate::diag::LoadError {
+        let ids: Vec<String> = sources
+            .iter()
+            .map(|s| self.g.get(s.elem).local_id.to_string())
+            .collect();
+        error(
+            origin(self.g.get(e).node),
+            &self.at(e),
+            format!(
+                "the wiring into localId {} from localIds {} is not series-parallel: {why}",
+                self.g.get(e).local_id,
+                ids.join(", ")
+            ),
+        )
+    }
+}

@@ -1,0 +1,110 @@
+//! PLCopen TC6 XML (the exchange format of IEC 61131-3 editors: Beremiz, OpenPLC Editor,
+//! CODESYS) → the surface syntax ([`crate::syntax`]), so that resolution, checks, analysis and
+//! execution are the JSON format's.
+//!
+//! The text is parsed by `roxmltree` (no DTD, so no entity expansion; at most
+//! [`xml::MAX_XML_BYTES`]; nesting at most [`xml::MAX_DEPTH`]); the project must be in one of
+//! the namespaces tc6_0201, tc6_0200 or the pre-2.0 tc6.xsd ([`xml::NAMESPACES`]), elements
+//! are matched by local name. [`project`] reads the POUs and configurations, [`interface`] the
+//! variable lists, [`ld`] (with [`ld_power`], [`ld_block`] and the shared [`wiring`] graph) the
+//! LD bodies, [`fbd`] the FBD bodies, [`textual`] stands ST, IL and SFC bodies in by their
+//! interface. What the reader did that changes meaning or skips vendor data is a [`Note`]
+//! (a warning with its place). The mapping, the order rules and their sources:
+//! docs/plcopen.md; the research behind them: docs/design/plcopen-semantics.md.
+//!
+//! Invariants: every error is one [`LoadError`] located at the XML node it is about (line and
+//! column computed from its byte offset); a construct the reader does not handle is an error,
+//! never dropped; a program loads whole or not at all.
+
+mod fbd;
+mod interface;
+mod ld;
+mod ld_block;
+mod ld_power;
+mod project;
+mod textual;
+mod wiring;
+mod xml;
+
+pub use xml::{Note, Notes, MAX_XML_BYTES, NAMESPACES};
+
+use crate::diag::LoadError;
+use crate::fbd::Fbd;
+use crate::model::Program;
+use crate::syntax;
+
+/// True when the text is XML rather than JSON: its first non-blank character is `<`.
+pub fn looks_like_xml(text: &str) -> bool {
+    text.trim_start_matches('\u{feff}')
+        .trim_start()
+        .starts_with('<')
+}
+
+/// Reads a PLCopen project into the surface syntax, with the reader's notes (errors carry line
+/// and column).
+pub fn parse(text: &str) -> Result<(syntax::Program<'static>, Notes), LoadError> {
+    let doc = xml::parse(text)?;
+    let ns = xml::project_namespace(&doc).map_err(|e| e.locate(text))?;
+    let mut notes = Notes::default();
+    let program =
+        project::program(xml::Tc6 { ns }, &doc, &mut notes).map_err(|e| e.locate(text))?;
+    Ok((program, notes))
+}
+
+/// Reads and resolves a PLCopen project: the program, its FBD bodies, and the reader's notes
+/// (with one for each FBD body whose executionOrderIds order its blocks otherwise than plc-deps).
+pub fn load(text: &str) -> Result<(Program, Fbd, Vec<Note>), LoadError> {
+    let (syntax, mut notes) = parse(text)?;
+    let (p, f) = crate::resolve::resolve(text, &syntax)?;
+    for x in &notes.exec_orders {
+        if let Some(n) = exec_order_note(&f, x) {
+            notes.list.push(n);
+        }
+    }
+    Ok((p, f, notes.list))
+}
+
+/// Compares the order of the file's executionOrderIds with the order plc-deps runs the same
+/// blocks in (the FBD text-generation paper's sort, docs/fbd.md): a note with both if they differ.
+fn exec_order_note(f: &Fbd, x: &xml::ExecOrder) -> Option<Note> {
+    let pou = f
+        .pous
+        .iter()
+        .find(|p| p.networks.iter().any(|n| Some(&n.id) == x.networks.first()))?;
+    let wanted: std::collections::HashSet<u32> = x.ids.iter().map(|&(_, l)| l).collect();
+    let ours: Vec<u32> = pou
+        .networks
+        .iter()
+        .zip(&pou.plans)
+        .flat_map(|(n, plan)| plan.order.iter().map(move |&b| n.block(b).id))
+        .filter(|id| wanted.contains(id))
+        .collect();
+    // Only the elements that are blocks here (an out variable is part of the block feeding it).
+    let file: Vec<u32> = x
+        .ids
+        .iter()
+        .map(|&(_, l)| l)
+        .filter(|l| ours.contains(l))
+        .collect();
+    if ours == file {
+        return None;
+    }
+    let show = |v: &[u32]| v.iter().map(u32::to_string).collect::<Vec<_>>().join(", ");
+    Some(Note {
+        origin: x.origin,
+        message: format!(
+            "pou {}, FBD: the file's executionOrderIds run localIds {}; plc-deps runs them {} (data flow first, ties by localId; `plc-deps order` shows the whole order)",
+            pou.name,
+            show(&file),
+            show(&ours)
+        ),
+    })
+}
+
+/// A note as the command line prints it after `warning: ` (`FILE:LINE:COLUMN: message`).
+pub fn note_text(file: &str, text: &str, n: &Note) -> String {
+    match n.origin.line_column(text) {
+        Some((l, c)) => format!("{file}:{l}:{c}: {}", n.message),
+        None => format!("{file}: {}", n.message),
+    }
+}

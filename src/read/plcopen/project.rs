@@ -1,0 +1,370 @@
+//! The project structure (TC6 `project`: `types/pous`, `types/dataTypes`,
+//! `instances/configurations`) → one syntax [`Program`]: the program POUs, the function block
+//! types, the global variables, and the order in which the tasks run the program instances.
+//!
+//! One program POU (instantiated at most once) is the main program: its variables and the
+//! globals are the program's variables. Several program POUs become subroutines of the same
+//! name, run by a main body of call rungs `<task>.<instance>` in task order — tasks by priority
+//! (0 first, ties in file order), each task's program instances in file order, then the
+//! resource's instances without a task (IEC 61131-3 6.8.2 gives each task its own interval;
+//! plc-deps runs every instance once a scan in that order, and a note says so when there are
+//! several tasks). Function block POUs become function block types.
+//!
+//! Deliberately not here (errors naming the POU): functions, a program instantiated twice,
+//! several configurations or resources, POUs with actions or transitions outside SFC.
+
+use super::interface::{self, name, Interface, Known};
+use super::xml::{add_data_note, attr, error, identifier, origin, Note, Notes, Tc6, R};
+use super::{fbd, ld, textual};
+use crate::syntax::{Body, Element, ElementKind, FunctionBlock, Program, Rung, Subroutine, Var};
+use roxmltree::{Document, Node};
+use std::collections::HashSet;
+
+/// A program POU as read.
+struct ProgramPou {
+    name: String,
+    origin: crate::diag::Origin,
+    vars: Vec<Var<'static>>,
+    body: Body<'static>,
+}
+
+/// Reads the whole project.
+pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static>> {
+    let root = doc.root_element();
+    add_data_note(tc6, root, notes);
+    if let Some(ch) = tc6.child(root, "contentHeader") {
+        add_data_note(tc6, ch, notes);
+    }
+    let types = tc6.child(root, "types");
+    let mut known = Known {
+        data_types: HashSet::new(),
+    };
+    if let Some(dts) = types.and_then(|t| tc6.child(t, "dataTypes")) {
+        for dt in tc6.children(dts, "dataType") {
+            known
+                .data_types
+                .insert(attr(dt, "name", "types/dataTypes")?);
+        }
+    }
+    let (mut programs, mut fbs) = (Vec::new(), Vec::new());
+    let pous = types.and_then(|t| tc6.child(t, "pous"));
+    for pou in pous.into_iter().flat_map(|p| tc6.children(p, "pou")) {
+        let raw = attr(pou, "name", "types/pous")?;
+        let pname = identifier(raw, "POU", pou, "types/pous")?;
+        let place = format!("pou {pname}");
+        add_data_note(tc6, pou, notes);
+        let kind = attr(pou, "pouType", &place)?;
+        let iface = interface::interface(tc6, tc6.child(pou, "interface"), &pname, &known)?;
+        match kind {
+            "program" => {
+                let body = body(tc6, pou, &pname, &iface, notes)?;
+                let mut vars = iface.inputs;
+                vars.extend(iface.outputs);
+                vars.extend(iface.locals);
+                vars.extend(iface.globals);
+                programs.push(ProgramPou {
+                    name: pname,
+                    origin: origin(pou),
+                    vars,
+                    body,
+                });
+            }
+            "functionBlock" => {
+                if let Some(g) = iface.globals.first() {
+                    return Err(error(
+                        g.origin,
+                        &place,
+                        format!("function block `{pname}` declares global variables"),
+                    ));
+                }
+                let body = body(tc6, pou, &pname, &iface, notes)?;
+                fbs.push(FunctionBlock {
+                    origin: origin(pou),
+                    name: pname.into(),
+                    inputs: iface.inputs,
+                    outputs: iface.outputs,
+                    vars: iface.locals,
+                    body: Some(body),
+                });
+            }
+            "function" => {
+                return Err(error(
+                    origin(pou),
+                    &place,
+                    format!("POU `{pname}` is a function: functions are not supported yet"),
+                ))
+            }
+            other => {
+                return Err(error(
+                    origin(pou),
+                    &place,
+                    format!("unknown pouType `{other}` of POU `{pname}`"),
+                ))
+            }
+        }
+    }
+    let (globals, order) = instances(tc6, root, &known, notes)?;
+    assemble(root, programs, fbs, globals, order)
+}
+
+/// Puts the POUs together: one program as the main program, several as subroutines called in
+/// task order.
+fn assemble(
+    root: Node,
+    mut programs: Vec<ProgramPou>,
+    fbs: Vec<FunctionBlock<'static>>,
+    mut globals: Vec<Var<'static>>,
+    order: Vec<(String, String, Node)>,
+) -> R<Program<'static>> {
+    let mut seen = HashSet::new();
+    for (_, ty, n) in &order {
+        if !programs.iter().any(|p| &p.name == ty) {
+            return Err(error(
+                origin(*n),
+                "instances",
+                format!("program instance of `{ty}`, which is not a program POU of the project"),
+            ));
+        }
+        if !seen.insert(ty.clone()) {
+            return Err(error(
+                origin(*n),
+                "instances",
+                format!("program `{ty}` is instantiated twice: several instances of one program are not supported yet"),
+            ));
+        }
+    }
+    if programs.is_empty() {
+        return Err(error(
+            origin(root),
+            "types/pous",
+            "the project has no program POU",
+        ));
+    }
+    let mut program = Program {
+        origin: origin(root),
+        name: "project".into(),
+        function_blocks: fbs,
+        ..Program::default()
+    };
+    if programs.len() == 1 {
+        let p = programs.pop().expect("one program");
+        globals.extend(p.vars);
+        program.name = p.name.into();
+        program.vars = globals;
+        program.body = Some(p.body);
+        return Ok(program);
+    }
+    let mut calls = Vec::new();
+    for (task, ty, n) in &order {
+        let at = origin(*n);
+        calls.push(Rung {
+            origin: at,
+            id: name(format!("{task}.{ty}"), at),
+            label: None,
+            comment: None,
+            ld: vec![Element {
+                origin: at,
+                kind: ElementKind::Call(name(ty.clone(), at)),
+            }],
+            ld_origin: at,
+            problem: None,
+            problem_in_rung: false,
+        });
+    }
+    if calls.is_empty() {
+        return Err(error(
+            origin(root),
+            "instances",
+            "the project has several program POUs and no configuration that says which run: add a task with program instances",
+        ));
+    }
+    program.vars = globals;
+    program.body = Some(Body::Rungs(calls));
+    program.subroutines = programs
+        .into_iter()
+        .map(|p| Subroutine {
+            origin: p.origin,
+            name: p.name.into(),
+            vars: p.vars,
+            body: Some(p.body),
+        })
+        .collect();
+    Ok(program)
+}
+
+/// The body of POU `pou` as syntax: LD rungs, an FBD body, or a textual or SFC body through
+/// its interface.
+fn body(tc6: Tc6, pou: Node, name: &str, iface: &Interface, notes: &mut Notes) -> R<Body<'static>> {
+    let place = format!("pou {name}");
+    let Some(b) = tc6.child(pou, "body") else {
+        return Err(error(
+            origin(pou),
+            &place,
+            format!("POU `{name}` has no body"),
+        ));
+    };
+    if tc6.children(pou, "body").count() > 1 {
+        notes.push(Note {
+            origin: origin(b),
+            message: format!("{place}: only the first of its bodies is read (as Beremiz does)"),
+        });
+    }
+    add_data_note(tc6, b, notes);
+    let Some(lang) = tc6
+        .elements(b)
+        .find(|e| e.tag_name().name() != "documentation" && e.tag_name().name() != "addData")
+    else {
+        return Err(error(
+            origin(b),
+            &place,
+            format!("the body of POU `{name}` is empty"),
+        ));
+    };
+    let tag = lang.tag_name().name();
+    if tag != "SFC" {
+        for extra in ["actions", "transitions"] {
+            if let Some(a) = tc6.child(pou, extra) {
+                return Err(error(
+                    origin(a),
+                    &place,
+                    format!("POU `{name}` has {extra} but an {tag} body: actions and transitions are read only as part of SFC (not yet)"),
+                ));
+            }
+        }
+    }
+    Ok(match tag {
+        "LD" => Body::Rungs(ld::rungs(tc6, lang, name, notes)?),
+        "FBD" => Body::Fbd(fbd::body(tc6, lang, name, notes)?),
+        "ST" | "IL" | "SFC" => {
+            let reads: Vec<&Var> = iface.inputs.iter().collect();
+            let writes: Vec<&Var> = iface
+                .outputs
+                .iter()
+                .chain(&iface.locals)
+                .chain(&iface.globals)
+                .collect();
+            Body::Rungs(textual::through_interface(
+                tag,
+                lang,
+                name,
+                &reads,
+                &writes,
+                &iface.externals,
+                notes,
+            ))
+        }
+        other => {
+            return Err(error(
+                origin(lang),
+                &place,
+                format!("unknown body language `{other}` of POU `{name}`"),
+            ))
+        }
+    })
+}
+
+/// Task order of program instances, the instance's task and type, and the global variables of
+/// the configuration and its resource.
+type Order<'a, 'i> = Vec<(String, String, Node<'a, 'i>)>;
+
+fn instances<'a, 'i>(
+    tc6: Tc6,
+    root: Node<'a, 'i>,
+    known: &Known,
+    notes: &mut Notes,
+) -> R<(Vec<Var<'static>>, Order<'a, 'i>)> {
+    let mut globals = Vec::new();
+    let mut order = Vec::new();
+    let Some(confs) = tc6
+        .child(root, "instances")
+        .and_then(|i| tc6.child(i, "configurations"))
+    else {
+        return Ok((globals, order));
+    };
+    let configurations: Vec<Node> = tc6.children(confs, "configuration").collect();
+    if configurations.len() > 1 {
+        return Err(error(
+            origin(configurations[1]),
+            "instances",
+            "several configurations are not supported yet",
+        ));
+    }
+    let Some(conf) = configurations.first().copied() else {
+        return Ok((globals, order));
+    };
+    add_data_note(tc6, conf, notes);
+    let place = "instances/configuration";
+    for gv in tc6.children(conf, "globalVars") {
+        globals.extend(interface::var_list(
+            tc6,
+            gv,
+            crate::syntax::VarClass::Default,
+            place,
+            known,
+        )?);
+    }
+    let resources: Vec<Node> = tc6.children(conf, "resource").collect();
+    if resources.len() > 1 {
+        return Err(error(
+            origin(resources[1]),
+            place,
+            "several resources are not supported yet",
+        ));
+    }
+    let Some(res) = resources.first().copied() else {
+        return Ok((globals, order));
+    };
+    for gv in tc6.children(res, "globalVars") {
+        globals.extend(interface::var_list(
+            tc6,
+            gv,
+            crate::syntax::VarClass::Default,
+            place,
+            known,
+        )?);
+    }
+    let mut tasks: Vec<(u32, Node)> = Vec::new();
+    for t in tc6.children(res, "task") {
+        let pr = t.attribute("priority").unwrap_or("0").trim();
+        let pr: u32 = pr.parse().map_err(|_| {
+            error(
+                origin(t),
+                place,
+                format!("task priority `{pr}` is not a whole number"),
+            )
+        })?;
+        tasks.push((pr, t));
+    }
+    tasks.sort_by_key(|(p, _)| *p);
+    let mut described = Vec::new();
+    for (pr, t) in &tasks {
+        let tname = identifier(attr(*t, "name", place)?, "task", *t, place)?;
+        let when = t
+            .attribute("interval")
+            .or(t.attribute("single"))
+            .unwrap_or("-");
+        described.push(format!("{tname} ({when}, priority {pr})"));
+        for pi in tc6.children(*t, "pouInstance") {
+            order.push((tname.clone(), instance_type(pi, place)?, pi));
+        }
+    }
+    for pi in tc6.children(res, "pouInstance") {
+        order.push(("resource".into(), instance_type(pi, place)?, pi));
+    }
+    if tasks.len() > 1 {
+        notes.push(Note {
+            origin: origin(res),
+            message: format!("tasks {} run one after another in every scan (in priority order), not each at its own interval", described.join(", ")),
+        });
+    }
+    Ok((globals, order))
+}
+
+/// The program a `pouInstance` runs (`typeName`; `type` in the pre-2.0 namespace).
+fn instance_type(pi: Node, place: &str) -> R<String> {
+    let ty = pi
+        .attribute("typeName")
+        .or(pi.attribute("type"))
+        .ok_or_else(|| error(origin(pi), place, "pouInstance has no typeName"))?;
+    identifier(ty, "program", pi, place)
+}

@@ -1,0 +1,175 @@
+//! Hand-written PLCopen TC6 XML for tests: a project around one body, and its elements.
+#![allow(dead_code)]
+
+pub const NS: &str = "http://www.plcopen.org/xml/tc6_0201";
+
+/// A project with one program `P` (its variables: `(class, name, type)`) and an LD body.
+pub fn project(vars: &[(&str, &str, &str)], ld: &str) -> String {
+    project_in("LD", vars, ld)
+}
+
+/// [`project`] with a body in `lang` (`LD`, `FBD`).
+pub fn project_in(lang: &str, vars: &[(&str, &str, &str)], body: &str) -> String {
+    let mut lists = String::new();
+    for class in ["inputVars", "outputVars", "localVars"] {
+        let vs: Vec<String> = vars
+            .iter()
+            .filter(|v| v.0 == class)
+            .map(|(_, n, t)| {
+                let ty = if ["BOOL", "INT", "DINT", "REAL", "TIME"].contains(t) {
+                    format!("<{t}/>")
+                } else {
+                    format!("<derived name=\"{t}\"/>")
+                };
+                format!("<variable name=\"{n}\"><type>{ty}</type></variable>")
+            })
+            .collect();
+        if !vs.is_empty() {
+            lists.push_str(&format!("<{class}>{}</{class}>\n", vs.concat()));
+        }
+    }
+    format!(
+        r#"<?xml version="1.0" encoding="utf-8"?>
+<project xmlns="{NS}">
+  <fileHeader companyName="t" productName="t" productVersion="1" creationDateTime="2024-01-01T00:00:00"/>
+  <contentHeader name="t"><coordinateInfo><fbd><scaling x="1" y="1"/></fbd><ld><scaling x="1" y="1"/></ld><sfc><scaling x="1" y="1"/></sfc></coordinateInfo></contentHeader>
+  <types><dataTypes/><pous>
+    <pou name="P" pouType="program">
+      <interface>
+{lists}      </interface>
+      <body><{lang}>
+{body}
+      </{lang}></body>
+    </pou>
+  </pous></types>
+  <instances><configurations/></instances>
+</project>
+"#
+    )
+}
+
+pub fn conn(from: &[u32]) -> String {
+    let c: Vec<String> = from
+        .iter()
+        .map(|r| format!("<connection refLocalId=\"{r}\"/>"))
+        .collect();
+    format!("<connectionPointIn>{}</connectionPointIn>", c.concat())
+}
+
+pub fn rail(id: u32) -> String {
+    format!("<leftPowerRail localId=\"{id}\"><connectionPointOut formalParameter=\"\"/></leftPowerRail>")
+}
+
+pub fn contact(id: u32, var: &str, from: &[u32], attrs: &str) -> String {
+    format!(
+        "<contact localId=\"{id}\" {attrs}>{}<connectionPointOut/><variable>{var}</variable></contact>",
+        conn(from)
+    )
+}
+
+pub fn coil(id: u32, var: &str, from: &[u32], attrs: &str) -> String {
+    format!(
+        "<coil localId=\"{id}\" {attrs}>{}<connectionPointOut/><variable>{var}</variable></coil>",
+        conn(from)
+    )
+}
+
+pub fn in_var(id: u32, expr: &str) -> String {
+    format!("<inVariable localId=\"{id}\"><connectionPointOut/><expression>{expr}</expression></inVariable>")
+}
+
+/// A block's inputs: `(pin, sources)`, a source `(localId, Some(output pin))`.
+pub type Wires<'a> = &'a [(&'a str, &'a [(u32, Option<&'a str>)])];
+
+/// An FBD block: `(pin, sources)` inputs (a source `(localId, Some(pin))`), output pin names.
+pub fn block(id: u32, ty: &str, instance: Option<&str>, inputs: Wires, outputs: &[&str]) -> String {
+    let ins: Vec<String> = inputs
+        .iter()
+        .map(|(pin, from)| {
+            let c: Vec<String> = from
+                .iter()
+                .map(|(r, p)| match p {
+                    Some(p) => format!("<connection refLocalId=\"{r}\" formalParameter=\"{p}\"/>"),
+                    None => format!("<connection refLocalId=\"{r}\"/>"),
+                })
+                .collect();
+            format!(
+                "<variable formalParameter=\"{pin}\"><connectionPointIn>{}</connectionPointIn></variable>",
+                c.concat()
+            )
+        })
+        .collect();
+    let outs: Vec<String> = outputs
+        .iter()
+        .map(|p| format!("<variable formalParameter=\"{p}\"><connectionPointOut/></variable>"))
+        .collect();
+    let inst = instance.map_or(String::new(), |i| format!(" instanceName=\"{i}\""));
+    format!(
+        "<block localId=\"{id}\" typeName=\"{ty}\"{inst}><inputVariables>{}</inputVariables><inOutVariables/><outputVariables>{}</outputVariables></block>",
+        ins.concat(),
+        outs.concat()
+    )
+}
+
+/// An out variable (or, with `tag`, an in-out variable) fed by `(localId, pin)`.
+pub fn var_in(tag: &str, id: u32, expr: &str, from: (u32, Option<&str>)) -> String {
+    let c = match from.1 {
+        Some(p) => format!(
+            "<connection refLocalId=\"{}\" formalParameter=\"{p}\"/>",
+            from.0
+        ),
+        None => format!("<connection refLocalId=\"{}\"/>", from.0),
+    };
+    let out = if tag == "inOutVariable" {
+        "<connectionPointOut/>"
+    } else {
+        ""
+    };
+    format!("<{tag} localId=\"{id}\"><connectionPointIn>{c}</connectionPointIn>{out}<expression>{expr}</expression></{tag}>")
+}
+
+/// A generated LD program of about `bytes` bytes (as Beremiz writes positions and relPositions):
+/// rungs `(a OR NOT b) AND c → coil d` over 2,000 BOOL variables, a splitmix sequence picking
+/// them. Returns the text and its number of rungs.
+pub fn generated_ld(bytes: usize) -> (String, usize) {
+    let nv = 2000u64;
+    let mut state = 1u64;
+    let mut pick = || {
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        (z ^ (z >> 31)) % nv
+    };
+    let mut s = String::with_capacity(bytes + 4096);
+    s.push_str(&format!("<?xml version=\"1.0\" encoding=\"utf-8\"?>\n<project xmlns=\"{NS}\">\n<types><dataTypes/><pous><pou name=\"Big\" pouType=\"program\"><interface><localVars>\n"));
+    for i in 0..nv {
+        s.push_str(&format!(
+            "<variable name=\"v{i}\"><type><BOOL/></type></variable>\n"
+        ));
+    }
+    s.push_str("</localVars></interface><body><LD>\n<leftPowerRail localId=\"1\"><position x=\"0\" y=\"0\"/><connectionPointOut formalParameter=\"\"/></leftPowerRail>\n");
+    let contact = |s: &mut String, id: u64, var: u64, refs: &[u64], neg: bool, y: u64| {
+        let n = if neg { " negated=\"true\"" } else { "" };
+        s.push_str(&format!("<contact localId=\"{id}\"{n}><position x=\"30\" y=\"{y}\"/><connectionPointIn><relPosition x=\"0\" y=\"15\"/>"));
+        for r in refs {
+            s.push_str(&format!("<connection refLocalId=\"{r}\"><position x=\"10\" y=\"{y}\"/><position x=\"20\" y=\"{y}\"/></connection>"));
+        }
+        s.push_str(&format!("</connectionPointIn><connectionPointOut><relPosition x=\"21\" y=\"15\"/></connectionPointOut><variable>v{var}</variable></contact>\n"));
+    };
+    let (mut id, mut rungs) = (2u64, 0usize);
+    while s.len() < bytes {
+        let y = rungs as u64 * 40;
+        let (a, b, c, d) = (id, id + 1, id + 2, id + 3);
+        id += 4;
+        contact(&mut s, a, pick(), &[1], false, y);
+        contact(&mut s, b, pick(), &[1], true, y);
+        contact(&mut s, c, pick(), &[a, b], false, y);
+        s.push_str(&format!("<coil localId=\"{d}\"><position x=\"90\" y=\"{y}\"/><connectionPointIn><relPosition x=\"0\" y=\"15\"/><connection refLocalId=\"{c}\"/></connectionPointIn><connectionPointOut/><variable>v{}</variable></coil>\n", pick()));
+        rungs += 1;
+    }
+    s.push_str(
+        "</LD></body></pou></pous></types><instances><configurations/></instances></project>\n",
+    );
+    (s, rungs)
+}

@@ -1,0 +1,164 @@
+//! PLCopen TC6 XML FBD bodies, hand-written: a counter whose loop closes through an in-out
+//! variable (as every Beremiz counter example does), run and reported; a wiring cycle refused.
+
+mod common;
+#[path = "plcopen_common/mod.rs"]
+mod px;
+
+use common::cli::{error_line, run_stdin};
+use px::{block, in_var, project_in, var_in};
+use serde_json::{json, Value};
+
+/// Cnt := SEL(G := Reset, IN0 := ADD(Cnt, 1), IN1 := 0); Big := GT(Cnt, 5).
+fn counter() -> String {
+    let body = [
+        in_var(1, "Reset"),
+        in_var(2, "1"),
+        in_var(3, "0"),
+        in_var(10, "Cnt"),
+        block(
+            4,
+            "ADD",
+            None,
+            &[("IN1", &[(10, None)]), ("IN2", &[(2, None)])],
+            &["OUT"],
+        ),
+        block(
+            5,
+            "SEL",
+            None,
+            &[
+                ("G", &[(1, None)]),
+                ("IN0", &[(4, Some("OUT"))]),
+                ("IN1", &[(3, None)]),
+            ],
+            &["OUT"],
+        ),
+        var_in("inOutVariable", 6, "Cnt", (5, Some("OUT"))),
+        in_var(7, "5"),
+        block(
+            8,
+            "GT",
+            None,
+            &[("IN1", &[(6, None)]), ("IN2", &[(7, None)])],
+            &["OUT"],
+        ),
+        var_in("outVariable", 9, "Big", (8, Some("OUT"))),
+    ]
+    .concat();
+    project_in(
+        "FBD",
+        &[
+            ("inputVars", "Reset", "BOOL"),
+            ("outputVars", "Cnt", "INT"),
+            ("outputVars", "Big", "BOOL"),
+        ],
+        &body,
+    )
+}
+
+#[test]
+fn a_counter_closes_its_loop_through_the_in_out_variable() {
+    let xml = counter();
+    let out = run_stdin(
+        &["run", "-", "--scans", "7", "--format", "json"],
+        xml.as_bytes(),
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["outputs"], json!({"Cnt": 7, "Big": true}));
+    let out = run_stdin(
+        &["run", "-", "--scans", "5", "--format", "json"],
+        xml.as_bytes(),
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["outputs"], json!({"Cnt": 5, "Big": false}));
+    let out = run_stdin(&["report", "-", "--format", "json"], xml.as_bytes());
+    let r: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let ids: Vec<&str> = r["rungs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x["id"].as_str().unwrap())
+        .collect();
+    // One rung per block, in data-flow order: ADD, SEL, GT.
+    assert_eq!(ids, ["P.4", "P.5", "P.8"]);
+}
+
+#[test]
+fn a_wiring_cycle_is_one_error_naming_the_blocks() {
+    let body = [
+        in_var(1, "X"),
+        block(
+            2,
+            "ADD",
+            None,
+            &[("IN1", &[(1, None)]), ("IN2", &[(3, Some("OUT"))])],
+            &["OUT"],
+        ),
+        block(
+            3,
+            "ADD",
+            None,
+            &[("IN1", &[(1, None)]), ("IN2", &[(2, Some("OUT"))])],
+            &["OUT"],
+        ),
+        var_in("outVariable", 4, "Y", (3, Some("OUT"))),
+    ]
+    .concat();
+    let xml = project_in(
+        "FBD",
+        &[("inputVars", "X", "INT"), ("outputVars", "Y", "INT")],
+        &body,
+    );
+    let out = run_stdin(&["report", "-"], xml.as_bytes());
+    let line = error_line(&out, "cycle");
+    assert!(
+        line.contains("blocks 2 → 3 → 2 form a cycle")
+            || line.contains("blocks 3 → 2 → 3 form a cycle"),
+        "{line}"
+    );
+    assert!(line.starts_with("error: <stdin>:"), "{line}");
+}
+
+#[test]
+fn execution_order_ids_that_disagree_with_the_data_flow_get_a_warning_with_both_orders() {
+    // SEL (5) numbered before ADD (4), which feeds it.
+    let xml = counter()
+        .replace(
+            "localId=\"4\" typeName=\"ADD\"",
+            "localId=\"4\" typeName=\"ADD\" executionOrderId=\"3\"",
+        )
+        .replace(
+            "localId=\"5\" typeName=\"SEL\"",
+            "localId=\"5\" typeName=\"SEL\" executionOrderId=\"1\"",
+        )
+        .replace(
+            "localId=\"8\" typeName=\"GT\"",
+            "localId=\"8\" typeName=\"GT\" executionOrderId=\"2\"",
+        );
+    let out = run_stdin(&["report", "-", "--format", "json"], xml.as_bytes());
+    assert_eq!(out.status.code(), Some(0));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let warnings: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.starts_with("warning: "))
+        .collect();
+    assert_eq!(warnings.len(), 1, "{stderr}");
+    assert!(warnings[0].ends_with("pou P, FBD: the file's executionOrderIds run localIds 5, 8, 4; plc-deps runs them 4, 5, 8 (data flow first, ties by localId; `plc-deps order` shows the whole order)"), "{stderr}");
+    assert!(warnings[0].starts_with("warning: <stdin>:"), "{stderr}");
+}
+
+#[test]
+fn comments_become_the_network_comment() {
+    let xml =
+        std::fs::read_to_string(common::cli::root().join("tests/plcopen/comment_fbd.xml")).unwrap();
+    let (_, fbd, notes) = plc_deps::read::plcopen::load(&xml).unwrap();
+    assert!(notes.is_empty());
+    assert_eq!(fbd.pous[0].networks[0].comment.as_deref(), Some("Adds one"));
+}
