@@ -303,17 +303,28 @@ impl<'a> Builder<'a> {
         Ok(Element::Arith { op, a, b, out })
     }
 
+    /// The hidden memory of the next edge contact of the rung in scope (made now, or taken
+    /// from those made in advance for it).
     pub(super) fn edge_memory(&mut self, s: &Scope) -> VarId {
         self.edge_count += 1;
+        if let Some(next) = self.edge_reserved.as_mut() {
+            *next += 1;
+            return VarId(*next - 1);
+        }
         let id = VarId(self.vars.len() as u32);
-        self.vars.push(Var {
-            name: format!("{}:edge{}", s.rung_id, self.edge_count),
-            ty: Type::Bool,
-            class: VarClass::Memory,
-            init: Value::Bool(false),
-            scope: None,
-            hidden: true,
-        });
+        self.vars.push(edge_var(s.rung_id, self.edge_count));
         id
+    }
+}
+
+/// The hidden memory of edge contact `k` (from 1) of rung `rung_id`.
+pub(super) fn edge_var(rung_id: &str, k: u32) -> Var {
+    Var {
+        name: format!("{rung_id}:edge{k}"),
+        ty: Type::Bool,
+        class: VarClass::Memory,
+        init: Value::Bool(false),
+        scope: None,
+        hidden: true,
     }
 }

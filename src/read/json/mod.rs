@@ -28,8 +28,17 @@ use serde::de::IgnoredAny;
 
 /// Reads a program file's text into the surface syntax. Only syntax errors fail here.
 pub fn parse(text: &str) -> Result<syntax::Program<'_>, LoadError> {
+    parse_with(text, None)
+}
+
+/// [`parse`], offering the main program's rungs to `sink` (see [`syntax::RungSink`]): when it
+/// takes them, the tree's main body has none.
+pub fn parse_with<'a>(
+    text: &'a str,
+    sink: Option<&mut dyn syntax::RungSink<'a>>,
+) -> Result<syntax::Program<'a>, LoadError> {
     let start = if text.starts_with('\u{feff}') { 3 } else { 0 };
-    let mut r = Reader::new(text, start);
+    let mut r = Reader::new(text, start, sink);
     match r.document() {
         Ok(program) => Ok(program),
         Err(Fail) => Err(syntax_error(text, start, r.c.offset())),
@@ -145,22 +154,44 @@ const SUBROUTINE_KEYS: &[&str] = &["vars", "rungs", "fbd", "comment"];
 const FB_KEYS: &[&str] = &["vars", "inputs", "outputs", "fbd", "rungs", "comment"];
 const VAR_KEYS: &[&str] = &["name", "type", "class", "init", "comment"];
 
-/// The reader: the cursor, the problems of the part being read, and the scratch stacks of
-/// elements and element keys (nested series and elements sit above their parents' entries).
-pub(super) struct Reader<'a> {
+/// The reader: the cursor, the problems of the part being read, the scratch stacks of
+/// elements and element keys (nested series and elements sit above their parents' entries), and
+/// what the main program's rungs may be handed to.
+pub(super) struct Reader<'a, 'r> {
     c: Cursor<'a>,
     problems: Vec<Problem>,
     elements: Vec<syntax::Element<'a>>,
     slots: Vec<element::SlotEntry<'a>>,
+    sink: Option<&'r mut dyn syntax::RungSink<'a>>,
 }
 
-impl<'a> Reader<'a> {
-    fn new(text: &'a str, start: usize) -> Reader<'a> {
+impl<'a, 'r> Reader<'a, 'r> {
+    fn new(
+        text: &'a str,
+        start: usize,
+        sink: Option<&'r mut dyn syntax::RungSink<'a>>,
+    ) -> Reader<'a, 'r> {
         Reader {
             c: Cursor::new(text, start),
             problems: Vec::new(),
             elements: Vec::with_capacity(64),
             slots: Vec::with_capacity(16),
+            sink,
+        }
+    }
+
+    /// At the main program's rung array: whether its rungs go to the sink (which takes them only
+    /// when nothing read so far is malformed or needs more than the variables to resolve).
+    fn offer(&mut self, parts: &Parts<'a>) -> bool {
+        let clean = self.problems.is_empty()
+            && parts.unknown.is_none()
+            && parts.fbd.is_none()
+            && parts.function_blocks.is_none()
+            && parts.vars.as_ref().is_none_or(|v| v.problems.is_empty());
+        let vars = parts.vars.as_ref().map_or(&[][..], |v| &v.value[..]);
+        match self.sink.as_deref_mut() {
+            Some(sink) if clean => sink.start(vars),
+            _ => false,
         }
     }
 
@@ -220,7 +251,10 @@ impl<'a> Reader<'a> {
                 "vars" => parts.vars = Some(self.part(|r| r.vars(&at()))?),
                 "inputs" => parts.inputs = Some(self.part(|r| r.vars(&at()))?),
                 "outputs" => parts.outputs = Some(self.part(|r| r.vars(&at()))?),
-                "rungs" => parts.rungs = Some(self.part(|r| r.rungs(&at()))?),
+                "rungs" => {
+                    let streamed = path.is_empty() && self.offer(&parts);
+                    parts.rungs = Some(self.part(|r| r.rungs(&at(), streamed))?)
+                }
                 "subroutines" => parts.subroutines = Some(self.part(|r| r.subroutines())?),
                 "function_blocks" => {
                     parts.function_blocks = Some(self.part(|r| r.function_blocks())?)
