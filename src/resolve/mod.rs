@@ -481,12 +481,15 @@ impl<'a> Builder<'a> {
             .pous
             .iter()
             .map(|p| p.rungs.len() + p.lowered.as_ref().map_or(0, Vec::len));
-        let mut ids: FastMap<Cow<'a, str>, (usize, Option<usize>)> = self
-            .streamed
-            .as_mut()
-            .map(|s| std::mem::take(&mut s.ids))
-            .unwrap_or_default();
+        let mut ids: FastMap<Cow<'a, str>, (usize, Option<usize>)> = FastMap::default();
         ids.reserve(total.sum());
+        // The main program's ids when it was streamed.
+        let streamed = self.streamed.as_ref();
+        let main_id = |key: &str| {
+            let s = streamed?;
+            let i = s.ids.get(key, |i| s.rungs[i as usize].id.as_str())?;
+            Some((0, Some(i as usize)))
+        };
         let first_path = |pous: &[PouDraft], (pou, i): (usize, Option<usize>)| match i {
             Some(i) => rung_path(&pous[pou].path, i),
             None => String::new(),
@@ -496,14 +499,15 @@ impl<'a> Builder<'a> {
         let mut errors = Vec::new();
         for (pi, pou) in self.pous.iter().enumerate() {
             let mut labels = FastMap::default();
-            if let (0, Some(s)) = (pi, self.streamed.as_mut()) {
-                labels = std::mem::take(&mut s.labels);
+            if let (0, Some(s)) = (pi, streamed) {
+                labels = s.labels.clone();
                 next_id += s.rungs.len() as u32;
             }
             let mut pou_heads = Vec::with_capacity(pou.rungs.len());
             if let Some(lowered) = &pou.lowered {
                 for r in lowered {
-                    if let Some(&first) = ids.get(r.id.as_str()) {
+                    if let Some(first) = ids.get(r.id.as_str()).copied().or_else(|| main_id(&r.id))
+                    {
                         let first = match first {
                             (p, None) => self.pous[p]
                                 .lowered
@@ -545,7 +549,7 @@ impl<'a> Builder<'a> {
                     errors.push(e.at(p.origin).at(r.origin));
                     continue;
                 }
-                if let Some(&first) = ids.get(key.as_ref()) {
+                if let Some(first) = ids.get(key.as_ref()).copied().or_else(|| main_id(&key)) {
                     let first = match first {
                         (p, None) => self.pous[p]
                             .lowered

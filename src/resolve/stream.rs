@@ -16,12 +16,12 @@
 //! here.
 
 use super::elements::edge_var;
+use super::table::IndexSet;
 use super::util::{check_name, FastMap};
 use super::Builder;
 use crate::fbd::Fbd;
 use crate::model::*;
 use crate::syntax;
-use std::borrow::Cow;
 
 /// The main program's rungs resolved while they were read.
 #[derive(Default)]
@@ -29,8 +29,8 @@ pub(super) struct Streamed<'a> {
     /// In file order; a held rung's series is empty until [`Builder::settle`].
     pub(super) rungs: Vec<Rung>,
     pub(super) held: Vec<Held<'a>>,
-    /// Rung ids → (POU, rung index), as pass 1 of the resolver keeps them.
-    pub(super) ids: FastMap<Cow<'a, str>, (usize, Option<usize>)>,
+    /// The rung ids, by their index in `rungs`.
+    pub(super) ids: IndexSet,
     /// Labels of the main program.
     pub(super) labels: FastMap<String, RungId>,
     /// The main program's declared variables (edge memories follow them while reading).
@@ -62,8 +62,6 @@ enum State {
 pub struct Stream<'t> {
     b: Builder<'t>,
     state: State,
-    /// Where the variables declared at the start are (so that a later `vars` is noticed).
-    vars: (usize, usize),
 }
 
 impl Default for Stream<'_> {
@@ -71,13 +69,12 @@ impl Default for Stream<'_> {
         Stream {
             b: Builder::default(),
             state: State::Idle,
-            vars: (0, 0),
         }
     }
 }
 
 impl<'t> syntax::RungSink<'t> for Stream<'t> {
-    fn start(&mut self, vars: &[syntax::Var<'t>]) -> bool {
+    fn start(&mut self, vars: &[syntax::Var<'t>], rungs: usize) -> bool {
         if self.state != State::Idle {
             // A second rung array: the last one counts, so the first must not have been taken.
             if self.state == State::Streaming {
@@ -92,11 +89,18 @@ impl<'t> syntax::RungSink<'t> for Stream<'t> {
         }
         self.b.streamed = Some(Streamed {
             declared: self.b.vars.len(),
+            // Sized up front: a million rungs would otherwise be moved twenty times.
+            rungs: Vec::with_capacity(rungs),
             ..Streamed::default()
         });
-        self.vars = (vars.as_ptr() as usize, vars.len());
         self.state = State::Streaming;
         true
+    }
+
+    fn retract(&mut self) {
+        if self.state == State::Streaming {
+            self.state = State::GaveUp;
+        }
     }
 
     fn rung(&mut self, rung: syntax::Rung<'t>) {
@@ -116,10 +120,9 @@ impl<'t> Stream<'t> {
     /// the same text); `None` when the stream gave up, or anything in the file is not right:
     /// then only resolving the whole tree (read again) gives the program or its errors.
     pub fn finish<'s>(self, syn: &'s syntax::Program<'t>) -> Option<(Program, Fbd)> {
-        let same_vars = self.vars == (syn.vars.as_ptr() as usize, syn.vars.len());
         let empty_body = matches!(&syn.body, Some(syntax::Body::Rungs(r)) if r.is_empty());
         if self.state != State::Streaming
-            || !same_vars
+            || !syn.vars.is_empty()
             || !empty_body
             || !syn.problems.is_empty()
             || !syn.function_blocks.is_empty()
@@ -141,11 +144,11 @@ impl<'a> Builder<'a> {
     /// anything that is not right (the whole-tree resolver will say what).
     fn stream_rung(&mut self, r: syntax::Rung<'a>) -> Option<()> {
         let s = self.streamed.as_mut()?;
-        if r.problem.is_some() || s.ids.contains_key(r.id.as_str()) {
+        let index = s.rungs.len();
+        let text = |i: u32| s.rungs[i as usize].id.as_str();
+        if r.problem.is_some() || !s.ids.insert(r.id.as_str(), index as u32, text) {
             return None;
         }
-        let index = s.rungs.len();
-        s.ids.insert(r.id.value.clone(), (0, Some(index)));
         let id = r.id.value.to_string();
         if let Some(l) = &r.label {
             check_name(l.as_str(), String::new, None).ok()?;

@@ -163,6 +163,8 @@ pub(super) struct Reader<'a, 'r> {
     elements: Vec<syntax::Element<'a>>,
     slots: Vec<element::SlotEntry<'a>>,
     sink: Option<&'r mut dyn syntax::RungSink<'a>>,
+    /// The sink took the program's variables and rungs.
+    streamed: bool,
 }
 
 impl<'a, 'r> Reader<'a, 'r> {
@@ -177,21 +179,39 @@ impl<'a, 'r> Reader<'a, 'r> {
             elements: Vec::with_capacity(64),
             slots: Vec::with_capacity(16),
             sink,
+            streamed: false,
         }
     }
 
-    /// At the main program's rung array: whether its rungs go to the sink (which takes them only
-    /// when nothing read so far is malformed or needs more than the variables to resolve).
-    fn offer(&mut self, parts: &Parts<'a>) -> bool {
+    /// At the main program's rung array: whether its variables and rungs go to the sink (which
+    /// takes them only when nothing read so far is malformed or needs more than the variables
+    /// to resolve); they then leave the tree.
+    fn offer(&mut self, parts: &mut Parts<'a>) -> bool {
+        if std::mem::take(&mut self.streamed) {
+            self.retract();
+            return false;
+        }
         let clean = self.problems.is_empty()
             && parts.unknown.is_none()
             && parts.fbd.is_none()
             && parts.function_blocks.is_none()
             && parts.vars.as_ref().is_none_or(|v| v.problems.is_empty());
         let vars = parts.vars.as_ref().map_or(&[][..], |v| &v.value[..]);
-        match self.sink.as_deref_mut() {
-            Some(sink) if clean => sink.start(vars),
+        let rungs = self.c.remaining() / 128;
+        self.streamed = match self.sink.as_deref_mut() {
+            Some(sink) if clean => sink.start(vars, rungs),
             _ => false,
+        };
+        if self.streamed {
+            parts.vars = None;
+        }
+        self.streamed
+    }
+
+    /// A part the sink took is read again: it must not be used.
+    fn retract(&mut self) {
+        if let Some(sink) = self.sink.as_deref_mut() {
+            sink.retract();
         }
     }
 
@@ -248,11 +268,15 @@ impl<'a, 'r> Reader<'a, 'r> {
             match key.as_ref() {
                 "program" => parts.name = Some((self.c.scalar()?, origin)),
                 "comment" => parts.comment = Some(self.c.scalar()?),
+                "vars" if path.is_empty() && self.streamed => {
+                    self.retract();
+                    parts.vars = Some(self.part(|r| r.vars(&at()))?)
+                }
                 "vars" => parts.vars = Some(self.part(|r| r.vars(&at()))?),
                 "inputs" => parts.inputs = Some(self.part(|r| r.vars(&at()))?),
                 "outputs" => parts.outputs = Some(self.part(|r| r.vars(&at()))?),
                 "rungs" => {
-                    let streamed = path.is_empty() && self.offer(&parts);
+                    let streamed = path.is_empty() && self.offer(&mut parts);
                     parts.rungs = Some(self.part(|r| r.rungs(&at(), streamed))?)
                 }
                 "subroutines" => parts.subroutines = Some(self.part(|r| r.subroutines())?),
