@@ -384,10 +384,16 @@ impl<'a> Builder<'a> {
         let (heads, next_id) = self.rung_heads();
         self.phase_end()?;
         // Pass 2: elements (the main program's are resolved already when it was streamed).
+        let mut loops = structure::Loops::default();
         let mut rungs = match self.streamed.take() {
-            Some(s) => self.settle(s)?,
+            Some(s) => self.settle(s, &mut loops)?,
             None => Vec::new(),
         };
+        for pou_heads in &heads {
+            loops.pair_pou(pou_heads.iter().filter_map(|(rid, syn, _)| {
+                Some((*rid, structure::loop_end(&syn.ld)?, syn.ld.len()))
+            }));
+        }
         rungs.reserve(next_id as usize - rungs.len());
         // The syntax of each ladder rung and where it is (none for rungs lowered from FBD or
         // streamed), for the paths and places of structural errors.
@@ -421,7 +427,9 @@ impl<'a> Builder<'a> {
             }
             for (rid, syn, id) in pou_heads {
                 let index = (rid.0 - pous[pi].rungs.start) as usize;
-                let series = match self.ladder_series(pou, &pou_paths[pi], index, syn, &id) {
+                let partner = loops.partner(rid);
+                let at = (pou_paths[pi].as_str(), index);
+                let series = match self.ladder_series(pou, at, syn, &id, partner) {
                     Ok(s) => s,
                     Err(e) => {
                         self.report(e.at(syn.origin));
@@ -445,28 +453,32 @@ impl<'a> Builder<'a> {
             }
         }
         self.phase_end()?;
-        let mut program = Program {
+        let program = Program {
             name,
             vars: self.vars,
             pous,
             rungs,
         };
-        structure::check(&mut program, &places)?;
+        structure::check(&program, &places, loops)?;
         Ok(program)
     }
 
     /// The elements of ladder rung `index` of POU `pou` (whose rung array is at `pou_path`),
-    /// whose id is `id`.
+    /// whose id is `id`; `partner`: its FOR's NEXT or its NEXT's FOR.
     fn ladder_series(
         &mut self,
         pou: PouId,
-        pou_path: &str,
-        index: usize,
+        (pou_path, index): (&str, usize),
         syn: &syntax::Rung,
         id: &str,
+        partner: Option<RungId>,
     ) -> Result<Series> {
         self.edge_count = 0;
-        let scope = Scope { pou, rung_id: id };
+        let scope = Scope {
+            pou,
+            rung_id: id,
+            partner,
+        };
         let base = At::rung(pou_path, index);
         let ld = base.key("ld");
         self.series(&syn.ld, &ld, Place::Top, &scope)

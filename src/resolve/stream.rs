@@ -6,7 +6,8 @@
 //! offers them (the program's variables read, nothing malformed before the rung array, no
 //! function block types); it declares the variables then, and resolves each rung with the same
 //! functions as the whole-tree resolver. Anything it cannot do in file order it does at the
-//! end: a rung with a jump or a call (whose label or subroutine may come later) is *held* — its
+//! end: a rung with a jump or a call (whose label or subroutine may come later), a FOR or a
+//! NEXT (made with its partner's id, which needs them all) is *held* — its
 //! syntax kept, its edge-contact memories made in advance so that variables keep their order —
 //! and resolved once the whole file is read. The edge memories of the streamed rungs are moved
 //! after the variables declared later (subroutine locals, instances), as the whole-tree
@@ -16,6 +17,7 @@
 //! here.
 
 use super::elements::edge_var;
+use super::structure::{loop_end, Loops};
 use super::table::IndexSet;
 use super::util::{check_name, FastMap};
 use super::Builder;
@@ -168,7 +170,7 @@ impl<'a> Builder<'a> {
             block_path: None,
             network: None,
         };
-        if refers_ahead(&r.ld) {
+        if refers_ahead(&r.ld) || loop_end(&r.ld).is_some() {
             let edges = self.vars.len() as u32;
             for k in 1..=edge_contacts(&r.ld) {
                 self.vars.push(edge_var(&rung.id, k));
@@ -182,14 +184,22 @@ impl<'a> Builder<'a> {
             });
             return Some(());
         }
-        rung.series = self.ladder_series(PouId(0), "", index, &r, &rung.id).ok()?;
+        rung.series = (self.ladder_series(PouId(0), ("", index), &r, &rung.id, None)).ok()?;
         self.streamed.as_mut()?.rungs.push(rung);
         Some(())
     }
 
     /// The streamed rungs, completed now that every declaration is made: their edge memories
     /// after all other variables, the held rungs resolved.
-    pub(super) fn settle(&mut self, s: Streamed<'a>) -> super::Result<Vec<Rung>> {
+    pub(super) fn settle(
+        &mut self,
+        s: Streamed<'a>,
+        loops: &mut Loops,
+    ) -> super::Result<Vec<Rung>> {
+        loops.pair_pou(s.held.iter().filter_map(|h| {
+            let end = loop_end(&h.rung.ld)?;
+            Some((RungId(h.index as u32), end, h.rung.ld.len()))
+        }));
         let offset = (self.vars.len() - s.declared) as u32;
         self.vars.extend(s.edges);
         let mut rungs = s.rungs;
@@ -201,7 +211,8 @@ impl<'a> Builder<'a> {
         for h in s.held {
             self.edge_reserved = Some(h.edges + offset);
             let id = std::mem::take(&mut rungs[h.index].id);
-            let series = self.ladder_series(PouId(0), "", h.index, &h.rung, &id);
+            let partner = loops.partner(RungId(h.index as u32));
+            let series = self.ladder_series(PouId(0), ("", h.index), &h.rung, &id, partner);
             self.edge_reserved = None;
             rungs[h.index].id = id;
             rungs[h.index].series = series?;
