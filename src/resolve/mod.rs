@@ -19,6 +19,11 @@
 //! when the resolution fails ([`LoadError::locate`]). Names are looked up in [`table`]s that
 //! cost one cache miss a lookup. Nothing is half-built: a program either resolves whole or not
 //! at all.
+//!
+//! The main program's rungs are usually resolved as the reader reads them ([`Stream`], a
+//! [`syntax::RungSink`]): a million rungs are then never held as syntax. That path gives the
+//! same model or gives up, and the whole tree is resolved instead (which reports the errors):
+//! errors always come from the phases above.
 
 mod elements;
 pub(crate) mod fbd_read;

@@ -12,6 +12,9 @@
 //! last value). A syntax error stops the reading; its message and place are `serde_json`'s, asked
 //! only then, so they read the same as they always have. A UTF-8 byte-order mark at the start of
 //! the text is skipped (offsets still count it: they are offsets into the text as given).
+//! Given a [`syntax::RungSink`] ([`parse_with`]), the reader offers it the program's variables
+//! and main rungs at the start of the rung array, and hands over each rung as it is read
+//! instead of keeping it.
 //!
 //! Deliberately not here: names, types, ids, labels and every other rule that needs more than
 //! one node (`crate::resolve`). FBD bodies are read by [`fbd`].
