@@ -3,8 +3,9 @@
 //!
 //! Target: at least 100 MB/s of program JSON, parse and resolve together. `cargo bench --bench
 //! load`; the `load` group loads as the command line does (the main rungs resolved as they are
-//! read), the `parse` group times the reader alone, into the whole syntax tree. The programs are generated in-process
-//! (`plc_deps::synth`) with every knob on, so the timers, loops, jumps and calls are read too.
+//! read), the `parse` group times the reader alone, into the whole syntax tree. The programs
+//! are generated in-process (`plc_deps::synth`) with every knob on, so the timers, loops, jumps
+//! and calls are read too.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use plc_deps::synth::{generate_string, GenConfig};
