@@ -2,8 +2,10 @@
 //! model) on generated programs of 100k and 1M rungs, with throughput in bytes of program text.
 //!
 //! Target: at least 100 MB/s of program JSON, parse and resolve together. `cargo bench --bench
-//! load`; the `parse` group times the reader alone. The programs are generated in-process
-//! (`plc_deps::synth`) with every knob on, so the timers, loops, jumps and calls are read too.
+//! load`; the `load` group loads as the command line does (the main rungs resolved as they are
+//! read), the `parse` group times the reader alone, into the whole syntax tree. The programs
+//! are generated in-process (`plc_deps::synth`) with every knob on, so the timers, loops, jumps
+//! and calls are read too.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use plc_deps::synth::{generate_string, GenConfig};

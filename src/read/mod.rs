@@ -25,7 +25,20 @@ pub fn program_from_json(text: &str) -> Result<Program, LoadError> {
 
 /// Parses and checks a program given as JSON text, and returns with it the FBD bodies it was
 /// written in (before lowering: their networks, execution orders and fragment trees).
+///
+/// The main program's rungs are resolved as they are read ([`crate::resolve::Stream`]), so that
+/// the whole syntax tree is never held; should that not resolve, the text is read again into
+/// the whole tree, whose resolution gives the program or every error, as it always would.
 pub fn program_and_fbd_from_json(text: &str) -> Result<(Program, Fbd), LoadError> {
+    let mut stream = crate::resolve::Stream::default();
+    let syntax = json::parse_with(text, Some(&mut stream))?;
+    if !stream.took_rungs() {
+        return crate::resolve::resolve(text, &syntax);
+    }
+    if let Some(done) = stream.finish(&syntax) {
+        return Ok(done);
+    }
+    drop(syntax);
     let syntax = json::parse(text)?;
     crate::resolve::resolve(text, &syntax)
         .map_err(|e| e.refine(text, |t, p| json::path_offset(t, p).map(|(start, _)| start)))

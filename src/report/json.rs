@@ -10,16 +10,80 @@
 //! lists of plain values on one line (`"unreachable": ["R2", "R7"]`). That is about a third of the
 //! bytes of fully pretty-printed JSON for the same document (a million-rung report is written in
 //! seconds), one entry per line for `grep` and diffs; any JSON parser reads both alike.
+//!
+//! The top-level object is written here key by key, in the order of [`Report`]'s fields; the
+//! entries of the three longest lists (rungs, dependences, CFG edges: millions of lines for a
+//! million rungs) are written straight into the writer ([`entries`]), everything else through
+//! `serde_json` with [`ReportFormatter`]. The bytes are those of serialising the whole
+//! [`Report`] with `serde_json` and the formatter, which the tests check.
+
+mod entries;
 
 use super::document::Report;
+use serde::Serialize;
 use serde_json::ser::Formatter;
 use std::io::{self, Write};
 
 /// Writes the report as JSON with a trailing newline.
 pub fn render_json(report: &Report, out: &mut impl Write) -> io::Result<()> {
-    let mut ser = serde_json::Serializer::with_formatter(&mut *out, ReportFormatter::default());
-    serde::Serialize::serialize(report, &mut ser).map_err(io::Error::other)?;
-    out.write_all(b"\n")
+    let mut first = true;
+    let mut key = |out: &mut dyn Write, k: &str| -> io::Result<()> {
+        out.write_all(if std::mem::take(&mut first) {
+            b"\n  \""
+        } else {
+            b",\n  \""
+        })?;
+        out.write_all(k.as_bytes())?;
+        out.write_all(b"\": ")
+    };
+    out.write_all(b"{")?;
+    key(out, "program")?;
+    value(out, &report.program)?;
+    key(out, "rungs")?;
+    entries::list(out, 1, report.rungs.iter(), entries::rung)?;
+    key(out, "dependences")?;
+    entries::list(out, 1, report.dependences.iter(), entries::dependence)?;
+    key(out, "dependences_listed")?;
+    value(out, &report.dependences_listed)?;
+    key(out, "dependence_counts")?;
+    value(out, &report.dependence_counts)?;
+    key(out, "self_control")?;
+    value(out, &report.self_control)?;
+    key(out, "cfg")?;
+    out.write_all(b"{\n    \"edges\": ")?;
+    entries::list(out, 2, report.cfg.edges.iter(), entries::cfg_edge)?;
+    out.write_all(b"\n  }")?;
+    key(out, "ipdom")?;
+    value(out, &report.ipdom)?;
+    key(out, "levels")?;
+    value(out, &report.levels)?;
+    key(out, "cycles")?;
+    value(out, &report.cycles)?;
+    key(out, "cost")?;
+    value(out, &report.cost)?;
+    key(out, "schedule")?;
+    value(out, &report.schedule)?;
+    key(out, "loops")?;
+    value(out, &report.loops)?;
+    key(out, "differences")?;
+    value(out, &report.differences)?;
+    key(out, "warnings")?;
+    value(out, &report.warnings)?;
+    if !report.networks.is_empty() {
+        key(out, "networks")?;
+        value(out, &report.networks)?;
+    }
+    if let Some(fbd) = &report.fbd {
+        key(out, "fbd")?;
+        value(out, fbd)?;
+    }
+    out.write_all(b"\n}\n")
+}
+
+/// Writes `v` as the value of a key of the top-level object.
+fn value<W: Write + ?Sized, T: Serialize + ?Sized>(out: &mut W, v: &T) -> io::Result<()> {
+    let mut ser = serde_json::Serializer::with_formatter(out, ReportFormatter::in_object(1));
+    v.serialize(&mut ser).map_err(io::Error::other)
 }
 
 /// One open array or object.
@@ -41,7 +105,7 @@ pub struct ReportFormatter {
 
 const SPACES: &[u8; 128] = &[b' '; 128];
 
-fn indent<W: ?Sized + Write>(w: &mut W, depth: usize) -> io::Result<()> {
+pub(super) fn indent<W: ?Sized + Write>(w: &mut W, depth: usize) -> io::Result<()> {
     let mut n = 2 * depth;
     while n > 0 {
         let k = n.min(SPACES.len());
@@ -52,6 +116,19 @@ fn indent<W: ?Sized + Write>(w: &mut W, depth: usize) -> io::Result<()> {
 }
 
 impl ReportFormatter {
+    /// The formatter for a value inside `depth` objects written one key per line.
+    fn in_object(depth: usize) -> ReportFormatter {
+        let frame = || Frame {
+            is_array: false,
+            inline: false,
+            multiline: true,
+            pending: None,
+        };
+        ReportFormatter {
+            stack: (0..depth).map(|_| frame()).collect(),
+        }
+    }
+
     /// A container opened now is written on one line: it is a list's element, or inside one.
     fn nested_inline(&self) -> bool {
         self.stack.last().is_some_and(|f| f.inline || f.is_array)
@@ -172,5 +249,51 @@ impl Formatter for ReportFormatter {
             indent(w, self.stack.len())?;
         }
         w.write_all(b"}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The report as `serde_json` serialises the whole document with the formatter.
+    fn reference(report: &Report) -> String {
+        let mut out = Vec::new();
+        let mut ser = serde_json::Serializer::with_formatter(&mut out, ReportFormatter::default());
+        report.serialize(&mut ser).expect("serialises");
+        out.push(b'\n');
+        String::from_utf8(out).expect("UTF-8")
+    }
+
+    fn check(text: &str) {
+        let (p, fbd) = crate::read::program_and_fbd_from_json(text).expect("loads");
+        let a = crate::analysis::analyse(&p);
+        let parts = crate::report::fbd_parts(&p, &fbd);
+        let doc = crate::report::document_with(&p, &a, parts.as_ref());
+        let mut out = Vec::new();
+        render_json(&doc, &mut out).expect("writes");
+        let written = String::from_utf8(out).expect("UTF-8");
+        assert_eq!(written, reference(&doc));
+    }
+
+    #[test]
+    fn the_written_report_is_the_serialised_document_byte_for_byte() {
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/analyses");
+        let mut checked = 0;
+        for entry in std::fs::read_dir(dir).expect("analyses/") {
+            let path = entry.expect("entry").path().join("program.json");
+            if let Ok(text) = std::fs::read_to_string(&path) {
+                check(&text);
+                checked += 1;
+            }
+        }
+        assert!(checked >= 10, "{checked} examples");
+        // Strings that need escaping, a label, control dependences with edges.
+        check(
+            r#"{"program": "P\"\u0001\\", "vars": [{"name": "A", "type": "BOOL"}],
+                "rungs": [{"id": "R\\1", "ld": [{"contact": "A"}, {"jmp": "L"}]},
+                          {"id": "R2é", "ld": [{"coil": "A"}]},
+                          {"id": "R3", "label": "L", "ld": [{"contact": "A"}, {"coil": "A"}]}]}"#,
+        );
     }
 }

@@ -23,6 +23,9 @@ pub(super) enum Place {
 pub(super) struct Scope<'s> {
     pub(super) pou: PouId,
     pub(super) rung_id: &'s str,
+    /// The rung's FOR's NEXT, or its NEXT's FOR (none: not a loop end, or unpaired, which the
+    /// structural checks report).
+    pub(super) partner: Option<RungId>,
 }
 
 impl<'a> Builder<'a> {
@@ -46,16 +49,15 @@ impl<'a> Builder<'a> {
             };
             // Placement first only where the old element had no errors of its own to report.
             let e = self.element(item, &p, s)?;
-            match (&e, place) {
-                (Element::For { .. }, Place::Top) if i + 1 == items.len() => {}
-                (Element::For { .. }, _) => {
+            use syntax::ElementKind as S;
+            match (&item.kind, place) {
+                (S::For(_), Place::Top) if i + 1 == items.len() => {}
+                (S::For(_), _) => {
                     return misplaced("`for`", "except as the last element of a rung")
                 }
-                (Element::Next { .. }, Place::Top) if items.len() == 1 => {}
-                (Element::Next { .. }, _) => {
-                    return misplaced("`next`", "except alone in its rung")
-                }
-                (Element::Contact { .. } | Element::Compare { .. } | Element::Or(_), _) => {}
+                (S::Next, Place::Top) if items.len() == 1 => {}
+                (S::Next, _) => return misplaced("`next`", "except alone in its rung"),
+                (k, _) if k.is_condition() => {}
                 (_, Place::Or) => {
                     return misplaced(
                         "this element",
@@ -64,7 +66,7 @@ impl<'a> Builder<'a> {
                 }
                 _ => {}
             }
-            out.push(e);
+            out.extend(e);
         }
         Ok(out)
     }
@@ -83,14 +85,21 @@ impl<'a> Builder<'a> {
         Ok(out)
     }
 
-    pub(super) fn element(&mut self, e: &syntax::Element, at: &At, s: &Scope) -> Result<Element> {
+    /// The element `e` resolved; `None` only for a FOR or NEXT without a partner (the rung is
+    /// refused by the structural checks, which say why).
+    pub(super) fn element(
+        &mut self,
+        e: &syntax::Element,
+        at: &At,
+        s: &Scope,
+    ) -> Result<Option<Element>> {
         use syntax::ElementKind as S;
         let rid = Some(s.rung_id);
         let err = |k: &str, origin: Origin, kind: Invalid| {
             LoadError::invalid(rid, &at.with(&format!(".{k}")), kind).at(origin)
         };
         let key = |k: &'static str| at.key(k);
-        Ok(match &e.kind {
+        Ok(Some(match &e.kind {
             S::Invalid(p) => {
                 let err = LoadError::invalid(rid, &at.with(&p.at), p.kind.clone());
                 return Err(err.at(p.origin).at(e.origin));
@@ -211,8 +220,10 @@ impl<'a> Builder<'a> {
                 }
                 Element::End
             }
-            // Paired with its FOR by the structural checks.
-            S::Next => Element::Next { head: RungId(0) },
+            S::Next => match s.partner {
+                Some(head) => Element::Next { head },
+                None => return Ok(None),
+            },
             S::Call(name) => {
                 let pou = self
                     .pous
@@ -253,15 +264,17 @@ impl<'a> Builder<'a> {
                 }
                 let from = self.operand_of(from, &fp.key("from"), s, ty, "a FOR bound")?;
                 let to = self.operand_of(to, &fp.key("to"), s, ty, "a FOR bound")?;
-                // The NEXT is found by the structural checks.
+                let Some(next) = s.partner else {
+                    return Ok(None);
+                };
                 Element::For {
                     var,
                     from,
                     to,
-                    next: RungId(0),
+                    next,
                 }
             }
-        })
+        }))
     }
 
     fn arith(
@@ -303,17 +316,28 @@ impl<'a> Builder<'a> {
         Ok(Element::Arith { op, a, b, out })
     }
 
+    /// The hidden memory of the next edge contact of the rung in scope (made now, or taken
+    /// from those made in advance for it).
     pub(super) fn edge_memory(&mut self, s: &Scope) -> VarId {
         self.edge_count += 1;
+        if let Some(next) = self.edge_reserved.as_mut() {
+            *next += 1;
+            return VarId(*next - 1);
+        }
         let id = VarId(self.vars.len() as u32);
-        self.vars.push(Var {
-            name: format!("{}:edge{}", s.rung_id, self.edge_count),
-            ty: Type::Bool,
-            class: VarClass::Memory,
-            init: Value::Bool(false),
-            scope: None,
-            hidden: true,
-        });
+        self.vars.push(edge_var(s.rung_id, self.edge_count));
         id
+    }
+}
+
+/// The hidden memory of edge contact `k` (from 1) of rung `rung_id`.
+pub(super) fn edge_var(rung_id: &str, k: u32) -> Var {
+    Var {
+        name: format!("{rung_id}:edge{k}"),
+        ty: Type::Bool,
+        class: VarClass::Memory,
+        init: Value::Bool(false),
+        scope: None,
+        hidden: true,
     }
 }

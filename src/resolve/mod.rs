@@ -19,6 +19,11 @@
 //! when the resolution fails ([`LoadError::locate`]). Names are looked up in [`table`]s that
 //! cost one cache miss a lookup. Nothing is half-built: a program either resolves whole or not
 //! at all.
+//!
+//! The main program's rungs are usually resolved as the reader reads them ([`Stream`], a
+//! [`syntax::RungSink`]): a million rungs are then never held as syntax. That path gives the
+//! same model or gives up, and the whole tree is resolved instead (which reports the errors):
+//! errors always come from the phases above.
 
 mod elements;
 pub(crate) mod fbd_read;
@@ -28,12 +33,14 @@ mod lowering;
 mod names;
 pub(crate) mod operand;
 mod path;
+mod stream;
 mod structure;
 mod table;
 pub(crate) mod util;
 mod vars;
 
 pub use lower::ACCUMULATE_PT_MS;
+pub use stream::Stream;
 
 use crate::diag::{Diagnostic, Invalid, LoadError, MAX_ERRORS};
 use crate::fbd::{Fbd, FbdPou, FbdPouKind};
@@ -63,62 +70,70 @@ fn resolve_syntax(syn: &syntax::Program<'_>) -> Result<(Program, Fbd)> {
         b.report(LoadError::invalid(None, &p.at, p.kind.clone()).at(p.origin));
     }
     b.declarations(syn);
-    b.phase_end()?;
-    // Instances of user function blocks: one POU each, after the subroutines.
-    let top_level: Vec<usize> = std::mem::take(&mut b.pending);
-    for i in top_level {
-        let r = b.expand(i, &mut Vec::new());
+    b.resolve_declared(syn)
+}
+
+impl<'a> Builder<'a> {
+    /// Everything after the declarations: instances, FBD lowering, the rungs, the structure.
+    fn resolve_declared(self, syn: &'a syntax::Program<'a>) -> Result<(Program, Fbd)> {
+        let mut b = self;
+        b.phase_end()?;
+        // Instances of user function blocks: one POU each, after the subroutines.
+        let top_level: Vec<usize> = std::mem::take(&mut b.pending);
+        for i in top_level {
+            let r = b.expand(i, &mut Vec::new());
+            b.collect(r);
+        }
+        b.phase_end()?;
+        let r = b.lower_fbd();
         b.collect(r);
-    }
-    b.phase_end()?;
-    let r = b.lower_fbd();
-    b.collect(r);
-    b.phase_end()?;
-    let mut bodies = std::mem::take(&mut b.fbd_bodies);
-    // Copied: the ladder rungs still read instance members through `b.instances`.
-    let mut instances: Vec<crate::fbd::FbInstance> = b
-        .instances
-        .iter()
-        .filter_map(|i| {
-            Some(crate::fbd::FbInstance {
-                pou: i.pou?,
-                name: i.display.clone(),
-                fb: i.fb.clone(),
-                ty: crate::fbd::FbTypeId(*b.fb_index.get(&i.fb)? as u32),
-                inputs: i.inputs.clone(),
-                outputs: i.outputs.clone(),
+        b.phase_end()?;
+        let mut bodies = std::mem::take(&mut b.fbd_bodies);
+        // Copied: the ladder rungs still read instance members through `b.instances`.
+        let mut instances: Vec<crate::fbd::FbInstance> = b
+            .instances
+            .iter()
+            .filter_map(|i| {
+                Some(crate::fbd::FbInstance {
+                    pou: i.pou?,
+                    name: i.display.clone(),
+                    fb: i.fb.clone(),
+                    ty: crate::fbd::FbTypeId(*b.fb_index.get(&i.fb)? as u32),
+                    inputs: i.inputs.clone(),
+                    outputs: i.outputs.clone(),
+                })
             })
-        })
-        .collect();
-    instances.sort_by_key(|i| i.pou);
-    let types = b.fb_type_models(&bodies);
-    let program = b.build(syn.name.to_string(), syn.origin)?;
-    for body in &mut bodies {
-        for copy in &mut body.copies {
-            let start = program.pou(copy.pou).rungs.start;
-            for r in &mut copy.networks {
-                *r = r.start + start..r.end + start;
-            }
-            for blocks in &mut copy.blocks {
-                for r in blocks.iter_mut() {
-                    r.0 += start;
+            .collect();
+        instances.sort_by_key(|i| i.pou);
+        let types = b.fb_type_models(&bodies);
+        let program = b.build(syn.name.to_string(), syn.origin)?;
+        for body in &mut bodies {
+            for copy in &mut body.copies {
+                let start = program.pou(copy.pou).rungs.start;
+                for r in &mut copy.networks {
+                    *r = r.start + start..r.end + start;
+                }
+                for blocks in &mut copy.blocks {
+                    for r in blocks.iter_mut() {
+                        r.0 += start;
+                    }
                 }
             }
         }
+        // Main program and subroutines first, then function block types (each in file order).
+        let (mut pous, fbs): (Vec<FbdPou>, Vec<FbdPou>) = bodies
+            .into_iter()
+            .partition(|p| p.kind != FbdPouKind::FunctionBlock);
+        pous.extend(fbs);
+        Ok((
+            program,
+            Fbd {
+                pous,
+                instances,
+                types,
+            },
+        ))
     }
-    // Main program and subroutines first, then function block types (each in file order).
-    let (mut pous, fbs): (Vec<FbdPou>, Vec<FbdPou>) = bodies
-        .into_iter()
-        .partition(|p| p.kind != FbdPouKind::FunctionBlock);
-    pous.extend(fbs);
-    Ok((
-        program,
-        Fbd {
-            pous,
-            instances,
-            types,
-        },
-    ))
 }
 
 struct PouDraft<'a> {
@@ -222,6 +237,11 @@ struct Builder<'a> {
     labels: Vec<FastMap<String, RungId>>,
     /// Per rung, during element resolution: number of edge contacts so far.
     edge_count: u32,
+    /// The main program's rungs when they were resolved as the reader read them.
+    streamed: Option<stream::Streamed<'a>>,
+    /// The variable of the next edge contact, when it was made before the rung was resolved
+    /// (a rung resolved after the rungs read after it: [`stream`]).
+    edge_reserved: Option<u32>,
 }
 
 /// A ladder rung after pass 1: its id, its syntax and its (prefixed) id text.
@@ -259,26 +279,36 @@ impl<'a> Builder<'a> {
     fn declarations(&mut self, syn: &'a syntax::Program<'a>) {
         let r = self.function_block_types(&syn.function_blocks);
         self.collect(r);
-        let name = syn.name.to_string();
-        self.pous
-            .push(PouDraft::new(name.clone(), PouKind::Main, String::new()));
-        self.locals.push(NameTable::default());
-        self.local_instances.push(NameTable::default());
-        // Sized up front: a million variables would otherwise be rehashed and moved twenty times.
-        self.globals.reserve(syn.vars.len());
-        self.vars.reserve(syn.vars.len());
-        self.declare_vars(&syn.vars, "vars", None, false);
+        self.declare_main(syn.name.to_string(), &syn.vars);
         if let Some(body) = &syn.body {
             let r = self.body(0, body, "");
             self.collect(r);
         }
+        self.declare_subroutines(syn);
+    }
+
+    /// The main program (named `name`) and its variables.
+    fn declare_main(&mut self, name: String, vars: &[syntax::Var]) {
+        self.pous
+            .push(PouDraft::new(name, PouKind::Main, String::new()));
+        self.locals.push(NameTable::default());
+        self.local_instances.push(NameTable::default());
+        // Sized up front: a million variables would otherwise be rehashed and moved twenty times.
+        self.globals.reserve(vars.len());
+        self.vars.reserve(vars.len());
+        self.declare_vars(vars, "vars", None, false);
+    }
+
+    /// Each subroutine with its variables and body, in file order.
+    fn declare_subroutines(&mut self, syn: &'a syntax::Program<'a>) {
+        let name = &syn.name;
         for sub in &syn.subroutines {
             let path = format!("subroutines.{}", sub.name);
             let r = check_name(&sub.name, || path.clone(), None).map_err(|e| e.at(sub.origin));
             if self.collect(r).is_none() {
                 continue;
             }
-            if sub.name == name {
+            if sub.name == *name {
                 self.report(
                     LoadError::invalid(
                         None,
@@ -352,22 +382,36 @@ impl<'a> Builder<'a> {
     }
 
     fn build(mut self, name: String, origin: syntax::Origin) -> Result<Program> {
-        if self.pous[0].fbd.is_none() && self.pous[0].rungs.is_empty() {
+        let streamed = self.streamed.as_ref().map_or(0, |s| s.rungs.len());
+        if self.pous[0].fbd.is_none() && self.pous[0].rungs.is_empty() && streamed == 0 {
             return Err(LoadError::invalid(None, "rungs", Invalid::Empty).at(origin));
         }
         let (heads, next_id) = self.rung_heads();
         self.phase_end()?;
-        // Pass 2: elements.
-        let mut rungs = Vec::with_capacity(next_id as usize);
-        // The syntax of each ladder rung and where it is (none for rungs lowered from FBD), for
-        // the paths and places of structural errors.
+        // Pass 2: elements (the main program's are resolved already when it was streamed).
+        let mut loops = structure::Loops::default();
+        let mut rungs = match self.streamed.take() {
+            Some(s) => self.settle(s, &mut loops)?,
+            None => Vec::new(),
+        };
+        for pou_heads in &heads {
+            loops.pair_pou(pou_heads.iter().filter_map(|(rid, syn, _)| {
+                Some((*rid, structure::loop_end(&syn.ld)?, syn.ld.len()))
+            }));
+        }
+        rungs.reserve(next_id as usize - rungs.len());
+        // The syntax of each ladder rung and where it is (none for rungs lowered from FBD or
+        // streamed), for the paths and places of structural errors.
         let pou_paths: Vec<String> = self.pous.iter().map(|p| p.path.clone()).collect();
         let mut places: Vec<Option<structure::Place>> = Vec::with_capacity(next_id as usize);
+        places.resize_with(rungs.len(), || None);
         let mut pous = Vec::with_capacity(self.pous.len());
         let mut start = 0u32;
-        for pou in &self.pous {
-            let end =
-                start + pou.rungs.len() as u32 + pou.lowered.as_ref().map_or(0, |l| l.len() as u32);
+        for (pi, pou) in self.pous.iter().enumerate() {
+            let end = start
+                + pou.rungs.len() as u32
+                + pou.lowered.as_ref().map_or(0, |l| l.len() as u32)
+                + if pi == 0 { streamed as u32 } else { 0 };
             pous.push(Pou {
                 name: pou.name.clone(),
                 kind: pou.kind,
@@ -388,11 +432,9 @@ impl<'a> Builder<'a> {
             }
             for (rid, syn, id) in pou_heads {
                 let index = (rid.0 - pous[pi].rungs.start) as usize;
-                self.edge_count = 0;
-                let scope = Scope { pou, rung_id: &id };
-                let base = At::rung(&pou_paths[pi], index);
-                let ld = base.key("ld");
-                let series = match self.series(&syn.ld, &ld, Place::Top, &scope) {
+                let partner = loops.partner(rid);
+                let at = (pou_paths[pi].as_str(), index);
+                let series = match self.ladder_series(pou, at, syn, &id, partner) {
                     Ok(s) => s,
                     Err(e) => {
                         self.report(e.at(syn.origin));
@@ -416,14 +458,35 @@ impl<'a> Builder<'a> {
             }
         }
         self.phase_end()?;
-        let mut program = Program {
+        let program = Program {
             name,
             vars: self.vars,
             pous,
             rungs,
         };
-        structure::check(&mut program, &places)?;
+        structure::check(&program, &places, loops)?;
         Ok(program)
+    }
+
+    /// The elements of ladder rung `index` of POU `pou` (whose rung array is at `pou_path`),
+    /// whose id is `id`; `partner`: its FOR's NEXT or its NEXT's FOR.
+    fn ladder_series(
+        &mut self,
+        pou: PouId,
+        (pou_path, index): (&str, usize),
+        syn: &syntax::Rung,
+        id: &str,
+        partner: Option<RungId>,
+    ) -> Result<Series> {
+        self.edge_count = 0;
+        let scope = Scope {
+            pou,
+            rung_id: id,
+            partner,
+        };
+        let base = At::rung(pou_path, index);
+        let ld = base.key("ld");
+        self.series(&syn.ld, &ld, Place::Top, &scope)
     }
 
     /// Pass 1: rung ids (program-wide) and labels (per POU); lowered FBD bodies: ids only, their
@@ -437,6 +500,13 @@ impl<'a> Builder<'a> {
             .map(|p| p.rungs.len() + p.lowered.as_ref().map_or(0, Vec::len));
         let mut ids: FastMap<Cow<'a, str>, (usize, Option<usize>)> = FastMap::default();
         ids.reserve(total.sum());
+        // The main program's ids when it was streamed.
+        let streamed = self.streamed.as_ref();
+        let main_id = |key: &str| {
+            let s = streamed?;
+            let i = s.ids.get(key, |i| s.rungs[i as usize].id.as_str())?;
+            Some((0, Some(i as usize)))
+        };
         let first_path = |pous: &[PouDraft], (pou, i): (usize, Option<usize>)| match i {
             Some(i) => rung_path(&pous[pou].path, i),
             None => String::new(),
@@ -446,10 +516,15 @@ impl<'a> Builder<'a> {
         let mut errors = Vec::new();
         for (pi, pou) in self.pous.iter().enumerate() {
             let mut labels = FastMap::default();
+            if let (0, Some(s)) = (pi, streamed) {
+                labels = s.labels.clone();
+                next_id += s.rungs.len() as u32;
+            }
             let mut pou_heads = Vec::with_capacity(pou.rungs.len());
             if let Some(lowered) = &pou.lowered {
                 for r in lowered {
-                    if let Some(&first) = ids.get(r.id.as_str()) {
+                    if let Some(first) = ids.get(r.id.as_str()).copied().or_else(|| main_id(&r.id))
+                    {
                         let first = match first {
                             (p, None) => self.pous[p]
                                 .lowered
@@ -491,7 +566,7 @@ impl<'a> Builder<'a> {
                     errors.push(e.at(p.origin).at(r.origin));
                     continue;
                 }
-                if let Some(&first) = ids.get(key.as_ref()) {
+                if let Some(first) = ids.get(key.as_ref()).copied().or_else(|| main_id(&key)) {
                     let first = match first {
                         (p, None) => self.pous[p]
                             .lowered

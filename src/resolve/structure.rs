@@ -1,14 +1,70 @@
-//! Structural checks that need the whole resolved program: FOR/NEXT pairing and nesting, no jump
-//! into a FOR body from outside it, no recursive subroutine calls.
+//! Structural checks: FOR/NEXT pairing and nesting ([`Loops`], on the rungs as written, before
+//! their elements are resolved, so that each FOR and NEXT is made with its partner's real id),
+//! and, on the whole resolved program, no jump into a FOR body from outside it, no recursive
+//! subroutine calls.
 //!
 //! S7-200 rules (the instruction set of Zhao & Yan's S7-200 examples): FOR/NEXT pairs nest like brackets inside one POU;
 //! a jump may leave a loop body but not enter one (the loop head would be bypassed); subroutines
 //! may nest but not recurse (the call graph is acyclic, which also keeps every CALL's access
 //! summary finite).
 
+use super::util::FastMap;
 use crate::diag::{Invalid, LoadError, Origin};
 use crate::model::*;
 use crate::syntax;
+
+/// Which end of a FOR/NEXT loop a rung is (by its last top-level element).
+#[derive(Copy, Clone, PartialEq, Eq)]
+pub(super) enum LoopEnd {
+    For,
+    Next,
+}
+
+/// The loop end a rung written as `ld` is, if any.
+pub(super) fn loop_end(ld: &[syntax::Element]) -> Option<LoopEnd> {
+    match ld.last().map(|e| &e.kind) {
+        Some(syntax::ElementKind::For(_)) => Some(LoopEnd::For),
+        Some(syntax::ElementKind::Next) => Some(LoopEnd::Next),
+        _ => None,
+    }
+}
+
+/// FOR/NEXT pairs (S7-200: they nest like brackets inside one POU), and the loop ends without
+/// a partner as the errors they are: each rung and the element the error points at.
+#[derive(Default)]
+pub(super) struct Loops {
+    partner: FastMap<RungId, RungId>,
+    errors: Vec<(RungId, usize, Invalid)>,
+}
+
+impl Loops {
+    /// Pairs the loop ends of one POU, given in program order as (rung, end, number of
+    /// top-level elements); errors in program order, NEXTs without FOR first.
+    pub(super) fn pair_pou(&mut self, ends: impl Iterator<Item = (RungId, LoopEnd, usize)>) {
+        let mut open: Vec<(RungId, usize)> = Vec::new();
+        for (r, end, n) in ends {
+            match end {
+                LoopEnd::For => open.push((r, n)),
+                LoopEnd::Next => match open.pop() {
+                    None => self.errors.push((r, 0, Invalid::NextWithoutFor)),
+                    Some((head, _)) => {
+                        self.partner.insert(head, r);
+                        self.partner.insert(r, head);
+                    }
+                },
+            }
+        }
+        for (head, n) in open {
+            let last = n.saturating_sub(1);
+            self.errors.push((head, last, Invalid::ForWithoutNext));
+        }
+    }
+
+    /// The NEXT of a FOR rung, the FOR of a NEXT rung.
+    pub(super) fn partner(&self, r: RungId) -> Option<RungId> {
+        self.partner.get(&r).copied()
+    }
+}
 
 /// A ladder rung's syntax and where it is: rung `index` of the POU whose rung array is at
 /// `pou_path`.
@@ -36,9 +92,10 @@ fn place(places: Places, r: RungId, element: Option<usize>) -> Origin {
 
 /// Every structural problem, in program order (loops and jumps per rung, then the first
 /// recursive call chain); jumps are checked only when the loops pair.
-pub(crate) fn check(p: &mut Program, places: Places) -> Result<(), LoadError> {
-    let mut errors = Vec::new();
-    pair_loops(p, places, &mut errors);
+pub(crate) fn check(p: &Program, places: Places, loops: Loops) -> Result<(), LoadError> {
+    let mut errors: Vec<Located> = (loops.errors.into_iter())
+        .map(|(r, element, kind)| err(p, places, r, Some(element), kind))
+        .collect();
     if errors.is_empty() {
         check_jumps(p, places, &mut errors);
     }
@@ -81,42 +138,6 @@ fn err(p: &Program, places: Places, r: RungId, element: Option<usize>, kind: Inv
 
 fn last_top(rung: &Rung) -> Option<&Element> {
     rung.series.last()
-}
-
-fn pair_loops(p: &mut Program, places: Places, errors: &mut Vec<Located>) {
-    for pou in 0..p.pous.len() {
-        let mut stack: Vec<RungId> = Vec::new();
-        for r in p.pou_rungs(PouId(pou as u32)) {
-            match last_top(p.rung(r)) {
-                Some(Element::For { .. }) => stack.push(r),
-                Some(Element::Next { .. }) => {
-                    let Some(head) = stack.pop() else {
-                        errors.push(err(p, places, r, Some(0), Invalid::NextWithoutFor));
-                        continue;
-                    };
-                    if let Some(Element::Next { head: h }) = p.rungs[r.index()].series.last_mut() {
-                        *h = head;
-                    }
-                    if let Some(Element::For { next, .. }) = p.rungs[head.index()].series.last_mut()
-                    {
-                        *next = r;
-                    }
-                }
-                _ => {}
-            }
-        }
-        // Unclosed heads, in program order.
-        for head in stack {
-            let n = p.rung(head).series.len();
-            errors.push(err(
-                p,
-                places,
-                head,
-                Some(n.saturating_sub(1)),
-                Invalid::ForWithoutNext,
-            ));
-        }
-    }
 }
 
 /// Jumps may leave loop bodies but not enter them.

@@ -8,7 +8,8 @@
 //! — for names of up to 22 bytes, which is nearly all of them — the name itself. Longer names
 //! are kept aside and compared there.
 //!
-//! Invariants: at most half the slots are full (probes stay short); a slot is `None` or holds
+//! Invariants: at most 3/4 of the slots are full (probes stay short: two slots share a cache
+//! line, and a million names take 64 MB rather than 128); a slot is `None` or holds
 //! one name; names are unique (an insert of a present name replaces its value). Deliberately no
 //! removal (scopes only grow) and no iteration order.
 
@@ -66,7 +67,7 @@ fn hash(name: &str) -> (u64, NonZeroU32) {
 impl<V: Copy> NameTable<V> {
     /// Room for `more` names without growing.
     pub(crate) fn reserve(&mut self, more: usize) {
-        let want = ((self.len + more) * 2).next_power_of_two().max(8);
+        let want = ((self.len + more) * 4 / 3 + 1).next_power_of_two().max(8);
         if want > self.slots.len() {
             self.rebuild(want);
         }
@@ -134,7 +135,7 @@ impl<V: Copy> NameTable<V> {
 
     /// Adds `name` (or gives it a new value); the old value, if it was there.
     pub(crate) fn insert(&mut self, name: &str, value: V) -> Option<V> {
-        if (self.len + 1) * 2 > self.slots.len() {
+        if (self.len + 1) * 4 > self.slots.len() * 3 {
             self.reserve(1.max(self.len));
         }
         match self.find(name) {
@@ -157,6 +158,81 @@ impl<V: Copy> NameTable<V> {
                 self.slots[i] = Some(Slot { tag, value, key });
                 self.len += 1;
                 None
+            }
+        }
+    }
+}
+
+/// A set of names kept elsewhere (the rung ids of the streamed main program, in the rungs they
+/// name): 8-byte slots of a hash tag and an index; the name of index `i` is `text(i)`, read
+/// only when a tag matches. The tag also places the slot, so growing reads no name. Same
+/// invariants as [`NameTable`], at most 3/4 full.
+#[derive(Default)]
+pub(crate) struct IndexSet {
+    slots: Vec<Option<(NonZeroU32, u32)>>,
+    len: usize,
+}
+
+impl IndexSet {
+    /// Room for `n` names in all.
+    pub(crate) fn with_capacity(n: usize) -> IndexSet {
+        IndexSet {
+            slots: vec![None; (n * 4 / 3 + 1).next_power_of_two().max(8)],
+            len: 0,
+        }
+    }
+
+    /// The index of `name`: `Ok` if present, else `Err` with the slot it would take.
+    fn find<'t>(&self, name: &str, text: impl Fn(u32) -> &'t str) -> Result<u32, usize> {
+        let tag = hash(name).1;
+        let mask = self.slots.len() - 1;
+        let mut i = Self::home(tag, mask);
+        loop {
+            match self.slots[i] {
+                None => return Err(i),
+                Some((t, idx)) if t == tag && text(idx) == name => return Ok(idx),
+                Some(_) => i = (i + 1) & mask,
+            }
+        }
+    }
+
+    /// The first slot a name with hash tag `tag` may take.
+    fn home(tag: NonZeroU32, mask: usize) -> usize {
+        (tag.get() >> 1) as usize & mask
+    }
+
+    pub(crate) fn get<'t>(&self, name: &str, text: impl Fn(u32) -> &'t str) -> Option<u32> {
+        if self.slots.is_empty() {
+            return None;
+        }
+        self.find(name, text).ok()
+    }
+
+    /// Adds `name` as index `idx`; false (and nothing changed) if it was there.
+    pub(crate) fn insert<'t>(
+        &mut self,
+        name: &str,
+        idx: u32,
+        text: impl Fn(u32) -> &'t str,
+    ) -> bool {
+        if (self.len + 1) * 4 > self.slots.len() * 3 {
+            let old = std::mem::replace(self, IndexSet::with_capacity(2 * self.len.max(4)));
+            for (t, i) in old.slots.into_iter().flatten() {
+                let mask = self.slots.len() - 1;
+                let mut at = Self::home(t, mask);
+                while self.slots[at].is_some() {
+                    at = (at + 1) & mask;
+                }
+                self.slots[at] = Some((t, i));
+                self.len += 1;
+            }
+        }
+        match self.find(name, &text) {
+            Ok(_) => false,
+            Err(at) => {
+                self.slots[at] = Some((hash(name).1, idx));
+                self.len += 1;
+                true
             }
         }
     }
@@ -186,5 +262,21 @@ mod tests {
         assert_eq!(t.get(&long[..30]), None);
         assert!(t.contains_key("M0") && !t.contains_key(""));
         assert_eq!(t.len, 1001);
+    }
+
+    #[test]
+    fn an_index_set_finds_names_by_their_index_through_growth() {
+        let names: Vec<String> = (0..1000).map(|i| format!("R{i}")).collect();
+        let text = |i: u32| names[i as usize].as_str();
+        let mut s = IndexSet::default();
+        assert_eq!(s.get("R1", text), None);
+        for i in 0..1000u32 {
+            assert!(s.insert(&names[i as usize], i, text));
+        }
+        assert!(!s.insert("R5", 7, text));
+        assert_eq!(s.get("R5", text), Some(5));
+        assert_eq!(s.get("R999", text), Some(999));
+        assert_eq!(s.get("R1000", text), None);
+        assert_eq!(s.len, 1000);
     }
 }

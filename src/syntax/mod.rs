@@ -211,6 +211,25 @@ pub enum VarClass {
     Default,
 }
 
+/// Takes the main program's rungs one at a time, as a reader reads them, so that the reader
+/// need not hold them all: a million rungs as syntax cost more memory than their text, and
+/// memory first touched is time. A reader offers the rungs only when it has read the program's
+/// variables and nothing before the rung array was malformed; whatever the sink does with
+/// them, the tree stays the format-neutral description of the file, except that the program's
+/// variables and the main body's rungs are then not in it (no `vars`, an empty `Body::Rungs`).
+pub trait RungSink<'a> {
+    /// At the start of the main program's rung array, with the variables read before it and an
+    /// estimate of the number of rungs (for sizing only). True: the sink takes the variables
+    /// and the rungs ([`RungSink::rung`]) and the tree gets neither; false: the reader keeps
+    /// them in the tree.
+    fn start(&mut self, vars: &[Var<'a>], rungs: usize) -> bool;
+    /// The next rung of the main program, in file order (only after `start` returned true).
+    fn rung(&mut self, rung: Rung<'a>);
+    /// What the sink took is not what the file means after all (the file repeats `vars`
+    /// or `rungs` later, and the last one counts): the sink must not use it.
+    fn retract(&mut self);
+}
+
 /// A ladder rung.
 #[derive(Clone, Debug)]
 pub struct Rung<'a> {

@@ -30,9 +30,10 @@ fn problem(
 /// The keys of a `for` object in file order: (key, its origin, the value).
 pub(super) type ForSlots<'a> = Vec<(Text<'a>, Origin, Operand<'a>)>;
 
-impl<'a> Reader<'a> {
+impl<'a> Reader<'a, '_> {
     /// The value of `rungs` at `path`: an array of rungs, or `None` (with a problem).
-    pub(super) fn rungs(&mut self, path: &str) -> P<Option<Vec<Rung<'a>>>> {
+    /// `streamed`: each rung goes to the sink as it is read, and the array is left empty.
+    pub(super) fn rungs(&mut self, path: &str, streamed: bool) -> P<Option<Vec<Rung<'a>>>> {
         let origin = self.c.origin();
         if self.c.peek() != Some(b'[') {
             let found = self.c.scalar()?;
@@ -42,11 +43,19 @@ impl<'a> Reader<'a> {
         // Room for as many rungs as the rest of the text holds at 128 bytes a rung (a generated
         // rung takes about 220): pages of the room a program does not use are never touched, and
         // a million rungs are not moved twenty times as the vector doubles.
-        let mut rungs = Vec::with_capacity(self.c.remaining() / 128);
+        let mut rungs = Vec::with_capacity(if streamed {
+            0
+        } else {
+            self.c.remaining() / 128
+        });
         self.c.begin_array()?;
         let mut first = true;
         while self.c.item(&mut first)? {
-            rungs.push(self.rung()?);
+            let rung = self.rung()?;
+            match self.sink.as_deref_mut() {
+                Some(sink) if streamed => sink.rung(rung),
+                _ => rungs.push(rung),
+            }
         }
         Ok(Some(rungs))
     }

@@ -12,6 +12,9 @@
 //! last value). A syntax error stops the reading; its message and place are `serde_json`'s, asked
 //! only then, so they read the same as they always have. A UTF-8 byte-order mark at the start of
 //! the text is skipped (offsets still count it: they are offsets into the text as given).
+//! Given a [`syntax::RungSink`] ([`parse_with`]), the reader offers it the program's variables
+//! and main rungs at the start of the rung array, and hands over each rung as it is read
+//! instead of keeping it.
 //!
 //! Deliberately not here: names, types, ids, labels and every other rule that needs more than
 //! one node (`crate::resolve`). FBD bodies are read by [`fbd`].
@@ -31,8 +34,17 @@ use serde::de::IgnoredAny;
 
 /// Reads a program file's text into the surface syntax. Only syntax errors fail here.
 pub fn parse(text: &str) -> Result<syntax::Program<'_>, LoadError> {
+    parse_with(text, None)
+}
+
+/// [`parse`], offering the main program's rungs to `sink` (see [`syntax::RungSink`]): when it
+/// takes them, the tree's main body has none.
+pub fn parse_with<'a>(
+    text: &'a str,
+    sink: Option<&mut dyn syntax::RungSink<'a>>,
+) -> Result<syntax::Program<'a>, LoadError> {
     let start = if text.starts_with('\u{feff}') { 3 } else { 0 };
-    let mut r = Reader::new(text, start);
+    let mut r = Reader::new(text, start, sink);
     match r.document() {
         Ok(program) => Ok(program),
         Err(Fail) => Err(syntax_error(text, start, r.c.offset())),
@@ -148,22 +160,64 @@ const SUBROUTINE_KEYS: &[&str] = &["vars", "rungs", "fbd", "comment"];
 const FB_KEYS: &[&str] = &["vars", "inputs", "outputs", "fbd", "rungs", "comment"];
 const VAR_KEYS: &[&str] = &["name", "type", "class", "init", "comment"];
 
-/// The reader: the cursor, the problems of the part being read, and the scratch stacks of
-/// elements and element keys (nested series and elements sit above their parents' entries).
-pub(super) struct Reader<'a> {
+/// The reader: the cursor, the problems of the part being read, the scratch stacks of
+/// elements and element keys (nested series and elements sit above their parents' entries), and
+/// what the main program's rungs may be handed to.
+pub(super) struct Reader<'a, 'r> {
     c: Cursor<'a>,
     problems: Vec<Problem>,
     elements: Vec<syntax::Element<'a>>,
     slots: Vec<element::SlotEntry<'a>>,
+    sink: Option<&'r mut dyn syntax::RungSink<'a>>,
+    /// The sink took the program's variables and rungs.
+    streamed: bool,
 }
 
-impl<'a> Reader<'a> {
-    fn new(text: &'a str, start: usize) -> Reader<'a> {
+impl<'a, 'r> Reader<'a, 'r> {
+    fn new(
+        text: &'a str,
+        start: usize,
+        sink: Option<&'r mut dyn syntax::RungSink<'a>>,
+    ) -> Reader<'a, 'r> {
         Reader {
             c: Cursor::new(text, start),
             problems: Vec::new(),
             elements: Vec::with_capacity(64),
             slots: Vec::with_capacity(16),
+            sink,
+            streamed: false,
+        }
+    }
+
+    /// At the main program's rung array: whether its variables and rungs go to the sink (which
+    /// takes them only when nothing read so far is malformed or needs more than the variables
+    /// to resolve); they then leave the tree.
+    fn offer(&mut self, parts: &mut Parts<'a>) -> bool {
+        if std::mem::take(&mut self.streamed) {
+            self.retract();
+            return false;
+        }
+        let clean = self.problems.is_empty()
+            && parts.unknown.is_none()
+            && parts.fbd.is_none()
+            && parts.function_blocks.is_none()
+            && parts.vars.as_ref().is_none_or(|v| v.problems.is_empty());
+        let vars = parts.vars.as_ref().map_or(&[][..], |v| &v.value[..]);
+        let rungs = self.c.remaining() / 128;
+        self.streamed = match self.sink.as_deref_mut() {
+            Some(sink) if clean => sink.start(vars, rungs),
+            _ => false,
+        };
+        if self.streamed {
+            parts.vars = None;
+        }
+        self.streamed
+    }
+
+    /// A part the sink took is read again: it must not be used.
+    fn retract(&mut self) {
+        if let Some(sink) = self.sink.as_deref_mut() {
+            sink.retract();
         }
     }
 
@@ -220,10 +274,17 @@ impl<'a> Reader<'a> {
             match key.as_ref() {
                 "program" => parts.name = Some((self.c.scalar()?, origin)),
                 "comment" => parts.comment = Some(self.c.scalar()?),
+                "vars" if path.is_empty() && self.streamed => {
+                    self.retract();
+                    parts.vars = Some(self.part(|r| r.vars(&at()))?)
+                }
                 "vars" => parts.vars = Some(self.part(|r| r.vars(&at()))?),
                 "inputs" => parts.inputs = Some(self.part(|r| r.vars(&at()))?),
                 "outputs" => parts.outputs = Some(self.part(|r| r.vars(&at()))?),
-                "rungs" => parts.rungs = Some(self.part(|r| r.rungs(&at()))?),
+                "rungs" => {
+                    let streamed = path.is_empty() && self.offer(&mut parts);
+                    parts.rungs = Some(self.part(|r| r.rungs(&at(), streamed))?)
+                }
                 "subroutines" => parts.subroutines = Some(self.part(|r| r.subroutines())?),
                 "function_blocks" => {
                     parts.function_blocks = Some(self.part(|r| r.function_blocks())?)
