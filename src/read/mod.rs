@@ -30,18 +30,20 @@ pub fn program_from_json(text: &str) -> Result<Program, LoadError> {
 /// the whole syntax tree is never held; should that not resolve, the text is read again into
 /// the whole tree, whose resolution gives the program or every error, as it always would.
 pub fn program_and_fbd_from_json(text: &str) -> Result<(Program, Fbd), LoadError> {
+    let whole = |syntax: &crate::syntax::Program<'_>| {
+        crate::resolve::resolve(text, syntax)
+            .map_err(|e| e.refine(text, |t, p| json::path_offset(t, p).map(|(start, _)| start)))
+    };
     let mut stream = crate::resolve::Stream::default();
     let syntax = json::parse_with(text, Some(&mut stream))?;
     if !stream.took_rungs() {
-        return crate::resolve::resolve(text, &syntax);
+        return whole(&syntax);
     }
     if let Some(done) = stream.finish(&syntax) {
         return Ok(done);
     }
     drop(syntax);
-    let syntax = json::parse(text)?;
-    crate::resolve::resolve(text, &syntax)
-        .map_err(|e| e.refine(text, |t, p| json::path_offset(t, p).map(|(start, _)| start)))
+    whole(&json::parse(text)?)
 }
 
 /// Builds a program from an already parsed JSON document (tests and benchmarks that build
