@@ -34,6 +34,24 @@ impl Machine {
         }
     }
 
+    /// One past the last byte any instruction (of any POU) reads or writes.
+    pub(super) fn access_end(&self) -> u64 {
+        let (mut reads, mut writes, mut callees) = (Vec::new(), Vec::new(), Vec::new());
+        let mut end = 0u64;
+        for &entry in &self.pou_entry {
+            reads.clear();
+            writes.clear();
+            self.op_accesses(entry.index(), false, &mut reads, &mut writes, &mut callees);
+            for &(at, w) in reads.iter().chain(&writes) {
+                end = end.max(at.0 as u64 + w as u64);
+            }
+        }
+        for &(_, at) in &self.counters {
+            end = end.max(at.0 as u64 + 8);
+        }
+        end
+    }
+
     /// The accesses of the instructions from `pc` to the next rung marker (`one_rung`) or to
     /// the end of the POU; callees not yet in `pous` are appended to it.
     fn op_accesses(

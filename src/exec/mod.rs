@@ -286,6 +286,15 @@ impl Machine {
             layout,
             config: *config,
         })
+        .inspect(|m| {
+            // What makes the unchecked store of `run_scan_in` sound: every byte any instruction
+            // touches is inside the state (loop counters and constants included; `begin_scan`
+            // writes only the counters the loop-back instructions use).
+            assert!(
+                m.access_end() <= m.size as u64,
+                "lowering placed an access past the state"
+            );
+        })
     }
 
     /// The layout the machine was built with.
@@ -427,10 +436,15 @@ impl Machine {
             mem.len() >= self.size as usize,
             "state too small for this machine"
         );
-        self.begin_scan(mem);
+        // SAFETY: `mem` has at least `size` bytes (asserted above), and every address the
+        // machine's instructions, loops and counters use ends inside `size` (asserted once in
+        // `Machine::new` from the same instructions, which are immutable); `exec` and
+        // `begin_scan` access nothing else.
+        let mut mem = unsafe { store::Trusted::new(mem) };
+        self.begin_scan(&mut mem);
         let mut ctx = self.context(scan, faults);
         self.exec(
-            mem,
+            &mut mem,
             &mut ctx,
             self.pou_entry[0].index(),
             self.main_first,

@@ -122,15 +122,47 @@ impl Store for [u8] {
     }
 }
 
+/// A state's memory with the bounds already checked for every address the machine uses: the
+/// sequential interpreter's store, without a bounds check per access.
+pub(crate) struct Trusted<'a>(&'a mut [u8]);
+
+impl<'a> Trusted<'a> {
+    /// # Safety
+    /// Every `(address, T)` that will be loaded or stored through it has `address + T::SIZE <=
+    /// mem.len()`.
+    #[inline(always)]
+    pub(crate) unsafe fn new(mem: &'a mut [u8]) -> Trusted<'a> {
+        Trusted(mem)
+    }
+}
+
+impl Store for Trusted<'_> {
+    #[inline(always)]
+    fn load<T: Word>(&self, at: Addr) -> T {
+        debug_assert!(at.index() + T::SIZE <= self.0.len());
+        // SAFETY: in bounds by the contract of `Trusted::new`.
+        T::read(unsafe { self.0.get_unchecked(at.index()..at.index() + T::SIZE) })
+    }
+    #[inline(always)]
+    fn store<T: Word>(&mut self, at: Addr, v: T) {
+        debug_assert!(at.index() + T::SIZE <= self.0.len());
+        // SAFETY: in bounds by the contract of `Trusted::new`.
+        v.write(unsafe { self.0.get_unchecked_mut(at.index()..at.index() + T::SIZE) })
+    }
+}
+
 /// The bits of the `width`-byte value at `at` (1, 2, 4 or 8), zero-extended: a layout-free view
 /// of a stored value, for digests and comparisons.
+///
+/// # Panics
+/// If `width` is not 1, 2, 4 or 8, or the value is not inside `mem`.
+#[inline(always)]
 pub fn load_bits(mem: &[u8], at: Addr, width: u32) -> u64 {
-    let mut b = [0u8; 8];
-    let w = width as usize;
-    if cfg!(target_endian = "little") {
-        b[..w].copy_from_slice(&mem[at.index()..at.index() + w]);
-    } else {
-        b[8 - w..].copy_from_slice(&mem[at.index()..at.index() + w]);
+    match width {
+        1 => mem.load::<u8>(at) as u64,
+        2 => mem.load::<i16>(at) as u16 as u64,
+        4 => mem.load::<i32>(at) as u32 as u64,
+        8 => mem.load::<u64>(at),
+        _ => panic!("no value is {width} bytes wide"),
     }
-    u64::from_ne_bytes(b)
 }

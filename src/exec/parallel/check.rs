@@ -141,6 +141,29 @@ mod tests {
     }
 
     #[test]
+    fn a_line_is_64_bytes_of_real_addresses() {
+        let p = program();
+        let a = crate::analysis::analyse(&p);
+        let config = PlanConfig {
+            strategy: Strategy::AllParallel,
+            ..PlanConfig::new(2)
+        };
+        let plan = Plan::build(&p, &a, &config);
+        let at = |x: u32, y: u32| {
+            let layout = Layout::from_starts(&p, vec![0, 1, x, y], 128).unwrap();
+            let m = Machine::new(&p, layout, &ExecConfig::default()).unwrap();
+            assert_eq!(m.state_size(), 128);
+            check_plan(&m, &plan)
+        };
+        // x (worker 0) and y (worker 1): bytes 63 and 64 are on two lines, 2 and 63 on one.
+        assert_eq!(at(63, 64), Ok(()));
+        assert_eq!(
+            at(2, 63),
+            Err("phase 0: workers 0 and 1 both write the line of byte 63".into())
+        );
+    }
+
+    #[test]
     fn two_workers_writing_one_slot_fail() {
         let p = program();
         let a = crate::analysis::analyse(&p);
