@@ -42,7 +42,7 @@ impl SharedSlots {
     /// The pointer to the `T` at `at`, checked: in bounds and aligned to `T::SIZE`.
     #[inline(always)]
     fn at<T: Word>(&self, at: Addr) -> *mut u8 {
-        if at.index() + T::SIZE > self.len || at.index() % T::SIZE != 0 {
+        if at.index() + T::SIZE > self.len || !at.index().is_multiple_of(T::SIZE) {
             bad_access(at, T::SIZE, self.len);
         }
         // SAFETY: in bounds of the allocation (checked just above).
@@ -52,8 +52,9 @@ impl SharedSlots {
     /// The memory as a slice, for worker 0 while every other worker waits at a barrier.
     ///
     /// # Safety
-    /// No other thread accesses the memory while the slice lives.
-    pub(super) unsafe fn bytes_mut(&self) -> &mut [u8] {
+    /// No other thread accesses the memory while the slice lives, and it does not outlive the
+    /// run (the `&mut State` the memory is borrowed from).
+    pub(super) unsafe fn bytes_mut<'a>(self) -> &'a mut [u8] {
         // SAFETY: `ptr..ptr + len` is the state's memory, borrowed mutably for the whole run;
         // the caller guarantees exclusive access while the slice lives.
         unsafe { std::slice::from_raw_parts_mut(self.ptr, self.len) }
