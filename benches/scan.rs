@@ -84,8 +84,8 @@ fn uniform(n: usize) -> Program {
 struct Nothing;
 
 impl ScanDriver for Nothing {
-    fn before_scan(&mut self, _: &Machine, _: u64, _: &mut [u64]) {}
-    fn after_scan(&mut self, _: &Machine, _: u64, _: &[u64], _: &[Fault], _: Duration) {}
+    fn before_scan(&mut self, _: &Machine, _: u64, _: &mut [u8]) {}
+    fn after_scan(&mut self, _: &Machine, _: u64, _: &[u8], _: &[Fault], _: Duration) {}
     fn wants_time(&self) -> bool {
         false
     }

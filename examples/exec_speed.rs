@@ -79,7 +79,7 @@ fn main() {
         total += ns;
     }
     let on = (inputs..inputs + rungs)
-        .filter(|&v| state.slots[v] != 0)
+        .filter(|&v| machine.value(&state, VarId(v as u32)).as_bool() == Some(true))
         .count();
     assert!(faults.is_empty());
     println!(

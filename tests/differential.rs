@@ -125,7 +125,7 @@ fn check_with(
         "{label}: one callback per scan"
     );
     let mut s = seq.initial_state();
-    assert_eq!(s.slots, par.initial_state().slots);
+    assert_eq!(s.bytes(), par.initial_state().bytes());
     stats.cases += 1;
     if par.plan().sequential().is_none() {
         stats.parallel_cases += 1;
@@ -135,16 +135,16 @@ fn check_with(
         let mut faults = Vec::new();
         seq.scan(&mut s, scan, &inputs[scan as usize], &mut faults);
         let got = &rec.states[scan as usize];
-        if got != &s.slots {
-            let slot = got.iter().zip(&s.slots).position(|(a, b)| a != b).unwrap();
+        if got[..] != *s.bytes() {
+            let byte = got.iter().zip(s.bytes()).position(|(a, b)| a != b).unwrap();
             let var = (0..p.vars.len() as u32)
                 .map(VarId)
-                .find(|&v| seq.layout().slots_of(v).contains(&(slot as u32)));
+                .find(|&v| seq.layout().bytes_of(v).contains(&(byte as u32)));
             panic!(
-                "{label}: state differs after scan {scan} at slot {slot} ({}): par {:#x}, seq {:#x}\n{}",
-                var.map_or("loop counter or padding".to_string(), |v| p.var(v).name.clone()),
-                got[slot],
-                s.slots[slot],
+                "{label}: state differs after scan {scan} at byte {byte} ({}): par {:#x}, seq {:#x}\n{}",
+                var.map_or("loop counter, constant or padding".to_string(), |v| p.var(v).name.clone()),
+                got[byte],
+                s.bytes()[byte],
                 par.explain(p)
             );
         }
@@ -500,7 +500,7 @@ fn one_scan_at_a_time_equals_a_run() {
             &inputs[scan as usize],
             &mut faults,
         );
-        assert_eq!(single.slots, rec.states[scan as usize]);
+        assert_eq!(single.bytes(), rec.states[scan as usize]);
         assert_eq!(faults, rec.faults[scan as usize]);
     }
 }

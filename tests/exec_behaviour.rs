@@ -1035,7 +1035,7 @@ fn run_from_reports_where_control_leaves_a_region() {
     let mut faults = Vec::new();
     let mut ctx = m.context(0, &mut faults);
     let r = RungId;
-    let store = &mut st.slots[..];
+    let store = st.bytes_mut();
     m.begin_scan(store);
     assert_eq!(
         m.run_from(store, &mut ctx, r(0), |x| x == r(0)),
@@ -1139,7 +1139,7 @@ fn scan_by_schedule(
 ) -> Vec<Fault> {
     use plc_deps::analysis::schedule::Successor;
     let mut faults = Vec::new();
-    m.begin_scan(&mut st.slots[..]);
+    m.begin_scan(st.bytes_mut());
     let mut ctx = m.context(scan, &mut faults);
     let n = sched.tasks.len();
     let mut exit: Vec<Option<Exit>> = vec![None; n];
@@ -1178,7 +1178,7 @@ fn scan_by_schedule(
                 }
             };
             let inside = |r: RungId| sched.task_of[r.index()] == Some(t);
-            exit[t.index()] = Some(m.resume(&mut st.slots[..], &mut ctx, at, inside));
+            exit[t.index()] = Some(m.resume(st.bytes_mut(), &mut ctx, at, inside));
         }
     }
     faults
@@ -1232,31 +1232,37 @@ fn schedule_driven_scan_equals_sequential_scan() {
 fn padded_permuted_layout_gives_the_same_values() {
     let p = plc_deps::read::program_from_json(EXAMPLE_B).unwrap();
     let dense = Machine::new(&p, Layout::dense(&p), &ExecConfig::default()).unwrap();
-    // Reverse order, one variable per 8-slot line.
-    let groups: Vec<Vec<VarId>> = (0..p.vars.len() as u32)
-        .rev()
-        .map(|v| vec![VarId(v)])
-        .collect();
-    let layout = Layout::from_groups(&p, &groups, 8).unwrap();
-    assert_eq!(layout.slot_count(), 8 * p.vars.len() as u32);
+    // Reverse order, one variable per 64-byte line.
+    let n = p.vars.len() as u32;
+    let groups: Vec<Vec<VarId>> = (0..n).rev().map(|v| vec![VarId(v)]).collect();
+    let layout = Layout::from_groups(&p, &groups, 64).unwrap();
+    assert_eq!(layout.size(), 64 * n);
+    assert_eq!(layout.bytes_of(VarId(0)), 64 * (n - 1)..64 * (n - 1) + 1);
+    let (idx, t1) = (VarId(7), VarId(13));
+    assert_eq!(layout.bytes_of(idx).len(), 2, "an INT is 2 bytes");
     assert_eq!(
-        layout.slots_of(VarId(0)),
-        8 * (p.vars.len() as u32 - 1)..8 * (p.vars.len() as u32 - 1) + 1
-    );
-    let t1 = VarId(13);
-    assert_eq!(
-        layout.slots_of(t1).len(),
-        plc_deps::exec::TIMER_SLOTS as usize
+        layout.bytes_of(t1).len(),
+        plc_deps::exec::TIMER_BYTES as usize
     );
     let padded = Machine::new(&p, layout.clone(), &ExecConfig::default()).unwrap();
     // The same layout through explicit starts.
-    let starts: Vec<u32> = (0..p.vars.len() as u32)
-        .map(|v| layout.start(VarId(v)))
-        .collect();
+    let starts: Vec<u32> = (0..n).map(|v| layout.start(VarId(v)).0).collect();
     assert_eq!(
-        Layout::from_starts(&p, starts, layout.slot_count()).unwrap(),
+        Layout::from_starts(&p, starts, layout.size()).unwrap(),
         layout
     );
+    // Dense: the 12 BOOLs packed first (in declaration order), then the INT, then the timer
+    // on its 8-byte alignment.
+    let dense_layout = dense.layout();
+    assert_eq!(dense_layout.bytes_of(VarId(0)), 0..1);
+    assert_eq!(
+        dense_layout.bytes_of(VarId(8)),
+        7..8,
+        "done follows the seven inputs"
+    );
+    assert_eq!(dense_layout.bytes_of(idx), 12..14);
+    assert_eq!(dense_layout.bytes_of(t1), 16..40);
+    assert_eq!(dense_layout.size(), 40);
     let (mut a, mut b) = (dense.initial_state(), padded.initial_state());
     for scan in 0..100u64 {
         let vals: Vec<(VarId, Value)> = (0..7)
@@ -1283,27 +1289,36 @@ fn padded_permuted_layout_gives_the_same_values() {
 #[test]
 fn bad_layouts_are_refused() {
     use plc_deps::exec::LayoutError;
-    let p = plc_deps::read::program_from_json(KASKAD_POST).unwrap(); // Count, idx
+    let p = plc_deps::read::program_from_json(KASKAD_POST).unwrap(); // Count, idx: 2 INTs
     assert_eq!(
-        Layout::from_starts(&p, vec![0], 2),
+        Layout::from_starts(&p, vec![0], 4),
         Err(LayoutError::WrongLength {
             expected: 2,
             found: 1
         })
     );
     assert_eq!(
-        Layout::from_starts(&p, vec![0, 0], 2),
+        Layout::from_starts(&p, vec![0, 0], 4),
         Err(LayoutError::Overlap { a: 0, b: 1 })
     );
+    assert_eq!(
+        Layout::from_starts(&p, vec![0, 1], 4),
+        Err(LayoutError::Misaligned {
+            var: 1,
+            start: 1,
+            align: 2
+        })
+    );
     assert!(matches!(
-        Layout::from_starts(&p, vec![0, 2], 2),
+        Layout::from_starts(&p, vec![0, 4], 4),
         Err(LayoutError::OutOfRange { var: 1, .. })
     ));
-    assert!(Layout::from_starts(&p, vec![5, 0], 6).is_ok());
+    assert!(Layout::from_starts(&p, vec![6, 0], 8).is_ok());
     assert_eq!(
-        Layout::from_groups(&p, &[vec![VarId(1)], vec![VarId(1)]], 8),
+        Layout::from_groups(&p, &[vec![VarId(1)], vec![VarId(1)]], 64),
         Err(LayoutError::BadVar { var: 1 })
     );
+    assert_eq!(Layout::from_groups(&p, &[], 48), Err(LayoutError::BadAlign));
     let other = plc_deps::read::program_from_json(EXAMPLE_B).unwrap();
     assert!(Machine::new(&p, Layout::dense(&other), &ExecConfig::default()).is_err());
 }

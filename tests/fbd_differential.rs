@@ -459,14 +459,14 @@ fn parallel_scan_equals_sequential_scan_on_random_fbd_programs() {
                 seq.scan(&mut s, scan, &inputs[scan as usize], &mut faults);
                 faults_seen += faults.len();
                 let got = &rec.states[scan as usize];
-                if got != &s.slots {
-                    let slot = got.iter().zip(&s.slots).position(|(x, y)| x != y).unwrap();
+                if got[..] != *s.bytes() {
+                    let byte = got.iter().zip(s.bytes()).position(|(x, y)| x != y).unwrap();
                     let var = (0..p.vars.len() as u32)
                         .map(VarId)
-                        .find(|&v| seq.layout().slots_of(v).contains(&(slot as u32)));
+                        .find(|&v| seq.layout().bytes_of(v).contains(&(byte as u32)));
                     panic!(
-                        "{label}: state differs after scan {scan} at slot {slot} ({})\n{text}\n{}",
-                        var.map_or("loop counter or padding".to_string(), |v| p
+                        "{label}: state differs after scan {scan} at byte {byte} ({})\n{text}\n{}",
+                        var.map_or("loop counter, constant or padding".to_string(), |v| p
                             .var(v)
                             .name
                             .clone()),
@@ -563,7 +563,7 @@ fn fbd_worked_examples_under_forced_parallel_plans() {
                 for scan in 0..scans {
                     let mut faults = Vec::new();
                     seq.scan(&mut s, scan, &inputs[scan as usize], &mut faults);
-                    assert_eq!(rec.states[scan as usize], s.slots, "{label}: scan {scan}");
+                    assert_eq!(rec.states[scan as usize], s.bytes(), "{label}: scan {scan}");
                     assert_eq!(
                         rec.faults[scan as usize], faults,
                         "{label}: faults of scan {scan}"

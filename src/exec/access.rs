@@ -1,31 +1,55 @@
-//! The slots each rung's lowered instructions actually read and write: the ground truth a
+//! The bytes each rung's lowered instructions actually read and write: the ground truth a
 //! parallel plan is checked against (`parallel::check`), independent of the analysis' IN/OUT
 //! sets the plan was built from.
 //!
 //! A rung's instructions run from its `Rung` marker to the next marker (or the end of its POU);
 //! a CALL adds every instruction of the called POU, transitively (whole POUs: which of their
-//! rungs run depends on the data, so all of them count). Instance boxes touch every slot of
-//! their instance; loop-backs their loop counter; FOR heads and tests their index. Constants
-//! are no slots. It deliberately over-approximates (a contact after a taken jump still counts):
-//! a check on it can only be too strict, never too lax.
+//! rungs run depends on the data, so all of them count). Every access is a span of bytes
+//! (address, width), in the width the interpreter loads or stores; instance boxes touch every
+//! byte of their instance; loop-backs their loop counter; FOR heads and tests their index.
+//! Constants are read like variables (no instruction writes them). It deliberately
+//! over-approximates (a contact after a taken jump still counts): a check on it can only be too
+//! strict, never too lax.
 
-use super::layout::{COUNTER_SLOTS, TIMER_SLOTS};
-use super::lower::{Op, CONST};
+use super::layout::{Repr, COUNTER_BYTES, TIMER_BYTES};
+use super::lower::{Op, Pc};
+use super::store::Addr;
 use super::Machine;
 use crate::model::RungId;
 
+/// A span of bytes an instruction reads or writes: (first byte, width).
+pub type Span = (Addr, u32);
+
 impl Machine {
-    /// Appends the slots `rung`'s instructions (and those of the POUs it calls) may read to
+    /// Appends the byte spans `rung`'s instructions (and those of the POUs it calls) may read to
     /// `reads` and may write to `writes` (unsorted, maybe with repeats).
-    pub fn rung_accesses(&self, rung: RungId, reads: &mut Vec<u32>, writes: &mut Vec<u32>) {
-        let mut pous: Vec<u32> = Vec::new();
-        let start = self.rung_op[rung.index()] as usize + 1;
+    pub fn rung_accesses(&self, rung: RungId, reads: &mut Vec<Span>, writes: &mut Vec<Span>) {
+        let mut pous: Vec<Pc> = Vec::new();
+        let start = self.rung_op[rung.index()].index() + 1;
         self.op_accesses(start, true, reads, writes, &mut pous);
         let mut i = 0;
         while i < pous.len() {
-            self.op_accesses(pous[i] as usize, false, reads, writes, &mut pous);
+            self.op_accesses(pous[i].index(), false, reads, writes, &mut pous);
             i += 1;
         }
+    }
+
+    /// One past the last byte any instruction (of any POU) reads or writes.
+    pub(super) fn access_end(&self) -> u64 {
+        let (mut reads, mut writes, mut callees) = (Vec::new(), Vec::new(), Vec::new());
+        let mut end = 0u64;
+        for &entry in &self.pou_entry {
+            reads.clear();
+            writes.clear();
+            self.op_accesses(entry.index(), false, &mut reads, &mut writes, &mut callees);
+            for &(at, w) in reads.iter().chain(&writes) {
+                end = end.max(at.0 as u64 + w as u64);
+            }
+        }
+        for &(_, at) in &self.counters {
+            end = end.max(at.0 as u64 + 8);
+        }
+        end
     }
 
     /// The accesses of the instructions from `pc` to the next rung marker (`one_rung`) or to
@@ -34,15 +58,11 @@ impl Machine {
         &self,
         mut pc: usize,
         one_rung: bool,
-        reads: &mut Vec<u32>,
-        writes: &mut Vec<u32>,
-        pous: &mut Vec<u32>,
+        reads: &mut Vec<Span>,
+        writes: &mut Vec<Span>,
+        pous: &mut Vec<Pc>,
     ) {
-        let read = |x: u32, reads: &mut Vec<u32>| {
-            if x & CONST == 0 {
-                reads.push(x);
-            }
-        };
+        let byte = |a: Addr| (a, 1);
         loop {
             let op = self.ops[pc];
             pc += 1;
@@ -59,42 +79,37 @@ impl Machine {
                 | Op::Jmp { .. }
                 | Op::Ret
                 | Op::End => {}
-                Op::Contact { slot, .. } => reads.push(slot),
-                Op::Contact2 { a, b, .. } => reads.extend([a, b]),
-                Op::Contact3 { a, b, c, .. } => reads.extend([a, b, c]),
-                Op::ContactN { s, .. } => reads.extend(s.iter().map(|&x| x as u32)),
-                Op::Rising { slot, mem } | Op::Falling { slot, mem } => {
-                    reads.extend([slot, mem]);
-                    writes.push(mem);
+                Op::Contact { at, .. } => reads.push(byte(at)),
+                Op::Contact2 { a, b, .. } => reads.extend([byte(a), byte(b)]),
+                Op::Contact3 { a, b, c, .. } => reads.extend([byte(a), byte(b), byte(c)]),
+                Op::ContactN { s, .. } => reads.extend(s.iter().map(|&x| byte(Addr(x as u32)))),
+                Op::Rising { at, mem } | Op::Falling { at, mem } => {
+                    reads.extend([byte(at), byte(mem)]);
+                    writes.push(byte(mem));
                 }
-                Op::CmpInt { a, b, .. } | Op::CmpReal { a, b, .. } => {
-                    read(a, reads);
-                    read(b, reads);
-                }
-                Op::Coil { slot, .. } => writes.push(slot),
+                Op::Cmp { num, a, b, .. } => reads.extend([(a, num.width()), (b, num.width())]),
+                Op::Coil { at, .. } => writes.push(byte(at)),
                 Op::Timer { inst, pt, .. } => {
-                    reads.extend(inst..inst + TIMER_SLOTS);
-                    writes.extend(inst..inst + TIMER_SLOTS);
-                    read(pt, reads);
+                    reads.extend([(inst, TIMER_BYTES), (pt, Repr::I32.width())]);
+                    writes.push((inst, TIMER_BYTES));
                 }
                 Op::Ctu { inst, pv, reset: x } | Op::Ctd { inst, pv, load: x } => {
-                    reads.extend(inst..inst + COUNTER_SLOTS);
-                    writes.extend(inst..inst + COUNTER_SLOTS);
-                    read(pv, reads);
-                    read(x, reads);
+                    reads.extend([(inst, COUNTER_BYTES), (pv, Repr::I16.width()), byte(x)]);
+                    writes.push((inst, COUNTER_BYTES));
                 }
-                Op::Move { from, to } => {
-                    read(from, reads);
-                    writes.push(to);
+                Op::Move { width, from, to } => {
+                    let w = width.bytes();
+                    reads.push((from, w));
+                    writes.push((to, w));
                 }
-                Op::Arith { a, b, out, .. } => {
-                    read(a, reads);
-                    read(b, reads);
-                    writes.push(out);
+                Op::Arith { num, a, b, out, .. } => {
+                    let w = num.width();
+                    reads.extend([(a, w), (b, w)]);
+                    writes.push((out, w));
                 }
                 Op::JmpBack { ctr, .. } => {
-                    reads.push(ctr);
-                    writes.push(ctr);
+                    reads.push((ctr, 8));
+                    writes.push((ctr, 8));
                 }
                 Op::Call { to } => {
                     if !pous.contains(&to) {
@@ -102,19 +117,21 @@ impl Machine {
                     }
                 }
                 Op::For { f } => {
-                    let l = &self.fors[f as usize];
-                    read(l.from, reads);
-                    writes.push(l.var);
+                    let l = &self.fors[f.index()];
+                    let w = l.num.width();
+                    reads.push((l.from, w));
+                    writes.push((l.var, w));
                 }
                 Op::ForTest { f } => {
-                    let l = &self.fors[f as usize];
-                    reads.push(l.var);
-                    read(l.to, reads);
+                    let l = &self.fors[f.index()];
+                    let w = l.num.width();
+                    reads.extend([(l.var, w), (l.to, w)]);
                 }
                 Op::Next { f } => {
-                    let l = &self.fors[f as usize];
-                    reads.extend([l.var, l.ctr]);
-                    writes.extend([l.var, l.ctr]);
+                    let l = &self.fors[f.index()];
+                    let w = l.num.width();
+                    reads.extend([(l.var, w), (l.ctr, 8)]);
+                    writes.extend([(l.var, w), (l.ctr, 8)]);
                 }
             }
         }

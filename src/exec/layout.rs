@@ -1,44 +1,129 @@
-//! Where each variable lives in the slot array.
+//! Where each variable lives in a state's memory: a byte address per variable, every value in its
+//! type's width and aligned to it.
 //!
-//! A scalar (BOOL, INT, DINT, REAL, TIME) takes one slot. A timer instance (TON, TOF, TP) takes
-//! [`TIMER_SLOTS`] slots: Q, ET, PT, then its start time and its state flags. A counter instance
-//! (CTU, CTD) takes [`COUNTER_SLOTS`]: Q, CV, PV, then the CU/CD of its previous evaluation. The
-//! readable fields are at [`field_offset`] from the instance's first slot.
+//! Widths are a function of the type ([`Repr`]): BOOL 1 byte (0 or 1), INT 2, DINT, REAL and
+//! TIME 4. An instance is a small fixed struct whose fields sit at fixed offsets
+//! ([`field_offset`]): a timer (TON, TOF, TP) is Q (1 byte) at 0, its state flags at 1, ET at 4,
+//! PT at 8 and its start time (8 bytes, ms) at 16 — [`TIMER_BYTES`] in all, aligned to 8; a
+//! counter (CTU, CTD) is Q at 0, the CU/CD of its previous evaluation at 1, CV at 2 and PV at 4
+//! — [`COUNTER_BYTES`], aligned to 2. [`parts`] lists every stored value of a type.
 //!
-//! The interpreter never assumes slots are dense or in declaration order: a parallel executor can
-//! permute and pad them (for instance, so that variables written by different workers sit on
-//! different cache lines) with [`Layout::from_groups`] or [`Layout::from_starts`].
+//! The interpreter never assumes variables are dense or in declaration order: a parallel
+//! executor can permute and pad them (so that variables written by different workers sit on
+//! different cache lines) with [`Layout::from_groups`] or [`Layout::from_starts`]. A layout does
+//! not place the machine's constants and loop counters (lowering appends them) and does no
+//! access itself (`store`).
 
+use super::store::Addr;
 use crate::model::{FbKind, Field, Program, Type, VarId};
 use std::ops::Range;
 
-/// Slots of a timer instance (Q, ET, PT, start, flags).
-pub const TIMER_SLOTS: u32 = 5;
-/// Slots of a counter instance (Q, CV, PV, previous CU/CD).
-pub const COUNTER_SLOTS: u32 = 4;
+/// How a scalar type is stored.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum Repr {
+    /// BOOL: one byte, 0 or 1.
+    Bool,
+    /// INT: 16-bit two's complement.
+    I16,
+    /// DINT, TIME (ms): 32-bit two's complement.
+    I32,
+    /// REAL: IEEE 754 single.
+    F32,
+}
 
-pub(crate) const Q: u32 = 0;
-pub(crate) const ET: u32 = 1; // and CV
-pub(crate) const PT: u32 = 2; // and PV
-pub(crate) const START: u32 = 3; // timers: start time (ms, i64 bits)
-pub(crate) const FLAGS: u32 = 4; // timers: state bits
-pub(crate) const PREV: u32 = 3; // counters: CU/CD of the previous evaluation
+impl Repr {
+    /// The representation of a scalar type; `None` for an instance type.
+    pub fn of(ty: Type) -> Option<Repr> {
+        match ty {
+            Type::Bool => Some(Repr::Bool),
+            Type::Int => Some(Repr::I16),
+            Type::Dint | Type::Time => Some(Repr::I32),
+            Type::Real => Some(Repr::F32),
+            Type::Fb(_) => None,
+        }
+    }
 
-/// Number of slots a variable of type `ty` takes.
-pub fn slot_width(ty: Type) -> u32 {
-    match ty {
-        Type::Fb(FbKind::Ton | FbKind::Tof | FbKind::Tp) => TIMER_SLOTS,
-        Type::Fb(FbKind::Ctu | FbKind::Ctd) => COUNTER_SLOTS,
-        _ => 1,
+    /// Width (and alignment) in bytes.
+    pub fn width(self) -> u32 {
+        match self {
+            Repr::Bool => 1,
+            Repr::I16 => 2,
+            Repr::I32 | Repr::F32 => 4,
+        }
     }
 }
 
-/// Offset of an instance field from the instance's first slot: Q 0, ET/CV 1, PT/PV 2.
+/// Bytes of a timer instance.
+pub const TIMER_BYTES: u32 = 24;
+/// Bytes of a counter instance.
+pub const COUNTER_BYTES: u32 = 6;
+
+/// Offsets inside an instance (the readable fields are also at [`field_offset`]).
+pub(crate) const Q: u32 = 0;
+pub(crate) const FLAGS: u32 = 1; // timers: state bits (u8)
+pub(crate) const PREV: u32 = 1; // counters: CU/CD of the previous evaluation (u8)
+pub(crate) const CV: u32 = 2; // counters: i16
+pub(crate) const PV: u32 = 4; // counters: i16
+pub(crate) const ET: u32 = 4; // timers: i32 ms
+pub(crate) const PT: u32 = 8; // timers: i32 ms
+pub(crate) const START: u32 = 16; // timers: start time, i64 ms
+
+const TIMER_PARTS: [(u32, u32); 5] = [(Q, 1), (FLAGS, 1), (ET, 4), (PT, 4), (START, 8)];
+const COUNTER_PARTS: [(u32, u32); 4] = [(Q, 1), (PREV, 1), (CV, 2), (PV, 2)];
+const SCALAR_PARTS: [[(u32, u32); 1]; 3] = [[(0, 1)], [(0, 2)], [(0, 4)]];
+
+// Every part aligned to its width, inside its instance.
+const _: () = {
+    let mut i = 0;
+    while i < TIMER_PARTS.len() {
+        let (o, w) = TIMER_PARTS[i];
+        assert!(o % w == 0 && o + w <= TIMER_BYTES);
+        i += 1;
+    }
+    let mut i = 0;
+    while i < COUNTER_PARTS.len() {
+        let (o, w) = COUNTER_PARTS[i];
+        assert!(o % w == 0 && o + w <= COUNTER_BYTES);
+        i += 1;
+    }
+};
+
+/// Every value a variable of type `ty` stores, as (offset, width) in bytes, in offset order: one
+/// for a scalar; an instance's fields and internal state.
+pub fn parts(ty: Type) -> &'static [(u32, u32)] {
+    match ty {
+        Type::Fb(FbKind::Ton | FbKind::Tof | FbKind::Tp) => &TIMER_PARTS,
+        Type::Fb(FbKind::Ctu | FbKind::Ctd) => &COUNTER_PARTS,
+        scalar => match Repr::of(scalar).map_or(1, Repr::width) {
+            1 => &SCALAR_PARTS[0],
+            2 => &SCALAR_PARTS[1],
+            _ => &SCALAR_PARTS[2],
+        },
+    }
+}
+
+/// Bytes a variable of type `ty` takes.
+pub fn type_size(ty: Type) -> u32 {
+    match ty {
+        Type::Fb(FbKind::Ton | FbKind::Tof | FbKind::Tp) => TIMER_BYTES,
+        Type::Fb(FbKind::Ctu | FbKind::Ctd) => COUNTER_BYTES,
+        scalar => Repr::of(scalar).map_or(1, Repr::width),
+    }
+}
+
+/// The alignment of a variable of type `ty`: its widest part.
+pub fn type_align(ty: Type) -> u32 {
+    parts(ty).iter().map(|&(_, w)| w).max().unwrap_or(1)
+}
+
+/// Offset of an instance field from the instance's address: Q 0, CV 2, ET and PV 4, PT 8.
 pub fn field_offset(field: Field) -> u32 {
     match field {
         Field::Q => Q,
-        Field::Et | Field::Cv => ET,
-        Field::Pt | Field::Pv => PT,
+        Field::Cv => CV,
+        Field::Et => ET,
+        Field::Pv => PV,
+        Field::Pt => PT,
     }
 }
 
@@ -53,19 +138,19 @@ pub enum LayoutError {
         /// Starts given.
         found: usize,
     },
-    /// A variable's slots go past the total.
-    #[error("variable {var} (slots {start}..{end}) does not fit in {total} slots")]
+    /// A variable's bytes go past the total.
+    #[error("variable {var} (bytes {start}..{end}) does not fit in {total} bytes")]
     OutOfRange {
         /// Variable index.
         var: u32,
-        /// First slot.
+        /// First byte.
         start: u32,
-        /// One past its last slot.
+        /// One past its last byte.
         end: u32,
-        /// Total slots of the layout.
+        /// Total bytes of the layout.
         total: u32,
     },
-    /// Two variables share a slot.
+    /// Two variables share a byte.
     #[error("variables {a} and {b} overlap")]
     Overlap {
         /// One variable index.
@@ -73,49 +158,81 @@ pub enum LayoutError {
         /// The other.
         b: u32,
     },
+    /// A variable starts at an address that is not a multiple of its alignment.
+    #[error("variable {var} at byte {start} is not aligned to {align} bytes")]
+    Misaligned {
+        /// Variable index.
+        var: u32,
+        /// Its first byte.
+        start: u32,
+        /// Its alignment.
+        align: u32,
+    },
     /// A variable index is not a variable of the program, or is listed twice.
     #[error("variable {var} is unknown or listed twice")]
     BadVar {
         /// Variable index.
         var: u32,
     },
-    /// An alignment of zero slots.
-    #[error("alignment must be at least one slot")]
-    ZeroAlign,
+    /// An alignment of zero bytes, or one that is not a power of two.
+    #[error("alignment must be a power of two bytes")]
+    BadAlign,
 }
 
-/// The slot of each variable: `slots_of(v) = start(v) .. start(v) + width(v)`.
+/// The address of each variable: `bytes_of(v) = start(v) .. start(v) + size(v)`.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Layout {
-    starts: Vec<u32>,
-    widths: Vec<u32>,
+    starts: Vec<Addr>,
+    sizes: Vec<u32>,
     total: u32,
 }
 
+/// Sizes and alignments of the program's variables.
+fn shapes(p: &Program) -> (Vec<u32>, Vec<u32>) {
+    p.vars
+        .iter()
+        .map(|v| (type_size(v.ty), type_align(v.ty)))
+        .unzip()
+}
+
+/// Places `vars` one after the other from `next`, narrowest alignment first (BOOLs first, then
+/// INTs, …; declaration order within one alignment), each at the lowest address its alignment
+/// allows; returns the end. Narrow first keeps the BOOLs that contacts read at low addresses
+/// (the interpreter fuses contacts on addresses below 2^16) and packed together.
+fn place(vars: &[VarId], sizes: &[u32], aligns: &[u32], starts: &mut [Addr], mut next: u32) -> u32 {
+    let mut order = vars.to_vec();
+    order.sort_by_key(|v| aligns[v.index()]); // stable
+    for v in order {
+        next = next.next_multiple_of(aligns[v.index()]);
+        starts[v.index()] = Addr(next);
+        next += sizes[v.index()];
+    }
+    next
+}
+
 impl Layout {
-    /// Variables one after the other, in declaration order, no padding.
+    /// Every variable packed, narrowest alignment first (declaration order within one
+    /// alignment), with only the padding alignment needs.
     pub fn dense(p: &Program) -> Layout {
-        let widths: Vec<u32> = p.vars.iter().map(|v| slot_width(v.ty)).collect();
-        let mut starts = Vec::with_capacity(widths.len());
-        let mut next = 0u32;
-        for &w in &widths {
-            starts.push(next);
-            next += w;
-        }
+        let (sizes, aligns) = shapes(p);
+        let all: Vec<VarId> = (0..p.vars.len() as u32).map(VarId).collect();
+        let mut starts = vec![Addr(0); sizes.len()];
+        let total = place(&all, &sizes, &aligns, &mut starts, 0);
         Layout {
             starts,
-            widths,
-            total: next,
+            sizes,
+            total,
         }
     }
 
-    /// A layout from explicit first slots (`starts[v]` for variable `v`) and a total slot count.
-    /// Gaps (padding) are allowed; overlaps and slots past `total` are not.
+    /// A layout from explicit first bytes (`starts[v]` for variable `v`) and a total size in
+    /// bytes. Gaps (padding) are allowed; overlaps, misaligned variables and bytes past `total`
+    /// are not.
     pub fn from_starts(p: &Program, starts: Vec<u32>, total: u32) -> Result<Layout, LayoutError> {
-        let widths: Vec<u32> = p.vars.iter().map(|v| slot_width(v.ty)).collect();
-        if starts.len() != widths.len() {
+        let (sizes, aligns) = shapes(p);
+        if starts.len() != sizes.len() {
             return Err(LayoutError::WrongLength {
-                expected: widths.len(),
+                expected: sizes.len(),
                 found: starts.len(),
             });
         }
@@ -123,8 +240,15 @@ impl Layout {
         order.sort_unstable_by_key(|&v| starts[v as usize]);
         let mut prev: Option<(u32, u32)> = None; // (var, end)
         for &v in &order {
-            let start = starts[v as usize];
-            let end = start as u64 + widths[v as usize] as u64;
+            let (start, align) = (starts[v as usize], aligns[v as usize]);
+            if start % align != 0 {
+                return Err(LayoutError::Misaligned {
+                    var: v,
+                    start,
+                    align,
+                });
+            }
+            let end = start as u64 + sizes[v as usize] as u64;
             if end > total as u64 {
                 return Err(LayoutError::OutOfRange {
                     var: v,
@@ -141,69 +265,78 @@ impl Layout {
             prev = Some((v, end as u32));
         }
         Ok(Layout {
-            starts,
-            widths,
+            starts: starts.into_iter().map(Addr).collect(),
+            sizes,
             total,
         })
     }
 
-    /// Groups of variables, each group dense and starting at a multiple of `align` slots; the
-    /// variables in no group follow, in declaration order, in a last aligned group. The total is
-    /// rounded up to `align`. With `align = 8` (64-byte lines of 8-byte slots), variables of
-    /// different groups never share a cache line.
+    /// Groups of variables, each group packed (as [`dense`](Self::dense) packs) from a multiple
+    /// of `align` bytes; the variables in no group follow, in a last aligned group. The total is
+    /// rounded up to `align`. With `align = 64` (a cache line; state memory starts on one),
+    /// variables of different groups never share a cache line.
     pub fn from_groups(
         p: &Program,
         groups: &[Vec<VarId>],
         align: u32,
     ) -> Result<Layout, LayoutError> {
-        if align == 0 {
-            return Err(LayoutError::ZeroAlign);
+        if !align.is_power_of_two() {
+            return Err(LayoutError::BadAlign);
         }
         let n = p.vars.len();
-        let widths: Vec<u32> = p.vars.iter().map(|v| slot_width(v.ty)).collect();
-        let mut starts = vec![u32::MAX; n];
+        let (sizes, aligns) = shapes(p);
+        let mut starts = vec![Addr(0); n];
+        let mut placed = vec![false; n];
         let mut next = 0u32;
-        let round = |x: u32| x.div_ceil(align) * align;
         for g in groups {
-            next = round(next);
             for &v in g {
-                if v.index() >= n || starts[v.index()] != u32::MAX {
+                if v.index() >= n || placed[v.index()] {
                     return Err(LayoutError::BadVar { var: v.0 });
                 }
-                starts[v.index()] = next;
-                next += widths[v.index()];
+                placed[v.index()] = true;
             }
+            next = place(
+                g,
+                &sizes,
+                &aligns,
+                &mut starts,
+                next.next_multiple_of(align),
+            );
         }
-        next = round(next);
-        for v in 0..n {
-            if starts[v] == u32::MAX {
-                starts[v] = next;
-                next += widths[v];
-            }
-        }
+        let rest: Vec<VarId> = (0..n as u32)
+            .map(VarId)
+            .filter(|v| !placed[v.index()])
+            .collect();
+        next = place(
+            &rest,
+            &sizes,
+            &aligns,
+            &mut starts,
+            next.next_multiple_of(align),
+        );
         Ok(Layout {
             starts,
-            widths,
-            total: round(next),
+            sizes,
+            total: next.next_multiple_of(align),
         })
     }
 
-    /// The slots of `var` (its fields and internal state for an instance).
+    /// The bytes of `var` (its fields and internal state for an instance).
     #[inline]
-    pub fn slots_of(&self, var: VarId) -> Range<u32> {
-        let s = self.starts[var.index()];
-        s..s + self.widths[var.index()]
+    pub fn bytes_of(&self, var: VarId) -> Range<u32> {
+        let s = self.starts[var.index()].0;
+        s..s + self.sizes[var.index()]
     }
 
-    /// The first slot of `var`.
+    /// The address of `var`.
     #[inline]
-    pub fn start(&self, var: VarId) -> u32 {
+    pub fn start(&self, var: VarId) -> Addr {
         self.starts[var.index()]
     }
 
-    /// Total number of slots of the variables (a machine adds its loop counters after them:
-    /// the length of a state's slot array is [`Machine::slot_count`](super::Machine::slot_count)).
-    pub fn slot_count(&self) -> u32 {
+    /// Total bytes of the variables (a machine adds its constants and loop counters after them:
+    /// the length of a state's memory is [`Machine::state_size`](super::Machine::state_size)).
+    pub fn size(&self) -> u32 {
         self.total
     }
 

@@ -3,30 +3,42 @@
 //! Every POU is a run of instructions: for each rung a [`Op::Rung`] marker then its elements in
 //! evaluation order, and after its last rung an [`Op::EndPou`]. Falling through from one rung to
 //! the next is just executing the next instruction. Jumps, calls and FOR exits carry
-//! instruction indices, patched once all rungs are placed. Operands are slot indices, or (high
-//! bit set) indices into a constant pool of already encoded values.
+//! instruction indices ([`Pc`]), patched once all rungs are placed. Operands are byte addresses
+//! ([`Addr`]) in the state: a variable's (from the [`Layout`]), or a constant's: constants live
+//! in the state too, after the loop counters, written once by `Machine::initial_state` and
+//! never again, so an operand is always a plain typed load (no constant pool, no tag bit).
+//!
+//! The state's memory is therefore: the layout's variables; from the next 64-byte line, one line
+//! per loop counter (a `u64`); then the constants, each aligned to its width.
 //!
 //! The interpreter keeps the power flow in a register `p` (0 or 1) and the powers saved by
 //! `or` and `branch` in a 64-bit stack `s` (an `or` uses two bits: its power in and the OR of
 //! its branches so far; a `branch` one: its power in). Lowering refuses nesting deeper than that.
 
-use super::layout::{field_offset, Layout};
-use super::value::encode;
+use super::layout::{field_offset, type_align, Layout, Repr};
+use super::mem::LINE_BYTES;
+use super::store::Addr;
 use crate::model::*;
 
 /// Output modes of [`Op::Coil`]: bit 0 = the value written when powered, bit 1 = no write when
 /// unpowered (set/reset), bit 2 = the value written when unpowered otherwise. One instruction
 /// for every output keeps the dispatch after a rung's conditions uniform (set/reset among coils
 /// made it mispredict: −15 % per rung on generated programs).
-pub(crate) const OUT_COIL: u32 = 0b001;
-pub(crate) const OUT_NCOIL: u32 = 0b100;
-pub(crate) const OUT_SET: u32 = 0b011;
-pub(crate) const OUT_RESET: u32 = 0b010;
+pub(crate) const OUT_COIL: u8 = 0b001;
+pub(crate) const OUT_NCOIL: u8 = 0b100;
+pub(crate) const OUT_SET: u8 = 0b011;
+pub(crate) const OUT_RESET: u8 = 0b010;
 
-/// Marks an operand as an index into the constant pool.
-pub(crate) const CONST: u32 = 1 << 31;
+index_type!(
+    /// An instruction: index into the machine's instruction array.
+    Pc
+);
+index_type!(
+    /// A FOR/NEXT loop: index into the machine's loops.
+    ForId
+);
 
-/// Numeric representation of an arithmetic or FOR variable.
+/// Numeric representation of a compare, an arithmetic box or a FOR index.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub(crate) enum Num {
     /// INT: wraps at 16 bits.
@@ -39,38 +51,77 @@ pub(crate) enum Num {
 
 impl Num {
     fn of(ty: Type) -> Num {
-        match ty {
-            Type::Int => Num::I16,
-            Type::Real => Num::F32,
+        match Repr::of(ty) {
+            Some(Repr::I16) => Num::I16,
+            Some(Repr::F32) => Num::F32,
             _ => Num::I32,
+        }
+    }
+
+    /// Bytes of a value of this representation.
+    pub(crate) fn width(self) -> u32 {
+        match self {
+            Num::I16 => Repr::I16.width(),
+            Num::I32 => Repr::I32.width(),
+            Num::F32 => Repr::F32.width(),
         }
     }
 }
 
-/// One instruction. Small (16 bytes) and `Copy`; fields are slot indices (`u32`), operands
-/// (`u32`, slot or [`CONST`]-marked pool index) and instruction indices.
+/// Bytes a MOVE copies: the width of its type (for an instance, whose first stored value is
+/// its Q, that byte).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub(crate) enum Width {
+    W1,
+    W2,
+    W4,
+}
+
+impl Width {
+    fn of(ty: Type) -> Width {
+        match Repr::of(ty).map_or(1, Repr::width) {
+            1 => Width::W1,
+            2 => Width::W2,
+            _ => Width::W4,
+        }
+    }
+
+    /// The bytes copied.
+    pub(crate) fn bytes(self) -> u32 {
+        match self {
+            Width::W1 => 1,
+            Width::W2 => 2,
+            Width::W4 => 4,
+        }
+    }
+}
+
+/// One instruction. Small (16 bytes) and `Copy`; operands are byte addresses of the state.
 #[derive(Copy, Clone, Debug)]
 pub(crate) enum Op {
     /// Start of a rung: leave if the rung is outside the region being run; power := TRUE.
-    Rung { id: u32 },
-    /// Contact on a BOOL slot: `p &= slot ^ neg` (`neg` 0 or 1).
-    Contact { neg: u8, slot: u32 },
+    Rung { id: RungId },
+    /// Contact on a BOOL byte: `p &= v ^ neg` (`neg` 0 or 1).
+    Contact { neg: u8, at: Addr },
     /// Two consecutive contacts (negation bits 0 and 1 of `neg`).
-    Contact2 { neg: u8, a: u32, b: u32 },
+    Contact2 { neg: u8, a: Addr, b: Addr },
     /// Three consecutive contacts (negation bits 0, 1 and 2 of `neg`).
-    Contact3 { neg: u8, a: u32, b: u32, c: u32 },
-    /// Four to six consecutive contacts on slots below 2^16 (negation bit k for contact k): one
+    Contact3 { neg: u8, a: Addr, b: Addr, c: Addr },
+    /// Four to six consecutive contacts on bytes below 2^16 (negation bit k for contact k): one
     /// dispatch and 16 bytes for what is most of a typical rung. Entries past `n` repeat `s[0]`
-    /// (a slot the rung reads anyway) and are masked out.
+    /// (a byte the rung reads anyway) and are masked out.
     ContactN { n: u8, neg: u8, s: [u16; 6] },
-    /// Rising-edge contact with its memory slot.
-    Rising { slot: u32, mem: u32 },
-    /// Falling-edge contact with its memory slot.
-    Falling { slot: u32, mem: u32 },
-    /// Compare of two integer operands (INT, DINT, TIME: all sign-extended, compared as i64).
-    CmpInt { op: CmpOp, a: u32, b: u32 },
-    /// Compare of two REAL operands.
-    CmpReal { op: CmpOp, a: u32, b: u32 },
+    /// Rising-edge contact with its memory byte.
+    Rising { at: Addr, mem: Addr },
+    /// Falling-edge contact with its memory byte.
+    Falling { at: Addr, mem: Addr },
+    /// Compare of two operands of one numeric type.
+    Cmp {
+        op: CmpOp,
+        num: Num,
+        a: Addr,
+        b: Addr,
+    },
     /// `or`: push power in and an empty OR.
     OrOpen,
     /// `or`, between branches: OR in this branch's power, restart from the power in.
@@ -83,44 +134,48 @@ pub(crate) enum Op {
     BrNext,
     /// `branch`, after its last branch: power := the power in; pop.
     BrClose,
-    /// Any output (coil, negated coil, set, reset; `neg` is the mode, see [`OUT_COIL`]):
-    /// powered, `slot := on`; unpowered, `slot := off` unless the mode keeps it.
-    Coil { slot: u32, neg: u32 },
-    /// Timer box on the instance starting at `inst`.
-    Timer { kind: TimerKind, inst: u32, pt: u32 },
+    /// Any output (coil, negated coil, set, reset; `mode` as [`OUT_COIL`]): powered,
+    /// `v := on`; unpowered, `v := off` unless the mode keeps it.
+    Coil { at: Addr, mode: u8 },
+    /// Timer box on the instance at `inst`.
+    Timer {
+        kind: TimerKind,
+        inst: Addr,
+        pt: Addr,
+    },
     /// CTU box.
-    Ctu { inst: u32, pv: u32, reset: u32 },
+    Ctu { inst: Addr, pv: Addr, reset: Addr },
     /// CTD box.
-    Ctd { inst: u32, pv: u32, load: u32 },
+    Ctd { inst: Addr, pv: Addr, load: Addr },
     /// MOVE box.
-    Move { from: u32, to: u32 },
+    Move { width: Width, from: Addr, to: Addr },
     /// Arithmetic box.
     Arith {
         op: ArithOp,
         num: Num,
-        a: u32,
-        b: u32,
-        out: u32,
+        a: Addr,
+        b: Addr,
+        out: Addr,
     },
-    /// Forward jump to the instruction index `to` (a `Rung`).
-    Jmp { to: u32 },
+    /// Forward jump to the instruction `to` (a `Rung`).
+    Jmp { to: Pc },
     /// Backward (or same-rung) jump: a loop-back. Counts one iteration in the rung's loop counter
-    /// slot `ctr`; past the cap the jump is refused: it acts as an unpowered jump (power := 0).
-    JmpBack { to: u32, ctr: u32 },
+    /// at `ctr`; past the cap the jump is refused: it acts as an unpowered jump (power := 0).
+    JmpBack { to: Pc, ctr: Addr },
     /// RET.
     Ret,
     /// END.
     End,
     /// CALL: run the POU whose first instruction is `to`.
-    Call { to: u32 },
+    Call { to: Pc },
     /// FOR head (after the head rung's conditions): when powered, `var := from` and on to the
     /// [`Op::ForTest`] that always follows; otherwise to the loop's exit.
-    For { f: u32 },
+    For { f: ForId },
     /// FOR test: `var <= to` enters the body (next instruction), otherwise to the loop's exit.
-    ForTest { f: u32 },
-    /// NEXT: a loop-back counted in the loop's counter slot; `var += 1`, back to the FOR test.
+    ForTest { f: ForId },
+    /// NEXT: a loop-back counted in the loop's counter; `var += 1`, back to the FOR test.
     /// Past the cap: no increment, on to the loop's exit.
-    Next { f: u32 },
+    Next { f: ForId },
     /// After the last rung of a POU.
     EndPou,
 }
@@ -130,37 +185,38 @@ const _: () = assert!(std::mem::size_of::<Op>() <= 16);
 /// One FOR/NEXT loop.
 #[derive(Copy, Clone, Debug)]
 pub(crate) struct ForLoop {
-    /// The index variable's slot.
-    pub var: u32,
+    /// The index variable.
+    pub var: Addr,
     pub num: Num,
-    pub from: u32,
-    pub to: u32,
-    /// Instruction index of its `ForTest`.
-    pub test: u32,
-    /// Instruction index of the loop exit (the rung after NEXT, or the POU's `EndPou`).
-    pub exit: u32,
+    pub from: Addr,
+    pub to: Addr,
+    /// Its `ForTest`.
+    pub test: Pc,
+    /// The loop exit (the rung after NEXT, or the POU's `EndPou`).
+    pub exit: Pc,
     /// The FOR head rung.
-    pub head: u32,
-    /// The loop counter slot of the NEXT rung.
-    pub ctr: u32,
+    pub head: RungId,
+    /// The loop counter of the NEXT rung.
+    pub ctr: Addr,
 }
 
 /// The lowered program.
 pub(crate) struct Code {
     pub ops: Vec<Op>,
-    pub consts: Vec<u64>,
+    /// The constants and where they live (written by `Machine::initial_state`).
+    pub consts: Vec<(Addr, Value)>,
     pub fors: Vec<ForLoop>,
-    /// Instruction index of each rung's `Rung` marker.
-    pub rung_op: Vec<u32>,
-    /// For each rung: the index into `fors` if it is a FOR head.
-    pub for_of_head: Vec<Option<u32>>,
-    /// Instruction index of each POU's first instruction.
-    pub pou_entry: Vec<u32>,
-    /// Loop-back rungs (a NEXT, or a rung with a backward jump) and their counter slots, in rung
+    /// Each rung's `Rung` marker.
+    pub rung_op: Vec<Pc>,
+    /// For each rung: its loop if it is a FOR head.
+    pub for_of_head: Vec<Option<ForId>>,
+    /// Each POU's first instruction.
+    pub pou_entry: Vec<Pc>,
+    /// Loop-back rungs (a NEXT, or a rung with a backward jump) and their counters, in rung
     /// order.
-    pub counters: Vec<(u32, u32)>,
-    /// Slots of the whole store: the layout's, then one 8-slot line per loop counter.
-    pub slot_count: u32,
+    pub counters: Vec<(RungId, Addr)>,
+    /// Bytes of the whole state: variables, loop counters, constants.
+    pub size: u32,
 }
 
 /// Why a program could not be lowered.
@@ -182,8 +238,8 @@ pub enum LowerError {
         /// Power-stack bits the rung needs.
         bits: u32,
     },
-    /// The program has more than 2^31 slots, constants or instructions.
-    #[error("the program is too large for 31-bit slot and instruction indices")]
+    /// The program's state or instructions do not fit 32-bit addresses and indices.
+    #[error("the program is too large for 32-bit state addresses and instruction indices")]
     TooLarge,
 }
 
@@ -191,15 +247,44 @@ struct Lowerer<'p> {
     p: &'p Program,
     layout: &'p Layout,
     code: Code,
-    /// (instruction index, target rung) of jumps; (instruction, pou) of calls.
+    /// (instruction, target rung) of jumps; (instruction, pou) of calls.
     jumps: Vec<(usize, RungId)>,
     calls: Vec<(usize, PouId)>,
-    /// (for index, NEXT rung) to patch the exits.
-    for_nexts: Vec<(usize, RungId)>,
-    /// First slot of the loop counters (the layout's total rounded up to a cache line).
-    counter_base: u32,
+    /// (loop, NEXT rung) to patch the exits.
+    for_nexts: Vec<(ForId, RungId)>,
+    /// The loop counter of each loop-back rung (see [`loop_counters`]).
+    counter_of: Vec<Option<Addr>>,
+    /// Where the next constant goes (past the loop counters).
+    next_const: u64,
     depth: u32,
     max_depth: u32,
+}
+
+/// Whether `series` (of rung `rung`) holds a loop-back: a NEXT, or a jump to `rung` or an
+/// earlier rung.
+fn loops_back(rung: RungId, series: &[Element]) -> bool {
+    series.iter().any(|e| match e {
+        Element::Next { .. } => true,
+        Element::Jmp { target, .. } => *target <= rung,
+        Element::Or(bs) | Element::Branch(bs) => bs.iter().any(|b| loops_back(rung, b)),
+        _ => false,
+    })
+}
+
+/// The loop counters: one `u64` per loop-back rung, each on its own 64-byte line from the line
+/// after the layout's variables (so that loops run by different workers of a parallel scan
+/// never write one cache line), in rung order; and the end of the last one.
+fn loop_counters(p: &Program, layout: &Layout) -> (Vec<(RungId, Addr)>, u64) {
+    let mut next = layout.size().next_multiple_of(LINE_BYTES) as u64;
+    let mut counters = Vec::new();
+    for (r, rung) in p.rungs.iter().enumerate() {
+        let r = RungId(r as u32);
+        if loops_back(r, &rung.series) {
+            counters.push((r, Addr(next.min(u32::MAX as u64) as u32)));
+            next += LINE_BYTES as u64;
+        }
+    }
+    (counters, next)
 }
 
 pub(crate) fn lower(p: &Program, layout: &Layout) -> Result<Code, LowerError> {
@@ -209,8 +294,10 @@ pub(crate) fn lower(p: &Program, layout: &Layout) -> Result<Code, LowerError> {
             found: layout.var_count(),
         });
     }
-    if layout.slot_count() >= CONST {
-        return Err(LowerError::TooLarge);
+    let (counters, counters_end) = loop_counters(p, layout);
+    let mut counter_of = vec![None; p.rungs.len()];
+    for &(r, at) in &counters {
+        counter_of[r.index()] = Some(at);
     }
     let mut l = Lowerer {
         p,
@@ -219,26 +306,27 @@ pub(crate) fn lower(p: &Program, layout: &Layout) -> Result<Code, LowerError> {
             ops: Vec::new(),
             consts: Vec::new(),
             fors: Vec::new(),
-            rung_op: vec![0; p.rungs.len()],
+            rung_op: vec![Pc(0); p.rungs.len()],
             for_of_head: vec![None; p.rungs.len()],
             pou_entry: Vec::with_capacity(p.pous.len()),
-            counters: Vec::new(),
-            slot_count: 0,
+            counters,
+            size: 0,
         },
         jumps: Vec::new(),
         calls: Vec::new(),
         for_nexts: Vec::new(),
-        counter_base: layout.slot_count().div_ceil(COUNTER_STRIDE) * COUNTER_STRIDE,
+        counter_of,
+        next_const: counters_end,
         depth: 0,
         max_depth: 0,
     };
     let mut pou_end = Vec::with_capacity(p.pous.len());
     for pou in &p.pous {
-        l.code.pou_entry.push(l.code.ops.len() as u32);
+        l.code.pou_entry.push(l.pc());
         for r in pou.rungs.clone() {
             let rung = &p.rungs[r as usize];
-            l.code.rung_op[r as usize] = l.code.ops.len() as u32;
-            l.code.ops.push(Op::Rung { id: r });
+            l.code.rung_op[r as usize] = l.pc();
+            l.code.ops.push(Op::Rung { id: RungId(r) });
             l.depth = 0;
             l.max_depth = 0;
             l.series(RungId(r), &rung.series);
@@ -249,21 +337,14 @@ pub(crate) fn lower(p: &Program, layout: &Layout) -> Result<Code, LowerError> {
                 });
             }
         }
-        pou_end.push(l.code.ops.len() as u32);
+        pou_end.push(l.pc());
         l.code.ops.push(Op::EndPou);
     }
-    let total = l.counter_base as u64 + COUNTER_STRIDE as u64 * l.code.counters.len() as u64;
-    if l.code.ops.len() >= CONST as usize
-        || l.code.consts.len() >= CONST as usize
-        || total >= CONST as u64
-    {
+    // The whole state (and one more value past it) must have 32-bit addresses.
+    if l.code.ops.len() >= u32::MAX as usize || l.next_const + 8 >= u32::MAX as u64 {
         return Err(LowerError::TooLarge);
     }
-    l.code.slot_count = if l.code.counters.is_empty() {
-        layout.slot_count()
-    } else {
-        total as u32
-    };
+    l.code.size = l.next_const as u32;
     let Lowerer {
         mut code,
         jumps,
@@ -278,7 +359,6 @@ pub(crate) fn lower(p: &Program, layout: &Layout) -> Result<Code, LowerError> {
             _ => unreachable!("jump patch on a jump"),
         }
     }
-
     for (at, pou) in calls {
         if let Op::Call { to } = &mut code.ops[at] {
             *to = code.pou_entry[pou.index()];
@@ -287,7 +367,7 @@ pub(crate) fn lower(p: &Program, layout: &Layout) -> Result<Code, LowerError> {
     for (f, next) in for_nexts {
         let pou = p.rung(next).pou;
         let after = next.0 + 1;
-        code.fors[f].exit = if after < p.pou(pou).rungs.end {
+        code.fors[f.index()].exit = if after < p.pou(pou).rungs.end {
             code.rung_op[after as usize]
         } else {
             pou_end[pou.index()]
@@ -296,41 +376,39 @@ pub(crate) fn lower(p: &Program, layout: &Layout) -> Result<Code, LowerError> {
     Ok(code)
 }
 
-/// Loop counters sit one per 8-slot (64-byte) line, so that loops run by different workers of a
-/// parallel scan never write the same cache line.
-pub(crate) const COUNTER_STRIDE: u32 = 8;
-
 impl Lowerer<'_> {
-    /// The loop counter slot of `rung`, allocated on first use (rungs are lowered in order, so
-    /// a rung's counter is always the last one allocated, if any).
-    fn counter(&mut self, rung: RungId) -> u32 {
-        match self.code.counters.last() {
-            Some(&(r, slot)) if r == rung.0 => slot,
-            _ => {
-                let slot = self.counter_base + COUNTER_STRIDE * self.code.counters.len() as u32;
-                self.code.counters.push((rung.0, slot));
-                slot
-            }
-        }
+    /// The next instruction's index.
+    fn pc(&self) -> Pc {
+        Pc(self.code.ops.len() as u32)
     }
 
-    fn slot(&self, r: VarRef) -> u32 {
-        self.layout.start(r.var) + r.field.map_or(0, field_offset)
+    /// The loop counter of loop-back rung `rung`.
+    fn counter(&self, rung: RungId) -> Addr {
+        self.counter_of[rung.index()].expect("a loop-back rung has a counter")
     }
 
-    fn operand(&mut self, o: &Operand) -> u32 {
+    fn addr(&self, r: VarRef) -> Addr {
+        self.layout
+            .start(r.var)
+            .offset(r.field.map_or(0, field_offset))
+    }
+
+    fn operand(&mut self, o: &Operand) -> Addr {
         match o {
-            Operand::Var(r) => self.slot(*r),
+            Operand::Var(r) => self.addr(*r),
             Operand::Const(v) => {
-                let bits = encode(*v);
-                let i = match self.code.consts.iter().position(|&c| c == bits) {
-                    Some(i) => i,
-                    None => {
-                        self.code.consts.push(bits);
-                        self.code.consts.len() - 1
-                    }
-                };
-                CONST | i as u32
+                // Equal constants of one type share their bytes (`Value` equality would merge
+                // 0.0 with -0.0 and never NaN with itself: compare the stored bits).
+                let same = |c: &Value| c.ty() == v.ty() && bits(*c) == bits(*v);
+                if let Some(&(at, _)) = self.code.consts.iter().find(|(_, c)| same(c)) {
+                    return at;
+                }
+                let align = type_align(v.ty()) as u64;
+                let at = self.next_const.next_multiple_of(align);
+                self.next_const = at + align;
+                let at = Addr(at.min(u32::MAX as u64) as u32);
+                self.code.consts.push((at, *v));
+                at
             }
         }
     }
@@ -356,39 +434,42 @@ impl Lowerer<'_> {
 
     /// Emits a plain contact, fused with the previous instruction when that is a plain contact
     /// (or a pair). Sound because no jump or FOR ever targets a contact instruction.
-    fn contact(&mut self, slot: u32, neg: u8) {
+    fn contact(&mut self, at: Addr, neg: u8) {
+        let short = |a: Addr| u16::try_from(a.0).ok();
         match self.code.ops.last_mut() {
-            Some(Op::Contact { neg: n, slot: a }) => {
+            Some(&mut Op::Contact { neg: n, at: a }) => {
                 *self.code.ops.last_mut().unwrap() = Op::Contact2 {
-                    neg: *n | neg << 1,
-                    a: *a,
-                    b: slot,
+                    neg: n | neg << 1,
+                    a,
+                    b: at,
                 }
             }
-            Some(Op::Contact2 { neg: n, a, b }) => {
+            Some(&mut Op::Contact2 { neg: n, a, b }) => {
                 *self.code.ops.last_mut().unwrap() = Op::Contact3 {
-                    neg: *n | neg << 2,
-                    a: *a,
-                    b: *b,
-                    c: slot,
+                    neg: n | neg << 2,
+                    a,
+                    b,
+                    c: at,
                 }
             }
-            Some(&mut Op::Contact3 { neg: n, a, b, c })
-                if a.max(b).max(c).max(slot) <= u16::MAX as u32 =>
-            {
-                let a = a as u16;
-                *self.code.ops.last_mut().unwrap() = Op::ContactN {
-                    n: 4,
-                    neg: n | neg << 3,
-                    s: [a, b as u16, c as u16, slot as u16, a, a],
+            Some(&mut Op::Contact3 { neg: n, a, b, c }) => {
+                match (short(a), short(b), short(c), short(at)) {
+                    (Some(a), Some(b), Some(c), Some(d)) => {
+                        *self.code.ops.last_mut().unwrap() = Op::ContactN {
+                            n: 4,
+                            neg: n | neg << 3,
+                            s: [a, b, c, d, a, a],
+                        }
+                    }
+                    _ => self.code.ops.push(Op::Contact { neg, at }),
                 }
             }
-            Some(Op::ContactN { n, neg: ng, s }) if *n < 6 && slot <= u16::MAX as u32 => {
-                s[*n as usize] = slot as u16;
+            Some(Op::ContactN { n, neg: ng, s }) if *n < 6 && short(at).is_some() => {
+                s[*n as usize] = at.0 as u16;
                 *ng |= neg << *n;
                 *n += 1;
             }
-            _ => self.code.ops.push(Op::Contact { neg, slot }),
+            _ => self.code.ops.push(Op::Contact { neg, at }),
         }
     }
 
@@ -403,75 +484,57 @@ impl Lowerer<'_> {
         }
     }
 
+    /// `or` / `branch`: the opening, the separators between branches and the closing.
+    fn branches(&mut self, rung: RungId, branches: &[Series], ops: [Op; 3], bits: u32) {
+        self.grow(bits);
+        self.push(ops[0]);
+        for (i, b) in branches.iter().enumerate() {
+            if i > 0 {
+                self.push(ops[1]);
+            }
+            self.series(rung, b);
+        }
+        self.push(ops[2]);
+        self.depth -= bits;
+    }
+
+    fn coil(&mut self, var: VarId, mode: u8) {
+        let at = self.layout.start(var);
+        self.push(Op::Coil { at, mode });
+    }
+
     fn element(&mut self, rung: RungId, e: &Element) {
         match e {
             Element::Contact { var, kind } => {
-                let slot = self.slot(*var);
+                let at = self.addr(*var);
                 let op = match kind {
-                    ContactKind::Normal => return self.contact(slot, 0),
-                    ContactKind::Negated => return self.contact(slot, 1),
+                    ContactKind::Normal => return self.contact(at, 0),
+                    ContactKind::Negated => return self.contact(at, 1),
                     ContactKind::Rising { memory } => Op::Rising {
-                        slot,
+                        at,
                         mem: self.layout.start(*memory),
                     },
                     ContactKind::Falling { memory } => Op::Falling {
-                        slot,
+                        at,
                         mem: self.layout.start(*memory),
                     },
                 };
                 self.push(op);
             }
             Element::Compare { op, a, b } => {
-                let real = self.operand_type(a) == Type::Real;
+                let num = Num::of(self.operand_type(a));
                 let (a, b) = (self.operand(a), self.operand(b));
-                self.push(if real {
-                    Op::CmpReal { op: *op, a, b }
-                } else {
-                    Op::CmpInt { op: *op, a, b }
-                });
+                self.push(Op::Cmp { op: *op, num, a, b });
             }
-            Element::Or(branches) => {
-                self.grow(2);
-                self.push(Op::OrOpen);
-                for (i, b) in branches.iter().enumerate() {
-                    if i > 0 {
-                        self.push(Op::OrNext);
-                    }
-                    self.series(rung, b);
-                }
-                self.push(Op::OrClose);
-                self.depth -= 2;
-            }
-            Element::Branch(branches) => {
-                self.grow(1);
-                self.push(Op::BrOpen);
-                for (i, b) in branches.iter().enumerate() {
-                    if i > 0 {
-                        self.push(Op::BrNext);
-                    }
-                    self.series(rung, b);
-                }
-                self.push(Op::BrClose);
-                self.depth -= 1;
+            Element::Or(bs) => self.branches(rung, bs, [Op::OrOpen, Op::OrNext, Op::OrClose], 2),
+            Element::Branch(bs) => {
+                self.branches(rung, bs, [Op::BrOpen, Op::BrNext, Op::BrClose], 1)
             }
             Element::Coil { var, negated } => {
-                let slot = self.layout.start(*var);
-                self.push(Op::Coil {
-                    slot,
-                    neg: if *negated { OUT_NCOIL } else { OUT_COIL },
-                });
+                self.coil(*var, if *negated { OUT_NCOIL } else { OUT_COIL })
             }
-            Element::Set(v) => {
-                let slot = self.layout.start(*v);
-                self.push(Op::Coil { slot, neg: OUT_SET });
-            }
-            Element::Reset(v) => {
-                let slot = self.layout.start(*v);
-                self.push(Op::Coil {
-                    slot,
-                    neg: OUT_RESET,
-                });
-            }
+            Element::Set(v) => self.coil(*v, OUT_SET),
+            Element::Reset(v) => self.coil(*v, OUT_RESET),
             Element::Timer { kind, instance, pt } => {
                 let inst = self.layout.start(*instance);
                 let pt = self.operand(pt);
@@ -496,9 +559,10 @@ impl Lowerer<'_> {
                 self.push(Op::Ctd { inst, pv, load });
             }
             Element::Move { from, to } => {
+                let width = Width::of(self.p.var(*to).ty);
                 let from = self.operand(from);
                 let to = self.layout.start(*to);
-                self.push(Op::Move { from, to });
+                self.push(Op::Move { width, from, to });
             }
             Element::Arith { op, a, b, out } => {
                 let num = Num::of(self.p.var(*out).ty);
@@ -514,18 +578,18 @@ impl Lowerer<'_> {
             }
             Element::Jmp { target, .. } => {
                 self.jumps.push((self.code.ops.len(), *target));
-                if target.0 <= rung.0 {
+                if *target <= rung {
                     let ctr = self.counter(rung);
-                    self.push(Op::JmpBack { to: 0, ctr });
+                    self.push(Op::JmpBack { to: Pc(0), ctr });
                 } else {
-                    self.push(Op::Jmp { to: 0 });
+                    self.push(Op::Jmp { to: Pc(0) });
                 }
             }
             Element::Ret => self.push(Op::Ret),
             Element::End => self.push(Op::End),
             Element::Call { pou } => {
                 self.calls.push((self.code.ops.len(), *pou));
-                self.push(Op::Call { to: 0 });
+                self.push(Op::Call { to: Pc(0) });
             }
             Element::For {
                 var,
@@ -533,32 +597,41 @@ impl Lowerer<'_> {
                 to,
                 next,
             } => {
-                let f = self.code.fors.len();
+                let f = ForId(self.code.fors.len() as u32);
                 let (from, to) = (self.operand(from), self.operand(to));
-                let test = self.code.ops.len() as u32 + 1;
+                let test = Pc(self.pc().0 + 1);
                 self.code.fors.push(ForLoop {
                     var: self.layout.start(*var),
                     num: Num::of(self.p.var(*var).ty),
                     from,
                     to,
                     test,
-                    exit: 0,
-                    head: rung.0,
-                    ctr: 0,
+                    exit: Pc(0),
+                    head: rung,
+                    ctr: Addr(0),
                 });
-                self.code.for_of_head[rung.index()] = Some(f as u32);
+                self.code.for_of_head[rung.index()] = Some(f);
                 self.for_nexts.push((f, *next));
-                self.push(Op::For { f: f as u32 });
-                self.push(Op::ForTest { f: f as u32 });
+                self.push(Op::For { f });
+                self.push(Op::ForTest { f });
             }
             Element::Next { head } => {
                 // FOR heads come before their NEXT, so the head is already lowered.
                 let f = self.code.for_of_head[head.index()]
                     .expect("the model puts a FOR head before its NEXT");
-                let ctr = self.counter(rung);
-                self.code.fors[f as usize].ctr = ctr;
+                self.code.fors[f.index()].ctr = self.counter(rung);
                 self.push(Op::Next { f });
             }
         }
+    }
+}
+
+/// The stored bits of a scalar (to tell constants apart).
+fn bits(v: Value) -> u32 {
+    match v {
+        Value::Bool(b) => b as u32,
+        Value::Int(i) => i as u16 as u32,
+        Value::Dint(i) | Value::Time(i) => i as u32,
+        Value::Real(f) => f.to_bits(),
     }
 }

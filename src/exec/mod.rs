@@ -71,7 +71,7 @@
 //! - **Iteration cap** ([`ExecConfig::loop_cap`], default 100 000): a *loop-back rung* is a NEXT
 //!   rung or a rung holding a backward jump (to itself or an earlier rung of its POU). Each
 //!   loop-back rung may loop back (NEXT: back to the FOR test; a taken backward jump: to its
-//!   target) at most `loop_cap` times per scan, counted in a hidden counter slot of its own that
+//!   target) at most `loop_cap` times per scan, counted in a hidden counter of its own that
 //!   [`Machine::begin_scan`] zeroes at the start of every scan (a subroutine's loop-back rungs
 //!   count over all its calls in the scan). A refused loop-back is not performed and control
 //!   goes on as if the loop had ended there: a refused NEXT does not increment the index and
@@ -87,23 +87,27 @@
 //!   allocation when there are none, or when its capacity is reused).
 //!
 //! # Design
-//! The model is lowered once ([`Machine::new`]) into a flat array of 16-byte instructions over a
-//! flat array of `u64` slots; a scan walks it with no allocation, hashing or strings. Contacts on
-//! BOOLs and coils are a load, an and (xor for negation) and a store; `or`/`branch` keep their
+//! The model is lowered once ([`Machine::new`]) into a flat array of 16-byte instructions over
+//! the state's bytes, every value stored in its type's width (BOOL one byte, INT two, DINT,
+//! REAL and TIME four; instances small structs: [`Layout`]) at an address aligned to it, so a
+//! thousand BOOLs take 1,000 bytes, not 8,000; a scan walks it with no allocation, hashing or
+//! strings. Contacts on BOOLs and coils are a byte load, an and (xor for negation) and a byte
+//! store; constants are bytes of the state too, so every operand is one typed load; `or`/`branch` keep their
 //! saved powers in a 64-bit register. The cost of an interpreter is its dispatches, and above
 //! all the mispredicted ones, so consecutive contacts are fused (up to six in one instruction
-//! when their slots fit in 16 bits) and every output (coil, negated coil, set, reset) is one
+//! when their addresses fit in 16 bits) and every output (coil, negated coil, set, reset) is one
 //! instruction computed without a branch: a typical rung is three uniform dispatches (rung,
-//! contacts, output). The slot of each variable comes from a [`Layout`], so a
+//! contacts, output). The address of each variable comes from a [`Layout`], so a
 //! parallel executor can permute and pad variables. Memory is accessed through the [`Store`]
-//! trait, monomorphised, so the same interpreter runs on a plain `[u64]` and on a shared store.
+//! trait's typed loads and stores, monomorphised, so the same interpreter runs on a plain `[u8]`
+//! and on a shared store. A state's memory ([`Mem`]) starts on a 64-byte line.
 //!
 //! For the parallel executor (tasks of `analysis::schedule`): [`Machine::run_from`] runs from a
 //! rung while control stays in a region (`inside`) and reports where it left ([`Exit`]);
 //! [`Machine::run_scan`] is [`begin_scan`](Machine::begin_scan) then `run_from(first main rung,
 //! everywhere)`. Per-scan context (time, scan index, fault sink) is explicit in [`ScanCtx`]; the
-//! loop counters are slots of the store, after the layout's (one 64-byte line each), so a loop
-//! task's counter lives with the data it runs on. [`parallel`] runs the combined schedule on
+//! loop counters are `u64`s of the state, after the layout's variables (one 64-byte line each),
+//! so a loop task's counter lives with the data it runs on. [`parallel`] runs the combined schedule on
 //! several threads, bit-identical to [`Machine::run_scan`].
 #![warn(missing_docs)]
 #![warn(clippy::undocumented_unsafe_blocks)]
@@ -111,18 +115,24 @@
 mod access;
 mod layout;
 mod lower;
+mod mem;
 pub mod parallel;
 mod run;
 mod store;
 mod value;
 
-pub use layout::{field_offset, slot_width, Layout, LayoutError, COUNTER_SLOTS, TIMER_SLOTS};
+pub use access::Span;
+pub use layout::{
+    field_offset, parts, type_align, type_size, Layout, LayoutError, Repr, COUNTER_BYTES,
+    TIMER_BYTES,
+};
 pub use lower::LowerError;
-pub use store::Store;
-pub use value::{decode, encode, VarValue};
+pub use mem::{Mem, LINE_BYTES};
+pub use store::{load_bits, Addr, Store, Word};
+pub use value::{load_value, store_value, VarValue};
 
 use crate::model::{Program, RungId, Type, Value, VarClass, VarId, VarRef};
-use lower::{ForLoop, Op};
+use lower::{ForId, ForLoop, Op, Pc};
 use run::{everywhere, Flow};
 
 /// Execution parameters.
@@ -144,11 +154,25 @@ impl Default for ExecConfig {
     }
 }
 
-/// The memory of a running program: every variable's slots (see [`Layout`]).
+/// The memory of a running program: every variable's bytes (see [`Layout`]), the loop counters
+/// and the constants, on 64-byte lines.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct State {
-    /// The slots, encoded as described in [`encode`].
-    pub slots: Vec<u64>,
+    mem: Mem,
+}
+
+impl State {
+    /// The state's bytes.
+    #[inline]
+    pub fn bytes(&self) -> &[u8] {
+        &self.mem
+    }
+
+    /// The state's bytes, to write.
+    #[inline]
+    pub fn bytes_mut(&mut self) -> &mut [u8] {
+        &mut self.mem
+    }
 }
 
 /// What went wrong in a scan.
@@ -216,14 +240,14 @@ struct VarInfo {
 #[derive(Debug)]
 pub struct Machine {
     ops: Vec<Op>,
-    consts: Vec<u64>,
+    consts: Vec<(Addr, Value)>,
     fors: Vec<ForLoop>,
-    rung_op: Vec<u32>,
-    for_of_head: Vec<Option<u32>>,
-    pou_entry: Vec<u32>,
-    counters: Vec<(u32, u32)>,
-    slot_count: u32,
-    main_first: u32,
+    rung_op: Vec<Pc>,
+    for_of_head: Vec<Option<ForId>>,
+    pou_entry: Vec<Pc>,
+    counters: Vec<(RungId, Addr)>,
+    size: u32,
+    main_first: RungId,
     vars: Vec<VarInfo>,
     inits: Vec<Value>,
     layout: Layout,
@@ -233,7 +257,7 @@ pub struct Machine {
 impl Machine {
     /// Lowers `program` with `layout` (which must have been built for it). Fails only for a
     /// layout of another program, `or`/`branch` nested beyond the 64-bit power stack, or a
-    /// program too large for 31-bit indices.
+    /// program too large for 32-bit addresses.
     pub fn new(
         program: &Program,
         layout: Layout,
@@ -241,7 +265,7 @@ impl Machine {
     ) -> Result<Machine, LowerError> {
         let code = lower::lower(program, &layout)?;
         Ok(Machine {
-            main_first: program.main().rungs.start,
+            main_first: RungId(program.main().rungs.start),
             ops: code.ops,
             consts: code.consts,
             fors: code.fors,
@@ -249,7 +273,7 @@ impl Machine {
             for_of_head: code.for_of_head,
             pou_entry: code.pou_entry,
             counters: code.counters,
-            slot_count: code.slot_count,
+            size: code.size,
             vars: program
                 .vars
                 .iter()
@@ -261,6 +285,15 @@ impl Machine {
             inits: program.vars.iter().map(|v| v.init).collect(),
             layout,
             config: *config,
+        })
+        .inspect(|m| {
+            // What makes the unchecked store of `run_scan_in` sound: every byte any instruction
+            // touches is inside the state (loop counters and constants included; `begin_scan`
+            // writes only the counters the loop-back instructions use).
+            assert!(
+                m.access_end() <= m.size as u64,
+                "lowering placed an access past the state"
+            );
         })
     }
 
@@ -274,16 +307,30 @@ impl Machine {
         &self.config
     }
 
-    /// Number of slots a store must have: the layout's, then (if the program has loop-back
-    /// rungs) the loop counters, one per 8-slot line from the layout's total rounded up to 8.
-    pub fn slot_count(&self) -> u32 {
-        self.slot_count
+    /// Bytes a state must have: the layout's variables, then (if the program has loop-back
+    /// rungs) the loop counters, one per 64-byte line from the next line, then the constants.
+    pub fn state_size(&self) -> u32 {
+        self.size
     }
 
-    /// The loop-back rungs (NEXT rungs and rungs with a backward jump, any POU) with their
-    /// counter slots, in rung order.
-    pub fn loop_counters(&self) -> impl ExactSizeIterator<Item = (RungId, u32)> + '_ {
-        self.counters.iter().map(|&(r, slot)| (RungId(r), slot))
+    /// The loop-back rungs (NEXT rungs and rungs with a backward jump, any POU) with the
+    /// addresses of their counters (`u64`), in rung order.
+    pub fn loop_counters(&self) -> impl ExactSizeIterator<Item = (RungId, Addr)> + '_ {
+        self.counters.iter().copied()
+    }
+
+    /// Every value the state holds but its constants, in an order that does not depend on the
+    /// layout, as (address, width in bytes): each variable's [`parts`] in declaration order,
+    /// then the loop counters in rung order. Two machines of one program give lists of the same
+    /// length and widths, so states of different layouts compare value by value.
+    pub fn canonical_values(&self) -> Vec<(Addr, u32)> {
+        let mut out: Vec<(Addr, u32)> = Vec::new();
+        for (v, info) in self.vars.iter().enumerate() {
+            let at = self.layout.start(VarId(v as u32));
+            out.extend(parts(info.ty).iter().map(|&(o, w)| (at.offset(o), w)));
+        }
+        out.extend(self.counters.iter().map(|&(_, at)| (at, 8)));
+        out
     }
 
     /// How many times loop-back rung `rung` looped back (or was refused) in the current scan of
@@ -291,8 +338,8 @@ impl Machine {
     pub fn loop_count(&self, state: &State, rung: RungId) -> Option<u64> {
         self.counters
             .iter()
-            .find(|&&(r, _)| r == rung.0)
-            .map(|&(_, slot)| state.slots[slot as usize])
+            .find(|&&(r, _)| r == rung)
+            .map(|&(_, at)| state.bytes().load::<u64>(at))
     }
 
     /// Starts a scan on `store`: zeroes the loop counters. [`run_scan`](Self::run_scan) does it
@@ -300,8 +347,8 @@ impl Machine {
     /// [`resume`](Self::resume) calls it once before the scan's first piece.
     #[inline]
     pub fn begin_scan<S: Store + ?Sized>(&self, store: &mut S) {
-        for &(_, slot) in &self.counters {
-            store.set(slot, 0);
+        for &(_, at) in &self.counters {
+            store.store(at, 0u64);
         }
     }
 
@@ -310,20 +357,29 @@ impl Machine {
         self.ops.len()
     }
 
-    /// The state at load: declared initial values, instances zero, padding zero.
+    /// The state at load: declared initial values, instances zero, padding zero, constants.
     pub fn initial_state(&self) -> State {
-        let mut slots = vec![0u64; self.slot_count as usize];
+        let mut mem = Mem::zeroed(self.size as usize);
         for (v, info) in self.vars.iter().enumerate() {
             if !matches!(info.ty, Type::Fb(_)) {
-                slots[self.layout.start(VarId(v as u32)) as usize] = encode(self.inits[v]);
+                store_value(
+                    &mut mem[..],
+                    self.layout.start(VarId(v as u32)),
+                    self.inits[v],
+                );
             }
         }
-        State { slots }
+        for &(at, c) in &self.consts {
+            store_value(&mut mem[..], at, c);
+        }
+        State { mem }
     }
 
-    /// The slot of a variable or instance field.
-    pub fn slot_of(&self, r: VarRef) -> u32 {
-        self.layout.start(r.var) + r.field.map_or(0, field_offset)
+    /// The address of a variable or instance field.
+    pub fn addr_of(&self, r: VarRef) -> Addr {
+        self.layout
+            .start(r.var)
+            .offset(r.field.map_or(0, field_offset))
     }
 
     /// Writes input values (normally of input variables; any scalar variable is accepted, which
@@ -332,14 +388,14 @@ impl Machine {
     /// # Panics
     /// If a variable is an instance, or a value's type is not the variable's type.
     pub fn set_inputs(&self, state: &mut State, inputs: &[(VarId, Value)]) {
-        self.set_inputs_in(&mut state.slots, inputs);
+        self.set_inputs_in(state.bytes_mut(), inputs);
     }
 
-    /// [`set_inputs`](Self::set_inputs) on a bare slot array (a state's `slots`).
+    /// [`set_inputs`](Self::set_inputs) on a state's bare bytes ([`State::bytes_mut`]).
     ///
     /// # Panics
     /// As `set_inputs`.
-    pub fn set_inputs_in(&self, slots: &mut [u64], inputs: &[(VarId, Value)]) {
+    pub fn set_inputs_in(&self, mem: &mut [u8], inputs: &[(VarId, Value)]) {
         for &(var, value) in inputs {
             let ty = self.vars[var.index()].ty;
             assert!(
@@ -348,7 +404,7 @@ impl Machine {
                 var.0,
                 value.ty()
             );
-            slots[self.layout.start(var) as usize] = encode(value);
+            store_value(mem, self.layout.start(var), value);
         }
     }
 
@@ -365,27 +421,32 @@ impl Machine {
     /// Faults are appended to `faults`.
     ///
     /// # Panics
-    /// If `state` has fewer slots than [`Machine::slot_count`].
+    /// If `state` has fewer bytes than [`Machine::state_size`].
     pub fn run_scan(&self, state: &mut State, scan: u64, faults: &mut Vec<Fault>) {
-        self.run_scan_in(&mut state.slots, scan, faults)
+        self.run_scan_in(state.bytes_mut(), scan, faults)
     }
 
-    /// [`run_scan`](Self::run_scan) on a bare slot array (a state's `slots`).
+    /// [`run_scan`](Self::run_scan) on a state's bare bytes ([`State::bytes_mut`]).
     ///
     /// # Panics
-    /// If `slots` has fewer than [`Machine::slot_count`] slots.
+    /// If `mem` has fewer than [`Machine::state_size`] bytes.
     #[inline]
-    pub fn run_scan_in(&self, slots: &mut [u64], scan: u64, faults: &mut Vec<Fault>) {
+    pub fn run_scan_in(&self, mem: &mut [u8], scan: u64, faults: &mut Vec<Fault>) {
         assert!(
-            slots.len() >= self.slot_count as usize,
+            mem.len() >= self.size as usize,
             "state too small for this machine"
         );
-        self.begin_scan(slots);
+        // SAFETY: `mem` has at least `size` bytes (asserted above), and every address the
+        // machine's instructions, loops and counters use ends inside `size` (asserted once in
+        // `Machine::new` from the same instructions, which are immutable); `exec` and
+        // `begin_scan` access nothing else.
+        let mut mem = unsafe { store::Trusted::new(mem) };
+        self.begin_scan(&mut mem);
         let mut ctx = self.context(scan, faults);
         self.exec(
-            slots,
+            &mut mem,
             &mut ctx,
-            self.pou_entry[0] as usize,
+            self.pou_entry[0].index(),
             self.main_first,
             &everywhere,
         );
@@ -429,7 +490,7 @@ impl Machine {
     {
         let (pc, rung) = match at {
             Exit::Stop => return Exit::Stop,
-            Exit::Rung(r) => (self.rung_op[r.index()], r.0),
+            Exit::Rung(r) => (self.rung_op[r.index()], r),
             Exit::ForTest(h) => {
                 let Some(f) = self.for_of_head[h.index()] else {
                     panic!("rung {} is not a FOR head", h.0);
@@ -437,28 +498,24 @@ impl Machine {
                 if !inside(h) {
                     return at;
                 }
-                (self.fors[f as usize].test, h.0)
+                (self.fors[f.index()].test, h)
             }
         };
-        match self.exec(store, ctx, pc as usize, rung, &inside) {
+        match self.exec(store, ctx, pc.index(), rung, &inside) {
             Flow::Return | Flow::Stop => Exit::Stop,
-            Flow::Rung(r) => Exit::Rung(RungId(r)),
-            Flow::ForTest(h) => Exit::ForTest(RungId(h)),
+            Flow::Rung(r) => Exit::Rung(r),
+            Flow::ForTest(h) => Exit::ForTest(h),
         }
     }
 
     /// The value of a variable: its scalar value, or an instance's readable fields.
     pub fn value(&self, state: &State, var: VarId) -> VarValue {
-        self.value_in(&state.slots, var)
+        self.value_in(state.bytes(), var)
     }
 
-    /// [`value`](Self::value) on a bare slot array (a state's `slots`).
-    pub fn value_in(&self, slots: &[u64], var: VarId) -> VarValue {
-        let range = self.layout.slots_of(var);
-        VarValue::from_slots(
-            self.vars[var.index()].ty,
-            &slots[range.start as usize..range.end as usize],
-        )
+    /// [`value`](Self::value) on a state's bare bytes ([`State::bytes`]).
+    pub fn value_in(&self, mem: &[u8], var: VarId) -> VarValue {
+        VarValue::load(self.vars[var.index()].ty, mem, self.layout.start(var))
     }
 
     /// The output variables and their values, in declaration order.

@@ -1,7 +1,11 @@
-//! The interpreter loop: one generic function over the store and the region predicate.
+//! The interpreter loop: one generic function over the store and the region predicate, and the
+//! function blocks it calls. Every load and store is typed: a BOOL is a byte (0 or 1), an INT an
+//! `i16`, DINT and TIME an `i32`, REAL an `f32`, at the addresses lowering put in the
+//! instructions. Arithmetic widens to `i64` and wraps back to the type's width.
 
-use super::layout::{ET, FLAGS, PREV, PT, Q, START};
-use super::lower::{Num, Op, CONST};
+use super::layout::{CV, ET, FLAGS, PREV, PT, PV, Q, START};
+use super::lower::{Num, Op, Width};
+use super::store::{Addr, Word};
 use super::{Fault, FaultKind, Machine, ScanCtx, Store};
 use crate::model::{ArithOp, CmpOp, RungId, TimerKind};
 
@@ -13,9 +17,9 @@ pub(crate) enum Flow {
     /// The scan ends (END).
     Stop,
     /// Control reached the start of a rung outside the region.
-    Rung(u32),
+    Rung(RungId),
     /// Control reached the test of a FOR head outside the region.
-    ForTest(u32),
+    ForTest(RungId),
 }
 
 /// The region predicate for subroutines (always inside); a fn item, so nested calls do not
@@ -26,10 +30,10 @@ pub(crate) fn everywhere(_: RungId) -> bool {
 }
 
 // Timer flag bits.
-const PREV_IN: u64 = 1;
-const ACTIVE: u64 = 2; // TON: timing since IN rose; TOF: timing since IN fell; TP: pulsing.
+const PREV_IN: u8 = 1;
+const ACTIVE: u8 = 2; // TON: timing since IN rose; TOF: timing since IN fell; TP: pulsing.
 
-/// `a OP b` for integers (as `i64`) and REAL (`f32`, IEEE: NaN compares false except NE).
+/// `a OP b` (REAL: IEEE, NaN compares false except NE).
 #[inline(always)]
 fn compare<T: PartialOrd>(op: CmpOp, a: T, b: T) -> bool {
     match op {
@@ -42,26 +46,107 @@ fn compare<T: PartialOrd>(op: CmpOp, a: T, b: T) -> bool {
     }
 }
 
-/// Truncates an integer result to the width of `num` (two's complement wrap), sign-extended.
+/// An integer representation: widened to `i64` for arithmetic and wrapped back.
+trait Int: Word + PartialOrd {
+    fn widen(self) -> i64;
+    /// Two's complement wrap to the width.
+    fn wrap(v: i64) -> Self;
+}
+
+impl Int for i16 {
+    #[inline(always)]
+    fn widen(self) -> i64 {
+        self as i64
+    }
+    #[inline(always)]
+    fn wrap(v: i64) -> i16 {
+        v as i16
+    }
+}
+
+impl Int for i32 {
+    #[inline(always)]
+    fn widen(self) -> i64 {
+        self as i64
+    }
+    #[inline(always)]
+    fn wrap(v: i64) -> i32 {
+        v as i32
+    }
+}
+
+/// `a OP b` of two loaded operands of representation `num`.
 #[inline(always)]
-fn wrap(num: Num, v: i64) -> u64 {
+fn compare_at<S: Store + ?Sized>(st: &S, op: CmpOp, num: Num, a: Addr, b: Addr) -> bool {
     match num {
-        Num::I16 => v as i16 as i64 as u64,
-        _ => v as i32 as i64 as u64,
+        Num::I16 => compare(op, st.load::<i16>(a), st.load(b)),
+        Num::I32 => compare(op, st.load::<i32>(a), st.load(b)),
+        Num::F32 => compare(op, st.load::<f32>(a), st.load(b)),
+    }
+}
+
+/// Copies the `T` at `from` to `to`.
+#[inline(always)]
+fn copy<T: Word, S: Store + ?Sized>(st: &mut S, from: Addr, to: Addr) {
+    let v = st.load::<T>(from);
+    st.store(to, v);
+}
+
+/// `out := a op b` in the integer representation `T`; false (and `out := 0`) for a DIV or MOD
+/// by zero.
+#[inline]
+fn int_arith<T: Int, S: Store + ?Sized>(
+    st: &mut S,
+    op: ArithOp,
+    a: Addr,
+    b: Addr,
+    out: Addr,
+) -> bool {
+    // Operands are 16- or 32-bit values: no i64 operation below overflows.
+    let (a, b) = (st.load::<T>(a).widen(), st.load::<T>(b).widen());
+    let r = match op {
+        ArithOp::Add => Some(a + b),
+        ArithOp::Sub => Some(a - b),
+        ArithOp::Mul => Some(a * b),
+        ArithOp::Div | ArithOp::Mod if b == 0 => None,
+        ArithOp::Div => Some(a / b),
+        ArithOp::Mod => Some(a % b),
+    };
+    st.store(out, T::wrap(r.unwrap_or(0)));
+    r.is_some()
+}
+
+/// `out := a op b` on REALs (IEEE: no faults).
+#[inline]
+fn real_arith<S: Store + ?Sized>(st: &mut S, op: ArithOp, a: Addr, b: Addr, out: Addr) {
+    let (a, b) = (st.load::<f32>(a), st.load::<f32>(b));
+    let r = match op {
+        ArithOp::Add => a + b,
+        ArithOp::Sub => a - b,
+        ArithOp::Mul => a * b,
+        ArithOp::Div => a / b,
+        ArithOp::Mod => a % b,
+    };
+    st.store(out, r);
+}
+
+/// The FOR index at `at` incremented, wrapping in its representation.
+#[inline]
+fn increment<T: Int, S: Store + ?Sized>(st: &mut S, at: Addr) {
+    let v = st.load::<T>(at).widen().wrapping_add(1);
+    st.store(at, T::wrap(v));
+}
+
+/// Whether the FOR index at `var` is past the bound at `to`.
+#[inline]
+fn past<S: Store + ?Sized>(st: &S, num: Num, var: Addr, to: Addr) -> bool {
+    match num {
+        Num::I16 => st.load::<i16>(var) > st.load(to),
+        _ => st.load::<i32>(var) > st.load(to),
     }
 }
 
 impl Machine {
-    /// An operand's bits: a slot, or a constant of the pool.
-    #[inline(always)]
-    fn src<S: Store + ?Sized>(&self, st: &S, x: u32) -> u64 {
-        if x & CONST != 0 {
-            self.consts[(x & !CONST) as usize]
-        } else {
-            st.get(x)
-        }
-    }
-
     /// Runs instructions from `pc` until the POU ends, the scan stops, or control reaches a rung
     /// (or FOR test) for which `inside` is false. `rung` is the rung `pc` belongs to (for faults
     /// before the first rung marker, i.e. when resuming at a FOR test).
@@ -70,7 +155,7 @@ impl Machine {
         st: &mut S,
         ctx: &mut ScanCtx<'_>,
         mut pc: usize,
-        mut rung: u32,
+        mut rung: RungId,
         inside: &F,
     ) -> Flow
     where
@@ -80,55 +165,47 @@ impl Machine {
         let ops = &self.ops[..];
         let mut p: u64 = 1;
         let mut s: u64 = 0;
+        let b = |st: &S, at: Addr| st.load::<u8>(at) as u64;
         loop {
             let op = ops[pc];
             pc += 1;
             match op {
                 Op::Rung { id } => {
-                    if !inside(RungId(id)) {
+                    if !inside(id) {
                         return Flow::Rung(id);
                     }
                     rung = id;
                     p = 1;
                 }
-                Op::Contact { neg, slot } => p &= st.get(slot) ^ neg as u64,
-                Op::Contact2 { neg, a, b } => {
+                Op::Contact { neg, at } => p &= b(st, at) ^ neg as u64,
+                Op::Contact2 { neg, a, b: c } => {
                     // Both BOOLs (each 0 or 1) must equal their negation bit's complement.
-                    let bits = st.get(a) | st.get(b) << 1;
+                    let bits = b(st, a) | b(st, c) << 1;
                     p &= ((bits ^ neg as u64) == 3) as u64;
                 }
-                Op::Contact3 { neg, a, b, c } => {
-                    let bits = st.get(a) | st.get(b) << 1 | st.get(c) << 2;
+                Op::Contact3 { neg, a, b: x, c } => {
+                    let bits = b(st, a) | b(st, x) << 1 | b(st, c) << 2;
                     p &= ((bits ^ neg as u64) == 7) as u64;
                 }
                 Op::ContactN { n, neg, s: sl } => {
                     let mut bits = 0u64;
                     for (k, &x) in sl.iter().enumerate() {
-                        bits |= st.get(x as u32) << k;
+                        bits |= b(st, Addr(x as u32)) << k;
                     }
                     let mask = (1u64 << n) - 1;
                     p &= (((bits ^ neg as u64) & mask) == mask) as u64;
                 }
-                Op::Rising { slot, mem } => {
-                    let v = st.get(slot);
-                    p &= v & !st.get(mem) & 1;
-                    st.set(mem, v);
+                Op::Rising { at, mem } => {
+                    let v = st.load::<u8>(at);
+                    p &= (v & !st.load::<u8>(mem) & 1) as u64;
+                    st.store(mem, v);
                 }
-                Op::Falling { slot, mem } => {
-                    let v = st.get(slot);
-                    p &= !v & st.get(mem) & 1;
-                    st.set(mem, v);
+                Op::Falling { at, mem } => {
+                    let v = st.load::<u8>(at);
+                    p &= (!v & st.load::<u8>(mem) & 1) as u64;
+                    st.store(mem, v);
                 }
-                Op::CmpInt { op, a, b } => {
-                    p &= compare(op, self.src(st, a) as i64, self.src(st, b) as i64) as u64
-                }
-                Op::CmpReal { op, a, b } => {
-                    let (a, b) = (
-                        f32::from_bits(self.src(st, a) as u32),
-                        f32::from_bits(self.src(st, b) as u32),
-                    );
-                    p &= compare(op, a, b) as u64;
-                }
+                Op::Cmp { op, num, a, b } => p &= compare_at(st, op, num, a, b) as u64,
                 Op::OrOpen => s = (s << 2) | (p << 1),
                 Op::OrNext => {
                     s |= p;
@@ -144,64 +221,70 @@ impl Machine {
                     p = s & 1;
                     s >>= 1;
                 }
-                Op::Coil { slot, neg } => {
+                Op::Coil { at, mode } => {
                     // Powered: bit 0 of the mode. Unpowered: bit 2, or no write (set/reset).
-                    let (on, keep, off) =
-                        (neg as u64 & 1, (neg as u64 >> 1) & 1, (neg as u64 >> 2) & 1);
+                    let m = mode as u64;
+                    let (on, keep, off) = (m & 1, (m >> 1) & 1, (m >> 2) & 1);
                     if (p | (keep ^ 1)) != 0 {
-                        st.set(slot, (p & on) | ((p ^ 1) & off));
+                        st.store(at, ((p & on) | ((p ^ 1) & off)) as u8);
                     }
                 }
                 Op::Timer { kind, inst, pt } => {
-                    let pt = self.src(st, pt) as i64;
-                    p = match kind {
-                        TimerKind::Ton => ton(st, ctx.now, inst, pt, p),
-                        TimerKind::Tof => tof(st, ctx.now, inst, pt, p),
-                        TimerKind::Tp => tp(st, ctx.now, inst, pt, p),
+                    let pt = st.load::<i32>(pt) as i64;
+                    let q = match kind {
+                        TimerKind::Ton => ton(st, ctx.now, inst, pt, p != 0),
+                        TimerKind::Tof => tof(st, ctx.now, inst, pt, p != 0),
+                        TimerKind::Tp => tp(st, ctx.now, inst, pt, p != 0),
                     };
+                    p = q as u64;
                 }
                 Op::Ctu { inst, pv, reset } => {
-                    let pv = self.src(st, pv) as i64;
-                    let reset = self.src(st, reset) != 0;
-                    p = counter(st, inst, pv, p, reset, true);
+                    let pv = st.load::<i16>(pv);
+                    let reset = st.load::<u8>(reset) != 0;
+                    p = counter(st, inst, pv, p as u8, reset, true) as u64;
                 }
                 Op::Ctd { inst, pv, load } => {
-                    let pv = self.src(st, pv) as i64;
-                    let load = self.src(st, load) != 0;
-                    p = counter(st, inst, pv, p, load, false);
+                    let pv = st.load::<i16>(pv);
+                    let load = st.load::<u8>(load) != 0;
+                    p = counter(st, inst, pv, p as u8, load, false) as u64;
                 }
-                Op::Move { from, to } => {
+                Op::Move { width, from, to } => {
                     if p != 0 {
-                        let v = self.src(st, from);
-                        st.set(to, v);
+                        match width {
+                            Width::W1 => copy::<u8, S>(st, from, to),
+                            Width::W2 => copy::<i16, S>(st, from, to),
+                            Width::W4 => copy::<i32, S>(st, from, to),
+                        }
                     }
                 }
                 Op::Arith { op, num, a, b, out } => {
                     if p != 0 {
-                        let (a, b) = (self.src(st, a), self.src(st, b));
-                        let v = match arith(op, num, a, b) {
-                            Some(v) => v,
-                            None => {
-                                ctx.faults.push(Fault {
-                                    scan: ctx.scan,
-                                    rung: RungId(rung),
-                                    kind: FaultKind::DivByZero,
-                                });
-                                0
+                        let ok = match num {
+                            Num::I16 => int_arith::<i16, S>(st, op, a, b, out),
+                            Num::I32 => int_arith::<i32, S>(st, op, a, b, out),
+                            Num::F32 => {
+                                real_arith(st, op, a, b, out);
+                                true
                             }
                         };
-                        st.set(out, v);
+                        if !ok {
+                            ctx.faults.push(Fault {
+                                scan: ctx.scan,
+                                rung,
+                                kind: FaultKind::DivByZero,
+                            });
+                        }
                     }
                 }
                 Op::Jmp { to } => {
                     if p != 0 {
-                        pc = to as usize;
+                        pc = to.index();
                     }
                 }
                 Op::JmpBack { to, ctr } => {
                     if p != 0 {
                         if self.loop_back(st, ctx, ctr, rung) {
-                            pc = to as usize;
+                            pc = to.index();
                         } else {
                             // Refused: the jump acts as if it had no power.
                             p = 0;
@@ -219,45 +302,49 @@ impl Machine {
                     }
                 }
                 Op::Call { to } => {
-                    if p != 0 && self.exec(st, ctx, to as usize, rung, &everywhere) != Flow::Return
-                    {
+                    if p != 0 && self.exec(st, ctx, to.index(), rung, &everywhere) != Flow::Return {
                         return Flow::Stop;
                     }
                 }
                 Op::For { f } => {
-                    let l = &self.fors[f as usize];
+                    let l = &self.fors[f.index()];
                     if p != 0 {
-                        let from = self.src(st, l.from);
-                        st.set(l.var, from);
+                        match l.num {
+                            Num::I16 => copy::<i16, S>(st, l.from, l.var),
+                            _ => copy::<i32, S>(st, l.from, l.var),
+                        }
                     } else {
-                        pc = l.exit as usize;
+                        pc = l.exit.index();
                     }
                 }
                 Op::ForTest { f } => {
-                    let l = &self.fors[f as usize];
-                    if st.get(l.var) as i64 > self.src(st, l.to) as i64 {
-                        pc = l.exit as usize;
+                    let l = &self.fors[f.index()];
+                    if past(st, l.num, l.var, l.to) {
+                        pc = l.exit.index();
                     }
                 }
                 Op::Next { f } => {
-                    let l = &self.fors[f as usize];
+                    let l = &self.fors[f.index()];
                     if !self.loop_back(st, ctx, l.ctr, rung) {
-                        pc = l.exit as usize;
+                        pc = l.exit.index();
                         continue;
                     }
-                    st.set(l.var, wrap(l.num, (st.get(l.var) as i64).wrapping_add(1)));
-                    if !inside(RungId(l.head)) {
+                    match l.num {
+                        Num::I16 => increment::<i16, S>(st, l.var),
+                        _ => increment::<i32, S>(st, l.var),
+                    }
+                    if !inside(l.head) {
                         return Flow::ForTest(l.head);
                     }
                     rung = l.head;
-                    pc = l.test as usize;
+                    pc = l.test.index();
                 }
                 Op::EndPou => return Flow::Return,
             }
         }
     }
 
-    /// Counts one loop-back of `rung` in its counter slot `ctr`; returns whether it may loop back.
+    /// Counts one loop-back of `rung` in its counter at `ctr`; returns whether it may loop back.
     /// The first refused loop-back of a scan records [`FaultKind::LoopCap`]; later ones (control
     /// can come back through another loop-back rung) are refused silently.
     #[inline]
@@ -265,11 +352,11 @@ impl Machine {
         &self,
         st: &mut S,
         ctx: &mut ScanCtx<'_>,
-        ctr: u32,
-        rung: u32,
+        ctr: Addr,
+        rung: RungId,
     ) -> bool {
-        let c = st.get(ctr).wrapping_add(1);
-        st.set(ctr, c);
+        let c = st.load::<u64>(ctr).wrapping_add(1);
+        st.store(ctr, c);
         let cap = self.config.loop_cap as u64;
         if c <= cap {
             return true;
@@ -277,7 +364,7 @@ impl Machine {
         if c == cap + 1 {
             ctx.faults.push(Fault {
                 scan: ctx.scan,
-                rung: RungId(rung),
+                rung,
                 kind: FaultKind::LoopCap,
             });
         }
@@ -285,148 +372,124 @@ impl Machine {
     }
 }
 
-/// `a op b` in the representation `num`; `None` for an integer DIV or MOD by zero.
-#[inline]
-fn arith(op: ArithOp, num: Num, a: u64, b: u64) -> Option<u64> {
-    if num == Num::F32 {
-        let (a, b) = (f32::from_bits(a as u32), f32::from_bits(b as u32));
-        let r = match op {
-            ArithOp::Add => a + b,
-            ArithOp::Sub => a - b,
-            ArithOp::Mul => a * b,
-            ArithOp::Div => a / b,
-            ArithOp::Mod => a % b,
-        };
-        return Some(r.to_bits() as u64);
-    }
-    // Operands are sign-extended 16- or 32-bit values: no i64 operation below overflows.
-    let (a, b) = (a as i64, b as i64);
-    let r = match op {
-        ArithOp::Add => a + b,
-        ArithOp::Sub => a - b,
-        ArithOp::Mul => a * b,
-        ArithOp::Div if b == 0 => return None,
-        ArithOp::Mod if b == 0 => return None,
-        ArithOp::Div => a / b,
-        ArithOp::Mod => a % b,
-    };
-    Some(wrap(num, r))
-}
-
 /// TON on the instance at `i`; returns Q.
 #[inline]
-fn ton<S: Store + ?Sized>(st: &mut S, now: i64, i: u32, pt: i64, input: u64) -> u64 {
-    st.set(i + PT, pt as u64);
-    if input == 0 {
-        st.set(i + Q, 0);
-        st.set(i + ET, 0);
-        st.set(i + FLAGS, 0);
-        return 0;
+fn ton<S: Store + ?Sized>(st: &mut S, now: i64, i: Addr, pt: i64, input: bool) -> bool {
+    st.store(i.offset(PT), pt as i32);
+    if !input {
+        st.store(i.offset(Q), 0u8);
+        st.store(i.offset(ET), 0i32);
+        st.store(i.offset(FLAGS), 0u8);
+        return false;
     }
-    let start = if st.get(i + FLAGS) & ACTIVE == 0 {
-        st.set(i + FLAGS, ACTIVE | PREV_IN);
-        st.set(i + START, now as u64);
+    let start = if st.load::<u8>(i.offset(FLAGS)) & ACTIVE == 0 {
+        st.store(i.offset(FLAGS), ACTIVE | PREV_IN);
+        st.store(i.offset(START), now);
         now
     } else {
-        st.get(i + START) as i64
+        st.load::<i64>(i.offset(START))
     };
     let et = now.wrapping_sub(start).min(pt);
-    let q = (et >= pt) as u64;
-    st.set(i + ET, et as u64);
-    st.set(i + Q, q);
+    let q = et >= pt;
+    st.store(i.offset(ET), et as i32);
+    st.store(i.offset(Q), q as u8);
     q
 }
 
 /// TOF on the instance at `i`; returns Q.
 #[inline]
-fn tof<S: Store + ?Sized>(st: &mut S, now: i64, i: u32, pt: i64, input: u64) -> u64 {
-    st.set(i + PT, pt as u64);
-    if input != 0 {
-        st.set(i + Q, 1);
-        st.set(i + ET, 0);
-        st.set(i + FLAGS, PREV_IN);
-        return 1;
+fn tof<S: Store + ?Sized>(st: &mut S, now: i64, i: Addr, pt: i64, input: bool) -> bool {
+    st.store(i.offset(PT), pt as i32);
+    if input {
+        st.store(i.offset(Q), 1u8);
+        st.store(i.offset(ET), 0i32);
+        st.store(i.offset(FLAGS), PREV_IN);
+        return true;
     }
-    let flags = st.get(i + FLAGS);
+    let flags = st.load::<u8>(i.offset(FLAGS));
     let mut active = flags & ACTIVE != 0;
     let start = if flags & PREV_IN != 0 {
         active = true;
-        st.set(i + START, now as u64);
+        st.store(i.offset(START), now);
         now
     } else {
-        st.get(i + START) as i64
+        st.load::<i64>(i.offset(START))
     };
     if active {
         let et = now.wrapping_sub(start).min(pt);
-        st.set(i + ET, et as u64);
+        st.store(i.offset(ET), et as i32);
         if et >= pt {
-            st.set(i + Q, 0);
+            st.store(i.offset(Q), 0u8);
             active = false;
         }
     }
-    st.set(i + FLAGS, if active { ACTIVE } else { 0 });
-    st.get(i + Q)
+    st.store(i.offset(FLAGS), if active { ACTIVE } else { 0 });
+    st.load::<u8>(i.offset(Q)) != 0
 }
 
 /// TP on the instance at `i`; returns Q.
 #[inline]
-fn tp<S: Store + ?Sized>(st: &mut S, now: i64, i: u32, pt: i64, input: u64) -> u64 {
-    st.set(i + PT, pt as u64);
-    let flags = st.get(i + FLAGS);
+fn tp<S: Store + ?Sized>(st: &mut S, now: i64, i: Addr, pt: i64, input: bool) -> bool {
+    st.store(i.offset(PT), pt as i32);
+    let flags = st.load::<u8>(i.offset(FLAGS));
     let mut pulsing = flags & ACTIVE != 0;
-    let mut q = 0;
-    let start = if !pulsing && input != 0 && flags & PREV_IN == 0 {
+    let mut q = false;
+    let start = if !pulsing && input && flags & PREV_IN == 0 {
         pulsing = true;
-        st.set(i + START, now as u64);
+        st.store(i.offset(START), now);
         now
     } else {
-        st.get(i + START) as i64
+        st.load::<i64>(i.offset(START))
     };
     if pulsing {
         let et = now.wrapping_sub(start);
         if et >= pt {
-            st.set(i + ET, pt as u64);
+            st.store(i.offset(ET), pt as i32);
             pulsing = false;
         } else {
-            st.set(i + ET, et as u64);
-            q = 1;
+            st.store(i.offset(ET), et as i32);
+            q = true;
         }
     }
-    if !pulsing && input == 0 {
-        st.set(i + ET, 0);
+    if !pulsing && !input {
+        st.store(i.offset(ET), 0i32);
     }
-    st.set(i + Q, q);
-    st.set(i + FLAGS, (if pulsing { ACTIVE } else { 0 }) | (input & 1));
+    st.store(i.offset(Q), q as u8);
+    st.store(
+        i.offset(FLAGS),
+        (if pulsing { ACTIVE } else { 0 }) | input as u8,
+    );
     q
 }
 
-/// CTU (`up`) or CTD on the instance at `i`: `clock` is CU/CD, `preset` R (CTU) or LD (CTD).
+/// CTU (`up`) or CTD on the instance at `i`: `clock` is CU/CD (0 or 1), `preset` R (CTU) or LD
+/// (CTD); returns Q.
 #[inline]
 fn counter<S: Store + ?Sized>(
     st: &mut S,
-    i: u32,
-    pv: i64,
-    clock: u64,
+    i: Addr,
+    pv: i16,
+    clock: u8,
     preset: bool,
     up: bool,
-) -> u64 {
-    st.set(i + PT, pv as u64);
-    let rising = clock & !st.get(i + PREV) & 1 != 0;
-    st.set(i + PREV, clock);
-    let mut cv = st.get(i + ET) as i64;
+) -> bool {
+    st.store(i.offset(PV), pv);
+    let rising = clock & !st.load::<u8>(i.offset(PREV)) & 1 != 0;
+    st.store(i.offset(PREV), clock);
+    let mut cv = st.load::<i16>(i.offset(CV));
     if up {
         if preset {
             cv = 0;
-        } else if rising && cv < i16::MAX as i64 {
+        } else if rising && cv < i16::MAX {
             cv += 1;
         }
     } else if preset {
         cv = pv;
-    } else if rising && cv > i16::MIN as i64 {
+    } else if rising && cv > i16::MIN {
         cv -= 1;
     }
-    st.set(i + ET, cv as u64);
-    let q = if up { cv >= pv } else { cv <= 0 } as u64;
-    st.set(i + Q, q);
+    st.store(i.offset(CV), cv);
+    let q = if up { cv >= pv } else { cv <= 0 };
+    st.store(i.offset(Q), q as u8);
     q
 }

@@ -1,26 +1,168 @@
-//! The memory the interpreter works on: a flat array of 64-bit slots, behind a small trait so the
-//! same (monomorphised) interpreter runs on a plain slice and on a shared store.
+//! The memory the interpreter works on: bytes, each value stored in its type's width at an
+//! address aligned to that width, read and written through typed loads and stores ([`Word`])
+//! behind a small trait ([`Store`]), so that the same (monomorphised) interpreter runs on a plain
+//! byte slice and on the parallel executor's shared memory.
+//!
+//! Invariants: an [`Addr`] is a byte address into a state; the machine only ever loads or stores
+//! a `T` at an address that is a multiple of `T::SIZE` (the layout aligns every value to its
+//! width), so a state whose memory starts on a 64-byte boundary ([`Mem`](super::Mem)) has every
+//! value inside one cache line, and byte address / 64 is its line. A BOOL byte always holds 0 or
+//! 1: the interpreter only ever writes those, and relies on it when it reads. This module knows
+//! nothing of types or variables (see `layout`).
 
-/// Slot memory read and written by the interpreter.
-///
-/// Slot indices come from the machine's [`Layout`](super::Layout); a store must accept every
-/// index below [`Machine::slot_count`](super::Machine::slot_count). A BOOL slot always holds 0
-/// or 1: the interpreter only ever writes those, and relies on it when it reads.
-pub trait Store {
-    /// The value of `slot`.
-    fn get(&self, slot: u32) -> u64;
-    /// Writes `v` to `slot`.
-    fn set(&mut self, slot: u32, v: u64);
+use std::sync::atomic::{
+    AtomicI16, AtomicI32, AtomicI64, AtomicU32, AtomicU64, AtomicU8, Ordering,
+};
+
+/// A byte address in a state's memory.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Default)]
+pub struct Addr(pub u32);
+
+impl Addr {
+    /// The byte index.
+    #[inline(always)]
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+
+    /// The address `bytes` further on.
+    #[inline(always)]
+    pub fn offset(self, bytes: u32) -> Addr {
+        Addr(self.0 + bytes)
+    }
 }
 
-/// The sequential store: the slots of a [`State`](super::State), indexed directly.
-impl Store for [u64] {
+mod sealed {
+    pub trait Sealed {}
+}
+
+/// A value the machine stores: a fixed number of bytes (its width, and its alignment), read and
+/// written in native byte order. Implemented for `u8` (BOOL and internal flags), `i16` (INT),
+/// `i32` (DINT, TIME), `f32` (REAL), `i64` and `u64` (internal times and loop counters).
+pub trait Word: Copy + sealed::Sealed {
+    /// Width in bytes (a power of two; also the alignment the layout gives the value).
+    const SIZE: usize;
+    /// Reads the value from exactly `SIZE` bytes.
+    fn read(bytes: &[u8]) -> Self;
+    /// Writes the value to exactly `SIZE` bytes.
+    fn write(self, bytes: &mut [u8]);
+    /// A Relaxed atomic load of the value at `p`.
+    ///
+    /// # Safety
+    /// `p` is aligned to `SIZE`, valid for reads of `SIZE` bytes, and no access of another size
+    /// to these bytes runs at the same time (`AtomicU8::from_ptr` and friends).
+    unsafe fn load_relaxed(p: *mut u8) -> Self;
+    /// A Relaxed atomic store of the value at `p`.
+    ///
+    /// # Safety
+    /// As [`load_relaxed`](Self::load_relaxed), and valid for writes.
+    unsafe fn store_relaxed(self, p: *mut u8);
+}
+
+/// `Word` for a type `$t` held in an atomic `$a` of the same width through bit casts
+/// `$to`/`$from` (the identity for integers).
+macro_rules! word {
+    ($t:ty, $a:ty, $to:expr, $from:expr) => {
+        impl sealed::Sealed for $t {}
+        impl Word for $t {
+            const SIZE: usize = std::mem::size_of::<$t>();
+            #[inline(always)]
+            fn read(bytes: &[u8]) -> Self {
+                <$t>::from_ne_bytes(bytes.try_into().expect("SIZE bytes"))
+            }
+            #[inline(always)]
+            fn write(self, bytes: &mut [u8]) {
+                bytes.copy_from_slice(&self.to_ne_bytes())
+            }
+            #[inline(always)]
+            unsafe fn load_relaxed(p: *mut u8) -> Self {
+                // SAFETY: the caller's contract is `from_ptr`'s: aligned, valid, no mixed-size
+                // access at the same time.
+                let a = unsafe { <$a>::from_ptr(p.cast()) };
+                $from(a.load(Ordering::Relaxed))
+            }
+            #[inline(always)]
+            unsafe fn store_relaxed(self, p: *mut u8) {
+                // SAFETY: as in `load_relaxed`.
+                let a = unsafe { <$a>::from_ptr(p.cast()) };
+                a.store($to(self), Ordering::Relaxed)
+            }
+        }
+    };
+}
+
+word!(u8, AtomicU8, |v| v, |v| v);
+word!(i16, AtomicI16, |v| v, |v| v);
+word!(i32, AtomicI32, |v| v, |v| v);
+word!(i64, AtomicI64, |v| v, |v| v);
+word!(u64, AtomicU64, |v| v, |v| v);
+word!(f32, AtomicU32, f32::to_bits, f32::from_bits);
+
+/// Memory read and written by the interpreter.
+///
+/// Addresses come from the machine's [`Layout`](super::Layout) and lowering; a store must
+/// accept every address below [`Machine::state_size`](super::Machine::state_size).
+pub trait Store {
+    /// The `T` at `at`.
+    fn load<T: Word>(&self, at: Addr) -> T;
+    /// Writes `v` at `at`.
+    fn store<T: Word>(&mut self, at: Addr, v: T);
+}
+
+/// The sequential store: the bytes of a [`State`](super::State), indexed directly (bounds
+/// checked; any alignment works, the layout's keeps each value in one cache line).
+impl Store for [u8] {
     #[inline(always)]
-    fn get(&self, slot: u32) -> u64 {
-        self[slot as usize]
+    fn load<T: Word>(&self, at: Addr) -> T {
+        T::read(&self[at.index()..at.index() + T::SIZE])
     }
     #[inline(always)]
-    fn set(&mut self, slot: u32, v: u64) {
-        self[slot as usize] = v;
+    fn store<T: Word>(&mut self, at: Addr, v: T) {
+        v.write(&mut self[at.index()..at.index() + T::SIZE])
+    }
+}
+
+/// A state's memory with the bounds already checked for every address the machine uses: the
+/// sequential interpreter's store, without a bounds check per access.
+pub(crate) struct Trusted<'a>(&'a mut [u8]);
+
+impl<'a> Trusted<'a> {
+    /// # Safety
+    /// Every `(address, T)` that will be loaded or stored through it has `address + T::SIZE <=
+    /// mem.len()`.
+    #[inline(always)]
+    pub(crate) unsafe fn new(mem: &'a mut [u8]) -> Trusted<'a> {
+        Trusted(mem)
+    }
+}
+
+impl Store for Trusted<'_> {
+    #[inline(always)]
+    fn load<T: Word>(&self, at: Addr) -> T {
+        debug_assert!(at.index() + T::SIZE <= self.0.len());
+        // SAFETY: in bounds by the contract of `Trusted::new`.
+        T::read(unsafe { self.0.get_unchecked(at.index()..at.index() + T::SIZE) })
+    }
+    #[inline(always)]
+    fn store<T: Word>(&mut self, at: Addr, v: T) {
+        debug_assert!(at.index() + T::SIZE <= self.0.len());
+        // SAFETY: in bounds by the contract of `Trusted::new`.
+        v.write(unsafe { self.0.get_unchecked_mut(at.index()..at.index() + T::SIZE) })
+    }
+}
+
+/// The bits of the `width`-byte value at `at` (1, 2, 4 or 8), zero-extended: a layout-free view
+/// of a stored value, for digests and comparisons.
+///
+/// # Panics
+/// If `width` is not 1, 2, 4 or 8, or the value is not inside `mem`.
+#[inline(always)]
+pub fn load_bits(mem: &[u8], at: Addr, width: u32) -> u64 {
+    match width {
+        1 => mem.load::<u8>(at) as u64,
+        2 => mem.load::<i16>(at) as u16 as u64,
+        4 => mem.load::<i32>(at) as u32 as u64,
+        8 => mem.load::<u64>(at),
+        _ => panic!("no value is {width} bytes wide"),
     }
 }

@@ -1,33 +1,37 @@
-//! Slot encoding of values, and the values a caller reads back.
+//! Values in state memory, and the values a caller reads back.
 //!
-//! Encoding of one slot: BOOL 0 or 1; INT, DINT and TIME (ms) sign-extended to 64 bits; REAL the
-//! `f32` bit pattern in the low 32 bits. Integers of every width therefore compare as `i64`.
+//! A scalar is stored in its type's representation ([`Repr`]): BOOL a byte 0 or 1, INT an
+//! `i16`, DINT and TIME (ms) an `i32`, REAL an `f32`, native byte order, at an address aligned
+//! to its width. This module converts between those bytes and [`Value`]s; it does not place
+//! variables (`layout`).
 
+use super::layout::{Repr, CV, ET, PT, PV, Q};
+use super::store::{Addr, Store};
 use crate::model::{FbKind, Type, Value};
 use serde::{Serialize, Serializer};
 use serde_json::{json, Value as Json};
 
-/// The slot bits of a scalar value.
+/// Writes the scalar `v` at `at` in its type's representation.
 #[inline]
-pub fn encode(v: Value) -> u64 {
+pub fn store_value<S: Store + ?Sized>(st: &mut S, at: Addr, v: Value) {
     match v {
-        Value::Bool(b) => b as u64,
-        Value::Int(i) => i as i64 as u64,
-        Value::Dint(i) | Value::Time(i) => i as i64 as u64,
-        Value::Real(f) => f.to_bits() as u64,
+        Value::Bool(b) => st.store(at, b as u8),
+        Value::Int(i) => st.store(at, i),
+        Value::Dint(i) | Value::Time(i) => st.store(at, i),
+        Value::Real(f) => st.store(at, f),
     }
 }
 
-/// The scalar value of type `ty` held in slot bits `bits`. Instance types have no scalar value:
-/// for them this returns the slot read as TIME (use [`Machine::value`](super::Machine::value)).
+/// The scalar of type `ty` stored at `at`. Instance types have no scalar value: for them this
+/// reads the instance's Q (use [`Machine::value`](super::Machine::value)).
 #[inline]
-pub fn decode(ty: Type, bits: u64) -> Value {
-    match ty {
-        Type::Bool => Value::Bool(bits != 0),
-        Type::Int => Value::Int(bits as i16),
-        Type::Dint => Value::Dint(bits as i32),
-        Type::Real => Value::Real(f32::from_bits(bits as u32)),
-        Type::Time | Type::Fb(_) => Value::Time(bits as i32),
+pub fn load_value<S: Store + ?Sized>(st: &S, at: Addr, ty: Type) -> Value {
+    match Repr::of(ty) {
+        Some(Repr::Bool) | None => Value::Bool(st.load::<u8>(at) != 0),
+        Some(Repr::I16) => Value::Int(st.load(at)),
+        Some(Repr::I32) if ty == Type::Time => Value::Time(st.load(at)),
+        Some(Repr::I32) => Value::Dint(st.load(at)),
+        Some(Repr::F32) => Value::Real(st.load(at)),
     }
 }
 
@@ -57,20 +61,21 @@ pub enum VarValue {
 }
 
 impl VarValue {
-    /// Decodes the slots of a variable of type `ty` (`slots` starts at its first slot).
-    pub(crate) fn from_slots(ty: Type, slots: &[u64]) -> VarValue {
+    /// Reads the variable of type `ty` stored at `at` in `mem`.
+    pub(crate) fn load(ty: Type, mem: &[u8], at: Addr) -> VarValue {
+        let q = mem.load::<u8>(at.offset(Q)) != 0;
         match ty {
             Type::Fb(FbKind::Ton | FbKind::Tof | FbKind::Tp) => VarValue::Timer {
-                q: slots[super::layout::Q as usize] != 0,
-                et: slots[super::layout::ET as usize] as i32,
-                pt: slots[super::layout::PT as usize] as i32,
+                q,
+                et: mem.load(at.offset(ET)),
+                pt: mem.load(at.offset(PT)),
             },
             Type::Fb(FbKind::Ctu | FbKind::Ctd) => VarValue::Counter {
-                q: slots[super::layout::Q as usize] != 0,
-                cv: slots[super::layout::ET as usize] as i16,
-                pv: slots[super::layout::PT as usize] as i16,
+                q,
+                cv: mem.load(at.offset(CV)),
+                pv: mem.load(at.offset(PV)),
             },
-            scalar => VarValue::Scalar(decode(scalar, slots[0])),
+            scalar => VarValue::Scalar(load_value(mem, at, scalar)),
         }
     }
 

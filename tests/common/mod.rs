@@ -15,15 +15,15 @@ use std::time::Duration;
 /// full state and the faults after every scan.
 pub struct Recorder<'a> {
     pub inputs: &'a [Vec<(VarId, PlcValue)>],
-    pub states: Vec<Vec<u64>>,
+    pub states: Vec<Vec<u8>>,
     pub faults: Vec<Vec<Fault>>,
 }
 
 impl ScanDriver for Recorder<'_> {
-    fn before_scan(&mut self, m: &Machine, scan: u64, slots: &mut [u64]) {
+    fn before_scan(&mut self, m: &Machine, scan: u64, slots: &mut [u8]) {
         m.set_inputs_in(slots, &self.inputs[scan as usize]);
     }
-    fn after_scan(&mut self, _: &Machine, _: u64, slots: &[u64], faults: &[Fault], _: Duration) {
+    fn after_scan(&mut self, _: &Machine, _: u64, slots: &[u8], faults: &[Fault], _: Duration) {
         self.states.push(slots.to_vec());
         self.faults.push(faults.to_vec());
     }

@@ -1,25 +1,21 @@
-//! Checking seq == par: every scan's full state in a layout-independent slot order condensed
-//! into a 128-bit digest, and the exact lockstep replay that names the first difference.
+//! Checking seq == par: every scan's full state in a layout-independent order of its stored
+//! values condensed into a 128-bit digest, and the exact lockstep replay that names the first
+//! difference.
 
 use super::inputs::InputTable;
 use crate::exec::parallel::{ParallelMachine, RunLog};
-use crate::exec::{Fault, FaultKind, Machine};
+use crate::exec::{load_bits, parts, Addr, Fault, FaultKind, Machine};
 use crate::model::{Program, VarId};
 use serde_json::{json, Value as Json};
 
-/// Slot order independent of the layout: every variable's slots in declaration order, then the
-/// loop counters in rung order.
-pub(super) fn canonical_slots(m: &Machine) -> Vec<u32> {
-    let l = m.layout();
-    let mut out: Vec<u32> = (0..l.var_count() as u32)
-        .flat_map(|v| l.slots_of(VarId(v)))
-        .collect();
-    out.extend(m.loop_counters().map(|(_, s)| s));
-    out
+/// Stored values in an order independent of the layout (`Machine::canonical_values`): every
+/// variable's values in declaration order, then the loop counters in rung order.
+pub(super) fn canonical_slots(m: &Machine) -> Vec<(Addr, u32)> {
+    m.canonical_values()
 }
 
-/// 128-bit digest of a scan's state (in canonical slot order) and faults.
-pub(super) fn digest(slots: &[u64], canon: &[u32], faults: &[Fault]) -> u128 {
+/// 128-bit digest of a scan's state (its values in canonical order) and faults.
+pub(super) fn digest(mem: &[u8], canon: &[(Addr, u32)], faults: &[Fault]) -> u128 {
     #[inline(always)]
     fn mix(mut z: u64) -> u64 {
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
@@ -34,8 +30,8 @@ pub(super) fn digest(slots: &[u64], canon: &[u32], faults: &[Fault]) -> u128 {
             .wrapping_add(mix(x ^ 0xA076_1D64_78BD_642F))
             .rotate_left(41);
     };
-    for (i, &s) in canon.iter().enumerate() {
-        feed(i as u64, slots[s as usize]);
+    for (i, &(at, w)) in canon.iter().enumerate() {
+        feed(i as u64, load_bits(mem, at, w));
     }
     for (i, f) in faults.iter().enumerate() {
         let kind = match f.kind {
@@ -60,9 +56,8 @@ pub(super) fn first_difference(
 ) -> Json {
     let (cs, cp) = (canonical_slots(seq), canonical_slots(par.machine()));
     let (mut a, mut b) = (seq.initial_state(), par.initial_state());
-    let n_var_slots: usize = (0..p.vars.len() as u32)
-        .map(|v| seq.layout().slots_of(VarId(v)).len())
-        .sum();
+    let n_var_slots: usize = p.vars.iter().map(|v| parts(v.ty).len()).sum();
+    let value = |mem: &[u8], (at, w): (Addr, u32)| load_bits(mem, at, w);
     for scan in 0..=until {
         let (mut fa, mut fb) = (Vec::new(), Vec::new());
         seq.scan(&mut a, scan, inputs.at(scan), &mut fa);
@@ -78,18 +73,19 @@ pub(super) fn first_difference(
         if let Some(i) = cs
             .iter()
             .zip(&cp)
-            .position(|(&x, &y)| a.slots[x as usize] != b.slots[y as usize])
+            .position(|(&x, &y)| value(a.bytes(), x) != value(b.bytes(), y))
         {
             if i < n_var_slots {
-                // Which variable holds canonical slot i.
+                // Which variable holds canonical value i.
                 let mut k = 0;
                 for v in (0..p.vars.len() as u32).map(VarId) {
-                    let w = seq.layout().slots_of(v).len();
+                    let w = parts(p.var(v).ty).len();
                     if i < k + w {
                         let (va, vb) = (seq.value(&a, v), par.machine().value(&b, v));
                         let mut d = json!({"scan": scan, "variable": p.var(v).name, "seq": va.to_json(), "par": vb.to_json()});
                         if va == vb {
-                            d["detail"] = json!(format!("internal slot {} of the instance", i - k));
+                            d["detail"] =
+                                json!(format!("internal value {} of the instance", i - k));
                         }
                         return d;
                     }
@@ -101,7 +97,7 @@ pub(super) fn first_difference(
                 .nth(i - n_var_slots)
                 .expect("a loop counter");
             return json!({"scan": scan, "variable": format!("loop counter of rung {}", p.rung(rung).id),
-                "seq": a.slots[cs[i] as usize], "par": b.slots[cp[i] as usize]});
+                "seq": value(a.bytes(), cs[i]), "par": value(b.bytes(), cp[i])});
         }
         if fa != fb {
             let list = |fs: &[Fault]| {
@@ -158,20 +154,32 @@ mod tests {
     }
 
     #[test]
-    fn digests_see_every_slot_and_the_faults() {
-        let canon = [0u32, 1, 2];
-        let base = digest(&[1, 2, 3], &canon, &[]);
-        assert_ne!(base, digest(&[1, 2, 4], &canon, &[]));
-        assert_ne!(base, digest(&[2, 1, 3], &canon, &[]));
+    fn digests_see_every_value_and_the_faults() {
+        let canon = [(Addr(0), 1), (Addr(2), 2), (Addr(4), 4)];
+        let state = |a: u8, b: i16, c: i32| {
+            let mut m = vec![0u8; 8];
+            m[0] = a;
+            m[2..4].copy_from_slice(&b.to_ne_bytes());
+            m[4..8].copy_from_slice(&c.to_ne_bytes());
+            m
+        };
+        let base = digest(&state(1, 2, 3), &canon, &[]);
+        assert_ne!(base, digest(&state(1, 2, 4), &canon, &[]));
+        assert_ne!(base, digest(&state(2, 1, 3), &canon, &[]));
+        assert_ne!(base, digest(&state(1, 2, 3 << 16), &canon, &[]));
         let f = Fault {
             scan: 0,
             rung: crate::model::RungId(0),
             kind: FaultKind::DivByZero,
         };
-        assert_ne!(base, digest(&[1, 2, 3], &canon, &[f]));
+        assert_ne!(base, digest(&state(1, 2, 3), &canon, &[f]));
+        // The same values at other addresses.
+        let mut moved = vec![9u8; 16];
+        moved[8..16].copy_from_slice(&state(1, 2, 3));
+        let canon_moved = canon.map(|(at, w)| (at.offset(8), w));
         assert_eq!(
             base,
-            digest(&[9, 1, 2, 3], &[1, 2, 3], &[]),
+            digest(&moved, &canon_moved, &[]),
             "the layout does not matter"
         );
     }

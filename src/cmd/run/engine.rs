@@ -13,7 +13,9 @@ use crate::cmd::progress::{Bar, Progress};
 use crate::exec::parallel::{
     run_sequential, Candidate, ParallelMachine, PlanConfig, PlanKind, RunLog, ScanDriver,
 };
-use crate::exec::{ExecConfig, Fault, FaultKind, Layout, Machine, VarValue};
+use crate::exec::{
+    load_value, Addr, ExecConfig, Fault, FaultKind, Layout, Machine, State, VarValue,
+};
 use crate::model::{Program, Type, VarClass, VarId, VarRef};
 use serde_json::Value as Json;
 use std::collections::HashMap;
@@ -93,7 +95,7 @@ impl FaultTally {
 /// Per-scan bookkeeping shared by both modes.
 struct Driver<'a> {
     inputs: &'a InputTable,
-    canon: Vec<u32>,
+    canon: Vec<(Addr, u32)>,
     /// Digests of the reference run (filled), or to check against.
     digests: Vec<u128>,
     check: bool,
@@ -132,7 +134,7 @@ impl<'a> Driver<'a> {
 }
 
 impl ScanDriver for Driver<'_> {
-    fn before_scan(&mut self, m: &Machine, scan: u64, slots: &mut [u64]) {
+    fn before_scan(&mut self, m: &Machine, scan: u64, slots: &mut [u8]) {
         m.set_inputs_in(slots, self.inputs.at(scan));
     }
 
@@ -140,7 +142,7 @@ impl ScanDriver for Driver<'_> {
         &mut self,
         m: &Machine,
         scan: u64,
-        slots: &[u64],
+        slots: &[u8],
         faults: &[Fault],
         elapsed: Duration,
     ) {
@@ -168,9 +170,9 @@ impl ScanDriver for Driver<'_> {
                     "{scan},{}",
                     (scan as i64).wrapping_mul(m.config().cycle_ms as i64)
                 );
-                for &(slot, ty) in &t.cols {
+                for &(at, ty) in &t.cols {
                     t.line.push(',');
-                    t.line.push_str(&cell(ty, slots[slot as usize]));
+                    t.line.push_str(&cell(load_value(slots, at, ty)));
                 }
                 t.line.push('\n');
                 if let Err(e) = t.out.write_all(t.line.as_bytes()) {
@@ -189,10 +191,10 @@ const WARM_UP: u64 = 16;
 struct Inputs<'a>(&'a InputTable);
 
 impl ScanDriver for Inputs<'_> {
-    fn before_scan(&mut self, m: &Machine, scan: u64, slots: &mut [u64]) {
+    fn before_scan(&mut self, m: &Machine, scan: u64, slots: &mut [u8]) {
         m.set_inputs_in(slots, self.0.at(scan));
     }
-    fn after_scan(&mut self, _: &Machine, _: u64, _: &[u64], _: &[Fault], _: Duration) {}
+    fn after_scan(&mut self, _: &Machine, _: u64, _: &[u8], _: &[Fault], _: Duration) {}
     fn wants_time(&self) -> bool {
         false
     }
@@ -361,13 +363,13 @@ struct Pass {
     fault_count: u64,
     tally: FaultTally,
     trace_error: Option<std::io::Error>,
-    slots: Vec<u64>,
+    state: State,
     /// What the parallel executor ran.
     log: Option<RunLog>,
 }
 
 impl Pass {
-    fn of(d: Driver<'_>, slots: Vec<u64>, log: Option<RunLog>) -> Pass {
+    fn of(d: Driver<'_>, state: State, log: Option<RunLog>) -> Pass {
         Pass {
             total: d.total,
             digests: d.digests,
@@ -376,7 +378,7 @@ impl Pass {
             fault_count: d.fault_count,
             tally: d.tally,
             trace_error: d.trace.and_then(|t| t.error),
-            slots,
+            state,
             log,
         }
     }
@@ -415,7 +417,7 @@ pub(super) fn execute(
         let mut d = Driver::new(inputs, m, Vec::new(), false, t, bar);
         let mut st = m.initial_state();
         run_sequential(m, &mut st, 0..scans, &mut d);
-        Pass::of(d, st.slots, None)
+        Pass::of(d, st, None)
     });
     let par = run_par.map(|pm| {
         {
@@ -434,7 +436,7 @@ pub(super) fn execute(
         let mut d = Driver::new(inputs, m, digests.unwrap_or_default(), check, t, bar);
         let mut st = pm.initial_state();
         let log = pm.run(pr.pool.as_ref(), &mut st, 0..scans, &mut d);
-        Pass::of(d, st.slots, Some(log))
+        Pass::of(d, st, Some(log))
     });
     let (identical, first_difference) = match (&pr.seq, run_par, &par) {
         (Some(s), Some(pm), Some(pass)) => match pass.first_mismatch {
@@ -544,7 +546,7 @@ fn report(pr: &Prepared, c: &RunConfig, m: &Machine, pass: Pass, extra: Extra) -
         plan_run,
         sequential_fallback,
     } = extra;
-    let slots = &pass.slots;
+    let slots = pass.state.bytes();
     let visible: Vec<VarId> = (0..p.vars.len() as u32)
         .map(VarId)
         .filter(|&v| !p.var(v).hidden)

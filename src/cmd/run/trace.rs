@@ -1,13 +1,13 @@
 //! The `--trace` CSV: the traced columns (`--trace-vars`), the header and one line per scan.
 
 use crate::cmd::io::CliError;
-use crate::exec::Machine;
+use crate::exec::{Addr, Machine};
 use crate::model::{Field, Program, Type, Value, VarId, VarRef};
 use std::io::Write;
 
-/// The CSV cell of one traced slot: BOOL 1/0, integers and TIME (ms) as numbers, REAL shortest.
-pub(super) fn cell(ty: Type, bits: u64) -> String {
-    match crate::exec::decode(ty, bits) {
+/// The CSV cell of one traced value: BOOL 1/0, integers and TIME (ms) as numbers, REAL shortest.
+pub(super) fn cell(v: Value) -> String {
+    match v {
         Value::Bool(b) => (if b { "1" } else { "0" }).to_string(),
         Value::Int(i) => i.to_string(),
         Value::Dint(i) | Value::Time(i) => i.to_string(),
@@ -17,7 +17,7 @@ pub(super) fn cell(ty: Type, bits: u64) -> String {
 
 pub(super) struct Trace<'a> {
     pub(super) out: &'a mut dyn Write,
-    pub(super) cols: Vec<(u32, Type)>,
+    pub(super) cols: Vec<(Addr, Type)>,
     pub(super) line: String,
     pub(super) error: Option<std::io::Error>,
 }
@@ -143,7 +143,7 @@ impl<'a> Trace<'a> {
         let error = out.write_all(line.as_bytes()).err();
         Trace {
             out,
-            cols: cols.iter().map(|&(_, r, t)| (m.slot_of(r), t)).collect(),
+            cols: cols.iter().map(|&(_, r, t)| (m.addr_of(r), t)).collect(),
             line,
             error,
         }

@@ -1,33 +1,36 @@
 //! The plan check run on every plan at plan time, in release builds too: from the *lowered
-//! instructions'* actual slot reads and writes (`Machine::rung_accesses`), not from the access
+//! instructions'* actual byte reads and writes (`Machine::rung_accesses`), not from the access
 //! sets the plan was built from, every parallel phase must satisfy
-//! - no slot written by one worker is read or written by another worker (no data race), and
-//! - no two workers write one 64-byte line (8 slots) of the state (no false sharing of writes:
-//!   the layout's padding did its job).
+//! - no byte written by one worker is read or written by another worker (no data race), and
+//! - no two workers write one 64-byte line of the state (no false sharing of writes: the
+//!   layout's padding did its job). The line of a byte is its address / 64: a state's memory
+//!   starts on a line (`exec::Mem`).
 //!
 //! A plan that fails is not run: `ParallelMachine::new` drops it with a warning and the run
 //! falls back to the sequential walk. Depends on the plan and the interpreter below it; it does
 //! not fix plans.
 
 use super::plan::Plan;
-use crate::exec::Machine;
+use crate::exec::{Machine, Span, LINE_BYTES};
 use crate::model::RungId;
 
-/// Slots per 64-byte line.
-const LINE: u32 = 8;
-
-/// Who touched a slot or a line last: (phase, worker).
+/// Who touched a byte or a line last: (phase, worker).
 type Owner = Option<(u32, u32)>;
 
+/// The bytes of a span.
+fn bytes((at, w): Span) -> std::ops::Range<usize> {
+    at.index()..at.index() + w as usize
+}
+
 /// Checks `plan` against `machine`'s lowered code; the error names the phase, the workers and
-/// the slot.
+/// the byte.
 pub(super) fn check_plan(machine: &Machine, plan: &Plan) -> Result<(), String> {
-    let n = machine.slot_count() as usize;
-    let mut slot_writer: Vec<Owner> = vec![None; n];
-    let mut line_writer: Vec<Owner> = vec![None; n.div_ceil(LINE as usize)];
+    let n = machine.state_size() as usize;
+    let mut byte_writer: Vec<Owner> = vec![None; n];
+    let mut line_writer: Vec<Owner> = vec![None; n.div_ceil(LINE_BYTES as usize)];
     let (mut reads, mut writes) = (Vec::new(), Vec::new());
-    // Per worker of a phase: the slots it reads (checked once all writers are known).
-    let mut read_by: Vec<Vec<u32>> = Vec::new();
+    // Per worker of a phase: the spans it reads (checked once all writers are known).
+    let mut read_by: Vec<Vec<Span>> = Vec::new();
     for (pi, ph) in plan.phases.iter().enumerate() {
         if !ph.is_parallel() {
             continue;
@@ -44,36 +47,38 @@ pub(super) fn check_plan(machine: &Machine, plan: &Plan) -> Result<(), String> {
                 machine.rung_accesses(r, &mut reads, &mut writes);
                 read_by[w].extend_from_slice(&reads);
                 let w = w as u32;
-                for &s in &writes {
-                    let Some(slot) = slot_writer.get_mut(s as usize) else {
-                        return Err(format!("rung {} writes slot {s}, past the state", r.0));
-                    };
-                    match *slot {
-                        Some((p, w2)) if p == pi && w2 != w => {
-                            return Err(format!(
-                                "phase {pi}: slot {s} written by workers {w2} and {w}"
-                            ))
+                for &span in &writes {
+                    for b in bytes(span) {
+                        let Some(byte) = byte_writer.get_mut(b) else {
+                            return Err(format!("rung {} writes byte {b}, past the state", r.0));
+                        };
+                        match *byte {
+                            Some((p, w2)) if p == pi && w2 != w => {
+                                return Err(format!(
+                                    "phase {pi}: byte {b} written by workers {w2} and {w}"
+                                ))
+                            }
+                            _ => *byte = Some((pi, w)),
                         }
-                        _ => *slot = Some((pi, w)),
-                    }
-                    let line = &mut line_writer[(s / LINE) as usize];
-                    match *line {
-                        Some((p, w2)) if p == pi && w2 != w => {
-                            return Err(format!(
-                                "phase {pi}: workers {w2} and {w} both write the line of slot {s}"
+                        let line = &mut line_writer[b / LINE_BYTES as usize];
+                        match *line {
+                            Some((p, w2)) if p == pi && w2 != w => {
+                                return Err(format!(
+                                "phase {pi}: workers {w2} and {w} both write the line of byte {b}"
                             ))
+                            }
+                            _ => *line = Some((pi, w)),
                         }
-                        _ => *line = Some((pi, w)),
                     }
                 }
             }
         }
-        for (w, slots) in read_by.iter().enumerate() {
-            for &s in slots {
-                if let Some(Some((p, w2))) = slot_writer.get(s as usize) {
+        for (w, spans) in read_by.iter().enumerate() {
+            for b in spans.iter().flat_map(|&s| bytes(s)) {
+                if let Some(Some((p, w2))) = byte_writer.get(b) {
                     if *p == pi && *w2 != w as u32 {
                         return Err(format!(
-                            "phase {pi}: slot {s} written by worker {w2} and read by worker {w}"
+                            "phase {pi}: byte {b} written by worker {w2} and read by worker {w}"
                         ));
                     }
                 }
@@ -122,16 +127,39 @@ mod tests {
         let groups = super::super::plan::layout_groups(&[&plan], p.vars.len());
         let padded = Machine::new(
             &p,
-            Layout::from_groups(&p, &groups, 8).unwrap(),
+            Layout::from_groups(&p, &groups, LINE_BYTES).unwrap(),
             &ExecConfig::default(),
         )
         .unwrap();
         assert_eq!(check_plan(&padded, &plan), Ok(()));
-        // x and y on one line, written by workers 0 and 1 in phase 0.
+        // x and y (bytes 2 and 3) on one line, written by workers 0 and 1 in phase 0.
         let dense = Machine::new(&p, Layout::dense(&p), &ExecConfig::default()).unwrap();
         assert_eq!(
             check_plan(&dense, &plan),
-            Err("phase 0: workers 0 and 1 both write the line of slot 3".into())
+            Err("phase 0: workers 0 and 1 both write the line of byte 3".into())
+        );
+    }
+
+    #[test]
+    fn a_line_is_64_bytes_of_real_addresses() {
+        let p = program();
+        let a = crate::analysis::analyse(&p);
+        let config = PlanConfig {
+            strategy: Strategy::AllParallel,
+            ..PlanConfig::new(2)
+        };
+        let plan = Plan::build(&p, &a, &config);
+        let at = |x: u32, y: u32| {
+            let layout = Layout::from_starts(&p, vec![0, 1, x, y], 128).unwrap();
+            let m = Machine::new(&p, layout, &ExecConfig::default()).unwrap();
+            assert_eq!(m.state_size(), 128);
+            check_plan(&m, &plan)
+        };
+        // x (worker 0) and y (worker 1): bytes 63 and 64 are on two lines, 2 and 63 on one.
+        assert_eq!(at(63, 64), Ok(()));
+        assert_eq!(
+            at(2, 63),
+            Err("phase 0: workers 0 and 1 both write the line of byte 63".into())
         );
     }
 
@@ -152,6 +180,6 @@ mod tests {
         plan.task_rungs[1] = vec![RungId(0), RungId(1)];
         let m = Machine::new(&p, Layout::dense(&p), &ExecConfig::default()).unwrap();
         let e = check_plan(&m, &plan).unwrap_err();
-        assert_eq!(e, "phase 0: slot 2 written by workers 0 and 1");
+        assert_eq!(e, "phase 0: byte 2 written by workers 0 and 1");
     }
 }

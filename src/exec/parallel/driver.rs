@@ -9,15 +9,15 @@ use std::time::{Duration, Instant};
 /// What a caller of [`ParallelMachine::run`](super::ParallelMachine::run) (or [`run_sequential`]) does around each scan. Both
 /// methods are called on the calling thread, with exclusive access to the state.
 pub trait ScanDriver {
-    /// Before scan `scan`: write its inputs (`Machine::set_inputs_in`).
-    fn before_scan(&mut self, machine: &Machine, scan: u64, slots: &mut [u64]);
+    /// Before scan `scan`: write its inputs (`Machine::set_inputs_in`) into the state's bytes.
+    fn before_scan(&mut self, machine: &Machine, scan: u64, slots: &mut [u8]);
     /// After scan `scan`: the state, the scan's faults in sequential order, and the time the
     /// scan took (inputs and this call excluded).
     fn after_scan(
         &mut self,
         machine: &Machine,
         scan: u64,
-        slots: &[u64],
+        slots: &[u8],
         faults: &[Fault],
         elapsed: Duration,
     );
@@ -38,11 +38,11 @@ pub fn run_sequential<D: ScanDriver + ?Sized>(
     let mut faults = Vec::new();
     let timed = driver.wants_time();
     for scan in scans {
-        driver.before_scan(machine, scan, &mut state.slots);
+        driver.before_scan(machine, scan, state.bytes_mut());
         faults.clear();
         let t0 = timed.then(Instant::now);
         machine.run_scan(state, scan, &mut faults);
         let elapsed = t0.map(|t| t.elapsed()).unwrap_or_default();
-        driver.after_scan(machine, scan, &state.slots, &faults, elapsed);
+        driver.after_scan(machine, scan, state.bytes(), &faults, elapsed);
     }
 }

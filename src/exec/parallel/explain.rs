@@ -92,13 +92,13 @@ impl ParallelMachine {
                     let _ = writeln!(s, "  phase {}: levels {}..={} merged into one sequential phase (worker 0, task order)", i + 1, ph.levels.start + 1, ph.levels.end);
                 }
             }
-            let dense: u32 = p.vars.iter().map(|v| crate::exec::slot_width(v.ty)).sum();
+            let dense: u32 = p.vars.iter().map(|v| crate::exec::type_size(v.ty)).sum();
             let m = &self.machine;
             let _ = writeln!(
                 s,
-                "padding: {} variable groups on 64-byte lines (one per set of (phase, worker) writers); {} slots for {} of data, {} loop counters (a line each), {} decision slots",
+                "padding: {} variable groups on 64-byte lines (one per set of (phase, worker) writers); {} bytes for {} bytes of variables, {} loop counters (a line each), {} decision slots",
                 self.layout_groups,
-                m.layout().slot_count(),
+                m.layout().size(),
                 dense,
                 m.loop_counters().len(),
                 plan.decision_slots
@@ -164,7 +164,8 @@ impl ParallelMachine {
             "phases": plan.phase_count(),
             "parallel_phases": plan.parallel_phases(),
             "barriers_per_scan": plan.barriers_per_scan(),
-            "slots": self.machine.slot_count(),
+            "slots": self.machine.state_size().div_ceil(8),
+            "state_bytes": self.machine.state_size(),
             "layout_groups": self.layout_groups,
             "decision_slots": plan.decision_slots,
             "levels": plan.levels.iter().map(|lp| json!({

@@ -7,7 +7,7 @@
 //!
 //! Invariants: worker 0 alone talks to the driver and the chooser, between barriers; every
 //! candidate works on the same state layout, so a switch between scans needs no copy; the
-//! results are those of [`Machine::run_scan`], slot for slot and fault for fault, whichever
+//! results are those of [`Machine::run_scan`], byte for byte and fault for fault, whichever
 //! candidates ran. It does not plan (`plan`) nor check plans (`check`); it runs what
 //! [`ParallelMachine::new`] kept.
 
@@ -22,7 +22,9 @@ use super::plan::{layout_groups, Plan};
 use super::shared::{Decisions, FaultBuffer, Shared, SharedSlots};
 use super::tasks::{Item, Region};
 use crate::analysis::Analysis;
-use crate::exec::{ExecConfig, Exit, Fault, Layout, LowerError, Machine, ScanCtx, State};
+use crate::exec::{
+    ExecConfig, Exit, Fault, Layout, LowerError, Machine, ScanCtx, State, LINE_BYTES,
+};
 use crate::model::{Program, RungId, VarId};
 use std::cell::UnsafeCell;
 use std::ops::Range;
@@ -99,7 +101,7 @@ struct WindowCell {
 
 impl ParallelMachine {
     /// Plans `program` (analysed as `analysis`) for `config.threads` workers: the candidate
-    /// plans of `config.kind`, each checked against the lowered instructions' slot accesses
+    /// plans of `config.kind`, each checked against the lowered instructions' byte accesses
     /// (a plan that fails is dropped with a warning, see [`warnings`](Self::warnings)), lowered
     /// on one layout padded for all of them.
     pub fn new(
@@ -114,8 +116,8 @@ impl ParallelMachine {
             (Layout::dense(program), 0)
         } else {
             let groups = layout_groups(&levelled, program.vars.len());
-            let layout =
-                Layout::from_groups(program, &groups, 8).expect("groups hold each variable once");
+            let layout = Layout::from_groups(program, &groups, LINE_BYTES)
+                .expect("groups hold each variable once");
             (layout, groups.len())
         };
         let machine = Machine::new(program, layout, exec)?;
@@ -213,7 +215,7 @@ impl ParallelMachine {
         self.machine.initial_state()
     }
 
-    /// Checks every levelled plan against the lowered instructions' slot accesses (what
+    /// Checks every levelled plan against the lowered instructions' byte accesses (what
     /// [`new`](Self::new) did); the analysis is not needed and not used.
     pub fn verify(&self, _p: &Program, _a: &Analysis) -> Result<(), String> {
         for plan in &self.plans {
@@ -252,17 +254,10 @@ impl ParallelMachine {
             faults: &'a mut Vec<Fault>,
         }
         impl ScanDriver for One<'_> {
-            fn before_scan(&mut self, m: &Machine, _: u64, slots: &mut [u64]) {
+            fn before_scan(&mut self, m: &Machine, _: u64, slots: &mut [u8]) {
                 m.set_inputs_in(slots, self.inputs);
             }
-            fn after_scan(
-                &mut self,
-                _: &Machine,
-                _: u64,
-                _: &[u64],
-                faults: &[Fault],
-                _: Duration,
-            ) {
+            fn after_scan(&mut self, _: &Machine, _: u64, _: &[u8], faults: &[Fault], _: Duration) {
                 self.faults.extend_from_slice(faults);
             }
             fn wants_time(&self) -> bool {
@@ -300,8 +295,8 @@ impl ParallelMachine {
         only: Option<usize>,
     ) -> RunLog {
         assert_eq!(
-            state.slots.len(),
-            self.machine.slot_count() as usize,
+            state.bytes().len(),
+            self.machine.state_size() as usize,
             "state of another machine"
         );
         let allowed: Vec<usize> = match only {
@@ -349,8 +344,8 @@ impl ParallelMachine {
             .collect();
         let shared = Shared {
             slots: SharedSlots {
-                ptr: state.slots.as_mut_ptr(),
-                len: state.slots.len(),
+                len: state.bytes().len(),
+                ptr: state.bytes_mut().as_mut_ptr(),
             },
             decisions: &decisions,
             faults: &faults,
@@ -524,7 +519,7 @@ impl ParallelMachine {
     ) {
         // SAFETY: the other workers wait at the window barrier (or have not started) and touch
         // no slot until worker 0 reaches it: worker 0 has the slots to itself for this window.
-        let slots = unsafe { std::slice::from_raw_parts_mut(sh.slots.ptr, sh.slots.len) };
+        let slots = unsafe { sh.slots.bytes_mut() };
         let mut faults = Vec::new();
         for scan in scans {
             driver.before_scan(&self.machine, scan, slots);
@@ -558,7 +553,7 @@ impl ParallelMachine {
             if let Some((d, timing, _)) = driver.as_mut() {
                 // SAFETY: the other workers wait at the next barrier (or have not started):
                 // worker 0 has the slots to itself until it reaches that barrier.
-                let slots = unsafe { std::slice::from_raw_parts_mut(sh.slots.ptr, sh.slots.len) };
+                let slots = unsafe { sh.slots.bytes_mut() };
                 d.before_scan(&self.machine, scan, slots);
                 t0 = timing.wants(scan).then(Instant::now);
                 self.machine.begin_scan(&mut store);
@@ -599,7 +594,7 @@ impl ParallelMachine {
                 b.out.extend(b.merged.iter().map(|&(_, f)| f));
                 // SAFETY: as above: nobody writes the slots until worker 0 reaches the next
                 // barrier, after the driver returned.
-                let slots = unsafe { std::slice::from_raw_parts(sh.slots.ptr, sh.slots.len) };
+                let slots: &[u8] = unsafe { sh.slots.bytes_mut() };
                 d.after_scan(&self.machine, scan, slots, &b.out, elapsed);
             }
         }
@@ -716,8 +711,8 @@ struct Buffers {
 struct NoDriver;
 
 impl ScanDriver for NoDriver {
-    fn before_scan(&mut self, _: &Machine, _: u64, _: &mut [u64]) {}
-    fn after_scan(&mut self, _: &Machine, _: u64, _: &[u64], _: &[Fault], _: Duration) {}
+    fn before_scan(&mut self, _: &Machine, _: u64, _: &mut [u8]) {}
+    fn after_scan(&mut self, _: &Machine, _: u64, _: &[u8], _: &[Fault], _: Duration) {}
 }
 
 fn slicing_name(s: Slicing) -> &'static str {

@@ -1,5 +1,5 @@
 //! The parallel scan: the combined schedule (`analysis::schedule`) run level by level on several
-//! threads, with a result identical — every slot and every fault, every scan — to
+//! threads, with a result identical — every byte and every fault, every scan — to
 //! [`Machine::run_scan`](crate::exec::Machine::run_scan).
 //!
 //! # Shape
@@ -34,7 +34,7 @@
 //!   schedule's guarantee), and the loop counters of main-program loops belong to one task
 //!   each; a level whose tasks may share a subroutine's loop counters is run sequentially.
 //!   Every plan is checked when it is built, in every build, against the lowered instructions'
-//!   actual slot accesses (`check`): no slot written by a worker in a parallel phase is read or
+//!   actual byte accesses (`check`): no byte written by a worker in a parallel phase is read or
 //!   written by another worker of that phase, and no two workers write one 64-byte line; a plan
 //!   that fails is not run.
 //! - Control: after a task runs, the slot of its *decision* records where control left (the rung
@@ -61,12 +61,14 @@
 //! machine), `explain`.
 //!
 //! # Memory
-//! The state is one slot array shared by all workers without locks ([`SharedSlots`]: a raw
-//! pointer; disjointness is the schedule's guarantee above, ordering comes from the barrier's
-//! release/acquire). Its layout ([`Layout::from_groups`](crate::exec::Layout::from_groups), 8-slot = 64-byte lines) groups the
-//! variables by the set of (phase, worker) pairs that write them, so two workers never write the
-//! same cache line in one phase; loop counters have a line each; decisions and fault buffers are
-//! padded per worker.
+//! The state is one block of bytes, each value in its type's width (`exec::Layout`), starting
+//! on a 64-byte line and shared by all workers without locks ([`SharedSlots`]: Relaxed atomic
+//! loads and stores of each value's width, plain moves on x86-64 and aarch64; disjointness is
+//! the schedule's guarantee above, ordering comes from the barrier's release/acquire). Its
+//! layout ([`Layout::from_groups`](crate::exec::Layout::from_groups) on 64-byte lines) groups
+//! the variables by the set of (phase, worker) pairs that write them, so two workers never write
+//! the same cache line in one phase; loop counters have a line each; decisions and fault
+//! buffers are padded per worker.
 
 mod barrier;
 mod calls;

@@ -1,55 +1,80 @@
-//! Memory shared by the workers without locks: the slot array ([`SharedSlots`]), the padded
-//! per-worker fault buffers and the decision cells. Every `unsafe` here rests on the plan's
-//! discipline (no slot written by one worker in a phase is read or written by another; checked
-//! against the lowered code by `check`), stated in its `// SAFETY:` comment. Depends on the
-//! barrier, padding and typed indices below it; it does not run anything.
+//! Memory shared by the workers without locks: the state's bytes ([`SharedSlots`]), the padded
+//! per-worker fault buffers and the decision cells. The state is read and written through
+//! Relaxed atomics of each value's width (on x86-64 and aarch64 the same plain loads and stores
+//! as unshared memory), so even a plan that broke its discipline would give wrong values, never
+//! a data race; the discipline (no byte written by one worker in a phase is read or written by
+//! another; checked against the lowered code by `check`) and the barrier between phases are
+//! what make the values right. Every `unsafe` states its argument. Depends on the barrier,
+//! padding and typed indices below it; it does not run anything.
 
 use super::barrier::SpinBarrier;
 use super::ids::{Decision, DecisionSlot};
 use super::pad::Padded;
-use crate::exec::{Fault, Store};
+use crate::exec::{Addr, Fault, Store, Word};
 use std::cell::UnsafeCell;
 use std::sync::atomic::{AtomicU32, Ordering};
 
-/// The slot array shared by all workers, without locks.
+/// The state's bytes, shared by all workers without locks.
 #[derive(Copy, Clone, Debug)]
 pub struct SharedSlots {
-    pub(super) ptr: *mut u64,
+    /// The first byte: on a 64-byte line (a `State`'s memory).
+    pub(super) ptr: *mut u8,
     pub(super) len: usize,
 }
 
 // SAFETY: a `SharedSlots` is only created by `ParallelMachine::run` from the `&mut State` it
-// holds for the whole run, and used by the workers under the plan's discipline: in a parallel
-// phase, no slot written by one worker is read or written by another (checked at plan time
-// against the lowered instructions' accesses), so there are no data races; between phases the
-// barrier's release/acquire orders all accesses.
+// holds for the whole run; every access through it is atomic (`Store` below), so sharing it
+// between threads cannot race; the plan's discipline and the barriers make the values right.
 unsafe impl Send for SharedSlots {}
 // SAFETY: as above.
 unsafe impl Sync for SharedSlots {}
 
 #[cold]
 #[inline(never)]
-fn out_of_range(slot: u32, len: usize) -> ! {
-    panic!("slot {slot} out of range ({len} slots)")
+fn bad_access(at: Addr, width: usize, len: usize) -> ! {
+    panic!(
+        "access of {width} bytes at byte {} out of range or misaligned ({len} bytes)",
+        at.0
+    )
+}
+
+impl SharedSlots {
+    /// The pointer to the `T` at `at`, checked: in bounds and aligned to `T::SIZE`.
+    #[inline(always)]
+    fn at<T: Word>(&self, at: Addr) -> *mut u8 {
+        if at.index() + T::SIZE > self.len || !at.index().is_multiple_of(T::SIZE) {
+            bad_access(at, T::SIZE, self.len);
+        }
+        // SAFETY: in bounds of the allocation (checked just above).
+        unsafe { self.ptr.add(at.index()) }
+    }
+
+    /// The memory as a slice, for worker 0 while every other worker waits at a barrier.
+    ///
+    /// # Safety
+    /// No other thread accesses the memory while the slice lives, and it does not outlive the
+    /// run (the `&mut State` the memory is borrowed from).
+    pub(super) unsafe fn bytes_mut<'a>(self) -> &'a mut [u8] {
+        // SAFETY: `ptr..ptr + len` is the state's memory, borrowed mutably for the whole run;
+        // the caller guarantees exclusive access while the slice lives.
+        unsafe { std::slice::from_raw_parts_mut(self.ptr, self.len) }
+    }
 }
 
 impl Store for SharedSlots {
     #[inline(always)]
-    fn get(&self, slot: u32) -> u64 {
-        if slot as usize >= self.len {
-            out_of_range(slot, self.len);
-        }
-        // SAFETY: in bounds (checked); no other worker writes this slot in this phase (the plan's
-        // discipline, see the `Sync` impl).
-        unsafe { self.ptr.add(slot as usize).read() }
+    fn load<T: Word>(&self, at: Addr) -> T {
+        let p = self.at::<T>(at);
+        // SAFETY: in bounds and aligned to `T::SIZE` (checked by `at`, with the memory starting
+        // on a 64-byte line); the machine accesses each value always in its one width, so no
+        // mixed-size access to these bytes runs at the same time.
+        unsafe { T::load_relaxed(p) }
     }
     #[inline(always)]
-    fn set(&mut self, slot: u32, v: u64) {
-        if slot as usize >= self.len {
-            out_of_range(slot, self.len);
-        }
-        // SAFETY: in bounds (checked); no other worker reads or writes this slot in this phase.
-        unsafe { self.ptr.add(slot as usize).write(v) }
+    fn store<T: Word>(&mut self, at: Addr, v: T) {
+        let p = self.at::<T>(at);
+        // SAFETY: as in `load`.
+        unsafe { v.store_relaxed(p) }
     }
 }
 

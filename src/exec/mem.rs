@@ -1,0 +1,86 @@
+//! The backing memory of a state: bytes on 64-byte-aligned lines, so that a byte address / 64 is
+//! the cache line it lives on (what the parallel plan check counts) and no value straddles two
+//! lines (the layout aligns each value to its width).
+//!
+//! A [`Mem`] is a whole number of [`Line`]s viewed as one byte slice of the requested length
+//! (the bytes past it, up to the end of the last line, are zero and never seen). It does no
+//! typed access (`store`) and knows no layout (`layout`).
+
+use std::fmt;
+use std::ops::{Deref, DerefMut};
+
+/// Bytes per cache line (x86-64, most aarch64).
+pub const LINE_BYTES: u32 = 64;
+
+/// One cache line of state memory.
+#[repr(C, align(64))]
+#[derive(Copy, Clone, PartialEq, Eq)]
+struct Line([u8; LINE_BYTES as usize]);
+
+/// A state's memory: `len` bytes starting on a 64-byte boundary, zero-initialised.
+#[derive(Clone)]
+pub struct Mem {
+    lines: Vec<Line>,
+    len: usize,
+}
+
+impl Mem {
+    /// `len` zero bytes.
+    pub fn zeroed(len: usize) -> Mem {
+        Mem {
+            lines: vec![Line([0; LINE_BYTES as usize]); len.div_ceil(LINE_BYTES as usize)],
+            len,
+        }
+    }
+}
+
+impl Deref for Mem {
+    type Target = [u8];
+    #[inline(always)]
+    fn deref(&self) -> &[u8] {
+        // SAFETY: `Line` is `repr(C)` around `[u8; 64]`: the lines are `64 × lines.len()`
+        // initialised bytes with no padding, and `len <= 64 × lines.len()` (see `zeroed`).
+        unsafe { std::slice::from_raw_parts(self.lines.as_ptr().cast::<u8>(), self.len) }
+    }
+}
+
+impl DerefMut for Mem {
+    #[inline(always)]
+    fn deref_mut(&mut self) -> &mut [u8] {
+        // SAFETY: as in `deref`; the `&mut self` borrow makes the slice the only access.
+        unsafe { std::slice::from_raw_parts_mut(self.lines.as_mut_ptr().cast::<u8>(), self.len) }
+    }
+}
+
+impl PartialEq for Mem {
+    fn eq(&self, other: &Mem) -> bool {
+        **self == **other
+    }
+}
+
+impl Eq for Mem {}
+
+impl fmt::Debug for Mem {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_list().entries(self.iter()).finish()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn memory_starts_on_a_line_and_has_its_length() {
+        for len in [0, 1, 63, 64, 65, 1000] {
+            let mut m = Mem::zeroed(len);
+            assert_eq!(m.len(), len);
+            assert_eq!(m.as_ptr() as usize % 64, 0);
+            assert!(m.iter().all(|&b| b == 0));
+            if len > 0 {
+                m[len - 1] = 7;
+                assert_eq!(m[len - 1], 7);
+            }
+        }
+    }
+}
