@@ -6,7 +6,7 @@
 //! full slot arrays compare directly, loop counters and hidden state included.
 //!
 //! The plans are forced to be as parallel as possible (every level a parallel phase, or the cost
-//! model with free barriers) and alternate contiguous and LPT slicing, so that barriers,
+//! model with free barriers) and alternate contiguous, LPT and locality slicing, so that barriers,
 //! decisions, guards, multi-entry loops and runs of tasks are all exercised; a small loop cap
 //! makes the cap's refusals frequent. One thread pool serves every case.
 
@@ -165,7 +165,7 @@ fn check_with(
 
 fn configs(threads: usize, seed: u64) -> PlanConfig {
     let mut c = PlanConfig::new(threads);
-    match seed % 4 {
+    match seed % 5 {
         0 => {
             c.strategy = Strategy::AllParallel;
             c.slicing = Slicing::Contiguous;
@@ -173,6 +173,10 @@ fn configs(threads: usize, seed: u64) -> PlanConfig {
         1 => {
             c.strategy = Strategy::AllParallel;
             c.slicing = Slicing::Lpt;
+        }
+        4 => {
+            c.strategy = Strategy::AllParallel;
+            c.slicing = Slicing::Locality;
         }
         2 => {
             // The cost model with free barriers and items: parallel wherever a level has two tasks,
@@ -319,6 +323,7 @@ fn parallel_scan_equals_sequential_scan_on_generated_programs() {
                 configs(threads, 0),
                 configs(threads, 1),
                 configs(threads, 2),
+                configs(threads, 4),
             ] {
                 let label = format!(
                     "gen {rungs}/{width}/{seed}, {threads} threads, {:?}/{:?}",
@@ -373,7 +378,7 @@ fn worked_examples_with_their_inputs_under_forced_parallel_plans() {
             },
         ] {
             for threads in [2, 4] {
-                for k in 0..4 {
+                for k in 0..5 {
                     let config = configs(threads, k);
                     let label = format!(
                         "{dir}, {threads} threads, {:?}/{:?}, cap {}",

@@ -69,6 +69,7 @@
 //! padded per worker.
 
 mod barrier;
+mod calibrate;
 mod calls;
 mod check;
 mod choice;
@@ -77,17 +78,22 @@ mod driver;
 mod explain;
 mod ids;
 mod machine;
+mod movement;
 mod pad;
+mod partition;
 mod plan;
 mod shared;
+mod slicing;
 mod tasks;
 
 pub use barrier::SpinBarrier;
+pub use calibrate::{measure_line_cost, LineTiming};
 pub use choice::{Chooser, Switch, Window};
-pub use config::{Measure, PlanConfig, PlanKind, Slicing, Strategy};
+pub use config::{LineCostSource, Measure, PlanConfig, PlanKind, Slicing, Strategy};
 pub use driver::{run_sequential, ScanDriver};
 pub use explain::{ns_text, run_log_json};
 pub use ids::{Decision, DecisionSlot, Next, TaskId};
 pub use machine::{Candidate, ParallelMachine, RunLog};
-pub use plan::{LevelPlan, Plan};
+pub use plan::Plan;
 pub use shared::SharedSlots;
+pub use slicing::LevelPlan;
