@@ -67,9 +67,20 @@ impl ParallelMachine {
             );
             if let (true, Some(m)) = (lp.parallel, lp.makespan) {
                 let moved: u64 = lp.lines.iter().sum();
+                let others: Vec<String> = lp
+                    .compared
+                    .iter()
+                    .filter(|(name, _)| *name != lp.slicing)
+                    .map(|(name, m)| format!("{name} {m}"))
+                    .collect();
+                let others = if others.is_empty() {
+                    String::new()
+                } else {
+                    format!(" [{}]", others.join(", "))
+                };
                 let _ = write!(
                     s,
-                    " ({}, makespan {m}, {} moved):",
+                    " ({}, makespan {m}{others}, {} moved):",
                     lp.slicing,
                     count(moved, "line")
                 );
@@ -197,6 +208,7 @@ impl ParallelMachine {
                 "parallel": lp.parallel,
                 "makespan": lp.makespan,
                 "slicing": if lp.parallel { Some(lp.slicing) } else { None },
+                "compared": lp.compared.iter().map(|&(name, m)| (name.to_string(), json!(m))).collect::<serde_json::Map<_, _>>(),
                 "workers": lp.workers.iter().enumerate().map(|(w, &(t, i, c))| json!({"tasks": t, "items": i, "cost": c, "lines": lp.lines.get(w).copied().unwrap_or(0)})).collect::<Vec<_>>(),
                 "reason": lp.reason,
             })).collect::<Vec<_>>(),

@@ -1,7 +1,8 @@
 //! The static plan of one candidate: the schedule's levels turned into phases and per-worker
-//! slices of items (a dynamic programme over the levels on the cost model, contiguous or LPT
-//! slicing), the decision slots, guards and entries that carry control between tasks, and the
-//! variables each (phase, worker) writes (the layout's padding groups).
+//! slices of items (a dynamic programme over the levels on the cost model, the slices from
+//! `slicing`), the data movement of the phases as built and the modelled scan, the decision
+//! slots, guards and entries that carry control between tasks, and the variables each (phase,
+//! worker) writes (the layout's padding groups); and the candidate plans of a measured run.
 //!
 //! Follows Zhao & Yan's data levelling (levels run one after another, the rungs of a level in
 //! parallel) on the *combined* schedule: data and control dependences together, loops kept whole.
@@ -117,7 +118,7 @@ impl Plan {
         } else {
             Vec::new()
         };
-        let phase_lines = phase_movement(p, a, &phases, threads);
+        let mut phase_lines = phase_movement(p, a, &phases, threads);
         let est_plan = if any_parallel {
             modelled_scan(&phases, &phase_lines, &mut level_plans, config)
         } else {
@@ -132,6 +133,7 @@ impl Plan {
         );
         if sequential.is_some() {
             phases.clear();
+            phase_lines.clear();
         }
         let mut plan = Plan {
             threads,

@@ -35,6 +35,9 @@ pub struct LevelPlan {
     pub workers: Vec<(usize, usize, u64)>,
     /// Per worker: the cache lines it reads that another worker wrote last (parallel levels).
     pub lines: Vec<u64>,
+    /// Every slicing the model compared for the level and its modelled makespan (more than
+    /// one under [`Slicing::Auto`]).
+    pub compared: Vec<(&'static str, u64)>,
     /// Why.
     pub reason: String,
 }
@@ -75,6 +78,7 @@ pub(super) fn slice_levels(
             slicing: "",
             workers: Vec::new(),
             lines: Vec::new(),
+            compared: Vec::new(),
             reason: String::new(),
         };
         let forced = config.strategy == Strategy::AllParallel;
@@ -94,8 +98,9 @@ pub(super) fn slice_levels(
             level_plans.push(lp);
             continue;
         }
-        let cut = best_cut(level, &weights, info, config, &movement);
+        let (cut, compared) = best_cut(level, &weights, info, config, &movement);
         movement.commit(&cut.slices);
+        lp.compared = compared;
         lp.makespan = Some(cut.makespan);
         lp.slicing = cut.slicing.name();
         lp.workers = cut.workers;
@@ -107,14 +112,15 @@ pub(super) fn slice_levels(
 }
 
 /// The configured slicing of `level`, or under [`Slicing::Auto`] the one with the smallest
-/// modelled makespan (ties: contiguous, LPT, locality).
+/// modelled makespan (ties: contiguous, LPT, locality); and every slicing compared, with its
+/// makespan.
 fn best_cut(
     level: &[TaskId],
     weights: &[u64],
     info: &Tasks<'_>,
     config: &PlanConfig,
     movement: &Movement<'_>,
-) -> Cut {
+) -> (Cut, Vec<(&'static str, u64)>) {
     let threads = config.threads.max(1);
     let contig: Slices = contiguous(weights, threads)
         .into_iter()
@@ -128,6 +134,7 @@ fn best_cut(
         Slicing::Locality => &[Slicing::Locality],
     };
     let mut best: Option<Cut> = None;
+    let mut compared = Vec::with_capacity(kinds.len());
     for &kind in kinds {
         let slices = match kind {
             Slicing::Lpt => by_lpt.clone(),
@@ -135,11 +142,12 @@ fn best_cut(
             Slicing::Contiguous | Slicing::Auto => contig.clone(),
         };
         let cut = evaluate(kind, slices, info, config, movement);
+        compared.push((kind.name(), cut.makespan));
         if best.as_ref().is_none_or(|b| cut.makespan < b.makespan) {
             best = Some(cut);
         }
     }
-    best.expect("at least one slicing")
+    (best.expect("at least one slicing"), compared)
 }
 
 /// A cut's per-worker items, costs and lines, and its makespan.
