@@ -9,8 +9,8 @@
 //!    number of breaks costs one `item_cost`: a shortest path over (task, worker, breaks)
 //!    states (Viterbi), O(tasks × workers³). Ties go to the reference partition's worker, so a
 //!    level whose tasks read nothing written by the workers keeps the reference partition.
-//! 2. **Units.** The path cut into units: maximal runs of one worker that would be one item,
-//!    at most `total / (16 × workers)` in weight each, so that balance can be repaired finely.
+//! 2. **Units.** The path cut into units: maximal runs of consecutive tasks on one worker, at
+//!    most `total / (16 × workers)` in weight each, so that balance can be repaired finely.
 //! 3. **Balance repair** (the move step of Fiduccia & Mattheyses 1982, on one objective):
 //!    while the heaviest worker is over the bound, move one of its units to the lightest
 //!    worker, choosing the move that loses least (affinity bytes that become remote, and items
@@ -20,7 +20,8 @@
 //! **The bound.** The heaviest worker's load (Σ task weights) is at most the reference's heaviest
 //! load plus a sixteenth (ε = 1/16, [`SLACK`]), the reference being the better of contiguous
 //! slicing and LPT (Graham 1969) on the same weights. If the repair cannot reach it, the
-//! partition *is* the reference. Every task is assigned to exactly one worker. It does not know
+//! partition *is* the reference (also when the path breaks into more than [`MAX_UNITS`]
+//! units). Every task is assigned to exactly one worker. It does not know
 //! about variables or lines (the caller turns them into `affinity`) nor decide whether the level
 //! runs in parallel (see `plan`).
 
@@ -30,6 +31,10 @@ pub(super) const SLACK: u64 = 16;
 /// Breaks of items per worker the affinity path may make for free (as many as the reference
 /// makes, up to this).
 const FREE_BREAKS_PER_WORKER: usize = 4;
+
+/// The most units the repair works with (each move looks at all of them): a level whose
+/// affinity path breaks into more keeps the reference partition.
+const MAX_UNITS: usize = 4096;
 
 /// Units per worker that the repair works with (at least).
 const UNITS_PER_WORKER: u64 = 16;
@@ -82,6 +87,9 @@ pub(super) fn locality(level: &Level<'_>, p: usize, costs: Costs) -> Vec<usize> 
     let mut assign = affinity_path(level, p, costs);
     let limit = bound(makespan(level.weights, level.reference, p));
     let units = units(level, &assign, p);
+    if units.len() > MAX_UNITS {
+        return level.reference.to_vec();
+    }
     repair(level, p, costs, &units, &mut assign, limit);
     if makespan(level.weights, &assign, p) > limit {
         return level.reference.to_vec();
@@ -152,7 +160,7 @@ fn affinity_path(level: &Level<'_>, p: usize, costs: Costs) -> Vec<usize> {
     out
 }
 
-/// Step 2: runs of one worker that are one item, cut at a weight cap: ranges of tasks.
+/// Step 2: runs of consecutive tasks of one worker, cut at a weight cap: ranges of tasks.
 fn units(level: &Level<'_>, assign: &[usize], p: usize) -> Vec<std::ops::Range<usize>> {
     let total: u64 = level.weights.iter().sum();
     let cap = total.div_ceil(p as u64 * UNITS_PER_WORKER).max(1);
@@ -160,8 +168,7 @@ fn units(level: &Level<'_>, assign: &[usize], p: usize) -> Vec<std::ops::Range<u
     let (mut start, mut sum) = (0, 0u64);
     for i in 0..assign.len() {
         let w = level.weights[i];
-        let joined = i > start && level.joins[i - 1] && assign[i] == assign[i - 1];
-        if i > start && (!joined || sum + w > cap) {
+        if i > start && (assign[i] != assign[i - 1] || sum + w > cap) {
             out.push(start..i);
             start = i;
             sum = 0;
@@ -182,9 +189,16 @@ fn repair(
     assign: &mut [usize],
     limit: u64,
 ) {
-    let weight = |u: usize| -> u64 { level.weights[units[u].clone()].iter().sum() };
-    let aff =
-        |u: usize, w: usize| -> u64 { units[u].clone().map(|i| level.affinity[i * p + w]).sum() };
+    let weights: Vec<u64> = units
+        .iter()
+        .map(|r| level.weights[r.clone()].iter().sum())
+        .collect();
+    let affinity: Vec<u64> = units
+        .iter()
+        .flat_map(|r| (0..p).map(move |w| r.clone().map(|i| level.affinity[i * p + w]).sum()))
+        .collect();
+    let weight = |u: usize| weights[u];
+    let aff = |u: usize, w: usize| affinity[u * p + w];
     // Items joined with unit `u` on worker `w` (its neighbours there, if one walk).
     let joins_on = |assign: &[usize], u: usize, w: usize| -> u64 {
         let r = &units[u];
