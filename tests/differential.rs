@@ -577,5 +577,7 @@ fn the_measured_plan_times_the_locality_partition_and_stays_exact() {
         &pool,
         &mut stats,
     );
-    assert!(stats.switches > 0, "the candidates were switched between");
+    // The first round of measurement runs every candidate (the locality plan included) on
+    // scans of the run, whatever the timings: the run mixed the walk and the levelled plans.
+    assert_eq!(stats.mixed_runs, 1);
 }

@@ -33,9 +33,24 @@ impl ParallelMachine {
         let (seq, est) = plan.estimates();
         let _ = writeln!(
             s,
-            "modelled scan: sequential {seq} steps, this plan {est} steps ({:.2}x)",
-            seq as f64 / est.max(1) as f64
+            "modelled scan: sequential {seq} steps, this plan {est} steps ({:.2}x, {} moved lines)",
+            seq as f64 / est.max(1) as f64,
+            plan.phase_lines.iter().flatten().sum::<u64>()
         );
+        for (i, c) in self.candidates.iter().enumerate() {
+            if let Candidate::Levelled(k) = *c {
+                if k > 0 {
+                    let other = &self.plans[k];
+                    let _ = writeln!(
+                        s,
+                        "  candidate {}: modelled {} steps per scan ({} moved lines)",
+                        self.names[i],
+                        other.est_plan,
+                        other.phase_lines.iter().flatten().sum::<u64>()
+                    );
+                }
+            }
+        }
         if let Some(why) = &plan.sequential {
             let _ = writeln!(
                 s,
