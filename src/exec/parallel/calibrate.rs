@@ -66,7 +66,7 @@ pub fn measure_line_cost() -> Option<LineTiming> {
         let mut spins = 0u32;
         while turn.load(Ordering::Acquire) < want {
             spins = spins.wrapping_add(1);
-            if spins % 64 == 0 {
+            if spins.is_multiple_of(64) {
                 let waited = start.elapsed();
                 if waited > ROUND_WAIT {
                     return None;
