@@ -369,7 +369,7 @@ fn input_table(p: &Program, seed: u64) -> Vec<Vec<(VarId, Value)>> {
 
 fn config(threads: usize, k: u64) -> PlanConfig {
     let mut c = PlanConfig::new(threads);
-    match k % 3 {
+    match k % 4 {
         0 => {
             c.strategy = Strategy::AllParallel;
             c.slicing = Slicing::Contiguous;
@@ -377,6 +377,10 @@ fn config(threads: usize, k: u64) -> PlanConfig {
         1 => {
             c.strategy = Strategy::AllParallel;
             c.slicing = Slicing::Lpt;
+        }
+        3 => {
+            c.strategy = Strategy::AllParallel;
+            c.slicing = Slicing::Locality;
         }
         _ => {
             c.barrier_cost = 0;
@@ -542,7 +546,7 @@ fn fbd_worked_examples_under_forced_parallel_plans() {
             .collect();
         let exec = ExecConfig::default();
         for threads in [2, 4] {
-            for k in 0..3 {
+            for k in 0..4 {
                 let c = config(threads, k);
                 let label = format!("{dir}, {threads} threads, {:?}/{:?}", c.strategy, c.slicing);
                 let par = ParallelMachine::new(&p, &a, &exec, &c).unwrap();

@@ -57,6 +57,9 @@ pub struct RunConfig {
     /// Show progress on standard error (default: when it is a terminal); a phase appears once it
     /// has taken half a second.
     pub progress: bool,
+    /// Measure the cost of a moved cache line before planning (a few ms; default on), instead
+    /// of the built-in default.
+    pub calibrate: bool,
 }
 
 impl RunConfig {
@@ -78,6 +81,7 @@ impl RunConfig {
             loop_cap: ExecConfig::default().loop_cap,
             output: None,
             progress: std::io::stderr().is_terminal(),
+            calibrate: true,
         }
     }
 }

@@ -311,7 +311,11 @@ pub(super) fn prepare(c: &RunConfig, progress: &Progress) -> Result<Prepared, Cl
                 &exec,
                 &PlanConfig {
                     kind: c.plan,
-                    ..PlanConfig::new(workers)
+                    ..if c.calibrate && c.plan != PlanKind::Seq {
+                        PlanConfig::new(workers).calibrated()
+                    } else {
+                        PlanConfig::new(workers)
+                    }
                 },
             )
             .map_err(lower_error)?,

@@ -75,11 +75,13 @@ pub fn run(c: &RunConfig) -> Result<(), CliError> {
     write_output(c.output.as_deref(), &out)
 }
 
-/// The deterministic JSON of a run (timing fields zero): what `analyses/*/run.json` holds.
+/// The deterministic JSON of a run (timing fields zero; the default line cost, not a measured
+/// one): what `analyses/*/run.json` holds.
 pub fn run_json_deterministic(c: &RunConfig) -> Result<String, CliError> {
     let c = RunConfig {
         progress: false,
         trace: None,
+        calibrate: false,
         ..c.clone()
     };
     Ok(render_json(&run_report(&c)?, true))

@@ -1,4 +1,4 @@
-//! The parameters of the parallel plan: worker count, modelled barrier and item costs, how
+//! The parameters of the parallel plan: worker count, modelled barrier, item and line costs, how
 //! levels become phases and parallel levels become slices, which candidate plans a run may use
 //! ([`PlanKind`]) and how the measured choice among them re-measures ([`Measure`]).
 //! Plain data at the bottom of the parallel module; nothing here decides anything.
@@ -6,8 +6,8 @@
 /// Which plans a run may use.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub enum PlanKind {
-    /// Measured: the sequential walk and the levelled plans (contiguous and LPT slicing) that
-    /// the cost model says may gain are timed on the run's first scans, the fastest runs, and
+    /// Measured: the sequential walk and the levelled plans (contiguous, LPT and locality
+    /// slicing) that the cost model says may gain are timed on the run's first scans, the fastest runs, and
     /// the choice is re-measured as the run goes (`plc-deps run --plan auto`, the default).
     Auto,
     /// The cost model decides, once, with no measurement (the levelled plan if it beats the
@@ -78,12 +78,48 @@ pub enum Strategy {
 /// How a parallel level is cut into slices.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub enum Slicing {
-    /// Contiguous or LPT, whichever the cost model says finishes first (ties: contiguous).
+    /// Contiguous, LPT or locality, whichever the cost model (with data movement) says
+    /// finishes first (ties: contiguous, then LPT).
     Auto,
     /// Contiguous runs of tasks in task order, balanced by cost.
     Contiguous,
     /// Longest processing time first: each task to the least loaded worker.
     Lpt,
+    /// Each task towards the worker that wrote what it reads, within a balance bound (the
+    /// heaviest load at most 1/16 over the better of contiguous and LPT; `partition`).
+    Locality,
+}
+
+impl Slicing {
+    /// `auto`, `contiguous`, `lpt`, `locality`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Slicing::Auto => "auto",
+            Slicing::Contiguous => "contiguous",
+            Slicing::Lpt => "lpt",
+            Slicing::Locality => "locality",
+        }
+    }
+}
+
+/// Where the modelled cost of a moved cache line came from.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum LineCostSource {
+    /// The built-in default ([`PlanConfig::DEFAULT_LINE_COST`]).
+    Default,
+    /// Measured on this machine at plan time (`calibrate`): ns per line read from another
+    /// core's cache and from the own cache, in tenths of a ns.
+    Measured {
+        /// A line another core wrote, 0.1 ns.
+        remote_tenths_ns: u64,
+        /// A line in the reader's own cache, 0.1 ns.
+        local_tenths_ns: u64,
+    },
+    /// The default, because the measurement gave up (the two threads could not run at once:
+    /// a busy machine).
+    GaveUp,
+    /// Set by the caller.
+    Given,
 }
 
 /// Parameters of the plan. Costs are in the cost model's element steps (a contact is 1; on the
@@ -97,6 +133,11 @@ pub struct PlanConfig {
     /// Modelled overhead of one item (one call into the interpreter: a run of tasks, or one
     /// guarded task), in steps.
     pub item_cost: u64,
+    /// Modelled cost of one cache line a worker reads that another worker wrote last, in
+    /// steps (`movement`).
+    pub line_cost: u64,
+    /// Where `line_cost` came from (for `--explain`).
+    pub line_cost_source: LineCostSource,
     /// How levels become phases.
     pub strategy: Strategy,
     /// How parallel levels are sliced.
@@ -109,14 +150,22 @@ pub struct PlanConfig {
 }
 
 impl PlanConfig {
+    /// The default cost of a moved line, in steps: on the 2-core AMD EPYC of the other
+    /// defaults a line another core wrote costs ≈ 20 ns more to read than a line in the own
+    /// cache when several such reads overlap (the interpreter's reads are independent loads).
+    pub const DEFAULT_LINE_COST: u64 = 20;
+
     /// The defaults for `threads` workers, measured on a 2-core AMD EPYC: a barrier of two
     /// spinning workers takes 100–150 ns, a step of generated programs 0.5–2 ns (≈ 1 ns for
-    /// 1,000 rungs): barrier 120 steps; an item (a call into the interpreter) ≈ 12 steps.
+    /// 1,000 rungs): barrier 120 steps; an item (a call into the interpreter) ≈ 12 steps; a
+    /// moved line [`DEFAULT_LINE_COST`](Self::DEFAULT_LINE_COST).
     pub fn new(threads: usize) -> PlanConfig {
         PlanConfig {
             threads: threads.max(1),
             barrier_cost: 120,
             item_cost: 12,
+            line_cost: Self::DEFAULT_LINE_COST,
+            line_cost_source: LineCostSource::Default,
             strategy: Strategy::Auto,
             slicing: Slicing::Auto,
             kind: PlanKind::Model,

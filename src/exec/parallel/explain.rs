@@ -1,6 +1,7 @@
 //! `plc-deps run --explain`: the plan in words and as JSON. The top of the parallel module:
 //! it reads the machine and its plan and changes nothing.
 
+use super::config::LineCostSource;
 use super::machine::{Candidate, ParallelMachine, RunLog};
 use crate::model::Program;
 use serde_json::json;
@@ -27,14 +28,29 @@ impl ParallelMachine {
         for w in &self.warnings {
             let _ = writeln!(s, "warning: {w}");
         }
-        let _ = writeln!(s, "parallel plan: {}, {}, cost model: barrier {} steps, item {} steps, strategy {:?}, slicing {:?}",
-            count(plan.threads, "worker"), count(plan.levels.len(), "level"), c.barrier_cost, c.item_cost, c.strategy, c.slicing);
+        let _ = writeln!(s, "parallel plan: {}, {}, cost model: barrier {} steps, item {} steps, line {} steps ({}), strategy {:?}, slicing {:?}",
+            count(plan.threads, "worker"), count(plan.levels.len(), "level"), c.barrier_cost, c.item_cost, c.line_cost, line_source(c.line_cost_source), c.strategy, c.slicing);
         let (seq, est) = plan.estimates();
         let _ = writeln!(
             s,
-            "modelled scan: sequential {seq} steps, this plan {est} steps ({:.2}x)",
-            seq as f64 / est.max(1) as f64
+            "modelled scan: sequential {seq} steps, this plan {est} steps ({:.2}x, {} moved lines)",
+            seq as f64 / est.max(1) as f64,
+            plan.phase_lines.iter().flatten().sum::<u64>()
         );
+        for (i, c) in self.candidates.iter().enumerate() {
+            if let Candidate::Levelled(k) = *c {
+                if k > 0 {
+                    let other = &self.plans[k];
+                    let _ = writeln!(
+                        s,
+                        "  candidate {}: modelled {} steps per scan ({} moved lines)",
+                        self.names[i],
+                        other.est_plan,
+                        other.phase_lines.iter().flatten().sum::<u64>()
+                    );
+                }
+            }
+        }
         if let Some(why) = &plan.sequential {
             let _ = writeln!(
                 s,
@@ -65,13 +81,31 @@ impl ParallelMachine {
                 lp.cost
             );
             if let (true, Some(m)) = (lp.parallel, lp.makespan) {
-                let _ = write!(s, " ({}, makespan {m}):", lp.slicing);
+                let moved: u64 = lp.lines.iter().sum();
+                let others: Vec<String> = lp
+                    .compared
+                    .iter()
+                    .filter(|(name, _)| *name != lp.slicing)
+                    .map(|(name, m)| format!("{name} {m}"))
+                    .collect();
+                let others = if others.is_empty() {
+                    String::new()
+                } else {
+                    format!(" [{}]", others.join(", "))
+                };
+                let _ = write!(
+                    s,
+                    " ({}, makespan {m}{others}, {} moved):",
+                    lp.slicing,
+                    count(moved, "line")
+                );
                 for (w, (tasks, items, cost)) in lp.workers.iter().enumerate() {
                     let _ = write!(
                         s,
-                        " w{w} {}/{}/{cost}",
+                        " w{w} {}/{}/{cost}+{}",
                         count(*tasks, "task"),
-                        count(*items, "item")
+                        count(*items, "item"),
+                        count(lp.lines.get(w).copied().unwrap_or(0), "line")
                     );
                     if w + 1 < lp.workers.len() {
                         s.push(',');
@@ -88,8 +122,22 @@ impl ParallelMachine {
         }
         if plan.sequential.is_none() {
             for (i, ph) in plan.phases.iter().enumerate() {
+                let moved = plan
+                    .phase_lines
+                    .get(i)
+                    .and_then(|l| l.first())
+                    .copied()
+                    .unwrap_or(0);
                 if !ph.is_parallel() && ph.levels.len() > 1 {
-                    let _ = writeln!(s, "  phase {}: levels {}..={} merged into one sequential phase (worker 0, task order)", i + 1, ph.levels.start + 1, ph.levels.end);
+                    let _ = writeln!(s, "  phase {}: levels {}..={} merged into one sequential phase (worker 0, task order), {} moved", i + 1, ph.levels.start + 1, ph.levels.end, count(moved, "line"));
+                } else if !ph.is_parallel() && moved > 0 {
+                    let _ = writeln!(
+                        s,
+                        "  phase {}: level {} sequential (worker 0), {} moved",
+                        i + 1,
+                        ph.levels.start + 1,
+                        count(moved, "line")
+                    );
                 }
             }
             let dense: u32 = p.vars.iter().map(|v| crate::exec::type_size(v.ty)).sum();
@@ -160,6 +208,8 @@ impl ParallelMachine {
             "sequential": plan.sequential,
             "barrier_cost": plan.config.barrier_cost,
             "item_cost": plan.config.item_cost,
+            "line_cost": plan.config.line_cost,
+            "line_cost_source": line_source(plan.config.line_cost_source),
             "modelled_steps": {"sequential": seq, "plan": est},
             "phases": plan.phase_count(),
             "parallel_phases": plan.parallel_phases(),
@@ -174,7 +224,8 @@ impl ParallelMachine {
                 "parallel": lp.parallel,
                 "makespan": lp.makespan,
                 "slicing": if lp.parallel { Some(lp.slicing) } else { None },
-                "workers": lp.workers.iter().map(|&(t, i, c)| json!({"tasks": t, "items": i, "cost": c})).collect::<Vec<_>>(),
+                "compared": lp.compared.iter().map(|&(name, m)| (name.to_string(), json!(m))).collect::<serde_json::Map<_, _>>(),
+                "workers": lp.workers.iter().enumerate().map(|(w, &(t, i, c))| json!({"tasks": t, "items": i, "cost": c, "lines": lp.lines.get(w).copied().unwrap_or(0)})).collect::<Vec<_>>(),
                 "reason": lp.reason,
             })).collect::<Vec<_>>(),
         })
@@ -213,6 +264,25 @@ pub fn run_log_json(log: &RunLog, deterministic: bool) -> serde_json::Value {
             })).collect::<Vec<_>>()
         },
     })
+}
+
+/// Where the line cost came from, in words.
+fn line_source(src: LineCostSource) -> String {
+    match src {
+        LineCostSource::Default => "default".into(),
+        LineCostSource::GaveUp => {
+            "default: the measurement gave up, the other core was busy".into()
+        }
+        LineCostSource::Given => "given".into(),
+        LineCostSource::Measured {
+            remote_tenths_ns,
+            local_tenths_ns,
+        } => format!(
+            "measured: a line from the other core {:.1} ns, from the own cache {:.1} ns",
+            remote_tenths_ns as f64 / 10.0,
+            local_tenths_ns as f64 / 10.0
+        ),
+    }
 }
 
 /// `1 task`, `2 tasks`.

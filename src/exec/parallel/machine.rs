@@ -14,11 +14,11 @@
 use super::barrier::SpinBarrier;
 use super::check::check_plan;
 use super::choice::{Chooser, Switch, Window};
-use super::config::{Measure, PlanConfig, PlanKind, Slicing};
+use super::config::{Measure, PlanConfig, PlanKind};
 use super::driver::{run_sequential, ScanDriver};
 use super::ids::{Decision, Next};
 use super::pad::Padded;
-use super::plan::{layout_groups, Plan};
+use super::plan::{candidate_plans, layout_groups, Plan};
 use super::shared::{Decisions, FaultBuffer, Shared, SharedSlots};
 use super::tasks::{Item, Region};
 use crate::analysis::Analysis;
@@ -44,7 +44,8 @@ pub enum Candidate {
 /// switch between them.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct RunLog {
-    /// Candidate names (`seq`, `par`, `par-contiguous`, `par-lpt`), by candidate index.
+    /// Candidate names (`seq`, `par`, `par-contiguous`, `par-lpt`, `par-locality`), by candidate
+    /// index.
     pub candidates: Vec<String>,
     /// Scans run on each candidate.
     pub scans_on: Vec<u64>,
@@ -143,7 +144,7 @@ impl ParallelMachine {
             if plan.sequential.is_none() {
                 candidates.push(Candidate::Levelled(i));
                 names.push(if levelled > 1 {
-                    format!("par-{}", slicing_name(plan.config.slicing))
+                    format!("par-{}", plan.config.slicing.name())
                 } else {
                     "par".to_string()
                 });
@@ -713,44 +714,4 @@ struct NoDriver;
 impl ScanDriver for NoDriver {
     fn before_scan(&mut self, _: &Machine, _: u64, _: &mut [u8]) {}
     fn after_scan(&mut self, _: &Machine, _: u64, _: &[u8], _: &[Fault], _: Duration) {}
-}
-
-fn slicing_name(s: Slicing) -> &'static str {
-    match s {
-        Slicing::Auto => "auto",
-        Slicing::Contiguous => "contiguous",
-        Slicing::Lpt => "lpt",
-    }
-}
-
-/// The plans of `config.kind`: the model's plan (model, seq, par), or the levelled plans of
-/// the model's phases under both slicings (auto, when slicing is left to the planner; one
-/// plan when both slicings give the same phases).
-fn candidate_plans(p: &Program, a: &Analysis, config: &PlanConfig) -> Vec<Plan> {
-    if config.kind != PlanKind::Auto || config.slicing != Slicing::Auto {
-        return vec![Plan::build(p, a, config)];
-    }
-    let contiguous = Plan::build(
-        p,
-        a,
-        &PlanConfig {
-            slicing: Slicing::Contiguous,
-            ..*config
-        },
-    );
-    let lpt = Plan::build(
-        p,
-        a,
-        &PlanConfig {
-            slicing: Slicing::Lpt,
-            ..*config
-        },
-    );
-    if lpt.sequential.is_some() || lpt.phases == contiguous.phases {
-        vec![contiguous]
-    } else if contiguous.sequential.is_some() {
-        vec![lpt]
-    } else {
-        vec![contiguous, lpt]
-    }
 }

@@ -11,8 +11,12 @@
 //!
 //! - a **parallel phase** is one level of the schedule, cut statically into one *slice* per
 //!   worker, balanced on the cost model (`Analysis::rung_costs`): contiguous runs of tasks
-//!   (best for many small rungs: a slice of consecutive rungs is one call into the interpreter)
-//!   or LPT (best for a few large tasks), whichever the model says finishes first;
+//!   (best for many small rungs: a slice of consecutive rungs is one call into the interpreter),
+//!   LPT (best for a few large tasks) or the *locality partition* (each task towards the worker
+//!   that wrote what it reads, within 1/16 of the better of the two: `partition`), whichever
+//!   the model says finishes first — the model counting, besides steps, the cache lines each
+//!   worker reads that another worker wrote (`movement`, at a per-line cost the run measures
+//!   once on the machine: `calibrate`);
 //! - a **sequential phase** is a run of consecutive levels that cannot pay for a barrier, merged
 //!   and run by worker 0 alone, in task order;
 //! - when nothing pays, the whole program runs as the sequential scan ([`Plan::sequential`]).
@@ -20,7 +24,8 @@
 //! The choice is a small dynamic programme over the levels (each level parallel or sequential,
 //! a barrier at every change and between parallel levels; sequential levels next to each other
 //! share their barriers): it minimises the modelled scan time `Σ parallel makespans + Σ
-//! sequential costs + barriers × barrier_cost`. With [`PlanKind::Model`] the plan is used only
+//! sequential costs + barriers × barrier_cost`, the makespans and sequential phases with their
+//! moved lines × line_cost. With [`PlanKind::Model`] the plan is used only
 //! if it beats the plain sequential scan by more than one barrier; with [`PlanKind::Auto`] the
 //! run measures the sequential walk and the levelled plans on its first scans and keeps the
 //! fastest, re-measuring as it goes (`choice`). `plc-deps run --explain` prints the decisions.
@@ -54,8 +59,11 @@
 //!
 //! # Modules, bottom to top
 //! Each depends only on the ones above it in this list: `ids` (typed indices and decisions),
-//! `config`, `pad`, `calls` (call closures, loop-backs), `tasks` (task facts, items, slicing),
-//! `plan` (phases on the cost model: the planning), `check` (a plan against the lowered code),
+//! `config`, `calibrate` (the per-line cost measured), `pad`, `calls` (call closures,
+//! loop-backs), `tasks` (task facts, items, contiguous and LPT cuts), `partition` (the
+//! locality partition of one level), `movement` (lines moved between workers), `slicing`
+//! (each level's slices and modelled makespan), `plan` (phases on the cost model: the
+//! planning, the candidate plans), `check` (a plan against the lowered code),
 //! `choice` (the measured choice among candidates), `driver` (the per-scan callbacks and the
 //! sequential loop), `barrier`, `shared` (lock-free shared memory), `machine` (the running
 //! machine), `explain`.
@@ -71,6 +79,7 @@
 //! buffers are padded per worker.
 
 mod barrier;
+mod calibrate;
 mod calls;
 mod check;
 mod choice;
@@ -79,17 +88,22 @@ mod driver;
 mod explain;
 mod ids;
 mod machine;
+mod movement;
 mod pad;
+mod partition;
 mod plan;
 mod shared;
+mod slicing;
 mod tasks;
 
 pub use barrier::SpinBarrier;
+pub use calibrate::{measure_line_cost, LineTiming};
 pub use choice::{Chooser, Switch, Window};
-pub use config::{Measure, PlanConfig, PlanKind, Slicing, Strategy};
+pub use config::{LineCostSource, Measure, PlanConfig, PlanKind, Slicing, Strategy};
 pub use driver::{run_sequential, ScanDriver};
 pub use explain::{ns_text, run_log_json};
 pub use ids::{Decision, DecisionSlot, Next, TaskId};
 pub use machine::{Candidate, ParallelMachine, RunLog};
-pub use plan::{LevelPlan, Plan};
+pub use plan::Plan;
 pub use shared::SharedSlots;
+pub use slicing::LevelPlan;

@@ -1,7 +1,8 @@
 //! The static plan of one candidate: the schedule's levels turned into phases and per-worker
-//! slices of items (a dynamic programme over the levels on the cost model, contiguous or LPT
-//! slicing), the decision slots, guards and entries that carry control between tasks, and the
-//! variables each (phase, worker) writes (the layout's padding groups).
+//! slices of items (a dynamic programme over the levels on the cost model, the slices from
+//! `slicing`), the data movement of the phases as built and the modelled scan, the decision
+//! slots, guards and entries that carry control between tasks, and the variables each (phase,
+//! worker) writes (the layout's padding groups); and the candidate plans of a measured run.
 //!
 //! Follows Zhao & Yan's data levelling (levels run one after another, the rungs of a level in
 //! parallel) on the *combined* schedule: data and control dependences together, loops kept whole.
@@ -13,7 +14,9 @@
 use super::calls::{call_closure, is_loop_back, rung_callees, uncovered_refusal};
 use super::config::{PlanConfig, PlanKind, Slicing, Strategy};
 use super::ids::{DecisionSlot, Next, TaskId};
-use super::tasks::{contiguous, lpt, Item, Tasks};
+use super::movement::Movement;
+use super::slicing::{slice_levels, worker_makespan, LevelPlan};
+use super::tasks::{Item, Tasks};
 use crate::analysis::{Analysis, EdgeKind, Successor};
 use crate::model::{PouId, Program, RungId, VarId};
 use std::collections::HashMap;
@@ -68,25 +71,6 @@ impl Phase {
     }
 }
 
-/// What the plan decided for one level (for `--explain`).
-#[derive(Clone, Debug)]
-pub struct LevelPlan {
-    /// Tasks of the level.
-    pub tasks: usize,
-    /// Σ task costs (steps).
-    pub cost: u64,
-    /// Whether the level is a parallel phase.
-    pub parallel: bool,
-    /// Modelled makespan of the parallel slices (steps; `None` if it cannot run in parallel).
-    pub makespan: Option<u64>,
-    /// "contiguous" or "lpt" (parallel levels).
-    pub slicing: &'static str,
-    /// Per worker: tasks, items, modelled cost (parallel levels).
-    pub workers: Vec<(usize, usize, u64)>,
-    /// Why.
-    pub reason: String,
-}
-
 /// A static plan: phases, slices, decision slots and the variables each (phase, worker) writes.
 /// Built once per program, thread count and configuration.
 #[derive(Clone, Debug)]
@@ -109,7 +93,10 @@ pub struct Plan {
     pub(super) decision_slots: usize,
     /// Per variable: the (phase, worker) pairs of parallel phases that write it.
     pub(super) write_keys: Vec<Vec<(u32, u32)>>,
-    /// Modelled scan costs: sequential, and this plan's.
+    /// Per phase and worker: the cache lines it reads that another worker wrote last
+    /// (`movement`; empty when no level runs in parallel).
+    pub(super) phase_lines: Vec<Vec<u64>>,
+    /// Modelled scan costs: sequential, and this plan's (data movement included).
     pub(super) est_sequential: u64,
     pub(super) est_plan: u64,
 }
@@ -123,43 +110,36 @@ impl Plan {
         let est_sequential: u64 = info.cost.iter().sum();
         let level_conflict = level_conflicts(p, a);
         let (mut level_plans, mut level_slices) =
-            slice_levels(a, &info, config, threads, &level_conflict);
-        let (choice, est_plan) = choose_phases(&level_plans, config);
+            slice_levels(p, a, &info, config, &level_conflict);
+        let (choice, _) = choose_phases(&level_plans, config);
         let any_parallel = choice.contains(&true);
-        let b = config.barrier_cost;
-        let sequential = if let Some(why) = uncovered_refusal(p, a, &task_of_rung) {
-            Some(why)
-        } else if config.strategy == Strategy::Sequential {
-            Some("sequential strategy requested".into())
-        } else if config.kind == PlanKind::Seq {
-            Some("the sequential walk was asked for (--plan seq)".into())
-        } else if threads == 1 && config.strategy != Strategy::AllParallel {
-            Some("one worker".into())
-        } else if !any_parallel {
-            Some("no level saves more than the barriers it needs".into())
-        } else if config.strategy == Strategy::Auto
-            && config.kind == PlanKind::Model
-            && est_plan + b > est_sequential
-        {
-            Some(format!(
-                "the best plan ({est_plan} steps per scan with barriers) does not beat the sequential scan ({est_sequential} steps) by a barrier"
-            ))
-        } else if config.strategy == Strategy::Auto
-            && config.kind == PlanKind::Auto
-            && est_plan >= est_sequential
-        {
-            Some(format!(
-                "the cost model sees no gain to measure ({est_plan} steps per scan with barriers, sequential {est_sequential})"
-            ))
+        let mut phases = if any_parallel {
+            build_phases(a, &info, config, &choice, &mut level_slices)
         } else {
-            None
+            Vec::new()
         };
-        explain_levels(&mut level_plans, &choice, sequential.is_some(), b);
+        let mut phase_lines = phase_movement(p, a, &phases, threads);
+        let est_plan = if any_parallel {
+            modelled_scan(&phases, &phase_lines, &mut level_plans, config)
+        } else {
+            est_sequential
+        };
+        let sequential = sequential_reason(p, a, config, any_parallel, est_plan, est_sequential);
+        explain_levels(
+            &mut level_plans,
+            &choice,
+            sequential.is_some(),
+            config.barrier_cost,
+        );
+        if sequential.is_some() {
+            phases.clear();
+            phase_lines.clear();
+        }
         let mut plan = Plan {
             threads,
             config: *config,
             sequential,
-            phases: Vec::new(),
+            phases,
             end_barrier: false,
             levels: level_plans,
             task_of_rung,
@@ -168,17 +148,13 @@ impl Plan {
             entry_slots: Vec::new(),
             decision_slots: 0,
             write_keys: vec![Vec::new(); p.vars.len()],
+            phase_lines,
             est_sequential,
-            est_plan: if any_parallel {
-                est_plan
-            } else {
-                est_sequential
-            },
+            est_plan,
         };
         if plan.sequential.is_some() {
             return plan;
         }
-        plan.phases = phases(a, &info, config, &choice, &mut level_slices);
         plan.end_barrier = plan.phases.last().is_some_and(Phase::is_parallel);
         plan.place_decisions(a, &info);
         plan.write_keys = write_keys(p, a, &plan.phases);
@@ -399,75 +375,96 @@ fn level_conflicts(p: &Program, a: &Analysis) -> Vec<Option<String>> {
     level_conflict
 }
 
-/// Per level: its plan for `--explain`, and its parallel slices (`None`: it cannot run in
-/// parallel).
-#[allow(clippy::type_complexity)]
-fn slice_levels(
+/// Why the whole program runs as the sequential scan, if it does.
+fn sequential_reason(
+    p: &Program,
     a: &Analysis,
-    info: &Tasks<'_>,
     config: &PlanConfig,
-    threads: usize,
-    level_conflict: &[Option<String>],
-) -> (Vec<LevelPlan>, Vec<Option<Vec<Vec<TaskId>>>>) {
-    let sched = &a.schedule;
-    let mut level_plans = Vec::with_capacity(sched.levels.len());
-    let mut level_slices = Vec::with_capacity(sched.levels.len());
-    for (l, level) in sched.levels.iter().enumerate() {
-        let level: Vec<TaskId> = level.clone();
-        let weights: Vec<u64> = level.iter().map(|t| info.cost[t.index()]).collect();
-        let mut lp = LevelPlan {
-            tasks: level.len(),
-            cost: weights.iter().sum(),
-            parallel: false,
-            makespan: None,
-            slicing: "",
-            workers: Vec::new(),
-            reason: String::new(),
-        };
-        let forced = config.strategy == Strategy::AllParallel;
-        if let Some(why) = &level_conflict[l] {
-            lp.reason = why.clone();
-            level_slices.push(None);
-        } else if (threads == 1 || level.len() < 2) && !forced {
-            lp.reason = if threads == 1 {
-                "one worker".into()
-            } else {
-                "a single task".into()
-            };
-            level_slices.push(None);
-        } else {
-            let slice_cost = |s: &[TaskId]| -> (usize, u64) {
-                let items = info.items(s, config.item_cost);
-                (items.len(), items.iter().map(|i| i.cost).sum())
-            };
-            let contig: Vec<Vec<TaskId>> = contiguous(&weights, threads)
-                .into_iter()
-                .map(|r| level[r].to_vec())
-                .collect();
-            let by_lpt = lpt(&level, &weights, threads);
-            let ms = |sl: &[Vec<TaskId>]| sl.iter().map(|s| slice_cost(s).1).max().unwrap_or(0);
-            let (m_c, m_l) = (ms(&contig), ms(&by_lpt));
-            let (mut slices, name, m) = match config.slicing {
-                Slicing::Contiguous => (contig, "contiguous", m_c),
-                Slicing::Lpt => (by_lpt, "lpt", m_l),
-                Slicing::Auto if m_l < m_c => (by_lpt, "lpt", m_l),
-                Slicing::Auto => (contig, "contiguous", m_c),
-            };
-            slices.resize(threads, Vec::new());
-            lp.makespan = Some(m);
-            lp.slicing = name;
-            lp.workers = slices
-                .iter()
-                .map(|s| {
-                    let (items, cost) = slice_cost(s);
-                    (s.len(), items, cost)
-                })
-                .collect();
-            level_slices.push(Some(slices));
-        }
-        level_plans.push(lp);
+    any_parallel: bool,
+    est_plan: u64,
+    est_sequential: u64,
+) -> Option<String> {
+    let b = config.barrier_cost;
+    if let Some(why) = uncovered_refusal(p, a, &a.schedule.task_of) {
+        Some(why)
+    } else if config.strategy == Strategy::Sequential {
+        Some("sequential strategy requested".into())
+    } else if config.kind == PlanKind::Seq {
+        Some("the sequential walk was asked for (--plan seq)".into())
+    } else if config.threads <= 1 && config.strategy != Strategy::AllParallel {
+        Some("one worker".into())
+    } else if !any_parallel {
+        Some("no level saves more than the barriers it needs".into())
+    } else if config.strategy == Strategy::Auto
+        && config.kind == PlanKind::Model
+        && est_plan + b > est_sequential
+    {
+        Some(format!(
+            "the best plan ({est_plan} steps per scan with barriers and data movement) does not beat the sequential scan ({est_sequential} steps) by a barrier"
+        ))
+    } else if config.strategy == Strategy::Auto
+        && config.kind == PlanKind::Auto
+        && est_plan >= est_sequential
+    {
+        Some(format!(
+            "the cost model sees no gain to measure ({est_plan} steps per scan with barriers and data movement, sequential {est_sequential})"
+        ))
+    } else {
+        None
     }
-    (level_plans, level_slices)
+}
+
+/// Per phase and worker of `phases`, in scan order: the lines it moves (`movement`).
+fn phase_movement(p: &Program, a: &Analysis, phases: &[Phase], threads: usize) -> Vec<Vec<u64>> {
+    let mut movement = Movement::new(p, a, threads);
+    phases
+        .iter()
+        .map(|ph| {
+            let slices: Vec<Vec<TaskId>> = match &ph.kind {
+                PhaseKind::Parallel(s) => s
+                    .iter()
+                    .map(|items| items.iter().flat_map(Item::tasks).collect())
+                    .collect(),
+                PhaseKind::Sequential(items) => vec![items.iter().flat_map(Item::tasks).collect()],
+            };
+            let lines = movement.phase_lines(&slices);
+            movement.commit(&slices);
+            lines
+        })
+        .collect()
+}
+
+/// The modelled scan of the phases as built: Σ parallel makespans (data movement included) +
+/// Σ sequential levels' costs and their moved lines + barriers. Sets each parallel level's
+/// lines and makespan to those of its phase.
+fn modelled_scan(
+    phases: &[Phase],
+    phase_lines: &[Vec<u64>],
+    levels: &mut [LevelPlan],
+    config: &PlanConfig,
+) -> u64 {
+    let b = config.barrier_cost;
+    let mut est = 0;
+    for (ph, lines) in phases.iter().zip(phase_lines) {
+        est += if ph.barrier_before { b } else { 0 };
+        if ph.is_parallel() {
+            let lp = &mut levels[ph.levels.start];
+            lp.lines = lines.clone();
+            let m = worker_makespan(&lp.workers, lines, config.line_cost);
+            lp.makespan = Some(m);
+            est += m;
+        } else {
+            let own: u64 = levels[ph.levels.clone()]
+                .iter()
+                .map(|lp| lp.cost + config.item_cost)
+                .sum();
+            est += own + lines.iter().sum::<u64>() * config.line_cost;
+        }
+    }
+    if phases.last().is_some_and(Phase::is_parallel) {
+        est += b;
+    }
+    est
 }
 
 /// Each level parallel (true) or sequential: the dynamic programme minimising the modelled scan
@@ -552,7 +549,7 @@ fn explain_levels(levels: &mut [LevelPlan], choice: &[bool], sequential: bool, b
 }
 
 /// The phases and their items.
-fn phases(
+fn build_phases(
     a: &Analysis,
     info: &Tasks<'_>,
     config: &PlanConfig,
@@ -651,4 +648,36 @@ pub(super) fn layout_groups(plans: &[&Plan], vars: usize) -> Vec<Vec<VarId>> {
         .into_iter()
         .map(|(_, g)| std::mem::take(&mut groups[g]))
         .collect()
+}
+
+/// The plans of `config.kind`: the model's plan (model, seq, par), or — auto, when slicing is
+/// left to the planner — the levelled plans of the model's phases under contiguous, LPT and
+/// locality slicing. LPT is kept when its phases differ from contiguous ones; locality when
+/// its phases differ from both and the model sees any gain over the contiguous plan (in data
+/// movement, what it is for): the measurement then decides.
+pub(super) fn candidate_plans(p: &Program, a: &Analysis, config: &PlanConfig) -> Vec<Plan> {
+    if config.kind != PlanKind::Auto || config.slicing != Slicing::Auto {
+        return vec![Plan::build(p, a, config)];
+    }
+    let with = |slicing: Slicing| Plan::build(p, a, &PlanConfig { slicing, ..*config });
+    let (contiguous, lpt, local) = (
+        with(Slicing::Contiguous),
+        with(Slicing::Lpt),
+        with(Slicing::Locality),
+    );
+    let keep_lpt = lpt.sequential.is_none() && lpt.phases != contiguous.phases;
+    let gains = contiguous.sequential.is_some() || local.est_plan < contiguous.est_plan;
+    let keep_local = local.sequential.is_none()
+        && gains
+        && local.phases != contiguous.phases
+        && (!keep_lpt || local.phases != lpt.phases);
+    let keep_contiguous = contiguous.sequential.is_none() || !(keep_lpt || keep_local);
+    [
+        (keep_contiguous, contiguous),
+        (keep_lpt, lpt),
+        (keep_local, local),
+    ]
+    .into_iter()
+    .filter_map(|(keep, plan)| keep.then_some(plan))
+    .collect()
 }
