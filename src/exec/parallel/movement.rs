@@ -23,23 +23,16 @@
 
 use super::ids::TaskId;
 use crate::analysis::Analysis;
-use crate::model::{FbKind, Program, Type, VarClass, VarId};
+use crate::model::{Program, Type, VarClass, VarId};
 use std::collections::HashMap;
 
-/// Bytes of a cache line.
-pub(super) const LINE_BYTES: u64 = 64;
+/// Bytes of a cache line (the state's, [`crate::exec::LINE_BYTES`]).
+pub(super) const LINE_BYTES: u64 = crate::exec::LINE_BYTES as u64;
 
-/// The modelled bytes of a variable of type `ty`: BOOL 1, INT 2, DINT/REAL/TIME 4; a timer its
-/// fields Q (1), ET, PT (4 each), start time (8) and state flags (1); a counter Q (1), CV, PV
-/// (2 each) and the previous CU/CD (1).
+/// The bytes of a variable of type `ty`, as the compact state stores it
+/// ([`crate::exec::type_size`]: BOOL 1, INT 2, DINT/REAL/TIME 4, a timer or counter its fields).
 pub(super) fn var_bytes(ty: Type) -> u64 {
-    match ty {
-        Type::Bool => 1,
-        Type::Int => 2,
-        Type::Dint | Type::Real | Type::Time => 4,
-        Type::Fb(FbKind::Ton | FbKind::Tof | FbKind::Tp) => 1 + 4 + 4 + 8 + 1,
-        Type::Fb(FbKind::Ctu | FbKind::Ctd) => 1 + 2 + 2 + 1,
-    }
+    u64::from(crate::exec::type_size(ty))
 }
 
 /// Where a variable's value was last written: by which worker, on which modelled line.
