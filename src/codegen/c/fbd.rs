@@ -61,7 +61,11 @@ pub(crate) fn pou(b: &mut Body, p: &Program, pou: &FbdPou, copy: &LoweredCopy) {
     let range = p.pou(copy.pou).rungs.clone();
     let mut r = range.start;
     while r < range.end {
-        match copy.networks.iter().position(|n| n.start == r && !n.is_empty()) {
+        match copy
+            .networks
+            .iter()
+            .position(|n| n.start == r && !n.is_empty())
+        {
             Some(k) => {
                 network(b, p, &pou.plans[k], copy.networks[k].start, &copy.blocks[k]);
                 r = copy.networks[k].end;

@@ -21,7 +21,9 @@ pub(crate) const HEADER_DECLS: &str = "extern const char *const _plc_input_names
 const PRINT_CHUNK: usize = 256;
 
 pub(crate) fn program_source(p: &Program, sh: &Shared) -> String {
-    let mut s = String::from("/* plc_program.c: state, scan and harness tables. */\n#include \"plc_program.h\"\n\n");
+    let mut s = String::from(
+        "/* plc_program.c: state, scan and harness tables. */\n#include \"plc_program.h\"\n\n",
+    );
     // The initial state: declared init values (zero is the default of a static object).
     let inits: Vec<String> = p
         .vars
@@ -41,12 +43,18 @@ pub(crate) fn program_source(p: &Program, sh: &Shared) -> String {
     if sh.counters.iter().any(Option::is_some) {
         s.push_str("    memset(self->_ctr, 0, sizeof self->_ctr);\n");
     }
-    push(&mut s, format_args!("    {}(self, ctx);\n}}\n\n", sh.pou_fns[0]));
+    push(
+        &mut s,
+        format_args!("    {}(self, ctx);\n}}\n\n", sh.pou_fns[0]),
+    );
     inputs(p, sh, &mut s);
     print_state(p, sh, &mut s);
     s.push_str("const char *const _plc_rung_ids[] = {\n");
     for r in &p.rungs {
-        push(&mut s, format_args!("    {},\n", c_string(&json_string(&r.id))));
+        push(
+            &mut s,
+            format_args!("    {},\n", c_string(&json_string(&r.id))),
+        );
     }
     s.push_str("    NULL\n};\n");
     s

@@ -276,8 +276,21 @@ impl<'a> Body<'a> {
                 );
                 self.boxed(call, last)
             }
-            Element::Ctu { instance, pv, reset } | Element::Ctd { instance, pv, load: reset } => {
-                let f = if matches!(e, Element::Ctu { .. }) { "_plc_ctu" } else { "_plc_ctd" };
+            Element::Ctu {
+                instance,
+                pv,
+                reset,
+            }
+            | Element::Ctd {
+                instance,
+                pv,
+                load: reset,
+            } => {
+                let f = if matches!(e, Element::Ctu { .. }) {
+                    "_plc_ctu"
+                } else {
+                    "_plc_ctd"
+                };
                 let call = format!(
                     "{f}(&{}, {}, {}, {})",
                     self.var(*instance),
@@ -351,6 +364,9 @@ impl<'a> Body<'a> {
                 match self.series(rung, b, Pw::True, false).0 {
                     Pw::True => terms.push("1".to_string()),
                     Pw::False => {}
+                    Pw::Expr(e) | Pw::Local(e) if e.contains(" && ") => {
+                        terms.push(format!("({e})"))
+                    }
                     Pw::Expr(e) | Pw::Local(e) => terms.push(e),
                 }
             }
@@ -400,22 +416,40 @@ impl<'a> Body<'a> {
             matches!(
                 o,
                 Operand::Const(
-                    Value::Int(i16::MIN | i16::MAX) | Value::Dint(i32::MIN | i32::MAX)
+                    Value::Int(i16::MIN | i16::MAX)
+                        | Value::Dint(i32::MIN | i32::MAX)
                         | Value::Time(i32::MIN | i32::MAX)
                 )
             )
         };
         let (x, y) = (self.operand(a), self.operand(b));
-        if sym != "==" && sym != "!=" && (at_limit(a) || at_limit(b)) {
+        let relational = sym != "==" && sym != "!=";
+        if x == y || (relational && (at_limit(a) || at_limit(b))) {
+            // GCC calls `x == x` tautological (it is not for a NaN) and a test against a type's
+            // limit always true or false: a function of the runtime compares instead.
             let f = match sym {
+                "==" => "eq",
+                "!=" => "ne",
                 "<" => "lt",
                 "<=" => "le",
                 ">" => "gt",
                 _ => "ge",
             };
-            return format!("_plc_{f}64({x}, {y})");
+            let real = self.operand_type(a) == Some(Type::Real);
+            let w = if real { "f32" } else { "i64" };
+            return format!("_plc_{f}_{w}({x}, {y})");
         }
         format!("({x} {sym} {y})")
+    }
+
+    fn operand_type(&self, o: &Operand) -> Option<Type> {
+        match o {
+            Operand::Const(v) => Some(v.ty()),
+            Operand::Var(r) => match (self.sh.p.var(r.var).ty, r.field) {
+                (Type::Fb(fb), Some(f)) => Field::lookup(fb, f.name()).map(|(_, t)| t),
+                (t, _) => Some(t),
+            },
+        }
     }
 
     fn counter(&self, rung: RungId) -> String {
@@ -434,7 +468,14 @@ impl<'a> Body<'a> {
                 let head = &rung.series[..rung.series.len() - 1];
                 let pw = self.series(r, head, Pw::True, false).0;
                 let v = self.var(*var);
-                let test = self.compare("<=", &Operand::Var(VarRef { var: *var, field: None }), to);
+                let test = self.compare(
+                    "<=",
+                    &Operand::Var(VarRef {
+                        var: *var,
+                        field: None,
+                    }),
+                    to,
+                );
                 let from = self.operand(from);
                 match pw {
                     Pw::True => self.line("{"),
@@ -459,7 +500,10 @@ impl<'a> Body<'a> {
                     Type::Int => "_plc_w16",
                     _ => "_plc_w32",
                 };
-                self.line(&format!("if (!_plc_loop_back(&{ctr}, ctx, {})) break;", r.0));
+                self.line(&format!(
+                    "if (!_plc_loop_back(&{ctr}, ctx, {})) break;",
+                    r.0
+                ));
                 self.line(&format!("{v} = {wrap}((int64_t){v} + 1);"));
                 self.indent -= 1;
                 self.line("}");

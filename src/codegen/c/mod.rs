@@ -180,7 +180,10 @@ fn program_header(p: &Program, sh: &Shared, stems: &[String]) -> String {
     }
     let k = counter_count(sh);
     if k > 0 {
-        ladder::push(&mut s, format_args!("    uint64_t _ctr[{k}]; /* loop counters */\n"));
+        ladder::push(
+            &mut s,
+            format_args!("    uint64_t _ctr[{k}]; /* loop counters */\n"),
+        );
     }
     if p.vars.is_empty() && k == 0 {
         s.push_str("    char _empty;\n");
@@ -214,7 +217,14 @@ fn fbd_copies(p: &Program, fbd: &Fbd) -> HashMap<usize, (usize, String)> {
     out
 }
 
-fn fbd_function(p: &Program, sh: &Shared, fbd: &Fbd, fp: usize, prefix: &str, pou: usize) -> String {
+fn fbd_function(
+    p: &Program,
+    sh: &Shared,
+    fbd: &Fbd,
+    fp: usize,
+    prefix: &str,
+    pou: usize,
+) -> String {
     let hidden: HashMap<&str, VarId> = p
         .vars
         .iter()
@@ -308,9 +318,15 @@ fn ladder_function(p: &Program, sh: &Shared, pou: usize, chunk: usize) -> String
             ),
         );
     }
-    ladder::push(&mut s, format_args!("void {f}(_plc_state *self, _plc_ctx *ctx) {{\n"));
+    ladder::push(
+        &mut s,
+        format_args!("void {f}(_plc_state *self, _plc_ctx *ctx) {{\n"),
+    );
     for k in 0..groups.len() {
-        ladder::push(&mut s, format_args!("    if ({f}_{k}(self, ctx)) return;\n"));
+        ladder::push(
+            &mut s,
+            format_args!("    if ({f}_{k}(self, ctx)) return;\n"),
+        );
     }
     s.push_str("}\n");
     s

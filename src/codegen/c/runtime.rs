@@ -145,11 +145,14 @@ static inline int32_t _plc_mod_i32(int32_t a, int32_t b, _plc_ctx *ctx, uint32_t
     if (b == 0) { _plc_fault(ctx, rung, _PLC_DIV_BY_ZERO); return 0; }
     return _plc_w32((int64_t)a % b);
 }
-/* Integer compares at a type's limit (see ladder.rs). */
-static inline bool _plc_lt64(int64_t a, int64_t b) { return a < b; }
-static inline bool _plc_le64(int64_t a, int64_t b) { return a <= b; }
-static inline bool _plc_gt64(int64_t a, int64_t b) { return a > b; }
-static inline bool _plc_ge64(int64_t a, int64_t b) { return a >= b; }
+/* Compares as functions, where GCC would warn on the operator (see ladder.rs). */
+#define _PLC_CMP(name, T, op) static inline bool name(T a, T b) { return a op b; }
+_PLC_CMP(_plc_eq_i64, int64_t, ==) _PLC_CMP(_plc_ne_i64, int64_t, !=)
+_PLC_CMP(_plc_lt_i64, int64_t, <) _PLC_CMP(_plc_le_i64, int64_t, <=)
+_PLC_CMP(_plc_gt_i64, int64_t, >) _PLC_CMP(_plc_ge_i64, int64_t, >=)
+_PLC_CMP(_plc_eq_f32, float, ==) _PLC_CMP(_plc_ne_f32, float, !=)
+_PLC_CMP(_plc_lt_f32, float, <) _PLC_CMP(_plc_le_f32, float, <=)
+_PLC_CMP(_plc_gt_f32, float, >) _PLC_CMP(_plc_ge_f32, float, >=)
 /* A REAL constant by its bits (NaN and infinities have no literal). */
 static inline float _plc_f32(uint32_t bits) { float f; memcpy(&f, &bits, sizeof f); return f; }
 
@@ -196,7 +199,7 @@ static inline void _plc_put_real(FILE *o, float f) {
     } else {
         fputc(digits[0], o);
         if (n > 1) { fputc('.', o); fwrite(digits + 1, 1, (size_t)(n - 1), o); }
-        fprintf(o, "e%d", kk - 1);
+        fprintf(o, "e%+d", kk - 1); /* serde_json: e+35, e-7 */
     }
 }
 static inline void _plc_put_bool(FILE *o, bool b) { fputs(b ? "true" : "false", o); }
