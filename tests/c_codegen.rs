@@ -237,3 +237,147 @@ fn generated_programs_with_every_feature_match_the_interpreter() {
         check(&text, &csv, 40, &cfg, &format!("gen-{seed}"));
     }
 }
+
+#[test]
+fn random_fbd_programs_match_the_interpreter() {
+    let mut checked = 0;
+    for seed in 0..50u64 {
+        let text = common::fbd::random_fbd_program(seed);
+        let Ok(p) = plc_deps::read::program_from_json(&text) else {
+            continue;
+        };
+        let mut rng = Rng::new(seed + 77);
+        let csv = random_csv(&p, &mut rng, 30);
+        let cfg = CConfig {
+            cycle_ms: 1 + rng.below(40) as u32,
+            loop_cap: 1 + rng.below(50) as u32,
+            ..CConfig::default()
+        };
+        check(&text, &csv, 40, &cfg, &format!("fbd-{seed}"));
+        checked += 1;
+    }
+    assert!(checked >= 20, "only {checked} random FBD programs loaded");
+}
+
+/// Example C of the FBD text-generation paper: compute 3 and 4; `if (3) {flag = 1; 8}`;
+/// `if (4) {flag = 1; 10; 27; if (27) {24}}`; `if (flag) {15; 17}` — checked on the text's
+/// structure (its lines without the comments), its behaviour by the example test above.
+#[test]
+fn example_c_has_the_shape_the_paper_prints() {
+    let text = std::fs::read_to_string(root().join("analyses/example-c/program.json")).unwrap();
+    let (p, fbd) = plc_deps::read::program_and_fbd_from_json(&text).unwrap();
+    let files = generate(&p, &fbd, &CConfig::default());
+    let body = &files
+        .iter()
+        .find(|f| f.name == "pou_block1.c")
+        .unwrap()
+        .text;
+    let code: Vec<&str> = body
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.starts_with("/*") && !l.is_empty())
+        .collect();
+    let start = code
+        .iter()
+        .position(|l| l.starts_with("_run0_3 = 0"))
+        .unwrap();
+    assert_eq!(
+        code[start..].to_vec(),
+        vec![
+            "_run0_3 = 0;",
+            "_3_0 = (self->Var1 == 1);",
+            "_4_0 = (self->Var1 == 2);",
+            "if (_3_0) {",
+            "_run0_3 = 1;",
+            "self->LVar = _plc_add_i16(self->Var2, 10);",
+            "}",
+            "if (_4_0) {",
+            "_run0_3 = 1;",
+            "_10_0 = _plc_mul_i16(self->Var2, 3);",
+            "self->LVar = _10_0;",
+            "_27_0 = (_10_0 > 0);",
+            "if (_27_0) {",
+            "self->Var3 = _plc_mul_i16(self->Var3, _10_0);",
+            "}",
+            "}",
+            "if (_run0_3) {",
+            "_15_0 = _plc_sub_i16(self->LVar, 1);",
+            "self->_uWriteValue__17_046IVal = _15_0;",
+            "_pou_WriteValue__17(self, ctx);",
+            "self->Written = self->_uWriteValue__17_046OVal;",
+            "}",
+            "}",
+        ]
+    );
+    // One local per data arc (3, 4, 10, 15, 27) and the run flag; nothing stored twice.
+    for local in ["_3_0", "_4_0", "_10_0", "_15_0", "_27_0", "_run0_3"] {
+        assert!(
+            code.iter().any(|l| l.contains(&format!(" {local} = 0;"))),
+            "{local}"
+        );
+    }
+}
+
+/// `_plc_put_real` prints every float as `run --format json` does (shortest decimal, ties up,
+/// serde_json's exponent form), on random bit patterns and on values near powers of ten.
+#[test]
+fn reals_print_as_the_run_report_prints_them() {
+    use plc_deps::exec::VarValue;
+    use plc_deps::model::Value;
+    let dir = fresh_dir("reals");
+    std::fs::write(dir.join("plc_runtime.h"), plc_deps::codegen::c::RUNTIME_H).unwrap();
+    std::fs::write(
+        dir.join("reals.c"),
+        "#include \"plc_runtime.h\"\nint main(void) { unsigned b; while (scanf(\"%u\", &b) == 1) \
+         { _plc_put_real(stdout, _plc_f32(b)); putchar('\\n'); } return 0; }\n",
+    )
+    .unwrap();
+    let out = Command::new("cc")
+        .args([
+            "-std=c11", "-Wall", "-Wextra", "-Werror", "-O2", "-o", "reals", "reals.c", "-lm",
+        ])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let mut rng = Rng::new(5);
+    let mut bits: Vec<u32> = (0..20_000).map(|_| rng.next() as u32).collect();
+    for e in -12..=20 {
+        for d in [1.0f32, 1.5, 9.999_999, 46.757_812_5, 0.1, 0.3] {
+            bits.push((d * 10f32.powi(e)).to_bits());
+        }
+    }
+    bits.extend([0, 0x8000_0000, 1, 0x7f7f_ffff, 0x7f80_0000, 0x7fc0_0000]);
+    let input: String = bits.iter().map(|b| format!("{b}\n")).collect();
+    let (lines, _) = {
+        let mut child = Command::new(dir.join("reals"))
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .spawn()
+            .unwrap();
+        use std::io::Write;
+        // Written from a thread: the program answers line by line, and both pipes are finite.
+        let mut stdin = child.stdin.take().unwrap();
+        let writer = std::thread::spawn(move || stdin.write_all(input.as_bytes()).unwrap());
+        let out = child.wait_with_output().unwrap();
+        writer.join().unwrap();
+        let l: Vec<String> = String::from_utf8(out.stdout)
+            .unwrap()
+            .lines()
+            .map(String::from)
+            .collect();
+        (l, ())
+    };
+    assert_eq!(lines.len(), bits.len());
+    for (b, line) in bits.iter().zip(&lines) {
+        let want = VarValue::Scalar(Value::Real(f32::from_bits(*b)))
+            .to_json()
+            .to_string();
+        assert_eq!(line, &want, "bits {b:#010x}");
+    }
+    let _ = std::fs::remove_dir_all(dir);
+}

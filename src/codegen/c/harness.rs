@@ -158,8 +158,17 @@ pub(crate) fn makefile(stems: &[String]) -> String {
 const MAIN_C: &str = r#"/* main.c: runs the generated program scan by scan on virtual time (docs/c.md).
    stdin: the CSV of `plc-deps run --inputs` (a header row of input names, one row per scan).
    argv[1]: the number of scans (default: the rows, at least 1).
-   stdout: after each scan the state as one JSON line; stderr: each fault as a JSON line. */
+   stdout: after each scan the state as one JSON line; stderr: each fault as a JSON line.
+   argv[2] = --time: only the last state, and {"ns_per_scan": T} on stderr (the time of the
+   scans alone: inputs and printing excluded). */
 #include "plc_program.h"
+#include <time.h>
+
+static double seconds(void) {
+    struct timespec ts;
+    timespec_get(&ts, TIME_UTC);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
 
 #define CYCLE_MS @CYCLE@
 #define LOOP_CAP @LOOP_CAP@
@@ -248,6 +257,8 @@ int main(int argc, char **argv) {
     size_t rows = nlines > 0 ? nlines - 1 : 0;
     unsigned long long scans = rows > 0 ? rows : 1;
     if (argc > 1) scans = strtoull(argv[1], NULL, 10);
+    int timing = argc > 2 && !strcmp(argv[2], "--time");
+    double spent = 0;
     static _plc_state state;
     state = _plc_initial;
     _plc_ctx ctx = {0, 0, LOOP_CAP, on_fault, NULL};
@@ -266,8 +277,14 @@ int main(int argc, char **argv) {
         }
         ctx.scan = k;
         ctx.now = (int64_t)k * CYCLE_MS;
+        double t0 = timing ? seconds() : 0;
         _plc_scan(&state, &ctx);
+        if (timing) spent += seconds() - t0;
+        else _plc_print_state(&state, stdout);
+    }
+    if (timing) {
         _plc_print_state(&state, stdout);
+        fprintf(stderr, "{\"ns_per_scan\": %.1f}\n", scans ? spent * 1e9 / (double)scans : 0.0);
     }
     free(lines);
     free(text);

@@ -221,7 +221,8 @@ impl<'a> Body<'a> {
                         } else {
                             format!("!{v} && {m}")
                         };
-                        self.line(&format!("bool {l} = {pulse};"));
+                        // `(void)`: an OR with a TRUE branch needs no pulse but still updates.
+                        self.line(&format!("bool {l} = {pulse}; (void){l};"));
                         self.line(&format!("{m} = {v};"));
                         and(pw, l)
                     }

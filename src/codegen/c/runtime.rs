@@ -170,19 +170,35 @@ static inline bool _plc_loop_back(uint64_t *ctr, _plc_ctx *ctx, uint32_t rung) {
 static inline void _plc_put_real(FILE *o, float f) {
     if (!isfinite(f)) { fputs("null", o); return; }
     if (f == 0) { fputs(signbit(f) ? "-0.0" : "0.0", o); return; }
-    char buf[40];
+    if (signbit(f)) { fputc('-', o); f = -f; }
+    char buf[40], digits[16];
     int prec = 1;
     for (; prec < 9; prec++) {
         snprintf(buf, sizeof buf, "%.*e", prec - 1, (double)f);
         if (strtof(buf, NULL) == f) break;
     }
     snprintf(buf, sizeof buf, "%.*e", prec - 1, (double)f);
-    char digits[16];
     int n = 0, i = 0;
-    if (buf[i] == '-') { fputc('-', o); i++; }
     for (; buf[i] && buf[i] != 'e'; i++) if (buf[i] != '.') digits[n++] = buf[i];
-    while (n > 1 && digits[n - 1] == '0') n--;
     int kk = atoi(buf + i + 1) + 1; /* the decimal point is kk digits after the first */
+    /* printf breaks a tie to even; the shortest form of Rust (and so of `run`) rounds it up. */
+    char exact[80], all[72];
+    snprintf(exact, sizeof exact, "%.60e", (double)f);
+    int m = 0;
+    for (int j = 0; exact[j] && exact[j] != 'e'; j++) if (exact[j] != '.') all[m++] = exact[j];
+    int tie = m > prec && all[prec] == '5';
+    for (int j = prec + 1; tie && j < m; j++) tie = all[j] == '0';
+    if (tie) {
+        int carry = 1;
+        for (int j = prec - 1; j >= 0; j--) {
+            digits[j] = all[j];
+            if (carry) { if (digits[j] == '9') digits[j] = '0'; else { digits[j]++; carry = 0; } }
+        }
+        kk = atoi(strchr(exact, 'e') + 1) + 1;
+        if (carry) { memmove(digits + 1, digits, (size_t)prec); digits[0] = '1'; kk++; }
+        n = prec + carry;
+    }
+    while (n > 1 && digits[n - 1] == '0') n--;
     int k = kk - n;
     if (0 <= k && kk <= 16) {
         fwrite(digits, 1, (size_t)n, o);

@@ -1,0 +1,167 @@
+//! `plc-deps c` as a user runs it: the Makefile builds, the program's last JSON line equals the
+//! `state` of `plc-deps run --format json`; hostile program names stay inside DIR and compile;
+//! `-o DIR` is all files or none, an existing folder with files is refused unless `--force`.
+
+mod common;
+
+use common::cli::{error_line, root, run, tmp};
+use std::process::{Command, Stdio};
+
+fn make(dir: &std::path::Path) {
+    let out = Command::new("make")
+        .arg("-s")
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+fn run_program(dir: &std::path::Path, csv: &[u8]) -> String {
+    use std::io::Write;
+    let mut child = Command::new(dir.join("plc_program"))
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child.stdin.take().unwrap().write_all(csv).unwrap();
+    let out = child.wait_with_output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+#[test]
+fn the_makefile_builds_a_program_whose_state_is_the_runs_state() {
+    let dir = tmp("c-conveyor");
+    let _ = std::fs::remove_dir_all(&dir);
+    let d = dir.to_str().unwrap();
+    let prog = "analyses/conveyor/program.json";
+    let out = run(&["c", prog, "-o", d, "--cycle", "1s"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    make(&dir);
+    let csv = std::fs::read(root().join("analyses/conveyor/inputs.csv")).unwrap();
+    let lines = run_program(&dir, &csv);
+    let last: serde_json::Value = serde_json::from_str(lines.lines().last().unwrap()).unwrap();
+    let runs = run(&[
+        "run",
+        prog,
+        "--inputs",
+        "analyses/conveyor/inputs.csv",
+        "--cycle",
+        "1s",
+        "--mode",
+        "seq",
+        "--format",
+        "json",
+    ]);
+    let report: serde_json::Value = serde_json::from_slice(&runs.stdout).unwrap();
+    assert_eq!(last, report["state"]);
+    assert_eq!(
+        lines.lines().count() as u64,
+        report["scans"].as_u64().unwrap()
+    );
+}
+
+#[test]
+fn hostile_names_stay_inside_the_folder_and_compile() {
+    let program = serde_json::json!({
+        "program": "../../evil\"*/ #define x",
+        "vars": [
+            {"name": "int", "type": "BOOL", "class": "input"},
+            {"name": "_plc_state", "type": "BOOL", "class": "input"},
+            {"name": "a.b", "type": "INT", "class": "output"},
+            {"name": "a_046b", "type": "INT"},
+            {"name": "_ua_046b", "type": "INT"},
+            {"name": "self", "type": "BOOL"},
+            {"name": "NULL", "type": "BOOL", "class": "output"},
+            {"name": "x\"*/y\\n", "type": "BOOL", "class": "output"}
+        ],
+        "rungs": [
+            {"id": "*/ }", "ld": [{"contact": "int"}, {"coil": "self"}]},
+            {"id": "R\"2", "ld": [{"contact": "self"}, {"op": "ADD", "in": ["a_046b", 1], "out": "a.b"}]},
+            {"id": "R3", "ld": [{"contact": "_plc_state"}, {"op": "ADD", "in": ["a.b", 2], "out": "_ua_046b"}, {"coil": "NULL"}]},
+            {"id": "R4", "ld": [{"contact": "NULL", "negated": true}, {"coil": "x\"*/y\\n"}, {"call": "../main"}]}
+        ],
+        "subroutines": {"../main": {"rungs": [{"id": "S1", "ld": [{"op": "ADD", "in": ["a_046b", 3], "out": "a_046b"}]}]},
+                        "MAIN": {"rungs": [{"id": "S2", "ld": [{"contact": "int"}, {"ret": true}]}]}}
+    });
+    let file = tmp("hostile.json");
+    std::fs::write(&file, program.to_string()).unwrap();
+    let dir = tmp("c-hostile");
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = run(&["c", file.to_str().unwrap(), "-o", dir.to_str().unwrap()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // Every file is directly inside DIR, with a plain name.
+    for e in std::fs::read_dir(&dir).unwrap() {
+        let name = e.unwrap().file_name().into_string().unwrap();
+        assert!(
+            name.bytes()
+                .all(|b| b.is_ascii_alphanumeric() || b"_.-".contains(&b)),
+            "{name}"
+        );
+    }
+    assert!(!tmp("evil").exists() && !dir.parent().unwrap().join("main.c").exists());
+    make(&dir);
+    let lines = run_program(&dir, b"int,_plc_state\ntrue,true\n0,1\n");
+    let first: serde_json::Value = serde_json::from_str(lines.lines().next().unwrap()).unwrap();
+    assert_eq!(first["self"], true);
+    assert_eq!(first["a.b"], 1);
+    assert_eq!(first["_ua_046b"], 3);
+    assert_eq!(first["a_046b"], 3);
+    assert_eq!(first["x\"*/y\\n"], false);
+}
+
+#[test]
+fn the_folder_is_written_whole_and_an_existing_one_needs_force() {
+    let dir = tmp("c-atomic");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("notes.txt"), "mine").unwrap();
+    let d = dir.to_str().unwrap();
+    let prog = "analyses/example-a/program.json";
+    let line = error_line(&run(&["c", prog, "-o", d]), "existing folder");
+    assert!(
+        line.contains("exists and is not empty (give --force"),
+        "{line}"
+    );
+    assert!(dir.join("notes.txt").exists());
+    // A bad program writes nothing.
+    let bad = tmp("bad.json");
+    std::fs::write(&bad, "{\"program\": 1}").unwrap();
+    let fresh = tmp("c-none");
+    let _ = std::fs::remove_dir_all(&fresh);
+    error_line(
+        &run(&["c", bad.to_str().unwrap(), "-o", fresh.to_str().unwrap()]),
+        "bad",
+    );
+    assert!(!fresh.exists());
+    // --force replaces the folder whole.
+    let out = run(&["c", prog, "-o", d, "--force"]);
+    assert!(out.status.success());
+    assert!(!dir.join("notes.txt").exists());
+    assert!(dir.join("main.c").exists() && dir.join("Makefile").exists());
+    let parent = dir.parent().unwrap();
+    let leftovers: Vec<_> = std::fs::read_dir(parent)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains(".tmp-") || n.contains(".old-"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+}
