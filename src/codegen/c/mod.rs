@@ -84,23 +84,31 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
         },
     ];
     let copies = fbd_copies(p, fbd);
+    let mut objects = Vec::new();
     for (i, pou) in p.pous.iter().enumerate() {
         let f = &sh.pou_fns[i];
+        let (sources, decls) = match copies.get(&i) {
+            Some((fp, prefix)) => {
+                let body = fbd_function(p, &sh, fbd, *fp, prefix, i);
+                let text = format!("#include \"plc_program.h\"\n\n{body}");
+                (vec![(String::new(), text)], String::new())
+            }
+            None => ladder_files(p, &sh, i, cfg.chunk_rungs),
+        };
         files.push(CFile {
             name: format!("{}.h", stems[i]),
             text: format!(
-                "/* POU {} */\n#include \"plc_program.h\"\nvoid {f}(_plc_state *self, _plc_ctx *ctx);\n",
+                "/* POU {} */\nvoid {f}(_plc_state *self, _plc_ctx *ctx);\n{decls}",
                 names::comment(&pou.name)
             ),
         });
-        let body = match copies.get(&i) {
-            Some((fp, prefix)) => fbd_function(p, &sh, fbd, *fp, prefix, i),
-            None => ladder_function(p, &sh, i, cfg.chunk_rungs),
-        };
-        files.push(CFile {
-            name: format!("{}.c", stems[i]),
-            text: format!("#include \"plc_program.h\"\n\n{body}"),
-        });
+        for (suffix, text) in sources {
+            objects.push(format!("{}{suffix}", stems[i]));
+            files.push(CFile {
+                name: format!("{}{suffix}.c", stems[i]),
+                text,
+            });
+        }
     }
     files.push(CFile {
         name: "main.c".into(),
@@ -108,7 +116,7 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
     });
     files.push(CFile {
         name: "Makefile".into(),
-        text: harness::makefile(&stems),
+        text: harness::makefile(&objects),
     });
     files
 }
@@ -287,37 +295,64 @@ fn chunks(p: &Program, pou: usize, chunk: usize) -> Vec<std::ops::Range<u32>> {
     out
 }
 
-fn ladder_function(p: &Program, sh: &Shared, pou: usize, chunk: usize) -> String {
+/// Chunk functions per source file of a large ladder POU (`pou_X_partN.c`), so that `make -j`
+/// compiles them in parallel and no translation unit grows with the program.
+const CHUNKS_PER_FILE: usize = 16;
+
+/// The C of a ladder POU: its function and, for a large POU, the part files of its chunks
+/// (`(file suffix, text)`; the first has no suffix), and the declarations for its header.
+fn ladder_files(
+    p: &Program,
+    sh: &Shared,
+    pou: usize,
+    chunk: usize,
+) -> (Vec<(String, String)>, String) {
     let f = &sh.pou_fns[pou];
     let groups = chunks(p, pou, chunk.max(1));
     let name = names::comment(&p.pous[pou].name);
+    let head = "#include \"plc_program.h\"\n\n";
     if groups.len() == 1 {
         let mut b = Body::new(sh, "return;", 1);
         b.line("(void)self; (void)ctx;");
         for r in groups[0].clone() {
             b.rung(RungId(r));
         }
-        return format!(
-            "/* ladder POU {name} */\nvoid {f}(_plc_state *self, _plc_ctx *ctx) {{\n{}}}\n",
+        let text = format!(
+            "{head}/* ladder POU {name} */\nvoid {f}(_plc_state *self, _plc_ctx *ctx) {{\n{}}}\n",
             b.finish()
         );
+        return (vec![(String::new(), text)], String::new());
     }
-    let mut s = format!("/* ladder POU {name}, in {} parts */\n", groups.len());
-    for (k, g) in groups.iter().enumerate() {
-        let mut b = Body::new(sh, "return 1;", 1);
-        b.line("(void)self; (void)ctx;");
-        for r in g.clone() {
-            b.rung(RungId(r));
+    let mut files = Vec::new();
+    let mut decls = String::new();
+    for (n, part) in groups.chunks(CHUNKS_PER_FILE).enumerate() {
+        let mut s = format!("{head}/* ladder POU {name}, part {n} */\n");
+        for (j, g) in part.iter().enumerate() {
+            let k = n * CHUNKS_PER_FILE + j;
+            let mut b = Body::new(sh, "return 1;", 1);
+            b.line("(void)self; (void)ctx;");
+            for r in g.clone() {
+                b.rung(RungId(r));
+            }
+            b.line("return 0;");
+            ladder::push(
+                &mut s,
+                format_args!(
+                    "bool {f}_{k}(_plc_state *self, _plc_ctx *ctx) {{\n{}}}\n\n",
+                    b.finish()
+                ),
+            );
+            ladder::push(
+                &mut decls,
+                format_args!("bool {f}_{k}(_plc_state *self, _plc_ctx *ctx);\n"),
+            );
         }
-        b.line("return 0;");
-        ladder::push(
-            &mut s,
-            format_args!(
-                "static bool {f}_{k}(_plc_state *self, _plc_ctx *ctx) {{\n{}}}\n\n",
-                b.finish()
-            ),
-        );
+        files.push((format!("_part{n}"), s));
     }
+    let mut s = format!(
+        "{head}/* ladder POU {name}, in {} functions */\n",
+        groups.len()
+    );
     ladder::push(
         &mut s,
         format_args!("void {f}(_plc_state *self, _plc_ctx *ctx) {{\n"),
@@ -329,5 +364,6 @@ fn ladder_function(p: &Program, sh: &Shared, pou: usize, chunk: usize) -> String
         );
     }
     s.push_str("}\n");
-    s
+    files.insert(0, (String::new(), s));
+    (files, decls)
 }
