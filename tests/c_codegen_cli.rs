@@ -95,7 +95,7 @@ fn hostile_names_stay_inside_the_folder_and_compile() {
         ],
         "rungs": [
             {"id": "*/#R1", "ld": [{"contact": "int"}, {"coil": "self"}]},
-            {"id": "R\"2", "ld": [{"contact": "self"}, {"op": "ADD", "in": ["INT16_MAX", 1], "out": "a_046b"}]},
+            {"id": "R\\2", "ld": [{"contact": "self"}, {"op": "ADD", "in": ["INT16_MAX", 1], "out": "a_046b"}]},
             {"id": "R3", "ld": [{"contact": "_plc_state"}, {"op": "ADD", "in": ["a_046b", 2], "out": "_ua__046b"}, {"coil": "NULL"}]},
             {"id": "R4", "ld": [{"contact": "NULL", "negated": true}, {"coil": "_L1"}, {"call": "main"}]},
             {"id": "R5", "ld": [{"contact": "ctx"}, {"coil": "_p1"}, {"call": "MAIN"}]}
