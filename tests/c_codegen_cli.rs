@@ -124,14 +124,25 @@ fn hostile_names_stay_inside_the_folder_and_compile() {
     }
     assert!(!tmp("evil").exists() && !dir.parent().unwrap().join("main.c").exists());
     make(&dir);
-    let lines = run_program(&dir, b"int,_plc_state\ntrue,true\n0,1\n");
-    let first: serde_json::Value = serde_json::from_str(lines.lines().next().unwrap()).unwrap();
-    assert_eq!(first["self"], true);
-    assert_eq!(first["a_046b"], 1);
-    assert_eq!(first["_ua__046b"], 3);
-    assert_eq!(first["NULL"], true);
-    assert_eq!(first["_L1"], false);
-    assert_eq!(first["INT16_MAX"], 3);
+    let csv = b"int,_plc_state\ntrue,true\n0,1\n";
+    let lines = run_program(&dir, csv);
+    let inputs = tmp("hostile.csv");
+    std::fs::write(&inputs, csv).unwrap();
+    let runs = run(&[
+        "run",
+        file.to_str().unwrap(),
+        "--inputs",
+        inputs.to_str().unwrap(),
+        "--mode",
+        "seq",
+        "--format",
+        "json",
+    ]);
+    let report: serde_json::Value = serde_json::from_slice(&runs.stdout).unwrap();
+    let last: serde_json::Value = serde_json::from_str(lines.lines().last().unwrap()).unwrap();
+    assert_eq!(last, report["state"]);
+    assert_eq!(last["a_046b"], 1);
+    assert_eq!(last["self"], false);
     // Two POUs whose names differ only in case get two files.
     let c_files = std::fs::read_dir(&dir)
         .unwrap()
