@@ -13,6 +13,7 @@
 //! [`synth`] the synthetic programs of `plc-deps gen`.
 pub mod analysis;
 pub mod cmd;
+pub mod codegen;
 pub mod diag;
 pub mod exec;
 pub mod fbd;

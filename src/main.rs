@@ -68,6 +68,23 @@ enum Command {
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
+    /// Generate C for every POU, a runtime header, main.c and a Makefile (docs/c.md).
+    C {
+        /// The program (JSON program format; `-`: standard input).
+        file: PathBuf,
+        /// The folder to write (all files or none).
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Replace an existing folder that is not empty.
+        #[arg(long)]
+        force: bool,
+        /// The scan cycle of the harness (a TIME: 10ms, T#1s).
+        #[arg(long, default_value = "10ms")]
+        cycle: String,
+        /// Loop-backs per loop-back rung and scan.
+        #[arg(long, default_value_t = 100_000)]
+        loop_cap: u32,
+    },
     /// Print the JSON Schema of the program format.
     Schema {
         /// Write to this file instead of standard output.
@@ -295,6 +312,25 @@ fn run(cli: Cli) -> Result<(), CliError> {
                 input: file,
                 format,
                 output,
+            })
+        }
+        Command::C {
+            file,
+            output,
+            force,
+            cycle,
+            loop_cap,
+        } => {
+            let cycle_ms = cmd::run::parse_cycle(&cycle)?;
+            cmd::c::c(&cmd::c::CCommand {
+                input: file,
+                output,
+                force,
+                config: plc_deps::codegen::c::CConfig {
+                    cycle_ms,
+                    loop_cap,
+                    ..Default::default()
+                },
             })
         }
         Command::Schema { output } => {

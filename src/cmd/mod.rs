@@ -1,11 +1,12 @@
 //! The commands behind the binary, one module each, as library functions over validated
-//! configurations: [`report`], [`order`], [`run`], [`schema`], [`gen`].
+//! configurations: [`report`], [`order`], [`run`], [`schema`], [`gen`], [`c`].
 //!
 //! `main.rs` turns command-line arguments into these configs and calls one function; everything
 //! here returns a [`CliError`] (rendered once, by `main`) instead of printing an error or
 //! exiting. [`io`] reads inputs and writes outputs (atomically, never half-written);
 //! [`progress`] shows long phases on a terminal. This is the top layer: nothing below imports it.
 
+pub mod c;
 pub mod gen;
 pub mod io;
 pub mod order;

@@ -4,6 +4,7 @@
 #![allow(dead_code)]
 
 pub mod cli;
+pub mod fbd;
 
 use plc_deps::exec::parallel::ScanDriver;
 use plc_deps::exec::{Fault, Machine};

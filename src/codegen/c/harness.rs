@@ -1,0 +1,293 @@
+//! The harness: `plc_program.c` (initial state, the scan, input and output tables), `main.c`
+//! (reads the CSV of `plc-deps run --inputs` on standard input, runs one scan per row on
+//! virtual time, prints after each scan one JSON line with the keys and value forms of the
+//! `state` object of `plc-deps run --format json`, and each fault as a JSON line
+//! `{"scan","rung","kind"}` on standard error) and the `Makefile`.
+//!
+//! Not here: the POUs' code (`ladder`, `fbd`).
+
+use super::ladder::{c_const, push, Shared};
+use super::names::{c_string, json_string};
+use super::CConfig;
+use crate::model::{FbKind, Program, Type, Value, VarClass};
+
+/// Declarations of the tables `plc_program.c` defines, for `plc_program.h`.
+pub(crate) const HEADER_DECLS: &str = "extern const char *const _plc_input_names[];\n\
+    int _plc_set_input(_plc_state *self, unsigned input, const char *text);\n\
+    void _plc_print_state(const _plc_state *self, FILE *out);\n\
+    extern const char *const _plc_rung_ids[];\n";
+
+/// Variables printed per function of `_plc_print_state` (keeps functions small).
+const PRINT_CHUNK: usize = 256;
+
+pub(crate) fn program_source(p: &Program, sh: &Shared) -> String {
+    let mut s = String::from(
+        "/* plc_program.c: state, scan and harness tables. */\n#include \"plc_program.h\"\n\n",
+    );
+    // The initial state: declared init values (zero is the default of a static object).
+    let inits: Vec<String> = p
+        .vars
+        .iter()
+        .enumerate()
+        .filter(|(_, v)| !matches!(v.ty, Type::Fb(_)) && !is_zero(v.init))
+        .map(|(i, v)| format!("    .{} = {},\n", field(sh, i), c_const(v.init)))
+        .collect();
+    if inits.is_empty() {
+        s.push_str("const _plc_state _plc_initial;\n\n");
+    } else {
+        s.push_str("const _plc_state _plc_initial = {\n");
+        s.extend(inits);
+        s.push_str("};\n\n");
+    }
+    s.push_str("void _plc_scan(_plc_state *self, _plc_ctx *ctx) {\n");
+    if sh.counters.iter().any(Option::is_some) {
+        s.push_str("    memset(self->_ctr, 0, sizeof self->_ctr);\n");
+    }
+    push(
+        &mut s,
+        format_args!("    {}(self, ctx);\n}}\n\n", sh.pou_fns[0]),
+    );
+    inputs(p, sh, &mut s);
+    print_state(p, sh, &mut s);
+    s.push_str("const char *const _plc_rung_ids[] = {\n");
+    for r in &p.rungs {
+        push(
+            &mut s,
+            format_args!("    {},\n", c_string(&json_string(&r.id))),
+        );
+    }
+    s.push_str("    NULL\n};\n");
+    s
+}
+
+fn is_zero(v: Value) -> bool {
+    match v {
+        Value::Bool(b) => !b,
+        Value::Int(i) => i == 0,
+        Value::Dint(i) | Value::Time(i) => i == 0,
+        Value::Real(f) => f.to_bits() == 0,
+    }
+}
+
+fn field(sh: &Shared, i: usize) -> String {
+    sh.vars[i].trim_start_matches("self->").to_string()
+}
+
+fn inputs(p: &Program, sh: &Shared, s: &mut String) {
+    let ins: Vec<usize> = (0..p.vars.len())
+        .filter(|&i| p.vars[i].class == VarClass::Input && !p.vars[i].hidden)
+        .collect();
+    s.push_str("const char *const _plc_input_names[] = {\n");
+    for &i in &ins {
+        push(s, format_args!("    {},\n", c_string(&p.vars[i].name)));
+    }
+    s.push_str("    NULL\n};\n\n");
+    s.push_str("int _plc_set_input(_plc_state *self, unsigned input, const char *text) {\n");
+    s.push_str("    switch (input) {\n");
+    for (k, &i) in ins.iter().enumerate() {
+        let f = &sh.vars[i];
+        let parse = match p.vars[i].ty {
+            Type::Bool => format!("return _plc_parse_bool(text, &{f});"),
+            Type::Int => format!(
+                "{{ long long v; if (!_plc_parse_int(text, INT16_MIN, INT16_MAX, &v)) return 0; {f} = (int16_t)v; return 1; }}"
+            ),
+            Type::Dint => format!(
+                "{{ long long v; if (!_plc_parse_int(text, INT32_MIN, INT32_MAX, &v)) return 0; {f} = (int32_t)v; return 1; }}"
+            ),
+            Type::Real => format!("return _plc_parse_real(text, &{f});"),
+            Type::Time => format!("return _plc_parse_time(text, &{f});"),
+            Type::Fb(_) => "return 0;".to_string(),
+        };
+        push(s, format_args!("    case {k}: {parse}\n"));
+    }
+    s.push_str("    default: (void)self; (void)text; return 0;\n    }\n}\n\n");
+}
+
+fn print_state(p: &Program, sh: &Shared, s: &mut String) {
+    let vis: Vec<usize> = (0..p.vars.len()).filter(|&i| !p.vars[i].hidden).collect();
+    let parts: Vec<&[usize]> = vis.chunks(PRINT_CHUNK).collect();
+    for (k, part) in parts.iter().enumerate() {
+        push(
+            s,
+            format_args!("static void _plc_print_{k}(const _plc_state *self, FILE *o) {{\n"),
+        );
+        for (j, &i) in part.iter().enumerate() {
+            let sep = if k == 0 && j == 0 { "" } else { "," };
+            let key = format!("{sep}{}:", json_string(&p.vars[i].name));
+            let f = &sh.vars[i];
+            let put = match p.vars[i].ty {
+                Type::Bool => format!("_plc_put_bool(o, {f});"),
+                Type::Int | Type::Dint | Type::Time => format!("fprintf(o, \"%d\", (int){f});"),
+                Type::Real => format!("_plc_put_real(o, {f});"),
+                Type::Fb(FbKind::Ton | FbKind::Tof | FbKind::Tp) => {
+                    format!("_plc_put_timer(o, &{f});")
+                }
+                Type::Fb(FbKind::Ctu | FbKind::Ctd) => format!("_plc_put_counter(o, &{f});"),
+            };
+            push(s, format_args!("    fputs({}, o); {put}\n", c_string(&key)));
+        }
+        s.push_str("}\n\n");
+    }
+    s.push_str("void _plc_print_state(const _plc_state *self, FILE *o) {\n    fputc('{', o);\n");
+    for k in 0..parts.len() {
+        push(s, format_args!("    _plc_print_{k}(self, o);\n"));
+    }
+    s.push_str("    fputs(\"}\\n\", o);\n    (void)self;\n}\n");
+}
+
+pub(crate) fn main_c(cfg: &CConfig) -> String {
+    MAIN_C
+        .replace("@CYCLE@", &cfg.cycle_ms.to_string())
+        .replace("@LOOP_CAP@", &cfg.loop_cap.to_string())
+}
+
+pub(crate) fn makefile(stems: &[String]) -> String {
+    let objs: Vec<String> = stems.iter().map(|s| format!("{s}.o")).collect();
+    format!(
+        "# Generated by plc-deps c. `make` builds ./plc_program; it reads the CSV of\n\
+         # `plc-deps run --inputs` on standard input and prints one JSON state per scan.\n\
+         CC ?= cc\nCFLAGS ?= -std=c11 -Wall -Wextra -Werror -O2\n\
+         OBJS = main.o plc_program.o {}\n\n\
+         plc_program: $(OBJS)\n\t$(CC) $(CFLAGS) -o $@ $(OBJS) -lm\n\n\
+         %.o: %.c plc_program.h plc_runtime.h\n\t$(CC) $(CFLAGS) -c -o $@ $<\n\n\
+         clean:\n\trm -f plc_program $(OBJS)\n\n.PHONY: clean\n",
+        objs.join(" ")
+    )
+}
+
+const MAIN_C: &str = r#"/* main.c: runs the generated program scan by scan on virtual time (docs/c.md).
+   stdin: the CSV of `plc-deps run --inputs` (a header row of input names, one row per scan).
+   argv[1]: the number of scans (default: the rows, at least 1).
+   stdout: after each scan the state as one JSON line; stderr: each fault as a JSON line.
+   argv[2] = --time: only the last state, and {"ns_per_scan": T} on stderr (the time of the
+   scans alone: inputs and printing excluded). */
+#include "plc_program.h"
+#include <time.h>
+
+static double seconds(void) {
+    struct timespec ts;
+    timespec_get(&ts, TIME_UTC);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+#define CYCLE_MS @CYCLE@
+#define LOOP_CAP @LOOP_CAP@
+
+static void on_fault(_plc_ctx *ctx, uint32_t rung, int kind) {
+    fprintf(stderr, "{\"scan\":%llu,\"rung\":%s,\"kind\":\"%s\"}\n", (unsigned long long)ctx->scan,
+            _plc_rung_ids[rung], kind == _PLC_DIV_BY_ZERO ? "div-by-zero" : "loop-cap");
+}
+
+/* Splits one CSV line into cells (double quotes as in RFC 4180); returns the count. */
+static int split(char *line, char **cells, int max) {
+    int n = 0;
+    char *r = line, *w = line;
+    while (n < max) {
+        cells[n++] = w;
+        if (*r == '"') {
+            r++;
+            for (;;) {
+                if (!*r) break;
+                if (*r == '"' && r[1] == '"') { *w++ = '"'; r += 2; continue; }
+                if (*r == '"') { r++; break; }
+                *w++ = *r++;
+            }
+            while (*r && *r != ',') r++;
+        } else {
+            while (*r && *r != ',') *w++ = *r++;
+        }
+        int more = *r == ',';
+        if (more) r++;
+        *w++ = 0;
+        if (!more) break;
+    }
+    return n;
+}
+
+static char *trim(char *s) {
+    while (*s == ' ' || *s == '\t') s++;
+    size_t n = strlen(s);
+    while (n && (s[n - 1] == ' ' || s[n - 1] == '\t' || s[n - 1] == '\r')) s[--n] = 0;
+    return s;
+}
+
+static int blank(const char *s) {
+    for (; *s; s++) if (*s != ' ' && *s != '\t' && *s != '\r') return 0;
+    return 1;
+}
+
+int main(int argc, char **argv) {
+    size_t cap = 1 << 16, len = 0;
+    char *text = malloc(cap);
+    if (!text) return 2;
+    for (size_t got; (got = fread(text + len, 1, cap - len - 1, stdin)) > 0;) {
+        len += got;
+        if (cap - len < 2) { cap *= 2; text = realloc(text, cap); if (!text) return 2; }
+    }
+    text[len] = 0;
+    /* Lines, without blank ones. */
+    size_t nlines = 0, lcap = 64;
+    char **lines = malloc(lcap * sizeof *lines);
+    for (char *s = text; s && *s;) {
+        char *nl = strchr(s, '\n');
+        if (nl) *nl = 0;
+        if (!blank(s)) {
+            if (nlines == lcap) { lcap *= 2; lines = realloc(lines, lcap * sizeof *lines); }
+            lines[nlines++] = s;
+        }
+        s = nl ? nl + 1 : NULL;
+    }
+    enum { MAX_COLS = 4096 };
+    static char *cells[MAX_COLS];
+    static int column_input[MAX_COLS];
+    int ncols = 0;
+    if (nlines > 0) {
+        ncols = split(lines[0], cells, MAX_COLS);
+        for (int c = 0; c < ncols; c++) {
+            char *name = trim(cells[c]);
+            column_input[c] = -1;
+            for (int i = 0; _plc_input_names[i]; i++)
+                if (!strcmp(_plc_input_names[i], name)) column_input[c] = i;
+            if (column_input[c] < 0) {
+                fprintf(stderr, "error: <stdin>:1: unknown input variable `%s`\n", name);
+                return 2;
+            }
+        }
+    }
+    size_t rows = nlines > 0 ? nlines - 1 : 0;
+    unsigned long long scans = rows > 0 ? rows : 1;
+    if (argc > 1) scans = strtoull(argv[1], NULL, 10);
+    int timing = argc > 2 && !strcmp(argv[2], "--time");
+    double spent = 0;
+    static _plc_state state;
+    state = _plc_initial;
+    _plc_ctx ctx = {0, 0, LOOP_CAP, on_fault, NULL};
+    for (unsigned long long k = 0; k < scans; k++) {
+        if (k < rows) {
+            int n = split(lines[k + 1], cells, MAX_COLS);
+            for (int c = 0; c < n && c < ncols; c++) {
+                char *cell = trim(cells[c]);
+                if (!*cell) continue;
+                if (!_plc_set_input(&state, (unsigned)column_input[c], cell)) {
+                    fprintf(stderr, "error: <stdin>: scan %llu, column `%s`: `%s` is not a value of that input\n",
+                            k, _plc_input_names[column_input[c]], cell);
+                    return 2;
+                }
+            }
+        }
+        ctx.scan = k;
+        ctx.now = (int64_t)k * CYCLE_MS;
+        double t0 = timing ? seconds() : 0;
+        _plc_scan(&state, &ctx);
+        if (timing) spent += seconds() - t0;
+        else _plc_print_state(&state, stdout);
+    }
+    if (timing) {
+        _plc_print_state(&state, stdout);
+        fprintf(stderr, "{\"ns_per_scan\": %.1f}\n", scans ? spent * 1e9 / (double)scans : 0.0);
+    }
+    free(lines);
+    free(text);
+    return 0;
+}
+"#;

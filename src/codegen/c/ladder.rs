@@ -1,0 +1,562 @@
+//! Ladder rungs → C statements: the series/parallel element tree of each rung becomes
+//! statements over a power value, one block of statements per rung.
+//!
+//! Power is carried as a C expression while it is pure (contacts, compares, ORs of them:
+//! `self->a && !self->b && (self->x < 5)`) and put into a local `_pN` only before an element
+//! that writes (a coil, a box, a call), so a rung of contacts and a coil is one assignment and
+//! no value is stored twice. Edge contacts compute their pulse into a local and update their
+//! memory at every evaluation, in order, as the interpreter does. Jumps are `goto` (a backward
+//! jump through the loop cap), FOR/NEXT is a C `for` (the NEXT asks the loop cap before it
+//! increments), calls are calls, RET and END return.
+//!
+//! Semantics: docs/scan.md, element by element as `src/exec/run.rs` runs them. Not here: the
+//! nesting of FBD fragments (`fbd`), files and the harness (`mod`, `harness`).
+
+use super::names;
+use crate::model::*;
+use std::collections::HashMap;
+use std::fmt::Write as _;
+
+/// Power as the emitter holds it.
+#[derive(Clone, Debug)]
+enum Pw {
+    True,
+    False,
+    /// A pure C expression (reads only, no side effects).
+    Expr(String),
+    /// A local that holds it.
+    Local(String),
+}
+
+/// What a POU's code needs to know about the whole program.
+pub(crate) struct Shared<'a> {
+    pub p: &'a Program,
+    /// The C lvalue of each variable (`self->Var1`).
+    pub vars: Vec<String>,
+    /// The C function of each POU.
+    pub pou_fns: Vec<String>,
+    /// Rungs that some jump targets.
+    pub labels: Vec<bool>,
+    /// Per rung: its loop counter index, for loop-back rungs.
+    pub counters: Vec<Option<u32>>,
+}
+
+/// The statements of one C function being written.
+pub(crate) struct Body<'a> {
+    pub sh: &'a Shared<'a>,
+    /// Variables held in locals of this function (FBD arcs, run flags).
+    pub locals: HashMap<VarId, String>,
+    pub out: String,
+    pub indent: usize,
+    tmp: u32,
+    /// The statement that ends the POU (`return;` or `return true;`).
+    pub ret: &'static str,
+    /// Rungs some emitted `goto` names (only their labels are written: GCC refuses unused ones).
+    pub used_labels: std::collections::HashSet<u32>,
+}
+
+fn is_condition(e: &Element) -> bool {
+    match e {
+        Element::Contact { .. } | Element::Compare { .. } => true,
+        Element::Or(bs) => bs.iter().all(|b| b.iter().all(is_condition)),
+        _ => false,
+    }
+}
+
+fn and(pw: Pw, e: String) -> Pw {
+    match pw {
+        Pw::True => Pw::Expr(e),
+        Pw::False => Pw::False,
+        Pw::Expr(x) | Pw::Local(x) => Pw::Expr(format!("{x} && {e}")),
+    }
+}
+
+/// `!c`, without a double negation of a simple name.
+pub(crate) fn negate(c: &str) -> String {
+    let atom = |s: &str| {
+        s.bytes()
+            .all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'.' || b == b'-' || b == b'>')
+    };
+    match c.strip_prefix('!') {
+        Some(rest) if atom(rest) => rest.to_string(),
+        _ if atom(c) => format!("!{c}"),
+        _ => format!("!({c})"),
+    }
+}
+
+/// The C type of an IEC type.
+pub(crate) fn c_type(ty: Type) -> &'static str {
+    match ty {
+        Type::Bool => "bool",
+        Type::Int => "int16_t",
+        Type::Dint | Type::Time => "int32_t",
+        Type::Real => "float",
+        Type::Fb(FbKind::Ton | FbKind::Tof | FbKind::Tp) => "_plc_timer",
+        Type::Fb(FbKind::Ctu | FbKind::Ctd) => "_plc_counter",
+    }
+}
+
+/// A C constant of a value.
+pub(crate) fn c_const(v: Value) -> String {
+    match v {
+        Value::Bool(b) => (if b { "1" } else { "0" }).to_string(),
+        Value::Int(i16::MIN) => "(-32767 - 1)".to_string(),
+        Value::Int(i) => i.to_string(),
+        Value::Dint(i32::MIN) | Value::Time(i32::MIN) => "(-2147483647 - 1)".to_string(),
+        Value::Dint(i) | Value::Time(i) => i.to_string(),
+        Value::Real(f) if f.is_finite() && f.is_sign_positive() => format!("{f:?}f"),
+        Value::Real(f) => format!("_plc_f32(0x{:08x}u)", f.to_bits()),
+    }
+}
+
+impl<'a> Body<'a> {
+    pub fn new(sh: &'a Shared<'a>, ret: &'static str, indent: usize) -> Body<'a> {
+        Body {
+            sh,
+            locals: HashMap::new(),
+            out: String::new(),
+            indent,
+            tmp: 0,
+            ret,
+            used_labels: Default::default(),
+        }
+    }
+
+    /// Writes one line at the current indentation.
+    pub fn line(&mut self, text: &str) {
+        for _ in 0..self.indent {
+            self.out.push_str("    ");
+        }
+        self.out.push_str(text);
+        self.out.push('\n');
+    }
+
+    fn fresh(&mut self, stem: &str) -> String {
+        self.tmp += 1;
+        format!("_{stem}{}", self.tmp)
+    }
+
+    pub fn var(&self, v: VarId) -> String {
+        match self.locals.get(&v) {
+            Some(l) => l.clone(),
+            None => self.sh.vars[v.index()].clone(),
+        }
+    }
+
+    fn var_ref(&self, r: VarRef) -> String {
+        match r.field {
+            None => self.var(r.var),
+            Some(f) => format!("{}.{}", self.var(r.var), f.name()),
+        }
+    }
+
+    fn operand(&self, o: &Operand) -> String {
+        match o {
+            Operand::Var(r) => self.var_ref(*r),
+            Operand::Const(v) => c_const(*v),
+        }
+    }
+
+    /// Puts an expression power into a local.
+    fn materialize(&mut self, pw: Pw) -> Pw {
+        match pw {
+            Pw::Expr(e) => {
+                let l = self.fresh("p");
+                self.line(&format!("bool {l} = {e};"));
+                Pw::Local(l)
+            }
+            other => other,
+        }
+    }
+
+    fn text(pw: &Pw) -> String {
+        match pw {
+            Pw::True => "1".into(),
+            Pw::False => "0".into(),
+            Pw::Expr(e) | Pw::Local(e) => e.clone(),
+        }
+    }
+
+    /// `stmt` when powered (nothing without power).
+    fn when(&mut self, pw: &Pw, stmt: &str) {
+        match pw {
+            Pw::True => self.line(stmt),
+            Pw::False => {}
+            p => {
+                let c = Self::text(p);
+                self.line(&format!("if ({c}) {stmt}"));
+            }
+        }
+    }
+
+    /// Emits `series` from power `pw`; returns the power out. `tail`: nothing reads the power
+    /// out, so the last element need not keep it.
+    fn series(&mut self, rung: RungId, series: &[Element], mut pw: Pw, tail: bool) -> PwOut {
+        let n = series.len();
+        for (i, e) in series.iter().enumerate() {
+            let last = tail && i + 1 == n;
+            pw = self.element(rung, e, pw, last);
+        }
+        PwOut(pw)
+    }
+
+    fn element(&mut self, rung: RungId, e: &Element, pw: Pw, last: bool) -> Pw {
+        let keep = |b: &mut Self, pw: Pw| if last { pw } else { b.materialize(pw) };
+        match e {
+            Element::Contact { var, kind } => {
+                let v = self.var_ref(*var);
+                match kind {
+                    ContactKind::Normal => and(pw, v),
+                    ContactKind::Negated => and(pw, negate(&v)),
+                    ContactKind::Rising { memory } | ContactKind::Falling { memory } => {
+                        let m = self.var(*memory);
+                        if matches!(pw, Pw::False) {
+                            // No power: only the memory is updated.
+                            self.line(&format!("{m} = {v};"));
+                            return Pw::False;
+                        }
+                        let l = self.fresh("e");
+                        let pulse = if matches!(kind, ContactKind::Rising { .. }) {
+                            format!("{v} && !{m}")
+                        } else {
+                            format!("!{v} && {m}")
+                        };
+                        // `(void)`: an OR with a TRUE branch needs no pulse but still updates.
+                        self.line(&format!("bool {l} = {pulse}; (void){l};"));
+                        self.line(&format!("{m} = {v};"));
+                        and(pw, l)
+                    }
+                }
+            }
+            Element::Compare { op, a, b } => {
+                let sym = match op {
+                    CmpOp::Eq => "==",
+                    CmpOp::Ne => "!=",
+                    CmpOp::Lt => "<",
+                    CmpOp::Le => "<=",
+                    CmpOp::Gt => ">",
+                    CmpOp::Ge => ">=",
+                };
+                let t = self.compare(sym, a, b);
+                and(pw, t)
+            }
+            Element::Or(branches) => self.or(rung, branches, pw),
+            Element::Coil { var, negated } => {
+                let pw = keep(self, pw);
+                let v = self.var(*var);
+                let c = Self::text(&pw);
+                let val = if *negated { negate(&c) } else { c };
+                self.line(&format!("{v} = {val};"));
+                pw
+            }
+            Element::Set(v) | Element::Reset(v) => {
+                let pw = keep(self, pw);
+                let one = if matches!(e, Element::Set(_)) { 1 } else { 0 };
+                let stmt = format!("{} = {one};", self.var(*v));
+                self.when(&pw, &stmt);
+                pw
+            }
+            Element::Branch(branches) => {
+                let pw = self.materialize(pw);
+                for b in branches {
+                    self.series(rung, b, pw.clone(), true);
+                }
+                pw
+            }
+            Element::Timer { kind, instance, pt } => {
+                let f = match kind {
+                    TimerKind::Ton => "_plc_ton",
+                    TimerKind::Tof => "_plc_tof",
+                    TimerKind::Tp => "_plc_tp",
+                };
+                let call = format!(
+                    "{f}(&{}, ctx->now, {}, {})",
+                    self.var(*instance),
+                    self.operand(pt),
+                    Self::text(&pw)
+                );
+                self.boxed(call, last)
+            }
+            Element::Ctu {
+                instance,
+                pv,
+                reset,
+            }
+            | Element::Ctd {
+                instance,
+                pv,
+                load: reset,
+            } => {
+                let f = if matches!(e, Element::Ctu { .. }) {
+                    "_plc_ctu"
+                } else {
+                    "_plc_ctd"
+                };
+                let call = format!(
+                    "{f}(&{}, {}, {}, {})",
+                    self.var(*instance),
+                    self.operand(pv),
+                    Self::text(&pw),
+                    self.operand(reset)
+                );
+                self.boxed(call, last)
+            }
+            Element::Move { from, to } => {
+                let pw = keep(self, pw);
+                let stmt = format!("{} = {};", self.var(*to), self.operand(from));
+                self.when(&pw, &stmt);
+                pw
+            }
+            Element::Arith { op, a, b, out } => {
+                let pw = keep(self, pw);
+                let value = self.arith(rung, *op, a, b, self.sh.p.var(*out).ty);
+                let stmt = format!("{} = {value};", self.var(*out));
+                self.when(&pw, &stmt);
+                pw
+            }
+            Element::Jmp { target, .. } => {
+                let goto = format!("goto _L{};", target.0);
+                if !matches!(pw, Pw::False) {
+                    self.used_labels.insert(target.0);
+                }
+                if target.0 <= rung.0 {
+                    let ctr = self.counter(rung);
+                    let stmt = format!("if (_plc_loop_back(&{ctr}, ctx, {})) {goto}", rung.0);
+                    self.when(&pw, &stmt);
+                } else {
+                    self.when(&pw, &goto);
+                }
+                Pw::False
+            }
+            Element::Ret | Element::End => {
+                let r = self.ret;
+                self.when(&pw, r);
+                Pw::False
+            }
+            Element::Call { pou } => {
+                let pw = self.materialize(pw);
+                let stmt = format!("{}(self, ctx);", self.sh.pou_fns[pou.index()]);
+                self.when(&pw, &stmt);
+                pw
+            }
+            Element::For { .. } | Element::Next { .. } => {
+                unreachable!("FOR and NEXT are emitted by the rung")
+            }
+        }
+    }
+
+    /// A timer or counter call: its Q is the power out.
+    fn boxed(&mut self, call: String, last: bool) -> Pw {
+        if last {
+            self.line(&format!("{call};"));
+            return Pw::False;
+        }
+        let l = self.fresh("p");
+        self.line(&format!("bool {l} = {call};"));
+        Pw::Local(l)
+    }
+
+    fn or(&mut self, rung: RungId, branches: &[Series], pw: Pw) -> Pw {
+        let mut terms = Vec::new();
+        if branches.iter().all(|b| b.iter().all(is_condition)) {
+            // Every branch is pure but for edge memories, which nothing else reads: OR the
+            // branches from TRUE and AND the power in.
+            for b in branches {
+                match self.series(rung, b, Pw::True, false).0 {
+                    Pw::True => terms.push("1".to_string()),
+                    Pw::False => {}
+                    Pw::Expr(e) | Pw::Local(e) if e.contains(" && ") => {
+                        terms.push(format!("({e})"))
+                    }
+                    Pw::Expr(e) | Pw::Local(e) => terms.push(e),
+                }
+            }
+            if terms.iter().any(|t| t == "1") {
+                return pw;
+            }
+            if terms.is_empty() {
+                return Pw::False;
+            }
+            return and(pw, format!("({})", terms.join(" || ")));
+        }
+        let pw = self.materialize(pw);
+        for b in branches {
+            let out = self.series(rung, b, pw.clone(), false).0;
+            let out = self.materialize(out);
+            terms.push(Self::text(&out));
+        }
+        Pw::Expr(format!("({})", terms.join(" || ")))
+    }
+
+    fn arith(&self, rung: RungId, op: ArithOp, a: &Operand, b: &Operand, ty: Type) -> String {
+        let (a, b) = (self.operand(a), self.operand(b));
+        let w = match ty {
+            Type::Int => "i16",
+            Type::Real => {
+                return match op {
+                    ArithOp::Add => format!("{a} + {b}"),
+                    ArithOp::Sub => format!("{a} - {b}"),
+                    ArithOp::Mul => format!("{a} * {b}"),
+                    ArithOp::Div => format!("{a} / {b}"),
+                    ArithOp::Mod => format!("fmodf({a}, {b})"),
+                }
+            }
+            _ => "i32",
+        };
+        let name = op.name().to_ascii_lowercase();
+        match op {
+            ArithOp::Div | ArithOp::Mod => format!("_plc_{name}_{w}({a}, {b}, ctx, {})", rung.0),
+            _ => format!("_plc_{name}_{w}({a}, {b})"),
+        }
+    }
+
+    /// `(a OP b)`; through `_plc_cmp` when a constant sits at its type's limit (where GCC's
+    /// `-Wtype-limits` would call the test always true or false).
+    fn compare(&self, sym: &str, a: &Operand, b: &Operand) -> String {
+        let at_limit = |o: &Operand| {
+            matches!(
+                o,
+                Operand::Const(
+                    Value::Int(i16::MIN | i16::MAX)
+                        | Value::Dint(i32::MIN | i32::MAX)
+                        | Value::Time(i32::MIN | i32::MAX)
+                )
+            )
+        };
+        let (x, y) = (self.operand(a), self.operand(b));
+        let relational = sym != "==" && sym != "!=";
+        if x == y || (relational && (at_limit(a) || at_limit(b))) {
+            // GCC calls `x == x` tautological (it is not for a NaN) and a test against a type's
+            // limit always true or false: a function of the runtime compares instead.
+            let f = match sym {
+                "==" => "eq",
+                "!=" => "ne",
+                "<" => "lt",
+                "<=" => "le",
+                ">" => "gt",
+                _ => "ge",
+            };
+            let real = self.operand_type(a) == Some(Type::Real);
+            let w = if real { "f32" } else { "i64" };
+            return format!("_plc_{f}_{w}({x}, {y})");
+        }
+        format!("({x} {sym} {y})")
+    }
+
+    fn operand_type(&self, o: &Operand) -> Option<Type> {
+        match o {
+            Operand::Const(v) => Some(v.ty()),
+            Operand::Var(r) => match (self.sh.p.var(r.var).ty, r.field) {
+                (Type::Fb(fb), Some(f)) => Field::lookup(fb, f.name()).map(|(_, t)| t),
+                (t, _) => Some(t),
+            },
+        }
+    }
+
+    fn counter(&self, rung: RungId) -> String {
+        let k = self.sh.counters[rung.index()].expect("a loop-back rung has a counter");
+        format!("self->_ctr[{k}]")
+    }
+
+    /// One rung: its label if a jump targets it, a comment, its statements. A FOR head opens
+    /// `if (power) { var = from; for (; var <= to; ) {`, which its NEXT rung closes.
+    pub fn rung(&mut self, r: RungId) {
+        let rung = self.sh.p.rung(r);
+        self.label(r);
+        self.line(&format!("/* {} */", names::comment(&rung.id)));
+        match rung.series.last() {
+            Some(Element::For { var, from, to, .. }) => {
+                let head = &rung.series[..rung.series.len() - 1];
+                let pw = self.series(r, head, Pw::True, false).0;
+                let v = self.var(*var);
+                let test = self.compare(
+                    "<=",
+                    &Operand::Var(VarRef {
+                        var: *var,
+                        field: None,
+                    }),
+                    to,
+                );
+                let from = self.operand(from);
+                match pw {
+                    Pw::True => self.line("{"),
+                    Pw::False => self.line("if (0) {"),
+                    p => {
+                        let c = Self::text(&p);
+                        self.line(&format!("if ({c}) {{"))
+                    }
+                }
+                self.indent += 1;
+                self.line(&format!("{v} = {from};"));
+                self.line(&format!("for (; {test}; ) {{"));
+                self.indent += 1;
+            }
+            Some(Element::Next { head }) => {
+                let Some(Element::For { var, .. }) = self.sh.p.rung(*head).series.last() else {
+                    unreachable!("a NEXT's head rung ends in FOR")
+                };
+                let v = self.var(*var);
+                let ctr = self.counter(r);
+                let wrap = match self.sh.p.var(*var).ty {
+                    Type::Int => "_plc_w16",
+                    _ => "_plc_w32",
+                };
+                self.line(&format!(
+                    "if (!_plc_loop_back(&{ctr}, ctx, {})) break;",
+                    r.0
+                ));
+                self.line(&format!("{v} = {wrap}((int64_t){v} + 1);"));
+                self.indent -= 1;
+                self.line("}");
+                self.indent -= 1;
+                self.line("}");
+            }
+            _ => {
+                self.series(r, &rung.series, Pw::True, true);
+            }
+        }
+    }
+
+    /// The label of rung `r`, if a jump targets it (removed by [`Body::finish`] if no emitted
+    /// `goto` names it).
+    pub fn label(&mut self, r: RungId) {
+        if self.sh.labels[r.index()] {
+            let l = format!("_L{}: ;", r.0);
+            self.line(&l);
+        }
+    }
+
+    /// The function body, without the labels no `goto` names.
+    pub fn finish(self) -> String {
+        let mut out = String::with_capacity(self.out.len());
+        for line in self.out.lines() {
+            let t = line.trim_start();
+            if let Some(n) = t.strip_prefix("_L").and_then(|x| x.strip_suffix(": ;")) {
+                if n.parse().is_ok_and(|n: u32| !self.used_labels.contains(&n)) {
+                    continue;
+                }
+            }
+            out.push_str(line);
+            out.push('\n');
+        }
+        out
+    }
+
+    /// The statements of `series` up to its final jump, and the power that takes the jump.
+    pub fn guard(&mut self, r: RungId, series: &[Element]) -> String {
+        let body = match series.last() {
+            Some(Element::Jmp { .. }) => &series[..series.len() - 1],
+            _ => series,
+        };
+        let pw = self.series(r, body, Pw::True, false).0;
+        Self::text(&pw)
+    }
+}
+
+/// The power at the end of a series.
+pub(crate) struct PwOut(Pw);
+
+/// Writes `text` into `out` (a `String`, cannot fail).
+pub(crate) fn push(out: &mut String, text: std::fmt::Arguments<'_>) {
+    out.write_fmt(text).expect("writing to a String");
+}

@@ -1,0 +1,369 @@
+//! C from ladder and FBD programs (the FBD text-generation paper's generator, extended to the
+//! whole program): for every POU a header and a source file, a runtime header, the program's
+//! state and harness tables, `main.c` and a `Makefile`.
+//!
+//! Shape: the program's persistent data (every variable: globals, subroutine and instance
+//! locals, timers, counters, edge memories, the loop counters) is one struct `_plc_state`
+//! passed to every POU function as `self`; each POU is a function `_pou_<name>(self, ctx)`
+//! (`ctx`: virtual time, scan, loop cap, fault sink). Ladder rungs are one block of statements
+//! each (`ladder`); FBD networks are nested `if` blocks following their fragment trees, with
+//! one local per data arc (`fbd`). A ladder POU of more than [`CConfig::chunk_rungs`] rungs is
+//! cut into functions of about that many rungs at boundaries no jump and no FOR loop crosses,
+//! so the C compiler's time grows linearly with the program.
+//!
+//! Invariants: the generated program computes after every scan exactly the state and the faults
+//! of the sequential interpreter (`crate::exec::Machine`) given the same inputs (tests:
+//! `tests/c_codegen*.rs` compile it with `cc -std=c11 -Wall -Wextra -Werror -O2` and compare
+//! every scan); every identifier and file name is made by `names` (no program name can change
+//! the C's meaning or leave the output folder).
+//!
+//! Not here: writing the files (`crate::cmd::c`), reading the program.
+
+mod fbd;
+mod harness;
+mod ladder;
+pub mod names;
+mod runtime;
+
+use crate::fbd::Fbd;
+use crate::model::{walk_elements, Element, PouKind, Program, RungId, VarId};
+use ladder::{c_type, Body, Shared};
+use std::collections::HashMap;
+
+pub use runtime::RUNTIME_H;
+
+/// What `plc-deps c` was asked for.
+#[derive(Clone, Debug)]
+pub struct CConfig {
+    /// The scan cycle the harness runs (`--cycle`), ms.
+    pub cycle_ms: u32,
+    /// Loop-backs per loop-back rung and scan (`--loop-cap`).
+    pub loop_cap: u32,
+    /// Rungs per function of a large ladder POU.
+    pub chunk_rungs: usize,
+}
+
+impl Default for CConfig {
+    fn default() -> Self {
+        CConfig {
+            cycle_ms: 10,
+            loop_cap: 100_000,
+            chunk_rungs: 256,
+        }
+    }
+}
+
+/// One generated file: its name (no folder) and text.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct CFile {
+    pub name: String,
+    pub text: String,
+}
+
+/// The C of `p` (with its FBD bodies `fbd`), as files.
+pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
+    let sh = shared(p);
+    let stems: Vec<String> = p
+        .pous
+        .iter()
+        .enumerate()
+        .map(|(i, pou)| format!("pou_{}", names::encode_file(&pou.name, i)))
+        .collect();
+    let mut files = vec![
+        CFile {
+            name: "plc_runtime.h".into(),
+            text: RUNTIME_H.into(),
+        },
+        CFile {
+            name: "plc_program.h".into(),
+            text: program_header(p, &sh, &stems),
+        },
+        CFile {
+            name: "plc_program.c".into(),
+            text: harness::program_source(p, &sh),
+        },
+    ];
+    let copies = fbd_copies(p, fbd);
+    let mut objects = Vec::new();
+    for (i, pou) in p.pous.iter().enumerate() {
+        let f = &sh.pou_fns[i];
+        let (sources, decls) = match copies.get(&i) {
+            Some((fp, prefix)) => {
+                let body = fbd_function(p, &sh, fbd, *fp, prefix, i);
+                let text = format!("#include \"plc_program.h\"\n\n{body}");
+                (vec![(String::new(), text)], String::new())
+            }
+            None => ladder_files(p, &sh, i, cfg.chunk_rungs),
+        };
+        files.push(CFile {
+            name: format!("{}.h", stems[i]),
+            text: format!(
+                "/* POU {} */\nvoid {f}(_plc_state *self, _plc_ctx *ctx);\n{decls}",
+                names::comment(&pou.name)
+            ),
+        });
+        for (suffix, text) in sources {
+            objects.push(format!("{}{suffix}", stems[i]));
+            files.push(CFile {
+                name: format!("{}{suffix}.c", stems[i]),
+                text,
+            });
+        }
+    }
+    files.push(CFile {
+        name: "main.c".into(),
+        text: harness::main_c(cfg),
+    });
+    files.push(CFile {
+        name: "Makefile".into(),
+        text: harness::makefile(&objects),
+    });
+    files
+}
+
+/// Names, labels and loop counters of the whole program.
+fn shared(p: &Program) -> Shared<'_> {
+    let vars = p
+        .vars
+        .iter()
+        .enumerate()
+        .map(|(i, v)| {
+            if v.hidden {
+                format!("self->_h{i}")
+            } else {
+                format!("self->{}", names::user_ident(&v.name))
+            }
+        })
+        .collect();
+    let pou_fns = p
+        .pous
+        .iter()
+        .map(|pou| format!("_pou_{}", names::encode_ident(&pou.name)))
+        .collect();
+    let mut labels = vec![false; p.rungs.len()];
+    let mut counters = vec![None; p.rungs.len()];
+    let mut next = 0u32;
+    for (i, r) in p.rungs.iter().enumerate() {
+        let mut back = false;
+        walk_elements(&r.series, &mut |e| match e {
+            Element::Jmp { target, .. } => {
+                labels[target.index()] = true;
+                back |= target.index() <= i;
+            }
+            Element::Next { .. } => back = true,
+            _ => {}
+        });
+        if back {
+            counters[i] = Some(next);
+            next += 1;
+        }
+    }
+    Shared {
+        p,
+        vars,
+        pou_fns,
+        labels,
+        counters,
+    }
+}
+
+/// The number of loop counters.
+fn counter_count(sh: &Shared) -> usize {
+    sh.counters.iter().flatten().count()
+}
+
+fn program_header(p: &Program, sh: &Shared, stems: &[String]) -> String {
+    let mut s = String::from(
+        "/* plc_program.h: the persistent data of the program, generated by plc-deps. */\n\
+         #ifndef PLC_PROGRAM_H\n#define PLC_PROGRAM_H\n#include \"plc_runtime.h\"\n\n\
+         typedef struct _plc_state {\n",
+    );
+    for (i, v) in p.vars.iter().enumerate() {
+        let field = sh.vars[i].trim_start_matches("self->");
+        let ty = c_type(v.ty);
+        ladder::push(
+            &mut s,
+            format_args!("    {ty} {field}; /* {} */\n", names::comment(&v.name)),
+        );
+    }
+    let k = counter_count(sh);
+    if k > 0 {
+        ladder::push(
+            &mut s,
+            format_args!("    uint64_t _ctr[{k}]; /* loop counters */\n"),
+        );
+    }
+    if p.vars.is_empty() && k == 0 {
+        s.push_str("    char _empty;\n");
+    }
+    s.push_str("} _plc_state;\n\nextern const _plc_state _plc_initial;\n");
+    s.push_str("void _plc_scan(_plc_state *self, _plc_ctx *ctx);\n");
+    s.push_str(harness::HEADER_DECLS);
+    for stem in stems {
+        ladder::push(&mut s, format_args!("#include \"{stem}.h\"\n"));
+    }
+    s.push_str("#endif\n");
+    s
+}
+
+/// The FBD body of each POU written in FBD: POU index → (index into `fbd.pous`, var prefix).
+fn fbd_copies(p: &Program, fbd: &Fbd) -> HashMap<usize, (usize, String)> {
+    let mut out = HashMap::new();
+    for (i, fp) in fbd.pous.iter().enumerate() {
+        for c in &fp.copies {
+            let pou = p.pou(c.pou);
+            let prefix = if pou.kind == PouKind::Main {
+                String::new()
+            } else if fbd.instances.iter().any(|inst| inst.pou == c.pou) {
+                format!("{}.", pou.name)
+            } else {
+                format!("{}:", pou.name)
+            };
+            out.insert(c.pou.index(), (i, prefix));
+        }
+    }
+    out
+}
+
+fn fbd_function(
+    p: &Program,
+    sh: &Shared,
+    fbd: &Fbd,
+    fp: usize,
+    prefix: &str,
+    pou: usize,
+) -> String {
+    let hidden: HashMap<&str, VarId> = p
+        .vars
+        .iter()
+        .enumerate()
+        .filter(|(_, v)| v.hidden)
+        .map(|(i, v)| (v.name.as_str(), VarId(i as u32)))
+        .collect();
+    let fpou = &fbd.pous[fp];
+    let copy = fpou
+        .copies
+        .iter()
+        .find(|c| c.pou.index() == pou)
+        .expect("the copy of this POU");
+    let mut b = Body::new(sh, "return;", 1);
+    b.line("(void)self; (void)ctx;");
+    let locals = fbd::locals(p, &hidden, fpou, prefix);
+    fbd::declare(&mut b, p, &locals);
+    fbd::pou(&mut b, p, fpou, copy);
+    let f = &sh.pou_fns[pou];
+    format!(
+        "/* FBD {} {}: networks as fragment trees */\nvoid {f}(_plc_state *self, _plc_ctx *ctx) {{\n{}}}\n",
+        fpou.kind.name(),
+        names::comment(&fpou.name),
+        b.finish()
+    )
+}
+
+/// Cut points of a ladder POU's rungs: groups of about `chunk` rungs that no jump or FOR
+/// crosses.
+fn chunks(p: &Program, pou: usize, chunk: usize) -> Vec<std::ops::Range<u32>> {
+    let range = p.pous[pou].rungs.clone();
+    let n = (range.end - range.start) as usize;
+    // blocked[i]: the boundary before rung start + i is crossed by a jump or a loop.
+    let mut diff = vec![0i32; n + 1];
+    let mut span = |a: u32, b: u32| {
+        let (lo, hi) = (a.min(b) - range.start, a.max(b) - range.start);
+        if lo < hi {
+            diff[lo as usize + 1] += 1;
+            diff[hi as usize + 1] -= 1;
+        }
+    };
+    for r in range.clone() {
+        walk_elements(&p.rungs[r as usize].series, &mut |e| match e {
+            Element::Jmp { target, .. } => span(r, target.0),
+            Element::For { next, .. } => span(r, next.0),
+            _ => {}
+        });
+    }
+    let mut out = Vec::new();
+    let (mut start, mut depth) = (range.start, 0i32);
+    for i in 1..n {
+        depth += diff[i];
+        let at = range.start + i as u32;
+        if depth == 0 && (at - start) as usize >= chunk {
+            out.push(start..at);
+            start = at;
+        }
+    }
+    out.push(start..range.end);
+    out
+}
+
+/// Chunk functions per source file of a large ladder POU (`pou_X_partN.c`), so that `make -j`
+/// compiles them in parallel and no translation unit grows with the program.
+const CHUNKS_PER_FILE: usize = 16;
+
+/// The C of a ladder POU: its function and, for a large POU, the part files of its chunks
+/// (`(file suffix, text)`; the first has no suffix), and the declarations for its header.
+fn ladder_files(
+    p: &Program,
+    sh: &Shared,
+    pou: usize,
+    chunk: usize,
+) -> (Vec<(String, String)>, String) {
+    let f = &sh.pou_fns[pou];
+    let groups = chunks(p, pou, chunk.max(1));
+    let name = names::comment(&p.pous[pou].name);
+    let head = "#include \"plc_program.h\"\n\n";
+    if groups.len() == 1 {
+        let mut b = Body::new(sh, "return;", 1);
+        b.line("(void)self; (void)ctx;");
+        for r in groups[0].clone() {
+            b.rung(RungId(r));
+        }
+        let text = format!(
+            "{head}/* ladder POU {name} */\nvoid {f}(_plc_state *self, _plc_ctx *ctx) {{\n{}}}\n",
+            b.finish()
+        );
+        return (vec![(String::new(), text)], String::new());
+    }
+    let mut files = Vec::new();
+    let mut decls = String::new();
+    for (n, part) in groups.chunks(CHUNKS_PER_FILE).enumerate() {
+        let mut s = format!("{head}/* ladder POU {name}, part {n} */\n");
+        for (j, g) in part.iter().enumerate() {
+            let k = n * CHUNKS_PER_FILE + j;
+            let mut b = Body::new(sh, "return 1;", 1);
+            b.line("(void)self; (void)ctx;");
+            for r in g.clone() {
+                b.rung(RungId(r));
+            }
+            b.line("return 0;");
+            ladder::push(
+                &mut s,
+                format_args!(
+                    "bool {f}_{k}(_plc_state *self, _plc_ctx *ctx) {{\n{}}}\n\n",
+                    b.finish()
+                ),
+            );
+            ladder::push(
+                &mut decls,
+                format_args!("bool {f}_{k}(_plc_state *self, _plc_ctx *ctx);\n"),
+            );
+        }
+        files.push((format!("_part{n}"), s));
+    }
+    let mut s = format!(
+        "{head}/* ladder POU {name}, in {} functions */\n",
+        groups.len()
+    );
+    ladder::push(
+        &mut s,
+        format_args!("void {f}(_plc_state *self, _plc_ctx *ctx) {{\n"),
+    );
+    for k in 0..groups.len() {
+        ladder::push(
+            &mut s,
+            format_args!("    if ({f}_{k}(self, ctx)) return;\n"),
+        );
+    }
+    s.push_str("}\n");
+    files.insert(0, (String::new(), s));
+    (files, decls)
+}

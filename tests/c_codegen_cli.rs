@@ -1,0 +1,196 @@
+//! `plc-deps c` as a user runs it: the Makefile builds, the program's last JSON line equals the
+//! `state` of `plc-deps run --format json`; hostile program names stay inside DIR and compile;
+//! `-o DIR` is all files or none, an existing folder with files is refused unless `--force`.
+
+mod common;
+
+use common::cli::{error_line, root, run, tmp};
+use std::process::{Command, Stdio};
+
+fn make(dir: &std::path::Path) {
+    let out = Command::new("make")
+        .arg("-s")
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+fn run_program(dir: &std::path::Path, csv: &[u8]) -> String {
+    use std::io::Write;
+    let mut child = Command::new(dir.join("plc_program"))
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child.stdin.take().unwrap().write_all(csv).unwrap();
+    let out = child.wait_with_output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+#[test]
+fn the_makefile_builds_a_program_whose_state_is_the_runs_state() {
+    let dir = tmp("c-conveyor");
+    let _ = std::fs::remove_dir_all(&dir);
+    let d = dir.to_str().unwrap();
+    let prog = "analyses/conveyor/program.json";
+    let out = run(&["c", prog, "-o", d, "--cycle", "1s"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    make(&dir);
+    let csv = std::fs::read(root().join("analyses/conveyor/inputs.csv")).unwrap();
+    let lines = run_program(&dir, &csv);
+    let last: serde_json::Value = serde_json::from_str(lines.lines().last().unwrap()).unwrap();
+    let runs = run(&[
+        "run",
+        prog,
+        "--inputs",
+        "analyses/conveyor/inputs.csv",
+        "--cycle",
+        "1s",
+        "--mode",
+        "seq",
+        "--format",
+        "json",
+    ]);
+    let report: serde_json::Value = serde_json::from_slice(&runs.stdout).unwrap();
+    assert_eq!(last, report["state"]);
+    assert_eq!(
+        lines.lines().count() as u64,
+        report["scans"].as_u64().unwrap()
+    );
+}
+
+#[test]
+fn hostile_names_stay_inside_the_folder_and_compile() {
+    // Variable names must be identifiers (the reader refuses others); these are the ones that
+    // could still break C: keywords, macros, names of the generated code, encodings of each other.
+    // The program name and rung ids are free text.
+    let program = serde_json::json!({
+        "program": "../../evil\"*/ #define x",
+        "vars": [
+            {"name": "int", "type": "BOOL", "class": "input"},
+            {"name": "_plc_state", "type": "BOOL", "class": "input"},
+            {"name": "a_046b", "type": "INT", "class": "output"},
+            {"name": "_ua__046b", "type": "INT"},
+            {"name": "self", "type": "BOOL"},
+            {"name": "NULL", "type": "BOOL", "class": "output"},
+            {"name": "_L1", "type": "BOOL"},
+            {"name": "_p1", "type": "BOOL"},
+            {"name": "INT16_MAX", "type": "INT"},
+            {"name": "ctx", "type": "BOOL"}
+        ],
+        "rungs": [
+            {"id": "*/#R1", "ld": [{"contact": "int"}, {"coil": "self"}]},
+            {"id": "R\\2", "ld": [{"contact": "self"}, {"op": "ADD", "in": ["INT16_MAX", 1], "out": "a_046b"}]},
+            {"id": "R3", "ld": [{"contact": "_plc_state"}, {"op": "ADD", "in": ["a_046b", 2], "out": "_ua__046b"}, {"coil": "NULL"}]},
+            {"id": "R4", "ld": [{"contact": "NULL", "negated": true}, {"coil": "_L1"}, {"call": "main"}]},
+            {"id": "R5", "ld": [{"contact": "ctx"}, {"coil": "_p1"}, {"call": "MAIN"}]}
+        ],
+        "subroutines": {"main": {"rungs": [{"id": "S1", "ld": [{"op": "ADD", "in": ["INT16_MAX", 3], "out": "INT16_MAX"}]}]},
+                        "MAIN": {"rungs": [{"id": "S2", "ld": [{"contact": "int"}, {"ret": true}]}]}}
+    });
+    let file = tmp("hostile.json");
+    std::fs::write(&file, program.to_string()).unwrap();
+    let dir = tmp("c-hostile");
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = run(&["c", file.to_str().unwrap(), "-o", dir.to_str().unwrap()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // Every file is directly inside DIR, with a plain name.
+    for e in std::fs::read_dir(&dir).unwrap() {
+        let name = e.unwrap().file_name().into_string().unwrap();
+        assert!(
+            name.bytes()
+                .all(|b| b.is_ascii_alphanumeric() || b"_.-".contains(&b)),
+            "{name}"
+        );
+    }
+    assert!(!tmp("evil").exists() && !dir.parent().unwrap().join("main.c").exists());
+    make(&dir);
+    let csv = b"int,_plc_state\ntrue,true\n0,1\n";
+    let lines = run_program(&dir, csv);
+    let inputs = tmp("hostile.csv");
+    std::fs::write(&inputs, csv).unwrap();
+    let runs = run(&[
+        "run",
+        file.to_str().unwrap(),
+        "--inputs",
+        inputs.to_str().unwrap(),
+        "--mode",
+        "seq",
+        "--format",
+        "json",
+    ]);
+    let report: serde_json::Value = serde_json::from_slice(&runs.stdout).unwrap();
+    let last: serde_json::Value = serde_json::from_str(lines.lines().last().unwrap()).unwrap();
+    assert_eq!(last, report["state"]);
+    assert_eq!(last["a_046b"], 1);
+    assert_eq!(last["self"], false);
+    // Two POUs whose names differ only in case get two files.
+    let c_files = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().ends_with(".c"))
+        .count();
+    assert_eq!(c_files, 5, "main.c, plc_program.c and three POUs");
+}
+
+#[test]
+fn the_folder_is_written_whole_and_an_existing_one_needs_force() {
+    let dir = tmp("c-atomic");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("notes.txt"), "mine").unwrap();
+    let d = dir.to_str().unwrap();
+    let prog = "analyses/example-a/program.json";
+    let line = error_line(&run(&["c", prog, "-o", d]), "existing folder");
+    assert!(
+        line.contains("exists and is not empty (give --force"),
+        "{line}"
+    );
+    assert!(dir.join("notes.txt").exists());
+    // A bad program writes nothing.
+    let bad = tmp("bad.json");
+    std::fs::write(
+        &bad,
+        r#"{"program": "p", "vars": [], "rungs": [{"id": "R1", "ld": [{"contact": "nope"}]}]}"#,
+    )
+    .unwrap();
+    let fresh = tmp("c-none");
+    let _ = std::fs::remove_dir_all(&fresh);
+    error_line(
+        &run(&["c", bad.to_str().unwrap(), "-o", fresh.to_str().unwrap()]),
+        "bad",
+    );
+    assert!(!fresh.exists());
+    // --force replaces the folder whole.
+    let out = run(&["c", prog, "-o", d, "--force"]);
+    assert!(out.status.success());
+    assert!(!dir.join("notes.txt").exists());
+    assert!(dir.join("main.c").exists() && dir.join("Makefile").exists());
+    let parent = dir.parent().unwrap();
+    let leftovers: Vec<_> = std::fs::read_dir(parent)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains(".tmp-") || n.contains(".old-"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+}
