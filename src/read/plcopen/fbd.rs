@@ -46,18 +46,9 @@ const FBD_TAGS: &[&str] = &[
 pub fn body(tc6: Tc6, node: Node, pou: &str, notes: &mut Notes) -> R<FbdBody<'static>> {
     let place = format!("pou {pou}, FBD");
     let g = graph(tc6, node, &place)?;
+    g.only(FBD_TAGS, "FBD", &place)?;
     let mut ordered = Vec::new();
-    for (i, el) in g.elems.iter().enumerate() {
-        if !FBD_TAGS.contains(&el.tag) {
-            return Err(error(
-                origin(el.node),
-                &g.place(&place, ElemId(i as u32)),
-                format!(
-                    "`{}` is not an element of an FBD body that plc-deps reads",
-                    el.tag
-                ),
-            ));
-        }
+    for el in &g.elems {
         if let Some(x) = el
             .node
             .attribute("executionOrderId")

@@ -54,17 +54,8 @@ const LD_TAGS: &[&str] = &[
 pub fn rungs(tc6: Tc6, node: Node, pou: &str, notes: &mut Notes) -> R<Vec<Rung<'static>>> {
     let place = format!("pou {pou}, LD");
     let g = graph(tc6, node, &place)?;
-    for (i, el) in g.elems.iter().enumerate() {
-        if !LD_TAGS.contains(&el.tag) {
-            return Err(error(
-                origin(el.node),
-                &g.place(&place, ElemId(i as u32)),
-                format!(
-                    "`{}` is not an element of an LD body that plc-deps reads",
-                    el.tag
-                ),
-            ));
-        }
+    g.only(LD_TAGS, "LD", &place)?;
+    for el in &g.elems {
         if let Some(x) = el.node.attribute("executionOrderId") {
             if x.trim() != "0" && el.tag != "block" {
                 notes.push(Note {

@@ -68,6 +68,25 @@ impl<'a, 'i> Graph<'a, 'i> {
         let el = self.get(e);
         format!("{body}, {} localId {}", el.tag, el.local_id)
     }
+
+    /// An error at the first element whose tag is not one of `tags`, the elements a
+    /// `language` body (`LD`, `FBD`) may hold; `body` names the body in errors.
+    pub fn only(&self, tags: &[&str], language: &str, body: &str) -> R<()> {
+        match self.elems.iter().position(|el| !tags.contains(&el.tag)) {
+            None => Ok(()),
+            Some(i) => {
+                let el = &self.elems[i];
+                Err(error(
+                    origin(el.node),
+                    &self.place(body, ElemId(i as u32)),
+                    format!(
+                        "`{}` is not an element of an {language} body that plc-deps reads",
+                        el.tag
+                    ),
+                ))
+            }
+        }
+    }
 }
 
 /// Elements that are not wired: read by their callers directly (labels, comments).
