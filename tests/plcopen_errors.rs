@@ -119,3 +119,22 @@ fn types_the_model_lacks_are_named_with_their_variable() {
     let sr = project(&[("localVars", "S0", "SR")], &rail(1));
     assert!(error_of(&sr).ends_with("variable `S0` is an instance of the standard function block SR, which is not supported yet (supported: TON, TOF, TP, CTU, CTD)"));
 }
+
+#[test]
+fn an_element_an_ld_body_cannot_hold_is_named() {
+    let xml = project(
+        &bools(&["A", "X"]),
+        &[
+            rail(1),
+            contact(2, "A", &[1], ""),
+            coil(3, "X", &[2], ""),
+            "<inOutVariable localId=\"4\"><expression>A</expression></inOutVariable>".to_owned(),
+        ]
+        .concat(),
+    );
+    let e = error_of(&xml);
+    assert!(
+        e.ends_with("at pou P, LD, inOutVariable localId 4: `inOutVariable` is not an element of an LD body that plc-deps reads"),
+        "{e}"
+    );
+}
