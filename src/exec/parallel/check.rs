@@ -114,15 +114,19 @@ mod tests {
         .unwrap()
     }
 
-    #[test]
-    fn a_padded_layout_passes_and_a_dense_one_fails_on_the_shared_line() {
-        let p = program();
-        let a = crate::analysis::analyse(&p);
+    /// The plan that runs every level in parallel on two workers.
+    fn all_parallel(p: &crate::model::Program) -> Plan {
         let config = PlanConfig {
             strategy: Strategy::AllParallel,
             ..PlanConfig::new(2)
         };
-        let plan = Plan::build(&p, &a, &config);
+        Plan::build(p, &crate::analysis::analyse(p), &config)
+    }
+
+    #[test]
+    fn a_padded_layout_passes_and_a_dense_one_fails_on_the_shared_line() {
+        let p = program();
+        let plan = all_parallel(&p);
         assert_eq!(plan.parallel_phases(), 1);
         let groups = super::super::plan::layout_groups(&[&plan], p.vars.len());
         let padded = Machine::new(
@@ -143,12 +147,7 @@ mod tests {
     #[test]
     fn a_line_is_64_bytes_of_real_addresses() {
         let p = program();
-        let a = crate::analysis::analyse(&p);
-        let config = PlanConfig {
-            strategy: Strategy::AllParallel,
-            ..PlanConfig::new(2)
-        };
-        let plan = Plan::build(&p, &a, &config);
+        let plan = all_parallel(&p);
         let at = |x: u32, y: u32| {
             let layout = Layout::from_starts(&p, vec![0, 1, x, y], 128).unwrap();
             let m = Machine::new(&p, layout, &ExecConfig::default()).unwrap();

@@ -294,15 +294,15 @@ fn instances<'a, 'i>(
     };
     add_data_note(tc6, conf, notes);
     let place = "instances/configuration";
-    for gv in tc6.children(conf, "globalVars") {
-        globals.extend(interface::var_list(
-            tc6,
-            gv,
-            crate::syntax::VarClass::Default,
-            place,
-            known,
-        )?);
-    }
+    // The globals of the configuration, then of its resource.
+    let globals_of = |node: Node, globals: &mut Vec<Var<'static>>| -> R<()> {
+        for gv in tc6.children(node, "globalVars") {
+            let class = crate::syntax::VarClass::Default;
+            globals.extend(interface::var_list(tc6, gv, class, place, known)?);
+        }
+        Ok(())
+    };
+    globals_of(conf, &mut globals)?;
     let resources: Vec<Node> = tc6.children(conf, "resource").collect();
     if resources.len() > 1 {
         return Err(error(
@@ -314,15 +314,7 @@ fn instances<'a, 'i>(
     let Some(res) = resources.first().copied() else {
         return Ok((globals, order));
     };
-    for gv in tc6.children(res, "globalVars") {
-        globals.extend(interface::var_list(
-            tc6,
-            gv,
-            crate::syntax::VarClass::Default,
-            place,
-            known,
-        )?);
-    }
+    globals_of(res, &mut globals)?;
     let mut tasks: Vec<(u32, Node)> = Vec::new();
     for t in tc6.children(res, "task") {
         let pr = t.attribute("priority").unwrap_or("0").trim();
