@@ -35,7 +35,11 @@ pub fn program_and_fbd_from_json(text: &str) -> Result<(Program, Fbd), LoadError
             .map_err(|e| e.refine(text, |t, p| json::path_offset(t, p).map(|(start, _)| start)))
     };
     let mut stream = crate::resolve::Stream::default();
-    let syntax = json::parse_with(text, Some(&mut stream))?;
+    let syntax = if text.len() >= PIPE_FROM && two_cores() {
+        crate::syntax::pipe::through_pipe(&mut stream, |sink| json::parse_with(text, Some(sink)))?
+    } else {
+        json::parse_with(text, Some(&mut stream))?
+    };
     if !stream.took_rungs() {
         return whole(&syntax);
     }
@@ -44,6 +48,14 @@ pub fn program_and_fbd_from_json(text: &str) -> Result<(Program, Fbd), LoadError
     }
     drop(syntax);
     whole(&json::parse(text)?)
+}
+
+/// Files from this size on are read on one thread and resolved on another
+/// ([`crate::syntax::pipe`]); below it, starting a thread costs more than it gains.
+const PIPE_FROM: usize = 1 << 20;
+
+fn two_cores() -> bool {
+    std::thread::available_parallelism().is_ok_and(|n| n.get() > 1)
 }
 
 /// Builds a program from an already parsed JSON document (tests and benchmarks that build

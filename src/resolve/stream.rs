@@ -51,12 +51,11 @@ pub(super) struct Held<'a> {
 
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 enum State {
-    /// No rungs offered (yet).
+    /// No rungs offered (yet): the tree has them.
     Idle,
-    /// Offered and refused: the tree has them.
-    Refused,
     Streaming,
-    /// Rungs were taken, then something could not be resolved: only the whole tree will do.
+    /// Rungs were taken, then something could not be resolved (a declaration, a rung, a
+    /// second rung array): only the whole tree will do.
     GaveUp,
 }
 
@@ -76,18 +75,17 @@ impl Default for Stream<'_> {
 }
 
 impl<'t> syntax::RungSink<'t> for Stream<'t> {
-    fn start(&mut self, vars: &[syntax::Var<'t>], rungs: usize) -> bool {
+    fn start(&mut self, vars: Vec<syntax::Var<'t>>, rungs: usize) {
         if self.state != State::Idle {
             // A second rung array: the last one counts, so the first must not have been taken.
-            if self.state == State::Streaming {
-                self.state = State::GaveUp;
-            }
-            return false;
+            self.state = State::GaveUp;
+            return;
         }
-        self.b.declare_main(String::new(), vars);
+        self.b.declare_main(String::new(), &vars);
+        drop(vars);
         if !self.b.errors.is_empty() || !self.b.pending.is_empty() {
-            self.state = State::Refused;
-            return false;
+            self.state = State::GaveUp;
+            return;
         }
         self.b.streamed = Some(Streamed {
             declared: self.b.vars.len(),
@@ -96,7 +94,6 @@ impl<'t> syntax::RungSink<'t> for Stream<'t> {
             ..Streamed::default()
         });
         self.state = State::Streaming;
-        true
     }
 
     fn retract(&mut self) {
@@ -307,7 +304,7 @@ mod tests {
     }
 
     #[test]
-    fn the_stream_gives_up_on_any_problem_and_refuses_what_it_cannot_start() {
+    fn the_stream_gives_up_on_any_problem() {
         let gives_up = [
             r#"{"program": "P", "vars": [], "rungs": [{"id": "R1", "ld": [{"coil": "Z"}]}]}"#,
             r#"{"program": "P", "vars": [{"name": "A", "type": "BOOL"}],
@@ -316,6 +313,9 @@ mod tests {
                 "rungs": [{"id": "R1", "ld": [{"coil": "A"}]}], "vars": []}"#,
             r#"{"program": "P", "vars": [{"name": "A", "type": "BOOL"}],
                 "rungs": [{"id": "R1", "ld": [{"jmp": "NOWHERE"}]}]}"#,
+            // A declaration that does not resolve: the rungs were taken all the same.
+            r#"{"program": "P", "vars": [{"name": "A", "type": "NOPE"}],
+                "rungs": [{"id": "R1", "ld": [{"coil": "A"}]}]}"#,
         ];
         for text in gives_up {
             let mut stream = Stream::default();
@@ -323,10 +323,11 @@ mod tests {
             assert!(stream.took_rungs(), "{text}");
             assert!(stream.finish(&syn).is_none(), "{text}");
         }
-        let refused = r#"{"program": "P", "vars": [{"name": "A", "type": "NOPE"}],
+        // Not offered: something before the rungs is malformed; the tree keeps them.
+        let kept = r#"{"program": "P", "vars": [{"name": "A", "type": "BOOL"}], "x": 1,
             "rungs": [{"id": "R1", "ld": [{"coil": "A"}]}]}"#;
         let mut stream = Stream::default();
-        let syn = crate::read::json::parse_with(refused, Some(&mut stream)).expect("parses");
+        let syn = crate::read::json::parse_with(kept, Some(&mut stream)).expect("parses");
         assert!(!stream.took_rungs());
         assert!(matches!(&syn.body, Some(syntax::Body::Rungs(r)) if r.len() == 1));
     }

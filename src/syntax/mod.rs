@@ -20,6 +20,7 @@
 //! resolver's), and anything JSON-specific beyond [`Scalar`] (a leaf as written, for messages).
 
 pub mod fbd;
+pub mod pipe;
 
 use crate::diag::Invalid;
 use crate::model::{ArithOp, CmpOp, TimerKind};
@@ -214,16 +215,18 @@ pub enum VarClass {
 /// Takes the main program's rungs one at a time, as a reader reads them, so that the reader
 /// need not hold them all: a million rungs as syntax cost more memory than their text, and
 /// memory first touched is time. A reader offers the rungs only when it has read the program's
-/// variables and nothing before the rung array was malformed; whatever the sink does with
-/// them, the tree stays the format-neutral description of the file, except that the program's
-/// variables and the main body's rungs are then not in it (no `vars`, an empty `Body::Rungs`).
+/// variables and nothing before the rung array was malformed; the sink then takes the
+/// variables and every rung, and the tree gets none of them (no `vars`, an empty
+/// `Body::Rungs`): whatever the sink does with them, the rest of the tree stays the
+/// format-neutral description of the file. A sink that finds it cannot use what it took (a
+/// declaration that does not resolve, say) must say so to its own caller, which then reads the
+/// file again without a sink. Taking without answering lets the sink work on another thread
+/// while the reader goes on ([`pipe`]).
 pub trait RungSink<'a> {
     /// At the start of the main program's rung array, with the variables read before it and an
-    /// estimate of the number of rungs (for sizing only). True: the sink takes the variables
-    /// and the rungs ([`RungSink::rung`]) and the tree gets neither; false: the reader keeps
-    /// them in the tree.
-    fn start(&mut self, vars: &[Var<'a>], rungs: usize) -> bool;
-    /// The next rung of the main program, in file order (only after `start` returned true).
+    /// estimate of the number of rungs (for sizing only).
+    fn start(&mut self, vars: Vec<Var<'a>>, rungs: usize);
+    /// The next rung of the main program, in file order (only after `start`).
     fn rung(&mut self, rung: Rung<'a>);
     /// What the sink took is not what the file means after all (the file repeats `vars`
     /// or `rungs` later, and the last one counts): the sink must not use it.

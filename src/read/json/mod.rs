@@ -189,9 +189,9 @@ impl<'a, 'r> Reader<'a, 'r> {
         }
     }
 
-    /// At the main program's rung array: whether its variables and rungs go to the sink (which
-    /// takes them only when nothing read so far is malformed or needs more than the variables
-    /// to resolve); they then leave the tree.
+    /// At the main program's rung array: whether its variables and rungs go to the sink (they
+    /// do when nothing read so far is malformed or needs more than the variables to resolve);
+    /// they then leave the tree.
     fn offer(&mut self, parts: &mut Parts<'a>) -> bool {
         if std::mem::take(&mut self.streamed) {
             self.retract();
@@ -202,14 +202,14 @@ impl<'a, 'r> Reader<'a, 'r> {
             && parts.fbd.is_none()
             && parts.function_blocks.is_none()
             && parts.vars.as_ref().is_none_or(|v| v.problems.is_empty());
-        let vars = parts.vars.as_ref().map_or(&[][..], |v| &v.value[..]);
         let rungs = self.c.remaining() / 128;
-        self.streamed = match self.sink.as_deref_mut() {
-            Some(sink) if clean => sink.start(vars, rungs),
-            _ => false,
-        };
-        if self.streamed {
-            parts.vars = None;
+        match self.sink.as_deref_mut() {
+            Some(sink) if clean => {
+                let vars = parts.vars.take().map_or_else(Vec::new, |v| v.value);
+                sink.start(vars, rungs);
+                self.streamed = true;
+            }
+            _ => self.streamed = false,
         }
         self.streamed
     }
@@ -489,7 +489,13 @@ impl<'a, 'r> Reader<'a, 'r> {
             self.problem(path, origin, shape("an array", &found));
             return Ok(Vec::new());
         }
-        let mut out = Vec::new();
+        // The program's variables are sized for the rest of the text at a short declaration
+        // each: a million of them would otherwise be moved twenty times, and what is reserved
+        // and never touched costs no memory. (Once: not for every function block's inputs.)
+        let mut out = match path {
+            "vars" => Vec::with_capacity(self.c.remaining() / 32),
+            _ => Vec::new(),
+        };
         self.c.begin_array()?;
         let mut first = true;
         while self.c.item(&mut first)? {
