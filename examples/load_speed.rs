@@ -19,6 +19,7 @@ fn main() {
         std::process::exit(2);
     };
     let text = std::fs::read_to_string(&path).expect("read the file");
+    let text_size = text.len();
     let runs: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(1);
     let mut peaks = vec![("text", peak_mb())];
     for run in 0..runs {
@@ -28,6 +29,17 @@ fn main() {
         let total = t.elapsed();
         if run == 0 {
             peaks.push(("loaded", peak_mb()));
+            // What stays resident with the model alive is the text and the model: the rest of
+            // the peak is what loading needed beyond the model (the text included).
+            if let (Some(text), Some(resident), Some(peak)) = (peaks[0].1, resident_mb(), peak_mb())
+            {
+                let model = resident - text;
+                eprintln!(
+                    "model {model:.0} MB; loading needed {:.0} MB beyond the model = {:.2}x the file",
+                    peak - model,
+                    (peak - model) / (text_size as f64 / 1e6)
+                );
+            }
         }
         let mb = text.len() as f64 / 1e6;
         eprintln!(
@@ -55,8 +67,17 @@ fn main() {
 
 /// The peak resident memory so far (Linux: VmHWM of /proc/self/status), in MB.
 fn peak_mb() -> Option<f64> {
+    status_mb("VmHWM:")
+}
+
+/// The resident memory now (VmRSS), in MB.
+fn resident_mb() -> Option<f64> {
+    status_mb("VmRSS:")
+}
+
+fn status_mb(key: &str) -> Option<f64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let line = status.lines().find(|l| l.starts_with(key))?;
     let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
     Some(kb / 1000.0)
 }
