@@ -10,7 +10,8 @@
 //! `order`, `run`, `schema`, `gen`) on top. Beside the pipeline: [`diag`] the diagnostics every
 //! stage reports (below everything), [`fbd`] the FBD model and its pure ordering and fragment
 //! algorithms, [`graph`] the generic graph algorithms (CSR, SCCs, Semi-NCA dominators), and
-//! [`synth`] the synthetic programs of `plc-deps gen`.
+//! [`synth`] the synthetic programs of `plc-deps gen`; [`write`] the surface syntax back out as
+//! the JSON program format (`plc-deps convert`).
 pub mod analysis;
 pub mod cmd;
 pub mod codegen;
@@ -24,3 +25,4 @@ pub mod report;
 pub mod resolve;
 pub mod syntax;
 pub mod synth;
+pub mod write;

@@ -68,6 +68,15 @@ enum Command {
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
+    /// Write a program file (PLCopen TC6 XML, or JSON) as the JSON program format: what
+    /// plc-deps understood of it (docs/format.md).
+    Convert {
+        /// The program (PLCopen TC6 XML or the JSON program format; `-`: standard input).
+        file: PathBuf,
+        /// Write to this file instead of standard output.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
     /// Generate C for every POU, a runtime header, main.c and a Makefile (docs/c.md).
     C {
         /// The program (JSON program format; `-`: standard input).
@@ -314,6 +323,10 @@ fn run(cli: Cli) -> Result<(), CliError> {
                 output,
             })
         }
+        Command::Convert { file, output } => cmd::convert::convert(&cmd::convert::ConvertConfig {
+            input: file,
+            output,
+        }),
         Command::C {
             file,
             output,

@@ -1,5 +1,5 @@
 //! The commands behind the binary, one module each, as library functions over validated
-//! configurations: [`report`], [`order`], [`run`], [`schema`], [`gen`], [`c`].
+//! configurations: [`report`], [`order`], [`run`], [`schema`], [`gen`], [`c`], [`convert`].
 //!
 //! `main.rs` turns command-line arguments into these configs and calls one function; everything
 //! here returns a [`CliError`] (rendered once, by `main`) instead of printing an error or
@@ -7,6 +7,7 @@
 //! [`progress`] shows long phases on a terminal. This is the top layer: nothing below imports it.
 
 pub mod c;
+pub mod convert;
 pub mod gen;
 pub mod io;
 pub mod order;
