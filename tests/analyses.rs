@@ -128,3 +128,74 @@ fn every_worked_example_matches_its_committed_reports() {
         failures.join("\n")
     );
 }
+
+/// The real PLCopen exports of `analyses/plcopen/*/program.xml` (as editors wrote them; where
+/// each came from is in `tests/plcopen/MANIFEST.md`): the reader's warnings (`notes.txt`: what
+/// it read only through an interface, what it ignored), and the reports and a 100-scan run of
+/// each file that loads, or the error of each file that does not (`error.txt`).
+#[test]
+fn every_plcopen_export_matches_its_committed_outputs() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("analyses/plcopen");
+    let mut dirs: Vec<PathBuf> = std::fs::read_dir(&root)
+        .expect("analyses/plcopen/ exists")
+        .map(|e| e.expect("readable entry").path())
+        .filter(|p| p.join("program.xml").is_file())
+        .collect();
+    dirs.sort();
+    assert!(dirs.len() >= 12, "found {}", dirs.len());
+    let mut failures = Vec::new();
+    for dir in dirs {
+        let text = std::fs::read_to_string(dir.join("program.xml")).expect("read program");
+        let stale = |name: &str| {
+            let p = dir.join(name);
+            if std::env::var_os("UPDATE_EXPECT").is_some() && p.exists() {
+                std::fs::remove_file(p).expect("remove a stale expectation");
+            }
+        };
+        match plc_deps::read::plcopen::load(&text) {
+            Err(e) => {
+                let shown = format!("error: {}\n", e.locate(&text).in_file("program.xml"));
+                check(&dir.join("error.txt"), &shown, &mut failures);
+                for name in ["notes.txt", "report.txt", "report.json", "run.json"] {
+                    stale(name);
+                }
+            }
+            Ok((program, fbd, notes)) => {
+                stale("error.txt");
+                let notes: String = notes
+                    .iter()
+                    .map(|n| {
+                        let note = plc_deps::read::plcopen::note_text("program.xml", &text, n);
+                        format!("warning: {note}\n")
+                    })
+                    .collect();
+                check(&dir.join("notes.txt"), &notes, &mut failures);
+                check(
+                    &dir.join("report.txt"),
+                    &render_report(&program, &fbd, ReportFormat::Text, View::All),
+                    &mut failures,
+                );
+                check(
+                    &dir.join("report.json"),
+                    &render_report(&program, &fbd, ReportFormat::Json, View::All),
+                    &mut failures,
+                );
+                let mut c = plc_deps::cmd::run::RunConfig::new(dir.join("program.xml"));
+                c.scans = Some(100);
+                c.cycle_ms = 10;
+                c.threads = 2;
+                c.mode = plc_deps::cmd::run::RunMode::Both;
+                let run = plc_deps::cmd::run::run_json_deterministic(&c)
+                    .unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
+                let doc: serde_json::Value = serde_json::from_str(&run).expect("run JSON");
+                assert_eq!(doc["identical"], true, "{}", dir.display());
+                check(&dir.join("run.json"), &run, &mut failures);
+            }
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{}\n(re-bless with UPDATE_EXPECT=1 if the change is intended)",
+        failures.join("\n")
+    );
+}
