@@ -12,6 +12,7 @@
 
 pub mod json;
 pub mod plcopen;
+pub mod st;
 
 pub use crate::diag::{Invalid, LoadError, Location};
 

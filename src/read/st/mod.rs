@@ -1,0 +1,216 @@
+//! Structured Text (IEC 61131-3, 3rd edition, 7.3): the statements of an ST body, parsed for
+//! real ([`parser`]: expressions, assignments, IF / CASE / FOR / WHILE / REPEAT / EXIT /
+//! RETURN, function block and function calls with formal and informal arguments), and what
+//! each top-level statement reads and writes ([`accesses`]), so that a POU written in ST is
+//! analysed with its statements as units — an ST statement plays the part of a rung.
+//!
+//! Accesses are at whole-variable granularity: `a.b[i] := x` writes `a` and reads `i` and `x`;
+//! a compound statement (IF, CASE, a loop) is one unit that reads and writes what any of its
+//! parts may (its conditions and bounds read, its loop variable written). A call of a function
+//! block instance `T1(IN := x, Q => y)` reads `x` and `T1` (its state), writes `T1` and `y`;
+//! a function call reads its arguments. Names are reported as written (the caller resolves
+//! them against the POU's declarations, case-insensitively as IEC names are).
+//!
+//! Deliberately not here: executing ST (a later step: `run` says which POU it cannot execute),
+//! declarations (a PLCopen file declares variables in the POU's interface), and IL.
+
+pub mod ast;
+pub mod lexer;
+pub mod parser;
+
+pub use lexer::LexError;
+pub use parser::statements;
+
+use ast::*;
+
+/// What a statement reads and writes, and the names it calls, each in order of first mention.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Accesses {
+    pub reads: Vec<String>,
+    pub writes: Vec<String>,
+    /// Functions and function block instances called (an instance is also read and written).
+    pub calls: Vec<String>,
+}
+
+impl Accesses {
+    fn read(&mut self, name: &str) {
+        push_once(&mut self.reads, name);
+    }
+    fn write(&mut self, name: &str) {
+        push_once(&mut self.writes, name);
+    }
+}
+
+fn push_once(v: &mut Vec<String>, name: &str) {
+    if !v.iter().any(|n| n.eq_ignore_ascii_case(name)) {
+        v.push(name.to_owned());
+    }
+}
+
+/// What `s` (and every statement inside it) reads and writes.
+pub fn accesses(s: &Statement) -> Accesses {
+    let mut a = Accesses::default();
+    statement(s, &mut a);
+    a
+}
+
+fn statement(s: &Statement, a: &mut Accesses) {
+    match &s.kind {
+        Stmt::Assign { target, value } => {
+            expr(value, a);
+            write_place(target, a);
+        }
+        Stmt::Call { callee, args } => call(callee, args, a, true),
+        Stmt::If { arms, otherwise } => {
+            for (cond, body) in arms {
+                expr(cond, a);
+                body.iter().for_each(|s| statement(s, a));
+            }
+            otherwise.iter().for_each(|s| statement(s, a));
+        }
+        Stmt::Case {
+            selector,
+            arms,
+            otherwise,
+        } => {
+            expr(selector, a);
+            for (labels, body) in arms {
+                for l in labels {
+                    match l {
+                        CaseLabel::One(e) => expr(e, a),
+                        CaseLabel::Range(x, y) => {
+                            expr(x, a);
+                            expr(y, a);
+                        }
+                    }
+                }
+                body.iter().for_each(|s| statement(s, a));
+            }
+            otherwise.iter().for_each(|s| statement(s, a));
+        }
+        Stmt::For {
+            var,
+            from,
+            to,
+            by,
+            body,
+        } => {
+            expr(from, a);
+            expr(to, a);
+            if let Some(by) = by {
+                expr(by, a);
+            }
+            write_place(var, a);
+            read_place(var, a);
+            body.iter().for_each(|s| statement(s, a));
+        }
+        Stmt::While { cond, body } => {
+            expr(cond, a);
+            body.iter().for_each(|s| statement(s, a));
+        }
+        Stmt::Repeat { body, until } => {
+            body.iter().for_each(|s| statement(s, a));
+            expr(until, a);
+        }
+        Stmt::Exit | Stmt::Continue | Stmt::Return | Stmt::Empty => {}
+    }
+}
+
+/// A call: the arguments' reads, the outputs' writes; a statement call of an instance also reads
+/// and writes the instance (its state).
+fn call(callee: &Place, args: &[Arg], a: &mut Accesses, statement: bool) {
+    push_once(&mut a.calls, &callee.base);
+    for arg in args {
+        match arg {
+            Arg::Input { value, .. } => expr(value, a),
+            Arg::Output { target, .. } => write_place(target, a),
+        }
+    }
+    if statement {
+        a.read(&callee.base);
+        a.write(&callee.base);
+    }
+}
+
+fn indices(p: &Place, a: &mut Accesses) {
+    for s in &p.selectors {
+        if let Selector::Index(es) = s {
+            es.iter().for_each(|e| expr(e, a));
+        }
+    }
+}
+
+fn read_place(p: &Place, a: &mut Accesses) {
+    indices(p, a);
+    a.read(&p.base);
+}
+
+fn write_place(p: &Place, a: &mut Accesses) {
+    indices(p, a);
+    // Writing through a pointer reads the pointer; writing a part of a variable keeps the rest.
+    if p.selectors
+        .iter()
+        .any(|s| matches!(s, Selector::Deref | Selector::Index(_) | Selector::Field(_)))
+    {
+        a.read(&p.base);
+    }
+    a.write(&p.base);
+}
+
+fn expr(e: &Expr, a: &mut Accesses) {
+    match e {
+        Expr::Literal(_) => {}
+        Expr::Var(p) => read_place(p, a),
+        Expr::Unary(_, x) => expr(x, a),
+        Expr::Binary(_, x, y) => {
+            expr(x, a);
+            expr(y, a);
+        }
+        Expr::Call { callee, args } => call(callee, args, a, false),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn of(text: &str) -> Vec<Accesses> {
+        statements(text).unwrap().iter().map(accesses).collect()
+    }
+
+    fn names(v: &[&str]) -> Vec<String> {
+        v.iter().map(|s| s.to_string()).collect()
+    }
+
+    #[test]
+    fn each_statement_reads_and_writes_exactly_its_variables() {
+        let a = of("
+            x := a + b * c;
+            IF start AND NOT stop THEN run := TRUE; ELSIF reset THEN count := 0; END_IF;
+            T1(IN := run, PT := T#5s, Q => done);
+            FOR i := lo TO hi DO arr[i] := arr[i] + 1; END_FOR;
+            y := MAX(a, LIMIT(0, z, 10));
+            cfg.speed := 3;");
+        assert_eq!(a[0].reads, names(&["a", "b", "c"]));
+        assert_eq!(a[0].writes, names(&["x"]));
+        assert_eq!(a[1].reads, names(&["start", "stop", "reset"]));
+        assert_eq!(a[1].writes, names(&["run", "count"]));
+        assert_eq!(a[2].reads, names(&["run", "T1"]));
+        assert_eq!(a[2].writes, names(&["done", "T1"]));
+        assert_eq!(a[2].calls, names(&["T1"]));
+        assert_eq!(a[3].reads, names(&["lo", "hi", "i", "arr"]));
+        assert_eq!(a[3].writes, names(&["i", "arr"]));
+        assert_eq!(a[4].reads, names(&["a", "z"]));
+        assert_eq!(a[4].writes, names(&["y"]));
+        assert_eq!(a[4].calls, names(&["MAX", "LIMIT"]));
+        assert_eq!(a[5].reads, names(&["cfg"]));
+        assert_eq!(a[5].writes, names(&["cfg"]));
+    }
+
+    #[test]
+    fn names_are_reported_once_whatever_their_case() {
+        let a = of("X := x + X;");
+        assert_eq!(a[0].reads, names(&["x"]));
+        assert_eq!(a[0].writes, names(&["X"]));
+    }
+}
