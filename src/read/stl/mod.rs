@@ -19,6 +19,8 @@
 //! instruction set: docs/il.md; the stack shapes follow Zhou & Zhang 2015 and the S7-200 system
 //! manual.
 
+mod decode;
+mod flat;
 mod net;
 mod operand;
 
