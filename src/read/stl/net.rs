@@ -139,7 +139,7 @@ fn depth(text: &str, n: &RawNet) -> Result<(), LoadError> {
         if matches!(ins.op.as_str(), "LRD" | "LPP") {
             if forks.last() != Some(&d) {
                 let why = if forks.is_empty() {
-                    "no LPS is open".to_string()
+                    "no LPS open".to_string()
                 } else {
                     format!("{} value(s) above its LPS", d - floor)
                 };
