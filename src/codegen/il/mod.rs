@@ -83,7 +83,7 @@ pub fn generate(p: &Program, fbd: &Fbd) -> Result<String, IlError> {
     let names = Names::new(p);
     let mut out = String::new();
     let _ = writeln!(out, "// {}: S7-200 STL written by plc-deps il", p.name);
-    declarations(&mut out, p, &names, None, "");
+    declarations(&mut out, p, &names, None);
     for (i, pou) in p.pous.iter().enumerate() {
         let id = PouId(i as u32);
         if fbd.instances.iter().any(|inst| inst.pou == id) {
@@ -98,7 +98,7 @@ pub fn generate(p: &Program, fbd: &Fbd) -> Result<String, IlError> {
         };
         let _ = writeln!(out, "{kind} {}:{tag}", pou.name);
         if pou.kind == PouKind::Subroutine {
-            declarations(&mut out, p, &names, Some(id), "");
+            declarations(&mut out, p, &names, Some(id));
         }
         out.push_str("BEGIN\n");
         let nets = match fbd.pous.iter().find(|f| {
@@ -252,7 +252,7 @@ pub(crate) fn constant(v: Value) -> String {
 }
 
 /// The declaration sections of the program's variables (`scope` None) or of one subroutine's.
-fn declarations(out: &mut String, p: &Program, names: &Names, scope: Option<PouId>, _i: &str) {
+fn declarations(out: &mut String, p: &Program, names: &Names, scope: Option<PouId>) {
     for (section, class) in [
         ("VAR_INPUT", VarClass::Input),
         ("VAR_OUTPUT", VarClass::Output),

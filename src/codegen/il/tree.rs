@@ -64,7 +64,7 @@ struct Tree<'a> {
     net: &'a Network,
     names: &'a Names<'a>,
     pou: PouId,
-    /// Per block: its consumers (block, input index) and the variables it writes.
+    /// Per block: the blocks its output feeds (one entry per arc).
     users: Vec<Vec<BlockId>>,
     place: String,
 }
@@ -95,7 +95,7 @@ pub(super) fn pou(
         let mut events = Vec::new();
         for root in t.roots()? {
             let r = t.fork(root)?;
-            t.emit(r, &mut code, false, &mut events);
+            t.emit(r, &mut code, &mut events);
         }
         check(&t.place, &code)?;
         let order: HashMap<BlockId, usize> = plan
@@ -327,9 +327,8 @@ impl Tree<'_> {
         Ok(out)
     }
 
-    /// Post-order emission of node `n`; `combine`: ANDed/ORed into the top (the kind of the
-    /// parent), else loaded.
-    fn emit(&self, n: usize, code: &mut Net, _inner: bool, ev: &mut Vec<Event>) {
+    /// Post-order emission of node `n` (a value is loaded; consumers act on the top).
+    fn emit(&self, n: usize, code: &mut Net, ev: &mut Vec<Event>) {
         match &self.nodes[n].kind {
             Kind::Leaf {
                 name,
@@ -341,7 +340,7 @@ impl Tree<'_> {
             }
             Kind::And | Kind::Or => {
                 let cs = self.children(n);
-                self.emit(cs[0], code, true, ev);
+                self.emit(cs[0], code, ev);
                 let is_and = self.nodes[n].kind == Kind::And;
                 for &c in &cs[1..] {
                     self.combine(c, is_and, code, ev);
@@ -349,12 +348,12 @@ impl Tree<'_> {
             }
             Kind::Not => {
                 let cs = self.children(n);
-                self.emit(cs[0], code, true, ev);
+                self.emit(cs[0], code, ev);
                 code.emit("NOT", &[], 0);
             }
             Kind::Root => {
                 let cs = self.children(n);
-                self.emit(cs[0], code, true, ev);
+                self.emit(cs[0], code, ev);
                 self.emit_consumers(&cs[1..], code, ev);
             }
             Kind::Then => self.emit_consumers(&self.children(n), code, ev),
@@ -369,7 +368,7 @@ impl Tree<'_> {
                         }
                     }
                 }
-                self.emit(*then, code, true, ev);
+                self.emit(*then, code, ev);
             }
             Kind::Out { name, block } => {
                 ev.push((name.clone(), *block, true, code.code.len()));
@@ -396,7 +395,7 @@ impl Tree<'_> {
             code.emit(op, &[name], 0);
             return;
         }
-        self.emit(c, code, true, ev);
+        self.emit(c, code, ev);
         code.emit(if and { "ALD" } else { "OLD" }, &[], -1);
     }
 
@@ -407,7 +406,7 @@ impl Tree<'_> {
             .iter()
             .partition(|&&c| matches!(self.nodes[c].kind, Kind::Out { .. }));
         for o in outs {
-            self.emit(o, code, true, ev);
+            self.emit(o, code, ev);
         }
         let k = blocks.len();
         for (i, &b) in blocks.iter().enumerate() {
@@ -418,7 +417,7 @@ impl Tree<'_> {
                     _ => code.lrd(),
                 }
             }
-            self.emit(b, code, true, ev);
+            self.emit(b, code, ev);
         }
     }
 
