@@ -82,6 +82,7 @@ impl Net {
 pub fn generate(p: &Program, fbd: &Fbd) -> Result<String, IlError> {
     let names = Names::new(p);
     let mut out = String::new();
+    let mut headers = Vec::new();
     let _ = writeln!(out, "// {}: S7-200 STL written by plc-deps il", p.name);
     declarations(&mut out, p, &names, None);
     for (i, pou) in p.pous.iter().enumerate() {
@@ -101,13 +102,14 @@ pub fn generate(p: &Program, fbd: &Fbd) -> Result<String, IlError> {
             declarations(&mut out, p, &names, Some(id));
         }
         out.push_str("BEGIN\n");
-        let nets = match fbd.pous.iter().find(|f| {
+        let (nets, what) = match fbd.pous.iter().find(|f| {
             f.kind != FbdPouKind::FunctionBlock && f.copies.first().map(|c| c.pou) == Some(id)
         }) {
-            Some(f) => tree::pou(p, &names, id, f)?,
-            None => ladder::pou(p, &names, id)?,
+            Some(f) => (tree::pou(p, &names, id, f)?, "network"),
+            None => (ladder::pou(p, &names, id)?, "rung"),
         };
         for (n, (title, net)) in nets.iter().enumerate() {
+            headers.push((out.len(), format!("{what} {title}")));
             let _ = writeln!(out, "NETWORK {} // {title}", n + 1);
             for ins in &net.code {
                 if ins.args.is_empty() {
@@ -119,7 +121,38 @@ pub fn generate(p: &Program, fbd: &Fbd) -> Result<String, IlError> {
         }
         let _ = writeln!(out, "END_{kind}");
     }
+    reads_back(&out, &headers)?;
     Ok(out)
+}
+
+/// What `il` writes, the STL reader reads: a network the reader cannot rebuild as one rung
+/// (a flat network that would re-read a variable after writing it) is an error naming it.
+fn reads_back(out: &str, headers: &[(usize, String)]) -> Result<(), IlError> {
+    let Err(e) = crate::read::stl::parse(out) else {
+        return Ok(());
+    };
+    let line = match &e {
+        crate::diag::LoadError::Syntax { line, .. } => *line,
+        _ => 0,
+    };
+    let offset: usize = out
+        .split_inclusive('\n')
+        .take(line.saturating_sub(1))
+        .map(str::len)
+        .sum();
+    let place = headers
+        .iter()
+        .rev()
+        .find(|(at, _)| *at <= offset)
+        .map_or("the program".to_string(), |h| h.1.clone());
+    let message = match &e {
+        crate::diag::LoadError::Syntax { message, .. } => message.clone(),
+        other => other.to_string(),
+    };
+    Err(IlError {
+        place,
+        message: format!("its STL has no rung shape for the STL reader: {message}"),
+    })
 }
 
 /// Checks a finished network: the stack depth it needs and that every LPS was popped.

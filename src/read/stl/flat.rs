@@ -47,6 +47,11 @@ fn writes(e: &E) -> Option<String> {
 /// A condition with the number of writes done when the S7-200 evaluated it.
 type Timed = (E, usize);
 
+/// When the earliest of `s` was evaluated (a combination is as old as its oldest part).
+fn earliest(s: &[Timed], now: usize) -> usize {
+    s.iter().map(|x| x.1).min().unwrap_or(now)
+}
+
 /// The flat build: exact stack semantics on pure conditions, one path per run of outputs.
 pub(super) fn flat(cx: &mut Context, code: &[Ins]) -> Result<Series<'static>, LoadError> {
     let mut st: Vec<(Vec<Timed>, u32)> = Vec::new();
@@ -75,8 +80,9 @@ pub(super) fn flat(cx: &mut Context, code: &[Ins]) -> Result<Series<'static>, Lo
                 if m == 'A' {
                     t.0.push((e, clock));
                 } else {
+                    let c = earliest(&t.0, clock);
                     let s: Series<'static> = t.0.drain(..).map(|x| x.0).collect();
-                    t.0 = or(s, vec![e]).into_iter().map(|x| (x, clock)).collect();
+                    t.0 = or(s, vec![e]).into_iter().map(|x| (x, c)).collect();
                 }
                 fresh(&mut t.1);
             }
@@ -86,9 +92,10 @@ pub(super) fn flat(cx: &mut Context, code: &[Ins]) -> Result<Series<'static>, Lo
                 if s == "ALD" {
                     t.0.extend(b);
                 } else {
+                    let c = earliest(&t.0, clock).min(earliest(&b, clock));
                     let a: Series<'static> = t.0.drain(..).map(|x| x.0).collect();
                     let b: Series<'static> = b.into_iter().map(|x| x.0).collect();
-                    t.0 = or(a, b).into_iter().map(|x| (x, clock)).collect();
+                    t.0 = or(a, b).into_iter().map(|x| (x, c)).collect();
                 }
                 fresh(&mut t.1);
             }
@@ -102,14 +109,16 @@ pub(super) fn flat(cx: &mut Context, code: &[Ins]) -> Result<Series<'static>, Lo
                         "NOT of this value has no rung form (an edge, or always on; not yet)",
                     ));
                 };
-                t.0 = n.into_iter().map(|x| (x, clock)).collect();
+                let c = earliest(&t.0, clock);
+                t.0 = n.into_iter().map(|x| (x, c)).collect();
                 fresh(&mut t.1);
             }
             Op::Stack(e @ ("EU" | "ED")) => {
                 let t = st.last_mut().expect("checked");
                 let mut s: Series<'static> = t.0.iter().map(|x| x.0.clone()).collect();
                 edge(cx.text, &mut s, e == "EU", at)?;
-                t.0 = s.into_iter().map(|x| (x, clock)).collect();
+                let c = earliest(&t.0, clock);
+                t.0 = s.into_iter().map(|x| (x, c)).collect();
                 fresh(&mut t.1);
             }
             Op::Stack("LPS") => {
