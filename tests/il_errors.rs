@@ -124,3 +124,39 @@ fn blocks_subroutines_interrupts_and_the_first_scan_bit() {
         ]
     );
 }
+
+#[test]
+fn set_and_reset_of_n_bits_count_on_from_the_address() {
+    let text = std::fs::read_to_string(common::cli::root().join("tests/stl/set-bits.stl")).unwrap();
+    let (p, _, _) = plc_deps::read::stl::load(&text).unwrap();
+    let m = Machine::new(
+        &p,
+        Layout::dense(&p),
+        &ExecConfig {
+            cycle_ms: 10,
+            loop_cap: 10,
+        },
+    )
+    .unwrap();
+    let id = |n: &str| VarId(p.vars.iter().position(|v| v.name == n).unwrap() as u32);
+    let mut st = m.initial_state();
+    let bits = ["M0_6", "M0_7", "M1_0"];
+    let mut seen = Vec::new();
+    for (k, (i0, i1)) in [(true, false), (false, true)].into_iter().enumerate() {
+        m.set_inputs(
+            &mut st,
+            &[(id("I0_0"), Value::Bool(i0)), (id("I0_1"), Value::Bool(i1))],
+        );
+        m.run_scan(&mut st, k as u64, &mut Vec::new());
+        seen.push(
+            bits.map(|b| m.value(&st, id(b)).to_json().to_string())
+                .join(" "),
+        );
+    }
+    assert_eq!(seen, ["true true true", "true false false"]);
+    let out = run(&["report", "tests/stl/set-symbolic.stl"]);
+    assert_eq!(
+        error_line(&out, "symbolic"),
+        "error: tests/stl/set-symbolic.stl:8:8: S of 2 bits needs an absolute bit address (I, Q, M, V) to count from"
+    );
+}

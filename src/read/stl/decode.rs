@@ -84,6 +84,29 @@ pub(super) fn arg<'a>(
     Ok(ins.args[k])
 }
 
+/// The N of `S bit, N` / `R bit, N`: 1 to 255 bits.
+fn bit_count(cx: &Context, t: super::Tok) -> Result<u32, LoadError> {
+    match t.text.strip_prefix('+').unwrap_or(t.text).parse::<u32>() {
+        Ok(n @ 1..=255) => Ok(n),
+        _ => Err(error(
+            cx.text,
+            t.at,
+            format!("the number of bits must be 1 to 255, found `{}`", t.text),
+        )),
+    }
+}
+
+/// The bit `k` places after absolute bit `start` (`M0.7` + 1 is `M1.0`).
+fn next_bit(start: &str, k: u32) -> Option<String> {
+    let up = start.to_ascii_uppercase();
+    let area = ["I", "Q", "M", "V"]
+        .into_iter()
+        .find(|a| up.starts_with(a) && !up.starts_with("SM"))?;
+    let (byte, bit) = up[1..].split_once('.')?;
+    let at = byte.parse::<u32>().ok()? * 8 + bit.parse::<u32>().ok().filter(|b| *b < 8)? + k;
+    Some(format!("{area}{}.{}", at / 8, at % 8))
+}
+
 /// Decodes one instruction (the stack check has accepted its mnemonic).
 pub(super) fn decode(cx: &mut Context, ins: &Ins, empty: bool) -> Result<Op, LoadError> {
     let at = ins.at;
@@ -112,25 +135,39 @@ pub(super) fn decode(cx: &mut Context, ins: &Ins, empty: bool) -> Result<Op, Loa
         "=" | "S" | "R" => {
             let n = if op == "=" { 1 } else { 2 };
             let t = arg(cx, ins, 0, n)?;
-            if n == 2 && ins.args[1].text != "1" {
-                return Err(error(
-                    cx.text,
-                    ins.args[1].at,
-                    format!(
-                        "{op} of {} bits is not read yet (only `{op} x, 1`)",
-                        ins.args[1].text
-                    ),
-                ));
+            let count = if n == 2 {
+                bit_count(cx, ins.args[1])?
+            } else {
+                1
+            };
+            let mut outs = Vec::new();
+            for k in 0..count {
+                let bit = match k {
+                    0 => t.text.to_string(),
+                    _ => next_bit(t.text, k).ok_or_else(|| {
+                        error(cx.text, t.at, format!("{op} of {count} bits needs an absolute bit address (I, Q, M, V) to count from"))
+                    })?,
+                };
+                let v = name(
+                    &cx.bit(super::Tok {
+                        text: &bit,
+                        at: t.at,
+                    })?,
+                    t.at,
+                );
+                outs.push(kind(match op {
+                    "=" => ElementKind::Coil {
+                        var: v,
+                        negated: false,
+                    },
+                    "S" => ElementKind::Set(v),
+                    _ => ElementKind::Reset(v),
+                }));
             }
-            let v = name(&cx.bit(t)?, t.at);
-            Op::Out(kind(match op {
-                "=" => ElementKind::Coil {
-                    var: v,
-                    negated: false,
-                },
-                "S" => ElementKind::Set(v),
-                _ => ElementKind::Reset(v),
-            }))
+            match outs.len() {
+                1 => Op::Out(outs.pop().expect("one")),
+                _ => Op::Out(kind(ElementKind::Branch(vec![outs]))),
+            }
         }
         "TON" | "TOF" => {
             let (t, p) = (arg(cx, ins, 0, 2)?, arg(cx, ins, 1, 2)?);

@@ -11,7 +11,8 @@
 //! `I0.0`, `Q0.0`, `M0.0`, `V10.1` bits (variables `I0_0` …, class input, output, memory; the
 //! format's names have no dots), `VW`/`MW` words (INT), `VD`/`MD` double words (DINT, REAL for
 //! the R instructions), `T37`/`C5` timers and counters (typed by their instruction, the PT in the
-//! timer's resolution), `SM0.0` always on, `SM0.1` on in the first scan only. [`net`] executes
+//! timer's resolution), `SM0.0` always on, `SM0.1` on in the first scan only; `S M0.0, N` / `R M0.0, N` act on N
+//! consecutive bits. [`net`] executes
 //! the 9-level logic stack of each network at read time and rebuilds it as one rung.
 //!
 //! Invariants: every error carries the file's line and column; a program loads whole or not at
