@@ -314,3 +314,22 @@ fn declarations(out: &mut String, p: &Program, names: &Names, scope: Option<PouI
         let _ = writeln!(out, "END_VAR");
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn absolute_forms_of_variable_names() {
+        assert_eq!(absolute_form("I0_0").as_deref(), Some("I0.0"));
+        assert_eq!(absolute_form("Q12_7").as_deref(), Some("Q12.7"));
+        assert_eq!(absolute_form("SM0_1").as_deref(), Some("SM0.1"));
+        assert_eq!(absolute_form("V100_3").as_deref(), Some("V100.3"));
+        assert_eq!(absolute_form("I0_8"), None, "bits are 0-7");
+        assert_eq!(absolute_form("Input_1"), None);
+        assert_eq!(absolute_form("I0"), None);
+        assert_eq!(absolute_class("I0.0"), VarClass::Input);
+        assert_eq!(absolute_class("Q0.0"), VarClass::Output);
+        assert_eq!(absolute_class("M0.0"), VarClass::Memory);
+    }
+}
