@@ -94,6 +94,14 @@ enum Command {
         #[arg(long, default_value_t = 100_000)]
         loop_cap: u32,
     },
+    /// Write the program as S7-200 Instruction List (STL), as STEP 7-Micro/WIN shows it (docs/il.md).
+    Il {
+        /// The program (JSON program format, PLCopen XML or STL; `-`: standard input).
+        file: PathBuf,
+        /// Write to this file instead of standard output.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
     /// Print the JSON Schema of the program format.
     Schema {
         /// Write to this file instead of standard output.
@@ -346,6 +354,10 @@ fn run(cli: Cli) -> Result<(), CliError> {
                 },
             })
         }
+        Command::Il { file, output } => cmd::il::il(&cmd::il::IlCommand {
+            input: file,
+            output,
+        }),
         Command::Schema { output } => {
             cmd::io::write_output(output.as_deref(), cmd::schema::PROGRAM_SCHEMA)
         }

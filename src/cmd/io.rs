@@ -9,7 +9,8 @@
 //! failure never leaves a half-written file; temporary files in the making are listed in a
 //! registry that [`remove_temp_files`] empties (the binary calls it on SIGINT/SIGTERM), so a
 //! stopped command leaves none behind. A program is recognised by its content ([`load_text`]:
-//! PLCopen TC6 XML or JSON). Nothing here prints but the PLCopen reader's warnings.
+//! S7-200 STL, PLCopen TC6 XML or JSON). Nothing here prints but the STL and PLCopen readers'
+//! warnings.
 
 use crate::fbd::Fbd;
 use crate::model::Program;
@@ -209,10 +210,22 @@ pub fn load_program_and_fbd(path: &Path) -> Result<(Program, Fbd), CliError> {
     load_text(file, &text)
 }
 
-/// Checks a program's text, recognised by its content: PLCopen TC6 XML when it starts with
-/// `<` (the reader's notes go to standard error as warnings), else the JSON format.
+/// Checks a program's text, recognised by its content: S7-200 STL when its first line opens a
+/// block or a declaration section (or the file is named `.stl`/`.awl`), PLCopen TC6 XML when it
+/// starts with `<` (the readers' notes go to standard error as warnings), else the JSON format.
 pub fn load_text(file: String, text: &str) -> Result<(Program, Fbd), CliError> {
-    use crate::read::plcopen;
+    use crate::read::{plcopen, stl};
+    let lower = file.to_ascii_lowercase();
+    if stl::looks_like_stl(text) || lower.ends_with(".stl") || lower.ends_with(".awl") {
+        let (p, f, notes) = stl::load(text).map_err(|error| CliError::Load {
+            file: file.clone(),
+            error,
+        })?;
+        for n in &notes {
+            eprintln!("warning: {}", plcopen::note_text(&file, text, n));
+        }
+        return Ok((p, f));
+    }
     if plcopen::looks_like_xml(text) {
         let (p, f, notes) = plcopen::load(text).map_err(|error| CliError::Load {
             file: file.clone(),

@@ -1,5 +1,6 @@
 //! The commands behind the binary, one module each, as library functions over validated
 //! configurations: [`report`], [`order`], [`run`], [`schema`], [`gen`], [`c`], [`convert`].
+//! configurations: [`report`], [`order`], [`run`], [`schema`], [`gen`], [`c`], [`il`].
 //!
 //! `main.rs` turns command-line arguments into these configs and calls one function; everything
 //! here returns a [`CliError`] (rendered once, by `main`) instead of printing an error or
@@ -9,6 +10,7 @@
 pub mod c;
 pub mod convert;
 pub mod gen;
+pub mod il;
 pub mod io;
 pub mod order;
 pub mod progress;

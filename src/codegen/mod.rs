@@ -3,7 +3,9 @@
 //! the interpreter's lowered instructions.
 //!
 //! - [`c`]: C for every POU, a runtime header and a harness (the FBD text-generation paper).
+//! - [`il`]: S7-200 Instruction List (Zhou & Zhang 2015); read back by `crate::read::stl`.
 //!
 //! Layer: uses `model`, `fbd`; nothing here imports `cmd`, `exec` or `report`.
 
 pub mod c;
+pub mod il;

@@ -1,7 +1,7 @@
 //! Readers: program files in → the surface syntax ([`crate::syntax`]) → through the resolver
 //! ([`crate::resolve`]) one resolved [`crate::model::Program`] out.
 //!
-//! Two formats: PLCopen TC6 XML ([`plcopen`], docs/plcopen.md) and the JSON program format
+//! Three formats: S7-200 STL ([`stl`], docs/il.md), PLCopen TC6 XML ([`plcopen`], docs/plcopen.md) and the JSON program format
 //! (docs/format.md, docs/fbd.md; [`json`]), which
 //! reads the text into the syntax types in one pass (syntax errors carry line and column; a
 //! byte-order mark is skipped), the resolver checks and resolves everything else (those errors
@@ -13,6 +13,7 @@
 pub mod json;
 pub mod plcopen;
 pub mod st;
+pub mod stl;
 
 pub use crate::diag::{Invalid, LoadError, Location};
 

@@ -1,0 +1,368 @@
+//! Ladder rungs → S7-200 STL networks: the series/parallel element tree of each rung is walked
+//! left to right with the logic stack holding the power (Zhou & Zhang 2015 for the stack
+//! shapes; the S7-200 system manual's STL forms of each LAD element).
+//!
+//! A series loads its first condition (LD/LDN, LDW= …, `LD x` + `EU` for an edge contact) and
+//! ANDs the rest (A/AN, AW= …); an `or` in first place is its branches joined by O/ON or OLD,
+//! elsewhere it is loaded and joined by ALD. Outputs act on the top of the stack: `=`, `S x, 1`,
+//! `R x, 1`, a negated coil `NOT`/`=`/`NOT`; output branches are LPS/LRD/LPP (the power after
+//! the branch element is one more branch). A timer or counter in the middle of a series is
+//! followed by `LD T`: its Q is the power from there on. A series that starts with an output
+//! loads `SM0.0` (always on). Arithmetic is the S7-200 two-operand form: `out := a op b` is
+//! `MOVW a, out` then `+I b, out`.
+//!
+//! Not here: TP timers, MOD, BOOL moves, `out := a - out` (no S7-200 form without a scratch
+//! word), a timer's Q feeding more elements inside an output branch: each one error naming the
+//! rung.
+
+use super::{check, IlError, Names, Net};
+use crate::model::*;
+
+/// The networks of a ladder POU: one per rung, titled with the rung id.
+pub(super) fn pou(p: &Program, names: &Names, pou: PouId) -> Result<Vec<(String, Net)>, IlError> {
+    let main = p.pou(pou).kind == PouKind::Main;
+    let mut nets = Vec::new();
+    for r in p.pou_rungs(pou) {
+        let rung = p.rung(r);
+        let place = format!("rung {}", rung.id);
+        let mut e = Emit {
+            names,
+            net: Net::default(),
+            place: &place,
+            main,
+        };
+        if let Some(l) = &rung.label {
+            e.net.emit("LBL", &[l], 0);
+        }
+        e.series(&rung.series, false, false)?;
+        check(&place, &e.net)?;
+        nets.push((rung.id.clone(), e.net));
+    }
+    Ok(nets)
+}
+
+struct Emit<'a> {
+    names: &'a Names<'a>,
+    net: Net,
+    place: &'a str,
+    main: bool,
+}
+
+fn word_suffix(ty: Type) -> Option<&'static str> {
+    match ty {
+        Type::Int => Some("W"),
+        Type::Dint | Type::Time => Some("D"),
+        Type::Real => Some("R"),
+        _ => None,
+    }
+}
+
+fn cmp_symbol(op: CmpOp) -> &'static str {
+    match op {
+        CmpOp::Eq => "=",
+        CmpOp::Ne => "<>",
+        CmpOp::Lt => "<",
+        CmpOp::Le => "<=",
+        CmpOp::Gt => ">",
+        CmpOp::Ge => ">=",
+    }
+}
+
+impl Emit<'_> {
+    fn fail<T>(&self, message: impl Into<String>) -> Result<T, IlError> {
+        Err(IlError {
+            place: self.place.to_string(),
+            message: message.into(),
+        })
+    }
+
+    fn operand_type(&self, o: &Operand) -> Type {
+        match o {
+            Operand::Const(v) => v.ty(),
+            Operand::Var(r) => match r.field {
+                None => self.names.p.var(r.var).ty,
+                Some(Field::Q) => Type::Bool,
+                Some(Field::Et | Field::Pt) => Type::Time,
+                Some(Field::Cv | Field::Pv) => Type::Int,
+            },
+        }
+    }
+
+    /// Emits `series`; `loaded`: a value is on the stack already (the series ANDs into it);
+    /// `in_branch`: the series is one output branch (it must leave the stack as it found it).
+    fn series(&mut self, series: &[Element], loaded: bool, in_branch: bool) -> Result<(), IlError> {
+        let mut loaded = loaded;
+        let base = self.net.depth;
+        for (i, e) in series.iter().enumerate() {
+            let rest = &series[i + 1..];
+            if let Some(done) = self.condition(e, loaded)? {
+                loaded = done;
+                continue;
+            }
+            if !loaded && !matches!(e, Element::Next { .. }) {
+                self.net.emit("LD", &["SM0.0"], 1);
+                loaded = true;
+            }
+            self.action(e, rest)?;
+            if let Element::Branch(_) = e {
+                break;
+            }
+        }
+        if in_branch && self.net.depth > base {
+            return self.fail("a timer's or counter's Q feeds more elements inside an output branch: no S7-200 form (not yet: move them to a rung of their own reading the Q)");
+        }
+        Ok(())
+    }
+
+    /// Emits a condition element (`None` if `e` is not one): loads it, or ANDs it into the value.
+    fn condition(&mut self, e: &Element, loaded: bool) -> Result<Option<bool>, IlError> {
+        match e {
+            Element::Contact { var, kind } => {
+                let name = self.names.bit(*var);
+                match kind {
+                    ContactKind::Normal => self.load_or(loaded, "LD", "A", &name),
+                    ContactKind::Negated => self.load_or(loaded, "LDN", "AN", &name),
+                    ContactKind::Rising { .. } | ContactKind::Falling { .. } => {
+                        self.net.emit("LD", &[&name], 1);
+                        let edge = if matches!(kind, ContactKind::Rising { .. }) {
+                            "EU"
+                        } else {
+                            "ED"
+                        };
+                        self.net.emit(edge, &[], 0);
+                        if loaded {
+                            self.net.emit("ALD", &[], -1);
+                        }
+                    }
+                }
+            }
+            Element::Compare { op, a, b } => {
+                let ty = self.operand_type(a);
+                let Some(sfx) = word_suffix(ty) else {
+                    return self.fail(format!("a compare of {ty} has no S7-200 instruction"));
+                };
+                let (la, lb) = (self.names.operand(a), self.names.operand(b));
+                let sym = cmp_symbol(*op);
+                let (load, and) = (format!("LD{sfx}{sym}"), format!("A{sfx}{sym}"));
+                self.load_or(loaded, &load, &and, &format!("{la}, {lb}"));
+            }
+            Element::Or(branches) => {
+                if loaded {
+                    self.or(branches)?;
+                    self.net.emit("ALD", &[], -1);
+                } else {
+                    self.or(branches)?;
+                }
+            }
+            _ => return Ok(None),
+        }
+        Ok(Some(true))
+    }
+
+    fn load_or(&mut self, loaded: bool, load: &str, and: &str, arg: &str) {
+        if loaded {
+            self.net.emit(and, &[arg], 0);
+        } else {
+            self.net.emit(load, &[arg], 1);
+        }
+    }
+
+    /// Pushes the OR of `branches` (each a series of conditions).
+    fn or(&mut self, branches: &[Series]) -> Result<(), IlError> {
+        for (k, b) in branches.iter().enumerate() {
+            if k > 0 {
+                if let [single] = &b[..] {
+                    if self.or_single(single) {
+                        continue;
+                    }
+                }
+            }
+            let mut loaded = false;
+            for e in b {
+                loaded = self.condition(e, loaded)?.unwrap_or(loaded);
+            }
+            if !loaded {
+                self.net.emit("LD", &["SM0.0"], 1);
+            }
+            if k > 0 {
+                self.net.emit("OLD", &[], -1);
+            }
+        }
+        Ok(())
+    }
+
+    /// ORs a single plain contact or compare into the top (`O x`, `ON x`, `OW= a, b`).
+    fn or_single(&mut self, e: &Element) -> bool {
+        match e {
+            Element::Contact {
+                var,
+                kind: kind @ (ContactKind::Normal | ContactKind::Negated),
+            } => {
+                let op = if *kind == ContactKind::Normal {
+                    "O"
+                } else {
+                    "ON"
+                };
+                let name = self.names.bit(*var);
+                self.net.emit(op, &[&name], 0);
+                true
+            }
+            Element::Compare { op, a, b } => match word_suffix(self.operand_type(a)) {
+                Some(sfx) => {
+                    let arg = format!("{}, {}", self.names.operand(a), self.names.operand(b));
+                    self.net
+                        .emit(&format!("O{sfx}{}", cmp_symbol(*op)), &[&arg], 0);
+                    true
+                }
+                None => false,
+            },
+            _ => false,
+        }
+    }
+
+    /// Emits an output, box or control element on the value on top of the stack; `rest` is
+    /// what follows it in its series.
+    fn action(&mut self, e: &Element, rest: &[Element]) -> Result<(), IlError> {
+        let n = self.names;
+        match e {
+            Element::Coil { var, negated } => {
+                if *negated {
+                    self.net.emit("NOT", &[], 0);
+                    self.net.emit("=", &[n.var(*var)], 0);
+                    self.net.emit("NOT", &[], 0);
+                } else {
+                    self.net.emit("=", &[n.var(*var)], 0);
+                }
+            }
+            Element::Set(v) => self.net.emit("S", &[n.var(*v), "1"], 0),
+            Element::Reset(v) => self.net.emit("R", &[n.var(*v), "1"], 0),
+            Element::Branch(branches) => self.branch(branches, rest)?,
+            Element::Timer { kind, instance, pt } => {
+                let op = match kind {
+                    TimerKind::Ton => "TON",
+                    TimerKind::Tof => "TOF",
+                    TimerKind::Tp => {
+                        return self.fail(
+                            "TP has no S7-200 instruction (the S7-200 has TON, TONR and TOF)",
+                        )
+                    }
+                };
+                self.net.emit(op, &[n.var(*instance), &n.operand(pt)], 0);
+                self.q_after(*instance, rest);
+            }
+            Element::Ctu {
+                instance,
+                pv,
+                reset,
+            } => self.counter("CTU", *instance, pv, reset, rest),
+            Element::Ctd { instance, pv, load } => self.counter("CTD", *instance, pv, load, rest),
+            Element::Move { from, to } => {
+                let op = match n.p.var(*to).ty {
+                    Type::Int => "MOVW",
+                    Type::Dint | Type::Time => "MOVD",
+                    Type::Real => "MOVR",
+                    ty => return self.fail(format!("a MOVE of {ty} has no S7-200 instruction")),
+                };
+                self.net.emit(op, &[&n.operand(from), n.var(*to)], 0);
+            }
+            Element::Arith { op, a, b, out } => self.arith(*op, a, b, *out)?,
+            Element::Jmp { label, .. } => self.net.emit("JMP", &[label], 0),
+            Element::Ret if self.main => self.net.emit("END", &[], 0),
+            Element::Ret => self.net.emit("CRET", &[], 0),
+            Element::End => self.net.emit("END", &[], 0),
+            Element::Call { pou } => self.net.emit("CALL", &[&n.p.pou(*pou).name], 0),
+            Element::For { var, from, to, .. } => {
+                self.net
+                    .emit("FOR", &[n.var(*var), &n.operand(from), &n.operand(to)], 0)
+            }
+            Element::Next { .. } => self.net.emit("NEXT", &[], 0),
+            Element::Contact { .. } | Element::Compare { .. } | Element::Or(_) => {
+                unreachable!("conditions are emitted by `condition`")
+            }
+        }
+        Ok(())
+    }
+
+    /// After a timer or counter with more elements after it: its Q is the power from here.
+    fn q_after(&mut self, instance: VarId, rest: &[Element]) {
+        if !rest.is_empty() {
+            self.net.emit("LD", &[self.names.var(instance)], 1);
+        }
+    }
+
+    fn counter(&mut self, op: &str, inst: VarId, pv: &Operand, aux: &Operand, rest: &[Element]) {
+        match aux {
+            Operand::Const(Value::Bool(true)) => self.net.emit("LD", &["SM0.0"], 1),
+            Operand::Const(_) => self.net.emit("LDN", &["SM0.0"], 1),
+            Operand::Var(r) => {
+                let bit = self.names.bit(*r);
+                self.net.emit("LD", &[&bit], 1)
+            }
+        }
+        let pv = self.names.operand(pv);
+        self.net.emit(op, &[self.names.var(inst), &pv], -1);
+        self.q_after(inst, rest);
+    }
+
+    fn arith(&mut self, op: ArithOp, a: &Operand, b: &Operand, out: VarId) -> Result<(), IlError> {
+        let n = self.names;
+        let ty = n.p.var(out).ty;
+        let (sfx, mov) = match ty {
+            Type::Int => ("I", "MOVW"),
+            Type::Dint | Type::Time => ("D", "MOVD"),
+            Type::Real => ("R", "MOVR"),
+            _ => return self.fail(format!("arithmetic on {ty} has no S7-200 instruction")),
+        };
+        let sym = match op {
+            ArithOp::Add => "+",
+            ArithOp::Sub => "-",
+            ArithOp::Mul => "*",
+            ArithOp::Div => "/",
+            ArithOp::Mod => {
+                return self.fail("MOD has no S7-200 instruction (DIV gives quotient and remainder together; not yet)")
+            }
+        };
+        let is_out =
+            |o: &Operand| matches!(o, Operand::Var(r) if r.var == out && r.field.is_none());
+        let instr = format!("{sym}{sfx}");
+        let target = n.var(out);
+        if is_out(a) {
+            self.net.emit(&instr, &[&n.operand(b), target], 0);
+        } else if is_out(b) {
+            if !matches!(op, ArithOp::Add | ArithOp::Mul) {
+                return self.fail(format!(
+                    "`{target} := {} {sym} {target}` has no two-operand S7-200 form (not yet)",
+                    n.operand(a)
+                ));
+            }
+            self.net.emit(&instr, &[&n.operand(a), target], 0);
+        } else {
+            self.net.emit(mov, &[&n.operand(a), target], 0);
+            self.net.emit(&instr, &[&n.operand(b), target], 0);
+        }
+        Ok(())
+    }
+
+    /// Output branches: LPS, the first, LRD, …, LPP, the last; what follows the branch element
+    /// in its series is one more branch (it gets the same power).
+    fn branch(&mut self, branches: &[Series], rest: &[Element]) -> Result<(), IlError> {
+        let mut all: Vec<&[Element]> = branches.iter().map(|b| &b[..]).collect();
+        if !rest.is_empty() {
+            all.push(rest);
+        }
+        let k = all.len();
+        if k == 1 {
+            return self.series(all[0], true, false);
+        }
+        for (i, b) in all.iter().enumerate() {
+            match i {
+                0 => self.net.lps(),
+                _ if i + 1 == k => self.net.lpp(),
+                _ => self.net.lrd(),
+            }
+            let last = i + 1 == k;
+            self.series(b, true, !last)?;
+        }
+        Ok(())
+    }
+}
