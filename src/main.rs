@@ -29,10 +29,10 @@ enum Command {
         /// The program (JSON program format, see docs/format.md; `-`: standard input).
         file: PathBuf,
         /// Output format.
-        #[arg(long, value_enum, default_value_t = FormatArg::Text)]
-        format: FormatArg,
-        /// Which levellings the output shows (JSON always has all of them) [default: all for
-        /// text, combined for DOT, which draws one levelling].
+        #[arg(long, value_enum, default_value_t = ReportFormatArg::Text)]
+        format: ReportFormatArg,
+        /// Which levellings the output shows (JSON and HTML always have all of them) [default:
+        /// all for text, combined for DOT, which draws one levelling].
         #[arg(long, value_enum)]
         view: Option<ViewArg>,
         /// Print every row of every text section (by default each shows its first rows).
@@ -234,6 +234,16 @@ enum FormatArg {
     Dot,
 }
 
+/// `report --format`: the order formats and the HTML page.
+#[derive(Copy, Clone, ValueEnum)]
+enum ReportFormatArg {
+    Text,
+    Json,
+    Dot,
+    /// One self-contained page (docs/html.md).
+    Html,
+}
+
 #[derive(Copy, Clone, ValueEnum)]
 enum ViewArg {
     Paper,
@@ -261,9 +271,10 @@ fn run(cli: Cli) -> Result<(), CliError> {
             output,
         } => {
             let format = match format {
-                FormatArg::Text => ReportFormat::Text,
-                FormatArg::Json => ReportFormat::Json,
-                FormatArg::Dot => ReportFormat::Dot,
+                ReportFormatArg::Text => ReportFormat::Text,
+                ReportFormatArg::Json => ReportFormat::Json,
+                ReportFormatArg::Dot => ReportFormat::Dot,
+                ReportFormatArg::Html => ReportFormat::Html,
             };
             let selection = match (pou, rungs) {
                 (Some(name), _) => Selection::Pou(name),

@@ -1,4 +1,4 @@
-//! `plc-deps report`: load, analyse, build the report document, render it (text, JSON or DOT)
+//! `plc-deps report`: load, analyse, build the report document, render it (text, JSON, DOT or HTML)
 //! to standard output or atomically to `-o`. Warnings go to standard error as well as into the
 //! report. Long phases show progress on a terminal.
 
@@ -9,8 +9,8 @@ use crate::analysis::{analyse, analyse_with, Analysis, AnalysisConfig, Dependenc
 use crate::fbd::Fbd;
 use crate::model::Program;
 use crate::report::{
-    document_with, fbd_parts, render_dot, render_json, render_text, select_rungs, FbdParts, Rows,
-    Selection, TextOptions, View, DOT_MAX_RUNGS,
+    document_with, fbd_parts, render_dot, render_html, render_json, render_text, select_rungs,
+    FbdParts, HtmlInput, Rows, Selection, TextOptions, View, DOT_MAX_RUNGS,
 };
 use std::collections::HashSet;
 use std::path::PathBuf;
@@ -21,6 +21,8 @@ pub enum ReportFormat {
     Text,
     Json,
     Dot,
+    /// One self-contained page (docs/html.md).
+    Html,
 }
 
 /// A validated `plc-deps report` invocation.
@@ -40,10 +42,26 @@ pub struct ReportConfig {
 }
 
 /// Writes the report of `p` (with `fbd`, what its FBD lowering made) in `format`; the DOT report
-/// draws only the rungs in `drawn` when it is given.
+/// draws only the rungs in `drawn` when it is given. (The HTML report draws FBD blocks as their
+/// lowered rungs here: [`write_report_with`] gives it the FBD bodies.)
 pub fn write_report(
     p: &Program,
     a: &Analysis,
+    fbd: Option<&FbdParts>,
+    format: ReportFormat,
+    text: &TextOptions,
+    drawn: Option<&HashSet<String>>,
+    out: &mut impl std::io::Write,
+) -> std::io::Result<()> {
+    write_report_with(p, a, None, fbd, format, text, drawn, out)
+}
+
+/// [`write_report`] with the FBD bodies as written (`bodies`), which the HTML report draws.
+#[allow(clippy::too_many_arguments)]
+pub fn write_report_with(
+    p: &Program,
+    a: &Analysis,
+    bodies: Option<&Fbd>,
     fbd: Option<&FbdParts>,
     format: ReportFormat,
     text: &TextOptions,
@@ -58,6 +76,15 @@ pub fn write_report(
         ReportFormat::Text => render_text(&doc, text, &mut out),
         ReportFormat::Json => render_json(&doc, &mut out),
         ReportFormat::Dot => render_dot(&doc, text.view, drawn, &mut out),
+        ReportFormat::Html => render_html(
+            &HtmlInput {
+                doc: &doc,
+                program: p,
+                analysis: a,
+                fbd: bodies,
+            },
+            &mut out,
+        ),
     }?;
     std::io::Write::flush(&mut out)
 }
@@ -72,8 +99,17 @@ pub fn render_report(p: &Program, fbd: &Fbd, format: ReportFormat, view: View) -
         view,
         ..TextOptions::default()
     };
-    write_report(p, &a, parts.as_ref(), format, &text, None, &mut out)
-        .expect("writing to memory cannot fail");
+    write_report_with(
+        p,
+        &a,
+        Some(fbd),
+        parts.as_ref(),
+        format,
+        &text,
+        None,
+        &mut out,
+    )
+    .expect("writing to memory cannot fail");
     String::from_utf8(out).expect("reports are UTF-8")
 }
 
@@ -115,9 +151,10 @@ pub fn report(c: &ReportConfig) -> Result<(), CliError> {
     let _phase = progress.phase("writing the report");
     write_output_with(c.output.as_deref(), |w| {
         let mut w = w;
-        write_report(
+        write_report_with(
             &p,
             &a,
+            Some(&fbd),
             parts.as_ref(),
             c.format,
             &text,

@@ -1,6 +1,7 @@
 //! `plc-deps report`: the analysis as one [`Report`] document ([`document`]), rendered as text
 //! (for people, bounded at any program size), JSON (for tools; the document's serde keys are the
-//! normative keys of docs/report.md) and DOT (for Graphviz).
+//! normative keys of docs/report.md), DOT (for Graphviz) and HTML (one self-contained page,
+//! docs/html.md).
 //!
 //! The document is built once from the model and its [`Analysis`]; renderers write it to an
 //! `impl Write` and never print, so the caller decides where output goes and writes an output
@@ -11,12 +12,14 @@
 pub mod document;
 mod dot;
 mod explain;
+pub mod html;
 mod json;
 pub mod order;
 pub mod text;
 
 pub use document::{document, document_with, Report};
 pub use dot::{render_dot, select_rungs, Selection, MAX_RUNGS as DOT_MAX_RUNGS};
+pub use html::{render_html, HtmlInput};
 pub use json::render_json;
 pub use text::{render_text, Rows, TextOptions};
 
