@@ -357,3 +357,61 @@ fn each_box_reads_and_writes_its_instance_and_reads_its_operands() {
         assert_eq!(names(acc.outs(r)), *outs, "OUT of R{}", k + 1);
     }
 }
+
+#[test]
+fn fbd_blocks_run_the_same_bodies_with_every_output_wired() {
+    let mut vars = bool_vars(
+        &["s", "r", "cu", "cd"],
+        &["q1", "q2", "qr", "qf", "qu", "qd"],
+    );
+    vars.push(json!({"name": "cv", "type": "INT", "class": "output"}));
+    for (n, t) in [
+        ("B1", "SR"),
+        ("B2", "RS"),
+        ("E1", "R_TRIG"),
+        ("E2", "F_TRIG"),
+        ("C", "CTUD"),
+    ] {
+        vars.push(json!({"name": n, "type": t}));
+    }
+    let text = json!({"program": "fbd_fbs", "vars": vars, "fbd": {"networks": [{"id": "N1", "blocks": [
+        {"id": 1, "op": "SR", "instance": "B1", "in": {"S1": "s", "R": "r"}, "out": {"Q1": "q1"}},
+        {"id": 2, "op": "RS", "instance": "B2", "in": {"S": "s", "R1": "r"}, "out": {"Q1": "q2"}},
+        {"id": 3, "op": "R_TRIG", "instance": "E1", "in": {"CLK": "s"}, "out": {"Q": "qr"}},
+        {"id": 4, "op": "F_TRIG", "instance": "E2", "in": {"CLK": "s"}, "out": {"Q": "qf"}},
+        {"id": 5, "op": "CTUD", "instance": "C",
+         "in": {"CU": {"from": 3, "pin": "Q"}, "CD": "cd", "R": "r", "LD": false, "PV": 2},
+         "out": {"QU": "qu", "QD": "qd", "CV": "cv"}}
+    ]}]}})
+    .to_string();
+    // (S, R, CD) → SR, RS, R_TRIG(S), F_TRIG(S), and CTUD counting the rising edges of S up and
+    // of CD down, with R; PV 2.
+    #[allow(clippy::type_complexity)]
+    let table: [([i64; 3], (bool, bool, bool, bool), i64); 8] = [
+        ([0, 0, 0], (false, false, false, true), 0),
+        ([1, 0, 0], (true, true, true, false), 1),
+        ([0, 0, 0], (true, true, false, true), 1),
+        ([1, 0, 0], (true, true, true, false), 2),
+        ([1, 1, 0], (true, false, false, false), 0),
+        ([0, 0, 1], (true, false, false, true), -1),
+        ([0, 1, 0], (false, false, false, false), 0),
+        // Both edges at once: no count.
+        ([1, 0, 1], (true, true, true, false), 0),
+    ];
+    let rows: Vec<Vec<i64>> = table
+        .iter()
+        .map(|(r, _, _)| vec![r[0], r[1], 0, r[2]])
+        .collect();
+    let expect: Vec<Vec<Json>> = table
+        .iter()
+        .map(|(_, (a, b, c, d), cv)| {
+            [*a, *b, *c, *d, *cv >= 2, *cv <= 0]
+                .iter()
+                .map(|x| json!(x))
+                .chain([json!(cv)])
+                .collect()
+        })
+        .collect();
+    let outs = ["q1", "q2", "qr", "qf", "qu", "qd", "cv"];
+    check(&text, "fbd", &["s", "r", "cu", "cd"], &rows, &outs, &expect);
+}
