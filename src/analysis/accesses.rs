@@ -255,6 +255,30 @@ pub(crate) fn rung_accesses(
                 operand(pv, reads);
                 operand(other, reads);
             }
+            Element::Bistable {
+                instance, reset, ..
+            } => {
+                reads.push(*instance);
+                writes.push(*instance);
+                operand(reset, reads);
+            }
+            Element::Trigger { instance, .. } => {
+                reads.push(*instance);
+                writes.push(*instance);
+            }
+            Element::Ctud {
+                instance,
+                cd,
+                reset,
+                load,
+                pv,
+            } => {
+                reads.push(*instance);
+                writes.push(*instance);
+                for o in [cd, reset, load, pv] {
+                    operand(o, reads);
+                }
+            }
             Element::Move { from, to } => {
                 operand(from, reads);
                 writes.push(*to);

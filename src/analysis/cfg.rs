@@ -189,7 +189,10 @@ fn walk_series(
             | Element::Compare { .. }
             | Element::Timer { .. }
             | Element::Ctu { .. }
-            | Element::Ctd { .. } => always = false,
+            | Element::Ctd { .. }
+            | Element::Bistable { .. }
+            | Element::Trigger { .. }
+            | Element::Ctud { .. } => always = false,
             Element::Or(bs) => {
                 let mut any = false;
                 for b in bs {

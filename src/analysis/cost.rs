@@ -69,7 +69,11 @@ fn series_cost(series: &[Element], pou_totals: &[u64]) -> u64 {
                 1 + bs.iter().map(|b| series_cost(b, pou_totals)).sum::<u64>()
             }
             Element::Move { .. } | Element::Arith { .. } | Element::For { .. } => 2,
-            Element::Timer { .. } | Element::Ctu { .. } | Element::Ctd { .. } => 4,
+            Element::Timer { .. }
+            | Element::Ctu { .. }
+            | Element::Ctd { .. }
+            | Element::Ctud { .. } => 4,
+            Element::Bistable { .. } | Element::Trigger { .. } => 2,
             Element::Call { pou } => 1 + pou_totals[pou.index()],
             _ => 1,
         })

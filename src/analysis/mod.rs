@@ -321,7 +321,34 @@ fn paper_control_view(p: &Program, control: &[ControlDependence]) -> Vec<PaperCo
         walk_elements(&p.rung(r).series, &mut |e| match e {
             Element::Timer { instance, .. }
             | Element::Ctu { instance, .. }
-            | Element::Ctd { instance, .. } => own_boxes.push(*instance),
+            | Element::Ctd { instance, .. }
+            | Element::Trigger { instance, .. } => own_boxes.push(*instance),
+            Element::Bistable {
+                instance, reset, ..
+            } => {
+                own_boxes.push(*instance);
+                if let Operand::Var(v) = reset {
+                    if v.field.is_some() {
+                        field_reads.push(v.var);
+                    }
+                }
+            }
+            Element::Ctud {
+                instance,
+                cd,
+                reset,
+                load,
+                pv,
+            } => {
+                own_boxes.push(*instance);
+                for o in [cd, reset, load, pv] {
+                    if let Operand::Var(v) = o {
+                        if v.field.is_some() {
+                            field_reads.push(v.var);
+                        }
+                    }
+                }
+            }
             Element::Contact { var, .. } if var.field.is_some() => field_reads.push(var.var),
             Element::Compare { a, b, .. } | Element::Arith { a, b, .. } => {
                 for o in [a, b] {

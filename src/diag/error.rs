@@ -11,7 +11,7 @@ use std::fmt;
 
 /// The op names of the FBD format, as the unknown-op message lists them (re-exported by
 /// `crate::fbd`).
-pub const OP_NAMES: &str = "EQ, NE, LT, LE, GT, GE, ADD, SUB, MUL, DIV, MOD, AND, OR, XOR, NOT, MOVE, SEL, MAX, MIN, LIMIT, TON, TOF, TP, CTU, CTD, JMP, RET, TSTART, TSTOP";
+pub const OP_NAMES: &str = "EQ, NE, LT, LE, GT, GE, ADD, SUB, MUL, DIV, MOD, AND, OR, XOR, NOT, MOVE, SEL, MAX, MIN, LIMIT, TON, TOF, TP, CTU, CTD, SR, RS, R_TRIG, F_TRIG, CTUD, JMP, RET, TSTART, TSTOP";
 
 /// Where in the program file an error is.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -111,12 +111,12 @@ pub enum Invalid {
         what: &'static str,
         allowed: String,
     },
-    #[error("unknown element {{{keys}}} (an element has one of the keys contact, compare, or, coil, set, reset, branch, ton, tof, tp, ctu, ctd, move, op, jmp, ret, end, call, for, next)")]
+    #[error("unknown element {{{keys}}} (an element has one of the keys contact, compare, or, coil, set, reset, branch, ton, tof, tp, ctu, ctd, ctud, sr, rs, r_trig, f_trig, move, op, jmp, ret, end, call, for, next)")]
     UnknownElement { keys: String },
     #[error("`{name}` is not a valid name (letters, digits and _, not starting with a digit)")]
     BadName { name: String },
     #[error(
-        "unknown type `{name}` (expected BOOL, INT, DINT, REAL, TIME, TON, TOF, TP, CTU or CTD)"
+        "unknown type `{name}` (expected BOOL, INT, DINT, REAL, TIME, TON, TOF, TP, CTU, CTD, SR, RS, R_TRIG, F_TRIG or CTUD)"
     )]
     UnknownType { name: String },
     #[error("variable `{name}` is declared twice")]
@@ -235,7 +235,7 @@ pub enum Invalid {
         member: String,
         members: String,
     },
-    #[error("unknown type `{name}` (expected BOOL, INT, DINT, REAL, TIME, TON, TOF, TP, CTU, CTD or a function block: {fbs})")]
+    #[error("unknown type `{name}` (expected BOOL, INT, DINT, REAL, TIME, TON, TOF, TP, CTU, CTD, SR, RS, R_TRIG, F_TRIG, CTUD or a function block: {fbs})")]
     UnknownTypeOrFb { name: String, fbs: String },
     // ---- PLCopen TC6 XML (docs/plcopen.md)
     /// What the PLCopen reader cannot take (the message names the element, its localId or name).

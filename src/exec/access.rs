@@ -11,7 +11,7 @@
 //! over-approximates (a contact after a taken jump still counts): a check on it can only be too
 //! strict, never too lax.
 
-use super::layout::{Repr, COUNTER_BYTES, TIMER_BYTES};
+use super::layout::{Repr, COUNTER_BYTES, CTUD_BYTES, TIMER_BYTES, TRIGGER_BYTES};
 use super::lower::{Op, Pc};
 use super::store::Addr;
 use super::Machine;
@@ -96,6 +96,20 @@ impl Machine {
                 Op::Ctu { inst, pv, reset: x } | Op::Ctd { inst, pv, load: x } => {
                     reads.extend([(inst, COUNTER_BYTES), (pv, Repr::I16.width()), byte(x)]);
                     writes.push((inst, COUNTER_BYTES));
+                }
+                Op::Bistable { inst, reset, .. } => {
+                    reads.extend([byte(inst), byte(reset)]);
+                    writes.push(byte(inst));
+                }
+                Op::Trigger { inst, .. } => {
+                    reads.push((inst, TRIGGER_BYTES));
+                    writes.push((inst, TRIGGER_BYTES));
+                }
+                Op::Ctud { inst, pins } => {
+                    let c = self.ctuds[pins.index()];
+                    reads.extend([(inst, CTUD_BYTES), (c.pv, Repr::I16.width())]);
+                    reads.extend([byte(c.cd), byte(c.reset), byte(c.load)]);
+                    writes.push((inst, CTUD_BYTES));
                 }
                 Op::Move { width, from, to } => {
                     let w = width.bytes();

@@ -6,7 +6,11 @@
 //! ([`field_offset`]): a timer (TON, TOF, TP) is Q (1 byte) at 0, its state flags at 1, ET at 4,
 //! PT at 8 and its start time (8 bytes, ms) at 16 — [`TIMER_BYTES`] in all, aligned to 8; a
 //! counter (CTU, CTD) is Q at 0, the CU/CD of its previous evaluation at 1, CV at 2 and PV at 4
-//! — [`COUNTER_BYTES`], aligned to 2. [`parts`] lists every stored value of a type.
+//! — [`COUNTER_BYTES`], aligned to 2. A bistable (SR, RS) is Q1 at 0 ([`BISTABLE_BYTES`]); an
+//! edge detector (R_TRIG, F_TRIG) Q at 0 and its memory M at 1 ([`TRIGGER_BYTES`]); an up-down
+//! counter (CTUD) QU at 0, the CU (bit 0) and CD (bit 1) of its previous evaluation at 1, CV at
+//! 2, PV at 4 and QD at 6 ([`CTUD_BYTES`], aligned to 2). [`parts`] lists every stored value of a
+//! type.
 //!
 //! The interpreter never assumes variables are dense or in declaration order: a parallel
 //! executor can permute and pad them (so that variables written by different workers sit on
@@ -58,6 +62,13 @@ pub const TIMER_BYTES: u32 = 24;
 /// Bytes of a counter instance.
 pub const COUNTER_BYTES: u32 = 6;
 
+/// Bytes of an SR or RS instance.
+pub const BISTABLE_BYTES: u32 = 1;
+/// Bytes of an R_TRIG or F_TRIG instance.
+pub const TRIGGER_BYTES: u32 = 2;
+/// Bytes of a CTUD instance.
+pub const CTUD_BYTES: u32 = 8;
+
 /// Offsets inside an instance (the readable fields are also at [`field_offset`]).
 pub(crate) const Q: u32 = 0;
 pub(crate) const FLAGS: u32 = 1; // timers: state bits (u8)
@@ -67,9 +78,13 @@ pub(crate) const PV: u32 = 4; // counters: i16
 pub(crate) const ET: u32 = 4; // timers: i32 ms
 pub(crate) const PT: u32 = 8; // timers: i32 ms
 pub(crate) const START: u32 = 16; // timers: start time, i64 ms
+pub(crate) const MEM: u32 = 1; // R_TRIG, F_TRIG: M (u8)
+pub(crate) const QD: u32 = 6; // CTUD: QD (u8)
 
 const TIMER_PARTS: [(u32, u32); 5] = [(Q, 1), (FLAGS, 1), (ET, 4), (PT, 4), (START, 8)];
 const COUNTER_PARTS: [(u32, u32); 4] = [(Q, 1), (PREV, 1), (CV, 2), (PV, 2)];
+const TRIGGER_PARTS: [(u32, u32); 2] = [(Q, 1), (MEM, 1)];
+const CTUD_PARTS: [(u32, u32); 5] = [(Q, 1), (PREV, 1), (CV, 2), (PV, 2), (QD, 1)];
 const SCALAR_PARTS: [[(u32, u32); 1]; 3] = [[(0, 1)], [(0, 2)], [(0, 4)]];
 
 // Every part aligned to its width, inside its instance.
@@ -86,6 +101,13 @@ const _: () = {
         assert!(o % w == 0 && o + w <= COUNTER_BYTES);
         i += 1;
     }
+    let mut i = 0;
+    while i < CTUD_PARTS.len() {
+        let (o, w) = CTUD_PARTS[i];
+        assert!(o % w == 0 && o + w <= CTUD_BYTES);
+        i += 1;
+    }
+    assert!(MEM < TRIGGER_BYTES);
 };
 
 /// Every value a variable of type `ty` stores, as (offset, width) in bytes, in offset order: one
@@ -94,6 +116,9 @@ pub fn parts(ty: Type) -> &'static [(u32, u32)] {
     match ty {
         Type::Fb(FbKind::Ton | FbKind::Tof | FbKind::Tp) => &TIMER_PARTS,
         Type::Fb(FbKind::Ctu | FbKind::Ctd) => &COUNTER_PARTS,
+        Type::Fb(FbKind::Sr | FbKind::Rs) => &SCALAR_PARTS[0],
+        Type::Fb(FbKind::RTrig | FbKind::FTrig) => &TRIGGER_PARTS,
+        Type::Fb(FbKind::Ctud) => &CTUD_PARTS,
         scalar => match Repr::of(scalar).map_or(1, Repr::width) {
             1 => &SCALAR_PARTS[0],
             2 => &SCALAR_PARTS[1],
@@ -107,6 +132,9 @@ pub fn type_size(ty: Type) -> u32 {
     match ty {
         Type::Fb(FbKind::Ton | FbKind::Tof | FbKind::Tp) => TIMER_BYTES,
         Type::Fb(FbKind::Ctu | FbKind::Ctd) => COUNTER_BYTES,
+        Type::Fb(FbKind::Sr | FbKind::Rs) => BISTABLE_BYTES,
+        Type::Fb(FbKind::RTrig | FbKind::FTrig) => TRIGGER_BYTES,
+        Type::Fb(FbKind::Ctud) => CTUD_BYTES,
         scalar => Repr::of(scalar).map_or(1, Repr::width),
     }
 }
@@ -116,10 +144,12 @@ pub fn type_align(ty: Type) -> u32 {
     parts(ty).iter().map(|&(_, w)| w).max().unwrap_or(1)
 }
 
-/// Offset of an instance field from the instance's address: Q 0, CV 2, ET and PV 4, PT 8.
+/// Offset of an instance field from the instance's address: Q, Q1 and QU 0, CV 2, ET and PV 4,
+/// QD 6, PT 8.
 pub fn field_offset(field: Field) -> u32 {
     match field {
-        Field::Q => Q,
+        Field::Q | Field::Q1 | Field::Qu => Q,
+        Field::Qd => QD,
         Field::Cv => CV,
         Field::Et => ET,
         Field::Pv => PV,

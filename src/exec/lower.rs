@@ -15,6 +15,7 @@
 //! `or` and `branch` in a 64-bit stack `s` (an `or` uses two bits: its power in and the OR of
 //! its branches so far; a `branch` one: its power in). Lowering refuses nesting deeper than that.
 
+use super::fb::{CtudId, CtudPins};
 use super::layout::{field_offset, type_align, Layout, Repr};
 use super::mem::LINE_BYTES;
 use super::store::Addr;
@@ -147,6 +148,16 @@ pub(crate) enum Op {
     Ctu { inst: Addr, pv: Addr, reset: Addr },
     /// CTD box.
     Ctd { inst: Addr, pv: Addr, load: Addr },
+    /// SR/RS box on the instance at `inst`; power in is S1/S, `reset` R/R1.
+    Bistable {
+        kind: BistableKind,
+        inst: Addr,
+        reset: Addr,
+    },
+    /// R_TRIG/F_TRIG box on the instance at `inst`; power in is CLK.
+    Trigger { kind: TriggerKind, inst: Addr },
+    /// CTUD box on the instance at `inst`; power in is CU, the other operands in `ctuds`.
+    Ctud { inst: Addr, pins: CtudId },
     /// MOVE box.
     Move { width: Width, from: Addr, to: Addr },
     /// Arithmetic box.
@@ -206,6 +217,8 @@ pub(crate) struct Code {
     /// The constants and where they live (written by `Machine::initial_state`).
     pub consts: Vec<(Addr, Value)>,
     pub fors: Vec<ForLoop>,
+    /// The operands of each CTUD box but CU.
+    pub ctuds: Vec<CtudPins>,
     /// Each rung's `Rung` marker.
     pub rung_op: Vec<Pc>,
     /// For each rung: its loop if it is a FOR head.
@@ -306,6 +319,7 @@ pub(crate) fn lower(p: &Program, layout: &Layout) -> Result<Code, LowerError> {
             ops: Vec::new(),
             consts: Vec::new(),
             fors: Vec::new(),
+            ctuds: Vec::new(),
             rung_op: vec![Pc(0); p.rungs.len()],
             for_of_head: vec![None; p.rungs.len()],
             pou_entry: Vec::with_capacity(p.pous.len()),
@@ -557,6 +571,41 @@ impl Lowerer<'_> {
                 let inst = self.layout.start(*instance);
                 let (pv, load) = (self.operand(pv), self.operand(load));
                 self.push(Op::Ctd { inst, pv, load });
+            }
+            Element::Bistable {
+                kind,
+                instance,
+                reset,
+            } => {
+                let inst = self.layout.start(*instance);
+                let reset = self.operand(reset);
+                self.push(Op::Bistable {
+                    kind: *kind,
+                    inst,
+                    reset,
+                });
+            }
+            Element::Trigger { kind, instance } => {
+                let inst = self.layout.start(*instance);
+                self.push(Op::Trigger { kind: *kind, inst });
+            }
+            Element::Ctud {
+                instance,
+                cd,
+                reset,
+                load,
+                pv,
+            } => {
+                let inst = self.layout.start(*instance);
+                let pins = CtudPins {
+                    cd: self.operand(cd),
+                    reset: self.operand(reset),
+                    load: self.operand(load),
+                    pv: self.operand(pv),
+                };
+                let id = CtudId(self.code.ctuds.len() as u32);
+                self.code.ctuds.push(pins);
+                self.push(Op::Ctud { inst, pins: id });
             }
             Element::Move { from, to } => {
                 let width = Width::of(self.p.var(*to).ty);

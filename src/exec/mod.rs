@@ -113,6 +113,7 @@
 #![warn(clippy::undocumented_unsafe_blocks)]
 
 mod access;
+mod fb;
 mod layout;
 mod lower;
 mod mem;
@@ -242,6 +243,7 @@ pub struct Machine {
     ops: Vec<Op>,
     consts: Vec<(Addr, Value)>,
     fors: Vec<ForLoop>,
+    ctuds: Vec<fb::CtudPins>,
     rung_op: Vec<Pc>,
     for_of_head: Vec<Option<ForId>>,
     pou_entry: Vec<Pc>,
@@ -269,6 +271,7 @@ impl Machine {
             ops: code.ops,
             consts: code.consts,
             fors: code.fors,
+            ctuds: code.ctuds,
             rung_op: code.rung_op,
             for_of_head: code.for_of_head,
             pou_entry: code.pou_entry,

@@ -248,6 +248,17 @@ impl Machine {
                     let load = st.load::<u8>(load) != 0;
                     p = counter(st, inst, pv, p as u8, load, false) as u64;
                 }
+                Op::Bistable { kind, inst, reset } => {
+                    let reset = st.load::<u8>(reset) != 0;
+                    p = super::fb::bistable(st, kind, inst, p != 0, reset) as u64;
+                }
+                Op::Trigger { kind, inst } => {
+                    p = super::fb::trigger(st, kind, inst, p != 0) as u64;
+                }
+                Op::Ctud { inst, pins } => {
+                    let pins = self.ctuds[pins.index()];
+                    p = super::fb::ctud(st, inst, pins, p != 0) as u64;
+                }
                 Op::Move { width, from, to } => {
                     if p != 0 {
                         match width {

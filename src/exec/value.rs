@@ -5,7 +5,7 @@
 //! to its width. This module converts between those bytes and [`Value`]s; it does not place
 //! variables (`layout`).
 
-use super::layout::{Repr, CV, ET, PT, PV, Q};
+use super::layout::{Repr, CV, ET, PT, PV, Q, QD};
 use super::store::{Addr, Store};
 use crate::model::{FbKind, Type, Value};
 use serde::{Serialize, Serializer};
@@ -58,6 +58,27 @@ pub enum VarValue {
         /// The preset value of its last evaluation.
         pv: i16,
     },
+    /// An SR or RS instance.
+    Bistable {
+        /// Output.
+        q1: bool,
+    },
+    /// An R_TRIG or F_TRIG instance.
+    Trigger {
+        /// Output.
+        q: bool,
+    },
+    /// A CTUD instance.
+    UpDown {
+        /// Up output (`CV >= PV`).
+        qu: bool,
+        /// Down output (`CV <= 0`).
+        qd: bool,
+        /// Current value.
+        cv: i16,
+        /// The preset value of its last evaluation.
+        pv: i16,
+    },
 }
 
 impl VarValue {
@@ -75,6 +96,14 @@ impl VarValue {
                 cv: mem.load(at.offset(CV)),
                 pv: mem.load(at.offset(PV)),
             },
+            Type::Fb(FbKind::Sr | FbKind::Rs) => VarValue::Bistable { q1: q },
+            Type::Fb(FbKind::RTrig | FbKind::FTrig) => VarValue::Trigger { q },
+            Type::Fb(FbKind::Ctud) => VarValue::UpDown {
+                qu: q,
+                qd: mem.load::<u8>(at.offset(QD)) != 0,
+                cv: mem.load(at.offset(CV)),
+                pv: mem.load(at.offset(PV)),
+            },
             scalar => VarValue::Scalar(load_value(mem, at, scalar)),
         }
     }
@@ -87,23 +116,33 @@ impl VarValue {
         }
     }
 
-    /// The BOOL value, or the Q of an instance.
+    /// The BOOL value, or the Q of an instance (Q1 of a bistable, QU of a CTUD).
     pub fn as_bool(&self) -> Option<bool> {
         match self {
             VarValue::Scalar(Value::Bool(b)) => Some(*b),
-            VarValue::Timer { q, .. } | VarValue::Counter { q, .. } => Some(*q),
+            VarValue::Timer { q, .. }
+            | VarValue::Counter { q, .. }
+            | VarValue::Bistable { q1: q }
+            | VarValue::Trigger { q }
+            | VarValue::UpDown { qu: q, .. } => Some(*q),
             _ => None,
         }
     }
 
     /// JSON form: BOOL `true`/`false`; INT, DINT numbers; REAL a number (its shortest decimal
     /// form; `null` for NaN and infinities, which JSON cannot hold); TIME milliseconds; a timer
-    /// `{"Q", "ET", "PT"}` and a counter `{"Q", "CV", "PV"}`.
+    /// `{"Q", "ET", "PT"}`, a counter `{"Q", "CV", "PV"}`, a bistable `{"Q1"}`, an edge detector
+    /// `{"Q"}` and an up-down counter `{"QU", "QD", "CV", "PV"}`.
     pub fn to_json(&self) -> Json {
         match *self {
             VarValue::Scalar(v) => scalar_json(v),
             VarValue::Timer { q, et, pt } => json!({"Q": q, "ET": et, "PT": pt}),
             VarValue::Counter { q, cv, pv } => json!({"Q": q, "CV": cv, "PV": pv}),
+            VarValue::Bistable { q1 } => json!({ "Q1": q1 }),
+            VarValue::Trigger { q } => json!({ "Q": q }),
+            VarValue::UpDown { qu, qd, cv, pv } => {
+                json!({"QU": qu, "QD": qd, "CV": cv, "PV": pv})
+            }
         }
     }
 }

@@ -7,7 +7,7 @@
 //! are kept by name or as written ([`Input`]): a function block type's body is read once and
 //! resolved once per instance.
 
-use crate::model::{ArithOp, CmpOp, PouId, RungId, TimerKind, VarId};
+use crate::model::{ArithOp, BistableKind, CmpOp, PouId, RungId, TimerKind, TriggerKind, VarId};
 use std::ops::Range;
 
 use crate::model::index_type;
@@ -244,6 +244,9 @@ pub enum OpKind {
     Timer(TimerKind),
     Ctu,
     Ctd,
+    Bistable(BistableKind),
+    Trigger(TriggerKind),
+    Ctud,
     Jmp,
     Ret,
     TStart,
@@ -283,6 +286,20 @@ pub enum Op {
     },
     /// CTD (CD, LD, PV) on `instance`; outputs Q, CV.
     Ctd {
+        instance: String,
+    },
+    /// SR (S1, R) or RS (S, R1) on `instance`; output Q1.
+    Bistable {
+        kind: BistableKind,
+        instance: String,
+    },
+    /// R_TRIG or F_TRIG (CLK) on `instance`; output Q.
+    Trigger {
+        kind: TriggerKind,
+        instance: String,
+    },
+    /// CTUD (CU, CD, R, LD, PV) on `instance`; outputs QU, QD, CV.
+    Ctud {
         instance: String,
     },
     /// Jump to the network labelled `label` when `cond` holds (always without `cond`).
@@ -328,6 +345,11 @@ impl OpKind {
             "TP" => OpKind::Timer(TimerKind::Tp),
             "CTU" => OpKind::Ctu,
             "CTD" => OpKind::Ctd,
+            "SR" => OpKind::Bistable(BistableKind::SetDominant),
+            "RS" => OpKind::Bistable(BistableKind::ResetDominant),
+            "R_TRIG" => OpKind::Trigger(TriggerKind::Rising),
+            "F_TRIG" => OpKind::Trigger(TriggerKind::Falling),
+            "CTUD" => OpKind::Ctud,
             "JMP" => OpKind::Jmp,
             "RET" => OpKind::Ret,
             "TSTART" => OpKind::TStart,
@@ -355,6 +377,11 @@ impl OpKind {
             OpKind::Timer(TimerKind::Tp) => "TP",
             OpKind::Ctu => "CTU",
             OpKind::Ctd => "CTD",
+            OpKind::Bistable(BistableKind::SetDominant) => "SR",
+            OpKind::Bistable(BistableKind::ResetDominant) => "RS",
+            OpKind::Trigger(TriggerKind::Rising) => "R_TRIG",
+            OpKind::Trigger(TriggerKind::Falling) => "F_TRIG",
+            OpKind::Ctud => "CTUD",
             OpKind::Jmp => "JMP",
             OpKind::Ret => "RET",
             OpKind::TStart => "TSTART",
@@ -380,7 +407,13 @@ impl OpKind {
     pub fn needs_instance(self) -> bool {
         matches!(
             self,
-            OpKind::Timer(_) | OpKind::Ctu | OpKind::Ctd | OpKind::Call
+            OpKind::Timer(_)
+                | OpKind::Ctu
+                | OpKind::Ctd
+                | OpKind::Bistable(_)
+                | OpKind::Trigger(_)
+                | OpKind::Ctud
+                | OpKind::Call
         )
     }
 
@@ -397,6 +430,10 @@ impl OpKind {
             OpKind::Timer(_) => &["IN", "PT"],
             OpKind::Ctu => &["CU", "R", "PV"],
             OpKind::Ctd => &["CD", "LD", "PV"],
+            OpKind::Bistable(BistableKind::SetDominant) => &["S1", "R"],
+            OpKind::Bistable(BistableKind::ResetDominant) => &["S", "R1"],
+            OpKind::Trigger(_) => &["CLK"],
+            OpKind::Ctud => &["CU", "CD", "R", "LD", "PV"],
             OpKind::Jmp
             | OpKind::Ret
             | OpKind::Call
@@ -415,6 +452,9 @@ impl OpKind {
         match self {
             OpKind::Timer(_) => &["Q", "ET"],
             OpKind::Ctu | OpKind::Ctd => &["Q", "CV"],
+            OpKind::Bistable(_) => &["Q1"],
+            OpKind::Trigger(_) => &["Q"],
+            OpKind::Ctud => &["QU", "QD", "CV"],
             OpKind::Jmp | OpKind::Ret | OpKind::TStart | OpKind::TStop | OpKind::Call => &[],
             _ => &["OUT"],
         }
@@ -438,6 +478,9 @@ impl Op {
             Op::Timer { kind, .. } => OpKind::Timer(*kind),
             Op::Ctu { .. } => OpKind::Ctu,
             Op::Ctd { .. } => OpKind::Ctd,
+            Op::Bistable { kind, .. } => OpKind::Bistable(*kind),
+            Op::Trigger { kind, .. } => OpKind::Trigger(*kind),
+            Op::Ctud { .. } => OpKind::Ctud,
             Op::Jmp { .. } => OpKind::Jmp,
             Op::Ret => OpKind::Ret,
             Op::TStart => OpKind::TStart,
@@ -460,6 +503,9 @@ impl Op {
             Op::Timer { instance, .. }
             | Op::Ctu { instance }
             | Op::Ctd { instance }
+            | Op::Bistable { instance, .. }
+            | Op::Trigger { instance, .. }
+            | Op::Ctud { instance }
             | Op::Call { instance, .. } => Some(instance),
             _ => None,
         }

@@ -154,6 +154,23 @@ pub enum Element {
         pv: Operand,
         load: Operand,
     },
+    /// SR/RS bistable (IEC 61131-3 2.5.2.3.1); power in is S1 (SR) or S (RS), `reset` is R (SR)
+    /// or R1 (RS), power out is Q1.
+    Bistable {
+        kind: BistableKind,
+        instance: VarId,
+        reset: Operand,
+    },
+    /// R_TRIG/F_TRIG edge detector (IEC 61131-3 2.5.2.3.2); power in is CLK, power out is Q.
+    Trigger { kind: TriggerKind, instance: VarId },
+    /// Up-down counter (IEC 61131-3 2.5.2.3.3); power in is CU, power out is QU.
+    Ctud {
+        instance: VarId,
+        cd: Operand,
+        reset: Operand,
+        load: Operand,
+        pv: Operand,
+    },
     /// MOVE box: when powered, `to := from`; power out = power in (ENO).
     Move { from: Operand, to: VarId },
     /// Arithmetic box: when powered, `out := a op b`; power out = power in (ENO).

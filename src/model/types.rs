@@ -1,8 +1,9 @@
 //! Elementary IEC 61131-3 types, values and operands of the program model.
 //!
 //! TIME values are held as signed 32-bit milliseconds (CODESYS and S7 `TIME` are 32-bit ms).
-//! Function block types (TON, TOF, TP, CTU, CTD) are instance types: a variable of such a type is
-//! an instance, and its readable fields are listed by [`Field`].
+//! Function block types (TON, TOF, TP, CTU, CTD, and the bistables SR, RS, the edge detectors
+//! R_TRIG, F_TRIG and the up-down counter CTUD of IEC 61131-3 2.5.2.3) are instance types: a
+//! variable of such a type is an instance, and its readable fields are listed by [`Field`].
 
 use super::VarId;
 use std::fmt;
@@ -31,6 +32,52 @@ pub enum FbKind {
     Tp,
     Ctu,
     Ctd,
+    /// Set-dominant bistable (S1, R → Q1).
+    Sr,
+    /// Reset-dominant bistable (S, R1 → Q1).
+    Rs,
+    /// Rising edge detector (CLK → Q).
+    RTrig,
+    /// Falling edge detector (CLK → Q).
+    FTrig,
+    /// Up-down counter (CU, CD, R, LD, PV → QU, QD, CV).
+    Ctud,
+}
+
+/// The two IEC bistables: which input dominates when both are TRUE.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
+pub enum BistableKind {
+    /// SR: `Q1 := S1 OR (NOT R AND Q1)`.
+    SetDominant,
+    /// RS: `Q1 := NOT R1 AND (S OR Q1)`.
+    ResetDominant,
+}
+
+impl BistableKind {
+    pub fn fb(self) -> FbKind {
+        match self {
+            BistableKind::SetDominant => FbKind::Sr,
+            BistableKind::ResetDominant => FbKind::Rs,
+        }
+    }
+}
+
+/// The two IEC edge detectors.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
+pub enum TriggerKind {
+    /// R_TRIG: `Q := CLK AND NOT M; M := CLK`.
+    Rising,
+    /// F_TRIG: `Q := NOT CLK AND NOT M; M := NOT CLK`.
+    Falling,
+}
+
+impl TriggerKind {
+    pub fn fb(self) -> FbKind {
+        match self {
+            TriggerKind::Rising => FbKind::RTrig,
+            TriggerKind::Falling => FbKind::FTrig,
+        }
+    }
 }
 
 /// The three IEC timers.
@@ -72,6 +119,11 @@ impl Type {
             "TP" => Type::Fb(FbKind::Tp),
             "CTU" => Type::Fb(FbKind::Ctu),
             "CTD" => Type::Fb(FbKind::Ctd),
+            "SR" => Type::Fb(FbKind::Sr),
+            "RS" => Type::Fb(FbKind::Rs),
+            "R_TRIG" => Type::Fb(FbKind::RTrig),
+            "F_TRIG" => Type::Fb(FbKind::FTrig),
+            "CTUD" => Type::Fb(FbKind::Ctud),
             _ => return None,
         })
     }
@@ -104,6 +156,11 @@ impl fmt::Display for Type {
             Type::Fb(FbKind::Tp) => "TP",
             Type::Fb(FbKind::Ctu) => "CTU",
             Type::Fb(FbKind::Ctd) => "CTD",
+            Type::Fb(FbKind::Sr) => "SR",
+            Type::Fb(FbKind::Rs) => "RS",
+            Type::Fb(FbKind::RTrig) => "R_TRIG",
+            Type::Fb(FbKind::FTrig) => "F_TRIG",
+            Type::Fb(FbKind::Ctud) => "CTUD",
         })
     }
 }
@@ -111,38 +168,60 @@ impl fmt::Display for Type {
 /// A readable field of a function block instance.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
 pub enum Field {
-    /// Output (timers and counters), BOOL.
+    /// Output (timers, CTU, CTD, R_TRIG, F_TRIG), BOOL.
     Q,
+    /// Output of SR and RS, BOOL.
+    Q1,
+    /// Up output of CTUD (`CV >= PV`), BOOL.
+    Qu,
+    /// Down output of CTUD (`CV <= 0`), BOOL.
+    Qd,
     /// Elapsed time (timers), TIME.
     Et,
     /// Preset time (timers), TIME.
     Pt,
-    /// Current value (counters), INT.
+    /// Current value (counters, CTUD), INT.
     Cv,
-    /// Preset value (counters), INT.
+    /// Preset value (counters, CTUD), INT.
     Pv,
 }
 
 impl Field {
     /// The field of `fb` called `name`, with its type.
     pub fn lookup(fb: FbKind, name: &str) -> Option<(Field, Type)> {
-        let timer = matches!(fb, FbKind::Ton | FbKind::Tof | FbKind::Tp);
-        Some(match (name, timer) {
-            ("Q", _) => (Field::Q, Type::Bool),
-            ("ET", true) => (Field::Et, Type::Time),
-            ("PT", true) => (Field::Pt, Type::Time),
-            ("CV", false) => (Field::Cv, Type::Int),
-            ("PV", false) => (Field::Pv, Type::Int),
+        use FbKind::*;
+        Some(match (fb, name) {
+            (Ton | Tof | Tp | Ctu | Ctd | RTrig | FTrig, "Q") => (Field::Q, Type::Bool),
+            (Ton | Tof | Tp, "ET") => (Field::Et, Type::Time),
+            (Ton | Tof | Tp, "PT") => (Field::Pt, Type::Time),
+            (Ctu | Ctd | Ctud, "CV") => (Field::Cv, Type::Int),
+            (Ctu | Ctd | Ctud, "PV") => (Field::Pv, Type::Int),
+            (Sr | Rs, "Q1") => (Field::Q1, Type::Bool),
+            (Ctud, "QU") => (Field::Qu, Type::Bool),
+            (Ctud, "QD") => (Field::Qd, Type::Bool),
             _ => return None,
         })
     }
     pub fn name(self) -> &'static str {
         match self {
             Field::Q => "Q",
+            Field::Q1 => "Q1",
+            Field::Qu => "QU",
+            Field::Qd => "QD",
             Field::Et => "ET",
             Field::Pt => "PT",
             Field::Cv => "CV",
             Field::Pv => "PV",
+        }
+    }
+    /// The readable fields of `fb`, in the order the state shows them.
+    pub fn all(fb: FbKind) -> &'static [Field] {
+        match fb {
+            FbKind::Ton | FbKind::Tof | FbKind::Tp => &[Field::Q, Field::Et, Field::Pt],
+            FbKind::Ctu | FbKind::Ctd => &[Field::Q, Field::Cv, Field::Pv],
+            FbKind::Sr | FbKind::Rs => &[Field::Q1],
+            FbKind::RTrig | FbKind::FTrig => &[Field::Q],
+            FbKind::Ctud => &[Field::Qu, Field::Qd, Field::Cv, Field::Pv],
         }
     }
     /// The names of the fields of `fb`, for error messages.
@@ -150,6 +229,9 @@ impl Field {
         match fb {
             FbKind::Ton | FbKind::Tof | FbKind::Tp => "Q, ET, PT",
             FbKind::Ctu | FbKind::Ctd => "Q, CV, PV",
+            FbKind::Sr | FbKind::Rs => "Q1",
+            FbKind::RTrig | FbKind::FTrig => "Q",
+            FbKind::Ctud => "QU, QD, CV, PV",
         }
     }
 }

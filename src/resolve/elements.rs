@@ -181,6 +181,46 @@ impl<'a> Builder<'a> {
                     self.operand_of(&c.aux, &key("load"), s, Type::Bool, "a counter's load")?;
                 Element::Ctd { instance, pv, load }
             }
+            S::Bistable(b) => {
+                let name = match b.kind {
+                    BistableKind::SetDominant => "sr",
+                    BistableKind::ResetDominant => "rs",
+                };
+                let instance = self.instance(&b.instance, &key(name), s, b.kind.fb())?;
+                let reset =
+                    self.operand_of(&b.reset, &key("reset"), s, Type::Bool, "a bistable's reset")?;
+                Element::Bistable {
+                    kind: b.kind,
+                    instance,
+                    reset,
+                }
+            }
+            S::Trigger { kind, instance } => {
+                let name = match kind {
+                    TriggerKind::Rising => "r_trig",
+                    TriggerKind::Falling => "f_trig",
+                };
+                let instance = self.instance(instance, &key(name), s, kind.fb())?;
+                Element::Trigger {
+                    kind: *kind,
+                    instance,
+                }
+            }
+            S::Ctud(c) => {
+                let instance = self.instance(&c.instance, &key("ctud"), s, FbKind::Ctud)?;
+                let pin = |o, k, what| self.operand_of(o, &key(k), s, Type::Bool, what);
+                let cd = pin(&c.cd, "cd", "a counter's CD")?;
+                let reset = pin(&c.reset, "reset", "a counter's reset")?;
+                let load = pin(&c.load, "load", "a counter's load")?;
+                let pv = self.operand_of(&c.pv, &key("pv"), s, Type::Int, "a counter's PV")?;
+                Element::Ctud {
+                    instance,
+                    cd,
+                    reset,
+                    load,
+                    pv,
+                }
+            }
             S::Move(m) => {
                 let to = self.writable(&m.to, &key("to"), s, "a move", None)?;
                 let ty = self.vars[to.index()].ty;

@@ -156,7 +156,7 @@ pub(crate) fn field_ref(
             var: name.to_owned(),
             ty: ty.to_string(),
             field: f.to_owned(),
-            fields: "none: only TON, TOF, TP, CTU and CTD instances have fields",
+            fields: "none: only instances of function blocks have fields",
         }),
     }
 }

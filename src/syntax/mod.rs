@@ -23,7 +23,7 @@ pub mod fbd;
 pub mod pipe;
 
 use crate::diag::Invalid;
-use crate::model::{ArithOp, CmpOp, TimerKind};
+use crate::model::{ArithOp, BistableKind, CmpOp, TimerKind, TriggerKind};
 use std::borrow::Cow;
 
 pub use fbd::FbdBody;
@@ -281,6 +281,15 @@ pub enum ElementKind<'a> {
     Timer(Box<Timer<'a>>),
     /// CTU (`load` false: `aux` is R) or CTD (`aux` is LD).
     Counter(Box<Counter<'a>>),
+    /// SR or RS: power in is S1/S, `reset` R/R1.
+    Bistable(Box<Bistable<'a>>),
+    /// R_TRIG or F_TRIG: power in is CLK.
+    Trigger {
+        kind: TriggerKind,
+        instance: Name<'a>,
+    },
+    /// CTUD: power in is CU.
+    Ctud(Box<Ctud<'a>>),
     Move(Box<Move<'a>>),
     Arith(Box<Arith<'a>>),
     Jmp(Name<'a>),
@@ -317,6 +326,24 @@ pub struct Counter<'a> {
     pub pv: Operand<'a>,
     /// R of a CTU, LD of a CTD.
     pub aux: Operand<'a>,
+}
+
+/// `{"sr": B, "reset": R}` or `{"rs": B, "reset": R1}`.
+#[derive(Clone, Debug)]
+pub struct Bistable<'a> {
+    pub kind: BistableKind,
+    pub instance: Name<'a>,
+    pub reset: Operand<'a>,
+}
+
+/// `{"ctud": C, "cd": CD, "reset": R, "load": LD, "pv": PV}`.
+#[derive(Clone, Debug)]
+pub struct Ctud<'a> {
+    pub instance: Name<'a>,
+    pub cd: Operand<'a>,
+    pub reset: Operand<'a>,
+    pub load: Operand<'a>,
+    pub pv: Operand<'a>,
 }
 
 /// `{"move": FROM, "to": TO}`.

@@ -215,6 +215,35 @@ fn body(rng: &mut Rng, s: &Scope, networks: usize) -> Json {
                     outs.push(("OUT", Ty::Int));
                     outs.push(("Q", Ty::Bool));
                 }
+                20 if s.ctu.is_some() => {
+                    // The standard function blocks of the main program's instances.
+                    let (op, inst) = *rng.pick(&[
+                        ("SR", "sr0"),
+                        ("RS", "rs0"),
+                        ("R_TRIG", "rt0"),
+                        ("F_TRIG", "ft0"),
+                        ("CTUD", "ud0"),
+                    ]);
+                    b.insert("op".into(), json!(op));
+                    b.insert("instance".into(), json!(inst));
+                    let ins = match op {
+                        "SR" => json!({"S1": bool_in(rng), "R": bool_in(rng)}),
+                        "RS" => json!({"S": bool_in(rng), "R1": bool_in(rng)}),
+                        "CTUD" => json!({"CU": bool_in(rng), "CD": bool_in(rng),
+                            "R": bool_in(rng), "LD": bool_in(rng), "PV": int_in(rng)}),
+                        _ => json!({"CLK": bool_in(rng)}),
+                    };
+                    b.insert("in".into(), ins);
+                    match op {
+                        "SR" | "RS" => outs.push(("Q1", Ty::Bool)),
+                        "CTUD" => {
+                            outs.push(("QU", Ty::Bool));
+                            outs.push(("QD", Ty::Bool));
+                            outs.push(("CV", Ty::Int));
+                        }
+                        _ => outs.push(("Q", Ty::Bool)),
+                    }
+                }
                 _ => {
                     b.insert("op".into(), json!("ADD"));
                     b.insert("in".into(), json!([int_in(rng), 1]));
@@ -278,9 +307,11 @@ fn body(rng: &mut Rng, s: &Scope, networks: usize) -> Json {
 pub fn random_fbd_program(seed: u64) -> String {
     let mut rng = Rng::new(seed ^ 0x5EED_F00D);
     let main = Scope {
-        bools_read: vec!["i0", "i1", "b0", "b1", "q", "t0.Q", "c0.Q", "f0.Q"],
+        bools_read: vec![
+            "i0", "i1", "b0", "b1", "q", "t0.Q", "c0.Q", "f0.Q", "sr0.Q1", "ud0.QD",
+        ],
         bools_write: vec!["b0", "b1", "q"],
-        ints_read: vec!["k", "n0", "n1", "c0.CV", "f1.OUT"],
+        ints_read: vec!["k", "n0", "n1", "c0.CV", "f1.OUT", "ud0.CV"],
         ints_write: vec!["n0", "n1", "n2"],
         time_var: "tv",
         ton: Some("t0"),
@@ -317,6 +348,9 @@ pub fn random_fbd_program(seed: u64) -> String {
             {"name": "tv", "type": "TIME"},
             {"name": "t0", "type": "TON"}, {"name": "t1", "type": "TOF"},
             {"name": "c0", "type": "CTU"}, {"name": "c1", "type": "CTD"},
+            {"name": "sr0", "type": "SR"}, {"name": "rs0", "type": "RS"},
+            {"name": "rt0", "type": "R_TRIG"}, {"name": "ft0", "type": "F_TRIG"},
+            {"name": "ud0", "type": "CTUD"},
             {"name": "f0", "type": "FB1"}, {"name": "f1", "type": "FB1"}
         ],
         "function_blocks": {"FB1": {

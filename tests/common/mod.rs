@@ -1,5 +1,6 @@
 //! Random ladder programs for property tests: every element kind, jumps (forward and backward),
-//! FOR/NEXT loops, calls, timers, counters, set/reset and edges. Programs are built as JSON text
+//! FOR/NEXT loops, calls, timers, counters, the bistables, edge detectors and up-down counter,
+//! set/reset and edges. Programs are built as JSON text
 //! from a seed, so a failing case is reproducible and printable.
 #![allow(dead_code)]
 
@@ -79,6 +80,11 @@ fn vars() -> Vec<Value> {
     v.push(json!({"name": "c0", "type": "CTU"}));
     v.push(json!({"name": "c1", "type": "CTD"}));
     v.push(json!({"name": "li", "type": "INT"}));
+    v.push(json!({"name": "s0", "type": "SR"}));
+    v.push(json!({"name": "s1", "type": "RS"}));
+    v.push(json!({"name": "e0", "type": "R_TRIG"}));
+    v.push(json!({"name": "e1", "type": "F_TRIG"}));
+    v.push(json!({"name": "u0", "type": "CTUD"}));
     v
 }
 
@@ -88,7 +94,9 @@ fn bool_read(rng: &mut Rng) -> &'static str {
         4..=6 => *rng.pick(INPUTS),
         7 => "t0.Q",
         8 => "c0.Q",
-        _ => *rng.pick(&["t1.Q", "t2.Q", "c1.Q", "q"]),
+        _ => *rng.pick(&[
+            "t1.Q", "t2.Q", "c1.Q", "q", "s0.Q1", "s1.Q1", "e0.Q", "e1.Q", "u0.QU", "u0.QD",
+        ]),
     }
 }
 
@@ -96,7 +104,7 @@ fn int_operand(rng: &mut Rng) -> Value {
     match rng.below(5) {
         0 => json!(rng.below(7) as i64 - 2),
         1 => json!("k"),
-        2 => json!("c0.CV"),
+        2 => json!(rng.pick(&["c0.CV", "u0.CV"])),
         _ => json!(rng.pick(INTS)),
     }
 }
@@ -130,7 +138,7 @@ fn condition(rng: &mut Rng, depth: u32) -> Value {
 /// An output, box or control element; `labels` are the jump targets available in this POU.
 fn action(rng: &mut Rng, labels: &[String], subs: &[String], depth: u32) -> Value {
     let w = *rng.pick(BOOLS);
-    match rng.below(if depth > 0 { 16 } else { 18 }) {
+    match rng.below(if depth > 0 { 21 } else { 23 }) {
         0..=2 => json!({"coil": w}),
         3 => json!({"coil": w, "negated": true}),
         4 => json!({"set": w}),
@@ -148,6 +156,13 @@ fn action(rng: &mut Rng, labels: &[String], subs: &[String], depth: u32) -> Valu
         14 if !labels.is_empty() => json!({"jmp": rng.pick(labels)}),
         14 | 15 if !subs.is_empty() => json!({"call": rng.pick(subs)}),
         14 | 15 => json!({"coil": "q"}),
+        16 => json!({"sr": "s0", "reset": bool_read(rng)}),
+        17 => json!({"rs": "s1", "reset": bool_read(rng)}),
+        18 => json!({"r_trig": "e0"}),
+        19 => json!({"f_trig": "e1"}),
+        20 => {
+            json!({"ctud": "u0", "cd": bool_read(rng), "reset": bool_read(rng), "load": bool_read(rng), "pv": int_operand(rng)})
+        }
         _ => {
             let n = 2 + rng.below(2);
             let branches: Vec<Value> = (0..n)

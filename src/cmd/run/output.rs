@@ -21,6 +21,12 @@ fn value_text(v: VarValue) -> String {
         VarValue::Counter { q, cv, pv } => {
             format!("Q={} CV={cv} PV={pv}", if q { "TRUE" } else { "FALSE" })
         }
+        VarValue::Bistable { q1 } => format!("Q1={}", if q1 { "TRUE" } else { "FALSE" }),
+        VarValue::Trigger { q } => format!("Q={}", if q { "TRUE" } else { "FALSE" }),
+        VarValue::UpDown { qu, qd, cv, pv } => {
+            let b = |x: bool| if x { "TRUE" } else { "FALSE" };
+            format!("QU={} QD={} CV={cv} PV={pv}", b(qu), b(qd))
+        }
     }
 }
 

@@ -31,16 +31,10 @@ pub(super) fn trace_columns(
 ) -> Result<Vec<(String, VarRef, Type)>, CliError> {
     let fields_of = |v: VarId| -> Vec<(Field, Type)> {
         match p.var(v).ty {
-            Type::Fb(crate::model::FbKind::Ctu | crate::model::FbKind::Ctd) => vec![
-                (Field::Q, Type::Bool),
-                (Field::Cv, Type::Int),
-                (Field::Pv, Type::Int),
-            ],
-            Type::Fb(_) => vec![
-                (Field::Q, Type::Bool),
-                (Field::Et, Type::Time),
-                (Field::Pt, Type::Time),
-            ],
+            Type::Fb(fb) => Field::all(fb)
+                .iter()
+                .filter_map(|f| Field::lookup(fb, f.name()))
+                .collect(),
             _ => vec![],
         }
     };

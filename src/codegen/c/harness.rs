@@ -123,6 +123,9 @@ fn print_state(p: &Program, sh: &Shared, s: &mut String) {
                     format!("_plc_put_timer(o, &{f});")
                 }
                 Type::Fb(FbKind::Ctu | FbKind::Ctd) => format!("_plc_put_counter(o, &{f});"),
+                Type::Fb(FbKind::Sr | FbKind::Rs) => format!("_plc_put_bistable(o, &{f});"),
+                Type::Fb(FbKind::RTrig | FbKind::FTrig) => format!("_plc_put_trigger(o, &{f});"),
+                Type::Fb(FbKind::Ctud) => format!("_plc_put_updown(o, &{f});"),
             };
             push(s, format_args!("    fputs({}, o); {put}\n", c_string(&key)));
         }

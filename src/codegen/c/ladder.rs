@@ -93,6 +93,9 @@ pub(crate) fn c_type(ty: Type) -> &'static str {
         Type::Real => "float",
         Type::Fb(FbKind::Ton | FbKind::Tof | FbKind::Tp) => "_plc_timer",
         Type::Fb(FbKind::Ctu | FbKind::Ctd) => "_plc_counter",
+        Type::Fb(FbKind::Sr | FbKind::Rs) => "_plc_bistable",
+        Type::Fb(FbKind::RTrig | FbKind::FTrig) => "_plc_trigger",
+        Type::Fb(FbKind::Ctud) => "_plc_updown",
     }
 }
 
@@ -298,6 +301,49 @@ impl<'a> Body<'a> {
                     self.operand(pv),
                     Self::text(&pw),
                     self.operand(reset)
+                );
+                self.boxed(call, last)
+            }
+            Element::Bistable {
+                kind,
+                instance,
+                reset,
+            } => {
+                let f = match kind {
+                    BistableKind::SetDominant => "_plc_sr",
+                    BistableKind::ResetDominant => "_plc_rs",
+                };
+                let call = format!(
+                    "{f}(&{}, {}, {})",
+                    self.var(*instance),
+                    Self::text(&pw),
+                    self.operand(reset)
+                );
+                self.boxed(call, last)
+            }
+            Element::Trigger { kind, instance } => {
+                let f = match kind {
+                    TriggerKind::Rising => "_plc_r_trig",
+                    TriggerKind::Falling => "_plc_f_trig",
+                };
+                let call = format!("{f}(&{}, {})", self.var(*instance), Self::text(&pw));
+                self.boxed(call, last)
+            }
+            Element::Ctud {
+                instance,
+                cd,
+                reset,
+                load,
+                pv,
+            } => {
+                let call = format!(
+                    "_plc_ctud(&{}, {}, {}, {}, {}, {})",
+                    self.var(*instance),
+                    self.operand(pv),
+                    Self::text(&pw),
+                    self.operand(cd),
+                    self.operand(reset),
+                    self.operand(load)
                 );
                 self.boxed(call, last)
             }

@@ -7,7 +7,8 @@
 //! define the conversion as modulo 2^N); DIV truncates, MOD takes the dividend's sign, an
 //! integer DIV or MOD by zero gives 0 and records a fault; TON/TOF/TP and CTU/CTD follow the
 //! interpreter's state machine field by field (a timer's start time and flags, a counter's
-//! previous CU/CD). REAL is `float` (C11 with `FLT_EVAL_METHOD == 0` on x86-64 and AArch64, and
+//! previous CU/CD); SR/RS, R_TRIG/F_TRIG and CTUD the bodies of IEC 61131-3 2.5.2.3 as
+//! `src/exec/fb.rs` runs them. REAL is `float` (C11 with `FLT_EVAL_METHOD == 0` on x86-64 and AArch64, and
 //! no contraction under `-std=c11`).
 //!
 //! Not here: anything that depends on the program (the generated files have that).
@@ -43,6 +44,13 @@ static inline void _plc_fault(_plc_ctx *ctx, uint32_t rung, int kind) {
 typedef struct { bool Q; int32_t ET; int32_t PT; int64_t start; uint8_t flags; } _plc_timer;
 /* A CTU/CTD instance: the readable fields, then CU/CD of the previous evaluation. */
 typedef struct { bool Q; int16_t CV; int16_t PV; bool prev; } _plc_counter;
+
+/* An SR/RS instance. */
+typedef struct { bool Q1; } _plc_bistable;
+/* An R_TRIG/F_TRIG instance: Q, then the memory M. */
+typedef struct { bool Q; bool M; } _plc_trigger;
+/* A CTUD instance: the readable fields, then CU (bit 0) and CD (bit 1) of the previous evaluation. */
+typedef struct { bool QU; bool QD; int16_t CV; int16_t PV; uint8_t prev; } _plc_updown;
 
 #define _PLC_PREV_IN 1u
 #define _PLC_ACTIVE 2u
@@ -118,6 +126,46 @@ static inline bool _plc_ctd(_plc_counter *c, int16_t pv, bool cd, bool ld) {
     c->CV = cv;
     c->Q = cv <= 0;
     return c->Q;
+}
+
+/* SR: Q1 := S1 OR (NOT R AND Q1); RS: Q1 := NOT R1 AND (S OR Q1). */
+static inline bool _plc_sr(_plc_bistable *b, bool s1, bool r) {
+    b->Q1 = s1 || (!r && b->Q1);
+    return b->Q1;
+}
+static inline bool _plc_rs(_plc_bistable *b, bool s, bool r1) {
+    b->Q1 = !r1 && (s || b->Q1);
+    return b->Q1;
+}
+
+/* R_TRIG: Q := CLK AND NOT M; M := CLK. F_TRIG: Q := NOT CLK AND NOT M; M := NOT CLK. */
+static inline bool _plc_r_trig(_plc_trigger *t, bool clk) {
+    t->Q = clk && !t->M;
+    t->M = clk;
+    return t->Q;
+}
+static inline bool _plc_f_trig(_plc_trigger *t, bool clk) {
+    t->Q = !clk && !t->M;
+    t->M = !clk;
+    return t->Q;
+}
+
+/* CTUD: both edges first, then R, LD, or one edge alone counts (stopping at the INT limits). */
+static inline bool _plc_ctud(_plc_updown *c, int16_t pv, bool cu, bool cd, bool r, bool ld) {
+    bool up = cu && !(c->prev & 1u), down = cd && !(c->prev & 2u);
+    c->prev = (uint8_t)((cu ? 1u : 0u) | (cd ? 2u : 0u));
+    int16_t cv = c->CV;
+    if (r) cv = 0;
+    else if (ld) cv = pv;
+    else if (!(up && down)) {
+        if (up && cv < INT16_MAX) cv++;
+        else if (down && cv > INT16_MIN) cv--;
+    }
+    c->CV = cv;
+    c->PV = pv;
+    c->QU = cv >= pv;
+    c->QD = cv <= 0;
+    return c->QU;
 }
 
 /* Integer arithmetic: computed wide, wrapped to the type's width (two's complement). */
@@ -224,6 +272,16 @@ static inline void _plc_put_timer(FILE *o, const _plc_timer *t) {
 }
 static inline void _plc_put_counter(FILE *o, const _plc_counter *c) {
     fprintf(o, "{\"Q\":%s,\"CV\":%d,\"PV\":%d}", c->Q ? "true" : "false", (int)c->CV, (int)c->PV);
+}
+static inline void _plc_put_bistable(FILE *o, const _plc_bistable *b) {
+    fprintf(o, "{\"Q1\":%s}", b->Q1 ? "true" : "false");
+}
+static inline void _plc_put_trigger(FILE *o, const _plc_trigger *t) {
+    fprintf(o, "{\"Q\":%s}", t->Q ? "true" : "false");
+}
+static inline void _plc_put_updown(FILE *o, const _plc_updown *c) {
+    fprintf(o, "{\"QU\":%s,\"QD\":%s,\"CV\":%d,\"PV\":%d}", c->QU ? "true" : "false",
+            c->QD ? "true" : "false", (int)c->CV, (int)c->PV);
 }
 
 /* Input cells of the harness (docs/scan.md, Inputs): 0 when the text is not a value. */

@@ -1,10 +1,11 @@
 //! Classifying one element object: which kind (by the key it has, in the format's order —
-//! `ctu`/`ctd` before `reset`, since a counter has a `reset` operand), which keys it may have, and
+//! `ctu`/`ctd`/`ctud`/`sr`/`rs` before `reset`, since these boxes have a `reset` operand), which keys it may have, and
 //! the shape of each field. Names and operands are left to the resolver. The element's keys are
 //! the top of the reader's scratch stack (from `mark` on); they are taken from there.
 
 use super::ladder::{arith_op, cmp_op, edge, timer_kind, ForSlots};
 use crate::diag::Invalid;
+use crate::model::{BistableKind, TriggerKind};
 use crate::syntax::{
     self, ElementKind, Located, Name, Operand, Origin, Problem, Scalar, Series, Text,
 };
@@ -31,6 +32,11 @@ pub(super) struct SlotEntry<'a> {
 const ELEMENT_KINDS: &[(&str, &[&str])] = &[
     ("ctu", &["ctu", "pv", "reset"]),
     ("ctd", &["ctd", "pv", "load"]),
+    ("ctud", &["ctud", "cd", "reset", "load", "pv"]),
+    ("sr", &["sr", "reset"]),
+    ("rs", &["rs", "reset"]),
+    ("r_trig", &["r_trig"]),
+    ("f_trig", &["f_trig"]),
     ("contact", &["contact", "negated", "edge"]),
     ("compare", &["compare", "a", "b"]),
     ("or", &["or"]),
@@ -65,6 +71,11 @@ fn element_what(key: &str) -> &'static str {
         "tp" => "a TP box",
         "ctu" => "a CTU box",
         "ctd" => "a CTD box",
+        "ctud" => "a CTUD box",
+        "sr" => "an SR box",
+        "rs" => "an RS box",
+        "r_trig" => "an R_TRIG box",
+        "f_trig" => "an F_TRIG box",
         "move" => "a move box",
         "op" => "an arithmetic box",
         "jmp" => "a jump",
@@ -272,6 +283,41 @@ pub(super) fn classify<'a>(
                 aux,
             }))
         }
+        "ctud" => {
+            let instance = f.string(key)?;
+            let cd = f.operand("cd")?;
+            let reset = f.operand("reset")?;
+            let load = f.operand("load")?;
+            let pv = f.operand("pv")?;
+            ElementKind::Ctud(Box::new(syntax::Ctud {
+                instance,
+                cd,
+                reset,
+                load,
+                pv,
+            }))
+        }
+        "sr" | "rs" => {
+            let instance = f.string(key)?;
+            let reset = f.operand("reset")?;
+            ElementKind::Bistable(Box::new(syntax::Bistable {
+                kind: if key == "sr" {
+                    BistableKind::SetDominant
+                } else {
+                    BistableKind::ResetDominant
+                },
+                instance,
+                reset,
+            }))
+        }
+        "r_trig" | "f_trig" => ElementKind::Trigger {
+            kind: if key == "r_trig" {
+                TriggerKind::Rising
+            } else {
+                TriggerKind::Falling
+            },
+            instance: f.string(key)?,
+        },
         "move" => {
             let to = f.string("to")?;
             let from = f.operand("move")?;

@@ -341,6 +341,17 @@ impl Net<'_, '_, '_> {
             OpKind::Ctd => Op::Ctd {
                 instance: self.instance(d)?,
             },
+            OpKind::Bistable(kind) => Op::Bistable {
+                kind,
+                instance: self.instance(d)?,
+            },
+            OpKind::Trigger(kind) => Op::Trigger {
+                kind,
+                instance: self.instance(d)?,
+            },
+            OpKind::Ctud => Op::Ctud {
+                instance: self.instance(d)?,
+            },
             OpKind::Call => Op::Call {
                 fb: d.op.to_owned(),
                 instance: self.instance(d)?,

@@ -46,6 +46,9 @@ impl Cx<'_> {
             Op::Max | Op::Min | Op::Limit => self.extreme(nx, b, &vals),
             Op::Timer { kind, instance } => self.timer(nx, b, &vals, *kind, instance),
             Op::Ctu { instance } | Op::Ctd { instance } => self.counter(nx, b, &vals, instance),
+            Op::Bistable { kind, instance } => self.bistable(nx, b, &vals, *kind, instance),
+            Op::Trigger { kind, instance } => self.trigger(nx, b, &vals, *kind, instance),
+            Op::Ctud { instance } => self.ctud(nx, b, &vals, instance),
             Op::Jmp { .. } | Op::Ret => self.jump(nx, b, labels),
             Op::TStart | Op::TStop => self.accumulate(nx, b),
             Op::Call { fb, instance } => self.call(nx, b, fb, instance),
@@ -352,7 +355,7 @@ impl Cx<'_> {
             nx,
             b,
             inst,
-            [(Field::Q, Type::Bool), (Field::Et, Type::Time)],
+            &[(Field::Q, Type::Bool), (Field::Et, Type::Time)],
             first,
         )
     }
@@ -413,7 +416,7 @@ impl Cx<'_> {
             nx,
             b,
             inst,
-            [(Field::Q, Type::Bool), (Field::Cv, Type::Int)],
+            &[(Field::Q, Type::Bool), (Field::Cv, Type::Int)],
             first,
         )
     }

@@ -35,11 +35,11 @@ impl Cx<'_> {
         nx: &mut Net,
         b: BlockId,
         inst: VarId,
-        fields: [(Field, Type); 2],
+        fields: &[(Field, Type)],
         first: Series,
     ) -> Result<Series> {
         let mut parts = vec![first];
-        for (pin, (f, ty)) in fields.into_iter().enumerate() {
+        for (pin, &(f, ty)) in fields.iter().enumerate() {
             nx.values[b.index()][pin] = Some((field_op(inst, f), ty));
             for v in self.out_vars(nx, b, pin, Some(ty))? {
                 parts.push(vec![Element::Move {

@@ -24,6 +24,7 @@ mod blocks;
 mod fragments;
 mod instances;
 mod pins;
+mod standard;
 mod time;
 mod typed;
 
