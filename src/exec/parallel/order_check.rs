@@ -225,3 +225,201 @@ impl Seen {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::exec::parallel::config::{PlanConfig, PlanKind, Slicing, Strategy};
+    use crate::exec::parallel::{deps_plan, plan::layout_groups};
+    use crate::exec::{ExecConfig, Layout};
+    use crate::model::Program;
+    use proptest::prelude::*;
+
+    /// R1 (a → x) and R2 (b → y) in level 0, R3 (x, y → z) in level 1: on two workers with
+    /// contiguous slices R1 and R3 run on worker 0, R2 on worker 1, and R3 waits for R2.
+    fn program() -> Program {
+        crate::read::program_from_json(
+            r#"{"program": "p", "vars": [
+                {"name": "a", "type": "BOOL", "class": "input"},
+                {"name": "b", "type": "BOOL", "class": "input"},
+                {"name": "x", "type": "BOOL", "class": "output"},
+                {"name": "y", "type": "BOOL", "class": "output"},
+                {"name": "z", "type": "BOOL", "class": "output"}],
+              "rungs": [{"id": "R1", "ld": [{"contact": "a"}, {"coil": "x"}]},
+                        {"id": "R2", "ld": [{"contact": "b"}, {"coil": "y"}]},
+                        {"id": "R3", "ld": [{"contact": "x"}, {"contact": "y"}, {"coil": "z"}]}]}"#,
+        )
+        .unwrap()
+    }
+
+    fn config(threads: usize, slicing: Slicing) -> PlanConfig {
+        PlanConfig {
+            strategy: Strategy::AllParallel,
+            slicing,
+            kind: PlanKind::Deps,
+            ..PlanConfig::new(threads)
+        }
+    }
+
+    /// The machine on the plan's padded layout.
+    fn machine(p: &Program, plan: &Plan) -> Machine {
+        let groups = layout_groups(&[plan], p.vars.len());
+        let layout = Layout::from_groups(p, &groups, LINE_BYTES).unwrap();
+        Machine::new(p, layout, &ExecConfig::default()).unwrap()
+    }
+
+    #[test]
+    fn the_plan_waits_for_the_producer_and_the_check_refuses_it_without_the_wait() {
+        let p = program();
+        let a = crate::analysis::analyse(&p);
+        let mut plan = deps_plan::build(&p, &a, &config(2, Slicing::Contiguous));
+        assert_eq!(plan.sequential(), None);
+        let items = worker_items(&plan).unwrap();
+        let tasks = |w: usize| -> Vec<u32> {
+            items[w]
+                .iter()
+                .flat_map(|it| it.tasks().map(|t| t.0))
+                .collect()
+        };
+        assert_eq!((tasks(0), tasks(1)), (vec![0, 2], vec![1]));
+        assert_eq!(plan.waits, vec![Wait { worker: 1, done: 1 }]);
+        assert_eq!(items[0][1].waits, 0..1);
+        assert!(items[1][0].publish && !items[0][0].publish);
+        let r = plan.ready().unwrap();
+        assert_eq!(
+            (r.waits_per_worker.clone(), r.cross_dependences),
+            (vec![1, 0], 1)
+        );
+        let m = machine(&p, &plan);
+        assert_eq!(check_ordered(&m, &plan), Ok(()));
+        // The same plan without its wait: R3 reads y, which worker 1 writes, unordered (the walk
+        // runs worker 0's items first: the read is seen before the write).
+        let SlicesMut(slices) = parallel_mut(&mut plan);
+        slices[0][1].waits = 0..0;
+        let y = m.layout().start(crate::model::VarId(3)).index();
+        assert_eq!(
+            check_ordered(&m, &plan),
+            Err(format!(
+                "byte {y} read and written by worker 0 item 1 and worker 1 item 0 (rung 1) with no wait ordering them"
+            ))
+        );
+        // A wait on itself, or a cycle of waits, can never be satisfied.
+        plan.waits = vec![Wait { worker: 0, done: 2 }];
+        parallel_mut(&mut plan).0[1][0].waits = 0..1;
+        parallel_mut(&mut plan).0[0][1].waits = 0..0;
+        parallel_mut(&mut plan).0[0][0].waits = 0..0;
+        plan.waits.push(Wait { worker: 1, done: 1 });
+        parallel_mut(&mut plan).0[0][0].waits = 1..2;
+        assert_eq!(
+            check_ordered(&m, &plan),
+            Err("worker 0 item 0 waits for items that can never finish (a cycle of waits)".into())
+        );
+    }
+
+    /// The items of the plan's parallel phase, mutable.
+    struct SlicesMut<'a>(&'a mut Vec<Vec<Item>>);
+
+    fn parallel_mut(plan: &mut Plan) -> SlicesMut<'_> {
+        match &mut plan.phases[0].kind {
+            super::super::plan::PhaseKind::Parallel(s) => SlicesMut(s),
+            super::super::plan::PhaseKind::Sequential(_) => panic!("a parallel phase"),
+        }
+    }
+
+    /// Happened-before by brute force: the transitive closure of program order and the waits.
+    fn closure(items: &[&[Item]], waits: &[Wait]) -> Vec<Vec<Vec<bool>>> {
+        let ids: Vec<At> = items
+            .iter()
+            .enumerate()
+            .flat_map(|(w, s)| (0..s.len()).map(move |i| (w, i)))
+            .collect();
+        let index = |x: At| ids.iter().position(|&y| y == x).unwrap();
+        let n = ids.len();
+        let mut preds: Vec<Vec<usize>> = vec![Vec::new(); n];
+        for (k, &(w, i)) in ids.iter().enumerate() {
+            if i > 0 {
+                preds[k].push(index((w, i - 1)));
+            }
+            let r = &items[w][i].waits;
+            for x in &waits[r.start as usize..r.end as usize] {
+                preds[k].push(index((x.worker as usize, x.done as usize - 1)));
+            }
+        }
+        let mut hb = vec![vec![false; n]; n]; // hb[y][x]: x before y
+        for y in 0..n {
+            let mut stack = preds[y].clone();
+            while let Some(x) = stack.pop() {
+                if !hb[y][x] {
+                    hb[y][x] = true;
+                    stack.extend_from_slice(&preds[x]);
+                }
+            }
+        }
+        let mut out: Vec<Vec<Vec<bool>>> = Vec::new();
+        for (k, &(w, i)) in ids.iter().enumerate() {
+            if out.len() <= w {
+                out.resize(w + 1, Vec::new());
+            }
+            if out[w].len() <= i {
+                out[w].resize(i + 1, Vec::new());
+            }
+            out[w][i] = hb[k].clone();
+        }
+        out
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(48))]
+        /// On generated programs with every feature, every pair of items of different workers
+        /// that touch a common byte of the lowered code, one writing, is ordered by program
+        /// order and waits (checked pair by pair, independently of the walk of the check).
+        #[test]
+        fn every_conflicting_cross_worker_pair_is_ordered(
+            rungs in 20usize..160,
+            width in 2usize..40,
+            seed in 0u64..1000,
+            threads in 2usize..5,
+            slicing in prop_oneof![Just(Slicing::Contiguous), Just(Slicing::Lpt), Just(Slicing::Locality)],
+        ) {
+            let json = crate::synth::generate_string(
+                &crate::synth::GenConfig::all_features(rungs, width, seed));
+            let p = crate::read::program_from_json(&json).unwrap();
+            let a = crate::analysis::analyse(&p);
+            let plan = deps_plan::build(&p, &a, &config(threads, slicing));
+            prop_assume!(plan.sequential().is_none());
+            let m = machine(&p, &plan);
+            prop_assert_eq!(check_ordered(&m, &plan), Ok(()));
+            let items = worker_items(&plan).unwrap();
+            let ids: Vec<At> = items.iter().enumerate()
+                .flat_map(|(w, s)| (0..s.len()).map(move |i| (w, i))).collect();
+            let n = ids.len();
+            let all = closure(&items, &plan.waits);
+            let flat: Vec<&Vec<bool>> = ids.iter().map(|&(w, i)| &all[w][i]).collect();
+            let mut acc: Vec<(Vec<usize>, Vec<usize>)> = Vec::new();
+            for &(w, i) in &ids {
+                let (mut r, mut wr) = (Vec::new(), Vec::new());
+                let (mut rs, mut ws) = (Vec::new(), Vec::new());
+                for t in items[w][i].tasks() {
+                    for &rung in &plan.task_rungs[t.index()] {
+                        m.rung_accesses(rung, &mut rs, &mut ws);
+                    }
+                }
+                r.extend(rs.iter().flat_map(|&s| bytes(s)));
+                wr.extend(ws.iter().flat_map(|&s| bytes(s)));
+                acc.push((r, wr));
+            }
+            for x in 0..n {
+                for y in 0..n {
+                    if ids[x].0 == ids[y].0 || x == y {
+                        continue;
+                    }
+                    let conflict = acc[x].1.iter().any(|b| acc[y].0.contains(b) || acc[y].1.contains(b));
+                    if conflict {
+                        prop_assert!(flat[y][x] || flat[x][y],
+                            "items {:?} and {:?} conflict unordered", ids[x], ids[y]);
+                    }
+                }
+            }
+        }
+    }
+}
