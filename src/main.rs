@@ -188,7 +188,8 @@ enum Command {
         explain: bool,
         /// Which plans the parallel executor may use: measured among the sequential walk and
         /// the levelled plans (auto), the cost model's choice (model), always the sequential
-        /// walk (seq), always the levelled plan (par).
+        /// walk (seq), always the levelled plan (par), always the dependence-driven plan (deps:
+        /// ready flags instead of a barrier per level).
         #[arg(long, value_enum, default_value_t = PlanArg::Auto)]
         plan: PlanArg,
         /// Loop-backs allowed per loop-back rung and scan (the iteration cap).
@@ -206,6 +207,7 @@ enum PlanArg {
     Model,
     Seq,
     Par,
+    Deps,
 }
 
 #[derive(Copy, Clone, ValueEnum)]
@@ -447,6 +449,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
                 PlanArg::Model => plc_deps::exec::parallel::PlanKind::Model,
                 PlanArg::Seq => plc_deps::exec::parallel::PlanKind::Seq,
                 PlanArg::Par => plc_deps::exec::parallel::PlanKind::Par,
+                PlanArg::Deps => plc_deps::exec::parallel::PlanKind::Deps,
             };
             config.loop_cap = loop_cap;
             config.output = output;

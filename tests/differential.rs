@@ -63,6 +63,9 @@ struct Stats {
     /// Cases where the run mixed the sequential walk and a levelled plan.
     mixed_runs: u64,
     switches: u64,
+    /// Cases that ran a dependence-driven plan, and its waits per scan.
+    deps_cases: u64,
+    deps_waits: u64,
 }
 
 /// Runs one program under one plan configuration and compares every scan.
@@ -96,6 +99,13 @@ fn check_with(
     if let Err(e) = par.verify(p, &a) {
         panic!("{label}: unsafe plan: {e}\n{}", par.explain(p));
     }
+    // A plan that failed its check was dropped with a warning: that is a planner bug here.
+    assert!(
+        par.warnings().is_empty(),
+        "{label}: {:?}\n{}",
+        par.warnings(),
+        par.explain(p)
+    );
     let seq = Machine::new(p, par.machine().layout().clone(), exec).unwrap();
     let mut rec = Recorder {
         inputs,
@@ -130,6 +140,15 @@ fn check_with(
     if par.plan().sequential().is_none() {
         stats.parallel_cases += 1;
         stats.parallel_phases += par.plan().parallel_phases() as u64;
+    }
+    if let Some(r) = par
+        .plans()
+        .iter()
+        .filter(|pl| pl.sequential().is_none())
+        .find_map(|pl| pl.ready())
+    {
+        stats.deps_cases += 1;
+        stats.deps_waits += r.waits();
     }
     for scan in 0..scans {
         let mut faults = Vec::new();
@@ -244,6 +263,55 @@ fn parallel_scan_equals_sequential_scan_on_random_programs() {
     );
 }
 
+/// The dependence-driven plan (ready flags instead of barriers) on random programs with 1, 2,
+/// 4 and 8 workers, every level sliced (forced) under each slicing: the state after every scan
+/// and the faults are the sequential scan's, and most cases really run with waits.
+#[test]
+fn dependence_driven_plan_equals_sequential_scan_on_random_programs() {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(7)
+        .build()
+        .unwrap();
+    let exec = ExecConfig {
+        cycle_ms: 10,
+        loop_cap: 12,
+    };
+    let mut stats = Stats::default();
+    let mut loaded = 0;
+    for seed in 0..800u64 {
+        let json = common::random_program(seed + 90_000, 24);
+        let Ok(p) = plc_deps::read::program_from_json(&json) else {
+            continue;
+        };
+        loaded += 1;
+        for threads in [1, 2, 4, 8] {
+            let mut config = configs(threads, seed + threads as u64);
+            config.kind = PlanKind::Deps;
+            let label = format!(
+                "seed {seed}, {threads} threads, --plan deps, {:?}/{:?}",
+                config.strategy, config.slicing
+            );
+            check(&p, &label, &config, &exec, SCANS, seed, &pool, &mut stats);
+        }
+    }
+    eprintln!(
+        "{loaded} programs, {} cases, {} dependence-driven ({} waits per scan in all), faults: {} loop-cap, {} div-by-zero",
+        stats.cases, stats.deps_cases, stats.deps_waits, stats.loop_cap_faults, stats.div_faults
+    );
+    assert!(loaded >= 600, "only {loaded} random programs loaded");
+    assert!(
+        stats.deps_cases >= stats.cases / 3,
+        "too few dependence-driven plans: {} of {}",
+        stats.deps_cases,
+        stats.cases
+    );
+    assert!(stats.deps_waits > stats.deps_cases, "waits are exercised");
+    assert!(
+        stats.loop_cap_faults > 0 && stats.div_faults > 0,
+        "faults are exercised"
+    );
+}
+
 /// Measuring that re-measures every few scans: the run switches between the sequential walk
 /// and the levelled plans all the time, whichever is faster.
 fn restless() -> Measure {
@@ -277,6 +345,7 @@ fn every_plan_kind_with_up_to_eight_workers_equals_the_sequential_scan() {
                 PlanKind::Seq,
                 PlanKind::Model,
                 PlanKind::Par,
+                PlanKind::Deps,
                 PlanKind::Auto,
             ] {
                 let mut config = configs(threads, seed);

@@ -110,6 +110,11 @@ impl SpinBarrier {
         true
     }
 
+    /// Whether a worker panicked (every waiter is released for good).
+    pub fn is_poisoned(&self) -> bool {
+        self.poisoned.load(Ordering::SeqCst)
+    }
+
     /// Releases every waiter for good (a worker panicked).
     pub fn poison(&self) {
         self.poisoned.store(true, Ordering::SeqCst);

@@ -6,10 +6,15 @@
 //!   layout's padding did its job). The line of a byte is its address / 64: a state's memory
 //!   starts on a line (`exec::Mem`).
 //!
+//! A dependence-driven plan (one parallel phase whose workers order their items by ready
+//! flags) is checked by `order_check` instead: conflicting accesses of different workers must
+//! be ordered by its waits rather than absent.
+//!
 //! A plan that fails is not run: `ParallelMachine::new` drops it with a warning and the run
 //! falls back to the sequential walk. Depends on the plan and the interpreter below it; it does
 //! not fix plans.
 
+use super::order_check::check_ordered;
 use super::plan::Plan;
 use crate::exec::{Machine, Span, LINE_BYTES};
 use crate::model::RungId;
@@ -23,8 +28,11 @@ fn bytes((at, w): Span) -> std::ops::Range<usize> {
 }
 
 /// Checks `plan` against `machine`'s lowered code; the error names the phase, the workers and
-/// the byte.
+/// the byte. A dependence-driven plan is checked for order instead (`order_check`).
 pub(super) fn check_plan(machine: &Machine, plan: &Plan) -> Result<(), String> {
+    if plan.ready.is_some() {
+        return check_ordered(machine, plan);
+    }
     let n = machine.state_size() as usize;
     let mut byte_writer: Vec<Owner> = vec![None; n];
     let mut line_writer: Vec<Owner> = vec![None; n.div_ceil(LINE_BYTES as usize)];

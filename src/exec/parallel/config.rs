@@ -6,9 +6,10 @@
 /// Which plans a run may use.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub enum PlanKind {
-    /// Measured: the sequential walk and the levelled plans (contiguous, LPT and locality
-    /// slicing) that the cost model says may gain are timed on the run's first scans, the fastest runs, and
-    /// the choice is re-measured as the run goes (`plc-deps run --plan auto`, the default).
+    /// Measured: the sequential walk, the levelled plans (contiguous, LPT and locality
+    /// slicing) and the dependence-driven plan that the cost model says may gain are timed on
+    /// the run's first scans, the fastest runs, and the choice is re-measured as the run goes
+    /// (`plc-deps run --plan auto`, the default).
     Auto,
     /// The cost model decides, once, with no measurement (the levelled plan if it beats the
     /// sequential scan by a modelled barrier, else the sequential walk).
@@ -18,16 +19,21 @@ pub enum PlanKind {
     /// Always the levelled plan of the cost model's phases, even if the model says it does not
     /// pay (the sequential walk only when no level can run in parallel at all).
     Par,
+    /// Always the dependence-driven plan (`deps_plan`): each worker runs its tasks of every
+    /// level in order and waits, before a task, only for the tasks it depends on that run on
+    /// another worker (ready flags instead of a barrier per level).
+    Deps,
 }
 
 impl PlanKind {
-    /// `auto`, `model`, `seq`, `par`.
+    /// `auto`, `model`, `seq`, `par`, `deps`.
     pub fn name(self) -> &'static str {
         match self {
             PlanKind::Auto => "auto",
             PlanKind::Model => "model",
             PlanKind::Seq => "seq",
             PlanKind::Par => "par",
+            PlanKind::Deps => "deps",
         }
     }
 }
@@ -130,6 +136,9 @@ pub struct PlanConfig {
     pub threads: usize,
     /// Modelled cost of one barrier (all workers meeting), in steps.
     pub barrier_cost: u64,
+    /// Modelled cost of one wait of the dependence-driven plan (a worker reading another's
+    /// ready flag: about one moved line and a spin), in steps.
+    pub wait_cost: u64,
     /// Modelled overhead of one item (one call into the interpreter: a run of tasks, or one
     /// guarded task), in steps.
     pub item_cost: u64,
@@ -157,12 +166,14 @@ impl PlanConfig {
 
     /// The defaults for `threads` workers, measured on a 2-core AMD EPYC: a barrier of two
     /// spinning workers takes 100–150 ns, a step of generated programs 0.5–2 ns (≈ 1 ns for
-    /// 1,000 rungs): barrier 120 steps; an item (a call into the interpreter) ≈ 12 steps; a
+    /// 1,000 rungs): barrier 120 steps; a wait on a ready flag 40 steps (a line from the other
+    /// core and the spin that notices it, not measured separately); an item (a call into the interpreter) ≈ 12 steps; a
     /// moved line [`DEFAULT_LINE_COST`](Self::DEFAULT_LINE_COST).
     pub fn new(threads: usize) -> PlanConfig {
         PlanConfig {
             threads: threads.max(1),
             barrier_cost: 120,
+            wait_cost: 40,
             item_cost: 12,
             line_cost: Self::DEFAULT_LINE_COST,
             line_cost_source: LineCostSource::Default,

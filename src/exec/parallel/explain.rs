@@ -51,6 +51,7 @@ impl ParallelMachine {
                 }
             }
         }
+        self.explain_deps(&mut s);
         if let Some(why) = &plan.sequential {
             let _ = writeln!(
                 s,
@@ -157,6 +158,70 @@ impl ParallelMachine {
         s
     }
 
+    /// The dependence-driven plan, if one was built: its waits per worker and modelled scan.
+    fn explain_deps(&self, s: &mut String) {
+        let Some((plan, r)) = self
+            .plans
+            .iter()
+            .find_map(|p| p.ready.as_ref().map(|r| (p, r)))
+        else {
+            return;
+        };
+        if let Some(why) = &plan.sequential {
+            let _ = writeln!(s, "dependence-driven plan (par-deps): not run: {why}");
+            return;
+        }
+        let per: Vec<String> = (0..plan.threads)
+            .map(|w| {
+                format!(
+                    "w{w} {}/{} waits/{} publishing",
+                    count(r.items_per_worker[w], "item"),
+                    r.waits_per_worker[w],
+                    r.publishing_per_worker[w]
+                )
+            })
+            .collect();
+        let _ = writeln!(
+            s,
+            "dependence-driven plan (par-deps): {} per scan instead of a barrier per level ({} cross-worker dependences, the latest producer per worker kept): {}",
+            count(r.waits(), "wait"),
+            r.cross_dependences,
+            per.join(", ")
+        );
+        let _ = writeln!(
+            s,
+            "  modelled scan: critical path {} steps (wait {} steps each) + 2 barriers ({}) = {} steps, sequential {} steps",
+            r.critical_path,
+            plan.config.wait_cost,
+            plan.config.barrier_cost,
+            plan.est_plan,
+            plan.est_sequential
+        );
+    }
+
+    /// The dependence-driven plan as JSON (`null` if none was built).
+    fn deps_json(&self) -> serde_json::Value {
+        let Some((plan, r)) = self
+            .plans
+            .iter()
+            .find_map(|p| p.ready.as_ref().map(|r| (p, r)))
+        else {
+            return serde_json::Value::Null;
+        };
+        json!({
+            "candidate": "par-deps",
+            "sequential": plan.sequential,
+            "waits_per_scan": r.waits(),
+            "waits_per_worker": r.waits_per_worker,
+            "items_per_worker": r.items_per_worker,
+            "publishing_per_worker": r.publishing_per_worker,
+            "cross_dependences": r.cross_dependences,
+            "critical_path": r.critical_path,
+            "wait_cost": plan.config.wait_cost,
+            "modelled_steps": {"sequential": plan.est_sequential, "plan": plan.est_plan},
+        })
+    }
+
     /// What a run chose, in words: the candidates' measured times, the scans each ran, and
     /// every switch (`plc-deps run --explain`, after the run).
     pub fn explain_run(&self, log: &RunLog) -> String {
@@ -218,6 +283,7 @@ impl ParallelMachine {
             "state_bytes": self.machine.state_size(),
             "layout_groups": self.layout_groups,
             "decision_slots": plan.decision_slots,
+            "deps": self.deps_json(),
             "levels": plan.levels.iter().map(|lp| json!({
                 "tasks": lp.tasks,
                 "cost": lp.cost,
@@ -246,10 +312,11 @@ pub fn ns_text(ns: u64) -> String {
 
 /// The run log as JSON (the `plan_run` of `plc-deps run --format json`); `deterministic`
 /// zeroes what depends on timing (measured times; scans per candidate and switches when there
-/// is more than one candidate).
+/// is more than one candidate). With a dependence-driven candidate, `waits_per_scan` gives its
+/// waits per scan (a property of the plan, not of timing).
 pub fn run_log_json(log: &RunLog, deterministic: bool) -> serde_json::Value {
     let timed = deterministic && log.candidates.len() > 1;
-    json!({
+    let mut doc = json!({
         "candidates": log.candidates,
         "scans": log.candidates.iter().zip(&log.scans_on)
             .map(|(n, &k)| (n.clone(), json!(if timed { 0 } else { k })))
@@ -263,7 +330,18 @@ pub fn run_log_json(log: &RunLog, deterministic: bool) -> serde_json::Value {
                 "scan": s.scan, "from": log.candidates[s.from], "to": log.candidates[s.to], "why": s.why,
             })).collect::<Vec<_>>()
         },
-    })
+    });
+    // Only with a dependence-driven candidate: the waits per scan of each such candidate.
+    let waits: serde_json::Map<String, serde_json::Value> = log
+        .candidates
+        .iter()
+        .zip(&log.waits)
+        .filter_map(|(n, w)| w.map(|w| (n.clone(), json!(w))))
+        .collect();
+    if !waits.is_empty() {
+        doc["waits_per_scan"] = serde_json::Value::Object(waits);
+    }
+    doc
 }
 
 /// Where the line cost came from, in words.

@@ -12,13 +12,15 @@
 //! [`ParallelMachine::new`] kept.
 
 use super::barrier::SpinBarrier;
+use super::candidates::candidate_plans;
 use super::check::check_plan;
 use super::choice::{Chooser, Switch, Window};
 use super::config::{Measure, PlanConfig, PlanKind};
 use super::driver::{run_sequential, ScanDriver};
+use super::flags::ReadyFlags;
 use super::ids::{Decision, Next};
 use super::pad::Padded;
-use super::plan::{candidate_plans, layout_groups, Plan};
+use super::plan::{layout_groups, Plan};
 use super::shared::{Decisions, FaultBuffer, Shared, SharedSlots};
 use super::tasks::{Item, Region};
 use crate::analysis::Analysis;
@@ -36,7 +38,8 @@ use std::time::{Duration, Instant};
 pub enum Candidate {
     /// The sequential walk ([`Machine::run_scan`]) on worker 0.
     Sequential,
-    /// The levelled plan `plans[i]` on all workers.
+    /// The plan `plans[i]` on all workers: a levelled plan, or the dependence-driven one
+    /// (named `par-deps`).
     Levelled(usize),
 }
 
@@ -44,7 +47,7 @@ pub enum Candidate {
 /// switch between them.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct RunLog {
-    /// Candidate names (`seq`, `par`, `par-contiguous`, `par-lpt`, `par-locality`), by candidate
+    /// Candidate names (`seq`, `par`, `par-contiguous`, `par-lpt`, `par-locality`, `par-deps`), by candidate
     /// index.
     pub candidates: Vec<String>,
     /// Scans run on each candidate.
@@ -57,6 +60,8 @@ pub struct RunLog {
     pub last: usize,
     /// Runs of scans on one candidate: (first scan, candidate), ascending.
     pub segments: Vec<(u64, usize)>,
+    /// Per candidate: the waits per scan of a dependence-driven plan (`None` for the others).
+    pub waits: Vec<Option<u64>>,
 }
 
 impl RunLog {
@@ -138,12 +143,17 @@ impl ParallelMachine {
         if config.kind == PlanKind::Auto || plans.iter().all(|p| p.sequential.is_some()) {
             candidates.push(Candidate::Sequential);
         }
-        let levelled = plans.iter().filter(|p| p.sequential.is_none()).count();
+        let levelled = plans
+            .iter()
+            .filter(|p| p.sequential.is_none() && p.ready.is_none())
+            .count();
         let mut names: Vec<String> = candidates.iter().map(|_| "seq".to_string()).collect();
         for (i, plan) in plans.iter().enumerate() {
             if plan.sequential.is_none() {
                 candidates.push(Candidate::Levelled(i));
-                names.push(if levelled > 1 {
+                names.push(if plan.ready.is_some() {
+                    "par-deps".to_string()
+                } else if levelled > 1 {
                     format!("par-{}", plan.config.slicing.name())
                 } else {
                     "par".to_string()
@@ -311,6 +321,14 @@ impl ParallelMachine {
             switches: Vec::new(),
             last: allowed[0],
             segments: Vec::new(),
+            waits: self
+                .candidates
+                .iter()
+                .map(|c| match *c {
+                    Candidate::Levelled(i) => self.plans[i].ready.as_ref().map(|r| r.waits()),
+                    Candidate::Sequential => None,
+                })
+                .collect(),
         };
         let threads = self
             .plans
@@ -340,6 +358,7 @@ impl ParallelMachine {
             .max()
             .unwrap_or(0);
         let decisions = Decisions::new(decision_slots);
+        let ready = ReadyFlags::new(threads);
         let faults: Vec<FaultBuffer> = (0..threads)
             .map(|_| Padded(UnsafeCell::new(Vec::new())))
             .collect();
@@ -351,6 +370,7 @@ impl ParallelMachine {
             decisions: &decisions,
             faults: &faults,
             barrier: SpinBarrier::new(threads),
+            ready: &ready,
         };
         let window = WindowCell {
             plan: AtomicUsize::new(0),
@@ -564,8 +584,19 @@ impl ParallelMachine {
                 if ph.barrier_before && !sh.barrier.wait(w, epoch) {
                     return false;
                 }
-                for it in ph.items_of(w) {
+                for (i, it) in ph.items_of(w).iter().enumerate() {
+                    for x in &plan.waits[it.waits.start as usize..it.waits.end as usize] {
+                        if !sh
+                            .ready
+                            .wait(x.worker as usize, *epoch, x.done, &sh.barrier)
+                        {
+                            return false;
+                        }
+                    }
                     self.run_item(plan, it, &mut store, &mut ctx, sh);
+                    if it.publish {
+                        sh.ready.publish(w, *epoch, i as u32 + 1);
+                    }
                     if !ctx.faults.is_empty() {
                         // SAFETY: only worker `w` touches its fault buffer during a scan;
                         // worker 0 reads it after the scan's last barrier.

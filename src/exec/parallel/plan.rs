@@ -12,9 +12,10 @@
 //! against the lowered code (see `check`).
 
 use super::calls::{call_closure, is_loop_back, rung_callees, uncovered_refusal};
-use super::config::{PlanConfig, PlanKind, Slicing, Strategy};
+use super::config::{PlanConfig, PlanKind, Strategy};
 use super::ids::{DecisionSlot, Next, TaskId};
 use super::movement::Movement;
+use super::ready::{Ready, Wait};
 use super::slicing::{slice_levels, worker_makespan, LevelPlan};
 use super::tasks::{Item, Tasks};
 use crate::analysis::{Analysis, EdgeKind, Successor};
@@ -99,6 +100,12 @@ pub struct Plan {
     /// Modelled scan costs: sequential, and this plan's (data movement included).
     pub(super) est_sequential: u64,
     pub(super) est_plan: u64,
+    /// The waits of the items of a dependence-driven plan (`Item::waits` index it).
+    pub(super) waits: Vec<Wait>,
+    /// `Some` for a dependence-driven plan (`deps_plan`): one parallel phase whose workers
+    /// order their items by ready flags; the plan check then proves the order instead of the
+    /// disjointness of the workers (`order_check`).
+    pub(super) ready: Option<Ready>,
 }
 
 impl Plan {
@@ -151,6 +158,8 @@ impl Plan {
             phase_lines,
             est_sequential,
             est_plan,
+            waits: Vec::new(),
+            ready: None,
         };
         if plan.sequential.is_some() {
             return plan;
@@ -163,7 +172,7 @@ impl Plan {
 
     /// Decision slots, grouped per (phase, worker) and padded to a line; then each item's
     /// decision, guard and entries.
-    fn place_decisions(&mut self, a: &Analysis, info: &Tasks<'_>) {
+    pub(super) fn place_decisions(&mut self, a: &Analysis, info: &Tasks<'_>) {
         let sched = &a.schedule;
         let mut slot_of_task: Vec<Option<DecisionSlot>> = vec![None; sched.tasks.len()];
         let mut next = 0usize;
@@ -262,11 +271,20 @@ impl Plan {
     pub fn config(&self) -> &PlanConfig {
         &self.config
     }
+
+    /// The dependence-driven plan's waits and model (`None` for a levelled plan).
+    pub fn ready(&self) -> Option<&Ready> {
+        self.ready.as_ref()
+    }
 }
 
 /// Costs, only successors, decisions and entry predecessors of the tasks, from the main
 /// program's live CFG edges condensed to tasks.
-fn task_facts<'a>(p: &Program, a: &'a Analysis, task_of: &[Option<TaskId>]) -> Tasks<'a> {
+pub(super) fn task_facts<'a>(
+    p: &Program,
+    a: &'a Analysis,
+    task_of: &[Option<TaskId>],
+) -> Tasks<'a> {
     let sched = &a.schedule;
     let nt = sched.tasks.len();
     let n = p.rungs.len() as u32;
@@ -338,7 +356,7 @@ fn task_facts<'a>(p: &Program, a: &'a Analysis, task_of: &[Option<TaskId>]) -> T
 }
 
 /// Per level: why it must not run in parallel (tasks sharing a subroutine's loop counters).
-fn level_conflicts(p: &Program, a: &Analysis) -> Vec<Option<String>> {
+pub(super) fn level_conflicts(p: &Program, a: &Analysis) -> Vec<Option<String>> {
     let sched = &a.schedule;
     let closure = call_closure(p);
     let pou_loops: Vec<bool> = (0..p.pous.len())
@@ -376,7 +394,7 @@ fn level_conflicts(p: &Program, a: &Analysis) -> Vec<Option<String>> {
 }
 
 /// Why the whole program runs as the sequential scan, if it does.
-fn sequential_reason(
+pub(super) fn sequential_reason(
     p: &Program,
     a: &Analysis,
     config: &PlanConfig,
@@ -648,36 +666,4 @@ pub(super) fn layout_groups(plans: &[&Plan], vars: usize) -> Vec<Vec<VarId>> {
         .into_iter()
         .map(|(_, g)| std::mem::take(&mut groups[g]))
         .collect()
-}
-
-/// The plans of `config.kind`: the model's plan (model, seq, par), or — auto, when slicing is
-/// left to the planner — the levelled plans of the model's phases under contiguous, LPT and
-/// locality slicing. LPT is kept when its phases differ from contiguous ones; locality when
-/// its phases differ from both and the model sees any gain over the contiguous plan (in data
-/// movement, what it is for): the measurement then decides.
-pub(super) fn candidate_plans(p: &Program, a: &Analysis, config: &PlanConfig) -> Vec<Plan> {
-    if config.kind != PlanKind::Auto || config.slicing != Slicing::Auto {
-        return vec![Plan::build(p, a, config)];
-    }
-    let with = |slicing: Slicing| Plan::build(p, a, &PlanConfig { slicing, ..*config });
-    let (contiguous, lpt, local) = (
-        with(Slicing::Contiguous),
-        with(Slicing::Lpt),
-        with(Slicing::Locality),
-    );
-    let keep_lpt = lpt.sequential.is_none() && lpt.phases != contiguous.phases;
-    let gains = contiguous.sequential.is_some() || local.est_plan < contiguous.est_plan;
-    let keep_local = local.sequential.is_none()
-        && gains
-        && local.phases != contiguous.phases
-        && (!keep_lpt || local.phases != lpt.phases);
-    let keep_contiguous = contiguous.sequential.is_none() || !(keep_lpt || keep_local);
-    [
-        (keep_contiguous, contiguous),
-        (keep_lpt, lpt),
-        (keep_local, local),
-    ]
-    .into_iter()
-    .filter_map(|(keep, plan)| keep.then_some(plan))
-    .collect()
 }

@@ -8,6 +8,7 @@
 //! padding and typed indices below it; it does not run anything.
 
 use super::barrier::SpinBarrier;
+use super::flags::ReadyFlags;
 use super::ids::{Decision, DecisionSlot};
 use super::pad::Padded;
 use crate::exec::{Addr, Fault, Store, Word};
@@ -112,6 +113,8 @@ pub(super) struct Shared<'a> {
     pub(super) decisions: &'a Decisions,
     pub(super) faults: &'a [FaultBuffer],
     pub(super) barrier: SpinBarrier,
+    /// The workers' ready flags (dependence-driven plans).
+    pub(super) ready: &'a ReadyFlags,
 }
 
 // SAFETY: the fault buffers are each used by one worker during a scan and by worker 0 between

@@ -36,6 +36,11 @@ pub(super) struct Item {
     pub(super) entries: Range<u32>,
     /// Decision slot of `last`, if a later task reads where control left it.
     pub(super) decision: Option<DecisionSlot>,
+    /// Ready flags to wait for before it runs (dependence-driven plans): range into
+    /// `Plan::waits`; empty in levelled plans.
+    pub(super) waits: Range<u32>,
+    /// Publish the worker's ready flag after it (a later item of another worker waits for it).
+    pub(super) publish: bool,
     /// Modelled cost (tasks + item overhead).
     pub(super) cost: u64,
 }
@@ -116,6 +121,8 @@ impl Tasks<'_> {
             guard: 0..0,
             entries: 0..0,
             decision: None,
+            waits: 0..0,
+            publish: false,
             cost: (first.0..=last.0)
                 .map(|t| self.cost[t as usize])
                 .sum::<u64>()
