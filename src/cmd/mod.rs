@@ -1,6 +1,6 @@
 //! The commands behind the binary, one module each, as library functions over validated
-//! configurations: [`report`], [`order`], [`run`], [`schema`], [`gen`], [`c`], [`convert`].
-//! configurations: [`report`], [`order`], [`run`], [`schema`], [`gen`], [`c`], [`il`].
+//! configurations: [`report`], [`order`], [`run`], [`schema`], [`gen`], [`c`], [`il`],
+//! [`convert`].
 //!
 //! `main.rs` turns command-line arguments into these configs and calls one function; everything
 //! here returns a [`CliError`] (rendered once, by `main`) instead of printing an error or

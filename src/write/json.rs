@@ -242,6 +242,25 @@ fn element(e: &Element) -> io::Result<Value> {
                 "load": operand(&c.aux.value)
             }),
         },
+        K::Bistable(b) => {
+            let key = match b.kind {
+                crate::model::BistableKind::SetDominant => "sr",
+                crate::model::BistableKind::ResetDominant => "rs",
+            };
+            let mut o = Map::new();
+            o.insert(key.into(), string(b.instance.as_str()));
+            o.insert("reset".into(), operand(&b.reset.value));
+            Value::Object(o)
+        }
+        K::Trigger { kind, instance } => match kind {
+            crate::model::TriggerKind::Rising => json!({ "r_trig": instance.as_str() }),
+            crate::model::TriggerKind::Falling => json!({ "f_trig": instance.as_str() }),
+        },
+        K::Ctud(c) => json!({
+            "ctud": c.instance.as_str(), "cd": operand(&c.cd.value),
+            "reset": operand(&c.reset.value), "load": operand(&c.load.value),
+            "pv": operand(&c.pv.value)
+        }),
         K::Move(m) => json!({ "move": operand(&m.from.value), "to": m.to.as_str() }),
         K::Arith(a) => json!({
             "op": a.op.name(), "in": [operand(&a.a.value), operand(&a.b.value)],
@@ -399,7 +418,10 @@ mod tests {
         let text = r#"{"program": "P", "comment": "c",
           "vars": [{"name": "A", "type": "BOOL", "class": "input"}, {"name": "B", "type": "BOOL"},
                    {"name": "N", "type": "INT", "init": 3}, {"name": "T1", "type": "TON"},
-                   {"name": "C1", "type": "CTU"}, {"name": "C2", "type": "CTD"}],
+                   {"name": "C1", "type": "CTU"}, {"name": "C2", "type": "CTD"},
+                   {"name": "B1", "type": "SR"}, {"name": "B2", "type": "RS"},
+                   {"name": "E1", "type": "R_TRIG"}, {"name": "E2", "type": "F_TRIG"},
+                   {"name": "U1", "type": "CTUD"}],
           "rungs": [
             {"id": "R1", "label": "L", "comment": "x", "ld": [{"contact": "A", "edge": "rising"},
               {"or": [[{"contact": "B", "negated": true}], [{"compare": "GE", "a": "N", "b": 2}]]},
@@ -410,7 +432,10 @@ mod tests {
             {"id": "R3", "ld": [{"for": {"var": "N", "from": 1, "to": 3}}]},
             {"id": "R4", "ld": [{"next": true}]},
             {"id": "R5", "ld": [{"call": "S"}, {"ret": true}]},
-            {"id": "R6", "ld": [{"end": true}]}],
+            {"id": "R6", "ld": [{"end": true}]},
+            {"id": "R7", "ld": [{"sr": "B1", "reset": "A"}, {"rs": "B2", "reset": false},
+              {"r_trig": "E1"}, {"f_trig": "E2"},
+              {"ctud": "U1", "cd": "A", "reset": false, "load": "B", "pv": 4}]}],
           "subroutines": {"S": {"vars": [], "rungs": [{"id": "S1", "ld": [{"coil": "B"}]}]}}}"#;
         let out = converted(text);
         let a: Value = serde_json::from_str(text).unwrap();

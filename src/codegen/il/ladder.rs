@@ -81,7 +81,7 @@ impl Emit<'_> {
             Operand::Const(v) => v.ty(),
             Operand::Var(r) => match r.field {
                 None => self.names.p.var(r.var).ty,
-                Some(Field::Q) => Type::Bool,
+                Some(Field::Q | Field::Q1 | Field::Qu | Field::Qd) => Type::Bool,
                 Some(Field::Et | Field::Pt) => Type::Time,
                 Some(Field::Cv | Field::Pv) => Type::Int,
             },
@@ -276,6 +276,11 @@ impl Emit<'_> {
                     .emit("FOR", &[n.var(*var), &n.operand(from), &n.operand(to)], 0)
             }
             Element::Next { .. } => self.net.emit("NEXT", &[], 0),
+            Element::Bistable { .. } | Element::Trigger { .. } | Element::Ctud { .. } => {
+                return self.fail(
+                    "SR, RS, R_TRIG, F_TRIG and CTUD boxes have no S7-200 instruction (write them with S/R, EU/ED and CTUD counters by hand)",
+                )
+            }
             Element::Contact { .. } | Element::Compare { .. } | Element::Or(_) => {
                 unreachable!("conditions are emitted by `condition`")
             }

@@ -127,6 +127,15 @@ fn op_name(op: &Op) -> String {
         Op::Timer { kind, .. } => kind.name().to_uppercase(),
         Op::Ctu { .. } => "CTU".into(),
         Op::Ctd { .. } => "CTD".into(),
+        Op::Bistable { kind, .. } => match kind {
+            crate::model::BistableKind::SetDominant => "SR".into(),
+            crate::model::BistableKind::ResetDominant => "RS".into(),
+        },
+        Op::Trigger { kind, .. } => match kind {
+            crate::model::TriggerKind::Rising => "R_TRIG".into(),
+            crate::model::TriggerKind::Falling => "F_TRIG".into(),
+        },
+        Op::Ctud { .. } => "CTUD".into(),
         Op::Jmp { .. } => "JMP".into(),
         Op::Ret => "RET".into(),
         Op::TStart => "TSTART".into(),

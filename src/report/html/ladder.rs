@@ -100,6 +100,42 @@ fn shape(p: &Program, e: &Element) -> Shape {
             format!("{} {}", kind.name().to_uppercase(), var(instance)),
             format!("PT {}", operand(p, pt)),
         ]),
+        Element::Bistable {
+            kind,
+            instance,
+            reset,
+        } => boxed(vec![
+            format!(
+                "{} {}",
+                match kind {
+                    crate::model::BistableKind::SetDominant => "SR",
+                    crate::model::BistableKind::ResetDominant => "RS",
+                },
+                var(instance)
+            ),
+            format!("R {}", operand(p, reset)),
+        ]),
+        Element::Trigger { kind, instance } => boxed(vec![format!(
+            "{} {}",
+            match kind {
+                crate::model::TriggerKind::Rising => "R_TRIG",
+                crate::model::TriggerKind::Falling => "F_TRIG",
+            },
+            var(instance)
+        )]),
+        Element::Ctud {
+            instance,
+            cd,
+            reset,
+            load,
+            pv,
+        } => boxed(vec![
+            format!("CTUD {}", var(instance)),
+            format!("CD {}", operand(p, cd)),
+            format!("R {}", operand(p, reset)),
+            format!("LD {}", operand(p, load)),
+            format!("PV {}", operand(p, pv)),
+        ]),
         Element::Ctu {
             instance,
             pv,
