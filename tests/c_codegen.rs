@@ -143,7 +143,10 @@ fn every_example_matches_the_interpreter_after_every_scan() {
     let mut seen = 0;
     for e in std::fs::read_dir(root().join("analyses")).unwrap() {
         let dir = e.unwrap().path();
-        let text = std::fs::read_to_string(dir.join("program.json")).unwrap();
+        // `analyses/plcopen/` holds the PLCopen exports, checked by their own test.
+        let Ok(text) = std::fs::read_to_string(dir.join("program.json")) else {
+            continue;
+        };
         let csv = std::fs::read_to_string(dir.join("inputs.csv")).unwrap_or_default();
         // The committed runs use a 1 s cycle (their timers run out within the scenario); the
         // KASKAD examples run 700 scans of 10 ms (their toggles are at 100, 201, …).
