@@ -627,7 +627,7 @@ fn the_measured_plan_times_the_locality_partition_and_stays_exact() {
         .collect();
     assert_eq!(
         names,
-        ["seq", "par-contiguous", "par-locality"],
+        ["seq", "par-contiguous", "par-locality", "par-deps"],
         "{}",
         par.explain(&p)
     );

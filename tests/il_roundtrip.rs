@@ -34,7 +34,13 @@ fn s7_only(v: &mut Json) {
             }
             m.values_mut().for_each(s7_only);
         }
-        Json::Array(a) => a.iter_mut().for_each(s7_only),
+        Json::Array(a) => {
+            // The standard FBs with no S7-200 instruction (SR, RS, R_TRIG, F_TRIG, CTUD) are
+            // left out of the series they are in.
+            const NONE: [&str; 5] = ["sr", "rs", "r_trig", "f_trig", "ctud"];
+            a.retain(|e| !NONE.iter().any(|k| e.get(k).is_some()));
+            a.iter_mut().for_each(s7_only)
+        }
         _ => {}
     }
 }
