@@ -18,7 +18,10 @@ fn s7_only(v: &mut Json) {
             if let Some(t) = m.remove("tp") {
                 m.insert("ton".into(), t);
             }
-            if m.get("type") == Some(&Json::from("TP")) {
+            // TP, and the standard FBs S7-200 has no instruction for (their boxes are left
+            // out below; what reads their outputs then reads a TON's, or fails to load).
+            let none = ["TP", "SR", "RS", "R_TRIG", "F_TRIG", "CTUD"];
+            if none.iter().any(|t| m.get("type") == Some(&Json::from(*t))) {
                 m.insert("type".into(), "TON".into());
             }
             if m.get("op") == Some(&Json::from("MOD")) {
