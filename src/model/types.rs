@@ -328,6 +328,18 @@ impl CmpOp {
             CmpOp::Ge => "GE",
         }
     }
+
+    /// The operator as IEC 61131-3 writes it in ST and IL (`=`, `<>`, `<`, `<=`, `>`, `>=`).
+    pub fn symbol(self) -> &'static str {
+        match self {
+            CmpOp::Eq => "=",
+            CmpOp::Ne => "<>",
+            CmpOp::Lt => "<",
+            CmpOp::Le => "<=",
+            CmpOp::Gt => ">",
+            CmpOp::Ge => ">=",
+        }
+    }
 }
 
 /// Arithmetic box operators.

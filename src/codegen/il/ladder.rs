@@ -57,17 +57,6 @@ fn word_suffix(ty: Type) -> Option<&'static str> {
     }
 }
 
-fn cmp_symbol(op: CmpOp) -> &'static str {
-    match op {
-        CmpOp::Eq => "=",
-        CmpOp::Ne => "<>",
-        CmpOp::Lt => "<",
-        CmpOp::Le => "<=",
-        CmpOp::Gt => ">",
-        CmpOp::Ge => ">=",
-    }
-}
-
 impl Emit<'_> {
     fn fail<T>(&self, message: impl Into<String>) -> Result<T, IlError> {
         Err(IlError {
@@ -142,7 +131,7 @@ impl Emit<'_> {
                     return self.fail(format!("a compare of {ty} has no S7-200 instruction"));
                 };
                 let (la, lb) = (self.names.operand(a), self.names.operand(b));
-                let sym = cmp_symbol(*op);
+                let sym = op.symbol();
                 let (load, and) = (format!("LD{sfx}{sym}"), format!("A{sfx}{sym}"));
                 self.load_or(loaded, &load, &and, &format!("{la}, {lb}"));
             }
@@ -210,8 +199,7 @@ impl Emit<'_> {
             Element::Compare { op, a, b } => match word_suffix(self.operand_type(a)) {
                 Some(sfx) => {
                     let arg = format!("{}, {}", self.names.operand(a), self.names.operand(b));
-                    self.net
-                        .emit(&format!("O{sfx}{}", cmp_symbol(*op)), &[&arg], 0);
+                    self.net.emit(&format!("O{sfx}{}", op.symbol()), &[&arg], 0);
                     true
                 }
                 None => false,

@@ -45,17 +45,6 @@ fn operand(p: &Program, o: &Operand) -> String {
     }
 }
 
-fn cmp_symbol(op: CmpOp) -> &'static str {
-    match op {
-        CmpOp::Eq => "=",
-        CmpOp::Ne => "<>",
-        CmpOp::Lt => "<",
-        CmpOp::Le => "<=",
-        CmpOp::Gt => ">",
-        CmpOp::Ge => ">=",
-    }
-}
-
 /// What an element draws as: a contact or coil with its mark and name, or a box of text lines.
 enum Shape {
     Contact { mark: &'static str, name: String },
@@ -80,7 +69,7 @@ fn shape(p: &Program, e: &Element) -> Shape {
         Element::Compare { op, a, b } => boxed(vec![format!(
             "{} {} {}",
             operand(p, a),
-            cmp_symbol(*op),
+            op.symbol(),
             operand(p, b)
         )]),
         Element::Or(_) | Element::Branch(_) => Shape::Parallel,
