@@ -88,7 +88,9 @@ pub fn trip_count(e: &Element) -> Option<u64> {
         _ => None,
     };
     match e {
-        Element::For { from, to, .. } => Some((int(to)? - int(from)? + 1).max(0) as u64),
+        Element::For { bounds, .. } => {
+            Some((int(&bounds.to)? - int(&bounds.from)? + 1).max(0) as u64)
+        }
         _ => None,
     }
 }

@@ -333,15 +333,9 @@ fn paper_control_view(p: &Program, control: &[ControlDependence]) -> Vec<PaperCo
                     }
                 }
             }
-            Element::Ctud {
-                instance,
-                cd,
-                reset,
-                load,
-                pv,
-            } => {
+            Element::Ctud { instance, inputs } => {
                 own_boxes.push(*instance);
-                for o in [cd, reset, load, pv] {
+                for o in inputs.operands() {
                     if let Operand::Var(v) = o {
                         if v.field.is_some() {
                             field_reads.push(v.var);
