@@ -69,7 +69,7 @@ fn idle_rungs(p: &Program, acc: &Accesses) -> (Vec<RungId>, Vec<RungId>) {
     let (mut empty, mut no_effect) = (Vec::new(), Vec::new());
     for r in p.rung_ids() {
         let rung = p.rung(r);
-        if rung.network.is_some() {
+        if rung.network().is_some() {
             continue;
         }
         if rung.series.is_empty() {

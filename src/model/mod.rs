@@ -107,13 +107,31 @@ pub struct Rung {
     pub comment: Option<String>,
     pub pou: PouId,
     pub series: Series,
-    /// For a rung lowered from an FBD block (or a fragment guard of it): the JSON path of what
-    /// it was lowered from (`fbd.networks[0].blocks[2]`). Ladder rungs have none: the resolver
-    /// renders their path (`rungs[3]`) from where they are, only when an error names them.
-    pub block_path: Option<String>,
-    /// For a rung lowered from an FBD block (or a fragment guard of it): the id of its network.
-    /// The rungs of one network are contiguous.
+    /// For a rung lowered from an FBD block (or a fragment guard of it): what it was lowered
+    /// from. Ladder rungs have none (and pay one pointer for it): the resolver renders their
+    /// path (`rungs[3]`) from where they are, only when an error names them.
+    pub lowered: Option<Box<LoweredFrom>>,
+}
+
+/// Where a rung lowered from an FBD body comes from.
+#[derive(Clone, Debug)]
+pub struct LoweredFrom {
+    /// The path of the block it was lowered from (`fbd.networks[0].blocks[2]`).
+    pub block_path: String,
+    /// The id of its network, once the network is lowered. The rungs of one network are
+    /// contiguous.
     pub network: Option<String>,
+}
+
+impl Rung {
+    /// For a rung lowered from an FBD block: the path of that block.
+    pub fn block_path(&self) -> Option<&str> {
+        self.lowered.as_ref().map(|l| l.block_path.as_str())
+    }
+    /// For a rung lowered from an FBD network: the network's id.
+    pub fn network(&self) -> Option<&str> {
+        self.lowered.as_ref().and_then(|l| l.network.as_deref())
+    }
 }
 
 /// A series of elements; power flows through them in order.
@@ -292,5 +310,11 @@ mod tests {
     #[test]
     fn an_element_is_32_bytes() {
         assert_eq!(std::mem::size_of::<Element>(), 32);
+    }
+
+    /// The same for rungs: what only FBD-lowered rungs carry is behind one pointer.
+    #[test]
+    fn a_rung_is_112_bytes() {
+        assert_eq!(std::mem::size_of::<Rung>(), 112);
     }
 }
