@@ -239,11 +239,7 @@ pub fn analyse_with(p: &Program, config: &AnalysisConfig) -> Analysis {
                 rung_costs[r.index()] = base[r.index()] * m;
             }
         }
-        let task_costs: Vec<u64> = schedule
-            .tasks
-            .iter()
-            .map(|t| t.rungs.iter().map(|r| rung_costs[r.index()]).sum())
-            .collect();
+        let task_costs = cost::task_costs(&schedule, &rung_costs);
         let task_levels: Vec<u32> = schedule.tasks.iter().map(|t| t.level).collect();
         let cost = cost::summarise(&task_costs, &schedule.preds, &task_levels);
         (schedule, rung_costs, cost)
