@@ -11,6 +11,7 @@ const WITH_STL: &[&str] = &[
     "example-a",
     "example-b",
     "example-d",
+    "encoder-interrupt",
     "mixing-station",
     "packaging-line",
 ];

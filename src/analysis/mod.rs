@@ -16,6 +16,7 @@ pub mod cfg;
 pub mod control;
 pub mod cost;
 pub mod dependences;
+pub mod interrupts;
 pub mod levels;
 pub mod schedule;
 
@@ -57,6 +58,8 @@ pub enum Warning {
     Endless(Vec<RungId>),
     /// A subroutine nothing calls.
     Uncalled(PouId),
+    /// An interrupt routine: it may run between any two rungs, and the scan raises no events.
+    Interrupt(PouId),
     /// Rungs with no elements at all (written by the user, not FBD lowering).
     Empty(Vec<RungId>),
     /// Rungs that write nothing and transfer no control: they have no effect on the scan.
@@ -156,6 +159,8 @@ pub struct Analysis {
     /// Cost of each rung (calls included, loop multipliers applied).
     pub rung_costs: Vec<u64>,
     pub warnings: Vec<Warning>,
+    /// What each interrupt routine shares with the main program.
+    pub interrupts: Vec<interrupts::InterruptSharing>,
 }
 
 /// Runs every analysis on `p` with the default [`AnalysisConfig`].
@@ -263,7 +268,10 @@ pub fn analyse_with(p: &Program, config: &AnalysisConfig) -> Analysis {
         }
     }
     for &pou in &cfg.uncalled {
-        warnings.push(Warning::Uncalled(pou));
+        warnings.push(match p.pou(pou).kind {
+            PouKind::Interrupt => Warning::Interrupt(pou),
+            _ => Warning::Uncalled(pou),
+        });
     }
     let (empty, no_effect) = idle_rungs(p, &acc);
     if !empty.is_empty() {
@@ -272,7 +280,9 @@ pub fn analyse_with(p: &Program, config: &AnalysisConfig) -> Analysis {
     if !no_effect.is_empty() {
         warnings.push(Warning::NoEffect(no_effect));
     }
+    let interrupts = interrupts::interrupt_sharing(p, &acc);
     Analysis {
+        interrupts,
         accesses: acc,
         data,
         listed,

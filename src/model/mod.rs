@@ -75,6 +75,9 @@ pub struct Pou {
 pub enum PouKind {
     Main,
     Subroutine,
+    /// An interrupt routine: nothing calls it; it runs when its event occurs, which may be
+    /// between any two rungs of the scan. `plc-deps run` raises no interrupt events.
+    Interrupt,
 }
 
 /// A declared (or hidden) variable.

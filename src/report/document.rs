@@ -77,6 +77,9 @@ pub struct Report<'a> {
     pub warnings: Vec<String>,
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub networks: Vec<NetworkEntry<'a>>,
+    /// For programs with interrupt routines: what each shares with the main program.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub interrupts: Vec<InterruptEntry<'a>>,
     /// For programs with FBD bodies: the program as written, in blocks and networks.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub fbd: Option<FbdSection<'a>>,
@@ -305,6 +308,23 @@ pub struct NetworkEntry<'a> {
     pub out: Vec<&'a str>,
 }
 
+/// An interrupt routine and the variables it shares with the main program.
+#[derive(serde::Serialize)]
+pub struct InterruptEntry<'a> {
+    pub pou: &'a str,
+    pub shared: Vec<SharedVarEntry<'a>>,
+}
+
+/// A variable an interrupt routine and the main program share, and who reads and writes it.
+#[derive(serde::Serialize)]
+pub struct SharedVarEntry<'a> {
+    pub var: &'a str,
+    pub interrupt_reads: bool,
+    pub interrupt_writes: bool,
+    pub main_readers: Vec<&'a str>,
+    pub main_writers: Vec<&'a str>,
+}
+
 fn label_name(b: Option<Branch>) -> Option<&'static str> {
     b.map(|b| match b {
         Branch::T => "T",
@@ -528,6 +548,24 @@ pub fn document_with<'a>(p: &'a Program, a: &'a Analysis, fbd: Option<&'a FbdPar
             .map(|w| super::warning_text(p, w))
             .collect(),
         networks,
+        interrupts: a
+            .interrupts
+            .iter()
+            .map(|i| InterruptEntry {
+                pou: &p.pou(i.pou).name,
+                shared: i
+                    .shared
+                    .iter()
+                    .map(|s| SharedVarEntry {
+                        var: &p.var(s.var).name,
+                        interrupt_reads: s.interrupt_reads,
+                        interrupt_writes: s.interrupt_writes,
+                        main_readers: s.main_readers.iter().map(|&r| id(r)).collect(),
+                        main_writers: s.main_writers.iter().map(|&r| id(r)).collect(),
+                    })
+                    .collect(),
+            })
+            .collect(),
         fbd: fbd_section,
         shown_levels,
         summary: Summary {

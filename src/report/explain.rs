@@ -82,7 +82,12 @@ impl<'a> Explainer<'a> {
         let Some(t) = s.task_of[r.index()] else {
             let reason = if rung.pou.index() != 0 {
                 let c = &self.callers[rung.pou.index()];
-                if c.is_empty() {
+                if p.pou(rung.pou).kind == PouKind::Interrupt {
+                    format!(
+                        "in interrupt routine {}, which runs when its event occurs (not in the schedule)",
+                        p.pou(rung.pou).name
+                    )
+                } else if c.is_empty() {
                     format!(
                         "in subroutine {}, which nothing calls",
                         p.pou(rung.pou).name

@@ -73,6 +73,10 @@ pub fn render_json(report: &Report, out: &mut impl Write) -> io::Result<()> {
         key(out, "networks")?;
         value(out, &report.networks)?;
     }
+    if !report.interrupts.is_empty() {
+        key(out, "interrupts")?;
+        value(out, &report.interrupts)?;
+    }
     if let Some(fbd) = &report.fbd {
         key(out, "fbd")?;
         value(out, fbd)?;

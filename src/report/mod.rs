@@ -170,6 +170,10 @@ pub fn warning_text(p: &Program, w: &Warning) -> String {
             ids(rs)
         ),
         Warning::Uncalled(pou) => format!("subroutine {} is never called", p.pou(*pou).name),
+        Warning::Interrupt(pou) => format!(
+            "interrupt routine {} may run between any two rungs of the scan: it is analysed on its own (the report's interrupts section lists what it shares with the main program), and `plc-deps run` raises no interrupt events, so it never runs there",
+            p.pou(*pou).name
+        ),
         Warning::Empty(rs) => format!("{} {} empty (no elements)", ids(rs), if rs.len() == 1 { "is" } else { "are" }),
         Warning::NoEffect(rs) => format!(
             "{} {} no effect: nothing is written and control is not transferred",

@@ -254,9 +254,14 @@ pub fn render_text(r: &Report, o: &TextOptions, out: &mut impl Write) -> io::Res
     } else if s.main_rungs == m {
         writeln!(out, "{}: {}", r.program, plural(m, "rung", "rungs"))?;
     } else {
+        let others = if r.interrupts.is_empty() {
+            "subroutines"
+        } else {
+            "subroutines and interrupt routines"
+        };
         writeln!(
             out,
-            "{}: {} ({} in the main program, {} in subroutines)",
+            "{}: {} ({} in the main program, {} in {others})",
             r.program,
             plural(m, "rung", "rungs"),
             thousands(s.main_rungs),
@@ -270,6 +275,7 @@ pub fn render_text(r: &Report, o: &TextOptions, out: &mut impl Write) -> io::Res
     }
     rungs(r, o, out)?;
     networks(r, o, out)?;
+    interrupts(r, o, out)?;
     dependences(r, o, out)?;
     cfg(r, o, out)?;
     post_dominators(r, o, out)?;
@@ -468,6 +474,45 @@ fn networks(r: &Report, o: &TextOptions, out: &mut impl Write) -> io::Result<()>
     }
     t.render(out)?;
     more_rows(out, shown, r.networks.len())
+}
+
+/// Per interrupt routine, the variables it shares with the main program and who touches them.
+fn interrupts(r: &Report, o: &TextOptions, out: &mut impl Write) -> io::Result<()> {
+    // A rung list in one cell: cut to one line unless every row is asked for.
+    let rungs = |ids: &[&str]| match o.rows {
+        Rows::All => list(ids),
+        Rows::First(_) if ids.is_empty() => list(ids),
+        Rows::First(_) => wrap_words(ids.iter().copied(), 48, Some(1)).remove(0),
+    };
+    for i in &r.interrupts {
+        writeln!(
+            out,
+            "\nInterrupt routine {} (it may run between any two rungs): {} shared with the main program",
+            i.pou,
+            plural(i.shared.len(), "variable", "variables")
+        )?;
+        if i.shared.is_empty() {
+            continue;
+        }
+        let mut t = Table::new(&["variable", "interrupt", "main reads", "main writes"]);
+        let shown = i.shared.len().min(o.limit());
+        for s in i.shared.iter().take(shown) {
+            let access = match (s.interrupt_reads, s.interrupt_writes) {
+                (true, true) => "reads, writes",
+                (false, true) => "writes",
+                _ => "reads",
+            };
+            t.row(vec![
+                s.var.into(),
+                access.into(),
+                rungs(&s.main_readers),
+                rungs(&s.main_writers),
+            ]);
+        }
+        t.render(out)?;
+        more_rows(out, shown, i.shared.len())?;
+    }
+    Ok(())
 }
 
 fn dependences(r: &Report, o: &TextOptions, out: &mut impl Write) -> io::Result<()> {

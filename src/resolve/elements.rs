@@ -267,6 +267,18 @@ impl<'a> Builder<'a> {
                 None => return Ok(None),
             },
             S::Call(name) => {
+                let interrupt =
+                    |p: &&super::PouDraft| p.kind == PouKind::Interrupt && p.name == name.as_str();
+                if self.pous.iter().any(|p| interrupt(&p)) {
+                    return Err(err(
+                        "call",
+                        name.origin,
+                        Invalid::Misplaced {
+                            what: "a call of an interrupt routine",
+                            place: "(nothing calls an interrupt routine: it runs when its event occurs)",
+                        },
+                    ));
+                }
                 let pou = self
                     .pous
                     .iter()

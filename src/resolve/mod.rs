@@ -303,7 +303,11 @@ impl<'a> Builder<'a> {
     fn declare_subroutines(&mut self, syn: &'a syntax::Program<'a>) {
         let name = &syn.name;
         for sub in &syn.subroutines {
-            let path = format!("subroutines.{}", sub.name);
+            let (container, kind) = match sub.kind {
+                syntax::RoutineKind::Subroutine => ("subroutines", PouKind::Subroutine),
+                syntax::RoutineKind::Interrupt => ("interrupts", PouKind::Interrupt),
+            };
+            let path = format!("{container}.{}", sub.name);
             let r = check_name(&sub.name, || path.clone(), None).map_err(|e| e.at(sub.origin));
             if self.collect(r).is_none() {
                 continue;
@@ -333,7 +337,7 @@ impl<'a> Builder<'a> {
             );
             self.pous.push(PouDraft::new(
                 sub.name.to_string(),
-                PouKind::Subroutine,
+                kind,
                 format!("{path}.rungs"),
             ));
             if let Some(body) = &sub.body {

@@ -167,13 +167,25 @@ pub enum Body<'a> {
     Fbd(FbdBody<'a>),
 }
 
-/// A subroutine (called by `call`; IEC 61131-3 would make it a function without result).
+/// A subroutine (called by `call`; IEC 61131-3 would make it a function without result), or an
+/// interrupt routine (S7-200 `INTERRUPT_BLOCK`), which nothing calls.
 #[derive(Clone, Debug)]
 pub struct Subroutine<'a> {
     pub origin: Origin,
+    pub kind: RoutineKind,
     pub name: Text<'a>,
     pub vars: Vec<Var<'a>>,
     pub body: Option<Body<'a>>,
+}
+
+/// What kind of routine a [`Subroutine`] is.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum RoutineKind {
+    /// Runs where a `call` calls it.
+    Subroutine,
+    /// Runs when its event occurs: between any two rungs of the scan (S7-200 `INT`/`RETI`).
+    /// Nothing calls it.
+    Interrupt,
 }
 
 /// A user function block type (IEC 61131-3 6.6.3): its interface, its own data and its body.

@@ -15,8 +15,8 @@ use crate::syntax::fbd::{
     Block, Connection, FbdBody, Input, Inputs, Network, OutVar, Outputs, Read, Targets,
 };
 use crate::syntax::{
-    Body, Edge, Element, ElementKind, FunctionBlock, Problem, Program, Rung, Scalar, Series,
-    Subroutine, Var, VarClass,
+    Body, Edge, Element, ElementKind, FunctionBlock, Problem, Program, RoutineKind, Rung, Scalar,
+    Series, Subroutine, Var, VarClass,
 };
 use serde_json::{json, Map, Value};
 use std::io::{self, Write};
@@ -36,9 +36,16 @@ pub fn program(p: &Program, w: &mut impl Write) -> io::Result<()> {
         write!(w, ",\n")?;
         body(b, w, "")?;
     }
-    if !p.subroutines.is_empty() {
-        write!(w, ",\n\"subroutines\": {{")?;
-        for (i, s) in p.subroutines.iter().enumerate() {
+    for (key, kind) in [
+        ("subroutines", RoutineKind::Subroutine),
+        ("interrupts", RoutineKind::Interrupt),
+    ] {
+        let mut routines = p.subroutines.iter().filter(|s| s.kind == kind).peekable();
+        if routines.peek().is_none() {
+            continue;
+        }
+        write!(w, ",\n\"{key}\": {{")?;
+        for (i, s) in routines.enumerate() {
             write!(w, "{}\n  {}: ", comma(i), string(&s.name))?;
             subroutine(s, w)?;
         }

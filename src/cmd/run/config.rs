@@ -111,6 +111,9 @@ pub enum RunWarning {
         scans: u64,
         scans_given: bool,
     },
+    /// The program has an interrupt routine, which the scans never run.
+    #[error("interrupt routine {0} never runs here: plc-deps run raises no interrupt events (`plc-deps report` lists what it shares with the main program)")]
+    InterruptNotRun(String),
 }
 
 /// `n` and the noun in the singular or plural (`1 scan`, `2 scans`).

@@ -16,7 +16,7 @@ use crate::exec::parallel::{
 use crate::exec::{
     load_value, Addr, ExecConfig, Fault, FaultKind, Layout, Machine, State, VarValue,
 };
-use crate::model::{Program, Type, VarClass, VarId, VarRef};
+use crate::model::{PouKind, Program, Type, VarClass, VarId, VarRef};
 use serde_json::Value as Json;
 use std::collections::HashMap;
 use std::fmt::Write as _;
@@ -258,7 +258,12 @@ pub(super) fn prepare(c: &RunConfig, progress: &Progress) -> Result<Prepared, Cl
         let _phase = progress.phase(&format!("reading {}", c.input.display()));
         load_program(&c.input)?
     };
-    let mut warnings = Vec::new();
+    let mut warnings: Vec<RunWarning> = p
+        .pous
+        .iter()
+        .filter(|pou| pou.kind == PouKind::Interrupt)
+        .map(|pou| RunWarning::InterruptNotRun(pou.name.clone()))
+        .collect();
     let inputs = match &c.inputs {
         Some(path) => {
             let _phase = progress.phase(&format!("reading {}", path.display()));

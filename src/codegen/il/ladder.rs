@@ -20,7 +20,7 @@ use crate::model::*;
 
 /// The networks of a ladder POU: one per rung, titled with the rung id.
 pub(super) fn pou(p: &Program, names: &Names, pou: PouId) -> Result<Vec<(String, Net)>, IlError> {
-    let main = p.pou(pou).kind == PouKind::Main;
+    let kind = p.pou(pou).kind;
     let mut nets = Vec::new();
     for r in p.pou_rungs(pou) {
         let rung = p.rung(r);
@@ -29,7 +29,7 @@ pub(super) fn pou(p: &Program, names: &Names, pou: PouId) -> Result<Vec<(String,
             names,
             net: Net::default(),
             place: &place,
-            main,
+            kind,
         };
         if let Some(l) = &rung.label {
             e.net.emit("LBL", &[l], 0);
@@ -45,7 +45,8 @@ struct Emit<'a> {
     names: &'a Names<'a>,
     net: Net,
     place: &'a str,
-    main: bool,
+    /// The POU's kind, for how a RET is written.
+    kind: PouKind,
 }
 
 fn word_suffix(ty: Type) -> Option<&'static str> {
@@ -255,8 +256,11 @@ impl Emit<'_> {
             }
             Element::Arith { op, a, b, out } => self.arith(*op, a, b, *out)?,
             Element::Jmp { label, .. } => self.net.emit("JMP", &[label], 0),
-            Element::Ret if self.main => self.net.emit("END", &[], 0),
-            Element::Ret => self.net.emit("CRET", &[], 0),
+            Element::Ret => match self.kind {
+                PouKind::Main => self.net.emit("END", &[], 0),
+                PouKind::Subroutine => self.net.emit("CRET", &[], 0),
+                PouKind::Interrupt => self.net.emit("CRETI", &[], 0),
+            },
             Element::End => self.net.emit("END", &[], 0),
             Element::Call { pou } => self.net.emit("CALL", &[&n.p.pou(*pou).name], 0),
             Element::For { var, bounds, .. } => self.net.emit(

@@ -85,6 +85,7 @@ pub fn generate(p: &Program, fbd: &Fbd) -> Result<String, IlError> {
     let mut headers = Vec::new();
     let _ = writeln!(out, "// {}: S7-200 STL written by plc-deps il", p.name);
     declarations(&mut out, p, &names, None);
+    let (mut subroutines, mut interrupts) = (0, 0);
     for (i, pou) in p.pous.iter().enumerate() {
         let id = PouId(i as u32);
         if fbd.instances.iter().any(|inst| inst.pou == id) {
@@ -95,10 +96,17 @@ pub fn generate(p: &Program, fbd: &Fbd) -> Result<String, IlError> {
         }
         let (kind, tag) = match pou.kind {
             PouKind::Main => ("ORGANIZATION_BLOCK", "OB1".to_string()),
-            PouKind::Subroutine => ("SUBROUTINE_BLOCK", format!("SBR{}", i - 1)),
+            PouKind::Subroutine => {
+                subroutines += 1;
+                ("SUBROUTINE_BLOCK", format!("SBR{}", subroutines - 1))
+            }
+            PouKind::Interrupt => {
+                interrupts += 1;
+                ("INTERRUPT_BLOCK", format!("INT{}", interrupts - 1))
+            }
         };
         let _ = writeln!(out, "{kind} {}:{tag}", pou.name);
-        if pou.kind == PouKind::Subroutine {
+        if pou.kind != PouKind::Main {
             declarations(&mut out, p, &names, Some(id));
         }
         out.push_str("BEGIN\n");

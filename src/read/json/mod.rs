@@ -28,7 +28,9 @@ mod locate;
 pub(crate) use locate::path_offset;
 
 use crate::diag::{Invalid, LoadError};
-use crate::syntax::{self, Body, Located, Name, Origin, Problem, Scalar, Text, Var, VarClass};
+use crate::syntax::{
+    self, Body, Located, Name, Origin, Problem, RoutineKind, Scalar, Text, Var, VarClass,
+};
 use cursor::{Cursor, Fail, P};
 use serde::de::IgnoredAny;
 
@@ -144,6 +146,7 @@ struct Parts<'a> {
     rungs: Option<Part<Option<Vec<syntax::Rung<'a>>>>>,
     fbd: Option<syntax::FbdBody<'a>>,
     subroutines: Option<Part<Vec<syntax::Subroutine<'a>>>>,
+    interrupts: Option<Part<Vec<syntax::Subroutine<'a>>>>,
     function_blocks: Option<Part<Vec<syntax::FunctionBlock<'a>>>>,
 }
 
@@ -153,6 +156,7 @@ const PROGRAM_KEYS: &[&str] = &[
     "rungs",
     "fbd",
     "subroutines",
+    "interrupts",
     "function_blocks",
     "comment",
 ];
@@ -286,6 +290,7 @@ impl<'a, 'r> Reader<'a, 'r> {
                     parts.rungs = Some(self.part(|r| r.rungs(&at(), streamed))?)
                 }
                 "subroutines" => parts.subroutines = Some(self.part(|r| r.subroutines())?),
+                "interrupts" => parts.interrupts = Some(self.part(|r| r.interrupts())?),
                 "function_blocks" => {
                     parts.function_blocks = Some(self.part(|r| r.function_blocks())?)
                 }
@@ -347,9 +352,10 @@ impl<'a, 'r> Reader<'a, 'r> {
             origin,
             &mut problems,
         );
-        if let Some(subs) = parts.subroutines {
-            problems.extend(subs.problems);
-            p.subroutines = subs.value;
+        // Subroutines first, then interrupt routines, each in file order.
+        for routines in [parts.subroutines, parts.interrupts].into_iter().flatten() {
+            problems.extend(routines.problems);
+            p.subroutines.extend(routines.value);
         }
         p.problems = problems;
         Ok(p)
@@ -405,29 +411,52 @@ impl<'a, 'r> Reader<'a, 'r> {
             "subroutines",
             "an object of subroutines",
             "an object (a subroutine)",
-            |r, name, origin, path| {
-                let parts = r.parts(path, SUBROUTINE_KEYS)?;
-                if let Some((k, o)) = &parts.unknown {
-                    let p = unknown_field(join(path, k), *o, k, "a subroutine", SUBROUTINE_KEYS);
-                    r.problems.push(p);
-                }
-                let vars = r.take(parts.vars);
-                let body = body(
-                    parts.rungs,
-                    parts.fbd,
-                    path,
-                    "a subroutine",
-                    origin,
-                    &mut r.problems,
-                );
-                Ok(syntax::Subroutine {
-                    origin,
-                    name,
-                    vars,
-                    body,
-                })
-            },
+            |r, name, origin, path| r.routine(RoutineKind::Subroutine, name, origin, path),
         )
+    }
+
+    fn interrupts(&mut self) -> P<Vec<syntax::Subroutine<'a>>> {
+        self.named(
+            "interrupts",
+            "an object of interrupt routines",
+            "an object (an interrupt routine)",
+            |r, name, origin, path| r.routine(RoutineKind::Interrupt, name, origin, path),
+        )
+    }
+
+    /// One subroutine or interrupt routine, at its `{`.
+    fn routine(
+        &mut self,
+        kind: RoutineKind,
+        name: Text<'a>,
+        origin: Origin,
+        path: &str,
+    ) -> P<syntax::Subroutine<'a>> {
+        let what = match kind {
+            RoutineKind::Subroutine => "a subroutine",
+            RoutineKind::Interrupt => "an interrupt routine",
+        };
+        let parts = self.parts(path, SUBROUTINE_KEYS)?;
+        if let Some((k, o)) = &parts.unknown {
+            let p = unknown_field(join(path, k), *o, k, what, SUBROUTINE_KEYS);
+            self.problems.push(p);
+        }
+        let vars = self.take(parts.vars);
+        let body = body(
+            parts.rungs,
+            parts.fbd,
+            path,
+            what,
+            origin,
+            &mut self.problems,
+        );
+        Ok(syntax::Subroutine {
+            origin,
+            kind,
+            name,
+            vars,
+            body,
+        })
     }
 
     fn function_blocks(&mut self) -> P<Vec<syntax::FunctionBlock<'a>>> {

@@ -16,7 +16,9 @@
 use super::interface::{self, name, Interface, Known};
 use super::xml::{add_data_note, attr, error, identifier, origin, Note, Notes, Tc6, R};
 use super::{fbd, ld, textual};
-use crate::syntax::{Body, Element, ElementKind, FunctionBlock, Program, Rung, Subroutine, Var};
+use crate::syntax::{
+    Body, Element, ElementKind, FunctionBlock, Program, RoutineKind, Rung, Subroutine, Var,
+};
 use roxmltree::{Document, Node};
 use std::collections::HashSet;
 
@@ -184,6 +186,7 @@ fn assemble(
         .into_iter()
         .map(|p| Subroutine {
             origin: p.origin,
+            kind: RoutineKind::Subroutine,
             name: p.name.into(),
             vars: p.vars,
             body: Some(p.body),

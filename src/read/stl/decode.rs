@@ -208,8 +208,8 @@ pub(super) fn decode(cx: &mut Context, ins: &Ins, empty: bool) -> Result<Op, Loa
         "END" => Op::Out(kind(ElementKind::End)),
         "MEND" if empty => Op::Alone(kind(ElementKind::End)),
         "MEND" => Op::Out(kind(ElementKind::End)),
-        "CRET" | "RET" if empty => Op::Alone(kind(ElementKind::Ret)),
-        "CRET" | "RET" => Op::Out(kind(ElementKind::Ret)),
+        "CRET" | "RET" | "CRETI" | "RETI" if empty => Op::Alone(kind(ElementKind::Ret)),
+        "CRET" | "RET" | "CRETI" | "RETI" => Op::Out(kind(ElementKind::Ret)),
         "NEXT" => Op::Alone(kind(ElementKind::Next)),
         "FOR" => {
             let v = arg(cx, ins, 0, 3)?;

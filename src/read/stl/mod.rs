@@ -28,7 +28,7 @@ mod operand;
 use crate::diag::{LoadError, Origin};
 use crate::fbd::Fbd;
 use crate::model::Program;
-use crate::syntax::{self, Body, Located, Subroutine, Var, VarClass};
+use crate::syntax::{self, Body, Located, RoutineKind, Subroutine, Var, VarClass};
 use std::borrow::Cow;
 
 pub use crate::read::plcopen::Note;
@@ -155,7 +155,7 @@ pub fn parse(text: &str) -> Result<(syntax::Program<'static>, Vec<Note>), LoadEr
         origin: Origin::at(ls.first().map_or(0, |l| l.0)),
         ..Default::default()
     };
-    let mut notes = Vec::new();
+    let notes = Vec::new();
     let mut i = 0;
     let mut blocks: Vec<Block> = Vec::new();
     while i < ls.len() {
@@ -227,14 +227,14 @@ pub fn parse(text: &str) -> Result<(syntax::Program<'static>, Vec<Note>), LoadEr
                 program.body = Some(Body::Rungs(rungs));
             }
             _ => {
-                if kind == "INTERRUPT_BLOCK" {
-                    notes.push(Note {
-                        origin: Origin::at(at),
-                        message: format!("interrupt routine {name} is read as a subroutine that nothing calls (plc-deps has no interrupt events; not yet)"),
-                    });
-                }
+                let kind = if kind == "INTERRUPT_BLOCK" {
+                    RoutineKind::Interrupt
+                } else {
+                    RoutineKind::Subroutine
+                };
                 program.subroutines.push(Subroutine {
                     origin: Origin::at(name_at),
+                    kind,
                     name: Cow::Owned(name.to_string()),
                     vars,
                     body: Some(Body::Rungs(rungs)),

@@ -121,7 +121,7 @@ fn effect(op: &str) -> Option<(usize, usize, usize)> {
         _ if op.len() == 2 && "+-*/".contains(&op[..1]) && "IDR".contains(&op[1..]) => (1, 0, 0),
         "ALD" | "OLD" | "CTU" | "CTD" => (2, 1, 0),
         "LPP" => (1, 1, 0),
-        "CRET" | "RET" | "MEND" | "NEXT" | "LBL" => (0, 0, 0),
+        "CRET" | "RET" | "CRETI" | "RETI" | "MEND" | "NEXT" | "LBL" => (0, 0, 0),
         _ => return None,
     })
 }
