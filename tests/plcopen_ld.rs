@@ -9,19 +9,7 @@ use serde_json::{json, Value};
 #[path = "plcopen_common/mod.rs"]
 mod px;
 
-use px::{coil, conn, contact, in_var, project, rail};
-
-/// The JSON report of an XML text (read from standard input).
-fn report(xml: &str) -> Value {
-    let out = run_stdin(&["report", "-", "--format", "json"], xml.as_bytes());
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).unwrap()
-}
+use px::{coil, conn, contact, in_var, io, project, rail, report};
 
 fn deps(r: &Value) -> Vec<(String, String, String, String)> {
     r["dependences"]
@@ -42,21 +30,6 @@ fn deps(r: &Value) -> Vec<(String, String, String, String)> {
 
 fn dep(kind: &str, from: &str, to: &str, var: &str) -> (String, String, String, String) {
     (kind.into(), from.into(), to.into(), var.into())
-}
-
-fn io(r: &Value) -> Vec<(String, Value, Value)> {
-    r["rungs"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|x| {
-            (
-                x["id"].as_str().unwrap().to_owned(),
-                x["in"].clone(),
-                x["out"].clone(),
-            )
-        })
-        .collect()
 }
 
 /// A seal-in latch: (Start OR Motor) AND NOT Stop → Motor; then Motor → Lamp.

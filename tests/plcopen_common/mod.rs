@@ -173,3 +173,78 @@ pub fn generated_ld(bytes: usize) -> (String, usize) {
     );
     (s, rungs)
 }
+
+/// The JSON report of an XML text (read from standard input); the command must succeed.
+pub fn report(xml: &str) -> serde_json::Value {
+    report_and_warnings(xml).0
+}
+
+/// [`report`], with the command's standard error (its warnings).
+pub fn report_and_warnings(xml: &str) -> (serde_json::Value, String) {
+    json_output(&["report", "-", "--format", "json"], xml)
+}
+
+/// The JSON standard output of `plc-deps ARGS` (with `stdin`), which must succeed, and its
+/// standard error.
+pub fn json_output(args: &[&str], stdin: &str) -> (serde_json::Value, String) {
+    let out = crate::common::cli::run_stdin(args, stdin.as_bytes());
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    (serde_json::from_slice(&out.stdout).unwrap(), err)
+}
+
+/// Each rung of a JSON report: its id, what it reads (IN) and what it writes (OUT).
+pub fn io(r: &serde_json::Value) -> Vec<(String, serde_json::Value, serde_json::Value)> {
+    r["rungs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| {
+            (
+                x["id"].as_str().unwrap().to_owned(),
+                x["in"].clone(),
+                x["out"].clone(),
+            )
+        })
+        .collect()
+}
+
+/// Runs the XML text one scan per row of `inputs` (a CSV with a header of input names) and
+/// returns, for each of `columns`, its value after each scan as the trace writes it.
+pub fn trace(tag: &str, xml: &str, inputs: &str, columns: &[&str]) -> Vec<Vec<String>> {
+    let path = crate::common::cli::tmp(&format!("{tag}.xml"));
+    std::fs::write(&path, xml).unwrap();
+    let csv = crate::common::cli::tmp(&format!("{tag}.csv"));
+    std::fs::write(&csv, inputs).unwrap();
+    let tr = crate::common::cli::tmp(&format!("{tag}-trace.csv"));
+    let out = crate::common::cli::run(&[
+        "run",
+        path.to_str().unwrap(),
+        "--inputs",
+        csv.to_str().unwrap(),
+        "--trace",
+        tr.to_str().unwrap(),
+        "--format",
+        "json",
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&tr).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    columns
+        .iter()
+        .map(|c| {
+            let k = header
+                .iter()
+                .position(|h| h == c)
+                .unwrap_or_else(|| panic!("no column {c} in {header:?}"));
+            rows.iter().map(|r| r[k].to_owned()).collect()
+        })
+        .collect()
+}

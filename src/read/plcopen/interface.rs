@@ -34,14 +34,11 @@ pub struct Interface {
 }
 
 /// Standard function blocks the model has.
-const MODEL_FBS: &[&str] = &["TON", "TOF", "TP", "CTU", "CTD"];
+const MODEL_FBS: &[&str] = &[
+    "TON", "TOF", "TP", "CTU", "CTD", "SR", "RS", "R_TRIG", "F_TRIG", "CTUD",
+];
 /// Standard function blocks of IEC 61131-3 the model does not have yet.
 const OTHER_STD_FBS: &[&str] = &[
-    "SR",
-    "RS",
-    "R_TRIG",
-    "F_TRIG",
-    "CTUD",
     "CTU_DINT",
     "CTD_DINT",
     "CTUD_DINT",
