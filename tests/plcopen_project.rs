@@ -1,4 +1,4 @@
-//! PLCopen projects as wholes: tasks and program instances, ST bodies through their interface,
+//! PLCopen projects as wholes: tasks and program instances, a CODESYS ST body,
 //! recognition by content. What each of the editors' real files (tests/plcopen/, copied from
 //! /work/shared/plcopen with their MANIFEST.md) gives is pinned, whole, by the committed outputs
 //! of analyses/plcopen/ (tests/analyses.rs).
@@ -55,7 +55,7 @@ fn tasks_run_their_program_instances_in_priority_order() {
 }
 
 #[test]
-fn an_st_body_is_analysed_through_its_interface_with_a_warning() {
+fn a_codesys_st_body_is_analysed_per_statement_with_a_warning() {
     let (r, err) = json_output(
         &[
             "report",
@@ -66,10 +66,10 @@ fn an_st_body_is_analysed_through_its_interface_with_a_warning() {
         "",
     );
     let rung = &r["rungs"][0];
-    assert_eq!(rung["id"], "PLC_PRG.body");
+    assert_eq!(rung["id"], "PLC_PRG.st1");
     assert_eq!(rung["in"], serde_json::json!(["i"]));
     assert_eq!(rung["out"], serde_json::json!(["i"]));
-    assert!(err.contains("warning: tests/plcopen/e-cockpit-python-scripting__plc.xml:36:11: pou PLC_PRG: its ST body is not read yet; it is analysed through its interface (inputs read; outputs, locals and externals written) and not executed by `run`"), "{err}");
+    assert!(err.contains("warning: tests/plcopen/e-cockpit-python-scripting__plc.xml:36:11: pou PLC_PRG: its ST body is analysed per statement (1 top-level statement, rungs PLC_PRG.st1 …, each reading and writing whole variables) and not executed by `run`"), "{err}");
     assert!(err.contains("warning: tests/plcopen/e-cockpit-python-scripting__plc.xml:16:5: vendor data (addData) ignored: http://www.3s-software.com/plcopenxml/projectinformation"), "{err}");
 }
 

@@ -49,6 +49,12 @@ const OTHER_STD_FBS: &[&str] = &[
 ];
 const MODEL_ELEMENTARY: &[&str] = &["BOOL", "INT", "DINT", "REAL", "TIME"];
 
+/// True when a declared type (as the reader writes it into the syntax) is elementary, not a
+/// function block type.
+pub fn is_elementary(ty: &str) -> bool {
+    MODEL_ELEMENTARY.contains(&ty)
+}
+
 /// Reads the interface of POU `pou` (its `interface` element; none is an empty interface).
 pub fn interface(tc6: Tc6, node: Option<Node>, pou: &str, known: &Known) -> R<Interface> {
     let mut out = Interface::default();

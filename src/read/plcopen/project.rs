@@ -15,7 +15,7 @@
 
 use super::interface::{self, name, Interface, Known};
 use super::xml::{add_data_note, attr, error, identifier, origin, Note, Notes, Tc6, R};
-use super::{fbd, ld, textual};
+use super::{fbd, ld, st_body, textual};
 use crate::syntax::{Body, Element, ElementKind, FunctionBlock, Program, Rung, Subroutine, Var};
 use roxmltree::{Document, Node};
 use std::collections::HashSet;
@@ -46,18 +46,44 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
                 .insert(attr(dt, "name", "types/dataTypes")?);
         }
     }
-    let (mut programs, mut fbs) = (Vec::new(), Vec::new());
+    // The interfaces first, then the globals, then the bodies: an ST body resolves its names
+    // against them all.
+    let mut read = Vec::new();
     let pous = types.and_then(|t| tc6.child(t, "pous"));
     for pou in pous.into_iter().flat_map(|p| tc6.children(p, "pou")) {
         let raw = attr(pou, "name", "types/pous")?;
         let pname = identifier(raw, "POU", pou, "types/pous")?;
         let place = format!("pou {pname}");
-        add_data_note(tc6, pou, notes);
         let kind = attr(pou, "pouType", &place)?;
+        if !matches!(kind, "program" | "functionBlock" | "function") {
+            return Err(error(
+                origin(pou),
+                &place,
+                format!("unknown pouType `{kind}` of POU `{pname}`"),
+            ));
+        }
         let iface = interface::interface(tc6, tc6.child(pou, "interface"), &pname, &known)?;
+        read.push((pou, pname, kind, iface));
+    }
+    let mut later = Notes::default();
+    let (globals, order) = instances(tc6, root, &known, &mut later)?;
+    let global_types: Vec<(&str, &str)> = globals
+        .iter()
+        .chain(read.iter().flat_map(|r| &r.3.globals))
+        .map(|v| (v.name.as_str(), v.ty.as_str()))
+        .collect();
+    let mut bodies = Vec::new();
+    for (pou, pname, _, iface) in &read {
+        add_data_note(tc6, *pou, notes);
+        let scope = scope(iface, &global_types);
+        bodies.push(body(tc6, *pou, pname, iface, &scope, notes)?);
+    }
+    notes.list.extend(later.list);
+    let (mut programs, mut fbs) = (Vec::new(), Vec::new());
+    for ((pou, pname, kind, iface), body) in read.into_iter().zip(bodies) {
+        let place = format!("pou {pname}");
         match kind {
             "program" => {
-                let body = body(tc6, pou, &pname, &iface, notes)?;
                 let mut vars = iface.inputs;
                 vars.extend(iface.outputs);
                 vars.extend(iface.locals);
@@ -77,7 +103,6 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
                         format!("function block `{pname}` declares global variables"),
                     ));
                 }
-                let body = body(tc6, pou, &pname, &iface, notes)?;
                 fbs.push(FunctionBlock {
                     origin: origin(pou),
                     name: pname.into(),
@@ -87,24 +112,37 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
                     body: Some(body),
                 });
             }
-            "function" => {
+            _ => {
                 return Err(error(
                     origin(pou),
                     &place,
                     format!("POU `{pname}` is a function: functions are not supported yet"),
                 ))
             }
-            other => {
-                return Err(error(
-                    origin(pou),
-                    &place,
-                    format!("unknown pouType `{other}` of POU `{pname}`"),
-                ))
-            }
         }
     }
-    let (globals, order) = instances(tc6, root, &known, notes)?;
     assemble(root, programs, fbs, globals, order)
+}
+
+/// The names an ST body of a POU with interface `iface` sees: its own variables and the globals
+/// it declares external (`globals`: the name and type of every global of the project).
+fn scope(iface: &Interface, globals: &[(&str, &str)]) -> st_body::Scope {
+    let mut s = st_body::Scope::default();
+    for v in iface
+        .inputs
+        .iter()
+        .chain(&iface.outputs)
+        .chain(&iface.locals)
+        .chain(&iface.globals)
+    {
+        s.declare(v.name.as_str(), v.ty.as_str());
+    }
+    for e in &iface.externals {
+        if let Some((n, t)) = globals.iter().find(|(n, _)| n.eq_ignore_ascii_case(e)) {
+            s.declare(n, t);
+        }
+    }
+    s
 }
 
 /// Puts the POUs together: one program as the main program, several as subroutines called in
@@ -192,9 +230,16 @@ fn assemble(
     Ok(program)
 }
 
-/// The body of POU `pou` as syntax: LD rungs, an FBD body, or a textual or SFC body through
-/// its interface.
-fn body(tc6: Tc6, pou: Node, name: &str, iface: &Interface, notes: &mut Notes) -> R<Body<'static>> {
+/// The body of POU `pou` as syntax: LD rungs, an FBD body, a stand-in rung per ST statement,
+/// or an IL or SFC body through its interface.
+fn body(
+    tc6: Tc6,
+    pou: Node,
+    name: &str,
+    iface: &Interface,
+    scope: &st_body::Scope,
+    notes: &mut Notes,
+) -> R<Body<'static>> {
     let place = format!("pou {name}");
     let Some(b) = tc6.child(pou, "body") else {
         return Err(error(
@@ -235,7 +280,8 @@ fn body(tc6: Tc6, pou: Node, name: &str, iface: &Interface, notes: &mut Notes) -
     Ok(match tag {
         "LD" => Body::Rungs(ld::rungs(tc6, lang, name, notes)?),
         "FBD" => Body::Fbd(fbd::body(tc6, lang, name, notes)?),
-        "ST" | "IL" | "SFC" => {
+        "ST" => Body::Rungs(st_body::rungs(lang, name, scope, notes)?),
+        "IL" | "SFC" => {
             let reads: Vec<&Var> = iface.inputs.iter().collect();
             let writes: Vec<&Var> = iface
                 .outputs
