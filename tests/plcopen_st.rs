@@ -9,7 +9,7 @@ mod common;
 mod px;
 
 use common::cli::{error_line, run_stdin};
-use px::{io, project_in, report_and_warnings};
+use px::{io, line_col, project_in, report_and_warnings};
 use serde_json::{json, Value};
 
 const VARS: &[(&str, &str, &str)] = &[
@@ -42,14 +42,6 @@ const BODY: &[&str] = &[
     ";",
     "done := T1.Q;",
 ];
-
-/// The line and column where `needle` starts in `text`.
-fn line_col(text: &str, needle: &str) -> String {
-    let at = text.find(needle).unwrap();
-    let line = text[..at].matches('\n').count() + 1;
-    let col = at - text[..at].rfind('\n').map_or(0, |k| k + 1) + 1;
-    format!("{line}:{col}")
-}
 
 #[test]
 fn each_statement_is_a_rung_with_exactly_its_reads_and_writes() {

@@ -248,3 +248,11 @@ pub fn trace(tag: &str, xml: &str, inputs: &str, columns: &[&str]) -> Vec<Vec<St
         })
         .collect()
 }
+
+/// The line and column (`L:C`, 1-based) where `needle` first starts in `text`.
+pub fn line_col(text: &str, needle: &str) -> String {
+    let at = text.find(needle).unwrap();
+    let line = text[..at].matches('\n').count() + 1;
+    let col = at - text[..at].rfind('\n').map_or(0, |k| k + 1) + 1;
+    format!("{line}:{col}")
+}

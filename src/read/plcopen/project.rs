@@ -66,7 +66,14 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
         read.push((pou, pname, kind, iface));
     }
     let mut later = Notes::default();
-    let (globals, order) = instances(tc6, root, &known, &mut later)?;
+    let mut mapped_globals = Vec::new();
+    let (globals, order) = instances(tc6, root, &known, &mut later, &mut mapped_globals)?;
+    let mapped: Vec<(Option<String>, interface::Mapped)> = read
+        .iter()
+        .flat_map(|(_, p, _, i)| i.mapped.iter().map(|m| (Some(p.clone()), m.clone())))
+        .chain(mapped_globals.into_iter().map(|m| (None, m)))
+        .collect();
+    later.list.extend(interface::mapped_note(&mapped));
     let global_types: Vec<(&str, &str)> = globals
         .iter()
         .chain(read.iter().flat_map(|r| &r.3.globals))
@@ -277,6 +284,13 @@ fn body(
             }
         }
     }
+    if let (Some(m), "LD" | "FBD") = (iface.mapped.iter().find(|m| m.text), tag) {
+        return Err(error(
+            m.origin,
+            &place,
+            format!("variable `{}` is a {}, for which plc-deps has no values: strings are read only in POUs whose body `run` does not execute (ST, IL, SFC), and `{name}` has an {tag} body", m.var, m.from),
+        ));
+    }
     Ok(match tag {
         "LD" => Body::Rungs(ld::rungs(tc6, lang, name, notes)?),
         "FBD" => Body::Fbd(fbd::body(tc6, lang, name, notes)?),
@@ -318,6 +332,7 @@ fn instances<'a, 'i>(
     root: Node<'a, 'i>,
     known: &Known,
     notes: &mut Notes,
+    mapped: &mut Vec<interface::Mapped>,
 ) -> R<(Vec<Var<'static>>, Order<'a, 'i>)> {
     let mut globals = Vec::new();
     let mut order = Vec::new();
@@ -341,10 +356,10 @@ fn instances<'a, 'i>(
     add_data_note(tc6, conf, notes);
     let place = "instances/configuration";
     // The globals of the configuration, then of its resource.
-    let globals_of = |node: Node, globals: &mut Vec<Var<'static>>| -> R<()> {
+    let mut globals_of = |node: Node, globals: &mut Vec<Var<'static>>| -> R<()> {
         for gv in tc6.children(node, "globalVars") {
             let class = crate::syntax::VarClass::Default;
-            globals.extend(interface::var_list(tc6, gv, class, place, known)?);
+            globals.extend(interface::var_list(tc6, gv, class, place, known, mapped)?);
         }
         Ok(())
     };
