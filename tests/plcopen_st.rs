@@ -9,8 +9,8 @@ mod common;
 mod px;
 
 use common::cli::{error_line, run_stdin};
-use px::{io, line_col, project_in, report_and_warnings};
-use serde_json::{json, Value};
+use px::{io, line_col, project_in, report_and_warnings, run_scans, rung};
+use serde_json::json;
 
 const VARS: &[(&str, &str, &str)] = &[
     ("inputVars", "start", "BOOL"),
@@ -49,14 +49,14 @@ fn each_statement_is_a_rung_with_exactly_its_reads_and_writes() {
     assert_eq!(
         io(&r),
         vec![
-            ("P.st1".into(), json!(["count"]), json!(["count"])),
-            (
-                "P.st2".into(),
-                json!(["start", "stop", "run", "count"]),
-                json!(["run", "count"])
+            rung("P.st1", &["count"], &["count"]),
+            rung(
+                "P.st2",
+                &["start", "stop", "run", "count"],
+                &["run", "count"]
             ),
-            ("P.st3".into(), json!(["run", "T1"]), json!([])),
-            ("P.st5".into(), json!(["done", "T1"]), json!(["done"])),
+            rung("P.st3", &["run", "T1"], &[]),
+            rung("P.st5", &["done", "T1"], &["done"]),
         ]
     );
     let deps: Vec<(String, String, String, String)> = r["dependences"]
@@ -90,17 +90,7 @@ fn each_statement_is_a_rung_with_exactly_its_reads_and_writes() {
 #[test]
 fn a_run_leaves_the_values_unchanged() {
     let xml = st(BODY);
-    let out = run_stdin(
-        &["run", "-", "--scans", "3", "--format", "json"],
-        xml.as_bytes(),
-    );
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v = run_scans(&xml, 3);
     assert_eq!(v["outputs"], json!({"run": false, "done": false}));
     assert_eq!(v["state"]["count"], json!(0));
 }
@@ -143,10 +133,10 @@ fn an_il_body_is_still_analysed_through_its_interface() {
     let (r, err) = report_and_warnings(&xml);
     assert_eq!(
         io(&r),
-        vec![(
-            "P.body".into(),
-            json!(["start", "stop", "run", "done", "count"]),
-            json!(["run", "done", "count"])
+        vec![rung(
+            "P.body",
+            &["start", "stop", "run", "done", "count"],
+            &["run", "done", "count"]
         )]
     );
     assert!(err.contains(&format!("warning: <stdin>:{}: pou P: its IL body is not read yet; it is analysed through its interface (inputs read; outputs, locals and externals written) and not executed by `run`; the function block instances T1 are not written", line_col(&xml, "<IL>"))), "{err}");

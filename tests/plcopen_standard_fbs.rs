@@ -6,8 +6,9 @@ mod common;
 #[path = "plcopen_common/mod.rs"]
 mod px;
 
-use px::{block, coil, contact, in_var, io, project, project_in, rail, report, trace, var_in};
-use serde_json::json;
+use px::{
+    block, coil, contact, in_var, io, project, project_in, rail, report, rung, trace, var_in,
+};
 
 /// A coil on output `pin` of block `from`.
 fn coil_on(id: u32, var: &str, from: u32, pin: &str) -> String {
@@ -77,13 +78,9 @@ fn sr_r_trig_and_ctud_boxes_in_rungs_read_and_write_their_instances() {
     assert_eq!(
         io(&report(&ld_boxes())),
         vec![
-            ("P.R1".into(), json!(["s", "r", "B"]), json!(["q1", "B"])),
-            ("P.R2".into(), json!(["clk", "E"]), json!(["pulse", "E"])),
-            (
-                "P.R3".into(),
-                json!(["up", "down", "clr", "C"]),
-                json!(["full", "C"])
-            ),
+            rung("P.R1", &["s", "r", "B"], &["q1", "B"]),
+            rung("P.R2", &["clk", "E"], &["pulse", "E"]),
+            rung("P.R3", &["up", "down", "clr", "C"], &["full", "C"]),
         ]
     );
 }

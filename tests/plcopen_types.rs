@@ -8,8 +8,8 @@ mod common;
 mod px;
 
 use common::cli::{error_line, run_stdin};
-use px::{coil, contact, line_col, project_in, rail, report_and_warnings};
-use serde_json::{json, Value};
+use px::{coil, contact, line_col, project_in, rail, report_and_warnings, run_scans};
+use serde_json::json;
 
 /// `ty` typed variables: `(class, name, TC6 type element, initial value)`.
 fn with_types(lang: &str, vars: &[(&str, &str, &str, &str)], body: &str) -> String {
@@ -59,17 +59,7 @@ fn mapped_types_load_run_and_are_named_in_one_note() {
         err.trim_end(),
         format!("warning: <stdin>:{}: elementary types the model lacks are read as one it has: P.b BYTE → INT, P.u UINT → DINT, P.r LREAL → REAL; `run` computes them at the model's width (INT 16-bit, DINT 32-bit, signed; REAL 32-bit), so it differs from a PLC where a value leaves the declared type's range or needs LREAL precision, and a string has no value (it stands in as a DINT 0)", line_col(&xml, "<variable name=\"b\""))
     );
-    let out = run_stdin(
-        &["run", "-", "--scans", "1", "--format", "json"],
-        xml.as_bytes(),
-    );
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v = run_scans(&xml, 1);
     assert_eq!(
         v["outputs"],
         json!({"lamp": false, "b": 16, "u": 7, "r": 2.5})

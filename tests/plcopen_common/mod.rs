@@ -209,30 +209,49 @@ pub fn io(r: &serde_json::Value) -> Vec<(String, serde_json::Value, serde_json::
         .collect()
 }
 
-/// Runs the XML text one scan per row of `inputs` (a CSV with a header of input names) and
-/// returns, for each of `columns`, its value after each scan as the trace writes it.
-pub fn trace(tag: &str, xml: &str, inputs: &str, columns: &[&str]) -> Vec<Vec<String>> {
+/// One rung of a JSON report as [`io`] gives it.
+pub fn rung(
+    id: &str,
+    ins: &[&str],
+    outs: &[&str],
+) -> (String, serde_json::Value, serde_json::Value) {
+    (
+        id.to_owned(),
+        serde_json::json!(ins),
+        serde_json::json!(outs),
+    )
+}
+
+/// The JSON output of `plc-deps run` of the XML text for `scans` scans (from standard input).
+pub fn run_scans(xml: &str, scans: u32) -> serde_json::Value {
+    let n = scans.to_string();
+    json_output(&["run", "-", "--scans", &n, "--format", "json"], xml).0
+}
+
+/// The JSON output of `plc-deps run` of the XML text (written to the scratch file `tag.xml`),
+/// one scan per row of `inputs` (a CSV with a header of input names), with `extra` arguments.
+pub fn run_inputs(tag: &str, xml: &str, inputs: &str, extra: &[&str]) -> serde_json::Value {
     let path = crate::common::cli::tmp(&format!("{tag}.xml"));
     std::fs::write(&path, xml).unwrap();
     let csv = crate::common::cli::tmp(&format!("{tag}.csv"));
     std::fs::write(&csv, inputs).unwrap();
-    let tr = crate::common::cli::tmp(&format!("{tag}-trace.csv"));
-    let out = crate::common::cli::run(&[
+    let mut args = vec![
         "run",
         path.to_str().unwrap(),
         "--inputs",
         csv.to_str().unwrap(),
-        "--trace",
-        tr.to_str().unwrap(),
         "--format",
         "json",
-    ]);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    ];
+    args.extend(extra);
+    json_output(&args, "").0
+}
+
+/// Runs the XML text one scan per row of `inputs` ([`run_inputs`]) and returns, for each of
+/// `columns`, its value after each scan as the trace writes it.
+pub fn trace(tag: &str, xml: &str, inputs: &str, columns: &[&str]) -> Vec<Vec<String>> {
+    let tr = crate::common::cli::tmp(&format!("{tag}-trace.csv"));
+    run_inputs(tag, xml, inputs, &["--trace", tr.to_str().unwrap()]);
     let text = std::fs::read_to_string(&tr).unwrap();
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
