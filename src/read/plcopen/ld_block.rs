@@ -83,7 +83,7 @@ impl Spec {
     }
 }
 
-const SUPPORTED: &str = "TON, TOF, TP, CTU, CTD, SR, RS, R_TRIG, F_TRIG, CTUD, ADD, SUB, MUL, DIV, MOD, MOVE, EQ, NE, LT, LE, GT, GE";
+const SUPPORTED: &str = "TON, TOF, TP, CTU, CTD, SR, RS, R_TRIG, F_TRIG, CTUD, ADD, SUB, MUL, DIV, MOD, MOVE, EQ, NE, LT, LE, GT, GE, AND, OR, XOR, NOT";
 
 /// True when out variable `e` is the result of an ADD … MOD or MOVE block (part of its box).
 pub fn absorbed(p: &Power, e: ElemId) -> bool {
@@ -109,6 +109,9 @@ pub fn power_out(p: &mut Power, e: ElemId, pin: Option<&str>) -> R<Path> {
     let node = el.node;
     let here = p.at(e);
     let ty = super::xml::attr(node, "typeName", &here)?;
+    if super::ld_logic::is_logic(ty) {
+        return super::ld_logic::power_out(p, e, ty);
+    }
     let Some(spec) = Spec::of(ty) else {
         return Err(error(
             origin(node),
