@@ -6,7 +6,7 @@ mod common;
 mod px;
 
 use common::cli::{error_line, run_stdin};
-use px::{block, in_var, project_in, var_in};
+use px::{block, in_var, project_in, run_scans, var_in};
 use serde_json::{json, Value};
 
 /// Cnt := SEL(G := Reset, IN0 := ADD(Cnt, 1), IN1 := 0); Big := GT(Cnt, 5).
@@ -60,24 +60,14 @@ fn counter() -> String {
 #[test]
 fn a_counter_closes_its_loop_through_the_in_out_variable() {
     let xml = counter();
-    let out = run_stdin(
-        &["run", "-", "--scans", "7", "--format", "json"],
-        xml.as_bytes(),
+    assert_eq!(
+        run_scans(&xml, 7)["outputs"],
+        json!({"Cnt": 7, "Big": true})
     );
     assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+        run_scans(&xml, 5)["outputs"],
+        json!({"Cnt": 5, "Big": false})
     );
-    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert_eq!(v["outputs"], json!({"Cnt": 7, "Big": true}));
-    let out = run_stdin(
-        &["run", "-", "--scans", "5", "--format", "json"],
-        xml.as_bytes(),
-    );
-    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert_eq!(v["outputs"], json!({"Cnt": 5, "Big": false}));
     let out = run_stdin(&["report", "-", "--format", "json"], xml.as_bytes());
     let r: Value = serde_json::from_slice(&out.stdout).unwrap();
     let ids: Vec<&str> = r["rungs"]

@@ -3,25 +3,15 @@
 
 mod common;
 
-use common::cli::{run, run_stdin};
 use serde_json::{json, Value};
 
 #[path = "plcopen_common/mod.rs"]
 mod px;
 
-use px::{coil, conn, contact, in_var, project, rail};
-
-/// The JSON report of an XML text (read from standard input).
-fn report(xml: &str) -> Value {
-    let out = run_stdin(&["report", "-", "--format", "json"], xml.as_bytes());
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).unwrap()
-}
+use px::{
+    coil, conn, contact, in_var, io, project, rail, report, report_and_warnings, run_inputs,
+    run_scans, rung, trace,
+};
 
 fn deps(r: &Value) -> Vec<(String, String, String, String)> {
     r["dependences"]
@@ -42,21 +32,6 @@ fn deps(r: &Value) -> Vec<(String, String, String, String)> {
 
 fn dep(kind: &str, from: &str, to: &str, var: &str) -> (String, String, String, String) {
     (kind.into(), from.into(), to.into(), var.into())
-}
-
-fn io(r: &Value) -> Vec<(String, Value, Value)> {
-    r["rungs"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|x| {
-            (
-                x["id"].as_str().unwrap().to_owned(),
-                x["in"].clone(),
-                x["out"].clone(),
-            )
-        })
-        .collect()
 }
 
 /// A seal-in latch: (Start OR Motor) AND NOT Stop → Motor; then Motor → Lamp.
@@ -88,12 +63,8 @@ fn a_latch_is_one_rung_with_a_parallel_branch_and_feeds_the_next() {
     assert_eq!(
         io(&r),
         vec![
-            (
-                "P.R1".into(),
-                json!(["Start", "Stop", "Motor"]),
-                json!(["Motor"])
-            ),
-            ("P.R2".into(), json!(["Motor"]), json!(["Lamp"])),
+            rung("P.R1", &["Start", "Stop", "Motor"], &["Motor"]),
+            rung("P.R2", &["Motor"], &["Lamp"]),
         ]
     );
     assert_eq!(deps(&r), vec![dep("flow", "P.R1", "P.R2", "Motor")]);
@@ -103,40 +74,10 @@ fn a_latch_is_one_rung_with_a_parallel_branch_and_feeds_the_next() {
 
 #[test]
 fn a_latch_runs_as_a_latch() {
-    let path = common::cli::tmp("latch.xml");
-    std::fs::write(&path, latch()).unwrap();
-    let inputs = common::cli::tmp("latch.csv");
-    std::fs::write(&inputs, "Start,Stop\n1,0\n0,0\n0,0\n0,1\n0,0\n").unwrap();
-    let out = run(&[
-        "run",
-        path.to_str().unwrap(),
-        "--inputs",
-        inputs.to_str().unwrap(),
-        "--trace",
-        common::cli::tmp("latch-trace.csv").to_str().unwrap(),
-        "--format",
-        "json",
-    ]);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert_eq!(v["outputs"], json!({"Motor": false, "Lamp": false}));
-    let trace = std::fs::read_to_string(common::cli::tmp("latch-trace.csv")).unwrap();
-    let motor: Vec<&str> = trace
-        .lines()
-        .skip(1)
-        .map(|l| {
-            let header: Vec<&str> = trace.lines().next().unwrap().split(',').collect();
-            let k = header.iter().position(|h| *h == "Motor").unwrap();
-            l.split(',').nth(k).unwrap()
-        })
-        .collect();
+    let inputs = "Start,Stop\n1,0\n0,0\n0,0\n0,1\n0,0\n";
+    let motor = trace("latch", &latch(), inputs, &["Motor"]);
     // Set by Start in scan 0, held while Start is released, dropped by Stop in scan 3.
-    assert_eq!(motor, ["1", "1", "1", "0", "0"]);
+    assert_eq!(motor[0], ["1", "1", "1", "0", "0"]);
 }
 
 #[test]
@@ -168,9 +109,9 @@ fn shared_prefixes_become_branches_and_parallel_wires_an_or() {
     assert_eq!(
         io(&r),
         vec![
-            ("P.R1".into(), json!(["A", "B"]), json!(["X", "Y"])),
-            ("P.R2".into(), json!(["C", "D"]), json!(["Z"])),
-            ("P.R3".into(), json!(["X"]), json!(["W"])),
+            rung("P.R1", &["A", "B"], &["X", "Y"]),
+            rung("P.R2", &["C", "D"], &["Z"]),
+            rung("P.R3", &["X"], &["W"]),
         ]
     );
     assert_eq!(deps(&r), vec![dep("flow", "P.R1", "P.R3", "X")]);
@@ -202,17 +143,9 @@ fn negated_and_edge_contacts_and_set_reset_coils() {
     assert_eq!(
         io(&r),
         vec![
-            (
-                "P.R1".into(),
-                json!(["S", "P.R1:edge1"]),
-                json!(["M", "P.R1:edge1"])
-            ),
-            (
-                "P.R2".into(),
-                json!(["S", "P.R2:edge1"]),
-                json!(["M", "P.R2:edge1"])
-            ),
-            ("P.R3".into(), json!(["M"]), json!(["N"])),
+            rung("P.R1", &["S", "P.R1:edge1"], &["M", "P.R1:edge1"]),
+            rung("P.R2", &["S", "P.R2:edge1"], &["M", "P.R2:edge1"]),
+            rung("P.R3", &["M"], &["N"]),
         ]
     );
     assert_eq!(
@@ -225,13 +158,10 @@ fn negated_and_edge_contacts_and_set_reset_coils() {
     );
     assert_eq!(r["levels"]["data"], json!([["P.R1"], ["P.R2"], ["P.R3"]]));
     // S rises in scan 1 (M set), falls in scan 3 (M reset).
-    let out = run_stdin(
-        &["run", "-", "--scans", "2", "--format", "json"],
-        xml.as_bytes(),
+    assert_eq!(
+        run_scans(&xml, 2)["outputs"],
+        json!({"M": false, "N": true})
     );
-    assert_eq!(out.status.code(), Some(0));
-    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert_eq!(v["outputs"], json!({"M": false, "N": true}));
 }
 
 #[test]
@@ -271,39 +201,19 @@ fn a_ton_in_a_rung_times_its_input() {
     assert_eq!(
         io(&r),
         vec![
-            (
-                "P.R1".into(),
-                json!(["Enable", "TON0"]),
-                json!(["Done", "TON0"])
-            ),
-            ("P.R2".into(), json!(["Done"]), json!(["Lamp"])),
+            rung("P.R1", &["Enable", "TON0"], &["Done", "TON0"]),
+            rung("P.R2", &["Done"], &["Lamp"]),
         ]
     );
     assert_eq!(deps(&r), vec![dep("flow", "P.R1", "P.R2", "Done")]);
-    let path = common::cli::tmp("ton.xml");
-    std::fs::write(&path, &xml).unwrap();
-    let inputs = common::cli::tmp("ton.csv");
-    std::fs::write(&inputs, "Enable\n1\n").unwrap();
     for (scans, done) in [(2, false), (3, true)] {
-        let out = run(&[
-            "run",
-            path.to_str().unwrap(),
-            "--inputs",
-            inputs.to_str().unwrap(),
-            "--scans",
-            &scans.to_string(),
-            "--cycle",
-            "10ms",
-            "--format",
-            "json",
-        ]);
-        assert_eq!(
-            out.status.code(),
-            Some(0),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
+        let n = scans.to_string();
+        let v = run_inputs(
+            "ton",
+            &xml,
+            "Enable\n1\n",
+            &["--scans", &n, "--cycle", "10ms"],
         );
-        let v: Value = serde_json::from_slice(&out.stdout).unwrap();
         assert_eq!(
             v["outputs"],
             json!({"Done": done, "Lamp": done}),
@@ -396,40 +306,19 @@ fn counters_compares_and_arithmetic_boxes_in_rungs() {
     assert_eq!(
         io(&r),
         vec![
-            (
-                "P.R1".into(),
-                json!(["Pulse", "Reset", "CTU0", "P.R1:edge1"]),
-                json!(["Full", "CTU0", "P.R1:edge1"])
+            rung(
+                "P.R1",
+                &["Pulse", "Reset", "CTU0", "P.R1:edge1"],
+                &["Full", "CTU0", "P.R1:edge1"]
             ),
-            ("P.R2".into(), json!(["N"]), json!(["High"])),
-            ("P.R3".into(), json!(["Go", "N"]), json!(["N"])),
+            rung("P.R2", &["N"], &["High"]),
+            rung("P.R3", &["Go", "N"], &["N"]),
         ]
     );
     assert_eq!(deps(&r), vec![dep("anti", "P.R2", "P.R3", "N")]);
-    let path = common::cli::tmp("boxes.xml");
-    std::fs::write(&path, &xml).unwrap();
-    let inputs = common::cli::tmp("boxes.csv");
     // Three rising edges of Pulse; Go on in six scans.
-    std::fs::write(
-        &inputs,
-        "Pulse,Reset,Go\n1,0,1\n0,0,1\n1,0,1\n0,0,1\n1,0,1\n0,0,1\n0,0,0\n",
-    )
-    .unwrap();
-    let out = run(&[
-        "run",
-        path.to_str().unwrap(),
-        "--inputs",
-        inputs.to_str().unwrap(),
-        "--format",
-        "json",
-    ]);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let inputs = "Pulse,Reset,Go\n1,0,1\n0,0,1\n1,0,1\n0,0,1\n1,0,1\n0,0,1\n0,0,0\n";
+    let v = run_inputs("boxes", &xml, inputs, &[]);
     // N counts 0..6 (High from the scan that starts with N = 5), CTU0 reaches PV = 3.
     assert_eq!(v["outputs"], json!({"Full": true, "High": true, "N": 6}));
 }
@@ -456,17 +345,14 @@ fn outputs_of_rungs_that_interleave_in_the_file_get_a_warning() {
         ],
         &ld,
     );
-    let out = run_stdin(&["report", "-", "--format", "json"], xml.as_bytes());
-    assert_eq!(out.status.code(), Some(0));
-    let r: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let (r, stderr) = report_and_warnings(&xml);
     assert_eq!(
         io(&r),
         vec![
-            ("P.R1".into(), json!(["A"]), json!(["X", "Z"])),
-            ("P.R2".into(), json!(["B"]), json!(["Y"])),
+            rung("P.R1", &["A"], &["X", "Z"]),
+            rung("P.R2", &["B"], &["Y"]),
         ]
     );
-    let stderr = String::from_utf8_lossy(&out.stderr);
     let warnings: Vec<&str> = stderr
         .lines()
         .filter_map(|l| l.strip_prefix("warning: <stdin>:"))

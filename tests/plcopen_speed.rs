@@ -1,6 +1,7 @@
 //! A 50 MB generated PLCopen LD file loads whole (every rung, each with its OR), and how long the
 //! XML parse and the resolution take (printed; the figure to compare is in docs/plcopen.md).
 
+mod common;
 #[path = "plcopen_common/mod.rs"]
 mod px;
 

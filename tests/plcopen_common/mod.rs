@@ -173,3 +173,105 @@ pub fn generated_ld(bytes: usize) -> (String, usize) {
     );
     (s, rungs)
 }
+
+/// The JSON report of an XML text (read from standard input); the command must succeed.
+pub fn report(xml: &str) -> serde_json::Value {
+    report_and_warnings(xml).0
+}
+
+/// [`report`], with the command's standard error (its warnings).
+pub fn report_and_warnings(xml: &str) -> (serde_json::Value, String) {
+    json_output(&["report", "-", "--format", "json"], xml)
+}
+
+/// The JSON standard output of `plc-deps ARGS` (with `stdin`), which must succeed, and its
+/// standard error.
+pub fn json_output(args: &[&str], stdin: &str) -> (serde_json::Value, String) {
+    let out = crate::common::cli::run_stdin(args, stdin.as_bytes());
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    (serde_json::from_slice(&out.stdout).unwrap(), err)
+}
+
+/// Each rung of a JSON report: its id, what it reads (IN) and what it writes (OUT).
+pub fn io(r: &serde_json::Value) -> Vec<(String, serde_json::Value, serde_json::Value)> {
+    r["rungs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| {
+            (
+                x["id"].as_str().unwrap().to_owned(),
+                x["in"].clone(),
+                x["out"].clone(),
+            )
+        })
+        .collect()
+}
+
+/// One rung of a JSON report as [`io`] gives it.
+pub fn rung(
+    id: &str,
+    ins: &[&str],
+    outs: &[&str],
+) -> (String, serde_json::Value, serde_json::Value) {
+    (
+        id.to_owned(),
+        serde_json::json!(ins),
+        serde_json::json!(outs),
+    )
+}
+
+/// The JSON output of `plc-deps run` of the XML text for `scans` scans (from standard input).
+pub fn run_scans(xml: &str, scans: u32) -> serde_json::Value {
+    let n = scans.to_string();
+    json_output(&["run", "-", "--scans", &n, "--format", "json"], xml).0
+}
+
+/// The JSON output of `plc-deps run` of the XML text (written to the scratch file `tag.xml`),
+/// one scan per row of `inputs` (a CSV with a header of input names), with `extra` arguments.
+pub fn run_inputs(tag: &str, xml: &str, inputs: &str, extra: &[&str]) -> serde_json::Value {
+    let path = crate::common::cli::tmp(&format!("{tag}.xml"));
+    std::fs::write(&path, xml).unwrap();
+    let csv = crate::common::cli::tmp(&format!("{tag}.csv"));
+    std::fs::write(&csv, inputs).unwrap();
+    let mut args = vec![
+        "run",
+        path.to_str().unwrap(),
+        "--inputs",
+        csv.to_str().unwrap(),
+        "--format",
+        "json",
+    ];
+    args.extend(extra);
+    json_output(&args, "").0
+}
+
+/// Runs the XML text one scan per row of `inputs` ([`run_inputs`]) and returns, for each of
+/// `columns`, its value after each scan as the trace writes it.
+pub fn trace(tag: &str, xml: &str, inputs: &str, columns: &[&str]) -> Vec<Vec<String>> {
+    let tr = crate::common::cli::tmp(&format!("{tag}-trace.csv"));
+    run_inputs(tag, xml, inputs, &["--trace", tr.to_str().unwrap()]);
+    let text = std::fs::read_to_string(&tr).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    columns
+        .iter()
+        .map(|c| {
+            let k = header
+                .iter()
+                .position(|h| h == c)
+                .unwrap_or_else(|| panic!("no column {c} in {header:?}"));
+            rows.iter().map(|r| r[k].to_owned()).collect()
+        })
+        .collect()
+}
+
+/// The line and column (`L:C`, 1-based) where `needle` first starts in `text`.
+pub fn line_col(text: &str, needle: &str) -> String {
+    let at = text.find(needle).unwrap();
+    let line = text[..at].matches('\n').count() + 1;
+    let col = at - text[..at].rfind('\n').map_or(0, |k| k + 1) + 1;
+    format!("{line}:{col}")
+}

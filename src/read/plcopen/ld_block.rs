@@ -2,29 +2,36 @@
 //! block boxes in ladder; TC6 `block` with `inputVariables`/`outputVariables`).
 //!
 //! A block takes its power from `EN` when it has one, else from its first BOOL input (`IN` of
-//! TON/TOF/TP, `CU` of CTU, `CD` of CTD; functions without `EN` run always, from the rail) and
-//! gives power out on `ENO`, or `Q` (timers, counters), or `OUT` (compares). Its data inputs are
+//! TON/TOF/TP, `CU` of CTU and CTUD, `CD` of CTD, `S1` of SR, `S` of RS, `CLK` of R_TRIG and
+//! F_TRIG: IEC 61131-3 2.5.2.3; functions without `EN` run always, from the rail) and gives power
+//! out on `ENO`, or its first output (`Q` of timers, counters and triggers, `Q1` of SR/RS, `QU`
+//! of CTUD), or `OUT` (compares). Its data inputs are
 //! fed by `inVariable`s (a variable or a constant); the result of ADD … MOD and MOVE goes to the
-//! `outVariable` wired to `OUT` (exactly one). A counter's `R`/`LD` may also be a single
-//! contact on the rail (its variable is the operand).
+//! `outVariable` wired to `OUT` (exactly one). A BOOL data input (`R`/`LD` of a counter, `R`/`R1`
+//! of SR/RS, `CD`/`R`/`LD` of CTUD) may also be a single contact on the rail (its variable is
+//! the operand).
 //!
 //! Deliberately not here (each an error naming the block and its localId): other block types
 //! (standard ones the model lacks, user function blocks and functions in LD), EN/ENO on timers
-//! and counters, outputs other than the power output wired (`ET`, `CV`), a data pin fed by a
+//! and counters, outputs other than the power output wired (`ET`, `CV`, `QD`), a data pin fed by a
 //! block or a contact network.
 
 use super::ld_power::{Item, Key, Path, Power};
 use super::wiring::ElemId;
 use super::xml::{error, origin, variable_ref, R};
-use crate::model::{ArithOp, CmpOp, TimerKind};
+use crate::model::{ArithOp, BistableKind, CmpOp, TimerKind, TriggerKind};
 use crate::syntax::{
-    Arith, Compare, Counter, Element, ElementKind, Located, Move, Name, Operand, Scalar, Timer,
+    Arith, Bistable, Compare, Counter, Ctud, Element, ElementKind, Located, Move, Name, Operand,
+    Scalar, Timer,
 };
 
 /// The block types an LD rung can hold, with their pins.
 enum Spec {
     Timer(TimerKind),
     Counter { down: bool },
+    Bistable(BistableKind),
+    Trigger(TriggerKind),
+    Ctud,
     Arith(ArithOp),
     Move,
     Compare(CmpOp),
@@ -38,6 +45,11 @@ impl Spec {
             "TP" => Spec::Timer(TimerKind::Tp),
             "CTU" => Spec::Counter { down: false },
             "CTD" => Spec::Counter { down: true },
+            "SR" => Spec::Bistable(BistableKind::SetDominant),
+            "RS" => Spec::Bistable(BistableKind::ResetDominant),
+            "R_TRIG" => Spec::Trigger(TriggerKind::Rising),
+            "F_TRIG" => Spec::Trigger(TriggerKind::Falling),
+            "CTUD" => Spec::Ctud,
             "MOVE" => Spec::Move,
             _ => match (ArithOp::parse(ty), CmpOp::parse(ty)) {
                 (Some(op), _) => Spec::Arith(op),
@@ -60,6 +72,10 @@ impl Spec {
             Spec::Timer(_) => ("IN", &["PT"], "Q", None),
             Spec::Counter { down: false } => ("CU", &["R", "PV"], "Q", None),
             Spec::Counter { down: true } => ("CD", &["LD", "PV"], "Q", None),
+            Spec::Bistable(BistableKind::SetDominant) => ("S1", &["R"], "Q1", None),
+            Spec::Bistable(BistableKind::ResetDominant) => ("S", &["R1"], "Q1", None),
+            Spec::Trigger(_) => ("CLK", &[], "Q", None),
+            Spec::Ctud => ("CU", &["CD", "R", "LD", "PV"], "QU", None),
             Spec::Arith(_) => ("EN", &["IN1", "IN2"], "ENO", Some("OUT")),
             Spec::Move => ("EN", &["IN"], "ENO", Some("OUT")),
             Spec::Compare(_) => ("EN", &["IN1", "IN2"], "OUT", None),
@@ -67,8 +83,7 @@ impl Spec {
     }
 }
 
-const SUPPORTED: &str =
-    "TON, TOF, TP, CTU, CTD, ADD, SUB, MUL, DIV, MOD, MOVE, EQ, NE, LT, LE, GT, GE";
+const SUPPORTED: &str = "TON, TOF, TP, CTU, CTD, SR, RS, R_TRIG, F_TRIG, CTUD, ADD, SUB, MUL, DIV, MOD, MOVE, EQ, NE, LT, LE, GT, GE, AND, OR, XOR, NOT";
 
 /// True when out variable `e` is the result of an ADD … MOD or MOVE block (part of its box).
 pub fn absorbed(p: &Power, e: ElemId) -> bool {
@@ -94,6 +109,9 @@ pub fn power_out(p: &mut Power, e: ElemId, pin: Option<&str>) -> R<Path> {
     let node = el.node;
     let here = p.at(e);
     let ty = super::xml::attr(node, "typeName", &here)?;
+    if super::ld_logic::is_logic(ty) {
+        return super::ld_logic::power_out(p, e, ty);
+    }
     let Some(spec) = Spec::of(ty) else {
         return Err(error(
             origin(node),
@@ -181,6 +199,31 @@ fn box_kind(p: &mut Power, e: ElemId, spec: &Spec, ty: &str) -> R<ElementKind<'s
             instance: instance()?,
             pv: operand(p, e, "PV", ty)?,
             aux: operand(p, e, if down { "LD" } else { "R" }, ty)?,
+        })),
+        Spec::Bistable(kind) => ElementKind::Bistable(Box::new(Bistable {
+            kind,
+            instance: instance()?,
+            reset: operand(
+                p,
+                e,
+                if kind == BistableKind::SetDominant {
+                    "R"
+                } else {
+                    "R1"
+                },
+                ty,
+            )?,
+        })),
+        Spec::Trigger(kind) => ElementKind::Trigger {
+            kind,
+            instance: instance()?,
+        },
+        Spec::Ctud => ElementKind::Ctud(Box::new(Ctud {
+            instance: instance()?,
+            cd: operand(p, e, "CD", ty)?,
+            reset: operand(p, e, "R", ty)?,
+            load: operand(p, e, "LD", ty)?,
+            pv: operand(p, e, "PV", ty)?,
         })),
         Spec::Arith(op) => ElementKind::Arith(Box::new(Arith {
             op,

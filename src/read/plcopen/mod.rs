@@ -6,9 +6,9 @@
 //! [`xml::MAX_XML_BYTES`]; nesting at most [`xml::MAX_DEPTH`]); the project must be in one of
 //! the namespaces tc6_0201, tc6_0200 or the pre-2.0 tc6.xsd ([`xml::NAMESPACES`]), elements
 //! are matched by local name. [`project`] reads the POUs and configurations, [`interface`] the
-//! variable lists, [`ld`] (with [`ld_power`], [`ld_block`] and the shared [`wiring`] graph) the
-//! LD bodies, [`fbd`] the FBD bodies, [`textual`] stands ST, IL and SFC bodies in by their
-//! interface. What the reader did that changes meaning or skips vendor data is a [`Note`]
+//! variable lists, [`ld`] (with [`ld_power`], [`ld_block`], [`ld_logic`] and the shared [`wiring`] graph) the
+//! LD bodies, [`fbd`] the FBD bodies, [`st_body`] the ST bodies (a stand-in rung per statement,
+//! from the ST parser), [`textual`] stands IL and SFC bodies in by their interface. What the reader did that changes meaning or skips vendor data is a [`Note`]
 //! (a warning with its place). The mapping, the order rules and their sources:
 //! docs/plcopen.md; the research behind them: docs/design/plcopen-semantics.md.
 //!
@@ -20,8 +20,10 @@ mod fbd;
 mod interface;
 mod ld;
 mod ld_block;
+mod ld_logic;
 mod ld_power;
 mod project;
+mod st_body;
 mod textual;
 mod wiring;
 mod xml;

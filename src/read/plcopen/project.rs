@@ -15,7 +15,7 @@
 
 use super::interface::{self, name, Interface, Known};
 use super::xml::{add_data_note, attr, error, identifier, origin, Note, Notes, Tc6, R};
-use super::{fbd, ld, textual};
+use super::{fbd, ld, st_body, textual};
 use crate::syntax::{
     Body, Element, ElementKind, FunctionBlock, Program, RoutineKind, Rung, Subroutine, Var,
 };
@@ -48,18 +48,51 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
                 .insert(attr(dt, "name", "types/dataTypes")?);
         }
     }
-    let (mut programs, mut fbs) = (Vec::new(), Vec::new());
+    // The interfaces first, then the globals, then the bodies: an ST body resolves its names
+    // against them all.
+    let mut read = Vec::new();
     let pous = types.and_then(|t| tc6.child(t, "pous"));
     for pou in pous.into_iter().flat_map(|p| tc6.children(p, "pou")) {
         let raw = attr(pou, "name", "types/pous")?;
         let pname = identifier(raw, "POU", pou, "types/pous")?;
         let place = format!("pou {pname}");
-        add_data_note(tc6, pou, notes);
         let kind = attr(pou, "pouType", &place)?;
+        if !matches!(kind, "program" | "functionBlock" | "function") {
+            return Err(error(
+                origin(pou),
+                &place,
+                format!("unknown pouType `{kind}` of POU `{pname}`"),
+            ));
+        }
         let iface = interface::interface(tc6, tc6.child(pou, "interface"), &pname, &known)?;
+        read.push((pou, pname, kind, iface));
+    }
+    let mut later = Notes::default();
+    let mut mapped_globals = Vec::new();
+    let (globals, order) = instances(tc6, root, &known, &mut later, &mut mapped_globals)?;
+    let mapped: Vec<(Option<String>, interface::Mapped)> = read
+        .iter()
+        .flat_map(|(_, p, _, i)| i.mapped.iter().map(|m| (Some(p.clone()), m.clone())))
+        .chain(mapped_globals.into_iter().map(|m| (None, m)))
+        .collect();
+    later.list.extend(interface::mapped_note(&mapped));
+    let global_types: Vec<(&str, &str)> = globals
+        .iter()
+        .chain(read.iter().flat_map(|r| &r.3.globals))
+        .map(|v| (v.name.as_str(), v.ty.as_str()))
+        .collect();
+    let mut bodies = Vec::new();
+    for (pou, pname, _, iface) in &read {
+        add_data_note(tc6, *pou, notes);
+        let scope = scope(iface, &global_types);
+        bodies.push(body(tc6, *pou, pname, iface, &scope, notes)?);
+    }
+    notes.list.extend(later.list);
+    let (mut programs, mut fbs) = (Vec::new(), Vec::new());
+    for ((pou, pname, kind, iface), body) in read.into_iter().zip(bodies) {
+        let place = format!("pou {pname}");
         match kind {
             "program" => {
-                let body = body(tc6, pou, &pname, &iface, notes)?;
                 let mut vars = iface.inputs;
                 vars.extend(iface.outputs);
                 vars.extend(iface.locals);
@@ -79,7 +112,6 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
                         format!("function block `{pname}` declares global variables"),
                     ));
                 }
-                let body = body(tc6, pou, &pname, &iface, notes)?;
                 fbs.push(FunctionBlock {
                     origin: origin(pou),
                     name: pname.into(),
@@ -89,24 +121,37 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
                     body: Some(body),
                 });
             }
-            "function" => {
+            _ => {
                 return Err(error(
                     origin(pou),
                     &place,
                     format!("POU `{pname}` is a function: functions are not supported yet"),
                 ))
             }
-            other => {
-                return Err(error(
-                    origin(pou),
-                    &place,
-                    format!("unknown pouType `{other}` of POU `{pname}`"),
-                ))
-            }
         }
     }
-    let (globals, order) = instances(tc6, root, &known, notes)?;
     assemble(root, programs, fbs, globals, order)
+}
+
+/// The names an ST body of a POU with interface `iface` sees: its own variables and the globals
+/// it declares external (`globals`: the name and type of every global of the project).
+fn scope(iface: &Interface, globals: &[(&str, &str)]) -> st_body::Scope {
+    let mut s = st_body::Scope::default();
+    for v in iface
+        .inputs
+        .iter()
+        .chain(&iface.outputs)
+        .chain(&iface.locals)
+        .chain(&iface.globals)
+    {
+        s.declare(v.name.as_str(), v.ty.as_str());
+    }
+    for e in &iface.externals {
+        if let Some((n, t)) = globals.iter().find(|(n, _)| n.eq_ignore_ascii_case(e)) {
+            s.declare(n, t);
+        }
+    }
+    s
 }
 
 /// Puts the POUs together: one program as the main program, several as subroutines called in
@@ -195,9 +240,16 @@ fn assemble(
     Ok(program)
 }
 
-/// The body of POU `pou` as syntax: LD rungs, an FBD body, or a textual or SFC body through
-/// its interface.
-fn body(tc6: Tc6, pou: Node, name: &str, iface: &Interface, notes: &mut Notes) -> R<Body<'static>> {
+/// The body of POU `pou` as syntax: LD rungs, an FBD body, a stand-in rung per ST statement,
+/// or an IL or SFC body through its interface.
+fn body(
+    tc6: Tc6,
+    pou: Node,
+    name: &str,
+    iface: &Interface,
+    scope: &st_body::Scope,
+    notes: &mut Notes,
+) -> R<Body<'static>> {
     let place = format!("pou {name}");
     let Some(b) = tc6.child(pou, "body") else {
         return Err(error(
@@ -235,10 +287,18 @@ fn body(tc6: Tc6, pou: Node, name: &str, iface: &Interface, notes: &mut Notes) -
             }
         }
     }
+    if let (Some(m), "LD" | "FBD") = (iface.mapped.iter().find(|m| m.text), tag) {
+        return Err(error(
+            m.origin,
+            &place,
+            format!("variable `{}` is a {}, for which plc-deps has no values: strings are read only in POUs whose body `run` does not execute (ST, IL, SFC), and `{name}` has an {tag} body", m.var, m.from),
+        ));
+    }
     Ok(match tag {
         "LD" => Body::Rungs(ld::rungs(tc6, lang, name, notes)?),
         "FBD" => Body::Fbd(fbd::body(tc6, lang, name, notes)?),
-        "ST" | "IL" | "SFC" => {
+        "ST" => Body::Rungs(st_body::rungs(lang, name, scope, notes)?),
+        "IL" | "SFC" => {
             let reads: Vec<&Var> = iface.inputs.iter().collect();
             let writes: Vec<&Var> = iface
                 .outputs
@@ -275,6 +335,7 @@ fn instances<'a, 'i>(
     root: Node<'a, 'i>,
     known: &Known,
     notes: &mut Notes,
+    mapped: &mut Vec<interface::Mapped>,
 ) -> R<(Vec<Var<'static>>, Order<'a, 'i>)> {
     let mut globals = Vec::new();
     let mut order = Vec::new();
@@ -298,10 +359,10 @@ fn instances<'a, 'i>(
     add_data_note(tc6, conf, notes);
     let place = "instances/configuration";
     // The globals of the configuration, then of its resource.
-    let globals_of = |node: Node, globals: &mut Vec<Var<'static>>| -> R<()> {
+    let mut globals_of = |node: Node, globals: &mut Vec<Var<'static>>| -> R<()> {
         for gv in tc6.children(node, "globalVars") {
             let class = crate::syntax::VarClass::Default;
-            globals.extend(interface::var_list(tc6, gv, class, place, known)?);
+            globals.extend(interface::var_list(tc6, gv, class, place, known, mapped)?);
         }
         Ok(())
     };

@@ -1,0 +1,272 @@
+//! ST bodies (TC6 `ST`, its text in an XHTML element, usually as CDATA) → one stand-in rung per
+//! top-level statement ([`super::textual::stand_in`]), from what the ST parser
+//! ([`crate::read::st`], IEC 61131-3 7.3) finds each statement reads and writes.
+//!
+//! A statement `k` (1-based, in text order) of POU `P` is rung `P.stk`, located at the
+//! statement's line and column in the XML file: the offsets of the ST text are translated to
+//! offsets of the file through its CDATA sections, entity and character references and line
+//! ends ([`file_offsets`]). A compound statement (IF, CASE, FOR, WHILE, REPEAT) is one rung with
+//! everything any of its parts reads (conditions and bounds included) and writes. Names resolve
+//! case-insensitively against the POU's declarations ([`Scope`]); a read of a standard function
+//! block instance reads its first output field (`T1.Q`, `B.Q1`, `C.QU`), which the analysis
+//! counts as reading the instance. Not seen by the analysis, and named in the POU's note: writes
+//! of instances (only an instance's own box writes it), reads of user function block
+//! instances, direct addresses (`%IX0.1`). A name that is neither declared nor called (a
+//! function) is an error at its statement; so is an ST syntax error, at its line and column.
+//!
+//! Deliberately not here: executing ST (`run` leaves the values unchanged, and the note says
+//! the body is not executed), IL and SFC (through their interface, [`super::textual`]).
+
+use super::textual::{stand_in, Read};
+use super::xml::{error, origin, Note, Notes, R};
+use crate::diag::Origin;
+use crate::read::st;
+use crate::syntax::Rung;
+use roxmltree::Node;
+use std::collections::HashMap;
+
+/// What a name of an ST body is: an elementary variable (with its type) or an instance (with
+/// the BOOL-or-not field a read of it stands for, when it has one).
+#[derive(Clone, Debug)]
+pub enum Decl {
+    Elementary { name: String, ty: String },
+    Instance { name: String, read: Option<Read> },
+}
+
+/// The declarations an ST body sees, by lower-case name.
+#[derive(Default)]
+pub struct Scope {
+    pub names: HashMap<String, Decl>,
+}
+
+impl Scope {
+    /// Declares `name` of type `ty` (elementary or a function block type).
+    pub fn declare(&mut self, name: &str, ty: &str) {
+        let decl = if super::interface::is_elementary(ty) {
+            Decl::Elementary {
+                name: name.to_owned(),
+                ty: ty.to_owned(),
+            }
+        } else {
+            Decl::Instance {
+                name: name.to_owned(),
+                read: first_output(ty).map(|(f, b)| Read {
+                    name: format!("{name}.{f}"),
+                    bool: b,
+                }),
+            }
+        };
+        self.names.insert(name.to_ascii_lowercase(), decl);
+    }
+
+    fn get(&self, name: &str) -> Option<&Decl> {
+        self.names.get(&name.to_ascii_lowercase())
+    }
+}
+
+/// The first output of a standard function block (IEC 61131-3 2.5.2.3), and whether it is BOOL.
+fn first_output(ty: &str) -> Option<(&'static str, bool)> {
+    Some(match ty {
+        "TON" | "TOF" | "TP" | "CTU" | "CTD" | "R_TRIG" | "F_TRIG" => ("Q", true),
+        "SR" | "RS" => ("Q1", true),
+        "CTUD" => ("QU", true),
+        _ => return None,
+    })
+}
+
+/// What the statements of a body leave out of the analysis, for the note.
+#[derive(Default)]
+struct Unseen {
+    instances_written: Vec<String>,
+    instances_read: Vec<String>,
+    addresses: Vec<String>,
+}
+
+fn push_once(v: &mut Vec<String>, s: &str) {
+    if !v.iter().any(|x| x == s) {
+        v.push(s.to_owned());
+    }
+}
+
+/// The rungs of ST body `node` of POU `pou`: one per top-level statement that reads or writes
+/// something.
+pub fn rungs(node: Node, pou: &str, scope: &Scope, notes: &mut Notes) -> R<Vec<Rung<'static>>> {
+    let place = format!("pou {pou}, ST");
+    let source = node.document().input_text();
+    let mut out = Vec::new();
+    let mut unseen = Unseen::default();
+    let mut k = 0;
+    for t in node.descendants().filter(|d| d.is_text()) {
+        let text = t.text().unwrap_or("");
+        if text.trim().is_empty() {
+            continue;
+        }
+        let map = file_offsets(source, t.range().start, text);
+        let at = |off: usize| match &map {
+            Some(m) => Origin::at(m.get(off).copied().unwrap_or(t.range().start)),
+            None => origin(t),
+        };
+        let statements = st::statements(text)
+            .map_err(|e| error(at(e.at), &place, format!("ST syntax error: {}", e.message)))?;
+        for s in &statements {
+            k += 1;
+            if s.kind == st::ast::Stmt::Empty {
+                continue;
+            }
+            let here = at(s.at);
+            let (reads, writes) = resolve(&st::accesses(s), scope, &mut unseen)
+                .map_err(|n| error(here, &place, format!("`{n}` is not a variable of POU `{pou}` (nor a global it declares external), nor a function it calls")))?;
+            out.extend(stand_in(format!("{pou}.st{k}"), here, &reads, &writes));
+        }
+    }
+    notes.push(Note {
+        origin: origin(node),
+        message: message(pou, k, &unseen),
+    });
+    Ok(out)
+}
+
+fn message(pou: &str, statements: usize, unseen: &Unseen) -> String {
+    let plural = if statements == 1 { "" } else { "s" };
+    let mut m = format!("pou {pou}: its ST body is analysed per statement ({statements} top-level statement{plural}, rungs {pou}.st1 …, each reading and writing whole variables) and not executed by `run`");
+    let mut add = |what: &str, v: &[String]| {
+        if !v.is_empty() {
+            m.push_str(&format!("; {what}: {}", v.join(", ")));
+        }
+    };
+    add(
+        "the function block instances it calls are not seen as written",
+        &unseen.instances_written,
+    );
+    add(
+        "the user function block instances it reads are not seen",
+        &unseen.instances_read,
+    );
+    add(
+        "the direct addresses it uses are not seen",
+        &unseen.addresses,
+    );
+    m
+}
+
+/// The reads and writes of a statement as stand-in operands, or the first name that is neither
+/// declared nor called.
+fn resolve(
+    a: &st::Accesses,
+    scope: &Scope,
+    unseen: &mut Unseen,
+) -> Result<(Vec<Read>, Vec<String>), String> {
+    let called = |n: &str| a.calls.iter().any(|c| c.eq_ignore_ascii_case(n));
+    let mut reads = Vec::new();
+    for n in &a.reads {
+        match scope.get(n) {
+            Some(Decl::Elementary { name, ty }) => reads.push(Read {
+                name: name.clone(),
+                bool: ty == "BOOL",
+            }),
+            Some(Decl::Instance { read: Some(r), .. }) => reads.push(Read {
+                name: r.name.clone(),
+                bool: r.bool,
+            }),
+            Some(Decl::Instance { name, read: None }) => {
+                push_once(&mut unseen.instances_read, name)
+            }
+            None if n.starts_with('%') => push_once(&mut unseen.addresses, n),
+            None if called(n) => {}
+            None => return Err(n.clone()),
+        }
+    }
+    let mut writes = Vec::new();
+    for n in &a.writes {
+        match scope.get(n) {
+            Some(Decl::Elementary { name, .. }) => writes.push(name.clone()),
+            Some(Decl::Instance { name, .. }) => push_once(&mut unseen.instances_written, name),
+            None if n.starts_with('%') => push_once(&mut unseen.addresses, n),
+            None if called(n) => {}
+            None => return Err(n.clone()),
+        }
+    }
+    Ok((reads, writes))
+}
+
+/// For each byte offset of `text` (and its end), the offset in `source` it was read from, when
+/// `text` is what XML makes of `source` from `start` on: CDATA sections taken as they are,
+/// entity and character references decoded, `\r\n` and `\r` read as `\n` (XML 1.0, 2.11).
+/// `None` when the two do not agree (then statements are placed at the text's start).
+pub fn file_offsets(source: &str, start: usize, text: &str) -> Option<Vec<usize>> {
+    let (s, t) = (source.as_bytes(), text.as_bytes());
+    let mut map = Vec::with_capacity(t.len() + 1);
+    let (mut i, mut j, mut cdata) = (start, 0, false);
+    while j < t.len() {
+        let rest = source.get(i..)?;
+        if !cdata && rest.starts_with("<![CDATA[") {
+            (i, cdata) = (i + 9, true);
+        } else if cdata && rest.starts_with("]]>") {
+            (i, cdata) = (i + 3, false);
+        } else if !cdata && rest.starts_with('&') {
+            let end = rest.find(';')?;
+            let c = reference(&rest[1..end])?;
+            let mut buf = [0u8; 4];
+            let bytes = c.encode_utf8(&mut buf).as_bytes();
+            if t.get(j..j + bytes.len())? != bytes {
+                return None;
+            }
+            map.extend(std::iter::repeat_n(i, bytes.len()));
+            (i, j) = (i + end + 1, j + bytes.len());
+        } else if *s.get(i)? == b'\r' {
+            if t[j] != b'\n' {
+                return None;
+            }
+            map.push(i);
+            i += if s.get(i + 1) == Some(&b'\n') { 2 } else { 1 };
+            j += 1;
+        } else if (!cdata && s[i] == b'<') || s[i] != t[j] {
+            return None;
+        } else {
+            map.push(i);
+            (i, j) = (i + 1, j + 1);
+        }
+    }
+    map.push(i);
+    Some(map)
+}
+
+/// The character an entity or character reference (between `&` and `;`) stands for.
+fn reference(r: &str) -> Option<char> {
+    Some(match r {
+        "lt" => '<',
+        "gt" => '>',
+        "amp" => '&',
+        "quot" => '"',
+        "apos" => '\'',
+        _ => {
+            let n = if let Some(h) = r.strip_prefix("#x") {
+                u32::from_str_radix(h, 16).ok()?
+            } else {
+                r.strip_prefix('#')?.parse().ok()?
+            };
+            char::from_u32(n)?
+        }
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn offsets_go_through_cdata_references_and_line_ends() {
+        let src = "<p>a &lt; b;\r\n<![CDATA[x<y]]>&#x41;</p>";
+        let text = "a < b;\nx<yA";
+        let m = file_offsets(src, 3, text).unwrap();
+        assert_eq!(m[0], 3); // a
+        assert_eq!(m[2], 5); // < from &lt;
+        assert_eq!(m[4], 10); // b
+        assert_eq!(m[6], 12); // \n from \r\n
+        assert_eq!(m[7], 23); // x inside CDATA
+        assert_eq!(m[8], 24); // < inside CDATA
+        assert_eq!(m[10], 29); // A from &#x41;
+        assert_eq!(m[11], 35); // the end
+        assert_eq!(file_offsets(src, 3, "a > b"), None);
+    }
+}

@@ -1,0 +1,94 @@
+//! The boolean functions AND, OR, XOR and NOT as blocks in hand-written PLCopen TC6 LD rungs:
+//! rewritten into contacts and ORs, they give the truth tables of IEC 61131-3 (2.5.1.5.2), and
+//! what cannot be rewritten is one located error.
+
+mod common;
+#[path = "plcopen_common/mod.rs"]
+mod px;
+
+use common::cli::{error_line, run_stdin};
+use px::{block, coil, contact, io, project, rail, report, rung, trace};
+
+fn on(op: &str, id: u32, ins: &[u32]) -> String {
+    let pins: Vec<String> = (1..=ins.len()).map(|k| format!("IN{k}")).collect();
+    let wires: Vec<(u32, Option<&str>)> = ins.iter().map(|&i| (i, None)).collect();
+    let inputs: Vec<(&str, &[(u32, Option<&str>)])> = if op == "NOT" {
+        vec![("IN", &wires[..1])]
+    } else {
+        pins.iter()
+            .zip(&wires)
+            .map(|(p, w)| (p.as_str(), std::slice::from_ref(w)))
+            .collect()
+    };
+    block(id, op, None, &inputs, &["OUT"])
+}
+
+/// a, b → AND → x, OR → y, XOR → z; NOT a → n.
+fn gates() -> String {
+    let ld = [
+        rail(1),
+        contact(2, "a", &[1], ""),
+        contact(3, "b", &[1], ""),
+        on("AND", 4, &[2, 3]),
+        coil(5, "x", &[4], ""),
+        on("OR", 6, &[2, 3]),
+        coil(7, "y", &[6], ""),
+        on("XOR", 8, &[2, 3]),
+        coil(9, "z", &[8], ""),
+        on("NOT", 10, &[2]),
+        coil(11, "n", &[10], ""),
+    ]
+    .concat();
+    let mut vars = vec![("inputVars", "a", "BOOL"), ("inputVars", "b", "BOOL")];
+    for o in ["x", "y", "z", "n"] {
+        vars.push(("outputVars", o, "BOOL"));
+    }
+    project(&vars, &ld)
+}
+
+#[test]
+fn and_or_xor_and_not_blocks_give_their_truth_tables() {
+    let got = trace(
+        "gates",
+        &gates(),
+        "a,b\n0,0\n0,1\n1,0\n1,1\n",
+        &["x", "y", "z", "n"],
+    );
+    assert_eq!(got[0], ["0", "0", "0", "1"], "AND");
+    assert_eq!(got[1], ["0", "1", "1", "1"], "OR");
+    assert_eq!(got[2], ["0", "1", "1", "0"], "XOR");
+    assert_eq!(got[3], ["1", "1", "0", "0"], "NOT");
+    assert_eq!(
+        io(&report(&gates())),
+        vec![rung("P.R1", &["a", "b"], &["x", "y", "z", "n"])]
+    );
+}
+
+#[test]
+fn a_not_of_a_timer_output_is_refused_with_the_block() {
+    let ld = [
+        rail(1),
+        contact(2, "a", &[1], ""),
+        px::in_var(3, "T#1s"),
+        block(
+            4,
+            "TON",
+            Some("T0"),
+            &[("IN", &[(2, None)]), ("PT", &[(3, None)])],
+            &["Q"],
+        ),
+        on("NOT", 5, &[4]),
+        coil(6, "n", &[5], ""),
+    ]
+    .concat();
+    let xml = project(
+        &[
+            ("inputVars", "a", "BOOL"),
+            ("outputVars", "n", "BOOL"),
+            ("localVars", "T0", "TON"),
+        ],
+        &ld,
+    );
+    let e = error_line(&run_stdin(&["report", "-"], xml.as_bytes()), "NOT of Q");
+    assert!(e.ends_with("at pou P, LD, block localId 5: NOT (localId 5) negates a series that holds an output or a box (only contacts, compares and ORs can be negated)"), "{e}");
+}

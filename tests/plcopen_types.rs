@@ -1,0 +1,89 @@
+//! The elementary types of IEC 61131-3 the model lacks, in hand-written PLCopen TC6 XML: read
+//! as one it has (BYTE as INT, UINT as DINT, LREAL as REAL …) with one note naming every mapped
+//! variable and what `run` computes differently; typed and based literals as initial values;
+//! strings accepted only where `run` does not execute the body.
+
+mod common;
+#[path = "plcopen_common/mod.rs"]
+mod px;
+
+use common::cli::{error_line, run_stdin};
+use px::{coil, contact, line_col, project_in, rail, report_and_warnings, run_scans};
+use serde_json::json;
+
+/// `ty` typed variables: `(class, name, TC6 type element, initial value)`.
+fn with_types(lang: &str, vars: &[(&str, &str, &str, &str)], body: &str) -> String {
+    let mut xml = project_in(
+        lang,
+        &vars.iter().map(|v| (v.0, v.1, "BOOL")).collect::<Vec<_>>(),
+        body,
+    );
+    for (_, name, ty, init) in vars {
+        let init = if init.is_empty() {
+            String::new()
+        } else {
+            format!("<initialValue><simpleValue value=\"{init}\"/></initialValue>")
+        };
+        xml = xml.replace(
+            &format!("<variable name=\"{name}\"><type><BOOL/></type></variable>"),
+            &format!("<variable name=\"{name}\"><type>{ty}</type>{init}</variable>"),
+        );
+    }
+    xml
+}
+
+fn ld() -> String {
+    [
+        rail(1),
+        contact(2, "go", &[1], ""),
+        coil(3, "lamp", &[2], ""),
+    ]
+    .concat()
+}
+
+#[test]
+fn mapped_types_load_run_and_are_named_in_one_note() {
+    let xml = with_types(
+        "LD",
+        &[
+            ("inputVars", "go", "<BOOL/>", ""),
+            ("outputVars", "lamp", "<BOOL/>", ""),
+            ("outputVars", "b", "<BYTE/>", "16#10"),
+            ("outputVars", "u", "<UINT/>", "UINT#7"),
+            ("outputVars", "r", "<LREAL/>", "2.5"),
+        ],
+        &ld(),
+    );
+    let (_, err) = report_and_warnings(&xml);
+    assert_eq!(
+        err.trim_end(),
+        format!("warning: <stdin>:{}: elementary types the model lacks are read as one it has: P.b BYTE → INT, P.u UINT → DINT, P.r LREAL → REAL; `run` computes them at the model's width (INT 16-bit, DINT 32-bit, signed; REAL 32-bit), so it differs from a PLC where a value leaves the declared type's range or needs LREAL precision, and a string has no value (it stands in as a DINT 0)", line_col(&xml, "<variable name=\"b\""))
+    );
+    let v = run_scans(&xml, 1);
+    assert_eq!(
+        v["outputs"],
+        json!({"lamp": false, "b": 16, "u": 7, "r": 2.5})
+    );
+}
+
+#[test]
+fn a_string_is_refused_where_run_executes_the_body_and_read_where_it_does_not() {
+    let vars = [
+        ("inputVars", "go", "<BOOL/>", ""),
+        ("outputVars", "lamp", "<BOOL/>", ""),
+        ("localVars", "msg", "<string/>", "'hello'"),
+    ];
+    let xml = with_types("LD", &vars, &ld());
+    let e = error_line(&run_stdin(&["report", "-"], xml.as_bytes()), "string in LD");
+    let at = line_col(&xml, "<variable name=\"msg\"");
+    assert_eq!(e, format!("error: <stdin>:{at}: at pou P: variable `msg` is a STRING, for which plc-deps has no values: strings are read only in POUs whose body `run` does not execute (ST, IL, SFC), and `P` has an LD body"));
+    let st = with_types(
+        "ST",
+        &vars,
+        "<xhtml xmlns=\"http://www.w3.org/1999/xhtml\">IF go THEN msg := 'on'; END_IF;</xhtml>",
+    );
+    let (r, err) = report_and_warnings(&st);
+    assert_eq!(r["rungs"][0]["in"], json!(["go", "msg"]));
+    assert_eq!(r["rungs"][0]["out"], json!(["msg"]));
+    assert!(err.contains("P.msg STRING → DINT"), "{err}");
+}
