@@ -85,8 +85,14 @@ fn blocks_subroutines_interrupts_and_the_first_scan_bit() {
         "seq",
     ]);
     assert_eq!(
-        String::from_utf8_lossy(&out.stderr).trim_end(),
-        "warning: tests/stl/blocks.stl:20:1: interrupt routine INT_0 is read as a subroutine that nothing calls (plc-deps has no interrupt events; not yet)"
+        String::from_utf8_lossy(&out.stderr),
+        "warning[W0601]: interrupt routine INT_0 is read as a subroutine that nothing calls (plc-deps has no interrupt events; not yet)
+   --> tests/stl/blocks.stl:20:1
+   |
+20 | INTERRUPT_BLOCK INT_0:INT0
+   | ^^^^^^^^^^^^^^^
+
+"
     );
     let text = std::fs::read_to_string(common::cli::root().join("tests/stl/blocks.stl")).unwrap();
     let (p, _, notes) = plc_deps::read::stl::load(&text).unwrap();

@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::cli::{run, run_stdin};
+use common::cli::{one_line, run, run_stdin};
 use serde_json::{json, Value};
 
 #[path = "plcopen_common/mod.rs"]
@@ -466,7 +466,7 @@ fn outputs_of_rungs_that_interleave_in_the_file_get_a_warning() {
             ("P.R2".into(), json!(["B"]), json!(["Y"])),
         ]
     );
-    let stderr = String::from_utf8_lossy(&out.stderr);
+    let stderr = one_line(&String::from_utf8_lossy(&out.stderr));
     let warnings: Vec<&str> = stderr
         .lines()
         .filter_map(|l| l.strip_prefix("warning: <stdin>:"))

@@ -6,7 +6,7 @@ mod common;
 #[path = "plcopen_common/mod.rs"]
 mod px;
 
-use common::cli::{run, run_stdin};
+use common::cli::{one_line, run, run_stdin};
 use px::{coil, contact, rail, NS};
 use serde_json::Value;
 
@@ -19,7 +19,7 @@ fn pou(name: &str, var: (&str, &str), ld: &str) -> String {
 
 fn json_report(args: &[&str], stdin: &str) -> (Value, String) {
     let out = run_stdin(args, stdin.as_bytes());
-    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    let err = one_line(&String::from_utf8_lossy(&out.stderr));
     assert_eq!(out.status.code(), Some(0), "{err}");
     (serde_json::from_slice(&out.stdout).unwrap(), err)
 }

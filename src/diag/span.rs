@@ -37,7 +37,7 @@ pub fn token_at(text: &str, at: usize) -> Range<usize> {
         (from..line_end).find(|&i| !ok(b[i])).unwrap_or(line_end)
     };
     let end = match first {
-        b'"' => string_end(b, at, line_end),
+        b'"' => member_end(b, string_end(b, at, line_end), line_end),
         b'<' => {
             let name = (at + 1..line_end)
                 .find(|&i| !matches!(b[i], b'/' | b'?' | b'!'))
@@ -71,6 +71,30 @@ fn string_end(b: &[u8], at: usize, line_end: usize) -> usize {
         }
     }
     line_end
+}
+
+/// The end of a JSON member whose key ends at `key_end`: after its value when that is a
+/// string, a number, `true`, `false` or `null` on the same line (the member is the token:
+/// `"out": "G1.RESULT"`), else `key_end` (not a key, or a key of an object or array).
+fn member_end(b: &[u8], key_end: usize, line_end: usize) -> usize {
+    let skip = |mut i: usize| {
+        while i < line_end && b[i].is_ascii_whitespace() {
+            i += 1;
+        }
+        i
+    };
+    let colon = skip(key_end);
+    if colon >= line_end || b[colon] != b':' {
+        return key_end;
+    }
+    let v = skip(colon + 1);
+    match b.get(v) {
+        Some(b'"') if v < line_end => string_end(b, v, line_end),
+        Some(c) if v < line_end && (c.is_ascii_alphanumeric() || *c == b'-') => (v..line_end)
+            .find(|&i| !(b[i].is_ascii_alphanumeric() || matches!(b[i], b'.' | b'+' | b'-')))
+            .unwrap_or(line_end),
+        _ => key_end,
+    }
 }
 
 /// The end of the object or array that opens at `at`, if it closes on the same line.
@@ -173,8 +197,10 @@ mod tests {
     #[test]
     fn the_token_at_an_origin_is_a_string_number_word_tag_name_or_bracket() {
         let json = r#"{"contact": "St\"art", "n": -12.5e3, "ld": [1, 2]}"#;
-        assert_eq!(token(json, 1), r#""contact""#);
+        assert_eq!(token(json, 1), r#""contact": "St\"art""#);
         assert_eq!(token(json, 12), r#""St\"art""#);
+        assert_eq!(token(json, 23), r#""n": -12.5e3"#);
+        assert_eq!(token(json, 37), r#""ld""#);
         assert_eq!(token(json, 28), "-12.5e3");
         assert_eq!(token(json, 43), "[1, 2]");
         assert_eq!(token(json, 0), json);
