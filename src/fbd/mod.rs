@@ -44,6 +44,14 @@ pub fn plan(net: &Network) -> Result<Plan, LoadError> {
                 blocks: names.join(" → "),
             },
         )
+        .with_hint(&format!(
+            "the blocks of the cycle: {}",
+            cycle
+                .iter()
+                .map(|b| format!("{} at {}", net.block(*b).id, net.block(*b).path))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ))
     })?;
     fragments::fragments(net, topological)
 }
