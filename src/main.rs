@@ -472,13 +472,31 @@ fn remove_temp_files_on_signal() {
     });
 }
 
+/// How errors and warnings are printed: as JSON lines when the command was given `--format json`.
+fn error_format(cli: &Cli) -> cmd::errors::Format {
+    let json = match &cli.command {
+        Command::Report { format, .. } => matches!(format, ReportFormatArg::Json),
+        Command::Order { format, .. } => matches!(format, FormatArg::Json),
+        Command::Run { format, .. } => matches!(format, RunFormatArg::Json),
+        _ => false,
+    };
+    if json {
+        cmd::errors::Format::Json
+    } else {
+        cmd::errors::Format::Text
+    }
+}
+
+/// Exit codes (README, docs/diagnostics.md): 0 done, 1 a run that faulted or whose modes
+/// differed, 2 bad input or usage (clap's usage errors are 2 too), 130 stopped by a signal.
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    cmd::errors::set_format(error_format(&cli));
     remove_temp_files_on_signal();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            cmd::errors::print_error(&e);
             ExitCode::from(e.exit_code())
         }
     }

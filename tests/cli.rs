@@ -2,8 +2,8 @@
 //! without touching the output file; good ones give reports, the schema, DOT that Graphviz
 //! renders cleanly, and generated programs that load.
 //!
-//! `tests/errors/NAME.json` holds a bad program and `NAME.err` the exact error text
-//! (`UPDATE_EXPECT=1` re-blesses).
+//! `tests/errors/NAME.json` holds a bad program and `NAME.err` the exact error as the command
+//! line renders it (rustc style, without colour: stderr is a pipe) (`UPDATE_EXPECT=1` re-blesses).
 
 mod common;
 
@@ -37,7 +37,12 @@ fn every_bad_program_gives_one_located_error_and_exit_code_2() {
         assert_eq!(out.status.code(), Some(2), "{rel}: {stderr}");
         assert!(out.stdout.is_empty(), "{rel}: nothing on stdout");
         assert!(!out_file.exists(), "{rel}: no output file on error");
-        assert_eq!(stderr.lines().count(), 1, "{rel}: one line: {stderr}");
+        assert_eq!(
+            one_line(&stderr).lines().count(),
+            1,
+            "{rel}: one error: {stderr}"
+        );
+        assert!(stderr.starts_with("error[E0"), "{rel}: {stderr}");
         assert!(!stderr.contains("panicked"), "{rel}: {stderr}");
         let expected_path = case.with_extension("err");
         if std::env::var_os("UPDATE_EXPECT").is_some() {

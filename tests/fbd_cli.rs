@@ -167,7 +167,7 @@ fn refused(program: &str) -> String {
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(out.stdout.is_empty());
     assert!(!file.exists());
-    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert_eq!(one_line(&stderr).lines().count(), 1, "{stderr}");
     stderr
 }
 

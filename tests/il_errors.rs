@@ -85,9 +85,8 @@ fn blocks_subroutines_interrupts_and_the_first_scan_bit() {
         "seq",
     ]);
     assert_eq!(
-        String::from_utf8_lossy(&out.stderr).trim_end(),
-        "warning: interrupt routine INT_0 never runs here: plc-deps run raises no interrupt events (`plc-deps report` lists what it shares with the main program)"
-    );
+        String::from_utf8_lossy(&out.stderr),
+        "warning[W0104]: interrupt routine INT_0 never runs here: plc-deps run raises no interrupt events (`plc-deps report` lists what it shares with the main program)\n\n"    );
     let text = std::fs::read_to_string(common::cli::root().join("tests/stl/blocks.stl")).unwrap();
     let (p, _, notes) = plc_deps::read::stl::load(&text).unwrap();
     assert!(notes.is_empty());

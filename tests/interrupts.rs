@@ -83,7 +83,7 @@ fn run_says_the_interrupt_routine_never_runs() {
     assert!(out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
-        err.contains("warning: interrupt routine ENCODER never runs here"),
+        err.contains("warning[W0104]: interrupt routine ENCODER never runs here"),
         "{err}"
     );
 }

@@ -5,7 +5,7 @@ mod common;
 #[path = "plcopen_common/mod.rs"]
 mod px;
 
-use common::cli::{error_line, run_stdin};
+use common::cli::{error_line, one_line, run_stdin};
 use px::{block, in_var, project_in, run_scans, var_in};
 use serde_json::{json, Value};
 
@@ -134,7 +134,7 @@ fn execution_order_ids_that_disagree_with_the_data_flow_get_a_warning_with_both_
         );
     let out = run_stdin(&["report", "-", "--format", "json"], xml.as_bytes());
     assert_eq!(out.status.code(), Some(0));
-    let stderr = String::from_utf8_lossy(&out.stderr);
+    let stderr = one_line(&String::from_utf8_lossy(&out.stderr));
     let warnings: Vec<&str> = stderr
         .lines()
         .filter(|l| l.starts_with("warning: "))

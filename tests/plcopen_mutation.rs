@@ -248,7 +248,10 @@ fn the_command_line_exits_cleanly_on_mutants() {
             Some(2) => {
                 assert!(!out.exists(), "{name} {e:?}: a refused file left an output");
                 assert!(!stderr.contains("panicked"), "{stderr}");
-                for line in stderr.lines().filter(|l| l.starts_with("error")) {
+                for line in common::cli::one_line(&stderr)
+                    .lines()
+                    .filter(|l| l.starts_with("error"))
+                {
                     let file = input.to_string_lossy();
                     let rest = line.split_once(&*file).map(|(_, r)| r).unwrap_or("");
                     let mut parts = rest.trim_start_matches(':').split(':');

@@ -25,10 +25,28 @@ fn json_of(out: &Output) -> Value {
     serde_json::from_slice(&out.stdout).expect("JSON on stdout")
 }
 
+/// The JSON report of a run that faulted: written whole on stdout, exit code 1 and the error
+/// `the run faulted: N faults (first: KIND on rung R in scan S; …)` as one JSON line on stderr.
+fn faulted_json(out: &Output, first: &str) -> Value {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    let e: Value = serde_json::from_str(stderr.trim_end()).expect("one JSON error");
+    assert_eq!(e["severity"], "error");
+    assert!(
+        e["message"]
+            .as_str()
+            .unwrap()
+            .starts_with("the run faulted: ")
+            && e["message"].as_str().unwrap().contains(first),
+        "{stderr}"
+    );
+    serde_json::from_slice(&out.stdout).expect("JSON on stdout")
+}
+
 /// A failing run: exit code 2, one `error:` line on stderr containing `needle`, nothing on stdout.
 fn fails(args: &[&str], needle: &str) -> String {
     let out = run(args);
-    let stderr = String::from_utf8(out.stderr).unwrap();
+    let stderr = one_line(&String::from_utf8(out.stderr).unwrap());
     assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
     assert!(out.stdout.is_empty(), "{args:?}: nothing on stdout");
     assert_eq!(stderr.lines().count(), 1, "{args:?}: one line: {stderr}");
@@ -409,7 +427,7 @@ fn more_threads_than_cores_is_a_warning_and_plans_for_the_cores() {
         "--explain",
     ]);
     assert!(out.status.success());
-    let err = String::from_utf8(out.stderr).unwrap();
+    let err = one_line(&String::from_utf8(out.stderr).unwrap());
     let plural = if cores == 1 { "core" } else { "cores" };
     assert!(
         err.contains(&format!(
@@ -477,16 +495,19 @@ fn faults_are_reported_with_scan_rung_and_kind() {
         ]}"#,
     );
     let inputs = write("faulty.csv", "d\n0\n5\n0\n");
-    let j = json_of(&run(&[
-        "run",
-        &program,
-        "--inputs",
-        &inputs,
-        "--loop-cap",
-        "50",
-        "--format",
-        "json",
-    ]));
+    let j = faulted_json(
+        &run(&[
+            "run",
+            &program,
+            "--inputs",
+            &inputs,
+            "--loop-cap",
+            "50",
+            "--format",
+            "json",
+        ]),
+        "5 faults (first: div-by-zero on rung DIV in scan 0;",
+    );
     let faults = j["faults"].as_array().unwrap();
     assert_eq!(
         faults[0],
@@ -510,9 +531,12 @@ fn faults_are_reported_with_scan_rung_and_kind() {
             {"rung": "J", "kind": "loop-cap", "count": 3, "first_scan": 0, "last_scan": 2}
         ])
     );
-    let text =
-        String::from_utf8(run(&["run", &program, "--inputs", &inputs, "--loop-cap", "50"]).stdout)
-            .unwrap();
+    let out = run(&["run", &program, "--inputs", &inputs, "--loop-cap", "50"]);
+    assert_eq!(
+        (out.status.code(), String::from_utf8_lossy(&out.stderr).as_ref()),
+        (Some(1), "error: the run faulted: 5 faults (first: div-by-zero on rung DIV in scan 0; faults in the report)\n")
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
     assert!(
         text.contains(
             "faults: 5 (2 distinct faults)\n  rung DIV: div-by-zero, 2 times, scans 0 to 2\n  rung J: loop-cap, 3 times, scans 0 to 2\n"
@@ -533,11 +557,7 @@ const ALWAYS_FAULTY: &str = r#"{"program": "always",
 fn a_fault_of_every_scan_is_one_summary_line_and_an_endless_loop_ends_at_the_cap() {
     let program = write("always.json", ALWAYS_FAULTY);
     let out = run(&["run", &program, "--loop-cap", "10"]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_eq!(out.status.code(), Some(1), "a faulted run exits with 1");
     let text = String::from_utf8(out.stdout).unwrap();
     let faults: Vec<&str> = text
         .lines()
@@ -554,16 +574,19 @@ fn a_fault_of_every_scan_is_one_summary_line_and_an_endless_loop_ends_at_the_cap
         "{text}"
     );
     // The endless loop runs `--loop-cap` loop-backs (11 passes) per scan, then the scan ends.
-    let j = json_of(&run(&[
-        "run",
-        &program,
-        "--loop-cap",
-        "10",
-        "--scans",
-        "3",
-        "--format",
-        "json",
-    ]));
+    let j = faulted_json(
+        &run(&[
+            "run",
+            &program,
+            "--loop-cap",
+            "10",
+            "--scans",
+            "3",
+            "--format",
+            "json",
+        ]),
+        "6 faults",
+    );
     assert_eq!(j["outputs"]["i"], 33);
     assert_eq!(j["fault_count"], 6);
     assert_eq!(j["faults"].as_array().unwrap().len(), 6);
@@ -623,8 +646,8 @@ fn an_inputs_file_without_rows_is_a_warning_and_the_run_goes_on() {
         assert_eq!(
             String::from_utf8(out.stderr.clone()).unwrap(),
             format!(
-                "warning: --inputs {inputs} has no rows: every input keeps its initial value; \
-                 running 1 scan (give --scans N for more)\n"
+                "{{\"code\":\"W0103\",\"severity\":\"warning\",\"message\":\"--inputs {inputs} has no rows: every input keeps its initial value; \
+                 running 1 scan (give --scans N for more)\",\"file\":null,\"line\":null,\"column\":null,\"span\":null,\"hint\":null,\"location\":null}}\n"
             )
         );
         assert_eq!(json_of(&out)["scans"], 1);
@@ -633,7 +656,7 @@ fn an_inputs_file_without_rows_is_a_warning_and_the_run_goes_on() {
         assert_eq!(
             String::from_utf8(out.stderr).unwrap(),
             format!(
-                "warning: --inputs {inputs} has no rows: every input keeps its initial value\n"
+                "warning[W0103]: --inputs {inputs} has no rows: every input keeps its initial value\n\n"
             )
         );
     }

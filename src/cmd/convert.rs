@@ -22,10 +22,7 @@ pub struct ConvertConfig {
 pub fn convert(c: &ConvertConfig) -> Result<(), CliError> {
     let (file, text) = read_program_text(&c.input)?;
     load_text(file.clone(), &text)?;
-    let load_error = |error| CliError::Load {
-        file: file.clone(),
-        error,
-    };
+    let load_error = |error| CliError::load(file.clone(), &text, error);
     if plcopen::looks_like_xml(&text) {
         let (syntax, _) = plcopen::parse(&text).map_err(load_error)?;
         write_output_with(c.output.as_deref(), |mut w| {

@@ -10,8 +10,9 @@
 //! registry that [`remove_temp_files`] empties (the binary calls it on SIGINT/SIGTERM), so a
 //! stopped command leaves none behind. A program is recognised by its content ([`load_text`]:
 //! S7-200 STL, PLCopen TC6 XML or JSON). Nothing here prints but the STL and PLCopen readers'
-//! warnings.
+//! warnings (through [`super::errors`]).
 
+use crate::diag::Shown;
 use crate::fbd::Fbd;
 use crate::model::Program;
 use crate::read::LoadError;
@@ -63,9 +64,14 @@ fn io_reason(e: &std::io::Error) -> String {
 pub enum CliError {
     /// The program file is not a valid program: `file:line:column: message` for syntax
     /// errors, `file: rung R at path: message` for the others (one line per error when there
-    /// are several, each naming the file).
+    /// are several, each naming the file); `shown` is what the command line prints (see
+    /// [`CliError::load`] and [`super::errors`]).
     #[error("{}", error.in_file(file))]
-    Load { file: String, error: LoadError },
+    Load {
+        file: String,
+        error: LoadError,
+        shown: Vec<Shown>,
+    },
     /// A file could not be read or written: `cannot read the program P: reason`,
     /// `cannot write -o P: reason` (see [`FileRole`]).
     #[error("cannot {} {} {path}: {}", role.verb(), role.what(), io_reason(source))]
@@ -81,13 +87,31 @@ pub enum CliError {
     /// The worker threads of the parallel executor could not be started.
     #[error("cannot start the worker threads: {0}")]
     Threads(String),
+    /// A run ran, and its report was written, but it faulted (a division by zero, a loop past
+    /// its cap) or its sequential and parallel runs differed.
+    #[error("{0}")]
+    Run(String),
 }
 
 impl CliError {
-    /// Exit code: 2 for every error (bad program, arguments, files). Exit code 1 is reserved
-    /// for a run that faulted or whose modes differed.
+    /// Exit code: 1 for a run that faulted or whose modes differed ([`CliError::Run`]), 2 for
+    /// every other error (bad program, arguments, files). README and docs/diagnostics.md list
+    /// them.
     pub fn exit_code(&self) -> u8 {
-        2
+        match self {
+            CliError::Run(_) => 1,
+            _ => 2,
+        }
+    }
+
+    /// The error of loading `text`, the program file named `file`, with its diagnostics made
+    /// ready to show (the text is not kept).
+    pub fn load(file: String, text: &str, error: LoadError) -> CliError {
+        CliError::Load {
+            shown: Shown::load_error(&file, text, &error),
+            file,
+            error,
+        }
     }
 
     /// An I/O error about `path` in `role`.
@@ -212,31 +236,42 @@ pub fn load_program_and_fbd(path: &Path) -> Result<(Program, Fbd), CliError> {
 
 /// Checks a program's text, recognised by its content: S7-200 STL when its first line opens a
 /// block or a declaration section (or the file is named `.stl`/`.awl`), PLCopen TC6 XML when it
-/// starts with `<` (the readers' notes go to standard error as warnings), else the JSON format.
+/// starts with `<` (the readers' notes go to standard error as warnings W0601 and W0501), else the JSON format.
 pub fn load_text(file: String, text: &str) -> Result<(Program, Fbd), CliError> {
     use crate::read::{plcopen, stl};
     let lower = file.to_ascii_lowercase();
     if stl::looks_like_stl(text) || lower.ends_with(".stl") || lower.ends_with(".awl") {
-        let (p, f, notes) = stl::load(text).map_err(|error| CliError::Load {
-            file: file.clone(),
-            error,
-        })?;
-        for n in &notes {
-            eprintln!("warning: {}", plcopen::note_text(&file, text, n));
-        }
+        let (p, f, notes) =
+            stl::load(text).map_err(|error| CliError::load(file.clone(), text, error))?;
+        warn_notes(STL_NOTE, &file, text, &notes);
         return Ok((p, f));
     }
     if plcopen::looks_like_xml(text) {
-        let (p, f, notes) = plcopen::load(text).map_err(|error| CliError::Load {
-            file: file.clone(),
-            error,
-        })?;
-        for n in &notes {
-            eprintln!("warning: {}", plcopen::note_text(&file, text, n));
-        }
+        let (p, f, notes) =
+            plcopen::load(text).map_err(|error| CliError::load(file.clone(), text, error))?;
+        warn_notes(PLCOPEN_NOTE, &file, text, &notes);
         return Ok((p, f));
     }
-    crate::read::program_and_fbd_from_json(text).map_err(|error| CliError::Load { file, error })
+    crate::read::program_and_fbd_from_json(text).map_err(|error| CliError::load(file, text, error))
+}
+
+/// The code of a PLCopen reader's note (what it read only through an interface, ignored, or
+/// ordered otherwise than the file).
+pub const PLCOPEN_NOTE: &str = "W0501";
+/// The code of an STL reader's note (an interrupt routine read as a subroutine).
+pub const STL_NOTE: &str = "W0601";
+
+/// Prints a reader's notes as warnings with `code`.
+fn warn_notes(code: &'static str, file: &str, text: &str, notes: &[crate::read::plcopen::Note]) {
+    for n in notes {
+        super::errors::warn(&Shown::warning(
+            code,
+            n.message.clone(),
+            file,
+            text,
+            n.origin,
+        ));
+    }
 }
 
 /// Checks, before any work, that an output file can be written at `path`: not a folder, in a

@@ -3,12 +3,13 @@
 //! [`convert`].
 //!
 //! `main.rs` turns command-line arguments into these configs and calls one function; everything
-//! here returns a [`CliError`] (rendered once, by `main`) instead of printing an error or
-//! exiting. [`io`] reads inputs and writes outputs (atomically, never half-written);
+//! here returns a [`CliError`] (printed once, by `main`, through [`errors`], which also prints
+//! the warnings) instead of printing an error or exiting. [`io`] reads inputs and writes outputs (atomically, never half-written);
 //! [`progress`] shows long phases on a terminal. This is the top layer: nothing below imports it.
 
 pub mod c;
 pub mod convert;
+pub mod errors;
 pub mod gen;
 pub mod il;
 pub mod io;

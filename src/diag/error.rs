@@ -306,6 +306,19 @@ impl LoadError {
         InFile { error: self, file }
     }
 
+    /// Gives each problem `hint` (shown as `help:`), where it has none yet.
+    pub(crate) fn with_hint(mut self, hint: &str) -> LoadError {
+        let ds: &mut [Diagnostic] = match &mut self {
+            LoadError::Syntax { .. } => return self,
+            LoadError::Invalid(d) => std::slice::from_mut(&mut **d),
+            LoadError::Several(ds) => ds,
+        };
+        for d in ds {
+            d.hint = d.hint.take().or_else(|| Some(hint.to_owned()));
+        }
+        self
+    }
+
     /// Gives each problem the origin of the node it is in, where it has none yet (so the
     /// innermost node that knows its place wins).
     pub(crate) fn at(mut self, origin: Origin) -> LoadError {

@@ -10,13 +10,20 @@
 //! offsets only when the errors are final ([`LoadError::locate`], one pass over the text for all
 //! of them), so a program that loads pays nothing for them. It deliberately knows nothing about
 //! files: the caller that opened the file adds its name ([`LoadError::in_file`]), and that
-//! rendering (`FILE:LINE:COLUMN: LOCATION: message`) is the only one with line and column.
+//! one-line rendering (`FILE:LINE:COLUMN: LOCATION: message`) has line and column. The command
+//! line shows them in the style of rustc, or as JSON, through [`render::Shown`] (the source
+//! line, a caret under the token at the origin ([`span`]), the hint, e.g. [`suggest`]'s
+//! "did you mean"); every code is documented with an example in docs/diagnostics.md.
 
 mod error;
 mod origin;
+pub mod render;
+pub mod span;
+pub mod suggest;
 
 pub use error::{Invalid, LoadError, Location, OP_NAMES};
 pub use origin::Origin;
+pub use render::{Shown, SYNTAX_CODE};
 
 use std::fmt;
 

@@ -28,19 +28,30 @@ pub use types::*;
 use crate::diag::{Invalid, LoadError};
 
 /// Orders `net` and builds its fragment tree: a cycle of arcs or a block that depends on a
-/// fragment that is neither its own nor an ancestor is an error naming the blocks.
+/// fragment that is neither its own nor an ancestor is an error naming the blocks (a cycle is
+/// placed at its first block).
 pub fn plan(net: &Network) -> Result<Plan, LoadError> {
     let topological = order::topological_order(net).map_err(|cycle| {
         let mut names: Vec<String> = cycle.iter().map(|b| net.block(*b).id.to_string()).collect();
         names.push(names[0].clone());
+        // Placed at the cycle's first block, so that the error points at a block of it.
+        let first = net.block(cycle[0]);
         LoadError::fbd(
             &net.id,
-            None,
-            &net.path,
+            Some(first.id),
+            &first.path,
             Invalid::Cycle {
                 blocks: names.join(" → "),
             },
         )
+        .with_hint(&format!(
+            "the blocks of the cycle: {}",
+            cycle
+                .iter()
+                .map(|b| format!("{} at {}", net.block(*b).id, net.block(*b).path))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ))
     })?;
     fragments::fragments(net, topological)
 }

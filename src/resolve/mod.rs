@@ -252,7 +252,10 @@ impl<'a> Builder<'a> {
     fn report(&mut self, e: LoadError) {
         if let Ok(ds) = e.into_diagnostics() {
             let room = MAX_ERRORS.saturating_sub(self.errors.len());
-            self.errors.extend(ds.into_iter().take(room));
+            for d in ds.into_iter().take(room) {
+                let d = self.hinted(d);
+                self.errors.push(d);
+            }
         }
     }
 

@@ -6,7 +6,7 @@ use super::operand::{self, Untyped};
 use super::path::At;
 use super::util::expect_type;
 use super::{Builder, Result};
-use crate::diag::{Invalid, LoadError, Origin};
+use crate::diag::{Diagnostic, Invalid, LoadError, Origin};
 use crate::model::*;
 use crate::syntax::{Name, Operand as SynOperand};
 
@@ -16,6 +16,25 @@ fn fail(s: &Scope, at: &At, origin: Origin, kind: Invalid) -> LoadError {
 }
 
 impl<'a> Builder<'a> {
+    /// `d` with a "did you mean" hint when it is an undefined variable and a declared variable
+    /// or instance (of any POU) has a name close to it ([`crate::diag::suggest`]).
+    pub(super) fn hinted(&self, d: Diagnostic) -> Diagnostic {
+        let Invalid::UndefinedVar { name } = &d.kind else {
+            return d;
+        };
+        if d.hint.is_some() {
+            return d;
+        }
+        // Display names are `SBR_0:name` for subroutine locals: the declared name is the last part.
+        fn declared(n: &str) -> &str {
+            n.rsplit(':').next().unwrap_or(n)
+        }
+        let vars = self.vars.iter().map(|v| declared(&v.name));
+        let instances = self.instances.iter().map(|i| declared(&i.display));
+        let hint = crate::diag::suggest::did_you_mean(name, vars.chain(instances));
+        d.with_hint(hint)
+    }
+
     /// A name a block or element writes, in the scope of `pou`: not an input, not a field, not
     /// a member or an instance.
     pub(super) fn writable_name(

@@ -136,6 +136,12 @@ fn err(p: &Program, places: Places, r: RungId, element: Option<usize>, kind: Inv
     (r, element, e)
 }
 
+/// The index of the first top-level element of `rung` that `is` holds for (none when the
+/// element sought is inside a branch: the error then names the series).
+fn top_level(rung: &Rung, is: impl Fn(&Element) -> bool) -> Option<usize> {
+    rung.series.iter().position(is)
+}
+
 fn last_top(rung: &Rung) -> Option<&Element> {
     rung.series.last()
 }
@@ -177,11 +183,15 @@ fn check_jumps(p: &Program, places: Places, errors: &mut Vec<Located>) {
             }
         });
         if let Some((label, head)) = bad {
+            let jump = top_level(
+                p.rung(r),
+                |e| matches!(e, Element::Jmp { label: l, .. } if *l == label),
+            );
             errors.push(err(
                 p,
                 places,
                 r,
-                None,
+                jump,
                 Invalid::JumpIntoLoop {
                     label,
                     head: p.rung(head).id.clone(),
@@ -234,11 +244,15 @@ fn check_recursion(p: &Program, places: Places) -> Result<(), Located> {
                             .map(|&(q, _)| p.pous[q].name.as_str())
                             .collect();
                         chain.push(&p.pou(callee).name);
+                        let call = top_level(
+                            p.rung(rung),
+                            |e| matches!(e, Element::Call { pou } if *pou == callee),
+                        );
                         return Err(err(
                             p,
                             places,
                             rung,
-                            None,
+                            call,
                             Invalid::Recursion {
                                 name: p.pou(callee).name.clone(),
                                 chain: chain.join(" → "),

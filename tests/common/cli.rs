@@ -1,5 +1,5 @@
 //! Running the `plc-deps` binary from tests: the checkout root, a run (with or without standard
-//! input), the one-line error of a failure, scratch files and leftover temporary files, and the
+//! input), the one-line form of a failure's diagnostics, scratch files and leftover temporary files, and the
 //! Graphviz check that DOT output renders without warnings.
 
 use std::path::PathBuf;
@@ -37,14 +37,84 @@ pub fn run_stdin(args: &[&str], stdin: &[u8]) -> Output {
     child.wait_with_output().expect("run plc-deps")
 }
 
-/// The single `error: ` line of a failed command with exit code 2 and nothing on stdout.
+/// The error of a failed command with exit code 2 and nothing on stdout, as one line: the
+/// one diagnostic on stderr in its one-line form ([`one_line`]).
 pub fn error_line(out: &Output, what: &str) -> String {
     let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
     assert_eq!(out.status.code(), Some(2), "{what}: {stderr}");
     assert!(out.stdout.is_empty(), "{what}: nothing on stdout");
-    assert_eq!(stderr.lines().count(), 1, "{what}: one line: {stderr}");
-    assert!(stderr.starts_with("error: "), "{what}: {stderr}");
-    stderr.trim_end().to_string()
+    let line = one_line(&stderr);
+    assert_eq!(line.lines().count(), 1, "{what}: one diagnostic: {stderr}");
+    assert!(line.starts_with("error: "), "{what}: {stderr}");
+    line.trim_end().to_string()
+}
+
+/// The diagnostics of a command's stderr, rendered in the style of rustc, each as one line
+/// `SEVERITY: FILE:LINE:COLUMN: LOCATION: message` (the form `LoadError::in_file` writes),
+/// reassembled from the header (`error[E0204]: message`), the `-->` line and the label after
+/// the carets, or from the keys of a JSON diagnostic (`--format json`); lines that are not
+/// part of a diagnostic (`error: cannot read …`) are kept as they are. The rendering itself is
+/// compared whole in tests/errors/*.err.
+pub fn one_line(stderr: &str) -> String {
+    let mut out = Vec::new();
+    let mut lines = stderr.lines().peekable();
+    while let Some(line) = lines.next() {
+        if let Ok(d) = serde_json::from_str::<serde_json::Value>(line) {
+            out.push(json_one_line(&d));
+            continue;
+        }
+        let header = ["error[", "warning["]
+            .iter()
+            .find(|p| line.starts_with(**p))
+            .and_then(|_| line.split_once("]: "));
+        let Some((severity, message)) = header else {
+            if !line.trim().is_empty() {
+                out.push(line.to_string());
+            }
+            continue;
+        };
+        let severity = severity.split('[').next().unwrap();
+        let (mut place, mut label) = (None, None);
+        while let Some(next) = lines.peek() {
+            if next.starts_with("error") || next.starts_with("warning") {
+                break;
+            }
+            let next = lines.next().unwrap().trim();
+            if let Some(p) = next.strip_prefix("--> ") {
+                place = Some(p.to_string());
+            } else if let Some(n) = next.strip_prefix("= note: in ") {
+                place = Some(n.to_string());
+            } else if let Some(rest) = next.strip_prefix('|') {
+                let rest = rest.trim_start();
+                if rest.starts_with('^') {
+                    let l = rest.trim_start_matches('^').trim();
+                    label = (!l.is_empty()).then(|| l.to_string());
+                }
+            }
+        }
+        out.push(match (place, label) {
+            (Some(p), Some(l)) => format!("{severity}: {p}: {l}: {message}"),
+            (Some(p), None) => format!("{severity}: {p}: {message}"),
+            _ => format!("{severity}: {message}"),
+        });
+    }
+    out.join("\n")
+}
+
+/// A JSON diagnostic as one line (see [`one_line`]).
+fn json_one_line(d: &serde_json::Value) -> String {
+    let mut s = format!("{}: ", d["severity"].as_str().unwrap());
+    if let Some(f) = d["file"].as_str() {
+        s += f;
+        if let (Some(l), Some(c)) = (d["line"].as_u64(), d["column"].as_u64()) {
+            s += &format!(":{l}:{c}");
+        }
+        s += ": ";
+    }
+    if let Some(l) = d["location"].as_str() {
+        s += &format!("{l}: ");
+    }
+    s + d["message"].as_str().unwrap()
 }
 
 /// The files of a folder whose name contains `.tmp-` (leftover temporary files).

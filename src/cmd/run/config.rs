@@ -86,7 +86,7 @@ impl RunConfig {
     }
 }
 
-/// Something the user should know about a run that still runs (printed as `warning: …`).
+/// Something the user should know about a run that still runs (printed as `warning[W01xx]: …`).
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum RunWarning {
     /// More `--threads` than cores: the plan is made for the cores that exist.
@@ -114,6 +114,18 @@ pub enum RunWarning {
     /// The program has an interrupt routine, which the scans never run.
     #[error("interrupt routine {0} never runs here: plc-deps run raises no interrupt events (`plc-deps report` lists what it shares with the main program)")]
     InterruptNotRun(String),
+}
+
+impl RunWarning {
+    /// The stable code of this warning (docs/diagnostics.md).
+    pub fn code(&self) -> &'static str {
+        match self {
+            RunWarning::Oversubscribed { .. } => "W0101",
+            RunWarning::PlanDropped(_) => "W0102",
+            RunWarning::NoInputRows { .. } => "W0103",
+            RunWarning::InterruptNotRun(_) => "W0104",
+        }
+    }
 }
 
 /// `n` and the noun in the singular or plural (`1 scan`, `2 scans`).

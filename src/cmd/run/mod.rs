@@ -64,15 +64,52 @@ pub fn run_report_with(
     }
 }
 
-/// `plc-deps run`: warnings on standard error, the report on standard output or `-o`.
+/// `plc-deps run`: warnings on standard error, the report on standard output or `-o`; then,
+/// if the run faulted or its modes differed, a [`CliError::Run`] (exit code 1) saying so.
 pub fn run(c: &RunConfig) -> Result<(), CliError> {
     let progress = Progress::new(c.progress);
-    let r = run_report_with(c, &progress, &mut |w| eprintln!("warning: {w}"))?;
+    let r = run_report_with(c, &progress, &mut |w| {
+        crate::cmd::errors::warn(&crate::diag::Shown::unplaced(
+            crate::diag::Severity::Warning,
+            w.code(),
+            w.to_string(),
+        ))
+    })?;
     let out = match c.format {
         RunFormat::Text => render_text(&r),
         RunFormat::Json => render_json(&r, false),
     };
-    write_output(c.output.as_deref(), &out)
+    write_output(c.output.as_deref(), &out)?;
+    match failure(&r) {
+        Some(why) => Err(CliError::Run(why)),
+        None => Ok(()),
+    }
+}
+
+/// Why a run that ran failed: its sequential and parallel runs differed (`identical` false),
+/// or a scan faulted (any fault: a DIV or MOD by zero, a loop-back past the cap); none for a
+/// clean run.
+pub fn failure(r: &RunReport) -> Option<String> {
+    if r.identical == Some(false) {
+        let at = r
+            .first_difference
+            .as_ref()
+            .and_then(|d| Some((d.get("scan")?.as_u64()?, d.get("variable")?.as_str()?)));
+        return Some(match at {
+            Some((scan, var)) => format!(
+                "the sequential and parallel runs differ (first in scan {scan}, variable {var}; first_difference in the report)"
+            ),
+            None => "the sequential and parallel runs differ (first_difference in the report)".into(),
+        });
+    }
+    let first = r.fault_summary.first()?;
+    Some(format!(
+        "the run faulted: {} (first: {} on rung {} in scan {}; faults in the report)",
+        config::count(r.fault_count, "fault", "faults"),
+        first.kind.name(),
+        first.rung,
+        first.first_scan
+    ))
 }
 
 /// The deterministic JSON of a run (timing fields zero; the default line cost, not a measured
