@@ -262,6 +262,38 @@ fn random_fbd_programs_match_the_interpreter() {
     assert!(checked >= 20, "only {checked} random FBD programs loaded");
 }
 
+#[test]
+fn random_fbd_programs_with_nested_fb_types_match_the_interpreter() {
+    let mut checked = 0;
+    for seed in 0..40u64 {
+        let text = common::fbd::random_nested_fbd_program(seed);
+        let Ok((p, fbd)) = plc_deps::read::program_and_fbd_from_json(&text) else {
+            continue;
+        };
+        // One function per type: FB1, FB2 (nested in FB1 and at the top), FB3 (ladder).
+        let files = generate(&p, &fbd, &CConfig::default());
+        let fns: usize = files
+            .iter()
+            .filter(|f| f.name.starts_with("fb_"))
+            .map(|f| f.text.matches("_body(_fb_").count())
+            .sum();
+        assert_eq!(fns, 3, "fbd-nested-{seed}: functions of the 3 types");
+        let mut rng = Rng::new(seed + 91);
+        let csv = random_csv(&p, &mut rng, 30);
+        let cfg = CConfig {
+            cycle_ms: 1 + rng.below(40) as u32,
+            loop_cap: 1 + rng.below(50) as u32,
+            ..CConfig::default()
+        };
+        check(&text, &csv, 40, &cfg, &format!("fbd-nested-{seed}"));
+        checked += 1;
+    }
+    assert!(
+        checked >= 15,
+        "only {checked} random nested FBD programs loaded"
+    );
+}
+
 /// Example C of the FBD text-generation paper: compute 3 and 4; `if (3) {flag = 1; 8}`;
 /// `if (4) {flag = 1; 10; 27; if (27) {24}}`; `if (flag) {15; 17}` — checked on the text's
 /// structure (its lines without the comments), its behaviour by the example test above.
@@ -305,9 +337,9 @@ fn example_c_has_the_shape_the_paper_prints() {
             "}",
             "if (_run0_3) {",
             "_15_0 = _plc_sub_i16(self->LVar, 1);",
-            "self->_uWriteValue__17_046IVal = _15_0;",
-            "_pou_WriteValue__17(self, ctx);",
-            "self->Written = self->_uWriteValue__17_046OVal;",
+            "self->WriteValue_17.IVal = _15_0;",
+            "_fb_WriteValue_body(&self->WriteValue_17, self, ctx);",
+            "self->Written = self->WriteValue_17.OVal;",
             "}",
             "}",
         ]

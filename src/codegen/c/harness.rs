@@ -20,7 +20,8 @@ pub(crate) const HEADER_DECLS: &str = "extern const char *const _plc_input_names
 /// Variables printed per function of `_plc_print_state` (keeps functions small).
 const PRINT_CHUNK: usize = 256;
 
-pub(crate) fn program_source(p: &Program, sh: &Shared) -> String {
+/// `extra`: initializers of the instances' bases (`    .G1._rung0 = 12,\n`).
+pub(crate) fn program_source(p: &Program, sh: &Shared, extra: &[String]) -> String {
     let mut s = String::from(
         "/* plc_program.c: state, scan and harness tables. */\n#include \"plc_program.h\"\n\n",
     );
@@ -31,6 +32,7 @@ pub(crate) fn program_source(p: &Program, sh: &Shared) -> String {
         .enumerate()
         .filter(|(_, v)| !matches!(v.ty, Type::Fb(_)) && !is_zero(v.init))
         .map(|(i, v)| format!("    .{} = {},\n", field(sh, i), c_const(v.init)))
+        .chain(extra.iter().cloned())
         .collect();
     if inits.is_empty() {
         s.push_str("const _plc_state _plc_initial;\n\n");
