@@ -108,7 +108,11 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
         },
         CFile {
             name: "plc_program.c".into(),
-            text: harness::program_source(p, &sh, &instance_inits(&sh, fbd)),
+            text: harness::program_source(p, &sh, &instance_inits(&sh, fbd), cfg),
+        },
+        CFile {
+            name: "plc_main.h".into(),
+            text: harness::PLC_MAIN_H.into(),
         },
     ];
     let mut objects = Vec::new();
@@ -147,7 +151,7 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
     }
     files.push(CFile {
         name: "main.c".into(),
-        text: harness::main_c(cfg),
+        text: harness::MAIN_C.into(),
     });
     files.push(CFile {
         name: "Makefile".into(),
