@@ -446,18 +446,7 @@ pub fn random_fbd_program(seed: u64) -> String {
         ctd: Some("c1"),
         instances: vec![("f0", "FB1"), ("f1", "FB1")],
     };
-    let fb = Scope {
-        bools_read: vec!["EN", "Q", "L0"],
-        bools_write: vec!["Q", "L0"],
-        ints_read: vec!["IN1", "ACC", "OUT"],
-        ints_write: vec!["ACC", "OUT"],
-        time_var: "TV",
-        ton: Some("T"),
-        tof: Some("TF"),
-        ctu: None,
-        ctd: None,
-        instances: vec![],
-    };
+    let fb = fb_scope(vec![]);
     let networks = 1 + rng.below(4) as usize;
     let main_body = body(&mut rng, &main, networks);
     let fb_networks = 1 + rng.below(2) as usize;
@@ -479,12 +468,7 @@ pub fn random_fbd_program(seed: u64) -> String {
             {"name": "ud0", "type": "CTUD"},
             {"name": "f0", "type": "FB1"}, {"name": "f1", "type": "FB1"}
         ],
-        "function_blocks": {"FB1": {
-            "inputs": [{"name": "IN1", "type": "INT"}, {"name": "EN", "type": "BOOL"}],
-            "outputs": [{"name": "OUT", "type": "INT"}, {"name": "Q", "type": "BOOL"}],
-            "vars": [{"name": "ACC", "type": "INT"}, {"name": "L0", "type": "BOOL"}, {"name": "T", "type": "TON"}, {"name": "TF", "type": "TOF"}, {"name": "TV", "type": "TIME"}],
-            "fbd": fb_body
-        }},
+        "function_blocks": {"FB1": fb_type(&[], ("fbd", fb_body))},
         "fbd": main_body
     })
     .to_string()

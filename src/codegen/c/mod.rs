@@ -1,10 +1,12 @@
 //! C from ladder and FBD programs (the FBD text-generation paper's generator, extended to the
-//! whole program): for every POU a header and a source file, a runtime header, the program's
-//! state and harness tables, `main.c` and a `Makefile`.
+//! whole program): for every POU a header and a source file, for every user function block
+//! type with instances a source file (`types`: one struct and one function per type), a runtime
+//! header, the program's state and harness tables, the harness's driver, `main.c` and a
+//! `Makefile`.
 //!
-//! Shape: the program's persistent data (every variable: globals, subroutine and instance
-//! locals, timers, counters, edge memories, the loop counters) is one struct `_plc_state`
-//! passed to every POU function as `self`; each POU is a function `_pou_<name>(self, ctx)`
+//! Shape: the program's persistent data (every variable: globals, subroutine locals, timers,
+//! counters, edge memories, the loop counters, and each top-level function block instance as a
+//! struct member) is one struct `_plc_state` passed to every POU function as `self`; each POU is a function `_pou_<name>(self, ctx)`
 //! (`ctx`: virtual time, scan, loop cap, fault sink). Ladder rungs are one block of statements
 //! each (`ladder`); FBD networks are nested `if` blocks following their fragment trees, with
 //! one local per data arc (`fbd`). A ladder POU of more than [`CConfig::chunk_rungs`] rungs is
