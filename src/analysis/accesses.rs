@@ -266,16 +266,10 @@ pub(crate) fn rung_accesses(
                 reads.push(*instance);
                 writes.push(*instance);
             }
-            Element::Ctud {
-                instance,
-                cd,
-                reset,
-                load,
-                pv,
-            } => {
+            Element::Ctud { instance, inputs } => {
                 reads.push(*instance);
                 writes.push(*instance);
-                for o in [cd, reset, load, pv] {
+                for o in inputs.operands() {
                     operand(o, reads);
                 }
             }
@@ -290,9 +284,9 @@ pub(crate) fn rung_accesses(
             }
             Element::Jmp { .. } | Element::Ret | Element::End | Element::Next { .. } => {}
             Element::Call { pou } => call(*pou, reads, writes),
-            Element::For { var, from, to, .. } => {
-                operand(from, reads);
-                operand(to, reads);
+            Element::For { var, bounds, .. } => {
+                operand(&bounds.from, reads);
+                operand(&bounds.to, reads);
                 reads.push(*var);
                 writes.push(*var);
             }

@@ -11,7 +11,7 @@
 //! W/S bounds the speed-up of any schedule; the makespan for P cores comes from list scheduling
 //! (highest bottom level first, Graham 1969 / Coffman) on the same DAG, O((V + E) log V) each.
 
-use super::schedule::TaskId;
+use super::schedule::{Schedule, TaskId};
 use crate::model::*;
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
@@ -88,7 +88,9 @@ pub fn trip_count(e: &Element) -> Option<u64> {
         _ => None,
     };
     match e {
-        Element::For { from, to, .. } => Some((int(to)? - int(from)? + 1).max(0) as u64),
+        Element::For { bounds, .. } => {
+            Some((int(&bounds.to)? - int(&bounds.from)? + 1).max(0) as u64)
+        }
         _ => None,
     }
 }
@@ -137,34 +139,7 @@ pub fn summarise(costs: &[u64], preds: &[Vec<TaskId>], levels: &[u32]) -> CostSu
         finish[t] = start + costs[t];
     }
     let span = finish.iter().copied().max().unwrap_or(0);
-    // Bottom levels for priorities; successors from preds.
-    let mut succ_count = vec![0u32; n + 1];
-    for ps in preds {
-        for &p in ps {
-            succ_count[p.index() + 1] += 1;
-        }
-    }
-    for i in 0..n {
-        succ_count[i + 1] += succ_count[i];
-    }
-    let mut succ = vec![0u32; succ_count[n] as usize];
-    let mut fill = succ_count.clone();
-    for (t, ps) in preds.iter().enumerate() {
-        for &p in ps {
-            succ[fill[p.index()] as usize] = t as u32;
-            fill[p.index()] += 1;
-        }
-    }
-    let successors = |t: usize| &succ[succ_count[t] as usize..succ_count[t + 1] as usize];
-    let mut bottom = vec![0u64; n];
-    for t in (0..n).rev() {
-        bottom[t] = costs[t]
-            + successors(t)
-                .iter()
-                .map(|&s| bottom[s as usize])
-                .max()
-                .unwrap_or(0);
-    }
+    let dag = TaskDag::new(costs, preds);
     let cores = [1u32, 2, 4, 8];
     // One core runs everything back to back: its makespan is the work. The others are simulated,
     // in parallel (they are independent).
@@ -177,7 +152,9 @@ pub fn summarise(costs: &[u64], preds: &[Vec<TaskId>], levels: &[u32]) -> CostSu
                 if p == 1 {
                     work
                 } else {
-                    list_schedule(costs, preds, &successors, &bottom, p as usize)
+                    let mut end = 0;
+                    dag.schedule(costs, preds, p as usize, |s| end = end.max(s.finish));
+                    end
                 },
             )
         })
@@ -215,64 +192,132 @@ fn lpt(jobs: impl Iterator<Item = u64>, p: usize) -> u64 {
     machines.into_iter().map(|Reverse(m)| m).max().unwrap_or(0)
 }
 
-/// Greedy list scheduling: whenever a core is free, it takes the ready task with the highest
-/// bottom level (ties: earlier task).
-fn list_schedule<'a>(
-    costs: &[u64],
-    preds: &[Vec<TaskId>],
-    successors: &(dyn Fn(usize) -> &'a [u32] + Sync),
-    bottom: &[u64],
-    p: usize,
-) -> u64 {
-    let n = costs.len();
-    let mut waiting: Vec<u32> = preds.iter().map(|ps| ps.len() as u32).collect();
-    let mut ready: BinaryHeap<(u64, Reverse<u32>)> = (0..n)
-        .filter(|&t| waiting[t] == 0)
-        .map(|t| (bottom[t], Reverse(t as u32)))
-        .collect();
-    // Running tasks by finish time.
-    let mut running: BinaryHeap<Reverse<(u64, u32)>> = BinaryHeap::new();
-    let mut now = 0u64;
-    let mut idle = p;
-    let mut end = 0u64;
-    loop {
-        while idle > 0 {
-            match ready.pop() {
-                Some((_, Reverse(t))) => {
-                    idle -= 1;
-                    running.push(Reverse((now + costs[t as usize], t)));
-                }
-                None => break,
+/// One task's place in a list schedule: which core runs it, from when to when.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub struct Slot {
+    pub task: TaskId,
+    pub core: u32,
+    pub start: u64,
+    pub finish: u64,
+}
+
+/// The list schedule of a task DAG on `p` cores (`preds[t]`: what task `t` waits for), one slot
+/// per task in start order. Its last finish is [`CostSummary::makespan`] for the same `p`.
+pub fn list_schedule(costs: &[u64], preds: &[Vec<TaskId>], p: usize) -> Vec<Slot> {
+    let mut slots = Vec::with_capacity(costs.len());
+    TaskDag::new(costs, preds).schedule(costs, preds, p, |s| slots.push(s));
+    slots
+}
+
+/// The cost of every task of `schedule`: the sum of its rungs' costs.
+pub fn task_costs(schedule: &Schedule, rung_costs: &[u64]) -> Vec<u64> {
+    schedule
+        .tasks
+        .iter()
+        .map(|t| t.rungs.iter().map(|r| rung_costs[r.index()]).sum())
+        .collect()
+}
+
+/// A task DAG's successor lists (compressed rows, built from the predecessor lists) and the
+/// bottom level of each task (its cost plus the costliest path after it): the priorities of
+/// list scheduling.
+struct TaskDag {
+    succ_start: Vec<u32>,
+    succ: Vec<u32>,
+    bottom: Vec<u64>,
+}
+
+impl TaskDag {
+    fn new(costs: &[u64], preds: &[Vec<TaskId>]) -> TaskDag {
+        let n = costs.len();
+        let mut succ_start = vec![0u32; n + 1];
+        for ps in preds {
+            for &p in ps {
+                succ_start[p.index() + 1] += 1;
             }
         }
-        let Some(Reverse((f, t))) = running.pop() else {
-            break;
+        for i in 0..n {
+            succ_start[i + 1] += succ_start[i];
+        }
+        let mut succ = vec![0u32; succ_start[n] as usize];
+        let mut fill = succ_start.clone();
+        for (t, ps) in preds.iter().enumerate() {
+            for &p in ps {
+                succ[fill[p.index()] as usize] = t as u32;
+                fill[p.index()] += 1;
+            }
+        }
+        let mut dag = TaskDag {
+            succ_start,
+            succ,
+            bottom: vec![0; n],
         };
-        now = f;
-        end = end.max(f);
-        idle += 1;
-        for &s in successors(t as usize) {
-            waiting[s as usize] -= 1;
-            if waiting[s as usize] == 0 {
-                ready.push((bottom[s as usize], Reverse(s)));
-            }
+        for t in (0..n).rev() {
+            let after = dag.successors(t).iter().map(|&s| dag.bottom[s as usize]);
+            dag.bottom[t] = costs[t] + after.max().unwrap_or(0);
         }
-        // Release every task finishing at the same instant before assigning again.
-        while let Some(&Reverse((f2, t2))) = running.peek() {
-            if f2 != now {
-                break;
+        dag
+    }
+
+    fn successors(&self, t: usize) -> &[u32] {
+        &self.succ[self.succ_start[t] as usize..self.succ_start[t + 1] as usize]
+    }
+
+    /// Greedy list scheduling (Graham 1969): whenever a core is free, the lowest-numbered free
+    /// core takes the ready task with the highest bottom level (ties: the earlier task); every
+    /// task finishing at one instant is released before cores are assigned again. Calls
+    /// `started` for each task as it starts. O((V + E) log V).
+    fn schedule(
+        &self,
+        costs: &[u64],
+        preds: &[Vec<TaskId>],
+        p: usize,
+        mut started: impl FnMut(Slot),
+    ) {
+        let n = costs.len();
+        let mut waiting: Vec<u32> = preds.iter().map(|ps| ps.len() as u32).collect();
+        let mut ready: BinaryHeap<(u64, Reverse<u32>)> = (0..n)
+            .filter(|&t| waiting[t] == 0)
+            .map(|t| (self.bottom[t], Reverse(t as u32)))
+            .collect();
+        let mut free: BinaryHeap<Reverse<u32>> = (0..p as u32).map(Reverse).collect();
+        // Running tasks by finish time, then task.
+        let mut running: BinaryHeap<Reverse<(u64, u32, u32)>> = BinaryHeap::new();
+        let mut now = 0u64;
+        loop {
+            while !free.is_empty() {
+                let Some((_, Reverse(t))) = ready.pop() else {
+                    break;
+                };
+                let Reverse(core) = free.pop().expect("checked");
+                let finish = now + costs[t as usize];
+                running.push(Reverse((finish, t, core)));
+                started(Slot {
+                    task: TaskId(t),
+                    core,
+                    start: now,
+                    finish,
+                });
             }
-            running.pop();
-            idle += 1;
-            for &s in successors(t2 as usize) {
-                waiting[s as usize] -= 1;
-                if waiting[s as usize] == 0 {
-                    ready.push((bottom[s as usize], Reverse(s)));
+            let Some(&Reverse((f, _, _))) = running.peek() else {
+                break;
+            };
+            now = f;
+            while let Some(&Reverse((f2, t, core))) = running.peek() {
+                if f2 != now {
+                    break;
+                }
+                running.pop();
+                free.push(Reverse(core));
+                for &s in self.successors(t as usize) {
+                    waiting[s as usize] -= 1;
+                    if waiting[s as usize] == 0 {
+                        ready.push((self.bottom[s as usize], Reverse(s)));
+                    }
                 }
             }
         }
     }
-    end
 }
 
 #[cfg(test)]
@@ -290,5 +335,21 @@ mod tests {
         assert_eq!(s.makespan, vec![(1, 10), (2, 6), (4, 4), (8, 4)]);
         // Levels {0,1,3} then {2}: LPT on 2 cores: 4 | 3+2 → 5, then 1.
         assert_eq!(s.level_makespan, vec![(1, 10), (2, 6), (4, 5), (8, 5)]);
+    }
+
+    #[test]
+    fn the_list_schedule_places_each_task_on_a_core() {
+        // The same DAG on 2 cores. Bottom levels 3, 4, 1, 4: tasks 1 and 3 start first (the tie
+        // to the earlier task puts 1 on core 0), then 0 where 1 finished, then 2.
+        let costs = [2, 3, 1, 4];
+        let preds = vec![vec![], vec![], vec![TaskId(0), TaskId(1)], vec![]];
+        let s = list_schedule(&costs, &preds, 2);
+        let slot = |t: u32| *s.iter().find(|x| x.task == TaskId(t)).unwrap();
+        assert_eq!((slot(1).core, slot(1).start), (0, 0));
+        assert_eq!((slot(3).core, slot(3).start), (1, 0));
+        assert_eq!((slot(0).core, slot(0).start), (0, 3));
+        assert_eq!((slot(2).start, slot(2).finish), (5, 6));
+        let makespan = s.iter().map(|x| x.finish).max();
+        assert_eq!(makespan, Some(6), "the summary's makespan for P = 2");
     }
 }

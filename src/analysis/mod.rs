@@ -69,7 +69,7 @@ fn idle_rungs(p: &Program, acc: &Accesses) -> (Vec<RungId>, Vec<RungId>) {
     let (mut empty, mut no_effect) = (Vec::new(), Vec::new());
     for r in p.rung_ids() {
         let rung = p.rung(r);
-        if rung.network.is_some() {
+        if rung.network().is_some() {
             continue;
         }
         if rung.series.is_empty() {
@@ -239,11 +239,7 @@ pub fn analyse_with(p: &Program, config: &AnalysisConfig) -> Analysis {
                 rung_costs[r.index()] = base[r.index()] * m;
             }
         }
-        let task_costs: Vec<u64> = schedule
-            .tasks
-            .iter()
-            .map(|t| t.rungs.iter().map(|r| rung_costs[r.index()]).sum())
-            .collect();
+        let task_costs = cost::task_costs(&schedule, &rung_costs);
         let task_levels: Vec<u32> = schedule.tasks.iter().map(|t| t.level).collect();
         let cost = cost::summarise(&task_costs, &schedule.preds, &task_levels);
         (schedule, rung_costs, cost)
@@ -333,15 +329,9 @@ fn paper_control_view(p: &Program, control: &[ControlDependence]) -> Vec<PaperCo
                     }
                 }
             }
-            Element::Ctud {
-                instance,
-                cd,
-                reset,
-                load,
-                pv,
-            } => {
+            Element::Ctud { instance, inputs } => {
                 own_boxes.push(*instance);
-                for o in [cd, reset, load, pv] {
+                for o in inputs.operands() {
                     if let Operand::Var(v) = o {
                         if v.field.is_some() {
                             field_reads.push(v.var);

@@ -589,19 +589,13 @@ impl Lowerer<'_> {
                 let inst = self.layout.start(*instance);
                 self.push(Op::Trigger { kind: *kind, inst });
             }
-            Element::Ctud {
-                instance,
-                cd,
-                reset,
-                load,
-                pv,
-            } => {
+            Element::Ctud { instance, inputs } => {
                 let inst = self.layout.start(*instance);
                 let pins = CtudPins {
-                    cd: self.operand(cd),
-                    reset: self.operand(reset),
-                    load: self.operand(load),
-                    pv: self.operand(pv),
+                    cd: self.operand(&inputs.cd),
+                    reset: self.operand(&inputs.reset),
+                    load: self.operand(&inputs.load),
+                    pv: self.operand(&inputs.pv),
                 };
                 let id = CtudId(self.code.ctuds.len() as u32);
                 self.code.ctuds.push(pins);
@@ -640,14 +634,9 @@ impl Lowerer<'_> {
                 self.calls.push((self.code.ops.len(), *pou));
                 self.push(Op::Call { to: Pc(0) });
             }
-            Element::For {
-                var,
-                from,
-                to,
-                next,
-            } => {
+            Element::For { var, bounds, next } => {
                 let f = ForId(self.code.fors.len() as u32);
-                let (from, to) = (self.operand(from), self.operand(to));
+                let (from, to) = (self.operand(&bounds.from), self.operand(&bounds.to));
                 let test = Pc(self.pc().0 + 1);
                 self.code.fors.push(ForLoop {
                     var: self.layout.start(*var),

@@ -107,13 +107,31 @@ pub struct Rung {
     pub comment: Option<String>,
     pub pou: PouId,
     pub series: Series,
-    /// For a rung lowered from an FBD block (or a fragment guard of it): the JSON path of what
-    /// it was lowered from (`fbd.networks[0].blocks[2]`). Ladder rungs have none: the resolver
-    /// renders their path (`rungs[3]`) from where they are, only when an error names them.
-    pub block_path: Option<String>,
-    /// For a rung lowered from an FBD block (or a fragment guard of it): the id of its network.
-    /// The rungs of one network are contiguous.
+    /// For a rung lowered from an FBD block (or a fragment guard of it): what it was lowered
+    /// from. Ladder rungs have none (and pay one pointer for it): the resolver renders their
+    /// path (`rungs[3]`) from where they are, only when an error names them.
+    pub lowered: Option<Box<LoweredFrom>>,
+}
+
+/// Where a rung lowered from an FBD body comes from.
+#[derive(Clone, Debug)]
+pub struct LoweredFrom {
+    /// The path of the block it was lowered from (`fbd.networks[0].blocks[2]`).
+    pub block_path: String,
+    /// The id of its network, once the network is lowered. The rungs of one network are
+    /// contiguous.
     pub network: Option<String>,
+}
+
+impl Rung {
+    /// For a rung lowered from an FBD block: the path of that block.
+    pub fn block_path(&self) -> Option<&str> {
+        self.lowered.as_ref().map(|l| l.block_path.as_str())
+    }
+    /// For a rung lowered from an FBD network: the network's id.
+    pub fn network(&self) -> Option<&str> {
+        self.lowered.as_ref().and_then(|l| l.network.as_deref())
+    }
 }
 
 /// A series of elements; power flows through them in order.
@@ -163,13 +181,12 @@ pub enum Element {
     },
     /// R_TRIG/F_TRIG edge detector (IEC 61131-3 2.5.2.3.2); power in is CLK, power out is Q.
     Trigger { kind: TriggerKind, instance: VarId },
-    /// Up-down counter (IEC 61131-3 2.5.2.3.3); power in is CU, power out is QU.
+    /// Up-down counter (IEC 61131-3 2.5.2.3.3); power in is CU, power out is QU. Its four other
+    /// inputs are boxed: the counter is rare, and inline they would make every element 56 bytes
+    /// instead of 32.
     Ctud {
         instance: VarId,
-        cd: Operand,
-        reset: Operand,
-        load: Operand,
-        pv: Operand,
+        inputs: Box<CtudInputs>,
     },
     /// MOVE box: when powered, `to := from`; power out = power in (ENO).
     Move { from: Operand, to: VarId },
@@ -192,12 +209,35 @@ pub enum Element {
     /// `var <= to`; the body is the rungs up to `next`.
     For {
         var: VarId,
-        from: Operand,
-        to: Operand,
+        /// `from` and `to`, boxed so that an element stays 32 bytes (loops are rare).
+        bounds: Box<ForBounds>,
         next: RungId,
     },
     /// NEXT (alone in its rung): `var += 1` and back to the FOR head's test.
     Next { head: RungId },
+}
+
+/// The inputs of an up-down counter besides CU (its power in).
+#[derive(Clone, Debug)]
+pub struct CtudInputs {
+    pub cd: Operand,
+    pub reset: Operand,
+    pub load: Operand,
+    pub pv: Operand,
+}
+
+impl CtudInputs {
+    /// CD, R, LD and PV, in that order.
+    pub fn operands(&self) -> [&Operand; 4] {
+        [&self.cd, &self.reset, &self.load, &self.pv]
+    }
+}
+
+/// The bounds of a FOR head: `var := from`, loop while `var <= to`.
+#[derive(Clone, Debug)]
+pub struct ForBounds {
+    pub from: Operand,
+    pub to: Operand,
 }
 
 /// How a contact reads its BOOL.
@@ -258,5 +298,23 @@ pub fn walk_elements<'a>(series: &'a [Element], f: &mut impl FnMut(&'a Element))
             }
             _ => {}
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A million-rung program holds about seven million elements: each byte of `Element` is
+    /// seven megabytes of memory to fault in while loading. Rare, large variants are boxed.
+    #[test]
+    fn an_element_is_32_bytes() {
+        assert_eq!(std::mem::size_of::<Element>(), 32);
+    }
+
+    /// The same for rungs: what only FBD-lowered rungs carry is behind one pointer.
+    #[test]
+    fn a_rung_is_112_bytes() {
+        assert_eq!(std::mem::size_of::<Rung>(), 112);
     }
 }

@@ -492,7 +492,7 @@ pub fn document_with<'a>(p: &'a Program, a: &'a Analysis, fbd: Option<&'a FbdPar
         .into_iter()
         .map(|n| NetworkEntry {
             pou: p.pou(n.pou).name.as_str(),
-            id: p.rung(n.rungs[0]).network.as_deref().unwrap_or_default(),
+            id: p.rung(n.rungs[0]).network().unwrap_or_default(),
             rungs: n.rungs.iter().map(|&r| id(r)).collect(),
             ins: names(&n.ins),
             out: names(&n.outs),

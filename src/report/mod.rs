@@ -117,14 +117,14 @@ pub(crate) fn networks(p: &Program, a: &Analysis) -> Vec<Network> {
     let mut out: Vec<Network> = Vec::new();
     for r in p.rung_ids() {
         let rung = p.rung(r);
-        let Some(net) = &rung.network else { continue };
+        let Some(net) = rung.network() else { continue };
         let same = out.last().is_some_and(|n| {
-            n.pou == rung.pou && &n.id == net && n.rungs.last().is_some_and(|l| l.0 + 1 == r.0)
+            n.pou == rung.pou && n.id == net && n.rungs.last().is_some_and(|l| l.0 + 1 == r.0)
         });
         if !same {
             out.push(Network {
                 pou: rung.pou,
-                id: net.clone(),
+                id: net.to_owned(),
                 rungs: Vec::new(),
                 ins: Vec::new(),
                 outs: Vec::new(),

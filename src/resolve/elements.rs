@@ -215,10 +215,12 @@ impl<'a> Builder<'a> {
                 let pv = self.operand_of(&c.pv, &key("pv"), s, Type::Int, "a counter's PV")?;
                 Element::Ctud {
                     instance,
-                    cd,
-                    reset,
-                    load,
-                    pv,
+                    inputs: Box::new(CtudInputs {
+                        cd,
+                        reset,
+                        load,
+                        pv,
+                    }),
                 }
             }
             S::Move(m) => {
@@ -309,8 +311,7 @@ impl<'a> Builder<'a> {
                 };
                 Element::For {
                     var,
-                    from,
-                    to,
+                    bounds: Box::new(ForBounds { from, to }),
                     next,
                 }
             }

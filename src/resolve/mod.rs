@@ -452,8 +452,7 @@ impl<'a> Builder<'a> {
                     comment: syn.comment.as_ref().map(|c| c.to_string()),
                     pou,
                     series,
-                    block_path: None,
-                    network: None,
+                    lowered: None,
                 });
             }
         }
@@ -531,13 +530,13 @@ impl<'a> Builder<'a> {
                                 .iter()
                                 .flatten()
                                 .find(|x| x.id == r.id)
-                                .and_then(|x| x.block_path.clone())
+                                .and_then(|x| x.block_path().map(str::to_owned))
                                 .unwrap_or_default(),
                             other => first_path(&self.pous, other),
                         };
                         errors.push(LoadError::invalid(
                             Some(&r.id),
-                            r.block_path.as_deref().unwrap_or_default(),
+                            r.block_path().unwrap_or_default(),
                             Invalid::DuplicateRung {
                                 id: r.id.clone(),
                                 first,
@@ -573,7 +572,7 @@ impl<'a> Builder<'a> {
                             .iter()
                             .flatten()
                             .find(|x| x.id == id)
-                            .and_then(|x| x.block_path.clone())
+                            .and_then(|x| x.block_path().map(str::to_owned))
                             .unwrap_or_default(),
                         other => first_path(&self.pous, other),
                     };

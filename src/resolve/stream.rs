@@ -164,8 +164,7 @@ impl<'a> Builder<'a> {
             comment: r.comment.as_ref().map(|c| c.to_string()),
             pou: PouId(0),
             series: Vec::new(),
-            block_path: None,
-            network: None,
+            lowered: None,
         };
         if refers_ahead(&r.ld) || loop_end(&r.ld).is_some() {
             let edges = self.vars.len() as u32;

@@ -123,9 +123,9 @@ type Located = (RungId, Option<usize>, LoadError);
 
 fn err(p: &Program, places: Places, r: RungId, element: Option<usize>, kind: Invalid) -> Located {
     let rung = p.rung(r);
-    let base = match (places.get(r.index()), &rung.block_path) {
+    let base = match (places.get(r.index()), rung.block_path()) {
         (Some(Some(at)), _) => super::util::rung_path(at.pou_path, at.index),
-        (_, Some(block)) => block.clone(),
+        (_, Some(block)) => block.to_owned(),
         (_, None) => String::new(),
     };
     let suffix = match element {

@@ -392,21 +392,15 @@ impl<'a> Body<'a> {
                 let call = format!("{f}(&{}, {})", self.var(*instance), Self::text(&pw));
                 self.boxed(call, last)
             }
-            Element::Ctud {
-                instance,
-                cd,
-                reset,
-                load,
-                pv,
-            } => {
+            Element::Ctud { instance, inputs } => {
                 let call = format!(
                     "_plc_ctud(&{}, {}, {}, {}, {}, {})",
                     self.var(*instance),
-                    self.operand(pv),
+                    self.operand(&inputs.pv),
                     Self::text(&pw),
-                    self.operand(cd),
-                    self.operand(reset),
-                    self.operand(load)
+                    self.operand(&inputs.cd),
+                    self.operand(&inputs.reset),
+                    self.operand(&inputs.load)
                 );
                 self.boxed(call, last)
             }
@@ -590,7 +584,8 @@ impl<'a> Body<'a> {
             self.line(&format!("/* {} */", names::comment(&rung.id)));
         }
         match rung.series.last() {
-            Some(Element::For { var, from, to, .. }) => {
+            Some(Element::For { var, bounds, .. }) => {
+                let ForBounds { from, to } = &**bounds;
                 let head = &rung.series[..rung.series.len() - 1];
                 let pw = self.series(r, head, Pw::True, false).0;
                 let v = self.var(*var);

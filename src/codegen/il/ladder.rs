@@ -259,10 +259,11 @@ impl Emit<'_> {
             Element::Ret => self.net.emit("CRET", &[], 0),
             Element::End => self.net.emit("END", &[], 0),
             Element::Call { pou } => self.net.emit("CALL", &[&n.p.pou(*pou).name], 0),
-            Element::For { var, from, to, .. } => {
-                self.net
-                    .emit("FOR", &[n.var(*var), &n.operand(from), &n.operand(to)], 0)
-            }
+            Element::For { var, bounds, .. } => self.net.emit(
+                "FOR",
+                &[n.var(*var), &n.operand(&bounds.from), &n.operand(&bounds.to)],
+                0,
+            ),
             Element::Next { .. } => self.net.emit("NEXT", &[], 0),
             Element::Bistable { .. } | Element::Trigger { .. } | Element::Ctud { .. } => {
                 return self.fail(

@@ -2,107 +2,24 @@
 //! scheduling and level by level, from the report's cost figures) and the Gantt chart of the
 //! combined schedule on P cores.
 //!
-//! The Gantt chart replays the cost model's list scheduling (Graham 1969; highest bottom level
-//! first, ties to the earlier task, every task finishing at one instant released before cores
-//! are assigned again) and records which core runs which task when; its makespan is the
-//! report's `cost.makespan` for the same P (tested). Past [`GANTT_MAX_BARS`] tasks, consecutive
+//! The Gantt chart draws the cost model's own list schedule (`analysis::cost::list_schedule`:
+//! which core runs which task when), so its makespan is the report's `cost.makespan` for the
+//! same P. Past [`GANTT_MAX_BARS`] tasks, consecutive
 //! tasks of one core are merged into one busy bar, and the chart says so.
 //!
 //! Deliberately not here: measured times (this is the model's schedule, not a trace of
 //! `plc-deps run`).
 
 use super::esc;
-use crate::analysis::schedule::TaskId;
+use crate::analysis::cost::{list_schedule, task_costs, Slot};
 use crate::analysis::Analysis;
 use crate::model::Program;
 use crate::report::document::Report;
-use std::cmp::Reverse;
-use std::collections::BinaryHeap;
 use std::io::{self, Write};
 
 /// More tasks than this and the Gantt chart merges each core's consecutive tasks.
 pub const GANTT_MAX_BARS: usize = 2000;
 const CHART_W: f64 = 900.0;
-
-/// One task on one core.
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
-pub(super) struct Slot {
-    pub task: TaskId,
-    pub core: u32,
-    pub start: u64,
-    pub finish: u64,
-}
-
-/// Cost of every task of the combined schedule.
-pub(super) fn task_costs(a: &Analysis) -> Vec<u64> {
-    a.schedule
-        .tasks
-        .iter()
-        .map(|t| t.rungs.iter().map(|r| a.rung_costs[r.index()]).sum())
-        .collect()
-}
-
-/// The list schedule of the task DAG on `p` cores, one slot per task in start order.
-pub(super) fn list_schedule(costs: &[u64], preds: &[Vec<TaskId>], p: usize) -> Vec<Slot> {
-    let n = costs.len();
-    let mut succ: Vec<Vec<usize>> = vec![Vec::new(); n];
-    for (t, ps) in preds.iter().enumerate() {
-        for q in ps {
-            succ[q.index()].push(t);
-        }
-    }
-    let mut bottom = vec![0u64; n];
-    for t in (0..n).rev() {
-        bottom[t] = costs[t] + succ[t].iter().map(|&s| bottom[s]).max().unwrap_or(0);
-    }
-    let mut waiting: Vec<usize> = preds.iter().map(Vec::len).collect();
-    let mut ready: BinaryHeap<(u64, Reverse<usize>)> = (0..n)
-        .filter(|&t| waiting[t] == 0)
-        .map(|t| (bottom[t], Reverse(t)))
-        .collect();
-    let mut free: BinaryHeap<Reverse<u32>> = (0..p as u32).map(Reverse).collect();
-    let mut running: BinaryHeap<Reverse<(u64, usize, u32)>> = BinaryHeap::new();
-    let mut slots = Vec::with_capacity(n);
-    let mut now = 0u64;
-    let mut release = |t: usize, ready: &mut BinaryHeap<(u64, Reverse<usize>)>| {
-        for &s in &succ[t] {
-            waiting[s] -= 1;
-            if waiting[s] == 0 {
-                ready.push((bottom[s], Reverse(s)));
-            }
-        }
-    };
-    loop {
-        while !free.is_empty() {
-            let Some((_, Reverse(t))) = ready.pop() else {
-                break;
-            };
-            let Reverse(core) = free.pop().expect("checked");
-            running.push(Reverse((now + costs[t], t, core)));
-            slots.push(Slot {
-                task: TaskId(t as u32),
-                core,
-                start: now,
-                finish: now + costs[t],
-            });
-        }
-        let Some(Reverse((f, t, core))) = running.pop() else {
-            break;
-        };
-        now = f;
-        free.push(Reverse(core));
-        release(t, &mut ready);
-        while let Some(&Reverse((f2, t2, c2))) = running.peek() {
-            if f2 != now {
-                break;
-            }
-            running.pop();
-            free.push(Reverse(c2));
-            release(t2, &mut ready);
-        }
-    }
-    slots
-}
 
 /// The makespan bars: for each P, the list-scheduling and the level-by-level makespan.
 pub(super) fn write_bars(out: &mut impl Write, r: &Report) -> io::Result<()> {
@@ -162,7 +79,7 @@ pub(super) fn write_gantt(
     a: &Analysis,
     p: usize,
 ) -> io::Result<()> {
-    let costs = task_costs(a);
+    let costs = task_costs(&a.schedule, &a.rung_costs);
     let slots = list_schedule(&costs, &a.schedule.preds, p);
     let makespan = slots.iter().map(|s| s.finish).max().unwrap_or(0);
     let merged = slots.len() > GANTT_MAX_BARS;
@@ -277,25 +194,4 @@ fn write_slot(
         )?;
     }
     out.write_all(b"</g>\n")
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn replays_the_cost_models_list_schedule() {
-        // 0 → 2, 1 → 2, 3 independent; costs 2, 3, 1, 4 (the cost model's own test DAG).
-        let costs = [2, 3, 1, 4];
-        let preds = vec![vec![], vec![], vec![TaskId(0), TaskId(1)], vec![]];
-        let s = list_schedule(&costs, &preds, 2);
-        // Bottom levels 3, 4, 1, 4: tasks 1 and 3 first (tie to the earlier), then 0, then 2.
-        let slot = |t: u32| *s.iter().find(|x| x.task == TaskId(t)).unwrap();
-        assert_eq!((slot(1).core, slot(1).start), (0, 0));
-        assert_eq!((slot(3).core, slot(3).start), (1, 0));
-        assert_eq!((slot(0).core, slot(0).start), (0, 3));
-        assert_eq!((slot(2).start, slot(2).finish), (5, 6));
-        let makespan = s.iter().map(|x| x.finish).max().unwrap();
-        assert_eq!(makespan, 6, "the cost model's makespan for P = 2");
-    }
 }

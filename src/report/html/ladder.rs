@@ -112,18 +112,12 @@ fn shape(p: &Program, e: &Element) -> Shape {
             },
             var(instance)
         )]),
-        Element::Ctud {
-            instance,
-            cd,
-            reset,
-            load,
-            pv,
-        } => boxed(vec![
+        Element::Ctud { instance, inputs } => boxed(vec![
             format!("CTUD {}", var(instance)),
-            format!("CD {}", operand(p, cd)),
-            format!("R {}", operand(p, reset)),
-            format!("LD {}", operand(p, load)),
-            format!("PV {}", operand(p, pv)),
+            format!("CD {}", operand(p, &inputs.cd)),
+            format!("R {}", operand(p, &inputs.reset)),
+            format!("LD {}", operand(p, &inputs.load)),
+            format!("PV {}", operand(p, &inputs.pv)),
         ]),
         Element::Ctu {
             instance,
@@ -160,11 +154,14 @@ fn shape(p: &Program, e: &Element) -> Shape {
             name: String::new(),
         },
         Element::Call { pou } => boxed(vec![format!("CALL {}", p.pou(*pou).name)]),
-        Element::For {
-            var: v, from, to, ..
-        } => boxed(vec![
+        Element::For { var: v, bounds, .. } => boxed(vec![
             "FOR".into(),
-            format!("{} := {} TO {}", var(v), operand(p, from), operand(p, to)),
+            format!(
+                "{} := {} TO {}",
+                var(v),
+                operand(p, &bounds.from),
+                operand(p, &bounds.to)
+            ),
         ]),
         Element::Next { .. } => boxed(vec!["NEXT".into()]),
     }

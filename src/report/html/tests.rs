@@ -3,7 +3,7 @@
 //! cost model's. (The browser test is tests/html_browser.rs.)
 
 use super::*;
-use crate::analysis::analyse;
+use crate::analysis::{analyse, cost};
 use crate::report::document_with;
 use crate::report::fbd_parts;
 use std::collections::BTreeSet;
@@ -166,9 +166,9 @@ fn fbd_blocks_are_drawn_as_blocks_with_their_arcs() {
 fn the_gantt_makespans_are_the_cost_models() {
     for example in ["example-b", "packaging-line", "mixing-station"] {
         let (html, _, a) = page(example);
-        let costs = charts::task_costs(&a);
+        let costs = cost::task_costs(&a.schedule, &a.rung_costs);
         for &(p, m) in &a.cost.makespan {
-            let slots = charts::list_schedule(&costs, &a.schedule.preds, p as usize);
+            let slots = cost::list_schedule(&costs, &a.schedule.preds, p as usize);
             assert_eq!(slots.len(), a.schedule.tasks.len());
             let got = slots.iter().map(|s| s.finish).max().unwrap_or(0);
             assert_eq!(got, m, "{example}, P = {p}");

@@ -117,7 +117,9 @@ pub(crate) fn lower(fbd: &FbdPou, env: &mut dyn Env, names: &Names, pou: PouId) 
         let (block_rungs, typed_net) = cx.network(net, plan, &labels, &mut jumps)?;
         typed.push(typed_net);
         for rung in &mut cx.rungs[start as usize..] {
-            rung.network = Some(net.id.clone());
+            if let Some(from) = &mut rung.lowered {
+                from.network = Some(net.id.clone());
+            }
         }
         networks.push(start..cx.rungs.len() as u32);
         blocks.push(block_rungs);
@@ -258,8 +260,10 @@ impl Cx<'_> {
             comment,
             pou: self.pou,
             series,
-            block_path: Some(path.to_owned()),
-            network: None,
+            lowered: Some(Box::new(LoweredFrom {
+                block_path: path.to_owned(),
+                network: None,
+            })),
         });
         self.rungs.len() - 1
     }

@@ -72,10 +72,12 @@ impl Cx<'_> {
         let mut first = condition(ops[0], false);
         first.push(Element::Ctud {
             instance: inst,
-            cd: ops[1],
-            reset: ops[2],
-            load: ops[3],
-            pv,
+            inputs: Box::new(CtudInputs {
+                cd: ops[1],
+                reset: ops[2],
+                load: ops[3],
+                pv,
+            }),
         });
         let outs = [
             (Field::Qu, Type::Bool),
