@@ -306,6 +306,26 @@ fn body(rng: &mut Rng, s: &Scope, networks: usize) -> Json {
     json!({ "networks": nets })
 }
 
+/// The names the main program's body may use: these reads and instances, and its variables.
+fn main_scope(
+    bools_read: Vec<&'static str>,
+    ints_read: Vec<&'static str>,
+    instances: Vec<(&'static str, &'static str)>,
+) -> Scope {
+    Scope {
+        bools_read,
+        bools_write: vec!["b0", "b1", "q"],
+        ints_read,
+        ints_write: vec!["n0", "n1", "n2"],
+        time_var: "tv",
+        ton: Some("t0"),
+        tof: Some("t1"),
+        ctu: Some("c0"),
+        ctd: Some("c1"),
+        instances,
+    }
+}
+
 /// The names a function block type's body may use (its pins, own variables, nested instances).
 fn fb_scope(instances: Vec<(&'static str, &'static str)>) -> Scope {
     let mut ints_read = vec!["IN1", "ACC", "OUT"];
@@ -397,18 +417,11 @@ fn fb_ladder(rng: &mut Rng) -> Json {
 pub fn random_nested_fbd_program(seed: u64) -> String {
     let mut rng = Rng::new(seed ^ 0x0FB5_7E57);
     let mut v: Json = serde_json::from_str(&random_fbd_program(seed)).unwrap();
-    let main_scope = Scope {
-        bools_read: vec!["i0", "i1", "b0", "q", "t0.Q", "f0.Q", "f2.Q", "ud0.QD"],
-        bools_write: vec!["b0", "b1", "q"],
-        ints_read: vec!["k", "n0", "n1", "f1.OUT", "f2.OUT"],
-        ints_write: vec!["n0", "n1", "n2"],
-        time_var: "tv",
-        ton: Some("t0"),
-        tof: Some("t1"),
-        ctu: Some("c0"),
-        ctd: Some("c1"),
-        instances: vec![("f0", "FB1"), ("f1", "FB1"), ("f2", "FB2")],
-    };
+    let main_scope = main_scope(
+        vec!["i0", "i1", "b0", "q", "t0.Q", "f0.Q", "f2.Q", "ud0.QD"],
+        vec!["k", "n0", "n1", "f1.OUT", "f2.OUT"],
+        vec![("f0", "FB1"), ("f1", "FB1"), ("f2", "FB2")],
+    );
     let main_nets = 1 + rng.below(3) as usize;
     v["fbd"] = body(&mut rng, &main_scope, main_nets);
     v["vars"]
@@ -432,20 +445,13 @@ pub fn random_nested_fbd_program(seed: u64) -> String {
 /// A random FBD program (main body and a user function block FB1 with two instances).
 pub fn random_fbd_program(seed: u64) -> String {
     let mut rng = Rng::new(seed ^ 0x5EED_F00D);
-    let main = Scope {
-        bools_read: vec![
+    let main = main_scope(
+        vec![
             "i0", "i1", "b0", "b1", "q", "t0.Q", "c0.Q", "f0.Q", "sr0.Q1", "ud0.QD",
         ],
-        bools_write: vec!["b0", "b1", "q"],
-        ints_read: vec!["k", "n0", "n1", "c0.CV", "f1.OUT", "ud0.CV"],
-        ints_write: vec!["n0", "n1", "n2"],
-        time_var: "tv",
-        ton: Some("t0"),
-        tof: Some("t1"),
-        ctu: Some("c0"),
-        ctd: Some("c1"),
-        instances: vec![("f0", "FB1"), ("f1", "FB1")],
-    };
+        vec!["k", "n0", "n1", "c0.CV", "f1.OUT", "ud0.CV"],
+        vec![("f0", "FB1"), ("f1", "FB1")],
+    );
     let fb = fb_scope(vec![]);
     let networks = 1 + rng.below(4) as usize;
     let main_body = body(&mut rng, &main, networks);
