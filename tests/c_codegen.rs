@@ -1,146 +1,27 @@
 //! The generated C, compiled with `cc -std=c11 -Wall -Wextra -Werror -O2` and run, gives after
 //! every scan the same state (as the JSON line of `plc-deps run --format json`'s `state`) and the
-//! same faults as the sequential interpreter: on every `analyses/` example and on random ladder
-//! and generated programs. Example C's C has the shape the FBD text-generation paper prints.
+//! same faults as the sequential interpreter: on every `analyses/` example and on thousands of
+//! random ladder and FBD programs (with nested function block types) and generated programs,
+//! compiled many to a binary (`common::c::Batch`). Example C's C has the shape the FBD
+//! text-generation paper prints.
 
 mod common;
 
+use common::c::{compile, fresh_dir, random_csv, run_with_input, Batch};
 use common::Rng;
 use plc_deps::codegen::c::{generate, CConfig};
-use plc_deps::exec::{ExecConfig, Layout, Machine};
-use plc_deps::model::{Program, Type, VarClass};
-use serde_json::{json, Map};
-use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
-use std::sync::atomic::{AtomicU32, Ordering};
-
-fn fresh_dir(tag: &str) -> PathBuf {
-    static N: AtomicU32 = AtomicU32::new(0);
-    let d = std::env::temp_dir().join(format!(
-        "plc-c-{}-{tag}-{}",
-        std::process::id(),
-        N.fetch_add(1, Ordering::Relaxed)
-    ));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// Writes the C of `text` into a fresh folder and compiles it with the exact flags.
-fn build(text: &str, cfg: &CConfig, tag: &str) -> PathBuf {
-    let (p, fbd) = plc_deps::read::program_and_fbd_from_json(text).expect("program loads");
-    let dir = fresh_dir(tag);
-    let mut sources = Vec::new();
-    for f in generate(&p, &fbd, cfg) {
-        if f.name.ends_with(".c") {
-            sources.push(f.name.clone());
-        }
-        std::fs::write(dir.join(&f.name), f.text).unwrap();
-    }
-    let out = Command::new("cc")
-        .args([
-            "-std=c11", "-Wall", "-Wextra", "-Werror", "-O2", "-o", "prog",
-        ])
-        .args(&sources)
-        .arg("-lm")
-        .current_dir(&dir)
-        .output()
-        .expect("cc runs");
-    assert!(
-        out.status.success(),
-        "cc failed in {}:\n{}",
-        dir.display(),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    dir
-}
-
-/// Runs the built program: its state lines and fault lines.
-fn run_c(dir: &Path, csv: &str, scans: u64) -> (Vec<String>, Vec<String>) {
-    let mut child = Command::new(dir.join("prog"))
-        .arg(scans.to_string())
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    use std::io::Write;
-    child
-        .stdin
-        .take()
-        .unwrap()
-        .write_all(csv.as_bytes())
-        .unwrap();
-    let out = child.wait_with_output().unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let lines = |b: &[u8]| {
-        String::from_utf8_lossy(b)
-            .lines()
-            .map(String::from)
-            .collect()
-    };
-    (lines(&out.stdout), lines(&out.stderr))
-}
-
-/// What the interpreter gives for the same inputs: the state line after every scan, the faults.
-fn run_interpreter(text: &str, csv: &str, scans: u64, cfg: &CConfig) -> (Vec<String>, Vec<String>) {
-    let p = plc_deps::read::program_from_json(text).unwrap();
-    let exec = ExecConfig {
-        cycle_ms: cfg.cycle_ms,
-        loop_cap: cfg.loop_cap,
-    };
-    let m = Machine::new(&p, Layout::dense(&p), &exec).unwrap();
-    let table = plc_deps::cmd::run::parse_inputs_csv(&p, csv, "inputs.csv").unwrap();
-    let mut st = m.initial_state();
-    let (mut lines, mut faults) = (Vec::new(), Vec::new());
-    for k in 0..scans {
-        let mut f = Vec::new();
-        m.set_inputs(&mut st, table.at(k));
-        m.run_scan(&mut st, k, &mut f);
-        lines.push(state_line(&p, &m, &st));
-        for x in f {
-            let rung = &p.rung(x.rung).id;
-            faults.push(json!({"scan": x.scan, "rung": rung, "kind": x.kind.name()}).to_string());
-        }
-    }
-    (lines, faults)
-}
-
-fn state_line(p: &Program, m: &Machine, st: &plc_deps::exec::State) -> String {
-    let mut map = Map::new();
-    for (i, v) in p.vars.iter().enumerate() {
-        if !v.hidden {
-            let value = m.value(st, plc_deps::model::VarId(i as u32));
-            map.insert(v.name.clone(), value.to_json());
-        }
-    }
-    serde_json::Value::Object(map).to_string()
-}
-
-/// Builds, runs and compares scan by scan.
-fn check(text: &str, csv: &str, scans: u64, cfg: &CConfig, tag: &str) {
-    let dir = build(text, cfg, tag);
-    let (c_lines, c_faults) = run_c(&dir, csv, scans);
-    let (i_lines, i_faults) = run_interpreter(text, csv, scans, cfg);
-    assert_eq!(c_lines.len(), i_lines.len(), "{tag}: scans");
-    for (k, (c, i)) in c_lines.iter().zip(&i_lines).enumerate() {
-        assert_eq!(c, i, "{tag}: state after scan {k} ({})", dir.display());
-    }
-    assert_eq!(c_faults, i_faults, "{tag}: faults");
-    let _ = std::fs::remove_dir_all(dir);
-}
+use std::path::PathBuf;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
+/// Binaries per batch: compiled in parallel on the two cores.
+const PARTS: usize = 2;
+
 #[test]
 fn every_example_matches_the_interpreter_after_every_scan() {
-    let mut seen = 0;
+    let mut batch = Batch::default();
     for e in std::fs::read_dir(root().join("analyses")).unwrap() {
         let dir = e.unwrap().path();
         // `analyses/plcopen/` holds the PLCopen exports, checked by their own test.
@@ -160,106 +41,99 @@ fn every_example_matches_the_interpreter_after_every_scan() {
             ..CConfig::default()
         };
         let name = dir.file_name().unwrap().to_string_lossy().into_owned();
-        check(&text, &csv, scans, &cfg, &name);
-        seen += 1;
+        batch.add(text, csv, scans, cfg, name);
     }
-    assert!(seen >= 11, "{seen} examples");
+    assert!(batch.len() >= 11, "{} examples", batch.len());
+    batch.check(PARTS, "examples");
 }
 
-/// A CSV of random values for the program's inputs, `rows` rows (some cells empty).
-fn random_csv(p: &Program, rng: &mut Rng, rows: usize) -> String {
-    let ins: Vec<_> = p
-        .vars
-        .iter()
-        .filter(|v| v.class == VarClass::Input && !v.hidden)
-        .collect();
-    if ins.is_empty() {
-        return String::new();
-    }
-    let mut s = ins
-        .iter()
-        .map(|v| v.name.as_str())
-        .collect::<Vec<_>>()
-        .join(",");
-    s.push('\n');
-    for _ in 0..rows {
-        let cells: Vec<String> = ins
-            .iter()
-            .map(|v| {
-                if rng.chance(20) {
-                    return String::new();
-                }
-                match v.ty {
-                    Type::Bool => (if rng.chance(50) { "true" } else { "0" }).to_string(),
-                    Type::Int => (rng.below(200) as i64 - 100).to_string(),
-                    Type::Dint => (rng.below(2_000_000) as i64 - 1_000_000).to_string(),
-                    Type::Real => format!("{}", (rng.below(4000) as f64 - 2000.0) / 8.0),
-                    _ => (rng.below(5000)).to_string(),
-                }
-            })
-            .collect();
-        s.push_str(&cells.join(","));
-        s.push('\n');
-    }
-    s
-}
-
-#[test]
-fn random_ladder_programs_match_the_interpreter() {
-    let mut checked = 0;
-    for seed in 0..60u64 {
-        let text = common::random_program(seed, 24);
+/// Compares the programs `make(seed)` gives for `seeds` (those that load), each with random
+/// inputs and a random cycle and loop cap; at least `min` must load.
+fn random_programs(
+    tag: &str,
+    seeds: std::ops::Range<u64>,
+    min: usize,
+    make: impl Fn(u64) -> String,
+    chunk_rungs: impl Fn(&mut Rng) -> usize,
+) {
+    let mut batch = Batch::default();
+    for seed in seeds {
+        let text = make(seed);
         let Ok(p) = plc_deps::read::program_from_json(&text) else {
             continue;
         };
         let mut rng = Rng::new(seed + 1000);
-        let csv = random_csv(&p, &mut rng, 40);
+        let csv = random_csv(&p, &mut rng, 30);
         let cfg = CConfig {
             cycle_ms: 1 + rng.below(50) as u32,
             loop_cap: 1 + rng.below(200) as u32,
-            chunk_rungs: 1 + rng.below(8) as usize,
+            chunk_rungs: chunk_rungs(&mut rng),
         };
-        check(&text, &csv, 50, &cfg, &format!("random-{seed}"));
-        checked += 1;
+        batch.add(text, csv, 40, cfg, format!("{tag}-{seed}"));
     }
-    assert!(checked >= 30, "only {checked} random programs loaded");
+    assert!(
+        batch.len() >= min,
+        "only {} {tag} programs loaded",
+        batch.len()
+    );
+    batch.check(PARTS, tag);
+}
+
+#[test]
+fn random_ladder_programs_match_the_interpreter() {
+    random_programs(
+        "ladder",
+        0..700,
+        350,
+        |seed| common::random_program(seed, 24),
+        |rng| 1 + rng.below(8) as usize,
+    );
 }
 
 #[test]
 fn generated_programs_with_every_feature_match_the_interpreter() {
-    for seed in 0..6u64 {
-        let gc = plc_deps::synth::GenConfig::all_features(400, 20, seed);
-        let text = plc_deps::synth::generate_string(&gc);
-        let p = plc_deps::read::program_from_json(&text).unwrap();
-        let mut rng = Rng::new(seed);
-        let csv = random_csv(&p, &mut rng, 30);
-        let cfg = CConfig {
-            chunk_rungs: 64,
-            ..CConfig::default()
-        };
-        check(&text, &csv, 40, &cfg, &format!("gen-{seed}"));
-    }
+    random_programs(
+        "gen",
+        0..6,
+        6,
+        |seed| {
+            let gc = plc_deps::synth::GenConfig::all_features(400, 20, seed);
+            plc_deps::synth::generate_string(&gc)
+        },
+        |_| 64,
+    );
 }
 
 #[test]
 fn random_fbd_programs_match_the_interpreter() {
-    let mut checked = 0;
-    for seed in 0..50u64 {
-        let text = common::fbd::random_fbd_program(seed);
-        let Ok(p) = plc_deps::read::program_from_json(&text) else {
+    random_programs("fbd", 0..500, 200, common::fbd::random_fbd_program, |_| {
+        CConfig::default().chunk_rungs
+    });
+}
+
+#[test]
+fn random_fbd_programs_with_nested_fb_types_match_the_interpreter() {
+    // One function per type: FB1, FB2 (nested in FB1 and at the top), FB3 (ladder).
+    for seed in 0..40u64 {
+        let text = common::fbd::random_nested_fbd_program(seed);
+        let Ok((p, fbd)) = plc_deps::read::program_and_fbd_from_json(&text) else {
             continue;
         };
-        let mut rng = Rng::new(seed + 77);
-        let csv = random_csv(&p, &mut rng, 30);
-        let cfg = CConfig {
-            cycle_ms: 1 + rng.below(40) as u32,
-            loop_cap: 1 + rng.below(50) as u32,
-            ..CConfig::default()
-        };
-        check(&text, &csv, 40, &cfg, &format!("fbd-{seed}"));
-        checked += 1;
+        let files = generate(&p, &fbd, &CConfig::default());
+        let fns: usize = files
+            .iter()
+            .filter(|f| f.name.starts_with("fb_"))
+            .map(|f| f.text.matches("_body(_fb_").count())
+            .sum();
+        assert_eq!(fns, 3, "fbd-nested-{seed}: functions of the 3 types");
     }
-    assert!(checked >= 20, "only {checked} random FBD programs loaded");
+    random_programs(
+        "fbd-nested",
+        0..500,
+        150,
+        common::fbd::random_nested_fbd_program,
+        |_| CConfig::default().chunk_rungs,
+    );
 }
 
 /// Example C of the FBD text-generation paper: compute 3 and 4; `if (3) {flag = 1; 8}`;
@@ -305,9 +179,9 @@ fn example_c_has_the_shape_the_paper_prints() {
             "}",
             "if (_run0_3) {",
             "_15_0 = _plc_sub_i16(self->LVar, 1);",
-            "self->_uWriteValue__17_046IVal = _15_0;",
-            "_pou_WriteValue__17(self, ctx);",
-            "self->Written = self->_uWriteValue__17_046OVal;",
+            "self->WriteValue_17.IVal = _15_0;",
+            "_fb_WriteValue_body(&self->WriteValue_17, self, ctx);",
+            "self->Written = self->WriteValue_17.OVal;",
             "}",
             "}",
         ]
@@ -335,18 +209,7 @@ fn reals_print_as_the_run_report_prints_them() {
          { _plc_put_real(stdout, _plc_f32(b)); putchar('\\n'); } return 0; }\n",
     )
     .unwrap();
-    let out = Command::new("cc")
-        .args([
-            "-std=c11", "-Wall", "-Wextra", "-Werror", "-O2", "-o", "reals", "reals.c", "-lm",
-        ])
-        .current_dir(&dir)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    compile(&dir, "reals", &["reals.c".to_string()]);
     let mut rng = Rng::new(5);
     let mut bits: Vec<u32> = (0..20_000).map(|_| rng.next() as u32).collect();
     for e in -12..=20 {
@@ -356,31 +219,14 @@ fn reals_print_as_the_run_report_prints_them() {
     }
     bits.extend([0, 0x8000_0000, 1, 0x7f7f_ffff, 0x7f80_0000, 0x7fc0_0000]);
     let input: String = bits.iter().map(|b| format!("{b}\n")).collect();
-    let (lines, _) = {
-        let mut child = Command::new(dir.join("reals"))
-            .stdin(Stdio::piped())
-            .stdout(Stdio::piped())
-            .spawn()
-            .unwrap();
-        use std::io::Write;
-        // Written from a thread: the program answers line by line, and both pipes are finite.
-        let mut stdin = child.stdin.take().unwrap();
-        let writer = std::thread::spawn(move || stdin.write_all(input.as_bytes()).unwrap());
-        let out = child.wait_with_output().unwrap();
-        writer.join().unwrap();
-        let l: Vec<String> = String::from_utf8(out.stdout)
-            .unwrap()
-            .lines()
-            .map(String::from)
-            .collect();
-        (l, ())
-    };
+    let out = run_with_input(&dir.join("reals"), &[], input.as_bytes());
+    let lines: Vec<&str> = std::str::from_utf8(&out.stdout).unwrap().lines().collect();
     assert_eq!(lines.len(), bits.len());
     for (b, line) in bits.iter().zip(&lines) {
         let want = VarValue::Scalar(Value::Real(f32::from_bits(*b)))
             .to_json()
             .to_string();
-        assert_eq!(line, &want, "bits {b:#010x}");
+        assert_eq!(*line, want, "bits {b:#010x}");
     }
     let _ = std::fs::remove_dir_all(dir);
 }

@@ -4,8 +4,9 @@
 
 mod common;
 
-use common::cli::{error_line, root, run, tmp};
-use std::process::{Command, Stdio};
+use common::c::{assert_ok, run_with_input};
+use common::cli::{error_line, files_in, root, run, tmp};
+use std::process::Command;
 
 fn make(dir: &std::path::Path) {
     let out = Command::new("make")
@@ -13,28 +14,11 @@ fn make(dir: &std::path::Path) {
         .current_dir(dir)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out, "make");
 }
 
 fn run_program(dir: &std::path::Path, csv: &[u8]) -> String {
-    use std::io::Write;
-    let mut child = Command::new(dir.join("plc_program"))
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    child.stdin.take().unwrap().write_all(csv).unwrap();
-    let out = child.wait_with_output().unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = run_with_input(&dir.join("plc_program"), &[], csv);
     String::from_utf8(out.stdout).unwrap()
 }
 
@@ -45,11 +29,7 @@ fn the_makefile_builds_a_program_whose_state_is_the_runs_state() {
     let d = dir.to_str().unwrap();
     let prog = "analyses/conveyor/program.json";
     let out = run(&["c", prog, "-o", d, "--cycle", "1s"]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out, "plc-deps c");
     make(&dir);
     let csv = std::fs::read(root().join("analyses/conveyor/inputs.csv")).unwrap();
     let lines = run_program(&dir, &csv);
@@ -108,14 +88,9 @@ fn hostile_names_stay_inside_the_folder_and_compile() {
     let dir = tmp("c-hostile");
     let _ = std::fs::remove_dir_all(&dir);
     let out = run(&["c", file.to_str().unwrap(), "-o", dir.to_str().unwrap()]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out, "plc-deps c");
     // Every file is directly inside DIR, with a plain name.
-    for e in std::fs::read_dir(&dir).unwrap() {
-        let name = e.unwrap().file_name().into_string().unwrap();
+    for name in files_in(&dir, |_| true) {
         assert!(
             name.bytes()
                 .all(|b| b.is_ascii_alphanumeric() || b"_.-".contains(&b)),
@@ -144,11 +119,7 @@ fn hostile_names_stay_inside_the_folder_and_compile() {
     assert_eq!(last["a_046b"], 1);
     assert_eq!(last["self"], false);
     // Two POUs whose names differ only in case get two files.
-    let c_files = std::fs::read_dir(&dir)
-        .unwrap()
-        .filter_map(|e| e.ok())
-        .filter(|e| e.file_name().to_string_lossy().ends_with(".c"))
-        .count();
+    let c_files = files_in(&dir, |n| n.ends_with(".c")).len();
     assert_eq!(c_files, 5, "main.c, plc_program.c and three POUs");
 }
 
@@ -186,11 +157,6 @@ fn the_folder_is_written_whole_and_an_existing_one_needs_force() {
     assert!(!dir.join("notes.txt").exists());
     assert!(dir.join("main.c").exists() && dir.join("Makefile").exists());
     let parent = dir.parent().unwrap();
-    let leftovers: Vec<_> = std::fs::read_dir(parent)
-        .unwrap()
-        .filter_map(|e| e.ok())
-        .map(|e| e.file_name().to_string_lossy().into_owned())
-        .filter(|n| n.contains(".tmp-") || n.contains(".old-"))
-        .collect();
+    let leftovers = files_in(parent, |n| n.contains(".tmp-") || n.contains(".old-"));
     assert!(leftovers.is_empty(), "{leftovers:?}");
 }

@@ -4,15 +4,31 @@
 //! (compiled with `cc -std=c11 -Wall -Wextra -Werror`) must give it. Also the analysis: a box
 //! reads and writes its whole instance and reads its operands.
 
+mod common;
+
+use common::c::{build, run_c};
 use plc_deps::analysis::accesses::accesses;
-use plc_deps::codegen::c::{generate, CConfig};
+use plc_deps::codegen::c::CConfig;
 use plc_deps::exec::{ExecConfig, Layout, Machine};
 use plc_deps::model::{Program, RungId, Value, VarId};
 use serde_json::{json, Value as Json};
-use std::process::{Command, Stdio};
 
 fn program(vars: Json, rungs: Json) -> String {
     json!({"program": "fbs", "vars": vars, "rungs": rungs}).to_string()
+}
+
+/// One instance of each standard function block: B1 SR, B2 RS, E1 R_TRIG, E2 F_TRIG, C CTUD.
+fn instances() -> Vec<Json> {
+    [
+        ("B1", "SR"),
+        ("B2", "RS"),
+        ("E1", "R_TRIG"),
+        ("E2", "F_TRIG"),
+        ("C", "CTUD"),
+    ]
+    .iter()
+    .map(|(n, t)| json!({"name": n, "type": t}))
+    .collect()
 }
 
 fn var(p: &Program, name: &str) -> VarId {
@@ -60,56 +76,18 @@ fn compiled(
     rows: &[Vec<i64>],
     outs: &[&str],
 ) -> Vec<Vec<Json>> {
-    let (p, fbd) = plc_deps::read::program_and_fbd_from_json(text).unwrap();
-    let dir = std::env::temp_dir().join(format!("plc-fbs-{}-{tag}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    let mut sources = Vec::new();
-    for f in generate(&p, &fbd, &CConfig::default()) {
-        if f.name.ends_with(".c") {
-            sources.push(f.name.clone());
-        }
-        std::fs::write(dir.join(&f.name), f.text).unwrap();
-    }
-    let cc = Command::new("cc")
-        .args([
-            "-std=c11", "-Wall", "-Wextra", "-Werror", "-O2", "-o", "prog",
-        ])
-        .args(&sources)
-        .arg("-lm")
-        .current_dir(&dir)
-        .output()
-        .expect("cc runs");
-    assert!(
-        cc.status.success(),
-        "{}",
-        String::from_utf8_lossy(&cc.stderr)
-    );
+    let dir = build(text, &CConfig::default(), tag);
     let mut csv = ins.join(",") + "\n";
     for row in rows {
         let cells: Vec<String> = row.iter().map(|x| x.to_string()).collect();
         csv.push_str(&cells.join(","));
         csv.push('\n');
     }
-    let mut child = Command::new(dir.join("prog"))
-        .arg(rows.len().to_string())
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    use std::io::Write;
-    child
-        .stdin
-        .take()
-        .unwrap()
-        .write_all(csv.as_bytes())
-        .unwrap();
-    let out = child.wait_with_output().unwrap();
-    assert!(out.status.success());
+    let (lines, faults) = run_c(&dir, &csv, rows.len() as u64);
+    assert!(faults.is_empty(), "{faults:?}");
     let _ = std::fs::remove_dir_all(&dir);
-    String::from_utf8(out.stdout)
-        .unwrap()
-        .lines()
+    lines
+        .iter()
         .map(|l| {
             let state: Json = serde_json::from_str(l).unwrap();
             outs.iter().map(|n| state[*n].clone()).collect()
@@ -317,15 +295,7 @@ fn ctud_stops_at_the_int_limits() {
 fn each_box_reads_and_writes_its_instance_and_reads_its_operands() {
     let mut vars = bool_vars(&["a", "b", "c", "d"], &["q"]);
     vars.push(json!({"name": "n", "type": "INT"}));
-    for (n, t) in [
-        ("B1", "SR"),
-        ("B2", "RS"),
-        ("E1", "R_TRIG"),
-        ("E2", "F_TRIG"),
-        ("C", "CTUD"),
-    ] {
-        vars.push(json!({"name": n, "type": t}));
-    }
+    vars.extend(instances());
     let text = program(
         Json::Array(vars),
         json!([
@@ -365,15 +335,7 @@ fn fbd_blocks_run_the_same_bodies_with_every_output_wired() {
         &["q1", "q2", "qr", "qf", "qu", "qd"],
     );
     vars.push(json!({"name": "cv", "type": "INT", "class": "output"}));
-    for (n, t) in [
-        ("B1", "SR"),
-        ("B2", "RS"),
-        ("E1", "R_TRIG"),
-        ("E2", "F_TRIG"),
-        ("C", "CTUD"),
-    ] {
-        vars.push(json!({"name": n, "type": t}));
-    }
+    vars.extend(instances());
     let text = json!({"program": "fbd_fbs", "vars": vars, "fbd": {"networks": [{"id": "N1", "blocks": [
         {"id": 1, "op": "SR", "instance": "B1", "in": {"S1": "s", "R": "r"}, "out": {"Q1": "q1"}},
         {"id": 2, "op": "RS", "instance": "B2", "in": {"S": "s", "R1": "r"}, "out": {"Q1": "q2"}},

@@ -119,11 +119,16 @@ fn json_one_line(d: &serde_json::Value) -> String {
 
 /// The files of a folder whose name contains `.tmp-` (leftover temporary files).
 pub fn temp_files_in(dir: &std::path::Path) -> Vec<String> {
+    files_in(dir, |n| n.contains(".tmp-"))
+}
+
+/// The names of the entries of a folder that `keep` keeps (none if it cannot be read).
+pub fn files_in(dir: &std::path::Path, keep: impl Fn(&str) -> bool) -> Vec<String> {
     std::fs::read_dir(dir)
         .map(|d| {
             d.filter_map(|e| e.ok())
                 .map(|e| e.file_name().to_string_lossy().into_owned())
-                .filter(|n| n.contains(".tmp-"))
+                .filter(|n| keep(n))
                 .collect()
         })
         .unwrap_or_default()

@@ -1,7 +1,8 @@
 //! Random FBD programs for property tests (the differential test of the parallel executor and
 //! the C generator's test): every op — compares, arithmetic, logic, MOVE, SEL, MAX/MIN/LIMIT,
 //! timers, counters, JMP forward and backward, RET, TSTART/TSTOP, calls of a user function block
-//! with two instances; data arcs in any id order, conditional arcs, one-source and compound
+//! with two instances (and, in [`random_nested_fbd_program`], FB types nested in it, one with a
+//! ladder body); data arcs in any id order, conditional arcs, one-source and compound
 //! control arcs. Some break a rule of the reader; callers skip those.
 
 use super::Rng;
@@ -25,7 +26,8 @@ struct Scope {
     tof: Option<&'static str>,
     ctu: Option<&'static str>,
     ctd: Option<&'static str>,
-    instances: Vec<&'static str>,
+    /// User function block instances with their types (each type has the pins IN1, EN → OUT, Q).
+    instances: Vec<(&'static str, &'static str)>,
 }
 
 /// A random FBD body of `networks` networks.
@@ -202,8 +204,9 @@ fn body(rng: &mut Rng, s: &Scope, networks: usize) -> Json {
                     b.insert("in".into(), json!([s.time_var]));
                 }
                 18..=19 if !s.instances.is_empty() => {
-                    b.insert("op".into(), json!("FB1"));
-                    b.insert("instance".into(), json!(rng.pick(&s.instances)));
+                    let (inst, ty) = *rng.pick(&s.instances);
+                    b.insert("op".into(), json!(ty));
+                    b.insert("instance".into(), json!(inst));
                     let mut ins = serde_json::Map::new();
                     if rng.chance(80) {
                         ins.insert("IN1".into(), int_in(rng));
@@ -303,35 +306,153 @@ fn body(rng: &mut Rng, s: &Scope, networks: usize) -> Json {
     json!({ "networks": nets })
 }
 
-/// A random FBD program (main body and a user function block FB1 with two instances).
-pub fn random_fbd_program(seed: u64) -> String {
-    let mut rng = Rng::new(seed ^ 0x5EED_F00D);
-    let main = Scope {
-        bools_read: vec![
-            "i0", "i1", "b0", "b1", "q", "t0.Q", "c0.Q", "f0.Q", "sr0.Q1", "ud0.QD",
-        ],
+/// The names the main program's body may use: these reads and instances, and its variables.
+fn main_scope(
+    bools_read: Vec<&'static str>,
+    ints_read: Vec<&'static str>,
+    instances: Vec<(&'static str, &'static str)>,
+) -> Scope {
+    Scope {
+        bools_read,
         bools_write: vec!["b0", "b1", "q"],
-        ints_read: vec!["k", "n0", "n1", "c0.CV", "f1.OUT", "ud0.CV"],
+        ints_read,
         ints_write: vec!["n0", "n1", "n2"],
         time_var: "tv",
         ton: Some("t0"),
         tof: Some("t1"),
         ctu: Some("c0"),
         ctd: Some("c1"),
-        instances: vec!["f0", "f1"],
-    };
-    let fb = Scope {
-        bools_read: vec!["EN", "Q", "L0"],
+        instances,
+    }
+}
+
+/// The names a function block type's body may use (its pins, own variables, nested instances).
+fn fb_scope(instances: Vec<(&'static str, &'static str)>) -> Scope {
+    let mut ints_read = vec!["IN1", "ACC", "OUT"];
+    let mut bools_read = vec!["EN", "Q", "L0"];
+    for &(inst, _) in &instances {
+        let (int, b) = match inst {
+            "g0" => ("g0.OUT", "g0.Q"),
+            "g1" => ("g1.OUT", "g1.Q"),
+            _ => ("h0.OUT", "h0.Q"),
+        };
+        ints_read.push(int);
+        bools_read.push(b);
+    }
+    Scope {
+        bools_read,
         bools_write: vec!["Q", "L0"],
-        ints_read: vec!["IN1", "ACC", "OUT"],
+        ints_read,
         ints_write: vec!["ACC", "OUT"],
         time_var: "TV",
         ton: Some("T"),
         tof: Some("TF"),
         ctu: None,
         ctd: None,
-        instances: vec![],
-    };
+        instances,
+    }
+}
+
+/// The interface of the test's function block types: IN1, EN → OUT, Q and own variables.
+fn fb_type(extra_vars: &[(&str, &str)], body: (&str, Json)) -> Json {
+    let mut vars = vec![
+        json!({"name": "ACC", "type": "INT"}),
+        json!({"name": "L0", "type": "BOOL"}),
+        json!({"name": "T", "type": "TON"}),
+        json!({"name": "TF", "type": "TOF"}),
+        json!({"name": "TV", "type": "TIME"}),
+    ];
+    for (n, t) in extra_vars {
+        vars.push(json!({"name": n, "type": t}));
+    }
+    let mut t = json!({
+        "inputs": [{"name": "IN1", "type": "INT"}, {"name": "EN", "type": "BOOL"}],
+        "outputs": [{"name": "OUT", "type": "INT"}, {"name": "Q", "type": "BOOL"}],
+        "vars": vars,
+    });
+    t[body.0] = body.1;
+    t
+}
+
+/// A random ladder body over the function block interface of [`fb_type`] (plus a counter
+/// `C`): edge contacts (hidden memories per instance), compares, a counter, arithmetic with
+/// DIV (faults), a backward jump (the loop cap), RET.
+fn fb_ladder(rng: &mut Rng) -> Json {
+    let n = 2 + rng.below(4) as usize;
+    let mut rungs = Vec::new();
+    for i in 0..n {
+        let cond = match rng.below(5) {
+            0 => json!({"contact": "EN", "edge": "rising"}),
+            1 => json!({"contact": *rng.pick(&["EN", "Q", "L0", "C.Q"]), "negated": true}),
+            2 => {
+                json!({"compare": *rng.pick(&["LT", "GE", "NE"]), "a": *rng.pick(&["IN1", "ACC", "OUT"]), "b": rng.below(5) as i64})
+            }
+            3 => json!({"contact": "EN", "edge": "falling"}),
+            _ => json!({"contact": *rng.pick(&["EN", "L0", "T.Q"])}),
+        };
+        let act = match rng.below(8) {
+            0 => json!({"coil": *rng.pick(&["Q", "L0"])}),
+            1 => json!({"ctu": "C", "pv": 3, "reset": "L0"}),
+            2 => {
+                json!({"op": *rng.pick(&["ADD", "SUB", "DIV", "MOD"]), "in": [*rng.pick(&["IN1", "ACC", "OUT"]), *rng.pick(&["IN1", "ACC", "C.CV"])], "out": *rng.pick(&["ACC", "OUT"])})
+            }
+            3 => json!({"ton": "T", "pt": "T#20ms"}),
+            4 if i > 0 => json!({"jmp": "B0"}),
+            5 => json!({"ret": true}),
+            6 => json!({"set": "L0"}),
+            _ => json!({"move": *rng.pick(&["IN1", "ACC"]), "to": "OUT"}),
+        };
+        let mut r = json!({"id": format!("R{i}"), "ld": [cond, act]});
+        if i == 0 {
+            r["label"] = json!("B0");
+        }
+        rungs.push(r);
+    }
+    Json::Array(rungs)
+}
+
+/// A random FBD program whose function block FB1 holds two instances of FB2 (FBD) and one of
+/// FB3 (ladder); the main program has two instances of FB1 and one of FB2 (a type instantiated
+/// both at the top and nested).
+pub fn random_nested_fbd_program(seed: u64) -> String {
+    let mut rng = Rng::new(seed ^ 0x0FB5_7E57);
+    let mut v: Json = serde_json::from_str(&random_fbd_program(seed)).unwrap();
+    let main_scope = main_scope(
+        vec!["i0", "i1", "b0", "q", "t0.Q", "f0.Q", "f2.Q", "ud0.QD"],
+        vec!["k", "n0", "n1", "f1.OUT", "f2.OUT"],
+        vec![("f0", "FB1"), ("f1", "FB1"), ("f2", "FB2")],
+    );
+    let main_nets = 1 + rng.below(3) as usize;
+    v["fbd"] = body(&mut rng, &main_scope, main_nets);
+    v["vars"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"name": "f2", "type": "FB2"}));
+    let fb1 = fb_scope(vec![("g0", "FB2"), ("g1", "FB2"), ("h0", "FB3")]);
+    let fb1_nets = 1 + rng.below(3) as usize;
+    let fb1_body = body(&mut rng, &fb1, fb1_nets);
+    let fb2_nets = 1 + rng.below(2) as usize;
+    let fb2_body = body(&mut rng, &fb_scope(vec![]), fb2_nets);
+    let fb3_body = fb_ladder(&mut rng);
+    v["function_blocks"] = json!({
+        "FB1": fb_type(&[("g0", "FB2"), ("g1", "FB2"), ("h0", "FB3")], ("fbd", fb1_body)),
+        "FB2": fb_type(&[], ("fbd", fb2_body)),
+        "FB3": fb_type(&[("C", "CTU")], ("rungs", fb3_body)),
+    });
+    v.to_string()
+}
+
+/// A random FBD program (main body and a user function block FB1 with two instances).
+pub fn random_fbd_program(seed: u64) -> String {
+    let mut rng = Rng::new(seed ^ 0x5EED_F00D);
+    let main = main_scope(
+        vec![
+            "i0", "i1", "b0", "b1", "q", "t0.Q", "c0.Q", "f0.Q", "sr0.Q1", "ud0.QD",
+        ],
+        vec!["k", "n0", "n1", "c0.CV", "f1.OUT", "ud0.CV"],
+        vec![("f0", "FB1"), ("f1", "FB1")],
+    );
+    let fb = fb_scope(vec![]);
     let networks = 1 + rng.below(4) as usize;
     let main_body = body(&mut rng, &main, networks);
     let fb_networks = 1 + rng.below(2) as usize;
@@ -353,12 +474,7 @@ pub fn random_fbd_program(seed: u64) -> String {
             {"name": "ud0", "type": "CTUD"},
             {"name": "f0", "type": "FB1"}, {"name": "f1", "type": "FB1"}
         ],
-        "function_blocks": {"FB1": {
-            "inputs": [{"name": "IN1", "type": "INT"}, {"name": "EN", "type": "BOOL"}],
-            "outputs": [{"name": "OUT", "type": "INT"}, {"name": "Q", "type": "BOOL"}],
-            "vars": [{"name": "ACC", "type": "INT"}, {"name": "L0", "type": "BOOL"}, {"name": "T", "type": "TON"}, {"name": "TF", "type": "TOF"}, {"name": "TV", "type": "TIME"}],
-            "fbd": fb_body
-        }},
+        "function_blocks": {"FB1": fb_type(&[], ("fbd", fb_body))},
         "fbd": main_body
     })
     .to_string()

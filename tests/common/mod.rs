@@ -4,6 +4,7 @@
 //! from a seed, so a failing case is reproducible and printable.
 #![allow(dead_code)]
 
+pub mod c;
 pub mod cli;
 pub mod fbd;
 

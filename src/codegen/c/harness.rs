@@ -1,5 +1,7 @@
-//! The harness: `plc_program.c` (initial state, the scan, input and output tables), `main.c`
-//! (reads the CSV of `plc-deps run --inputs` on standard input, runs one scan per row on
+//! The harness: `plc_program.c` (initial state, the scan, input and output tables, and the
+//! program's descriptor `_plc_program_desc` that points at them), `plc_main.h` (the driver
+//! `_plc_main`, the same for every program: it runs a program through its descriptor), `main.c`
+//! (calls the driver; it reads the CSV of `plc-deps run --inputs` on standard input, runs one scan per row on
 //! virtual time, prints after each scan one JSON line with the keys and value forms of the
 //! `state` object of `plc-deps run --format json`, and each fault as a JSON line
 //! `{"scan","rung","kind"}` on standard error) and the `Makefile`.
@@ -15,12 +17,14 @@ use crate::model::{FbKind, Program, Type, Value, VarClass};
 pub(crate) const HEADER_DECLS: &str = "extern const char *const _plc_input_names[];\n\
     int _plc_set_input(_plc_state *self, unsigned input, const char *text);\n\
     void _plc_print_state(const _plc_state *self, FILE *out);\n\
-    extern const char *const _plc_rung_ids[];\n";
+    extern const char *const _plc_rung_ids[];\n\
+    extern const _plc_program _plc_program_desc;\n";
 
 /// Variables printed per function of `_plc_print_state` (keeps functions small).
 const PRINT_CHUNK: usize = 256;
 
-pub(crate) fn program_source(p: &Program, sh: &Shared) -> String {
+/// `extra`: initializers of the instances' bases (`    .G1._rung0 = 12,\n`).
+pub(crate) fn program_source(p: &Program, sh: &Shared, extra: &[String], cfg: &CConfig) -> String {
     let mut s = String::from(
         "/* plc_program.c: state, scan and harness tables. */\n#include \"plc_program.h\"\n\n",
     );
@@ -31,6 +35,7 @@ pub(crate) fn program_source(p: &Program, sh: &Shared) -> String {
         .enumerate()
         .filter(|(_, v)| !matches!(v.ty, Type::Fb(_)) && !is_zero(v.init))
         .map(|(i, v)| format!("    .{} = {},\n", field(sh, i), c_const(v.init)))
+        .chain(extra.iter().cloned())
         .collect();
     if inits.is_empty() {
         s.push_str("const _plc_state _plc_initial;\n\n");
@@ -57,8 +62,27 @@ pub(crate) fn program_source(p: &Program, sh: &Shared) -> String {
         );
     }
     s.push_str("    NULL\n};\n");
+    s.push_str(
+        &DESCRIPTOR
+            .replace("@CYCLE@", &cfg.cycle_ms.to_string())
+            .replace("@LOOP_CAP@", &cfg.loop_cap.to_string()),
+    );
     s
 }
+
+/// The program's descriptor: what the driver (`plc_main.h`) runs it through.
+const DESCRIPTOR: &str = "
+static void _plc_desc_scan(void *self, _plc_ctx *ctx) { _plc_scan(self, ctx); }
+static int _plc_desc_set_input(void *self, unsigned input, const char *text) {
+    return _plc_set_input(self, input, text);
+}
+static void _plc_desc_print(const void *self, FILE *out) { _plc_print_state(self, out); }
+
+const _plc_program _plc_program_desc = {
+    sizeof(_plc_state), &_plc_initial, _plc_desc_scan, _plc_desc_set_input, _plc_desc_print,
+    _plc_input_names, _plc_rung_ids, @CYCLE@, @LOOP_CAP@
+};
+";
 
 fn is_zero(v: Value) -> bool {
     match v {
@@ -138,11 +162,14 @@ fn print_state(p: &Program, sh: &Shared, s: &mut String) {
     s.push_str("    fputs(\"}\\n\", o);\n    (void)self;\n}\n");
 }
 
-pub(crate) fn main_c(cfg: &CConfig) -> String {
-    MAIN_C
-        .replace("@CYCLE@", &cfg.cycle_ms.to_string())
-        .replace("@LOOP_CAP@", &cfg.loop_cap.to_string())
-}
+/// `main.c`: runs the program through the driver.
+pub(crate) const MAIN_C: &str =
+    "/* main.c: runs the generated program scan by scan on virtual time (docs/c.md). */
+#include \"plc_program.h\"
+#include \"plc_main.h\"
+
+int main(int argc, char **argv) { return _plc_main(&_plc_program_desc, argc, argv); }
+";
 
 pub(crate) fn makefile(stems: &[String]) -> String {
     let objs: Vec<String> = stems.iter().map(|s| format!("{s}.o")).collect();
@@ -152,19 +179,22 @@ pub(crate) fn makefile(stems: &[String]) -> String {
          CC ?= cc\nCFLAGS ?= -std=c11 -Wall -Wextra -Werror -O2\n\
          OBJS = main.o plc_program.o {}\n\n\
          plc_program: $(OBJS)\n\t$(CC) $(CFLAGS) -o $@ $(OBJS) -lm\n\n\
-         %.o: %.c plc_program.h plc_runtime.h\n\t$(CC) $(CFLAGS) -c -o $@ $<\n\n\
+         %.o: %.c plc_program.h plc_runtime.h plc_main.h\n\t$(CC) $(CFLAGS) -c -o $@ $<\n\n\
          clean:\n\trm -f plc_program $(OBJS)\n\n.PHONY: clean\n",
         objs.join(" ")
     )
 }
 
-const MAIN_C: &str = r#"/* main.c: runs the generated program scan by scan on virtual time (docs/c.md).
+/// `plc_main.h`: the driver, the same for every program.
+pub(crate) const PLC_MAIN_H: &str = r#"/* plc_main.h: runs a generated program scan by scan on virtual time (docs/c.md).
    stdin: the CSV of `plc-deps run --inputs` (a header row of input names, one row per scan).
    argv[1]: the number of scans (default: the rows, at least 1).
    stdout: after each scan the state as one JSON line; stderr: each fault as a JSON line.
    argv[2] = --time: only the last state, and {"ns_per_scan": T} on stderr (the time of the
    scans alone: inputs and printing excluded). */
-#include "plc_program.h"
+#ifndef PLC_MAIN_H
+#define PLC_MAIN_H
+#include "plc_runtime.h"
 #include <time.h>
 
 static double seconds(void) {
@@ -173,12 +203,10 @@ static double seconds(void) {
     return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
 }
 
-#define CYCLE_MS @CYCLE@
-#define LOOP_CAP @LOOP_CAP@
-
 static void on_fault(_plc_ctx *ctx, uint32_t rung, int kind) {
+    const _plc_program *prog = ctx->user;
     fprintf(stderr, "{\"scan\":%llu,\"rung\":%s,\"kind\":\"%s\"}\n", (unsigned long long)ctx->scan,
-            _plc_rung_ids[rung], kind == _PLC_DIV_BY_ZERO ? "div-by-zero" : "loop-cap");
+            prog->rung_ids[rung], kind == _PLC_DIV_BY_ZERO ? "div-by-zero" : "loop-cap");
 }
 
 /* Splits one CSV line into cells (double quotes as in RFC 4180); returns the count. */
@@ -219,7 +247,8 @@ static int blank(const char *s) {
     return 1;
 }
 
-int main(int argc, char **argv) {
+/* The harness of `prog`: argv[1] the number of scans, argv[2] `--time`; 0, or 2 on bad input. */
+static int _plc_main(const _plc_program *prog, int argc, char **argv) {
     size_t cap = 1 << 16, len = 0;
     char *text = malloc(cap);
     if (!text) return 2;
@@ -249,8 +278,8 @@ int main(int argc, char **argv) {
         for (int c = 0; c < ncols; c++) {
             char *name = trim(cells[c]);
             column_input[c] = -1;
-            for (int i = 0; _plc_input_names[i]; i++)
-                if (!strcmp(_plc_input_names[i], name)) column_input[c] = i;
+            for (int i = 0; prog->input_names[i]; i++)
+                if (!strcmp(prog->input_names[i], name)) column_input[c] = i;
             if (column_input[c] < 0) {
                 fprintf(stderr, "error: <stdin>:1: unknown input variable `%s`\n", name);
                 return 2;
@@ -262,35 +291,38 @@ int main(int argc, char **argv) {
     if (argc > 1) scans = strtoull(argv[1], NULL, 10);
     int timing = argc > 2 && !strcmp(argv[2], "--time");
     double spent = 0;
-    static _plc_state state;
-    state = _plc_initial;
-    _plc_ctx ctx = {0, 0, LOOP_CAP, on_fault, NULL};
+    void *state = malloc(prog->size);
+    if (!state) return 2;
+    memcpy(state, prog->initial, prog->size);
+    _plc_ctx ctx = {0, 0, prog->loop_cap, on_fault, (void *)prog};
     for (unsigned long long k = 0; k < scans; k++) {
         if (k < rows) {
             int n = split(lines[k + 1], cells, MAX_COLS);
             for (int c = 0; c < n && c < ncols; c++) {
                 char *cell = trim(cells[c]);
                 if (!*cell) continue;
-                if (!_plc_set_input(&state, (unsigned)column_input[c], cell)) {
+                if (!prog->set_input(state, (unsigned)column_input[c], cell)) {
                     fprintf(stderr, "error: <stdin>: scan %llu, column `%s`: `%s` is not a value of that input\n",
-                            k, _plc_input_names[column_input[c]], cell);
+                            k, prog->input_names[column_input[c]], cell);
                     return 2;
                 }
             }
         }
         ctx.scan = k;
-        ctx.now = (int64_t)k * CYCLE_MS;
+        ctx.now = (int64_t)k * prog->cycle_ms;
         double t0 = timing ? seconds() : 0;
-        _plc_scan(&state, &ctx);
+        prog->scan(state, &ctx);
         if (timing) spent += seconds() - t0;
-        else _plc_print_state(&state, stdout);
+        else prog->print(state, stdout);
     }
     if (timing) {
-        _plc_print_state(&state, stdout);
+        prog->print(state, stdout);
         fprintf(stderr, "{\"ns_per_scan\": %.1f}\n", scans ? spent * 1e9 / (double)scans : 0.0);
     }
+    free(state);
     free(lines);
     free(text);
     return 0;
 }
+#endif
 "#;

@@ -35,6 +35,13 @@ pub(crate) struct Shared<'a> {
     pub vars: Vec<String>,
     /// The C function of each POU.
     pub pou_fns: Vec<String>,
+    /// Per POU: the user function block instance it was expanded into (index into
+    /// `Fbd::instances`), whose calls go to its type's function with its struct.
+    pub inst_of_pou: Vec<Option<usize>>,
+    /// Per instance: its struct as an lvalue of `_plc_state` (`self->G1.INNER`).
+    pub inst_paths: Vec<String>,
+    /// Per instance: the function of its type that runs it (set type by type, nested first).
+    pub inst_fns: Vec<String>,
     /// Rungs that some jump targets.
     pub labels: Vec<bool>,
     /// Per rung: its loop counter index, for loop-back rungs.
@@ -53,6 +60,23 @@ pub(crate) struct Body<'a> {
     pub ret: &'static str,
     /// Rungs some emitted `goto` names (only their labels are written: GCC refuses unused ones).
     pub used_labels: std::collections::HashSet<u32>,
+    /// Set for the function of a user function block type: whose rungs are emitted.
+    pub inst: Option<InstanceCtx>,
+    /// Whether each rung gets a comment with its id (off to compare instances' code).
+    pub comments: bool,
+}
+
+/// The instance whose lowered rungs a function block type's function is written from: its
+/// members become `self->…` (the type's struct), every other variable `_g->…` (the program's
+/// state), rungs and loop counters are numbered from the instance's first ones (their bases are
+/// members of the struct), so every instance of the type gives the same text.
+pub(crate) struct InstanceCtx {
+    /// The instance's struct in `_plc_state` terms, with a final dot (`self->G1.`).
+    pub prefix: String,
+    /// The instance POU's first rung.
+    pub rung0: u32,
+    /// Its first loop counter.
+    pub ctr0: u32,
 }
 
 fn is_condition(e: &Element) -> bool {
@@ -122,7 +146,46 @@ impl<'a> Body<'a> {
             tmp: 0,
             ret,
             used_labels: Default::default(),
+            inst: None,
+            comments: true,
         }
+    }
+
+    /// A `_plc_state` lvalue (`self->x`) as this function names it.
+    fn place(&self, e: &str) -> String {
+        match &self.inst {
+            None => e.to_string(),
+            Some(c) => match e.strip_prefix(c.prefix.as_str()) {
+                Some(rest) => format!("self->{rest}"),
+                None => match e.strip_prefix("self->") {
+                    Some(rest) => format!("_g->{rest}"),
+                    None => e.to_string(),
+                },
+            },
+        }
+    }
+
+    /// The program's state in this function.
+    fn state(&self) -> &'static str {
+        if self.inst.is_some() {
+            "_g"
+        } else {
+            "self"
+        }
+    }
+
+    /// Rung `r` as a fault names it (an index into `_plc_rung_ids`).
+    fn rung_no(&self, r: RungId) -> String {
+        match &self.inst {
+            None => r.0.to_string(),
+            Some(c) if r.0 == c.rung0 => "self->_rung0".to_string(),
+            Some(c) => format!("self->_rung0 + {}", r.0 - c.rung0),
+        }
+    }
+
+    /// The number of rung `r`'s label (`_L<n>`).
+    fn label_no(&self, r: u32) -> u32 {
+        r - self.inst.as_ref().map_or(0, |c| c.rung0)
     }
 
     /// Writes one line at the current indentation.
@@ -142,7 +205,7 @@ impl<'a> Body<'a> {
     pub fn var(&self, v: VarId) -> String {
         match self.locals.get(&v) {
             Some(l) => l.clone(),
-            None => self.sh.vars[v.index()].clone(),
+            None => self.place(&self.sh.vars[v.index()]),
         }
     }
 
@@ -355,13 +418,14 @@ impl<'a> Body<'a> {
                 pw
             }
             Element::Jmp { target, .. } => {
-                let goto = format!("goto _L{};", target.0);
+                let goto = format!("goto _L{};", self.label_no(target.0));
                 if !matches!(pw, Pw::False) {
-                    self.used_labels.insert(target.0);
+                    self.used_labels.insert(self.label_no(target.0));
                 }
                 if target.0 <= rung.0 {
                     let ctr = self.counter(rung);
-                    let stmt = format!("if (_plc_loop_back(&{ctr}, ctx, {})) {goto}", rung.0);
+                    let no = self.rung_no(rung);
+                    let stmt = format!("if (_plc_loop_back(&{ctr}, ctx, {no})) {goto}");
                     self.when(&pw, &stmt);
                 } else {
                     self.when(&pw, &goto);
@@ -375,7 +439,15 @@ impl<'a> Body<'a> {
             }
             Element::Call { pou } => {
                 let pw = self.materialize(pw);
-                let stmt = format!("{}(self, ctx);", self.sh.pou_fns[pou.index()]);
+                let g = self.state();
+                let stmt = match self.sh.inst_of_pou[pou.index()] {
+                    Some(k) => format!(
+                        "{}(&{}, {g}, ctx);",
+                        self.sh.inst_fns[k],
+                        self.place(&self.sh.inst_paths[k])
+                    ),
+                    None => format!("{}({g}, ctx);", self.sh.pou_fns[pou.index()]),
+                };
                 self.when(&pw, &stmt);
                 pw
             }
@@ -445,7 +517,9 @@ impl<'a> Body<'a> {
         };
         let name = op.name().to_ascii_lowercase();
         match op {
-            ArithOp::Div | ArithOp::Mod => format!("_plc_{name}_{w}({a}, {b}, ctx, {})", rung.0),
+            ArithOp::Div | ArithOp::Mod => {
+                format!("_plc_{name}_{w}({a}, {b}, ctx, {})", self.rung_no(rung))
+            }
             _ => format!("_plc_{name}_{w}({a}, {b})"),
         }
     }
@@ -495,7 +569,10 @@ impl<'a> Body<'a> {
 
     fn counter(&self, rung: RungId) -> String {
         let k = self.sh.counters[rung.index()].expect("a loop-back rung has a counter");
-        format!("self->_ctr[{k}]")
+        match &self.inst {
+            None => format!("self->_ctr[{k}]"),
+            Some(c) => format!("_g->_ctr[self->_ctr0 + {}]", k - c.ctr0),
+        }
     }
 
     /// One rung: its label if a jump targets it, a comment, its statements. A FOR head opens
@@ -503,7 +580,9 @@ impl<'a> Body<'a> {
     pub fn rung(&mut self, r: RungId) {
         let rung = self.sh.p.rung(r);
         self.label(r);
-        self.line(&format!("/* {} */", names::comment(&rung.id)));
+        if self.comments {
+            self.line(&format!("/* {} */", names::comment(&rung.id)));
+        }
         match rung.series.last() {
             Some(Element::For { var, bounds, .. }) => {
                 let ForBounds { from, to } = &**bounds;
@@ -542,10 +621,8 @@ impl<'a> Body<'a> {
                     Type::Int => "_plc_w16",
                     _ => "_plc_w32",
                 };
-                self.line(&format!(
-                    "if (!_plc_loop_back(&{ctr}, ctx, {})) break;",
-                    r.0
-                ));
+                let no = self.rung_no(r);
+                self.line(&format!("if (!_plc_loop_back(&{ctr}, ctx, {no})) break;"));
                 self.line(&format!("{v} = {wrap}((int64_t){v} + 1);"));
                 self.indent -= 1;
                 self.line("}");
@@ -562,7 +639,7 @@ impl<'a> Body<'a> {
     /// `goto` names it).
     pub fn label(&mut self, r: RungId) {
         if self.sh.labels[r.index()] {
-            let l = format!("_L{}: ;", r.0);
+            let l = format!("_L{}: ;", self.label_no(r.0));
             self.line(&l);
         }
     }

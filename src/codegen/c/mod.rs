@@ -1,10 +1,12 @@
 //! C from ladder and FBD programs (the FBD text-generation paper's generator, extended to the
-//! whole program): for every POU a header and a source file, a runtime header, the program's
-//! state and harness tables, `main.c` and a `Makefile`.
+//! whole program): for every POU a header and a source file, for every user function block
+//! type with instances a source file (`types`: one struct and one function per type), a runtime
+//! header, the program's state and harness tables, the harness's driver, `main.c` and a
+//! `Makefile`.
 //!
-//! Shape: the program's persistent data (every variable: globals, subroutine and instance
-//! locals, timers, counters, edge memories, the loop counters) is one struct `_plc_state`
-//! passed to every POU function as `self`; each POU is a function `_pou_<name>(self, ctx)`
+//! Shape: the program's persistent data (every variable: globals, subroutine locals, timers,
+//! counters, edge memories, the loop counters, and each top-level function block instance as a
+//! struct member) is one struct `_plc_state` passed to every POU function as `self`; each POU is a function `_pou_<name>(self, ctx)`
 //! (`ctx`: virtual time, scan, loop cap, fault sink). Ladder rungs are one block of statements
 //! each (`ladder`); FBD networks are nested `if` blocks following their fragment trees, with
 //! one local per data arc (`fbd`). A ladder POU of more than [`CConfig::chunk_rungs`] rungs is
@@ -24,6 +26,7 @@ mod harness;
 mod ladder;
 pub mod names;
 mod runtime;
+mod types;
 
 use crate::fbd::Fbd;
 use crate::model::{walk_elements, Element, PouKind, Program, RungId, VarId};
@@ -62,13 +65,40 @@ pub struct CFile {
 
 /// The C of `p` (with its FBD bodies `fbd`), as files.
 pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
-    let sh = shared(p);
-    let stems: Vec<String> = p
+    let lay = types::layout(p, fbd);
+    let mut sh = shared(p, fbd, &lay);
+    let copies = fbd_copies(p, fbd);
+    let fbd_of: HashMap<usize, usize> = copies.iter().map(|(&k, (fp, _))| (k, *fp)).collect();
+    // The function block types first (nested types before their owners: a call names the
+    // function its callee's type got).
+    let order = types::order(fbd, &lay);
+    let (mut type_files, mut type_decls) = (Vec::new(), String::new());
+    for &t in &order {
+        let (text, decls) = types::functions(&mut sh, fbd, t, &fbd_of);
+        type_files.push((
+            format!("fb_{}", names::encode_file(&fbd.types[t].name, t)),
+            text,
+        ));
+        type_decls.push_str(&decls);
+    }
+    let structs = types::structs(p, fbd, &lay, &order);
+    let stems: Vec<Option<String>> = p
         .pous
         .iter()
         .enumerate()
-        .map(|(i, pou)| format!("pou_{}", names::encode_file(&pou.name, i)))
+        .map(|(i, pou)| {
+            sh.inst_of_pou[i]
+                .is_none()
+                .then(|| format!("pou_{}", names::encode_file(&pou.name, i)))
+        })
         .collect();
+    let header = Header {
+        stems: stems.iter().flatten().cloned().collect(),
+        structs,
+        type_decls,
+        fbd,
+        lay: &lay,
+    };
     let mut files = vec![
         CFile {
             name: "plc_runtime.h".into(),
@@ -76,16 +106,20 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
         },
         CFile {
             name: "plc_program.h".into(),
-            text: program_header(p, &sh, &stems),
+            text: program_header(p, &sh, &header),
         },
         CFile {
             name: "plc_program.c".into(),
-            text: harness::program_source(p, &sh),
+            text: harness::program_source(p, &sh, &instance_inits(&sh, fbd), cfg),
+        },
+        CFile {
+            name: "plc_main.h".into(),
+            text: harness::PLC_MAIN_H.into(),
         },
     ];
-    let copies = fbd_copies(p, fbd);
     let mut objects = Vec::new();
     for (i, pou) in p.pous.iter().enumerate() {
+        let Some(stem) = &stems[i] else { continue };
         let f = &sh.pou_fns[i];
         let (sources, decls) = match copies.get(&i) {
             Some((fp, prefix)) => {
@@ -96,23 +130,30 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
             None => ladder_files(p, &sh, i, cfg.chunk_rungs),
         };
         files.push(CFile {
-            name: format!("{}.h", stems[i]),
+            name: format!("{stem}.h"),
             text: format!(
                 "/* POU {} */\nvoid {f}(_plc_state *self, _plc_ctx *ctx);\n{decls}",
                 names::comment(&pou.name)
             ),
         });
         for (suffix, text) in sources {
-            objects.push(format!("{}{suffix}", stems[i]));
+            objects.push(format!("{stem}{suffix}"));
             files.push(CFile {
-                name: format!("{}{suffix}.c", stems[i]),
+                name: format!("{stem}{suffix}.c"),
                 text,
             });
         }
     }
+    for (stem, text) in type_files {
+        files.push(CFile {
+            name: format!("{stem}.c"),
+            text,
+        });
+        objects.push(stem);
+    }
     files.push(CFile {
         name: "main.c".into(),
-        text: harness::main_c(cfg),
+        text: harness::MAIN_C.into(),
     });
     files.push(CFile {
         name: "Makefile".into(),
@@ -121,20 +162,30 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
     files
 }
 
+/// The initializers of every instance's rung and loop counter bases (`.G1._rung0 = 12,`).
+fn instance_inits(sh: &Shared, fbd: &Fbd) -> Vec<String> {
+    let mut out = Vec::new();
+    for (k, inst) in fbd.instances.iter().enumerate() {
+        let rungs = sh.p.pou(inst.pou).rungs.clone();
+        let path = sh.inst_paths[k].trim_start_matches("self->");
+        let ctr0 = types::ctr0(sh, rungs.clone());
+        if rungs.start != 0 {
+            out.push(format!("    .{path}._rung0 = {},\n", rungs.start));
+        }
+        if ctr0 != 0 {
+            out.push(format!("    .{path}._ctr0 = {ctr0},\n"));
+        }
+    }
+    out
+}
+
 /// Names, labels and loop counters of the whole program.
-fn shared(p: &Program) -> Shared<'_> {
-    let vars = p
-        .vars
-        .iter()
-        .enumerate()
-        .map(|(i, v)| {
-            if v.hidden {
-                format!("self->_h{i}")
-            } else {
-                format!("self->{}", names::user_ident(&v.name))
-            }
-        })
-        .collect();
+fn shared<'a>(p: &'a Program, fbd: &Fbd, lay: &types::Layout) -> Shared<'a> {
+    let vars = lay.vars.iter().map(|(path, _)| path.clone()).collect();
+    let mut inst_of_pou = vec![None; p.pous.len()];
+    for (k, inst) in fbd.instances.iter().enumerate() {
+        inst_of_pou[inst.pou.index()] = Some(k);
+    }
     let pou_fns = p
         .pous
         .iter()
@@ -162,6 +213,9 @@ fn shared(p: &Program) -> Shared<'_> {
         p,
         vars,
         pou_fns,
+        inst_of_pou,
+        inst_paths: lay.paths.clone(),
+        inst_fns: vec![String::new(); fbd.instances.len()],
         labels,
         counters,
     }
@@ -172,19 +226,52 @@ fn counter_count(sh: &Shared) -> usize {
     sh.counters.iter().flatten().count()
 }
 
-fn program_header(p: &Program, sh: &Shared, stems: &[String]) -> String {
+/// What `plc_program.h` declares besides the program's variables.
+struct Header<'a> {
+    /// The POUs' file stems (instances have none: their types' functions run them).
+    stems: Vec<String>,
+    /// The function block types' structs, nested types first.
+    structs: String,
+    /// The function block types' functions.
+    type_decls: String,
+    fbd: &'a Fbd,
+    lay: &'a types::Layout,
+}
+
+fn program_header(p: &Program, sh: &Shared, h: &Header) -> String {
     let mut s = String::from(
         "/* plc_program.h: the persistent data of the program, generated by plc-deps. */\n\
          #ifndef PLC_PROGRAM_H\n#define PLC_PROGRAM_H\n#include \"plc_runtime.h\"\n\n\
-         typedef struct _plc_state {\n",
+         typedef struct _plc_state _plc_state;\n\n",
     );
+    s.push_str(&h.structs);
+    s.push_str("struct _plc_state {\n");
+    let mut fields = 0;
     for (i, v) in p.vars.iter().enumerate() {
+        if h.lay.vars[i].1.is_some() {
+            continue; // a member of an instance's struct
+        }
         let field = sh.vars[i].trim_start_matches("self->");
         let ty = c_type(v.ty);
+        fields += 1;
         ladder::push(
             &mut s,
             format_args!("    {ty} {field}; /* {} */\n", names::comment(&v.name)),
         );
+    }
+    for (k, inst) in h.fbd.instances.iter().enumerate() {
+        if h.lay.owner[k].is_none() {
+            let ty = types::struct_name(h.fbd, inst.ty.index());
+            let field = h.lay.paths[k].trim_start_matches("self->");
+            fields += 1;
+            ladder::push(
+                &mut s,
+                format_args!(
+                    "    {ty} {field}; /* instance {} */\n",
+                    names::comment(&inst.name)
+                ),
+            );
+        }
     }
     let k = counter_count(sh);
     if k > 0 {
@@ -193,13 +280,14 @@ fn program_header(p: &Program, sh: &Shared, stems: &[String]) -> String {
             format_args!("    uint64_t _ctr[{k}]; /* loop counters */\n"),
         );
     }
-    if p.vars.is_empty() && k == 0 {
+    if fields == 0 && k == 0 {
         s.push_str("    char _empty;\n");
     }
-    s.push_str("} _plc_state;\n\nextern const _plc_state _plc_initial;\n");
+    s.push_str("};\n\nextern const _plc_state _plc_initial;\n");
     s.push_str("void _plc_scan(_plc_state *self, _plc_ctx *ctx);\n");
+    s.push_str(&h.type_decls);
     s.push_str(harness::HEADER_DECLS);
-    for stem in stems {
+    for stem in &h.stems {
         ladder::push(&mut s, format_args!("#include \"{stem}.h\"\n"));
     }
     s.push_str("#endif\n");

@@ -36,6 +36,20 @@ typedef struct _plc_ctx {
     void *user;
 } _plc_ctx;
 
+/* A generated program as the harness's driver (plc_main.h) runs it: its state's size and
+   initial value, its scan, its input and output tables, the cycle and loop cap it was made for. */
+typedef struct _plc_program {
+    size_t size;
+    const void *initial;
+    void (*scan)(void *self, _plc_ctx *ctx);
+    int (*set_input)(void *self, unsigned input, const char *text);
+    void (*print)(const void *self, FILE *out);
+    const char *const *input_names;
+    const char *const *rung_ids;
+    int64_t cycle_ms;
+    uint64_t loop_cap;
+} _plc_program;
+
 static inline void _plc_fault(_plc_ctx *ctx, uint32_t rung, int kind) {
     if (ctx->fault) ctx->fault(ctx, rung, kind);
 }
