@@ -340,6 +340,18 @@ impl CmpOp {
             CmpOp::Ge => ">=",
         }
     }
+
+    /// The comparison that is true exactly when this one is false (`<` for `>=`).
+    pub fn negated(self) -> CmpOp {
+        match self {
+            CmpOp::Eq => CmpOp::Ne,
+            CmpOp::Ne => CmpOp::Eq,
+            CmpOp::Lt => CmpOp::Ge,
+            CmpOp::Ge => CmpOp::Lt,
+            CmpOp::Gt => CmpOp::Le,
+            CmpOp::Le => CmpOp::Gt,
+        }
+    }
 }
 
 /// Arithmetic box operators.

@@ -17,7 +17,6 @@
 use super::ld_power::{Item, Key, Path, Power};
 use super::wiring::{ElemId, Source};
 use super::xml::{error, origin, R};
-use crate::model::CmpOp;
 use crate::syntax::{Element, ElementKind, Series};
 
 /// True for the boolean functions this module rewrites.
@@ -201,14 +200,7 @@ fn negate(x: &Element<'static>) -> Option<Series<'static>> {
         },
         ElementKind::Compare(c) => {
             let mut c = c.clone();
-            c.op = match c.op {
-                CmpOp::Eq => CmpOp::Ne,
-                CmpOp::Ne => CmpOp::Eq,
-                CmpOp::Lt => CmpOp::Ge,
-                CmpOp::Ge => CmpOp::Lt,
-                CmpOp::Gt => CmpOp::Le,
-                CmpOp::Le => CmpOp::Gt,
-            };
+            c.op = c.op.negated();
             ElementKind::Compare(c)
         }
         // NOT (b1 OR b2 …) = NOT b1 AND NOT b2 …: the negated branches in series.

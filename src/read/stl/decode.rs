@@ -278,14 +278,7 @@ pub(super) fn negate(s: &[E]) -> Option<Series<'static>> {
                 e.origin.offset().unwrap_or(0),
             )]),
             ElementKind::Compare(c) => {
-                let op = match c.op {
-                    CmpOp::Eq => CmpOp::Ne,
-                    CmpOp::Ne => CmpOp::Eq,
-                    CmpOp::Lt => CmpOp::Ge,
-                    CmpOp::Ge => CmpOp::Lt,
-                    CmpOp::Gt => CmpOp::Le,
-                    CmpOp::Le => CmpOp::Gt,
-                };
+                let op = c.op.negated();
                 Some(vec![Element {
                     origin: e.origin,
                     kind: ElementKind::Compare(Box::new(syntax::Compare {
