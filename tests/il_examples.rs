@@ -75,7 +75,7 @@ fn the_stl_of_each_example_is_the_committed_one_and_runs_the_same() {
                 path.display()
             ));
         }
-        let (back, _, _) = plc_deps::read::stl::load(&stl)
+        let (back, _) = plc_deps::read::stl::load(&stl)
             .unwrap_or_else(|e| panic!("{name}: {}", e.in_file("program.stl")));
         let csv = std::fs::read_to_string(dir(name).join("inputs.csv")).unwrap();
         let table = plc_deps::cmd::run::parse_inputs_csv(&p, &csv, "inputs.csv").unwrap();

@@ -113,7 +113,7 @@ fn round_trip(seed: u64) -> bool {
             return false;
         }
     };
-    let (back, _, _) = plc_deps::read::stl::load(&stl)
+    let (back, _) = plc_deps::read::stl::load(&stl)
         .unwrap_or_else(|e| panic!("{}\n{stl}", e.in_file("il.stl")));
     let mut rng = Rng::new(seed ^ 77);
     let inputs: Vec<Vec<bool>> = (0..10)

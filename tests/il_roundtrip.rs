@@ -106,7 +106,7 @@ fn round_trip(seed: u64, input_seed: u64) -> Outcome {
             return Outcome::NoForm;
         }
     };
-    let (back, _, _) = plc_deps::read::stl::load(&stl)
+    let (back, _) = plc_deps::read::stl::load(&stl)
         .unwrap_or_else(|e| panic!("seed {seed}: {}\n{stl}", e.in_file("il.stl")));
     let names: Vec<String> = p
         .vars

@@ -236,15 +236,12 @@ pub fn load_program_and_fbd(path: &Path) -> Result<(Program, Fbd), CliError> {
 
 /// Checks a program's text, recognised by its content: S7-200 STL when its first line opens a
 /// block or a declaration section (or the file is named `.stl`/`.awl`), PLCopen TC6 XML when it
-/// starts with `<` (the readers' notes go to standard error as warnings W0601 and W0501), else the JSON format.
+/// starts with `<` (the PLCopen reader's notes go to standard error as warnings W0501), else the JSON format.
 pub fn load_text(file: String, text: &str) -> Result<(Program, Fbd), CliError> {
     use crate::read::{plcopen, stl};
     let lower = file.to_ascii_lowercase();
     if stl::looks_like_stl(text) || lower.ends_with(".stl") || lower.ends_with(".awl") {
-        let (p, f, notes) =
-            stl::load(text).map_err(|error| CliError::load(file.clone(), text, error))?;
-        warn_notes(STL_NOTE, &file, text, &notes);
-        return Ok((p, f));
+        return stl::load(text).map_err(|error| CliError::load(file, text, error));
     }
     if plcopen::looks_like_xml(text) {
         let (p, f, notes) =
@@ -258,9 +255,6 @@ pub fn load_text(file: String, text: &str) -> Result<(Program, Fbd), CliError> {
 /// The code of a PLCopen reader's note (what it read only through an interface, ignored, or
 /// ordered otherwise than the file).
 pub const PLCOPEN_NOTE: &str = "W0501";
-/// The code of an STL reader's note (an interrupt routine read as a subroutine).
-pub const STL_NOTE: &str = "W0601";
-
 /// Prints a reader's notes as warnings with `code`.
 fn warn_notes(code: &'static str, file: &str, text: &str, notes: &[crate::read::plcopen::Note]) {
     for n in notes {

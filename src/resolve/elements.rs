@@ -267,9 +267,9 @@ impl<'a> Builder<'a> {
                 None => return Ok(None),
             },
             S::Call(name) => {
-                let interrupt =
-                    |p: &&super::PouDraft| p.kind == PouKind::Interrupt && p.name == name.as_str();
-                if self.pous.iter().any(|p| interrupt(&p)) {
+                let is_interrupt =
+                    |p: &super::PouDraft| p.kind == PouKind::Interrupt && p.name == name.as_str();
+                if self.pous.iter().any(is_interrupt) {
                     return Err(err(
                         "call",
                         name.origin,

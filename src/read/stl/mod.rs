@@ -147,15 +147,14 @@ fn operands(rest: &str, at: usize) -> Vec<Tok<'_>> {
     out
 }
 
-/// Reads an STL file into the surface syntax, with the reader's notes (warnings).
-pub fn parse(text: &str) -> Result<(syntax::Program<'static>, Vec<Note>), LoadError> {
+/// Reads an STL file into the surface syntax.
+pub fn parse(text: &str) -> Result<syntax::Program<'static>, LoadError> {
     let ls = lines(text);
     let mut cx = operand::Context::new(text);
     let mut program = syntax::Program {
         origin: Origin::at(ls.first().map_or(0, |l| l.0)),
         ..Default::default()
     };
-    let notes = Vec::new();
     let mut i = 0;
     let mut blocks: Vec<Block> = Vec::new();
     while i < ls.len() {
@@ -250,7 +249,7 @@ pub fn parse(text: &str) -> Result<(syntax::Program<'static>, Vec<Note>), LoadEr
         ));
     }
     cx.finish(&mut program);
-    Ok((program, notes))
+    Ok(program)
 }
 
 /// A block's optional `TITLE=` and `VAR` sections, `BEGIN`, networks, up to `END_<kind>`.
@@ -397,9 +396,8 @@ fn declarations(
     ))
 }
 
-/// Reads and resolves an STL file: the program, its (empty) FBD bodies, and the notes.
-pub fn load(text: &str) -> Result<(Program, Fbd, Vec<Note>), LoadError> {
-    let (syntax, notes) = parse(text)?;
-    let (p, f) = crate::resolve::resolve(text, &syntax)?;
-    Ok((p, f, notes))
+/// Reads and resolves an STL file: the program and its (empty) FBD bodies.
+pub fn load(text: &str) -> Result<(Program, Fbd), LoadError> {
+    let syntax = parse(text)?;
+    crate::resolve::resolve(text, &syntax)
 }
