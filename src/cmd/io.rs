@@ -385,7 +385,6 @@ pub fn write_file_as(
     role: FileRole,
     write: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>,
 ) -> Result<(), CliError> {
-    use std::io::Write;
     let tmp = temp_name(path);
     temp_files().push(tmp.clone());
     let unregister = |tmp: &Path| temp_files().retain(|t| t != tmp);
@@ -396,9 +395,9 @@ pub fn write_file_as(
             return Err(output_error(path, role, e));
         }
     };
-    let mut w = std::io::BufWriter::new(file);
-    let result = write(&mut w).and_then(|_| w.flush());
-    drop(w);
+    let mut file = file;
+    let result = super::background::write_in_background(&mut file, write);
+    drop(file);
     let mut files = temp_files();
     let result = result.and_then(|_| std::fs::rename(&tmp, path));
     if result.is_err() {

@@ -7,6 +7,7 @@
 //! the warnings) instead of printing an error or exiting. [`io`] reads inputs and writes outputs (atomically, never half-written);
 //! [`progress`] shows long phases on a terminal. This is the top layer: nothing below imports it.
 
+mod background;
 pub mod c;
 pub mod convert;
 pub mod errors;
