@@ -16,6 +16,7 @@
 //! column computed from its byte offset); a construct the reader does not handle is an error,
 //! never dropped; a program loads whole or not at all.
 
+mod data_types;
 mod fbd;
 mod interface;
 mod ld;

@@ -13,6 +13,7 @@
 //! Deliberately not here (errors naming the POU): functions, a program instantiated twice,
 //! several configurations or resources, POUs with actions or transitions outside SFC.
 
+use super::data_types::DataTypes;
 use super::interface::{self, name, Interface, Known};
 use super::xml::{add_data_note, attr, error, identifier, origin, Note, Notes, Tc6, R};
 use super::{fbd, ld, st_body, textual};
@@ -38,16 +39,9 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
         add_data_note(tc6, ch, notes);
     }
     let types = tc6.child(root, "types");
-    let mut known = Known {
-        data_types: HashSet::new(),
+    let known = Known {
+        data_types: DataTypes::read(tc6, types.and_then(|t| tc6.child(t, "dataTypes")))?,
     };
-    if let Some(dts) = types.and_then(|t| tc6.child(t, "dataTypes")) {
-        for dt in tc6.children(dts, "dataType") {
-            known
-                .data_types
-                .insert(attr(dt, "name", "types/dataTypes")?);
-        }
-    }
     // The interfaces first, then the globals, then the bodies: an ST body resolves its names
     // against them all.
     let mut read = Vec::new();
@@ -75,7 +69,7 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
         .flat_map(|(_, p, _, i)| i.mapped.iter().map(|m| (Some(p.clone()), m.clone())))
         .chain(mapped_globals.into_iter().map(|m| (None, m)))
         .collect();
-    later.list.extend(interface::mapped_note(&mapped));
+    later.list.extend(interface::mapped_notes(&mapped));
     let global_types: Vec<(&str, &str)> = globals
         .iter()
         .chain(read.iter().flat_map(|r| &r.3.globals))
@@ -84,7 +78,7 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
     let mut bodies = Vec::new();
     for (pou, pname, _, iface) in &read {
         add_data_note(tc6, *pou, notes);
-        let scope = scope(iface, &global_types);
+        let scope = scope(iface, &global_types, &known);
         bodies.push(body(tc6, *pou, pname, iface, &scope, notes)?);
     }
     notes.list.extend(later.list);
@@ -135,7 +129,7 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
 
 /// The names an ST body of a POU with interface `iface` sees: its own variables and the globals
 /// it declares external (`globals`: the name and type of every global of the project).
-fn scope(iface: &Interface, globals: &[(&str, &str)]) -> st_body::Scope {
+fn scope(iface: &Interface, globals: &[(&str, &str)], known: &Known) -> st_body::Scope {
     let mut s = st_body::Scope::default();
     for v in iface
         .inputs
@@ -150,6 +144,9 @@ fn scope(iface: &Interface, globals: &[(&str, &str)]) -> st_body::Scope {
         if let Some((n, t)) = globals.iter().find(|(n, _)| n.eq_ignore_ascii_case(e)) {
             s.declare(n, t);
         }
+    }
+    for (v, _) in known.data_types.enum_values() {
+        s.constant(&v);
     }
     s
 }
@@ -291,7 +288,7 @@ fn body(
         return Err(error(
             m.origin,
             &place,
-            format!("variable `{}` is a {}, for which plc-deps has no values: strings are read only in POUs whose body `run` does not execute (ST, IL, SFC), and `{name}` has an {tag} body", m.var, m.from),
+            format!("variable `{}` is a {}, for which plc-deps has no values: strings, arrays and structures are read only in POUs whose body `run` does not execute (ST, IL, SFC), and `{name}` has an {tag} body", m.var, m.from),
         ));
     }
     Ok(match tag {

@@ -9,7 +9,7 @@
 //! everything any of its parts reads (conditions and bounds included) and writes. Names resolve
 //! case-insensitively against the POU's declarations ([`Scope`]); a read of a standard function
 //! block instance reads its first output field (`T1.Q`, `B.Q1`, `C.QU`), which the analysis
-//! counts as reading the instance. Not seen by the analysis, and named in the POU's note: writes
+//! counts as reading the instance. The values of the project's enumerations are constants. Not seen by the analysis, and named in the POU's note: writes
 //! of instances (only an instance's own box writes it), reads of user function block
 //! instances, direct addresses (`%IX0.1`). A name that is neither declared nor called (a
 //! function) is an error at its statement; so is an ST syntax error, at its line and column.
@@ -29,8 +29,16 @@ use std::collections::HashMap;
 /// the BOOL-or-not field a read of it stands for, when it has one).
 #[derive(Clone, Debug)]
 pub enum Decl {
-    Elementary { name: String, ty: String },
-    Instance { name: String, read: Option<Read> },
+    Elementary {
+        name: String,
+        ty: String,
+    },
+    Instance {
+        name: String,
+        read: Option<Read>,
+    },
+    /// A value of an enumeration data type (a constant: reading it reads no variable).
+    Constant,
 }
 
 /// The declarations an ST body sees, by lower-case name.
@@ -57,6 +65,13 @@ impl Scope {
             }
         };
         self.names.insert(name.to_ascii_lowercase(), decl);
+    }
+
+    /// Declares an enumeration value (a constant), unless a variable has its name.
+    pub fn constant(&mut self, name: &str) {
+        self.names
+            .entry(name.to_ascii_lowercase())
+            .or_insert(Decl::Constant);
     }
 
     fn get(&self, name: &str) -> Option<&Decl> {
@@ -171,6 +186,7 @@ fn resolve(
             Some(Decl::Instance { name, read: None }) => {
                 push_once(&mut unseen.instances_read, name)
             }
+            Some(Decl::Constant) => {}
             None if n.starts_with('%') => push_once(&mut unseen.addresses, n),
             None if called(n) => {}
             None => return Err(n.clone()),
@@ -181,6 +197,7 @@ fn resolve(
         match scope.get(n) {
             Some(Decl::Elementary { name, .. }) => writes.push(name.clone()),
             Some(Decl::Instance { name, .. }) => push_once(&mut unseen.instances_written, name),
+            Some(Decl::Constant) => return Err(n.clone()),
             None if n.starts_with('%') => push_once(&mut unseen.addresses, n),
             None if called(n) => {}
             None => return Err(n.clone()),
