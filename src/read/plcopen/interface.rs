@@ -40,6 +40,8 @@ pub struct Interface {
     pub externals: Vec<String>,
     /// The variables whose elementary type was mapped onto one of the model's.
     pub mapped: Vec<Mapped>,
+    /// Where the `returnType` of a function is.
+    pub returns: Option<crate::diag::Origin>,
 }
 
 /// A variable whose IEC 61131-3 elementary type the model lacks, read as one it has.
@@ -120,13 +122,8 @@ pub fn interface(tc6: Tc6, node: Option<Node>, pou: &str, known: &Known) -> R<In
         let kind = list.tag_name().name();
         let place = format!("pou {pou}, {kind}");
         match kind {
-            "returnType" => {
-                return Err(error(
-                    origin(list),
-                    &place,
-                    format!("POU `{pou}` is a function (it has a return type): functions are not supported yet"),
-                ))
-            }
+            // A function's result type (whether the POU may have one is the project's check).
+            "returnType" => out.returns = Some(origin(list)),
             "inputVars" | "outputVars" | "localVars" | "tempVars" | "globalVars" => {
                 let class = match kind {
                     "inputVars" => VarClass::Input,

@@ -10,7 +10,11 @@
 //! plc-deps runs every instance once a scan in that order, and a note says so when there are
 //! several tasks). Function block POUs become function block types.
 //!
-//! Deliberately not here (errors naming the POU): functions, a program instantiated twice,
+//! A function POU (it has a return type) is not part of the model: its calls in ST are black
+//! boxes (the ST reader reads the arguments and writes what the call assigns), and a note says
+//! its body is not read.
+//!
+//! Deliberately not here (errors naming the POU): a program instantiated twice,
 //! several configurations or resources, POUs with actions or transitions outside SFC.
 
 use super::data_types::DataTypes;
@@ -76,15 +80,23 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
         .map(|v| (v.name.as_str(), v.ty.as_str()))
         .collect();
     let mut bodies = Vec::new();
-    for (pou, pname, _, iface) in &read {
+    for (pou, pname, kind, iface) in &read {
         add_data_note(tc6, *pou, notes);
+        check_return(*pou, pname, kind, iface)?;
+        if *kind == "function" {
+            notes.push(function_note(*pou, pname));
+            bodies.push(None);
+            continue;
+        }
         let scope = scope(iface, &global_types, &known);
-        bodies.push(body(tc6, *pou, pname, iface, &scope, notes)?);
+        bodies.push(Some(body(tc6, *pou, pname, iface, &scope, notes)?));
     }
     notes.list.extend(later.list);
     let (mut programs, mut fbs) = (Vec::new(), Vec::new());
     for ((pou, pname, kind, iface), body) in read.into_iter().zip(bodies) {
         let place = format!("pou {pname}");
+        // A function is called, not instantiated: it has no body in the model.
+        let Some(body) = body else { continue };
         match kind {
             "program" => {
                 let mut vars = iface.inputs;
@@ -115,16 +127,37 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
                     body: Some(body),
                 });
             }
-            _ => {
-                return Err(error(
-                    origin(pou),
-                    &place,
-                    format!("POU `{pname}` is a function: functions are not supported yet"),
-                ))
-            }
+            // A function (its body is `None`, skipped above).
+            _ => {}
         }
     }
     assemble(root, programs, fbs, globals, order)
+}
+
+/// A function must have a return type (IEC 61131-3 6.6.2), and nothing else may have one.
+fn check_return(pou: Node, pname: &str, kind: &str, iface: &Interface) -> R<()> {
+    let place = format!("pou {pname}");
+    match (kind == "function", iface.returns) {
+        (true, Some(_)) | (false, None) => Ok(()),
+        (true, None) => Err(error(
+            origin(pou),
+            &place,
+            format!("function `{pname}` has no return type"),
+        )),
+        (false, Some(at)) => Err(error(
+            at,
+            &format!("{place}, returnType"),
+            format!("POU `{pname}` is a {kind} but has a return type: only a function has one"),
+        )),
+    }
+}
+
+/// The note of a function POU: its calls are black boxes, its body is not read.
+fn function_note(pou: Node, pname: &str) -> Note {
+    Note {
+        origin: origin(pou),
+        message: format!("pou {pname}: a function; its body is not read: a call of it in an ST body is analysed as a black box through its arguments (the inputs it is given read, the result and the outputs assigned written), and `run` does not execute it"),
+    }
 }
 
 /// The names an ST body of a POU with interface `iface` sees: its own variables and the globals

@@ -11,7 +11,9 @@
 //! block instance reads its first output field (`T1.Q`, `B.Q1`, `C.QU`), which the analysis
 //! counts as reading the instance. The values of the project's enumerations are constants. Not seen by the analysis, and named in the POU's note: writes
 //! of instances (only an instance's own box writes it), reads of user function block
-//! instances, direct addresses (`%IX0.1`). A name that is neither declared nor called (a
+//! instances, direct addresses (`%IX0.1`); a call of a function (standard, of the project or
+//! unknown) is a black box whose arguments are read and whose result and outputs are written where
+//! the call assigns them. A name that is neither declared nor called (a
 //! function) is an error at its statement; so is an ST syntax error, at its line and column.
 //!
 //! Deliberately not here: executing ST (`run` leaves the values unchanged, and the note says
@@ -95,6 +97,7 @@ struct Unseen {
     instances_written: Vec<String>,
     instances_read: Vec<String>,
     addresses: Vec<String>,
+    functions: Vec<String>,
 }
 
 fn push_once(v: &mut Vec<String>, s: &str) {
@@ -161,6 +164,10 @@ fn message(pou: &str, statements: usize, unseen: &Unseen) -> String {
         "the direct addresses it uses are not seen",
         &unseen.addresses,
     );
+    add(
+        "the functions it calls are black boxes (the arguments read, the result and outputs written where the call assigns them)",
+        &unseen.functions,
+    );
     m
 }
 
@@ -172,6 +179,11 @@ fn resolve(
     unseen: &mut Unseen,
 ) -> Result<(Vec<Read>, Vec<String>), String> {
     let called = |n: &str| a.calls.iter().any(|c| c.eq_ignore_ascii_case(n));
+    for c in &a.calls {
+        if scope.get(c).is_none() {
+            push_once(&mut unseen.functions, c);
+        }
+    }
     let mut reads = Vec::new();
     for n in &a.reads {
         match scope.get(n) {
