@@ -99,7 +99,6 @@ const OTHER_STD_FBS: &[&str] = &[
     "CTU_LINT",
     "CTU_UDINT",
     "CTU_ULINT",
-    "RTC",
 ];
 const MODEL_ELEMENTARY: &[&str] = &["BOOL", "INT", "DINT", "REAL", "TIME"];
 

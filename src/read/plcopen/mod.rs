@@ -23,6 +23,7 @@ mod ld;
 mod ld_block;
 mod ld_logic;
 mod ld_power;
+mod library;
 mod project;
 mod st_body;
 mod textual;

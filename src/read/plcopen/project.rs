@@ -20,7 +20,7 @@
 use super::data_types::DataTypes;
 use super::interface::{self, name, Interface, Known};
 use super::xml::{add_data_note, attr, error, identifier, origin, Note, Notes, Tc6, R};
-use super::{fbd, ld, st_body, textual};
+use super::{fbd, ld, library, st_body, textual};
 use crate::syntax::{
     Body, Element, ElementKind, FunctionBlock, Program, RoutineKind, Rung, Subroutine, Var,
 };
@@ -131,7 +131,54 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
             _ => {}
         }
     }
+    library_fbs(&mut fbs, &programs, &globals, notes);
     assemble(root, programs, fbs, globals, order)
+}
+
+/// Adds the stand-in type of each library block ([`super::library`]) that a variable is an
+/// instance of and the project does not define, with its note.
+fn library_fbs(
+    fbs: &mut Vec<FunctionBlock<'static>>,
+    programs: &[ProgramPou],
+    globals: &[Var<'static>],
+    notes: &mut Notes,
+) {
+    let mut uses: Vec<(String, crate::diag::Origin, Vec<String>)> = Vec::new();
+    let fb_vars = fbs.iter().flat_map(|f| {
+        f.inputs
+            .iter()
+            .chain(&f.outputs)
+            .chain(&f.vars)
+            .map(move |v| (f.name.to_string(), v))
+    });
+    let prog_vars = programs
+        .iter()
+        .flat_map(|p| p.vars.iter().map(move |v| (p.name.clone(), v)));
+    let all: Vec<(String, &Var<'static>)> = fb_vars
+        .chain(prog_vars)
+        .chain(globals.iter().map(|v| (String::new(), v)))
+        .collect();
+    for (pou, v) in all {
+        let ty = v.ty.as_str();
+        if !library::is_library_fb(ty) || fbs.iter().any(|f| f.name.as_ref() == ty) {
+            continue;
+        }
+        let who = if pou.is_empty() {
+            v.name.as_str().to_owned()
+        } else {
+            format!("{pou}.{}", v.name.as_str())
+        };
+        match uses.iter_mut().find(|u| u.0 == ty) {
+            Some(u) => u.2.push(who),
+            None => uses.push((ty.to_owned(), v.origin, vec![who])),
+        }
+    }
+    for (ty, at, who) in uses {
+        if let Some((fb, note)) = library::stand_in_fb(&ty, at, &who) {
+            fbs.push(fb);
+            notes.push(note);
+        }
+    }
 }
 
 /// A function must have a return type (IEC 61131-3 6.6.2), and nothing else may have one.
