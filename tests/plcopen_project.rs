@@ -104,3 +104,39 @@ fn a_program_is_recognised_by_its_content_not_its_extension() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// A function POU of the project: not a part of the model; an ST call of it (and of an unknown
+/// function) is a black box reading its arguments and writing what the call assigns.
+#[test]
+fn a_function_of_the_project_is_called_as_a_black_box_from_st() {
+    let func = "<pou name=\"Avg\" pouType=\"function\"><interface><returnType><REAL/></returnType><inputVars><variable name=\"a\"><type><REAL/></type></variable><variable name=\"b\"><type><REAL/></type></variable></inputVars></interface><body><ST><xhtml xmlns=\"http://www.w3.org/1999/xhtml\">Avg := (a + b) / 2.0;</xhtml></ST></body></pou>";
+    let xml = px::project_in(
+        "ST",
+        &[
+            ("inputVars", "x", "REAL"),
+            ("inputVars", "y", "REAL"),
+            ("outputVars", "m", "REAL"),
+            ("outputVars", "n", "REAL"),
+        ],
+        "<xhtml xmlns=\"http://www.w3.org/1999/xhtml\">m := Avg(x, y);\nn := Other(IN := m);</xhtml>",
+    )
+    .replace("<pous>", &format!("<pous>{func}"));
+    let (r, err) = px::report_and_warnings(&xml);
+    assert_eq!(
+        px::io(&r),
+        vec![
+            px::rung("P.st1", &["x", "y", "m"], &["m"]),
+            px::rung("P.st2", &["m", "n"], &["n"]),
+        ]
+    );
+    let f = px::line_col(&xml, "<pou name=\"Avg\"");
+    assert!(err.contains(&format!("<stdin>:{f}: pou Avg: a function; its body is not read: a call of it in an ST body is analysed as a black box through its arguments")), "{err}");
+    assert!(err.contains("; the functions it calls are black boxes (the arguments read, the result and outputs written where the call assigns them): Avg, Other"), "{err}");
+    let no_return = xml.replace("<returnType><REAL/></returnType>", "");
+    let out = common::cli::run_stdin(&["report", "-"], no_return.as_bytes());
+    let e = common::cli::error_line(&out, "function without a return type");
+    assert_eq!(
+        e,
+        format!("error: <stdin>:{f}: at pou Avg: function `Avg` has no return type")
+    );
+}

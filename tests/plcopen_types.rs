@@ -76,7 +76,7 @@ fn a_string_is_refused_where_run_executes_the_body_and_read_where_it_does_not() 
     let xml = with_types("LD", &vars, &ld());
     let e = error_line(&run_stdin(&["report", "-"], xml.as_bytes()), "string in LD");
     let at = line_col(&xml, "<variable name=\"msg\"");
-    assert_eq!(e, format!("error: <stdin>:{at}: at pou P: variable `msg` is a STRING, for which plc-deps has no values: strings are read only in POUs whose body `run` does not execute (ST, IL, SFC), and `P` has an LD body"));
+    assert_eq!(e, format!("error: <stdin>:{at}: at pou P: variable `msg` is a STRING, for which plc-deps has no values: strings, arrays and structures are read only in POUs whose body `run` does not execute (ST, IL, SFC), and `P` has an LD body"));
     let st = with_types(
         "ST",
         &vars,

@@ -10,18 +10,23 @@
 //! The elementary types the model lacks (SINT, WORD, LREAL, STRING …) are read as one it has
 //! ([`MAPPED`]), and each such variable is recorded ([`Mapped`]) for the POU's note.
 //!
-//! Deliberately not here: user data types, arrays, structured initial values and `VAR_IN_OUT`
+//! A user data type (or a library one, [`super::data_types`]) is read as its base: an alias or
+//! subrange as its elementary type, an enumeration as INT, an array or a structure (named or
+//! declared in place) as a whole variable without a value; each such variable is recorded
+//! too, with the type's description.
+//!
+//! Deliberately not here: structured initial values of elementary variables and `VAR_IN_OUT`
 //! — each an error naming the variable, until the model has them.
 
+use super::data_types::{Aggregate, Base, DataType, DataTypes};
 use super::xml::{error, identifier, origin, Tc6, R};
 use crate::syntax::{Located, Name, Operand, Scalar, Var, VarClass};
 use roxmltree::Node;
 use std::borrow::Cow;
-use std::collections::HashSet;
 
 /// The names of the project's own data types, function blocks and functions, for messages.
-pub struct Known<'d> {
-    pub data_types: HashSet<&'d str>,
+pub struct Known {
+    pub data_types: DataTypes,
 }
 
 /// The lists of an interface, in the order the standard's keywords name them.
@@ -35,6 +40,8 @@ pub struct Interface {
     pub externals: Vec<String>,
     /// The variables whose elementary type was mapped onto one of the model's.
     pub mapped: Vec<Mapped>,
+    /// Where the `returnType` of a function is.
+    pub returns: Option<crate::diag::Origin>,
 }
 
 /// A variable whose IEC 61131-3 elementary type the model lacks, read as one it has.
@@ -44,8 +51,11 @@ pub struct Mapped {
     pub origin: crate::diag::Origin,
     pub from: String,
     pub to: &'static str,
-    /// A string type: the model has no value for it (the variable stands in as a DINT 0).
+    /// A string, array or structure: the model has no value for it (the variable stands in as
+    /// a DINT 0).
     pub text: bool,
+    /// The data type's description when `from` is a derived type ([`DataType::describe`]).
+    pub via: Option<String>,
 }
 
 /// The elementary types of IEC 61131-3 (6.4.2, Table 10) the model lacks, and the model's type
@@ -89,9 +99,13 @@ const OTHER_STD_FBS: &[&str] = &[
     "CTU_LINT",
     "CTU_UDINT",
     "CTU_ULINT",
-    "RTC",
 ];
 const MODEL_ELEMENTARY: &[&str] = &["BOOL", "INT", "DINT", "REAL", "TIME"];
+
+/// True when a TC6 type element's tag is an elementary type (the model's or a mapped one).
+pub fn is_elementary_tag(tag: &str) -> bool {
+    MODEL_ELEMENTARY.contains(&tag) || MAPPED.iter().any(|(f, _)| *f == tag)
+}
 
 /// True when a declared type (as the reader writes it into the syntax) is elementary, not a
 /// function block type.
@@ -107,13 +121,8 @@ pub fn interface(tc6: Tc6, node: Option<Node>, pou: &str, known: &Known) -> R<In
         let kind = list.tag_name().name();
         let place = format!("pou {pou}, {kind}");
         match kind {
-            "returnType" => {
-                return Err(error(
-                    origin(list),
-                    &place,
-                    format!("POU `{pou}` is a function (it has a return type): functions are not supported yet"),
-                ))
-            }
+            // A function's result type (whether the POU may have one is the project's check).
+            "returnType" => out.returns = Some(origin(list)),
             "inputVars" | "outputVars" | "localVars" | "tempVars" | "globalVars" => {
                 let class = match kind {
                     "inputVars" => VarClass::Input,
@@ -189,31 +198,55 @@ fn variable(
     let ty_node = tc6
         .child(v, "type")
         .ok_or_else(|| error(origin(v), &place, format!("variable `{name}` has no type")))?;
-    let (mut ty, is_fb) = type_name(tc6, ty_node, &name, &place, known)?;
-    let mut text = false;
+    let (mut ty, is_fb, data) = match type_name(tc6, ty_node, &name, &place, known)? {
+        Ty::Elementary(t) => (t, false, None),
+        Ty::Fb(t) => (t, true, None),
+        Ty::Data(d) => (data_base(&d), false, Some(d)),
+    };
+    let mut text = data
+        .as_ref()
+        .is_some_and(|d| matches!(d.base, Base::Whole(_)));
     if let Some(&(from, to)) = MAPPED.iter().find(|(f, _)| *f == ty) {
-        text = from.eq_ignore_ascii_case("string") || from.eq_ignore_ascii_case("wstring");
+        text |= from.eq_ignore_ascii_case("string") || from.eq_ignore_ascii_case("wstring");
+        ty = to.to_owned();
+        if data.is_none() {
+            mapped.push(Mapped {
+                var: name.clone(),
+                origin: origin(v),
+                from: from.to_ascii_uppercase(),
+                to,
+                text,
+                via: None,
+            });
+        }
+    }
+    if let Some(d) = &data {
         mapped.push(Mapped {
             var: name.clone(),
             origin: origin(v),
-            from: from.to_ascii_uppercase(),
-            to,
+            from: d.name.clone(),
+            to: if text { "DINT" } else { model_type(&ty) },
             text,
+            via: Some(d.describe()),
         });
-        ty = to.to_owned();
     }
-    let init = match tc6.child(v, "initialValue") {
-        // A string's initial value has no value in the model (the stand-in starts at 0).
-        Some(_) if text => None,
-        Some(iv) if is_fb => {
+    let init = match (tc6.child(v, "initialValue"), &data) {
+        // A string's, array's or structure's initial value has no value in the model (the
+        // stand-in starts at 0).
+        (Some(_), _) if text => None,
+        (Some(iv), _) if is_fb => {
             return Err(error(
                 origin(iv),
                 &place,
                 format!("function block instance `{name}` has an initial value"),
             ))
         }
-        Some(iv) => Some(Box::new(initial_value(tc6, iv, &name, &place)?)),
-        None => None,
+        (Some(iv), Some(d)) if matches!(d.base, Base::Enum(_)) => {
+            Some(Box::new(enum_initial(tc6, iv, d, &name, &place)?))
+        }
+        (Some(iv), _) => Some(Box::new(initial_value(tc6, iv, &name, &place)?)),
+        (None, Some(d)) if !text => type_initial(d, &name, &place)?.map(Box::new),
+        (None, _) => None,
     };
     let at = origin(v);
     Ok(Var {
@@ -235,8 +268,36 @@ fn variable(
     })
 }
 
-/// The type's name and whether it is (or may be) a function block type.
-fn type_name(tc6: Tc6, ty: Node, var: &str, place: &str, known: &Known) -> R<(String, bool)> {
+/// A variable's declared type.
+enum Ty {
+    /// An elementary type as TC6 writes it.
+    Elementary(String),
+    /// A function block type (the project's or a standard one).
+    Fb(String),
+    /// A data type of the project or a library, or an array or structure declared in place.
+    Data(DataType),
+}
+
+/// The TC6 name of the elementary type a data type is read as (an enumeration as INT; an array
+/// or structure as `string`, the stand-in without a value).
+fn data_base(d: &DataType) -> String {
+    match &d.base {
+        Base::Elementary(t) => t.clone(),
+        Base::Enum(_) => "INT".to_owned(),
+        Base::Whole(_) => "string".to_owned(),
+    }
+}
+
+/// The model's type name as a static string.
+fn model_type(ty: &str) -> &'static str {
+    MODEL_ELEMENTARY
+        .iter()
+        .find(|t| **t == ty)
+        .copied()
+        .unwrap_or("DINT")
+}
+
+fn type_name(tc6: Tc6, ty: Node, var: &str, place: &str, known: &Known) -> R<Ty> {
     let Some(t) = tc6.elements(ty).next() else {
         return Err(error(
             origin(ty),
@@ -245,24 +306,32 @@ fn type_name(tc6: Tc6, ty: Node, var: &str, place: &str, known: &Known) -> R<(St
         ));
     };
     let tag = t.tag_name().name();
-    if MODEL_ELEMENTARY.contains(&tag) || MAPPED.iter().any(|(f, _)| *f == tag) {
-        return Ok((tag.to_owned(), false));
+    if is_elementary_tag(tag) {
+        return Ok(Ty::Elementary(tag.to_owned()));
     }
-    if tag != "derived" {
-        return Err(error(
+    let whole = |a: Aggregate, n: &str| {
+        Ok(Ty::Data(DataType {
+            name: n.to_owned(),
+            base: Base::Whole(a),
+            range: None,
+            init: None,
+            library: None,
+        }))
+    };
+    match tag {
+        "array" => return whole(Aggregate::Array, "ARRAY"),
+        "struct" => return whole(Aggregate::Structure, "STRUCT"),
+        "derived" => {}
+        _ => return Err(error(
             origin(t),
             place,
-            format!("type {tag} of variable `{var}` is not supported yet (supported: {}, the other elementary types of IEC 61131-3, and function block types)", MODEL_ELEMENTARY.join(", ")),
-        ));
+            format!("type {tag} of variable `{var}` is not supported yet (supported: {}, the other elementary types of IEC 61131-3, data types, arrays, structures and function block types)", MODEL_ELEMENTARY.join(", ")),
+        )),
     }
     let name = super::xml::attr(t, "name", place)?;
     let name = identifier(name, "type", t, place)?;
-    if known.data_types.contains(name.as_str()) {
-        return Err(error(
-            origin(t),
-            place,
-            format!("variable `{var}` has the user data type `{name}`: data types (types/dataTypes) are not supported yet"),
-        ));
+    if let Some(d) = known.data_types.get(&name) {
+        return Ok(Ty::Data(d));
     }
     if OTHER_STD_FBS.contains(&name.as_str()) {
         return Err(error(
@@ -271,7 +340,61 @@ fn type_name(tc6: Tc6, ty: Node, var: &str, place: &str, known: &Known) -> R<(St
             format!("variable `{var}` is an instance of the standard function block {name}, which is not supported yet (supported: {})", MODEL_FBS.join(", ")),
         ));
     }
-    Ok((name, true))
+    Ok(Ty::Fb(name))
+}
+
+/// The initial value of enumeration variable `var`: one of its type's values.
+fn enum_initial(tc6: Tc6, iv: Node, d: &DataType, var: &str, place: &str) -> R<Operand<'static>> {
+    let simple = tc6.child(iv, "simpleValue").ok_or_else(|| {
+        error(
+            origin(iv),
+            place,
+            format!("the initial value of `{var}` is not a simple value"),
+        )
+    })?;
+    let text = super::xml::attr(simple, "value", place)?;
+    enum_operand(d, text, origin(simple), var, place)
+}
+
+fn enum_operand(
+    d: &DataType,
+    text: &str,
+    at: crate::diag::Origin,
+    var: &str,
+    place: &str,
+) -> R<Operand<'static>> {
+    let i = DataTypes::enum_value(d, text).ok_or_else(|| {
+        error(
+            at,
+            place,
+            format!(
+                "initial value `{text}` of `{var}` is not a value of enumeration `{}`",
+                d.name
+            ),
+        )
+    })?;
+    Ok(Located {
+        value: Scalar::Number(i.into()),
+        origin: at,
+    })
+}
+
+/// The initial value a variable of data type `d` gets from its type (IEC 61131-3 6.4.4), if any.
+fn type_initial(d: &DataType, var: &str, place: &str) -> R<Option<Operand<'static>>> {
+    let Some((text, at)) = &d.init else {
+        return Ok(None);
+    };
+    if matches!(d.base, Base::Enum(_)) {
+        return enum_operand(d, text, *at, var, place).map(Some);
+    }
+    let value = literal(text).ok_or_else(|| {
+        error(
+            *at,
+            place,
+            format!("initial value `{text}` of data type `{}` is not a boolean, a number or a TIME literal", d.name),
+        )
+    })?;
+    Ok(Some(Located { value, origin: *at }))
 }
 
 /// `initialValue/simpleValue@value` as an operand (a boolean in any case, a number, a TIME
@@ -352,6 +475,67 @@ pub fn name(s: impl Into<String>, at: crate::diag::Origin) -> Name<'static> {
     }
 }
 
+/// The notes of a file whose variables' types were mapped (`mapped`: with the POU, or `None`
+/// for a global): one for the elementary types, one for the data types.
+pub fn mapped_notes(mapped: &[(Option<String>, Mapped)]) -> Vec<super::xml::Note> {
+    let (derived, elementary): (Vec<_>, Vec<_>) =
+        mapped.iter().cloned().partition(|(_, m)| m.via.is_some());
+    mapped_note(&elementary)
+        .into_iter()
+        .chain(derived_note(&derived))
+        .collect()
+}
+
+fn qualified(pou: &Option<String>, m: &Mapped) -> String {
+    pou.as_ref()
+        .map_or(m.var.clone(), |p| format!("{p}.{}", m.var))
+}
+
+/// The one note of the variables whose type is a data type.
+fn derived_note(mapped: &[(Option<String>, Mapped)]) -> Option<super::xml::Note> {
+    let first = mapped.first()?;
+    // By type, in the order of their first variable.
+    let mut groups: Vec<(&Mapped, Vec<String>)> = Vec::new();
+    for (pou, m) in mapped {
+        match groups
+            .iter_mut()
+            .find(|(g, _)| g.from == m.from && g.via == m.via)
+        {
+            Some((_, vars)) => vars.push(qualified(pou, m)),
+            None => groups.push((m, vec![qualified(pou, m)])),
+        }
+    }
+    let list: Vec<String> = groups
+        .iter()
+        .map(|(m, vars)| {
+            format!(
+                "{} → {} ({}): {}",
+                m.from,
+                m.to,
+                m.via.as_deref().unwrap_or(""),
+                vars.join(", ")
+            )
+        })
+        .collect();
+    Some(super::xml::Note {
+        origin: first.1.origin,
+        message: format!("data types are read as the model's types (IEC 61131-3 6.4.4): {}; `run` does not check subranges, and an array or structure is one whole variable (a read or write of any element reads or writes it) with no value", list.join("; ")),
+    })
+}
+
+/// The one note of the variables whose elementary type was mapped.
+fn mapped_note(mapped: &[(Option<String>, Mapped)]) -> Option<super::xml::Note> {
+    let first = mapped.first()?;
+    let list: Vec<String> = mapped
+        .iter()
+        .map(|(pou, m)| format!("{} {} → {}", qualified(pou, m), m.from, m.to))
+        .collect();
+    Some(super::xml::Note {
+        origin: first.1.origin,
+        message: format!("elementary types the model lacks are read as one it has: {}; `run` computes them at the model's width (INT 16-bit, DINT 32-bit, signed; REAL 32-bit), so it differs from a PLC where a value leaves the declared type's range or needs LREAL precision, and a string has no value (it stands in as a DINT 0)", list.join(", ")),
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -378,23 +562,4 @@ mod tests {
         );
         assert_eq!(literal("FOO#5"), None);
     }
-}
-
-/// The one note of a file whose variables' types were mapped (`mapped`: with the POU, or
-/// `None` for a global), or none.
-pub fn mapped_note(mapped: &[(Option<String>, Mapped)]) -> Option<super::xml::Note> {
-    let first = mapped.first()?;
-    let list: Vec<String> = mapped
-        .iter()
-        .map(|(pou, m)| {
-            let name = pou
-                .as_ref()
-                .map_or(m.var.clone(), |p| format!("{p}.{}", m.var));
-            format!("{name} {} → {}", m.from, m.to)
-        })
-        .collect();
-    Some(super::xml::Note {
-        origin: first.1.origin,
-        message: format!("elementary types the model lacks are read as one it has: {}; `run` computes them at the model's width (INT 16-bit, DINT 32-bit, signed; REAL 32-bit), so it differs from a PLC where a value leaves the declared type's range or needs LREAL precision, and a string has no value (it stands in as a DINT 0)", list.join(", ")),
-    })
 }

@@ -10,12 +10,17 @@
 //! plc-deps runs every instance once a scan in that order, and a note says so when there are
 //! several tasks). Function block POUs become function block types.
 //!
-//! Deliberately not here (errors naming the POU): functions, a program instantiated twice,
+//! A function POU (it has a return type) is not part of the model: its calls in ST are black
+//! boxes (the ST reader reads the arguments and writes what the call assigns), and a note says
+//! its body is not read.
+//!
+//! Deliberately not here (errors naming the POU): a program instantiated twice,
 //! several configurations or resources, POUs with actions or transitions outside SFC.
 
+use super::data_types::DataTypes;
 use super::interface::{self, name, Interface, Known};
 use super::xml::{add_data_note, attr, error, identifier, origin, Note, Notes, Tc6, R};
-use super::{fbd, ld, st_body, textual};
+use super::{fbd, ld, library, st_body, textual};
 use crate::syntax::{
     Body, Element, ElementKind, FunctionBlock, Program, RoutineKind, Rung, Subroutine, Var,
 };
@@ -38,16 +43,9 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
         add_data_note(tc6, ch, notes);
     }
     let types = tc6.child(root, "types");
-    let mut known = Known {
-        data_types: HashSet::new(),
+    let known = Known {
+        data_types: DataTypes::read(tc6, types.and_then(|t| tc6.child(t, "dataTypes")))?,
     };
-    if let Some(dts) = types.and_then(|t| tc6.child(t, "dataTypes")) {
-        for dt in tc6.children(dts, "dataType") {
-            known
-                .data_types
-                .insert(attr(dt, "name", "types/dataTypes")?);
-        }
-    }
     // The interfaces first, then the globals, then the bodies: an ST body resolves its names
     // against them all.
     let mut read = Vec::new();
@@ -75,22 +73,30 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
         .flat_map(|(_, p, _, i)| i.mapped.iter().map(|m| (Some(p.clone()), m.clone())))
         .chain(mapped_globals.into_iter().map(|m| (None, m)))
         .collect();
-    later.list.extend(interface::mapped_note(&mapped));
+    later.list.extend(interface::mapped_notes(&mapped));
     let global_types: Vec<(&str, &str)> = globals
         .iter()
         .chain(read.iter().flat_map(|r| &r.3.globals))
         .map(|v| (v.name.as_str(), v.ty.as_str()))
         .collect();
     let mut bodies = Vec::new();
-    for (pou, pname, _, iface) in &read {
+    for (pou, pname, kind, iface) in &read {
         add_data_note(tc6, *pou, notes);
-        let scope = scope(iface, &global_types);
-        bodies.push(body(tc6, *pou, pname, iface, &scope, notes)?);
+        check_return(*pou, pname, kind, iface)?;
+        if *kind == "function" {
+            notes.push(function_note(*pou, pname));
+            bodies.push(None);
+            continue;
+        }
+        let scope = scope(iface, &global_types, &known);
+        bodies.push(Some(body(tc6, *pou, pname, iface, &scope, notes)?));
     }
     notes.list.extend(later.list);
     let (mut programs, mut fbs) = (Vec::new(), Vec::new());
     for ((pou, pname, kind, iface), body) in read.into_iter().zip(bodies) {
         let place = format!("pou {pname}");
+        // A function is called, not instantiated: it has no body in the model.
+        let Some(body) = body else { continue };
         match kind {
             "program" => {
                 let mut vars = iface.inputs;
@@ -121,21 +127,89 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
                     body: Some(body),
                 });
             }
-            _ => {
-                return Err(error(
-                    origin(pou),
-                    &place,
-                    format!("POU `{pname}` is a function: functions are not supported yet"),
-                ))
-            }
+            // A function (its body is `None`, skipped above).
+            _ => {}
         }
     }
+    library_fbs(&mut fbs, &programs, &globals, notes);
     assemble(root, programs, fbs, globals, order)
+}
+
+/// Adds the stand-in type of each library block ([`super::library`]) that a variable is an
+/// instance of and the project does not define, with its note.
+fn library_fbs(
+    fbs: &mut Vec<FunctionBlock<'static>>,
+    programs: &[ProgramPou],
+    globals: &[Var<'static>],
+    notes: &mut Notes,
+) {
+    let mut uses: Vec<(String, crate::diag::Origin, Vec<String>)> = Vec::new();
+    let fb_vars = fbs.iter().flat_map(|f| {
+        f.inputs
+            .iter()
+            .chain(&f.outputs)
+            .chain(&f.vars)
+            .map(move |v| (f.name.to_string(), v))
+    });
+    let prog_vars = programs
+        .iter()
+        .flat_map(|p| p.vars.iter().map(move |v| (p.name.clone(), v)));
+    let all: Vec<(String, &Var<'static>)> = fb_vars
+        .chain(prog_vars)
+        .chain(globals.iter().map(|v| (String::new(), v)))
+        .collect();
+    for (pou, v) in all {
+        let ty = v.ty.as_str();
+        if !library::is_library_fb(ty) || fbs.iter().any(|f| f.name.as_ref() == ty) {
+            continue;
+        }
+        let who = if pou.is_empty() {
+            v.name.as_str().to_owned()
+        } else {
+            format!("{pou}.{}", v.name.as_str())
+        };
+        match uses.iter_mut().find(|u| u.0 == ty) {
+            Some(u) => u.2.push(who),
+            None => uses.push((ty.to_owned(), v.origin, vec![who])),
+        }
+    }
+    for (ty, at, who) in uses {
+        if let Some((fb, note)) = library::stand_in_fb(&ty, at, &who) {
+            fbs.push(fb);
+            notes.push(note);
+        }
+    }
+}
+
+/// A function must have a return type (IEC 61131-3 6.6.2), and nothing else may have one.
+fn check_return(pou: Node, pname: &str, kind: &str, iface: &Interface) -> R<()> {
+    let place = format!("pou {pname}");
+    match (kind == "function", iface.returns) {
+        (true, Some(_)) | (false, None) => Ok(()),
+        (true, None) => Err(error(
+            origin(pou),
+            &place,
+            format!("function `{pname}` has no return type"),
+        )),
+        (false, Some(at)) => Err(error(
+            at,
+            &format!("{place}, returnType"),
+            format!("POU `{pname}` is a {kind} but has a return type: only a function has one"),
+        )),
+    }
+}
+
+/// The note of a function POU: its calls are black boxes, its body is not read.
+fn function_note(pou: Node, pname: &str) -> Note {
+    Note {
+        origin: origin(pou),
+        message: format!("pou {pname}: a function; its body is not read: a call of it in an ST body is analysed as a black box through its arguments (the inputs it is given read, the result and the outputs assigned written), and `run` does not execute it"),
+    }
 }
 
 /// The names an ST body of a POU with interface `iface` sees: its own variables and the globals
 /// it declares external (`globals`: the name and type of every global of the project).
-fn scope(iface: &Interface, globals: &[(&str, &str)]) -> st_body::Scope {
+fn scope(iface: &Interface, globals: &[(&str, &str)], known: &Known) -> st_body::Scope {
     let mut s = st_body::Scope::default();
     for v in iface
         .inputs
@@ -150,6 +224,9 @@ fn scope(iface: &Interface, globals: &[(&str, &str)]) -> st_body::Scope {
         if let Some((n, t)) = globals.iter().find(|(n, _)| n.eq_ignore_ascii_case(e)) {
             s.declare(n, t);
         }
+    }
+    for (v, _) in known.data_types.enum_values() {
+        s.constant(&v);
     }
     s
 }
@@ -291,7 +368,7 @@ fn body(
         return Err(error(
             m.origin,
             &place,
-            format!("variable `{}` is a {}, for which plc-deps has no values: strings are read only in POUs whose body `run` does not execute (ST, IL, SFC), and `{name}` has an {tag} body", m.var, m.from),
+            format!("variable `{}` is a {}, for which plc-deps has no values: strings, arrays and structures are read only in POUs whose body `run` does not execute (ST, IL, SFC), and `{name}` has an {tag} body", m.var, m.from),
         ));
     }
     Ok(match tag {

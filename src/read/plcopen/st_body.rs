@@ -9,9 +9,11 @@
 //! everything any of its parts reads (conditions and bounds included) and writes. Names resolve
 //! case-insensitively against the POU's declarations ([`Scope`]); a read of a standard function
 //! block instance reads its first output field (`T1.Q`, `B.Q1`, `C.QU`), which the analysis
-//! counts as reading the instance. Not seen by the analysis, and named in the POU's note: writes
+//! counts as reading the instance. The values of the project's enumerations are constants. Not seen by the analysis, and named in the POU's note: writes
 //! of instances (only an instance's own box writes it), reads of user function block
-//! instances, direct addresses (`%IX0.1`). A name that is neither declared nor called (a
+//! instances, direct addresses (`%IX0.1`); a call of a function (standard, of the project or
+//! unknown) is a black box whose arguments are read and whose result and outputs are written where
+//! the call assigns them. A name that is neither declared nor called (a
 //! function) is an error at its statement; so is an ST syntax error, at its line and column.
 //!
 //! Deliberately not here: executing ST (`run` leaves the values unchanged, and the note says
@@ -29,8 +31,16 @@ use std::collections::HashMap;
 /// the BOOL-or-not field a read of it stands for, when it has one).
 #[derive(Clone, Debug)]
 pub enum Decl {
-    Elementary { name: String, ty: String },
-    Instance { name: String, read: Option<Read> },
+    Elementary {
+        name: String,
+        ty: String,
+    },
+    Instance {
+        name: String,
+        read: Option<Read>,
+    },
+    /// A value of an enumeration data type (a constant: reading it reads no variable).
+    Constant,
 }
 
 /// The declarations an ST body sees, by lower-case name.
@@ -59,6 +69,13 @@ impl Scope {
         self.names.insert(name.to_ascii_lowercase(), decl);
     }
 
+    /// Declares an enumeration value (a constant), unless a variable has its name.
+    pub fn constant(&mut self, name: &str) {
+        self.names
+            .entry(name.to_ascii_lowercase())
+            .or_insert(Decl::Constant);
+    }
+
     fn get(&self, name: &str) -> Option<&Decl> {
         self.names.get(&name.to_ascii_lowercase())
     }
@@ -80,6 +97,7 @@ struct Unseen {
     instances_written: Vec<String>,
     instances_read: Vec<String>,
     addresses: Vec<String>,
+    functions: Vec<String>,
 }
 
 fn push_once(v: &mut Vec<String>, s: &str) {
@@ -146,6 +164,10 @@ fn message(pou: &str, statements: usize, unseen: &Unseen) -> String {
         "the direct addresses it uses are not seen",
         &unseen.addresses,
     );
+    add(
+        "the functions it calls are black boxes (the arguments read, the result and outputs written where the call assigns them)",
+        &unseen.functions,
+    );
     m
 }
 
@@ -157,6 +179,11 @@ fn resolve(
     unseen: &mut Unseen,
 ) -> Result<(Vec<Read>, Vec<String>), String> {
     let called = |n: &str| a.calls.iter().any(|c| c.eq_ignore_ascii_case(n));
+    for c in &a.calls {
+        if scope.get(c).is_none() {
+            push_once(&mut unseen.functions, c);
+        }
+    }
     let mut reads = Vec::new();
     for n in &a.reads {
         match scope.get(n) {
@@ -171,6 +198,7 @@ fn resolve(
             Some(Decl::Instance { name, read: None }) => {
                 push_once(&mut unseen.instances_read, name)
             }
+            Some(Decl::Constant) => {}
             None if n.starts_with('%') => push_once(&mut unseen.addresses, n),
             None if called(n) => {}
             None => return Err(n.clone()),
@@ -181,6 +209,7 @@ fn resolve(
         match scope.get(n) {
             Some(Decl::Elementary { name, .. }) => writes.push(name.clone()),
             Some(Decl::Instance { name, .. }) => push_once(&mut unseen.instances_written, name),
+            Some(Decl::Constant) => return Err(n.clone()),
             None if n.starts_with('%') => push_once(&mut unseen.addresses, n),
             None if called(n) => {}
             None => return Err(n.clone()),
