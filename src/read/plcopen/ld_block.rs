@@ -9,7 +9,9 @@
 //! fed by `inVariable`s (a variable or a constant); the result of ADD … MOD and MOVE goes to the
 //! `outVariable` wired to `OUT` (exactly one). A BOOL data input (`R`/`LD` of a counter, `R`/`R1`
 //! of SR/RS, `CD`/`R`/`LD` of CTUD) may also be a single contact on the rail (its variable is
-//! the operand).
+//! the operand). The extensible comparisons (IEC 61131-3 Table 31: `IN1 op IN2 AND IN2 op IN3
+//! …`) become one compare per neighbouring pair in series; the extensible ADD and MUL (Table 29)
+//! one arithmetic box per step, each writing OUT (so an `INk`, k ≥ 3, may not read OUT).
 //!
 //! Deliberately not here (each an error naming the block and its localId): other block types
 //! (standard ones the model lacks, user function blocks and functions in LD), EN/ENO on timers
@@ -83,6 +85,22 @@ impl Spec {
     }
 }
 
+impl Spec {
+    /// True when `pin` is an input `IN3`, `IN4` … of an extensible block (IEC 61131-3 Tables 29
+    /// and 31: ADD, MUL and the comparisons take any number of inputs).
+    fn extends(&self, pin: &str) -> bool {
+        let extensible = matches!(
+            self,
+            Spec::Compare(_) | Spec::Arith(ArithOp::Add | ArithOp::Mul)
+        );
+        extensible
+            && pin
+                .strip_prefix("IN")
+                .and_then(|k| k.parse::<u32>().ok())
+                .is_some_and(|k| k >= 3 && pin == format!("IN{k}"))
+    }
+}
+
 const SUPPORTED: &str = "TON, TOF, TP, CTU, CTD, SR, RS, R_TRIG, F_TRIG, CTUD, ADD, SUB, MUL, DIV, MOD, MOVE, EQ, NE, LT, LE, GT, GE, AND, OR, XOR, NOT";
 
 /// True when out variable `e` is the result of an ADD … MOD or MOVE block (part of its box).
@@ -122,7 +140,7 @@ pub fn power_out(p: &mut Power, e: ElemId, pin: Option<&str>) -> R<Path> {
     let (power_in, data, power_out, result) = spec.pins();
     let pin_names: Vec<&str> = el.inputs.iter().filter_map(|p| p.name).collect();
     for name in &pin_names {
-        if *name != power_in && !data.contains(name) {
+        if *name != power_in && !data.contains(name) && !spec.extends(name) {
             return Err(error(
                 origin(node),
                 &here,
@@ -151,7 +169,7 @@ pub fn power_out(p: &mut Power, e: ElemId, pin: Option<&str>) -> R<Path> {
             ));
         }
     }
-    let kind = box_kind(p, e, &spec, ty)?;
+    let kinds = box_kinds(p, e, &spec, ty)?;
     let k = el.inputs.iter().position(|x| x.name == Some(power_in));
     let mut path = match k {
         Some(k) if !el.inputs[k].sources.is_empty() => p.input(e, k)?,
@@ -167,14 +185,81 @@ pub fn power_out(p: &mut Power, e: ElemId, pin: Option<&str>) -> R<Path> {
             ))
         }
     };
-    path.push(Item {
+    path.extend(kinds.into_iter().map(|kind| Item {
         key: Key::Elem(e),
         element: Element {
             origin: origin(node),
             kind,
         },
-    });
+    }));
     Ok(path)
+}
+
+/// The elements of block `e`: one, or for an extensible block with `IN3` … one per step.
+fn box_kinds(p: &mut Power, e: ElemId, spec: &Spec, ty: &str) -> R<Vec<ElementKind<'static>>> {
+    let extra = extended_pins(p, e, spec);
+    match *spec {
+        Spec::Compare(op) if !extra.is_empty() => {
+            // IN1 op IN2 AND IN2 op IN3 …: a series of compares (IEC 61131-3 Table 31).
+            let mut pins = vec!["IN1".to_string(), "IN2".to_string()];
+            pins.extend(extra);
+            let mut ops = Vec::with_capacity(pins.len());
+            for x in &pins {
+                ops.push(operand(p, e, x, ty)?);
+            }
+            Ok(ops
+                .windows(2)
+                .map(|w| {
+                    ElementKind::Compare(Box::new(Compare {
+                        op,
+                        a: w[0].clone(),
+                        b: w[1].clone(),
+                    }))
+                })
+                .collect())
+        }
+        Spec::Arith(op) if !extra.is_empty() => {
+            // OUT := IN1 op IN2 op IN3 …, left to right: OUT := IN1 op IN2, then OUT := OUT op IN3 …
+            let out = result(p, e, ty)?;
+            let mut kinds = vec![ElementKind::Arith(Box::new(Arith {
+                op,
+                a: operand(p, e, "IN1", ty)?,
+                b: operand(p, e, "IN2", ty)?,
+                out: out.clone(),
+            }))];
+            for x in &extra {
+                let b = operand(p, e, x, ty)?;
+                if matches!(&b.value, Scalar::Str(v) if v == &out.value) {
+                    let el = p.g.get(e);
+                    return Err(error(
+                        b.origin,
+                        &p.at(e),
+                        format!("input {x} of {ty} (localId {}) reads `{}`, which its OUT writes: plc-deps computes an extensible {ty} step by step in OUT, so it cannot read OUT after IN2", el.local_id, out.value),
+                    ));
+                }
+                kinds.push(ElementKind::Arith(Box::new(Arith {
+                    op,
+                    a: Located {
+                        value: Scalar::Str(out.value.clone()),
+                        origin: out.origin,
+                    },
+                    b,
+                    out: out.clone(),
+                })));
+            }
+            Ok(kinds)
+        }
+        _ => Ok(vec![box_kind(p, e, spec, ty)?]),
+    }
+}
+
+/// The inputs `IN3`, `IN4` … of extensible block `e`, in order; an empty list for others.
+fn extended_pins(p: &Power, e: ElemId, spec: &Spec) -> Vec<String> {
+    let names: Vec<&str> = p.g.get(e).inputs.iter().filter_map(|x| x.name).collect();
+    (3..)
+        .map(|k| format!("IN{k}"))
+        .take_while(|n| spec.extends(n) && names.contains(&n.as_str()))
+        .collect()
 }
 
 fn box_kind(p: &mut Power, e: ElemId, spec: &Spec, ty: &str) -> R<ElementKind<'static>> {

@@ -1,0 +1,177 @@
+//! Block pins in hand-written PLCopen TC6 LD rungs beyond one wire per pin and the power output:
+//! extensible comparisons and ADD/MUL (`IN3` …), outputs other than the power output read after
+//! the box, and several wires into one data pin (their OR), each with the rungs the report shows
+//! and a run worked out by hand from the IEC 61131-3 meaning of the diagram.
+
+mod common;
+#[path = "plcopen_common/mod.rs"]
+mod px;
+
+use common::cli::{error_line, run_stdin};
+use px::{block, coil, in_var, io, project, rail, report, run_inputs, rung, var_in};
+use serde_json::json;
+
+/// A coil fed by output `pin` of block `from`.
+fn coil_on(id: u32, var: &str, from: u32, pin: &str) -> String {
+    coil(id, var, &[], "").replace(
+        "<connectionPointIn></connectionPointIn>",
+        &format!("<connectionPointIn><connection refLocalId=\"{from}\" formalParameter=\"{pin}\"/></connectionPointIn>"),
+    )
+}
+
+/// The outputs after one scan with the inputs of the CSV row.
+fn outputs(tag: &str, xml: &str, header: &str, row: &str) -> serde_json::Value {
+    run_inputs(tag, xml, &format!("{header}\n{row}\n"), &[])["outputs"].clone()
+}
+
+/// a, b, c → EQ(a, b, c) → Same; GT(a, b, c) → Down; ADD(a, b, c) → S; MUL(a, b, c) → P.
+fn extensible() -> String {
+    // Each block with in variables of its own (localIds 10 * id + 1 …), so each is a rung.
+    let three = |id: u32, ty: &str, outs: &[&str]| {
+        let v = 10 * id;
+        [
+            in_var(v + 1, "a"),
+            in_var(v + 2, "b"),
+            in_var(v + 3, "c"),
+            block(
+                id,
+                ty,
+                None,
+                &[
+                    ("IN1", &[(v + 1, None)]),
+                    ("IN2", &[(v + 2, None)]),
+                    ("IN3", &[(v + 3, None)]),
+                ],
+                outs,
+            ),
+        ]
+        .concat()
+    };
+    let ld = [
+        rail(1),
+        three(5, "EQ", &["OUT"]),
+        coil_on(6, "Same", 5, "OUT"),
+        three(7, "GT", &["OUT"]),
+        coil_on(8, "Down", 7, "OUT"),
+        three(9, "ADD", &["OUT"]),
+        var_in("outVariable", 10, "S", (9, Some("OUT"))),
+        three(11, "MUL", &["OUT"]),
+        var_in("outVariable", 12, "P", (11, Some("OUT"))),
+    ]
+    .concat();
+    project(
+        &[
+            ("inputVars", "a", "INT"),
+            ("inputVars", "b", "INT"),
+            ("inputVars", "c", "INT"),
+            ("outputVars", "Same", "BOOL"),
+            ("outputVars", "Down", "BOOL"),
+            ("outputVars", "S", "INT"),
+            ("outputVars", "P", "INT"),
+        ],
+        &ld,
+    )
+}
+
+#[test]
+fn extensible_compares_chain_and_extensible_adds_sum() {
+    let xml = extensible();
+    let r = report(&xml);
+    assert_eq!(
+        io(&r),
+        vec![
+            rung("P.R1", &["a", "b", "c"], &["Same"]),
+            rung("P.R2", &["a", "b", "c"], &["Down"]),
+            // The steps read OUT after writing it, so the report counts S and P as read too.
+            rung("P.R3", &["a", "b", "c", "S"], &["S"]),
+            rung("P.R4", &["a", "b", "c", "P"], &["P"]),
+        ]
+    );
+    let h = "a,b,c";
+    // EQ(a, b, c) = a = b AND b = c; GT(a, b, c) = a > b AND b > c.
+    assert_eq!(
+        outputs("ext1", &xml, h, "2,2,2"),
+        json!({"Same": true, "Down": false, "S": 6, "P": 8})
+    );
+    assert_eq!(
+        outputs("ext2", &xml, h, "2,2,3"),
+        json!({"Same": false, "Down": false, "S": 7, "P": 12})
+    );
+    assert_eq!(
+        outputs("ext3", &xml, h, "5,3,1"),
+        json!({"Same": false, "Down": true, "S": 9, "P": 15})
+    );
+    // a > b but not b > c: the chain, not a > c alone.
+    assert_eq!(
+        outputs("ext4", &xml, h, "5,3,4"),
+        json!({"Same": false, "Down": false, "S": 12, "P": 60})
+    );
+}
+
+#[test]
+fn an_extensible_add_that_reads_its_own_out_after_in2_is_an_error() {
+    let ld = [
+        rail(1),
+        in_var(2, "a"),
+        in_var(3, "b"),
+        in_var(4, "S"),
+        block(
+            5,
+            "ADD",
+            None,
+            &[
+                ("IN1", &[(2, None)]),
+                ("IN2", &[(3, None)]),
+                ("IN3", &[(4, None)]),
+            ],
+            &["OUT"],
+        ),
+        var_in("outVariable", 6, "S", (5, Some("OUT"))),
+    ]
+    .concat();
+    let xml = project(
+        &[
+            ("inputVars", "a", "INT"),
+            ("inputVars", "b", "INT"),
+            ("outputVars", "S", "INT"),
+        ],
+        &ld,
+    );
+    let out = run_stdin(&["report", "-"], xml.as_bytes());
+    let line = error_line(&out, "ADD reading its OUT");
+    assert!(
+        line.contains("input IN3 of ADD (localId 5) reads `S`, which its OUT writes: plc-deps computes an extensible ADD step by step in OUT, so it cannot read OUT after IN2"),
+        "{line}"
+    );
+}
+
+#[test]
+fn a_sub_with_three_inputs_is_refused() {
+    let ld = [
+        rail(1),
+        in_var(2, "a"),
+        block(
+            5,
+            "SUB",
+            None,
+            &[
+                ("IN1", &[(2, None)]),
+                ("IN2", &[(2, None)]),
+                ("IN3", &[(2, None)]),
+            ],
+            &["OUT"],
+        ),
+        var_in("outVariable", 6, "S", (5, Some("OUT"))),
+    ]
+    .concat();
+    let xml = project(
+        &[("inputVars", "a", "INT"), ("outputVars", "S", "INT")],
+        &ld,
+    );
+    let out = run_stdin(&["report", "-"], xml.as_bytes());
+    let line = error_line(&out, "SUB of three");
+    assert!(
+        line.contains("SUB (localId 5) has the input `IN3`"),
+        "{line}"
+    );
+}
