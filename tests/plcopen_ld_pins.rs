@@ -8,7 +8,9 @@ mod common;
 mod px;
 
 use common::cli::{error_line, run_stdin};
-use px::{block, coil, in_var, io, project, rail, report, run_inputs, rung, var_in};
+use px::{
+    block, coil, contact, in_var, io, project, rail, report, run_inputs, rung, trace, var_in,
+};
 use serde_json::json;
 
 /// A coil fed by output `pin` of block `from`.
@@ -172,6 +174,114 @@ fn a_sub_with_three_inputs_is_refused() {
     let line = error_line(&out, "SUB of three");
     assert!(
         line.contains("SUB (localId 5) has the input `IN3`"),
+        "{line}"
+    );
+}
+
+/// Cu, Cd → CTUD0 (R unconnected: FALSE; LD := 0, a BOOL literal; PV := 2); QD → Down, written
+/// in the file before the block, QU → Up; CV ≥ 1 (GE fed by CV) → Some.
+fn updown() -> String {
+    let ld = [
+        rail(1),
+        coil_on(2, "Down", 5, "QD"),
+        contact(3, "Cu", &[1], ""),
+        contact(4, "Cd", &[1], ""),
+        block(
+            5,
+            "CTUD",
+            Some("CTUD0"),
+            &[
+                ("CU", &[(3, None)]),
+                ("CD", &[(4, None)]),
+                ("R", &[]),
+                ("LD", &[(6, None)]),
+                ("PV", &[(7, None)]),
+            ],
+            &["QU", "QD", "CV"],
+        ),
+        in_var(6, "0"),
+        in_var(7, "2"),
+        coil_on(8, "Up", 5, "QU"),
+        in_var(9, "1"),
+        block(
+            10,
+            "GE",
+            None,
+            &[("IN1", &[(5, Some("CV"))]), ("IN2", &[(9, None)])],
+            &["OUT"],
+        ),
+        coil_on(11, "Some", 10, "OUT"),
+    ]
+    .concat();
+    project(
+        &[
+            ("inputVars", "Cu", "BOOL"),
+            ("inputVars", "Cd", "BOOL"),
+            ("outputVars", "Up", "BOOL"),
+            ("outputVars", "Down", "BOOL"),
+            ("outputVars", "Some", "BOOL"),
+            ("localVars", "CTUD0", "CTUD"),
+        ],
+        &ld,
+    )
+}
+
+#[test]
+fn outputs_of_a_box_other_than_its_power_are_read_after_it() {
+    let xml = updown();
+    assert_eq!(
+        io(&report(&xml)),
+        vec![rung(
+            "P.R1",
+            &["Cu", "Cd", "CTUD0"],
+            &["Up", "Down", "Some", "CTUD0"]
+        )]
+    );
+    // CV: 0, 1, 1, 2, 1 (QD is CV ≤ 0, QU is CV ≥ PV = 2). In the first scan Down is TRUE only
+    // because QD is read after the call (before it, the instance's QD is still FALSE).
+    let got = trace(
+        "updown",
+        &xml,
+        "Cu,Cd\n0,0\n1,0\n0,0\n1,0\n0,1\n",
+        &["Down", "Up", "Some"],
+    );
+    assert_eq!(got[0], ["1", "0", "0", "0", "0"], "Down = QD");
+    assert_eq!(got[1], ["0", "0", "0", "1", "0"], "Up = QU");
+    assert_eq!(got[2], ["0", "1", "1", "1", "1"], "Some = CV >= 1");
+}
+
+#[test]
+fn an_edge_on_a_timer_input_is_an_error() {
+    let ld = [
+        rail(1),
+        contact(2, "Go", &[1], ""),
+        in_var(3, "T#1s"),
+        block(
+            4,
+            "TON",
+            Some("T0"),
+            &[("IN", &[(2, None)]), ("PT", &[(3, None)])],
+            &["Q"],
+        )
+        .replace(
+            "formalParameter=\"IN\"",
+            "formalParameter=\"IN\" edge=\"rising\"",
+        ),
+        coil_on(5, "Done", 4, "Q"),
+    ]
+    .concat();
+    let xml = project(
+        &[
+            ("inputVars", "Go", "BOOL"),
+            ("outputVars", "Done", "BOOL"),
+            ("localVars", "T0", "TON"),
+        ],
+        &ld,
+    );
+    let out = run_stdin(&["report", "-"], xml.as_bytes());
+    let line = error_line(&out, "edge on IN");
+    assert!(
+        line.contains("input IN of TON (localId 4) is edge-qualified (rising)"),
         "{line}"
     );
 }

@@ -87,6 +87,7 @@ pub fn rungs(tc6: Tc6, node: Node, pou: &str, notes: &mut Notes) -> R<Vec<Rung<'
         for &o in group {
             paths.push(output_path(&mut power, o)?);
         }
+        let paths = after_their_boxes(&power, group, paths);
         let refs: Vec<&[Item]> = paths.iter().map(|p| p.as_slice()).collect();
         let ld = merge(&refs);
         let first = origin(g.get(group[0]).node);
@@ -124,8 +125,10 @@ fn outputs(p: &Power) -> R<Vec<ElemId>> {
             "coil" | "contact" if !feeds_on(i) => first.push(e),
             "outVariable" if !ld_block::absorbed(p, e) => first.push(e),
             "block"
-                if !g.consumers[i].iter().any(|(c, _, _)| {
-                    g.get(*c).tag != "rightPowerRail" && !ld_block::absorbed(p, *c)
+                if !g.consumers[i].iter().any(|(c, _, pin)| {
+                    g.get(*c).tag != "rightPowerRail"
+                        && !ld_block::absorbed(p, *c)
+                        && !ld_block::reads_side(p, e, *pin)
                 }) =>
             {
                 last.push(e)
@@ -152,6 +155,51 @@ fn outputs(p: &Power) -> R<Vec<ElemId>> {
     }
     first.extend(last);
     Ok(first)
+}
+
+/// The outputs' paths reordered so that a path that reads an output of a function block other
+/// than its power output (`C1.QD`) comes after the path that holds the block's box: the box is
+/// called before its outputs are read, as in the diagram. Otherwise file order is kept; a
+/// block whose output feeds back into itself is read before it (its previous value).
+fn after_their_boxes(p: &Power, group: &[ElemId], paths: Vec<Path>) -> Vec<Path> {
+    let reads: Vec<Vec<ElemId>> = group.iter().map(|&o| side_reads(p, o)).collect();
+    if reads.iter().all(Vec::is_empty) {
+        return paths;
+    }
+    let holds = |path: &Path, b: ElemId| path.iter().any(|x| x.key == Key::Elem(b));
+    let mut placed: Vec<usize> = Vec::with_capacity(paths.len());
+    while placed.len() < paths.len() {
+        let ready = (0..paths.len()).find(|&i| {
+            !placed.contains(&i)
+                && reads[i].iter().all(|&b| {
+                    placed.iter().any(|&j| holds(&paths[j], b))
+                        || holds(&paths[i], b)
+                        || !paths.iter().any(|q| holds(q, b))
+                })
+        });
+        // A feedback loop: the rest in file order.
+        let next =
+            ready.unwrap_or_else(|| (0..paths.len()).find(|i| !placed.contains(i)).unwrap_or(0));
+        placed.push(next);
+    }
+    let mut paths: Vec<Option<Path>> = paths.into_iter().map(Some).collect();
+    placed.iter().filter_map(|&i| paths[i].take()).collect()
+}
+
+/// The function blocks whose outputs other than the power output feed `o`, through any wiring.
+fn side_reads(p: &Power, o: ElemId) -> Vec<ElemId> {
+    let mut seen = vec![false; p.g.elems.len()];
+    let (mut stack, mut out) = (vec![o], Vec::new());
+    while let Some(x) = stack.pop() {
+        for s in p.g.get(x).inputs.iter().flat_map(|pin| &pin.sources) {
+            if ld_block::reads_side(p, s.elem, s.pin) {
+                out.push(s.elem);
+            } else if !std::mem::replace(&mut seen[s.elem.0 as usize], true) {
+                stack.push(s.elem);
+            }
+        }
+    }
+    out
 }
 
 /// The series of one output, ending with it.

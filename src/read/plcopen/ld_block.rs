@@ -15,8 +15,13 @@
 //!
 //! Deliberately not here (each an error naming the block and its localId): other block types
 //! (standard ones the model lacks, user function blocks and functions in LD), EN/ENO on timers
-//! and counters, outputs other than the power output wired (`ET`, `CV`, `QD`), a data pin fed by a
-//! block or a contact network.
+//! and counters, a data pin fed by a function's output or a contact network, negated or
+//! edge-qualified pins other than a rising edge on a counter's `CU`/`CD` (the counter's own edge).
+//!
+//! The other outputs of a function block (`QD`, `CV` of CTUD, `ET` of a timer) are its instance's
+//! fields, read after the box: a contact on `C1.QD` from the rail when they feed power, the
+//! operand `C1.CV` when they feed a data pin (`super::ld` runs the box's output first). An
+//! unconnected BOOL input or PV of a function block is its initial value (FALSE, 0).
 
 use super::ld_power::{Item, Key, Path, Power};
 use super::wiring::ElemId;
@@ -86,6 +91,18 @@ impl Spec {
 }
 
 impl Spec {
+    /// True for the function blocks (with an instance whose outputs are fields).
+    fn is_instance(&self) -> bool {
+        matches!(
+            self,
+            Spec::Timer(_)
+                | Spec::Counter { .. }
+                | Spec::Bistable(_)
+                | Spec::Trigger(_)
+                | Spec::Ctud
+        )
+    }
+
     /// True when `pin` is an input `IN3`, `IN4` … of an extensible block (IEC 61131-3 Tables 29
     /// and 31: ADD, MUL and the comparisons take any number of inputs).
     fn extends(&self, pin: &str) -> bool {
@@ -121,6 +138,53 @@ pub fn absorbed(p: &Power, e: ElemId) -> bool {
         && s.pin.is_none_or(|p| p == "OUT")
 }
 
+/// True when `pin` of block `e` is an output of a function block instance other than its power
+/// output (`QD` or `CV` of a CTUD, `ET` of a timer): it is read after the box, as the instance's
+/// field.
+pub fn reads_side(p: &Power, e: ElemId, pin: Option<&str>) -> bool {
+    let el = p.g.get(e);
+    let Some(pin) = pin else {
+        return false;
+    };
+    if el.tag != "block" {
+        return false;
+    }
+    let Some(spec) = el.node.attribute("typeName").and_then(Spec::of) else {
+        return false;
+    };
+    spec.is_instance() && pin != spec.pins().2 && el.outputs.iter().any(|(o, _)| *o == pin)
+}
+
+/// The contact that reads output `pin` of function block `e` (its field `instance.pin`); the
+/// rung puts it after the box (`super::ld` orders the outputs that read it after the box's).
+pub fn side_output(p: &Power, e: ElemId, pin: &str) -> R<Item> {
+    let node = p.g.get(e).node;
+    let name = field(p, e, pin)?;
+    Ok(Item {
+        key: Key::Pin(e, pin.to_owned()),
+        element: Element {
+            origin: origin(node),
+            kind: ElementKind::Contact {
+                var: Located {
+                    value: name.into(),
+                    origin: origin(node),
+                },
+                negated: false,
+                edge: None,
+            },
+        },
+    })
+}
+
+/// `instance.pin`: the field that holds output `pin` of function block `e`.
+fn field(p: &Power, e: ElemId, pin: &str) -> R<String> {
+    let node = p.g.get(e).node;
+    let here = p.at(e);
+    let raw = super::xml::attr(node, "instanceName", &here)?;
+    let instance = super::xml::identifier(raw, "instance", node, &here)?;
+    Ok(format!("{instance}.{pin}"))
+}
+
 /// The series out of block `e`'s power output (`pin`: the output asked for).
 pub fn power_out(p: &mut Power, e: ElemId, pin: Option<&str>) -> R<Path> {
     let el = p.g.get(e);
@@ -148,8 +212,12 @@ pub fn power_out(p: &mut Power, e: ElemId, pin: Option<&str>) -> R<Path> {
             ));
         }
     }
-    // Every wired output is the power output or the result.
+    qualified_pins(p, e, &spec, ty)?;
+    // Every wired output is the power output, the result, or an output of an instance.
     for &(c, _, out_pin) in &p.g.consumers[e.0 as usize] {
+        if reads_side(p, e, out_pin) {
+            continue;
+        }
         let first = if result.is_some() { "OUT" } else { power_out };
         let name = out_pin.unwrap_or(first);
         if name != power_out && Some(name) != result {
@@ -340,6 +408,16 @@ fn operand(p: &mut Power, e: ElemId, pin: &str, ty: &str) -> R<Operand<'static>>
             format!("{ty} (localId {}) has no input {pin}", el.local_id),
         ));
     };
+    // An unconnected input of a function block keeps the instance's value, which nothing else
+    // in an LD body can set: its initial value (IEC 61131-3 2.5.2.1), FALSE or 0.
+    if input.sources.is_empty() && spec_of(p, e).is_some_and(|s| s.is_instance()) {
+        if let Some(value) = unconnected_default(pin) {
+            return Ok(Located {
+                value,
+                origin: origin(input.node),
+            });
+        }
+    }
     let [s] = input.sources.as_slice() else {
         return Err(error(
             origin(input.node),
@@ -356,11 +434,18 @@ fn operand(p: &mut Power, e: ElemId, pin: &str, ty: &str) -> R<Operand<'static>>
         "inVariable" => {
             let text = p.expression(s.elem)?;
             match super::interface::literal(&text) {
+                // IEC 61131-3 6.3.2: `0` and `1` are BOOL literals too.
+                Some(Scalar::Number(n)) if unconnected_default(pin) == Some(Scalar::Bool(false)) && (n.as_u64() == Some(0) || n.as_u64() == Some(1)) => {
+                    Scalar::Bool(n.as_u64() == Some(1))
+                }
                 Some(v) => v,
                 None => Scalar::Str(variable_ref(&text, src.node, &p.at(s.elem))?.into()),
             }
         }
         "leftPowerRail" => Scalar::Bool(true),
+        "block" if reads_side(p, s.elem, s.pin) => {
+            Scalar::Str(field(p, s.elem, s.pin.unwrap_or(""))?.into())
+        }
         "contact"
             if src.node.attribute("negated").is_none_or(|n| n == "false")
                 && src.node.attribute("edge").is_none_or(|n| n == "none")
@@ -380,6 +465,42 @@ fn operand(p: &mut Power, e: ElemId, pin: &str, ty: &str) -> R<Operand<'static>>
         value,
         origin: s.origin,
     })
+}
+
+/// Negated and edge-qualified input pins: a rising edge on the count input of a counter (`CU`,
+/// `CD` of CTU, CTD, CTUD) is what the counter detects anyway (an `R_TRIG` in front of it
+/// rises in the same scans as its input), so it is read as the plain pin; any other is an error.
+fn qualified_pins(p: &Power, e: ElemId, spec: &Spec, ty: &str) -> R<()> {
+    let el = p.g.get(e);
+    for pin in &el.inputs {
+        let name = pin.name.unwrap_or("");
+        let negated = pin.node.attribute("negated").is_some_and(|x| x == "true");
+        let edge = pin.node.attribute("edge").filter(|x| *x != "none");
+        let counts =
+            matches!(spec, Spec::Counter { .. } | Spec::Ctud) && matches!(name, "CU" | "CD");
+        if negated || (edge.is_some() && !(counts && edge == Some("rising"))) {
+            return Err(error(
+                origin(pin.node),
+                &p.at(e),
+                format!("input {name} of {ty} (localId {}) is {}: plc-deps reads negated and edge-qualified pins in LD only as a rising edge on CU or CD of a counter", el.local_id, if negated { "negated".to_string() } else { format!("edge-qualified ({})", edge.unwrap_or("")) }),
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn spec_of(p: &Power, e: ElemId) -> Option<Spec> {
+    p.g.get(e).node.attribute("typeName").and_then(Spec::of)
+}
+
+/// The initial value of a function block's data input `pin` (BOOL FALSE, PV 0); `None` for PT,
+/// which has no useful default and stays an error when unconnected.
+fn unconnected_default(pin: &str) -> Option<Scalar<'static>> {
+    match pin {
+        "R" | "R1" | "LD" | "CD" => Some(Scalar::Bool(false)),
+        "PV" => Some(Scalar::Number(0.into())),
+        _ => None,
+    }
 }
 
 /// The out variable written by the result (`OUT`) of block `e`: exactly one.
