@@ -285,3 +285,54 @@ fn an_edge_on_a_timer_input_is_an_error() {
         "{line}"
     );
 }
+
+/// S → SR0.S1; R := a OR b (two wires into R) → SR0; Q1 → Q.
+fn sr_two_resets() -> String {
+    let ld = [
+        rail(1),
+        contact(2, "S", &[1], ""),
+        contact(3, "a", &[1], ""),
+        contact(4, "b", &[1], ""),
+        block(
+            5,
+            "SR",
+            Some("SR0"),
+            &[("S1", &[(2, None)]), ("R", &[(3, None), (4, None)])],
+            &["Q1"],
+        ),
+        coil_on(6, "Q", 5, "Q1"),
+    ]
+    .concat();
+    project(
+        &[
+            ("inputVars", "S", "BOOL"),
+            ("inputVars", "a", "BOOL"),
+            ("inputVars", "b", "BOOL"),
+            ("outputVars", "Q", "BOOL"),
+            ("localVars", "SR0", "SR"),
+        ],
+        &ld,
+    )
+}
+
+#[test]
+fn two_wires_into_a_data_pin_are_their_or() {
+    let xml = sr_two_resets();
+    // The OR is written into SR0__R before the box, in the same rung.
+    assert_eq!(
+        io(&report(&xml)),
+        vec![rung(
+            "P.R1",
+            &["S", "a", "b", "SR0", "SR0__R"],
+            &["Q", "SR0", "SR0__R"]
+        )]
+    );
+    // Q1 := S1 OR (NOT R AND Q1), R = a OR b: set, hold, reset by a, set, hold, reset by b.
+    let got = trace(
+        "sr-or",
+        &xml,
+        "S,a,b\n1,0,0\n0,0,0\n0,1,0\n1,0,0\n0,0,0\n0,0,1\n0,0,0\n",
+        &["Q"],
+    );
+    assert_eq!(got[0], ["1", "1", "0", "1", "1", "0", "0"]);
+}

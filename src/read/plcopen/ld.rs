@@ -88,6 +88,7 @@ pub fn rungs(tc6: Tc6, node: Node, pou: &str, notes: &mut Notes) -> R<Vec<Rung<'
             paths.push(output_path(&mut power, o)?);
         }
         let paths = after_their_boxes(&power, group, paths);
+        let paths = with_feeds(&mut power, paths);
         let refs: Vec<&[Item]> = paths.iter().map(|p| p.as_slice()).collect();
         let ld = merge(&refs);
         let first = origin(g.get(group[0]).node);
@@ -105,6 +106,9 @@ pub fn rungs(tc6: Tc6, node: Node, pou: &str, notes: &mut Notes) -> R<Vec<Rung<'
             problem_in_rung: false,
         });
     }
+    notes
+        .ld_vars
+        .extend(power.vars.drain(..).map(|v| (pou.to_owned(), v)));
     Ok(out)
 }
 
@@ -184,6 +188,28 @@ fn after_their_boxes(p: &Power, group: &[ElemId], paths: Vec<Path>) -> Vec<Path>
     }
     let mut paths: Vec<Option<Path>> = paths.into_iter().map(Some).collect();
     placed.iter().filter_map(|&i| paths[i].take()).collect()
+}
+
+/// The paths with the series that feed data pins of their boxes ([`Power::feeds`]) put just
+/// before the first path that holds the box.
+fn with_feeds(p: &mut Power, paths: Vec<Path>) -> Vec<Path> {
+    if p.feeds.is_empty() {
+        return paths;
+    }
+    let mut out = Vec::with_capacity(paths.len() + p.feeds.len());
+    for path in paths {
+        let mut k = 0;
+        while k < p.feeds.len() {
+            let b = p.feeds[k].0;
+            if path.iter().any(|x| x.key == Key::Elem(b)) {
+                out.push(p.feeds.remove(k).1);
+            } else {
+                k += 1;
+            }
+        }
+        out.push(path);
+    }
+    out
 }
 
 /// The function blocks whose outputs other than the power output feed `o`, through any wiring.

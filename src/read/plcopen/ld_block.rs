@@ -21,7 +21,9 @@
 //! The other outputs of a function block (`QD`, `CV` of CTUD, `ET` of a timer) are its instance's
 //! fields, read after the box: a contact on `C1.QD` from the rail when they feed power, the
 //! operand `C1.CV` when they feed a data pin (`super::ld` runs the box's output first). An
-//! unconnected BOOL input or PV of a function block is its initial value (FALSE, 0).
+//! unconnected BOOL input or PV of a function block is its initial value (FALSE, 0). A BOOL data
+//! input fed by several wires (their OR) or by a contact network is written, before the box in
+//! the same rung, into the BOOL `instance__pin` that the box reads ([`Power::feeds`]).
 
 use super::ld_power::{Item, Key, Path, Power};
 use super::wiring::ElemId;
@@ -418,6 +420,20 @@ fn operand(p: &mut Power, e: ElemId, pin: &str, ty: &str) -> R<Operand<'static>>
             });
         }
     }
+    let simple = match input.sources.as_slice() {
+        [s] => {
+            let src = p.g.get(s.elem);
+            src.tag != "contact"
+                || (src.node.attribute("negated").is_none_or(|n| n == "false")
+                    && src.node.attribute("edge").is_none_or(|n| n == "none")
+                    && p.input(s.elem, 0)?.is_empty())
+        }
+        _ => false,
+    };
+    if !simple && !input.sources.is_empty() && unconnected_default(pin) == Some(Scalar::Bool(false))
+    {
+        return fed_by_network(p, e, pin, ty);
+    }
     let [s] = input.sources.as_slice() else {
         return Err(error(
             origin(input.node),
@@ -487,6 +503,60 @@ fn qualified_pins(p: &Power, e: ElemId, spec: &Spec, ty: &str) -> R<()> {
         }
     }
     Ok(())
+}
+
+/// A BOOL data pin fed by several wires (their OR) or by a contact network: the network is
+/// written, earlier in the same rung, into the BOOL `instance__pin`, which the box reads.
+fn fed_by_network(p: &mut Power, e: ElemId, pin: &str, ty: &str) -> R<Operand<'static>> {
+    let el = p.g.get(e);
+    let here = p.at(e);
+    let k = el
+        .inputs
+        .iter()
+        .position(|x| x.name == Some(pin))
+        .unwrap_or(0);
+    let at = origin(el.inputs[k].node);
+    let mut path = p.input(e, k)?;
+    if let Some(bad) = path.iter().find(|x| !x.element.kind.is_condition()) {
+        return Err(error(
+            bad.element.origin,
+            &here,
+            format!("input {pin} of {ty} (localId {}) is fed through an output or a box; plc-deps reads a data pin fed by contacts, compares and their ORs only", el.local_id),
+        ));
+    }
+    let raw = super::xml::attr(el.node, "instanceName", &here)?;
+    let instance = super::xml::identifier(raw, "instance", el.node, &here)?;
+    let name = format!("{instance}__{pin}");
+    let located = |v: &str| Located {
+        value: std::borrow::Cow::Owned(v.to_owned()),
+        origin: at,
+    };
+    p.vars.push(crate::syntax::Var {
+        origin: at,
+        name: located(&name),
+        ty: located("BOOL"),
+        class: Located {
+            value: crate::syntax::VarClass::Memory,
+            origin: at,
+        },
+        init: None,
+        problem: None,
+    });
+    path.push(Item {
+        key: Key::Feed(e, pin.to_owned()),
+        element: Element {
+            origin: at,
+            kind: ElementKind::Coil {
+                var: located(&name),
+                negated: false,
+            },
+        },
+    });
+    p.feeds.push((e, path));
+    Ok(Located {
+        value: Scalar::Str(name.into()),
+        origin: at,
+    })
 }
 
 fn spec_of(p: &Power, e: ElemId) -> Option<Spec> {
