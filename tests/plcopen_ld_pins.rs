@@ -336,3 +336,42 @@ fn two_wires_into_a_data_pin_are_their_or() {
     );
     assert_eq!(got[0], ["1", "1", "0", "1", "1", "0", "0"]);
 }
+
+#[test]
+fn a_box_whose_fed_pin_cannot_run_first_in_its_rung_is_an_error() {
+    // Contact S feeds coil X (first in the file) and SR0.S1; R := a OR b. Merged, the shared
+    // contact S would run SR0 before the OR that feeds R is written: refused, not misordered.
+    let ld = [
+        rail(1),
+        contact(2, "S", &[1], ""),
+        coil(7, "X", &[2], ""),
+        contact(3, "a", &[1], ""),
+        contact(4, "b", &[1], ""),
+        block(
+            5,
+            "SR",
+            Some("SR0"),
+            &[("S1", &[(2, None)]), ("R", &[(3, None), (4, None)])],
+            &["Q1"],
+        ),
+        coil_on(6, "Q", 5, "Q1"),
+    ]
+    .concat();
+    let xml = project(
+        &[
+            ("inputVars", "S", "BOOL"),
+            ("inputVars", "a", "BOOL"),
+            ("inputVars", "b", "BOOL"),
+            ("outputVars", "Q", "BOOL"),
+            ("outputVars", "X", "BOOL"),
+            ("localVars", "SR0", "SR"),
+        ],
+        &ld,
+    );
+    let out = run_stdin(&["report", "-"], xml.as_bytes());
+    let line = error_line(&out, "feed after box");
+    assert!(
+        line.contains("block localId 5 cannot be placed in one left-to-right rung: the network feeding one of its data pins must run before it"),
+        "{line}"
+    );
+}

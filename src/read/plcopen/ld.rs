@@ -89,6 +89,7 @@ pub fn rungs(tc6: Tc6, node: Node, pou: &str, notes: &mut Notes) -> R<Vec<Rung<'
         }
         let paths = after_their_boxes(&power, group, paths);
         let paths = with_feeds(&mut power, paths);
+        check_order(&power, &paths)?;
         let refs: Vec<&[Item]> = paths.iter().map(|p| p.as_slice()).collect();
         let ld = merge(&refs);
         let first = origin(g.get(group[0]).node);
@@ -210,6 +211,58 @@ fn with_feeds(p: &mut Power, paths: Vec<Path>) -> Vec<Path> {
         out.push(path);
     }
     out
+}
+
+/// The order [`merge`] evaluates the paths in: those that end first, then each group of paths
+/// with the same next key, groups in the order of their first path.
+fn merged_order(paths: &[Path], idx: Vec<usize>, depth: usize, out: &mut Vec<usize>) {
+    let (ended, rest): (Vec<usize>, Vec<usize>) =
+        idx.into_iter().partition(|&i| paths[i].len() <= depth);
+    out.extend(ended);
+    let mut groups: Vec<(&Key, Vec<usize>)> = Vec::new();
+    for i in rest {
+        let k = &paths[i][depth].key;
+        match groups.iter_mut().find(|(g, _)| *g == k) {
+            Some((_, g)) => g.push(i),
+            None => groups.push((k, vec![i])),
+        }
+    }
+    for (_, g) in groups {
+        merged_order(paths, g, depth + 1, out);
+    }
+}
+
+/// An error when merging the paths into one series would evaluate a box before the series
+/// that feeds its data pin, or a read of a box's output before the box: sharing a prefix with
+/// an earlier output pulls the box ahead, and one left-to-right rung cannot express the order.
+fn check_order(p: &Power, paths: &[Path]) -> R<()> {
+    let mut order = Vec::with_capacity(paths.len());
+    merged_order(paths, (0..paths.len()).collect(), 0, &mut order);
+    let rank = |i: usize| order.iter().position(|&j| j == i).unwrap_or(0);
+    let first = |pred: &dyn Fn(&Key) -> bool| {
+        (0..paths.len())
+            .filter(|&i| paths[i].iter().any(|x| pred(&x.key)))
+            .min_by_key(|&i| rank(i))
+    };
+    for b in paths.iter().flatten().filter_map(|x| match x.key {
+        Key::Elem(b) if p.g.get(b).tag == "block" => Some(b),
+        _ => None,
+    }) {
+        let boxed = first(&|k| *k == Key::Elem(b));
+        let fed = first(&|k| matches!(k, Key::Feed(f, _) if *f == b));
+        let read = first(&|k| matches!(k, Key::Pin(f, _) if *f == b));
+        let late_feed = matches!((fed, boxed), (Some(f), Some(x)) if rank(f) > rank(x));
+        let early_read = matches!((read, boxed), (Some(r), Some(x)) if rank(r) < rank(x) && !paths[r].iter().any(|y| y.key == Key::Elem(b)));
+        if late_feed || early_read {
+            let el = p.g.get(b);
+            return Err(error(
+                origin(el.node),
+                &p.at(b),
+                format!("block localId {} cannot be placed in one left-to-right rung: {}; the rung shares its start with another output that would run it first", el.local_id, if late_feed { "the network feeding one of its data pins must run before it" } else { "an output of it is read by an output that would run before it" }),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The function blocks whose outputs other than the power output feed `o`, through any wiring.
