@@ -15,7 +15,10 @@
 //! consumer, blocks nothing consumes at the end; `executionOrderId` is not read for LD. So rungs
 //! run in the order of their first coil, out variable, jump or return in the file (a rung of
 //! blocks only: of its first block), and within a rung the output paths in the order of their
-//! outputs. Where the outputs of two rungs interleave in the file, Beremiz's statement order
+//! outputs — except that an output reading an output of a function block other than its power
+//! output (`C1.QD`) goes after the output whose series holds the box, and the series that writes
+//! the network feeding a box's data pin goes just before it; a rung whose merge cannot keep
+//! those orders is an error. Where the outputs of two rungs interleave in the file, Beremiz's statement order
 //! differs from running each rung whole: a note names the rungs. A `label` starts the first rung
 //! whose first output follows it in the file.
 //!
