@@ -15,7 +15,10 @@
 //! consumer, blocks nothing consumes at the end; `executionOrderId` is not read for LD. So rungs
 //! run in the order of their first coil, out variable, jump or return in the file (a rung of
 //! blocks only: of its first block), and within a rung the output paths in the order of their
-//! outputs. Where the outputs of two rungs interleave in the file, Beremiz's statement order
+//! outputs — except that an output reading an output of a function block other than its power
+//! output (`C1.QD`) goes after the output whose series holds the box, and the series that writes
+//! the network feeding a box's data pin goes just before it; a rung whose merge cannot keep
+//! those orders is an error. Where the outputs of two rungs interleave in the file, Beremiz's statement order
 //! differs from running each rung whole: a note names the rungs. A `label` starts the first rung
 //! whose first output follows it in the file.
 //!
@@ -87,6 +90,9 @@ pub fn rungs(tc6: Tc6, node: Node, pou: &str, notes: &mut Notes) -> R<Vec<Rung<'
         for &o in group {
             paths.push(output_path(&mut power, o)?);
         }
+        let paths = after_their_boxes(&power, group, paths);
+        let paths = with_feeds(&mut power, paths);
+        check_order(&power, &paths)?;
         let refs: Vec<&[Item]> = paths.iter().map(|p| p.as_slice()).collect();
         let ld = merge(&refs);
         let first = origin(g.get(group[0]).node);
@@ -104,6 +110,9 @@ pub fn rungs(tc6: Tc6, node: Node, pou: &str, notes: &mut Notes) -> R<Vec<Rung<'
             problem_in_rung: false,
         });
     }
+    notes
+        .ld_vars
+        .extend(power.vars.drain(..).map(|v| (pou.to_owned(), v)));
     Ok(out)
 }
 
@@ -124,8 +133,10 @@ fn outputs(p: &Power) -> R<Vec<ElemId>> {
             "coil" | "contact" if !feeds_on(i) => first.push(e),
             "outVariable" if !ld_block::absorbed(p, e) => first.push(e),
             "block"
-                if !g.consumers[i].iter().any(|(c, _, _)| {
-                    g.get(*c).tag != "rightPowerRail" && !ld_block::absorbed(p, *c)
+                if !g.consumers[i].iter().any(|(c, _, pin)| {
+                    g.get(*c).tag != "rightPowerRail"
+                        && !ld_block::absorbed(p, *c)
+                        && !ld_block::reads_side(p, e, *pin)
                 }) =>
             {
                 last.push(e)
@@ -152,6 +163,125 @@ fn outputs(p: &Power) -> R<Vec<ElemId>> {
     }
     first.extend(last);
     Ok(first)
+}
+
+/// The outputs' paths reordered so that a path that reads an output of a function block other
+/// than its power output (`C1.QD`) comes after the path that holds the block's box: the box is
+/// called before its outputs are read, as in the diagram. Otherwise file order is kept; a
+/// block whose output feeds back into itself is read before it (its previous value).
+fn after_their_boxes(p: &Power, group: &[ElemId], paths: Vec<Path>) -> Vec<Path> {
+    let reads: Vec<Vec<ElemId>> = group.iter().map(|&o| side_reads(p, o)).collect();
+    if reads.iter().all(Vec::is_empty) {
+        return paths;
+    }
+    let holds = |path: &Path, b: ElemId| path.iter().any(|x| x.key == Key::Elem(b));
+    let mut placed: Vec<usize> = Vec::with_capacity(paths.len());
+    while placed.len() < paths.len() {
+        let ready = (0..paths.len()).find(|&i| {
+            !placed.contains(&i)
+                && reads[i].iter().all(|&b| {
+                    placed.iter().any(|&j| holds(&paths[j], b))
+                        || holds(&paths[i], b)
+                        || !paths.iter().any(|q| holds(q, b))
+                })
+        });
+        // A feedback loop: the rest in file order.
+        let next =
+            ready.unwrap_or_else(|| (0..paths.len()).find(|i| !placed.contains(i)).unwrap_or(0));
+        placed.push(next);
+    }
+    let mut paths: Vec<Option<Path>> = paths.into_iter().map(Some).collect();
+    placed.iter().filter_map(|&i| paths[i].take()).collect()
+}
+
+/// The paths with the series that feed data pins of their boxes ([`Power::feeds`]) put just
+/// before the first path that holds the box.
+fn with_feeds(p: &mut Power, paths: Vec<Path>) -> Vec<Path> {
+    if p.feeds.is_empty() {
+        return paths;
+    }
+    let mut out = Vec::with_capacity(paths.len() + p.feeds.len());
+    for path in paths {
+        let mut k = 0;
+        while k < p.feeds.len() {
+            let b = p.feeds[k].0;
+            if path.iter().any(|x| x.key == Key::Elem(b)) {
+                out.push(p.feeds.remove(k).1);
+            } else {
+                k += 1;
+            }
+        }
+        out.push(path);
+    }
+    out
+}
+
+/// The order [`merge`] evaluates the paths in: those that end first, then each group of paths
+/// with the same next key, groups in the order of their first path.
+fn merged_order(paths: &[Path], idx: Vec<usize>, depth: usize, out: &mut Vec<usize>) {
+    let (ended, rest): (Vec<usize>, Vec<usize>) =
+        idx.into_iter().partition(|&i| paths[i].len() <= depth);
+    out.extend(ended);
+    let mut groups: Vec<(&Key, Vec<usize>)> = Vec::new();
+    for i in rest {
+        let k = &paths[i][depth].key;
+        match groups.iter_mut().find(|(g, _)| *g == k) {
+            Some((_, g)) => g.push(i),
+            None => groups.push((k, vec![i])),
+        }
+    }
+    for (_, g) in groups {
+        merged_order(paths, g, depth + 1, out);
+    }
+}
+
+/// An error when merging the paths into one series would evaluate a box before the series
+/// that feeds its data pin, or a read of a box's output before the box: sharing a prefix with
+/// an earlier output pulls the box ahead, and one left-to-right rung cannot express the order.
+fn check_order(p: &Power, paths: &[Path]) -> R<()> {
+    let mut order = Vec::with_capacity(paths.len());
+    merged_order(paths, (0..paths.len()).collect(), 0, &mut order);
+    let rank = |i: usize| order.iter().position(|&j| j == i).unwrap_or(0);
+    let first = |pred: &dyn Fn(&Key) -> bool| {
+        (0..paths.len())
+            .filter(|&i| paths[i].iter().any(|x| pred(&x.key)))
+            .min_by_key(|&i| rank(i))
+    };
+    for b in paths.iter().flatten().filter_map(|x| match x.key {
+        Key::Elem(b) if p.g.get(b).tag == "block" => Some(b),
+        _ => None,
+    }) {
+        let boxed = first(&|k| *k == Key::Elem(b));
+        let fed = first(&|k| matches!(k, Key::Feed(f, _) if *f == b));
+        let read = first(&|k| matches!(k, Key::Pin(f, _) if *f == b));
+        let late_feed = matches!((fed, boxed), (Some(f), Some(x)) if rank(f) > rank(x));
+        let early_read = matches!((read, boxed), (Some(r), Some(x)) if rank(r) < rank(x) && !paths[r].iter().any(|y| y.key == Key::Elem(b)));
+        if late_feed || early_read {
+            let el = p.g.get(b);
+            return Err(error(
+                origin(el.node),
+                &p.at(b),
+                format!("block localId {} cannot be placed in one left-to-right rung: {}; the rung shares its start with another output that would run it first", el.local_id, if late_feed { "the network feeding one of its data pins must run before it" } else { "an output of it is read by an output that would run before it" }),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The function blocks whose outputs other than the power output feed `o`, through any wiring.
+fn side_reads(p: &Power, o: ElemId) -> Vec<ElemId> {
+    let mut seen = vec![false; p.g.elems.len()];
+    let (mut stack, mut out) = (vec![o], Vec::new());
+    while let Some(x) = stack.pop() {
+        for s in p.g.get(x).inputs.iter().flat_map(|pin| &pin.sources) {
+            if ld_block::reads_side(p, s.elem, s.pin) {
+                out.push(s.elem);
+            } else if !std::mem::replace(&mut seen[s.elem.0 as usize], true) {
+                stack.push(s.elem);
+            }
+        }
+    }
+    out
 }
 
 /// The series of one output, ending with it.

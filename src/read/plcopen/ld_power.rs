@@ -30,6 +30,10 @@ pub enum Key {
     Elem(ElemId),
     /// An `or` of these sources (sorted).
     Or(Vec<ElemId>),
+    /// The contact that reads output pin `.1` of function block `.0` after its box.
+    Pin(ElemId, String),
+    /// The coil that writes the network feeding data pin `.1` of block `.0` before its box.
+    Feed(ElemId, String),
 }
 
 /// One element of a path from the left rail.
@@ -49,6 +53,11 @@ pub struct Power<'g, 'a, 'i> {
     pub place: String,
     memo: HashMap<ElemId, Path>,
     visiting: Vec<bool>,
+    /// Series that must run before a box in its rung: each writes the contact network feeding a
+    /// data pin of the block into a variable of [`Power::vars`] (`super::ld` places them).
+    pub feeds: Vec<(ElemId, Path)>,
+    /// The variables those series write.
+    pub vars: Vec<crate::syntax::Var<'static>>,
 }
 
 impl<'g, 'a, 'i> Power<'g, 'a, 'i> {
@@ -58,6 +67,8 @@ impl<'g, 'a, 'i> Power<'g, 'a, 'i> {
             place,
             memo: HashMap::new(),
             visiting: vec![false; g.elems.len()],
+            feeds: Vec::new(),
+            vars: Vec::new(),
         }
     }
 
@@ -67,6 +78,9 @@ impl<'g, 'a, 'i> Power<'g, 'a, 'i> {
 
     /// The series that brings power out of `e` (through its output pin `pin`).
     pub fn out(&mut self, e: ElemId, pin: Option<&str>) -> R<Path> {
+        if let Some(side) = pin.filter(|&x| ld_block::reads_side(self, e, Some(x))) {
+            return ld_block::side_output(self, e, side).map(|item| vec![item]);
+        }
         if let Some(p) = self.memo.get(&e) {
             return Ok(p.clone());
         }
@@ -256,7 +270,7 @@ impl<'g, 'a, 'i> Power<'g, 'a, 'i> {
             if let Some(bad) = rest.iter().find(|x| !x.element.kind.is_condition()) {
                 let what = match &bad.key {
                     Key::Elem(b) => format!("localId {}", self.g.get(*b).local_id),
-                    Key::Or(_) => "an element".into(),
+                    Key::Or(_) | Key::Pin(..) | Key::Feed(..) => "an element".into(),
                 };
                 let _ = s;
                 return Err(self.not_sp(e, sources, &format!("the parallel branch through {what} holds an output or a block, which a parallel (OR) branch cannot")));

@@ -103,6 +103,7 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
                 vars.extend(iface.outputs);
                 vars.extend(iface.locals);
                 vars.extend(iface.globals);
+                vars.extend(notes.take_ld_vars(&pname));
                 programs.push(ProgramPou {
                     name: pname,
                     origin: origin(pou),
@@ -120,10 +121,14 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
                 }
                 fbs.push(FunctionBlock {
                     origin: origin(pou),
-                    name: pname.into(),
+                    name: pname.clone().into(),
                     inputs: iface.inputs,
                     outputs: iface.outputs,
-                    vars: iface.locals,
+                    vars: iface
+                        .locals
+                        .into_iter()
+                        .chain(notes.take_ld_vars(&pname))
+                        .collect(),
                     body: Some(body),
                 });
             }

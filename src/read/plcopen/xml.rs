@@ -67,11 +67,24 @@ pub struct ExecOrder {
 pub struct Notes {
     pub list: Vec<Note>,
     pub exec_orders: Vec<ExecOrder>,
+    /// Variables an LD body needs that the file does not declare, with their POU: the BOOL
+    /// that holds a contact network feeding a block's data pin (`SR0__R`, a name no file can
+    /// declare: IEC 61131-3 identifiers have no double `_`).
+    pub ld_vars: Vec<(String, crate::syntax::Var<'static>)>,
 }
 
 impl Notes {
     pub fn push(&mut self, n: Note) {
         self.list.push(n);
+    }
+
+    /// The variables an LD body of POU `pou` added ([`Notes::ld_vars`]).
+    pub fn take_ld_vars(&mut self, pou: &str) -> Vec<crate::syntax::Var<'static>> {
+        let (mine, rest) = std::mem::take(&mut self.ld_vars)
+            .into_iter()
+            .partition(|(p, _)| p == pou);
+        self.ld_vars = rest;
+        mine.into_iter().map(|(_, v)| v).collect()
     }
 }
 
