@@ -38,7 +38,7 @@ fn shape(rungs: usize) -> GenConfig {
 }
 
 fn load(config: &GenConfig) -> Program {
-    plc_deps::read::program_from_json(&generate_string(config)).expect("generated programs load")
+    plc_deps::load::program_from_json(&generate_string(config)).expect("generated programs load")
 }
 
 fn program(rungs: usize) -> Program {

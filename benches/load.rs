@@ -24,7 +24,7 @@ fn load(c: &mut Criterion) {
         let t = text(rungs);
         group.throughput(Throughput::Bytes(t.len() as u64));
         group.bench_with_input(BenchmarkId::from_parameter(rungs), &t, |b, t| {
-            b.iter(|| plc_deps::read::program_from_json(t).expect("generated programs load"))
+            b.iter(|| plc_deps::load::program_from_json(t).expect("generated programs load"))
         });
     }
     group.finish();

@@ -26,7 +26,7 @@ fn program(rungs: usize) -> Program {
         calls: false,
         ..Default::default()
     };
-    plc_deps::read::program_from_json(&generate_string(&config)).expect("generated programs load")
+    plc_deps::load::program_from_json(&generate_string(&config)).expect("generated programs load")
 }
 
 /// Counts the bytes written (so the output cannot be optimised away) and keeps none.

@@ -27,7 +27,7 @@ fn generated(rungs: usize, width: usize, reads: plc_deps::synth::Reads) -> Progr
         reads,
         ..Default::default()
     });
-    plc_deps::read::program_from_json(&text).expect("generated program loads")
+    plc_deps::load::program_from_json(&text).expect("generated program loads")
 }
 
 /// Rung i reads the coil of rung i − 1 and an input.
@@ -43,7 +43,7 @@ fn chain(n: usize) -> Program {
         };
         rungs.push(json!({"id": format!("R{i}"), "ld": [{"contact": prev}, {"contact": "go"}, {"coil": format!("c{i}")}]}));
     }
-    plc_deps::read::program_from_value(&json!({"program": "chain", "vars": vars, "rungs": rungs}))
+    plc_deps::load::program_from_value(&json!({"program": "chain", "vars": vars, "rungs": rungs}))
         .expect("chain loads")
 }
 
@@ -77,7 +77,7 @@ fn uniform(n: usize) -> Program {
             json!({"id": format!("R{k}"), "ld": ld})
         })
         .collect();
-    plc_deps::read::program_from_value(&json!({"program": "uniform", "vars": vars, "rungs": rungs}))
+    plc_deps::load::program_from_value(&json!({"program": "uniform", "vars": vars, "rungs": rungs}))
         .expect("uniform loads")
 }
 

@@ -49,7 +49,7 @@ fn main() {
         rung_list.push(json!({"id": format!("R{k}"), "ld": ld}));
     }
     let doc = json!({"program": "speed", "vars": vars, "rungs": rung_list});
-    let program = plc_deps::read::program_from_value(&doc).expect("program loads");
+    let program = plc_deps::load::program_from_value(&doc).expect("program loads");
     let machine =
         Machine::new(&program, Layout::dense(&program), &ExecConfig::default()).expect("lowers");
     let mut state = machine.initial_state();

@@ -25,7 +25,7 @@ fn main() {
     for run in 0..runs {
         // As the command line loads a program: the main rungs resolved as they are read.
         let t = Instant::now();
-        let (p, _) = plc_deps::read::program_and_fbd_from_json(&text).expect("loads");
+        let (p, _) = plc_deps::load::program_and_fbd_from_json(&text).expect("loads");
         let total = t.elapsed();
         if run == 0 {
             peaks.push(("loaded", peak_mb()));

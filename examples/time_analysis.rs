@@ -10,7 +10,7 @@ fn main() {
     let path = std::env::args().nth(1).expect("usage: time_analysis FILE");
     let text = std::fs::read_to_string(&path).expect("read");
     let t = Instant::now();
-    let p = plc_deps::read::program_from_json(&text).expect("load");
+    let p = plc_deps::load::program_from_json(&text).expect("load");
     eprintln!("load: {:?} ({} rungs)", t.elapsed(), p.rungs.len());
     let all = Instant::now();
     let t = Instant::now();

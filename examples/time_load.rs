@@ -12,7 +12,7 @@ fn main() {
     let v: serde_json::Value = serde_json::from_str(&text).expect("json");
     eprintln!("parse: {:?}", t.elapsed());
     let t = Instant::now();
-    let p = plc_deps::read::program_from_value(&v).expect("load");
+    let p = plc_deps::load::program_from_value(&v).expect("load");
     eprintln!("resolve: {:?} ({} rungs)", t.elapsed(), p.rungs.len());
     let t = Instant::now();
     drop(v);

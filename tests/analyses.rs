@@ -58,7 +58,7 @@ fn every_worked_example_matches_its_committed_reports() {
     let mut runs = 0;
     for dir in dirs {
         let text = std::fs::read_to_string(dir.join("program.json")).expect("read program");
-        let (program, fbd) = plc_deps::read::program_and_fbd_from_json(&text)
+        let (program, fbd) = plc_deps::load::program_and_fbd_from_json(&text)
             .unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
         check(
             &dir.join("report.txt"),
@@ -152,7 +152,7 @@ fn every_plcopen_export_matches_its_committed_outputs() {
                 std::fs::remove_file(p).expect("remove a stale expectation");
             }
         };
-        match plc_deps::read::plcopen::load(&text) {
+        match plc_deps::load::plcopen(&text) {
             Err(e) => {
                 let shown = format!("error: {}\n", e.locate(&text).in_file("program.xml"));
                 check(&dir.join("error.txt"), &shown, &mut failures);

@@ -171,7 +171,7 @@ proptest! {
 
 /// Checks the combined schedule's safety conditions pairwise on one program.
 fn check_schedule(text: &str) -> Result<bool, TestCaseError> {
-    let Ok(p) = plc_deps::read::program_from_json(text) else {
+    let Ok(p) = plc_deps::load::program_from_json(text) else {
         return Ok(false);
     };
     let a = analyse(&p);
@@ -258,7 +258,7 @@ proptest! {
     #[test]
     fn levels_and_schedule_do_not_depend_on_the_listing(seed in any::<u64>()) {
         let text = common::random_program(seed, 24);
-        let Ok(p) = plc_deps::read::program_from_json(&text) else {
+        let Ok(p) = plc_deps::load::program_from_json(&text) else {
             return Err(TestCaseError::reject("not a valid program"));
         };
         let cfg = |dependences| AnalysisConfig { dependences };

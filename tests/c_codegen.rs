@@ -59,7 +59,7 @@ fn random_programs(
     let mut batch = Batch::default();
     for seed in seeds {
         let text = make(seed);
-        let Ok(p) = plc_deps::read::program_from_json(&text) else {
+        let Ok(p) = plc_deps::load::program_from_json(&text) else {
             continue;
         };
         let mut rng = Rng::new(seed + 1000);
@@ -116,7 +116,7 @@ fn random_fbd_programs_with_nested_fb_types_match_the_interpreter() {
     // One function per type: FB1, FB2 (nested in FB1 and at the top), FB3 (ladder).
     for seed in 0..40u64 {
         let text = common::fbd::random_nested_fbd_program(seed);
-        let Ok((p, fbd)) = plc_deps::read::program_and_fbd_from_json(&text) else {
+        let Ok((p, fbd)) = plc_deps::load::program_and_fbd_from_json(&text) else {
             continue;
         };
         let files = generate(&p, &fbd, &CConfig::default());
@@ -142,7 +142,7 @@ fn random_fbd_programs_with_nested_fb_types_match_the_interpreter() {
 #[test]
 fn example_c_has_the_shape_the_paper_prints() {
     let text = std::fs::read_to_string(root().join("analyses/example-c/program.json")).unwrap();
-    let (p, fbd) = plc_deps::read::program_and_fbd_from_json(&text).unwrap();
+    let (p, fbd) = plc_deps::load::program_and_fbd_from_json(&text).unwrap();
     let files = generate(&p, &fbd, &CConfig::default());
     let body = &files
         .iter()

@@ -15,9 +15,9 @@ use std::path::{Path, PathBuf};
 /// The model and FBD bodies of a program text, as `Debug` text.
 fn model_of(text: &str) -> Option<String> {
     let loaded = if plc_deps::read::plcopen::looks_like_xml(text) {
-        plc_deps::read::plcopen::load(text).map(|(p, f, _)| (p, f))
+        plc_deps::load::plcopen(text).map(|(p, f, _)| (p, f))
     } else {
-        plc_deps::read::program_and_fbd_from_json(text)
+        plc_deps::load::program_and_fbd_from_json(text)
     };
     loaded.ok().map(|(p, f)| format!("{p:#?}\n{f:#?}"))
 }

@@ -230,7 +230,7 @@ fn parallel_scan_equals_sequential_scan_on_random_programs() {
     let mut loaded = 0;
     for seed in 0..PROGRAMS {
         let json = common::random_program(seed, 24);
-        let Ok(p) = plc_deps::read::program_from_json(&json) else {
+        let Ok(p) = plc_deps::load::program_from_json(&json) else {
             continue;
         };
         loaded += 1;
@@ -280,7 +280,7 @@ fn dependence_driven_plan_equals_sequential_scan_on_random_programs() {
     let mut loaded = 0;
     for seed in 0..800u64 {
         let json = common::random_program(seed + 90_000, 24);
-        let Ok(p) = plc_deps::read::program_from_json(&json) else {
+        let Ok(p) = plc_deps::load::program_from_json(&json) else {
             continue;
         };
         loaded += 1;
@@ -337,7 +337,7 @@ fn every_plan_kind_with_up_to_eight_workers_equals_the_sequential_scan() {
     let mut stats = Stats::default();
     for seed in 0..400u64 {
         let json = common::random_program(seed + 50_000, 24);
-        let Ok(p) = plc_deps::read::program_from_json(&json) else {
+        let Ok(p) = plc_deps::load::program_from_json(&json) else {
             continue;
         };
         for threads in [2, 8] {
@@ -385,7 +385,7 @@ fn parallel_scan_equals_sequential_scan_on_generated_programs() {
         let json = plc_deps::synth::generate_string(&plc_deps::synth::GenConfig::all_features(
             rungs, width, seed,
         ));
-        let p = plc_deps::read::program_from_json(&json).unwrap();
+        let p = plc_deps::load::program_from_json(&json).unwrap();
         for threads in [2, 4] {
             for config in [
                 PlanConfig::new(threads),
@@ -423,7 +423,7 @@ fn worked_examples_with_their_inputs_under_forced_parallel_plans() {
         "mixing-station",
         "packaging-line",
     ] {
-        let p = plc_deps::read::program_from_json(
+        let p = plc_deps::load::program_from_json(
             &std::fs::read_to_string(root.join(dir).join("program.json")).unwrap(),
         )
         .unwrap();
@@ -473,7 +473,7 @@ fn wide_program_gets_a_parallel_plan_and_a_chain_falls_back() {
         width: 200,
         ..Default::default()
     });
-    let p = plc_deps::read::program_from_json(&wide).unwrap();
+    let p = plc_deps::load::program_from_json(&wide).unwrap();
     let a = analyse(&p);
     let par = ParallelMachine::new(&p, &a, &ExecConfig::default(), &PlanConfig::new(2)).unwrap();
     let plan = par.plan();
@@ -486,7 +486,7 @@ fn wide_program_gets_a_parallel_plan_and_a_chain_falls_back() {
     assert!(par.explain(&p).contains("contiguous"));
     // A chain: each rung reads the previous rung's coil; no level has two tasks.
     let chain = chain_program(50);
-    let p = plc_deps::read::program_from_json(&chain).unwrap();
+    let p = plc_deps::load::program_from_json(&chain).unwrap();
     let a = analyse(&p);
     let par = ParallelMachine::new(&p, &a, &ExecConfig::default(), &PlanConfig::new(2)).unwrap();
     assert!(par.plan().sequential().is_some(), "{}", par.explain(&p));
@@ -525,7 +525,7 @@ fn unconditional_backward_jump_refusal_is_a_cfg_edge_and_runs_in_parallel() {
         {"id": "R3", "ld": [{"contact": "x"}, {"coil": "after"}]}
       ]
     }"#;
-    let p = plc_deps::read::program_from_json(json).unwrap();
+    let p = plc_deps::load::program_from_json(json).unwrap();
     let a = analyse(&p);
     let refused: Vec<(u32, u32)> = a
         .cfg
@@ -552,7 +552,7 @@ fn unconditional_backward_jump_refusal_is_a_cfg_edge_and_runs_in_parallel() {
 fn one_scan_at_a_time_equals_a_run() {
     let json =
         plc_deps::synth::generate_string(&plc_deps::synth::GenConfig::all_features(800, 50, 9));
-    let p = plc_deps::read::program_from_json(&json).unwrap();
+    let p = plc_deps::load::program_from_json(&json).unwrap();
     let a = analyse(&p);
     let pool = pool();
     let par = ParallelMachine::new(&p, &a, &ExecConfig::default(), &PlanConfig::new(2)).unwrap();
@@ -614,7 +614,7 @@ fn swapped_chains(n: usize) -> String {
 
 #[test]
 fn the_measured_plan_times_the_locality_partition_and_stays_exact() {
-    let p = plc_deps::read::program_from_json(&swapped_chains(100)).unwrap();
+    let p = plc_deps::load::program_from_json(&swapped_chains(100)).unwrap();
     let a = analyse(&p);
     let config = PlanConfig {
         kind: PlanKind::Auto,

@@ -3,7 +3,7 @@
 //!
 //! The rule, by the info string of a fenced block:
 //! * ```` ```json ```` — a **whole program**: one JSON object with a `"program"` key, loaded with
-//!   `plc_deps::read::program_from_json` (FBD bodies included); it must load.
+//!   `plc_deps::load::program_from_json` (FBD bodies included); it must load.
 //! * ```` ```json fragment ```` — a **fragment** (an element, a declaration, a list of inputs):
 //!   not loaded, but it must be a sequence of one or more valid JSON values (one per line, say).
 //! * any other info string starting with `json` is an error (so no block is skipped silently);
@@ -64,7 +64,7 @@ fn check(b: &Block) -> Result<bool, String> {
                     "not a whole program (no \"program\" key): mark it ```json fragment".into(),
                 );
             }
-            plc_deps::read::program_from_json(&b.text)
+            plc_deps::load::program_from_json(&b.text)
                 .map(|_| true)
                 .map_err(|e| format!("the program does not load: {e}"))
         }

@@ -21,7 +21,7 @@ impl Sim {
     }
 
     fn with(json: &str, config: ExecConfig) -> Sim {
-        let p = plc_deps::read::program_from_json(json).expect("test program loads");
+        let p = plc_deps::load::program_from_json(json).expect("test program loads");
         let m = Machine::new(&p, Layout::dense(&p), &config).expect("test program lowers");
         let st = m.initial_state();
         Sim {
@@ -1192,7 +1192,7 @@ fn schedule_driven_scan_equals_sequential_scan() {
         .into_iter()
         .flat_map(|j| [100_000, 1, 2, 3].map(|c| (j, c)))
     {
-        let p = plc_deps::read::program_from_json(json).unwrap();
+        let p = plc_deps::load::program_from_json(json).unwrap();
         let sched = plc_deps::analysis::analyse(&p).schedule;
         let config = ExecConfig {
             loop_cap,
@@ -1230,7 +1230,7 @@ fn schedule_driven_scan_equals_sequential_scan() {
 
 #[test]
 fn padded_permuted_layout_gives_the_same_values() {
-    let p = plc_deps::read::program_from_json(EXAMPLE_B).unwrap();
+    let p = plc_deps::load::program_from_json(EXAMPLE_B).unwrap();
     let dense = Machine::new(&p, Layout::dense(&p), &ExecConfig::default()).unwrap();
     // Reverse order, one variable per 64-byte line.
     let n = p.vars.len() as u32;
@@ -1289,7 +1289,7 @@ fn padded_permuted_layout_gives_the_same_values() {
 #[test]
 fn bad_layouts_are_refused() {
     use plc_deps::exec::LayoutError;
-    let p = plc_deps::read::program_from_json(KASKAD_POST).unwrap(); // Count, idx: 2 INTs
+    let p = plc_deps::load::program_from_json(KASKAD_POST).unwrap(); // Count, idx: 2 INTs
     assert_eq!(
         Layout::from_starts(&p, vec![0], 4),
         Err(LayoutError::WrongLength {
@@ -1319,7 +1319,7 @@ fn bad_layouts_are_refused() {
         Err(LayoutError::BadVar { var: 1 })
     );
     assert_eq!(Layout::from_groups(&p, &[], 48), Err(LayoutError::BadAlign));
-    let other = plc_deps::read::program_from_json(EXAMPLE_B).unwrap();
+    let other = plc_deps::load::program_from_json(EXAMPLE_B).unwrap();
     assert!(Machine::new(&p, Layout::dense(&other), &ExecConfig::default()).is_err());
 }
 

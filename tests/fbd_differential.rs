@@ -89,7 +89,7 @@ fn parallel_scan_equals_sequential_scan_on_random_fbd_programs() {
         .unwrap_or(PROGRAMS);
     for seed in 0..programs {
         let text = random_fbd_program(seed);
-        let (p, fbd) = match plc_deps::read::program_and_fbd_from_json(&text) {
+        let (p, fbd) = match plc_deps::load::program_and_fbd_from_json(&text) {
             Ok(x) => x,
             Err(e) => {
                 refused.push(e.to_string());
@@ -204,7 +204,7 @@ fn fbd_worked_examples_under_forced_parallel_plans() {
         "kaskad-5",
     ] {
         let text = std::fs::read_to_string(root.join(dir).join("program.json")).unwrap();
-        let p = plc_deps::read::program_from_json(&text).unwrap();
+        let p = plc_deps::load::program_from_json(&text).unwrap();
         let a = analyse(&p);
         // Inputs from the committed table when there is one, 450 scans (past KASKAD 5's toggle
         // at scan 401), on a 10 ms cycle.

@@ -22,7 +22,7 @@ impl Sim {
             .join(example)
             .join("program.json");
         let text = std::fs::read_to_string(&path).expect("example exists");
-        let (p, fbd) = plc_deps::read::program_and_fbd_from_json(&text)
+        let (p, fbd) = plc_deps::load::program_and_fbd_from_json(&text)
             .unwrap_or_else(|e| panic!("{example}: {e}"));
         let m = Machine::new(&p, Layout::dense(&p), &ExecConfig::default()).expect("lowers");
         let st = m.initial_state();

@@ -18,7 +18,7 @@ struct Sim {
 
 impl Sim {
     fn new(doc: Json) -> Sim {
-        let (p, fbd) = plc_deps::read::program_and_fbd_from_json(&doc.to_string())
+        let (p, fbd) = plc_deps::load::program_and_fbd_from_json(&doc.to_string())
             .unwrap_or_else(|e| panic!("{e}"));
         let m = Machine::new(&p, Layout::dense(&p), &ExecConfig::default()).unwrap();
         let st = m.initial_state();
@@ -105,7 +105,7 @@ fn program(vars: Json, blocks: Json) -> Json {
 }
 
 fn err(doc: Json) -> String {
-    match plc_deps::read::program_and_fbd_from_json(&doc.to_string()) {
+    match plc_deps::load::program_and_fbd_from_json(&doc.to_string()) {
         Ok(_) => panic!("expected an error"),
         Err(e) => e.to_string(),
     }

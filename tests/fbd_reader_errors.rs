@@ -370,7 +370,7 @@ fn every_malformed_part_is_one_located_error_with_its_exact_text() {
         for (k, v) in extra.as_object().expect("an object") {
             doc[k] = v.clone();
         }
-        match plc_deps::read::program_and_fbd_from_json(&doc.to_string()) {
+        match plc_deps::load::program_and_fbd_from_json(&doc.to_string()) {
             Ok(_) => failures.push(format!("{fbd}: loaded, expected `{expected}`")),
             Err(e) => {
                 let got = e.to_string();
@@ -386,11 +386,11 @@ fn every_malformed_part_is_one_located_error_with_its_exact_text() {
 #[test]
 fn an_fbd_error_carries_the_line_and_column_of_the_field_it_names() {
     let text = "{\"program\": \"p\", \"vars\": [{\"name\": \"A\", \"type\": \"INT\"}],\n\"fbd\": {\"networks\": [{\"id\": \"N1\", \"blocks\": [\n  {\"id\": 1, \"op\": \"MOVE\", \"in\": [\"A\"], \"out\": \"A\"},\n  {\"id\": 2, \"op\": \"SQRT\"}]}]}}";
-    let e = plc_deps::read::program_from_json(text).expect_err("SQRT is no op");
+    let e = plc_deps::load::program_from_json(text).expect_err("SQRT is no op");
     let d = &e.diagnostics()[0];
     assert_eq!(d.location.position, Some((4, 13)));
     let text = text.replace("\"SQRT\"", "\"MOVE\", \"in\": [{\"from\": 7}]");
-    let e = plc_deps::read::program_from_json(&text).expect_err("no block 7");
+    let e = plc_deps::load::program_from_json(&text).expect_err("no block 7");
     assert_eq!(e.diagnostics()[0].location.position, Some((4, 35)));
 }
 
@@ -399,7 +399,7 @@ fn a_repeated_key_keeps_its_last_value() {
     let text = r#"{"program": "p", "vars": [{"name": "A", "type": "INT"}, {"name": "B", "type": "INT"}],
         "fbd": {"networks": [{"id": "N1", "blocks": 5, "blocks": [
             {"id": 1, "op": "SUB", "in": {"IN2": "A", "IN1": "B", "IN2": 5}, "out": "B"}]}]}}"#;
-    let (_, fbd) = plc_deps::read::program_and_fbd_from_json(text).expect("loads");
+    let (_, fbd) = plc_deps::load::program_and_fbd_from_json(text).expect("loads");
     let b = &fbd.pous[0].networks[0].blocks[0];
     let pins: Vec<(&str, Option<&plc_deps::fbd::Input>)> = b
         .inputs

@@ -8,7 +8,7 @@ use plc_deps::model::{Field, Program, Type, Value, VarId};
 use serde_json::json;
 
 fn load(text: &str) -> (Program, Fbd) {
-    plc_deps::read::program_and_fbd_from_json(text).expect("the program loads")
+    plc_deps::load::program_and_fbd_from_json(text).expect("the program loads")
 }
 
 fn own(slot: Slot) -> TypedRef {

@@ -885,7 +885,7 @@ fn for_bodies(v: &Value) -> Vec<usize> {
 }
 
 fn loads(text: &str, c: &GenConfig) {
-    if let Err(e) = plc_deps::read::program_from_json(text) {
+    if let Err(e) = plc_deps::load::program_from_json(text) {
         panic!("{c:?}: the reader refuses the program: {e}");
     }
 }

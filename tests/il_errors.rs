@@ -88,7 +88,7 @@ fn blocks_subroutines_interrupts_and_the_first_scan_bit() {
         String::from_utf8_lossy(&out.stderr),
         "warning[W0104]: interrupt routine INT_0 never runs here: plc-deps run raises no interrupt events (`plc-deps report` lists what it shares with the main program)\n\n"    );
     let text = std::fs::read_to_string(common::cli::root().join("tests/stl/blocks.stl")).unwrap();
-    let (p, _) = plc_deps::read::stl::load(&text).unwrap();
+    let (p, _) = plc_deps::load::stl(&text).unwrap();
     let pous: Vec<(&str, PouKind)> = p.pous.iter().map(|u| (u.name.as_str(), u.kind)).collect();
     assert_eq!(
         pous,
@@ -133,7 +133,7 @@ fn blocks_subroutines_interrupts_and_the_first_scan_bit() {
 #[test]
 fn set_and_reset_of_n_bits_count_on_from_the_address() {
     let text = std::fs::read_to_string(common::cli::root().join("tests/stl/set-bits.stl")).unwrap();
-    let (p, _) = plc_deps::read::stl::load(&text).unwrap();
+    let (p, _) = plc_deps::load::stl(&text).unwrap();
     let m = Machine::new(
         &p,
         Layout::dense(&p),

@@ -102,13 +102,13 @@ fn instructions(stl: &str) -> usize {
 
 #[test]
 fn the_generated_stl_is_at_most_the_papers_33_instructions_and_computes_its_formulas() {
-    let (p, fbd) = plc_deps::read::program_and_fbd_from_json(&analyses("program.json")).unwrap();
+    let (p, fbd) = plc_deps::load::program_and_fbd_from_json(&analyses("program.json")).unwrap();
     let stl = plc_deps::codegen::il::generate(&p, &fbd).unwrap();
     assert_eq!(instructions(&stl), 32, "{stl}");
     assert_eq!(instructions(&analyses("paper.stl")), 33);
     let want = expected();
     assert_eq!(truth_table(&p, &OUTS), want, "the FBD program itself");
-    let (back, _) = plc_deps::read::stl::load(&stl).unwrap();
+    let (back, _) = plc_deps::load::stl(&stl).unwrap();
     assert_eq!(
         truth_table(&back, &OUTS),
         want,
@@ -118,7 +118,7 @@ fn the_generated_stl_is_at_most_the_papers_33_instructions_and_computes_its_form
 
 #[test]
 fn the_papers_own_listing_computes_the_same_truth_table() {
-    let (p, _) = plc_deps::read::stl::load(&analyses("paper.stl")).unwrap();
+    let (p, _) = plc_deps::load::stl(&analyses("paper.stl")).unwrap();
     assert_eq!(truth_table(&p, &OUTS), expected());
 }
 
@@ -128,7 +128,7 @@ fn the_verbatim_listing_writes_q0_3_twice_and_the_second_write_wins() {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/stl/example-d-verbatim.stl"),
     )
     .unwrap();
-    let (p, _) = plc_deps::read::stl::load(&text).unwrap();
+    let (p, _) = plc_deps::load::stl(&text).unwrap();
     assert!(p.vars.iter().all(|v| v.name != "Q0_1"));
     let outs = ["Q0_0", "Q0_2", "Q0_3", "Q0_4", "Q1_0", "Q1_1"];
     let want: Vec<Vec<bool>> = expected()

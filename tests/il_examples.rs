@@ -24,7 +24,7 @@ fn dir(name: &str) -> std::path::PathBuf {
 
 fn load(name: &str) -> (Program, plc_deps::fbd::Fbd) {
     let text = std::fs::read_to_string(dir(name).join("program.json")).unwrap();
-    plc_deps::read::program_and_fbd_from_json(&text).unwrap()
+    plc_deps::load::program_and_fbd_from_json(&text).unwrap()
 }
 
 /// Every declared variable after each scan of `inputs` (by name), as `name=value`.
@@ -75,7 +75,7 @@ fn the_stl_of_each_example_is_the_committed_one_and_runs_the_same() {
                 path.display()
             ));
         }
-        let (back, _) = plc_deps::read::stl::load(&stl)
+        let (back, _) = plc_deps::load::stl(&stl)
             .unwrap_or_else(|e| panic!("{name}: {}", e.in_file("program.stl")));
         let csv = std::fs::read_to_string(dir(name).join("inputs.csv")).unwrap();
         let table = plc_deps::cmd::run::parse_inputs_csv(&p, &csv, "inputs.csv").unwrap();

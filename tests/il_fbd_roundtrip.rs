@@ -103,7 +103,7 @@ fn states(p: &Program, names: &[&str], inputs: &[Vec<bool>]) -> Vec<String> {
 /// True when compared (panics on a difference); false when the loader or `il` refused it.
 fn round_trip(seed: u64) -> bool {
     let text = program(seed);
-    let Ok((p, fbd)) = plc_deps::read::program_and_fbd_from_json(&text) else {
+    let Ok((p, fbd)) = plc_deps::load::program_and_fbd_from_json(&text) else {
         return false;
     };
     let stl = match plc_deps::codegen::il::generate(&p, &fbd) {
@@ -113,8 +113,8 @@ fn round_trip(seed: u64) -> bool {
             return false;
         }
     };
-    let (back, _) = plc_deps::read::stl::load(&stl)
-        .unwrap_or_else(|e| panic!("{}\n{stl}", e.in_file("il.stl")));
+    let (back, _) =
+        plc_deps::load::stl(&stl).unwrap_or_else(|e| panic!("{}\n{stl}", e.in_file("il.stl")));
     let mut rng = Rng::new(seed ^ 77);
     let inputs: Vec<Vec<bool>> = (0..10)
         .map(|_| (0..4).map(|_| rng.chance(50)).collect())

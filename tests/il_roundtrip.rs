@@ -93,7 +93,7 @@ enum Outcome {
 fn round_trip(seed: u64, input_seed: u64) -> Outcome {
     let mut doc: Json = serde_json::from_str(&common::random_program(seed, 16)).unwrap();
     s7_only(&mut doc);
-    let Ok((p, fbd)) = plc_deps::read::program_and_fbd_from_json(&doc.to_string()) else {
+    let Ok((p, fbd)) = plc_deps::load::program_and_fbd_from_json(&doc.to_string()) else {
         return Outcome::Refused;
     };
     let stl = match plc_deps::codegen::il::generate(&p, &fbd) {
@@ -106,7 +106,7 @@ fn round_trip(seed: u64, input_seed: u64) -> Outcome {
             return Outcome::NoForm;
         }
     };
-    let (back, _) = plc_deps::read::stl::load(&stl)
+    let (back, _) = plc_deps::load::stl(&stl)
         .unwrap_or_else(|e| panic!("seed {seed}: {}\n{stl}", e.in_file("il.stl")));
     let names: Vec<String> = p
         .vars

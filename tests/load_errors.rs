@@ -1,7 +1,8 @@
 //! The loader's error behaviour beyond one error per file (tests/errors/ holds those): several
 //! errors in program order, line and column of the node, a byte-order mark, an empty file.
 
-use plc_deps::read::{program_from_json, LoadError};
+use plc_deps::load::program_from_json;
+use plc_deps::read::LoadError;
 
 fn err(text: &str) -> LoadError {
     program_from_json(text).expect_err("the program is invalid")
@@ -147,7 +148,7 @@ fn instances_map_to_their_function_block_type_and_pou() {
       "function_blocks": {"GEN": {"inputs": [{"name": "IN", "type": "INT"}],
         "outputs": [{"name": "OUT", "type": "INT"}],
         "rungs": [{"id": "B1", "ld": [{"move": "IN", "to": "OUT"}]}]}}}"#;
-    let (p, fbd) = plc_deps::read::program_and_fbd_from_json(text).expect("loads");
+    let (p, fbd) = plc_deps::load::program_and_fbd_from_json(text).expect("loads");
     let names: Vec<(&str, &str)> = fbd
         .instances
         .iter()

@@ -148,7 +148,7 @@ fn execution_order_ids_that_disagree_with_the_data_flow_get_a_warning_with_both_
 fn comments_become_the_network_comment() {
     let xml =
         std::fs::read_to_string(common::cli::root().join("tests/plcopen/comment_fbd.xml")).unwrap();
-    let (_, fbd, notes) = plc_deps::read::plcopen::load(&xml).unwrap();
+    let (_, fbd, notes) = plc_deps::load::plcopen(&xml).unwrap();
     assert!(notes.is_empty());
     assert_eq!(fbd.pous[0].networks[0].comment.as_deref(), Some("Adds one"));
 }

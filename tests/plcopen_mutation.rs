@@ -144,7 +144,7 @@ fn apply(text: &mut String, e: &Edit) {
 
 /// Loads a mutant: a loaded one is analysed and scanned; a refused one has a place in the text.
 fn check(name: &str, text: &str) -> Result<(), TestCaseError> {
-    match plc_deps::read::plcopen::load(text) {
+    match plc_deps::load::plcopen(text) {
         Ok((program, _fbd, _notes)) => {
             let _ = plc_deps::analysis::analyse(&program);
             use plc_deps::exec::{ExecConfig, Layout, Machine};
@@ -279,7 +279,7 @@ fn mutants_both_load_and_fail() {
             ] {
                 let mut t = text.clone();
                 apply(&mut t, &e);
-                match plc_deps::read::plcopen::load(&t) {
+                match plc_deps::load::plcopen(&t) {
                     Ok(_) => loaded += 1,
                     Err(_) => refused += 1,
                 }

@@ -14,7 +14,7 @@ fn a_50_mb_ld_file_loads_whole() {
     let t = Instant::now();
     let (syntax, _) = plc_deps::read::plcopen::parse(&xml).unwrap();
     let parsed = t.elapsed();
-    let (p, _, notes) = plc_deps::read::plcopen::load(&xml).unwrap();
+    let (p, _, notes) = plc_deps::load::plcopen(&xml).unwrap();
     let loaded = t.elapsed() - parsed;
     drop(syntax);
     assert_eq!(p.rungs.len(), rungs);

@@ -2,7 +2,7 @@
 //! a rung nothing reaches, a subroutine nothing calls.
 
 use plc_deps::cmd::report::{render_report, ReportFormat};
-use plc_deps::read::program_and_fbd_from_json;
+use plc_deps::load::program_and_fbd_from_json;
 use plc_deps::report::View;
 use serde_json::{json, Value};
 

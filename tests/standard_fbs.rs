@@ -38,7 +38,7 @@ fn var(p: &Program, name: &str) -> VarId {
 /// The interpreter's value of each of `outs` (an instance as its JSON fields) after each scan
 /// of `rows` (values of `ins`, BOOL or INT).
 fn interpret(text: &str, ins: &[&str], rows: &[Vec<i64>], outs: &[&str]) -> Vec<Vec<Json>> {
-    let p = plc_deps::read::program_from_json(text).expect("program loads");
+    let p = plc_deps::load::program_from_json(text).expect("program loads");
     let m = Machine::new(&p, Layout::dense(&p), &ExecConfig::default()).unwrap();
     let mut st = m.initial_state();
     let mut got = Vec::new();
@@ -307,7 +307,7 @@ fn each_box_reads_and_writes_its_instance_and_reads_its_operands() {
                 {"ctud": "C", "cd": "E2.Q", "reset": "d", "load": false, "pv": "n"}]}
         ]),
     );
-    let p = plc_deps::read::program_from_json(&text).unwrap();
+    let p = plc_deps::load::program_from_json(&text).unwrap();
     let acc = accesses(&p);
     let names = |vs: &[VarId]| -> Vec<String> {
         let mut v: Vec<String> = vs.iter().map(|&x| p.var(x).name.clone()).collect();

@@ -100,7 +100,7 @@ mod tests {
     use crate::analysis::accesses::accesses;
 
     fn load(json: &str) -> Program {
-        crate::read::program_and_fbd_from_json(json)
+        crate::load::program_and_fbd_from_json(json)
             .expect("loads")
             .0
     }

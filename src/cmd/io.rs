@@ -241,15 +241,15 @@ pub fn load_text(file: String, text: &str) -> Result<(Program, Fbd), CliError> {
     use crate::read::{plcopen, stl};
     let lower = file.to_ascii_lowercase();
     if stl::looks_like_stl(text) || lower.ends_with(".stl") || lower.ends_with(".awl") {
-        return stl::load(text).map_err(|error| CliError::load(file, text, error));
+        return crate::load::stl(text).map_err(|error| CliError::load(file, text, error));
     }
     if plcopen::looks_like_xml(text) {
-        let (p, f, notes) =
-            plcopen::load(text).map_err(|error| CliError::load(file.clone(), text, error))?;
+        let (p, f, notes) = crate::load::plcopen(text)
+            .map_err(|error| CliError::load(file.clone(), text, error))?;
         warn_notes(PLCOPEN_NOTE, &file, text, &notes);
         return Ok((p, f));
     }
-    crate::read::program_and_fbd_from_json(text).map_err(|error| CliError::load(file, text, error))
+    crate::load::program_and_fbd_from_json(text).map_err(|error| CliError::load(file, text, error))
 }
 
 /// The code of a PLCopen reader's note (what it read only through an interface, ignored, or

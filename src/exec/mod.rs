@@ -4,7 +4,7 @@
 //! ```
 //! use plc_deps::exec::{ExecConfig, Layout, Machine};
 //! use plc_deps::model::{Value, VarId};
-//! let p = plc_deps::read::program_from_json(r#"{"program": "p",
+//! let p = plc_deps::load::program_from_json(r#"{"program": "p",
 //!     "vars": [{"name": "a", "type": "BOOL", "class": "input"}, {"name": "q", "type": "BOOL", "class": "output"}],
 //!     "rungs": [{"id": "R1", "ld": [{"contact": "a"}, {"coil": "q"}]}]}"#).unwrap();
 //! let m = Machine::new(&p, Layout::dense(&p), &ExecConfig::default()).unwrap();

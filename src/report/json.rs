@@ -270,7 +270,7 @@ mod tests {
     }
 
     fn check(text: &str) {
-        let (p, fbd) = crate::read::program_and_fbd_from_json(text).expect("loads");
+        let (p, fbd) = crate::load::program_and_fbd_from_json(text).expect("loads");
         let a = crate::analysis::analyse(&p);
         let parts = crate::report::fbd_parts(&p, &fbd);
         let doc = crate::report::document_with(&p, &a, parts.as_ref());

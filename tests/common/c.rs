@@ -60,7 +60,7 @@ pub fn compile(dir: &Path, exe: &str, sources: &[String]) {
 /// Writes the C of `text` into `dir` (without the runtime header when `runtime` is false); the
 /// names of its C sources.
 fn write(text: &str, cfg: &CConfig, dir: &Path, runtime: bool) -> Vec<String> {
-    let (p, fbd) = plc_deps::read::program_and_fbd_from_json(text).expect("program loads");
+    let (p, fbd) = plc_deps::load::program_and_fbd_from_json(text).expect("program loads");
     let mut sources = Vec::new();
     for f in generate(&p, &fbd, cfg) {
         if (f.name == "plc_runtime.h" || f.name == "plc_main.h") && !runtime {
@@ -122,7 +122,7 @@ pub fn run_interpreter(
     scans: u64,
     cfg: &CConfig,
 ) -> (Vec<String>, Vec<String>) {
-    let p = plc_deps::read::program_from_json(text).unwrap();
+    let p = plc_deps::load::program_from_json(text).unwrap();
     let exec = ExecConfig {
         cycle_ms: cfg.cycle_ms,
         loop_cap: cfg.loop_cap,

@@ -264,7 +264,7 @@ pub fn example_report(name: &str) -> serde_json::Value {
         env!("CARGO_MANIFEST_DIR")
     );
     let text = std::fs::read_to_string(path).unwrap();
-    let (p, fbd) = plc_deps::read::program_and_fbd_from_json(&text).unwrap();
+    let (p, fbd) = plc_deps::load::program_and_fbd_from_json(&text).unwrap();
     let json = render_report(&p, &fbd, ReportFormat::Json, plc_deps::report::View::All);
     serde_json::from_str(&json).unwrap()
 }

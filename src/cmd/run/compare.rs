@@ -118,7 +118,7 @@ mod tests {
     #[test]
     fn first_difference_names_the_variable_and_both_values() {
         // The same program on two clocks: the timer's ET differs from scan 1 on.
-        let p = crate::read::program_from_json(
+        let p = crate::load::program_from_json(
             r#"{"program": "t", "vars": [{"name": "go", "type": "BOOL", "class": "input", "init": true},
                 {"name": "T1", "type": "TON"}], "rungs": [{"id": "R1", "ld": [{"contact": "go"}, {"ton": "T1", "pt": "T#1s"}]}]}"#,
         )

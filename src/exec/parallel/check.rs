@@ -110,7 +110,7 @@ mod tests {
 
     /// Two independent rungs writing two BOOLs: a parallel level of two tasks.
     fn program() -> crate::model::Program {
-        crate::read::program_from_json(
+        crate::load::program_from_json(
             r#"{"program": "p", "vars": [
                 {"name": "a", "type": "BOOL", "class": "input"},
                 {"name": "b", "type": "BOOL", "class": "input"},

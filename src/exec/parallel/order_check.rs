@@ -238,7 +238,7 @@ mod tests {
     /// R1 (a → x) and R2 (b → y) in level 0, R3 (x, y → z) in level 1: on two workers with
     /// contiguous slices R1 and R3 run on worker 0, R2 on worker 1, and R3 waits for R2.
     fn program() -> Program {
-        crate::read::program_from_json(
+        crate::load::program_from_json(
             r#"{"program": "p", "vars": [
                 {"name": "a", "type": "BOOL", "class": "input"},
                 {"name": "b", "type": "BOOL", "class": "input"},
@@ -383,7 +383,7 @@ mod tests {
         ) {
             let json = crate::synth::generate_string(
                 &crate::synth::GenConfig::all_features(rungs, width, seed));
-            let p = crate::read::program_from_json(&json).unwrap();
+            let p = crate::load::program_from_json(&json).unwrap();
             let a = crate::analysis::analyse(&p);
             let plan = deps_plan::build(&p, &a, &config(threads, slicing));
             prop_assume!(plan.sequential().is_none());

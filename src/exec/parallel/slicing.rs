@@ -278,7 +278,7 @@ mod tests {
             vars.join(", "),
             rungs.join(", ")
         );
-        crate::read::program_from_json(&json).expect("a valid program")
+        crate::load::program_from_json(&json).expect("a valid program")
     }
 
     fn plan(p: &crate::model::Program, slicing: Slicing) -> Plan {

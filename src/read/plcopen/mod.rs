@@ -30,11 +30,9 @@ mod textual;
 mod wiring;
 mod xml;
 
-pub use xml::{Note, Notes, MAX_XML_BYTES, NAMESPACES};
+pub use xml::{ExecOrder, Note, Notes, MAX_XML_BYTES, NAMESPACES};
 
 use crate::diag::LoadError;
-use crate::fbd::Fbd;
-use crate::model::Program;
 use crate::syntax;
 
 /// True when the text is XML rather than JSON: its first non-blank character is `<`.
@@ -53,56 +51,6 @@ pub fn parse(text: &str) -> Result<(syntax::Program<'static>, Notes), LoadError>
     let program =
         project::program(xml::Tc6 { ns }, &doc, &mut notes).map_err(|e| e.locate(text))?;
     Ok((program, notes))
-}
-
-/// Reads and resolves a PLCopen project: the program, its FBD bodies, and the reader's notes
-/// (with one for each FBD body whose executionOrderIds order its blocks otherwise than plc-deps).
-pub fn load(text: &str) -> Result<(Program, Fbd, Vec<Note>), LoadError> {
-    let (syntax, mut notes) = parse(text)?;
-    let (p, f) = crate::resolve::resolve(text, &syntax)?;
-    for x in &notes.exec_orders {
-        if let Some(n) = exec_order_note(&f, x) {
-            notes.list.push(n);
-        }
-    }
-    Ok((p, f, notes.list))
-}
-
-/// Compares the order of the file's executionOrderIds with the order plc-deps runs the same
-/// blocks in (the FBD text-generation paper's sort, docs/fbd.md): a note with both if they differ.
-fn exec_order_note(f: &Fbd, x: &xml::ExecOrder) -> Option<Note> {
-    let pou = f
-        .pous
-        .iter()
-        .find(|p| p.networks.iter().any(|n| Some(&n.id) == x.networks.first()))?;
-    let wanted: std::collections::HashSet<u32> = x.ids.iter().map(|&(_, l)| l).collect();
-    let ours: Vec<u32> = pou
-        .networks
-        .iter()
-        .zip(&pou.plans)
-        .flat_map(|(n, plan)| plan.order.iter().map(move |&b| n.block(b).id))
-        .filter(|id| wanted.contains(id))
-        .collect();
-    // Only the elements that are blocks here (an out variable is part of the block feeding it).
-    let file: Vec<u32> = x
-        .ids
-        .iter()
-        .map(|&(_, l)| l)
-        .filter(|l| ours.contains(l))
-        .collect();
-    if ours == file {
-        return None;
-    }
-    let show = |v: &[u32]| v.iter().map(u32::to_string).collect::<Vec<_>>().join(", ");
-    Some(Note {
-        origin: x.origin,
-        message: format!(
-            "pou {}, FBD: the file's executionOrderIds run localIds {}; plc-deps runs them {} (data flow first, ties by localId; `plc-deps order` shows the whole order)",
-            pou.name,
-            show(&file),
-            show(&ours)
-        ),
-    })
 }
 
 /// A note as the command line prints it after `warning: ` (`FILE:LINE:COLUMN: message`).

@@ -26,8 +26,6 @@ mod net;
 mod operand;
 
 use crate::diag::{LoadError, Origin};
-use crate::fbd::Fbd;
-use crate::model::Program;
 use crate::syntax::{self, Body, Located, RoutineKind, Subroutine, Var, VarClass};
 use std::borrow::Cow;
 
@@ -394,10 +392,4 @@ fn declarations(
         at0,
         "declaration section not closed by END_VAR",
     ))
-}
-
-/// Reads and resolves an STL file: the program and its (empty) FBD bodies.
-pub fn load(text: &str) -> Result<(Program, Fbd), LoadError> {
-    let syntax = parse(text)?;
-    crate::resolve::resolve(text, &syntax)
 }

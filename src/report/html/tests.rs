@@ -14,7 +14,7 @@ fn page(example: &str) -> (String, Program, Analysis) {
         env!("CARGO_MANIFEST_DIR")
     );
     let text = std::fs::read_to_string(path).expect("example");
-    let (p, fbd) = crate::read::program_and_fbd_from_json(&text).expect("loads");
+    let (p, fbd) = crate::load::program_and_fbd_from_json(&text).expect("loads");
     let a = analyse(&p);
     let parts = fbd_parts(&p, &fbd);
     let doc = document_with(&p, &a, parts.as_ref());

@@ -1,0 +1,129 @@
+//! Loading: a program file's text → its reader ([`crate::read`]: JSON, PLCopen TC6 XML or S7-200
+//! STL) → the surface syntax ([`crate::syntax`]) → the resolver ([`crate::resolve`]) → one
+//! resolved [`Program`] with its FBD bodies ([`Fbd`]).
+//!
+//! This is the one place where a reader and the resolver meet, so that neither imports the
+//! other: the readers know only the syntax, the resolver only the syntax and the model.
+//!
+//! Invariants: a program loads whole or not at all; every error is one [`LoadError`] located in
+//! the text (line and column, the rung or block). It does not read files or pick the format by
+//! content: the commands do that (`cmd::io`).
+
+use crate::diag::LoadError;
+use crate::fbd::Fbd;
+use crate::model::Program;
+use crate::read;
+use crate::read::plcopen::{ExecOrder, Note};
+use crate::resolve;
+
+/// Parses and checks a program given as JSON text.
+pub fn program_from_json(text: &str) -> Result<Program, LoadError> {
+    program_and_fbd_from_json(text).map(|(p, _)| p)
+}
+
+/// Parses and checks a program given as JSON text, and returns with it the FBD bodies it was
+/// written in (before lowering: their networks, execution orders and fragment trees).
+///
+/// The main program's rungs are resolved as they are read ([`resolve::Stream`]), so that
+/// the whole syntax tree is never held; should that not resolve, the text is read again into
+/// the whole tree, whose resolution gives the program or every error, as it always would.
+pub fn program_and_fbd_from_json(text: &str) -> Result<(Program, Fbd), LoadError> {
+    let whole = |syntax: &crate::syntax::Program<'_>| {
+        resolve::resolve(text, syntax).map_err(|e| {
+            e.refine(text, |t, p| {
+                read::json::path_offset(t, p).map(|(start, _)| start)
+            })
+        })
+    };
+    let mut stream = resolve::Stream::default();
+    let syntax = if text.len() >= PIPE_FROM && two_cores() {
+        crate::syntax::pipe::through_pipe(&mut stream, |sink| {
+            read::json::parse_with(text, Some(sink))
+        })?
+    } else {
+        read::json::parse_with(text, Some(&mut stream))?
+    };
+    if !stream.took_rungs() {
+        return whole(&syntax);
+    }
+    if let Some(done) = stream.finish(&syntax) {
+        return Ok(done);
+    }
+    drop(syntax);
+    whole(&read::json::parse(text)?)
+}
+
+/// Files from this size on are read on one thread and resolved on another
+/// ([`crate::syntax::pipe`]); below it, starting a thread costs more than it gains.
+const PIPE_FROM: usize = 1 << 20;
+
+fn two_cores() -> bool {
+    std::thread::available_parallelism().is_ok_and(|n| n.get() > 1)
+}
+
+/// Builds a program from an already parsed JSON document (tests and benchmarks that build
+/// programs with `serde_read::json::json!`). Loading from text is the fast path.
+pub fn program_from_value(doc: &serde_json::Value) -> Result<Program, LoadError> {
+    program_from_json(&doc.to_string())
+}
+
+/// [`program_from_value`], with the FBD bodies.
+pub fn program_and_fbd_from_value(doc: &serde_json::Value) -> Result<(Program, Fbd), LoadError> {
+    program_and_fbd_from_json(&doc.to_string())
+}
+
+/// Reads and resolves a PLCopen project: the program, its FBD bodies, and the reader's notes
+/// (with one for each FBD body whose executionOrderIds order its blocks otherwise than plc-deps).
+pub fn plcopen(text: &str) -> Result<(Program, Fbd, Vec<Note>), LoadError> {
+    let (syntax, mut notes) = read::plcopen::parse(text)?;
+    let (p, f) = resolve::resolve(text, &syntax)?;
+    for x in &notes.exec_orders {
+        if let Some(n) = exec_order_note(&f, x) {
+            notes.list.push(n);
+        }
+    }
+    Ok((p, f, notes.list))
+}
+
+/// Compares the order of the file's executionOrderIds with the order plc-deps runs the same
+/// blocks in (the FBD text-generation paper's sort, docs/fbd.md): a note with both if they differ.
+fn exec_order_note(f: &Fbd, x: &ExecOrder) -> Option<Note> {
+    let pou = f
+        .pous
+        .iter()
+        .find(|p| p.networks.iter().any(|n| Some(&n.id) == x.networks.first()))?;
+    let wanted: std::collections::HashSet<u32> = x.ids.iter().map(|&(_, l)| l).collect();
+    let ours: Vec<u32> = pou
+        .networks
+        .iter()
+        .zip(&pou.plans)
+        .flat_map(|(n, plan)| plan.order.iter().map(move |&b| n.block(b).id))
+        .filter(|id| wanted.contains(id))
+        .collect();
+    // Only the elements that are blocks here (an out variable is part of the block feeding it).
+    let file: Vec<u32> = x
+        .ids
+        .iter()
+        .map(|&(_, l)| l)
+        .filter(|l| ours.contains(l))
+        .collect();
+    if ours == file {
+        return None;
+    }
+    let show = |v: &[u32]| v.iter().map(u32::to_string).collect::<Vec<_>>().join(", ");
+    Some(Note {
+        origin: x.origin,
+        message: format!(
+            "pou {}, FBD: the file's executionOrderIds run localIds {}; plc-deps runs them {} (data flow first, ties by localId; `plc-deps order` shows the whole order)",
+            pou.name,
+            show(&file),
+            show(&ours)
+        ),
+    })
+}
+
+/// Reads and resolves an STL file: the program and its (empty) FBD bodies.
+pub fn stl(text: &str) -> Result<(Program, Fbd), LoadError> {
+    let syntax = read::stl::parse(text)?;
+    resolve::resolve(text, &syntax)
+}
