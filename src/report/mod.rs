@@ -19,7 +19,9 @@ pub mod text;
 
 pub use document::{document, document_with, Report};
 pub use dot::{render_dot, select_rungs, Selection, MAX_RUNGS as DOT_MAX_RUNGS};
-pub use html::{render_html, HtmlInput};
+pub use html::{
+    render_html, render_run_html, FaultRow, HtmlInput, ModeFigures, PlanFigures, RunFigures,
+};
 pub use json::render_json;
 pub use text::{render_text, Rows, TextOptions};
 
