@@ -198,8 +198,8 @@ pub(super) fn write_summary(out: &mut impl Write, r: &Report) -> io::Result<()> 
     out.write_all(b"</div>\n</div>\n")?;
     if !r.warnings.is_empty() {
         out.write_all(b"<ul class=\"warnings\">\n")?;
-        for w in &r.warnings {
-            writeln!(out, "<li class=\"note\">warning: {}</li>", esc(w))?;
+        for (w, code) in r.warnings.iter().zip(&r.warning_codes) {
+            writeln!(out, "<li class=\"note\">warning[{code}]: {}</li>", esc(w))?;
         }
         out.write_all(b"</ul>\n")?;
     }
