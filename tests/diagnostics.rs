@@ -335,3 +335,62 @@ fn listing_only_the_direct_pairs_is_a_coded_warning() {
         "{message}"
     );
 }
+
+/// The hint of a fragment-rule error is a fix: applied to the program, it loads.
+#[test]
+fn a_fragment_rule_error_hints_the_fix_and_the_fix_loads() {
+    let broken =
+        std::fs::read_to_string(root().join("tests/errors/fbd-fragment-rule.json")).unwrap();
+    let out = run_stdin(&["order", "-"], broken.as_bytes());
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        stderr.contains("= help: write that output of block 9 to a variable and use the variable in block 12 instead of the arc: it keeps its last value in the scans where block 9 does not run"),
+        "{stderr}"
+    );
+    // The fix: block 9 writes V, block 12 reads V.
+    let fixed = broken
+        .replace(
+            r#"{"name": "Y", "type": "INT", "class": "output"}"#,
+            r#"{"name": "Y", "type": "INT", "class": "output"}, {"name": "V", "type": "INT"}"#,
+        )
+        .replace(
+            r#""cond": {"from": 4}}"#,
+            r#""cond": {"from": 4}, "out": "V"}"#,
+        )
+        .replace(r#"{"from": 9}]"#, r#""V"]"#);
+    assert_ne!(fixed, broken);
+    let out = run_stdin(&["order", "-"], fixed.as_bytes());
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // A one-source control arc from another fragment: the hint is to remove it.
+    let ordered = broken.replace(
+        r#"[{"from": 8}, {"from": 9}]"#,
+        r#"[{"from": 8}, 1], "after": [9]"#,
+    );
+    let out = run_stdin(&["order", "-"], ordered.as_bytes());
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        stderr.starts_with("error[E0410]: block 12 (fragment F(3)) runs after block 9"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("= help: remove the control arc from block 9 to block 12: block 9 does not run in every scan that runs block 12, so it cannot order it"),
+        "{stderr}"
+    );
+    let out = run_stdin(
+        &["order", "-"],
+        ordered.replace(r#", "after": [9]"#, "").as_bytes(),
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
