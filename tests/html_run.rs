@@ -272,3 +272,32 @@ fn a_page_is_written_whole_or_not_at_all() {
     assert_eq!(out.status.code(), Some(2));
     assert!(!nowhere.exists());
 }
+
+#[test]
+fn the_runs_warnings_are_on_its_page_as_on_standard_error() {
+    let page = tmp("interrupt.html");
+    let out = run(&[
+        "run",
+        "analyses/encoder-interrupt/program.json",
+        "--scans",
+        "3",
+        "--mode",
+        "seq",
+        "--format",
+        "html",
+        "-o",
+        page.to_str().unwrap(),
+    ]);
+    assert!(out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let want = "warning[W0104]: interrupt routine ENCODER never runs here";
+    assert!(stderr.starts_with(want), "{stderr}");
+    let html = std::fs::read_to_string(&page).unwrap();
+    let run_section = html.split("<section id=\"run\">").nth(1).unwrap();
+    assert!(run_section.contains(&format!("<li class=\"note\">{want}")));
+    // The analysis's warning stays in the summary, with its code.
+    let summary = html.split("<section id=\"run\">").next().unwrap();
+    assert!(
+        summary.contains("<li class=\"note\">warning[W0204]: interrupt routine ENCODER may run")
+    );
+}

@@ -94,7 +94,9 @@ pub fn run(c: &RunConfig) -> Result<(), CliError> {
         RunFormat::Html => {
             let (p, a, fbd) = pr.page_parts().expect("prepared for the HTML page");
             let _phase = progress.phase("writing the page");
-            write_output_with(c.output.as_deref(), |w| write_html(p, a, fbd, &r, w))?
+            write_output_with(c.output.as_deref(), |w| {
+                write_html(p, a, fbd, &r, &pr.warnings, w)
+            })?
         }
     }
     match failure(&r) {

@@ -2,7 +2,7 @@
 //! and its deterministic form for `analyses/*/run.json`, and the HTML page (the program's report
 //! page with the run's figures, drawn by `report::html`; this module only hands it the figures).
 
-use super::config::count;
+use super::config::{count, RunWarning};
 use super::engine::RunReport;
 use crate::analysis::Analysis;
 use crate::exec::parallel::run_log_json;
@@ -290,8 +290,9 @@ pub fn render_text(r: &RunReport) -> String {
     s
 }
 
-/// The figures the HTML page shows of a run (measured times as they are, not zeroed).
-pub fn run_figures(r: &RunReport) -> RunFigures {
+/// The figures the HTML page shows of a run (measured times as they are, not zeroed), with the
+/// warnings it gave.
+pub fn run_figures(r: &RunReport, warnings: &[RunWarning]) -> RunFigures {
     RunFigures {
         scans: r.scans,
         cycle_ms: r.cycle_ms,
@@ -338,16 +339,18 @@ pub fn run_figures(r: &RunReport) -> RunFigures {
             })
             .collect(),
         explain: r.explain.as_ref().map(|(text, _)| text.clone()),
+        warnings: warnings.iter().map(|w| (w.code(), w.to_string())).collect(),
     }
 }
 
-/// Writes the HTML page of a run of `p` (analysed as `a`, FBD bodies `fbd`): the report page
-/// of the program with the run's section (docs/html.md).
+/// Writes the HTML page of a run of `p` (analysed as `a`, FBD bodies `fbd`) that gave
+/// `warnings`: the report page of the program with the run's section (docs/html.md).
 pub fn write_html(
     p: &Program,
     a: &Analysis,
     fbd: &Fbd,
     r: &RunReport,
+    warnings: &[RunWarning],
     out: &mut dyn std::io::Write,
 ) -> std::io::Result<()> {
     let parts = fbd_parts(p, fbd);
@@ -360,7 +363,7 @@ pub fn write_html(
             analysis: a,
             fbd: Some(fbd),
         },
-        &run_figures(r),
+        &run_figures(r, warnings),
         &mut out,
     )?;
     std::io::Write::flush(&mut out)

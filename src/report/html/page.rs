@@ -196,14 +196,30 @@ pub(super) fn write_summary(out: &mut impl Write, r: &Report) -> io::Result<()> 
     )?;
     super::charts::write_bars(out, r)?;
     out.write_all(b"</div>\n</div>\n")?;
-    if !r.warnings.is_empty() {
-        out.write_all(b"<ul class=\"warnings\">\n")?;
-        for (w, code) in r.warnings.iter().zip(&r.warning_codes) {
-            writeln!(out, "<li class=\"note\">warning[{code}]: {}</li>", esc(w))?;
-        }
-        out.write_all(b"</ul>\n")?;
-    }
+    write_warnings(
+        out,
+        r.warning_codes
+            .iter()
+            .copied()
+            .zip(r.warnings.iter().map(String::as_str)),
+    )?;
     out.write_all(b"</section>\n")
+}
+
+/// A list of warnings, `(code, message)` each (nothing when there are none).
+pub(super) fn write_warnings<'w>(
+    out: &mut impl Write,
+    warnings: impl Iterator<Item = (&'w str, &'w str)>,
+) -> io::Result<()> {
+    let mut warnings = warnings.peekable();
+    if warnings.peek().is_none() {
+        return Ok(());
+    }
+    out.write_all(b"<ul class=\"warnings\">\n")?;
+    for (code, w) in warnings {
+        writeln!(out, "<li class=\"note\">warning[{code}]: {}</li>", esc(w))?;
+    }
+    out.write_all(b"</ul>\n")
 }
 
 /// The legend of the level view.

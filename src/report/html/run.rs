@@ -80,6 +80,8 @@ pub struct RunFigures {
     pub faults: Vec<FaultRow>,
     /// The text of `--explain`, when asked for.
     pub explain: Option<String>,
+    /// The run's warnings: (code, message).
+    pub warnings: Vec<(&'static str, String)>,
 }
 
 impl RunFigures {
@@ -127,6 +129,7 @@ pub(super) fn write_run(out: &mut impl Write, doc: &Report, run: &RunFigures) ->
             String::new()
         }
     )?;
+    super::page::write_warnings(out, run.warnings.iter().map(|(c, w)| (*c, w.as_str())))?;
     out.write_all(b"<div class=\"summary\">\n")?;
     write_rates(out, run)?;
     write_ideal(out, doc, run)?;

@@ -243,6 +243,7 @@ fn example_a_run() -> RunFigures {
             last_scan: 9,
         }],
         explain: None,
+        warnings: Vec::new(),
     }
 }
 
@@ -326,6 +327,10 @@ fn a_run_page_says_when_the_parallel_pass_fell_back_and_what_differed() {
     run.identical = Some(false);
     run.first_difference = Some(r#"{"scan":3,"variable":"X"}"#.into());
     run.workers = 3;
+    run.warnings = vec![(
+        "W0101",
+        "--threads 3 is more than the 2 cores <of this machine>".into(),
+    )];
     run.fault_count = 0;
     run.faults.clear();
     let (html, _, _) = page_with("example-a", Some(&run));
@@ -340,6 +345,7 @@ fn a_run_page_says_when_the_parallel_pass_fell_back_and_what_differed() {
     // Three workers: the model has no row for them, and says so.
     assert!(!html.contains("(this run)") && html.contains("this run had 3 workers"));
     assert!(!html.contains("model, P ="));
+    assert!(html.contains("<li class=\"note\">warning[W0101]: --threads 3 is more than the 2 cores &lt;of this machine&gt;</li>"));
     assert!(html.contains("<p class=\"faults\">none</p>"));
 }
 
