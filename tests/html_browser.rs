@@ -415,4 +415,60 @@ fn every_example_page_loads_clicks_and_highlights_in_chromium() {
     for e in &examples {
         check_example(&mut b, e, &shots);
     }
+    check_fault_chip(&mut b);
+}
+
+/// A run that faults: its page lists the fault with its rung as a chip, and clicking the chip
+/// selects the rung's card.
+fn check_fault_chip(b: &mut Browser) {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("html-pages");
+    std::fs::create_dir_all(&dir).unwrap();
+    let program = dir.join("faulty.json");
+    std::fs::write(
+        &program,
+        r#"{"program": "faulty", "vars": [{"name": "d", "type": "INT", "class": "input"}, {"name": "x", "type": "INT", "class": "output"}, {"name": "q", "type": "BOOL", "class": "output"}],
+  "rungs": [{"id": "DIV", "ld": [{"op": "DIV", "in": [10, "d"], "out": "x"}]},
+            {"id": "Q", "ld": [{"compare": "GT", "a": "x", "b": 1}, {"coil": "q"}]}]}"#,
+    )
+    .unwrap();
+    let page = dir.join("faulty-run.html");
+    let status = Command::new(env!("CARGO_BIN_EXE_plc-deps"))
+        .arg("run")
+        .arg(&program)
+        .args(["--scans", "4", "--format", "html", "-o"])
+        .arg(&page)
+        .status()
+        .unwrap();
+    assert_eq!(status.code(), Some(1), "a faulted run");
+    b.events.clear();
+    b.call(
+        "Page.navigate",
+        json!({"url": format!("file://{}", page.display())}),
+    );
+    b.wait_event("Page.loadEventFired");
+    assert!(b.errors().is_empty(), "{:?}", b.errors());
+    let rows = b.eval(
+        "Array.from(document.querySelectorAll('#run table.faults tr')).slice(1).map(r => Array.from(r.cells).map(c => c.textContent))",
+    );
+    assert_eq!(rows, json!([["DIV", "div-by-zero", "4", "0", "3"]]));
+    let rect = b.eval(
+        "(() => { const c = document.querySelector('#run table.faults .chip'); c.scrollIntoView({block: 'center'}); const r = c.getBoundingClientRect(); return [r.left + r.width / 2, r.top + r.height / 2]; })()",
+    );
+    b.click(rect[0].as_f64().unwrap(), rect[1].as_f64().unwrap());
+    let state = b.eval(
+        "[document.getElementById('rung-DIV').classList.contains('sel'), document.getElementById('rung-Q').classList.contains('user'), document.getElementById('info').textContent]",
+    );
+    assert_eq!(
+        state[0],
+        json!(true),
+        "the faulting rung's card is selected"
+    );
+    assert_eq!(state[1], json!(true), "Q, which reads x, depends on it");
+    assert!(
+        state[2]
+            .as_str()
+            .unwrap()
+            .starts_with("DIV depends on nothing; depending on it: Q"),
+        "{state}"
+    );
 }
