@@ -333,7 +333,9 @@ fn a_run_page_says_when_the_parallel_pass_fell_back_and_what_differed() {
     )];
     run.fault_count = 0;
     run.faults.clear();
+    run.explain = Some("level 1: R1 R2 <R5>".into());
     let (html, _, _) = page_with("example-a", Some(&run));
+    assert!(html.contains("<details><summary>The parallel plan (--explain)</summary><pre>level 1: R1 R2 &lt;R5&gt;</pre></details>"));
     assert_eq!(
         rows(&html, "rates")[1],
         "par|0.025|40,000,000|200.0|sequential fallback (no level saves more than the barriers it needs)"
