@@ -227,6 +227,8 @@ enum ModeArg {
 enum RunFormatArg {
     Text,
     Json,
+    /// The report page of the program with the run's figures (docs/html.md).
+    Html,
 }
 
 #[derive(Copy, Clone, ValueEnum)]
@@ -442,6 +444,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
             config.format = match format {
                 RunFormatArg::Text => RunFormat::Text,
                 RunFormatArg::Json => RunFormat::Json,
+                RunFormatArg::Html => RunFormat::Html,
             };
             config.explain = explain;
             config.plan = match plan {

@@ -3,7 +3,8 @@
 //! renders cleanly, and generated programs that load.
 //!
 //! `tests/errors/NAME.json` holds a bad program and `NAME.err` the exact error as the command
-//! line renders it (rustc style, without colour: stderr is a pipe) (`UPDATE_EXPECT=1` re-blesses).
+//! line renders it (rustc style, without colour: stderr is a pipe) (`UPDATE_EXPECT=1` re-blesses);
+//! so do the STL reader's error cases, `tests/stl/NAME.stl` with `NAME.err` beside it.
 
 mod common;
 
@@ -13,13 +14,23 @@ use std::path::PathBuf;
 
 #[test]
 fn every_bad_program_gives_one_located_error_and_exit_code_2() {
-    let mut cases: Vec<PathBuf> = std::fs::read_dir(root().join("tests/errors"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "json"))
-        .collect();
-    cases.sort();
+    let files = |dir: &str, ext: &str| -> Vec<PathBuf> {
+        std::fs::read_dir(root().join(dir))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == ext))
+            .collect()
+    };
+    let mut cases = files("tests/errors", "json");
     assert!(cases.len() >= 15);
+    // The STL reader's error cases: the files of tests/stl with an expected rendering beside them.
+    let stl: Vec<PathBuf> = files("tests/stl", "err")
+        .into_iter()
+        .map(|e| e.with_extension("stl"))
+        .collect();
+    assert!(stl.len() >= 6 && stl.iter().all(|p| p.is_file()), "{stl:?}");
+    cases.extend(stl);
+    cases.sort();
     let mut failures = Vec::new();
     for case in cases {
         let rel = case

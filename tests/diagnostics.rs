@@ -229,3 +229,168 @@ fn a_run_whose_modes_differ_is_a_failure_naming_the_first_difference() {
     );
     assert_eq!(e.exit_code(), 1);
 }
+
+/// Rungs the analysis warns about: R2 skipped by a jump, R4 empty, R5 without effect, and a
+/// subroutine nothing calls.
+const IDLE: &str = r#"{"program": "p",
+ "vars": [{"name": "a", "type": "BOOL", "class": "input"}, {"name": "y", "type": "BOOL"}],
+ "rungs": [
+   {"id": "R1", "ld": [{"jmp": "L3"}]},
+   {"id": "R2", "ld": [{"contact": "a"}, {"coil": "y"}]},
+   {"id": "R3", "label": "L3", "ld": [{"contact": "y"}, {"coil": "y"}]},
+   {"id": "R4", "ld": []},
+   {"id": "R5", "ld": [{"contact": "a"}]}
+ ],
+ "subroutines": {"S": {"rungs": [{"id": "S1", "ld": [{"contact": "a"}, {"coil": "y"}]}]}}}"#;
+
+#[test]
+fn the_analysis_warnings_are_coded_diagnostics_naming_the_file() {
+    let out = run_stdin(&["report", "-", "--format", "json"], IDLE.as_bytes());
+    assert_eq!(out.status.code(), Some(0));
+    let shown: Vec<Value> = String::from_utf8(out.stderr)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let brief: Vec<(&str, &str, &str)> = shown
+        .iter()
+        .map(|d| {
+            assert_eq!(d["severity"], "warning");
+            assert_eq!(
+                (d["line"].clone(), d["span"].clone()),
+                (Value::Null, Value::Null)
+            );
+            (
+                d["code"].as_str().unwrap(),
+                d["file"].as_str().unwrap(),
+                d["message"].as_str().unwrap(),
+            )
+        })
+        .collect();
+    assert_eq!(
+        brief,
+        [
+            (
+                "W0201",
+                "<stdin>",
+                "rung R2 can never run (no path from the start of the scan reaches it)"
+            ),
+            ("W0203", "<stdin>", "subroutine S is never called"),
+            ("W0205", "<stdin>", "rung R4 is empty (no elements)"),
+            (
+                "W0206",
+                "<stdin>",
+                "rung R5 has no effect: nothing is written and control is not transferred"
+            ),
+        ]
+    );
+    // The report has the same warnings with their codes.
+    let report: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(
+        report["warning_codes"],
+        serde_json::json!(["W0201", "W0203", "W0205", "W0206"])
+    );
+    assert_eq!(report["warnings"][3], brief[3].2);
+    // As text, in the rustc style, the file on a note line.
+    let out = run_stdin(&["report", "-"], IDLE.as_bytes());
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        stderr.starts_with("warning[W0201]: rung R2 can never run (no path from the start of the scan reaches it)\n = in <stdin>\n\nwarning[W0203]: "),
+        "{stderr}"
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        text.contains("\n  warning[W0206]: rung R5 has no effect"),
+        "{text}"
+    );
+}
+
+#[test]
+fn listing_only_the_direct_pairs_is_a_coded_warning() {
+    // R1 writes X; R2 and R3 read it: with --max-pairs 1 only the direct pairs are listed.
+    let program = r#"{"program": "p", "vars": [{"name": "a", "type": "BOOL", "class": "input"}, {"name": "x", "type": "BOOL"}, {"name": "y", "type": "BOOL"}],
+      "rungs": [{"id": "R1", "ld": [{"contact": "a"}, {"coil": "x"}]},
+                {"id": "R2", "ld": [{"contact": "x"}, {"coil": "x"}]},
+                {"id": "R3", "ld": [{"contact": "x"}, {"coil": "y"}]}]}"#;
+    let out = run_stdin(
+        &["report", "-", "--format", "json", "--max-pairs", "1"],
+        program.as_bytes(),
+    );
+    assert_eq!(out.status.code(), Some(0));
+    let d: Value = serde_json::from_slice(&out.stderr).unwrap();
+    assert_eq!(d["code"], "W0207", "{d}");
+    let report: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["dependences_listed"], "direct");
+    let message = d["message"].as_str().unwrap();
+    let listed = report["dependences"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|x| x["kind"] != "control")
+        .count();
+    assert!(
+        message.ends_with(&format!(
+            "data dependence pairs are more than --max-pairs allows; listing the {listed} direct ones (they imply the rest; --dependences all lists every pair)"
+        )),
+        "{message}"
+    );
+}
+
+/// The hint of a fragment-rule error is a fix: applied to the program, it loads.
+#[test]
+fn a_fragment_rule_error_hints_the_fix_and_the_fix_loads() {
+    let broken =
+        std::fs::read_to_string(root().join("tests/errors/fbd-fragment-rule.json")).unwrap();
+    let out = run_stdin(&["order", "-"], broken.as_bytes());
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        stderr.contains("= help: write that output of block 9 to a variable and use the variable in block 12 instead of the arc: it keeps its last value in the scans where block 9 does not run"),
+        "{stderr}"
+    );
+    // The fix: block 9 writes V, block 12 reads V.
+    let fixed = broken
+        .replace(
+            r#"{"name": "Y", "type": "INT", "class": "output"}"#,
+            r#"{"name": "Y", "type": "INT", "class": "output"}, {"name": "V", "type": "INT"}"#,
+        )
+        .replace(
+            r#""cond": {"from": 4}}"#,
+            r#""cond": {"from": 4}, "out": "V"}"#,
+        )
+        .replace(r#"{"from": 9}]"#, r#""V"]"#);
+    assert_ne!(fixed, broken);
+    let out = run_stdin(&["order", "-"], fixed.as_bytes());
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // A one-source control arc from another fragment: the hint is to remove it.
+    let ordered = broken.replace(
+        r#"[{"from": 8}, {"from": 9}]"#,
+        r#"[{"from": 8}, 1], "after": [9]"#,
+    );
+    let out = run_stdin(&["order", "-"], ordered.as_bytes());
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        stderr.starts_with("error[E0410]: block 12 (fragment F(3)) runs after block 9"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("= help: remove the control arc from block 9 to block 12: block 9 does not run in every scan that runs block 12, so it cannot order it"),
+        "{stderr}"
+    );
+    let out = run_stdin(
+        &["order", "-"],
+        ordered.replace(r#", "after": [9]"#, "").as_bytes(),
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

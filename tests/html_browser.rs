@@ -1,11 +1,14 @@
 //! The HTML report in a real browser: headless Chromium (`/usr/bin/chromium`, which `.ci/run`
-//! installs) opens the page of every `analyses/` example and is driven over the DevTools
+//! installs) opens the page of every `analyses/` example, the report's and the run's (the same
+//! page with the run's measured figures: both modes' rates, the model's table, the outputs, checked
+//! here as the browser shows them), and is driven over the DevTools
 //! protocol on a pipe (`--remote-debugging-pipe`: NUL-terminated JSON on file descriptors 3 and
 //! 4), with serde_json and the standard library only. Each page must load with no console error
 //! and no uncaught exception, have a card for every rung, and highlight a rung's dependences
 //! when the rung is clicked (a real mouse press and release at the card's centre). A
 //! screenshot of each is written to `target/html-screenshots/`; with `UPDATE_EXPECT=1` those
-//! of Examples A and B are also written to `docs/` (the README shows them).
+//! of Examples A and B are also written to `docs/` (the README shows them), and the run page of
+//! Example B at its run section (docs/html.md shows it).
 
 use serde_json::{json, Value};
 use std::io::{Read, Write};
@@ -206,25 +209,31 @@ fn decode_base64(s: &str) -> Vec<u8> {
     out
 }
 
-/// The page of an example, written by the command into the target folder.
-fn page_of(example: &str) -> PathBuf {
+/// The page of an example, written by the command (`report`, or `run` for 20 scans) into the
+/// target folder.
+fn page_of(example: &str, command: &str) -> PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("html-pages");
     std::fs::create_dir_all(&dir).unwrap();
-    let out = dir.join(format!("{example}.html"));
+    let out = dir.join(format!("{example}-{command}.html"));
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let status = Command::new(env!("CARGO_BIN_EXE_plc-deps"))
-        .current_dir(root)
-        .args([
-            "report",
-            &format!("analyses/{example}/program.json"),
-            "--format",
-            "html",
-            "-o",
-        ])
-        .arg(&out)
-        .status()
-        .unwrap();
-    assert!(status.success(), "{example}");
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_plc-deps"));
+    cmd.current_dir(root).args([
+        command,
+        &format!("analyses/{example}/program.json"),
+        "--format",
+        "html",
+        "-o",
+    ]);
+    cmd.arg(&out);
+    if command == "run" {
+        cmd.args(["--scans", "20"]);
+    }
+    let status = cmd.status().unwrap();
+    // A run that faults still writes its page (exit 1).
+    assert!(
+        status.success() || (command == "run" && status.code() == Some(1)),
+        "{example}"
+    );
     out
 }
 
@@ -251,8 +260,10 @@ fn rung_ids(example: &str) -> Vec<String> {
         .collect()
 }
 
-fn check_example(b: &mut Browser, example: &str, shots: &Path) {
-    let file = page_of(example);
+/// Loads the page of `example` made by `command`: no console error, every rung's card, a click
+/// on a rung highlighting its dependences; returns its screenshot.
+fn check_page(b: &mut Browser, example: &str, command: &str) -> Vec<u8> {
+    let file = page_of(example, command);
     b.events.clear();
     b.call(
         "Page.navigate",
@@ -302,14 +313,74 @@ fn check_example(b: &mut Browser, example: &str, shots: &Path) {
         );
         b.eval("window.scrollTo(0, 0)");
     }
+    if command == "run" {
+        check_run_section(b, example);
+        b.eval("document.getElementById('run').scrollIntoView()");
+    }
     let shot = b.call("Page.captureScreenshot", json!({"format": "png"}));
     let png = decode_base64(shot["data"].as_str().unwrap());
     assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n", "{example}: a PNG");
+    png
+}
+
+/// The run section as the browser shows it: both modes' rates (positive, µs/scan and scans/s
+/// agreeing), the model's table for P = 1, 2, 4, 8, and one output row per output variable of
+/// the example's committed run report.
+fn check_run_section(b: &mut Browser, example: &str) {
+    let rates = b.eval(
+        "Array.from(document.querySelectorAll('#run table.rates tr')).slice(1).map(r => Array.from(r.cells).map(c => c.textContent))",
+    );
+    let rates = rates.as_array().unwrap();
+    assert_eq!(rates.len(), 2, "{example}: seq and par");
+    for (r, mode) in rates.iter().zip(["seq", "par"]) {
+        assert_eq!(r[0], json!(mode), "{example}");
+        let us: f64 = r[1].as_str().unwrap().parse().unwrap();
+        let per_s: f64 = r[2].as_str().unwrap().replace(',', "").parse().unwrap();
+        assert!(
+            us > 0.0 && (us * per_s / 1e6 - 1.0).abs() < 0.05,
+            "{example}: {r}"
+        );
+    }
+    let par = rates[1][4].as_str().unwrap();
+    assert!(
+        par.starts_with("sequential fallback (") || par.ends_with(" over 20 scans"),
+        "{example}: {par}"
+    );
+    let ideal = b.eval("document.querySelectorAll('#run table.ideal tr').length");
+    assert_eq!(ideal, json!(5), "{example}: P = 1, 2, 4, 8");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(root.join(format!("analyses/{example}/run.json"))).unwrap();
+    let j: Value = serde_json::from_str(&text).unwrap();
+    let outputs = j["outputs"].as_object().unwrap().len();
+    let shown = b.eval("document.querySelectorAll('#run table.outputs tr').length");
+    let want = if outputs == 0 {
+        0
+    } else {
+        outputs.min(500) + 1
+    };
+    assert_eq!(shown, json!(want), "{example}: the outputs");
+    let visible =
+        b.eval("document.querySelector('#run svg.ratios').getBoundingClientRect().width > 0");
+    assert_eq!(
+        visible,
+        json!(true),
+        "{example}: the speed-up chart is drawn"
+    );
+}
+
+/// The report page and the run page of `example` in the browser; screenshots to `shots`.
+fn check_example(b: &mut Browser, example: &str, shots: &Path) {
+    let png = check_page(b, example, "report");
     std::fs::write(shots.join(format!("{example}.png")), &png).unwrap();
-    if std::env::var_os("UPDATE_EXPECT").is_some() && ["example-a", "example-b"].contains(&example)
-    {
-        let docs = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs");
+    let update = std::env::var_os("UPDATE_EXPECT").is_some();
+    let docs = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs");
+    if update && ["example-a", "example-b"].contains(&example) {
         std::fs::write(docs.join(format!("html-{example}.png")), &png).unwrap();
+    }
+    let png = check_page(b, example, "run");
+    std::fs::write(shots.join(format!("{example}-run.png")), &png).unwrap();
+    if update && example == "example-b" {
+        std::fs::write(docs.join("html-run-example-b.png"), &png).unwrap();
     }
 }
 
@@ -344,4 +415,60 @@ fn every_example_page_loads_clicks_and_highlights_in_chromium() {
     for e in &examples {
         check_example(&mut b, e, &shots);
     }
+    check_fault_chip(&mut b);
+}
+
+/// A run that faults: its page lists the fault with its rung as a chip, and clicking the chip
+/// selects the rung's card.
+fn check_fault_chip(b: &mut Browser) {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("html-pages");
+    std::fs::create_dir_all(&dir).unwrap();
+    let program = dir.join("faulty.json");
+    std::fs::write(
+        &program,
+        r#"{"program": "faulty", "vars": [{"name": "d", "type": "INT", "class": "input"}, {"name": "x", "type": "INT", "class": "output"}, {"name": "q", "type": "BOOL", "class": "output"}],
+  "rungs": [{"id": "DIV", "ld": [{"op": "DIV", "in": [10, "d"], "out": "x"}]},
+            {"id": "Q", "ld": [{"compare": "GT", "a": "x", "b": 1}, {"coil": "q"}]}]}"#,
+    )
+    .unwrap();
+    let page = dir.join("faulty-run.html");
+    let status = Command::new(env!("CARGO_BIN_EXE_plc-deps"))
+        .arg("run")
+        .arg(&program)
+        .args(["--scans", "4", "--format", "html", "-o"])
+        .arg(&page)
+        .status()
+        .unwrap();
+    assert_eq!(status.code(), Some(1), "a faulted run");
+    b.events.clear();
+    b.call(
+        "Page.navigate",
+        json!({"url": format!("file://{}", page.display())}),
+    );
+    b.wait_event("Page.loadEventFired");
+    assert!(b.errors().is_empty(), "{:?}", b.errors());
+    let rows = b.eval(
+        "Array.from(document.querySelectorAll('#run table.faults tr')).slice(1).map(r => Array.from(r.cells).map(c => c.textContent))",
+    );
+    assert_eq!(rows, json!([["DIV", "div-by-zero", "4", "0", "3"]]));
+    let rect = b.eval(
+        "(() => { const c = document.querySelector('#run table.faults .chip'); c.scrollIntoView({block: 'center'}); const r = c.getBoundingClientRect(); return [r.left + r.width / 2, r.top + r.height / 2]; })()",
+    );
+    b.click(rect[0].as_f64().unwrap(), rect[1].as_f64().unwrap());
+    let state = b.eval(
+        "[document.getElementById('rung-DIV').classList.contains('sel'), document.getElementById('rung-Q').classList.contains('user'), document.getElementById('info').textContent]",
+    );
+    assert_eq!(
+        state[0],
+        json!(true),
+        "the faulting rung's card is selected"
+    );
+    assert_eq!(state[1], json!(true), "Q, which reads x, depends on it");
+    assert!(
+        state[2]
+            .as_str()
+            .unwrap()
+            .starts_with("DIV depends on nothing; depending on it: Q"),
+        "{state}"
+    );
 }

@@ -44,7 +44,8 @@ fn endless_loop_is_a_warning_with_a_sound_tree() {
             .starts_with("rungs R2, R3 can never reach the end of the scan")),
         "{warnings:?}"
     );
-    assert!(text.contains("warning: rungs R2, R3 can never reach the end of the scan"));
+    assert!(text.contains("warning[W0202]: rungs R2, R3 can never reach the end of the scan"));
+    assert_eq!(j["warning_codes"], json!(["W0202"]));
     // The tree treats R3 (the loop's last rung) as the loop's exit: R2 → R3 → STOP.
     assert_eq!(j["ipdom"]["R2"], "R3");
     assert_eq!(j["ipdom"]["R3"], "STOP");
@@ -78,7 +79,8 @@ fn unreachable_rungs_and_uncalled_subroutines_are_reported() {
             "subroutine S is never called"
         ]
     );
-    assert!(text.contains("warning: subroutine S is never called"));
+    assert!(text.contains("warning[W0203]: subroutine S is never called"));
+    assert_eq!(j["warning_codes"], json!(["W0201", "W0203"]));
 }
 
 #[test]
@@ -100,7 +102,8 @@ fn empty_rungs_and_rungs_without_effect_are_warnings() {
             "rung R2 has no effect: nothing is written and control is not transferred"
         ]
     );
-    assert!(text.contains("warning: rung R1 is empty (no elements)"));
+    assert!(text.contains("warning[W0205]: rung R1 is empty (no elements)"));
+    assert_eq!(j["warning_codes"], json!(["W0205", "W0206"]));
 }
 
 /// The CLI prints warnings on standard error too, and the endless-loop warning says what
@@ -115,14 +118,29 @@ fn warnings_go_to_stderr_and_the_endless_loop_warning_agrees_with_run() {
         .output()
         .unwrap();
     assert!(out.status.success());
+    // With --format json the warning is a JSON diagnostic with its code and file.
     let stderr = String::from_utf8(out.stderr).unwrap();
+    let d: Value = serde_json::from_str(stderr.trim_end()).expect("one JSON diagnostic");
+    assert_eq!(d["code"], "W0202");
+    assert_eq!(d["severity"], "warning");
+    assert_eq!(d["file"], file.to_str().unwrap());
+    let message = d["message"].as_str().unwrap();
     assert!(
-        stderr.contains("warning: ")
-            && stderr.contains("rungs R2, R3 can never reach the end of the scan")
-            && stderr.contains(
+        message.starts_with("rungs R2, R3 can never reach the end of the scan")
+            && message.contains(
                 "leaves the loop after --loop-cap loop-backs of each loop-back rung per scan"
             ),
         "{stderr}"
+    );
+    // As text, in the style of the other diagnostics.
+    let out = std::process::Command::new(bin)
+        .args(["report", file.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(
+        stderr,
+        format!("warning[W0202]: {message}\n = in {}\n\n", file.display())
     );
     let run = std::process::Command::new(bin)
         .args([

@@ -128,7 +128,7 @@ impl CliError {
 pub const MAX_INPUT_BYTES: u64 = 2 << 30;
 
 /// How a path is named in messages: `<stdin>` for `-`.
-fn display_name(path: &Path) -> String {
+pub(crate) fn display_name(path: &Path) -> String {
     if is_stdin(path) {
         "<stdin>".to_string()
     } else {

@@ -1,16 +1,19 @@
 //! `plc-deps report`: load, analyse, build the report document, render it (text, JSON, DOT or HTML)
-//! to standard output or atomically to `-o`. Warnings go to standard error as well as into the
-//! report. Long phases show progress on a terminal.
+//! to standard output or atomically to `-o`. Warnings (coded `W02xx`, docs/diagnostics.md) go to
+//! standard error, as diagnostics in the command's format, as well as into the report. Long
+//! phases show progress on a terminal.
 
 use super::io::{check_output_path, load_program_and_fbd, write_output_with, FileRole};
 use super::progress::Progress;
 use super::CliError;
 use crate::analysis::{analyse, analyse_with, Analysis, AnalysisConfig, DependenceListing, Listed};
+use crate::diag::{Severity, Shown};
 use crate::fbd::Fbd;
 use crate::model::Program;
 use crate::report::{
     document_with, fbd_parts, render_dot, render_html, render_json, render_text, select_rungs,
-    FbdParts, HtmlInput, Rows, Selection, TextOptions, View, DOT_MAX_RUNGS,
+    warning_code, warning_text, FbdParts, HtmlInput, Rows, Selection, TextOptions, View,
+    DIRECT_PAIRS_ONLY, DOT_MAX_RUNGS,
 };
 use std::collections::HashSet;
 use std::path::PathBuf;
@@ -130,20 +133,21 @@ pub fn report(c: &ReportConfig) -> Result<(), CliError> {
         let _phase = progress.phase("analysing");
         analyse_with(&p, &c.analysis)
     };
+    let file = super::io::display_name(&c.input);
+    let warn = |code: &'static str, message: String| {
+        let mut shown = Shown::unplaced(Severity::Warning, code, message);
+        shown.file = file.clone();
+        super::errors::warn(&shown);
+    };
     for w in &a.warnings {
-        eprintln!(
-            "warning: {}: {}",
-            c.input.display(),
-            crate::report::warning_text(&p, w)
-        );
+        warn(warning_code(w), warning_text(&p, w));
     }
     if a.listed == Listed::Direct && c.analysis.dependences != DependenceListing::Direct {
-        eprintln!(
-            "warning: {}: {} data dependence pairs are more than --max-pairs allows; listing the {} direct ones (they imply the rest; --dependences all lists every pair)",
-            c.input.display(),
+        warn(DIRECT_PAIRS_ONLY, format!(
+            "{} data dependence pairs are more than --max-pairs allows; listing the {} direct ones (they imply the rest; --dependences all lists every pair)",
             crate::report::text::thousands(a.counts.total() as usize),
             crate::report::text::thousands(a.data.len())
-        );
+        ));
     }
     let text = TextOptions {
         view: c.view,

@@ -157,7 +157,8 @@ pub fn fragments(net: &Network, topological: Vec<BlockId>) -> Result<Plan, LoadE
                         dep: net.block(d).id,
                         dep_fragment: t.frags[fdep.index()].name.clone(),
                     },
-                ));
+                )
+                .with_hint(&fragment_rule_fix(how, b.id, net.block(d).id)));
             }
         }
     }
@@ -184,6 +185,18 @@ pub fn fragments(net: &Network, topological: Vec<BlockId>) -> Result<Plan, LoadE
         fragment_of: of,
         steps,
     })
+}
+
+/// The shortest fix of a fragment-rule violation (block `block` depends, `how`, on block `dep` of
+/// a fragment that may not have run): a value or condition goes through a variable, which keeps
+/// its last value in the scans where `dep` does not run; a one-source control arc, which only
+/// orders, is dropped.
+fn fragment_rule_fix(how: &str, block: u32, dep: u32) -> String {
+    if how == "runs after" {
+        format!("remove the control arc from block {dep} to block {block}: block {dep} does not run in every scan that runs block {block}, so it cannot order it")
+    } else {
+        format!("write that output of block {dep} to a variable and use the variable in block {block} instead of the arc: it keeps its last value in the scans where block {dep} does not run")
+    }
 }
 
 struct Tree {

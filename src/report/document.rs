@@ -75,6 +75,9 @@ pub struct Report<'a> {
     pub loops: Vec<LoopEntry<'a>>,
     pub differences: Lazy<'a, DifferenceEntry>,
     pub warnings: Vec<String>,
+    /// The code of each warning, in the same order (docs/diagnostics.md).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warning_codes: Vec<&'static str>,
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub networks: Vec<NetworkEntry<'a>>,
     /// For programs with interrupt routines: what each shares with the main program.
@@ -547,6 +550,7 @@ pub fn document_with<'a>(p: &'a Program, a: &'a Analysis, fbd: Option<&'a FbdPar
             .iter()
             .map(|w| super::warning_text(p, w))
             .collect(),
+        warning_codes: a.warnings.iter().map(super::warning_code).collect(),
         networks,
         interrupts: a
             .interrupts

@@ -69,6 +69,10 @@ pub fn render_json(report: &Report, out: &mut impl Write) -> io::Result<()> {
     value(out, &report.differences)?;
     key(out, "warnings")?;
     value(out, &report.warnings)?;
+    if !report.warning_codes.is_empty() {
+        key(out, "warning_codes")?;
+        value(out, &report.warning_codes)?;
+    }
     if !report.networks.is_empty() {
         key(out, "networks")?;
         value(out, &report.networks)?;

@@ -19,7 +19,9 @@ pub mod text;
 
 pub use document::{document, document_with, Report};
 pub use dot::{render_dot, select_rungs, Selection, MAX_RUNGS as DOT_MAX_RUNGS};
-pub use html::{render_html, HtmlInput};
+pub use html::{
+    render_html, render_run_html, FaultRow, HtmlInput, ModeFigures, PlanFigures, RunFigures,
+};
 pub use json::render_json;
 pub use text::{render_text, Rows, TextOptions};
 
@@ -182,6 +184,23 @@ pub fn warning_text(p: &Program, w: &Warning) -> String {
         ),
     }
 }
+
+/// The stable code of an analysis warning (`W02xx`, each documented with an example in
+/// docs/diagnostics.md); [`warning_text`] is its message.
+pub fn warning_code(w: &Warning) -> &'static str {
+    match w {
+        Warning::Unreachable(_) => "W0201",
+        Warning::Endless(_) => "W0202",
+        Warning::Uncalled(_) => "W0203",
+        Warning::Interrupt(_) => "W0204",
+        Warning::Empty(_) => "W0205",
+        Warning::NoEffect(_) => "W0206",
+    }
+}
+
+/// The code of the report's warning that only the direct data dependences are listed
+/// (`--max-pairs`).
+pub const DIRECT_PAIRS_ONLY: &str = "W0207";
 
 /// What a rung of the lowered program is to the user who wrote the program.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]

@@ -288,8 +288,8 @@ pub fn render_text(r: &Report, o: &TextOptions, out: &mut impl Write) -> io::Res
     }
     if !r.warnings.is_empty() {
         writeln!(out, "\nWarnings")?;
-        for w in &r.warnings {
-            writeln!(out, "  warning: {w}")?;
+        for (w, code) in r.warnings.iter().zip(&r.warning_codes) {
+            writeln!(out, "  warning[{code}]: {w}")?;
         }
     }
     Ok(())

@@ -25,6 +25,8 @@ pub enum RunMode {
 pub enum RunFormat {
     Text,
     Json,
+    /// The report page of the program with the run's figures (docs/html.md).
+    Html,
 }
 
 /// A validated `plc-deps run` invocation.

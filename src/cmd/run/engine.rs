@@ -4,11 +4,11 @@
 //! progress) and the report they add up to. It prints nothing: warnings are returned as data.
 
 use super::compare::{canonical_slots, digest, first_difference};
-use super::config::{RunConfig, RunMode, RunWarning};
+use super::config::{RunConfig, RunFormat, RunMode, RunWarning};
 use super::inputs::{load_inputs, InputTable};
 use super::trace::{cell, trace_columns, Trace};
-use crate::analysis::analyse;
-use crate::cmd::io::{check_output_path, load_program, CliError, FileRole};
+use crate::analysis::{analyse, Analysis};
+use crate::cmd::io::{check_output_path, load_program_and_fbd, CliError, FileRole};
 use crate::cmd::progress::{Bar, Progress};
 use crate::exec::parallel::{
     run_sequential, Candidate, ParallelMachine, PlanConfig, PlanKind, RunLog, ScanDriver,
@@ -16,6 +16,7 @@ use crate::exec::parallel::{
 use crate::exec::{
     load_value, Addr, ExecConfig, Fault, FaultKind, Layout, Machine, State, VarValue,
 };
+use crate::fbd::Fbd;
 use crate::model::{PouKind, Program, Type, VarClass, VarId, VarRef};
 use serde_json::Value as Json;
 use std::collections::HashMap;
@@ -210,8 +211,18 @@ pub(super) struct Prepared {
     pool: Option<rayon::ThreadPool>,
     workers: usize,
     trace_cols: Option<Vec<(String, VarRef, Type)>>,
+    /// For the HTML page only (kept only then): the analysis and the FBD bodies as written.
+    page: Option<(Analysis, Fbd)>,
     /// What the user should know before the run starts.
     pub(super) warnings: Vec<RunWarning>,
+}
+
+impl Prepared {
+    /// What the HTML page draws besides the run: the program, its analysis and its FBD bodies
+    /// (`None` unless the format is HTML).
+    pub(super) fn page_parts(&self) -> Option<(&Program, &Analysis, &Fbd)> {
+        self.page.as_ref().map(|(a, f)| (&self.p, a, f))
+    }
 }
 
 /// Checks the arguments alone, before any file is touched.
@@ -254,9 +265,9 @@ pub(super) fn prepare(c: &RunConfig, progress: &Progress) -> Result<Prepared, Cl
     if let Some(t) = &c.trace {
         check_output_path(t, FileRole::Trace)?;
     }
-    let p = {
+    let (p, fbd) = {
         let _phase = progress.phase(&format!("reading {}", c.input.display()));
-        load_program(&c.input)?
+        load_program_and_fbd(&c.input)?
     };
     let mut warnings: Vec<RunWarning> = p
         .pous
@@ -307,12 +318,14 @@ pub(super) fn prepare(c: &RunConfig, progress: &Progress) -> Result<Prepared, Cl
             cores,
         });
     }
-    let par = if c.mode != RunMode::Seq || c.explain {
-        let a = analyse(&p);
+    let html = c.format == RunFormat::Html;
+    let needs_par = c.mode != RunMode::Seq || c.explain;
+    let analysis = (needs_par || html).then(|| analyse(&p));
+    let par = if let (true, Some(a)) = (needs_par, &analysis) {
         Some(
             ParallelMachine::new(
                 &p,
-                &a,
+                a,
                 &exec,
                 &PlanConfig {
                     kind: c.plan,
@@ -359,6 +372,7 @@ pub(super) fn prepare(c: &RunConfig, progress: &Progress) -> Result<Prepared, Cl
         pool,
         workers,
         trace_cols,
+        page: analysis.filter(|_| html).map(|a| (a, fbd)),
         warnings,
     })
 }

@@ -29,10 +29,10 @@ pub use crate::cmd::progress::Progress;
 pub use config::{parse_cycle, RunConfig, RunFormat, RunMode, RunWarning};
 pub use engine::{FaultSummary, RunReport};
 pub use inputs::{load_inputs, parse_inputs_csv, parse_inputs_json, InputTable};
-pub use output::{render_json, render_text};
+pub use output::{render_json, render_text, run_figures, write_html};
 
-use crate::cmd::io::{write_file_as, write_output, CliError, FileRole};
-use engine::{execute, prepare};
+use crate::cmd::io::{write_file_as, write_output, write_output_with, CliError, FileRole};
+use engine::{execute, prepare, Prepared};
 
 /// Checks and loads everything a run needs, runs it, and returns the report (the trace file, if
 /// any, is written whole, or not at all). Quiet: no progress, warnings dropped.
@@ -46,6 +46,15 @@ pub fn run_report_with(
     progress: &Progress,
     warn: &mut dyn FnMut(&RunWarning),
 ) -> Result<RunReport, CliError> {
+    run_kept(c, progress, warn).map(|(_, r)| r)
+}
+
+/// [`run_report_with`], keeping what was prepared (the HTML page draws the program).
+fn run_kept(
+    c: &RunConfig,
+    progress: &Progress,
+    warn: &mut dyn FnMut(&RunWarning),
+) -> Result<(Prepared, RunReport), CliError> {
     let pr = prepare(c, progress)?;
     for w in &pr.warnings {
         warn(w);
@@ -58,9 +67,13 @@ pub fn run_report_with(
                 result = Some(r);
                 err.map_or(Ok(()), Err)
             })?;
-            Ok(result.expect("the run finished"))
+            let r = result.expect("the run finished");
+            Ok((pr, r))
         }
-        None => Ok(execute(&pr, c, None, progress).0),
+        None => {
+            let r = execute(&pr, c, None, progress).0;
+            Ok((pr, r))
+        }
     }
 }
 
@@ -68,18 +81,24 @@ pub fn run_report_with(
 /// if the run faulted or its modes differed, a [`CliError::Run`] (exit code 1) saying so.
 pub fn run(c: &RunConfig) -> Result<(), CliError> {
     let progress = Progress::new(c.progress);
-    let r = run_report_with(c, &progress, &mut |w| {
+    let (pr, r) = run_kept(c, &progress, &mut |w| {
         crate::cmd::errors::warn(&crate::diag::Shown::unplaced(
             crate::diag::Severity::Warning,
             w.code(),
             w.to_string(),
         ))
     })?;
-    let out = match c.format {
-        RunFormat::Text => render_text(&r),
-        RunFormat::Json => render_json(&r, false),
-    };
-    write_output(c.output.as_deref(), &out)?;
+    match c.format {
+        RunFormat::Text => write_output(c.output.as_deref(), &render_text(&r))?,
+        RunFormat::Json => write_output(c.output.as_deref(), &render_json(&r, false))?,
+        RunFormat::Html => {
+            let (p, a, fbd) = pr.page_parts().expect("prepared for the HTML page");
+            let _phase = progress.phase("writing the page");
+            write_output_with(c.output.as_deref(), |w| {
+                write_html(p, a, fbd, &r, &pr.warnings, w)
+            })?
+        }
+    }
     match failure(&r) {
         Some(why) => Err(CliError::Run(why)),
         None => Ok(()),

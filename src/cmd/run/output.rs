@@ -1,11 +1,18 @@
 //! Rendering a run's report: the text report, the JSON report (normative keys: docs/scan.md)
-//! and its deterministic form for `analyses/*/run.json`.
+//! and its deterministic form for `analyses/*/run.json`, and the HTML page (the program's report
+//! page with the run's figures, drawn by `report::html`; this module only hands it the figures).
 
-use super::config::count;
+use super::config::{count, RunWarning};
 use super::engine::RunReport;
+use crate::analysis::Analysis;
 use crate::exec::parallel::run_log_json;
 use crate::exec::VarValue;
-use crate::model::Value;
+use crate::fbd::Fbd;
+use crate::model::{Program, Value};
+use crate::report::{
+    document_with, fbd_parts, render_run_html, FaultRow, HtmlInput, ModeFigures, PlanFigures,
+    RunFigures,
+};
 use serde_json::{json, Map, Value as Json};
 use std::fmt::Write as _;
 
@@ -281,4 +288,83 @@ pub fn render_text(r: &RunReport) -> String {
         _ => {}
     }
     s
+}
+
+/// The figures the HTML page shows of a run (measured times as they are, not zeroed), with the
+/// warnings it gave.
+pub fn run_figures(r: &RunReport, warnings: &[RunWarning]) -> RunFigures {
+    RunFigures {
+        scans: r.scans,
+        cycle_ms: r.cycle_ms,
+        threads: r.threads,
+        workers: r.workers,
+        rungs: r.rungs,
+        modes: r
+            .modes
+            .iter()
+            .map(|&(name, total)| ModeFigures {
+                name,
+                ns_per_scan: total.as_nanos() as f64 / r.scans.max(1) as f64,
+            })
+            .collect(),
+        plan: r.plan_run.as_ref().map(|log| PlanFigures {
+            kind: r.plan_kind.name(),
+            scans_on: log
+                .candidates
+                .iter()
+                .cloned()
+                .zip(log.scans_on.iter().copied())
+                .collect(),
+            last: log.candidates.get(log.last).cloned().unwrap_or_default(),
+            switches: log.switches.len(),
+            fallback: r.sequential_fallback.clone(),
+        }),
+        identical: r.identical,
+        first_difference: r.first_difference.as_ref().map(|d| d.to_string()),
+        outputs: r
+            .outputs
+            .iter()
+            .map(|(n, v)| (n.clone(), value_text(*v)))
+            .collect(),
+        fault_count: r.fault_count,
+        faults: r
+            .fault_summary
+            .iter()
+            .map(|f| FaultRow {
+                rung: f.rung.clone(),
+                kind: f.kind.name(),
+                count: f.count,
+                first_scan: f.first_scan,
+                last_scan: f.last_scan,
+            })
+            .collect(),
+        explain: r.explain.as_ref().map(|(text, _)| text.clone()),
+        warnings: warnings.iter().map(|w| (w.code(), w.to_string())).collect(),
+    }
+}
+
+/// Writes the HTML page of a run of `p` (analysed as `a`, FBD bodies `fbd`) that gave
+/// `warnings`: the report page of the program with the run's section (docs/html.md).
+pub fn write_html(
+    p: &Program,
+    a: &Analysis,
+    fbd: &Fbd,
+    r: &RunReport,
+    warnings: &[RunWarning],
+    out: &mut dyn std::io::Write,
+) -> std::io::Result<()> {
+    let parts = fbd_parts(p, fbd);
+    let doc = document_with(p, a, parts.as_ref());
+    let mut out = std::io::BufWriter::with_capacity(1 << 16, out);
+    render_run_html(
+        &HtmlInput {
+            doc: &doc,
+            program: p,
+            analysis: a,
+            fbd: Some(fbd),
+        },
+        &run_figures(r, warnings),
+        &mut out,
+    )?;
+    std::io::Write::flush(&mut out)
 }

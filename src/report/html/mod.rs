@@ -10,7 +10,8 @@
 //! 2012); the Gantt chart of the list schedule on 2 and 4 cores; the CFG with T/F edges and the
 //! post-dominator tree, laid out in Rust by a simple Sugiyama scheme ([`layout`], [`graphs`]).
 //! Hovering or clicking a rung (a card, a chip, a Gantt bar, a CFG node) highlights it, what it
-//! depends on and what depends on it, everywhere on the page.
+//! depends on and what depends on it, everywhere on the page. The page of `plc-deps run` is the
+//! same page with a section of the run's measured figures after the summary ([`run`]).
 //!
 //! Invariants: the page is well-formed XML as well as HTML (the tests parse it), every attribute
 //! and text is escaped, every rung card has `id="rung-ID"`, and it is written to an
@@ -28,10 +29,14 @@ mod ladder;
 mod layout;
 mod levels;
 mod page;
+mod run;
 
 pub use charts::GANTT_MAX_BARS;
 pub use graphs::MAX_GRAPH_NODES;
 pub use levels::{MAX_DETAILED_RUNGS, MAX_EDGES};
+pub use run::{
+    FaultRow, ModeFigures, PlanFigures, RunFigures, FAULT_ROWS_SHOWN, OUTPUT_ROWS_SHOWN,
+};
 
 use super::document::Report;
 use crate::analysis::Analysis;
@@ -73,9 +78,27 @@ pub(crate) fn esc(s: &str) -> Cow<'_, str> {
 
 /// Writes the HTML report of `input`.
 pub fn render_html(input: &HtmlInput, out: &mut impl Write) -> io::Result<()> {
+    write_page(input, None, out)
+}
+
+/// Writes the page of `plc-deps run --format html`: the report page of the program with the
+/// run's section (measured rates beside the model, outputs, faults) after the summary.
+pub fn render_run_html(
+    input: &HtmlInput,
+    run: &RunFigures,
+    out: &mut impl Write,
+) -> io::Result<()> {
+    write_page(input, Some(run), out)
+}
+
+/// The page, with the run section when there is a run.
+fn write_page(input: &HtmlInput, run: Option<&RunFigures>, out: &mut impl Write) -> io::Result<()> {
     let r = input.doc;
-    page::write_head(out, r.program)?;
+    page::write_head(out, r.program, if run.is_some() { "run" } else { "report" })?;
     page::write_summary(out, r)?;
+    if let Some(run) = run {
+        run::write_run(out, r, run)?;
+    }
     out.write_all(b"<section id=\"levels\">\n<h2>Levels of the combined schedule</h2>\n")?;
     page::write_level_legend(out)?;
     levels::write_levels(out, input)?;

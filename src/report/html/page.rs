@@ -43,7 +43,8 @@ svg text{font-family:ui-monospace,"DejaVu Sans Mono",Menlo,monospace;font-size:1
 .looptask{border:1px dashed #8e44ad;border-radius:10px;padding:1px 3px}
 .chip.sel,.chip.dep,.chip.user{outline:2px solid #111}.chip.dep{background:#ffeedd}.chip.user{background:#e4efff}
 tr.sel,tr.dep,tr.user{background:#fff6c2}
-.bar.list{fill:#2e86c1}.bar.level{fill:#aab7b8}.axis{stroke:#555}
+.bar.list{fill:#2e86c1}.bar.level{fill:#aab7b8}.bar.measured{fill:#d35400}.bar.ideal{fill:#7d3c98}.axis{stroke:#555}.axis.one{stroke-dasharray:3 3}
+tr.this td{background:#fff6c2;font-weight:bold}
 .sw{display:inline-block;width:12px;height:12px;vertical-align:-2px}.sw.list{background:#2e86c1}.sw.level{background:#aab7b8}
 .legend .k{display:inline-block;width:26px;height:0;vertical-align:middle;margin:0 4px 0 12px;border-top:2px solid}
 .k.flow{border-color:#222}.k.anti{border-top:2px dashed #1f6fd1}.k.output{border-top:2px dotted #c0392b}.k.control{border-top:3px solid #1e8449}
@@ -123,10 +124,11 @@ const SCRIPT: &str = r#"
 "#;
 
 /// Writes the doctype, the head with the style sheet, the shared SVG definitions and the title.
-pub(super) fn write_head(out: &mut impl Write, program: &str) -> io::Result<()> {
+/// `command` is the command the page is of (`report`, `run`), for the title.
+pub(super) fn write_head(out: &mut impl Write, program: &str, command: &str) -> io::Result<()> {
     writeln!(
         out,
-        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\"/>\n<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\"/>\n<meta name=\"generator\" content=\"plc-deps {}\"/>\n<title>{} — plc-deps report</title>\n<style>{STYLE}</style>\n</head>\n<body>",
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\"/>\n<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\"/>\n<meta name=\"generator\" content=\"plc-deps {}\"/>\n<title>{} — plc-deps {command}</title>\n<style>{STYLE}</style>\n</head>\n<body>",
         env!("CARGO_PKG_VERSION"),
         esc(program)
     )?;
@@ -194,14 +196,30 @@ pub(super) fn write_summary(out: &mut impl Write, r: &Report) -> io::Result<()> 
     )?;
     super::charts::write_bars(out, r)?;
     out.write_all(b"</div>\n</div>\n")?;
-    if !r.warnings.is_empty() {
-        out.write_all(b"<ul class=\"warnings\">\n")?;
-        for w in &r.warnings {
-            writeln!(out, "<li class=\"note\">warning: {}</li>", esc(w))?;
-        }
-        out.write_all(b"</ul>\n")?;
-    }
+    write_warnings(
+        out,
+        r.warning_codes
+            .iter()
+            .copied()
+            .zip(r.warnings.iter().map(String::as_str)),
+    )?;
     out.write_all(b"</section>\n")
+}
+
+/// A list of warnings, `(code, message)` each (nothing when there are none).
+pub(super) fn write_warnings<'w>(
+    out: &mut impl Write,
+    warnings: impl Iterator<Item = (&'w str, &'w str)>,
+) -> io::Result<()> {
+    let mut warnings = warnings.peekable();
+    if warnings.peek().is_none() {
+        return Ok(());
+    }
+    out.write_all(b"<ul class=\"warnings\">\n")?;
+    for (code, w) in warnings {
+        writeln!(out, "<li class=\"note\">warning[{code}]: {}</li>", esc(w))?;
+    }
+    out.write_all(b"</ul>\n")
 }
 
 /// The legend of the level view.

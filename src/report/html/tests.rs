@@ -1,6 +1,7 @@
 //! Structural tests of the HTML report: the page parses as XML, every rung has its card, every
 //! dependence its edge, nothing points outside the file, and the Gantt chart's makespans are the
-//! cost model's. (The browser test is tests/html_browser.rs.)
+//! cost model's; the run page shows the run's figures beside the model's. (The browser test is
+//! tests/html_browser.rs; the run page from the command line is tested in tests/html_run.rs.)
 
 use super::*;
 use crate::analysis::{analyse, cost};
@@ -9,6 +10,11 @@ use crate::report::fbd_parts;
 use std::collections::BTreeSet;
 
 fn page(example: &str) -> (String, Program, Analysis) {
+    page_with(example, None)
+}
+
+/// The page of an example: the report page, or with `run` the run page.
+fn page_with(example: &str, run: Option<&RunFigures>) -> (String, Program, Analysis) {
     let path = format!(
         "{}/analyses/{example}/program.json",
         env!("CARGO_MANIFEST_DIR")
@@ -25,7 +31,11 @@ fn page(example: &str) -> (String, Program, Analysis) {
         analysis: &a,
         fbd: Some(&fbd),
     };
-    render_html(&input, &mut out).expect("in memory");
+    match run {
+        Some(run) => render_run_html(&input, run, &mut out),
+        None => render_html(&input, &mut out),
+    }
+    .expect("in memory");
     drop(doc);
     (String::from_utf8(out).expect("UTF-8"), p, a)
 }
@@ -194,4 +204,178 @@ fn the_gantt_makespans_are_the_cost_models() {
 fn escaping_covers_markup_and_quotes() {
     assert_eq!(esc("a<b>&\"c'"), "a&lt;b&gt;&amp;&quot;c&#39;");
     assert!(matches!(esc("plain"), Cow::Borrowed("plain")));
+}
+
+/// A run of Example A on 2 workers: seq 50 ns a scan, par 25 ns.
+fn example_a_run() -> RunFigures {
+    RunFigures {
+        scans: 1000,
+        cycle_ms: 10,
+        threads: 2,
+        workers: 2,
+        rungs: 5,
+        modes: vec![
+            ModeFigures {
+                name: "seq",
+                ns_per_scan: 50.0,
+            },
+            ModeFigures {
+                name: "par",
+                ns_per_scan: 25.0,
+            },
+        ],
+        plan: Some(PlanFigures {
+            kind: "auto",
+            scans_on: vec![("seq".into(), 40), ("par-lpt".into(), 960)],
+            last: "par-lpt".into(),
+            switches: 1,
+            fallback: None,
+        }),
+        identical: Some(true),
+        first_difference: None,
+        outputs: vec![("Q1".into(), "TRUE".into()), ("Y".into(), "FALSE".into())],
+        fault_count: 3,
+        faults: vec![FaultRow {
+            rung: "R4".into(),
+            kind: "div-by-zero",
+            count: 3,
+            first_scan: 2,
+            last_scan: 9,
+        }],
+        explain: None,
+        warnings: Vec::new(),
+    }
+}
+
+/// The text of every row of the table with class `class`, cells joined by `|`.
+fn rows(html: &str, class: &str) -> Vec<String> {
+    let doc = parse(html);
+    let table = doc
+        .descendants()
+        .find(|n| n.has_tag_name("table") && has_class(n, class))
+        .unwrap_or_else(|| panic!("a table {class}"));
+    table
+        .children()
+        .filter(|n| n.has_tag_name("tr"))
+        .skip(1)
+        .map(|tr| {
+            tr.children()
+                .filter(|n| n.is_element())
+                .map(|td| {
+                    td.descendants()
+                        .filter(|n| n.is_text())
+                        .map(|n| n.text().unwrap())
+                        .collect::<String>()
+                })
+                .collect::<Vec<_>>()
+                .join("|")
+        })
+        .collect()
+}
+
+#[test]
+fn a_run_page_is_the_report_page_with_the_run_beside_the_model() {
+    let run = example_a_run();
+    let (html, _, _) = page_with("example-a", Some(&run));
+    let (report, _, _) = page("example-a");
+    assert_eq!(cards(&html), cards(&report), "the same rung cards");
+    assert_eq!(edges(&html), edges(&report), "the same edges");
+    // The run section sits between the summary and the levels.
+    let at = |id: &str| html.find(&format!("<section id=\"{id}\">")).unwrap();
+    assert!(at("summary") < at("run") && at("run") < at("levels"));
+    assert!(!report.contains("<section id=\"run\">"));
+    assert!(html.contains("<title>example_a — plc-deps run</title>"));
+    assert_eq!(
+        rows(&html, "rates"),
+        [
+            "seq|0.050|20,000,000|100.0|",
+            "par|0.025|40,000,000|200.0|×2.00 over 1,000 scans"
+        ]
+    );
+    assert!(html.contains("plan chosen (<code>--plan auto</code>): <b>par-lpt</b>; ran <code>seq</code> 40 scans, <code>par-lpt</code> 960 scans, 1 switch."));
+    // Example A: W = 10, S = 6; makespans 10, 6, 6, 6 and level by level 10, 8, 6, 6.
+    assert_eq!(
+        rows(&html, "ideal"),
+        [
+            "1|10|×1.00|10|×1.00",
+            "2 (this run)|6|×1.67|8|×1.25",
+            "4|6|×1.67|6|×1.67",
+            "8|6|×1.67|6|×1.67"
+        ]
+    );
+    assert!(html.contains("<title>measured: ×2.00</title>"));
+    assert!(html.contains("<title>model, P = 2: ×1.67</title>"));
+    assert!(html.contains("<title>levels, P = 2: ×1.25</title>"));
+    assert!(html.contains("<title>W/S: ×1.67</title>"));
+    assert!(html.contains("identical: yes"));
+    assert_eq!(rows(&html, "outputs"), ["Q1|TRUE", "Y|FALSE"]);
+    assert_eq!(rows(&html, "faults"), ["R4|div-by-zero|3|2|9"]);
+    assert!(html.contains(r#"<span class="chip" data-rung="R4">R4</span>"#));
+    assert!(html.contains("3 faults (1 distinct)"));
+}
+
+#[test]
+fn a_run_page_says_when_the_parallel_pass_fell_back_and_what_differed() {
+    let mut run = example_a_run();
+    run.plan = Some(PlanFigures {
+        kind: "auto",
+        scans_on: vec![("seq".into(), 1000)],
+        last: "seq".into(),
+        switches: 0,
+        fallback: Some("no level saves more than the barriers it needs".into()),
+    });
+    run.identical = Some(false);
+    run.first_difference = Some(r#"{"scan":3,"variable":"X"}"#.into());
+    run.workers = 3;
+    run.warnings = vec![(
+        "W0101",
+        "--threads 3 is more than the 2 cores <of this machine>".into(),
+    )];
+    run.fault_count = 0;
+    run.faults.clear();
+    run.explain = Some("level 1: R1 R2 <R5>".into());
+    let (html, _, _) = page_with("example-a", Some(&run));
+    assert!(html.contains("<details><summary>The parallel plan (--explain)</summary><pre>level 1: R1 R2 &lt;R5&gt;</pre></details>"));
+    assert_eq!(
+        rows(&html, "rates")[1],
+        "par|0.025|40,000,000|200.0|sequential fallback (no level saves more than the barriers it needs)"
+    );
+    assert!(html.contains("<title>measured (fallback): ×2.00</title>"));
+    assert!(html.contains(
+        "identical: NO, first difference: {&quot;scan&quot;:3,&quot;variable&quot;:&quot;X&quot;}"
+    ));
+    // Three workers: the model has no row for them, and says so.
+    assert!(!html.contains("(this run)") && html.contains("this run had 3 workers"));
+    assert!(!html.contains("model, P ="));
+    assert!(html.contains("<li class=\"note\">warning[W0101]: --threads 3 is more than the 2 cores &lt;of this machine&gt;</li>"));
+    assert!(html.contains("<p class=\"faults\">none</p>"));
+}
+
+#[test]
+fn a_run_pages_lists_are_bounded() {
+    let mut run = example_a_run();
+    run.outputs = (0..OUTPUT_ROWS_SHOWN + 7)
+        .map(|i| (format!("Q{i}"), "TRUE".into()))
+        .collect();
+    run.faults = (0..FAULT_ROWS_SHOWN + 3)
+        .map(|i| FaultRow {
+            rung: format!("R{i}"),
+            kind: "loop-cap",
+            count: 1,
+            first_scan: 0,
+            last_scan: 0,
+        })
+        .collect();
+    run.modes.truncate(1);
+    run.plan = None;
+    run.identical = None;
+    let (html, _, _) = page_with("example-a", Some(&run));
+    assert_eq!(rows(&html, "outputs").len(), OUTPUT_ROWS_SHOWN);
+    assert!(html.contains("… and 7 more outputs"));
+    assert_eq!(rows(&html, "faults").len(), FAULT_ROWS_SHOWN);
+    assert!(html.contains("… and 3 more distinct faults"));
+    // Sequential only: one row, no plan, no comparison, no measured bar.
+    assert_eq!(rows(&html, "rates").len(), 1);
+    assert!(!html.contains("plan chosen") && !html.contains("identical:"));
+    assert!(!html.contains("<title>measured"));
 }
