@@ -51,7 +51,7 @@ impl Default for CConfig {
         CConfig {
             cycle_ms: 10,
             loop_cap: 100_000,
-            chunk_rungs: 256,
+            chunk_rungs: 64,
         }
     }
 }
