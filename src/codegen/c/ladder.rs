@@ -16,7 +16,7 @@
 //! Semantics: docs/scan.md, element by element as `src/exec/run.rs` runs them. Not here: the
 //! nesting of FBD fragments (`fbd`), files and the harness (`mod`, `harness`).
 
-use super::names;
+use super::{fold, names};
 use crate::model::*;
 use std::collections::HashMap;
 use std::fmt::Write as _;
@@ -273,11 +273,65 @@ impl<'a> Body<'a> {
     /// out, so the last element need not keep it.
     fn series(&mut self, rung: RungId, series: &[Element], mut pw: Pw, tail: bool) -> PwOut {
         let n = series.len();
-        for (i, e) in series.iter().enumerate() {
-            let last = tail && i + 1 == n;
-            pw = self.element(rung, e, pw, last);
+        let mut i = 0;
+        while i < n {
+            // An arithmetic chain into one variable (an n-input block) is one statement.
+            let k = fold::arith_chain(&series[i..]).max(1);
+            let last = tail && i + k == n;
+            pw = match k {
+                1 => self.element(rung, &series[i], pw, last),
+                _ => self.arith_steps(rung, &series[i..i + k], pw, last),
+            };
+            i += k;
         }
         PwOut(pw)
+    }
+
+    /// `out := …` of one or more arithmetic steps into one variable, as one expression
+    /// (`fold::arith_chain`).
+    fn arith_steps(&mut self, rung: RungId, steps: &[Element], pw: Pw, last: bool) -> Pw {
+        let pw = if last { pw } else { self.materialize(pw) };
+        let mut value = String::new();
+        let mut target = None;
+        for e in steps {
+            let Element::Arith { op, a, b, out } = e else {
+                unreachable!("an arithmetic chain has only arithmetic steps")
+            };
+            let ty = self.sh.p.var(*out).ty;
+            let a = match target {
+                None => self.operand(a),
+                // REAL steps are infix: the running value in parentheses.
+                Some(_) if ty == Type::Real => format!("({value})"),
+                Some(_) => value,
+            };
+            value = self.arith(rung, *op, &a, &self.operand(b), ty);
+            target = Some(*out);
+        }
+        let out = target.expect("at least one step");
+        let stmt = format!("{} = {value};", self.var(out));
+        self.when(&pw, &stmt);
+        pw
+    }
+
+    /// `out := MAX/MIN/LIMIT(…)` of an output branch with that shape, as one expression.
+    fn extreme(&mut self, x: &fold::Extreme, pw: Pw) -> Pw {
+        let pw = self.materialize(pw);
+        let w = match self.sh.p.var(x.out).ty {
+            Type::Int => "i16",
+            Type::Real => "f32",
+            _ => "i32",
+        };
+        let mut value = self.operand(&x.first);
+        for (pick, o) in &x.steps {
+            let f = match pick {
+                fold::Pick::Max => "max",
+                fold::Pick::Min => "min",
+            };
+            value = format!("_plc_{f}_{w}({value}, {})", self.operand(o));
+        }
+        let stmt = format!("{} = {value};", self.var(x.out));
+        self.when(&pw, &stmt);
+        pw
     }
 
     fn element(&mut self, rung: RungId, e: &Element, pw: Pw, last: bool) -> Pw {
@@ -344,6 +398,9 @@ impl<'a> Body<'a> {
                 pw
             }
             Element::Branch(branches) => {
+                if let Some(x) = fold::extreme(branches) {
+                    return self.extreme(&x, pw);
+                }
                 let pw = self.materialize(pw);
                 for b in branches {
                     self.series(rung, b, pw.clone(), true);
@@ -439,13 +496,7 @@ impl<'a> Body<'a> {
                 self.when(&pw, &stmt);
                 pw
             }
-            Element::Arith { op, a, b, out } => {
-                let pw = keep(self, pw);
-                let value = self.arith(rung, *op, a, b, self.sh.p.var(*out).ty);
-                let stmt = format!("{} = {value};", self.var(*out));
-                self.when(&pw, &stmt);
-                pw
-            }
+            Element::Arith { .. } => self.arith_steps(rung, std::slice::from_ref(e), pw, last),
             Element::Jmp { target, .. } => {
                 let goto = format!("goto _L{};", self.label_no(target.0));
                 if !matches!(pw, Pw::False) {
@@ -531,8 +582,8 @@ impl<'a> Body<'a> {
         Pw::Expr(format!("({})", terms.join(" | ")))
     }
 
-    fn arith(&self, rung: RungId, op: ArithOp, a: &Operand, b: &Operand, ty: Type) -> String {
-        let (a, b) = (self.operand(a), self.operand(b));
+    /// `a op b` in type `ty` (operands as C text).
+    fn arith(&self, rung: RungId, op: ArithOp, a: &str, b: &str, ty: Type) -> String {
         let w = match ty {
             Type::Int => "i16",
             Type::Real => {

@@ -22,6 +22,7 @@
 //! Not here: writing the files (`crate::cmd::c`), reading the program.
 
 mod fbd;
+mod fold;
 mod harness;
 mod ladder;
 pub mod names;

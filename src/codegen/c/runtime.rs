@@ -217,6 +217,14 @@ _PLC_CMP(_plc_eq_f32, float, ==) _PLC_CMP(_plc_ne_f32, float, !=)
 _PLC_CMP(_plc_lt_f32, float, <) _PLC_CMP(_plc_le_f32, float, <=)
 _PLC_CMP(_plc_gt_f32, float, >) _PLC_CMP(_plc_ge_f32, float, >=)
 /* A REAL constant by its bits (NaN and infinities have no literal). */
+/* MAX, MIN, LIMIT step by step as the interpreter compares: x replaces the running value m
+   when it is greater (smaller); a NaN never does. */
+static inline int16_t _plc_max_i16(int16_t m, int16_t x) { return x > m ? x : m; }
+static inline int16_t _plc_min_i16(int16_t m, int16_t x) { return x < m ? x : m; }
+static inline int32_t _plc_max_i32(int32_t m, int32_t x) { return x > m ? x : m; }
+static inline int32_t _plc_min_i32(int32_t m, int32_t x) { return x < m ? x : m; }
+static inline float _plc_max_f32(float m, float x) { return x > m ? x : m; }
+static inline float _plc_min_f32(float m, float x) { return x < m ? x : m; }
 static inline float _plc_f32(uint32_t bits) { float f; memcpy(&f, &bits, sizeof f); return f; }
 
 /* One loop-back of a loop-back rung: allowed up to the cap per scan; the first refusal of a
