@@ -56,7 +56,10 @@ impl Options {
         };
         let mut args = std::env::args().skip(1);
         while let Some(a) = args.next() {
-            let mut value = || args.next().unwrap_or_else(|| usage(&format!("{a} needs a value")));
+            let mut value = || {
+                args.next()
+                    .unwrap_or_else(|| usage(&format!("{a} needs a value")))
+            };
             match a.as_str() {
                 "--sizes" => {
                     o.sizes = value()
@@ -65,7 +68,11 @@ impl Options {
                         .collect()
                 }
                 "--shapes" => o.shapes = value().split(',').map(str::to_string).collect(),
-                "--runs" => o.runs = value().parse().unwrap_or_else(|_| usage("--runs: a number")),
+                "--runs" => {
+                    o.runs = value()
+                        .parse()
+                        .unwrap_or_else(|_| usage("--runs: a number"))
+                }
                 "--dir" => o.dir = PathBuf::from(value()),
                 _ => usage(&format!("unknown argument {a}")),
             }
@@ -105,7 +112,10 @@ fn plc_deps_binary() -> PathBuf {
         .map(|d| d.join("plc-deps"))
         .expect("the target folder");
     if !bin.exists() {
-        usage(&format!("{} is missing: run `cargo build --release` first", bin.display()));
+        usage(&format!(
+            "{} is missing: run `cargo build --release` first",
+            bin.display()
+        ));
     }
     bin
 }
@@ -235,9 +245,9 @@ impl BuildCost {
         };
         let secs = |k: &str| field(k).parse::<f64>().expect("seconds");
         let wall = field("Elapsed (wall clock) time (h:mm:ss or m:ss):");
-        let wall_s = wall
-            .split(':')
-            .fold(0.0, |acc, part| acc * 60.0 + part.parse::<f64>().expect("h:mm:ss"));
+        let wall_s = wall.split(':').fold(0.0, |acc, part| {
+            acc * 60.0 + part.parse::<f64>().expect("h:mm:ss")
+        });
         BuildCost {
             wall_s,
             cpu_s: secs("User time (seconds):") + secs("System time (seconds):"),

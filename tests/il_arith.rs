@@ -2,7 +2,8 @@
 //! `out := 0` when a variable divisor is 0) and `out := a - out` / `out := a / out`. The STL of
 //! one MOD rung is pinned instruction by instruction; the whole program, read back by the STL
 //! reader, gives the interpreter's state and faults after every scan for divisors of both
-//! signs, zero, and the one overflowing quotient (-32768 / -1).
+//! signs, zero, and the one overflowing quotient (-32768 / -1). Also a counter in a word
+//! instruction, which the S7-200 reads as its count.
 
 use plc_deps::exec::{ExecConfig, Layout, Machine};
 use plc_deps::model::{Program, Value, VarId};
@@ -117,4 +118,53 @@ fn the_stl_read_back_gives_the_interpreters_results_and_faults() {
     assert!(at(-7, 3).contains("r2=-1 "), "{}", at(-7, 3));
     assert!(at(7, -4).contains("r2=3 "), "{}", at(7, -4));
     assert!(at(7, 0).contains("r2=0 "), "{}", at(7, 0));
+}
+
+/// A counter in a word instruction is its count: `il` writes a CTU's CV that way (`LDW>= c1,
+/// 2`, `MOVW c1, n`), and the reader reads it back, for a declared counter as for `C5`.
+#[test]
+fn a_counter_as_a_word_is_its_count() {
+    let doc = json!({"program": "cv", "vars": [
+        {"name": "up", "type": "BOOL", "class": "input"}, {"name": "r", "type": "BOOL", "class": "input"},
+        {"name": "c1", "type": "CTU"}, {"name": "n", "type": "INT"}, {"name": "q", "type": "BOOL"}
+    ], "rungs": [
+        {"id": "R1", "ld": [{"contact": "up"}, {"ctu": "c1", "pv": 5, "reset": "r"}]},
+        {"id": "R2", "ld": [{"compare": "GE", "a": "c1.CV", "b": 2}, {"coil": "q"}]},
+        {"id": "R3", "ld": [{"move": "c1.CV", "to": "n"}]}
+    ]});
+    let (p, fbd) = load(&doc);
+    let stl = plc_deps::codegen::il::generate(&p, &fbd).unwrap();
+    assert!(stl.contains("\nLDW>=  c1, 2\n"), "{stl}");
+    assert!(stl.contains("\nMOVW   c1, n\n"), "{stl}");
+    let (back, _) = plc_deps::read::stl::load(&stl).unwrap_or_else(|e| panic!("{e:?}\n{stl}"));
+    let absolute = "ORGANIZATION_BLOCK m:OB1\nNETWORK 1\nLD I0.0\nLD I0.1\nCTU C5, 5\n\
+        NETWORK 2\nLDW>= C5, 2\n= Q0.0\nNETWORK 3\nLD SM0.0\nMOVW C5, VW0\nEND_ORGANIZATION_BLOCK\n";
+    let (abs, _) = plc_deps::read::stl::load(absolute).unwrap_or_else(|e| panic!("{e:?}"));
+    let trace = |p: &Program, names: [&str; 5]| {
+        let m = Machine::new(p, Layout::dense(p), &ExecConfig::default()).unwrap();
+        let id = |n: &str| VarId(p.vars.iter().position(|v| v.name == n).unwrap() as u32);
+        let mut st = m.initial_state();
+        (0..12u64)
+            .map(|k| {
+                let (up, r) = (k % 2 == 0, k == 9);
+                m.set_inputs(
+                    &mut st,
+                    &[
+                        (id(names[0]), Value::Bool(up)),
+                        (id(names[1]), Value::Bool(r)),
+                    ],
+                );
+                m.run_scan(&mut st, k, &mut Vec::new());
+                format!(
+                    "{} {}",
+                    m.value(&st, id(names[2])).to_json(),
+                    m.value(&st, id(names[3])).to_json()
+                ) + &format!(" {}", m.value(&st, id(names[4])).to_json())
+            })
+            .collect::<Vec<_>>()
+    };
+    let want = trace(&p, ["up", "r", "q", "n", "c1"]);
+    assert_eq!(trace(&back, ["up", "r", "q", "n", "c1"]), want);
+    assert_eq!(trace(&abs, ["I0_0", "I0_1", "Q0_0", "VW0", "C5"]), want);
+    assert!(want[4].starts_with("true 3 "), "{:?}", want);
 }

@@ -18,7 +18,10 @@
 use crate::model::{CmpOp, Element, Operand, Series, VarId, VarRef};
 
 fn whole(v: VarId) -> Operand {
-    Operand::Var(VarRef { var: v, field: None })
+    Operand::Var(VarRef {
+        var: v,
+        field: None,
+    })
 }
 
 /// How many elements from the start of `s` form one arithmetic chain into one variable (0 or
@@ -99,7 +102,12 @@ mod tests {
             b,
             out: VarId(0),
         };
-        let s = [step(v(1), v(2)), step(v(0), v(3)), step(v(0), v(0)), step(v(0), v(4))];
+        let s = [
+            step(v(1), v(2)),
+            step(v(0), v(3)),
+            step(v(0), v(0)),
+            step(v(0), v(4)),
+        ];
         assert_eq!(arith_chain(&s), 2);
         assert_eq!(arith_chain(&s[2..]), 2);
         assert_eq!(arith_chain(&[Element::Ret]), 0);
@@ -111,11 +119,19 @@ mod tests {
         let b = vec![
             vec![Element::Move { from: x, to: d }],
             vec![
-                Element::Compare { op: CmpOp::Lt, a: whole(d), b: mn },
+                Element::Compare {
+                    op: CmpOp::Lt,
+                    a: whole(d),
+                    b: mn,
+                },
                 Element::Move { from: mn, to: d },
             ],
             vec![
-                Element::Compare { op: CmpOp::Gt, a: whole(d), b: mx },
+                Element::Compare {
+                    op: CmpOp::Gt,
+                    a: whole(d),
+                    b: mx,
+                },
                 Element::Move { from: mx, to: d },
             ],
         ];
@@ -124,7 +140,10 @@ mod tests {
         assert_eq!(e.steps, vec![(Pick::Max, mn), (Pick::Min, mx)]);
         // A step whose move writes another variable is no fold.
         let mut other = b.clone();
-        other[2][1] = Element::Move { from: mx, to: VarId(5) };
+        other[2][1] = Element::Move {
+            from: mx,
+            to: VarId(5),
+        };
         assert!(extreme(&other).is_none());
     }
 }

@@ -484,7 +484,12 @@ impl<'a> Body<'a> {
             }
             Element::Move { from, to } => {
                 let pw = keep(self, pw);
-                if *from == Operand::Var(VarRef { var: *to, field: None }) {
+                if *from
+                    == Operand::Var(VarRef {
+                        var: *to,
+                        field: None,
+                    })
+                {
                     // A move of a variable onto itself changes nothing (and a box's Q local
                     // before it may have no other reader).
                     if let Pw::Local(l) = &pw {
@@ -557,9 +562,7 @@ impl<'a> Body<'a> {
                 match self.series(rung, b, Pw::True, false).0 {
                     Pw::True => terms.push("1".to_string()),
                     Pw::False => {}
-                    Pw::Expr(e) | Pw::Local(e) if e.contains(" & ") => {
-                        terms.push(format!("({e})"))
-                    }
+                    Pw::Expr(e) | Pw::Local(e) if e.contains(" & ") => terms.push(format!("({e})")),
                     Pw::Expr(e) | Pw::Local(e) => terms.push(e),
                 }
             }

@@ -387,7 +387,8 @@ impl Emit<'_> {
         if b_var {
             let cmp = word_suffix(ty).expect("an integer type");
             self.net.lps();
-            self.net.emit(&format!("A{cmp}="), &[&format!("{lb}, 0")], 0);
+            self.net
+                .emit(&format!("A{cmp}="), &[&format!("{lb}, 0")], 0);
             self.net.emit(mov, &["0", target], 0);
             self.net.lpp();
         }

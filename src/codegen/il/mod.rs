@@ -296,11 +296,19 @@ impl<'a> Names<'a> {
         }
     }
 
-    /// A word operand: a variable, a field, or a constant.
+    /// A word operand: a variable, a field, or a constant. A counter's current value is the
+    /// counter itself, as the S7-200 reads `C5` in a word instruction.
     pub fn operand(&self, o: &crate::model::Operand) -> String {
+        let counter = |v: VarId| {
+            matches!(
+                self.p.var(v).ty,
+                Type::Fb(crate::model::FbKind::Ctu | crate::model::FbKind::Ctd)
+            )
+        };
         match o {
             crate::model::Operand::Var(r) => match r.field {
                 None => self.var(r.var).to_string(),
+                Some(Field::Cv) if counter(r.var) => self.var(r.var).to_string(),
                 Some(f) => format!("{}.{}", self.var(r.var), f.name()),
             },
             crate::model::Operand::Const(v) => constant(*v),
@@ -369,7 +377,9 @@ fn declarations(out: &mut String, p: &Program, names: &Names, scope: Option<PouI
             .collect();
         if scope.is_none() && class == VarClass::Memory {
             for (ty, name) in &names.scratch {
-                lines.push(format!("    {name} : {ty}; // scratch word of the arithmetic"));
+                lines.push(format!(
+                    "    {name} : {ty}; // scratch word of the arithmetic"
+                ));
             }
         }
         if lines.is_empty() {
