@@ -195,6 +195,52 @@ fn example_c_has_the_shape_the_paper_prints() {
     }
 }
 
+/// n-input blocks are one statement into their destination (no store per step), and run as
+/// the interpreter runs them: INT wrap-around, a REAL chain's rounding, a destination that is
+/// also an input (the lowering's temporary), MAX/MIN/LIMIT.
+#[test]
+fn n_input_blocks_are_one_statement() {
+    let doc = serde_json::json!({"program": "nin", "vars": [
+        {"name": "a", "type": "INT", "class": "input"}, {"name": "b", "type": "INT", "class": "input"},
+        {"name": "c", "type": "INT", "class": "input"}, {"name": "x", "type": "REAL", "class": "input"},
+        {"name": "s", "type": "INT"}, {"name": "m", "type": "INT"}, {"name": "l", "type": "INT"},
+        {"name": "r", "type": "REAL"}, {"name": "acc", "type": "INT", "init": 1}],
+     "fbd": {"networks": [{"id": "N1", "blocks": [
+        {"id": 1, "op": "ADD", "in": ["a", "b", "c"], "out": "s"},
+        {"id": 2, "op": "MAX", "in": ["a", "b", "c"], "out": "m"},
+        {"id": 3, "op": "LIMIT", "in": [-5, "a", 10], "out": "l"},
+        {"id": 4, "op": "MUL", "in": ["x", 0.1, "x", 3.0], "out": "r"},
+        {"id": 5, "op": "MUL", "in": ["acc", "a", "acc"], "out": "acc"}
+     ]}]}})
+    .to_string();
+    let (p, fbd) = plc_deps::read::program_and_fbd_from_json(&doc).unwrap();
+    let files = generate(&p, &fbd, &CConfig::default());
+    let body = &files.iter().find(|f| f.name == "pou_nin.c").unwrap().text;
+    for line in [
+        "self->s = _plc_add_i16(_plc_add_i16(self->a, self->b), self->c);",
+        "self->m = _plc_max_i16(_plc_max_i16(self->a, self->b), self->c);",
+        "self->l = _plc_min_i16(_plc_max_i16(self->a, -5), 10);",
+        "self->r = ((self->x * 0.1f) * self->x) * 3.0f;",
+    ] {
+        assert!(body.lines().any(|l| l.trim() == line), "{line}\n{body}");
+    }
+    let mut rng = Rng::new(11);
+    let mut csv = String::from("a,b,c,x\n");
+    for _ in 0..60 {
+        let int = |rng: &mut Rng| match rng.below(4) {
+            0 => 32767i64,
+            1 => -32768,
+            _ => rng.below(201) as i64 - 100,
+        };
+        let (a, b, c) = (int(&mut rng), int(&mut rng), int(&mut rng));
+        let x = (rng.below(20001) as f64 - 10000.0) / 7.0;
+        csv.push_str(&format!("{a},{b},{c},{x}\n"));
+    }
+    let mut batch = Batch::default();
+    batch.add(doc, csv, 60, CConfig::default(), "nin".into());
+    batch.check(1, "nin");
+}
+
 /// `_plc_put_real` prints every float as `run --format json` does (shortest decimal, ties up,
 /// serde_json's exponent form), on random bit patterns and on values near powers of ten.
 #[test]

@@ -10,8 +10,10 @@ use plc_deps::model::{Program, Type, Value, VarClass, VarId};
 use proptest::prelude::*;
 use serde_json::Value as Json;
 
-/// The random programs use TP and MOD, which the S7-200 has not, and `out := a - out`, which
-/// has no two-operand form: turned into TON, ADD and `out := a - 2` before generating.
+/// The random programs use TP, which the S7-200 has not, and `b := a MOD b`, which has no
+/// S7-200 form (the divisor's zero test would read the result): turned into TON and
+/// `b := a MOD 2` before generating. MOD and `out := a - out` / `out := a / out` stay: the
+/// STL computes them through a scratch word.
 fn s7_only(v: &mut Json) {
     match v {
         Json::Object(m) => {
@@ -24,14 +26,11 @@ fn s7_only(v: &mut Json) {
             if none.iter().any(|t| m.get("type") == Some(&Json::from(*t))) {
                 m.insert("type".into(), "TON".into());
             }
-            if m.get("op") == Some(&Json::from("MOD")) {
-                m.insert("op".into(), "ADD".into());
-            }
             let out = m.get("out").cloned();
             if let (Some(Json::String(op)), Some(Json::Array(ins))) =
                 (m.get("op").cloned(), m.get_mut("in"))
             {
-                if (op == "SUB" || op == "DIV") && out.is_some() && ins.get(1) == out.as_ref() {
+                if op == "MOD" && out.is_some() && ins.get(1) == out.as_ref() {
                     ins[1] = Json::from(2);
                 }
             }
@@ -48,7 +47,8 @@ fn s7_only(v: &mut Json) {
     }
 }
 
-/// The state of every declared variable of `names` after each scan, as JSON text.
+/// The state of every declared variable of `names` after each scan, as JSON text, and the
+/// scan's faults (rung id and kind).
 fn states(p: &Program, names: &[String], inputs: &[Vec<(String, Value)>]) -> Vec<Vec<String>> {
     let exec = ExecConfig {
         cycle_ms: 10,
@@ -68,13 +68,19 @@ fn states(p: &Program, names: &[String], inputs: &[Vec<(String, Value)>]) -> Vec
     for (k, scan) in inputs.iter().enumerate() {
         let set: Vec<(VarId, Value)> = scan.iter().map(|(n, v)| (id(n), *v)).collect();
         m.set_inputs(&mut st, &set);
-        m.run_scan(&mut st, k as u64, &mut Vec::new());
-        out.push(
-            names
+        let mut faults = Vec::new();
+        m.run_scan(&mut st, k as u64, &mut faults);
+        let mut line: Vec<String> = names
+            .iter()
+            .map(|n| format!("{n}={}", m.value(&st, id(n)).to_json()))
+            .collect();
+        // The faults too (a MOD by zero is a DIV by zero in the STL: the same rung, once).
+        line.extend(
+            faults
                 .iter()
-                .map(|n| format!("{n}={}", m.value(&st, id(n)).to_json()))
-                .collect(),
+                .map(|f| format!("fault {} {:?}", p.rung(f.rung).id, f.kind)),
         );
+        out.push(line);
     }
     out
 }

@@ -216,13 +216,15 @@ pub struct Batch {
 }
 
 /// Symbols of the harness that every program defines (its POU and function block functions
-/// are found in its text: `_pou_…`, `_fb_…`, `_plc_print_<n>`).
+/// are found in its text: `_pou_…`, `_fb_…`).
 const HARNESS_SYMBOLS: &[&str] = &[
     "_plc_state",
     "_plc_initial",
     "_plc_scan",
     "_plc_input_names",
+    "_plc_input_slots",
     "_plc_set_input",
+    "_plc_state_slots",
     "_plc_print_state",
     "_plc_rung_ids",
     "_plc_program_desc",
@@ -237,10 +239,7 @@ const HARNESS_MACROS: &[&str] = &["PLC_PROGRAM_H"];
 /// Every identifier in `text` that a program defines and others would too.
 fn program_symbols(text: &str, out: &mut std::collections::BTreeSet<String>) {
     for id in text.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_')) {
-        let numbered = id
-            .strip_prefix("_plc_print_")
-            .is_some_and(|n| !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()));
-        if id.starts_with("_pou_") || id.starts_with("_fb_") || numbered {
+        if id.starts_with("_pou_") || id.starts_with("_fb_") {
             out.insert(id.to_string());
         }
     }

@@ -20,9 +20,6 @@ pub(crate) const HEADER_DECLS: &str = "extern const char *const _plc_input_names
     extern const char *const _plc_rung_ids[];\n\
     extern const _plc_program _plc_program_desc;\n";
 
-/// Variables printed per function of `_plc_print_state` (keeps functions small).
-const PRINT_CHUNK: usize = 256;
-
 /// `extra`: initializers of the instances' bases (`    .G1._rung0 = 12,\n`).
 pub(crate) fn program_source(p: &Program, sh: &Shared, extra: &[String], cfg: &CConfig) -> String {
     let mut s = String::from(
@@ -97,6 +94,47 @@ fn field(sh: &Shared, i: usize) -> String {
     sh.vars[i].trim_start_matches("self->").to_string()
 }
 
+/// The harness's slot kind of a type (`_PLC_K_…` of `plc_runtime.h`).
+fn slot_kind(ty: Type) -> &'static str {
+    match ty {
+        Type::Bool => "_PLC_K_BOOL",
+        Type::Int => "_PLC_K_INT",
+        Type::Dint => "_PLC_K_DINT",
+        Type::Time => "_PLC_K_TIME",
+        Type::Real => "_PLC_K_REAL",
+        Type::Fb(FbKind::Ton | FbKind::Tof | FbKind::Tp) => "_PLC_K_TIMER",
+        Type::Fb(FbKind::Ctu | FbKind::Ctd) => "_PLC_K_COUNTER",
+        Type::Fb(FbKind::Sr | FbKind::Rs) => "_PLC_K_BISTABLE",
+        Type::Fb(FbKind::RTrig | FbKind::FTrig) => "_PLC_K_TRIGGER",
+        Type::Fb(FbKind::Ctud) => "_PLC_K_UPDOWN",
+    }
+}
+
+/// A static table `name` of `_plc_slot`s, one per variable of `vars` with its JSON key
+/// (`"x":`); returns the number of entries (C has no empty arrays: an empty table gets one
+/// unused entry).
+fn slot_table(p: &Program, sh: &Shared, s: &mut String, name: &str, vars: &[usize]) -> usize {
+    push(s, format_args!("static const _plc_slot {name}[] = {{\n"));
+    for &i in vars {
+        let key = format!("{}:", json_string(&p.vars[i].name));
+        push(
+            s,
+            format_args!(
+                "    {{{}, offsetof(_plc_state, {}), {}}},\n",
+                c_string(&key),
+                field(sh, i),
+                slot_kind(p.vars[i].ty)
+            ),
+        );
+    }
+    if vars.is_empty() {
+        s.push_str("    {\"\", 0, _PLC_K_BOOL}\n");
+    }
+    s.push_str("};\n\n");
+    vars.len()
+}
+
+/// The input names and `_plc_set_input`, through a table of the inputs.
 fn inputs(p: &Program, sh: &Shared, s: &mut String) {
     let ins: Vec<usize> = (0..p.vars.len())
         .filter(|&i| p.vars[i].class == VarClass::Input && !p.vars[i].hidden)
@@ -106,60 +144,32 @@ fn inputs(p: &Program, sh: &Shared, s: &mut String) {
         push(s, format_args!("    {},\n", c_string(&p.vars[i].name)));
     }
     s.push_str("    NULL\n};\n\n");
+    let n = slot_table(p, sh, s, "_plc_input_slots", &ins);
     s.push_str("int _plc_set_input(_plc_state *self, unsigned input, const char *text) {\n");
-    s.push_str("    switch (input) {\n");
-    for (k, &i) in ins.iter().enumerate() {
-        let f = &sh.vars[i];
-        let parse = match p.vars[i].ty {
-            Type::Bool => format!("return _plc_parse_bool(text, &{f});"),
-            Type::Int => format!(
-                "{{ long long v; if (!_plc_parse_int(text, INT16_MIN, INT16_MAX, &v)) return 0; {f} = (int16_t)v; return 1; }}"
-            ),
-            Type::Dint => format!(
-                "{{ long long v; if (!_plc_parse_int(text, INT32_MIN, INT32_MAX, &v)) return 0; {f} = (int32_t)v; return 1; }}"
-            ),
-            Type::Real => format!("return _plc_parse_real(text, &{f});"),
-            Type::Time => format!("return _plc_parse_time(text, &{f});"),
-            Type::Fb(_) => "return 0;".to_string(),
-        };
-        push(s, format_args!("    case {k}: {parse}\n"));
-    }
-    s.push_str("    default: (void)self; (void)text; return 0;\n    }\n}\n\n");
-}
-
-fn print_state(p: &Program, sh: &Shared, s: &mut String) {
-    let vis: Vec<usize> = (0..p.vars.len()).filter(|&i| !p.vars[i].hidden).collect();
-    let parts: Vec<&[usize]> = vis.chunks(PRINT_CHUNK).collect();
-    for (k, part) in parts.iter().enumerate() {
+    if n == 0 {
+        // `input < 0u` would be a warning: no input is ever set.
+        s.push_str("    (void)self; (void)input; (void)text; (void)_plc_input_slots;\n    return 0;\n}\n\n");
+    } else {
         push(
             s,
-            format_args!("static void _plc_print_{k}(const _plc_state *self, FILE *o) {{\n"),
+            format_args!(
+                "    return input < {n}u ? _plc_set_slot(self, &_plc_input_slots[input], text) : 0;\n}}\n\n"
+            ),
         );
-        for (j, &i) in part.iter().enumerate() {
-            let sep = if k == 0 && j == 0 { "" } else { "," };
-            let key = format!("{sep}{}:", json_string(&p.vars[i].name));
-            let f = &sh.vars[i];
-            let put = match p.vars[i].ty {
-                Type::Bool => format!("_plc_put_bool(o, {f});"),
-                Type::Int | Type::Dint | Type::Time => format!("fprintf(o, \"%d\", (int){f});"),
-                Type::Real => format!("_plc_put_real(o, {f});"),
-                Type::Fb(FbKind::Ton | FbKind::Tof | FbKind::Tp) => {
-                    format!("_plc_put_timer(o, &{f});")
-                }
-                Type::Fb(FbKind::Ctu | FbKind::Ctd) => format!("_plc_put_counter(o, &{f});"),
-                Type::Fb(FbKind::Sr | FbKind::Rs) => format!("_plc_put_bistable(o, &{f});"),
-                Type::Fb(FbKind::RTrig | FbKind::FTrig) => format!("_plc_put_trigger(o, &{f});"),
-                Type::Fb(FbKind::Ctud) => format!("_plc_put_updown(o, &{f});"),
-            };
-            push(s, format_args!("    fputs({}, o); {put}\n", c_string(&key)));
-        }
-        s.push_str("}\n\n");
     }
-    s.push_str("void _plc_print_state(const _plc_state *self, FILE *o) {\n    fputc('{', o);\n");
-    for k in 0..parts.len() {
-        push(s, format_args!("    _plc_print_{k}(self, o);\n"));
-    }
-    s.push_str("    fputs(\"}\\n\", o);\n    (void)self;\n}\n");
+}
+
+/// `_plc_print_state`, through a table of the visible variables.
+fn print_state(p: &Program, sh: &Shared, s: &mut String) {
+    let vis: Vec<usize> = (0..p.vars.len()).filter(|&i| !p.vars[i].hidden).collect();
+    let n = slot_table(p, sh, s, "_plc_state_slots", &vis);
+    push(
+        s,
+        format_args!(
+            "void _plc_print_state(const _plc_state *self, FILE *o) {{\n    \
+             _plc_put_slots(o, self, _plc_state_slots, {n});\n}}\n\n"
+        ),
+    );
 }
 
 /// `main.c`: runs the program through the driver.

@@ -22,6 +22,7 @@
 //! Not here: writing the files (`crate::cmd::c`), reading the program.
 
 mod fbd;
+mod fold;
 mod harness;
 mod ladder;
 pub mod names;
@@ -51,7 +52,7 @@ impl Default for CConfig {
         CConfig {
             cycle_ms: 10,
             loop_cap: 100_000,
-            chunk_rungs: 256,
+            chunk_rungs: 64,
         }
     }
 }

@@ -11,9 +11,12 @@
 //! loads `SM0.0` (always on). Arithmetic is the S7-200 two-operand form: `out := a op b` is
 //! `MOVW a, out` then `+I b, out`.
 //!
-//! Not here: TP timers, MOD, BOOL moves, `out := a - out` (no S7-200 form without a scratch
-//! word), a timer's Q feeding more elements inside an output branch: each one error naming the
-//! rung.
+//! `out := a - out`, `out := a / out` and MOD go through a scratch word of the result's type,
+//! declared by the generator (`Names::scratch`).
+//!
+//! Not here: TP timers (the S7-200 has TON, TONR and TOF; a TP built of them would not be the
+//! instance with its Q and ET), `b := a MOD b`, BOOL moves, a timer's Q feeding
+//! more elements inside an output branch: each one error naming the rung.
 
 use super::{check, IlError, Names, Net};
 use crate::model::*;
@@ -302,6 +305,12 @@ impl Emit<'_> {
         self.q_after(inst, rest);
     }
 
+    /// `out := a op b` in the S7-200's two-operand form (`+I IN, OUT` is `OUT := OUT + IN`):
+    /// `MOVW a, out` then `+I b, out`, or `+I b, out` alone when `a` is `out`. `out := a - out`
+    /// and `out := a / out` go through the scratch word `s` of out's type (`MOVW a, s`,
+    /// `-I out, s`, `MOVW s, out`); a MOD too, since the S7-200 has no remainder instruction
+    /// that plc-deps models (its DIV leaves the remainder in the high word of a double word):
+    /// [`Emit::modulo`].
     fn arith(&mut self, op: ArithOp, a: &Operand, b: &Operand, out: VarId) -> Result<(), IlError> {
         let n = self.names;
         let ty = n.p.var(out).ty;
@@ -316,9 +325,7 @@ impl Emit<'_> {
             ArithOp::Sub => "-",
             ArithOp::Mul => "*",
             ArithOp::Div => "/",
-            ArithOp::Mod => {
-                return self.fail("MOD has no S7-200 instruction (DIV gives quotient and remainder together; not yet)")
-            }
+            ArithOp::Mod => return self.modulo(a, b, out, sfx, mov),
         };
         let is_out =
             |o: &Operand| matches!(o, Operand::Var(r) if r.var == out && r.field.is_none());
@@ -326,17 +333,64 @@ impl Emit<'_> {
         let target = n.var(out);
         if is_out(a) {
             self.net.emit(&instr, &[&n.operand(b), target], 0);
+        } else if is_out(b) && matches!(op, ArithOp::Sub | ArithOp::Div) {
+            let s = n.scratch(ty);
+            self.net.emit(mov, &[&n.operand(a), s], 0);
+            self.net.emit(&instr, &[target, s], 0);
+            self.net.emit(mov, &[s, target], 0);
         } else if is_out(b) {
-            if !matches!(op, ArithOp::Add | ArithOp::Mul) {
-                return self.fail(format!(
-                    "`{target} := {} {sym} {target}` has no two-operand S7-200 form (not yet)",
-                    n.operand(a)
-                ));
-            }
             self.net.emit(&instr, &[&n.operand(a), target], 0);
         } else {
             self.net.emit(mov, &[&n.operand(a), target], 0);
             self.net.emit(&instr, &[&n.operand(b), target], 0);
+        }
+        Ok(())
+    }
+
+    /// `out := a MOD b` as `a - (a / b) * b` (DIV truncates, so the remainder takes the sign of
+    /// `a`, as MOD does), through the scratch word `s`: `MOVW a, s`, `/I b, s`, `*I b, s`,
+    /// `MOVW a, out`, `-I s, out`. The `/I` faults on a zero `b` as the MOD does, once; a
+    /// variable `b` then needs `out := 0` (`a - 0` is `a`): `LPS`, `AW= b, 0`, `MOVW 0, out`,
+    /// `LPP`. Wrap-around: only `-32768 / -1` overflows, and `-32768 - -32768` gives the 0 it
+    /// should.
+    fn modulo(
+        &mut self,
+        a: &Operand,
+        b: &Operand,
+        out: VarId,
+        sfx: &str,
+        mov: &str,
+    ) -> Result<(), IlError> {
+        let n = self.names;
+        let ty = n.p.var(out).ty;
+        let target = n.var(out);
+        if ty == Type::Real {
+            // The loader refuses MOD of REAL (IEC 61131-3: ANY_INT); kept as an error here.
+            return self.fail("MOD of REAL has no S7-200 instruction");
+        }
+        let b_var = matches!(b, Operand::Var(_));
+        if matches!(b, Operand::Var(r) if r.var == out && r.field.is_none()) {
+            return self.fail(format!(
+                "`{target} := {} MOD {target}` has no S7-200 form (the zero test of the divisor would read the result: write the result to another variable)",
+                n.operand(a)
+            ));
+        }
+        let s = n.scratch(ty);
+        let (la, lb) = (n.operand(a), n.operand(b));
+        self.net.emit(mov, &[&la, s], 0);
+        self.net.emit(&format!("/{sfx}"), &[&lb, s], 0);
+        self.net.emit(&format!("*{sfx}"), &[&lb, s], 0);
+        if !matches!(a, Operand::Var(r) if r.var == out && r.field.is_none()) {
+            self.net.emit(mov, &[&la, target], 0);
+        }
+        self.net.emit(&format!("-{sfx}"), &[s, target], 0);
+        if b_var {
+            let cmp = word_suffix(ty).expect("an integer type");
+            self.net.lps();
+            self.net
+                .emit(&format!("A{cmp}="), &[&format!("{lb}, 0")], 0);
+            self.net.emit(mov, &["0", target], 0);
+            self.net.lpp();
         }
         Ok(())
     }

@@ -15,15 +15,19 @@
 //! every LPS is closed by an LPP in the same network, and the reader `crate::read::stl` reads
 //! the text back into a program with the same scan behaviour (tests/il_roundtrip.rs).
 //!
-//! Deliberately not here: what has no S7-200 instruction (TP timers, MOD, XOR blocks, FBD
-//! networks with non-boolean blocks, conditional arcs, function block types) is one error naming
-//! the rung or block ([`IlError`]) — never an approximation. The format: docs/il.md.
+//! Deliberately not here: what has no S7-200 instruction (TP timers, `b := a MOD b`, XOR blocks,
+//! FBD networks with non-boolean blocks, conditional arcs, function block types) is one error
+//! naming the rung or block ([`IlError`]) — never an approximation. MOD and `out := a - out`
+//! are written through a scratch word the STL declares (`IL_TMP_INT`). The format: docs/il.md.
 
 mod ladder;
 mod tree;
 
 use crate::fbd::{Fbd, FbdPouKind};
-use crate::model::{Field, PouId, PouKind, Program, Type, Value, VarClass, VarId, VarRef};
+use crate::model::{
+    walk_elements, ArithOp, Element, Field, Operand, PouId, PouKind, Program, Type, Value,
+    VarClass, VarId, VarRef,
+};
 use std::fmt::Write as _;
 
 /// Levels of the S7-200 logic stack.
@@ -185,6 +189,43 @@ pub(crate) struct Names<'a> {
     pub text: Vec<String>,
     /// Per variable: written in absolute form (so not declared).
     pub absolute: Vec<bool>,
+    /// The scratch words the arithmetic needs, one per type (`IL_TMP_INT : INT`): a MOD, and
+    /// `out := a - out` / `out := a / out`, have no S7-200 form without one.
+    pub scratch: Vec<(Type, String)>,
+}
+
+/// Whether `out := a op b` needs a scratch word of out's type in the STL (ladder::arith).
+fn needs_scratch(op: ArithOp, b: &Operand, out: VarId) -> bool {
+    let b_is_out = matches!(b, Operand::Var(r) if r.var == out && r.field.is_none());
+    op == ArithOp::Mod || (b_is_out && matches!(op, ArithOp::Sub | ArithOp::Div))
+}
+
+/// The scratch words `p`'s arithmetic needs: one per type, named `IL_TMP_<TYPE>` (a number
+/// added while that names a variable of the program).
+fn scratch_words(p: &Program) -> Vec<(Type, String)> {
+    let mut types: Vec<Type> = Vec::new();
+    for r in &p.rungs {
+        walk_elements(&r.series, &mut |e| {
+            if let Element::Arith { op, b, out, .. } = e {
+                let ty = p.var(*out).ty;
+                if needs_scratch(*op, b, *out) && !types.contains(&ty) {
+                    types.push(ty);
+                }
+            }
+        });
+    }
+    let taken = |n: &str| p.vars.iter().any(|v| v.name.eq_ignore_ascii_case(n));
+    types
+        .into_iter()
+        .map(|ty| {
+            let stem = format!("IL_TMP_{ty}");
+            let name = std::iter::once(stem.clone())
+                .chain((2..).map(|k| format!("{stem}_{k}")))
+                .find(|n| !taken(n))
+                .expect("an unused name");
+            (ty, name)
+        })
+        .collect()
 }
 
 /// The absolute address a variable name stands for (`I0_0` → `I0.0`, `SM0_1` → `SM0.1`), when
@@ -229,7 +270,18 @@ impl<'a> Names<'a> {
             absolute.push(abs.is_some());
             text.push(abs.unwrap_or(short));
         }
-        Names { p, text, absolute }
+        Names {
+            p,
+            text,
+            absolute,
+            scratch: scratch_words(p),
+        }
+    }
+
+    /// The scratch word of type `ty` (one [`scratch_words`] found a use for).
+    pub fn scratch(&self, ty: Type) -> &str {
+        let found = self.scratch.iter().find(|(t, _)| *t == ty);
+        &found.expect("a scratch word of this type was declared").1
     }
 
     pub fn var(&self, v: VarId) -> &str {
@@ -244,11 +296,19 @@ impl<'a> Names<'a> {
         }
     }
 
-    /// A word operand: a variable, a field, or a constant.
+    /// A word operand: a variable, a field, or a constant. A counter's current value is the
+    /// counter itself, as the S7-200 reads `C5` in a word instruction.
     pub fn operand(&self, o: &crate::model::Operand) -> String {
+        let counter = |v: VarId| {
+            matches!(
+                self.p.var(v).ty,
+                Type::Fb(crate::model::FbKind::Ctu | crate::model::FbKind::Ctd)
+            )
+        };
         match o {
             crate::model::Operand::Var(r) => match r.field {
                 None => self.var(r.var).to_string(),
+                Some(Field::Cv) if counter(r.var) => self.var(r.var).to_string(),
                 Some(f) => format!("{}.{}", self.var(r.var), f.name()),
             },
             crate::model::Operand::Const(v) => constant(*v),
@@ -299,25 +359,35 @@ fn declarations(out: &mut String, p: &Program, names: &Names, scope: Option<PouI
         ("VAR_OUTPUT", VarClass::Output),
         ("VAR", VarClass::Memory),
     ] {
-        let vars: Vec<usize> = (0..p.vars.len())
+        let mut lines: Vec<String> = (0..p.vars.len())
             .filter(|&i| {
                 let v = &p.vars[i];
                 !v.hidden && v.scope == scope && v.class == class && !names.absolute[i]
             })
+            .map(|i| {
+                let v = &p.vars[i];
+                let name = names.text[i].trim_start_matches('#');
+                let init = match v.ty {
+                    Type::Fb(_) => String::new(),
+                    ty if v.init == ty.zero() => String::new(),
+                    _ => format!(" := {}", constant(v.init)),
+                };
+                format!("    {name} : {}{init};", v.ty)
+            })
             .collect();
-        if vars.is_empty() {
+        if scope.is_none() && class == VarClass::Memory {
+            for (ty, name) in &names.scratch {
+                lines.push(format!(
+                    "    {name} : {ty}; // scratch word of the arithmetic"
+                ));
+            }
+        }
+        if lines.is_empty() {
             continue;
         }
         let _ = writeln!(out, "{section}");
-        for i in vars {
-            let v = &p.vars[i];
-            let name = names.text[i].trim_start_matches('#');
-            let init = match v.ty {
-                Type::Fb(_) => String::new(),
-                ty if v.init == ty.zero() => String::new(),
-                _ => format!(" := {}", constant(v.init)),
-            };
-            let _ = writeln!(out, "    {name} : {}{init};", v.ty);
+        for l in lines {
+            let _ = writeln!(out, "{l}");
         }
         let _ = writeln!(out, "END_VAR");
     }

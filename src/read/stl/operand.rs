@@ -209,12 +209,26 @@ impl<'t> Context<'t> {
                         Scalar::Str(Cow::Owned(self.implicit(up, ty, VarClass::Memory, t.at)))
                     }
                     _ if box_address(text).is_some() && self.declared(text).is_none() => {
-                        return Err(error(self.text, t.at, format!("{up} as a word (its current value) is not read yet: use a symbolic timer or counter and its .ET or .CV")));
+                        // A counter as a word is its current value (S7-200: the INT count);
+                        // a timer's is counted in its resolution, which ET in ms is not.
+                        match self.boxes.get(&up) {
+                            Some(&ty @ ("CTU" | "CTD")) => {
+                                self.implicit(up.clone(), ty, VarClass::Memory, t.at);
+                                Scalar::Str(Cow::Owned(format!("{up}.CV")))
+                            }
+                            _ => return Err(error(self.text, t.at, format!("{up} as a word (its current value) is not read yet: use a symbolic timer and its .ET"))),
+                        }
                     }
                     _ => {
                         let name = text.strip_prefix('#').unwrap_or(text).to_string();
                         self.check_name(t, &name)?;
-                        Scalar::Str(Cow::Owned(name))
+                        // A declared counter as a word: its current value, as above.
+                        let counter = matches!(self.declared(&name), Some("CTU" | "CTD"));
+                        Scalar::Str(Cow::Owned(if counter {
+                            format!("{name}.CV")
+                        } else {
+                            name
+                        }))
                     }
                 }
             }

@@ -1,0 +1,170 @@
+//! The arithmetic `plc-deps il` writes through a scratch word: MOD (`a - (a / b) * b`, with
+//! `out := 0` when a variable divisor is 0) and `out := a - out` / `out := a / out`. The STL of
+//! one MOD rung is pinned instruction by instruction; the whole program, read back by the STL
+//! reader, gives the interpreter's state and faults after every scan for divisors of both
+//! signs, zero, and the one overflowing quotient (-32768 / -1). Also a counter in a word
+//! instruction, which the S7-200 reads as its count.
+
+use plc_deps::exec::{ExecConfig, Layout, Machine};
+use plc_deps::model::{Program, Value, VarId};
+use serde_json::json;
+
+fn program() -> serde_json::Value {
+    let int = |name: &str, class: &str| json!({"name": name, "type": "INT", "class": class});
+    json!({"program": "arith", "vars": [
+        {"name": "go", "type": "BOOL", "class": "input"},
+        int("a", "input"), int("b", "input"),
+        int("r1", "memory"), int("r2", "memory"), int("r3", "memory"), int("r4", "memory"),
+        int("r5", "memory"),
+        {"name": "d", "type": "DINT", "init": 1000001}, {"name": "e", "type": "DINT"}
+    ], "rungs": [
+        {"id": "R1", "ld": [{"contact": "go"}, {"op": "MOD", "in": ["a", -3], "out": "r1"}]},
+        {"id": "R2", "ld": [{"op": "MOD", "in": ["a", "b"], "out": "r2"}]},
+        {"id": "R3", "ld": [{"op": "ADD", "in": ["r3", 11], "out": "r3"},
+                            {"op": "MOD", "in": ["r3", "b"], "out": "r3"}]},
+        {"id": "R4", "ld": [{"op": "SUB", "in": ["a", "r4"], "out": "r4"}]},
+        {"id": "R5", "ld": [{"op": "ADD", "in": ["r5", 7], "out": "r5"},
+                            {"op": "DIV", "in": [1000, "r5"], "out": "r5"}]},
+        {"id": "R6", "ld": [{"op": "MOD", "in": ["d", 7], "out": "e"},
+                            {"op": "ADD", "in": ["d", 3], "out": "d"}]}
+    ]})
+}
+
+fn load(doc: &serde_json::Value) -> (Program, plc_deps::fbd::Fbd) {
+    plc_deps::read::program_and_fbd_from_json(&doc.to_string()).expect("the program loads")
+}
+
+#[test]
+fn a_mod_by_a_variable_is_a_division_a_product_a_difference_and_a_zero_test() {
+    let (p, fbd) = load(&program());
+    let stl = plc_deps::codegen::il::generate(&p, &fbd).unwrap();
+    let net = |title: &str| {
+        let start = stl.find(&format!("// {title}\n")).unwrap();
+        let body = &stl[start..];
+        let end = body[1..].find("NETWORK").map_or(body.len(), |e| e + 1);
+        let end = body[..end].find("END_").unwrap_or(end);
+        body[..end].lines().skip(1).collect::<Vec<_>>().join("\n")
+    };
+    assert_eq!(
+        net("R2"),
+        "LD     SM0.0\nMOVW   a, IL_TMP_INT\n/I     b, IL_TMP_INT\n*I     b, IL_TMP_INT\n\
+         MOVW   a, r2\n-I     IL_TMP_INT, r2\nLPS\nAW=    b, 0\nMOVW   0, r2\nLPP"
+    );
+    // A constant divisor needs no zero test; `out := a - out` goes through the scratch word.
+    assert_eq!(
+        net("R1"),
+        "LD     go\nMOVW   a, IL_TMP_INT\n/I     -3, IL_TMP_INT\n*I     -3, IL_TMP_INT\n\
+         MOVW   a, r1\n-I     IL_TMP_INT, r1"
+    );
+    assert_eq!(
+        net("R4"),
+        "LD     SM0.0\nMOVW   a, IL_TMP_INT\n-I     r4, IL_TMP_INT\nMOVW   IL_TMP_INT, r4"
+    );
+    assert!(stl.contains("    IL_TMP_INT : INT; // scratch word of the arithmetic\n"));
+    assert!(stl.contains("    IL_TMP_DINT : DINT; // scratch word of the arithmetic\n"));
+}
+
+/// The state of the program's variables and the faults (rung id, kind) after each scan.
+fn run(p: &Program, scans: &[(bool, i16, i16)]) -> Vec<String> {
+    let m = Machine::new(p, Layout::dense(p), &ExecConfig::default()).unwrap();
+    let id = |n: &str| VarId(p.vars.iter().position(|v| v.name == n).unwrap() as u32);
+    let names = ["r1", "r2", "r3", "r4", "r5", "d", "e"];
+    let mut st = m.initial_state();
+    let mut out = Vec::new();
+    for (k, &(go, a, b)) in scans.iter().enumerate() {
+        let set = [
+            (id("go"), Value::Bool(go)),
+            (id("a"), Value::Int(a)),
+            (id("b"), Value::Int(b)),
+        ];
+        m.set_inputs(&mut st, &set);
+        let mut faults = Vec::new();
+        m.run_scan(&mut st, k as u64, &mut faults);
+        let mut line: Vec<String> = names
+            .iter()
+            .map(|n| format!("{n}={}", m.value(&st, id(n)).to_json()))
+            .collect();
+        line.extend(
+            faults
+                .iter()
+                .map(|f| format!("{} {:?}", p.rung(f.rung).id, f.kind)),
+        );
+        out.push(line.join(" "));
+    }
+    out
+}
+
+#[test]
+fn the_stl_read_back_gives_the_interpreters_results_and_faults() {
+    let (p, fbd) = load(&program());
+    let stl = plc_deps::codegen::il::generate(&p, &fbd).unwrap();
+    let (back, _) = plc_deps::read::stl::load(&stl).unwrap_or_else(|e| panic!("{e:?}\n{stl}"));
+    let mut scans = Vec::new();
+    for a in [-7i16, 7, 0, -32768, 32767, 5] {
+        for b in [3i16, 0, -1, -4, 1] {
+            scans.push((a % 2 == 0, a, b));
+        }
+    }
+    let want = run(&p, &scans);
+    assert_eq!(run(&back, &scans), want, "\n{stl}");
+    // The cases are the ones meant: -32768 MOD -1, a zero divisor (a fault, r2 = 0), a
+    // negative dividend (the remainder takes its sign).
+    assert!(want.iter().any(|l| l.contains("R2 DivByZero")));
+    let at = |a: i16, b: i16| {
+        let k = scans.iter().position(|s| s.1 == a && s.2 == b).unwrap();
+        want[k].clone()
+    };
+    assert!(at(-32768, -1).contains("r2=0 "), "{}", at(-32768, -1));
+    assert!(at(-7, 3).contains("r2=-1 "), "{}", at(-7, 3));
+    assert!(at(7, -4).contains("r2=3 "), "{}", at(7, -4));
+    assert!(at(7, 0).contains("r2=0 "), "{}", at(7, 0));
+}
+
+/// A counter in a word instruction is its count: `il` writes a CTU's CV that way (`LDW>= c1,
+/// 2`, `MOVW c1, n`), and the reader reads it back, for a declared counter as for `C5`.
+#[test]
+fn a_counter_as_a_word_is_its_count() {
+    let doc = json!({"program": "cv", "vars": [
+        {"name": "up", "type": "BOOL", "class": "input"}, {"name": "r", "type": "BOOL", "class": "input"},
+        {"name": "c1", "type": "CTU"}, {"name": "n", "type": "INT"}, {"name": "q", "type": "BOOL"}
+    ], "rungs": [
+        {"id": "R1", "ld": [{"contact": "up"}, {"ctu": "c1", "pv": 5, "reset": "r"}]},
+        {"id": "R2", "ld": [{"compare": "GE", "a": "c1.CV", "b": 2}, {"coil": "q"}]},
+        {"id": "R3", "ld": [{"move": "c1.CV", "to": "n"}]}
+    ]});
+    let (p, fbd) = load(&doc);
+    let stl = plc_deps::codegen::il::generate(&p, &fbd).unwrap();
+    assert!(stl.contains("\nLDW>=  c1, 2\n"), "{stl}");
+    assert!(stl.contains("\nMOVW   c1, n\n"), "{stl}");
+    let (back, _) = plc_deps::read::stl::load(&stl).unwrap_or_else(|e| panic!("{e:?}\n{stl}"));
+    let absolute = "ORGANIZATION_BLOCK m:OB1\nNETWORK 1\nLD I0.0\nLD I0.1\nCTU C5, 5\n\
+        NETWORK 2\nLDW>= C5, 2\n= Q0.0\nNETWORK 3\nLD SM0.0\nMOVW C5, VW0\nEND_ORGANIZATION_BLOCK\n";
+    let (abs, _) = plc_deps::read::stl::load(absolute).unwrap_or_else(|e| panic!("{e:?}"));
+    let trace = |p: &Program, names: [&str; 5]| {
+        let m = Machine::new(p, Layout::dense(p), &ExecConfig::default()).unwrap();
+        let id = |n: &str| VarId(p.vars.iter().position(|v| v.name == n).unwrap() as u32);
+        let mut st = m.initial_state();
+        (0..12u64)
+            .map(|k| {
+                let (up, r) = (k % 2 == 0, k == 9);
+                m.set_inputs(
+                    &mut st,
+                    &[
+                        (id(names[0]), Value::Bool(up)),
+                        (id(names[1]), Value::Bool(r)),
+                    ],
+                );
+                m.run_scan(&mut st, k, &mut Vec::new());
+                format!(
+                    "{} {}",
+                    m.value(&st, id(names[2])).to_json(),
+                    m.value(&st, id(names[3])).to_json()
+                ) + &format!(" {}", m.value(&st, id(names[4])).to_json())
+            })
+            .collect::<Vec<_>>()
+    };
+    let want = trace(&p, ["up", "r", "q", "n", "c1"]);
+    assert_eq!(trace(&back, ["up", "r", "q", "n", "c1"]), want);
+    assert_eq!(trace(&abs, ["I0_0", "I0_1", "Q0_0", "VW0", "C5"]), want);
+    assert!(want[4].starts_with("true 3 "), "{:?}", want);
+}
