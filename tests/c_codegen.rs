@@ -213,7 +213,7 @@ fn n_input_blocks_are_one_statement() {
         {"id": 5, "op": "MUL", "in": ["acc", "a", "acc"], "out": "acc"}
      ]}]}})
     .to_string();
-    let (p, fbd) = plc_deps::read::program_and_fbd_from_json(&doc).unwrap();
+    let (p, fbd) = plc_deps::load::program_and_fbd_from_json(&doc).unwrap();
     let files = generate(&p, &fbd, &CConfig::default());
     let body = &files.iter().find(|f| f.name == "pou_nin.c").unwrap().text;
     for line in [

@@ -31,7 +31,7 @@ fn program() -> serde_json::Value {
 }
 
 fn load(doc: &serde_json::Value) -> (Program, plc_deps::fbd::Fbd) {
-    plc_deps::read::program_and_fbd_from_json(&doc.to_string()).expect("the program loads")
+    plc_deps::load::program_and_fbd_from_json(&doc.to_string()).expect("the program loads")
 }
 
 #[test]
@@ -98,7 +98,7 @@ fn run(p: &Program, scans: &[(bool, i16, i16)]) -> Vec<String> {
 fn the_stl_read_back_gives_the_interpreters_results_and_faults() {
     let (p, fbd) = load(&program());
     let stl = plc_deps::codegen::il::generate(&p, &fbd).unwrap();
-    let (back, _) = plc_deps::read::stl::load(&stl).unwrap_or_else(|e| panic!("{e:?}\n{stl}"));
+    let (back, _) = plc_deps::load::stl(&stl).unwrap_or_else(|e| panic!("{e:?}\n{stl}"));
     let mut scans = Vec::new();
     for a in [-7i16, 7, 0, -32768, 32767, 5] {
         for b in [3i16, 0, -1, -4, 1] {
@@ -136,10 +136,10 @@ fn a_counter_as_a_word_is_its_count() {
     let stl = plc_deps::codegen::il::generate(&p, &fbd).unwrap();
     assert!(stl.contains("\nLDW>=  c1, 2\n"), "{stl}");
     assert!(stl.contains("\nMOVW   c1, n\n"), "{stl}");
-    let (back, _) = plc_deps::read::stl::load(&stl).unwrap_or_else(|e| panic!("{e:?}\n{stl}"));
+    let (back, _) = plc_deps::load::stl(&stl).unwrap_or_else(|e| panic!("{e:?}\n{stl}"));
     let absolute = "ORGANIZATION_BLOCK m:OB1\nNETWORK 1\nLD I0.0\nLD I0.1\nCTU C5, 5\n\
         NETWORK 2\nLDW>= C5, 2\n= Q0.0\nNETWORK 3\nLD SM0.0\nMOVW C5, VW0\nEND_ORGANIZATION_BLOCK\n";
-    let (abs, _) = plc_deps::read::stl::load(absolute).unwrap_or_else(|e| panic!("{e:?}"));
+    let (abs, _) = plc_deps::load::stl(absolute).unwrap_or_else(|e| panic!("{e:?}"));
     let trace = |p: &Program, names: [&str; 5]| {
         let m = Machine::new(p, Layout::dense(p), &ExecConfig::default()).unwrap();
         let id = |n: &str| VarId(p.vars.iter().position(|v| v.name == n).unwrap() as u32);
