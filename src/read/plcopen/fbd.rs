@@ -21,11 +21,14 @@
 //! Deliberately not here (errors naming the element): negated or edge-qualified pins, several
 //! wires into one FBD pin, ENO wired on, expressions as in/out variables.
 
-use super::interface::literal;
+use super::black_box::{self, BlackBox, Ctx};
+use super::interface::{literal, name};
 use super::wiring::{graph, ElemId, Graph, Source};
 use super::xml::{attr, error, identifier, origin, variable_ref, ExecOrder, Notes, Tc6, R};
 use crate::syntax::fbd::{Block, Connection, Input, Inputs, Network, OutVar, Outputs, Targets};
-use crate::syntax::FbdBody;
+use crate::diag::Origin;
+use crate::syntax::{FbdBody, Located, Scalar, Var, VarClass};
+use std::cell::RefCell;
 use roxmltree::Node;
 use std::borrow::Cow;
 
@@ -43,7 +46,13 @@ const FBD_TAGS: &[&str] = &[
 ];
 
 /// Reads FBD body `node` of POU `pou`.
-pub fn body(tc6: Tc6, node: Node, pou: &str, notes: &mut Notes) -> R<FbdBody<'static>> {
+pub fn body(
+    tc6: Tc6,
+    node: Node,
+    pou: &str,
+    ctx: &Ctx,
+    notes: &mut Notes,
+) -> R<FbdBody<'static>> {
     let place = format!("pou {pou}, FBD");
     let g = graph(tc6, node, &place)?;
     g.only(FBD_TAGS, "FBD", &place)?;
@@ -60,7 +69,13 @@ pub fn body(tc6: Tc6, node: Node, pou: &str, notes: &mut Notes) -> R<FbdBody<'st
         }
     }
     ordered.sort_unstable();
-    let f = Fbd { g: &g, place };
+    let f = Fbd {
+        g: &g,
+        place,
+        a: RefCell::new(Added::new(&g)),
+        ctx,
+        boxes: RefCell::new(std::mem::take(&mut notes.black_boxes)),
+    };
     let mut networks: Vec<Network<'static>> = Vec::new();
     let mut current: Vec<Block<'static>> = Vec::new();
     let mut label: Option<(String, Node)> = None;
@@ -105,6 +120,7 @@ pub fn body(tc6: Tc6, node: Node, pou: &str, notes: &mut Notes) -> R<FbdBody<'st
             }
             _ => {}
         }
+        current.append(&mut f.a.borrow_mut().blocks);
     }
     let k = networks.len();
     networks.push(network(pou, k, label, current, comments));
@@ -113,6 +129,9 @@ pub fn body(tc6: Tc6, node: Node, pou: &str, notes: &mut Notes) -> R<FbdBody<'st
             n.id = Ok(Cow::Owned(pou.to_owned()));
         }
     }
+    notes.black_boxes = f.boxes.take();
+    let vars = std::mem::take(&mut f.a.borrow_mut().vars);
+    notes.ld_vars.extend(vars.into_iter().map(|v| (pou.to_owned(), v)));
     if !ordered.is_empty() {
         notes.exec_orders.push(ExecOrder {
             networks: networks
@@ -154,6 +173,221 @@ fn network(
 struct Fbd<'g, 'a, 'i> {
     g: &'g Graph<'a, 'i>,
     place: String,
+    /// Blocks the reader adds (NOT of a negated pin, edge detectors), for the current network.
+    a: RefCell<Added>,
+    /// What blocks may call, and the types of the names the body sees.
+    ctx: &'g Ctx,
+    /// The project's black boxes so far ([`black_box`]).
+    boxes: RefCell<Vec<BlackBox>>,
+}
+
+/// A block's output pin as the syntax names it: the unnamed result of a user function
+/// (`formalParameter=""`, old Beremiz files) is `OUT`.
+pub fn pin_of(p: &str) -> &str {
+    if p.is_empty() {
+        "OUT"
+    } else {
+        p
+    }
+}
+
+/// Blocks and variables a reader adds to a body: NOT of a negated pin, edge detectors, the
+/// gates of an LD body read as data flow ([`super::ld_flow`]). Their ids count up from above
+/// every localId of the body.
+pub struct Added {
+    pub next_id: u32,
+    pub blocks: Vec<Block<'static>>,
+    /// Edge-detector instances (`R_TRIG__<localId>`), to add to the POU.
+    pub vars: Vec<Var<'static>>,
+}
+
+pub fn konst(b: bool, at: Origin) -> Input<'static> {
+    Input {
+        origin: at,
+        from: Connection::Constant(Scalar::Bool(b)),
+    }
+}
+
+pub fn is_const(i: &Input, b: bool) -> bool {
+    matches!(i.from, Connection::Constant(Scalar::Bool(x)) if x == b)
+}
+
+impl Added {
+    pub fn new(g: &Graph) -> Added {
+        Added {
+            next_id: g.elems.iter().map(|el| el.local_id).max().unwrap_or(0) + 1,
+            blocks: Vec::new(),
+            vars: Vec::new(),
+        }
+    }
+
+    /// Adds block `op` with `inputs` (by pin name) at `at`: an arc from its first output.
+    pub fn add(&mut self, op: &str, inputs: Vec<(&str, Input<'static>)>, at: Origin) -> Input<'static> {
+        let named = inputs
+            .into_iter()
+            .map(|(p, i)| (Cow::Owned(p.to_owned()), i))
+            .collect();
+        self.add_on(op, None, Inputs::Named(named), at)
+    }
+
+    /// Adds block `op` (on `instance`) with `inputs` at `at`: an arc from its first output.
+    pub fn add_on(
+        &mut self,
+        op: &str,
+        instance: Option<String>,
+        inputs: Inputs<'static>,
+        at: Origin,
+    ) -> Input<'static> {
+        let id = self.next_id;
+        self.next_id += 1;
+        self.blocks.push(Block {
+            origin: at,
+            id: Ok(id),
+            op: Ok(Cow::Owned(op.to_owned())),
+            inputs: Some(Ok(inputs)),
+            outputs: None,
+            instance: instance.map(|i| Ok(Cow::Owned(i))),
+            label: None,
+            cond: None,
+            after: None,
+            comment: None,
+            problem: None,
+        });
+        let first = if op.ends_with("_TRIG") { "Q" } else { "OUT" };
+        Input {
+            origin: at,
+            from: Connection::Arc {
+                block: id,
+                pin: Some(Ok(Cow::Borrowed(first))),
+            },
+        }
+    }
+
+    pub fn and(&mut self, a: Input<'static>, b: Input<'static>, at: Origin) -> Input<'static> {
+        if is_const(&a, true) {
+            return b;
+        }
+        if is_const(&b, true) {
+            return a;
+        }
+        self.add("AND", vec![("IN1", a), ("IN2", b)], at)
+    }
+
+    pub fn not(&mut self, a: Input<'static>, at: Origin) -> Input<'static> {
+        match a.from {
+            Connection::Constant(Scalar::Bool(x)) => konst(!x, at),
+            _ => self.add("NOT", vec![("IN", a)], at),
+        }
+    }
+
+    /// An extensible comparison `op(IN1, …, INn)`, n ≥ 3 (IEC 61131-3 Table 31:
+    /// `IN1 op IN2 AND IN2 op IN3 …`): `b` becomes the AND of a new comparison per neighbouring
+    /// pair, keeping its id and outputs.
+    pub fn extensible_compare(&mut self, b: &mut Block<'static>) {
+        let op = match &b.op {
+            Ok(op) if crate::model::CmpOp::parse(op).is_some() => op.to_string(),
+            _ => return,
+        };
+        let Some(Ok(Inputs::Named(ins))) = &b.inputs else { return };
+        if ins.len() < 3 {
+            return;
+        }
+        let ins: Vec<Input<'static>> = ins.iter().map(|(_, i)| i.clone()).collect();
+        let mut pairs = Vec::new();
+        for w in ins.windows(2) {
+            let at = w[1].origin;
+            pairs.push(self.add(&op, vec![("IN1", w[0].clone()), ("IN2", w[1].clone())], at));
+        }
+        let named = pairs
+            .into_iter()
+            .enumerate()
+            .map(|(k, i)| (Cow::Owned(format!("IN{}", k + 1)), i))
+            .collect();
+        b.op = Ok(Cow::Borrowed("AND"));
+        b.inputs = Some(Ok(Inputs::Named(named)));
+    }
+
+    /// Declares instance `inst` of function block type `ty` in the POU.
+    pub fn declare(&mut self, inst: &str, ty: &str, at: Origin) {
+        self.vars.push(Var {
+            origin: at,
+            name: name(inst, at),
+            ty: name(ty, at),
+            class: Located {
+                value: VarClass::Memory,
+                origin: at,
+            },
+            init: None,
+            problem: None,
+        });
+    }
+
+    /// An R_TRIG (`rising`) or F_TRIG of `clk` on a new instance named after `local_id`.
+    pub fn trigger(&mut self, edge: &str, clk: Input<'static>, local_id: u32, at: Origin) -> Input<'static> {
+        let kind = if edge == "falling" { "F_TRIG" } else { "R_TRIG" };
+        let inst = format!("{kind}__{local_id}");
+        let mut k = 1;
+        let mut unique = inst.clone();
+        while self.vars.iter().any(|v| v.name.value == unique) {
+            k += 1;
+            unique = format!("{inst}_{k}");
+        }
+        self.declare(&unique, kind, at);
+        let inputs = Inputs::Named(vec![(Cow::Borrowed("CLK"), clk)]);
+        self.add_on(kind, Some(unique), inputs, at)
+    }
+}
+
+/// What an `inVariable` or `inOutVariable` element `node` gives to a pin (at `at`): its
+/// literal, else its variable.
+pub fn block_input(node: Node, place: &str, at: Origin) -> R<Input<'static>> {
+    let text = node
+        .children()
+        .find(|c| c.is_element() && c.tag_name().name() == "expression")
+        .and_then(|c| c.text())
+        .unwrap_or("");
+    let from = match literal(text) {
+        Some(v) => Connection::Constant(v),
+        None => Connection::Variable(Cow::Owned(variable_ref(text, node, place)?)),
+    };
+    Ok(Input { origin: at, from })
+}
+
+/// The qualifiers of input pin `pin` (its `variable` node `pnode`) of block `ty`: negated, and
+/// the edge (`rising`/`falling`). A `storage` qualifier is an error.
+pub fn pin_modifiers<'n>(
+    pnode: Node<'n, '_>,
+    ty: &str,
+    pin: &str,
+    local_id: u32,
+    place: &str,
+) -> R<(bool, Option<&'n str>)> {
+    if matches!(pnode.attribute("storage"), Some(v) if v != "none") {
+        return Err(error(
+            origin(pnode),
+            place,
+            format!("input {pin} of {ty} (localId {local_id}) has a storage qualifier, which only a coil can have"),
+        ));
+    }
+    let negated = matches!(pnode.attribute("negated"), Some("true" | "1"));
+    let edge = pnode.attribute("edge").filter(|e| *e != "none");
+    if negated && edge.is_some() {
+        return Err(error(
+            origin(pnode),
+            place,
+            format!("input {pin} of {ty} (localId {local_id}) is both negated and edge-qualified"),
+        ));
+    }
+    Ok((negated, edge))
+}
+
+/// True when output `pin` of block element `node` is negated (`None`: its first output).
+pub fn output_negated(outputs: &[(&str, Node)], pin: Option<&str>) -> bool {
+    let found = match pin {
+        Some(p) => outputs.iter().find(|(n, _)| *n == p),
+        None => outputs.iter().find(|(n, _)| *n != "ENO"),
+    };
+    found.is_some_and(|(_, n)| matches!(n.attribute("negated"), Some("true" | "1")))
 }
 
 impl Fbd<'_, '_, '_> {
@@ -191,16 +425,8 @@ impl Fbd<'_, '_, '_> {
         let mut inputs = Vec::new();
         for pin in &el.inputs {
             let name = pin.name.unwrap_or("");
-            for a in ["negated", "edge", "storage"] {
-                if matches!(pin.node.attribute(a), Some(v) if v != "false" && v != "none") {
-                    return Err(error(
-                        origin(pin.node),
-                        &here,
-                        format!("input {name} of {ty} (localId {}) is {a}: qualified pins are not supported yet", el.local_id),
-                    ));
-                }
-            }
-            let input = match pin.sources.as_slice() {
+            let (negated, edge) = pin_modifiers(pin.node, ty, name, el.local_id, &here)?;
+            let mut input = match pin.sources.as_slice() {
                 [] => continue,
                 [s] => self.input(e, s)?,
                 _ => {
@@ -211,6 +437,19 @@ impl Fbd<'_, '_, '_> {
                     ))
                 }
             };
+            let at = origin(pin.node);
+            let counter_edge = matches!(ty, "CTU" | "CTD" | "CTUD") && matches!(name, "CU" | "CD");
+            let mut a = self.a.borrow_mut();
+            match edge {
+                Some(edge) if !(counter_edge && edge == "rising") => {
+                    input = a.trigger(edge, input, el.local_id, at)
+                }
+                _ => {}
+            }
+            if negated {
+                input = a.not(input, at);
+            }
+            drop(a);
             if name == "EN" {
                 b.cond = Some(input);
             } else {
@@ -218,16 +457,40 @@ impl Fbd<'_, '_, '_> {
             }
         }
         b.inputs = Some(Ok(Inputs::Named(inputs)));
+        self.a.borrow_mut().extensible_compare(&mut b);
+        if !black_box::is_known(self.ctx, ty) {
+            let t = black_box::Typer { ctx: self.ctx, g: self.g };
+            let mut boxes = self.boxes.borrow_mut();
+            if let Some((inst, bt)) = black_box::rewrite(&t, e, &mut b, &mut boxes, &here)? {
+                self.a.borrow_mut().declare(&inst, &bt, b.origin);
+            }
+        }
         let mut outputs = Vec::new();
         for (pin, pnode) in &el.outputs {
-            if matches!(pnode.attribute("negated"), Some("true" | "1")) {
-                return Err(error(
-                    origin(*pnode),
-                    &here,
-                    format!("output {pin} of {ty} (localId {}) is negated: qualified pins are not supported yet", el.local_id),
-                ));
-            }
             let targets = self.targets(e, pin, el.outputs.first().map(|o| o.0) == Some(*pin))?;
+            let negated = matches!(pnode.attribute("negated"), Some("true" | "1"));
+            let targets = if negated && !targets.is_empty() {
+                // The variables a negated output writes get NOT of it.
+                let at = origin(*pnode);
+                let arc = Input {
+                    origin: at,
+                    from: Connection::Arc {
+                        block: el.local_id,
+                        pin: Some(Ok(Cow::Owned(pin_of(pin).to_owned()))),
+                    },
+                };
+                let mut a = self.a.borrow_mut();
+                a.not(arc, at);
+                if let Some(n) = a.blocks.last_mut() {
+                    n.outputs = Some(Ok(Outputs::Named(vec![(
+                        Cow::Borrowed("OUT"),
+                        Ok(Targets::Many(targets.into_iter().map(Ok).collect())),
+                    )])));
+                }
+                Vec::new()
+            } else {
+                targets
+            };
             if *pin == "ENO" && !targets.is_empty() {
                 return Err(error(
                     origin(*pnode),
@@ -240,7 +503,7 @@ impl Fbd<'_, '_, '_> {
             }
             if !targets.is_empty() {
                 outputs.push((
-                    Cow::Owned(pin.to_string()),
+                    Cow::Owned(pin_of(pin).to_owned()),
                     Ok(Targets::Many(targets.into_iter().map(Ok).collect())),
                 ));
             }
@@ -291,42 +554,30 @@ impl Fbd<'_, '_, '_> {
     /// What source `s` gives to an input of block `consumer`.
     fn input(&self, consumer: ElemId, s: &Source) -> R<Input<'static>> {
         let src = self.g.get(s.elem);
-        let from = match src.tag {
-            "block" => Connection::Arc {
-                block: src.local_id,
-                pin: s.pin.map(|p| Ok(Cow::Owned(p.to_owned()))),
-            },
-            "inVariable" | "inOutVariable" => {
-                let text = src
-                    .node
-                    .children()
-                    .find(|c| c.is_element() && c.tag_name().name() == "expression")
-                    .and_then(|c| c.text())
-                    .unwrap_or("");
-                match literal(text) {
-                    Some(v) => Connection::Constant(v),
-                    None => Connection::Variable(Cow::Owned(variable_ref(
-                        text,
-                        src.node,
-                        &self.at(s.elem),
-                    )?)),
+        match src.tag {
+            "block" => {
+                let arc = Input {
+                    origin: s.origin,
+                    from: Connection::Arc {
+                        block: src.local_id,
+                        pin: s.pin.map(|p| Ok(Cow::Owned(pin_of(p).to_owned()))),
+                    },
+                };
+                if output_negated(&src.outputs, s.pin) {
+                    return Ok(self.a.borrow_mut().not(arc, s.origin));
                 }
+                Ok(arc)
             }
-            other => {
-                return Err(error(
+            "inVariable" | "inOutVariable" => block_input(src.node, &self.at(s.elem), s.origin),
+            other => Err(error(
                     s.origin,
                     &self.at(consumer),
                     format!(
                         "a {other} (localId {}) cannot feed an input in FBD",
                         src.local_id
                     ),
-                ))
-            }
-        };
-        Ok(Input {
-            origin: s.origin,
-            from,
-        })
+            )),
+        }
     }
 
     /// JMP and RET blocks.

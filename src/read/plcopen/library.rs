@@ -63,26 +63,10 @@ pub fn stand_in_fb(
     instances: &[String],
 ) -> Option<(FunctionBlock<'static>, Note)> {
     let b = BLOCKS.iter().find(|b| b.name == ty)?;
-    let inputs: Vec<Var<'static>> = b
-        .inputs
-        .iter()
-        .map(|(n, t)| var(n, t, VarClass::Input, at))
-        .collect();
-    let outputs: Vec<Var<'static>> = b
-        .outputs
-        .iter()
-        .map(|(n, t)| var(n, t, VarClass::Output, at))
-        .collect();
-    let reads: Vec<Read> = b
-        .inputs
-        .iter()
-        .map(|(n, t)| Read {
-            name: (*n).to_owned(),
-            bool: *t == "BOOL",
-        })
-        .collect();
-    let writes: Vec<String> = b.outputs.iter().map(|(n, _)| (*n).to_owned()).collect();
-    let body = stand_in(format!("{ty}.body"), at, &reads, &writes);
+    let pins = |v: &[(&str, &str)]| -> Vec<(String, String)> {
+        v.iter().map(|(n, t)| (n.to_string(), t.to_string())).collect()
+    };
+    let fb = stand_in_type(ty, &pins(b.inputs), &pins(b.outputs), at);
     let show = |v: &[(&str, &str)]| v.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", ");
     let note = Note {
         origin: at,
@@ -95,13 +79,60 @@ pub fn stand_in_fb(
             show(b.outputs)
         ),
     };
-    let fb = FunctionBlock {
+    Some((fb, note))
+}
+
+/// The outputs (name, model type) of each library block, for typing what they feed.
+pub fn outputs() -> impl Iterator<Item = (&'static str, Vec<(String, String)>)> {
+    BLOCKS.iter().map(|b| {
+        let o = b.outputs.iter().map(|(n, t)| (n.to_string(), t.to_string()));
+        (b.name, o.collect())
+    })
+}
+
+/// A black-box function block type `ty` with `inputs` and `outputs` (name, model type): one
+/// stand-in rung reading every input and writing every output with its own value.
+pub fn stand_in_type(
+    ty: &str,
+    inputs: &[(String, String)],
+    outputs: &[(String, String)],
+    at: Origin,
+) -> FunctionBlock<'static> {
+    let reads: Vec<Read> = inputs
+        .iter()
+        .map(|(n, t)| Read {
+            name: n.clone(),
+            bool: t == "BOOL",
+        })
+        .collect();
+    let writes: Vec<String> = outputs.iter().map(|(n, _)| n.clone()).collect();
+    let body = stand_in(format!("{ty}.body"), at, &reads, &writes);
+    FunctionBlock {
         origin: at,
         name: ty.to_owned().into(),
-        inputs,
-        outputs,
+        inputs: inputs.iter().map(|(n, t)| var(n, t, VarClass::Input, at)).collect(),
+        outputs: outputs.iter().map(|(n, t)| var(n, t, VarClass::Output, at)).collect(),
         vars: Vec::new(),
         body: Some(Body::Rungs(body.into_iter().collect())),
+    }
+}
+
+/// The black-box type of a block the model lacks ([`super::black_box`]), with its note.
+pub fn black_box_type(b: &super::black_box::BlackBox) -> (FunctionBlock<'static>, Note) {
+    let fb = stand_in_type(&b.name, &b.sig.inputs, &b.sig.outputs, b.origin);
+    let show = |v: &[(String, String)]| {
+        v.iter().map(|(n, t)| format!("{n} {t}")).collect::<Vec<_>>().join(", ")
     };
-    Some((fb, note))
+    let note = Note {
+        origin: b.origin,
+        message: format!(
+            "{} is read as a black box (a function block type {} reading its inputs {} and writing its outputs {}): the analysis sees those reads and writes; `run` does not compute it (its outputs keep their initial values). Called at: {}",
+            b.op,
+            b.name,
+            show(&b.sig.inputs),
+            show(&b.sig.outputs),
+            b.sites.join("; ")
+        ),
+    };
+    (fb, note)
 }

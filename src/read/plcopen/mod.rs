@@ -16,11 +16,13 @@
 //! column computed from its byte offset); a construct the reader does not handle is an error,
 //! never dropped; a program loads whole or not at all.
 
+mod black_box;
 mod data_types;
 mod fbd;
 mod interface;
 mod ld;
 mod ld_block;
+mod ld_flow;
 mod ld_logic;
 mod ld_power;
 mod library;

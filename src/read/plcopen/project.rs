@@ -20,7 +20,9 @@
 use super::data_types::DataTypes;
 use super::interface::{self, name, Interface, Known};
 use super::xml::{add_data_note, attr, error, identifier, origin, Note, Notes, Tc6, R};
-use super::{fbd, ld, library, st_body, textual};
+use super::black_box::{Ctx, Sig};
+use super::{fbd, ld, ld_flow, library, st_body, textual};
+use crate::diag::LoadError;
 use crate::syntax::{
     Body, Element, ElementKind, FunctionBlock, Program, RoutineKind, Rung, Subroutine, Var,
 };
@@ -79,6 +81,7 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
         .chain(read.iter().flat_map(|r| &r.3.globals))
         .map(|v| (v.name.as_str(), v.ty.as_str()))
         .collect();
+    let base = base_ctx(&read);
     let mut bodies = Vec::new();
     for (pou, pname, kind, iface) in &read {
         add_data_note(tc6, *pou, notes);
@@ -89,7 +92,8 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
             continue;
         }
         let scope = scope(iface, &global_types, &known);
-        bodies.push(Some(body(tc6, *pou, pname, iface, &scope, notes)?));
+        let ctx = pou_ctx(&base, iface, &global_types);
+        bodies.push(Some(body(tc6, *pou, pname, iface, &scope, &ctx, notes)?));
     }
     notes.list.extend(later.list);
     let (mut programs, mut fbs) = (Vec::new(), Vec::new());
@@ -135,6 +139,11 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
             // A function (its body is `None`, skipped above).
             _ => {}
         }
+    }
+    for b in std::mem::take(&mut notes.black_boxes) {
+        let (fb, note) = library::black_box_type(&b);
+        fbs.push(fb);
+        notes.push(note);
     }
     library_fbs(&mut fbs, &programs, &globals, notes);
     assemble(root, programs, fbs, globals, order)
@@ -330,6 +339,7 @@ fn body(
     name: &str,
     iface: &Interface,
     scope: &st_body::Scope,
+    ctx: &Ctx,
     notes: &mut Notes,
 ) -> R<Body<'static>> {
     let place = format!("pou {name}");
@@ -377,8 +387,8 @@ fn body(
         ));
     }
     Ok(match tag {
-        "LD" => Body::Rungs(ld::rungs(tc6, lang, name, notes)?),
-        "FBD" => Body::Fbd(fbd::body(tc6, lang, name, notes)?),
+        "LD" => ld_body(tc6, lang, name, ctx, notes)?,
+        "FBD" => Body::Fbd(fbd::body(tc6, lang, name, ctx, notes)?),
         "ST" => Body::Rungs(st_body::rungs(lang, name, scope, notes)?),
         "IL" | "SFC" => {
             let reads: Vec<&Var> = iface.inputs.iter().collect();
@@ -505,4 +515,93 @@ fn instance_type(pi: Node, place: &str) -> R<String> {
         .or(pi.attribute("type"))
         .ok_or_else(|| error(origin(pi), place, "pouInstance has no typeName"))?;
     identifier(ty, "program", pi, place)
+}
+
+/// An LD body: its rungs, or, where the rung reader cannot express its wiring as series-parallel
+/// rungs, the data-flow network Beremiz makes of it ([`ld_flow`]), with a note saying why. When
+/// both fail, the rung reader's error.
+fn ld_body(tc6: Tc6, lang: Node, name: &str, ctx: &Ctx, notes: &mut Notes) -> R<Body<'static>> {
+    let (list, vars) = (notes.list.len(), notes.ld_vars.len());
+    let why = match ld::rungs(tc6, lang, name, notes) {
+        Ok(r) => return Ok(Body::Rungs(r)),
+        Err(e) => e,
+    };
+    notes.list.truncate(list);
+    notes.ld_vars.truncate(vars);
+    match ld_flow::body(tc6, lang, name, ctx, notes) {
+        Ok(b) => {
+            let (at, what) = match &why {
+                LoadError::Invalid(d) => (d.location.origin, d.to_string()),
+                other => (origin(lang), other.to_string()),
+            };
+            notes.push(Note {
+                origin: at,
+                message: format!(
+                    "pou {name}: its LD body is read as a data-flow network (FBD networks {name}.N1 …, each rung's power flow as boolean blocks, as Beremiz generates LD) because it is not series-parallel rungs of contacts, coils and boxes: {what}"
+                ),
+            });
+            Ok(Body::Fbd(b))
+        }
+        Err(_) => Err(why),
+    }
+}
+
+
+/// What any body of the project may call: its user functions (with their pins' types) and the
+/// function block types of the project and of the library (with their outputs' types).
+fn base_ctx(read: &[(Node, String, &str, Interface)]) -> Ctx {
+    let pins = |v: &[Var]| -> Vec<(String, String)> {
+        v.iter()
+            .map(|v| (v.name.as_str().to_owned(), v.ty.as_str().to_owned()))
+            .collect()
+    };
+    let mut ctx = Ctx::default();
+    for (_, name, kind, iface) in read {
+        match *kind {
+            "function" => {
+                let mut outputs = Vec::new();
+                if let Some(t) = &iface.return_ty {
+                    outputs.push(("OUT".to_owned(), t.clone()));
+                }
+                outputs.extend(pins(&iface.outputs));
+                let sig = Sig {
+                    inputs: pins(&iface.inputs),
+                    outputs,
+                };
+                ctx.functions.insert(name.clone(), sig);
+            }
+            "functionBlock" => {
+                ctx.fbs.insert(name.clone(), pins(&iface.outputs));
+            }
+            _ => {}
+        }
+    }
+    for (name, outputs) in library::outputs() {
+        ctx.fbs.entry(name.to_owned()).or_insert(outputs);
+    }
+    ctx
+}
+
+/// [`base_ctx`] with the variables a POU sees (its own and the globals it names external).
+fn pou_ctx(base: &Ctx, iface: &Interface, globals: &[(&str, &str)]) -> Ctx {
+    let mut vars = std::collections::HashMap::new();
+    for v in iface
+        .inputs
+        .iter()
+        .chain(&iface.outputs)
+        .chain(&iface.locals)
+        .chain(&iface.globals)
+    {
+        vars.insert(v.name.as_str().to_ascii_lowercase(), v.ty.as_str().to_owned());
+    }
+    for (n, t) in globals {
+        if iface.externals.iter().any(|e| e.eq_ignore_ascii_case(n)) {
+            vars.insert(n.to_ascii_lowercase(), t.to_string());
+        }
+    }
+    Ctx {
+        functions: base.functions.clone(),
+        fbs: base.fbs.clone(),
+        vars,
+    }
 }
