@@ -228,6 +228,23 @@ pub fn load_program(path: &Path) -> Result<Program, CliError> {
     load_program_and_fbd(path).map(|(p, _)| p)
 }
 
+/// Reads and checks a program file (`-`: standard input) for `run`: a PLCopen project with
+/// something `run` cannot execute (a string in an LD or FBD body) is an error.
+pub fn load_program_for_run(path: &Path) -> Result<Program, CliError> {
+    let (file, text) = read_program_text(path)?;
+    let lower = file.to_ascii_lowercase();
+    let stl = crate::read::stl::looks_like_stl(&text)
+        || lower.ends_with(".stl")
+        || lower.ends_with(".awl");
+    if !stl && crate::read::plcopen::looks_like_xml(&text) {
+        let (p, _, notes) = crate::read::plcopen::load_for_run(&text)
+            .map_err(|error| CliError::load(file.clone(), &text, error))?;
+        warn_notes(PLCOPEN_NOTE, &file, &text, &notes);
+        return Ok(p);
+    }
+    load_text(file, &text).map(|(p, _)| p)
+}
+
 /// Reads and checks a program file (`-`: standard input), with its FBD bodies as written.
 pub fn load_program_and_fbd(path: &Path) -> Result<(Program, Fbd), CliError> {
     let (file, text) = read_program_text(path)?;

@@ -54,6 +54,8 @@ pub struct Ctx {
     pub functions: HashMap<String, Sig>,
     /// Function block types the model has or the project defines, with their outputs' types.
     pub fbs: HashMap<String, Vec<(String, String)>>,
+    /// The input pins' types of the function block types of the project and the library.
+    pub fb_inputs: HashMap<String, Vec<(String, String)>>,
     /// The POU's variables and the globals it sees: lower-case name → model type.
     pub vars: HashMap<String, String>,
 }
@@ -75,7 +77,29 @@ fn standard_outputs(fb: &str) -> Option<&'static [(&'static str, &'static str)]>
     })
 }
 
+/// The BOOL inputs of the model's blocks (IEC 61131-3 2.5.1.5, 2.5.2.3).
+fn standard_bool_input(op: &str, pin: &str) -> bool {
+    match op {
+        "AND" | "OR" | "XOR" | "NOT" => true,
+        "SEL" => pin == "G",
+        "TON" | "TOF" | "TP" => pin == "IN",
+        "CTU" | "CTD" | "CTUD" => matches!(pin, "CU" | "CD" | "R" | "LD"),
+        "SR" | "RS" => matches!(pin, "S1" | "R" | "S" | "R1"),
+        "R_TRIG" | "F_TRIG" => pin == "CLK",
+        _ => pin == "EN",
+    }
+}
+
 impl Ctx {
+    /// The type of input `pin` of a block `op`, where it is known.
+    pub fn input_type(&self, op: &str, pin: &str) -> Option<String> {
+        if standard_bool_input(op, pin) {
+            return Some("BOOL".to_owned());
+        }
+        let sig = self.fb_inputs.get(op).or_else(|| self.functions.get(op).map(|s| &s.inputs))?;
+        sig.iter().find(|(n, _)| n == pin).map(|(_, t)| t.clone())
+    }
+
     /// The type of the variable or field `name` (`T1.Q`).
     fn var_type(&self, name: &str) -> Option<String> {
         let mut parts = name.split('.');

@@ -289,10 +289,23 @@ impl Added {
             _ => return,
         };
         let Some(Ok(Inputs::Named(ins))) = &b.inputs else { return };
-        if ins.len() < 3 {
+        let index = |p: &str| p.strip_prefix("IN").and_then(|k| k.parse::<usize>().ok());
+        let n = ins.iter().filter_map(|(p, _)| index(p)).max().unwrap_or(0);
+        if n < 3 {
             return;
         }
-        let ins: Vec<Input<'static>> = ins.iter().map(|(_, i)| i.clone()).collect();
+        // An unconnected input of a function is its type's default, 0 (IEC 61131-3 2.5.1.1).
+        let ins: Vec<Input<'static>> = (1..=n)
+            .map(|k| {
+                ins.iter()
+                    .find(|(p, _)| index(p) == Some(k))
+                    .map(|(_, i)| i.clone())
+                    .unwrap_or(Input {
+                        origin: b.origin,
+                        from: Connection::Constant(Scalar::Number(0.into())),
+                    })
+            })
+            .collect();
         let mut pairs = Vec::new();
         for w in ins.windows(2) {
             let at = w[1].origin;
@@ -348,9 +361,34 @@ pub fn block_input(node: Node, place: &str, at: Origin) -> R<Input<'static>> {
         .unwrap_or("");
     let from = match literal(text) {
         Some(v) => Connection::Constant(v),
+        // A string has no value in the model: a stand-in 0 (`run` refuses such a body).
+        None if is_string_literal(text) => Connection::Constant(Scalar::Number(0.into())),
         None => Connection::Variable(Cow::Owned(variable_ref(text, node, place)?)),
     };
     Ok(Input { origin: at, from })
+}
+
+/// A `0` or `1` feeding a BOOL input pin is FALSE or TRUE (IEC 61131-3 6.3.2: literals are
+/// typed by their use).
+pub fn bool_literal(ctx: &Ctx, ty: &str, pin: &str, mut i: Input<'static>) -> Input<'static> {
+    if let Connection::Constant(Scalar::Number(n)) = &i.from {
+        let b = match n.as_u64() {
+            Some(0) => false,
+            Some(1) => true,
+            _ => return i,
+        };
+        if ctx.input_type(ty, pin).as_deref() == Some("BOOL") {
+            i.from = Connection::Constant(Scalar::Bool(b));
+        }
+    }
+    i
+}
+
+/// True when `text` is an IEC 61131-3 string literal (`'…'` or `"…"`, 6.3.3).
+pub fn is_string_literal(text: &str) -> bool {
+    let t = text.trim();
+    t.len() >= 2
+        && ((t.starts_with('\'') && t.ends_with('\'')) || (t.starts_with('"') && t.ends_with('"')))
 }
 
 /// The qualifiers of input pin `pin` (its `variable` node `pnode`) of block `ty`: negated, and
@@ -450,6 +488,12 @@ impl Fbd<'_, '_, '_> {
                 input = a.not(input, at);
             }
             drop(a);
+            if let Connection::Variable(v) = &input.from {
+                if let Some(k) = super::library::library_constant(ty, name, v) {
+                    input.from = Connection::Constant(Scalar::Number(k.into()));
+                }
+            }
+            input = bool_literal(self.ctx, ty, name, input);
             if name == "EN" {
                 b.cond = Some(input);
             } else {

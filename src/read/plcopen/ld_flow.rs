@@ -28,7 +28,7 @@
 //! and the ops themselves (the FBD resolver checks them, located at the block).
 
 use super::black_box::{self, BlackBox, Ctx};
-use super::fbd::{block_input, is_const, konst, output_negated, pin_modifiers, pin_of, Added};
+use super::fbd::{block_input, bool_literal, is_const, konst, output_negated, pin_modifiers, pin_of, Added};
 use super::ld::components;
 use super::wiring::{graph, ElemId, Graph, Source};
 use super::xml::{attr, error, identifier, origin, variable_ref, Notes, Tc6, R};
@@ -300,6 +300,7 @@ impl Flow<'_, '_, '_> {
             if negated {
                 v = self.a.not(v, at);
             }
+            let v = bool_literal(self.ctx, ty, pname, v);
             if pname == "EN" {
                 cond = Some(v);
             } else {

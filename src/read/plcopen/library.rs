@@ -6,7 +6,9 @@
 //! leaves the outputs at their initial values (a note says so).
 //!
 //! The blocks: RTC of IEC 61131-3 (2.5.2.3.5: IN, PDT → Q, CDT; the real-time clock, which
-//! Beremiz's standard library implements), its DT values read as DINT like every date and time.
+//! Beremiz's standard library implements), its DT values read as DINT like every date and time;
+//! Beremiz's LOGGER (TRIG, MSG, LEVEL) and its Python blocks python_eval, python_poll,
+//! python_gear (TRIG, CODE [, N] → ACK, RESULT), their strings read as the DINT stand-in.
 //!
 //! Deliberately not here: what the blocks compute (a clock has no value a scan could compute
 //! without the PLC's time), and blocks with string pins (the model has no strings).
@@ -26,12 +28,59 @@ struct Block {
     source: &'static str,
 }
 
-const BLOCKS: &[Block] = &[Block {
-    name: "RTC",
-    inputs: &[("IN", "BOOL"), ("PDT", "DINT")],
-    outputs: &[("Q", "BOOL"), ("CDT", "DINT")],
-    source: "IEC 61131-3 2.5.2.3.5",
-}];
+const PY_IN: &[(&str, &str)] = &[("TRIG", "BOOL"), ("CODE", "DINT")];
+const PY_OUT: &[(&str, &str)] = &[("ACK", "BOOL"), ("RESULT", "DINT")];
+const PY_SRC: &str = "Beremiz's py_ext library";
+
+const BLOCKS: &[Block] = &[
+    Block {
+        name: "RTC",
+        inputs: &[("IN", "BOOL"), ("PDT", "DINT")],
+        outputs: &[("Q", "BOOL"), ("CDT", "DINT")],
+        source: "IEC 61131-3 2.5.2.3.5",
+    },
+    Block {
+        name: "python_eval",
+        inputs: PY_IN,
+        outputs: PY_OUT,
+        source: PY_SRC,
+    },
+    Block {
+        name: "python_poll",
+        inputs: PY_IN,
+        outputs: PY_OUT,
+        source: PY_SRC,
+    },
+    Block {
+        name: "python_gear",
+        inputs: &[("N", "DINT"), ("TRIG", "BOOL"), ("CODE", "DINT")],
+        outputs: PY_OUT,
+        source: PY_SRC,
+    },
+    Block {
+        name: "LOGGER",
+        inputs: &[("TRIG", "BOOL"), ("MSG", "DINT"), ("LEVEL", "INT")],
+        outputs: &[],
+        source: "Beremiz's standard library (LEVEL: LOGLEVEL, read as INT)",
+    },
+];
+
+/// Beremiz's `LOGLEVEL` enumeration (`(CRITICAL, WARNING, INFO, DEBUG)`), numbered as its
+/// compiler numbers enumerations: the value a LOGGER's LEVEL pin fed by `name` reads.
+pub fn library_constant(block: &str, pin: &str, name: &str) -> Option<i64> {
+    if block != "LOGGER" || pin != "LEVEL" {
+        return None;
+    }
+    let name = name.trim();
+    let name = name
+        .strip_prefix("LOGLEVEL#")
+        .or_else(|| name.strip_prefix("LogLevel#"))
+        .unwrap_or(name);
+    ["CRITICAL", "WARNING", "INFO", "DEBUG"]
+        .iter()
+        .position(|v| v.eq_ignore_ascii_case(name))
+        .map(|i| i as i64)
+}
 
 /// True when `ty` is a library block this module stands in.
 pub fn is_library_fb(ty: &str) -> bool {
@@ -82,12 +131,16 @@ pub fn stand_in_fb(
     Some((fb, note))
 }
 
-/// The outputs (name, model type) of each library block, for typing what they feed.
-pub fn outputs() -> impl Iterator<Item = (&'static str, Vec<(String, String)>)> {
-    BLOCKS.iter().map(|b| {
-        let o = b.outputs.iter().map(|(n, t)| (n.to_string(), t.to_string()));
-        (b.name, o.collect())
-    })
+/// Pins as (name, model type).
+type Pins = Vec<(String, String)>;
+
+/// The inputs and outputs (name, model type) of each library block, for typing what they read
+/// and feed.
+pub fn pins() -> impl Iterator<Item = (&'static str, Pins, Pins)> {
+    let own = |v: &[(&str, &str)]| -> Pins {
+        v.iter().map(|(n, t)| (n.to_string(), t.to_string())).collect()
+    };
+    BLOCKS.iter().map(move |b| (b.name, own(b.inputs), own(b.outputs)))
 }
 
 /// A black-box function block type `ty` with `inputs` and `outputs` (name, model type): one

@@ -60,6 +60,23 @@ pub fn parse(text: &str) -> Result<(syntax::Program<'static>, Notes), LoadError>
 /// Reads and resolves a PLCopen project: the program, its FBD bodies, and the reader's notes
 /// (with one for each FBD body whose executionOrderIds order its blocks otherwise than plc-deps).
 pub fn load(text: &str) -> Result<(Program, Fbd, Vec<Note>), LoadError> {
+    let (p, f, notes, no_run) = load_all(text)?;
+    Ok((p, f, notes.into_iter().chain(no_run).collect()))
+}
+
+/// [`load`] for `run`: an error (located) when the project has something `run` cannot execute
+/// (a string in an LD or FBD body).
+pub fn load_for_run(text: &str) -> Result<(Program, Fbd, Vec<Note>), LoadError> {
+    let (p, f, notes, no_run) = load_all(text)?;
+    match no_run {
+        Some(n) => Err(xml::error(n.origin, "run", n.message).locate(text)),
+        None => Ok((p, f, notes)),
+    }
+}
+
+type Loaded = (Program, Fbd, Vec<Note>, Option<Note>);
+
+fn load_all(text: &str) -> Result<Loaded, LoadError> {
     let (syntax, mut notes) = parse(text)?;
     let (p, f) = crate::resolve::resolve(text, &syntax)?;
     for x in &notes.exec_orders {
@@ -67,7 +84,7 @@ pub fn load(text: &str) -> Result<(Program, Fbd, Vec<Note>), LoadError> {
             notes.list.push(n);
         }
     }
-    Ok((p, f, notes.list))
+    Ok((p, f, notes.list, notes.no_run))
 }
 
 /// Compares the order of the file's executionOrderIds with the order plc-deps runs the same

@@ -380,11 +380,16 @@ fn body(
         }
     }
     if let (Some(m), "LD" | "FBD") = (iface.mapped.iter().find(|m| m.text), tag) {
-        return Err(error(
-            m.origin,
-            &place,
-            format!("variable `{}` is a {}, for which plc-deps has no values: strings, arrays and structures are read only in POUs whose body `run` does not execute (ST, IL, SFC), and `{name}` has an {tag} body", m.var, m.from),
-        ));
+        notes.no_run.get_or_insert(Note {
+            origin: m.origin,
+            message: format!("{place}: variable `{}` is a {}, for which plc-deps has no values: the analysis reads it as a whole variable, but `run` cannot execute the {tag} body of `{name}`", m.var, m.from),
+        });
+    }
+    if let (Some(n), "LD" | "FBD") = (string_literal(lang), tag) {
+        notes.no_run.get_or_insert(Note {
+            origin: origin(n),
+            message: format!("{place}: the {} localId {} is a string literal, for which plc-deps has no values: the analysis reads it as a constant, but `run` cannot execute the {tag} body of `{name}`", n.tag_name().name(), n.attribute("localId").unwrap_or("?")),
+        });
     }
     Ok(match tag {
         "LD" => ld_body(tc6, lang, name, ctx, notes)?,
@@ -572,12 +577,16 @@ fn base_ctx(read: &[(Node, String, &str, Interface)]) -> Ctx {
             }
             "functionBlock" => {
                 ctx.fbs.insert(name.clone(), pins(&iface.outputs));
+                ctx.fb_inputs.insert(name.clone(), pins(&iface.inputs));
             }
             _ => {}
         }
     }
-    for (name, outputs) in library::outputs() {
-        ctx.fbs.entry(name.to_owned()).or_insert(outputs);
+    for (name, inputs, outputs) in library::pins() {
+        if !ctx.fbs.contains_key(name) {
+            ctx.fbs.insert(name.to_owned(), outputs);
+            ctx.fb_inputs.insert(name.to_owned(), inputs);
+        }
     }
     ctx
 }
@@ -602,6 +611,19 @@ fn pou_ctx(base: &Ctx, iface: &Interface, globals: &[(&str, &str)]) -> Ctx {
     Ctx {
         functions: base.functions.clone(),
         fbs: base.fbs.clone(),
+        fb_inputs: base.fb_inputs.clone(),
         vars,
     }
+}
+
+/// The first `inVariable` of a graphical body whose expression is a string literal (`'…'`).
+fn string_literal<'a, 'i>(lang: Node<'a, 'i>) -> Option<Node<'a, 'i>> {
+    lang.children()
+        .filter(|n| n.tag_name().name() == "inVariable")
+        .find(|n| {
+            n.children()
+                .find(|c| c.tag_name().name() == "expression")
+                .and_then(|c| c.text())
+                .is_some_and(|t| super::fbd::is_string_literal(t))
+        })
 }

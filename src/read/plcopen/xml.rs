@@ -74,6 +74,8 @@ pub struct Notes {
     /// The stand-in function block types of the blocks the model lacks
     /// ([`super::black_box`]).
     pub black_boxes: Vec<super::black_box::BlackBox>,
+    /// Why `run` cannot execute the project (a string in a body it would execute), if so.
+    pub no_run: Option<Note>,
 }
 
 impl Notes {
