@@ -233,7 +233,8 @@ pub fn is_known(ctx: &Ctx, ty: &str) -> bool {
 }
 
 /// Rewrites block `b` (element `e`, op `ty`) that the model lacks: a conversion in place, or a
-/// call of a black box on a new instance (returned, to declare in the POU, with its type).
+/// call of a black box on a new instance. Returns a variable to declare in the POU, with its
+/// type: the new instance, or the result variable of a conversion from BOOL.
 pub fn rewrite(
     t: &Typer,
     e: ElemId,
@@ -273,7 +274,17 @@ pub fn rewrite(
             b.inputs = Some(Ok(Inputs::Named(
                 ins.into_iter().map(|(p, i)| (Cow::Borrowed(p), i)).collect(),
             )));
-            return Ok(None);
+            if op != "SEL" {
+                return Ok(None);
+            }
+            // A SEL of constants only would be DINT: its result variable fixes the type.
+            let v = format!("{ty}__{}", el.local_id);
+            let target = crate::syntax::fbd::OutVar {
+                origin: at,
+                name: Cow::Owned(v.clone()),
+            };
+            super::fbd::add_target(b, "OUT".to_owned(), target);
+            return Ok(Some((v, to)));
         }
     }
     // A black box: its signature.

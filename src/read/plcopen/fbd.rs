@@ -280,10 +280,13 @@ impl Added {
         }
     }
 
-    /// An extensible comparison `op(IN1, …, INn)`, n ≥ 3 (IEC 61131-3 Table 31:
-    /// `IN1 op IN2 AND IN2 op IN3 …`): `b` becomes the AND of a new comparison per neighbouring
-    /// pair, keeping its id and outputs.
-    pub fn extensible_compare(&mut self, b: &mut Block<'static>) {
+    /// A comparison block `b`: extensible, `op(IN1, …, INn)` with n ≥ 3 (IEC 61131-3 Table
+    /// 31: `IN1 op IN2 AND IN2 op IN3 …`), it becomes the AND of a new comparison per
+    /// neighbouring pair, keeping its id and outputs; EQ and NE of BOOLs (which IEC allows, the
+    /// model's comparison does not) become `NOT (a XOR b)` and `a XOR b`. An unconnected input
+    /// is 0, a function input's default (IEC 61131-3 2.5.1.1).
+    pub fn compare(&mut self, b: &mut Block<'static>, ty: &dyn Fn(&Input) -> Option<String>) {
+        let is_bool = |i: &Input| ty(i).as_deref() == Some("BOOL");
         let op = match &b.op {
             Ok(op) if crate::model::CmpOp::parse(op).is_some() => op.to_string(),
             _ => return,
@@ -291,10 +294,6 @@ impl Added {
         let Some(Ok(Inputs::Named(ins))) = &b.inputs else { return };
         let index = |p: &str| p.strip_prefix("IN").and_then(|k| k.parse::<usize>().ok());
         let n = ins.iter().filter_map(|(p, _)| index(p)).max().unwrap_or(0);
-        if n < 3 {
-            return;
-        }
-        // An unconnected input of a function is its type's default, 0 (IEC 61131-3 2.5.1.1).
         let ins: Vec<Input<'static>> = (1..=n)
             .map(|k| {
                 ins.iter()
@@ -306,18 +305,77 @@ impl Added {
                     })
             })
             .collect();
+        let bools = ins.iter().filter(|i| is_bool(i)).count();
+        let boolean = matches!(op.as_str(), "EQ" | "NE") && bools == ins.len();
+        // BOOLs compared with numbers (which IEC 61131-3 does not type) are compared as
+        // BOOL_TO_INT of them, 0 or 1.
+        let number = ins.iter().find_map(|i| ty(i).filter(|t| t != "BOOL"));
+        let ins: Vec<Input<'static>> = if bools > 0 && !boolean {
+            ins.into_iter()
+                .map(|i| {
+                    if !is_bool(&i) {
+                        return i;
+                    }
+                    let at = i.origin;
+                    let n = |v: i64| Input {
+                        origin: at,
+                        from: Connection::Constant(Scalar::Number(v.into())),
+                    };
+                    let sel = self.add("SEL", vec![("G", i), ("IN0", n(0)), ("IN1", n(1))], at);
+                    self.typed(number.as_deref(), at);
+                    sel
+                })
+                .collect()
+        } else {
+            ins
+        };
+        if bools > 0 && !boolean && n == 2 {
+            b.inputs = Some(Ok(Inputs::Named(vec![
+                (Cow::Borrowed("IN1"), ins[0].clone()),
+                (Cow::Borrowed("IN2"), ins[1].clone()),
+            ])));
+            return;
+        }
+        if n < 2 || (n == 2 && !boolean) {
+            return;
+        }
         let mut pairs = Vec::new();
         for w in ins.windows(2) {
             let at = w[1].origin;
-            pairs.push(self.add(&op, vec![("IN1", w[0].clone()), ("IN2", w[1].clone())], at));
+            let pair = vec![("IN1", w[0].clone()), ("IN2", w[1].clone())];
+            pairs.push(match (boolean, op.as_str()) {
+                (false, _) => self.add(&op, pair, at),
+                (true, "NE") => self.add("XOR", pair, at),
+                (true, _) => {
+                    let x = self.add("XOR", pair, at);
+                    self.add("NOT", vec![("IN", x)], at)
+                }
+            });
         }
-        let named = pairs
-            .into_iter()
-            .enumerate()
-            .map(|(k, i)| (Cow::Owned(format!("IN{}", k + 1)), i))
-            .collect();
-        b.op = Ok(Cow::Borrowed("AND"));
+        let named: Vec<(Cow<'static, str>, Input<'static>)> = if pairs.len() == 1 {
+            b.op = Ok(Cow::Borrowed("MOVE"));
+            vec![(Cow::Borrowed("IN"), pairs.remove(0))]
+        } else {
+            b.op = Ok(Cow::Borrowed("AND"));
+            pairs
+                .into_iter()
+                .enumerate()
+                .map(|(k, i)| (Cow::Owned(format!("IN{}", k + 1)), i))
+                .collect()
+        };
         b.inputs = Some(Ok(Inputs::Named(named)));
+    }
+
+    /// Gives the last block added (a SEL of constants) a variable of type `ty` to write, so
+    /// that its output has that type (a block of constants only would be DINT); the variable
+    /// is `<op>__<id>`, declared in the POU.
+    pub fn typed(&mut self, ty: Option<&str>, at: Origin) {
+        let Some(ty) = ty else { return };
+        let Some(b) = self.blocks.last_mut() else { return };
+        let (Ok(op), Ok(id)) = (&b.op, &b.id) else { return };
+        let v = format!("{op}__{id}");
+        add_target(b, "OUT".to_owned(), OutVar { origin: at, name: Cow::Owned(v.clone()) });
+        self.declare(&v, ty, at);
     }
 
     /// Declares instance `inst` of function block type `ty` in the POU.
@@ -382,6 +440,19 @@ pub fn bool_literal(ctx: &Ctx, ty: &str, pin: &str, mut i: Input<'static>) -> In
         }
     }
     i
+}
+
+/// Adds `target` to output `pin` of block `b`.
+pub fn add_target(b: &mut Block<'static>, pin: String, target: OutVar<'static>) {
+    let mut outs = match b.outputs.take() {
+        Some(Ok(Outputs::Named(v))) => v,
+        _ => Vec::new(),
+    };
+    match outs.iter_mut().find(|(p, _)| p.as_ref() == pin) {
+        Some((_, Ok(Targets::Many(v)))) => v.push(Ok(target)),
+        _ => outs.push((Cow::Owned(pin), Ok(Targets::Many(vec![Ok(target)])))),
+    }
+    b.outputs = Some(Ok(Outputs::Named(outs)));
 }
 
 /// True when `text` is an IEC 61131-3 string literal (`'…'` or `"…"`, 6.3.3).
@@ -501,7 +572,8 @@ impl Fbd<'_, '_, '_> {
             }
         }
         b.inputs = Some(Ok(Inputs::Named(inputs)));
-        self.a.borrow_mut().extensible_compare(&mut b);
+        let t = black_box::Typer { ctx: self.ctx, g: self.g };
+        self.a.borrow_mut().compare(&mut b, &|i: &Input| t.input(i, 0));
         if !black_box::is_known(self.ctx, ty) {
             let t = black_box::Typer { ctx: self.ctx, g: self.g };
             let mut boxes = self.boxes.borrow_mut();
@@ -509,7 +581,6 @@ impl Fbd<'_, '_, '_> {
                 self.a.borrow_mut().declare(&inst, &bt, b.origin);
             }
         }
-        let mut outputs = Vec::new();
         for (pin, pnode) in &el.outputs {
             let targets = self.targets(e, pin, el.outputs.first().map(|o| o.0) == Some(*pin))?;
             let negated = matches!(pnode.attribute("negated"), Some("true" | "1"));
@@ -545,15 +616,9 @@ impl Fbd<'_, '_, '_> {
                     ),
                 ));
             }
-            if !targets.is_empty() {
-                outputs.push((
-                    Cow::Owned(pin_of(pin).to_owned()),
-                    Ok(Targets::Many(targets.into_iter().map(Ok).collect())),
-                ));
+            for t in targets {
+                add_target(&mut b, pin_of(pin).to_owned(), t);
             }
-        }
-        if !outputs.is_empty() {
-            b.outputs = Some(Ok(Outputs::Named(outputs)));
         }
         Ok(b)
     }

@@ -28,12 +28,12 @@
 //! and the ops themselves (the FBD resolver checks them, located at the block).
 
 use super::black_box::{self, BlackBox, Ctx};
-use super::fbd::{block_input, bool_literal, is_const, konst, output_negated, pin_modifiers, pin_of, Added};
+use super::fbd::{add_target, block_input, bool_literal, is_const, konst, output_negated, pin_modifiers, pin_of, Added};
 use super::ld::components;
 use super::wiring::{graph, ElemId, Graph, Source};
 use super::xml::{attr, error, identifier, origin, variable_ref, Notes, Tc6, R};
 use crate::diag::Origin;
-use crate::syntax::fbd::{Block, Connection, Input, Inputs, Network, OutVar, Outputs, Targets};
+use crate::syntax::fbd::{Block, Connection, Input, Inputs, Network, OutVar, Outputs};
 use crate::syntax::{FbdBody, Scalar};
 use roxmltree::Node;
 use std::borrow::Cow;
@@ -311,7 +311,8 @@ impl Flow<'_, '_, '_> {
         net[idx].inputs = Some(Ok(Inputs::Named(inputs)));
         net[idx].cond = cond;
         let mut b = std::mem::replace(&mut self.a.blocks[idx], placeholder());
-        self.a.extensible_compare(&mut b);
+        let t = black_box::Typer { ctx: self.ctx, g: self.g };
+        self.a.compare(&mut b, &|i: &Input| t.input(i, 0));
         self.a.blocks[idx] = b;
         if !black_box::is_known(self.ctx, ty) {
             let t = black_box::Typer { ctx: self.ctx, g: self.g };
@@ -414,19 +415,6 @@ impl Flow<'_, '_, '_> {
         });
         Ok(())
     }
-}
-
-/// Adds `target` to output `pin` of block `b`.
-fn add_target(b: &mut Block<'static>, pin: String, target: OutVar<'static>) {
-    let mut outs = match b.outputs.take() {
-        Some(Ok(Outputs::Named(v))) => v,
-        _ => Vec::new(),
-    };
-    match outs.iter_mut().find(|(p, _)| p.as_ref() == pin) {
-        Some((_, Ok(Targets::Many(v)))) => v.push(Ok(target)),
-        _ => outs.push((Cow::Owned(pin), Ok(Targets::Many(vec![Ok(target)])))),
-    }
-    b.outputs = Some(Ok(Outputs::Named(outs)));
 }
 
 /// Two inputs that read the same thing (a duplicate wire of a wired OR).
