@@ -90,7 +90,18 @@ fn standard_bool_input(op: &str, pin: &str) -> bool {
     }
 }
 
+/// True for the standard function blocks the model has.
+pub fn is_standard_fb(ty: &str) -> bool {
+    standard_outputs(ty).is_some()
+}
+
 impl Ctx {
+    /// The function block type instance `inst` is declared with, if it is one.
+    pub fn fb_type_of(&self, inst: &str) -> Option<String> {
+        let t = self.vars.get(&inst.to_ascii_lowercase())?;
+        (is_standard_fb(t) || self.fbs.contains_key(t)).then(|| t.clone())
+    }
+
     /// The type of input `pin` of a block `op`, where it is known.
     pub fn input_type(&self, op: &str, pin: &str) -> Option<String> {
         if standard_bool_input(op, pin) {

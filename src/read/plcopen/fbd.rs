@@ -24,7 +24,7 @@
 use super::black_box::{self, BlackBox, Ctx};
 use super::interface::{literal, name};
 use super::wiring::{graph, ElemId, Graph, Source};
-use super::xml::{attr, error, identifier, origin, variable_ref, ExecOrder, Notes, Tc6, R};
+use super::xml::{attr, error, identifier, origin, variable_ref, ExecOrder, Note, Notes, Tc6, R};
 use crate::syntax::fbd::{Block, Connection, Input, Inputs, Network, OutVar, Outputs, Targets};
 use crate::diag::Origin;
 use crate::syntax::{FbdBody, Located, Scalar, Var, VarClass};
@@ -75,6 +75,7 @@ pub fn body(
         a: RefCell::new(Added::new(&g)),
         ctx,
         boxes: RefCell::new(std::mem::take(&mut notes.black_boxes)),
+        notes: RefCell::new(Vec::new()),
     };
     let mut networks: Vec<Network<'static>> = Vec::new();
     let mut current: Vec<Block<'static>> = Vec::new();
@@ -130,6 +131,7 @@ pub fn body(
         }
     }
     notes.black_boxes = f.boxes.take();
+    notes.list.extend(f.notes.take());
     let vars = std::mem::take(&mut f.a.borrow_mut().vars);
     notes.ld_vars.extend(vars.into_iter().map(|v| (pou.to_owned(), v)));
     if !ordered.is_empty() {
@@ -179,6 +181,7 @@ struct Fbd<'g, 'a, 'i> {
     ctx: &'g Ctx,
     /// The project's black boxes so far ([`black_box`]).
     boxes: RefCell<Vec<BlackBox>>,
+    notes: RefCell<Vec<Note>>,
 }
 
 /// A block's output pin as the syntax names it: the unnamed result of a user function
@@ -524,18 +527,36 @@ impl Fbd<'_, '_, '_> {
     fn block(&self, e: ElemId) -> R<Block<'static>> {
         let el = self.g.get(e);
         let here = self.at(e);
-        let ty = attr(el.node, "typeName", &here)?;
+        let mut ty = attr(el.node, "typeName", &here)?;
+        let declared_type;
         let mut b = self.new_block(e, ty);
         if let Some(inst) = el.node.attribute("instanceName") {
             b.instance = Some(Ok(Cow::Owned(identifier(
                 inst, "instance", el.node, &here,
             )?)));
+            // Beremiz calls the instance by name, so the instance's type decides what runs.
+            if let Some(declared) = self.ctx.fb_type_of(inst).filter(|d| d != ty) {
+                self.notes.borrow_mut().push(Note {
+                    origin: origin(el.node),
+                    message: format!("{here}: the block is a {ty} but its instance `{inst}` is declared {declared}; it is read as a call of {declared} (Beremiz calls the instance by name)"),
+                });
+                declared_type = declared;
+                ty = &declared_type;
+                b.op = Ok(Cow::Owned(ty.to_owned()));
+            }
         }
         let mut inputs = Vec::new();
         for pin in &el.inputs {
             let name = pin.name.unwrap_or("");
             let (negated, edge) = pin_modifiers(pin.node, ty, name, el.local_id, &here)?;
             let mut input = match pin.sources.as_slice() {
+                // An unconnected BOOL input of a standard function block keeps its initial
+                // value FALSE (nothing in the body sets it, IEC 61131-3 2.5.2.1).
+                [] if black_box::is_standard_fb(ty)
+                    && self.ctx.input_type(ty, name).as_deref() == Some("BOOL") =>
+                {
+                    konst(false, origin(pin.node))
+                }
                 [] => continue,
                 [s] => self.input(e, s)?,
                 _ => {
@@ -607,14 +628,16 @@ impl Fbd<'_, '_, '_> {
                 targets
             };
             if *pin == "ENO" && !targets.is_empty() {
-                return Err(error(
-                    origin(*pnode),
-                    &here,
-                    format!(
-                        "ENO of {ty} (localId {}) is wired: ENO is not supported in FBD yet",
-                        el.local_id
-                    ),
-                ));
+                // ENO is EN (IEC 61131-3 2.5.1.2: TRUE when the block ran without error).
+                let en = self.eno(e, origin(*pnode))?;
+                let mut a = self.a.borrow_mut();
+                a.add_on("MOVE", None, Inputs::List(vec![en]), origin(*pnode));
+                if let Some(m) = a.blocks.last_mut() {
+                    for t in targets {
+                        add_target(m, "OUT".to_owned(), t);
+                    }
+                }
+                continue;
             }
             for t in targets {
                 add_target(&mut b, pin_of(pin).to_owned(), t);
@@ -660,10 +683,20 @@ impl Fbd<'_, '_, '_> {
         variable_ref(text, el.node, &self.at(e))
     }
 
+    /// The ENO of block `e`: what feeds its EN, TRUE without one.
+    fn eno(&self, e: ElemId, at: Origin) -> R<Input<'static>> {
+        let el = self.g.get(e);
+        match el.inputs.iter().find(|p| p.name == Some("EN")).map(|p| p.sources.as_slice()) {
+            Some([s]) => self.input(e, s),
+            _ => Ok(konst(true, at)),
+        }
+    }
+
     /// What source `s` gives to an input of block `consumer`.
     fn input(&self, consumer: ElemId, s: &Source) -> R<Input<'static>> {
         let src = self.g.get(s.elem);
         match src.tag {
+            "block" if s.pin == Some("ENO") => self.eno(s.elem, s.origin),
             "block" => {
                 let arc = Input {
                     origin: s.origin,
