@@ -17,7 +17,7 @@
 //! error naming it.
 //!
 //! Invariants: a stand-in type is named after the op, with `__2`, `__3` … for a second
-//! signature of the same op; every black box of a body is in [`Notes::black_boxes`].
+//! signature of the same op (`__1`, `__2` … for a built-in op such as `SUB` of a DT and a TIME); every black box of a body is in [`Notes::black_boxes`].
 //!
 //! Deliberately not here: computing what the black boxes compute (`run` does not).
 
@@ -166,6 +166,30 @@ impl Typer<'_, '_, '_, '_> {
         }
     }
 
+    /// The type output `pin` of element `e` is used as (`first`: it is the first output, which
+    /// a connection without `formalParameter` means): the variable it writes, or the type of
+    /// the other inputs of a block it feeds.
+    fn consumer_type(&self, e: ElemId, pin: &str, first: bool) -> Option<String> {
+        self.g.consumers[e.0 as usize]
+            .iter()
+            .filter(|(_, _, p)| p.map_or(first, |p| p == pin))
+            .find_map(|&(c, k, _)| {
+                let cel = self.g.get(c);
+                if cel.tag != "block" {
+                    let i = super::fbd::block_input(cel.node, "", Origin::NONE).ok()?;
+                    return self.input(&i, 0);
+                }
+                cel.inputs
+                    .iter()
+                    .enumerate()
+                    .filter(|(j, p)| *j != k && !matches!(p.name, Some("EN" | "G" | "K")))
+                    .find_map(|(_, p)| {
+                        let s = p.sources.first()?;
+                        self.output(s.elem, s.pin, 1)
+                    })
+            })
+    }
+
     /// The type of output `pin` of element `e`.
     fn output(&self, e: ElemId, pin: Option<&str>, depth: u32) -> Option<String> {
         let el = self.g.get(e);
@@ -236,6 +260,23 @@ fn conversion(ty: &str) -> Option<(Option<String>, Option<String>)> {
     let (a, b) = ty.split_once("_TO_")?;
     let (a, b) = (model(a), model(b));
     (a.is_some() && b.is_some()).then_some((a, b))
+}
+
+/// True for ADD or SUB of inputs of different types: the date and time arithmetic of IEC
+/// 61131-3 Table 30 (`SUB(DT, TIME)`, `ADD(TOD, TIME)` …), which the model's arithmetic (one
+/// type) lacks, so it is a black box.
+pub fn mixed_arithmetic(t: &Typer, ty: &str, b: &Block) -> bool {
+    if !matches!(ty, "ADD" | "SUB") {
+        return false;
+    }
+    let Some(Ok(Inputs::Named(ins))) = &b.inputs else { return false };
+    // A number literal takes the type of its use; a TIME literal is TIME.
+    let types: Vec<String> = ins
+        .iter()
+        .filter(|(_, i)| !matches!(i.from, Connection::Constant(Scalar::Number(_))))
+        .filter_map(|(_, i)| t.input(i, 0))
+        .collect();
+    types.windows(2).any(|w| w[0] != w[1])
 }
 
 /// True when the model or the project has op `ty` (nothing to do here).
@@ -325,17 +366,13 @@ pub fn rewrite(
             continue;
         }
         let pname = if pin.is_empty() { "OUT" } else { pin };
-        let pty = t.output(e, Some(pin), 0).or_else(|| {
-            // An output wired only to variables: their type.
-            t.g.consumers[e.0 as usize]
-                .iter()
-                .filter(|(_, _, p)| p.map_or(k == 0, |p| p == *pin))
-                .find_map(|&(c, _, _)| {
-                    let cel = t.g.get(c);
-                    let i = super::fbd::block_input(cel.node, "", Origin::NONE).ok()?;
-                    t.input(&i, 0)
-                })
-        });
+        // A built-in op (date and time arithmetic) is typed by its use, anything else by its
+        // declaration or inputs first.
+        let pty = if OpKind::parse(ty).is_some() {
+            t.consumer_type(e, pin, k == 0).or_else(|| t.output(e, Some(pin), 0))
+        } else {
+            t.output(e, Some(pin), 0).or_else(|| t.consumer_type(e, pin, k == 0))
+        };
         let Some(pty) = pty else {
             return Err(error(
                 origin(*pnode),
@@ -365,7 +402,12 @@ fn stand_in_name(boxes: &mut Vec<BlackBox>, op: &str, sig: &Sig, at: Origin) -> 
         return b.name.clone();
     }
     let k = boxes.iter().filter(|b| b.op == op).count();
-    let name = if k == 0 { op.to_owned() } else { format!("{op}__{}", k + 1) };
+    // A built-in op's name would call the op, so its black boxes are numbered from 1.
+    let name = if k == 0 && OpKind::parse(op).is_none() {
+        op.to_owned()
+    } else {
+        format!("{op}__{}", k + 1)
+    };
     boxes.push(BlackBox {
         name: name.clone(),
         op: op.to_owned(),

@@ -595,8 +595,7 @@ impl Fbd<'_, '_, '_> {
         b.inputs = Some(Ok(Inputs::Named(inputs)));
         let t = black_box::Typer { ctx: self.ctx, g: self.g };
         self.a.borrow_mut().compare(&mut b, &|i: &Input| t.input(i, 0));
-        if !black_box::is_known(self.ctx, ty) {
-            let t = black_box::Typer { ctx: self.ctx, g: self.g };
+        if !black_box::is_known(self.ctx, ty) || black_box::mixed_arithmetic(&t, ty, &b) {
             let mut boxes = self.boxes.borrow_mut();
             if let Some((inst, bt)) = black_box::rewrite(&t, e, &mut b, &mut boxes, &here)? {
                 self.a.borrow_mut().declare(&inst, &bt, b.origin);

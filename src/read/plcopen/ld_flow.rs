@@ -314,8 +314,8 @@ impl Flow<'_, '_, '_> {
         let t = black_box::Typer { ctx: self.ctx, g: self.g };
         self.a.compare(&mut b, &|i: &Input| t.input(i, 0));
         self.a.blocks[idx] = b;
-        if !black_box::is_known(self.ctx, ty) {
-            let t = black_box::Typer { ctx: self.ctx, g: self.g };
+        let t = black_box::Typer { ctx: self.ctx, g: self.g };
+        if !black_box::is_known(self.ctx, ty) || black_box::mixed_arithmetic(&t, ty, &self.a.blocks[idx]) {
             let b = &mut self.a.blocks[idx];
             if let Some((inst, bt)) = black_box::rewrite(&t, e, b, &mut self.boxes, &here)? {
                 let at = b.origin;
