@@ -44,6 +44,9 @@ pub struct Interface {
     pub returns: Option<crate::diag::Origin>,
     /// The model type of a function's result, when it has one the model can read.
     pub return_ty: Option<String>,
+    /// The declarations of the `externalVars`, and those of them whose type was mapped.
+    pub external_decls: Vec<Var<'static>>,
+    pub external_mapped: Vec<Mapped>,
 }
 
 /// A variable whose IEC 61131-3 elementary type the model lacks, read as one it has.
@@ -159,6 +162,13 @@ pub fn interface(tc6: Tc6, node: Option<Node>, pou: &str, known: &Known) -> R<In
                 for v in tc6.children(list, "variable") {
                     let name = super::xml::attr(v, "name", &place)?;
                     out.externals.push(identifier(name, "variable", v, &place)?);
+                }
+                // Their declarations, for a global the file does not declare (an editor
+                // extension's); one that cannot be read is left to the global's.
+                let mut mapped = Vec::new();
+                if let Ok(vars) = var_list(tc6, list, VarClass::Default, &place, known, &mut mapped) {
+                    out.external_decls.extend(vars);
+                    out.external_mapped.extend(mapped);
                 }
             }
             "inOutVars" | "accessVars" => {

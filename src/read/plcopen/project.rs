@@ -69,7 +69,8 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
     }
     let mut later = Notes::default();
     let mut mapped_globals = Vec::new();
-    let (globals, order) = instances(tc6, root, &known, &mut later, &mut mapped_globals)?;
+    let (mut globals, order) = instances(tc6, root, &known, &mut later, &mut mapped_globals)?;
+    undeclared_globals(&read, &mut globals, &mut mapped_globals, notes);
     let mapped: Vec<(Option<String>, interface::Mapped)> = read
         .iter()
         .flat_map(|(_, p, _, i)| i.mapped.iter().map(|m| (Some(p.clone()), m.clone())))
@@ -626,4 +627,30 @@ fn string_literal<'a, 'i>(lang: Node<'a, 'i>) -> Option<Node<'a, 'i>> {
                 .and_then(|c| c.text())
                 .is_some_and(|t| super::fbd::is_string_literal(t))
         })
+}
+
+/// Adds, as a global, each external variable whose global the file does not declare: Beremiz's
+/// extensions declare some in code they generate (SVGHMI's `CURRENT_PAGE_0`), so a POU
+/// names them external with their type. A note names them.
+fn undeclared_globals(
+    read: &[(Node, String, &str, Interface)],
+    globals: &mut Vec<Var<'static>>,
+    mapped: &mut Vec<interface::Mapped>,
+    notes: &mut Notes,
+) {
+    for (_, pou, _, iface) in read {
+        for v in &iface.external_decls {
+            let n = v.name.as_str();
+            let known = |g: &Var| g.name.as_str().eq_ignore_ascii_case(n);
+            if globals.iter().any(known) || read.iter().any(|r| r.3.globals.iter().any(known)) {
+                continue;
+            }
+            notes.push(Note {
+                origin: v.origin,
+                message: format!("pou {pou}: external variable `{n}` has no global declaration in the file (an editor extension declares it in code it generates, as Beremiz's SVGHMI does for CURRENT_PAGE_0): read as a global of its declared type {}", v.ty.as_str()),
+            });
+            globals.push(v.clone());
+            mapped.extend(iface.external_mapped.iter().filter(|m| m.var == n).cloned());
+        }
+    }
 }
