@@ -39,6 +39,24 @@ use roxmltree::Node;
 use std::borrow::Cow;
 use std::collections::HashMap;
 
+/// The elements read here: the rung reader's, and in-out variables.
+const FLOW_TAGS: &[&str] = &[
+    "leftPowerRail",
+    "rightPowerRail",
+    "contact",
+    "coil",
+    "block",
+    "inVariable",
+    "outVariable",
+    "inOutVariable",
+    "connector",
+    "continuation",
+    "jump",
+    "label",
+    "return",
+    "comment",
+];
+
 /// Reads LD body `node` of POU `pou` as a data-flow network.
 pub fn body(
     tc6: Tc6,
@@ -49,6 +67,7 @@ pub fn body(
 ) -> R<FbdBody<'static>> {
     let place = format!("pou {pou}, LD");
     let g = graph(tc6, node, &place)?;
+    g.only(FLOW_TAGS, "LD", &place)?;
     if let Some(i) = g.elems.iter().position(|el| el.tag == "label") {
         let e = ElemId(i as u32);
         return Err(error(
