@@ -197,3 +197,21 @@ fn a_label_in_an_ld_body_read_as_data_flow_gives_the_rung_readers_error() {
     let e = error_line(&run_stdin(&["report", "-"], xml.as_bytes()), "label");
     assert!(e.ends_with("at pou P, LD, coil localId 5: the wiring into localId 5 from localIds 3, 4 is not series-parallel: the parallel branch through localId 3 holds an output or a block, which a parallel (OR) branch cannot"), "{e}");
 }
+
+#[test]
+fn a_loop_of_arcs_between_blocks_is_closed_with_a_one_scan_delay() {
+    // NOT (1) ← MOVE (2) ← NOT (1): Beremiz marks block 1 computed before its inputs, so the
+    // walk coming back to it reads its output as it is (last scan's). y := NOT(last y) toggles.
+    let fbd = [
+        block(1, "NOT", None, &[("IN", &[(2, Some("OUT"))])], &["OUT"]),
+        block(2, "MOVE", None, &[("IN", &[(1, Some("OUT"))])], &["OUT"]),
+        var_in("outVariable", 3, "y", (1, Some("OUT"))),
+    ]
+    .concat();
+    let v = vars(&[("inputVars", "go", "BOOL"), ("outputVars", "y", "BOOL")]);
+    let xml = project_in("FBD", &v, &fbd);
+    let (_, warnings) = report_and_warnings(&xml);
+    assert!(warnings.contains("blocks 2 and 1 are in a loop of arcs; as Beremiz closes it, block 2 reads output OUT of block 1 as the variable `NOT__1_OUT`"), "{warnings}");
+    let t = trace("flow-loop", &xml, "go\n0\n0\n0\n0\n", &["y"]);
+    assert_eq!(t[0], ["1", "0", "1", "0"]);
+}

@@ -107,6 +107,11 @@ impl Ctx {
         if standard_bool_input(op, pin) {
             return Some("BOOL".to_owned());
         }
+        match (op, pin) {
+            ("TON" | "TOF" | "TP", "PT") => return Some("TIME".to_owned()),
+            ("CTU" | "CTD" | "CTUD", "PV") => return Some("INT".to_owned()),
+            _ => {}
+        }
         let sig = self.fb_inputs.get(op).or_else(|| self.functions.get(op).map(|s| &s.inputs))?;
         sig.iter().find(|(n, _)| n == pin).map(|(_, t)| t.clone())
     }
@@ -179,6 +184,17 @@ impl Typer<'_, '_, '_, '_> {
                     let i = super::fbd::block_input(cel.node, "", Origin::NONE).ok()?;
                     return self.input(&i, 0);
                 }
+                let op = cel.node.attribute("typeName").unwrap_or("");
+                let pin = cel.inputs.get(k).and_then(|p| p.name).unwrap_or("");
+                if let Some(t) = self.ctx.input_type(op, pin) {
+                    return Some(t);
+                }
+                // Ops whose data inputs share one type: the others' type.
+                let same = matches!(op, "ADD" | "SUB" | "MUL" | "DIV" | "MOD" | "MOVE" | "SEL" | "MAX" | "MIN" | "LIMIT" | "MUX")
+                    || crate::model::CmpOp::parse(op).is_some();
+                if !same {
+                    return None;
+                }
                 cel.inputs
                     .iter()
                     .enumerate()
@@ -191,7 +207,7 @@ impl Typer<'_, '_, '_, '_> {
     }
 
     /// The type of output `pin` of element `e`.
-    fn output(&self, e: ElemId, pin: Option<&str>, depth: u32) -> Option<String> {
+    pub fn output(&self, e: ElemId, pin: Option<&str>, depth: u32) -> Option<String> {
         let el = self.g.get(e);
         if depth > 32 {
             return None;
@@ -262,14 +278,18 @@ fn conversion(ty: &str) -> Option<(Option<String>, Option<String>)> {
     (a.is_some() && b.is_some()).then_some((a, b))
 }
 
-/// True for ADD or SUB of inputs of different types: the date and time arithmetic of IEC
-/// 61131-3 Table 30 (`SUB(DT, TIME)`, `ADD(TOD, TIME)` …), which the model's arithmetic (one
-/// type) lacks, so it is a black box.
+/// True for ADD or SUB of inputs of different types, or MUL or DIV of a TIME: the date and
+/// time arithmetic of IEC 61131-3 Table 30 (`SUB(DT, TIME)`, `DIV(TIME, INT)` …), which the
+/// model's arithmetic (one numeric type) lacks, so it is a black box.
 pub fn mixed_arithmetic(t: &Typer, ty: &str, b: &Block) -> bool {
-    if !matches!(ty, "ADD" | "SUB") {
+    if !matches!(ty, "ADD" | "SUB" | "MUL" | "DIV") {
         return false;
     }
     let Some(Ok(Inputs::Named(ins))) = &b.inputs else { return false };
+    if matches!(ty, "MUL" | "DIV") {
+        // MUL_TIME, DIV_TIME: a TIME by a number.
+        return ins.iter().any(|(_, i)| t.input(i, 0).as_deref() == Some("TIME"));
+    }
     // A number literal takes the type of its use; a TIME literal is TIME.
     let types: Vec<String> = ins
         .iter()

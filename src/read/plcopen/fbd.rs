@@ -90,6 +90,7 @@ pub fn body(
                 let l = identifier(attr(el.node, "label", &here)?, "label", el.node, &here)?;
                 if !current.is_empty() || label.is_some() {
                     let k = networks.len();
+                    f.close_loops(&mut current);
                     networks.push(network(
                         pou,
                         k,
@@ -124,6 +125,7 @@ pub fn body(
         current.append(&mut f.a.borrow_mut().blocks);
     }
     let k = networks.len();
+    f.close_loops(&mut current);
     networks.push(network(pou, k, label, current, comments));
     if labels == 0 {
         if let Some(n) = networks.first_mut() {
@@ -680,6 +682,17 @@ impl Fbd<'_, '_, '_> {
                 )
             })?;
         variable_ref(text, el.node, &self.at(e))
+    }
+
+    /// Cuts the loops of arcs among `blocks` as Beremiz closes them ([`super::fbd_loops`]).
+    fn close_loops(&self, blocks: &mut [Block<'static>]) {
+        let t = black_box::Typer { ctx: self.ctx, g: self.g };
+        let ty = |id: u32, pin: Option<&str>| {
+            let e = self.g.elems.iter().position(|el| el.local_id == id)?;
+            t.output(ElemId(e as u32), pin, 0)
+        };
+        let notes = super::fbd_loops::cut(blocks, &mut self.a.borrow_mut(), &ty, &self.place);
+        self.notes.borrow_mut().extend(notes);
     }
 
     /// The ENO of block `e`: what feeds its EN, TRUE without one.

@@ -113,7 +113,14 @@ pub fn body(
                 _ => {}
             }
         }
-        let blocks = std::mem::take(&mut f.a.blocks);
+        let mut blocks = std::mem::take(&mut f.a.blocks);
+        let t = black_box::Typer { ctx, g: &g };
+        let ty = |id: u32, pin: Option<&str>| {
+            let e = g.elems.iter().position(|el| el.local_id == id)?;
+            t.output(ElemId(e as u32), pin, 0)
+        };
+        let cut = super::fbd_loops::cut(&mut blocks, &mut f.a, &ty, &f.place);
+        notes.list.extend(cut);
         if blocks.is_empty() {
             continue;
         }
