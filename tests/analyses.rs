@@ -157,7 +157,13 @@ fn every_plcopen_export_matches_its_committed_outputs() {
             Err(e) => {
                 let shown = format!("error: {}\n", e.locate(&text).in_file("program.xml"));
                 check(&dir.join("error.txt"), &shown, &mut failures);
-                for name in ["notes.txt", "report.txt", "report.json", "run.json", "run-refused.txt"] {
+                for name in [
+                    "notes.txt",
+                    "report.txt",
+                    "report.json",
+                    "run.json",
+                    "run-refused.txt",
+                ] {
                     stale(name);
                 }
             }

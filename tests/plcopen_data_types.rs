@@ -92,7 +92,10 @@ fn an_array_is_analysed_and_run_refuses_it_where_it_would_execute_the_body() {
         &ld(),
     );
     assert!(run_stdin(&["report", "-"], xml.as_bytes()).status.success());
-    let e = error_line(&run_stdin(&["run", "-", "--scans", "1"], xml.as_bytes()), "array in LD");
+    let e = error_line(
+        &run_stdin(&["run", "-", "--scans", "1"], xml.as_bytes()),
+        "array in LD",
+    );
     let at = line_col(&xml, "<variable name=\"tab\"");
     assert_eq!(e, format!("error: <stdin>:{at}: at run: pou P: variable `tab` is a TABLE, for which plc-deps has no values: the analysis reads it as a whole variable, but `run` cannot execute the LD body of `P`"));
 }

@@ -110,7 +110,10 @@ fn a_wiring_cycle_is_closed_as_beremiz_closes_it() {
     // 2's OUT of the last scan. So Y = X + last(2.OUT) and 2.OUT = X + Y: with X = 1,
     // Y = 1 (2.OUT = 2), 3 (4), 5 (6).
     let (_, warnings) = px::report_and_warnings(&xml);
-    assert!(warnings.contains("blocks 3 and 2 are in a loop of arcs"), "{warnings}");
+    assert!(
+        warnings.contains("blocks 3 and 2 are in a loop of arcs"),
+        "{warnings}"
+    );
     let t = px::trace("fbd-cycle", &xml, "X\n1\n1\n1\n", &["Y"]);
     assert_eq!(t[0], ["1", "3", "5"]);
 }

@@ -37,8 +37,14 @@ fn a_coil_inside_a_parallel_branch_passes_its_power_on() {
     ]);
     let xml = project(&v, &ld);
     let (_, warnings) = report_and_warnings(&xml);
-    assert!(warnings.contains("its LD body is read as a data-flow network"), "{warnings}");
-    assert!(warnings.contains("the parallel branch through localId 3 holds an output or a block"), "{warnings}");
+    assert!(
+        warnings.contains("its LD body is read as a data-flow network"),
+        "{warnings}"
+    );
+    assert!(
+        warnings.contains("the parallel branch through localId 3 holds an output or a block"),
+        "{warnings}"
+    );
     let t = trace("flow-sp", &xml, "A,B\n0,0\n1,0\n0,1\n1,1\n", &["X", "Y"]);
     assert_eq!(t[0], ["0", "1", "0", "1"]);
     assert_eq!(t[1], ["0", "1", "1", "1"]);
@@ -54,8 +60,19 @@ fn en_on_a_timer_in_ld_freezes_it() {
         contact(2, "E", &[1], ""),
         contact(3, "Go", &[1], ""),
         in_var(4, "T#20ms"),
-        block(5, "TON", Some("T1"), &[("EN", &[(2, None)]), ("IN", &[(3, None)]), ("PT", &[(4, None)])], &["ENO", "Q", "ET"]),
-        coil(6, "Q", &[5], "").replace("refLocalId=\"5\"", "refLocalId=\"5\" formalParameter=\"Q\""),
+        block(
+            5,
+            "TON",
+            Some("T1"),
+            &[
+                ("EN", &[(2, None)]),
+                ("IN", &[(3, None)]),
+                ("PT", &[(4, None)]),
+            ],
+            &["ENO", "Q", "ET"],
+        ),
+        coil(6, "Q", &[5], "")
+            .replace("refLocalId=\"5\"", "refLocalId=\"5\" formalParameter=\"Q\""),
     ]
     .concat();
     let v = vars(&[
@@ -65,7 +82,12 @@ fn en_on_a_timer_in_ld_freezes_it() {
         ("localVars", "T1", "TON"),
     ]);
     let xml = project(&v, &ld);
-    let t = trace("flow-en", &xml, "E,Go\n1,1\n1,1\n1,1\n0,1\n0,0\n1,0\n", &["Q"]);
+    let t = trace(
+        "flow-en",
+        &xml,
+        "E,Go\n1,1\n1,1\n1,1\n0,1\n0,0\n1,0\n",
+        &["Q"],
+    );
     assert_eq!(t[0], ["0", "0", "1", "1", "1", "0"]);
 }
 
@@ -78,7 +100,17 @@ fn a_conversion_feeding_an_extensible_compare_in_ld() {
         block(3, "BOOL_TO_INT", None, &[("IN", &[(2, None)])], &["OUT"]),
         in_var(4, "N"),
         in_var(5, "M"),
-        block(6, "EQ", None, &[("IN1", &[(4, None)]), ("IN2", &[(3, Some("OUT"))]), ("IN3", &[(5, None)])], &["OUT"]),
+        block(
+            6,
+            "EQ",
+            None,
+            &[
+                ("IN1", &[(4, None)]),
+                ("IN2", &[(3, Some("OUT"))]),
+                ("IN3", &[(5, None)]),
+            ],
+            &["OUT"],
+        ),
         coil(7, "X", &[6], ""),
     ]
     .concat();
@@ -89,7 +121,12 @@ fn a_conversion_feeding_an_extensible_compare_in_ld() {
         ("outputVars", "X", "BOOL"),
     ]);
     let xml = project(&v, &ld);
-    let t = trace("flow-eq", &xml, "A,N,M\n1,1,1\n0,1,1\n0,0,0\n1,1,0\n", &["X"]);
+    let t = trace(
+        "flow-eq",
+        &xml,
+        "A,N,M\n1,1,1\n0,1,1\n0,0,0\n1,1,0\n",
+        &["X"],
+    );
     assert_eq!(t[0], ["1", "0", "1", "0"]);
 }
 
@@ -100,8 +137,21 @@ fn negated_pins_and_a_wired_eno_in_fbd() {
         in_var(1, "A"),
         in_var(2, "B"),
         in_var(3, "C"),
-        block(4, "AND", None, &[("EN", &[(3, None)]), ("IN1", &[(1, None)]), ("IN2", &[(2, None)])], &["ENO", "OUT"])
-            .replace("<variable formalParameter=\"IN1\">", "<variable formalParameter=\"IN1\" negated=\"true\">"),
+        block(
+            4,
+            "AND",
+            None,
+            &[
+                ("EN", &[(3, None)]),
+                ("IN1", &[(1, None)]),
+                ("IN2", &[(2, None)]),
+            ],
+            &["ENO", "OUT"],
+        )
+        .replace(
+            "<variable formalParameter=\"IN1\">",
+            "<variable formalParameter=\"IN1\" negated=\"true\">",
+        ),
         var_in("outVariable", 5, "Y", (4, Some("OUT"))),
         var_in("outVariable", 6, "Z", (4, Some("ENO"))),
     ]
@@ -114,7 +164,12 @@ fn negated_pins_and_a_wired_eno_in_fbd() {
         ("outputVars", "Z", "BOOL"),
     ]);
     let xml = project_in("FBD", &v, &fbd);
-    let t = trace("flow-neg", &xml, "A,B,C\n0,1,1\n1,1,1\n0,0,1\n0,1,0\n", &["Y", "Z"]);
+    let t = trace(
+        "flow-neg",
+        &xml,
+        "A,B,C\n0,1,1\n1,1,1\n0,0,1\n0,1,0\n",
+        &["Y", "Z"],
+    );
     // Scan 3: EN is FALSE, so the AND does not run and Y keeps its value from scan 2.
     assert_eq!(t[0], ["1", "0", "0", "0"]);
     assert_eq!(t[1], ["1", "1", "1", "0"]);
@@ -126,7 +181,13 @@ fn a_function_the_model_lacks_is_a_black_box_with_its_pins() {
     let fbd = [
         in_var(1, "a"),
         in_var(2, "2"),
-        block(3, "SHL", None, &[("IN", &[(1, None)]), ("N", &[(2, None)])], &["OUT"]),
+        block(
+            3,
+            "SHL",
+            None,
+            &[("IN", &[(1, None)]), ("N", &[(2, None)])],
+            &["OUT"],
+        ),
         var_in("outVariable", 4, "y", (3, Some("OUT"))),
     ]
     .concat();
@@ -134,10 +195,28 @@ fn a_function_the_model_lacks_is_a_black_box_with_its_pins() {
     let xml = project_in("FBD", &v, &fbd);
     let (r, warnings) = report_and_warnings(&xml);
     assert!(warnings.contains("SHL is read as a black box (a function block type SHL reading its inputs IN INT, N INT and writing its outputs OUT INT)"), "{warnings}");
-    let ins: Vec<&serde_json::Value> = r["rungs"].as_array().unwrap().iter().map(|r| &r["in"]).collect();
-    let outs: Vec<&serde_json::Value> = r["rungs"].as_array().unwrap().iter().map(|r| &r["out"]).collect();
-    assert!(ins.iter().any(|i| i.as_array().unwrap().contains(&json!("a"))), "{ins:?}");
-    assert!(outs.iter().any(|o| o.as_array().unwrap().contains(&json!("y"))), "{outs:?}");
+    let ins: Vec<&serde_json::Value> = r["rungs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| &r["in"])
+        .collect();
+    let outs: Vec<&serde_json::Value> = r["rungs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| &r["out"])
+        .collect();
+    assert!(
+        ins.iter()
+            .any(|i| i.as_array().unwrap().contains(&json!("a"))),
+        "{ins:?}"
+    );
+    assert!(
+        outs.iter()
+            .any(|o| o.as_array().unwrap().contains(&json!("y"))),
+        "{outs:?}"
+    );
 }
 
 #[test]
@@ -145,7 +224,13 @@ fn a_string_literal_is_analysed_and_run_refuses_it() {
     let fbd = [
         in_var(1, "'hello'"),
         in_var(2, "go"),
-        block(3, "python_eval", Some("py"), &[("TRIG", &[(2, None)]), ("CODE", &[(1, None)])], &["ACK", "RESULT"]),
+        block(
+            3,
+            "python_eval",
+            Some("py"),
+            &[("TRIG", &[(2, None)]), ("CODE", &[(1, None)])],
+            &["ACK", "RESULT"],
+        ),
         var_in("outVariable", 4, "done", (3, Some("ACK"))),
     ]
     .concat();
@@ -157,7 +242,10 @@ fn a_string_literal_is_analysed_and_run_refuses_it() {
     let xml = project_in("FBD", &v, &fbd);
     let (_, warnings) = report_and_warnings(&xml);
     assert!(warnings.contains("python_eval"), "{warnings}");
-    let e = error_line(&run_stdin(&["run", "-", "--scans", "1"], xml.as_bytes()), "string literal");
+    let e = error_line(
+        &run_stdin(&["run", "-", "--scans", "1"], xml.as_bytes()),
+        "string literal",
+    );
     let at = line_col(&xml, "<inVariable localId=\"1\"");
     assert_eq!(e, format!("error: <stdin>:{at}: at run: pou P: the inVariable localId 1 is a string literal, for which plc-deps has no values: the analysis reads it as a constant, but `run` cannot execute the FBD body of `P`"));
 }
@@ -192,7 +280,12 @@ fn a_label_in_an_ld_body_read_as_data_flow_gives_the_rung_readers_error() {
         coil(5, "Y", &[3, 4], ""),
     ]
     .concat();
-    let v = vars(&[("inputVars", "A", "BOOL"), ("inputVars", "B", "BOOL"), ("outputVars", "X", "BOOL"), ("outputVars", "Y", "BOOL")]);
+    let v = vars(&[
+        ("inputVars", "A", "BOOL"),
+        ("inputVars", "B", "BOOL"),
+        ("outputVars", "X", "BOOL"),
+        ("outputVars", "Y", "BOOL"),
+    ]);
     let xml = project(&v, &ld);
     let e = error_line(&run_stdin(&["report", "-"], xml.as_bytes()), "label");
     assert!(e.ends_with("at pou P, LD, coil localId 5: the wiring into localId 5 from localIds 3, 4 is not series-parallel: the parallel branch through localId 3 holds an output or a block, which a parallel (OR) branch cannot"), "{e}");

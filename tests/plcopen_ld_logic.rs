@@ -95,5 +95,8 @@ fn a_not_of_a_timer_output_is_read_as_data_flow() {
     assert_eq!(got[0], ["1", "1", "1"]);
     let out = run_stdin(&["report", "-"], xml.as_bytes());
     let warnings = String::from_utf8_lossy(&out.stderr);
-    assert!(warnings.contains("NOT (localId 5) negates a series that holds an output or a box"), "{warnings}");
+    assert!(
+        warnings.contains("NOT (localId 5) negates a series that holds an output or a box"),
+        "{warnings}"
+    );
 }

@@ -170,7 +170,10 @@ fn a_sub_with_three_inputs_is_refused() {
     );
     let out = run_stdin(&["report", "-"], xml.as_bytes());
     let line = error_line(&out, "SUB of three");
-    assert!(line.contains("SUB has no input `IN3` (inputs: IN1, IN2)"), "{line}");
+    assert!(
+        line.contains("SUB has no input `IN3` (inputs: IN1, IN2)"),
+        "{line}"
+    );
 }
 
 /// Cu, Cd → CTUD0 (R unconnected: FALSE; LD := 0, a BOOL literal; PV := 2); QD → Down, written
@@ -366,7 +369,16 @@ fn a_box_whose_fed_pin_cannot_run_first_in_its_rung_is_read_as_data_flow() {
         ],
         &ld,
     );
-    let got = trace("feed-after", &xml, "S,a,b\n1,0,0\n0,0,0\n0,1,0\n1,0,1\n0,0,0\n", &["Q", "X"]);
-    assert_eq!(got[0], ["1", "1", "0", "1", "1"], "Q: set, held, reset, set wins, held");
+    let got = trace(
+        "feed-after",
+        &xml,
+        "S,a,b\n1,0,0\n0,0,0\n0,1,0\n1,0,1\n0,0,0\n",
+        &["Q", "X"],
+    );
+    assert_eq!(
+        got[0],
+        ["1", "1", "0", "1", "1"],
+        "Q: set, held, reset, set wins, held"
+    );
     assert_eq!(got[1], ["1", "0", "0", "1", "0"], "X = S");
 }

@@ -78,8 +78,14 @@ fn a_string_is_analysed_everywhere_and_run_refuses_it_where_it_would_execute_the
     let (r, err) = report_and_warnings(&xml);
     assert_eq!(r["rungs"][0]["out"], json!(["lamp"]));
     let at = line_col(&xml, "<variable name=\"msg\"");
-    assert!(err.contains(&format!("<stdin>:{at}: pou P: variable `msg` is a STRING")), "{err}");
-    let e = error_line(&run_stdin(&["run", "-", "--scans", "1"], xml.as_bytes()), "string in LD");
+    assert!(
+        err.contains(&format!("<stdin>:{at}: pou P: variable `msg` is a STRING")),
+        "{err}"
+    );
+    let e = error_line(
+        &run_stdin(&["run", "-", "--scans", "1"], xml.as_bytes()),
+        "string in LD",
+    );
     assert_eq!(e, format!("error: <stdin>:{at}: at run: pou P: variable `msg` is a STRING, for which plc-deps has no values: the analysis reads it as a whole variable, but `run` cannot execute the LD body of `P`"));
     let st = with_types(
         "ST",

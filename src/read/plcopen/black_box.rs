@@ -112,7 +112,10 @@ impl Ctx {
             ("CTU" | "CTD" | "CTUD", "PV") => return Some("INT".to_owned()),
             _ => {}
         }
-        let sig = self.fb_inputs.get(op).or_else(|| self.functions.get(op).map(|s| &s.inputs))?;
+        let sig = self
+            .fb_inputs
+            .get(op)
+            .or_else(|| self.functions.get(op).map(|s| &s.inputs))?;
         sig.iter().find(|(n, _)| n == pin).map(|(_, t)| t.clone())
     }
 
@@ -122,7 +125,10 @@ impl Ctx {
         let mut ty = self.vars.get(&parts.next()?.to_ascii_lowercase())?.clone();
         for f in parts {
             let outs: Vec<(String, String)> = match standard_outputs(&ty) {
-                Some(o) => o.iter().map(|(a, b)| (a.to_string(), b.to_string())).collect(),
+                Some(o) => o
+                    .iter()
+                    .map(|(a, b)| (a.to_string(), b.to_string()))
+                    .collect(),
                 None => self.fbs.get(&ty)?.clone(),
             };
             ty = outs.into_iter().find(|(n, _)| n.eq_ignore_ascii_case(f))?.1;
@@ -161,7 +167,10 @@ impl Typer<'_, '_, '_, '_> {
             Connection::Variable(v) => self.ctx.var_type(v),
             Connection::Constant(c) => Ctx::constant_type(c),
             Connection::Arc { block, pin } => {
-                let pin = pin.as_ref().and_then(|p| p.as_ref().ok()).map(|p| p.as_ref());
+                let pin = pin
+                    .as_ref()
+                    .and_then(|p| p.as_ref().ok())
+                    .map(|p| p.as_ref());
                 match self.g.elems.iter().position(|e| e.local_id == *block) {
                     Some(e) => self.output(ElemId(e as u32), pin, depth),
                     None => Some("BOOL".to_owned()),
@@ -181,7 +190,7 @@ impl Typer<'_, '_, '_, '_> {
             .find_map(|&(c, k, _)| {
                 let cel = self.g.get(c);
                 if cel.tag != "block" {
-                    let i = super::fbd::block_input(cel.node, "", Origin::NONE).ok()?;
+                    let i = super::pins::block_input(cel.node, "", Origin::NONE).ok()?;
                     return self.input(&i, 0);
                 }
                 let op = cel.node.attribute("typeName").unwrap_or("");
@@ -190,8 +199,20 @@ impl Typer<'_, '_, '_, '_> {
                     return Some(t);
                 }
                 // Ops whose data inputs share one type: the others' type.
-                let same = matches!(op, "ADD" | "SUB" | "MUL" | "DIV" | "MOD" | "MOVE" | "SEL" | "MAX" | "MIN" | "LIMIT" | "MUX")
-                    || crate::model::CmpOp::parse(op).is_some();
+                let same = matches!(
+                    op,
+                    "ADD"
+                        | "SUB"
+                        | "MUL"
+                        | "DIV"
+                        | "MOD"
+                        | "MOVE"
+                        | "SEL"
+                        | "MAX"
+                        | "MIN"
+                        | "LIMIT"
+                        | "MUX"
+                ) || crate::model::CmpOp::parse(op).is_some();
                 if !same {
                     return None;
                 }
@@ -214,7 +235,7 @@ impl Typer<'_, '_, '_, '_> {
         }
         match el.tag {
             "inVariable" | "inOutVariable" => {
-                let i = super::fbd::block_input(el.node, "", Origin::NONE).ok()?;
+                let i = super::pins::block_input(el.node, "", Origin::NONE).ok()?;
                 return self.input(&i, depth + 1);
             }
             "block" => {}
@@ -241,8 +262,10 @@ impl Typer<'_, '_, '_, '_> {
             return pick(&sig.outputs, pin);
         }
         if let Some(o) = standard_outputs(ty) {
-            let o: Vec<(String, String)> =
-                o.iter().map(|(a, b)| (a.to_string(), b.to_string())).collect();
+            let o: Vec<(String, String)> = o
+                .iter()
+                .map(|(a, b)| (a.to_string(), b.to_string()))
+                .collect();
             return pick(&o, pin);
         }
         if let Some(o) = self.ctx.fbs.get(ty) {
@@ -285,10 +308,14 @@ pub fn mixed_arithmetic(t: &Typer, ty: &str, b: &Block) -> bool {
     if !matches!(ty, "ADD" | "SUB" | "MUL" | "DIV") {
         return false;
     }
-    let Some(Ok(Inputs::Named(ins))) = &b.inputs else { return false };
+    let Some(Ok(Inputs::Named(ins))) = &b.inputs else {
+        return false;
+    };
     if matches!(ty, "MUL" | "DIV") {
         // MUL_TIME, DIV_TIME: a TIME by a number.
-        return ins.iter().any(|(_, i)| t.input(i, 0).as_deref() == Some("TIME"));
+        return ins
+            .iter()
+            .any(|(_, i)| t.input(i, 0).as_deref() == Some("TIME"));
     }
     // A number literal takes the type of its use; a TIME literal is TIME.
     let types: Vec<String> = ins
@@ -344,7 +371,9 @@ pub fn rewrite(
         if let Some((op, ins)) = done {
             b.op = Ok(Cow::Borrowed(op));
             b.inputs = Some(Ok(Inputs::Named(
-                ins.into_iter().map(|(p, i)| (Cow::Borrowed(p), i)).collect(),
+                ins.into_iter()
+                    .map(|(p, i)| (Cow::Borrowed(p), i))
+                    .collect(),
             )));
             if op != "SEL" {
                 return Ok(None);
@@ -355,7 +384,7 @@ pub fn rewrite(
                 origin: at,
                 name: Cow::Owned(v.clone()),
             };
-            super::fbd::add_target(b, "OUT".to_owned(), target);
+            super::pins::add_target(b, "OUT".to_owned(), target);
             return Ok(Some((v, to)));
         }
     }
@@ -367,9 +396,12 @@ pub fn rewrite(
         outputs: Vec::new(),
     };
     for (pin, input) in &inputs {
-        let from_decl = declared
-            .as_ref()
-            .and_then(|d| d.inputs.iter().find(|(n, _)| n == pin.as_ref()).map(|(_, t)| t.clone()));
+        let from_decl = declared.as_ref().and_then(|d| {
+            d.inputs
+                .iter()
+                .find(|(n, _)| n == pin.as_ref())
+                .map(|(_, t)| t.clone())
+        });
         let from_conv = conv.as_ref().and_then(|c| c.0.clone());
         let pty = from_decl.or(from_conv).or_else(|| t.input(input, 0));
         let Some(pty) = pty else {
@@ -389,9 +421,11 @@ pub fn rewrite(
         // A built-in op (date and time arithmetic) is typed by its use, anything else by its
         // declaration or inputs first.
         let pty = if OpKind::parse(ty).is_some() {
-            t.consumer_type(e, pin, k == 0).or_else(|| t.output(e, Some(pin), 0))
+            t.consumer_type(e, pin, k == 0)
+                .or_else(|| t.output(e, Some(pin), 0))
         } else {
-            t.output(e, Some(pin), 0).or_else(|| t.consumer_type(e, pin, k == 0))
+            t.output(e, Some(pin), 0)
+                .or_else(|| t.consumer_type(e, pin, k == 0))
         };
         let Some(pty) = pty else {
             return Err(error(
@@ -413,7 +447,11 @@ pub fn rewrite(
     b.op = Ok(Cow::Owned(name.clone()));
     b.instance = Some(Ok(Cow::Owned(inst.clone())));
     b.inputs = Some(Ok(Inputs::Named(inputs)));
-    Ok(el.node.attribute("instanceName").is_none().then_some((inst, name)))
+    Ok(el
+        .node
+        .attribute("instanceName")
+        .is_none()
+        .then_some((inst, name)))
 }
 
 /// The stand-in type for `op` with `sig` (made on first use).

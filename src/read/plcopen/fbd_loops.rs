@@ -13,7 +13,7 @@
 //! exact start order (its walk starts from the out variables in file order; this one from the
 //! blocks in file order, so in a loop with several entries the cut may fall elsewhere).
 
-use super::fbd::{add_target, Added};
+use super::pins::{add_target, Added};
 use super::xml::Note;
 use crate::diag::Origin;
 use crate::syntax::fbd::{Block, Connection, Input, Inputs, OutVar};
@@ -24,7 +24,9 @@ use std::collections::HashMap;
 fn arcs(b: &Block) -> Vec<(Option<usize>, u32, Option<String>)> {
     let mut out = Vec::new();
     let pin = |p: &Option<crate::syntax::fbd::Read<crate::syntax::Text>>| {
-        p.as_ref().and_then(|r| r.as_ref().ok()).map(|s| s.to_string())
+        p.as_ref()
+            .and_then(|r| r.as_ref().ok())
+            .map(|s| s.to_string())
     };
     if let Some(Ok(Inputs::Named(ins))) = &b.inputs {
         for (k, (_, i)) in ins.iter().enumerate() {
@@ -33,7 +35,11 @@ fn arcs(b: &Block) -> Vec<(Option<usize>, u32, Option<String>)> {
             }
         }
     }
-    if let Some(Input { from: Connection::Arc { block, pin: p }, .. }) = &b.cond {
+    if let Some(Input {
+        from: Connection::Arc { block, pin: p },
+        ..
+    }) = &b.cond
+    {
         out.push((None, *block, pin(p)));
     }
     out
@@ -70,7 +76,9 @@ pub fn cut(
             }
             let (k, producer, pin) = a[*next].clone();
             *next += 1;
-            let Some(&p) = index.get(&producer) else { continue };
+            let Some(&p) = index.get(&producer) else {
+                continue;
+            };
             match state[p] {
                 0 => {
                     state[p] = 1;
@@ -119,5 +127,6 @@ pub fn cut(
 }
 
 fn op_name(b: &Block) -> String {
-    b.op.as_ref().map_or_else(|_| "block".to_owned(), |o| o.to_string())
+    b.op.as_ref()
+        .map_or_else(|_| "block".to_owned(), |o| o.to_string())
 }

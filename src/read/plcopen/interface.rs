@@ -166,7 +166,8 @@ pub fn interface(tc6: Tc6, node: Option<Node>, pou: &str, known: &Known) -> R<In
                 // Their declarations, for a global the file does not declare (an editor
                 // extension's); one that cannot be read is left to the global's.
                 let mut mapped = Vec::new();
-                if let Ok(vars) = var_list(tc6, list, VarClass::Default, &place, known, &mut mapped) {
+                if let Ok(vars) = var_list(tc6, list, VarClass::Default, &place, known, &mut mapped)
+                {
                     out.external_decls.extend(vars);
                     out.external_mapped.extend(mapped);
                 }

@@ -28,8 +28,11 @@
 //! and the ops themselves (the FBD resolver checks them, located at the block).
 
 use super::black_box::{self, BlackBox, Ctx};
-use super::fbd::{add_target, block_input, bool_literal, is_const, konst, output_negated, pin_modifiers, pin_of, Added};
 use super::ld::components;
+use super::pins::{
+    add_target, block_input, bool_literal, is_const, konst, output_negated, pin_modifiers, pin_of,
+    Added,
+};
 use super::wiring::{graph, ElemId, Graph, Source};
 use super::xml::{attr, error, identifier, origin, variable_ref, Notes, Tc6, R};
 use crate::diag::Origin;
@@ -58,13 +61,7 @@ const FLOW_TAGS: &[&str] = &[
 ];
 
 /// Reads LD body `node` of POU `pou` as a data-flow network.
-pub fn body(
-    tc6: Tc6,
-    node: Node,
-    pou: &str,
-    ctx: &Ctx,
-    notes: &mut Notes,
-) -> R<FbdBody<'static>> {
+pub fn body(tc6: Tc6, node: Node, pou: &str, ctx: &Ctx, notes: &mut Notes) -> R<FbdBody<'static>> {
     let place = format!("pou {pou}, LD");
     let g = graph(tc6, node, &place)?;
     g.only(FLOW_TAGS, "LD", &place)?;
@@ -88,10 +85,19 @@ pub fn body(
     };
     // Networks in the order of their first statement; rungs of blocks only after the others.
     let mut order: Vec<usize> = Vec::new();
-    let statement = |t: &str| matches!(t, "coil" | "outVariable" | "inOutVariable" | "jump" | "return");
+    let statement = |t: &str| {
+        matches!(
+            t,
+            "coil" | "outVariable" | "inOutVariable" | "jump" | "return"
+        )
+    };
     for pass in [true, false] {
         for (i, el) in g.elems.iter().enumerate() {
-            let wanted = if pass { statement(el.tag) } else { el.tag == "block" };
+            let wanted = if pass {
+                statement(el.tag)
+            } else {
+                el.tag == "block"
+            };
             if wanted && !order.contains(&component[i]) {
                 order.push(component[i]);
             }
@@ -254,7 +260,10 @@ impl Flow<'_, '_, '_> {
                 return Err(error(
                     at,
                     &self.at(e),
-                    format!("a {other} (localId {}) cannot feed power or a value", el.local_id),
+                    format!(
+                        "a {other} (localId {}) cannot feed power or a value",
+                        el.local_id
+                    ),
                 ))
             }
         })
@@ -263,7 +272,11 @@ impl Flow<'_, '_, '_> {
     /// The text of element `e`'s `variable` (contacts, coils) or `expression` (variables).
     fn expression(&self, e: ElemId) -> R<String> {
         let el = self.g.get(e);
-        let tag = if matches!(el.tag, "contact" | "coil") { "variable" } else { "expression" };
+        let tag = if matches!(el.tag, "contact" | "coil") {
+            "variable"
+        } else {
+            "expression"
+        };
         el.node
             .children()
             .find(|c| c.is_element() && c.tag_name().name() == tag)
@@ -302,7 +315,9 @@ impl Flow<'_, '_, '_> {
             problem: None,
         };
         if let Some(inst) = el.node.attribute("instanceName") {
-            b.instance = Some(Ok(Cow::Owned(identifier(inst, "instance", el.node, &here)?)));
+            b.instance = Some(Ok(Cow::Owned(identifier(
+                inst, "instance", el.node, &here,
+            )?)));
         }
         // A placeholder keeps the block's place (before the blocks its inputs add, which the
         // FBD order puts first anyway by their arcs).
@@ -313,7 +328,9 @@ impl Flow<'_, '_, '_> {
             let pin = &el.inputs[k];
             let pname = pin.name.unwrap_or("");
             let pnode = pin.node;
-            let Some(mut v) = self.pin(e, k)? else { continue };
+            let Some(mut v) = self.pin(e, k)? else {
+                continue;
+            };
             let at = origin(pnode);
             let (negated, edge) = pin_modifiers(pnode, ty, pname, el.local_id, &here)?;
             let counter_edge = matches!(ty, "CTU" | "CTD" | "CTUD") && matches!(pname, "CU" | "CD");
@@ -337,11 +354,19 @@ impl Flow<'_, '_, '_> {
         net[idx].inputs = Some(Ok(Inputs::Named(inputs)));
         net[idx].cond = cond;
         let mut b = std::mem::replace(&mut self.a.blocks[idx], placeholder());
-        let t = black_box::Typer { ctx: self.ctx, g: self.g };
+        let t = black_box::Typer {
+            ctx: self.ctx,
+            g: self.g,
+        };
         self.a.compare(&mut b, &|i: &Input| t.input(i, 0));
         self.a.blocks[idx] = b;
-        let t = black_box::Typer { ctx: self.ctx, g: self.g };
-        if !black_box::is_known(self.ctx, ty) || black_box::mixed_arithmetic(&t, ty, &self.a.blocks[idx]) {
+        let t = black_box::Typer {
+            ctx: self.ctx,
+            g: self.g,
+        };
+        if !black_box::is_known(self.ctx, ty)
+            || black_box::mixed_arithmetic(&t, ty, &self.a.blocks[idx])
+        {
             let b = &mut self.a.blocks[idx];
             if let Some((inst, bt)) = black_box::rewrite(&t, e, b, &mut self.boxes, &here)? {
                 let at = b.origin;
@@ -359,9 +384,16 @@ impl Flow<'_, '_, '_> {
             name: Cow::Owned(var),
         };
         if let Connection::Arc { block, pin } = &v.from {
-            let pin = pin_name(pin).map(str::to_owned).or_else(|| self.first_output(*block));
+            let pin = pin_name(pin)
+                .map(str::to_owned)
+                .or_else(|| self.first_output(*block));
             let block = *block;
-            if let Some(b) = self.a.blocks.iter_mut().find(|b| b.id.as_ref().ok() == Some(&block)) {
+            if let Some(b) = self
+                .a
+                .blocks
+                .iter_mut()
+                .find(|b| b.id.as_ref().ok() == Some(&block))
+            {
                 add_target(b, pin.unwrap_or_else(|| "OUT".to_owned()), target);
                 return;
             }
@@ -374,7 +406,11 @@ impl Flow<'_, '_, '_> {
 
     /// The first output pin of the block with id `id`, when it is an element of the body.
     fn first_output(&self, id: u32) -> Option<String> {
-        let el = self.g.elems.iter().find(|el| el.local_id == id && el.tag == "block")?;
+        let el = self
+            .g
+            .elems
+            .iter()
+            .find(|el| el.local_id == id && el.tag == "block")?;
         el.outputs
             .iter()
             .map(|(p, _)| *p)
@@ -400,11 +436,13 @@ impl Flow<'_, '_, '_> {
         let v = match (flag("negated"), flag("storage"), flag("edge")) {
             (Some("true" | "1"), _, _) => self.a.not(p, at),
             (_, Some("set"), _) => {
-                self.a.add("OR", vec![("IN1", var_input(&var, at)), ("IN2", p)], at)
+                self.a
+                    .add("OR", vec![("IN1", var_input(&var, at)), ("IN2", p)], at)
             }
             (_, Some("reset"), _) => {
                 let np = self.a.not(p, at);
-                self.a.add("AND", vec![("IN1", var_input(&var, at)), ("IN2", np)], at)
+                self.a
+                    .add("AND", vec![("IN1", var_input(&var, at)), ("IN2", np)], at)
             }
             (_, _, Some(edge @ ("rising" | "falling"))) => self.a.trigger(edge, p, el.local_id, at),
             _ => p,
@@ -421,7 +459,12 @@ impl Flow<'_, '_, '_> {
         let p = self.power(e)?;
         let op = if el.tag == "jump" { "JMP" } else { "RET" };
         let label = match el.tag {
-            "jump" => Some(identifier(attr(el.node, "label", &here)?, "label", el.node, &here)?),
+            "jump" => Some(identifier(
+                attr(el.node, "label", &here)?,
+                "label",
+                el.node,
+                &here,
+            )?),
             _ => None,
         };
         let id = self.a.next_id;
@@ -456,7 +499,9 @@ fn same(a: &Input, b: &Input) -> bool {
 }
 
 /// The name of an arc's output pin, if given.
-fn pin_name<'x>(p: &'x Option<crate::syntax::fbd::Read<crate::syntax::Text<'_>>>) -> Option<&'x str> {
+fn pin_name<'x>(
+    p: &'x Option<crate::syntax::fbd::Read<crate::syntax::Text<'_>>>,
+) -> Option<&'x str> {
     p.as_ref().and_then(|r| r.as_ref().ok()).map(|s| s.as_ref())
 }
 

@@ -113,7 +113,9 @@ pub fn stand_in_fb(
 ) -> Option<(FunctionBlock<'static>, Note)> {
     let b = BLOCKS.iter().find(|b| b.name == ty)?;
     let pins = |v: &[(&str, &str)]| -> Vec<(String, String)> {
-        v.iter().map(|(n, t)| (n.to_string(), t.to_string())).collect()
+        v.iter()
+            .map(|(n, t)| (n.to_string(), t.to_string()))
+            .collect()
     };
     let fb = stand_in_type(ty, &pins(b.inputs), &pins(b.outputs), at);
     let show = |v: &[(&str, &str)]| v.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", ");
@@ -138,9 +140,13 @@ type Pins = Vec<(String, String)>;
 /// and feed.
 pub fn pins() -> impl Iterator<Item = (&'static str, Pins, Pins)> {
     let own = |v: &[(&str, &str)]| -> Pins {
-        v.iter().map(|(n, t)| (n.to_string(), t.to_string())).collect()
+        v.iter()
+            .map(|(n, t)| (n.to_string(), t.to_string()))
+            .collect()
     };
-    BLOCKS.iter().map(move |b| (b.name, own(b.inputs), own(b.outputs)))
+    BLOCKS
+        .iter()
+        .map(move |b| (b.name, own(b.inputs), own(b.outputs)))
 }
 
 /// A black-box function block type `ty` with `inputs` and `outputs` (name, model type): one
@@ -163,8 +169,14 @@ pub fn stand_in_type(
     FunctionBlock {
         origin: at,
         name: ty.to_owned().into(),
-        inputs: inputs.iter().map(|(n, t)| var(n, t, VarClass::Input, at)).collect(),
-        outputs: outputs.iter().map(|(n, t)| var(n, t, VarClass::Output, at)).collect(),
+        inputs: inputs
+            .iter()
+            .map(|(n, t)| var(n, t, VarClass::Input, at))
+            .collect(),
+        outputs: outputs
+            .iter()
+            .map(|(n, t)| var(n, t, VarClass::Output, at))
+            .collect(),
         vars: Vec::new(),
         body: Some(Body::Rungs(body.into_iter().collect())),
     }
@@ -174,7 +186,10 @@ pub fn stand_in_type(
 pub fn black_box_type(b: &super::black_box::BlackBox) -> (FunctionBlock<'static>, Note) {
     let fb = stand_in_type(&b.name, &b.sig.inputs, &b.sig.outputs, b.origin);
     let show = |v: &[(String, String)]| {
-        v.iter().map(|(n, t)| format!("{n} {t}")).collect::<Vec<_>>().join(", ")
+        v.iter()
+            .map(|(n, t)| format!("{n} {t}"))
+            .collect::<Vec<_>>()
+            .join(", ")
     };
     let note = Note {
         origin: b.origin,

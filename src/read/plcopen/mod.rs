@@ -28,6 +28,7 @@ mod ld_flow;
 mod ld_logic;
 mod ld_power;
 mod library;
+mod pins;
 mod project;
 mod st_body;
 mod textual;

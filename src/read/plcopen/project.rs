@@ -17,10 +17,10 @@
 //! Deliberately not here (errors naming the POU): a program instantiated twice,
 //! several configurations or resources, POUs with actions or transitions outside SFC.
 
+use super::black_box::{Ctx, Sig};
 use super::data_types::DataTypes;
 use super::interface::{self, name, Interface, Known};
 use super::xml::{add_data_note, attr, error, identifier, origin, Note, Notes, Tc6, R};
-use super::black_box::{Ctx, Sig};
 use super::{fbd, ld, ld_flow, library, st_body, textual};
 use crate::diag::LoadError;
 use crate::syntax::{
@@ -552,7 +552,6 @@ fn ld_body(tc6: Tc6, lang: Node, name: &str, ctx: &Ctx, notes: &mut Notes) -> R<
     }
 }
 
-
 /// What any body of the project may call: its user functions (with their pins' types) and the
 /// function block types of the project and of the library (with their outputs' types).
 fn base_ctx(read: &[(Node, String, &str, Interface)]) -> Ctx {
@@ -602,7 +601,10 @@ fn pou_ctx(base: &Ctx, iface: &Interface, globals: &[(&str, &str)]) -> Ctx {
         .chain(&iface.locals)
         .chain(&iface.globals)
     {
-        vars.insert(v.name.as_str().to_ascii_lowercase(), v.ty.as_str().to_owned());
+        vars.insert(
+            v.name.as_str().to_ascii_lowercase(),
+            v.ty.as_str().to_owned(),
+        );
     }
     for (n, t) in globals {
         if iface.externals.iter().any(|e| e.eq_ignore_ascii_case(n)) {
@@ -625,7 +627,7 @@ fn string_literal<'a, 'i>(lang: Node<'a, 'i>) -> Option<Node<'a, 'i>> {
             n.children()
                 .find(|c| c.tag_name().name() == "expression")
                 .and_then(|c| c.text())
-                .is_some_and(|t| super::fbd::is_string_literal(t))
+                .is_some_and(super::pins::is_string_literal)
         })
 }
 
