@@ -308,3 +308,17 @@ fn a_loop_of_arcs_between_blocks_is_closed_with_a_one_scan_delay() {
     let t = trace("flow-loop", &xml, "go\n0\n0\n0\n0\n", &["y"]);
     assert_eq!(t[0], ["1", "0", "1", "0"]);
 }
+
+#[test]
+fn a_block_type_that_is_not_an_identifier_is_an_error_naming_it() {
+    let fbd = [
+        in_var(1, "a"),
+        block(2, "../x", None, &[("IN", &[(1, None)])], &["OUT"]),
+        var_in("outVariable", 3, "y", (2, Some("OUT"))),
+    ]
+    .concat();
+    let v = vars(&[("inputVars", "a", "INT"), ("outputVars", "y", "INT")]);
+    let xml = project_in("FBD", &v, &fbd);
+    let e = error_line(&run_stdin(&["report", "-"], xml.as_bytes()), "bad type name");
+    assert!(e.contains("at pou P, FBD, block localId 2: block type name `../x` is not an IEC 61131-3 identifier"), "{e}");
+}

@@ -388,7 +388,8 @@ pub fn rewrite(
             return Ok(Some((v, to)));
         }
     }
-    // A black box: its signature.
+    // A black box: its name becomes a function block type's, so it must be an identifier.
+    super::xml::identifier(ty, "block type", el.node, place)?;
     let declared = t.ctx.functions.get(ty).cloned();
     let conv = conversion(ty);
     let mut sig = Sig {
