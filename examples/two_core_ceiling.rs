@@ -24,7 +24,9 @@ use std::time::{Duration, Instant};
 
 fn main() {
     let mut args = std::env::args().skip(1);
-    let file = args.next().expect("usage: two_core_ceiling FILE [scans] [rounds]");
+    let file = args
+        .next()
+        .expect("usage: two_core_ceiling FILE [scans] [rounds]");
     let scans: u64 = args.next().map_or(1000, |a| a.parse().expect("scan count"));
     let rounds: usize = args.next().map_or(7, |a| a.parse().expect("round count"));
     let text = std::fs::read_to_string(&file).expect("reads the program");
@@ -57,7 +59,10 @@ fn main() {
         t.elapsed()
     };
     println!("{file}: {rungs} rungs, {scans} scans a run, {rounds} rounds");
-    report("interpreter", &ceilings(rounds, &scan_many, scans * rungs as u64));
+    report(
+        "interpreter",
+        &ceilings(rounds, &scan_many, scans * rungs as u64),
+    );
     report("ALU loop (no memory)", &ceilings(rounds, &alu, 200_000_000));
 }
 
@@ -73,7 +78,11 @@ fn ceilings(rounds: usize, work: &(dyn Fn() -> Duration + Sync), units: u64) -> 
             });
             let side = a.max(b);
             let ns = |d: Duration| d.as_nanos() as f64 / units as f64;
-            [ns(alone), ns(side), 2.0 * alone.as_secs_f64() / side.as_secs_f64()]
+            [
+                ns(alone),
+                ns(side),
+                2.0 * alone.as_secs_f64() / side.as_secs_f64(),
+            ]
         })
         .collect()
 }

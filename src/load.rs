@@ -73,8 +73,27 @@ pub fn program_and_fbd_from_value(doc: &serde_json::Value) -> Result<(Program, F
 }
 
 /// Reads and resolves a PLCopen project: the program, its FBD bodies, and the reader's notes
-/// (with one for each FBD body whose executionOrderIds order its blocks otherwise than plc-deps).
+/// (with one for each FBD body whose executionOrderIds order its blocks otherwise than plc-deps,
+/// and one for what `run` could not execute).
 pub fn plcopen(text: &str) -> Result<(Program, Fbd, Vec<Note>), LoadError> {
+    let (p, f, notes, no_run) = plcopen_all(text)?;
+    Ok((p, f, notes.into_iter().chain(no_run).collect()))
+}
+
+/// [`plcopen`] for `run`: an error (located) when the project has something `run` cannot execute
+/// (a string in an LD or FBD body).
+pub fn plcopen_for_run(text: &str) -> Result<(Program, Fbd, Vec<Note>), LoadError> {
+    let (p, f, notes, no_run) = plcopen_all(text)?;
+    match no_run {
+        Some(n) => Err(read::plcopen::run_refusal(n, text)),
+        None => Ok((p, f, notes)),
+    }
+}
+
+/// The program, its FBD bodies, the reader's notes, and the note of what `run` cannot execute.
+type PlcOpenLoaded = (Program, Fbd, Vec<Note>, Option<Note>);
+
+fn plcopen_all(text: &str) -> Result<PlcOpenLoaded, LoadError> {
     let (syntax, mut notes) = read::plcopen::parse(text)?;
     let (p, f) = resolve::resolve(text, &syntax)?;
     for x in &notes.exec_orders {
@@ -82,7 +101,7 @@ pub fn plcopen(text: &str) -> Result<(Program, Fbd, Vec<Note>), LoadError> {
             notes.list.push(n);
         }
     }
-    Ok((p, f, notes.list))
+    Ok((p, f, notes.list, notes.no_run))
 }
 
 /// Compares the order of the file's executionOrderIds with the order plc-deps runs the same

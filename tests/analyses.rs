@@ -132,7 +132,8 @@ fn every_worked_example_matches_its_committed_reports() {
 /// The real PLCopen exports of `analyses/plcopen/*/program.xml` (as editors wrote them; where
 /// each came from is in `tests/plcopen/MANIFEST.md`): the reader's warnings (`notes.txt`: what
 /// it read only through an interface, what it ignored), and the reports and a 100-scan run of
-/// each file that loads, or the error of each file that does not (`error.txt`).
+/// each file that loads, or the error of each file that does not (`error.txt`); for a file that
+/// loads but that `run` refuses (a string in an LD or FBD body), `run-refused.txt` has the reason.
 #[test]
 fn every_plcopen_export_matches_its_committed_outputs() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("analyses/plcopen");
@@ -156,7 +157,13 @@ fn every_plcopen_export_matches_its_committed_outputs() {
             Err(e) => {
                 let shown = format!("error: {}\n", e.locate(&text).in_file("program.xml"));
                 check(&dir.join("error.txt"), &shown, &mut failures);
-                for name in ["notes.txt", "report.txt", "report.json", "run.json"] {
+                for name in [
+                    "notes.txt",
+                    "report.txt",
+                    "report.json",
+                    "run.json",
+                    "run-refused.txt",
+                ] {
                     stale(name);
                 }
             }
@@ -180,6 +187,14 @@ fn every_plcopen_export_matches_its_committed_outputs() {
                     &render_report(&program, &fbd, ReportFormat::Json, View::All),
                     &mut failures,
                 );
+                // A project `run` cannot execute (a string in an LD or FBD body): its reason.
+                if let Err(e) = plc_deps::load::plcopen_for_run(&text) {
+                    stale("run.json");
+                    let shown = format!("error: {}\n", e.in_file("program.xml"));
+                    check(&dir.join("run-refused.txt"), &shown, &mut failures);
+                    continue;
+                }
+                stale("run-refused.txt");
                 let mut c = plc_deps::cmd::run::RunConfig::new(dir.join("program.xml"));
                 c.scans = Some(100);
                 c.cycle_ms = 10;

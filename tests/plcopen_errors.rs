@@ -81,21 +81,6 @@ fn wiring_errors_name_the_local_ids() {
 }
 
 #[test]
-fn a_coil_inside_a_parallel_branch_is_not_series_parallel() {
-    // A → coil X → (joined with B) → coil Y: the OR branch through A holds a coil.
-    let ld = [
-        rail(1),
-        contact(2, "A", &[1], ""),
-        coil(3, "X", &[2], ""),
-        contact(4, "B", &[1], ""),
-        coil(5, "Y", &[3, 4], ""),
-    ]
-    .concat();
-    let e = error_of(&project(&bools(&["A", "B", "X", "Y"]), &ld));
-    assert!(e.ends_with("at pou P, LD, coil localId 5: the wiring into localId 5 from localIds 3, 4 is not series-parallel: the parallel branch through localId 3 holds an output or a block, which a parallel (OR) branch cannot"), "{e}");
-}
-
-#[test]
 fn names_from_the_file_must_be_identifiers() {
     let e = error_of(&project(
         &bools(&["A", "X"]),
@@ -130,13 +115,13 @@ fn an_element_an_ld_body_cannot_hold_is_named() {
             rail(1),
             contact(2, "A", &[1], ""),
             coil(3, "X", &[2], ""),
-            "<inOutVariable localId=\"4\"><expression>A</expression></inOutVariable>".to_owned(),
+            "<step localId=\"4\" name=\"S0\"/>".to_owned(),
         ]
         .concat(),
     );
     let e = error_of(&xml);
     assert!(
-        e.ends_with("at pou P, LD, inOutVariable localId 4: `inOutVariable` is not an element of an LD body that plc-deps reads"),
+        e.ends_with("at pou P, LD, step localId 4: `step` is not an element of an LD body that plc-deps reads"),
         "{e}"
     );
 }

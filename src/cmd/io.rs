@@ -228,6 +228,14 @@ pub fn load_program(path: &Path) -> Result<Program, CliError> {
     load_program_and_fbd(path).map(|(p, _)| p)
 }
 
+/// Reads and checks a program file (`-`: standard input) for `run`, with its FBD bodies: a
+/// PLCopen project with something `run` cannot execute (a string in an LD or FBD body) is an
+/// error.
+pub fn load_program_for_run(path: &Path) -> Result<(Program, Fbd), CliError> {
+    let (file, text) = read_program_text(path)?;
+    load_text_for(file, &text, Purpose::Run)
+}
+
 /// Reads and checks a program file (`-`: standard input), with its FBD bodies as written.
 pub fn load_program_and_fbd(path: &Path) -> Result<(Program, Fbd), CliError> {
     let (file, text) = read_program_text(path)?;
@@ -238,14 +246,29 @@ pub fn load_program_and_fbd(path: &Path) -> Result<(Program, Fbd), CliError> {
 /// block or a declaration section (or the file is named `.stl`/`.awl`), PLCopen TC6 XML when it
 /// starts with `<` (the PLCopen reader's notes go to standard error as warnings W0501), else the JSON format.
 pub fn load_text(file: String, text: &str) -> Result<(Program, Fbd), CliError> {
+    load_text_for(file, text, Purpose::Analyse)
+}
+
+/// What a program is loaded for: `run` refuses what it cannot execute, the analyses do not.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+enum Purpose {
+    Analyse,
+    Run,
+}
+
+fn load_text_for(file: String, text: &str, purpose: Purpose) -> Result<(Program, Fbd), CliError> {
     use crate::read::{plcopen, stl};
     let lower = file.to_ascii_lowercase();
     if stl::looks_like_stl(text) || lower.ends_with(".stl") || lower.ends_with(".awl") {
         return crate::load::stl(text).map_err(|error| CliError::load(file, text, error));
     }
     if plcopen::looks_like_xml(text) {
-        let (p, f, notes) = crate::load::plcopen(text)
-            .map_err(|error| CliError::load(file.clone(), text, error))?;
+        let load = match purpose {
+            Purpose::Analyse => crate::load::plcopen,
+            Purpose::Run => crate::load::plcopen_for_run,
+        };
+        let (p, f, notes) =
+            load(text).map_err(|error| CliError::load(file.clone(), text, error))?;
         warn_notes(PLCOPEN_NOTE, &file, text, &notes);
         return Ok((p, f));
     }

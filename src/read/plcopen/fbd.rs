@@ -21,13 +21,18 @@
 //! Deliberately not here (errors naming the element): negated or edge-qualified pins, several
 //! wires into one FBD pin, ENO wired on, expressions as in/out variables.
 
-use super::interface::literal;
+use super::black_box::{self, BlackBox, Ctx};
+use super::pins::{
+    add_target, block_input, bool_literal, konst, output_negated, pin_modifiers, pin_of, Added,
+};
 use super::wiring::{graph, ElemId, Graph, Source};
-use super::xml::{attr, error, identifier, origin, variable_ref, ExecOrder, Notes, Tc6, R};
+use super::xml::{attr, error, identifier, origin, variable_ref, ExecOrder, Note, Notes, Tc6, R};
+use crate::diag::Origin;
 use crate::syntax::fbd::{Block, Connection, Input, Inputs, Network, OutVar, Outputs, Targets};
-use crate::syntax::FbdBody;
+use crate::syntax::{FbdBody, Scalar};
 use roxmltree::Node;
 use std::borrow::Cow;
+use std::cell::RefCell;
 
 const FBD_TAGS: &[&str] = &[
     "block",
@@ -43,7 +48,7 @@ const FBD_TAGS: &[&str] = &[
 ];
 
 /// Reads FBD body `node` of POU `pou`.
-pub fn body(tc6: Tc6, node: Node, pou: &str, notes: &mut Notes) -> R<FbdBody<'static>> {
+pub fn body(tc6: Tc6, node: Node, pou: &str, ctx: &Ctx, notes: &mut Notes) -> R<FbdBody<'static>> {
     let place = format!("pou {pou}, FBD");
     let g = graph(tc6, node, &place)?;
     g.only(FBD_TAGS, "FBD", &place)?;
@@ -60,7 +65,14 @@ pub fn body(tc6: Tc6, node: Node, pou: &str, notes: &mut Notes) -> R<FbdBody<'st
         }
     }
     ordered.sort_unstable();
-    let f = Fbd { g: &g, place };
+    let f = Fbd {
+        g: &g,
+        place,
+        a: RefCell::new(Added::new(&g)),
+        ctx,
+        boxes: RefCell::new(std::mem::take(&mut notes.black_boxes)),
+        notes: RefCell::new(Vec::new()),
+    };
     let mut networks: Vec<Network<'static>> = Vec::new();
     let mut current: Vec<Block<'static>> = Vec::new();
     let mut label: Option<(String, Node)> = None;
@@ -74,6 +86,7 @@ pub fn body(tc6: Tc6, node: Node, pou: &str, notes: &mut Notes) -> R<FbdBody<'st
                 let l = identifier(attr(el.node, "label", &here)?, "label", el.node, &here)?;
                 if !current.is_empty() || label.is_some() {
                     let k = networks.len();
+                    f.close_loops(&mut current);
                     networks.push(network(
                         pou,
                         k,
@@ -105,14 +118,22 @@ pub fn body(tc6: Tc6, node: Node, pou: &str, notes: &mut Notes) -> R<FbdBody<'st
             }
             _ => {}
         }
+        current.append(&mut f.a.borrow_mut().blocks);
     }
     let k = networks.len();
+    f.close_loops(&mut current);
     networks.push(network(pou, k, label, current, comments));
     if labels == 0 {
         if let Some(n) = networks.first_mut() {
             n.id = Ok(Cow::Owned(pou.to_owned()));
         }
     }
+    notes.black_boxes = f.boxes.take();
+    notes.list.extend(f.notes.take());
+    let vars = std::mem::take(&mut f.a.borrow_mut().vars);
+    notes
+        .ld_vars
+        .extend(vars.into_iter().map(|v| (pou.to_owned(), v)));
     if !ordered.is_empty() {
         notes.exec_orders.push(ExecOrder {
             networks: networks
@@ -154,6 +175,13 @@ fn network(
 struct Fbd<'g, 'a, 'i> {
     g: &'g Graph<'a, 'i>,
     place: String,
+    /// Blocks the reader adds (NOT of a negated pin, edge detectors), for the current network.
+    a: RefCell<Added>,
+    /// What blocks may call, and the types of the names the body sees.
+    ctx: &'g Ctx,
+    /// The project's black boxes so far ([`black_box`]).
+    boxes: RefCell<Vec<BlackBox>>,
+    notes: RefCell<Vec<Note>>,
 }
 
 impl Fbd<'_, '_, '_> {
@@ -181,26 +209,36 @@ impl Fbd<'_, '_, '_> {
     fn block(&self, e: ElemId) -> R<Block<'static>> {
         let el = self.g.get(e);
         let here = self.at(e);
-        let ty = attr(el.node, "typeName", &here)?;
+        let mut ty = attr(el.node, "typeName", &here)?;
+        let declared_type;
         let mut b = self.new_block(e, ty);
         if let Some(inst) = el.node.attribute("instanceName") {
             b.instance = Some(Ok(Cow::Owned(identifier(
                 inst, "instance", el.node, &here,
             )?)));
+            // Beremiz calls the instance by name, so the instance's type decides what runs.
+            if let Some(declared) = self.ctx.fb_type_of(inst).filter(|d| d != ty) {
+                self.notes.borrow_mut().push(Note {
+                    origin: origin(el.node),
+                    message: format!("{here}: the block is a {ty} but its instance `{inst}` is declared {declared}; it is read as a call of {declared} (Beremiz calls the instance by name)"),
+                });
+                declared_type = declared;
+                ty = &declared_type;
+                b.op = Ok(Cow::Owned(ty.to_owned()));
+            }
         }
         let mut inputs = Vec::new();
         for pin in &el.inputs {
             let name = pin.name.unwrap_or("");
-            for a in ["negated", "edge", "storage"] {
-                if matches!(pin.node.attribute(a), Some(v) if v != "false" && v != "none") {
-                    return Err(error(
-                        origin(pin.node),
-                        &here,
-                        format!("input {name} of {ty} (localId {}) is {a}: qualified pins are not supported yet", el.local_id),
-                    ));
+            let (negated, edge) = pin_modifiers(pin.node, ty, name, el.local_id, &here)?;
+            let mut input = match pin.sources.as_slice() {
+                // An unconnected BOOL input of a standard function block keeps its initial
+                // value FALSE (nothing in the body sets it, IEC 61131-3 2.5.2.1).
+                [] if black_box::is_standard_fb(ty)
+                    && self.ctx.input_type(ty, name).as_deref() == Some("BOOL") =>
+                {
+                    konst(false, origin(pin.node))
                 }
-            }
-            let input = match pin.sources.as_slice() {
                 [] => continue,
                 [s] => self.input(e, s)?,
                 _ => {
@@ -211,6 +249,25 @@ impl Fbd<'_, '_, '_> {
                     ))
                 }
             };
+            let at = origin(pin.node);
+            let counter_edge = matches!(ty, "CTU" | "CTD" | "CTUD") && matches!(name, "CU" | "CD");
+            let mut a = self.a.borrow_mut();
+            match edge {
+                Some(edge) if !(counter_edge && edge == "rising") => {
+                    input = a.trigger(edge, input, el.local_id, at)
+                }
+                _ => {}
+            }
+            if negated {
+                input = a.not(input, at);
+            }
+            drop(a);
+            if let Connection::Variable(v) = &input.from {
+                if let Some(k) = super::library::library_constant(ty, name, v) {
+                    input.from = Connection::Constant(Scalar::Number(k.into()));
+                }
+            }
+            input = bool_literal(self.ctx, ty, name, input);
             if name == "EN" {
                 b.cond = Some(input);
             } else {
@@ -218,35 +275,59 @@ impl Fbd<'_, '_, '_> {
             }
         }
         b.inputs = Some(Ok(Inputs::Named(inputs)));
-        let mut outputs = Vec::new();
-        for (pin, pnode) in &el.outputs {
-            if matches!(pnode.attribute("negated"), Some("true" | "1")) {
-                return Err(error(
-                    origin(*pnode),
-                    &here,
-                    format!("output {pin} of {ty} (localId {}) is negated: qualified pins are not supported yet", el.local_id),
-                ));
-            }
-            let targets = self.targets(e, pin, el.outputs.first().map(|o| o.0) == Some(*pin))?;
-            if *pin == "ENO" && !targets.is_empty() {
-                return Err(error(
-                    origin(*pnode),
-                    &here,
-                    format!(
-                        "ENO of {ty} (localId {}) is wired: ENO is not supported in FBD yet",
-                        el.local_id
-                    ),
-                ));
-            }
-            if !targets.is_empty() {
-                outputs.push((
-                    Cow::Owned(pin.to_string()),
-                    Ok(Targets::Many(targets.into_iter().map(Ok).collect())),
-                ));
+        let t = black_box::Typer {
+            ctx: self.ctx,
+            g: self.g,
+        };
+        self.a
+            .borrow_mut()
+            .compare(&mut b, &|i: &Input| t.input(i, 0));
+        if !black_box::is_known(self.ctx, ty) || black_box::mixed_arithmetic(&t, ty, &b) {
+            let mut boxes = self.boxes.borrow_mut();
+            if let Some((inst, bt)) = black_box::rewrite(&t, e, &mut b, &mut boxes, &here)? {
+                self.a.borrow_mut().declare(&inst, &bt, b.origin);
             }
         }
-        if !outputs.is_empty() {
-            b.outputs = Some(Ok(Outputs::Named(outputs)));
+        for (pin, pnode) in &el.outputs {
+            let targets = self.targets(e, pin, el.outputs.first().map(|o| o.0) == Some(*pin))?;
+            let negated = matches!(pnode.attribute("negated"), Some("true" | "1"));
+            let targets = if negated && !targets.is_empty() {
+                // The variables a negated output writes get NOT of it.
+                let at = origin(*pnode);
+                let arc = Input {
+                    origin: at,
+                    from: Connection::Arc {
+                        block: el.local_id,
+                        pin: Some(Ok(Cow::Owned(pin_of(pin).to_owned()))),
+                    },
+                };
+                let mut a = self.a.borrow_mut();
+                a.not(arc, at);
+                if let Some(n) = a.blocks.last_mut() {
+                    n.outputs = Some(Ok(Outputs::Named(vec![(
+                        Cow::Borrowed("OUT"),
+                        Ok(Targets::Many(targets.into_iter().map(Ok).collect())),
+                    )])));
+                }
+                Vec::new()
+            } else {
+                targets
+            };
+            if *pin == "ENO" && !targets.is_empty() {
+                // ENO is EN (IEC 61131-3 2.5.1.2: TRUE when the block ran without error).
+                let en = self.eno(e, origin(*pnode))?;
+                let mut a = self.a.borrow_mut();
+                a.add_on("MOVE", None, Inputs::List(vec![en]), origin(*pnode));
+                if let Some(m) = a.blocks.last_mut() {
+                    for t in targets {
+                        add_target(m, "OUT".to_owned(), t);
+                    }
+                }
+                continue;
+            }
+            for t in targets {
+                add_target(&mut b, pin_of(pin).to_owned(), t);
+            }
         }
         Ok(b)
     }
@@ -288,45 +369,62 @@ impl Fbd<'_, '_, '_> {
         variable_ref(text, el.node, &self.at(e))
     }
 
+    /// Cuts the loops of arcs among `blocks` as Beremiz closes them ([`super::fbd_loops`]).
+    fn close_loops(&self, blocks: &mut [Block<'static>]) {
+        let t = black_box::Typer {
+            ctx: self.ctx,
+            g: self.g,
+        };
+        let ty = |id: u32, pin: Option<&str>| {
+            let e = self.g.elems.iter().position(|el| el.local_id == id)?;
+            t.output(ElemId(e as u32), pin, 0)
+        };
+        let notes = super::fbd_loops::cut(blocks, &mut self.a.borrow_mut(), &ty, &self.place);
+        self.notes.borrow_mut().extend(notes);
+    }
+
+    /// The ENO of block `e`: what feeds its EN, TRUE without one.
+    fn eno(&self, e: ElemId, at: Origin) -> R<Input<'static>> {
+        let el = self.g.get(e);
+        match el
+            .inputs
+            .iter()
+            .find(|p| p.name == Some("EN"))
+            .map(|p| p.sources.as_slice())
+        {
+            Some([s]) => self.input(e, s),
+            _ => Ok(konst(true, at)),
+        }
+    }
+
     /// What source `s` gives to an input of block `consumer`.
     fn input(&self, consumer: ElemId, s: &Source) -> R<Input<'static>> {
         let src = self.g.get(s.elem);
-        let from = match src.tag {
-            "block" => Connection::Arc {
-                block: src.local_id,
-                pin: s.pin.map(|p| Ok(Cow::Owned(p.to_owned()))),
-            },
-            "inVariable" | "inOutVariable" => {
-                let text = src
-                    .node
-                    .children()
-                    .find(|c| c.is_element() && c.tag_name().name() == "expression")
-                    .and_then(|c| c.text())
-                    .unwrap_or("");
-                match literal(text) {
-                    Some(v) => Connection::Constant(v),
-                    None => Connection::Variable(Cow::Owned(variable_ref(
-                        text,
-                        src.node,
-                        &self.at(s.elem),
-                    )?)),
+        match src.tag {
+            "block" if s.pin == Some("ENO") => self.eno(s.elem, s.origin),
+            "block" => {
+                let arc = Input {
+                    origin: s.origin,
+                    from: Connection::Arc {
+                        block: src.local_id,
+                        pin: s.pin.map(|p| Ok(Cow::Owned(pin_of(p).to_owned()))),
+                    },
+                };
+                if output_negated(&src.outputs, s.pin) {
+                    return Ok(self.a.borrow_mut().not(arc, s.origin));
                 }
+                Ok(arc)
             }
-            other => {
-                return Err(error(
-                    s.origin,
-                    &self.at(consumer),
-                    format!(
-                        "a {other} (localId {}) cannot feed an input in FBD",
-                        src.local_id
-                    ),
-                ))
-            }
-        };
-        Ok(Input {
-            origin: s.origin,
-            from,
-        })
+            "inVariable" | "inOutVariable" => block_input(src.node, &self.at(s.elem), s.origin),
+            other => Err(error(
+                s.origin,
+                &self.at(consumer),
+                format!(
+                    "a {other} (localId {}) cannot feed an input in FBD",
+                    src.local_id
+                ),
+            )),
+        }
     }
 
     /// JMP and RET blocks.

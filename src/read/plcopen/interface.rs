@@ -42,6 +42,11 @@ pub struct Interface {
     pub mapped: Vec<Mapped>,
     /// Where the `returnType` of a function is.
     pub returns: Option<crate::diag::Origin>,
+    /// The model type of a function's result, when it has one the model can read.
+    pub return_ty: Option<String>,
+    /// The declarations of the `externalVars`, and those of them whose type was mapped.
+    pub external_decls: Vec<Var<'static>>,
+    pub external_mapped: Vec<Mapped>,
 }
 
 /// A variable whose IEC 61131-3 elementary type the model lacks, read as one it has.
@@ -113,6 +118,15 @@ pub fn is_elementary(ty: &str) -> bool {
     MODEL_ELEMENTARY.contains(&ty)
 }
 
+/// The model type IEC elementary type `t` is read as (`None`: not an elementary type); a
+/// string as its stand-in DINT.
+pub fn model_type_of(t: &str) -> Option<&'static str> {
+    if let Some(m) = MODEL_ELEMENTARY.iter().find(|m| **m == t) {
+        return Some(m);
+    }
+    MAPPED.iter().find(|(f, _)| *f == t).map(|(_, m)| *m)
+}
+
 /// Reads the interface of POU `pou` (its `interface` element; none is an empty interface).
 pub fn interface(tc6: Tc6, node: Option<Node>, pou: &str, known: &Known) -> R<Interface> {
     let mut out = Interface::default();
@@ -122,7 +136,14 @@ pub fn interface(tc6: Tc6, node: Option<Node>, pou: &str, known: &Known) -> R<In
         let place = format!("pou {pou}, {kind}");
         match kind {
             // A function's result type (whether the POU may have one is the project's check).
-            "returnType" => out.returns = Some(origin(list)),
+            "returnType" => {
+                out.returns = Some(origin(list));
+                out.return_ty = match type_name(tc6, list, "result", &place, known)? {
+                    Ty::Elementary(t) => model_type_of(&t).map(str::to_owned),
+                    Ty::Data(d) => model_type_of(&data_base(&d)).map(str::to_owned),
+                    Ty::Fb(_) => None,
+                };
+            }
             "inputVars" | "outputVars" | "localVars" | "tempVars" | "globalVars" => {
                 let class = match kind {
                     "inputVars" => VarClass::Input,
@@ -141,6 +162,14 @@ pub fn interface(tc6: Tc6, node: Option<Node>, pou: &str, known: &Known) -> R<In
                 for v in tc6.children(list, "variable") {
                     let name = super::xml::attr(v, "name", &place)?;
                     out.externals.push(identifier(name, "variable", v, &place)?);
+                }
+                // Their declarations, for a global the file does not declare (an editor
+                // extension's); one that cannot be read is left to the global's.
+                let mut mapped = Vec::new();
+                if let Ok(vars) = var_list(tc6, list, VarClass::Default, &place, known, &mut mapped)
+                {
+                    out.external_decls.extend(vars);
+                    out.external_mapped.extend(mapped);
                 }
             }
             "inOutVars" | "accessVars" => {
@@ -248,6 +277,19 @@ fn variable(
         (None, Some(d)) if !text => type_initial(d, &name, &place)?.map(Box::new),
         (None, _) => None,
     };
+    // `0` / `1` for a BOOL are FALSE / TRUE (IEC 61131-3 6.3.2: the BOOL literals 0 and 1).
+    let init = init.map(|mut i| {
+        if ty == "BOOL" {
+            if let Scalar::Number(n) = &i.value {
+                match n.as_u64() {
+                    Some(0) => i.value = Scalar::Bool(false),
+                    Some(1) => i.value = Scalar::Bool(true),
+                    _ => {}
+                }
+            }
+        }
+        i
+    });
     let at = origin(v);
     Ok(Var {
         origin: at,

@@ -358,7 +358,7 @@ fn merge(paths: &[&[Item]]) -> Series<'static> {
 }
 
 /// The connected component of every element (rails excluded: they join nothing).
-fn components(g: &Graph) -> Vec<usize> {
+pub fn components(g: &Graph) -> Vec<usize> {
     let mut parent: Vec<usize> = (0..g.elems.len()).collect();
     fn find(parent: &mut [usize], mut x: usize) -> usize {
         while parent[x] != x {

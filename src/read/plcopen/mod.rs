@@ -7,7 +7,8 @@
 //! the namespaces tc6_0201, tc6_0200 or the pre-2.0 tc6.xsd ([`xml::NAMESPACES`]), elements
 //! are matched by local name. [`project`] reads the POUs and configurations, [`interface`] the
 //! variable lists, [`ld`] (with [`ld_power`], [`ld_block`], [`ld_logic`] and the shared [`wiring`] graph) the
-//! LD bodies, [`fbd`] the FBD bodies, [`st_body`] the ST bodies (a stand-in rung per statement,
+//! LD bodies ([`ld_flow`]: those that are not series-parallel rungs, as Beremiz's data-flow
+//! network), [`fbd`] the FBD bodies ([`black_box`]: conversions and blocks the model lacks), [`st_body`] the ST bodies (a stand-in rung per statement,
 //! from the ST parser), [`textual`] stands IL and SFC bodies in by their interface. What the reader did that changes meaning or skips vendor data is a [`Note`]
 //! (a warning with its place). The mapping, the order rules and their sources:
 //! docs/plcopen.md; the research behind them: docs/design/plcopen-semantics.md.
@@ -16,14 +17,18 @@
 //! column computed from its byte offset); a construct the reader does not handle is an error,
 //! never dropped; a program loads whole or not at all.
 
+mod black_box;
 mod data_types;
 mod fbd;
+mod fbd_loops;
 mod interface;
 mod ld;
 mod ld_block;
+mod ld_flow;
 mod ld_logic;
 mod ld_power;
 mod library;
+mod pins;
 mod project;
 mod st_body;
 mod textual;
@@ -51,6 +56,12 @@ pub fn parse(text: &str) -> Result<(syntax::Program<'static>, Notes), LoadError>
     let program =
         project::program(xml::Tc6 { ns }, &doc, &mut notes).map_err(|e| e.locate(text))?;
     Ok((program, notes))
+}
+
+/// The error `run` gives for what the reader noted it cannot execute (a string in an LD or FBD
+/// body), located at that place.
+pub fn run_refusal(note: Note, text: &str) -> LoadError {
+    xml::error(note.origin, "run", note.message).locate(text)
 }
 
 /// A note as the command line prints it after `warning: ` (`FILE:LINE:COLUMN: message`).

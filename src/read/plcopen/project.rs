@@ -17,10 +17,12 @@
 //! Deliberately not here (errors naming the POU): a program instantiated twice,
 //! several configurations or resources, POUs with actions or transitions outside SFC.
 
+use super::black_box::{Ctx, Sig};
 use super::data_types::DataTypes;
 use super::interface::{self, name, Interface, Known};
 use super::xml::{add_data_note, attr, error, identifier, origin, Note, Notes, Tc6, R};
-use super::{fbd, ld, library, st_body, textual};
+use super::{fbd, ld, ld_flow, library, st_body, textual};
+use crate::diag::LoadError;
 use crate::syntax::{
     Body, Element, ElementKind, FunctionBlock, Program, RoutineKind, Rung, Subroutine, Var,
 };
@@ -67,7 +69,8 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
     }
     let mut later = Notes::default();
     let mut mapped_globals = Vec::new();
-    let (globals, order) = instances(tc6, root, &known, &mut later, &mut mapped_globals)?;
+    let (mut globals, order) = instances(tc6, root, &known, &mut later, &mut mapped_globals)?;
+    undeclared_globals(&read, &mut globals, &mut mapped_globals, notes);
     let mapped: Vec<(Option<String>, interface::Mapped)> = read
         .iter()
         .flat_map(|(_, p, _, i)| i.mapped.iter().map(|m| (Some(p.clone()), m.clone())))
@@ -79,6 +82,7 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
         .chain(read.iter().flat_map(|r| &r.3.globals))
         .map(|v| (v.name.as_str(), v.ty.as_str()))
         .collect();
+    let base = base_ctx(&read);
     let mut bodies = Vec::new();
     for (pou, pname, kind, iface) in &read {
         add_data_note(tc6, *pou, notes);
@@ -89,7 +93,8 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
             continue;
         }
         let scope = scope(iface, &global_types, &known);
-        bodies.push(Some(body(tc6, *pou, pname, iface, &scope, notes)?));
+        let ctx = pou_ctx(&base, iface, &global_types);
+        bodies.push(Some(body(tc6, *pou, pname, iface, &scope, &ctx, notes)?));
     }
     notes.list.extend(later.list);
     let (mut programs, mut fbs) = (Vec::new(), Vec::new());
@@ -135,6 +140,11 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
             // A function (its body is `None`, skipped above).
             _ => {}
         }
+    }
+    for b in std::mem::take(&mut notes.black_boxes) {
+        let (fb, note) = library::black_box_type(&b);
+        fbs.push(fb);
+        notes.push(note);
     }
     library_fbs(&mut fbs, &programs, &globals, notes);
     assemble(root, programs, fbs, globals, order)
@@ -330,6 +340,7 @@ fn body(
     name: &str,
     iface: &Interface,
     scope: &st_body::Scope,
+    ctx: &Ctx,
     notes: &mut Notes,
 ) -> R<Body<'static>> {
     let place = format!("pou {name}");
@@ -370,15 +381,20 @@ fn body(
         }
     }
     if let (Some(m), "LD" | "FBD") = (iface.mapped.iter().find(|m| m.text), tag) {
-        return Err(error(
-            m.origin,
-            &place,
-            format!("variable `{}` is a {}, for which plc-deps has no values: strings, arrays and structures are read only in POUs whose body `run` does not execute (ST, IL, SFC), and `{name}` has an {tag} body", m.var, m.from),
-        ));
+        notes.no_run.get_or_insert(Note {
+            origin: m.origin,
+            message: format!("{place}: variable `{}` is a {}, for which plc-deps has no values: the analysis reads it as a whole variable, but `run` cannot execute the {tag} body of `{name}`", m.var, m.from),
+        });
+    }
+    if let (Some(n), "LD" | "FBD") = (string_literal(lang), tag) {
+        notes.no_run.get_or_insert(Note {
+            origin: origin(n),
+            message: format!("{place}: the {} localId {} is a string literal, for which plc-deps has no values: the analysis reads it as a constant, but `run` cannot execute the {tag} body of `{name}`", n.tag_name().name(), n.attribute("localId").unwrap_or("?")),
+        });
     }
     Ok(match tag {
-        "LD" => Body::Rungs(ld::rungs(tc6, lang, name, notes)?),
-        "FBD" => Body::Fbd(fbd::body(tc6, lang, name, notes)?),
+        "LD" => ld_body(tc6, lang, name, ctx, notes)?,
+        "FBD" => Body::Fbd(fbd::body(tc6, lang, name, ctx, notes)?),
         "ST" => Body::Rungs(st_body::rungs(lang, name, scope, notes)?),
         "IL" | "SFC" => {
             let reads: Vec<&Var> = iface.inputs.iter().collect();
@@ -505,4 +521,138 @@ fn instance_type(pi: Node, place: &str) -> R<String> {
         .or(pi.attribute("type"))
         .ok_or_else(|| error(origin(pi), place, "pouInstance has no typeName"))?;
     identifier(ty, "program", pi, place)
+}
+
+/// An LD body: its rungs, or, where the rung reader cannot express its wiring as series-parallel
+/// rungs, the data-flow network Beremiz makes of it ([`ld_flow`]), with a note saying why. When
+/// both fail, the rung reader's error.
+fn ld_body(tc6: Tc6, lang: Node, name: &str, ctx: &Ctx, notes: &mut Notes) -> R<Body<'static>> {
+    let (list, vars) = (notes.list.len(), notes.ld_vars.len());
+    let why = match ld::rungs(tc6, lang, name, notes) {
+        Ok(r) => return Ok(Body::Rungs(r)),
+        Err(e) => e,
+    };
+    notes.list.truncate(list);
+    notes.ld_vars.truncate(vars);
+    match ld_flow::body(tc6, lang, name, ctx, notes) {
+        Ok(b) => {
+            let (at, what) = match &why {
+                LoadError::Invalid(d) => (d.location.origin, d.to_string()),
+                other => (origin(lang), other.to_string()),
+            };
+            notes.push(Note {
+                origin: at,
+                message: format!(
+                    "pou {name}: its LD body is read as a data-flow network (FBD networks {name}.N1 …, each rung's power flow as boolean blocks, as Beremiz generates LD) because it is not series-parallel rungs of contacts, coils and boxes: {what}"
+                ),
+            });
+            Ok(Body::Fbd(b))
+        }
+        Err(_) => Err(why),
+    }
+}
+
+/// What any body of the project may call: its user functions (with their pins' types) and the
+/// function block types of the project and of the library (with their outputs' types).
+fn base_ctx(read: &[(Node, String, &str, Interface)]) -> Ctx {
+    let pins = |v: &[Var]| -> Vec<(String, String)> {
+        v.iter()
+            .map(|v| (v.name.as_str().to_owned(), v.ty.as_str().to_owned()))
+            .collect()
+    };
+    let mut ctx = Ctx::default();
+    for (_, name, kind, iface) in read {
+        match *kind {
+            "function" => {
+                let mut outputs = Vec::new();
+                if let Some(t) = &iface.return_ty {
+                    outputs.push(("OUT".to_owned(), t.clone()));
+                }
+                outputs.extend(pins(&iface.outputs));
+                let sig = Sig {
+                    inputs: pins(&iface.inputs),
+                    outputs,
+                };
+                ctx.functions.insert(name.clone(), sig);
+            }
+            "functionBlock" => {
+                ctx.fbs.insert(name.clone(), pins(&iface.outputs));
+                ctx.fb_inputs.insert(name.clone(), pins(&iface.inputs));
+            }
+            _ => {}
+        }
+    }
+    for (name, inputs, outputs) in library::pins() {
+        if !ctx.fbs.contains_key(name) {
+            ctx.fbs.insert(name.to_owned(), outputs);
+            ctx.fb_inputs.insert(name.to_owned(), inputs);
+        }
+    }
+    ctx
+}
+
+/// [`base_ctx`] with the variables a POU sees (its own and the globals it names external).
+fn pou_ctx(base: &Ctx, iface: &Interface, globals: &[(&str, &str)]) -> Ctx {
+    let mut vars = std::collections::HashMap::new();
+    for v in iface
+        .inputs
+        .iter()
+        .chain(&iface.outputs)
+        .chain(&iface.locals)
+        .chain(&iface.globals)
+    {
+        vars.insert(
+            v.name.as_str().to_ascii_lowercase(),
+            v.ty.as_str().to_owned(),
+        );
+    }
+    for (n, t) in globals {
+        if iface.externals.iter().any(|e| e.eq_ignore_ascii_case(n)) {
+            vars.insert(n.to_ascii_lowercase(), t.to_string());
+        }
+    }
+    Ctx {
+        functions: base.functions.clone(),
+        fbs: base.fbs.clone(),
+        fb_inputs: base.fb_inputs.clone(),
+        vars,
+    }
+}
+
+/// The first `inVariable` of a graphical body whose expression is a string literal (`'…'`).
+fn string_literal<'a, 'i>(lang: Node<'a, 'i>) -> Option<Node<'a, 'i>> {
+    lang.children()
+        .filter(|n| n.tag_name().name() == "inVariable")
+        .find(|n| {
+            n.children()
+                .find(|c| c.tag_name().name() == "expression")
+                .and_then(|c| c.text())
+                .is_some_and(super::pins::is_string_literal)
+        })
+}
+
+/// Adds, as a global, each external variable whose global the file does not declare: Beremiz's
+/// extensions declare some in code they generate (SVGHMI's `CURRENT_PAGE_0`), so a POU
+/// names them external with their type. A note names them.
+fn undeclared_globals(
+    read: &[(Node, String, &str, Interface)],
+    globals: &mut Vec<Var<'static>>,
+    mapped: &mut Vec<interface::Mapped>,
+    notes: &mut Notes,
+) {
+    for (_, pou, _, iface) in read {
+        for v in &iface.external_decls {
+            let n = v.name.as_str();
+            let known = |g: &Var| g.name.as_str().eq_ignore_ascii_case(n);
+            if globals.iter().any(known) || read.iter().any(|r| r.3.globals.iter().any(known)) {
+                continue;
+            }
+            notes.push(Note {
+                origin: v.origin,
+                message: format!("pou {pou}: external variable `{n}` has no global declaration in the file (an editor extension declares it in code it generates, as Beremiz's SVGHMI does for CURRENT_PAGE_0): read as a global of its declared type {}", v.ty.as_str()),
+            });
+            globals.push(v.clone());
+            mapped.extend(iface.external_mapped.iter().filter(|m| m.var == n).cloned());
+        }
+    }
 }

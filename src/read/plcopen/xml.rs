@@ -71,6 +71,11 @@ pub struct Notes {
     /// that holds a contact network feeding a block's data pin (`SR0__R`, a name no file can
     /// declare: IEC 61131-3 identifiers have no double `_`).
     pub ld_vars: Vec<(String, crate::syntax::Var<'static>)>,
+    /// The stand-in function block types of the blocks the model lacks
+    /// ([`super::black_box`]).
+    pub black_boxes: Vec<super::black_box::BlackBox>,
+    /// Why `run` cannot execute the project (a string in a body it would execute), if so.
+    pub no_run: Option<Note>,
 }
 
 impl Notes {
