@@ -244,7 +244,7 @@ const IDLE: &str = r#"{"program": "p",
  "subroutines": {"S": {"rungs": [{"id": "S1", "ld": [{"contact": "a"}, {"coil": "y"}]}]}}}"#;
 
 #[test]
-fn the_analysis_warnings_are_coded_diagnostics_naming_the_file() {
+fn the_analysis_warnings_are_coded_diagnostics_at_their_rungs() {
     let out = run_stdin(&["report", "-", "--format", "json"], IDLE.as_bytes());
     assert_eq!(out.status.code(), Some(0));
     let shown: Vec<Value> = String::from_utf8(out.stderr)
@@ -256,10 +256,6 @@ fn the_analysis_warnings_are_coded_diagnostics_naming_the_file() {
         .iter()
         .map(|d| {
             assert_eq!(d["severity"], "warning");
-            assert_eq!(
-                (d["line"].clone(), d["span"].clone()),
-                (Value::Null, Value::Null)
-            );
             (
                 d["code"].as_str().unwrap(),
                 d["file"].as_str().unwrap(),
@@ -284,6 +280,12 @@ fn the_analysis_warnings_are_coded_diagnostics_naming_the_file() {
             ),
         ]
     );
+    // Each is placed at its first rung (the subroutine at its first rung S1).
+    let places: Vec<(u64, u64)> = shown
+        .iter()
+        .map(|d| (d["line"].as_u64().unwrap(), d["column"].as_u64().unwrap()))
+        .collect();
+    assert_eq!(places, [(5, 4), (10, 34), (7, 4), (8, 4)]);
     // The report has the same warnings with their codes.
     let report: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(
@@ -291,11 +293,11 @@ fn the_analysis_warnings_are_coded_diagnostics_naming_the_file() {
         serde_json::json!(["W0201", "W0203", "W0205", "W0206"])
     );
     assert_eq!(report["warnings"][3], brief[3].2);
-    // As text, in the rustc style, the file on a note line.
+    // As text, in the rustc style, with the rung's line under a caret.
     let out = run_stdin(&["report", "-"], IDLE.as_bytes());
     let stderr = String::from_utf8(out.stderr).unwrap();
     assert!(
-        stderr.starts_with("warning[W0201]: rung R2 can never run (no path from the start of the scan reaches it)\n = in <stdin>\n\nwarning[W0203]: "),
+        stderr.starts_with("warning[W0201]: rung R2 can never run (no path from the start of the scan reaches it)\n  --> <stdin>:5:4\n  |\n5 |    {\"id\": \"R2\", "),
         "{stderr}"
     );
     let text = String::from_utf8(out.stdout).unwrap();

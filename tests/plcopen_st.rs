@@ -83,7 +83,7 @@ fn each_statement_is_a_rung_with_exactly_its_reads_and_writes() {
     assert_eq!(
         err.lines().collect::<Vec<_>>(),
         [format!("warning: <stdin>:{body}: pou P: its ST body is analysed per statement (5 top-level statements, rungs P.st1 …, each reading and writing whole variables) and not executed by `run`; the function block instances it calls are not seen as written: T1"),
-        "warning: <stdin>: rung P.st3 has no effect: nothing is written and control is not transferred".to_owned()]
+        "warning: <stdin>:17:1: rung P.st3 has no effect: nothing is written and control is not transferred".to_owned()]
     );
 }
 

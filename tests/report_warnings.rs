@@ -138,9 +138,19 @@ fn warnings_go_to_stderr_and_the_endless_loop_warning_agrees_with_run() {
         .output()
         .unwrap();
     let stderr = String::from_utf8(out.stderr).unwrap();
+    // Placed at the first rung of the loop, with its line under a caret.
     assert_eq!(
         stderr,
-        format!("warning[W0202]: {message}\n = in {}\n\n", file.display())
+        format!(
+            "warning[W0202]: {message}\n  --> {}:5:15\n  |\n5 |               {}\n  |               {}\n\n",
+            file.display(),
+            r#"{"id": "R2", "label": "L2", "ld": [{"coil": "y"}]},"#,
+            "^".repeat(50)
+        )
+    );
+    assert_eq!(
+        (d["line"].as_u64(), d["column"].as_u64()),
+        (Some(5), Some(15))
     );
     let run = std::process::Command::new(bin)
         .args([

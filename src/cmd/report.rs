@@ -3,17 +3,17 @@
 //! standard error, as diagnostics in the command's format, as well as into the report. Long
 //! phases show progress on a terminal.
 
-use super::io::{check_output_path, load_program_and_fbd, write_output_with, FileRole};
+use super::io::{check_output_path, load_text, read_program_text, write_output_with, FileRole};
 use super::progress::Progress;
 use super::CliError;
 use crate::analysis::{analyse, analyse_with, Analysis, AnalysisConfig, DependenceListing, Listed};
-use crate::diag::{Severity, Shown};
+use crate::diag::{Origin, Severity, Shown};
 use crate::fbd::Fbd;
 use crate::model::Program;
 use crate::report::{
     document_with, fbd_parts, render_dot, render_html, render_json, render_text, select_rungs,
-    warning_code, warning_text, FbdParts, HtmlInput, Rows, Selection, TextOptions, View,
-    DIRECT_PAIRS_ONLY, DOT_MAX_RUNGS,
+    warning_code, warning_origin, warning_text, FbdParts, HtmlInput, Rows, Selection, TextOptions,
+    View, DIRECT_PAIRS_ONLY, DOT_MAX_RUNGS,
 };
 use std::collections::HashSet;
 use std::path::PathBuf;
@@ -123,9 +123,10 @@ pub fn report(c: &ReportConfig) -> Result<(), CliError> {
         check_output_path(out, FileRole::Output)?;
     }
     let progress = Progress::stderr();
+    let (file, source) = read_program_text(&c.input)?;
     let (p, fbd) = {
         let _phase = progress.phase("reading the program");
-        load_program_and_fbd(&c.input)?
+        load_text(file.clone(), &source)?
     };
     let parts = fbd_parts(&p, &fbd);
     let drawn = dot_selection(c, &p)?;
@@ -133,22 +134,29 @@ pub fn report(c: &ReportConfig) -> Result<(), CliError> {
         let _phase = progress.phase("analysing");
         analyse_with(&p, &c.analysis)
     };
-    let file = super::io::display_name(&c.input);
-    let warn = |code: &'static str, message: String| {
-        let mut shown = Shown::unplaced(Severity::Warning, code, message);
-        shown.file = file.clone();
+    let warn = |code: &'static str, message: String, origin: Origin| {
+        let shown = if origin.is_none() {
+            let mut shown = Shown::unplaced(Severity::Warning, code, message);
+            shown.file = file.clone();
+            shown
+        } else {
+            Shown::warning(code, message, &file, &source, origin)
+        };
         super::errors::warn(&shown);
     };
     for w in &a.warnings {
-        warn(warning_code(w), warning_text(&p, w));
+        warn(warning_code(w), warning_text(&p, w), warning_origin(&p, w));
     }
     if a.listed == Listed::Direct && c.analysis.dependences != DependenceListing::Direct {
         warn(DIRECT_PAIRS_ONLY, format!(
             "{} data dependence pairs are more than --max-pairs allows; listing the {} direct ones (they imply the rest; --dependences all lists every pair)",
             crate::report::text::thousands(a.counts.total() as usize),
             crate::report::text::thousands(a.data.len())
-        ));
+        ), Origin::NONE);
     }
+    // The text placed the warnings; the report does not need it (a big program's text is a
+    // quarter of the memory the report takes).
+    drop(source);
     let text = TextOptions {
         view: c.view,
         rows: c.rows,

@@ -101,6 +101,8 @@ pub struct Network {
     pub comment: Option<String>,
     /// JSON path of the network.
     pub path: String,
+    /// Where the network starts in the program's text.
+    pub origin: crate::diag::Origin,
     /// Sorted by [`Block::id`].
     pub blocks: Vec<Block>,
 }
@@ -135,6 +137,8 @@ pub struct Block {
     pub op: Op,
     /// JSON path of the block.
     pub path: String,
+    /// Where the block starts in the program's text.
+    pub origin: crate::diag::Origin,
     /// One entry per input pin of the op.
     pub inputs: Vec<InputPin>,
     /// One entry per output pin.

@@ -93,6 +93,7 @@ mod tests {
                 id,
                 op: Op::Move,
                 path: String::new(),
+                origin: crate::diag::Origin::NONE,
                 inputs: edges
                     .iter()
                     .filter(|e| e.1 == id)
@@ -119,6 +120,7 @@ mod tests {
             label: None,
             comment: None,
             path: String::new(),
+            origin: crate::diag::Origin::NONE,
             blocks,
         }
     }

@@ -20,6 +20,7 @@
 mod types;
 pub use types::*;
 
+use crate::diag::Origin;
 use std::ops::Range;
 
 macro_rules! index_type {
@@ -114,6 +115,10 @@ pub struct Rung {
     /// from. Ladder rungs have none (and pay one pointer for it): the resolver renders their
     /// path (`rungs[3]`) from where they are, only when an error names them.
     pub lowered: Option<Box<LoweredFrom>>,
+    /// Where the rung starts in the program's text (for a rung lowered from FBD: its block, or
+    /// its network for a fragment's guard and landing); none for a rung the tool made up. It
+    /// places the analysis warnings about the rung.
+    pub origin: Origin,
 }
 
 /// Where a rung lowered from an FBD body comes from.

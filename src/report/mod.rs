@@ -187,6 +187,19 @@ pub fn warning_text(p: &Program, w: &Warning) -> String {
 
 /// The stable code of an analysis warning (`W02xx`, each documented with an example in
 /// docs/diagnostics.md); [`warning_text`] is its message.
+/// Where a warning points in the program's text: its first rung (for a routine, the routine's
+/// first rung), none when that rung has no origin.
+pub fn warning_origin(p: &Program, w: &Warning) -> crate::diag::Origin {
+    let first = match w {
+        Warning::Unreachable(rs)
+        | Warning::Endless(rs)
+        | Warning::Empty(rs)
+        | Warning::NoEffect(rs) => rs.first().copied(),
+        Warning::Uncalled(pou) | Warning::Interrupt(pou) => p.pou_rungs(*pou).next(),
+    };
+    first.map_or(crate::diag::Origin::NONE, |r| p.rung(r).origin)
+}
+
 pub fn warning_code(w: &Warning) -> &'static str {
     match w {
         Warning::Unreachable(_) => "W0201",

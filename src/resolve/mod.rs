@@ -460,6 +460,7 @@ impl<'a> Builder<'a> {
                     pou,
                     series,
                     lowered: None,
+                    origin: syn.origin,
                 });
             }
         }

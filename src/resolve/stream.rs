@@ -165,6 +165,7 @@ impl<'a> Builder<'a> {
             pou: PouId(0),
             series: Vec::new(),
             lowered: None,
+            origin: r.origin,
         };
         if refers_ahead(&r.ld) || loop_end(&r.ld).is_some() {
             let edges = self.vars.len() as u32;

@@ -80,6 +80,7 @@ impl Net<'_, '_, '_> {
             id: d.id,
             op,
             path: p.clone(),
+            origin: d.syn.origin,
             inputs,
             outputs,
             cond,

@@ -211,6 +211,7 @@ fn network(
         label,
         comment,
         path: path.to_owned(),
+        origin: n.origin,
         blocks,
     })
 }

@@ -97,7 +97,7 @@ impl Cx<'_> {
                         None,
                         comment,
                         series,
-                        &net.path,
+                        (&net.path, net.origin),
                     ));
                     pending.extend(
                         sets.get(&f)
@@ -115,7 +115,7 @@ impl Cx<'_> {
                         None,
                         blk.comment.clone(),
                         series,
-                        &blk.path,
+                        (&blk.path, blk.origin),
                     );
                     if let Op::Jmp { label } = &blk.op {
                         // Checked by the block's lowering: the label is defined.
@@ -133,7 +133,7 @@ impl Cx<'_> {
                         Some(landing),
                         None,
                         std::mem::take(&mut pending),
-                        &net.path,
+                        (&net.path, net.origin),
                     );
                     let g = guards.pop().expect("entered");
                     set_jump_target(&mut self.rungs[g], RungId(r as u32));

@@ -28,7 +28,7 @@ mod standard;
 mod time;
 mod typed;
 
-use crate::diag::{Invalid, LoadError};
+use crate::diag::{Invalid, LoadError, Origin};
 use crate::fbd::model::*;
 use crate::fbd::types::TypedBody;
 use crate::model::*;
@@ -252,7 +252,7 @@ impl Cx<'_> {
         label: Option<String>,
         comment: Option<String>,
         series: Series,
-        path: &str,
+        (path, origin): (&str, Origin),
     ) -> usize {
         self.rungs.push(Rung {
             id,
@@ -260,6 +260,7 @@ impl Cx<'_> {
             comment,
             pou: self.pou,
             series,
+            origin,
             lowered: Some(Box::new(LoweredFrom {
                 block_path: path.to_owned(),
                 network: None,

@@ -78,7 +78,7 @@ impl Cx<'_> {
                         "brings {name} up to date while it accumulates (TSTART/TSTOP)"
                     )),
                     series,
-                    &blk.path,
+                    (&blk.path, blk.origin),
                 );
                 self.accumulators.insert(v, Acc { acc, timer, last });
             }
