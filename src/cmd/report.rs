@@ -3,7 +3,10 @@
 //! standard error, as diagnostics in the command's format, as well as into the report. Long
 //! phases show progress on a terminal.
 
-use super::io::{check_output_path, load_text, read_program_text, write_output_with, FileRole};
+use super::io::{
+    check_output_path, is_stdin, load_text, read_program_text, read_text, write_output_with,
+    FileRole,
+};
 use super::progress::Progress;
 use super::CliError;
 use crate::analysis::{analyse, analyse_with, Analysis, AnalysisConfig, DependenceListing, Listed};
@@ -128,6 +131,18 @@ pub fn report(c: &ReportConfig) -> Result<(), CliError> {
         let _phase = progress.phase("reading the program");
         load_text(file.clone(), &source)?
     };
+    // The text places the warnings, which are known only after the analysis. A big program's
+    // text is a sixth of the memory the report takes, so a file is let go now and read again
+    // should a warning need it; standard input cannot be read again.
+    let kept = is_stdin(&c.input).then_some(source);
+    let source = std::cell::OnceCell::new();
+    let source = || {
+        source.get_or_init(|| {
+            kept.clone()
+                .or_else(|| read_text(&c.input, FileRole::Program).ok())
+                .unwrap_or_default()
+        })
+    };
     let parts = fbd_parts(&p, &fbd);
     let drawn = dot_selection(c, &p)?;
     let a = {
@@ -140,7 +155,7 @@ pub fn report(c: &ReportConfig) -> Result<(), CliError> {
             shown.file = file.clone();
             shown
         } else {
-            Shown::warning(code, message, &file, &source, origin)
+            Shown::warning(code, message, &file, source(), origin)
         };
         super::errors::warn(&shown);
     };
@@ -154,9 +169,6 @@ pub fn report(c: &ReportConfig) -> Result<(), CliError> {
             crate::report::text::thousands(a.data.len())
         ), Origin::NONE);
     }
-    // The text placed the warnings; the report does not need it (a big program's text is a
-    // quarter of the memory the report takes).
-    drop(source);
     let text = TextOptions {
         view: c.view,
         rows: c.rows,
