@@ -119,7 +119,7 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
         },
     ];
     let per_file = chunks_per_file(p, &stems, &copies, cfg.chunk_rungs);
-    let mut objects = Vec::new();
+    let (mut objects, mut parts) = (Vec::new(), Vec::new());
     for (i, pou) in p.pous.iter().enumerate() {
         let Some(stem) = &stems[i] else { continue };
         let f = &sh.pou_fns[i];
@@ -139,6 +139,9 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
             ),
         });
         for (suffix, text) in sources {
+            if !suffix.is_empty() {
+                parts.push(format!("{stem}{suffix}"));
+            }
             objects.push(format!("{stem}{suffix}"));
             files.push(CFile {
                 name: format!("{stem}{suffix}.c"),
@@ -159,7 +162,7 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
     });
     files.push(CFile {
         name: "Makefile".into(),
-        text: harness::makefile(&objects),
+        text: harness::makefile(&objects, &parts),
     });
     files
 }
