@@ -1,6 +1,7 @@
 //! `plc-deps c` as a user runs it: the Makefile builds, the program's last JSON line equals the
 //! `state` of `plc-deps run --format json`; hostile program names stay inside DIR and compile;
-//! `-o DIR` is all files or none, an existing folder with files is refused unless `--force`.
+//! `-o DIR` is all files or none, an existing folder with files is refused unless `--force`;
+//! `make PARTFLAGS=…` reaches the part files of a large ladder POU and nothing else.
 
 mod common;
 
