@@ -11,8 +11,8 @@
 //! each (`ladder`); FBD networks are nested `if` blocks following their fragment trees, with
 //! one local per data arc (`fbd`). A ladder POU of more than [`CConfig::chunk_rungs`] rungs is
 //! cut into functions of about that many rungs at boundaries no jump and no FOR loop crosses,
-//! in at most 16 part files (`chunks_per_file`), so the C compiler's time grows linearly with
-//! the program.
+//! in part files whose number is bounded (16, plus one per further large POU:
+//! `chunks_per_file`), so the C compiler's time grows linearly with the program.
 //!
 //! Invariants: the generated program computes after every scan exactly the state and the faults
 //! of the sequential interpreter (`crate::exec::Machine`) given the same inputs (tests:
