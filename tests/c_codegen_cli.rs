@@ -1,6 +1,7 @@
 //! `plc-deps c` as a user runs it: the Makefile builds, the program's last JSON line equals the
 //! `state` of `plc-deps run --format json`; hostile program names stay inside DIR and compile;
-//! `-o DIR` is all files or none, an existing folder with files is refused unless `--force`.
+//! `-o DIR` is all files or none, an existing folder with files is refused unless `--force`;
+//! `make PARTFLAGS=…` reaches the part files of a large ladder POU and nothing else.
 
 mod common;
 
@@ -161,4 +162,48 @@ fn the_folder_is_written_whole_and_an_existing_one_needs_force() {
     let parent = dir.parent().unwrap();
     let leftovers = files_in(parent, |n| n.contains(".tmp-") || n.contains(".old-"));
     assert!(leftovers.is_empty(), "{leftovers:?}");
+}
+
+/// `make PARTFLAGS=…` adds the flags to the part files of a large ladder POU and to nothing
+/// else, and the program builds with `PARTFLAGS=-O1` under `-Werror`.
+#[test]
+fn partflags_reach_the_part_files_only() {
+    let dir = tmp("c-partflags");
+    let _ = std::fs::remove_dir_all(&dir);
+    let json = tmp("c-partflags.json");
+    let gen = run(&["gen", "--rungs", "300"]);
+    assert_ok(&gen, "plc-deps gen");
+    std::fs::write(&json, &gen.stdout).unwrap();
+    let out = run(&["c", json.to_str().unwrap(), "-o", dir.to_str().unwrap()]);
+    assert_ok(&out, "plc-deps c");
+    let dry = Command::new("make")
+        .args(["-n", "PARTFLAGS=-O1"])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert_ok(&dry, "make -n");
+    let text = String::from_utf8(dry.stdout).unwrap();
+    let compiles: Vec<&str> = text.lines().filter(|l| l.contains(" -c ")).collect();
+    // 300 rungs: 5 functions of 64 rungs (the last 44), one part file.
+    let parts: Vec<&str> = compiles
+        .iter()
+        .copied()
+        .filter(|l| l.contains("_part"))
+        .collect();
+    assert_eq!(parts.len(), 1, "{text}");
+    assert!(
+        parts[0].ends_with("-O2 -O1 -c -o pou__g_e_n_part0.o pou__g_e_n_part0.c"),
+        "{text}"
+    );
+    assert!(compiles.len() > parts.len(), "{text}");
+    for l in compiles.iter().filter(|l| !l.contains("_part")) {
+        assert!(!l.contains("-O1"), "{l}");
+    }
+    let build = Command::new("make")
+        .args(["-s", "PARTFLAGS=-O1"])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert_ok(&build, "make PARTFLAGS=-O1");
+    assert!(dir.join("plc_program").is_file());
 }

@@ -11,7 +11,8 @@
 //! each (`ladder`); FBD networks are nested `if` blocks following their fragment trees, with
 //! one local per data arc (`fbd`). A ladder POU of more than [`CConfig::chunk_rungs`] rungs is
 //! cut into functions of about that many rungs at boundaries no jump and no FOR loop crosses,
-//! so the C compiler's time grows linearly with the program.
+//! in part files whose number is bounded (16, plus one per further large POU:
+//! `chunks_per_file`), so the C compiler's time grows linearly with the program.
 //!
 //! Invariants: the generated program computes after every scan exactly the state and the faults
 //! of the sequential interpreter (`crate::exec::Machine`) given the same inputs (tests:
@@ -118,7 +119,8 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
             text: harness::PLC_MAIN_H.into(),
         },
     ];
-    let mut objects = Vec::new();
+    let per_file = chunks_per_file(p, &stems, &copies, cfg.chunk_rungs);
+    let (mut objects, mut parts) = (Vec::new(), Vec::new());
     for (i, pou) in p.pous.iter().enumerate() {
         let Some(stem) = &stems[i] else { continue };
         let f = &sh.pou_fns[i];
@@ -128,7 +130,7 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
                 let text = format!("#include \"plc_program.h\"\n\n{body}");
                 (vec![(String::new(), text)], String::new())
             }
-            None => ladder_files(p, &sh, i, cfg.chunk_rungs),
+            None => ladder_files(p, &sh, i, cfg.chunk_rungs, per_file),
         };
         files.push(CFile {
             name: format!("{stem}.h"),
@@ -138,6 +140,9 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
             ),
         });
         for (suffix, text) in sources {
+            if !suffix.is_empty() {
+                parts.push(format!("{stem}{suffix}"));
+            }
             objects.push(format!("{stem}{suffix}"));
             files.push(CFile {
                 name: format!("{stem}{suffix}.c"),
@@ -158,7 +163,7 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
     });
     files.push(CFile {
         name: "Makefile".into(),
-        text: harness::makefile(&objects),
+        text: harness::makefile(&objects, &parts),
     });
     files
 }
@@ -384,9 +389,30 @@ fn chunks(p: &Program, pou: usize, chunk: usize) -> Vec<std::ops::Range<u32>> {
     out
 }
 
-/// Chunk functions per source file of a large ladder POU (`pou_X_partN.c`), so that `make -j`
-/// compiles them in parallel and no translation unit grows with the program.
-const CHUNKS_PER_FILE: usize = 16;
+/// Chunk functions per part file (`pou_X_partN.c`) of the large ladder POUs: at least
+/// [`MIN_CHUNKS_PER_FILE`], more when the program has more than [`MAX_PART_FILES`] files' worth,
+/// so that the parts stay few. Every translation unit parses the whole state struct (about
+/// 0.3 s of `cc` at 100,000 rungs, and the struct's members cost again in the optimiser), so
+/// parts of a fixed size would make the build quadratic in the program; a bounded number of
+/// parts keeps it linear, and still enough of them for `make -j` to use every core.
+fn chunks_per_file(
+    p: &Program,
+    stems: &[Option<String>],
+    copies: &HashMap<usize, (usize, String)>,
+    chunk: usize,
+) -> usize {
+    let total: usize = (0..p.pous.len())
+        .filter(|i| stems[*i].is_some() && !copies.contains_key(i))
+        .map(|i| chunks(p, i, chunk.max(1)).len())
+        .filter(|&n| n > 1)
+        .sum();
+    MIN_CHUNKS_PER_FILE.max(total.div_ceil(MAX_PART_FILES))
+}
+
+/// The fewest chunk functions in a part file (1,024 rungs of 64).
+const MIN_CHUNKS_PER_FILE: usize = 16;
+/// The most part files of a program before they grow instead of multiplying.
+const MAX_PART_FILES: usize = 16;
 
 /// The C of a ladder POU: its function and, for a large POU, the part files of its chunks
 /// (`(file suffix, text)`; the first has no suffix), and the declarations for its header.
@@ -395,6 +421,7 @@ fn ladder_files(
     sh: &Shared,
     pou: usize,
     chunk: usize,
+    per_file: usize,
 ) -> (Vec<(String, String)>, String) {
     let f = &sh.pou_fns[pou];
     let groups = chunks(p, pou, chunk.max(1));
@@ -414,10 +441,10 @@ fn ladder_files(
     }
     let mut files = Vec::new();
     let mut decls = String::new();
-    for (n, part) in groups.chunks(CHUNKS_PER_FILE).enumerate() {
+    for (n, part) in groups.chunks(per_file).enumerate() {
         let mut s = format!("{head}/* ladder POU {name}, part {n} */\n");
         for (j, g) in part.iter().enumerate() {
-            let k = n * CHUNKS_PER_FILE + j;
+            let k = n * per_file + j;
             let mut b = Body::new(sh, "return 1;", 1);
             b.line("(void)self; (void)ctx;");
             for r in g.clone() {
