@@ -271,24 +271,7 @@ impl Flow<'_, '_, '_> {
 
     /// The text of element `e`'s `variable` (contacts, coils) or `expression` (variables).
     fn expression(&self, e: ElemId) -> R<String> {
-        let el = self.g.get(e);
-        let tag = if matches!(el.tag, "contact" | "coil") {
-            "variable"
-        } else {
-            "expression"
-        };
-        el.node
-            .children()
-            .find(|c| c.is_element() && c.tag_name().name() == tag)
-            .and_then(|c| c.text())
-            .map(str::to_owned)
-            .ok_or_else(|| {
-                error(
-                    origin(el.node),
-                    &self.at(e),
-                    format!("the {} has no {tag}", el.tag),
-                )
-            })
+        self.g.expression(&self.place, e)
     }
 
     /// Emits block element `e` (once) and returns its id.

@@ -204,26 +204,9 @@ impl<'g, 'a, 'i> Power<'g, 'a, 'i> {
         })
     }
 
-    /// The text of an element's `variable` (contacts, coils) or `expression` (variables).
+    /// The text of element `e`'s `variable` (contacts, coils) or `expression` (variables).
     pub fn expression(&self, e: ElemId) -> R<String> {
-        let el = self.g.get(e);
-        let tag = if matches!(el.tag, "contact" | "coil") {
-            "variable"
-        } else {
-            "expression"
-        };
-        el.node
-            .children()
-            .find(|c| c.is_element() && c.tag_name().name() == tag)
-            .and_then(|c| c.text())
-            .map(str::to_owned)
-            .ok_or_else(|| {
-                error(
-                    origin(el.node),
-                    &self.at(e),
-                    format!("the {} has no `{tag}`", el.tag),
-                )
-            })
+        self.g.expression(&self.place, e)
     }
 
     /// The power into input pin `k` of `e`: the OR of its connections.

@@ -69,6 +69,29 @@ impl<'a, 'i> Graph<'a, 'i> {
         format!("{body}, {} localId {}", el.tag, el.local_id)
     }
 
+    /// The text of element `e`'s `variable` (contacts, coils) or `expression` (variables); `body`
+    /// names the body in errors.
+    pub fn expression(&self, body: &str, e: ElemId) -> R<String> {
+        let el = self.get(e);
+        let tag = if matches!(el.tag, "contact" | "coil") {
+            "variable"
+        } else {
+            "expression"
+        };
+        el.node
+            .children()
+            .find(|c| c.is_element() && c.tag_name().name() == tag)
+            .and_then(|c| c.text())
+            .map(str::to_owned)
+            .ok_or_else(|| {
+                error(
+                    origin(el.node),
+                    &self.place(body, e),
+                    format!("the {} has no `{tag}`", el.tag),
+                )
+            })
+    }
+
     /// An error at the first element whose tag is not one of `tags`, the elements a
     /// `language` body (`LD`, `FBD`) may hold; `body` names the body in errors.
     pub fn only(&self, tags: &[&str], language: &str, body: &str) -> R<()> {
