@@ -23,6 +23,7 @@ use super::interface::{self, name, Interface, Known};
 use super::xml::{add_data_note, attr, error, identifier, origin, Note, Notes, Tc6, R};
 use super::{fbd, ld, ld_flow, library, st_body, textual};
 use crate::diag::LoadError;
+use crate::model::{Configuration, ProgramInstance, Resource, Task};
 use crate::syntax::{
     Body, Element, ElementKind, FunctionBlock, Program, RoutineKind, Rung, Subroutine, Var,
 };
@@ -69,7 +70,8 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
     }
     let mut later = Notes::default();
     let mut mapped_globals = Vec::new();
-    let (mut globals, order) = instances(tc6, root, &known, &mut later, &mut mapped_globals)?;
+    let (mut globals, order, configuration) =
+        instances(tc6, root, &known, &mut later, &mut mapped_globals)?;
     undeclared_globals(&read, &mut globals, &mut mapped_globals, notes);
     let mapped: Vec<(Option<String>, interface::Mapped)> = read
         .iter()
@@ -147,7 +149,9 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
         notes.push(note);
     }
     library_fbs(&mut fbs, &programs, &globals, notes);
-    assemble(root, programs, fbs, globals, order)
+    let mut program = assemble(root, programs, fbs, globals, order)?;
+    program.configuration = configuration;
+    Ok(program)
 }
 
 /// Adds the stand-in type of each library block ([`super::library`]) that a variable is an
@@ -424,9 +428,12 @@ fn body(
     })
 }
 
-/// Task order of program instances, the instance's task and type, and the global variables of
-/// the configuration and its resource.
+/// Task order of program instances: the instance's task and type.
 type Order<'a, 'i> = Vec<(String, String, Node<'a, 'i>)>;
+
+/// The global variables of the configuration and its resource, the task order of the program
+/// instances, and the configuration as data.
+type Instances<'a, 'i> = (Vec<Var<'static>>, Order<'a, 'i>, Option<Configuration>);
 
 fn instances<'a, 'i>(
     tc6: Tc6,
@@ -434,14 +441,14 @@ fn instances<'a, 'i>(
     known: &Known,
     notes: &mut Notes,
     mapped: &mut Vec<interface::Mapped>,
-) -> R<(Vec<Var<'static>>, Order<'a, 'i>)> {
+) -> R<Instances<'a, 'i>> {
     let mut globals = Vec::new();
     let mut order = Vec::new();
     let Some(confs) = tc6
         .child(root, "instances")
         .and_then(|i| tc6.child(i, "configurations"))
     else {
-        return Ok((globals, order));
+        return Ok((globals, order, None));
     };
     let configurations: Vec<Node> = tc6.children(confs, "configuration").collect();
     if configurations.len() > 1 {
@@ -452,10 +459,14 @@ fn instances<'a, 'i>(
         ));
     }
     let Some(conf) = configurations.first().copied() else {
-        return Ok((globals, order));
+        return Ok((globals, order, None));
     };
     add_data_note(tc6, conf, notes);
     let place = "instances/configuration";
+    let mut configuration = Configuration {
+        name: identifier(attr(conf, "name", place)?, "configuration", conf, place)?,
+        resources: Vec::new(),
+    };
     // The globals of the configuration, then of its resource.
     let mut globals_of = |node: Node, globals: &mut Vec<Var<'static>>| -> R<()> {
         for gv in tc6.children(node, "globalVars") {
@@ -474,9 +485,13 @@ fn instances<'a, 'i>(
         ));
     }
     let Some(res) = resources.first().copied() else {
-        return Ok((globals, order));
+        return Ok((globals, order, Some(configuration)));
     };
     globals_of(res, &mut globals)?;
+    let mut resource = Resource {
+        name: identifier(attr(res, "name", place)?, "resource", res, place)?,
+        ..Resource::default()
+    };
     let mut tasks: Vec<(u32, Node)> = Vec::new();
     for t in tc6.children(res, "task") {
         let pr = t.attribute("priority").unwrap_or("0").trim();
@@ -498,11 +513,21 @@ fn instances<'a, 'i>(
             .or(t.attribute("single"))
             .unwrap_or("-");
         described.push(format!("{tname} ({when}, priority {pr})"));
+        let mut task = Task {
+            name: tname.clone(),
+            interval: t.attribute("interval").map(str::to_owned),
+            single: t.attribute("single").map(str::to_owned),
+            priority: *pr,
+            instances: Vec::new(),
+        };
         for pi in tc6.children(*t, "pouInstance") {
+            task.instances.push(program_instance(pi, place)?);
             order.push((tname.clone(), instance_type(pi, place)?, pi));
         }
+        resource.tasks.push(task);
     }
     for pi in tc6.children(res, "pouInstance") {
+        resource.instances.push(program_instance(pi, place)?);
         order.push(("resource".into(), instance_type(pi, place)?, pi));
     }
     if tasks.len() > 1 {
@@ -511,7 +536,16 @@ fn instances<'a, 'i>(
             message: format!("tasks {} run one after another in every scan (in priority order), not each at its own interval", described.join(", ")),
         });
     }
-    Ok((globals, order))
+    configuration.resources.push(resource);
+    Ok((globals, order, Some(configuration)))
+}
+
+/// A `pouInstance` as data: its name (an IEC identifier) and its program.
+fn program_instance(pi: Node, place: &str) -> R<ProgramInstance> {
+    Ok(ProgramInstance {
+        name: identifier(attr(pi, "name", place)?, "program instance", pi, place)?,
+        program: instance_type(pi, place)?,
+    })
 }
 
 /// The program a `pouInstance` runs (`typeName`; `type` in the pre-2.0 namespace).
