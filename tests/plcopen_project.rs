@@ -243,3 +243,44 @@ fn run_stdout(args: &[&str], stdin: &str) -> String {
     );
     String::from_utf8(out.stdout).unwrap()
 }
+
+#[test]
+fn pou_selects_the_program_to_analyse_and_to_run() {
+    let xml = two_task_project();
+    // Any case, as IEC 61131-3 names are.
+    let (r, _) = json_output(&["report", "-", "--format", "json", "--pou", "b"], &xml);
+    assert_eq!(r["program"], "B");
+    assert_eq!(rung_ids(&r), ["B.R1"]);
+    assert_eq!(
+        r["programs"],
+        serde_json::json!([{"task": "Slow", "instance": "sb", "program": "B"}])
+    );
+    assert_eq!(r["task_sharing"], serde_json::json!([]));
+    let out = run_stdout(&["report", "-", "--pou", "B"], &xml);
+    assert!(
+        out.contains("\nAnalysed: 1 program instance of 4: Slow.sb (B)\n"),
+        "{out}"
+    );
+    // `run` runs B alone.
+    let (r, _) = json_output(
+        &["run", "-", "--scans", "1", "--format", "json", "--pou", "B"],
+        &xml,
+    );
+    assert_eq!(r["program"], "B", "{r}");
+}
+
+#[test]
+fn an_unknown_pou_is_one_error_listing_the_programs() {
+    let xml = two_task_project();
+    for cmd in ["report", "run"] {
+        let out = common::cli::run_stdin(&[cmd, "-", "--pou", "Nope"], xml.as_bytes());
+        assert_eq!(out.status.code(), Some(2));
+        assert!(out.stdout.is_empty());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(
+            err.lines().take(2).collect::<Vec<_>>(),
+            ["error[E0501]: --pou Nope: the project has no program of that name; its programs are A, B, C, D", "  --> <stdin>:1:1"],
+            "{err}"
+        );
+    }
+}

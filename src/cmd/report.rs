@@ -3,7 +3,7 @@
 //! standard error, as diagnostics in the command's format, as well as into the report. Long
 //! phases show progress on a terminal.
 
-use super::io::{check_output_path, load_program_and_fbd, write_output_with, FileRole};
+use super::io::{check_output_path, load_program_and_fbd_selecting, write_output_with, FileRole};
 use super::progress::Progress;
 use super::CliError;
 use crate::analysis::{analyse, analyse_with, Analysis, AnalysisConfig, DependenceListing, Listed};
@@ -39,8 +39,11 @@ pub struct ReportConfig {
     pub rows: Rows,
     /// Which data dependences are listed.
     pub analysis: AnalysisConfig,
-    /// The rungs the DOT report draws (only `Selection::Whole` for text and JSON).
+    /// The rungs the DOT report draws (only `Selection::Whole` for text, JSON and HTML).
     pub selection: Selection,
+    /// The program of a PLCopen project to analyse (`--pou` with the text, JSON and HTML
+    /// reports); `None`: every program instance, in task order.
+    pub program: Option<String>,
     pub output: Option<PathBuf>,
 }
 
@@ -125,7 +128,7 @@ pub fn report(c: &ReportConfig) -> Result<(), CliError> {
     let progress = Progress::stderr();
     let (p, fbd) = {
         let _phase = progress.phase("reading the program");
-        load_program_and_fbd(&c.input)?
+        load_program_and_fbd_selecting(&c.input, c.program.as_deref())?
     };
     let parts = fbd_parts(&p, &fbd);
     let drawn = dot_selection(c, &p)?;

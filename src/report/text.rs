@@ -534,8 +534,9 @@ fn configuration(r: &Report, o: &TextOptions, out: &mut impl Write) -> io::Resul
             .collect();
         list(&named.iter().map(String::as_str).collect::<Vec<_>>())
     };
-    let mut total = 0;
+    let (mut total, mut groups) = (0, 0);
     for res in &c.resources {
+        groups += res.tasks.len() + usize::from(!res.instances.is_empty());
         writeln!(
             out,
             "\nTasks of configuration {}, resource {}: {}",
@@ -572,7 +573,9 @@ fn configuration(r: &Report, o: &TextOptions, out: &mut impl Write) -> io::Resul
         }
         t.render(out)?;
     }
-    let which = if r.programs.len() == total {
+    let which = if total == 1 && r.programs.len() == 1 {
+        "the only program instance".to_owned()
+    } else if r.programs.len() == total {
         format!(
             "all {}, in task order",
             plural(total, "program instance", "program instances")
@@ -585,7 +588,8 @@ fn configuration(r: &Report, o: &TextOptions, out: &mut impl Write) -> io::Resul
     };
     let analysed: Vec<String> = r.programs.iter().map(run).collect();
     writeln!(out, "Analysed: {which}: {}", analysed.join(", "))?;
-    let Some(shared) = &r.task_sharing else {
+    // With one task (or none), nothing is shared between tasks.
+    let Some(shared) = r.task_sharing.as_ref().filter(|_| groups > 1) else {
         return Ok(());
     };
     writeln!(

@@ -39,7 +39,13 @@ struct ProgramPou {
 }
 
 /// Reads the whole project.
-pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static>> {
+/// With `select`, only the program POU of that name (any case) is kept, as the main program.
+pub fn program(
+    tc6: Tc6,
+    doc: &Document,
+    select: Option<&str>,
+    notes: &mut Notes,
+) -> R<Program<'static>> {
     let root = doc.root_element();
     add_data_note(tc6, root, notes);
     if let Some(ch) = tc6.child(root, "contentHeader") {
@@ -149,6 +155,10 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
         notes.push(note);
     }
     library_fbs(&mut fbs, &programs, &globals, notes);
+    let (programs, order) = match select {
+        Some(s) => selected(root, programs, order, s)?,
+        None => (programs, order),
+    };
     let mut program = assemble(root, programs, fbs, globals, order)?;
     program.configuration = configuration;
     Ok(program)
@@ -198,6 +208,31 @@ fn library_fbs(
             notes.push(note);
         }
     }
+}
+
+/// The program POU named `select` (any case) alone, with its instances: an error listing the
+/// project's programs when none has that name.
+fn selected<'a, 'i>(
+    root: Node,
+    programs: Vec<ProgramPou>,
+    order: Order<'a, 'i>,
+    select: &str,
+) -> R<(Vec<ProgramPou>, Order<'a, 'i>)> {
+    let names: Vec<&str> = programs.iter().map(|p| p.name.as_str()).collect();
+    let Some(i) = names.iter().position(|n| n.eq_ignore_ascii_case(select)) else {
+        return Err(error(
+            origin(root),
+            "types/pous",
+            format!(
+                "--pou {select}: the project has no program of that name; its programs are {}",
+                names.join(", ")
+            ),
+        ));
+    };
+    let name = names[i].to_owned();
+    let order = order.into_iter().filter(|o| o.1 == name).collect();
+    let keep = programs.into_iter().nth(i).into_iter().collect();
+    Ok((keep, order))
 }
 
 /// A function must have a return type (IEC 61131-3 6.6.2), and nothing else may have one.
