@@ -91,3 +91,67 @@ pub fn task_sharing(p: &Program, acc: &Accesses) -> TaskSharing {
         .collect();
     TaskSharing { runs, shared }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analysis::accesses::accesses;
+
+    /// A program POU whose LD body copies global `read` into global `write`.
+    fn pou(name: &str, read: &str, write: &str) -> String {
+        let v = |n: &str| format!("<variable name=\"{n}\"><type><BOOL/></type></variable>");
+        format!(
+            "<pou name=\"{name}\" pouType=\"program\"><interface><externalVars>{}{}</externalVars></interface><body><LD>\
+             <leftPowerRail localId=\"1\"><connectionPointOut formalParameter=\"\"/></leftPowerRail>\
+             <contact localId=\"2\"><connectionPointIn><connection refLocalId=\"1\"/></connectionPointIn><connectionPointOut/><variable>{read}</variable></contact>\
+             <coil localId=\"3\"><connectionPointIn><connection refLocalId=\"2\"/></connectionPointIn><connectionPointOut/><variable>{write}</variable></coil>\
+             </LD></body></pou>",
+            v(read),
+            v(write)
+        )
+    }
+
+    #[test]
+    fn lists_the_globals_a_task_writes_and_another_touches() {
+        // T1 runs A (G1 → G2); T2 runs B (G2 → G3); the resource itself runs C (G1 → G3).
+        let globals: String = ["G1", "G2", "G3"]
+            .iter()
+            .map(|n| format!("<variable name=\"{n}\"><type><BOOL/></type></variable>"))
+            .collect();
+        let xml = format!(
+            "<project xmlns=\"http://www.plcopen.org/xml/tc6_0201\"><types><pous>{}{}{}</pous></types><instances><configurations><configuration name=\"K\"><globalVars>{globals}</globalVars><resource name=\"R\">\
+             <task name=\"T1\" priority=\"0\" interval=\"T#10ms\"><pouInstance name=\"a\" typeName=\"A\"/></task>\
+             <task name=\"T2\" priority=\"1\" interval=\"T#50ms\"><pouInstance name=\"b\" typeName=\"B\"/></task>\
+             <pouInstance name=\"c\" typeName=\"C\"/></resource></configuration></configurations></instances></project>",
+            pou("A", "G1", "G2"),
+            pou("B", "G2", "G3"),
+            pou("C", "G1", "G3"),
+        );
+        let p = crate::load::plcopen(&xml).expect("loads").0;
+        let s = task_sharing(&p, &accesses(&p));
+        let names: Vec<(Option<&str>, &str)> = s
+            .runs
+            .iter()
+            .map(|r| (r.task.as_deref(), r.instance.as_str()))
+            .collect();
+        assert_eq!(names, [(Some("T1"), "a"), (Some("T2"), "b"), (None, "c")]);
+        let var = |n: &str| VarId(p.vars.iter().position(|v| v.name == n).unwrap() as u32);
+        // G1 is only read (A, C): not listed. G2: A writes, B reads. G3: B and C (the
+        // resource's own, a task of its own) both write it.
+        assert_eq!(
+            s.shared,
+            [
+                SharedGlobal {
+                    var: var("G2"),
+                    readers: vec![1],
+                    writers: vec![0],
+                },
+                SharedGlobal {
+                    var: var("G3"),
+                    readers: vec![],
+                    writers: vec![1, 2],
+                },
+            ]
+        );
+    }
+}
