@@ -76,14 +76,31 @@ pub fn program_and_fbd_from_value(doc: &serde_json::Value) -> Result<(Program, F
 /// (with one for each FBD body whose executionOrderIds order its blocks otherwise than plc-deps,
 /// and one for what `run` could not execute).
 pub fn plcopen(text: &str) -> Result<(Program, Fbd, Vec<Note>), LoadError> {
-    let (p, f, notes, no_run) = plcopen_all(text)?;
+    plcopen_selected(text, None)
+}
+
+/// [`plcopen`] with only the program POU `select` (any case), when given, as the main program
+/// (`--pou`): an error listing the programs when the project has none of that name.
+pub fn plcopen_selected(
+    text: &str,
+    select: Option<&str>,
+) -> Result<(Program, Fbd, Vec<Note>), LoadError> {
+    let (p, f, notes, no_run) = plcopen_all(text, select)?;
     Ok((p, f, notes.into_iter().chain(no_run).collect()))
 }
 
 /// [`plcopen`] for `run`: an error (located) when the project has something `run` cannot execute
 /// (a string in an LD or FBD body).
 pub fn plcopen_for_run(text: &str) -> Result<(Program, Fbd, Vec<Note>), LoadError> {
-    let (p, f, notes, no_run) = plcopen_all(text)?;
+    plcopen_for_run_selected(text, None)
+}
+
+/// [`plcopen_for_run`] with only the program POU `select`, as [`plcopen_selected`].
+pub fn plcopen_for_run_selected(
+    text: &str,
+    select: Option<&str>,
+) -> Result<(Program, Fbd, Vec<Note>), LoadError> {
+    let (p, f, notes, no_run) = plcopen_all(text, select)?;
     match no_run {
         Some(n) => Err(read::plcopen::run_refusal(n, text)),
         None => Ok((p, f, notes)),
@@ -93,8 +110,8 @@ pub fn plcopen_for_run(text: &str) -> Result<(Program, Fbd, Vec<Note>), LoadErro
 /// The program, its FBD bodies, the reader's notes, and the note of what `run` cannot execute.
 type PlcOpenLoaded = (Program, Fbd, Vec<Note>, Option<Note>);
 
-fn plcopen_all(text: &str) -> Result<PlcOpenLoaded, LoadError> {
-    let (syntax, mut notes) = read::plcopen::parse(text)?;
+fn plcopen_all(text: &str, select: Option<&str>) -> Result<PlcOpenLoaded, LoadError> {
+    let (syntax, mut notes) = read::plcopen::parse_selected(text, select)?;
     let (p, f) = resolve::resolve(text, &syntax)?;
     for x in &notes.exec_orders {
         if let Some(n) = exec_order_note(&f, x) {

@@ -46,7 +46,9 @@ enum Command {
         /// The most data dependence pairs listed before the report lists the direct ones instead.
         #[arg(long, default_value_t = plc_deps::analysis::DEFAULT_MAX_PAIRS)]
         max_pairs: u64,
-        /// DOT only: draw the rungs of this POU (the program, a subroutine or an FB instance).
+        /// DOT: draw the rungs of this POU (the program, a subroutine or an FB instance). Text,
+        /// JSON, HTML: analyse only this program of a PLCopen project [default: every program
+        /// instance, in task order].
         #[arg(long, conflicts_with = "rungs")]
         pou: Option<String>,
         /// DOT only: draw the rungs from FIRST to LAST in file order (`R10..R50`, or one id).
@@ -195,6 +197,10 @@ enum Command {
         /// Loop-backs allowed per loop-back rung and scan (the iteration cap).
         #[arg(long, default_value_t = 100_000)]
         loop_cap: u32,
+        /// Run only this program of a PLCopen project [default: every program instance, in
+        /// task order].
+        #[arg(long)]
+        pou: Option<String>,
         /// Write the report to this file instead of standard output.
         #[arg(short, long)]
         output: Option<PathBuf>,
@@ -280,6 +286,11 @@ fn run(cli: Cli) -> Result<(), CliError> {
                 ReportFormatArg::Dot => ReportFormat::Dot,
                 ReportFormatArg::Html => ReportFormat::Html,
             };
+            // Outside DOT, --pou selects the PLCopen program to analyse.
+            let (pou, program) = match format {
+                ReportFormat::Dot => (pou, None),
+                _ => (None, pou),
+            };
             let selection = match (pou, rungs) {
                 (Some(name), _) => Selection::Pou(name),
                 (None, Some(range)) => match range.split_once("..") {
@@ -296,7 +307,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
             };
             if selection != Selection::Whole && format != ReportFormat::Dot {
                 return Err(CliError::Usage(
-                    "--pou and --rungs choose what the DOT report draws; add --format dot (the text and JSON reports cover the whole program)".into(),
+                    "--rungs chooses what the DOT report draws; add --format dot (the text and JSON reports cover the whole program)".into(),
                 ));
             }
             let view = match (view, format) {
@@ -326,6 +337,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
                     },
                 },
                 selection,
+                program,
                 output,
             };
             cmd::report::report(&config)
@@ -424,6 +436,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
             explain,
             plan,
             loop_cap,
+            pou,
             output,
         } => {
             use plc_deps::cmd::run::{self, RunConfig, RunFormat, RunMode};
@@ -456,6 +469,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
             };
             config.loop_cap = loop_cap;
             config.output = output;
+            config.program = pou;
             run::run(&config)
         }
     }

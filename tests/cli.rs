@@ -445,11 +445,12 @@ fn dot_selection_errors_are_clear() {
         .success());
     let b = "analyses/example-b/program.json";
     let big = format!("error: {path}: the selection has 2,400 rungs, too many to draw (2,000 at most); choose a shorter --rungs range");
-    let cases: [(&[&str], &str); 5] = [
+    let cases: [(&[&str], &str); 6] = [
         (&["report", b, "--format", "dot", "--pou", "X"], "error: analyses/example-b/program.json: --pou: no POU `X` in the program (POUs: example_b, SBR_A, SBR_B)"),
         (&["report", b, "--format", "dot", "--rungs", "R5..R2"], "error: analyses/example-b/program.json: --rungs R5..R2: `R2` comes before `R5` in the program"),
         (&["report", b, "--format", "dot", "--rungs", "R5..R99"], "error: analyses/example-b/program.json: --rungs: no rung `R99` in the program"),
-        (&["report", b, "--rungs", "R5"], "error: --pou and --rungs choose what the DOT report draws; add --format dot (the text and JSON reports cover the whole program)"),
+        (&["report", b, "--rungs", "R5"], "error: --rungs chooses what the DOT report draws; add --format dot (the text and JSON reports cover the whole program)"),
+        (&["report", b, "--pou", "SBR_A"], "error: analyses/example-b/program.json: --pou SBR_A selects a program of a PLCopen project, and this is not one (the DOT report's --pou draws one POU of any program: add --format dot)"),
         (&["report", path, "--format", "dot", "--rungs", "R1..R2400"], &big),
     ];
     for (args, expected) in cases {

@@ -140,3 +140,147 @@ fn a_function_of_the_project_is_called_as_a_black_box_from_st() {
         format!("error: <stdin>:{f}: at pou Avg: function `Avg` has no return type")
     );
 }
+
+/// A program POU whose LD body is one rung `contact read → coil write`, both globals it names
+/// external.
+fn global_pou(name: &str, read: &str, write: &str) -> String {
+    let ext: String = [read, write]
+        .iter()
+        .map(|v| format!("<variable name=\"{v}\"><type><BOOL/></type></variable>"))
+        .collect();
+    let ld = [
+        rail(1),
+        contact(2, read, &[1], ""),
+        coil(3, write, &[2], ""),
+    ]
+    .concat();
+    format!("<pou name=\"{name}\" pouType=\"program\"><interface><externalVars>{ext}</externalVars></interface><body><LD>{ld}</LD></body></pou>")
+}
+
+/// Two tasks: Fast runs `fa` (program A: G3 → G1), Slow runs `sb` (B: G1 → G2) and `sc`
+/// (C: G2 → G4); the resource itself runs `rd` (D: G3 → G5). Fast and the resource have the
+/// lowest numbers, Slow priority 2.
+fn two_task_project() -> String {
+    let pous = [
+        global_pou("A", "G3", "G1"),
+        global_pou("B", "G1", "G2"),
+        global_pou("C", "G2", "G4"),
+        global_pou("D", "G3", "G5"),
+    ]
+    .concat();
+    let globals: String = ["G1", "G2", "G3", "G4", "G5"]
+        .iter()
+        .map(|v| format!("<variable name=\"{v}\"><type><BOOL/></type></variable>"))
+        .collect();
+    format!(
+        "<project xmlns=\"{NS}\"><types><pous>{pous}</pous></types><instances><configurations><configuration name=\"Cfg\"><globalVars>{globals}</globalVars><resource name=\"Res\">\
+         <task name=\"Slow\" priority=\"2\" interval=\"T#100ms\"><pouInstance name=\"sb\" typeName=\"B\"/><pouInstance name=\"sc\" typeName=\"C\"/></task>\
+         <task name=\"Fast\" priority=\"0\" single=\"G3\"><pouInstance name=\"fa\" typeName=\"A\"/></task>\
+         <pouInstance name=\"rd\" typeName=\"D\"/>\
+         </resource></configuration></configurations></instances></project>"
+    )
+}
+
+#[test]
+fn the_report_names_the_tasks_and_the_globals_programs_of_different_tasks_share() {
+    let xml = two_task_project();
+    let (r, _) = json_output(&["report", "-", "--format", "json"], &xml);
+    let inst = |n: &str, p: &str| serde_json::json!({"name": n, "program": p});
+    assert_eq!(
+        r["configuration"],
+        serde_json::json!({"name": "Cfg", "resources": [{"name": "Res", "tasks": [
+            {"name": "Fast", "priority": 0, "interval": null, "single": "G3", "instances": [inst("fa", "A")]},
+            {"name": "Slow", "priority": 2, "interval": "T#100ms", "single": null,
+             "instances": [inst("sb", "B"), inst("sc", "C")]}],
+          "instances": [inst("rd", "D")]}]})
+    );
+    let run = |t: Option<&str>, i: &str, p: &str| serde_json::json!({"task": t, "instance": i, "program": p});
+    let (fa, sb, sc) = (
+        run(Some("Fast"), "fa", "A"),
+        run(Some("Slow"), "sb", "B"),
+        run(Some("Slow"), "sc", "C"),
+    );
+    assert_eq!(
+        r["programs"],
+        serde_json::json!([fa, sb, sc, run(None, "rd", "D")])
+    );
+    // G1: A (Fast) writes, B (Slow) reads. G2 and G4 stay inside Slow; G3 and G5 are only read
+    // across tasks (G5 written by the resource's D alone).
+    assert_eq!(
+        r["task_sharing"],
+        serde_json::json!([{"var": "G1", "readers": [sb], "writers": [fa]}])
+    );
+    let out = run_stdout(&["report", "-"], &xml);
+    let from = out
+        .find("\nTasks of configuration")
+        .expect("a tasks section");
+    let to = out[from..].find("\nData dependences").unwrap() + from;
+    assert_eq!(
+        &out[from..to],
+        "
+Tasks of configuration Cfg, resource Res: 2 tasks
+  task       priority  interval  single  program instances
+  Fast       0         -         G3      fa (A)
+  Slow       2         T#100ms   -       sb (B) sc (C)
+  (no task)  -         -         -       rd (D)
+Analysed: all 4 program instances, in task order: Fast.fa (A), Slow.sb (B), Slow.sc (C), rd (D)
+
+Globals shared between tasks (one task may see another's half-finished scan): 1 variable
+  variable  read by      written by
+  G1        Slow.sb (B)  Fast.fa (A)
+"
+    );
+}
+
+/// The standard output of `plc-deps ARGS` with `stdin`, which must succeed.
+fn run_stdout(args: &[&str], stdin: &str) -> String {
+    let out = common::cli::run_stdin(args, stdin.as_bytes());
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+#[test]
+fn pou_selects_the_program_to_analyse_and_to_run() {
+    let xml = two_task_project();
+    // Any case, as IEC 61131-3 names are.
+    let (r, _) = json_output(&["report", "-", "--format", "json", "--pou", "b"], &xml);
+    assert_eq!(r["program"], "B");
+    assert_eq!(rung_ids(&r), ["B.R1"]);
+    assert_eq!(
+        r["programs"],
+        serde_json::json!([{"task": "Slow", "instance": "sb", "program": "B"}])
+    );
+    assert_eq!(r["task_sharing"], serde_json::json!([]));
+    let out = run_stdout(&["report", "-", "--pou", "B"], &xml);
+    assert!(
+        out.contains("\nAnalysed: 1 program instance of 4: Slow.sb (B)\n"),
+        "{out}"
+    );
+    // `run` runs B alone.
+    let (r, _) = json_output(
+        &["run", "-", "--scans", "1", "--format", "json", "--pou", "B"],
+        &xml,
+    );
+    assert_eq!(r["program"], "B", "{r}");
+}
+
+#[test]
+fn an_unknown_pou_is_one_error_listing_the_programs() {
+    let xml = two_task_project();
+    for cmd in ["report", "run"] {
+        let out = common::cli::run_stdin(&[cmd, "-", "--pou", "Nope"], xml.as_bytes());
+        assert_eq!(out.status.code(), Some(2));
+        assert!(out.stdout.is_empty());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(
+            err.lines().take(2).collect::<Vec<_>>(),
+            ["error[E0501]: --pou Nope: the project has no program of that name; its programs are A, B, C, D", "  --> <stdin>:1:1"],
+            "{err}"
+        );
+    }
+}

@@ -19,6 +19,7 @@ pub mod dependences;
 pub mod interrupts;
 pub mod levels;
 pub mod schedule;
+pub mod task_sharing;
 
 use crate::model::*;
 pub use accesses::{accesses, Accesses, VarSets};
@@ -161,6 +162,9 @@ pub struct Analysis {
     pub warnings: Vec<Warning>,
     /// What each interrupt routine shares with the main program.
     pub interrupts: Vec<interrupts::InterruptSharing>,
+    /// The program instances of the PLCopen configuration, in run order, and the globals that
+    /// programs of different tasks share.
+    pub task_sharing: task_sharing::TaskSharing,
 }
 
 /// Runs every analysis on `p` with the default [`AnalysisConfig`].
@@ -281,8 +285,10 @@ pub fn analyse_with(p: &Program, config: &AnalysisConfig) -> Analysis {
         warnings.push(Warning::NoEffect(no_effect));
     }
     let interrupts = interrupts::interrupt_sharing(p, &acc);
+    let task_sharing = task_sharing::task_sharing(p, &acc);
     Analysis {
         interrupts,
+        task_sharing,
         accesses: acc,
         data,
         listed,

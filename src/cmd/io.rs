@@ -232,8 +232,37 @@ pub fn load_program(path: &Path) -> Result<Program, CliError> {
 /// PLCopen project with something `run` cannot execute (a string in an LD or FBD body) is an
 /// error.
 pub fn load_program_for_run(path: &Path) -> Result<(Program, Fbd), CliError> {
+    load_program_for_run_selecting(path, None)
+}
+
+/// [`load_program_for_run`] keeping, with `select` (`--pou`), only that program of a PLCopen
+/// project ([`crate::load::plcopen_selected`]); `select` on another kind of file is an error.
+pub fn load_program_for_run_selecting(
+    path: &Path,
+    select: Option<&str>,
+) -> Result<(Program, Fbd), CliError> {
     let (file, text) = read_program_text(path)?;
-    load_text_for(file, &text, Purpose::Run)
+    load_text_for(file, &text, Purpose::Run, select)
+}
+
+/// [`load_program_and_fbd`] keeping, with `select` (`--pou`), only that program of a PLCopen
+/// project; `select` on another kind of file is an error.
+pub fn load_program_and_fbd_selecting(
+    path: &Path,
+    select: Option<&str>,
+) -> Result<(Program, Fbd), CliError> {
+    let (file, text) = read_program_text(path)?;
+    load_text_for(file, &text, Purpose::Analyse, select)
+}
+
+/// [`load_text`] keeping, with `select` (`--pou`), only that program of a PLCopen project;
+/// `select` on another kind of text is an error.
+pub fn load_text_selecting(
+    file: String,
+    text: &str,
+    select: Option<&str>,
+) -> Result<(Program, Fbd), CliError> {
+    load_text_for(file, text, Purpose::Analyse, select)
 }
 
 /// Reads and checks a program file (`-`: standard input), with its FBD bodies as written.
@@ -246,7 +275,7 @@ pub fn load_program_and_fbd(path: &Path) -> Result<(Program, Fbd), CliError> {
 /// block or a declaration section (or the file is named `.stl`/`.awl`), PLCopen TC6 XML when it
 /// starts with `<` (the PLCopen reader's notes go to standard error as warnings W0501), else the JSON format.
 pub fn load_text(file: String, text: &str) -> Result<(Program, Fbd), CliError> {
-    load_text_for(file, text, Purpose::Analyse)
+    load_text_for(file, text, Purpose::Analyse, None)
 }
 
 /// What a program is loaded for: `run` refuses what it cannot execute, the analyses do not.
@@ -256,19 +285,29 @@ enum Purpose {
     Run,
 }
 
-fn load_text_for(file: String, text: &str, purpose: Purpose) -> Result<(Program, Fbd), CliError> {
+fn load_text_for(
+    file: String,
+    text: &str,
+    purpose: Purpose,
+    select: Option<&str>,
+) -> Result<(Program, Fbd), CliError> {
     use crate::read::{plcopen, stl};
+    if let (Some(name), false) = (select, plcopen::looks_like_xml(text)) {
+        return Err(CliError::Usage(format!(
+            "{file}: --pou {name} selects a program of a PLCopen project, and this is not one (the DOT report's --pou draws one POU of any program: add --format dot)"
+        )));
+    }
     let lower = file.to_ascii_lowercase();
     if stl::looks_like_stl(text) || lower.ends_with(".stl") || lower.ends_with(".awl") {
         return crate::load::stl(text).map_err(|error| CliError::load(file, text, error));
     }
     if plcopen::looks_like_xml(text) {
         let load = match purpose {
-            Purpose::Analyse => crate::load::plcopen,
-            Purpose::Run => crate::load::plcopen_for_run,
+            Purpose::Analyse => crate::load::plcopen_selected,
+            Purpose::Run => crate::load::plcopen_for_run_selected,
         };
         let (p, f, notes) =
-            load(text).map_err(|error| CliError::load(file.clone(), text, error))?;
+            load(text, select).map_err(|error| CliError::load(file.clone(), text, error))?;
         warn_notes(PLCOPEN_NOTE, &file, text, &notes);
         return Ok((p, f));
     }

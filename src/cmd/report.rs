@@ -4,8 +4,8 @@
 //! phases show progress on a terminal.
 
 use super::io::{
-    check_output_path, is_stdin, load_text, read_program_text, read_text, write_output_with,
-    FileRole,
+    check_output_path, is_stdin, load_text_selecting, read_program_text, read_text,
+    write_output_with, FileRole,
 };
 use super::progress::Progress;
 use super::CliError;
@@ -42,8 +42,11 @@ pub struct ReportConfig {
     pub rows: Rows,
     /// Which data dependences are listed.
     pub analysis: AnalysisConfig,
-    /// The rungs the DOT report draws (only `Selection::Whole` for text and JSON).
+    /// The rungs the DOT report draws (only `Selection::Whole` for text, JSON and HTML).
     pub selection: Selection,
+    /// The program of a PLCopen project to analyse (`--pou` with the text, JSON and HTML
+    /// reports); `None`: every program instance, in task order.
+    pub program: Option<String>,
     pub output: Option<PathBuf>,
 }
 
@@ -129,7 +132,7 @@ pub fn report(c: &ReportConfig) -> Result<(), CliError> {
     let (file, source) = read_program_text(&c.input)?;
     let (p, fbd) = {
         let _phase = progress.phase("reading the program");
-        load_text(file.clone(), &source)?
+        load_text_selecting(file.clone(), &source, c.program.as_deref())?
     };
     // The text places the warnings, which are known only after the analysis. A big program's
     // text is a sixth of the memory the report takes, so a file is let go now and read again

@@ -17,7 +17,9 @@
 //! It deliberately carries no analysis results: those are separate values computed from it.
 //! Element semantics follow IEC 61131-3 (LD, §4.2) and the S7-200 shapes of Zhao & Yan (2012).
 
+mod tasks;
 mod types;
+pub use tasks::*;
 pub use types::*;
 
 use crate::diag::Origin;
@@ -61,6 +63,9 @@ pub struct Program {
     pub vars: Vec<Var>,
     pub pous: Vec<Pou>,
     pub rungs: Vec<Rung>,
+    /// The PLCopen configuration that runs the program's POUs (tasks and program instances);
+    /// `None` for programs without one (JSON, STL, a project without instances).
+    pub configuration: Option<Configuration>,
 }
 
 /// The main program or one subroutine.

@@ -83,6 +83,17 @@ pub struct Report<'a> {
     /// For programs with interrupt routines: what each shares with the main program.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub interrupts: Vec<InterruptEntry<'a>>,
+    /// For PLCopen projects with a configuration: its resources, their tasks and the program
+    /// instances each runs.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub configuration: Option<super::configuration::ConfigurationEntry<'a>>,
+    /// For PLCopen projects with a configuration: the program instances analysed, in run order.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub programs: Vec<super::configuration::ProgramRunEntry<'a>>,
+    /// For PLCopen projects with a configuration: the globals that programs of different tasks
+    /// share, where one writes.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub task_sharing: Option<Vec<super::configuration::TaskSharedEntry<'a>>>,
     /// For programs with FBD bodies: the program as written, in blocks and networks.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub fbd: Option<FbdSection<'a>>,
@@ -570,6 +581,17 @@ pub fn document_with<'a>(p: &'a Program, a: &'a Analysis, fbd: Option<&'a FbdPar
                     .collect(),
             })
             .collect(),
+        configuration: p
+            .configuration
+            .as_ref()
+            .map(super::configuration::configuration_entry),
+        programs: a
+            .task_sharing
+            .runs
+            .iter()
+            .map(super::configuration::run_entry)
+            .collect(),
+        task_sharing: super::configuration::task_shared_entries(p, a),
         fbd: fbd_section,
         shown_levels,
         summary: Summary {

@@ -81,6 +81,18 @@ pub fn render_json(report: &Report, out: &mut impl Write) -> io::Result<()> {
         key(out, "interrupts")?;
         value(out, &report.interrupts)?;
     }
+    if let Some(c) = &report.configuration {
+        key(out, "configuration")?;
+        value(out, c)?;
+    }
+    if !report.programs.is_empty() {
+        key(out, "programs")?;
+        value(out, &report.programs)?;
+    }
+    if let Some(t) = &report.task_sharing {
+        key(out, "task_sharing")?;
+        value(out, t)?;
+    }
     if let Some(fbd) = &report.fbd {
         key(out, "fbd")?;
         value(out, fbd)?;

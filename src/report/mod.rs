@@ -9,6 +9,7 @@
 //! every format and the explanation of where the combined schedule differs from the paper's
 //! views (Zhao & Yan, 2012) live here and in `explain`.
 
+pub mod configuration;
 pub mod document;
 mod dot;
 mod explain;

@@ -13,6 +13,8 @@ use super::document::{DependenceEntry, Report, TaskName};
 use super::View;
 use std::io::{self, Write};
 
+mod configuration;
+
 /// No table column is wider than this; longer cells wrap.
 pub const COLUMN_WIDTH: usize = 72;
 /// A level's rung list is cut after this many lines unless every row is asked for.
@@ -276,6 +278,7 @@ pub fn render_text(r: &Report, o: &TextOptions, out: &mut impl Write) -> io::Res
     rungs(r, o, out)?;
     networks(r, o, out)?;
     interrupts(r, o, out)?;
+    configuration::configuration(r, o, out)?;
     dependences(r, o, out)?;
     cfg(r, o, out)?;
     post_dominators(r, o, out)?;

@@ -106,7 +106,8 @@ impl<'a> Builder<'a> {
             .collect();
         instances.sort_by_key(|i| i.pou);
         let types = b.fb_type_models(&bodies);
-        let program = b.build(syn.name.to_string(), syn.origin)?;
+        let mut program = b.build(syn.name.to_string(), syn.origin)?;
+        program.configuration = syn.configuration.clone();
         for body in &mut bodies {
             for copy in &mut body.copies {
                 let start = program.pou(copy.pou).rungs.start;
@@ -470,6 +471,7 @@ impl<'a> Builder<'a> {
             vars: self.vars,
             pous,
             rungs,
+            configuration: None,
         };
         structure::check(&program, &places, loops)?;
         Ok(program)

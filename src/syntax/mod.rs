@@ -156,6 +156,8 @@ pub struct Program<'a> {
     pub body: Option<Body<'a>>,
     pub subroutines: Vec<Subroutine<'a>>,
     pub function_blocks: Vec<FunctionBlock<'a>>,
+    /// The PLCopen configuration (tasks and program instances), carried to the model unchanged.
+    pub configuration: Option<crate::model::Configuration>,
     /// Problems of the program object itself and of its non-rung parts, with absolute paths.
     pub problems: Vec<Problem>,
 }

@@ -59,6 +59,9 @@ pub struct RunConfig {
     /// Show progress on standard error (default: when it is a terminal); a phase appears once it
     /// has taken half a second.
     pub progress: bool,
+    /// The program of a PLCopen project to run (`--pou`); `None`: every program instance, in
+    /// task order.
+    pub program: Option<String>,
     /// Measure the cost of a moved cache line before planning (a few ms; default on), instead
     /// of the built-in default.
     pub calibrate: bool,
@@ -84,6 +87,7 @@ impl RunConfig {
             output: None,
             progress: std::io::stderr().is_terminal(),
             calibrate: true,
+            program: None,
         }
     }
 }

@@ -8,7 +8,7 @@ use super::config::{RunConfig, RunFormat, RunMode, RunWarning};
 use super::inputs::{load_inputs, InputTable};
 use super::trace::{cell, trace_columns, Trace};
 use crate::analysis::{analyse, Analysis};
-use crate::cmd::io::{check_output_path, load_program_for_run, CliError, FileRole};
+use crate::cmd::io::{check_output_path, load_program_for_run_selecting, CliError, FileRole};
 use crate::cmd::progress::{Bar, Progress};
 use crate::exec::parallel::{
     run_sequential, Candidate, ParallelMachine, PlanConfig, PlanKind, RunLog, ScanDriver,
@@ -267,7 +267,7 @@ pub(super) fn prepare(c: &RunConfig, progress: &Progress) -> Result<Prepared, Cl
     }
     let (p, fbd) = {
         let _phase = progress.phase(&format!("reading {}", c.input.display()));
-        load_program_for_run(&c.input)?
+        load_program_for_run_selecting(&c.input, c.program.as_deref())?
     };
     let mut warnings: Vec<RunWarning> = p
         .pous

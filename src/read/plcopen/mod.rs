@@ -50,11 +50,21 @@ pub fn looks_like_xml(text: &str) -> bool {
 /// Reads a PLCopen project into the surface syntax, with the reader's notes (errors carry line
 /// and column).
 pub fn parse(text: &str) -> Result<(syntax::Program<'static>, Notes), LoadError> {
+    parse_selected(text, None)
+}
+
+/// [`parse`], keeping only the program POU named `select` (any case) when it is given: it is
+/// then the main program, as if the project had no other (an error listing the programs when
+/// there is none of that name).
+pub fn parse_selected(
+    text: &str,
+    select: Option<&str>,
+) -> Result<(syntax::Program<'static>, Notes), LoadError> {
     let doc = xml::parse(text)?;
     let ns = xml::project_namespace(&doc).map_err(|e| e.locate(text))?;
     let mut notes = Notes::default();
     let program =
-        project::program(xml::Tc6 { ns }, &doc, &mut notes).map_err(|e| e.locate(text))?;
+        project::program(xml::Tc6 { ns }, &doc, select, &mut notes).map_err(|e| e.locate(text))?;
     Ok((program, notes))
 }
 

@@ -23,6 +23,7 @@ use super::interface::{self, name, Interface, Known};
 use super::xml::{add_data_note, attr, error, identifier, origin, Note, Notes, Tc6, R};
 use super::{fbd, ld, ld_flow, library, st_body, textual};
 use crate::diag::LoadError;
+use crate::model::{Configuration, ProgramInstance, Resource, Task};
 use crate::syntax::{
     Body, Element, ElementKind, FunctionBlock, Program, RoutineKind, Rung, Subroutine, Var,
 };
@@ -38,7 +39,13 @@ struct ProgramPou {
 }
 
 /// Reads the whole project.
-pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static>> {
+/// With `select`, only the program POU of that name (any case) is kept, as the main program.
+pub fn program(
+    tc6: Tc6,
+    doc: &Document,
+    select: Option<&str>,
+    notes: &mut Notes,
+) -> R<Program<'static>> {
     let root = doc.root_element();
     add_data_note(tc6, root, notes);
     if let Some(ch) = tc6.child(root, "contentHeader") {
@@ -69,7 +76,8 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
     }
     let mut later = Notes::default();
     let mut mapped_globals = Vec::new();
-    let (mut globals, order) = instances(tc6, root, &known, &mut later, &mut mapped_globals)?;
+    let (mut globals, order, configuration) =
+        instances(tc6, root, &known, &mut later, &mut mapped_globals)?;
     undeclared_globals(&read, &mut globals, &mut mapped_globals, notes);
     let mapped: Vec<(Option<String>, interface::Mapped)> = read
         .iter()
@@ -147,7 +155,13 @@ pub fn program(tc6: Tc6, doc: &Document, notes: &mut Notes) -> R<Program<'static
         notes.push(note);
     }
     library_fbs(&mut fbs, &programs, &globals, notes);
-    assemble(root, programs, fbs, globals, order)
+    let (programs, order) = match select {
+        Some(s) => selected(root, programs, order, s)?,
+        None => (programs, order),
+    };
+    let mut program = assemble(root, programs, fbs, globals, order)?;
+    program.configuration = configuration;
+    Ok(program)
 }
 
 /// Adds the stand-in type of each library block ([`super::library`]) that a variable is an
@@ -194,6 +208,31 @@ fn library_fbs(
             notes.push(note);
         }
     }
+}
+
+/// The program POU named `select` (any case) alone, with its instances: an error listing the
+/// project's programs when none has that name.
+fn selected<'a, 'i>(
+    root: Node,
+    programs: Vec<ProgramPou>,
+    order: Order<'a, 'i>,
+    select: &str,
+) -> R<(Vec<ProgramPou>, Order<'a, 'i>)> {
+    let names: Vec<&str> = programs.iter().map(|p| p.name.as_str()).collect();
+    let Some(i) = names.iter().position(|n| n.eq_ignore_ascii_case(select)) else {
+        return Err(error(
+            origin(root),
+            "types/pous",
+            format!(
+                "--pou {select}: the project has no program of that name; its programs are {}",
+                names.join(", ")
+            ),
+        ));
+    };
+    let name = names[i].to_owned();
+    let order = order.into_iter().filter(|o| o.1 == name).collect();
+    let keep = programs.into_iter().nth(i).into_iter().collect();
+    Ok((keep, order))
 }
 
 /// A function must have a return type (IEC 61131-3 6.6.2), and nothing else may have one.
@@ -424,9 +463,12 @@ fn body(
     })
 }
 
-/// Task order of program instances, the instance's task and type, and the global variables of
-/// the configuration and its resource.
+/// Task order of program instances: the instance's task and type.
 type Order<'a, 'i> = Vec<(String, String, Node<'a, 'i>)>;
+
+/// The global variables of the configuration and its resource, the task order of the program
+/// instances, and the configuration as data.
+type Instances<'a, 'i> = (Vec<Var<'static>>, Order<'a, 'i>, Option<Configuration>);
 
 fn instances<'a, 'i>(
     tc6: Tc6,
@@ -434,14 +476,14 @@ fn instances<'a, 'i>(
     known: &Known,
     notes: &mut Notes,
     mapped: &mut Vec<interface::Mapped>,
-) -> R<(Vec<Var<'static>>, Order<'a, 'i>)> {
+) -> R<Instances<'a, 'i>> {
     let mut globals = Vec::new();
     let mut order = Vec::new();
     let Some(confs) = tc6
         .child(root, "instances")
         .and_then(|i| tc6.child(i, "configurations"))
     else {
-        return Ok((globals, order));
+        return Ok((globals, order, None));
     };
     let configurations: Vec<Node> = tc6.children(confs, "configuration").collect();
     if configurations.len() > 1 {
@@ -452,10 +494,14 @@ fn instances<'a, 'i>(
         ));
     }
     let Some(conf) = configurations.first().copied() else {
-        return Ok((globals, order));
+        return Ok((globals, order, None));
     };
     add_data_note(tc6, conf, notes);
     let place = "instances/configuration";
+    let mut configuration = Configuration {
+        name: identifier(attr(conf, "name", place)?, "configuration", conf, place)?,
+        resources: Vec::new(),
+    };
     // The globals of the configuration, then of its resource.
     let mut globals_of = |node: Node, globals: &mut Vec<Var<'static>>| -> R<()> {
         for gv in tc6.children(node, "globalVars") {
@@ -474,9 +520,13 @@ fn instances<'a, 'i>(
         ));
     }
     let Some(res) = resources.first().copied() else {
-        return Ok((globals, order));
+        return Ok((globals, order, Some(configuration)));
     };
     globals_of(res, &mut globals)?;
+    let mut resource = Resource {
+        name: identifier(attr(res, "name", place)?, "resource", res, place)?,
+        ..Resource::default()
+    };
     let mut tasks: Vec<(u32, Node)> = Vec::new();
     for t in tc6.children(res, "task") {
         let pr = t.attribute("priority").unwrap_or("0").trim();
@@ -498,11 +548,21 @@ fn instances<'a, 'i>(
             .or(t.attribute("single"))
             .unwrap_or("-");
         described.push(format!("{tname} ({when}, priority {pr})"));
+        let mut task = Task {
+            name: tname.clone(),
+            interval: t.attribute("interval").map(str::to_owned),
+            single: t.attribute("single").map(str::to_owned),
+            priority: *pr,
+            instances: Vec::new(),
+        };
         for pi in tc6.children(*t, "pouInstance") {
+            task.instances.push(program_instance(pi, place)?);
             order.push((tname.clone(), instance_type(pi, place)?, pi));
         }
+        resource.tasks.push(task);
     }
     for pi in tc6.children(res, "pouInstance") {
+        resource.instances.push(program_instance(pi, place)?);
         order.push(("resource".into(), instance_type(pi, place)?, pi));
     }
     if tasks.len() > 1 {
@@ -511,7 +571,16 @@ fn instances<'a, 'i>(
             message: format!("tasks {} run one after another in every scan (in priority order), not each at its own interval", described.join(", ")),
         });
     }
-    Ok((globals, order))
+    configuration.resources.push(resource);
+    Ok((globals, order, Some(configuration)))
+}
+
+/// A `pouInstance` as data: its name (an IEC identifier) and its program.
+fn program_instance(pi: Node, place: &str) -> R<ProgramInstance> {
+    Ok(ProgramInstance {
+        name: identifier(attr(pi, "name", place)?, "program instance", pi, place)?,
+        program: instance_type(pi, place)?,
+    })
 }
 
 /// The program a `pouInstance` runs (`typeName`; `type` in the pre-2.0 namespace).

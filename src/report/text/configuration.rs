@@ -1,0 +1,109 @@
+//! The text report's sections for a PLCopen configuration: the tasks of each resource and the
+//! program instances they run, the instances analysed, and the globals programs of different
+//! tasks share (docs/report.md). Layout only: the data is [`crate::report::configuration`]'s.
+
+use super::{list, more_rows, plural, Table, TextOptions};
+use crate::report::configuration::{InstanceEntry, ProgramRunEntry};
+use crate::report::document::Report;
+use std::io::{self, Write};
+
+/// A PLCopen project's tasks and what each runs, the program instances analysed, and the
+/// globals programs of different tasks share.
+pub(super) fn configuration(r: &Report, o: &TextOptions, out: &mut impl Write) -> io::Result<()> {
+    let Some(c) = &r.configuration else {
+        return Ok(());
+    };
+    let run = |e: &ProgramRunEntry| match e.task {
+        Some(t) => format!("{t}.{} ({})", e.instance, e.program),
+        None => format!("{} ({})", e.instance, e.program),
+    };
+    let instances = |v: &[InstanceEntry]| {
+        let named: Vec<String> = v
+            .iter()
+            .map(|i| format!("{} ({})", i.name, i.program))
+            .collect();
+        list(&named.iter().map(String::as_str).collect::<Vec<_>>())
+    };
+    let (mut total, mut groups) = (0, 0);
+    for res in &c.resources {
+        groups += res.tasks.len() + usize::from(!res.instances.is_empty());
+        writeln!(
+            out,
+            "\nTasks of configuration {}, resource {}: {}",
+            c.name,
+            res.name,
+            plural(res.tasks.len(), "task", "tasks")
+        )?;
+        let mut t = Table::new(&[
+            "task",
+            "priority",
+            "interval",
+            "single",
+            "program instances",
+        ]);
+        for task in &res.tasks {
+            total += task.instances.len();
+            t.row(vec![
+                task.name.into(),
+                task.priority.to_string(),
+                task.interval.unwrap_or("-").into(),
+                task.single.unwrap_or("-").into(),
+                instances(&task.instances),
+            ]);
+        }
+        if !res.instances.is_empty() {
+            total += res.instances.len();
+            t.row(vec![
+                "(no task)".into(),
+                "-".into(),
+                "-".into(),
+                "-".into(),
+                instances(&res.instances),
+            ]);
+        }
+        t.render(out)?;
+    }
+    let which = if total == 1 && r.programs.len() == 1 {
+        "the only program instance".to_owned()
+    } else if r.programs.len() == total {
+        format!(
+            "all {}, in task order",
+            plural(total, "program instance", "program instances")
+        )
+    } else {
+        format!(
+            "{} of {total}",
+            plural(r.programs.len(), "program instance", "program instances")
+        )
+    };
+    let analysed: Vec<String> = r.programs.iter().map(run).collect();
+    writeln!(out, "Analysed: {which}: {}", analysed.join(", "))?;
+    // With one task (or none), nothing is shared between tasks.
+    let Some(shared) = r.task_sharing.as_ref().filter(|_| groups > 1) else {
+        return Ok(());
+    };
+    writeln!(
+        out,
+        "\nGlobals shared between tasks (one task may see another's half-finished scan): {}",
+        plural(shared.len(), "variable", "variables")
+    )?;
+    if shared.is_empty() {
+        return Ok(());
+    }
+    let mut t = Table::new(&["variable", "read by", "written by"]);
+    let shown = shared.len().min(o.limit());
+    let runs = |v: &[ProgramRunEntry]| v.iter().map(run).collect::<Vec<_>>();
+    for s in shared.iter().take(shown) {
+        let (rd, wr) = (runs(&s.readers), runs(&s.writers));
+        let lines = |v: Vec<String>| {
+            if v.is_empty() {
+                vec!["-".to_owned()]
+            } else {
+                v
+            }
+        };
+        t.row_lines(vec![vec![s.var.to_owned()], lines(rd), lines(wr)]);
+    }
+    t.render(out)?;
+    more_rows(out, shown, shared.len())
+}
