@@ -21,8 +21,18 @@ fn model_of(text: &str) -> Option<String> {
     };
     // The JSON program format does not carry a PLCopen configuration (tasks and program
     // instances) yet: the round trip is checked on the rest of the model.
-    loaded.ok().map(|(mut p, f)| {
+    // Where a rung or block stands in its file is not part of what the two texts mean.
+    loaded.ok().map(|(mut p, mut f)| {
         p.configuration = None;
+        for r in &mut p.rungs {
+            r.origin = plc_deps::diag::Origin::NONE;
+        }
+        for n in f.pous.iter_mut().flat_map(|pou| &mut pou.networks) {
+            n.origin = plc_deps::diag::Origin::NONE;
+            for b in &mut n.blocks {
+                b.origin = plc_deps::diag::Origin::NONE;
+            }
+        }
         format!("{p:#?}\n{f:#?}")
     })
 }
