@@ -5,7 +5,7 @@ mod common;
 mod plcopen_common;
 
 use common::cli::{root, tmp};
-use plcopen_common::run_inputs;
+use plcopen_common::{run_inputs, trace_columns};
 
 /// Runs fixture `file` one scan per row of `inputs` with `--cycle cycle`; each of `columns`
 /// after each scan, from the trace.
@@ -19,19 +19,9 @@ fn run(file: &str, cycle: &str, inputs: &str, columns: &[&str]) -> Vec<String> {
         inputs,
         &["--cycle", cycle, "--trace", tr.to_str().unwrap()],
     );
-    let text = std::fs::read_to_string(&tr).unwrap();
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
-    columns
-        .iter()
-        .map(|c| {
-            let k = header
-                .iter()
-                .position(|h| h == c)
-                .unwrap_or_else(|| panic!("{c}"));
-            rows.iter().map(|r| r[k]).collect::<Vec<_>>().join("")
-        })
+    trace_columns(&tr, columns)
+        .into_iter()
+        .map(|values| values.concat())
         .collect()
 }
 

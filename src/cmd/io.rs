@@ -245,16 +245,6 @@ pub fn load_program_for_run_selecting(
     load_text_for(file, &text, Purpose::Run, select)
 }
 
-/// [`load_program_and_fbd`] keeping, with `select` (`--pou`), only that program of a PLCopen
-/// project; `select` on another kind of file is an error.
-pub fn load_program_and_fbd_selecting(
-    path: &Path,
-    select: Option<&str>,
-) -> Result<(Program, Fbd), CliError> {
-    let (file, text) = read_program_text(path)?;
-    load_text_for(file, &text, Purpose::Analyse, select)
-}
-
 /// [`load_text`] keeping, with `select` (`--pou`), only that program of a PLCopen project;
 /// `select` on another kind of text is an error.
 pub fn load_text_selecting(

@@ -208,7 +208,12 @@ pub fn run_inputs(tag: &str, xml: &str, inputs: &str, extra: &[&str]) -> serde_j
 pub fn trace(tag: &str, xml: &str, inputs: &str, columns: &[&str]) -> Vec<Vec<String>> {
     let tr = crate::common::cli::tmp(&format!("{tag}-trace.csv"));
     run_inputs(tag, xml, inputs, &["--trace", tr.to_str().unwrap()]);
-    let text = std::fs::read_to_string(&tr).unwrap();
+    trace_columns(&tr, columns)
+}
+
+/// For each of `columns`, its value after each scan in the trace file `tr`.
+pub fn trace_columns(tr: &std::path::Path, columns: &[&str]) -> Vec<Vec<String>> {
+    let text = std::fs::read_to_string(tr).unwrap();
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
