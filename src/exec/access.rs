@@ -25,7 +25,7 @@ impl Machine {
     /// `reads` and may write to `writes` (unsorted, maybe with repeats).
     pub fn rung_accesses(&self, rung: RungId, reads: &mut Vec<Span>, writes: &mut Vec<Span>) {
         let mut pous: Vec<Pc> = Vec::new();
-        let start = self.rung_op[rung.index()].index() + 1;
+        let start = self.rung_op[rung.index()].index();
         self.op_accesses(start, true, reads, writes, &mut pous);
         let mut i = 0;
         while i < pous.len() {
@@ -52,8 +52,9 @@ impl Machine {
         end
     }
 
-    /// The accesses of the instructions from `pc` to the next rung marker (`one_rung`) or to
-    /// the end of the POU; callees not yet in `pous` are appended to it.
+    /// The accesses of the instructions from `pc` (a rung's start when `one_rung`) to the start
+    /// of the next rung (`one_rung`) or to the end of the POU; callees not yet in `pous` are
+    /// appended to it.
     fn op_accesses(
         &self,
         mut pc: usize,
@@ -63,12 +64,20 @@ impl Machine {
         pous: &mut Vec<Pc>,
     ) {
         let byte = |a: Addr| (a, 1);
+        let first = pc;
         loop {
             let op = self.ops[pc];
             pc += 1;
             match op {
-                Op::Rung { .. } if one_rung => return,
+                _ if one_rung && pc - 1 != first && op.starts_rung().is_some() => return,
                 Op::EndPou => return,
+                Op::Fused { f, .. } => {
+                    // Every slot is loaded (padding included), and the output's old value.
+                    let r = &self.fused[f.index()];
+                    reads.extend(r.at.iter().map(|&a| byte(a)));
+                    reads.push(byte(r.out));
+                    writes.push(byte(r.out));
+                }
                 Op::Rung { .. }
                 | Op::OrOpen
                 | Op::OrNext

@@ -16,6 +16,7 @@
 //! its branches so far; a `branch` one: its power in). Lowering refuses nesting deeper than that.
 
 use super::fb::{CtudId, CtudPins};
+use super::fuse::{self, FusedId, FusedRung, Table, Tables, MAX_CONTACTS};
 use super::layout::{field_offset, type_align, Layout, Repr};
 use super::mem::LINE_BYTES;
 use super::store::Addr;
@@ -102,6 +103,17 @@ impl Width {
 pub(crate) enum Op {
     /// Start of a rung: leave if the rung is outside the region being run; power := TRUE.
     Rung { id: RungId },
+    /// A whole rung of plain contacts and one output (the `fuse` module), in place of its
+    /// `Rung` marker and everything after it: leave if the rung is outside the region; the
+    /// power is bit `index ^ neg` of truth table `table`, the index packing the bytes of
+    /// `fused[f].at`; then the output at `fused[f].out` as [`Op::Coil`] with `mode`.
+    Fused {
+        id: RungId,
+        f: FusedId,
+        table: u16,
+        neg: u8,
+        mode: u8,
+    },
     /// Contact on a BOOL byte: `p &= v ^ neg` (`neg` 0 or 1).
     Contact { neg: u8, at: Addr },
     /// Two consecutive contacts (negation bits 0 and 1 of `neg`).
@@ -193,6 +205,16 @@ pub(crate) enum Op {
 
 const _: () = assert!(std::mem::size_of::<Op>() <= 16);
 
+impl Op {
+    /// The rung this instruction starts, if it starts one (a marker or a fused rung).
+    pub(crate) fn starts_rung(&self) -> Option<RungId> {
+        match *self {
+            Op::Rung { id } | Op::Fused { id, .. } => Some(id),
+            _ => None,
+        }
+    }
+}
+
 /// One FOR/NEXT loop.
 #[derive(Copy, Clone, Debug)]
 pub(crate) struct ForLoop {
@@ -219,6 +241,10 @@ pub(crate) struct Code {
     pub fors: Vec<ForLoop>,
     /// The operands of each CTUD box but CU.
     pub ctuds: Vec<CtudPins>,
+    /// The operands of each fused rung.
+    pub fused: Vec<FusedRung>,
+    /// The fused rungs' truth tables.
+    pub tables: Vec<Table>,
     /// Each rung's `Rung` marker.
     pub rung_op: Vec<Pc>,
     /// For each rung: its loop if it is a FOR head.
@@ -269,6 +295,8 @@ struct Lowerer<'p> {
     counter_of: Vec<Option<Addr>>,
     /// Where the next constant goes (past the loop counters).
     next_const: u64,
+    /// The fused rungs' truth tables, shared by shape.
+    tables: Tables,
     depth: u32,
     max_depth: u32,
 }
@@ -320,6 +348,8 @@ pub(crate) fn lower(p: &Program, layout: &Layout) -> Result<Code, LowerError> {
             consts: Vec::new(),
             fors: Vec::new(),
             ctuds: Vec::new(),
+            fused: Vec::new(),
+            tables: Vec::new(),
             rung_op: vec![Pc(0); p.rungs.len()],
             for_of_head: vec![None; p.rungs.len()],
             pou_entry: Vec::with_capacity(p.pous.len()),
@@ -331,6 +361,7 @@ pub(crate) fn lower(p: &Program, layout: &Layout) -> Result<Code, LowerError> {
         for_nexts: Vec::new(),
         counter_of,
         next_const: counters_end,
+        tables: Tables::default(),
         depth: 0,
         max_depth: 0,
     };
@@ -340,6 +371,9 @@ pub(crate) fn lower(p: &Program, layout: &Layout) -> Result<Code, LowerError> {
         for r in pou.rungs.clone() {
             let rung = &p.rungs[r as usize];
             l.code.rung_op[r as usize] = l.pc();
+            if l.fused(RungId(r), &rung.series) {
+                continue;
+            }
             l.code.ops.push(Op::Rung { id: RungId(r) });
             l.depth = 0;
             l.max_depth = 0;
@@ -364,8 +398,10 @@ pub(crate) fn lower(p: &Program, layout: &Layout) -> Result<Code, LowerError> {
         jumps,
         calls,
         for_nexts,
+        tables,
         ..
     } = l;
+    code.tables = tables.tables;
     for (at, target) in jumps {
         let to = code.rung_op[target.index()];
         match &mut code.ops[at] {
@@ -510,6 +546,45 @@ impl Lowerer<'_> {
         }
         self.push(ops[2]);
         self.depth -= bits;
+    }
+
+    /// Lowers rung `rung` as one [`Op::Fused`] if its shape allows (`fuse`); whether it did.
+    fn fused(&mut self, rung: RungId, series: &[Element]) -> bool {
+        let Some((last, conds)) = series.split_last() else {
+            return false;
+        };
+        let (var, mode) = match *last {
+            Element::Coil { var, negated } => (var, if negated { OUT_NCOIL } else { OUT_COIL }),
+            Element::Set(var) => (var, OUT_SET),
+            Element::Reset(var) => (var, OUT_RESET),
+            _ => return false,
+        };
+        let Some(shape) = fuse::shape(conds) else {
+            return false;
+        };
+        let Some(table) = self.tables.index(&shape) else {
+            return false;
+        };
+        let out = self.layout.start(var);
+        let mut at = [out; MAX_CONTACTS];
+        let mut neg = 0u8;
+        for (k, &(v, n)) in shape.contacts.iter().enumerate() {
+            at[k] = self.addr(v);
+            neg |= (n as u8) << k;
+        }
+        for k in shape.contacts.len().max(1)..MAX_CONTACTS {
+            at[k] = at[0];
+        }
+        let f = FusedId(self.code.fused.len() as u32);
+        self.code.fused.push(FusedRung { at, out });
+        self.push(Op::Fused {
+            id: rung,
+            f,
+            table,
+            neg,
+            mode,
+        });
+        true
     }
 
     fn coil(&mut self, var: VarId, mode: u8) {

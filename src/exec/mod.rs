@@ -114,6 +114,7 @@
 
 mod access;
 mod fb;
+mod fuse;
 mod layout;
 mod lower;
 mod mem;
@@ -244,6 +245,8 @@ pub struct Machine {
     consts: Vec<(Addr, Value)>,
     fors: Vec<ForLoop>,
     ctuds: Vec<fb::CtudPins>,
+    fused: Vec<fuse::FusedRung>,
+    tables: Vec<fuse::Table>,
     rung_op: Vec<Pc>,
     for_of_head: Vec<Option<ForId>>,
     pou_entry: Vec<Pc>,
@@ -272,6 +275,8 @@ impl Machine {
             consts: code.consts,
             fors: code.fors,
             ctuds: code.ctuds,
+            fused: code.fused,
+            tables: code.tables,
             rung_op: code.rung_op,
             for_of_head: code.for_of_head,
             pou_entry: code.pou_entry,

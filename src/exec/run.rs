@@ -3,6 +3,7 @@
 //! `i16`, DINT and TIME an `i32`, REAL an `f32`, at the addresses lowering put in the
 //! instructions. Arithmetic widens to `i64` and wraps back to the type's width.
 
+use super::fuse::{lookup, FusedId};
 use super::layout::{CV, ET, FLAGS, PREV, PT, PV, Q, START};
 use super::lower::{Num, Op, Width};
 use super::store::{Addr, Word};
@@ -177,6 +178,34 @@ impl Machine {
                     rung = id;
                     p = 1;
                 }
+                Op::Fused {
+                    mut id,
+                    mut f,
+                    mut table,
+                    mut neg,
+                    mut mode,
+                } => loop {
+                    // A run of fused rungs stays in this loop: one well-predicted branch per
+                    // rung instead of a dispatch through the jump table.
+                    if !inside(id) {
+                        return Flow::Rung(id);
+                    }
+                    rung = id;
+                    p = self.fused_rung(st, f, table, neg, mode);
+                    match ops[pc] {
+                        Op::Fused {
+                            id: i,
+                            f: g,
+                            table: t,
+                            neg: n,
+                            mode: m,
+                        } => {
+                            (id, f, table, neg, mode) = (i, g, t, n, m);
+                            pc += 1;
+                        }
+                        _ => break,
+                    }
+                },
                 Op::Contact { neg, at } => p &= b(st, at) ^ neg as u64,
                 Op::Contact2 { neg, a, b: c } => {
                     // Both BOOLs (each 0 or 1) must equal their negation bit's complement.
@@ -353,6 +382,33 @@ impl Machine {
                 Op::EndPou => return Flow::Return,
             }
         }
+    }
+
+    /// Runs fused rung `f` (its instruction's other operands given): its power, looked up from
+    /// its contacts, and its output written without a branch (a set or reset without power
+    /// writes the byte's own value back). Returns the power.
+    #[inline(always)]
+    fn fused_rung<S: Store + ?Sized>(
+        &self,
+        st: &mut S,
+        f: FusedId,
+        table: u16,
+        neg: u8,
+        mode: u8,
+    ) -> u64 {
+        let r = &self.fused[f.index()];
+        let mut bits = 0usize;
+        for (k, &at) in r.at.iter().enumerate() {
+            bits |= (st.load::<u8>(at) as usize) << k;
+        }
+        let p = lookup(&self.tables[table as usize], bits ^ neg as usize);
+        // Powered: bit 0 of the mode. Unpowered: the old value (set/reset, bit 1) or bit 2.
+        let m = mode as u64;
+        let (on, keep, off) = (m & 1, (m >> 1) & 1, (m >> 2) & 1);
+        let old = st.load::<u8>(r.out) as u64;
+        let unpowered = (keep & old) | ((keep ^ 1) & off);
+        st.store(r.out, ((p & on) | ((p ^ 1) & unpowered)) as u8);
+        p
     }
 
     /// Counts one loop-back of `rung` in its counter at `ctr`; returns whether it may loop back.

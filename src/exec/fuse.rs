@@ -1,0 +1,193 @@
+//! Whole-rung superinstructions: a rung that is only plain contacts (in series and in `or`s of
+//! series, at most [`MAX_CONTACTS`] in all) followed by one output (coil, negated coil, set or
+//! reset) is lowered to one [`Op::Fused`](super::lower::Op) instruction instead of a rung marker,
+//! contact instructions, `or` brackets and an output.
+//!
+//! At run time such a rung loads its contacts' bytes (always [`MAX_CONTACTS`] loads: slots past
+//! the rung's contacts repeat a byte the rung reads anyway), packs them into an 8-bit index, xors
+//! in the negation bits and looks the power up in the rung's truth table (256 bits): one uniform,
+//! branch-free instruction per rung, whatever the mix of series and `or`s and whatever the
+//! values. Truth tables are shared: most rungs of a program have one of a few shapes (`n`
+//! contacts in series, one `or` of two contacts then a series...), so the tables stay few and
+//! in the first-level cache.
+//!
+//! Why this is exact: plain contacts have no side effects and an `or` of such series evaluates
+//! every branch from the same power in (`exec` module docs), so the rung's power before its
+//! output is a pure boolean function of its contacts' values, which is what the table holds
+//! (computed once per distinct shape). An `or` with no branch (power passes unchanged) and rungs
+//! with anything else (edge contacts, compares, boxes, jumps, several outputs) are not fused
+//! and keep the general instructions.
+//!
+//! This is the classic superinstruction of threaded interpreters (Ertl and Gregg 2003: fewer,
+//! larger dispatches for the most frequent instruction sequences).
+
+use super::store::Addr;
+use crate::model::{index_type, ContactKind, Element, VarRef};
+use std::collections::HashMap;
+
+/// Contacts a fused rung may have: one byte of truth-table index.
+pub(crate) const MAX_CONTACTS: usize = 8;
+
+index_type!(
+    /// A fused rung's operands: index into the machine's `fused`.
+    FusedId
+);
+
+/// The operands of a fused rung: its contacts' bytes (padded) and its output's byte.
+#[derive(Copy, Clone, Debug)]
+pub(crate) struct FusedRung {
+    /// Contact `k`'s byte; slots past the rung's contacts repeat slot 0 (or the output's byte
+    /// when the rung has no contact). The table ignores them.
+    pub at: [Addr; MAX_CONTACTS],
+    /// The output's byte.
+    pub out: Addr,
+}
+
+/// A truth table over the 8-bit contact index: bit `i` is the power for index `i` (bit `k` of
+/// the index: contact `k` passes, i.e. its byte xor its negation).
+pub(crate) type Table = [u64; 4];
+
+/// The power of `table` at `index`.
+#[inline(always)]
+pub(crate) fn lookup(table: &Table, index: usize) -> u64 {
+    (table[(index >> 6) & 3] >> (index & 63)) & 1
+}
+
+/// The boolean structure of a rung's conditions over its contacts (numbered in order).
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+enum Cond {
+    /// Contact `k` passes.
+    Lit(u8),
+    /// A series: all pass (an empty series passes).
+    All(Vec<Cond>),
+    /// An `or` (at least one branch): one passes.
+    Any(Vec<Cond>),
+}
+
+impl Cond {
+    fn eval(&self, index: usize) -> bool {
+        match self {
+            Cond::Lit(k) => (index >> k) & 1 == 1,
+            Cond::All(v) => v.iter().all(|c| c.eval(index)),
+            Cond::Any(v) => v.iter().any(|c| c.eval(index)),
+        }
+    }
+
+    fn table(&self) -> Table {
+        let mut t = [0u64; 4];
+        for i in 0..256usize {
+            if self.eval(i) {
+                t[i >> 6] |= 1 << (i & 63);
+            }
+        }
+        t
+    }
+}
+
+/// A rung's conditions that can be fused: the contacts in evaluation order (variable, negated)
+/// and the structure over them.
+pub(crate) struct Shape {
+    pub contacts: Vec<(VarRef, bool)>,
+    cond: Cond,
+}
+
+/// The conditions `series` (everything before the rung's output) as a [`Shape`], or `None` if
+/// they hold anything but plain contacts and non-empty `or`s, or more than [`MAX_CONTACTS`]
+/// contacts.
+pub(crate) fn shape(series: &[Element]) -> Option<Shape> {
+    let mut contacts = Vec::new();
+    let cond = series_cond(series, &mut contacts)?;
+    Some(Shape { contacts, cond })
+}
+
+fn series_cond(series: &[Element], contacts: &mut Vec<(VarRef, bool)>) -> Option<Cond> {
+    let mut all = Vec::with_capacity(series.len());
+    for e in series {
+        match e {
+            Element::Contact { var, kind } => {
+                let neg = match kind {
+                    ContactKind::Normal => false,
+                    ContactKind::Negated => true,
+                    _ => return None,
+                };
+                if contacts.len() == MAX_CONTACTS {
+                    return None;
+                }
+                all.push(Cond::Lit(contacts.len() as u8));
+                contacts.push((*var, neg));
+            }
+            Element::Or(bs) if !bs.is_empty() => {
+                let any = bs
+                    .iter()
+                    .map(|b| series_cond(b, contacts))
+                    .collect::<Option<Vec<_>>>()?;
+                all.push(Cond::Any(any));
+            }
+            _ => return None,
+        }
+    }
+    Some(Cond::All(all))
+}
+
+/// The machine's truth tables, one per distinct shape.
+#[derive(Default)]
+pub(crate) struct Tables {
+    pub tables: Vec<Table>,
+    of: HashMap<Cond, u16>,
+}
+
+impl Tables {
+    /// The index of `shape`'s table (added if new), or `None` past 2^16 distinct tables.
+    pub(crate) fn index(&mut self, shape: &Shape) -> Option<u16> {
+        if let Some(&i) = self.of.get(&shape.cond) {
+            return Some(i);
+        }
+        let i = u16::try_from(self.tables.len()).ok()?;
+        self.tables.push(shape.cond.table());
+        self.of.insert(shape.cond.clone(), i);
+        Some(i)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lit(k: u8) -> Cond {
+        Cond::Lit(k)
+    }
+
+    #[test]
+    fn a_series_passes_only_when_every_contact_does() {
+        let t = Cond::All(vec![lit(0), lit(1), lit(2)]).table();
+        for i in 0..256 {
+            assert_eq!(lookup(&t, i), (i & 7 == 7) as u64, "index {i}");
+        }
+    }
+
+    #[test]
+    fn an_or_then_a_series() {
+        // (c0 c1 | c2) c3
+        let c = Cond::All(vec![
+            Cond::Any(vec![
+                Cond::All(vec![lit(0), lit(1)]),
+                Cond::All(vec![lit(2)]),
+            ]),
+            lit(3),
+        ]);
+        let t = c.table();
+        for i in 0..256usize {
+            let b = |k: usize| (i >> k) & 1 == 1;
+            let want = ((b(0) && b(1)) || b(2)) && b(3);
+            assert_eq!(lookup(&t, i), want as u64, "index {i}");
+        }
+    }
+
+    #[test]
+    fn an_empty_series_passes_and_bits_past_the_contacts_are_ignored() {
+        let t = Cond::All(vec![]).table();
+        assert!((0..256).all(|i| lookup(&t, i) == 1));
+        let t = Cond::All(vec![lit(0)]).table();
+        assert!((0..256).all(|i| lookup(&t, i) == (i & 1) as u64));
+    }
+}
