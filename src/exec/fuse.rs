@@ -5,22 +5,27 @@
 //!
 //! At run time such a rung loads its contacts' bytes (always [`MAX_CONTACTS`] loads: slots past
 //! the rung's contacts repeat a byte the rung reads anyway), packs them into an 8-bit index, xors
-//! in the negation bits and looks the power up in the rung's truth table (256 bits): one uniform,
-//! branch-free instruction per rung, whatever the mix of series and `or`s and whatever the
-//! values. Truth tables are shared: most rungs of a program have one of a few shapes (`n`
-//! contacts in series, one `or` of two contacts then a series...), so the tables stay few and
-//! in the first-level cache.
+//! in the negation bits, adds the output's old value as bit 8 and reads the output's new value
+//! from the rung's table (512 bits, one cache line): one uniform, branch-free instruction per
+//! rung, whatever the mix of series and `or`s, the kind of output and the values. Tables are
+//! shared: most rungs of a program have one of a few shapes (`n` contacts in series, one `or` of
+//! two contacts then a series...) and one of four outputs, so the tables stay few and in the
+//! first-level cache.
 //!
 //! Why this is exact: plain contacts have no side effects and an `or` of such series evaluates
 //! every branch from the same power in (`exec` module docs), so the rung's power before its
-//! output is a pure boolean function of its contacts' values, which is what the table holds
-//! (computed once per distinct shape). An `or` with no branch (power passes unchanged) and rungs
+//! output is a pure boolean function of its contacts' values, and the output's new value a
+//! function of that power and its old value (a set or reset without power keeps it: the old
+//! value is written back), which is what the table holds (computed once per distinct shape and
+//! output). The power after the output is not kept: the next instruction starts a rung or ends
+//! the POU. An `or` with no branch (power passes unchanged) and rungs
 //! with anything else (edge contacts, compares, boxes, jumps, several outputs) are not fused
 //! and keep the general instructions.
 //!
 //! This is the classic superinstruction of threaded interpreters (Ertl and Gregg 2003: fewer,
 //! larger dispatches for the most frequent instruction sequences).
 
+use super::lower::{OUT_COIL, OUT_NCOIL, OUT_RESET, OUT_SET};
 use super::store::Addr;
 use crate::model::{index_type, ContactKind, Element, VarRef};
 use std::collections::HashMap;
@@ -43,14 +48,27 @@ pub(crate) struct FusedRung {
     pub out: Addr,
 }
 
-/// A truth table over the 8-bit contact index: bit `i` is the power for index `i` (bit `k` of
-/// the index: contact `k` passes, i.e. its byte xor its negation).
-pub(crate) type Table = [u64; 4];
+/// A rung's table over a 9-bit index: bit `i` is the output's new value for index `i`, whose
+/// bit `k < 8` says contact `k` passes (its byte xor its negation) and bit 8 is the output's old
+/// value.
+pub(crate) type Table = [u64; 8];
 
-/// The power of `table` at `index`.
+/// Bit `index` of `table` (only the index's low 9 bits count).
 #[inline(always)]
-pub(crate) fn lookup(table: &Table, index: usize) -> u64 {
-    (table[(index >> 6) & 3] >> (index & 63)) & 1
+pub(crate) fn lookup(table: &Table, index: usize) -> u8 {
+    ((table[(index >> 6) & 7] >> (index & 63)) & 1) as u8
+}
+
+/// The new value of an output of kind `mode` (`OUT_COIL`...) given the power and its old value
+/// (the `exec` module's coil semantics).
+fn output(mode: u8, power: bool, old: bool) -> bool {
+    match mode {
+        OUT_COIL => power,
+        OUT_NCOIL => !power,
+        OUT_SET => power || old,
+        OUT_RESET => !power && old,
+        _ => unreachable!("an output mode"),
+    }
 }
 
 /// The boolean structure of a rung's conditions over its contacts (numbered in order).
@@ -73,10 +91,10 @@ impl Cond {
         }
     }
 
-    fn table(&self) -> Table {
-        let mut t = [0u64; 4];
-        for i in 0..256usize {
-            if self.eval(i) {
+    fn table(&self, mode: u8) -> Table {
+        let mut t = [0u64; 8];
+        for i in 0..512usize {
+            if output(mode, self.eval(i & 255), i >> 8 == 1) {
                 t[i >> 6] |= 1 << (i & 63);
             }
         }
@@ -129,22 +147,24 @@ fn series_cond(series: &[Element], contacts: &mut Vec<(VarRef, bool)>) -> Option
     Some(Cond::All(all))
 }
 
-/// The machine's truth tables, one per distinct shape.
+/// The machine's rung tables, one per distinct shape and output mode.
 #[derive(Default)]
 pub(crate) struct Tables {
     pub tables: Vec<Table>,
-    of: HashMap<Cond, u16>,
+    of: HashMap<(Cond, u8), u16>,
 }
 
 impl Tables {
-    /// The index of `shape`'s table (added if new), or `None` past 2^16 distinct tables.
-    pub(crate) fn index(&mut self, shape: &Shape) -> Option<u16> {
-        if let Some(&i) = self.of.get(&shape.cond) {
+    /// The index of the table of `shape` with an output of kind `mode` (`OUT_COIL`...), added if
+    /// new; `None` past 2^16 distinct tables.
+    pub(crate) fn index(&mut self, shape: &Shape, mode: u8) -> Option<u16> {
+        let key = (shape.cond.clone(), mode);
+        if let Some(&i) = self.of.get(&key) {
             return Some(i);
         }
         let i = u16::try_from(self.tables.len()).ok()?;
-        self.tables.push(shape.cond.table());
-        self.of.insert(shape.cond.clone(), i);
+        self.tables.push(shape.cond.table(mode));
+        self.of.insert(key, i);
         Some(i)
     }
 }
@@ -159,9 +179,26 @@ mod tests {
 
     #[test]
     fn a_series_passes_only_when_every_contact_does() {
-        let t = Cond::All(vec![lit(0), lit(1), lit(2)]).table();
-        for i in 0..256 {
-            assert_eq!(lookup(&t, i), (i & 7 == 7) as u64, "index {i}");
+        let t = Cond::All(vec![lit(0), lit(1), lit(2)]).table(OUT_COIL);
+        for i in 0..512 {
+            assert_eq!(lookup(&t, i), (i & 7 == 7) as u8, "index {i}");
+        }
+    }
+
+    #[test]
+    fn outputs_follow_the_coil_semantics() {
+        let c = Cond::All(vec![lit(0)]);
+        // (index, coil, negated coil, set, reset): bit 0 the power, bit 8 the old value.
+        for (i, coil, ncoil, set, reset) in [
+            (0, 0, 1, 0, 0),
+            (1, 1, 0, 1, 0),
+            (256, 0, 1, 1, 1),
+            (257, 1, 0, 1, 0),
+        ] {
+            assert_eq!(lookup(&c.table(OUT_COIL), i), coil, "coil {i}");
+            assert_eq!(lookup(&c.table(OUT_NCOIL), i), ncoil, "negated coil {i}");
+            assert_eq!(lookup(&c.table(OUT_SET), i), set, "set {i}");
+            assert_eq!(lookup(&c.table(OUT_RESET), i), reset, "reset {i}");
         }
     }
 
@@ -175,19 +212,19 @@ mod tests {
             ]),
             lit(3),
         ]);
-        let t = c.table();
-        for i in 0..256usize {
+        let t = c.table(OUT_COIL);
+        for i in 0..512usize {
             let b = |k: usize| (i >> k) & 1 == 1;
             let want = ((b(0) && b(1)) || b(2)) && b(3);
-            assert_eq!(lookup(&t, i), want as u64, "index {i}");
+            assert_eq!(lookup(&t, i), want as u8, "index {i}");
         }
     }
 
     #[test]
     fn an_empty_series_passes_and_bits_past_the_contacts_are_ignored() {
-        let t = Cond::All(vec![]).table();
-        assert!((0..256).all(|i| lookup(&t, i) == 1));
-        let t = Cond::All(vec![lit(0)]).table();
-        assert!((0..256).all(|i| lookup(&t, i) == (i & 1) as u64));
+        let t = Cond::All(vec![]).table(OUT_COIL);
+        assert!((0..512).all(|i| lookup(&t, i) == 1));
+        let t = Cond::All(vec![lit(0)]).table(OUT_COIL);
+        assert!((0..512).all(|i| lookup(&t, i) == (i & 1) as u8));
     }
 }

@@ -105,14 +105,13 @@ pub(crate) enum Op {
     Rung { id: RungId },
     /// A whole rung of plain contacts and one output (the `fuse` module), in place of its
     /// `Rung` marker and everything after it: leave if the rung is outside the region; the
-    /// power is bit `index ^ neg` of truth table `table`, the index packing the bytes of
-    /// `fused[f].at`; then the output at `fused[f].out` as [`Op::Coil`] with `mode`.
+    /// output at `fused[f].out` := bit `(index ^ neg) | old << 8` of table `table`, the index
+    /// packing the bytes of `fused[f].at`, `old` the output's value.
     Fused {
         id: RungId,
         f: FusedId,
         table: u16,
         neg: u8,
-        mode: u8,
     },
     /// Contact on a BOOL byte: `p &= v ^ neg` (`neg` 0 or 1).
     Contact { neg: u8, at: Addr },
@@ -423,7 +422,43 @@ pub(crate) fn lower(p: &Program, layout: &Layout) -> Result<Code, LowerError> {
             pou_end[pou.index()]
         };
     }
+    check(&code);
     Ok(code)
+}
+
+/// Checks what the interpreter's unchecked accesses rely on, once per machine: the last
+/// instruction is an `EndPou` (so falling through never leaves the array), every instruction
+/// index the code holds (jumps, calls, FOR tests and exits, rung starts, POU entries) is an
+/// instruction, and every fused rung's operands and table exist.
+///
+/// # Panics
+/// If lowering broke one of these (a bug, never bad input).
+fn check(code: &Code) {
+    let n = code.ops.len();
+    assert!(
+        matches!(code.ops.last(), Some(Op::EndPou)),
+        "lowering: the code ends with an EndPou"
+    );
+    let pcs = code.rung_op.iter().chain(&code.pou_entry);
+    let loops = code.fors.iter().flat_map(|l| [l.test, l.exit]);
+    let jumps = code.ops.iter().filter_map(|op| match *op {
+        Op::Jmp { to } | Op::JmpBack { to, .. } | Op::Call { to } => Some(to),
+        _ => None,
+    });
+    for pc in pcs.copied().chain(loops).chain(jumps) {
+        assert!(pc.index() < n, "lowering: instruction {} of {n}", pc.0);
+    }
+    for op in &code.ops {
+        if let Op::Fused { f, table, .. } = *op {
+            assert!(
+                f.index() < code.fused.len() && (table as usize) < code.tables.len(),
+                "lowering: a fused rung's operands"
+            );
+        }
+        if let Op::For { f } | Op::ForTest { f } | Op::Next { f } = *op {
+            assert!(f.index() < code.fors.len(), "lowering: a FOR loop");
+        }
+    }
 }
 
 impl Lowerer<'_> {
@@ -562,7 +597,7 @@ impl Lowerer<'_> {
         let Some(shape) = fuse::shape(conds) else {
             return false;
         };
-        let Some(table) = self.tables.index(&shape) else {
+        let Some(table) = self.tables.index(&shape, mode) else {
             return false;
         };
         let out = self.layout.start(var);
@@ -582,7 +617,6 @@ impl Lowerer<'_> {
             f,
             table,
             neg,
-            mode,
         });
         true
     }

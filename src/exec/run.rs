@@ -168,7 +168,11 @@ impl Machine {
         let mut s: u64 = 0;
         let b = |st: &S, at: Addr| st.load::<u8>(at) as u64;
         loop {
-            let op = ops[pc];
+            // SAFETY: `pc` < `ops.len()`: every entry and target is an instruction, and control
+            // falls through only from instructions before the last, an `EndPou`, which returns
+            // (`lower::check`, run by `Machine::new` on these immutable instructions; callers
+            // pass a POU entry, a rung start or a FOR test).
+            let op = *unsafe { ops.get_unchecked(pc) };
             pc += 1;
             match op {
                 Op::Rung { id } => {
@@ -183,24 +187,25 @@ impl Machine {
                     mut f,
                     mut table,
                     mut neg,
-                    mut mode,
                 } => loop {
                     // A run of fused rungs stays in this loop: one well-predicted branch per
-                    // rung instead of a dispatch through the jump table.
+                    // rung instead of a dispatch through the jump table. The power is dead
+                    // after a fused rung (the next instruction starts a rung or ends the POU).
                     if !inside(id) {
                         return Flow::Rung(id);
                     }
                     rung = id;
-                    p = self.fused_rung(st, f, table, neg, mode);
-                    match ops[pc] {
+                    self.fused_rung(st, f, table, neg);
+                    // SAFETY: `pc` < `ops.len()`: a fused rung is never the last instruction
+                    // (`lower::check`, run by `Machine::new`).
+                    match *unsafe { ops.get_unchecked(pc) } {
                         Op::Fused {
                             id: i,
                             f: g,
                             table: t,
                             neg: n,
-                            mode: m,
                         } => {
-                            (id, f, table, neg, mode) = (i, g, t, n, m);
+                            (id, f, table, neg) = (i, g, t, n);
                             pc += 1;
                         }
                         _ => break,
@@ -384,31 +389,24 @@ impl Machine {
         }
     }
 
-    /// Runs fused rung `f` (its instruction's other operands given): its power, looked up from
-    /// its contacts, and its output written without a branch (a set or reset without power
-    /// writes the byte's own value back). Returns the power.
+    /// Runs fused rung `f` (its instruction's other operands given): its output's new value
+    /// looked up from its contacts and its old value, written without a branch.
     #[inline(always)]
-    fn fused_rung<S: Store + ?Sized>(
-        &self,
-        st: &mut S,
-        f: FusedId,
-        table: u16,
-        neg: u8,
-        mode: u8,
-    ) -> u64 {
-        let r = &self.fused[f.index()];
+    fn fused_rung<S: Store + ?Sized>(&self, st: &mut S, f: FusedId, table: u16, neg: u8) {
+        // SAFETY: every fused rung's operands and table exist (`lower::check`, run by
+        // `Machine::new` on these immutable instructions).
+        let (r, t) = unsafe {
+            (
+                self.fused.get_unchecked(f.index()),
+                self.tables.get_unchecked(table as usize),
+            )
+        };
         let mut bits = 0usize;
         for (k, &at) in r.at.iter().enumerate() {
             bits |= (st.load::<u8>(at) as usize) << k;
         }
-        let p = lookup(&self.tables[table as usize], bits ^ neg as usize);
-        // Powered: bit 0 of the mode. Unpowered: the old value (set/reset, bit 1) or bit 2.
-        let m = mode as u64;
-        let (on, keep, off) = (m & 1, (m >> 1) & 1, (m >> 2) & 1);
-        let old = st.load::<u8>(r.out) as u64;
-        let unpowered = (keep & old) | ((keep ^ 1) & off);
-        st.store(r.out, ((p & on) | ((p ^ 1) & unpowered)) as u8);
-        p
+        let old = st.load::<u8>(r.out) as usize;
+        st.store(r.out, lookup(t, (bits ^ neg as usize) | old << 8));
     }
 
     /// Counts one loop-back of `rung` in its counter at `ctr`; returns whether it may loop back.
