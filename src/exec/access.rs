@@ -78,6 +78,10 @@ impl Machine {
                     reads.push(byte(r.out));
                     writes.push(byte(r.out));
                 }
+                Op::FusedHead { f, .. } => {
+                    let r = &self.fused[f.index()];
+                    reads.extend(r.at.iter().map(|&a| byte(a)));
+                }
                 Op::Rung { .. }
                 | Op::OrOpen
                 | Op::OrNext

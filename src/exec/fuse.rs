@@ -1,7 +1,9 @@
 //! Whole-rung superinstructions: a rung that is only plain contacts (in series and in `or`s of
 //! series, at most [`MAX_CONTACTS`] in all) followed by one output (coil, negated coil, set or
 //! reset) is lowered to one [`Op::Fused`](super::lower::Op) instruction instead of a rung marker,
-//! contact instructions, `or` brackets and an output.
+//! contact instructions, `or` brackets and an output. Any other rung that starts with such
+//! contacts gets one [`Op::FusedHead`](super::lower::Op) for its marker and those contacts (the
+//! power they give, from the same kind of table), then the general instructions of the rest.
 //!
 //! At run time such a rung loads its contacts' bytes (always [`MAX_CONTACTS`] loads: slots past
 //! the rung's contacts repeat a byte the rung reads anyway), packs them into an 8-bit index, xors
@@ -107,6 +109,21 @@ impl Cond {
 pub(crate) struct Shape {
     pub contacts: Vec<(VarRef, bool)>,
     cond: Cond,
+}
+
+/// How many leading elements of `series` a head can take: plain contacts and `or`s of them,
+/// with at most [`MAX_CONTACTS`] contacts in all.
+pub(crate) fn prefix_len(series: &[Element]) -> usize {
+    let mut contacts = 0;
+    series
+        .iter()
+        .take_while(|e| {
+            let mut probe = Vec::new();
+            let fits = series_cond(std::slice::from_ref(*e), &mut probe).is_some();
+            contacts += probe.len();
+            fits && contacts <= MAX_CONTACTS
+        })
+        .count()
 }
 
 /// The conditions `series` (everything before the rung's output) as a [`Shape`], or `None` if

@@ -113,6 +113,16 @@ pub(crate) enum Op {
         table: u16,
         neg: u8,
     },
+    /// The start of a rung whose first elements are plain contacts (the `fuse` module), in
+    /// place of its `Rung` marker and those contacts: leave if the rung is outside the region;
+    /// power := bit `index ^ neg` of table `table` (a coil's: bit 8 does not count), the index
+    /// packing the bytes of `fused[f].at`. The rest of the rung follows.
+    FusedHead {
+        id: RungId,
+        f: FusedId,
+        table: u16,
+        neg: u8,
+    },
     /// Contact on a BOOL byte: `p &= v ^ neg` (`neg` 0 or 1).
     Contact { neg: u8, at: Addr },
     /// Two consecutive contacts (negation bits 0 and 1 of `neg`).
@@ -208,7 +218,7 @@ impl Op {
     /// The rung this instruction starts, if it starts one (a marker or a fused rung).
     pub(crate) fn starts_rung(&self) -> Option<RungId> {
         match *self {
-            Op::Rung { id } | Op::Fused { id, .. } => Some(id),
+            Op::Rung { id } | Op::Fused { id, .. } | Op::FusedHead { id, .. } => Some(id),
             _ => None,
         }
     }
@@ -370,13 +380,13 @@ pub(crate) fn lower(p: &Program, layout: &Layout) -> Result<Code, LowerError> {
         for r in pou.rungs.clone() {
             let rung = &p.rungs[r as usize];
             l.code.rung_op[r as usize] = l.pc();
-            if l.fused(RungId(r), &rung.series) {
-                continue;
+            let done = l.fused(RungId(r), &rung.series);
+            if done == 0 {
+                l.code.ops.push(Op::Rung { id: RungId(r) });
             }
-            l.code.ops.push(Op::Rung { id: RungId(r) });
             l.depth = 0;
             l.max_depth = 0;
-            l.series(RungId(r), &rung.series);
+            l.series(RungId(r), &rung.series[done..]);
             if l.max_depth > 64 {
                 return Err(LowerError::TooDeep {
                     rung: rung.id.clone(),
@@ -449,7 +459,7 @@ fn check(code: &Code) {
         assert!(pc.index() < n, "lowering: instruction {} of {n}", pc.0);
     }
     for op in &code.ops {
-        if let Op::Fused { f, table, .. } = *op {
+        if let Op::Fused { f, table, .. } | Op::FusedHead { f, table, .. } = *op {
             assert!(
                 f.index() < code.fused.len() && (table as usize) < code.tables.len(),
                 "lowering: a fused rung's operands"
@@ -583,40 +593,67 @@ impl Lowerer<'_> {
         self.depth -= bits;
     }
 
-    /// Lowers rung `rung` as one [`Op::Fused`] if its shape allows (`fuse`); whether it did.
-    fn fused(&mut self, rung: RungId, series: &[Element]) -> bool {
-        let Some((last, conds)) = series.split_last() else {
+    /// Starts rung `rung` with a fused instruction if its shape allows (`fuse`): the whole rung
+    /// as one [`Op::Fused`], or its leading contacts as an [`Op::FusedHead`]. Returns how many
+    /// of its elements that took (0: none, and no instruction was emitted).
+    fn fused(&mut self, rung: RungId, series: &[Element]) -> usize {
+        let output = |e: &Element| match *e {
+            Element::Coil { var, negated } => {
+                Some((var, if negated { OUT_NCOIL } else { OUT_COIL }))
+            }
+            Element::Set(var) => Some((var, OUT_SET)),
+            Element::Reset(var) => Some((var, OUT_RESET)),
+            _ => None,
+        };
+        if let Some((last, conds)) = series.split_last() {
+            if let (Some((var, mode)), Some(shape)) = (output(last), fuse::shape(conds)) {
+                let out = self.layout.start(var);
+                if self.fused_op(rung, &shape, mode, Some(out)) {
+                    return series.len();
+                }
+            }
+        }
+        let k = fuse::prefix_len(series);
+        match fuse::shape(&series[..k]) {
+            Some(shape)
+                if !shape.contacts.is_empty() && self.fused_op(rung, &shape, OUT_COIL, None) =>
+            {
+                k
+            }
+            _ => 0,
+        }
+    }
+
+    /// Emits the fused instruction of `shape`: a whole rung writing `out` with an output of kind
+    /// `mode`, or (no `out`) a head giving the power. False if the tables are full.
+    fn fused_op(&mut self, rung: RungId, shape: &fuse::Shape, mode: u8, out: Option<Addr>) -> bool {
+        let Some(table) = self.tables.index(shape, mode) else {
             return false;
         };
-        let (var, mode) = match *last {
-            Element::Coil { var, negated } => (var, if negated { OUT_NCOIL } else { OUT_COIL }),
-            Element::Set(var) => (var, OUT_SET),
-            Element::Reset(var) => (var, OUT_RESET),
-            _ => return false,
-        };
-        let Some(shape) = fuse::shape(conds) else {
-            return false;
-        };
-        let Some(table) = self.tables.index(&shape, mode) else {
-            return false;
-        };
-        let out = self.layout.start(var);
-        let mut at = [out; MAX_CONTACTS];
+        let mut at = [Addr(0); MAX_CONTACTS];
         let mut neg = 0u8;
         for (k, &(v, n)) in shape.contacts.iter().enumerate() {
             at[k] = self.addr(v);
             neg |= (n as u8) << k;
         }
-        for k in shape.contacts.len().max(1)..MAX_CONTACTS {
-            at[k] = at[0];
+        // Padding repeats a byte the rung reads anyway (a head always has a contact).
+        let pad = if shape.contacts.is_empty() {
+            out.unwrap_or(at[0])
+        } else {
+            at[0]
+        };
+        for slot in at.iter_mut().skip(shape.contacts.len()) {
+            *slot = pad;
         }
         let f = FusedId(self.code.fused.len() as u32);
-        self.code.fused.push(FusedRung { at, out });
-        self.push(Op::Fused {
-            id: rung,
-            f,
-            table,
-            neg,
+        self.code.fused.push(FusedRung {
+            at,
+            out: out.unwrap_or(at[0]),
+        });
+        let id = rung;
+        self.push(match out {
+            Some(_) => Op::Fused { id, f, table, neg },
+            None => Op::FusedHead { id, f, table, neg },
         });
         true
     }

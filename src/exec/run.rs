@@ -3,7 +3,7 @@
 //! `i16`, DINT and TIME an `i32`, REAL an `f32`, at the addresses lowering put in the
 //! instructions. Arithmetic widens to `i64` and wraps back to the type's width.
 
-use super::fuse::{lookup, FusedId};
+use super::fuse::{lookup, FusedId, FusedRung};
 use super::layout::{CV, ET, FLAGS, PREV, PT, PV, Q, START};
 use super::lower::{Num, Op, Width};
 use super::store::{Addr, Word};
@@ -211,6 +211,13 @@ impl Machine {
                         _ => break,
                     }
                 },
+                Op::FusedHead { id, f, table, neg } => {
+                    if !inside(id) {
+                        return Flow::Rung(id);
+                    }
+                    rung = id;
+                    p = self.fused_power(st, f, table, neg) as u64;
+                }
                 Op::Contact { neg, at } => p &= b(st, at) ^ neg as u64,
                 Op::Contact2 { neg, a, b: c } => {
                     // Both BOOLs (each 0 or 1) must equal their negation bit's complement.
@@ -401,12 +408,24 @@ impl Machine {
                 self.tables.get_unchecked(table as usize),
             )
         };
-        let mut bits = 0usize;
-        for (k, &at) in r.at.iter().enumerate() {
-            bits |= (st.load::<u8>(at) as usize) << k;
-        }
         let old = st.load::<u8>(r.out) as usize;
-        st.store(r.out, lookup(t, (bits ^ neg as usize) | old << 8));
+        st.store(
+            r.out,
+            lookup(t, (contact_bits(st, r) ^ neg as usize) | old << 8),
+        );
+    }
+
+    /// The power fused head `f` gives (its instruction's other operands given).
+    #[inline(always)]
+    fn fused_power<S: Store + ?Sized>(&self, st: &S, f: FusedId, table: u16, neg: u8) -> u8 {
+        // SAFETY: as in `fused_rung`.
+        let (r, t) = unsafe {
+            (
+                self.fused.get_unchecked(f.index()),
+                self.tables.get_unchecked(table as usize),
+            )
+        };
+        lookup(t, contact_bits(st, r) ^ neg as usize)
     }
 
     /// Counts one loop-back of `rung` in its counter at `ctr`; returns whether it may loop back.
@@ -435,6 +454,16 @@ impl Machine {
         }
         false
     }
+}
+
+/// The bytes of a fused rung's contact slots, slot `k` in bit `k`.
+#[inline(always)]
+fn contact_bits<S: Store + ?Sized>(st: &S, r: &FusedRung) -> usize {
+    let mut bits = 0usize;
+    for (k, &at) in r.at.iter().enumerate() {
+        bits |= (st.load::<u8>(at) as usize) << k;
+    }
+    bits
 }
 
 /// TON on the instance at `i`; returns Q.
