@@ -306,6 +306,8 @@ struct Lowerer<'p> {
     next_const: u64,
     /// The fused rungs' truth tables, shared by shape.
     tables: Tables,
+    /// Whether to emit fused instructions.
+    fuse: bool,
     depth: u32,
     max_depth: u32,
 }
@@ -337,7 +339,9 @@ fn loop_counters(p: &Program, layout: &Layout) -> (Vec<(RungId, Addr)>, u64) {
     (counters, next)
 }
 
-pub(crate) fn lower(p: &Program, layout: &Layout) -> Result<Code, LowerError> {
+/// Lowers `p` with `layout`; `fuse` chooses the fused instructions (the `fuse` module) where a
+/// rung allows them (off: only the general instructions, the reference they are tested against).
+pub(crate) fn lower(p: &Program, layout: &Layout, fuse: bool) -> Result<Code, LowerError> {
     if layout.var_count() != p.vars.len() {
         return Err(LowerError::LayoutMismatch {
             expected: p.vars.len(),
@@ -371,6 +375,7 @@ pub(crate) fn lower(p: &Program, layout: &Layout) -> Result<Code, LowerError> {
         counter_of,
         next_const: counters_end,
         tables: Tables::default(),
+        fuse,
         depth: 0,
         max_depth: 0,
     };
@@ -597,6 +602,9 @@ impl Lowerer<'_> {
     /// as one [`Op::Fused`], or its leading contacts as an [`Op::FusedHead`]. Returns how many
     /// of its elements that took (0: none, and no instruction was emitted).
     fn fused(&mut self, rung: RungId, series: &[Element]) -> usize {
+        if !self.fuse {
+            return 0;
+        }
         let output = |e: &Element| match *e {
             Element::Coil { var, negated } => {
                 Some((var, if negated { OUT_NCOIL } else { OUT_COIL }))

@@ -115,6 +115,8 @@
 mod access;
 mod fb;
 mod fuse;
+#[cfg(test)]
+mod fuse_tests;
 mod layout;
 mod lower;
 mod mem;
@@ -268,7 +270,27 @@ impl Machine {
         layout: Layout,
         config: &ExecConfig,
     ) -> Result<Machine, LowerError> {
-        let code = lower::lower(program, &layout)?;
+        Machine::build(program, layout, config, true)
+    }
+
+    /// [`Machine::new`] with only the general instructions (no fused rungs): the reference the
+    /// fused instructions are tested against.
+    #[cfg(test)]
+    pub(crate) fn new_unfused(
+        program: &Program,
+        layout: Layout,
+        config: &ExecConfig,
+    ) -> Result<Machine, LowerError> {
+        Machine::build(program, layout, config, false)
+    }
+
+    fn build(
+        program: &Program,
+        layout: Layout,
+        config: &ExecConfig,
+        fuse: bool,
+    ) -> Result<Machine, LowerError> {
+        let code = lower::lower(program, &layout, fuse)?;
         Ok(Machine {
             main_first: RungId(program.main().rungs.start),
             ops: code.ops,
