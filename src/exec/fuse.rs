@@ -29,7 +29,7 @@
 
 use super::lower::{OUT_COIL, OUT_NCOIL, OUT_RESET, OUT_SET};
 use super::store::Addr;
-use crate::model::{index_type, ContactKind, Element, VarRef};
+use crate::model::{index_type, ContactKind, Element, VarId, VarRef};
 use std::collections::HashMap;
 
 /// Contacts a fused rung may have: one byte of truth-table index.
@@ -46,7 +46,7 @@ pub(crate) struct FusedRung {
     /// Contact `k`'s byte; slots past the rung's contacts repeat slot 0 (or the output's byte
     /// when the rung has no contact). The table ignores them.
     pub at: [Addr; MAX_CONTACTS],
-    /// The output's byte.
+    /// The output's byte (a head's: slot 0, never written).
     pub out: Addr,
 }
 
@@ -106,14 +106,14 @@ impl Cond {
 
 /// A rung's conditions that can be fused: the contacts in evaluation order (variable, negated)
 /// and the structure over them.
-pub(crate) struct Shape {
-    pub contacts: Vec<(VarRef, bool)>,
+struct Shape {
+    contacts: Vec<(VarRef, bool)>,
     cond: Cond,
 }
 
 /// How many leading elements of `series` a head can take: plain contacts and `or`s of them,
 /// with at most [`MAX_CONTACTS`] contacts in all.
-pub(crate) fn prefix_len(series: &[Element]) -> usize {
+fn prefix_len(series: &[Element]) -> usize {
     let mut contacts = 0;
     series
         .iter()
@@ -129,7 +129,7 @@ pub(crate) fn prefix_len(series: &[Element]) -> usize {
 /// The conditions `series` (everything before the rung's output) as a [`Shape`], or `None` if
 /// they hold anything but plain contacts and non-empty `or`s, or more than [`MAX_CONTACTS`]
 /// contacts.
-pub(crate) fn shape(series: &[Element]) -> Option<Shape> {
+fn shape(series: &[Element]) -> Option<Shape> {
     let mut contacts = Vec::new();
     let cond = series_cond(series, &mut contacts)?;
     Some(Shape { contacts, cond })
@@ -164,6 +164,80 @@ fn series_cond(series: &[Element], contacts: &mut Vec<(VarRef, bool)>) -> Option
     Some(Cond::All(all))
 }
 
+/// A fused start of a rung: its instruction's operands.
+pub(crate) struct Start {
+    /// Whether it is the whole rung (`Op::Fused`) or a head (`Op::FusedHead`).
+    pub whole: bool,
+    /// How many of the rung's elements it takes.
+    pub taken: usize,
+    pub operands: FusedRung,
+    pub table: u16,
+    pub neg: u8,
+}
+
+/// How the rung `series` starts fused, if its shape allows: the whole rung (plain contacts,
+/// then one output), else a head of its leading plain contacts (at least one), else `None`
+/// (also when the tables are full). `addr` gives a contact's byte, `start` an output's.
+pub(crate) fn start(
+    series: &[Element],
+    tables: &mut Tables,
+    addr: impl Fn(VarRef) -> Addr,
+    start: impl Fn(VarId) -> Addr,
+) -> Option<Start> {
+    let output = |e: &Element| match *e {
+        Element::Coil { var, negated } => Some((var, if negated { OUT_NCOIL } else { OUT_COIL })),
+        Element::Set(var) => Some((var, OUT_SET)),
+        Element::Reset(var) => Some((var, OUT_RESET)),
+        _ => None,
+    };
+    if let Some((last, conds)) = series.split_last() {
+        if let (Some((var, mode)), Some(s)) = (output(last), shape(conds)) {
+            if let Some(table) = tables.index(&s, mode) {
+                let (operands, neg) = operands(&s, &addr, Some(start(var)));
+                let (whole, taken) = (true, series.len());
+                return Some(Start {
+                    whole,
+                    taken,
+                    operands,
+                    table,
+                    neg,
+                });
+            }
+        }
+    }
+    let taken = prefix_len(series);
+    let s = shape(&series[..taken]).filter(|s| !s.contacts.is_empty())?;
+    let table = tables.index(&s, OUT_COIL)?;
+    let (operands, neg) = operands(&s, &addr, None);
+    Some(Start {
+        whole: false,
+        taken,
+        operands,
+        table,
+        neg,
+    })
+}
+
+/// The operands of `shape` (output `out`, or none for a head) and its negation bits.
+fn operands(shape: &Shape, addr: impl Fn(VarRef) -> Addr, out: Option<Addr>) -> (FusedRung, u8) {
+    let mut at = [Addr(0); MAX_CONTACTS];
+    let mut neg = 0u8;
+    for (k, &(v, n)) in shape.contacts.iter().enumerate() {
+        at[k] = addr(v);
+        neg |= (n as u8) << k;
+    }
+    // Padding repeats a byte the rung reads anyway (a head always has a contact).
+    let pad = match (shape.contacts.is_empty(), out) {
+        (true, Some(out)) => out,
+        _ => at[0],
+    };
+    for slot in at.iter_mut().skip(shape.contacts.len()) {
+        *slot = pad;
+    }
+    let out = out.unwrap_or(at[0]);
+    (FusedRung { at, out }, neg)
+}
+
 /// The machine's rung tables, one per distinct shape and output mode.
 #[derive(Default)]
 pub(crate) struct Tables {
@@ -174,7 +248,7 @@ pub(crate) struct Tables {
 impl Tables {
     /// The index of the table of `shape` with an output of kind `mode` (`OUT_COIL`...), added if
     /// new; `None` past 2^16 distinct tables.
-    pub(crate) fn index(&mut self, shape: &Shape, mode: u8) -> Option<u16> {
+    fn index(&mut self, shape: &Shape, mode: u8) -> Option<u16> {
         let key = (shape.cond.clone(), mode);
         if let Some(&i) = self.of.get(&key) {
             return Some(i);

@@ -1,7 +1,9 @@
 //! Lowering: the model's element trees → one flat instruction array, once, at load.
 //!
 //! Every POU is a run of instructions: for each rung a [`Op::Rung`] marker then its elements in
-//! evaluation order, and after its last rung an [`Op::EndPou`]. Falling through from one rung to
+//! evaluation order (or, where the rung's shape allows, one [`Op::Fused`] for the whole rung or
+//! an [`Op::FusedHead`] for its marker and leading contacts: the `fuse` module), and after its
+//! last rung an [`Op::EndPou`]. Falling through from one rung to
 //! the next is just executing the next instruction. Jumps, calls and FOR exits carry
 //! instruction indices ([`Pc`]), patched once all rungs are placed. Operands are byte addresses
 //! ([`Addr`]) in the state: a variable's (from the [`Layout`]), or a constant's: constants live
@@ -16,7 +18,7 @@
 //! its branches so far; a `branch` one: its power in). Lowering refuses nesting deeper than that.
 
 use super::fb::{CtudId, CtudPins};
-use super::fuse::{self, FusedId, FusedRung, Table, Tables, MAX_CONTACTS};
+use super::fuse::{self, FusedId, FusedRung, Table, Tables};
 use super::layout::{field_offset, type_align, Layout, Repr};
 use super::mem::LINE_BYTES;
 use super::store::Addr;
@@ -488,9 +490,7 @@ impl Lowerer<'_> {
     }
 
     fn addr(&self, r: VarRef) -> Addr {
-        self.layout
-            .start(r.var)
-            .offset(r.field.map_or(0, field_offset))
+        var_addr(self.layout, r)
     }
 
     fn operand(&mut self, o: &Operand) -> Addr {
@@ -605,65 +605,19 @@ impl Lowerer<'_> {
         if !self.fuse {
             return 0;
         }
-        let output = |e: &Element| match *e {
-            Element::Coil { var, negated } => {
-                Some((var, if negated { OUT_NCOIL } else { OUT_COIL }))
-            }
-            Element::Set(var) => Some((var, OUT_SET)),
-            Element::Reset(var) => Some((var, OUT_RESET)),
-            _ => None,
+        let (layout, tables) = (self.layout, &mut self.tables);
+        let addr = |r: VarRef| var_addr(layout, r);
+        let Some(start) = fuse::start(series, tables, addr, |v| layout.start(v)) else {
+            return 0;
         };
-        if let Some((last, conds)) = series.split_last() {
-            if let (Some((var, mode)), Some(shape)) = (output(last), fuse::shape(conds)) {
-                let out = self.layout.start(var);
-                if self.fused_op(rung, &shape, mode, Some(out)) {
-                    return series.len();
-                }
-            }
-        }
-        let k = fuse::prefix_len(series);
-        match fuse::shape(&series[..k]) {
-            Some(shape)
-                if !shape.contacts.is_empty() && self.fused_op(rung, &shape, OUT_COIL, None) =>
-            {
-                k
-            }
-            _ => 0,
-        }
-    }
-
-    /// Emits the fused instruction of `shape`: a whole rung writing `out` with an output of kind
-    /// `mode`, or (no `out`) a head giving the power. False if the tables are full.
-    fn fused_op(&mut self, rung: RungId, shape: &fuse::Shape, mode: u8, out: Option<Addr>) -> bool {
-        let Some(table) = self.tables.index(shape, mode) else {
-            return false;
-        };
-        let mut at = [Addr(0); MAX_CONTACTS];
-        let mut neg = 0u8;
-        for (k, &(v, n)) in shape.contacts.iter().enumerate() {
-            at[k] = self.addr(v);
-            neg |= (n as u8) << k;
-        }
-        // Padding repeats a byte the rung reads anyway (a head always has a contact).
-        let pad = if shape.contacts.is_empty() {
-            out.unwrap_or(at[0])
-        } else {
-            at[0]
-        };
-        for slot in at.iter_mut().skip(shape.contacts.len()) {
-            *slot = pad;
-        }
         let f = FusedId(self.code.fused.len() as u32);
-        self.code.fused.push(FusedRung {
-            at,
-            out: out.unwrap_or(at[0]),
+        self.code.fused.push(start.operands);
+        let (id, table, neg) = (rung, start.table, start.neg);
+        self.push(match start.whole {
+            true => Op::Fused { id, f, table, neg },
+            false => Op::FusedHead { id, f, table, neg },
         });
-        let id = rung;
-        self.push(match out {
-            Some(_) => Op::Fused { id, f, table, neg },
-            None => Op::FusedHead { id, f, table, neg },
-        });
-        true
+        start.taken
     }
 
     fn coil(&mut self, var: VarId, mode: u8) {
@@ -816,6 +770,11 @@ impl Lowerer<'_> {
             }
         }
     }
+}
+
+/// The address of a variable or instance field.
+fn var_addr(layout: &Layout, r: VarRef) -> Addr {
+    layout.start(r.var).offset(r.field.map_or(0, field_offset))
 }
 
 /// The stored bits of a scalar (to tell constants apart).

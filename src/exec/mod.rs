@@ -94,10 +94,15 @@
 //! strings. Contacts on BOOLs and coils are a byte load, an and (xor for negation) and a byte
 //! store; constants are bytes of the state too, so every operand is one typed load; `or`/`branch` keep their
 //! saved powers in a 64-bit register. The cost of an interpreter is its dispatches, and above
-//! all the mispredicted ones, so consecutive contacts are fused (up to six in one instruction
-//! when their addresses fit in 16 bits) and every output (coil, negated coil, set, reset) is one
-//! instruction computed without a branch: a typical rung is three uniform dispatches (rung,
-//! contacts, output). The address of each variable comes from a [`Layout`], so a
+//! all the mispredicted ones, so a rung of plain contacts (in series and `or`s, up to eight)
+//! and one output is one instruction (`fuse`: the contacts' bytes index a shared table that
+//! gives the output's new value, without a branch), and runs of such rungs loop without going
+//! back through the dispatch; any other rung that starts with plain contacts starts with one
+//! instruction for its marker and those contacts. Elsewhere consecutive contacts are fused (up
+//! to six in one instruction when their addresses fit in 16 bits) and every output (coil,
+//! negated coil, set, reset) is one instruction computed without a branch. The instruction,
+//! operand and table reads are unchecked, behind a check of the lowered code when the machine
+//! is built. The address of each variable comes from a [`Layout`], so a
 //! parallel executor can permute and pad variables. Memory is accessed through the [`Store`]
 //! trait's typed loads and stores, monomorphised, so the same interpreter runs on a plain `[u8]`
 //! and on a shared store. A state's memory ([`Mem`]) starts on a 64-byte line.
