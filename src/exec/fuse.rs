@@ -8,7 +8,7 @@
 //! At run time such a rung loads its contacts' bytes (always [`MAX_CONTACTS`] loads: slots past
 //! the rung's contacts repeat a byte the rung reads anyway), packs them into an 8-bit index, xors
 //! in the negation bits, adds the output's old value as bit 8 and reads the output's new value
-//! from the rung's table (512 bits, one cache line): one uniform, branch-free instruction per
+//! from the rung's table (512 bits, 64 bytes): one uniform, branch-free instruction per
 //! rung, whatever the mix of series and `or`s, the kind of output and the values. Tables are
 //! shared: most rungs of a program have one of a few shapes (`n` contacts in series, one `or` of
 //! two contacts then a series...) and one of four outputs, so the tables stay few and in the
@@ -20,12 +20,13 @@
 //! function of that power and its old value (a set or reset without power keeps it: the old
 //! value is written back), which is what the table holds (computed once per distinct shape and
 //! output). The power after the output is not kept: the next instruction starts a rung or ends
-//! the POU. An `or` with no branch (power passes unchanged) and rungs
-//! with anything else (edge contacts, compares, boxes, jumps, several outputs) are not fused
-//! and keep the general instructions.
+//! the POU. Rungs with an `or` of no branch (power passes unchanged) or anything else (edge
+//! contacts, compares, boxes, jumps, several outputs) are not fused whole: they keep the general
+//! instructions, after a head when they start with plain contacts.
 //!
-//! This is the classic superinstruction of threaded interpreters (Ertl and Gregg 2003: fewer,
-//! larger dispatches for the most frequent instruction sequences).
+//! This is the superinstruction of fast interpreters (Ertl and Gregg 2003: fewer, larger
+//! dispatches for the most frequent instruction sequences). Not here: the general instructions
+//! (`lower`, `run`).
 
 use super::lower::{OUT_COIL, OUT_NCOIL, OUT_RESET, OUT_SET};
 use super::store::Addr;
