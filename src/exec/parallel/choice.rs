@@ -338,7 +338,8 @@ impl Chooser {
     }
 
     /// Starts a re-measurement: of every candidate after a jump in scan time (`jump`), else of
-    /// the current one and the best of the others at their last measurement.
+    /// the current one, the default (candidate 0: the sequential walk of a run, the one a run
+    /// must never be slower than) and the best of the others at their last measurement.
     fn remeasure(&mut self, jump: Option<String>) {
         if !self.recent.is_empty() {
             self.estimate[self.current] = Some(lower_median(&mut self.recent.clone()));
@@ -351,7 +352,12 @@ impl Chooser {
             .min_by_key(|&c| self.estimate[c]);
         let mut who = vec![self.current];
         match (&jump, runner_up) {
-            (None, Some(r)) => who.push(r),
+            (None, Some(r)) => {
+                if self.current != 0 && r != 0 {
+                    who.push(0);
+                }
+                who.push(r);
+            }
             _ => who.extend(others),
         }
         if jump.is_some() {
@@ -598,24 +604,27 @@ mod tests {
     }
 
     #[test]
-    fn re_measurements_compare_with_the_runner_up_and_the_interval_doubles() {
-        let mut ch = Chooser::new(3, measure(), 0);
-        let ns = |c: usize, _: u64, _: bool| [100_000, 60_000, 70_000][c];
-        let ran = drive(&mut ch, 3, 4000, ns);
-        // After the first measurement, only the runner-up (candidate 2) is timed again, after
-        // 128, 256, 512, 1024 and 2048 scans on candidate 1.
-        let after: Vec<usize> = ran[27..].to_vec();
-        assert!(!after.contains(&0), "the slowest is not measured again");
-        let probes = after.iter().filter(|&&c| c == 2).count();
-        assert_eq!(probes, 4 * 3 * 3, "three visits in each of four re-measurements");
+    fn re_measurements_compare_with_the_default_and_the_runner_up_and_the_interval_doubles() {
+        let mut ch = Chooser::new(4, measure(), 0);
+        let ns = |c: usize, _: u64, _: bool| [100_000, 60_000, 70_000, 90_000][c];
+        let ran = drive(&mut ch, 4, 4000, ns);
+        // After the first measurement, the default (candidate 0) and the runner-up (2) are
+        // timed again, after 128, 256, 512 and 1024 scans on candidate 1; candidate 3 is not.
+        let after: Vec<usize> = ran[36..].to_vec();
+        assert!(!after.contains(&3), "a slower candidate is not measured again");
+        for c in [0, 2] {
+            let probes = after.iter().filter(|&&x| x == c).count();
+            assert_eq!(probes, 4 * 3 * 3, "three visits in each of four re-measurements");
+        }
         let gaps: Vec<usize> = after
-            .split(|&c| c == 2)
+            .split(|&c| c != 1)
             .map(<[usize]>::len)
             .filter(|&n| n > 100)
             .collect();
         // Scans on candidate 1 between two re-measurements (the interval, and the visit of
         // candidate 1 that opens the re-measurement).
-        assert_eq!(gaps, [128 + 3, 256 + 3, 512 + 3, 1024 + 3, 4000 - 2016]);
+        assert_eq!(gaps.len(), 5, "{gaps:?}");
+        assert_eq!(gaps[..4], [128 + 3, 256 + 3, 512 + 3, 1024 + 3]);
         assert_eq!(ch.switches().len(), 1);
     }
 
