@@ -326,8 +326,8 @@ impl Chooser {
         }
         let verdict = choose(&m.table);
         let others_left = m.dropped.iter().skip(1).any(|&d| !d);
-        let stable = m.round >= self.measure.min_rounds.max(1) as usize
-            && m.last == Some(verdict.pick);
+        let stable =
+            m.round >= self.measure.min_rounds.max(1) as usize && m.last == Some(verdict.pick);
         let clear = m.round >= 2 && verdict.decisive;
         if stable || clear || !others_left || m.round >= self.measure.max_rounds.max(1) as usize {
             let m = std::mem::replace(m, Box::new(Measurement::new(Vec::new(), None)));
@@ -449,7 +449,11 @@ mod tests {
             assert!(w.scans >= 1 && w.candidate < candidates);
             let times: Vec<u64> = (scan..scan + w.scans)
                 .map(|s| {
-                    let before = if s == scan { ran.last() } else { Some(&w.candidate) };
+                    let before = if s == scan {
+                        ran.last()
+                    } else {
+                        Some(&w.candidate)
+                    };
                     ns(w.candidate, s, before != Some(&w.candidate))
                 })
                 .zip(scan..)
@@ -494,7 +498,10 @@ mod tests {
             &[50, 0, 0],
             &[60, 110, 60],
         ]));
-        assert_eq!((v.pick, v.ratio_permille, v.rounds, v.decisive), (2, 500, 1, true));
+        assert_eq!(
+            (v.pick, v.ratio_permille, v.rounds, v.decisive),
+            (2, 500, 1, true)
+        );
         // The current one when nothing else was measured.
         assert_eq!(choose(&table(&[&[100], &[0]])).pick, 0);
     }
@@ -517,7 +524,10 @@ mod tests {
         assert_eq!(ch.estimates(), &[Some(1_030_000), Some(1_250_000)]);
         // Three rounds of two visits of 3 scans, then the sequential walk until the first
         // re-measurement.
-        assert_eq!(ran[..18], [0, 0, 0, 1, 1, 1, 1, 1, 1, 0, 0, 0, 0, 0, 0, 1, 1, 1]);
+        assert_eq!(
+            ran[..18],
+            [0, 0, 0, 1, 1, 1, 1, 1, 1, 0, 0, 0, 0, 0, 0, 1, 1, 1]
+        );
         assert!(ran[18..18 + 128].iter().all(|&c| c == 0));
         let on_par = ran.iter().filter(|&&c| c == 1).count();
         assert!(on_par <= 40, "{on_par} of 1000 scans on the slower plan");
@@ -556,7 +566,7 @@ mod tests {
         let mut ch = Chooser::new(2, measure(), 0);
         let ns = |c: usize, s: u64, _: bool| {
             let round = s / 6;
-            if (c == 1) == (round % 2 == 0) {
+            if (c == 1) == (round.is_multiple_of(2)) {
                 80_000
             } else {
                 100_000
@@ -595,7 +605,9 @@ mod tests {
             sw[1].scan >= 200 && sw[1].scan < 300,
             "reacts within a window: {sw:?}"
         );
-        assert!(sw[1].why.starts_with("scan time rose from 60000 ns to 300000 ns; measured 100000"));
+        assert!(sw[1]
+            .why
+            .starts_with("scan time rose from 60000 ns to 300000 ns; measured 100000"));
         assert!(sw[2].scan > 1000 && sw[2].scan < 1000 + 2048 + 32, "{sw:?}");
         assert_eq!(ch.current(), 1);
         // While busy, the parallel candidate ran only its probes.
@@ -611,10 +623,17 @@ mod tests {
         // After the first measurement, the default (candidate 0) and the runner-up (2) are
         // timed again, after 128, 256, 512 and 1024 scans on candidate 1; candidate 3 is not.
         let after: Vec<usize> = ran[36..].to_vec();
-        assert!(!after.contains(&3), "a slower candidate is not measured again");
+        assert!(
+            !after.contains(&3),
+            "a slower candidate is not measured again"
+        );
         for c in [0, 2] {
             let probes = after.iter().filter(|&&x| x == c).count();
-            assert_eq!(probes, 4 * 3 * 3, "three visits in each of four re-measurements");
+            assert_eq!(
+                probes,
+                4 * 3 * 3,
+                "three visits in each of four re-measurements"
+            );
         }
         let gaps: Vec<usize> = after
             .split(|&c| c != 1)
