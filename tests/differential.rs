@@ -316,7 +316,10 @@ fn dependence_driven_plan_equals_sequential_scan_on_random_programs() {
 /// and the levelled plans all the time, whichever is faster.
 fn restless() -> Measure {
     Measure {
+        warm_scans: 0,
         probe_scans: 1,
+        min_rounds: 1,
+        max_rounds: 2,
         min_interval: 1,
         max_interval: 3,
         chunk: 2,

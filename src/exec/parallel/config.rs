@@ -38,11 +38,19 @@ impl PlanKind {
     }
 }
 
-/// How the measured choice ([`PlanKind::Auto`]) measures, in scans.
+/// How the measured choice ([`PlanKind::Auto`]) measures, in scans (`choice`).
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub struct Measure {
-    /// Scans timed per candidate and measurement (the first warms its caches up).
+    /// Scans at the start of each visit of a candidate that its time does not count (they pay
+    /// for moving state and code between the cores after a switch).
+    pub warm_scans: u64,
+    /// Timed scans per visit after those (their median is the visit's time).
     pub probe_scans: u64,
+    /// Rounds (one visit of each measured candidate) before a measurement may stop: it stops
+    /// when the choice after a round is the choice after the round before.
+    pub min_rounds: u64,
+    /// Rounds at most per measurement.
+    pub max_rounds: u64,
     /// Scans on the chosen candidate before the first re-measurement, and after a switch.
     pub min_interval: u64,
     /// The longest stretch between re-measurements (the interval doubles while the choice
@@ -56,11 +64,14 @@ pub struct Measure {
 }
 
 impl Default for Measure {
-    /// 4 scans per probe, re-measure after 128 scans doubling up to 2048, windows of 32 scans,
-    /// every 8th scan timed.
+    /// Visits of 1 warm-up and 2 timed scans, 3 to 8 rounds, re-measure after 128 scans
+    /// doubling up to 2048, windows of 32 scans, every 8th scan timed.
     fn default() -> Self {
         Measure {
-            probe_scans: 4,
+            warm_scans: 1,
+            probe_scans: 2,
+            min_rounds: 3,
+            max_rounds: 8,
             min_interval: 128,
             max_interval: 2048,
             chunk: 32,

@@ -20,7 +20,7 @@ use super::driver::{run_sequential, ScanDriver};
 use super::flags::ReadyFlags;
 use super::ids::{Decision, Next};
 use super::pad::Padded;
-use super::plan::{layout_groups, Plan};
+use super::plan::{bools_first, layout_groups, Plan};
 use super::shared::{Decisions, FaultBuffer, Shared, SharedSlots};
 use super::tasks::{Item, Region};
 use crate::analysis::Analysis;
@@ -121,7 +121,7 @@ impl ParallelMachine {
         let (layout, groups) = if levelled.is_empty() {
             (Layout::dense(program), 0)
         } else {
-            let groups = layout_groups(&levelled, program.vars.len());
+            let groups = bools_first(program, layout_groups(&levelled, program.vars.len()));
             let layout = Layout::from_groups(program, &groups, LINE_BYTES)
                 .expect("groups hold each variable once");
             (layout, groups.len())

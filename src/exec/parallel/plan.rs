@@ -667,3 +667,31 @@ pub(super) fn layout_groups(plans: &[&Plan], vars: usize) -> Vec<Vec<VarId>> {
         .map(|(_, g)| std::mem::take(&mut groups[g]))
         .collect()
 }
+
+/// The layout's groups reordered for the interpreter's fused contacts, which address bytes
+/// below 2^16 only (four to six contacts in one instruction): the variables no plan writes
+/// (inputs, constants read by many rungs) first, then every group's BOOLs, then the rest of
+/// every group (INTs, REALs, instances), each part a group of its own. Splitting a group keeps
+/// its writer set, so no line gets a second writer; it costs at most a line of padding per
+/// group. On gen 100k (188 KB of state) the plain order put the inputs after 64 KiB and left
+/// most rungs without fused contacts: 1.6–1.8× the sequential walk's time per rung.
+pub(super) fn bools_first(p: &Program, groups: Vec<Vec<VarId>>) -> Vec<Vec<VarId>> {
+    let mut written = vec![false; p.vars.len()];
+    for &v in groups.iter().flatten() {
+        written[v.index()] = true;
+    }
+    let is_bool = |v: &VarId| p.var(*v).ty == crate::model::Type::Bool;
+    let unwritten: Vec<VarId> = (0..p.vars.len() as u32)
+        .map(VarId)
+        .filter(|v| !written[v.index()])
+        .collect();
+    let split = |g: &[VarId]| -> (Vec<VarId>, Vec<VarId>) { g.iter().partition(|v| is_bool(v)) };
+    let (unwritten_bools, unwritten_rest) = split(&unwritten);
+    let (bools, rest): (Vec<Vec<VarId>>, Vec<Vec<VarId>>) = groups.iter().map(|g| split(g)).unzip();
+    std::iter::once(unwritten_bools)
+        .chain(bools)
+        .chain(std::iter::once(unwritten_rest))
+        .chain(rest)
+        .filter(|g| !g.is_empty())
+        .collect()
+}
