@@ -284,3 +284,31 @@ fn an_unknown_pou_is_one_error_listing_the_programs() {
         );
     }
 }
+
+/// The report keys and text of the configuration, from the XML and from its conversion to the
+/// JSON program format: the same.
+#[test]
+fn the_configuration_converted_to_json_reports_the_same_tasks_and_sharing() {
+    let xml = two_task_project();
+    let path = common::cli::tmp("two-task.xml");
+    std::fs::write(&path, &xml).unwrap();
+    let out = common::cli::run(&["convert", path.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0));
+    let json = String::from_utf8(out.stdout).unwrap();
+    assert!(json.contains("\n\"configuration\": {\"name\": \"Cfg\", \"resources\": ["), "{json}");
+    let (from_xml, _) = json_output(&["report", "-", "--format", "json"], &xml);
+    let (from_json, _) = json_output(&["report", "-", "--format", "json"], &json);
+    for key in ["configuration", "programs", "task_sharing"] {
+        assert!(from_xml[key].is_object() || from_xml[key].is_array(), "{key}");
+        assert_eq!(from_json[key], from_xml[key], "{key}");
+    }
+    let section = |out: &str| {
+        let from = out.find("\nTasks of configuration").expect("a tasks section");
+        let to = out[from..].find("\nData dependences").unwrap() + from;
+        out[from..to].to_owned()
+    };
+    assert_eq!(
+        section(&run_stdout(&["report", "-"], &json)),
+        section(&run_stdout(&["report", "-"], &xml))
+    );
+}
