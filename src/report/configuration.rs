@@ -88,6 +88,15 @@ pub fn run_entry(r: &ProgramRun) -> ProgramRunEntry<'_> {
     }
 }
 
+/// A program instance as the text outputs name it: `task.instance (program)`, or
+/// `instance (program)` for the resource's own.
+pub fn run_label(e: &ProgramRunEntry) -> String {
+    match e.task {
+        Some(t) => format!("{t}.{} ({})", e.instance, e.program),
+        None => format!("{} ({})", e.instance, e.program),
+    }
+}
+
 pub fn task_shared_entries<'a>(
     p: &'a Program,
     a: &'a Analysis,

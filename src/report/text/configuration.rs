@@ -3,7 +3,7 @@
 //! tasks share (docs/report.md). Layout only: the data is [`crate::report::configuration`]'s.
 
 use super::{list, more_rows, plural, Table, TextOptions};
-use crate::report::configuration::{InstanceEntry, ProgramRunEntry};
+use crate::report::configuration::{run_label, InstanceEntry, ProgramRunEntry};
 use crate::report::document::Report;
 use std::io::{self, Write};
 
@@ -13,10 +13,7 @@ pub(super) fn configuration(r: &Report, o: &TextOptions, out: &mut impl Write) -
     let Some(c) = &r.configuration else {
         return Ok(());
     };
-    let run = |e: &ProgramRunEntry| match e.task {
-        Some(t) => format!("{t}.{} ({})", e.instance, e.program),
-        None => format!("{} ({})", e.instance, e.program),
-    };
+    let run = run_label;
     let instances = |v: &[InstanceEntry]| {
         let named: Vec<String> = v
             .iter()
