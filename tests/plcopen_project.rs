@@ -295,15 +295,23 @@ fn the_configuration_converted_to_json_reports_the_same_tasks_and_sharing() {
     let out = common::cli::run(&["convert", path.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(0));
     let json = String::from_utf8(out.stdout).unwrap();
-    assert!(json.contains("\n\"configuration\": {\"name\": \"Cfg\", \"resources\": ["), "{json}");
+    assert!(
+        json.contains("\n\"configuration\": {\"name\": \"Cfg\", \"resources\": ["),
+        "{json}"
+    );
     let (from_xml, _) = json_output(&["report", "-", "--format", "json"], &xml);
     let (from_json, _) = json_output(&["report", "-", "--format", "json"], &json);
     for key in ["configuration", "programs", "task_sharing"] {
-        assert!(from_xml[key].is_object() || from_xml[key].is_array(), "{key}");
+        assert!(
+            from_xml[key].is_object() || from_xml[key].is_array(),
+            "{key}"
+        );
         assert_eq!(from_json[key], from_xml[key], "{key}");
     }
     let section = |out: &str| {
-        let from = out.find("\nTasks of configuration").expect("a tasks section");
+        let from = out
+            .find("\nTasks of configuration")
+            .expect("a tasks section");
         let to = out[from..].find("\nData dependences").unwrap() + from;
         out[from..to].to_owned()
     };
@@ -349,7 +357,12 @@ fn run_names_the_program_instances_it_ran() {
     // A program without a configuration says nothing of instances, and has no `programs`.
     let json = r#"{"program": "p", "vars": [{"name": "x", "type": "BOOL", "class": "output"}], "rungs": [{"id": "R1", "ld": [{"coil": "x"}]}]}"#;
     let out = run_stdout(&["run", "-", "--scans", "1"], json);
-    assert!(out.lines().nth(1).is_some_and(|l| l.starts_with("outputs after")), "{out}");
+    assert!(
+        out.lines()
+            .nth(1)
+            .is_some_and(|l| l.starts_with("outputs after")),
+        "{out}"
+    );
     let (r, _) = json_output(&["run", "-", "--scans", "1", "--format", "json"], json);
     assert!(r.get("programs").is_none());
 }

@@ -74,16 +74,6 @@ pub struct ProgramRun {
     pub pou: PouId,
 }
 
-impl Configuration {
-    /// How many program instances the configuration has, under tasks or not.
-    pub fn instance_count(&self) -> usize {
-        self.resources
-            .iter()
-            .map(|r| r.instances.len() + r.tasks.iter().map(|t| t.instances.len()).sum::<usize>())
-            .sum()
-    }
-}
-
 impl Program {
     /// Every program instance of the configuration, in run order, with its POU (instances whose
     /// program is no POU of the model are left out; the resolver refuses them). Empty without

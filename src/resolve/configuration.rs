@@ -72,8 +72,7 @@ pub(crate) fn check(p: &mut Program) -> Result<()> {
 fn instance(p: &Program, i: &ProgramInstance, path: &str) -> Result<()> {
     check_name(&i.name, || format!("{path}.name"), None)?;
     let runs = |kind: PouKind| kind != PouKind::Interrupt;
-    if p
-        .pous
+    if p.pous
         .iter()
         .any(|pou| pou.name == i.program && runs(pou.kind))
     {

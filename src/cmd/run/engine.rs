@@ -18,6 +18,7 @@ use crate::exec::{
 };
 use crate::fbd::Fbd;
 use crate::model::{PouKind, Program, ProgramRun, Type, VarClass, VarId, VarRef};
+use crate::report::configuration::configuration_entry;
 use serde_json::Value as Json;
 use std::collections::HashMap;
 use std::fmt::Write as _;
@@ -595,7 +596,7 @@ fn report(pr: &Prepared, c: &RunConfig, m: &Machine, pass: Pass, extra: Extra) -
         configured_instances: p
             .configuration
             .as_ref()
-            .map_or(0, |c| c.instance_count()),
+            .map_or(0, |c| configuration_entry(c).instance_count()),
         scans: pr.scans,
         cycle_ms: c.cycle_ms,
         threads: c.threads,
