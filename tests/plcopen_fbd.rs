@@ -154,3 +154,40 @@ fn comments_become_the_network_comment() {
     assert!(notes.is_empty());
     assert_eq!(fbd.pous[0].networks[0].comment.as_deref(), Some("Adds one"));
 }
+
+/// An untyped literal takes its type from where it is used (IEC 61131-3 2.3.1: an integer
+/// literal is ANY_INT until its use decides): `MUL(0, 0)` feeding an INT variable is an INT
+/// multiplication, the same feeding a DINT one is DINT, and `ADD(x, 3)` on a REAL is REAL.
+#[test]
+fn untyped_literals_take_the_type_their_use_needs() {
+    for (ty, a, b, want) in [
+        ("INT", "0", "0", "0"),
+        ("INT", "300", "100", "30000"),
+        ("DINT", "300", "1000", "300000"),
+        ("REAL", "1.5", "4", "6.0"),
+    ] {
+        let body = [
+            in_var(1, a),
+            in_var(2, b),
+            block(3, "MUL", None, &[("IN1", &[(1, None)]), ("IN2", &[(2, None)])], &["OUT"]),
+            var_in("outVariable", 4, "x", (3, Some("OUT"))),
+        ]
+        .concat();
+        let xml = project_in("FBD", &[("outputVars", "x", ty)], &body);
+        let r = run_scans(&xml, 1);
+        assert_eq!(r["outputs"]["x"].to_string(), want, "MUL({a}, {b}) → {ty}: {r}");
+    }
+    // A literal too big for the type its use decides is refused, naming it.
+    let body = [
+        in_var(1, "40000"),
+        in_var(2, "1"),
+        block(3, "MUL", None, &[("IN1", &[(1, None)]), ("IN2", &[(2, None)])], &["OUT"]),
+        var_in("outVariable", 4, "x", (3, Some("OUT"))),
+    ]
+    .concat();
+    let xml = project_in("FBD", &[("outputVars", "x", "INT")], &body);
+    let out = common::cli::run_stdin(&["report", "-"], xml.as_bytes());
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("40000") && err.contains("INT"), "{err}");
+}
