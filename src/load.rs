@@ -29,11 +29,7 @@ pub fn program_from_json(text: &str) -> Result<Program, LoadError> {
 /// the whole tree, whose resolution gives the program or every error, as it always would.
 pub fn program_and_fbd_from_json(text: &str) -> Result<(Program, Fbd), LoadError> {
     let whole = |syntax: &crate::syntax::Program<'_>| {
-        resolve::resolve(text, syntax).map_err(|e| {
-            e.refine(text, |t, p| {
-                read::json::path_offset(t, p).map(|(start, _)| start)
-            })
-        })
+        resolve::resolve(text, syntax).map_err(|e| placed(text, e))
     };
     let mut stream = resolve::Stream::default();
     let syntax = if text.len() >= PIPE_FROM && two_cores() {
@@ -43,14 +39,24 @@ pub fn program_and_fbd_from_json(text: &str) -> Result<(Program, Fbd), LoadError
     } else {
         read::json::parse_with(text, Some(&mut stream))?
     };
-    if !stream.took_rungs() {
-        return whole(&syntax);
-    }
-    if let Some(done) = stream.finish(&syntax) {
-        return Ok(done);
-    }
-    drop(syntax);
-    whole(&read::json::parse(text)?)
+    let (mut p, f) = if !stream.took_rungs() {
+        whole(&syntax)?
+    } else if let Some(done) = stream.finish(&syntax) {
+        done
+    } else {
+        drop(syntax);
+        whole(&read::json::parse(text)?)?
+    };
+    // After the resolution: the configuration names the POUs it made.
+    resolve::configuration::check(&mut p).map_err(|e| placed(text, e))?;
+    Ok((p, f))
+}
+
+/// An error of a JSON program placed at the value its path names.
+fn placed(text: &str, e: LoadError) -> LoadError {
+    e.refine(text, |t, p| {
+        read::json::path_offset(t, p).map(|(start, _)| start)
+    })
 }
 
 /// Files from this size on are read on one thread and resolved on another

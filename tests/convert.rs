@@ -19,11 +19,8 @@ fn model_of(text: &str) -> Option<String> {
     } else {
         plc_deps::load::program_and_fbd_from_json(text)
     };
-    // The JSON program format does not carry a PLCopen configuration (tasks and program
-    // instances) yet: the round trip is checked on the rest of the model.
     // Where a rung or block stands in its file is not part of what the two texts mean.
     loaded.ok().map(|(mut p, mut f)| {
-        p.configuration = None;
         for r in &mut p.rungs {
             r.origin = plc_deps::diag::Origin::NONE;
         }

@@ -416,6 +416,7 @@ fn every_example_page_loads_clicks_and_highlights_in_chromium() {
         check_example(&mut b, e, &shots);
     }
     check_fault_chip(&mut b);
+    check_tasks_section(&mut b, &shots);
 }
 
 /// A run that faults: its page lists the fault with its rung as a chip, and clicking the chip
@@ -471,4 +472,80 @@ fn check_fault_chip(b: &mut Browser) {
             .starts_with("DIV depends on nothing; depending on it: Q"),
         "{state}"
     );
+}
+
+/// A program with a configuration (two tasks, the example of docs/format.md): its page has the
+/// tasks section between the summary and the levels, drawn, with a row per task and per shared
+/// global as the browser shows them; a screenshot of the section to `shots`.
+fn check_tasks_section(b: &mut Browser, shots: &Path) {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("html-pages");
+    std::fs::create_dir_all(&dir).unwrap();
+    let program = dir.join("cell.json");
+    std::fs::write(
+        &program,
+        r#"{"program": "cell",
+ "vars": [{"name": "part_ready", "type": "BOOL"}, {"name": "clamp", "type": "BOOL"}],
+ "rungs": [{"id": "Fast.feed", "ld": [{"call": "feed"}]}, {"id": "Slow.hold", "ld": [{"call": "hold"}]}],
+ "subroutines": {
+   "feed": {"rungs": [{"id": "f1", "ld": [{"contact": "clamp", "negated": true}, {"coil": "part_ready"}]}]},
+   "hold": {"rungs": [{"id": "h1", "ld": [{"contact": "part_ready"}, {"set": "clamp"}]}]}},
+ "configuration": {"name": "Cell", "resources": [
+   {"name": "Cpu",
+    "tasks": [{"name": "Fast", "priority": 0, "interval": "T#10ms", "instances": [{"name": "f", "program": "feed"}]},
+              {"name": "Slow", "priority": 1, "interval": "T#100ms", "instances": [{"name": "h", "program": "hold"}]}]}]}}"#,
+    )
+    .unwrap();
+    let page = dir.join("cell-report.html");
+    let status = Command::new(env!("CARGO_BIN_EXE_plc-deps"))
+        .arg("report")
+        .arg(&program)
+        .args(["--format", "html", "-o"])
+        .arg(&page)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    b.events.clear();
+    b.call(
+        "Page.navigate",
+        json!({"url": format!("file://{}", page.display())}),
+    );
+    b.wait_event("Page.loadEventFired");
+    assert!(b.errors().is_empty(), "{:?}", b.errors());
+    let mut table = |which: &str| {
+        b.eval(&format!(
+            "Array.from(document.querySelectorAll('#tasks table.{which} tr')).slice(1).map(r => Array.from(r.cells).map(c => c.innerText))"
+        ))
+    };
+    assert_eq!(
+        table("tasks"),
+        json!([
+            ["Fast", "0", "T#10ms", "-", "f (feed)"],
+            ["Slow", "1", "T#100ms", "-", "h (hold)"]
+        ])
+    );
+    // In variable order (declaration order).
+    assert_eq!(
+        table("shared"),
+        json!([
+            ["part_ready", "Slow.h (hold)", "Fast.f (feed)"],
+            ["clamp", "Fast.f (feed)", "Slow.h (hold)"]
+        ])
+    );
+    let placed = b.eval(
+        "(() => { const t = document.getElementById('tasks'), r = t.getBoundingClientRect(); const after = (a, b) => !!(a.compareDocumentPosition(b) & Node.DOCUMENT_POSITION_FOLLOWING); return [r.width > 0 && r.height > 0, after(document.getElementById('summary'), t), after(t, document.getElementById('levels')), t.querySelector('p.analysed').innerText]; })()",
+    );
+    assert_eq!(
+        placed,
+        json!([
+            true,
+            true,
+            true,
+            "Analysed: all 2 program instances, in task order: Fast.f (feed), Slow.h (hold)."
+        ])
+    );
+    b.eval("document.getElementById('tasks').scrollIntoView()");
+    let shot = b.call("Page.captureScreenshot", json!({"format": "png"}));
+    let png = decode_base64(shot["data"].as_str().unwrap());
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    std::fs::write(shots.join("cell-tasks.png"), &png).unwrap();
 }

@@ -175,3 +175,58 @@ fn every_unpaired_for_and_next_is_reported() {
          rung R3 at rungs[2].ld[0]: FOR without a NEXT"
     );
 }
+
+/// A configuration is checked against the program once it resolves: each name, and each
+/// instance's program (a POU that can run); a malformed one is refused where `serde_json`
+/// stops in it. Each error is located at the value it names.
+#[test]
+fn a_configuration_that_does_not_fit_is_refused_where_it_goes_wrong() {
+    let program = |conf: &str| {
+        format!(
+            "{{\"program\": \"p\", \"rungs\": [{{\"id\": \"R1\", \"ld\": [{{\"call\": \"S\"}}]}}],\n \"subroutines\": {{\"S\": {{\"rungs\": [{{\"id\": \"S1\", \"ld\": [{{\"ret\": true}}]}}]}}}},\n \"interrupts\": {{\"I\": {{\"rungs\": [{{\"id\": \"I1\", \"ld\": [{{\"ret\": true}}]}}]}}}},\n \"configuration\": {conf}}}"
+        )
+    };
+    let ok = r#"{"name": "K", "resources": [{"name": "R", "tasks": [
+   {"name": "T", "priority": 1, "instances": [{"name": "s", "program": "S"}]},
+   {"name": "U", "interval": null, "instances": [{"name": "m", "program": "p"}]}]}]}"#;
+    let p = program_from_json(&program(ok)).expect("loads");
+    // Tasks in run order: by priority.
+    let c = p.configuration.expect("kept");
+    let tasks: Vec<(&str, u32)> = c.resources[0]
+        .tasks
+        .iter()
+        .map(|t| (t.name.as_str(), t.priority))
+        .collect();
+    assert_eq!(tasks, [("U", 0), ("T", 1)]);
+    let cases: &[(&str, &str, &str)] = &[
+        (
+            r#"{"name": "K", "resources": [{"name": "R", "instances": [
+   {"name": "i", "program": "I"}]}]}"#,
+            "p.json:5:18: at configuration.resources[0].instances[0].program: program instance `i` runs `I`, which is not a program or subroutine of this file (they are p, S)",
+            "E0309",
+        ),
+        (
+            r#"{"name": "K", "resources": [{"name": "R", "tasks": [
+   {"name": "T 1"}]}]}"#,
+            "p.json:5:5: at configuration.resources[0].tasks[0].name: `T 1` is not a valid name (letters, digits and _, not starting with a digit)",
+            "E0105",
+        ),
+        (
+            r#"{"name": "K", "resources": [{"name": "R", "tasks": [
+   {"name": "T", "cycle": "T#1s"}]}]}"#,
+            "p.json:5:24: at configuration: unknown field `cycle`, expected one of `name`, `priority`, `interval`, `single`, `instances`",
+            "E0309",
+        ),
+        (
+            r#"{"name": "K", "resources": [{"name": "R", "tasks": [
+   {"name": "T", "priority": -1}]}]}"#,
+            "p.json:5:31: at configuration: invalid value: integer `-1`, expected u32",
+            "E0309",
+        ),
+    ];
+    for (conf, expected, code) in cases {
+        let e = err(&program(conf));
+        assert_eq!(e.in_file("p.json").to_string(), *expected, "{conf}");
+        assert_eq!(e.diagnostics()[0].code(), *code);
+    }
+}

@@ -154,3 +154,180 @@ fn comments_become_the_network_comment() {
     assert!(notes.is_empty());
     assert_eq!(fbd.pous[0].networks[0].comment.as_deref(), Some("Adds one"));
 }
+
+/// An untyped literal takes its type from where it is used (IEC 61131-3 2.3.1: an integer
+/// literal is ANY_INT until its use decides): `MUL(0, 0)` feeding an INT variable is an INT
+/// multiplication, the same feeding a DINT one is DINT, and `ADD(x, 3)` on a REAL is REAL.
+#[test]
+fn untyped_literals_take_the_type_their_use_needs() {
+    for (ty, a, b, want) in [
+        ("INT", "0", "0", "0"),
+        ("INT", "300", "100", "30000"),
+        ("DINT", "300", "1000", "300000"),
+        ("REAL", "1.5", "4", "6.0"),
+    ] {
+        let body = [
+            in_var(1, a),
+            in_var(2, b),
+            block(
+                3,
+                "MUL",
+                None,
+                &[("IN1", &[(1, None)]), ("IN2", &[(2, None)])],
+                &["OUT"],
+            ),
+            var_in("outVariable", 4, "x", (3, Some("OUT"))),
+        ]
+        .concat();
+        let xml = project_in("FBD", &[("outputVars", "x", ty)], &body);
+        let r = run_scans(&xml, 1);
+        assert_eq!(
+            r["outputs"]["x"].to_string(),
+            want,
+            "MUL({a}, {b}) → {ty}: {r}"
+        );
+    }
+    // A literal too big for the type its use decides is refused, naming it.
+    let body = [
+        in_var(1, "40000"),
+        in_var(2, "1"),
+        block(
+            3,
+            "MUL",
+            None,
+            &[("IN1", &[(1, None)]), ("IN2", &[(2, None)])],
+            &["OUT"],
+        ),
+        var_in("outVariable", 4, "x", (3, Some("OUT"))),
+    ]
+    .concat();
+    let xml = project_in("FBD", &[("outputVars", "x", "INT")], &body);
+    let out = common::cli::run_stdin(&["report", "-"], xml.as_bytes());
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("40000") && err.contains("INT"), "{err}");
+}
+
+/// An in variable's expression is computed by the blocks it stands for, and the block it feeds
+/// reads exactly its variables: arithmetic with precedence and parentheses, unary minus,
+/// comparisons and boolean operators; a struct field is its variable reference.
+#[test]
+fn in_variable_expressions_are_computed_and_read_exactly() {
+    let fbd = |expr: &str, out_ty: &str| {
+        let body = [in_var(1, expr), var_in("outVariable", 2, "x", (1, None))].concat();
+        project_in(
+            "FBD",
+            &[
+                ("inputVars", "a", "INT"),
+                ("inputVars", "b", "INT"),
+                ("inputVars", "c", "BOOL"),
+                ("inputVars", "unused", "INT"),
+                ("outputVars", "x", out_ty),
+            ],
+            &body,
+        )
+    };
+    let csv = "a,b,c,unused\n7,5,1,9\n-3,4,0,9\n";
+    for (expr, ty, want) in [
+        ("a + b * 2", "INT", ["17", "5"]),
+        ("(a + b) * 2", "INT", ["24", "2"]),
+        ("-a MOD 4 + b", "INT", ["2", "7"]),
+        ("a &gt; b AND c", "BOOL", ["1", "0"]),
+        ("NOT (a = 7) OR a &lt;= -3", "BOOL", ["0", "1"]),
+    ] {
+        let xml = fbd(expr, ty);
+        let got = px::trace(&format!("expr-{}", want[0]), &xml, csv, &["x"]);
+        assert_eq!(got, [want.map(str::to_owned).to_vec()], "{expr}");
+        let r = px::report(&xml);
+        let (ins, outs) =
+            px::io(&r)
+                .into_iter()
+                .fold((Vec::new(), Vec::new()), |(mut i, mut o), (_, ri, ro)| {
+                    i.extend(
+                        ri.as_array()
+                            .unwrap()
+                            .iter()
+                            .map(|v| v.as_str().unwrap().to_owned()),
+                    );
+                    o.extend(
+                        ro.as_array()
+                            .unwrap()
+                            .iter()
+                            .map(|v| v.as_str().unwrap().to_owned()),
+                    );
+                    (i, o)
+                });
+        let mut ins: Vec<String> = ins.into_iter().filter(|v| !v.starts_with('_')).collect();
+        ins.sort();
+        ins.dedup();
+        let want_ins: Vec<&str> = if expr.contains('c') {
+            vec!["a", "b", "c"]
+        } else {
+            vec!["a", "b"]
+        };
+        let want_ins: Vec<&str> = if expr.starts_with("NOT") {
+            vec!["a"]
+        } else {
+            want_ins
+        };
+        assert_eq!(ins, want_ins, "{expr}: the reads");
+        assert!(outs.iter().any(|o| o == "x"), "{expr}: {outs:?}");
+    }
+    // A call, `**` and a malformed expression are one error each, naming the expression.
+    for (expr, why) in [
+        (
+            "MAX(a, b)",
+            "a call of `MAX` in an in variable is not read yet",
+        ),
+        ("a ** 2", "`**` has no block in plc-deps"),
+        ("a + ", "expression `a +`"),
+    ] {
+        let out = run_stdin(&["report", "-"], fbd(expr, "INT").as_bytes());
+        assert_eq!(out.status.code(), Some(2), "{expr}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains(why) && err.contains("inVariable localId 1"),
+            "{expr}: {err}"
+        );
+    }
+}
+
+/// An array element in an in variable reads the whole array and its subscript's variables (the
+/// model holds an array as one value), and `run` refuses the body, saying why; a struct field is
+/// read as its variable reference.
+#[test]
+fn an_array_element_expression_reads_the_array_and_its_subscript() {
+    let body = [in_var(1, "arr[i + 1] * 2"), var_in("outVariable", 2, "x", (1, None))].concat();
+    let xml = project_in(
+        "FBD",
+        &[
+            ("inputVars", "i", "INT"),
+            ("inputVars", "other", "INT"),
+            ("localVars", "arr", "ARRAY_OF_INT"),
+            // An array stands in as a DINT (docs/plcopen.md, "Data types").
+            ("outputVars", "x", "DINT"),
+        ],
+        &body,
+    )
+    .replace(
+        "<derived name=\"ARRAY_OF_INT\"/>",
+        "<array><dimension lower=\"0\" upper=\"9\"/><baseType><INT/></baseType></array>",
+    );
+    let r = px::report(&xml);
+    let mut ins: Vec<String> = px::io(&r)
+        .into_iter()
+        .flat_map(|(_, i, _)| i.as_array().unwrap().clone())
+        .map(|v| v.as_str().unwrap().to_owned())
+        .filter(|v| !v.starts_with('_'))
+        .collect();
+    ins.sort();
+    ins.dedup();
+    assert_eq!(ins, ["arr", "i"]);
+    let out = run_stdin(&["run", "-", "--scans", "1"], xml.as_bytes());
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("`run` cannot execute the FBD body of `P`"),
+        "{err}"
+    );
+}

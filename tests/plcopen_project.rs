@@ -284,3 +284,85 @@ fn an_unknown_pou_is_one_error_listing_the_programs() {
         );
     }
 }
+
+/// The report keys and text of the configuration, from the XML and from its conversion to the
+/// JSON program format: the same.
+#[test]
+fn the_configuration_converted_to_json_reports_the_same_tasks_and_sharing() {
+    let xml = two_task_project();
+    let path = common::cli::tmp("two-task.xml");
+    std::fs::write(&path, &xml).unwrap();
+    let out = common::cli::run(&["convert", path.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0));
+    let json = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        json.contains("\n\"configuration\": {\"name\": \"Cfg\", \"resources\": ["),
+        "{json}"
+    );
+    let (from_xml, _) = json_output(&["report", "-", "--format", "json"], &xml);
+    let (from_json, _) = json_output(&["report", "-", "--format", "json"], &json);
+    for key in ["configuration", "programs", "task_sharing"] {
+        assert!(
+            from_xml[key].is_object() || from_xml[key].is_array(),
+            "{key}"
+        );
+        assert_eq!(from_json[key], from_xml[key], "{key}");
+    }
+    let section = |out: &str| {
+        let from = out
+            .find("\nTasks of configuration")
+            .expect("a tasks section");
+        let to = out[from..].find("\nData dependences").unwrap() + from;
+        out[from..to].to_owned()
+    };
+    assert_eq!(
+        section(&run_stdout(&["report", "-"], &json)),
+        section(&run_stdout(&["report", "-"], &xml))
+    );
+}
+
+/// `run` says which program instances each scan ran: all of them in task order, or the one
+/// `--pou` selects; the JSON has them under `programs`.
+#[test]
+fn run_names_the_program_instances_it_ran() {
+    let xml = two_task_project();
+    let out = run_stdout(&["run", "-", "--scans", "1"], &xml);
+    assert_eq!(
+        out.lines().nth(1),
+        Some("ran all 4 program instances each scan, one after another in task order: Fast.fa (A), Slow.sb (B), Slow.sc (C), rd (D) (of a PLCopen file, --pou NAME runs one program alone)"),
+        "{out}"
+    );
+    let (r, _) = json_output(&["run", "-", "--scans", "1", "--format", "json"], &xml);
+    let run = |t: Option<&str>, i: &str, p: &str| serde_json::json!({"task": t, "instance": i, "program": p});
+    assert_eq!(
+        r["programs"],
+        serde_json::json!([
+            run(Some("Fast"), "fa", "A"),
+            run(Some("Slow"), "sb", "B"),
+            run(Some("Slow"), "sc", "C"),
+            run(None, "rd", "D")
+        ])
+    );
+    let out = run_stdout(&["run", "-", "--scans", "1", "--pou", "c"], &xml);
+    assert_eq!(
+        out.lines().nth(1),
+        Some("ran 1 program instance of 4, selected by --pou: Slow.sc (C)"),
+        "{out}"
+    );
+    let (r, _) = json_output(
+        &["run", "-", "--scans", "1", "--format", "json", "--pou", "D"],
+        &xml,
+    );
+    assert_eq!(r["programs"], serde_json::json!([run(None, "rd", "D")]));
+    // A program without a configuration says nothing of instances, and has no `programs`.
+    let json = r#"{"program": "p", "vars": [{"name": "x", "type": "BOOL", "class": "output"}], "rungs": [{"id": "R1", "ld": [{"coil": "x"}]}]}"#;
+    let out = run_stdout(&["run", "-", "--scans", "1"], json);
+    assert!(
+        out.lines()
+            .nth(1)
+            .is_some_and(|l| l.starts_with("outputs after")),
+        "{out}"
+    );
+    let (r, _) = json_output(&["run", "-", "--scans", "1", "--format", "json"], json);
+    assert!(r.get("programs").is_none());
+}

@@ -170,6 +170,9 @@ pub enum Invalid {
     ForWithoutNext,
     #[error("jump to `{label}` enters the body of the FOR on rung {head} from outside it")]
     JumpIntoLoop { label: String, head: String },
+    /// A `configuration` that is malformed or does not fit the program (docs/format.md).
+    #[error("{message}")]
+    Configuration { message: String },
     #[error("subroutine `{name}` calls itself (call chain {chain})")]
     Recursion { name: String, chain: String },
     #[error("the program has no rungs")]

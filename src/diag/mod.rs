@@ -107,6 +107,7 @@ impl Invalid {
             ForWithoutNext => "E0306",
             JumpIntoLoop { .. } => "E0307",
             Recursion { .. } => "E0308",
+            Configuration { .. } => "E0309",
             UnknownOp { .. } => "E0401",
             UnknownPin { .. } => "E0402",
             PinCount { .. } => "E0403",

@@ -8,41 +8,57 @@
 //! that name); tasks are in the order plc-deps runs them (priority, 0 first, ties in file order).
 //!
 //! It does not schedule anything: `run` runs every instance once a scan in task order.
+//!
+//! The JSON program format carries it as `configuration` (docs/format.md, "Configuration"), in
+//! the shape the report's `configuration` key has: these types (de)serialise to exactly that,
+//! unknown fields refused, absent optional fields read as `None`, no task or instance lists
+//! read as empty, an absent priority as 0 (TC6's default).
 
 use super::{PouId, PouKind, Program};
 
 /// A configuration (TC6 `configuration`).
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Configuration {
     pub name: String,
+    #[serde(default)]
     pub resources: Vec<Resource>,
 }
 
 /// A resource of a configuration: its tasks, and the program instances no task runs.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Resource {
     pub name: String,
     /// In run order: by priority, ties in file order.
+    #[serde(default)]
     pub tasks: Vec<Task>,
     /// The resource's own `pouInstance`s (run after every task's).
+    #[serde(default)]
     pub instances: Vec<ProgramInstance>,
 }
 
 /// A task (TC6 `task`): when it runs, and what.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Task {
     pub name: String,
+    #[serde(default)]
+    pub priority: u32,
     /// The `interval` attribute as written (`T#20ms`), if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub interval: Option<String>,
     /// The `single` attribute as written (the variable whose rising edge triggers it), if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub single: Option<String>,
-    pub priority: u32,
     /// In file order.
+    #[serde(default)]
     pub instances: Vec<ProgramInstance>,
 }
 
 /// One program instance (TC6 `pouInstance`): its name and the program POU it runs.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct ProgramInstance {
     pub name: String,
     pub program: String,

@@ -88,6 +88,59 @@ pub fn run_entry(r: &ProgramRun) -> ProgramRunEntry<'_> {
     }
 }
 
+/// A program instance as the text outputs name it: `task.instance (program)`, or
+/// `instance (program)` for the resource's own.
+pub fn run_label(e: &ProgramRunEntry) -> String {
+    match e.task {
+        Some(t) => format!("{t}.{} ({})", e.instance, e.program),
+        None => format!("{} ({})", e.instance, e.program),
+    }
+}
+
+impl ConfigurationEntry<'_> {
+    /// How many program instances the configuration has, under tasks or not.
+    pub fn instance_count(&self) -> usize {
+        self.resources
+            .iter()
+            .map(|r| r.instances.len() + r.tasks.iter().map(|t| t.instances.len()).sum::<usize>())
+            .sum()
+    }
+
+    /// Whether programs of different tasks can share anything: more than one task, counting
+    /// the resource's own instances as one.
+    pub fn several_tasks(&self) -> bool {
+        let groups: usize = self
+            .resources
+            .iter()
+            .map(|r| r.tasks.len() + usize::from(!r.instances.is_empty()))
+            .sum();
+        groups > 1
+    }
+}
+
+/// Which program instances of `c` were analysed (`programs`, in run order), in words: `the only
+/// program instance: T.i (P)`, `all 4 program instances, in task order: …`, `1 program instance
+/// of 4: …`.
+pub fn analysed_text(c: &ConfigurationEntry, programs: &[ProgramRunEntry]) -> String {
+    let total = c.instance_count();
+    let plural = crate::report::text::plural;
+    let which = if total == 1 && programs.len() == 1 {
+        "the only program instance".to_owned()
+    } else if programs.len() == total {
+        format!(
+            "all {}, in task order",
+            plural(total, "program instance", "program instances")
+        )
+    } else {
+        format!(
+            "{} of {total}",
+            plural(programs.len(), "program instance", "program instances")
+        )
+    };
+    let names: Vec<String> = programs.iter().map(run_label).collect();
+    format!("{which}: {}", names.join(", "))
+}
+
 pub fn task_shared_entries<'a>(
     p: &'a Program,
     a: &'a Analysis,

@@ -25,6 +25,7 @@
 //! same model or gives up, and the whole tree is resolved instead (which reports the errors):
 //! errors always come from the phases above.
 
+pub(crate) mod configuration;
 mod elements;
 pub(crate) mod fbd_read;
 mod function_blocks;

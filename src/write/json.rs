@@ -59,7 +59,24 @@ pub fn program(p: &Program, w: &mut impl Write) -> io::Result<()> {
         }
         write!(w, "\n}}")?;
     }
+    if let Some(c) = &p.configuration {
+        write!(w, ",\n\"configuration\": ")?;
+        configuration(c, w)?;
+    }
     writeln!(w, "\n}}")
+}
+
+/// The configuration: its own line, one line per resource (tasks and instances as the report's
+/// `configuration` key has them, optional attributes only when present).
+fn configuration(c: &crate::model::Configuration, w: &mut impl Write) -> io::Result<()> {
+    write!(w, "{{\"name\": {}, \"resources\": ", string(&c.name))?;
+    let items: Vec<Value> = c
+        .resources
+        .iter()
+        .map(|r| serde_json::to_value(r).map_err(io::Error::other))
+        .collect::<io::Result<_>>()?;
+    lines(&items, w, "")?;
+    write!(w, "}}")
 }
 
 fn subroutine(s: &Subroutine, w: &mut impl Write) -> io::Result<()> {

@@ -17,7 +17,8 @@ use crate::exec::{
     load_value, Addr, ExecConfig, Fault, FaultKind, Layout, Machine, State, VarValue,
 };
 use crate::fbd::Fbd;
-use crate::model::{PouKind, Program, Type, VarClass, VarId, VarRef};
+use crate::model::{PouKind, Program, ProgramRun, Type, VarClass, VarId, VarRef};
+use crate::report::configuration::configuration_entry;
 use serde_json::Value as Json;
 use std::collections::HashMap;
 use std::fmt::Write as _;
@@ -60,6 +61,11 @@ pub struct RunReport {
     pub first_difference: Option<Json>,
     /// The parallel plan (text, JSON) when asked for.
     pub explain: Option<(String, Json)>,
+    /// The program instances of the configuration that each scan runs, in run order (none
+    /// without a configuration), and how many instances the configuration has in all (more
+    /// than run when `--pou` selected one program).
+    pub instances: Vec<ProgramRun>,
+    pub configured_instances: usize,
 }
 
 /// One distinct fault of a run: a rung and a kind, how often, and the first and last scan.
@@ -586,6 +592,11 @@ fn report(pr: &Prepared, c: &RunConfig, m: &Machine, pass: Pass, extra: Extra) -
     let rung_id = |r: u32| p.rungs[r as usize].id.clone();
     RunReport {
         program: p.name.clone(),
+        instances: p.program_runs(),
+        configured_instances: p
+            .configuration
+            .as_ref()
+            .map_or(0, |c| configuration_entry(c).instance_count()),
         scans: pr.scans,
         cycle_ms: c.cycle_ms,
         threads: c.threads,

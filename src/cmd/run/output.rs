@@ -9,6 +9,7 @@ use crate::exec::parallel::run_log_json;
 use crate::exec::VarValue;
 use crate::fbd::Fbd;
 use crate::model::{Program, Value};
+use crate::report::configuration::{run_entry, run_label};
 use crate::report::{
     document_with, fbd_parts, render_run_html, FaultRow, HtmlInput, ModeFigures, PlanFigures,
     RunFigures,
@@ -42,6 +43,10 @@ fn value_text(v: VarValue) -> String {
 pub fn render_json(r: &RunReport, deterministic: bool) -> String {
     let mut doc = Map::new();
     doc.insert("program".into(), json!(r.program));
+    if !r.instances.is_empty() {
+        let runs: Vec<_> = r.instances.iter().map(run_entry).collect();
+        doc.insert("programs".into(), json!(runs));
+    }
     doc.insert("scans".into(), json!(r.scans));
     doc.insert("cycle_ms".into(), json!(r.cycle_ms));
     doc.insert("threads".into(), json!(r.threads));
@@ -211,6 +216,32 @@ fn mix_text(r: &RunReport) -> String {
     )
 }
 
+/// Which program instances of the configuration each scan ran, and how to run another alone.
+fn instances_text(r: &RunReport) -> Option<String> {
+    let names: Vec<String> = r
+        .instances
+        .iter()
+        .map(|i| run_label(&run_entry(i)))
+        .collect();
+    let names = names.join(", ");
+    match (r.instances.len(), r.configured_instances) {
+        (0, 0) => None,
+        (0, all) => Some(format!(
+            "ran program {} alone: none of the configuration's {} runs it",
+            r.program,
+            count(all as u64, "program instance", "program instances")
+        )),
+        (1, 1) => Some(format!("ran program instance {names}")),
+        (n, all) if n == all => Some(format!(
+            "ran all {n} program instances each scan, one after another in task order: {names} (of a PLCopen file, --pou NAME runs one program alone)"
+        )),
+        (n, all) => Some(format!(
+            "ran {} of {all}, selected by --pou: {names}",
+            count(n as u64, "program instance", "program instances")
+        )),
+    }
+}
+
 /// The text report.
 pub fn render_text(r: &RunReport) -> String {
     let mut s = String::new();
@@ -230,6 +261,9 @@ pub fn render_text(r: &RunReport) -> String {
             String::new()
         }
     );
+    if let Some(line) = instances_text(r) {
+        let _ = writeln!(s, "{line}");
+    }
     if let Some((text, _)) = &r.explain {
         s.push('\n');
         s.push_str(text);

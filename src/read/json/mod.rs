@@ -19,6 +19,7 @@
 //! Deliberately not here: names, types, ids, labels and every other rule that needs more than
 //! one node (`crate::resolve`). FBD bodies are read by [`fbd`].
 
+mod configuration;
 mod cursor;
 mod element;
 mod fbd;
@@ -148,6 +149,7 @@ struct Parts<'a> {
     subroutines: Option<Part<Vec<syntax::Subroutine<'a>>>>,
     interrupts: Option<Part<Vec<syntax::Subroutine<'a>>>>,
     function_blocks: Option<Part<Vec<syntax::FunctionBlock<'a>>>>,
+    configuration: Option<Result<crate::model::Configuration, Problem>>,
 }
 
 const PROGRAM_KEYS: &[&str] = &[
@@ -158,6 +160,7 @@ const PROGRAM_KEYS: &[&str] = &[
     "subroutines",
     "interrupts",
     "function_blocks",
+    "configuration",
     "comment",
 ];
 const SUBROUTINE_KEYS: &[&str] = &["vars", "rungs", "fbd", "comment"];
@@ -295,6 +298,9 @@ impl<'a, 'r> Reader<'a, 'r> {
                     parts.function_blocks = Some(self.part(|r| r.function_blocks())?)
                 }
                 "fbd" => parts.fbd = Some(fbd::body(&mut self.c)?),
+                "configuration" => {
+                    parts.configuration = Some(configuration::configuration(&mut self.c)?)
+                }
                 _ => self.c.skip()?,
             }
         }
@@ -356,6 +362,11 @@ impl<'a, 'r> Reader<'a, 'r> {
         for routines in [parts.subroutines, parts.interrupts].into_iter().flatten() {
             problems.extend(routines.problems);
             p.subroutines.extend(routines.value);
+        }
+        match parts.configuration {
+            Some(Ok(c)) => p.configuration = Some(c),
+            Some(Err(problem)) => problems.push(problem),
+            None => {}
         }
         p.problems = problems;
         Ok(p)

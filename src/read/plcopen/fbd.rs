@@ -22,9 +22,7 @@
 //! wires into one FBD pin, ENO wired on, expressions as in/out variables.
 
 use super::black_box::{self, BlackBox, Ctx};
-use super::pins::{
-    add_target, block_input, bool_literal, konst, output_negated, pin_modifiers, pin_of, Added,
-};
+use super::pins::{add_target, bool_literal, konst, output_negated, pin_modifiers, pin_of, Added};
 use super::wiring::{graph, ElemId, Graph, Source};
 use super::xml::{attr, error, identifier, origin, variable_ref, ExecOrder, Note, Notes, Tc6, R};
 use crate::diag::Origin;
@@ -415,7 +413,12 @@ impl Fbd<'_, '_, '_> {
                 }
                 Ok(arc)
             }
-            "inVariable" | "inOutVariable" => block_input(src.node, &self.at(s.elem), s.origin),
+            "inVariable" | "inOutVariable" => super::expression::block_input(
+                &mut self.a.borrow_mut(),
+                src.node,
+                &self.at(s.elem),
+                s.origin,
+            ),
             other => Err(error(
                 s.origin,
                 &self.at(consumer),

@@ -30,8 +30,7 @@
 use super::black_box::{self, BlackBox, Ctx};
 use super::ld::components;
 use super::pins::{
-    add_target, block_input, bool_literal, is_const, konst, output_negated, pin_modifiers, pin_of,
-    Added,
+    add_target, bool_literal, is_const, konst, output_negated, pin_modifiers, pin_of, Added,
 };
 use super::wiring::{graph, ElemId, Graph, Source};
 use super::xml::{attr, error, identifier, origin, variable_ref, Notes, Tc6, R};
@@ -217,7 +216,10 @@ impl Flow<'_, '_, '_> {
         let at = s.origin;
         Ok(match el.tag {
             "leftPowerRail" => konst(true, at),
-            "inVariable" | "inOutVariable" => block_input(el.node, &self.at(e), at)?,
+            "inVariable" | "inOutVariable" => {
+                let here = self.at(e);
+                super::expression::block_input(&mut self.a, el.node, &here, at)?
+            }
             "contact" => {
                 let lid = el.local_id;
                 let p = self.power(e)?;

@@ -8,7 +8,7 @@
 //! are matched by local name. [`project`] reads the POUs and configurations, [`interface`] the
 //! variable lists, [`ld`] (with [`ld_power`], [`ld_block`], [`ld_logic`] and the shared [`wiring`] graph) the
 //! LD bodies ([`ld_flow`]: those that are not series-parallel rungs, as Beremiz's data-flow
-//! network), [`fbd`] the FBD bodies ([`black_box`]: conversions and blocks the model lacks), [`st_body`] the ST bodies (a stand-in rung per statement,
+//! network), [`fbd`] the FBD bodies ([`black_box`]: conversions and blocks the model lacks; [`expression`]: in variables' expressions), [`st_body`] the ST bodies (a stand-in rung per statement,
 //! from the ST parser), [`textual`] stands IL and SFC bodies in by their interface. What the reader did that changes meaning or skips vendor data is a [`Note`]
 //! (a warning with its place). The mapping, the order rules and their sources:
 //! docs/plcopen.md; the research behind them: docs/design/plcopen-semantics.md.
@@ -19,6 +19,7 @@
 
 mod black_box;
 mod data_types;
+mod expression;
 mod fbd;
 mod fbd_loops;
 mod interface;

@@ -276,13 +276,9 @@ impl Added {
 }
 
 /// What an `inVariable` or `inOutVariable` element `node` gives to a pin (at `at`): its
-/// literal, else its variable.
+/// literal, else its variable (an expression: [`super::expression::block_input`]).
 pub fn block_input(node: Node, place: &str, at: Origin) -> R<Input<'static>> {
-    let text = node
-        .children()
-        .find(|c| c.is_element() && c.tag_name().name() == "expression")
-        .and_then(|c| c.text())
-        .unwrap_or("");
+    let text = super::expression::expression_text(node);
     let from = match literal(text) {
         Some(v) => Connection::Constant(v),
         // A string has no value in the model: a stand-in 0 (`run` refuses such a body).

@@ -431,6 +431,16 @@ fn body(
             message: format!("{place}: the {} localId {} is a string literal, for which plc-deps has no values: the analysis reads it as a constant, but `run` cannot execute the {tag} body of `{name}`", n.tag_name().name(), n.attribute("localId").unwrap_or("?")),
         });
     }
+    let array_element = lang.children().find(|n| {
+        matches!(n.tag_name().name(), "inVariable" | "inOutVariable")
+            && super::expression::reads_array_element(*n)
+    });
+    if let (Some(n), "LD" | "FBD") = (array_element, tag) {
+        notes.no_run.get_or_insert(Note {
+            origin: origin(n),
+            message: format!("{place}: the {} localId {} reads an array element, `{}`; the model holds an array as one value, so the analysis reads the whole array (and the subscripts), but `run` cannot execute the {tag} body of `{name}`", n.tag_name().name(), n.attribute("localId").unwrap_or("?"), super::expression::expression_text(n).trim()),
+        });
+    }
     Ok(match tag {
         "LD" => ld_body(tc6, lang, name, ctx, notes)?,
         "FBD" => Body::Fbd(fbd::body(tc6, lang, name, ctx, notes)?),

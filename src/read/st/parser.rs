@@ -28,6 +28,21 @@ pub fn statements(text: &str) -> Result<Vec<Statement>, LexError> {
     }
 }
 
+/// Parses one ST expression (an FBD in variable's, say): the whole text must be it.
+pub fn expression(text: &str) -> Result<Expr, LexError> {
+    let toks = tokens(text)?;
+    let mut p = Parser {
+        toks,
+        i: 0,
+        end: text.len(),
+    };
+    let e = p.expr()?;
+    match p.peek() {
+        None => Ok(e),
+        Some(t) => Err(p.unexpected(t.at, "the end of the expression")),
+    }
+}
+
 struct Parser<'a> {
     toks: Vec<Token<'a>>,
     i: usize,

@@ -11,7 +11,9 @@
 //! post-dominator tree, laid out in Rust by a simple Sugiyama scheme ([`layout`], [`graphs`]).
 //! Hovering or clicking a rung (a card, a chip, a Gantt bar, a CFG node) highlights it, what it
 //! depends on and what depends on it, everywhere on the page. The page of `plc-deps run` is the
-//! same page with a section of the run's measured figures after the summary ([`run`]).
+//! same page with a section of the run's measured figures after the summary ([`run`]). A program
+//! with a configuration (tasks and program instances) has a section of its tasks and of the
+//! globals programs of different tasks share next ([`tasks`]).
 //!
 //! Invariants: the page is well-formed XML as well as HTML (the tests parse it), every attribute
 //! and text is escaped, every rung card has `id="rung-ID"`, and it is written to an
@@ -30,6 +32,7 @@ mod layout;
 mod levels;
 mod page;
 mod run;
+mod tasks;
 
 pub use charts::GANTT_MAX_BARS;
 pub use graphs::MAX_GRAPH_NODES;
@@ -37,6 +40,7 @@ pub use levels::{MAX_DETAILED_RUNGS, MAX_EDGES};
 pub use run::{
     FaultRow, ModeFigures, PlanFigures, RunFigures, FAULT_ROWS_SHOWN, OUTPUT_ROWS_SHOWN,
 };
+pub use tasks::SHARED_ROWS_SHOWN;
 
 use super::document::Report;
 use crate::analysis::Analysis;
@@ -99,6 +103,7 @@ fn write_page(input: &HtmlInput, run: Option<&RunFigures>, out: &mut impl Write)
     if let Some(run) = run {
         run::write_run(out, r, run)?;
     }
+    tasks::write_tasks(out, r)?;
     out.write_all(b"<section id=\"levels\">\n<h2>Levels of the combined schedule</h2>\n")?;
     page::write_level_legend(out)?;
     levels::write_levels(out, input)?;

@@ -379,3 +379,76 @@ fn a_run_pages_lists_are_bounded() {
     assert!(!html.contains("plan chosen") && !html.contains("identical:"));
     assert!(!html.contains("<title>measured"));
 }
+
+/// A program with two tasks and an instance of the resource's own, as the JSON format writes it
+/// (the configuration of a PLCopen project after `plc-deps convert`).
+const TWO_TASKS: &str = r#"{"program": "cell",
+ "vars": [{"name": "G1", "type": "BOOL"}, {"name": "G2", "type": "BOOL"}, {"name": "G3", "type": "BOOL"}, {"name": "G4", "type": "BOOL"}],
+ "rungs": [{"id": "Fast.A", "ld": [{"call": "A"}]}, {"id": "Slow.B", "ld": [{"call": "B"}]},
+           {"id": "Slow.C", "ld": [{"call": "C"}]}, {"id": "resource.D", "ld": [{"call": "D"}]}],
+ "subroutines": {
+   "A": {"rungs": [{"id": "a1", "ld": [{"contact": "G3"}, {"coil": "G1"}]}]},
+   "B": {"rungs": [{"id": "b1", "ld": [{"contact": "G1"}, {"coil": "G2"}]}]},
+   "C": {"rungs": [{"id": "c1", "ld": [{"contact": "G2"}, {"coil": "G4"}]}]},
+   "D": {"rungs": [{"id": "d1", "ld": [{"contact": "G1"}, {"coil": "G4"}]}]}},
+ "configuration": {"name": "Cell", "resources": [{"name": "Cpu",
+   "tasks": [{"name": "Slow", "priority": 2, "interval": "T#100ms", "instances": [{"name": "b", "program": "B"}, {"name": "c", "program": "C"}]},
+             {"name": "Fast", "priority": 0, "single": "G3", "instances": [{"name": "a", "program": "A"}]}],
+   "instances": [{"name": "d", "program": "D"}]}]}}"#;
+
+/// The page of a program given as JSON text.
+fn page_of_text(text: &str) -> String {
+    let (p, fbd) = crate::load::program_and_fbd_from_json(text).expect("loads");
+    let a = analyse(&p);
+    let doc = document_with(&p, &a, None);
+    let mut out = Vec::new();
+    let input = HtmlInput {
+        doc: &doc,
+        program: &p,
+        analysis: &a,
+        fbd: Some(&fbd),
+    };
+    render_html(&input, &mut out).expect("in memory");
+    String::from_utf8(out).expect("UTF-8")
+}
+
+#[test]
+fn the_tasks_section_lists_the_tasks_their_instances_and_the_globals_they_share() {
+    let html = page_of_text(TWO_TASKS);
+    let at = |id: &str| html.find(&format!("<section id=\"{id}\">")).unwrap();
+    assert!(at("summary") < at("tasks") && at("tasks") < at("levels"));
+    assert!(html.contains("<h2>Tasks of configuration Cell</h2>\n<h3>Resource Cpu</h3>"));
+    // In run order: priority 0 first; the resource's own instance last.
+    assert_eq!(
+        rows(&html, "tasks"),
+        [
+            "Fast|0|-|G3|a (A)",
+            "Slow|2|T#100ms|-|b (B), c (C)",
+            "(no task)|-|-|-|d (D)"
+        ]
+    );
+    assert!(html.contains("<p class=\"analysed\">Analysed: all 4 program instances, in task order: Fast.a (A), Slow.b (B), Slow.c (C), d (D).</p>"));
+    // G1: Fast's A writes it, Slow's B and the resource's D read it. G4: Slow's C and D write
+    // it. G2 stays inside Slow, G3 is only read.
+    assert_eq!(
+        rows(&html, "shared"),
+        ["G1|Slow.b (B)d (D)|Fast.a (A)", "G4|-|Slow.c (C)d (D)"]
+    );
+    assert!(html.contains("2 globals are shared."));
+    // Without a configuration, no section.
+    let plain = page_of_text(
+        r#"{"program": "p", "vars": [{"name": "x", "type": "BOOL"}], "rungs": [{"id": "R1", "ld": [{"coil": "x"}]}]}"#,
+    );
+    assert!(!plain.contains("<section id=\"tasks\">"));
+    // With one task, nothing is shared between tasks.
+    let fast = ",\n             {\"name\": \"Fast\", \"priority\": 0, \"single\": \"G3\", \"instances\": [{\"name\": \"a\", \"program\": \"A\"}]}";
+    assert!(TWO_TASKS.contains(fast));
+    let one = TWO_TASKS.replace(fast, "").replace(
+        "\"instances\": [{\"name\": \"d\", \"program\": \"D\"}]",
+        "\"instances\": []",
+    );
+    let html = page_of_text(&one);
+    assert_eq!(rows(&html, "tasks"), ["Slow|2|T#100ms|-|b (B), c (C)"]);
+    assert!(html.contains("Analysed: all 2 program instances, in task order: Slow.b (B), Slow.c (C).</p>\n<p>One task: nothing is shared between tasks.</p>"));
+    assert!(!html.contains("<table class=\"shared\">"));
+}

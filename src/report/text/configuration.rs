@@ -3,7 +3,7 @@
 //! tasks share (docs/report.md). Layout only: the data is [`crate::report::configuration`]'s.
 
 use super::{list, more_rows, plural, Table, TextOptions};
-use crate::report::configuration::{InstanceEntry, ProgramRunEntry};
+use crate::report::configuration::{analysed_text, run_label, InstanceEntry, ProgramRunEntry};
 use crate::report::document::Report;
 use std::io::{self, Write};
 
@@ -13,10 +13,7 @@ pub(super) fn configuration(r: &Report, o: &TextOptions, out: &mut impl Write) -
     let Some(c) = &r.configuration else {
         return Ok(());
     };
-    let run = |e: &ProgramRunEntry| match e.task {
-        Some(t) => format!("{t}.{} ({})", e.instance, e.program),
-        None => format!("{} ({})", e.instance, e.program),
-    };
+    let run = run_label;
     let instances = |v: &[InstanceEntry]| {
         let named: Vec<String> = v
             .iter()
@@ -24,9 +21,7 @@ pub(super) fn configuration(r: &Report, o: &TextOptions, out: &mut impl Write) -
             .collect();
         list(&named.iter().map(String::as_str).collect::<Vec<_>>())
     };
-    let (mut total, mut groups) = (0, 0);
     for res in &c.resources {
-        groups += res.tasks.len() + usize::from(!res.instances.is_empty());
         writeln!(
             out,
             "\nTasks of configuration {}, resource {}: {}",
@@ -42,7 +37,6 @@ pub(super) fn configuration(r: &Report, o: &TextOptions, out: &mut impl Write) -
             "program instances",
         ]);
         for task in &res.tasks {
-            total += task.instances.len();
             t.row(vec![
                 task.name.into(),
                 task.priority.to_string(),
@@ -52,7 +46,6 @@ pub(super) fn configuration(r: &Report, o: &TextOptions, out: &mut impl Write) -
             ]);
         }
         if !res.instances.is_empty() {
-            total += res.instances.len();
             t.row(vec![
                 "(no task)".into(),
                 "-".into(),
@@ -63,23 +56,9 @@ pub(super) fn configuration(r: &Report, o: &TextOptions, out: &mut impl Write) -
         }
         t.render(out)?;
     }
-    let which = if total == 1 && r.programs.len() == 1 {
-        "the only program instance".to_owned()
-    } else if r.programs.len() == total {
-        format!(
-            "all {}, in task order",
-            plural(total, "program instance", "program instances")
-        )
-    } else {
-        format!(
-            "{} of {total}",
-            plural(r.programs.len(), "program instance", "program instances")
-        )
-    };
-    let analysed: Vec<String> = r.programs.iter().map(run).collect();
-    writeln!(out, "Analysed: {which}: {}", analysed.join(", "))?;
+    writeln!(out, "Analysed: {}", analysed_text(c, &r.programs))?;
     // With one task (or none), nothing is shared between tasks.
-    let Some(shared) = r.task_sharing.as_ref().filter(|_| groups > 1) else {
+    let Some(shared) = r.task_sharing.as_ref().filter(|_| c.several_tasks()) else {
         return Ok(());
     };
     writeln!(
