@@ -27,12 +27,14 @@ mod fold;
 mod harness;
 mod ladder;
 pub mod names;
+mod rows;
 mod runtime;
 mod types;
 
 use crate::fbd::Fbd;
 use crate::model::{walk_elements, Element, PouKind, Program, RungId, VarId};
 use ladder::{c_type, Body, Shared};
+use rows::Rows;
 use std::collections::HashMap;
 
 pub use runtime::RUNTIME_H;
@@ -427,18 +429,30 @@ fn ladder_files(
     let groups = chunks(p, pou, chunk.max(1));
     let name = names::comment(&p.pous[pou].name);
     let head = "#include \"plc_program.h\"\n\n";
+    // Generated names made from the function's (`_pou_` + the POU's encoded name, which starts
+    // with a letter or `_u`): `_pou__c3_X` (chunk 3), `_pou__r_X`, `_pou__s3_X` … (row tables)
+    // meet no POU's function.
+    let enc = f.trim_start_matches("_pou_");
     if groups.len() == 1 {
         let mut b = Body::new(sh, "return;", 1);
+        b.rows = Some(Rows::new([
+            format!("_pou__r_{enc}"),
+            format!("_pou__s_{enc}"),
+        ]));
         b.line("(void)self; (void)ctx;");
         for r in groups[0].clone() {
             b.rung(RungId(r));
         }
+        let table = table_of(&b);
         let text = format!(
-            "{head}/* ladder POU {name} */\nvoid {f}(_plc_state *self, _plc_ctx *ctx) {{\n{}}}\n",
+            "{head}{table}/* ladder POU {name} */\nvoid {f}(_plc_state *self, _plc_ctx *ctx) {{\n{}}}\n",
             b.finish()
         );
         return (vec![(String::new(), text)], String::new());
     }
+    // A chunk function takes the state as `void *`: GCC's interprocedural summaries walk every
+    // member of a parameter's pointed-to struct once per function (with `_plc_state *`, a
+    // 64-rung function of the 100,000-rung program took 0.12 s of `cc -O2`, 0.02 s without).
     let mut files = Vec::new();
     let mut decls = String::new();
     for (n, part) in groups.chunks(per_file).enumerate() {
@@ -446,21 +460,26 @@ fn ladder_files(
         for (j, g) in part.iter().enumerate() {
             let k = n * per_file + j;
             let mut b = Body::new(sh, "return 1;", 1);
+            b.rows = Some(Rows::new([
+                format!("_pou__r{k}_{enc}"),
+                format!("_pou__s{k}_{enc}"),
+            ]));
             b.line("(void)self; (void)ctx;");
             for r in g.clone() {
                 b.rung(RungId(r));
             }
             b.line("return 0;");
+            s.push_str(&table_of(&b));
             ladder::push(
                 &mut s,
                 format_args!(
-                    "bool {f}_{k}(_plc_state *self, _plc_ctx *ctx) {{\n{}}}\n\n",
+                    "bool _pou__c{k}_{enc}(void *_self, _plc_ctx *ctx) {{\n    _plc_state *self = _self;\n{}}}\n\n",
                     b.finish()
                 ),
             );
             ladder::push(
                 &mut decls,
-                format_args!("bool {f}_{k}(_plc_state *self, _plc_ctx *ctx);\n"),
+                format_args!("bool _pou__c{k}_{enc}(void *_self, _plc_ctx *ctx);\n"),
             );
         }
         files.push((format!("_part{n}"), s));
@@ -476,10 +495,20 @@ fn ladder_files(
     for k in 0..groups.len() {
         ladder::push(
             &mut s,
-            format_args!("    if ({f}_{k}(self, ctx)) return;\n"),
+            format_args!("    if (_pou__c{k}_{enc}(self, ctx)) return;\n"),
         );
     }
     s.push_str("}\n");
     files.insert(0, (String::new(), s));
     (files, decls)
+}
+
+/// The row table of the function `b` wrote (empty: none), with a blank line after it.
+fn table_of(b: &Body) -> String {
+    let t = b.rows.as_ref().map_or(String::new(), Rows::definitions);
+    if t.is_empty() {
+        t
+    } else {
+        t + "\n"
+    }
 }
