@@ -50,6 +50,9 @@ pub(crate) struct Shared<'a> {
     pub labels: Vec<bool>,
     /// Per rung: its loop counter index, for loop-back rungs.
     pub counters: Vec<Option<u32>>,
+    /// Per variable: held in a local of an FBD function only (an arc or a run flag), so no
+    /// struct has a member for it.
+    pub local_only: Vec<bool>,
 }
 
 /// The statements of one C function being written.
