@@ -48,8 +48,8 @@ pub struct CConfig {
     pub loop_cap: u32,
     /// Rungs per function of a large ladder POU.
     pub chunk_rungs: usize,
-    /// Rungs of contacts and coils as rows of tables (`rows`): `cc` time falls to about a
-    /// quarter, the rungs run about half as fast.
+    /// Rungs of contacts and coils as rows of tables (`rows`): `cc` time falls to a third to
+    /// a half, the rungs run 1.5–3 times slower (docs/c.md).
     pub rows: bool,
 }
 

@@ -3,10 +3,10 @@
 //!
 //! Why: `cc -O2` spends about a millisecond of CPU on each rung statement (spread over its
 //! passes: value numbering, dead store elimination, the register allocator, the scheduler …),
-//! so 100,000 rungs as statements took minutes to build however they were written; a table
-//! row costs only the parser (a few microseconds). Run time stays the same: the straight-line
-//! C of a large program is read from memory once per scan like the table is, and the row loop
-//! does per contact what the statement does (a load and an AND) plus one load of its offset.
+//! so 100,000 rungs as statements take minutes to build however they are written; a table row
+//! costs only the parser. The price is run time: a row loads each contact's offset and
+//! negation besides its byte, and keeps no value in a register from one rung to the next, so
+//! rows run 1.5–3 times slower than the statements (docs/c.md): an option (`--rows`).
 //!
 //! Two kinds of rows, each a table of fixed-size entries and a loop without branches:
 //! - `_plc_row`: a series of 1 to [`CLAUSES`] Normal or Negated contacts on BOOLs of the state
