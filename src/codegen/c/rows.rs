@@ -1,5 +1,5 @@
-//! Rungs of plain contacts and one coil as data: a row of a table that a loop of the runtime
-//! (`_plc_rows` in `plc_runtime.h`) runs, instead of one C statement per rung.
+//! Rungs of contacts and coils as data: a row of a table that a loop of the runtime
+//! (`_plc_rows`, `_plc_rows2` in `plc_runtime.h`) runs, instead of C statements per rung.
 //!
 //! Why: `cc -O2` spends about a millisecond of CPU on each rung statement (spread over its
 //! passes: value numbering, dead store elimination, the register allocator, the scheduler …),
@@ -33,6 +33,9 @@
 //! function's end) ends the run first, so rungs still run in program order. Only the ladder
 //! functions of POUs use rows (not FBD bodies or function block types, whose variables may be
 //! locals or another struct's).
+//!
+//! Not here: the C of the rungs that are no row (`ladder`), the tables' place in the files
+//! (`mod`), the loops themselves (`runtime`).
 
 use super::ladder::Body;
 use crate::model::{ContactKind, Element, Field, RungId, Series, Type, VarId, VarRef};
