@@ -68,6 +68,8 @@ fn random_programs(
             cycle_ms: 1 + rng.below(50) as u32,
             loop_cap: 1 + rng.below(200) as u32,
             chunk_rungs: chunk_rungs(&mut rng),
+            // Every other program with its rungs of contacts and coils as table rows.
+            rows: seed % 2 == 1,
         };
         batch.add(text, csv, 40, cfg, format!("{tag}-{seed}"));
     }
@@ -301,11 +303,7 @@ fn a_large_pou_is_cut_into_at_most_sixteen_part_files_and_stays_exact() {
         .map_while(|n| {
             let name = format!("_part{n}.c");
             let f = files.iter().find(|f| f.name.ends_with(&name))?;
-            Some(
-                f.text
-                    .matches("(_plc_state *self, _plc_ctx *ctx) {")
-                    .count(),
-            )
+            Some(f.text.matches("(void *_self, _plc_ctx *ctx) {").count())
         })
         .collect();
     let mut expected = vec![38; 15];
@@ -316,4 +314,48 @@ fn a_large_pou_is_cut_into_at_most_sixteen_part_files_and_stays_exact() {
     let mut batch = Batch::default();
     batch.add(text, csv, 40, cfg, "parts".into());
     batch.check(1, "parts");
+}
+
+/// With `rows`, the rungs of contacts and coils of a generated program (ORs, edges, set/reset,
+/// two-coil outputs) become rows of the two tables, and the C still matches the interpreter.
+#[test]
+fn rows_carry_the_contact_and_coil_rungs_and_stay_exact() {
+    let gc = plc_deps::synth::GenConfig {
+        rungs: 3000,
+        width: 100,
+        seed: 5,
+        ..Default::default()
+    };
+    let text = plc_deps::synth::generate_string(&gc);
+    let (p, fbd) = plc_deps::load::program_and_fbd_from_json(&text).unwrap();
+    let cfg = CConfig {
+        rows: true,
+        ..CConfig::default()
+    };
+    let files = generate(&p, &fbd, &cfg);
+    let c: String = files.iter().map(|f| f.text.as_str()).collect();
+    // A row ends with its rung's comment; a rung written as C starts with it.
+    let rows = c.matches("}, /* R").count();
+    let plain = c.matches("static const _plc_row _pou__r").count();
+    let general = c.matches("static const _plc_row2 _pou__s").count();
+    assert!(
+        rows * 10 >= p.rungs.len() * 9,
+        "{rows} rows of {} rungs",
+        p.rungs.len()
+    );
+    assert!(
+        plain > 0 && general > 0,
+        "{plain} plain tables, {general} general"
+    );
+    assert!(c.contains("_plc_rows2((uint8_t *)self, _pou__s"));
+    // Without the option there is no row.
+    let files = generate(&p, &fbd, &CConfig::default());
+    assert!(files
+        .iter()
+        .all(|f| !f.text.contains("_plc_rows((uint8_t *)self")));
+    let mut rng = Rng::new(5);
+    let csv = random_csv(&p, &mut rng, 30);
+    let mut batch = Batch::default();
+    batch.add(text, csv, 40, cfg, "rows".into());
+    batch.check(1, "rows");
 }

@@ -30,7 +30,7 @@ pub(crate) fn program_source(p: &Program, sh: &Shared, extra: &[String], cfg: &C
         .vars
         .iter()
         .enumerate()
-        .filter(|(_, v)| !matches!(v.ty, Type::Fb(_)) && !is_zero(v.init))
+        .filter(|(i, v)| !matches!(v.ty, Type::Fb(_)) && !is_zero(v.init) && !sh.local_only[*i])
         .map(|(i, v)| format!("    .{} = {},\n", field(sh, i), c_const(v.init)))
         .chain(extra.iter().cloned())
         .collect();

@@ -50,6 +50,9 @@ pub(crate) struct Shared<'a> {
     pub labels: Vec<bool>,
     /// Per rung: its loop counter index, for loop-back rungs.
     pub counters: Vec<Option<u32>>,
+    /// Per variable: held in a local of an FBD function only (an arc or a run flag), so no
+    /// struct has a member for it.
+    pub local_only: Vec<bool>,
 }
 
 /// The statements of one C function being written.
@@ -68,6 +71,8 @@ pub(crate) struct Body<'a> {
     pub inst: Option<InstanceCtx>,
     /// Whether each rung gets a comment with its id (off to compare instances' code).
     pub comments: bool,
+    /// Set where rungs of contacts and one coil become rows of a table (`rows`).
+    pub rows: Option<super::rows::Rows>,
 }
 
 /// The instance whose lowered rungs a function block type's function is written from: its
@@ -162,6 +167,7 @@ impl<'a> Body<'a> {
             used_labels: Default::default(),
             inst: None,
             comments: true,
+            rows: None,
         }
     }
 
@@ -202,8 +208,20 @@ impl<'a> Body<'a> {
         r - self.inst.as_ref().map_or(0, |c| c.rung0)
     }
 
-    /// Writes one line at the current indentation.
+    /// Writes one line at the current indentation (after the call of the rows before it).
     pub fn line(&mut self, text: &str) {
+        if let Some(call) = self.rows.as_mut().and_then(|r| r.take_call()) {
+            self.raw_line(&call);
+        }
+        self.raw_line(text);
+    }
+
+    /// Writes one line without ending the run of rows before it.
+    pub(crate) fn line_before_rows(&mut self, text: &str) {
+        self.raw_line(text);
+    }
+
+    fn raw_line(&mut self, text: &str) {
         for _ in 0..self.indent {
             self.out.push_str("    ");
         }
@@ -221,6 +239,11 @@ impl<'a> Body<'a> {
             Some(l) => l.clone(),
             None => self.place(&self.sh.vars[v.index()]),
         }
+    }
+
+    /// The C lvalue of `r` (a variable or a field of one).
+    pub fn var_ref_text(&self, r: VarRef) -> String {
+        self.var_ref(r)
     }
 
     fn var_ref(&self, r: VarRef) -> String {
@@ -665,6 +688,9 @@ impl<'a> Body<'a> {
     pub fn rung(&mut self, r: RungId) {
         let rung = self.sh.p.rung(r);
         self.label(r);
+        if super::rows::push_rung(self, r) {
+            return;
+        }
         if self.comments {
             self.line(&format!("/* {} */", names::comment(&rung.id)));
         }
@@ -730,7 +756,10 @@ impl<'a> Body<'a> {
     }
 
     /// The function body, without the labels no `goto` names.
-    pub fn finish(self) -> String {
+    pub fn finish(mut self) -> String {
+        if let Some(call) = self.rows.as_mut().and_then(|r| r.take_call()) {
+            self.raw_line(&call);
+        }
         let mut out = String::with_capacity(self.out.len());
         for line in self.out.lines() {
             let t = line.trim_start();

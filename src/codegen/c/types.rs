@@ -119,14 +119,21 @@ pub(crate) fn order(fbd: &Fbd, lay: &Layout) -> Vec<usize> {
 }
 
 /// The struct definitions of the types in `order`, for `plc_program.h`.
-pub(crate) fn structs(p: &Program, fbd: &Fbd, lay: &Layout, order: &[usize]) -> String {
+/// `local_only`: per variable, whether the type's function holds it in a local (no member).
+pub(crate) fn structs(
+    p: &Program,
+    fbd: &Fbd,
+    lay: &Layout,
+    order: &[usize],
+    local_only: &[bool],
+) -> String {
     let mut s = String::new();
     for &t in order {
         let mut fields: Vec<(String, String)> = Vec::new();
         let mut seen = std::collections::HashSet::new();
         for (i, (path, own)) in lay.vars.iter().enumerate() {
             let Some(k) = *own else { continue };
-            if fbd.instances[k].ty.index() != t {
+            if fbd.instances[k].ty.index() != t || local_only[i] {
                 continue;
             }
             let field = path[lay.paths[k].len() + 1..].to_string();
