@@ -91,9 +91,9 @@ fn subroutine(s: &Subroutine, w: &mut impl Write) -> io::Result<()> {
 
 fn function_block(f: &FunctionBlock, w: &mut impl Write) -> io::Result<()> {
     write!(w, "{{\"inputs\": ")?;
-    pins(&f.inputs, w, "    ")?;
+    vars(&f.inputs, w, "    ")?;
     write!(w, ",\n    \"outputs\": ")?;
-    pins(&f.outputs, w, "    ")?;
+    vars(&f.outputs, w, "    ")?;
     write!(w, ",\n    \"vars\": ")?;
     vars(&f.vars, w, "    ")?;
     if let Some(b) = &f.body {
@@ -155,22 +155,6 @@ fn read<'r, T>(r: &'r Read<T>) -> io::Result<&'r T> {
 
 fn vars(vs: &[Var], w: &mut impl Write, indent: &str) -> io::Result<()> {
     let items: Vec<Value> = vs.iter().map(var).collect::<io::Result<_>>()?;
-    lines(&items, w, indent)
-}
-
-/// A function block's inputs or outputs: variables without a `class`, which the list they are
-/// in says (the format's `pin_var`).
-fn pins(vs: &[Var], w: &mut impl Write, indent: &str) -> io::Result<()> {
-    let items: Vec<Value> = vs
-        .iter()
-        .map(|v| {
-            let mut o = var(v)?;
-            if let Value::Object(o) = &mut o {
-                o.remove("class");
-            }
-            Ok(o)
-        })
-        .collect::<io::Result<_>>()?;
     lines(&items, w, indent)
 }
 
