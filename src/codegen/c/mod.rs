@@ -237,15 +237,19 @@ fn shared<'a>(p: &'a Program, fbd: &Fbd, lay: &types::Layout) -> Shared<'a> {
     }
 }
 
-/// The variables every FBD function holds in locals (arcs and run flags of each copy).
-fn local_only(p: &Program, fbd: &Fbd, copies: &HashMap<usize, (usize, String)>) -> Vec<bool> {
-    let hidden: HashMap<&str, VarId> = p
-        .vars
+/// The program's hidden variables (the FBD lowering's arcs and run flags) by name.
+fn hidden_vars(p: &Program) -> HashMap<&str, VarId> {
+    p.vars
         .iter()
         .enumerate()
         .filter(|(_, v)| v.hidden)
         .map(|(i, v)| (v.name.as_str(), VarId(i as u32)))
-        .collect();
+        .collect()
+}
+
+/// The variables every FBD function holds in locals (arcs and run flags of each copy).
+fn local_only(p: &Program, fbd: &Fbd, copies: &HashMap<usize, (usize, String)>) -> Vec<bool> {
+    let hidden = hidden_vars(p);
     let mut out = vec![false; p.vars.len()];
     for (fp, prefix) in copies.values() {
         for (v, _) in fbd::locals(p, &hidden, &fbd.pous[*fp], prefix) {
@@ -355,13 +359,7 @@ fn fbd_function(
     prefix: &str,
     pou: usize,
 ) -> String {
-    let hidden: HashMap<&str, VarId> = p
-        .vars
-        .iter()
-        .enumerate()
-        .filter(|(_, v)| v.hidden)
-        .map(|(i, v)| (v.name.as_str(), VarId(i as u32)))
-        .collect();
+    let hidden = hidden_vars(p);
     let fpou = &fbd.pous[fp];
     let copy = fpou
         .copies
