@@ -297,7 +297,11 @@ fn in_variable_expressions_are_computed_and_read_exactly() {
 /// read as its variable reference.
 #[test]
 fn an_array_element_expression_reads_the_array_and_its_subscript() {
-    let body = [in_var(1, "arr[i + 1] * 2"), var_in("outVariable", 2, "x", (1, None))].concat();
+    let body = [
+        in_var(1, "arr[i + 1] * 2"),
+        var_in("outVariable", 2, "x", (1, None)),
+    ]
+    .concat();
     let xml = project_in(
         "FBD",
         &[
