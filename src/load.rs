@@ -52,6 +52,52 @@ pub fn program_and_fbd_from_json(text: &str) -> Result<(Program, Fbd), LoadError
     Ok((p, f))
 }
 
+/// [`program_and_fbd_from_json`] with only the program `select` (any case) that a program
+/// instance of the file's configuration runs, as the main program (`--pou`), as
+/// [`plcopen_selected`] gives a project's program: the whole file is checked first (every error
+/// it has), then the program alone is resolved; the configuration stays whole.
+pub fn program_and_fbd_from_json_selected(
+    text: &str,
+    select: &str,
+) -> Result<(Program, Fbd), LoadError> {
+    use crate::syntax::select::{select_program, NotSelectable};
+    let (whole, _) = program_and_fbd_from_json(text)?;
+    let not_found = |message: String| {
+        placed(
+            text,
+            LoadError::invalid(
+                None,
+                "configuration",
+                crate::diag::Invalid::Configuration { message },
+            ),
+        )
+    };
+    let syntax = match select_program(read::json::parse(text)?, select) {
+        Ok(s) => s,
+        Err(NotSelectable::NoConfiguration) => {
+            return Err(placed(
+                text,
+                LoadError::invalid(
+                    None,
+                    "",
+                    crate::diag::Invalid::Configuration {
+                        message: format!("--pou {select} selects a program that a program instance of the configuration runs, and this program has no `configuration` (the DOT report's --pou draws one POU of any program: add --format dot)"),
+                    },
+                ),
+            ))
+        }
+        Err(NotSelectable::Unknown { programs }) => {
+            return Err(not_found(format!(
+                "--pou {select}: no program instance runs a program of that name; they run {}",
+                programs.join(", ")
+            )))
+        }
+    };
+    let (mut p, f) = resolve::resolve(text, &syntax).map_err(|e| placed(text, e))?;
+    p.configuration = whole.configuration;
+    Ok((p, f))
+}
+
 /// An error of a JSON program placed at the value its path names.
 fn placed(text: &str, e: LoadError) -> LoadError {
     e.refine(text, |t, p| {

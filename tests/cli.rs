@@ -450,7 +450,7 @@ fn dot_selection_errors_are_clear() {
         (&["report", b, "--format", "dot", "--rungs", "R5..R2"], "error: analyses/example-b/program.json: --rungs R5..R2: `R2` comes before `R5` in the program"),
         (&["report", b, "--format", "dot", "--rungs", "R5..R99"], "error: analyses/example-b/program.json: --rungs: no rung `R99` in the program"),
         (&["report", b, "--rungs", "R5"], "error: --rungs chooses what the DOT report draws; add --format dot (the text and JSON reports cover the whole program)"),
-        (&["report", b, "--pou", "SBR_A"], "error: analyses/example-b/program.json: --pou SBR_A selects a program of a PLCopen project, and this is not one (the DOT report's --pou draws one POU of any program: add --format dot)"),
+        (&["report", b, "--pou", "SBR_A"], "error: --pou SBR_A selects a program that a program instance of the configuration runs, and this program has no `configuration` (the DOT report's --pou draws one POU of any program: add --format dot)"),
         (&["report", path, "--format", "dot", "--rungs", "R1..R2400"], &big),
     ];
     for (args, expected) in cases {

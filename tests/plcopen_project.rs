@@ -321,6 +321,49 @@ fn the_configuration_converted_to_json_reports_the_same_tasks_and_sharing() {
     );
 }
 
+/// `--pou` on the JSON conversion of a project selects the same program as on the XML: the
+/// same report, byte for byte, and the same scans; a name no instance runs is one located error.
+#[test]
+fn pou_selects_the_same_program_of_the_converted_json() {
+    let xml = two_task_project();
+    let path = common::cli::tmp("two-task-select.xml");
+    std::fs::write(&path, &xml).unwrap();
+    let json = run_stdout(&["convert", path.to_str().unwrap()], "");
+    for pou in ["A", "b", "C", "D"] {
+        for args in [
+            &["report", "-", "--format", "json", "--pou", pou][..],
+            &["report", "-", "--pou", pou],
+            &["run", "-", "--scans", "3", "--format", "json", "--pou", pou],
+        ] {
+            let from_json = run_stdout(args, &json);
+            let from_xml = run_stdout(args, &xml);
+            // `run` measures its speed, which differs run to run.
+            let strip = |s: &str| {
+                let mut v: serde_json::Value = match serde_json::from_str(s) {
+                    Ok(v) => v,
+                    Err(_) => return s.to_owned(),
+                };
+                for timed in ["modes", "speedup", "plan_run"] {
+                    v.as_object_mut().unwrap().remove(timed);
+                }
+                v.to_string()
+            };
+            assert_eq!(strip(&from_json), strip(&from_xml), "{args:?}");
+        }
+    }
+    let out = common::cli::run_stdin(&["report", "-", "--pou", "Nope"], json.as_bytes());
+    assert_eq!(out.status.code(), Some(2));
+    assert!(out.stdout.is_empty());
+    let err = String::from_utf8_lossy(&out.stderr);
+    let first = err.lines().next().unwrap_or("");
+    assert_eq!(
+        first,
+        "error[E0309]: --pou Nope: no program instance runs a program of that name; they run A, B, C, D",
+        "{err}"
+    );
+    assert!(err.contains("at configuration"), "{err}");
+}
+
 /// `run` says which program instances each scan ran: all of them in task order, or the one
 /// `--pou` selects; the JSON has them under `programs`.
 #[test]
@@ -329,7 +372,7 @@ fn run_names_the_program_instances_it_ran() {
     let out = run_stdout(&["run", "-", "--scans", "1"], &xml);
     assert_eq!(
         out.lines().nth(1),
-        Some("ran all 4 program instances each scan, one after another in task order: Fast.fa (A), Slow.sb (B), Slow.sc (C), rd (D) (of a PLCopen file, --pou NAME runs one program alone)"),
+        Some("ran all 4 program instances each scan, one after another in task order: Fast.fa (A), Slow.sb (B), Slow.sc (C), rd (D) (--pou NAME runs one program alone)"),
         "{out}"
     );
     let (r, _) = json_output(&["run", "-", "--scans", "1", "--format", "json"], &xml);

@@ -282,13 +282,13 @@ fn load_text_for(
     select: Option<&str>,
 ) -> Result<(Program, Fbd), CliError> {
     use crate::read::{plcopen, stl};
-    if let (Some(name), false) = (select, plcopen::looks_like_xml(text)) {
-        return Err(CliError::Usage(format!(
-            "{file}: --pou {name} selects a program of a PLCopen project, and this is not one (the DOT report's --pou draws one POU of any program: add --format dot)"
-        )));
-    }
     let lower = file.to_ascii_lowercase();
     if stl::looks_like_stl(text) || lower.ends_with(".stl") || lower.ends_with(".awl") {
+        if let Some(name) = select {
+            return Err(CliError::Usage(format!(
+                "{file}: --pou {name} selects a program of a PLCopen project or of a JSON program with a configuration, and this is an STL program (the DOT report's --pou draws one POU of any program: add --format dot)"
+            )));
+        }
         return crate::load::stl(text).map_err(|error| CliError::load(file, text, error));
     }
     if plcopen::looks_like_xml(text) {
@@ -301,7 +301,11 @@ fn load_text_for(
         warn_notes(PLCOPEN_NOTE, &file, text, &notes);
         return Ok((p, f));
     }
-    crate::load::program_and_fbd_from_json(text).map_err(|error| CliError::load(file, text, error))
+    match select {
+        Some(name) => crate::load::program_and_fbd_from_json_selected(text, name),
+        None => crate::load::program_and_fbd_from_json(text),
+    }
+    .map_err(|error| CliError::load(file, text, error))
 }
 
 /// The code of a PLCopen reader's note (what it read only through an interface, ignored, or

@@ -21,6 +21,7 @@
 
 pub mod fbd;
 pub mod pipe;
+pub mod select;
 
 use crate::diag::Invalid;
 use crate::model::{ArithOp, BistableKind, CmpOp, TimerKind, TriggerKind};

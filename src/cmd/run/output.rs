@@ -233,7 +233,7 @@ fn instances_text(r: &RunReport) -> Option<String> {
         )),
         (1, 1) => Some(format!("ran program instance {names}")),
         (n, all) if n == all => Some(format!(
-            "ran all {n} program instances each scan, one after another in task order: {names} (of a PLCopen file, --pou NAME runs one program alone)"
+            "ran all {n} program instances each scan, one after another in task order: {names} (--pou NAME runs one program alone)"
         )),
         (n, all) => Some(format!(
             "ran {} of {all}, selected by --pou: {names}",
