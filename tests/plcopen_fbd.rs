@@ -234,6 +234,11 @@ fn in_variable_expressions_are_computed_and_read_exactly() {
         ("-a MOD 4 + b", "INT", ["2", "7"]),
         ("a &gt; b AND c", "BOOL", ["1", "0"]),
         ("NOT (a = 7) OR a &lt;= -3", "BOOL", ["0", "1"]),
+        // Constant sub-expressions are folded (IEC 61131-3 constant expressions), so they keep
+        // the type of their use: INT here, never DINT.
+        ("a + 2 * 3", "INT", ["13", "3"]),
+        ("a * (10 - 4) / -(1 + 2)", "INT", ["-14", "6"]),
+        ("a &lt; 2 * 3", "BOOL", ["0", "1"]),
     ] {
         let xml = fbd(expr, ty);
         let got = px::trace(&format!("expr-{}", want[0]), &xml, csv, &["x"]);
@@ -260,16 +265,11 @@ fn in_variable_expressions_are_computed_and_read_exactly() {
         let mut ins: Vec<String> = ins.into_iter().filter(|v| !v.starts_with('_')).collect();
         ins.sort();
         ins.dedup();
-        let want_ins: Vec<&str> = if expr.contains('c') {
-            vec!["a", "b", "c"]
-        } else {
-            vec!["a", "b"]
-        };
-        let want_ins: Vec<&str> = if expr.starts_with("NOT") {
-            vec!["a"]
-        } else {
-            want_ins
-        };
+        // The variables are the expression's only lower-case letters besides `&lt;`/`&gt;`.
+        let want_ins: Vec<&str> = ["a", "b", "c"]
+            .into_iter()
+            .filter(|v| expr.contains(v))
+            .collect();
         assert_eq!(ins, want_ins, "{expr}: the reads");
         assert!(outs.iter().any(|o| o == "x"), "{expr}: {outs:?}");
     }
@@ -334,4 +334,37 @@ fn an_array_element_expression_reads_the_array_and_its_subscript() {
         err.contains("`run` cannot execute the FBD body of `P`"),
         "{err}"
     );
+}
+
+/// A function block instance's output in an in variable's expression (`NOT t.Q`) is that field:
+/// the block reads the instance (the report names variables, not fields) and `run` computes it.
+#[test]
+fn an_instance_field_in_an_expression_reads_that_field() {
+    let body = [
+        in_var(1, "NOT t.Q AND go"),
+        var_in("outVariable", 2, "y", (1, None)),
+    ]
+    .concat();
+    let xml = project_in(
+        "FBD",
+        &[
+            ("inputVars", "go", "BOOL"),
+            ("localVars", "t", "TON"),
+            ("outputVars", "y", "BOOL"),
+        ],
+        &body,
+    );
+    let r = px::report(&xml);
+    let mut reads: Vec<String> = px::io(&r)
+        .into_iter()
+        .flat_map(|(_, i, _)| i.as_array().unwrap().clone())
+        .map(|v| v.as_str().unwrap().to_owned())
+        .filter(|v| !v.starts_with('_'))
+        .collect();
+    reads.sort();
+    reads.dedup();
+    // The report names the instance a field belongs to.
+    assert_eq!(reads, ["go", "t"]);
+    let got = px::trace("instance-field", &xml, "go\n1\n0\n", &["y"]);
+    assert_eq!(got, [vec!["1".to_owned(), "0".to_owned()]]);
 }

@@ -3,10 +3,13 @@
 //! by the ST parser, [`crate::read::st::parser::expression`]) made into the blocks that compute
 //! it, added to the body ([`Added`]) — `a + b * 2` is `ADD(a, MUL(b, 2))`, `NOT x AND y` is
 //! `AND(NOT(x), y)`, `-x` is `SUB(0, x)` (`-3` the literal), comparisons their comparison
-//! blocks. So its reads are
-//! exactly its variables, and `run` computes it as the blocks do (literals typed by their use).
+//! blocks; an integer sub-expression of literals alone (`2 * 3`) is folded into the literal it
+//! makes, so that its use types it. So its reads are exactly its variables, and `run` computes it
+//! as the blocks do (literals typed by their use).
 //!
-//! A struct field (`s.f`) is the variable reference the model has for it. An array element
+//! A function block instance's output (`t.Q`) is the field reference the model has for it; a
+//! structure's field (`s.f`) is passed on as such and refused by the resolver (the model has no
+//! structures). An array element
 //! (`a[i]`) reads the whole array and the variables of its subscripts: the model holds an array
 //! as one value of its element type (docs/plcopen.md, "Data types"), so the element stands in as
 //! `SEL(NE(i, i), a, a)` — the value `a`, with `i` read — and `run` refuses the body (the
@@ -92,6 +95,9 @@ impl<F: Fn(String) -> LoadError> Lower<'_, F> {
                     from: Connection::Constant(Scalar::Number(0.into())),
                 };
                 let x = self.expr(x)?;
+                if let Some(v) = fold(BinaryOp::Sub, &zero, &x) {
+                    return Ok(v);
+                }
                 self.a.add("SUB", vec![("IN1", zero), ("IN2", x)], at)
             }
             Expr::Binary(op, l, r) => {
@@ -99,6 +105,9 @@ impl<F: Fn(String) -> LoadError> Lower<'_, F> {
                     (self.bad)("`**` has no block in plc-deps (no EXPT)".to_owned())
                 })?;
                 let (l, r) = (self.expr(l)?, self.expr(r)?);
+                if let Some(v) = fold(*op, &l, &r) {
+                    return Ok(v);
+                }
                 self.a.add(name, vec![("IN1", l), ("IN2", r)], at)
             }
             Expr::Call { callee, .. } => {
@@ -150,6 +159,32 @@ impl<F: Fn(String) -> LoadError> Lower<'_, F> {
         }
         Ok(value)
     }
+}
+
+/// `l op r` as one integer literal, when both are integer literals and the operator is
+/// arithmetic with a result (no division by zero, nothing beyond 64 bits): a constant expression
+/// (IEC 61131-3 7.3.2), so the result stays an untyped literal that its use types, as `6` would
+/// be (`a + 2 * 3` on an INT is INT). Division truncates toward zero and MOD takes the sign of
+/// the dividend, as the blocks do. Real literals are not folded: the block computes them in the
+/// type of its use, with that type's rounding.
+fn fold(op: BinaryOp, l: &Input, r: &Input) -> Option<Input<'static>> {
+    let int = |i: &Input| match &i.from {
+        Connection::Constant(Scalar::Number(n)) => n.as_i64(),
+        _ => None,
+    };
+    let (a, b) = (int(l)?, int(r)?);
+    let v = match op {
+        BinaryOp::Add => a.checked_add(b),
+        BinaryOp::Sub => a.checked_sub(b),
+        BinaryOp::Mul => a.checked_mul(b),
+        BinaryOp::Div => a.checked_div(b),
+        BinaryOp::Mod => a.checked_rem(b),
+        _ => None,
+    }?;
+    Some(Input {
+        origin: l.origin,
+        from: Connection::Constant(Scalar::Number(v.into())),
+    })
 }
 
 /// `-x` as a literal, when `x` is a number literal.
