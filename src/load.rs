@@ -170,7 +170,8 @@ fn plcopen_all(text: &str, select: Option<&str>) -> Result<PlcOpenLoaded, LoadEr
             notes.list.push(n);
         }
     }
-    Ok((p, f, notes.list, notes.no_run))
+    let no_run = notes.no_run.into_iter().next().map(|(_, n)| n);
+    Ok((p, f, notes.list, no_run))
 }
 
 /// Compares the order of the file's executionOrderIds with the order plc-deps runs the same

@@ -155,6 +155,17 @@ pub fn program(
         notes.push(note);
     }
     library_fbs(&mut fbs, &programs, &globals, notes);
+    if let Some(s) = select {
+        // `run` runs the selected program alone: the others' bodies do not matter to it.
+        let others: Vec<&str> = programs
+            .iter()
+            .map(|p| p.name.as_str())
+            .filter(|n| !n.eq_ignore_ascii_case(s))
+            .collect();
+        notes
+            .no_run
+            .retain(|(pou, _)| !others.contains(&pou.as_str()));
+    }
     let (programs, order) = match select {
         Some(s) => selected(root, programs, order, s)?,
         None => (programs, order),
@@ -420,26 +431,26 @@ fn body(
         }
     }
     if let (Some(m), "LD" | "FBD") = (iface.mapped.iter().find(|m| m.text), tag) {
-        notes.no_run.get_or_insert(Note {
+        notes.no_run.push((name.to_owned(), Note {
             origin: m.origin,
             message: format!("{place}: variable `{}` is a {}, for which plc-deps has no values: the analysis reads it as a whole variable, but `run` cannot execute the {tag} body of `{name}`", m.var, m.from),
-        });
+        }));
     }
     if let (Some(n), "LD" | "FBD") = (string_literal(lang), tag) {
-        notes.no_run.get_or_insert(Note {
+        notes.no_run.push((name.to_owned(), Note {
             origin: origin(n),
             message: format!("{place}: the {} localId {} is a string literal, for which plc-deps has no values: the analysis reads it as a constant, but `run` cannot execute the {tag} body of `{name}`", n.tag_name().name(), n.attribute("localId").unwrap_or("?")),
-        });
+        }));
     }
     let array_element = lang.children().find(|n| {
         matches!(n.tag_name().name(), "inVariable" | "inOutVariable")
             && super::expression::reads_array_element(*n)
     });
     if let (Some(n), "LD" | "FBD") = (array_element, tag) {
-        notes.no_run.get_or_insert(Note {
+        notes.no_run.push((name.to_owned(), Note {
             origin: origin(n),
             message: format!("{place}: the {} localId {} reads an array element, `{}`; the model holds an array as one value, so the analysis reads the whole array (and the subscripts), but `run` cannot execute the {tag} body of `{name}`", n.tag_name().name(), n.attribute("localId").unwrap_or("?"), super::expression::expression_text(n).trim()),
-        });
+        }));
     }
     Ok(match tag {
         "LD" => ld_body(tc6, lang, name, ctx, notes)?,

@@ -74,8 +74,10 @@ pub struct Notes {
     /// The stand-in function block types of the blocks the model lacks
     /// ([`super::black_box`]).
     pub black_boxes: Vec<super::black_box::BlackBox>,
-    /// Why `run` cannot execute the project (a string in a body it would execute), if so.
-    pub no_run: Option<Note>,
+    /// Why `run` cannot execute a POU's body (a string in a body it would execute): the POU's
+    /// name and the reason, in file order; `run` refuses the project for the first one whose POU
+    /// it runs.
+    pub no_run: Vec<(String, Note)>,
 }
 
 impl Notes {
