@@ -206,8 +206,12 @@ pub fn direct_dependences(reads: &VarSets, writes: &VarSets) -> Vec<DataDependen
     let mut last_writer: Vec<Option<u32>> = vec![None; vars];
     // Readers since the last write of each variable, as linked lists through `reader_links`.
     let mut readers_head: Vec<Option<u32>> = vec![None; vars];
-    let mut reader_links: Vec<(u32, Option<u32>)> = Vec::new();
-    let mut out = Vec::new();
+    // Sized once, from the bounds below: at 1M rungs these vectors are hundreds of megabytes,
+    // and growing them by doubling copies each into fresh memory the kernel must zero first.
+    // Capacity never written is never touched, so the bound costs no memory.
+    let mut reader_links: Vec<(u32, Option<u32>)> = Vec::with_capacity(reads.total());
+    // At most one flow pair per read, one anti pair per reader link, one output pair per write.
+    let mut out = Vec::with_capacity(2 * reads.total() + writes.total());
     for t in 0..reads.len() {
         let start = out.len();
         let tu = t as u32;

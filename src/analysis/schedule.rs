@@ -134,7 +134,8 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
         }
     }
     let mut indeg = vec![0u32; comp_count];
-    let mut comp_edges: Vec<(u32, u32)> = Vec::new();
+    // At most one per live edge (sized once: see `direct_dependences`).
+    let mut comp_edges: Vec<(u32, u32)> = Vec::with_capacity(live_edges.len());
     for &(a, b) in &live_edges {
         let (ca, cb) = (sccs.component_of(a), sccs.component_of(b));
         if ca != cb && comp_is_task[ca as usize] && comp_is_task[cb as usize] {
@@ -201,7 +202,7 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
             task_of[v as usize].expect("live rung").0
         }
     };
-    let mut cedges: Vec<(u32, u32)> = Vec::new();
+    let mut cedges: Vec<(u32, u32)> = Vec::with_capacity(live_edges.len());
     let mut entry_preds: Vec<Vec<u32>> = vec![Vec::new(); t as usize];
     for &(a, b) in &live_edges {
         let (ca, cb) = (node(a), node(b));
