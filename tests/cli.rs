@@ -118,6 +118,71 @@ fn bad_files_are_refused_before_parsing_with_the_file_and_the_byte_offset() {
     }
 }
 
+/// Files from 16 MiB on are mapped rather than read: the same checks and the same results. A
+/// program padded with spaces to 17 MiB, with a byte-order mark, reports as the small one does;
+/// a NUL or a byte that is not UTF-8 near its end is refused with its offset.
+#[test]
+fn a_large_file_is_mapped_with_the_same_checks_and_results() {
+    let dir = tmp("mapped-files");
+    std::fs::create_dir_all(&dir).unwrap();
+    let small = "analyses/example-b/program.json";
+    let program = std::fs::read(root().join(small)).unwrap();
+    let size = 17 << 20;
+    let padded = |bom: bool, tail: &[u8]| {
+        let mut bytes = Vec::with_capacity(size + 3);
+        if bom {
+            bytes.extend_from_slice("\u{feff}".as_bytes());
+        }
+        bytes.extend_from_slice(&program);
+        bytes.resize(size - tail.len(), b' ');
+        bytes.extend_from_slice(tail);
+        bytes
+    };
+    let file = |name: &str, bytes: Vec<u8>| {
+        let p = dir.join(name);
+        std::fs::write(&p, bytes).unwrap();
+        p.to_str().unwrap().to_owned()
+    };
+    let expected = run(&["report", small, "--format", "json"]);
+    assert!(expected.status.success());
+    let big = file("big.json", padded(true, b""));
+    let out = run(&["report", &big, "--format", "json"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(out.stdout, expected.stdout);
+    let nul = file("nul.json", padded(false, b"\0 "));
+    assert_eq!(
+        error_line(&run(&["report", &nul]), "NUL"),
+        format!(
+            "error: cannot read the program {nul}: binary data, not text (a NUL byte at offset {})",
+            size - 2
+        )
+    );
+    let latin1 = file("latin1.json", padded(false, b"\xe9"));
+    assert_eq!(
+        error_line(&run(&["order", &latin1]), "latin-1"),
+        format!(
+            "error: cannot read the program {latin1}: not UTF-8 text (byte 0xe9 at offset {} is not valid UTF-8)",
+            size - 1
+        )
+    );
+    // A load error in the mapped text is placed by line and column as in a read one.
+    let mut broken = padded(false, b"");
+    broken.extend_from_slice(b"x");
+    let broken = file("broken.json", broken);
+    let out = run(&["report", &broken]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains(&format!("{broken}:")),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn a_byte_order_mark_is_accepted_and_dash_reads_standard_input() {
     let program = std::fs::read(root().join("analyses/example-b/program.json")).unwrap();

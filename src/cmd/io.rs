@@ -12,6 +12,7 @@
 //! S7-200 STL, PLCopen TC6 XML or JSON). Nothing here prints but the STL and PLCopen readers'
 //! warnings (through [`super::errors`]).
 
+use super::source::{SourceText, MAP_FROM};
 use crate::diag::Shown;
 use crate::fbd::Fbd;
 use crate::model::Program;
@@ -144,36 +145,43 @@ fn invalid(kind: std::io::ErrorKind, message: String) -> std::io::Error {
     std::io::Error::new(kind, message)
 }
 
-/// The bytes as UTF-8 text without a leading byte-order mark, or why not: the byte offset of
-/// the first NUL byte (binary data) or of the first byte that is not UTF-8, whichever is first.
-fn utf8_text(bytes: Vec<u8>) -> Result<String, String> {
+/// Where the UTF-8 text of `bytes` starts (after a leading byte-order mark), or why they are not
+/// text: the byte offset of the first NUL byte (binary data) or of the first byte that is not
+/// UTF-8, whichever is first.
+fn check_text(bytes: &[u8]) -> Result<usize, String> {
     let nul = bytes.iter().position(|&b| b == 0);
-    let text = match String::from_utf8(bytes) {
-        Ok(text) => text,
-        Err(e) => {
-            let at = e.utf8_error().valid_up_to();
-            if nul.is_none_or(|n| n > at) {
-                let byte = e.as_bytes()[at];
-                return Err(format!(
-                    "not UTF-8 text (byte 0x{byte:02x} at offset {at} is not valid UTF-8)"
-                ));
-            }
-            String::new() // the NUL comes first
+    if let Err(e) = std::str::from_utf8(bytes) {
+        let at = e.valid_up_to();
+        if nul.is_none_or(|n| n > at) {
+            let byte = bytes[at];
+            return Err(format!(
+                "not UTF-8 text (byte 0x{byte:02x} at offset {at} is not valid UTF-8)"
+            ));
         }
-    };
+    }
     if let Some(n) = nul {
         return Err(format!("binary data, not text (a NUL byte at offset {n})"));
     }
-    Ok(match text.strip_prefix('\u{feff}') {
-        Some(rest) => rest.to_string(),
-        None => text,
+    Ok(if bytes.starts_with("\u{feff}".as_bytes()) {
+        3
+    } else {
+        0
     })
+}
+
+/// The bytes as UTF-8 text without a leading byte-order mark, or why not ([`check_text`]).
+fn utf8_text(bytes: Vec<u8>) -> Result<String, String> {
+    let start = check_text(&bytes)?;
+    let mut text = String::from_utf8(bytes).map_err(|e| e.to_string())?;
+    text.drain(..start);
+    Ok(text)
 }
 
 /// Reads a whole text file (`-`: standard input) for `role`, refusing folders, files over
 /// [`MAX_INPUT_BYTES`] (checked on the metadata, before reading), binary data and text that is
-/// not UTF-8; a UTF-8 byte-order mark is dropped.
-pub fn read_text(path: &Path, role: FileRole) -> Result<String, CliError> {
+/// not UTF-8; a UTF-8 byte-order mark is dropped. A large regular file is mapped rather than
+/// read ([`SourceText`]).
+pub fn read_text(path: &Path, role: FileRole) -> Result<SourceText, CliError> {
     use std::io::ErrorKind;
     let err = |e| CliError::io(role, path, e);
     let too_large = |len: u64| {
@@ -212,14 +220,22 @@ pub fn read_text(path: &Path, role: FileRole) -> Result<String, CliError> {
         if meta.len() > MAX_INPUT_BYTES {
             return Err(too_large(meta.len()));
         }
+        if meta.is_file() && meta.len() >= MAP_FROM {
+            let file = std::fs::File::open(path).map_err(err)?;
+            if let Some(text) = SourceText::mapped(&file, check_text) {
+                return text.map_err(|m| err(invalid(ErrorKind::InvalidData, m)));
+            }
+        }
         std::fs::read(path).map_err(err)?
     };
-    utf8_text(bytes).map_err(|m| err(invalid(ErrorKind::InvalidData, m)))
+    utf8_text(bytes)
+        .map(SourceText::owned)
+        .map_err(|m| err(invalid(ErrorKind::InvalidData, m)))
 }
 
 /// Reads a program's text (`-`: standard input; see [`read_text`]) and the name that errors
 /// about it use (`<stdin>` for `-`).
-pub fn read_program_text(path: &Path) -> Result<(String, String), CliError> {
+pub fn read_program_text(path: &Path) -> Result<(String, SourceText), CliError> {
     Ok((display_name(path), read_text(path, FileRole::Program)?))
 }
 

@@ -19,5 +19,6 @@ pub mod progress;
 pub mod report;
 pub mod run;
 pub mod schema;
+pub mod source;
 
 pub use io::{CliError, FileRole};

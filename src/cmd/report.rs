@@ -4,8 +4,7 @@
 //! phases show progress on a terminal.
 
 use super::io::{
-    check_output_path, is_stdin, load_text_selecting, read_program_text, read_text,
-    write_output_with, FileRole,
+    check_output_path, load_text_selecting, read_program_text, write_output_with, FileRole,
 };
 use super::progress::Progress;
 use super::CliError;
@@ -134,18 +133,9 @@ pub fn report(c: &ReportConfig) -> Result<(), CliError> {
         let _phase = progress.phase("reading the program");
         load_text_selecting(file.clone(), &source, c.program.as_deref())?
     };
-    // The text places the warnings, which are known only after the analysis. A big program's
-    // text is a sixth of the memory the report takes, so a file is let go now and read again
-    // should a warning need it; standard input cannot be read again.
-    let kept = is_stdin(&c.input).then_some(source);
-    let source = std::cell::OnceCell::new();
-    let source = || {
-        source.get_or_init(|| {
-            kept.clone()
-                .or_else(|| read_text(&c.input, FileRole::Program).ok())
-                .unwrap_or_default()
-        })
-    };
+    // The text places the warnings, which are known only after the analysis. It is kept: a big
+    // program file is mapped, not read (`SourceText`), so keeping it costs no memory of ours.
+    let source = || -> &str { &source };
     let parts = fbd_parts(&p, &fbd);
     let drawn = dot_selection(c, &p)?;
     let a = {
