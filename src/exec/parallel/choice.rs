@@ -404,6 +404,21 @@ impl Chooser {
         };
     }
 
+    /// Whether the next window is a measurement's visit of a candidate other than the current
+    /// one (one [`skip`](Self::skip) may leave out).
+    pub fn measuring_other(&self) -> bool {
+        matches!(&self.stage, Stage::Measure(m) if m.order()[m.at] != 0)
+    }
+
+    /// Leaves the next visit's candidate out of this measurement without running it, as if it
+    /// were hopeless (the machine knows it cannot gain now: its workers are not on a core).
+    /// Nothing when [`measuring_other`](Self::measuring_other) is false.
+    pub fn skip(&mut self) {
+        if self.measuring_other() {
+            self.end_visit();
+        }
+    }
+
     /// The candidate running now (or last).
     pub fn current(&self) -> usize {
         self.current

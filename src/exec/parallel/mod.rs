@@ -100,6 +100,7 @@ mod ready;
 mod shared;
 mod slicing;
 mod tasks;
+mod units;
 
 pub use barrier::SpinBarrier;
 pub use calibrate::{measure_line_cost, LineTiming};
