@@ -97,13 +97,14 @@ mod pad;
 mod partition;
 mod plan;
 mod ready;
+mod rung_cost;
 mod shared;
 mod slicing;
 mod tasks;
 mod units;
 
 pub use barrier::SpinBarrier;
-pub use calibrate::{measure_line_cost, LineTiming};
+pub use calibrate::{measure_handover, measure_line_cost, LineTiming};
 pub use choice::{Chooser, Switch, Window};
 pub use config::{LineCostSource, Measure, PlanConfig, PlanKind, Slicing, Strategy};
 pub use driver::{run_sequential, ScanDriver};
