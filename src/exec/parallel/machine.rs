@@ -2,8 +2,8 @@
 //! candidate plans, the plans, and the candidates a run chooses from) and its runs: the workers
 //! entered once per run; worker 0 (the calling thread) asks the measured choice (`choice`)
 //! which candidate runs the next window of scans, runs sequential windows alone while the
-//! others sleep at the window barrier, and runs parallel windows with them, meeting at the
-//! barrier between phases.
+//! others sleep on the window bell, and runs parallel windows with them: a levelled plan's as
+//! claimed units (`claimed`), a dependence-driven plan's meeting at the barrier.
 //!
 //! Invariants: worker 0 alone talks to the driver and the chooser, between barriers; every
 //! candidate works on the same state layout, so a switch between scans needs no copy; the
