@@ -12,7 +12,7 @@
 //! without a core loses its slices instead of holding the others at a barrier):
 //!
 //! - a **parallel phase** is one level of the schedule, cut statically into one *slice* per
-//!   worker, balanced on the cost model (`Analysis::rung_costs`): contiguous runs of tasks
+//!   worker, balanced on the cost model (`rung_cost`: what each rung costs the interpreter): contiguous runs of tasks
 //!   (best for many small rungs: a slice of consecutive rungs is one call into the interpreter),
 //!   LPT (best for a few large tasks) or the *locality partition* (each task towards the worker
 //!   that wrote what it reads, within 1/16 of the better of the two: `partition`), whichever
