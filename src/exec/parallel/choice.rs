@@ -593,6 +593,31 @@ mod tests {
     }
 
     #[test]
+    fn a_skipped_candidate_never_runs_in_that_measurement_and_the_others_decide() {
+        let mut ch = Chooser::new(3, measure(), 0);
+        let mut ran = Vec::new();
+        while ran.len() < 40 {
+            if ch.next().candidate == 2 {
+                assert!(ch.measuring_other());
+                ch.skip();
+                continue;
+            }
+            let w = ch.next();
+            let t = [100_000, 50_000, 10_000][w.candidate];
+            ran.extend(std::iter::repeat_n(w.candidate, w.scans as usize));
+            ch.record(w, &vec![t; w.scans as usize]);
+        }
+        assert!(!ran.contains(&2), "{ran:?}");
+        assert_eq!(ch.current(), 1, "the faster of the two measured");
+        assert_eq!(ch.estimates()[2], None);
+        // Not measuring another candidate: skip does nothing.
+        assert!(!ch.measuring_other());
+        let before = ch.next();
+        ch.skip();
+        assert_eq!(ch.next(), before);
+    }
+
+    #[test]
     fn a_hopeless_candidate_is_dropped_after_one_scan_and_the_default_kept() {
         let mut ch = Chooser::new(3, measure(), 0);
         let ns = |c: usize, _: u64, _: bool| [100_000, 1_000_000, 101_000][c];
