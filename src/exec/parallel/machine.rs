@@ -448,13 +448,18 @@ impl ParallelMachine {
                     chooser.skip();
                     win = chooser.next();
                 }
-                let n = win.scans.min(scans.end - scan);
                 let c = allowed[win.candidate];
+                let deps = self.is_deps(c);
+                // A dependence-driven window is short and timed whole: its waits cost a time
+                // slice each when another worker loses its core, so the chooser must see that
+                // within a few scans (it cannot take the other worker's items, as units can).
+                let cap = if deps { DEPS_WINDOW } else { u64::MAX };
+                let n = win.scans.min(scans.end - scan).min(cap);
                 log.scans_on[c] += n;
                 log.push_segment(scan, c);
                 times.clear();
                 let timing = Timing {
-                    all: win.timed || driver.wants_time(),
+                    all: win.timed || deps || driver.wants_time(),
                     every: self.measure.sample_every.max(1),
                 };
                 match self.candidates[c] {
@@ -751,6 +756,9 @@ impl ParallelMachine {
         }
     }
 }
+
+/// Scans at most per window of a dependence-driven plan.
+const DEPS_WINDOW: u64 = 4;
 
 /// Which scans of a window worker 0 times.
 #[derive(Copy, Clone, Debug)]
