@@ -115,6 +115,9 @@ pub(super) struct WindowNote {
     pub(super) base: u64,
 }
 
+/// A worker waiting on the bell: whether it is parked, and its thread.
+type Seat = Padded<(AtomicBool, OnceLock<Thread>)>;
+
 /// Worker 0's announcement of windows, and the other workers' seats to wait on it.
 pub(super) struct WindowBell {
     /// Odd while worker 0 writes the note; +2 per window.
@@ -123,7 +126,7 @@ pub(super) struct WindowBell {
     first: AtomicU64,
     scans: AtomicU64,
     base: AtomicU64,
-    seats: Box<[Padded<(AtomicBool, OnceLock<Thread>)>]>,
+    seats: Box<[Seat]>,
 }
 
 impl WindowBell {
