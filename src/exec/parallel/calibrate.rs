@@ -129,13 +129,81 @@ pub fn measure_line_cost() -> Option<LineTiming> {
     })
 }
 
+/// Round trips per batch of the hand-over measurement, and batches.
+const TRIPS: u64 = 2000;
+const BATCHES: usize = 7;
+
+/// The time of one phase hand-over between two threads on this machine, in ns: two threads
+/// increment one counter in turn (each waits, spinning, for the other's increment), as the
+/// workers' completion counter is passed between phases; the median over batches of the time
+/// per increment. A phase boundary of the plan costs about two of them (each worker's count
+/// reaching the other) plus the spin that notices the last: the barrier cost is taken as three.
+/// `None` when the threads could not both run (a batch took over 20 ms: a busy machine).
+pub fn measure_handover() -> Option<u64> {
+    let counter = AtomicU64::new(0);
+    let gave_up = std::sync::atomic::AtomicBool::new(false);
+    let (c, g) = (&counter, &gave_up);
+    // Thread `me` (0 or 1) increments when the count is its parity, up to `until`.
+    let play = move |me: u64, until: u64| -> bool {
+        let start = Instant::now();
+        let mut spins = 0u32;
+        loop {
+            let v = c.load(Ordering::Acquire);
+            if v >= until {
+                return true;
+            }
+            if v % 2 == me {
+                c.store(v + 1, Ordering::Release);
+                continue;
+            }
+            spins = spins.wrapping_add(1);
+            if spins.is_multiple_of(256)
+                && (g.load(Ordering::Relaxed) || start.elapsed() > ROUND_WAIT)
+            {
+                g.store(true, Ordering::Relaxed);
+                return false;
+            }
+            std::hint::spin_loop();
+        }
+    };
+    let mut per: Vec<u64> = Vec::with_capacity(BATCHES);
+    std::thread::scope(|s| {
+        s.spawn(move || {
+            for b in 0..BATCHES as u64 {
+                if !play(1, (b + 1) * 2 * TRIPS) {
+                    return;
+                }
+            }
+        });
+        for b in 0..BATCHES as u64 {
+            let t = Instant::now();
+            if !play(0, (b + 1) * 2 * TRIPS) {
+                return;
+            }
+            per.push(t.elapsed().as_nanos() as u64 / (2 * TRIPS));
+        }
+    });
+    if gave_up.load(Ordering::Relaxed) || per.len() < BATCHES {
+        return None;
+    }
+    per.sort_unstable();
+    Some(per[BATCHES / 2].max(1))
+}
+
 impl PlanConfig {
-    /// This configuration with the line cost measured on this machine ([`measure_line_cost`]);
-    /// unchanged for one worker; the default line cost, saying so, when the measurement gave up.
+    /// This configuration with the line cost ([`measure_line_cost`]) and the barrier cost
+    /// ([`measure_handover`]) measured on this machine; unchanged for one worker; the defaults,
+    /// saying so, when a measurement gave up.
     pub fn calibrated(self) -> PlanConfig {
         if self.threads < 2 {
             return self;
         }
+        let handover = measure_handover();
+        let s = PlanConfig {
+            barrier_cost: handover.map_or(self.barrier_cost, |h| 3 * h),
+            handover_ns: handover,
+            ..self
+        };
         match measure_line_cost() {
             Some(t) => PlanConfig {
                 line_cost: t.steps(),
@@ -143,11 +211,11 @@ impl PlanConfig {
                     remote_tenths_ns: t.remote_tenths_ns,
                     local_tenths_ns: t.local_tenths_ns,
                 },
-                ..self
+                ..s
             },
             None => PlanConfig {
                 line_cost_source: LineCostSource::GaveUp,
-                ..self
+                ..s
             },
         }
     }

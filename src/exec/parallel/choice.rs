@@ -404,6 +404,21 @@ impl Chooser {
         };
     }
 
+    /// Whether the next window is a measurement's visit of a candidate other than the current
+    /// one (one [`skip`](Self::skip) may leave out).
+    pub fn measuring_other(&self) -> bool {
+        matches!(&self.stage, Stage::Measure(m) if m.order()[m.at] != 0)
+    }
+
+    /// Leaves the next visit's candidate out of this measurement without running it, as if it
+    /// were hopeless (the machine knows it cannot gain now: its workers are not on a core).
+    /// Nothing when [`measuring_other`](Self::measuring_other) is false.
+    pub fn skip(&mut self) {
+        if self.measuring_other() {
+            self.end_visit();
+        }
+    }
+
     /// The candidate running now (or last).
     pub fn current(&self) -> usize {
         self.current
@@ -575,6 +590,31 @@ mod tests {
         let ran = drive(&mut ch, 2, 48 + 10, ns);
         assert!(ran[48..].iter().all(|&c| c == 0), "{:?}", &ran[40..]);
         assert!(ch.switches().is_empty());
+    }
+
+    #[test]
+    fn a_skipped_candidate_never_runs_in_that_measurement_and_the_others_decide() {
+        let mut ch = Chooser::new(3, measure(), 0);
+        let mut ran = Vec::new();
+        while ran.len() < 40 {
+            if ch.next().candidate == 2 {
+                assert!(ch.measuring_other());
+                ch.skip();
+                continue;
+            }
+            let w = ch.next();
+            let t = [100_000, 50_000, 10_000][w.candidate];
+            ran.extend(std::iter::repeat_n(w.candidate, w.scans as usize));
+            ch.record(w, &vec![t; w.scans as usize]);
+        }
+        assert!(!ran.contains(&2), "{ran:?}");
+        assert_eq!(ch.current(), 1, "the faster of the two measured");
+        assert_eq!(ch.estimates()[2], None);
+        // Not measuring another candidate: skip does nothing.
+        assert!(!ch.measuring_other());
+        let before = ch.next();
+        ch.skip();
+        assert_eq!(ch.next(), before);
     }
 
     #[test]

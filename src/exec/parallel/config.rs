@@ -139,8 +139,10 @@ pub enum LineCostSource {
     Given,
 }
 
-/// Parameters of the plan. Costs are in the cost model's element steps (a contact is 1; on the
-/// machine the defaults were measured on, a step takes 0.5–2 ns).
+/// Parameters of the plan. Costs are in steps of about 1 ns on the machine the defaults were
+/// measured on (a 2-core AMD EPYC): a rung the interpreter runs fused costs
+/// [`fused_rung_cost`](Self::fused_rung_cost), anything else the analysis' element steps times
+/// [`step_tenths`](Self::step_tenths) / 10 (`rung_cost`).
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub struct PlanConfig {
     /// Number of workers (threads), at least 1.
@@ -156,6 +158,14 @@ pub struct PlanConfig {
     /// Modelled cost of one cache line a worker reads that another worker wrote last, in
     /// steps (`movement`).
     pub line_cost: u64,
+    /// Modelled cost of a rung the interpreter runs as one fused table lookup (`exec::fuse`:
+    /// at most eight plain contacts and one output), in steps (`rung_cost`).
+    pub fused_rung_cost: u64,
+    /// Steps per element step of the analysis' cost model for everything not fused, in tenths.
+    pub step_tenths: u64,
+    /// The hand-over between two cores measured at plan time (`calibrate`), in ns, that
+    /// `barrier_cost` was set from (`None`: the default barrier).
+    pub handover_ns: Option<u64>,
     /// Where `line_cost` came from (for `--explain`).
     pub line_cost_source: LineCostSource,
     /// How levels become phases.
@@ -176,10 +186,14 @@ impl PlanConfig {
     pub const DEFAULT_LINE_COST: u64 = 20;
 
     /// The defaults for `threads` workers, measured on a 2-core AMD EPYC: a barrier of two
-    /// spinning workers takes 100–150 ns, a step of generated programs 0.5–2 ns (≈ 1 ns for
-    /// 1,000 rungs): barrier 120 steps; a wait on a ready flag 40 steps (a line from the other
-    /// core and the spin that notices it, not measured separately); an item (a call into the interpreter) ≈ 12 steps; a
-    /// moved line [`DEFAULT_LINE_COST`](Self::DEFAULT_LINE_COST).
+    /// spinning workers takes 100–150 ns: 120 steps; a wait on a ready flag 40 steps (a line from
+    /// the other core and the spin that notices it, not measured separately); an item (a call
+    /// into the interpreter) ≈ 12 steps; a moved line
+    /// [`DEFAULT_LINE_COST`](Self::DEFAULT_LINE_COST). A rung fused whole 4 steps and an element
+    /// step of the rest 1.5 (thread CPU time of `examples/interp_cpu`, 5 repetitions: 4.6 ns
+    /// per rung on `gen --rungs 20000 --width 1000`, 90 % of whose rungs are fused whole, and
+    /// 6.0 on the same with `--timers`, solved for the two: 3.7 ns a fused rung; the element step
+    /// from the unfused interpreter's 8.6–9.5 ns per 6-step rung).
     pub fn new(threads: usize) -> PlanConfig {
         PlanConfig {
             threads: threads.max(1),
@@ -187,6 +201,9 @@ impl PlanConfig {
             wait_cost: 40,
             item_cost: 12,
             line_cost: Self::DEFAULT_LINE_COST,
+            fused_rung_cost: 4,
+            step_tenths: 15,
+            handover_ns: None,
             line_cost_source: LineCostSource::Default,
             strategy: Strategy::Auto,
             slicing: Slicing::Auto,

@@ -44,7 +44,7 @@ struct Assignment {
 pub(super) fn build(p: &Program, a: &Analysis, config: &PlanConfig) -> Plan {
     let sched = &a.schedule;
     let threads = config.threads.max(1);
-    let info = task_facts(p, a, &sched.task_of);
+    let info = task_facts(p, a, &sched.task_of, config);
     let est_sequential: u64 = info.cost.iter().sum();
     let conflicts = level_conflicts(p, a);
     let (mut levels, slices) = slice_levels(p, a, &info, config, &conflicts);

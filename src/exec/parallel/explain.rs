@@ -28,8 +28,12 @@ impl ParallelMachine {
         for w in &self.warnings {
             let _ = writeln!(s, "warning: {w}");
         }
-        let _ = writeln!(s, "parallel plan: {}, {}, cost model: barrier {} steps, item {} steps, line {} steps ({}), strategy {:?}, slicing {:?}",
-            count(plan.threads, "worker"), count(plan.levels.len(), "level"), c.barrier_cost, c.item_cost, c.line_cost, line_source(c.line_cost_source), c.strategy, c.slicing);
+        let barrier = match c.handover_ns {
+            Some(h) => format!("measured: 3 hand-overs of {h} ns"),
+            None => "default".into(),
+        };
+        let _ = writeln!(s, "parallel plan: {}, {}, cost model: barrier {} steps ({barrier}), item {} steps, line {} steps ({}), fused rung {} steps, other element steps x{:.1}, strategy {:?}, slicing {:?}",
+            count(plan.threads, "worker"), count(plan.levels.len(), "level"), c.barrier_cost, c.item_cost, c.line_cost, line_source(c.line_cost_source), c.fused_rung_cost, c.step_tenths as f64 / 10.0, c.strategy, c.slicing);
         let (seq, est) = plan.estimates();
         let _ = writeln!(
             s,

@@ -2,14 +2,16 @@
 //! candidate plans, the plans, and the candidates a run chooses from) and its runs: the workers
 //! entered once per run; worker 0 (the calling thread) asks the measured choice (`choice`)
 //! which candidate runs the next window of scans, runs sequential windows alone while the
-//! others sleep at the window barrier, and runs parallel windows with them, meeting at the
-//! barrier between phases.
+//! others sleep on the window bell, and runs parallel windows with them: a levelled plan's as
+//! claimed units (`claimed`), a dependence-driven plan's meeting at the barrier.
 //!
 //! Invariants: worker 0 alone talks to the driver and the chooser, between barriers; every
 //! candidate works on the same state layout, so a switch between scans needs no copy; the
 //! results are those of [`Machine::run_scan`], byte for byte and fault for fault, whichever
 //! candidates ran. It does not plan (`plan`) nor check plans (`check`); it runs what
 //! [`ParallelMachine::new`] kept.
+
+mod claimed;
 
 use super::barrier::SpinBarrier;
 use super::candidates::candidate_plans;
@@ -23,6 +25,7 @@ use super::pad::Padded;
 use super::plan::{bools_first, layout_groups, Plan};
 use super::shared::{Decisions, FaultBuffer, Shared, SharedSlots};
 use super::tasks::{Item, Region};
+use super::units::{Units, WindowBell, WindowNote};
 use crate::analysis::Analysis;
 use crate::exec::{
     ExecConfig, Exit, Fault, Layout, LowerError, Machine, ScanCtx, State, LINE_BYTES,
@@ -30,7 +33,6 @@ use crate::exec::{
 use crate::model::{Program, RungId, VarId};
 use std::cell::UnsafeCell;
 use std::ops::Range;
-use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 /// One way to run a scan.
@@ -95,14 +97,6 @@ pub struct ParallelMachine {
     pub(super) layout_groups: usize,
     /// Why plans were dropped (a failed check), for the user.
     pub(super) warnings: Vec<String>,
-}
-
-/// The window the workers run next, published by worker 0 before the window barrier.
-struct WindowCell {
-    plan: AtomicUsize,
-    first: AtomicU64,
-    /// 0: the run is over.
-    scans: AtomicU64,
 }
 
 impl ParallelMachine {
@@ -359,6 +353,14 @@ impl ParallelMachine {
             .unwrap_or(0);
         let decisions = Decisions::new(decision_slots);
         let ready = ReadyFlags::new(threads);
+        let per_scan = self
+            .plans
+            .iter()
+            .map(|p| claimed::unit_layout(p).1)
+            .max()
+            .unwrap_or(1);
+        let units = Units::new(per_scan);
+        let bell = WindowBell::new(threads);
         let faults: Vec<FaultBuffer> = (0..threads)
             .map(|_| Padded(UnsafeCell::new(Vec::new())))
             .collect();
@@ -371,24 +373,13 @@ impl ParallelMachine {
             faults: &faults,
             barrier: SpinBarrier::new(threads),
             ready: &ready,
+            units: &units,
+            bell: &bell,
         };
-        let window = WindowCell {
-            plan: AtomicUsize::new(0),
-            first: AtomicU64::new(0),
-            scans: AtomicU64::new(0),
-        };
-        let (shared, window) = (&shared, &window);
+        let shared = &shared;
         let mut chooser = Chooser::new(allowed.len(), self.measure, scans.start);
         if threads == 1 {
-            self.leader(
-                shared,
-                window,
-                scans,
-                driver,
-                &mut chooser,
-                &allowed,
-                &mut log,
-            );
+            self.leader(shared, scans, driver, &mut chooser, &allowed, &mut log);
         } else {
             let pool = pool.expect("a thread pool for more than one worker");
             assert!(
@@ -404,17 +395,9 @@ impl ParallelMachine {
             );
             pool.in_place_scope(|s| {
                 for w in 1..threads {
-                    s.spawn(move |_| self.follower(w, shared, window));
+                    s.spawn(move |_| self.follower(w, shared));
                 }
-                self.leader(
-                    shared,
-                    window,
-                    scans,
-                    driver,
-                    &mut chooser,
-                    &allowed,
-                    &mut log,
-                );
+                self.leader(shared, scans, driver, &mut chooser, &allowed, &mut log);
             });
         }
         for (i, &c) in allowed.iter().enumerate() {
@@ -433,13 +416,12 @@ impl ParallelMachine {
         log
     }
 
-    /// Worker 0: chooses, runs sequential windows alone and parallel windows with the others,
-    /// then releases them.
-    #[allow(clippy::too_many_arguments)]
+    /// Worker 0: chooses, runs sequential windows alone and parallel windows with the others
+    /// (announced on the bell: a levelled plan's scans as claimed units, a dependence-driven
+    /// plan's behind the barrier), then tells them the run is over.
     fn leader<D: ScanDriver + ?Sized>(
         &self,
         sh: &Shared<'_>,
-        window: &WindowCell,
         scans: Range<u64>,
         driver: &mut D,
         chooser: &mut Chooser,
@@ -449,18 +431,35 @@ impl ParallelMachine {
         let body = std::panic::AssertUnwindSafe(|| {
             sh.barrier.register(0);
             let mut epoch = 0u64;
+            let mut base = 0u64;
             let mut times: Vec<u64> = Vec::new();
             let mut bufs = Buffers::default();
             let mut scan = scans.start;
+            // Whether the last levelled window ran most of the other workers' slices itself
+            // (they were not on a core): a dependence-driven plan, which must wait for them,
+            // is then not worth measuring.
+            let mut others_away = false;
             while scan < scans.end {
-                let win = chooser.next();
-                let n = win.scans.min(scans.end - scan);
+                let mut win = chooser.next();
+                while others_away
+                    && chooser.measuring_other()
+                    && self.is_deps(allowed[win.candidate])
+                {
+                    chooser.skip();
+                    win = chooser.next();
+                }
                 let c = allowed[win.candidate];
+                let deps = self.is_deps(c);
+                // A dependence-driven window is short and timed whole: its waits cost a time
+                // slice each when another worker loses its core, so the chooser must see that
+                // within a few scans (it cannot take the other worker's items, as units can).
+                let cap = if deps { DEPS_WINDOW } else { u64::MAX };
+                let n = win.scans.min(scans.end - scan).min(cap);
                 log.scans_on[c] += n;
                 log.push_segment(scan, c);
                 times.clear();
                 let timing = Timing {
-                    all: win.timed || driver.wants_time(),
+                    all: win.timed || deps || driver.wants_time(),
                     every: self.measure.sample_every.max(1),
                 };
                 match self.candidates[c] {
@@ -468,24 +467,53 @@ impl ParallelMachine {
                         self.sequential_window(sh, scan..scan + n, driver, timing, &mut times)
                     }
                     Candidate::Levelled(i) => {
-                        window.plan.store(i, Ordering::Relaxed);
-                        window.first.store(scan, Ordering::Relaxed);
-                        window.scans.store(n, Ordering::Relaxed);
-                        if !sh.barrier.wait(0, &mut epoch) {
-                            return;
-                        }
                         let plan = &self.plans[i];
-                        let d = Some((&mut *driver, timing, &mut times));
-                        if !self.plan_scans(0, plan, sh, scan..scan + n, &mut epoch, d, &mut bufs) {
-                            return;
+                        sh.bell.ring(WindowNote {
+                            plan: i,
+                            first: scan,
+                            scans: n,
+                            base,
+                        });
+                        if plan.ready.is_some() {
+                            if !sh.barrier.wait(0, &mut epoch) {
+                                return;
+                            }
+                            let d = Some((&mut *driver, timing, &mut times));
+                            if !self.plan_scans(
+                                0,
+                                plan,
+                                sh,
+                                scan..scan + n,
+                                &mut epoch,
+                                d,
+                                &mut bufs,
+                            ) {
+                                return;
+                            }
+                        } else {
+                            let r = scan..scan + n;
+                            let b = &mut bufs;
+                            let Some(taken) =
+                                self.leader_units(plan, sh, base, r, driver, timing, &mut times, b)
+                            else {
+                                return;
+                            };
+                            let others =
+                                n * (plan.threads as u64 - 1) * plan.parallel_phases() as u64;
+                            others_away = others > 0 && taken * 2 > others;
+                            base += n * claimed::unit_layout(plan).1 as u64;
                         }
                     }
                 }
                 chooser.record(Window { scans: n, ..win }, &times);
                 scan += n;
             }
-            window.scans.store(0, Ordering::Relaxed);
-            sh.barrier.wait(0, &mut epoch);
+            sh.bell.ring(WindowNote {
+                plan: 0,
+                first: scan,
+                scans: 0,
+                base,
+            });
         });
         if let Err(panic) = std::panic::catch_unwind(body) {
             sh.barrier.poison();
@@ -493,32 +521,37 @@ impl ParallelMachine {
         }
     }
 
+    /// Whether candidate `c` is a dependence-driven plan.
+    fn is_deps(&self, c: usize) -> bool {
+        matches!(self.candidates[c], Candidate::Levelled(i) if self.plans[i].ready.is_some())
+    }
+
     /// Workers 1..: wait for a window, run their part of it, until the run is over.
-    fn follower(&self, w: usize, sh: &Shared<'_>, window: &WindowCell) {
+    fn follower(&self, w: usize, sh: &Shared<'_>) {
         let body = std::panic::AssertUnwindSafe(|| {
             sh.barrier.register(w);
+            sh.bell.register(w);
             let mut epoch = 0u64;
             let mut bufs = Buffers::default();
+            let mut k = 1;
             loop {
-                if !sh.barrier.wait(w, &mut epoch) {
+                let Some((got, note)) = sh.bell.wait(w, k, &sh.barrier) else {
+                    return;
+                };
+                k = got + 1;
+                if note.scans == 0 {
                     return;
                 }
-                // Relaxed: written by worker 0 before the barrier just passed.
-                let n = window.scans.load(Ordering::Relaxed);
-                if n == 0 {
-                    return;
-                }
-                let first = window.first.load(Ordering::Relaxed);
-                let plan = &self.plans[window.plan.load(Ordering::Relaxed)];
-                if !self.plan_scans::<NoDriver>(
-                    w,
-                    plan,
-                    sh,
-                    first..first + n,
-                    &mut epoch,
-                    None,
-                    &mut bufs,
-                ) {
+                let plan = &self.plans[note.plan];
+                let scans = note.first..note.first + note.scans;
+                let ok = if plan.ready.is_some() {
+                    sh.barrier.wait(w, &mut epoch)
+                        && self
+                            .plan_scans::<NoDriver>(w, plan, sh, scans, &mut epoch, None, &mut bufs)
+                } else {
+                    self.follower_units(w, plan, sh, got, note, &mut bufs)
+                };
+                if !ok {
                     return;
                 }
             }
@@ -615,22 +648,31 @@ impl ParallelMachine {
                 }
                 // Every other worker has passed the scan's last barrier and waits at the next
                 // one: worker 0 has the buffers and slots to itself.
-                b.merged.clear();
-                for f in sh.faults.iter() {
-                    // SAFETY: as above; no other reference to the buffer exists now.
-                    let buf = unsafe { &mut *f.0.get() };
-                    b.merged.append(buf);
-                }
-                b.merged.sort_by_key(|&(t, _)| t); // stable: a task's faults keep their order
-                b.out.clear();
-                b.out.extend(b.merged.iter().map(|&(_, f)| f));
+                let faults = self.merged_faults(sh, b);
                 // SAFETY: as above: nobody writes the slots until worker 0 reaches the next
                 // barrier, after the driver returned.
                 let slots: &[u8] = unsafe { sh.slots.bytes_mut() };
-                d.after_scan(&self.machine, scan, slots, &b.out, elapsed);
+                d.after_scan(&self.machine, scan, slots, faults, elapsed);
             }
         }
         true
+    }
+
+    /// The faults of every worker's buffer in sequential order (by task; a task's faults keep
+    /// their order), the buffers emptied. Worker 0 only, when no other worker runs a unit or
+    /// item of the scan.
+    fn merged_faults<'b>(&self, sh: &Shared<'_>, b: &'b mut Buffers) -> &'b [Fault] {
+        b.merged.clear();
+        for f in sh.faults.iter() {
+            // SAFETY: no other worker touches its buffer until the next scan starts (the
+            // caller's condition); no other reference to it exists now.
+            let buf = unsafe { &mut *f.0.get() };
+            b.merged.append(buf);
+        }
+        b.merged.sort_by_key(|&(t, _)| t);
+        b.out.clear();
+        b.out.extend(b.merged.iter().map(|&(_, f)| f));
+        &b.out
     }
 
     /// Where a decision leads: the task holding the rung control went to, or the end of the
@@ -714,6 +756,9 @@ impl ParallelMachine {
         }
     }
 }
+
+/// Scans at most per window of a dependence-driven plan.
+const DEPS_WINDOW: u64 = 4;
 
 /// Which scans of a window worker 0 times.
 #[derive(Copy, Clone, Debug)]

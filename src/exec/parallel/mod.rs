@@ -6,11 +6,13 @@
 //! Granularity decides everything: a rung of 6 contacts and a coil costs about 3.5 ns, a level
 //! of a thousand of them a few µs, so the executor must not pay a thread wake-up per level. The
 //! workers are therefore entered **once per run** (one [`rayon::ThreadPool::in_place_scope`]
-//! around all scans: the calling thread is worker 0, the pool supplies the others) and meet at a
-//! barrier ([`SpinBarrier`]: spin, yield, then park) between the *phases* of every scan:
+//! around all scans: the calling thread is worker 0, the pool supplies the others) and pass each
+//! other the *phases* of every scan as claimed units (`units`: a worker runs its own slice, then
+//! any slice nobody claimed, and a phase starts when the units before it are done, so a worker
+//! without a core loses its slices instead of holding the others at a barrier):
 //!
 //! - a **parallel phase** is one level of the schedule, cut statically into one *slice* per
-//!   worker, balanced on the cost model (`Analysis::rung_costs`): contiguous runs of tasks
+//!   worker, balanced on the cost model (`rung_cost`: what each rung costs the interpreter): contiguous runs of tasks
 //!   (best for many small rungs: a slice of consecutive rungs is one call into the interpreter),
 //!   LPT (best for a few large tasks) or the *locality partition* (each task towards the worker
 //!   that wrote what it reads, within 1/16 of the better of the two: `partition`), whichever
@@ -59,14 +61,16 @@
 //!
 //! # Modules, bottom to top
 //! Each depends only on the ones above it in this list: `ids` (typed indices and decisions),
-//! `config`, `calibrate` (the per-line cost measured), `pad`, `calls` (call closures,
+//! `config`, `calibrate` (the per-line and hand-over costs measured), `pad`, `rung_cost` (what
+//! a rung costs the interpreter, fused or not), `calls` (call closures,
 //! loop-backs), `tasks` (task facts, items, contiguous and LPT cuts), `partition` (the
 //! locality partition of one level), `movement` (lines moved between workers), `slicing`
 //! (each level's slices and modelled makespan), `plan` (phases on the cost model: the
 //! planning, the candidate plans), `check` (a plan against the lowered code),
 //! `choice` (the measured choice among candidates), `driver` (the per-scan callbacks and the
-//! sequential loop), `barrier`, `shared` (lock-free shared memory), `machine` (the running
-//! machine), `explain`.
+//! sequential loop), `barrier`, `units` (claimed units, the window bell), `shared` (lock-free
+//! shared memory), `machine` (the running machine; `machine::claimed` runs a levelled plan's
+//! scans as units), `explain`.
 //!
 //! # Memory
 //! The state is one block of bytes, each value in its type's width (`exec::Layout`), starting
@@ -97,12 +101,14 @@ mod pad;
 mod partition;
 mod plan;
 mod ready;
+mod rung_cost;
 mod shared;
 mod slicing;
 mod tasks;
+mod units;
 
 pub use barrier::SpinBarrier;
-pub use calibrate::{measure_line_cost, LineTiming};
+pub use calibrate::{measure_handover, measure_line_cost, LineTiming};
 pub use choice::{Chooser, Switch, Window};
 pub use config::{LineCostSource, Measure, PlanConfig, PlanKind, Slicing, Strategy};
 pub use driver::{run_sequential, ScanDriver};

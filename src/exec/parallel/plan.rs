@@ -16,6 +16,7 @@ use super::config::{PlanConfig, PlanKind, Strategy};
 use super::ids::{DecisionSlot, Next, TaskId};
 use super::movement::Movement;
 use super::ready::{Ready, Wait};
+use super::rung_cost::interpreter_costs;
 use super::slicing::{slice_levels, worker_makespan, LevelPlan};
 use super::tasks::{Item, Tasks};
 use crate::analysis::{Analysis, EdgeKind, Successor};
@@ -113,7 +114,7 @@ impl Plan {
         let sched = &a.schedule;
         let threads = config.threads.max(1);
         let task_of_rung: Vec<Option<TaskId>> = sched.task_of.clone();
-        let info = task_facts(p, a, &task_of_rung);
+        let info = task_facts(p, a, &task_of_rung, config);
         let est_sequential: u64 = info.cost.iter().sum();
         let level_conflict = level_conflicts(p, a);
         let (mut level_plans, mut level_slices) =
@@ -284,7 +285,9 @@ pub(super) fn task_facts<'a>(
     p: &Program,
     a: &'a Analysis,
     task_of: &[Option<TaskId>],
+    config: &PlanConfig,
 ) -> Tasks<'a> {
+    let rung_cost = interpreter_costs(p, a, config);
     let sched = &a.schedule;
     let nt = sched.tasks.len();
     let n = p.rungs.len() as u32;
@@ -341,7 +344,7 @@ pub(super) fn task_facts<'a>(
         .map(|t| {
             t.rungs
                 .iter()
-                .map(|r| a.rung_costs[r.index()])
+                .map(|r| rung_cost[r.index()])
                 .sum::<u64>()
                 .max(1)
         })

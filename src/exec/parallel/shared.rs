@@ -11,6 +11,7 @@ use super::barrier::SpinBarrier;
 use super::flags::ReadyFlags;
 use super::ids::{Decision, DecisionSlot};
 use super::pad::Padded;
+use super::units::{Units, WindowBell};
 use crate::exec::{Addr, Fault, Store, Word};
 use std::cell::UnsafeCell;
 use std::sync::atomic::{AtomicU32, Ordering};
@@ -115,6 +116,10 @@ pub(super) struct Shared<'a> {
     pub(super) barrier: SpinBarrier,
     /// The workers' ready flags (dependence-driven plans).
     pub(super) ready: &'a ReadyFlags,
+    /// The claimed units of levelled plans (`units`).
+    pub(super) units: &'a Units,
+    /// Worker 0's announcements of windows.
+    pub(super) bell: &'a WindowBell,
 }
 
 // SAFETY: the fault buffers are each used by one worker during a scan and by worker 0 between

@@ -306,9 +306,12 @@ mod tests {
         // The locality partition follows the producers: nothing moves.
         assert_eq!(lines(&local), [vec![0, 0], vec![0, 0], vec![0, 0]]);
         assert_eq!(local.levels()[1].slicing, "locality");
+        // Each rung (one contact and a coil) is fused whole: 4 steps; one item of 12.
+        let fused = PlanConfig::new(2).fused_rung_cost;
+        assert_eq!(fused, 4);
         assert_eq!(
             local.levels()[1].workers,
-            [(200, 1, 200 * 2 + 12), (200, 1, 200 * 2 + 12)]
+            [(200, 1, 200 * fused + 12), (200, 1, 200 * fused + 12)]
         );
         // Auto slicing picks the locality cut where it moves less.
         let auto = plan(&p, Slicing::Auto);
