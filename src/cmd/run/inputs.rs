@@ -3,7 +3,9 @@
 
 use super::config::{count, time_refusal};
 use crate::cmd::io::{read_text, CliError, FileRole};
-use crate::model::{parse_time_literal, Program, Type, Value, VarClass, VarId};
+use crate::model::{
+    int_range, parse_int_literal, parse_time_literal, Program, Type, Value, VarClass, VarId, Wide,
+};
 use serde_json::Value as Json;
 use std::path::Path;
 
@@ -61,18 +63,17 @@ fn parse_value(ty: Type, s: &str) -> Result<Value, String> {
             "false" | "0" => Value::Bool(false),
             _ => return Err(format!("`{t}` is not a BOOL (true, false, 1 or 0)")),
         },
-        Type::Int => Value::Int(
-            t.parse()
-                .map_err(|_| format!("`{t}` is not an INT (-32768..32767)"))?,
-        ),
-        Type::Dint => Value::Dint(
-            t.parse()
-                .map_err(|_| format!("`{t}` is not a DINT (32-bit integer)"))?,
-        ),
         Type::Real => Value::Real(t.parse().map_err(|_| bad())?),
+        Type::Lreal => Value::Lreal(Wide::new(t.parse::<f64>().map_err(|_| bad())?.to_bits())),
+        ty if ty.is_int() || ty.is_bits() => {
+            let (lo, hi) = int_range(ty);
+            let range = || format!("`{t}` is not a {ty} ({lo}..{hi})");
+            let v = parse_int_literal(t).ok_or_else(range)?;
+            Value::int_of(ty, v).ok_or_else(range)?
+        }
         Type::Time => {
-            let ms = if let Ok(ms) = t.parse::<i64>() {
-                Some(ms)
+            let ms = if let Some(ms) = parse_int_literal(t).filter(|_| !t.contains('#')) {
+                Some(ms as i64)
             } else {
                 parse_time_literal(t)
             };
@@ -91,7 +92,7 @@ fn parse_value(ty: Type, s: &str) -> Result<Value, String> {
                 }
             }
         }
-        Type::Fb(_) => return Err(bad()),
+        _ => return Err(bad()),
     })
 }
 
