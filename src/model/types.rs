@@ -210,6 +210,9 @@ impl Type {
     }
 }
 
+/// The types [`Type::is_comparable`] accepts, for messages.
+pub const COMPARABLE: &str = "a number, TIME or bit string (not BOOL)";
+
 /// The elementary types but TIME, with their IEC names.
 pub const ELEMENTARY: [(&str, Type); 15] = [
     ("BOOL", Type::Bool),
@@ -570,6 +573,23 @@ impl ArithOp {
             "MOD" => ArithOp::Mod,
             _ => return None,
         })
+    }
+    /// Whether the operation takes operands of type `ty` (IEC 61131-3 2.5.1.5.2): ADD and SUB
+    /// ANY_NUM and TIME, MUL and DIV ANY_NUM, MOD ANY_INT. Never the bit strings (ANY_BIT).
+    pub fn accepts(self, ty: Type) -> bool {
+        match self {
+            ArithOp::Add | ArithOp::Sub => ty.is_numeric(),
+            ArithOp::Mul | ArithOp::Div => ty.is_int() || ty.is_real(),
+            ArithOp::Mod => ty.is_int(),
+        }
+    }
+    /// The types [`accepts`](Self::accepts) takes, for messages.
+    pub fn expected(self) -> &'static str {
+        match self {
+            ArithOp::Add | ArithOp::Sub => "a number or TIME",
+            ArithOp::Mul | ArithOp::Div => "a number (an integer or a real)",
+            ArithOp::Mod => "an integer",
+        }
     }
     pub fn name(self) -> &'static str {
         match self {

@@ -765,13 +765,10 @@ impl<'a> Body<'a> {
                 };
                 let v = self.var(*var);
                 let ctr = self.counter(r);
-                let wrap = match self.sh.p.var(*var).ty {
-                    Type::Int => "_plc_w16",
-                    _ => "_plc_w32",
-                };
+                let w = num_suffix(self.sh.p.var(*var).ty);
                 let no = self.rung_no(r);
                 self.line(&format!("if (!_plc_loop_back(&{ctr}, ctx, {no})) break;"));
-                self.line(&format!("{v} = {wrap}((int64_t){v} + 1);"));
+                self.line(&format!("{v} = _plc_add_{w}({v}, 1);"));
                 self.indent -= 1;
                 self.line("}");
                 self.indent -= 1;
