@@ -67,7 +67,13 @@ fn parse_value(ty: Type, s: &str) -> Result<Value, String> {
         Type::Lreal => Value::Lreal(Wide::new(t.parse::<f64>().map_err(|_| bad())?.to_bits())),
         ty if ty.is_int() || ty.is_bits() => {
             let (lo, hi) = int_range(ty);
-            let range = || format!("`{t}` is not a {ty} ({lo}..{hi})");
+            // "an INT", "an LINT", "a UINT", "a DWORD" (as the names are spoken).
+            let article = if matches!(ty, Type::Int | Type::Lint | Type::Lword) {
+                "an"
+            } else {
+                "a"
+            };
+            let range = || format!("`{t}` is not {article} {ty} ({lo}..{hi})");
             let v = parse_int_literal(t).ok_or_else(range)?;
             Value::int_of(ty, v).ok_or_else(range)?
         }
