@@ -245,6 +245,42 @@ fn csv_inputs_out_of_their_type_are_refused() {
 }
 
 #[test]
+fn json_inputs_take_64_bit_integers_exactly_and_based_strings() {
+    let prog = write("types-json.json", &PROGRAM.replace(
+        r#"{"name": "Z", "type": "USINT", "init": 9},"#,
+        r#"{"name": "Z", "type": "USINT", "init": 9}, {"name": "UL", "type": "ULINT", "class": "input"},"#,
+    ));
+    let inputs = write(
+        "types-in.json",
+        r#"[{"GO": false, "B": "16#FE", "UL": 18446744073709551615}]"#,
+    );
+    let args = [
+        "run",
+        prog.to_str().unwrap(),
+        "--inputs",
+        inputs.to_str().unwrap(),
+    ];
+    let out = run(&[&args[..], &["--mode", "seq", "--format", "json"]].concat());
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["state"]["UL"], u64::MAX);
+    assert_eq!(report["state"]["B"], 254);
+    let bad = write("types-bad.json", r#"[{"B": 300}]"#);
+    let line = error_line(
+        &run(&[
+            "run",
+            prog.to_str().unwrap(),
+            "--inputs",
+            bad.to_str().unwrap(),
+        ]),
+        "B = 300",
+    );
+    assert!(
+        line.ends_with("scan 0, input `B`: `300` is not a BYTE (0..255)"),
+        "{line}"
+    );
+}
+
+#[test]
 fn generated_c_prints_the_interpreters_state_after_every_scan() {
     let cfg = CConfig {
         cycle_ms: 10,

@@ -266,14 +266,30 @@ pub fn parse_inputs_json(p: &Program, text: &str, file: &str) -> Result<InputTab
                     (Json::Number(n), Type::Real) => {
                         Ok(Value::Real(n.as_f64().unwrap_or(f64::NAN) as f32))
                     }
-                    (Json::Number(n), Type::Int | Type::Dint | Type::Time) if n.is_i64() => {
+                    (Json::Number(n), Type::Lreal) => Ok(Value::Lreal(Wide::new(
+                        n.as_f64().unwrap_or(f64::NAN).to_bits(),
+                    ))),
+                    // Integers exactly (a ULINT up to 2^64 - 1), range-checked as in the CSV.
+                    (Json::Number(n), t)
+                        if (t.is_int() || t.is_bits() || t == Type::Time)
+                            && (n.is_i64() || n.is_u64()) =>
+                    {
                         parse_value(ty, &n.to_string())
                     }
-                    (Json::String(s), Type::Time) if s.contains('#') => parse_value(ty, s),
+                    // TIME literals, and based or plain integers as strings (`"16#FF"`).
+                    (Json::String(s), t)
+                        if (t == Type::Time && s.contains('#')) || t.is_int() || t.is_bits() =>
+                    {
+                        parse_value(ty, s)
+                    }
                     _ => Err(format!(
                         "{} is not {} {ty}",
                         describe_json(&raw),
-                        if matches!(ty, Type::Int) { "an" } else { "a" }
+                        if matches!(ty, Type::Int | Type::Lint | Type::Lword) {
+                            "an"
+                        } else {
+                            "a"
+                        }
                     )),
                 };
                 let value = value.map_err(|m| {
