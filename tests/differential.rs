@@ -25,7 +25,8 @@ const PROGRAMS: u64 = 2000;
 const SCANS: u64 = 30;
 const THREADS: [usize; 3] = [1, 2, 4];
 
-/// Random inputs per scan: the BOOL inputs and the INT input `k` (often 0: DIV/MOD faults).
+/// Random inputs per scan: the BOOL inputs, the INT input `k` (often 0: DIV/MOD faults) and the
+/// LINT input `kl` (`common::random_input`).
 fn input_table(p: &Program, seed: u64, scans: u64) -> Vec<Vec<(VarId, Value)>> {
     let mut rng = common::Rng::new(seed ^ 0xABCD);
     let inputs: Vec<VarId> = (0..p.vars.len() as u32)
@@ -39,13 +40,7 @@ fn input_table(p: &Program, seed: u64, scans: u64) -> Vec<Vec<(VarId, Value)>> {
                 if rng.chance(20) {
                     continue; // sometimes an input keeps its value
                 }
-                let value = match p.var(v).ty {
-                    plc_deps::model::Type::Bool => Value::Bool(rng.chance(50)),
-                    plc_deps::model::Type::Int => Value::Int(rng.below(9) as i16 - 3),
-                    plc_deps::model::Type::Dint => Value::Dint(rng.below(9) as i32 - 3),
-                    plc_deps::model::Type::Real => Value::Real(rng.below(9) as f32 * 0.5),
-                    _ => Value::Time(rng.below(100) as i32),
-                };
+                let value = common::random_input(p.var(v).ty, &mut rng);
                 row.push((v, value));
             }
             row

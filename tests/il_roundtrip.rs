@@ -38,9 +38,21 @@ fn s7_only(v: &mut Json) {
         }
         Json::Array(a) => {
             // The standard FBs with no S7-200 instruction (SR, RS, R_TRIG, F_TRIG, CTUD) are
-            // left out of the series they are in.
+            // left out of the series they are in; so are the elementary types S7-200 has no
+            // instructions for (`common::typed`, the LINT input `kl`): their variables and
+            // every element that names one.
             const NONE: [&str; 5] = ["sr", "rs", "r_trig", "f_trig", "ctud"];
             a.retain(|e| !NONE.iter().any(|k| e.get(k).is_some()));
+            let typed: Vec<String> = common::typed()
+                .iter()
+                .map(|(n, _, _)| n.to_string())
+                .chain(["kl".to_string()])
+                .map(|n| format!("\"{n}\""))
+                .collect();
+            a.retain(|e| {
+                let text = e.to_string();
+                !typed.iter().any(|n| text.contains(n.as_str()))
+            });
             a.iter_mut().for_each(s7_only)
         }
         _ => {}

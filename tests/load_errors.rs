@@ -46,8 +46,8 @@ fn every_error_points_at_its_most_precise_node() {
     let cases: &[(&str, &str)] = &[
         (
             r#"{"program": "p", "vars": [
-  {"name": "A", "type": "WORD"}], "rungs": [{"id": "R1", "ld": [{"ret": true}]}]}"#,
-            "p.json:2:25: at vars[0].type: unknown type `WORD`",
+  {"name": "A", "type": "STRING"}], "rungs": [{"id": "R1", "ld": [{"ret": true}]}]}"#,
+            "p.json:2:25: at vars[0].type: unknown type `STRING`",
         ),
         (
             r#"{"program": "p", "vars": [{"name": "A", "type": "BOOL", "init": 7}],
@@ -72,7 +72,7 @@ fn every_error_points_at_its_most_precise_node() {
             r#"{"program": "p", "vars": [{"name": "B", "type": "BOOL"}], "rungs": [
   {"id": "R1", "ld": [{"for": {"var": "B", "from": 1, "to": 2}}]},
   {"id": "R2", "ld": [{"next": true}]}]}"#,
-            "p.json:2:39: rung R1 at rungs[0].ld[0].for.var: a FOR index needs INT or DINT",
+            "p.json:2:39: rung R1 at rungs[0].ld[0].for.var: a FOR index needs an integer (SINT … LINT, USINT … ULINT)",
         ),
         (
             r#"{"program": "p", "rungs": [{"id": "R1", "ld": [{"ret": true}]}],

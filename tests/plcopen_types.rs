@@ -1,6 +1,7 @@
-//! The elementary types of IEC 61131-3 the model lacks, in hand-written PLCopen TC6 XML: read
-//! as one it has (BYTE as INT, UINT as DINT, LREAL as REAL …) with one note naming every mapped
-//! variable and what `run` computes differently; typed and based literals as initial values;
+//! The elementary types of IEC 61131-3 in hand-written PLCopen TC6 XML: those the model has
+//! (BYTE, UINT, LREAL, ULINT …) read as themselves; those it lacks read as one it has (LTIME as
+//! TIME, DATE as DINT …) with one note naming every mapped variable and what `run` computes
+//! differently; typed and based literals as initial values;
 //! strings accepted only where `run` does not execute the body.
 
 mod common;
@@ -42,7 +43,7 @@ fn ld() -> String {
 }
 
 #[test]
-fn mapped_types_load_run_and_are_named_in_one_note() {
+fn elementary_types_are_read_as_themselves_and_the_others_named_in_one_note() {
     let xml = with_types(
         "LD",
         &[
@@ -51,18 +52,21 @@ fn mapped_types_load_run_and_are_named_in_one_note() {
             ("outputVars", "b", "<BYTE/>", "16#10"),
             ("outputVars", "u", "<UINT/>", "UINT#7"),
             ("outputVars", "r", "<LREAL/>", "2.5"),
+            ("outputVars", "big", "<ULINT/>", "18446744073709551615"),
+            ("outputVars", "t", "<LTIME/>", "T#1s"),
         ],
         &ld(),
     );
     let (_, err) = report_and_warnings(&xml);
+    // Only LTIME is mapped: BYTE, UINT, LREAL and ULINT are the model's own.
     assert_eq!(
         err.trim_end(),
-        format!("warning: <stdin>:{}: elementary types the model lacks are read as one it has: P.b BYTE → INT, P.u UINT → DINT, P.r LREAL → REAL; `run` computes them at the model's width (INT 16-bit, DINT 32-bit, signed; REAL 32-bit), so it differs from a PLC where a value leaves the declared type's range or needs LREAL precision, and a string has no value (it stands in as a DINT 0)", line_col(&xml, "<variable name=\"b\""))
+        format!("warning: <stdin>:{}: elementary types the model lacks are read as one it has: P.t LTIME → TIME; `run` computes them as that type (dates and times of day as DINT, LTIME as 32-bit ms TIME), so it differs from a PLC where a value leaves that type's range, and a string has no value (it stands in as a DINT 0)", line_col(&xml, "<variable name=\"t\""))
     );
     let v = run_scans(&xml, 1);
     assert_eq!(
         v["outputs"],
-        json!({"lamp": false, "b": 16, "u": 7, "r": 2.5})
+        json!({"lamp": false, "b": 16, "u": 7, "r": 2.5, "big": 18446744073709551615u64, "t": 1000})
     );
 }
 

@@ -82,14 +82,15 @@ fn series_cost(series: &[Element], pou_totals: &[u64]) -> u64 {
 
 /// Constant trip count of a FOR head, if its bounds are constants.
 pub fn trip_count(e: &Element) -> Option<u64> {
+    // A FOR index is any integer type (ULINT bounds need more than i64).
     let int = |o: &Operand| match o {
-        Operand::Const(Value::Int(v)) => Some(*v as i64),
-        Operand::Const(Value::Dint(v)) => Some(*v as i64),
-        _ => None,
+        Operand::Const(v) => v.as_i128(),
+        Operand::Var(_) => None,
     };
     match e {
         Element::For { bounds, .. } => {
-            Some((int(&bounds.to)? - int(&bounds.from)? + 1).max(0) as u64)
+            let n = (int(&bounds.to)? - int(&bounds.from)? + 1).clamp(0, u64::MAX as i128);
+            Some(n as u64)
         }
         _ => None,
     }

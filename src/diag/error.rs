@@ -116,7 +116,7 @@ pub enum Invalid {
     #[error("`{name}` is not a valid name (letters, digits and _, not starting with a digit)")]
     BadName { name: String },
     #[error(
-        "unknown type `{name}` (expected BOOL, INT, DINT, REAL, TIME, TON, TOF, TP, CTU, CTD, SR, RS, R_TRIG, F_TRIG or CTUD)"
+        "unknown type `{name}` (expected BOOL, SINT, INT, DINT, LINT, USINT, UINT, UDINT, ULINT, REAL, LREAL, BYTE, WORD, DWORD, LWORD, TIME, TON, TOF, TP, CTU, CTD, SR, RS, R_TRIG, F_TRIG or CTUD)"
     )]
     UnknownType { name: String },
     #[error("variable `{name}` is declared twice")]
@@ -159,6 +159,8 @@ pub enum Invalid {
     Range { value: String, ty: String },
     #[error("`{text}` is not a valid TIME literal (write e.g. \"T#1s\", \"T#250ms\")")]
     BadTime { text: String },
+    #[error("`{text}` is not a valid literal (write e.g. \"16#FF\", \"2#1010\", \"UINT#5\", \"LREAL#1.5\")")]
+    BadLiteral { text: String },
     #[error("{what} is not allowed {place}")]
     Misplaced {
         what: &'static str,
@@ -238,7 +240,7 @@ pub enum Invalid {
         member: String,
         members: String,
     },
-    #[error("unknown type `{name}` (expected BOOL, INT, DINT, REAL, TIME, TON, TOF, TP, CTU, CTD, SR, RS, R_TRIG, F_TRIG, CTUD or a function block: {fbs})")]
+    #[error("unknown type `{name}` (expected BOOL, SINT, INT, DINT, LINT, USINT, UINT, UDINT, ULINT, REAL, LREAL, BYTE, WORD, DWORD, LWORD, TIME, TON, TOF, TP, CTU, CTD, SR, RS, R_TRIG, F_TRIG, CTUD or a function block: {fbs})")]
     UnknownTypeOrFb { name: String, fbs: String },
     // ---- PLCopen TC6 XML (docs/plcopen.md)
     /// What the PLCopen reader cannot take (the message names the element, its localId or name).

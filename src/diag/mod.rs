@@ -89,6 +89,7 @@ impl Invalid {
             BadTime { .. } => "E0106",
             Misplaced { .. } => "E0107",
             Empty => "E0108",
+            BadLiteral { .. } => "E0109",
             UnknownType { .. } => "E0201",
             UnknownTypeOrFb { .. } => "E0202",
             DuplicateVar { .. } => "E0203",

@@ -1,8 +1,8 @@
 //! Where each variable lives in a state's memory: a byte address per variable, every value in its
 //! type's width and aligned to it.
 //!
-//! Widths are a function of the type ([`Repr`]): BOOL 1 byte (0 or 1), INT 2, DINT, REAL and
-//! TIME 4. An instance is a small fixed struct whose fields sit at fixed offsets
+//! Widths are a function of the type ([`Repr`]): BOOL 1 byte (0 or 1), SINT, USINT and BYTE 1,
+//! INT, UINT and WORD 2, DINT, UDINT, DWORD, REAL and TIME 4, LINT, ULINT, LWORD and LREAL 8. An instance is a small fixed struct whose fields sit at fixed offsets
 //! ([`field_offset`]): a timer (TON, TOF, TP) is Q (1 byte) at 0, its state flags at 1, ET at 4,
 //! PT at 8 and its start time (8 bytes, ms) at 16 — [`TIMER_BYTES`] in all, aligned to 8; a
 //! counter (CTU, CTD) is Q at 0, the CU/CD of its previous evaluation at 1, CV at 2 and PV at 4
@@ -27,12 +27,26 @@ use std::ops::Range;
 pub enum Repr {
     /// BOOL: one byte, 0 or 1.
     Bool,
+    /// SINT: 8-bit two's complement.
+    I8,
     /// INT: 16-bit two's complement.
     I16,
     /// DINT, TIME (ms): 32-bit two's complement.
     I32,
+    /// LINT: 64-bit two's complement.
+    I64,
+    /// USINT, BYTE: 8-bit unsigned.
+    U8,
+    /// UINT, WORD: 16-bit unsigned.
+    U16,
+    /// UDINT, DWORD: 32-bit unsigned.
+    U32,
+    /// ULINT, LWORD: 64-bit unsigned.
+    U64,
     /// REAL: IEEE 754 single.
     F32,
+    /// LREAL: IEEE 754 double.
+    F64,
 }
 
 impl Repr {
@@ -40,9 +54,16 @@ impl Repr {
     pub fn of(ty: Type) -> Option<Repr> {
         match ty {
             Type::Bool => Some(Repr::Bool),
+            Type::Sint => Some(Repr::I8),
             Type::Int => Some(Repr::I16),
             Type::Dint | Type::Time => Some(Repr::I32),
+            Type::Lint => Some(Repr::I64),
+            Type::Usint | Type::Byte => Some(Repr::U8),
+            Type::Uint | Type::Word => Some(Repr::U16),
+            Type::Udint | Type::Dword => Some(Repr::U32),
+            Type::Ulint | Type::Lword => Some(Repr::U64),
             Type::Real => Some(Repr::F32),
+            Type::Lreal => Some(Repr::F64),
             Type::Fb(_) => None,
         }
     }
@@ -50,9 +71,10 @@ impl Repr {
     /// Width (and alignment) in bytes.
     pub fn width(self) -> u32 {
         match self {
-            Repr::Bool => 1,
-            Repr::I16 => 2,
-            Repr::I32 | Repr::F32 => 4,
+            Repr::Bool | Repr::I8 | Repr::U8 => 1,
+            Repr::I16 | Repr::U16 => 2,
+            Repr::I32 | Repr::U32 | Repr::F32 => 4,
+            Repr::I64 | Repr::U64 | Repr::F64 => 8,
         }
     }
 }
@@ -85,7 +107,7 @@ const TIMER_PARTS: [(u32, u32); 5] = [(Q, 1), (FLAGS, 1), (ET, 4), (PT, 4), (STA
 const COUNTER_PARTS: [(u32, u32); 4] = [(Q, 1), (PREV, 1), (CV, 2), (PV, 2)];
 const TRIGGER_PARTS: [(u32, u32); 2] = [(Q, 1), (MEM, 1)];
 const CTUD_PARTS: [(u32, u32); 5] = [(Q, 1), (PREV, 1), (CV, 2), (PV, 2), (QD, 1)];
-const SCALAR_PARTS: [[(u32, u32); 1]; 3] = [[(0, 1)], [(0, 2)], [(0, 4)]];
+const SCALAR_PARTS: [[(u32, u32); 1]; 4] = [[(0, 1)], [(0, 2)], [(0, 4)], [(0, 8)]];
 
 // Every part aligned to its width, inside its instance.
 const _: () = {
@@ -122,7 +144,8 @@ pub fn parts(ty: Type) -> &'static [(u32, u32)] {
         scalar => match Repr::of(scalar).map_or(1, Repr::width) {
             1 => &SCALAR_PARTS[0],
             2 => &SCALAR_PARTS[1],
-            _ => &SCALAR_PARTS[2],
+            4 => &SCALAR_PARTS[2],
+            _ => &SCALAR_PARTS[3],
         },
     }
 }

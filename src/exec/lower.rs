@@ -45,29 +45,51 @@ index_type!(
 /// Numeric representation of a compare, an arithmetic box or a FOR index.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub(crate) enum Num {
+    /// SINT: wraps at 8 bits.
+    I8,
     /// INT: wraps at 16 bits.
     I16,
     /// DINT, TIME: wrap at 32 bits.
     I32,
+    /// LINT: wraps at 64 bits.
+    I64,
+    /// USINT, BYTE: modulo 2^8.
+    U8,
+    /// UINT, WORD: modulo 2^16.
+    U16,
+    /// UDINT, DWORD: modulo 2^32.
+    U32,
+    /// ULINT, LWORD: modulo 2^64.
+    U64,
     /// REAL.
     F32,
+    /// LREAL.
+    F64,
 }
 
 impl Num {
     fn of(ty: Type) -> Num {
         match Repr::of(ty) {
+            Some(Repr::I8) => Num::I8,
             Some(Repr::I16) => Num::I16,
+            Some(Repr::I64) => Num::I64,
+            Some(Repr::U8) => Num::U8,
+            Some(Repr::U16) => Num::U16,
+            Some(Repr::U32) => Num::U32,
+            Some(Repr::U64) => Num::U64,
             Some(Repr::F32) => Num::F32,
-            _ => Num::I32,
+            Some(Repr::F64) => Num::F64,
+            Some(Repr::I32 | Repr::Bool) | None => Num::I32,
         }
     }
 
     /// Bytes of a value of this representation.
     pub(crate) fn width(self) -> u32 {
         match self {
-            Num::I16 => Repr::I16.width(),
-            Num::I32 => Repr::I32.width(),
-            Num::F32 => Repr::F32.width(),
+            Num::I8 | Num::U8 => 1,
+            Num::I16 | Num::U16 => 2,
+            Num::I32 | Num::U32 | Num::F32 => 4,
+            Num::I64 | Num::U64 | Num::F64 => 8,
         }
     }
 }
@@ -79,6 +101,7 @@ pub(crate) enum Width {
     W1,
     W2,
     W4,
+    W8,
 }
 
 impl Width {
@@ -86,7 +109,8 @@ impl Width {
         match Repr::of(ty).map_or(1, Repr::width) {
             1 => Width::W1,
             2 => Width::W2,
-            _ => Width::W4,
+            4 => Width::W4,
+            _ => Width::W8,
         }
     }
 
@@ -96,6 +120,7 @@ impl Width {
             Width::W1 => 1,
             Width::W2 => 2,
             Width::W4 => 4,
+            Width::W8 => 8,
         }
     }
 }
@@ -778,11 +803,6 @@ fn var_addr(layout: &Layout, r: VarRef) -> Addr {
 }
 
 /// The stored bits of a scalar (to tell constants apart).
-fn bits(v: Value) -> u32 {
-    match v {
-        Value::Bool(b) => b as u32,
-        Value::Int(i) => i as u16 as u32,
-        Value::Dint(i) | Value::Time(i) => i as u32,
-        Value::Real(f) => f.to_bits(),
-    }
+fn bits(v: Value) -> u64 {
+    v.to_bits()
 }

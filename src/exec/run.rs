@@ -1,7 +1,9 @@
 //! The interpreter loop: one generic function over the store and the region predicate, and the
 //! function blocks it calls. Every load and store is typed: a BOOL is a byte (0 or 1), an INT an
 //! `i16`, DINT and TIME an `i32`, REAL an `f32`, at the addresses lowering put in the
-//! instructions. Arithmetic widens to `i64` and wraps back to the type's width.
+//! instructions. Integer arithmetic wraps in the type's width (two's complement for the signed
+//! types, modulo 2^n for the unsigned ones and the bit strings); a DIV or MOD by zero writes 0
+//! and records a fault.
 
 use super::fuse::{lookup, FusedId, FusedRung};
 use super::layout::{CV, ET, FLAGS, PREV, PT, PV, Q, START};
@@ -47,43 +49,100 @@ fn compare<T: PartialOrd>(op: CmpOp, a: T, b: T) -> bool {
     }
 }
 
-/// An integer representation: widened to `i64` for arithmetic and wrapped back.
+/// An integer representation and its wrapping arithmetic (the width's two's complement, or
+/// modulo 2^n for an unsigned one).
 trait Int: Word + PartialOrd {
-    fn widen(self) -> i64;
-    /// Two's complement wrap to the width.
-    fn wrap(v: i64) -> Self;
+    const ZERO: Self;
+    const ONE: Self;
+    fn add(self, b: Self) -> Self;
+    fn sub(self, b: Self) -> Self;
+    fn mul(self, b: Self) -> Self;
+    /// Truncating division (`MIN / -1` wraps to `MIN`); `b` is not zero.
+    fn div(self, b: Self) -> Self;
+    /// The remainder with the sign of `self` (`MIN % -1` is 0); `b` is not zero.
+    fn rem(self, b: Self) -> Self;
 }
 
-impl Int for i16 {
-    #[inline(always)]
-    fn widen(self) -> i64 {
-        self as i64
-    }
-    #[inline(always)]
-    fn wrap(v: i64) -> i16 {
-        v as i16
-    }
+macro_rules! int {
+    ($($t:ty),*) => {$(
+        impl Int for $t {
+            const ZERO: $t = 0;
+            const ONE: $t = 1;
+            #[inline(always)]
+            fn add(self, b: $t) -> $t { self.wrapping_add(b) }
+            #[inline(always)]
+            fn sub(self, b: $t) -> $t { self.wrapping_sub(b) }
+            #[inline(always)]
+            fn mul(self, b: $t) -> $t { self.wrapping_mul(b) }
+            #[inline(always)]
+            fn div(self, b: $t) -> $t { self.wrapping_div(b) }
+            #[inline(always)]
+            fn rem(self, b: $t) -> $t { self.wrapping_rem(b) }
+        }
+    )*};
 }
 
-impl Int for i32 {
-    #[inline(always)]
-    fn widen(self) -> i64 {
-        self as i64
-    }
-    #[inline(always)]
-    fn wrap(v: i64) -> i32 {
-        v as i32
-    }
+int!(i8, i16, i32, i64, u8, u16, u32, u64);
+
+/// Runs `$e` with `$t` the Rust type of the integer representation `$num` (`$real` for REAL
+/// and LREAL, with `$t` the float type).
+macro_rules! by_num {
+    ($num:expr, $t:ident => $e:expr, $real:expr) => {
+        match $num {
+            Num::I8 => {
+                type $t = i8;
+                $e
+            }
+            Num::I16 => {
+                type $t = i16;
+                $e
+            }
+            Num::I32 => {
+                type $t = i32;
+                $e
+            }
+            Num::I64 => {
+                type $t = i64;
+                $e
+            }
+            Num::U8 => {
+                type $t = u8;
+                $e
+            }
+            Num::U16 => {
+                type $t = u16;
+                $e
+            }
+            Num::U32 => {
+                type $t = u32;
+                $e
+            }
+            Num::U64 => {
+                type $t = u64;
+                $e
+            }
+            Num::F32 => {
+                #[allow(dead_code)]
+                type $t = f32;
+                $real
+            }
+            Num::F64 => {
+                #[allow(dead_code)]
+                type $t = f64;
+                $real
+            }
+        }
+    };
 }
 
 /// `a OP b` of two loaded operands of representation `num`.
 #[inline(always)]
 fn compare_at<S: Store + ?Sized>(st: &S, op: CmpOp, num: Num, a: Addr, b: Addr) -> bool {
-    match num {
-        Num::I16 => compare(op, st.load::<i16>(a), st.load(b)),
-        Num::I32 => compare(op, st.load::<i32>(a), st.load(b)),
-        Num::F32 => compare(op, st.load::<f32>(a), st.load(b)),
-    }
+    by_num!(
+        num,
+        T => compare(op, st.load::<T>(a), st.load::<T>(b)),
+        compare(op, st.load::<T>(a), st.load::<T>(b))
+    )
 }
 
 /// Copies the `T` at `from` to `to`.
@@ -103,24 +162,28 @@ fn int_arith<T: Int, S: Store + ?Sized>(
     b: Addr,
     out: Addr,
 ) -> bool {
-    // Operands are 16- or 32-bit values: no i64 operation below overflows.
-    let (a, b) = (st.load::<T>(a).widen(), st.load::<T>(b).widen());
+    let (a, b) = (st.load::<T>(a), st.load::<T>(b));
     let r = match op {
-        ArithOp::Add => Some(a + b),
-        ArithOp::Sub => Some(a - b),
-        ArithOp::Mul => Some(a * b),
-        ArithOp::Div | ArithOp::Mod if b == 0 => None,
-        ArithOp::Div => Some(a / b),
-        ArithOp::Mod => Some(a % b),
+        ArithOp::Add => Some(a.add(b)),
+        ArithOp::Sub => Some(a.sub(b)),
+        ArithOp::Mul => Some(a.mul(b)),
+        ArithOp::Div | ArithOp::Mod if b == T::ZERO => None,
+        ArithOp::Div => Some(a.div(b)),
+        ArithOp::Mod => Some(a.rem(b)),
     };
-    st.store(out, T::wrap(r.unwrap_or(0)));
+    st.store(out, r.unwrap_or(T::ZERO));
     r.is_some()
 }
 
-/// `out := a op b` on REALs (IEEE: no faults).
+/// `out := a op b` on REALs or LREALs (IEEE: no faults).
 #[inline]
-fn real_arith<S: Store + ?Sized>(st: &mut S, op: ArithOp, a: Addr, b: Addr, out: Addr) {
-    let (a, b) = (st.load::<f32>(a), st.load::<f32>(b));
+fn real_arith<T, S>(st: &mut S, op: ArithOp, a: Addr, b: Addr, out: Addr)
+where
+    T: Word + std::ops::Add<Output = T> + std::ops::Sub<Output = T> + std::ops::Mul<Output = T>,
+    T: std::ops::Div<Output = T> + std::ops::Rem<Output = T>,
+    S: Store + ?Sized,
+{
+    let (a, b) = (st.load::<T>(a), st.load::<T>(b));
     let r = match op {
         ArithOp::Add => a + b,
         ArithOp::Sub => a - b,
@@ -134,17 +197,14 @@ fn real_arith<S: Store + ?Sized>(st: &mut S, op: ArithOp, a: Addr, b: Addr, out:
 /// The FOR index at `at` incremented, wrapping in its representation.
 #[inline]
 fn increment<T: Int, S: Store + ?Sized>(st: &mut S, at: Addr) {
-    let v = st.load::<T>(at).widen().wrapping_add(1);
-    st.store(at, T::wrap(v));
+    let v = st.load::<T>(at).add(T::ONE);
+    st.store(at, v);
 }
 
 /// Whether the FOR index at `var` is past the bound at `to`.
 #[inline]
 fn past<S: Store + ?Sized>(st: &S, num: Num, var: Addr, to: Addr) -> bool {
-    match num {
-        Num::I16 => st.load::<i16>(var) > st.load(to),
-        _ => st.load::<i32>(var) > st.load(to),
-    }
+    by_num!(num, T => st.load::<T>(var) > st.load::<T>(to), false)
 }
 
 impl Machine {
@@ -306,19 +366,16 @@ impl Machine {
                             Width::W1 => copy::<u8, S>(st, from, to),
                             Width::W2 => copy::<i16, S>(st, from, to),
                             Width::W4 => copy::<i32, S>(st, from, to),
+                            Width::W8 => copy::<u64, S>(st, from, to),
                         }
                     }
                 }
                 Op::Arith { op, num, a, b, out } => {
                     if p != 0 {
-                        let ok = match num {
-                            Num::I16 => int_arith::<i16, S>(st, op, a, b, out),
-                            Num::I32 => int_arith::<i32, S>(st, op, a, b, out),
-                            Num::F32 => {
-                                real_arith(st, op, a, b, out);
-                                true
-                            }
-                        };
+                        let ok = by_num!(num, T => int_arith::<T, S>(st, op, a, b, out), {
+                            real_arith::<T, S>(st, op, a, b, out);
+                            true
+                        });
                         if !ok {
                             ctx.faults.push(Fault {
                                 scan: ctx.scan,
@@ -361,10 +418,7 @@ impl Machine {
                 Op::For { f } => {
                     let l = &self.fors[f.index()];
                     if p != 0 {
-                        match l.num {
-                            Num::I16 => copy::<i16, S>(st, l.from, l.var),
-                            _ => copy::<i32, S>(st, l.from, l.var),
-                        }
+                        by_num!(l.num, T => copy::<T, S>(st, l.from, l.var), {});
                     } else {
                         pc = l.exit.index();
                     }
@@ -381,10 +435,7 @@ impl Machine {
                         pc = l.exit.index();
                         continue;
                     }
-                    match l.num {
-                        Num::I16 => increment::<i16, S>(st, l.var),
-                        _ => increment::<i32, S>(st, l.var),
-                    }
+                    by_num!(l.num, T => increment::<T, S>(st, l.var), {});
                     if !inside(l.head) {
                         return Flow::ForTest(l.head);
                     }

@@ -11,7 +11,7 @@
 //! nothing of types or variables (see `layout`).
 
 use std::sync::atomic::{
-    AtomicI16, AtomicI32, AtomicI64, AtomicU32, AtomicU64, AtomicU8, Ordering,
+    AtomicI16, AtomicI32, AtomicI64, AtomicI8, AtomicU16, AtomicU32, AtomicU64, AtomicU8, Ordering,
 };
 
 /// A byte address in a state's memory.
@@ -92,11 +92,15 @@ macro_rules! word {
 }
 
 word!(u8, AtomicU8, |v| v, |v| v);
+word!(i8, AtomicI8, |v| v, |v| v);
 word!(i16, AtomicI16, |v| v, |v| v);
+word!(u16, AtomicU16, |v| v, |v| v);
 word!(i32, AtomicI32, |v| v, |v| v);
+word!(u32, AtomicU32, |v| v, |v| v);
 word!(i64, AtomicI64, |v| v, |v| v);
 word!(u64, AtomicU64, |v| v, |v| v);
 word!(f32, AtomicU32, f32::to_bits, f32::from_bits);
+word!(f64, AtomicU64, f64::to_bits, f64::from_bits);
 
 /// Memory read and written by the interpreter.
 ///

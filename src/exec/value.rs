@@ -1,8 +1,8 @@
 //! Values in state memory, and the values a caller reads back.
 //!
-//! A scalar is stored in its type's representation ([`Repr`]): BOOL a byte 0 or 1, INT an
-//! `i16`, DINT and TIME (ms) an `i32`, REAL an `f32`, native byte order, at an address aligned
-//! to its width. This module converts between those bytes and [`Value`]s; it does not place
+//! A scalar is stored in its type's representation ([`Repr`]): BOOL a byte 0 or 1, the
+//! integers and bit strings in their width (SINT an `i8`, WORD a `u16`, …), TIME (ms) an `i32`,
+//! REAL an `f32`, LREAL an `f64`, native byte order, at an address aligned to its width. This module converts between those bytes and [`Value`]s; it does not place
 //! variables (`layout`).
 
 use super::layout::{Repr, CV, ET, PT, PV, Q, QD};
@@ -14,11 +14,13 @@ use serde_json::{json, Value as Json};
 /// Writes the scalar `v` at `at` in its type's representation.
 #[inline]
 pub fn store_value<S: Store + ?Sized>(st: &mut S, at: Addr, v: Value) {
-    match v {
-        Value::Bool(b) => st.store(at, b as u8),
-        Value::Int(i) => st.store(at, i),
-        Value::Dint(i) | Value::Time(i) => st.store(at, i),
-        Value::Real(f) => st.store(at, f),
+    // Every representation is its value's bits in native order: store the low bytes.
+    let bits = v.to_bits();
+    match Repr::of(v.ty()).map_or(1, Repr::width) {
+        1 => st.store(at, bits as u8),
+        2 => st.store(at, bits as u16),
+        4 => st.store(at, bits as u32),
+        _ => st.store(at, bits),
     }
 }
 
@@ -26,19 +28,22 @@ pub fn store_value<S: Store + ?Sized>(st: &mut S, at: Addr, v: Value) {
 /// reads the instance's Q (use [`Machine::value`](super::Machine::value)).
 #[inline]
 pub fn load_value<S: Store + ?Sized>(st: &S, at: Addr, ty: Type) -> Value {
-    match Repr::of(ty) {
-        Some(Repr::Bool) | None => Value::Bool(st.load::<u8>(at) != 0),
-        Some(Repr::I16) => Value::Int(st.load(at)),
-        Some(Repr::I32) if ty == Type::Time => Value::Time(st.load(at)),
-        Some(Repr::I32) => Value::Dint(st.load(at)),
-        Some(Repr::F32) => Value::Real(st.load(at)),
-    }
+    let Some(repr) = Repr::of(ty) else {
+        return Value::Bool(st.load::<u8>(at) != 0);
+    };
+    let bits = match repr.width() {
+        1 => st.load::<u8>(at) as u64,
+        2 => st.load::<u16>(at) as u64,
+        4 => st.load::<u32>(at) as u64,
+        _ => st.load::<u64>(at),
+    };
+    Value::from_bits(ty, bits)
 }
 
 /// The value of a variable as a caller sees it: a scalar, or the readable fields of an instance.
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub enum VarValue {
-    /// A BOOL, INT, DINT, REAL or TIME variable.
+    /// A variable of an elementary type.
     Scalar(Value),
     /// A TON, TOF or TP instance.
     Timer {
@@ -129,8 +134,10 @@ impl VarValue {
         }
     }
 
-    /// JSON form: BOOL `true`/`false`; INT, DINT numbers; REAL a number (its shortest decimal
-    /// form; `null` for NaN and infinities, which JSON cannot hold); TIME milliseconds; a timer
+    /// JSON form: BOOL `true`/`false`; the integers and bit strings exact JSON integers (a
+    /// ULINT above 2^53 too: readers that parse JSON numbers as doubles round it); REAL and
+    /// LREAL a number (the shortest decimal that reads back as the value; `null` for NaN and
+    /// infinities, which JSON cannot hold); TIME milliseconds; a timer
     /// `{"Q", "ET", "PT"}`, a counter `{"Q", "CV", "PV"}`, a bistable `{"Q1"}`, an edge detector
     /// `{"Q"}` and an up-down counter `{"QU", "QD", "CV", "PV"}`.
     pub fn to_json(&self) -> Json {
@@ -150,8 +157,6 @@ impl VarValue {
 fn scalar_json(v: Value) -> Json {
     match v {
         Value::Bool(b) => Json::Bool(b),
-        Value::Int(i) => Json::from(i),
-        Value::Dint(i) | Value::Time(i) => Json::from(i),
         Value::Real(f) => {
             // The shortest decimal that reads back as this f32 (0.1, not 0.10000000149…).
             let shortest: f64 = format!("{f}").parse().unwrap_or(f64::NAN);
@@ -159,6 +164,14 @@ fn scalar_json(v: Value) -> Json {
                 .map(Json::Number)
                 .unwrap_or(Json::Null)
         }
+        Value::Lreal(_) => v
+            .as_f64()
+            .and_then(serde_json::Number::from_f64)
+            .map_or(Json::Null, Json::Number),
+        v => match v.as_i128().unwrap_or(0) {
+            i if i < 0 => Json::from(i as i64),
+            i => Json::from(i as u64),
+        },
     }
 }
 

@@ -1,6 +1,14 @@
 //! Elementary IEC 61131-3 types, values and operands of the program model.
 //!
-//! TIME values are held as signed 32-bit milliseconds (CODESYS and S7 `TIME` are 32-bit ms).
+//! The elementary types of IEC 61131-3 (2.3.1, table 10) at their declared widths: the signed
+//! integers SINT, INT, DINT, LINT (8 to 64 bits), the unsigned USINT, UINT, UDINT, ULINT, the
+//! reals REAL and LREAL (IEEE 754 single and double), the bit strings BYTE, WORD, DWORD, LWORD
+//! and BOOL. TIME values are held as signed 32-bit milliseconds (CODESYS and S7 `TIME` are 32-bit
+//! ms). Which operations accept which types follows the generic types of 2.3.2 ([`Type::is_int`]
+//! for ANY_INT, [`Type::is_real`] for ANY_REAL, [`Type::is_bits`] for ANY_BIT): arithmetic on
+//! ANY_NUM (ADD and SUB also on TIME, MOD only on ANY_INT), comparisons on every elementary type
+//! but BOOL, MOVE on any. A 64-bit constant is held as two 32-bit halves ([`Wide`]) so that a
+//! [`Value`] stays 4-byte aligned and 12 bytes, and a model element 32 bytes.
 //! Function block types (TON, TOF, TP, CTU, CTD, and the bistables SR, RS, the edge detectors
 //! R_TRIG, F_TRIG and the up-down counter CTUD of IEC 61131-3 2.5.2.3) are instance types: a
 //! variable of such a type is an instance, and its readable fields are listed by [`Field`].
@@ -12,12 +20,34 @@ use std::fmt;
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
 pub enum Type {
     Bool,
+    /// 8-bit signed integer.
+    Sint,
     /// 16-bit signed integer.
     Int,
     /// 32-bit signed integer.
     Dint,
+    /// 64-bit signed integer.
+    Lint,
+    /// 8-bit unsigned integer.
+    Usint,
+    /// 16-bit unsigned integer.
+    Uint,
+    /// 32-bit unsigned integer.
+    Udint,
+    /// 64-bit unsigned integer.
+    Ulint,
     /// 32-bit IEEE 754 float.
     Real,
+    /// 64-bit IEEE 754 float.
+    Lreal,
+    /// 8-bit bit string.
+    Byte,
+    /// 16-bit bit string.
+    Word,
+    /// 32-bit bit string.
+    Dword,
+    /// 64-bit bit string.
+    Lword,
     /// Milliseconds, 32-bit signed.
     Time,
     /// A function block instance.
@@ -108,11 +138,10 @@ impl TimerKind {
 impl Type {
     /// Parses a type name of the program format.
     pub fn parse(s: &str) -> Option<Type> {
+        if let Some(t) = Type::elementary(s) {
+            return Some(t);
+        }
         Some(match s {
-            "BOOL" => Type::Bool,
-            "INT" => Type::Int,
-            "DINT" => Type::Dint,
-            "REAL" => Type::Real,
             "TIME" => Type::Time,
             "TON" => Type::Fb(FbKind::Ton),
             "TOF" => Type::Fb(FbKind::Tof),
@@ -127,29 +156,88 @@ impl Type {
             _ => return None,
         })
     }
-    /// True for INT, DINT, REAL and TIME (the types compare and arithmetic accept).
+    /// The elementary types but TIME, by name: the table [`ELEMENTARY`].
+    fn elementary(s: &str) -> Option<Type> {
+        ELEMENTARY.iter().find(|(n, _)| *n == s).map(|&(_, t)| t)
+    }
+    /// The name of an elementary type but TIME.
+    fn elementary_name(self) -> Option<&'static str> {
+        ELEMENTARY.iter().find(|(_, t)| *t == self).map(|&(n, _)| n)
+    }
+    /// ANY_SIGNED: SINT, INT, DINT, LINT.
+    pub fn is_signed(self) -> bool {
+        matches!(self, Type::Sint | Type::Int | Type::Dint | Type::Lint)
+    }
+    /// ANY_UNSIGNED: USINT, UINT, UDINT, ULINT.
+    pub fn is_unsigned(self) -> bool {
+        matches!(self, Type::Usint | Type::Uint | Type::Udint | Type::Ulint)
+    }
+    /// ANY_INT: the signed and unsigned integers.
+    pub fn is_int(self) -> bool {
+        self.is_signed() || self.is_unsigned()
+    }
+    /// ANY_REAL: REAL, LREAL.
+    pub fn is_real(self) -> bool {
+        matches!(self, Type::Real | Type::Lreal)
+    }
+    /// ANY_BIT but BOOL: BYTE, WORD, DWORD, LWORD.
+    pub fn is_bits(self) -> bool {
+        matches!(self, Type::Byte | Type::Word | Type::Dword | Type::Lword)
+    }
+    /// ANY_NUM (the integers and reals) and TIME: the types ADD and SUB accept.
     pub fn is_numeric(self) -> bool {
-        matches!(self, Type::Int | Type::Dint | Type::Real | Type::Time)
+        self.is_int() || self.is_real() || self == Type::Time
+    }
+    /// The types a comparison accepts: every elementary type but BOOL (numbers, TIME and the
+    /// bit strings, IEC 61131-3 2.5.1.5.4 `ANY_ELEMENTARY`).
+    pub fn is_comparable(self) -> bool {
+        self.is_numeric() || self.is_bits()
+    }
+    /// The width in bits of an integer, real or bit-string type (TIME 32; BOOL 1).
+    pub fn bits(self) -> u32 {
+        match self {
+            Type::Bool => 1,
+            Type::Sint | Type::Usint | Type::Byte => 8,
+            Type::Int | Type::Uint | Type::Word => 16,
+            Type::Dint | Type::Udint | Type::Dword | Type::Real | Type::Time => 32,
+            Type::Lint | Type::Ulint | Type::Lword | Type::Lreal => 64,
+            Type::Fb(_) => 0,
+        }
     }
     /// The zero value (FALSE, 0, 0.0, T#0ms); instances have no scalar value.
     pub fn zero(self) -> Value {
-        match self {
-            Type::Bool => Value::Bool(false),
-            Type::Int => Value::Int(0),
-            Type::Dint => Value::Dint(0),
-            Type::Real => Value::Real(0.0),
-            Type::Time | Type::Fb(_) => Value::Time(0),
-        }
+        Value::from_bits(self, 0)
     }
 }
 
+/// The types [`Type::is_comparable`] accepts, for messages.
+pub const COMPARABLE: &str = "a number, TIME or bit string (not BOOL)";
+
+/// The elementary types but TIME, with their IEC names.
+pub const ELEMENTARY: [(&str, Type); 15] = [
+    ("BOOL", Type::Bool),
+    ("SINT", Type::Sint),
+    ("INT", Type::Int),
+    ("DINT", Type::Dint),
+    ("LINT", Type::Lint),
+    ("USINT", Type::Usint),
+    ("UINT", Type::Uint),
+    ("UDINT", Type::Udint),
+    ("ULINT", Type::Ulint),
+    ("REAL", Type::Real),
+    ("LREAL", Type::Lreal),
+    ("BYTE", Type::Byte),
+    ("WORD", Type::Word),
+    ("DWORD", Type::Dword),
+    ("LWORD", Type::Lword),
+];
+
 impl fmt::Display for Type {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if let Some(name) = self.elementary_name() {
+            return f.write_str(name);
+        }
         f.write_str(match self {
-            Type::Bool => "BOOL",
-            Type::Int => "INT",
-            Type::Dint => "DINT",
-            Type::Real => "REAL",
             Type::Time => "TIME",
             Type::Fb(FbKind::Ton) => "TON",
             Type::Fb(FbKind::Tof) => "TOF",
@@ -161,6 +249,7 @@ impl fmt::Display for Type {
             Type::Fb(FbKind::RTrig) => "R_TRIG",
             Type::Fb(FbKind::FTrig) => "F_TRIG",
             Type::Fb(FbKind::Ctud) => "CTUD",
+            _ => unreachable!("elementary types are named by ELEMENTARY"),
         })
     }
 }
@@ -243,13 +332,40 @@ pub struct VarRef {
     pub field: Option<Field>,
 }
 
+/// 64 bits held as two 32-bit halves (low first), so that a [`Value`] holding one is 4-byte
+/// aligned: a `u64` would make every model element 8 bytes larger.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
+pub struct Wide([u32; 2]);
+
+impl Wide {
+    pub fn new(bits: u64) -> Wide {
+        Wide([bits as u32, (bits >> 32) as u32])
+    }
+    pub fn bits(self) -> u64 {
+        self.0[0] as u64 | (self.0[1] as u64) << 32
+    }
+}
+
 /// A constant value.
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub enum Value {
     Bool(bool),
+    Sint(i8),
     Int(i16),
     Dint(i32),
+    /// LINT, as its two's complement bits.
+    Lint(Wide),
+    Usint(u8),
+    Uint(u16),
+    Udint(u32),
+    Ulint(Wide),
     Real(f32),
+    /// LREAL, as its IEEE 754 bits.
+    Lreal(Wide),
+    Byte(u8),
+    Word(u16),
+    Dword(u32),
+    Lword(Wide),
     /// Milliseconds.
     Time(i32),
 }
@@ -258,11 +374,94 @@ impl Value {
     pub fn ty(self) -> Type {
         match self {
             Value::Bool(_) => Type::Bool,
+            Value::Sint(_) => Type::Sint,
             Value::Int(_) => Type::Int,
             Value::Dint(_) => Type::Dint,
+            Value::Lint(_) => Type::Lint,
+            Value::Usint(_) => Type::Usint,
+            Value::Uint(_) => Type::Uint,
+            Value::Udint(_) => Type::Udint,
+            Value::Ulint(_) => Type::Ulint,
             Value::Real(_) => Type::Real,
+            Value::Lreal(_) => Type::Lreal,
+            Value::Byte(_) => Type::Byte,
+            Value::Word(_) => Type::Word,
+            Value::Dword(_) => Type::Dword,
+            Value::Lword(_) => Type::Lword,
             Value::Time(_) => Type::Time,
         }
+    }
+
+    /// The stored bits, zero-extended to 64 (a signed value's two's complement bits of its
+    /// width; a real's IEEE bits).
+    pub fn to_bits(self) -> u64 {
+        match self {
+            Value::Bool(b) => b as u64,
+            Value::Sint(v) => v as u8 as u64,
+            Value::Int(v) => v as u16 as u64,
+            Value::Dint(v) | Value::Time(v) => v as u32 as u64,
+            Value::Usint(v) | Value::Byte(v) => v as u64,
+            Value::Uint(v) | Value::Word(v) => v as u64,
+            Value::Udint(v) | Value::Dword(v) => v as u64,
+            Value::Real(v) => v.to_bits() as u64,
+            Value::Lint(w) | Value::Ulint(w) | Value::Lreal(w) | Value::Lword(w) => w.bits(),
+        }
+    }
+
+    /// The value of type `ty` whose stored bits are the low bits of `bits` (the inverse of
+    /// [`to_bits`](Self::to_bits)); an instance type gives `Time(0)`.
+    pub fn from_bits(ty: Type, bits: u64) -> Value {
+        match ty {
+            Type::Bool => Value::Bool(bits & 1 != 0),
+            Type::Sint => Value::Sint(bits as i8),
+            Type::Int => Value::Int(bits as i16),
+            Type::Dint => Value::Dint(bits as i32),
+            Type::Lint => Value::Lint(Wide::new(bits)),
+            Type::Usint => Value::Usint(bits as u8),
+            Type::Uint => Value::Uint(bits as u16),
+            Type::Udint => Value::Udint(bits as u32),
+            Type::Ulint => Value::Ulint(Wide::new(bits)),
+            Type::Real => Value::Real(f32::from_bits(bits as u32)),
+            Type::Lreal => Value::Lreal(Wide::new(bits)),
+            Type::Byte => Value::Byte(bits as u8),
+            Type::Word => Value::Word(bits as u16),
+            Type::Dword => Value::Dword(bits as u32),
+            Type::Lword => Value::Lword(Wide::new(bits)),
+            Type::Time => Value::Time(bits as i32),
+            Type::Fb(_) => Value::Time(0),
+        }
+    }
+
+    /// An integer value (signed, unsigned, bit string, TIME ms) widened exactly; `None` for
+    /// BOOL and the reals.
+    pub fn as_i128(self) -> Option<i128> {
+        let bits = self.to_bits();
+        let ty = self.ty();
+        match ty {
+            Type::Bool | Type::Real | Type::Lreal | Type::Fb(_) => None,
+            t if t.is_signed() || t == Type::Time => {
+                let shift = 64 - t.bits();
+                Some((((bits << shift) as i64) >> shift) as i128)
+            }
+            _ => Some(bits as i128),
+        }
+    }
+
+    /// A real value as `f64` (REAL widened exactly); `None` for other types.
+    pub fn as_f64(self) -> Option<f64> {
+        match self {
+            Value::Real(v) => Some(v as f64),
+            Value::Lreal(w) => Some(f64::from_bits(w.bits())),
+            _ => None,
+        }
+    }
+
+    /// The integer `v` as a value of the integer, bit-string or TIME type `ty`, if it is in
+    /// that type's range.
+    pub fn int_of(ty: Type, v: i128) -> Option<Value> {
+        let is_int = ty.is_int() || ty.is_bits() || ty == Type::Time;
+        let (lo, hi) = int_range(ty);
+        (is_int && (lo..=hi).contains(&v)).then(|| Value::from_bits(ty, v as u64))
     }
 }
 
@@ -270,10 +469,10 @@ impl fmt::Display for Value {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Value::Bool(b) => write!(f, "{}", if *b { "TRUE" } else { "FALSE" }),
-            Value::Int(v) => write!(f, "{v}"),
-            Value::Dint(v) => write!(f, "{v}"),
             Value::Real(v) => write!(f, "{v:?}"),
+            Value::Lreal(w) => write!(f, "{:?}", f64::from_bits(w.bits())),
             Value::Time(ms) => write!(f, "T#{ms}ms"),
+            v => write!(f, "{}", v.as_i128().unwrap_or(0)),
         }
     }
 }
@@ -375,6 +574,23 @@ impl ArithOp {
             _ => return None,
         })
     }
+    /// Whether the operation takes operands of type `ty` (IEC 61131-3 2.5.1.5.2): ADD and SUB
+    /// ANY_NUM and TIME, MUL and DIV ANY_NUM, MOD ANY_INT. Never the bit strings (ANY_BIT).
+    pub fn accepts(self, ty: Type) -> bool {
+        match self {
+            ArithOp::Add | ArithOp::Sub => ty.is_numeric(),
+            ArithOp::Mul | ArithOp::Div => ty.is_int() || ty.is_real(),
+            ArithOp::Mod => ty.is_int(),
+        }
+    }
+    /// The types [`accepts`](Self::accepts) takes, for messages.
+    pub fn expected(self) -> &'static str {
+        match self {
+            ArithOp::Add | ArithOp::Sub => "a number or TIME",
+            ArithOp::Mul | ArithOp::Div => "a number (an integer or a real)",
+            ArithOp::Mod => "an integer",
+        }
+    }
     pub fn name(self) -> &'static str {
         match self {
             ArithOp::Add => "ADD",
@@ -384,6 +600,61 @@ impl ArithOp {
             ArithOp::Mod => "MOD",
         }
     }
+}
+
+/// The range of an integer, bit-string or TIME type (two's complement for the signed types and
+/// TIME, `0..2^n - 1` for the others); `(0, 0)` for other types.
+pub fn int_range(ty: Type) -> (i128, i128) {
+    let n = ty.bits();
+    if ty.is_signed() || ty == Type::Time {
+        (-(1i128 << (n - 1)), (1i128 << (n - 1)) - 1)
+    } else if ty.is_unsigned() || ty.is_bits() {
+        (0, (1i128 << n) - 1)
+    } else {
+        (0, 0)
+    }
+}
+
+/// Parses an IEC integer literal (IEC 61131-3 2.2.1): decimal with an optional sign (`-5`,
+/// `1_000`), or based, unsigned (`2#1010`, `8#17`, `16#FF`); `_` separates digits. `None` when
+/// the text is not one or its value is beyond ±2^100 (no IEC type holds it anyway).
+pub fn parse_int_literal(s: &str) -> Option<i128> {
+    let (neg, body) = match s.as_bytes().first()? {
+        b'-' => (true, &s[1..]),
+        b'+' => (false, &s[1..]),
+        _ => (false, s),
+    };
+    let (radix, digits) = match body.split_once('#') {
+        Some(("2", d)) if !neg => (2, d),
+        Some(("8", d)) if !neg => (8, d),
+        Some(("16", d)) if !neg => (16, d),
+        Some(_) => return None,
+        None => (10, body),
+    };
+    if digits.is_empty()
+        || digits.starts_with('_')
+        || digits.ends_with('_')
+        || digits.contains("__")
+    {
+        return None;
+    }
+    let mut v: i128 = 0;
+    for c in digits.chars().filter(|&c| c != '_') {
+        v = v.checked_mul(radix)? + c.to_digit(radix as u32)? as i128;
+        if v > 1 << 100 {
+            return None;
+        }
+    }
+    Some(if neg { -v } else { v })
+}
+
+/// Splits a typed literal `TYPE#rest` (`UINT#5`, `WORD#16#FF`, `LREAL#1.5`) into its
+/// elementary type and the rest; `None` when the text does not start with an elementary type
+/// name (other than TIME, whose literals are [`parse_time_literal`]'s) and `#`.
+pub fn split_typed_literal(s: &str) -> Option<(Type, &str)> {
+    let (name, rest) = s.split_once('#')?;
+    let ty = Type::elementary(&name.to_ascii_uppercase())?;
+    Some((ty, rest))
 }
 
 /// Parses an IEC TIME literal (`T#1s`, `T#250ms`, `TIME#1m30s`, `T#1.5s`) into milliseconds.

@@ -130,7 +130,7 @@ impl<'a> Builder<'a> {
                 Element::Contact { var, kind }
             }
             S::Compare(c) => {
-                let (a, b) = self.numeric_pair(&c.a, &c.b, at, s, "a comparison", |_| true)?;
+                let (a, b) = self.numeric_pair(&c.a, &c.b, at, s, "a comparison")?;
                 Element::Compare { op: c.op, a, b }
             }
             S::Or(bs) => Element::Or(self.branches(bs, &key("or"), Place::Or, s)?),
@@ -303,13 +303,13 @@ impl<'a> Builder<'a> {
                 let fp = key("for");
                 let var = self.writable(name, &fp.key("var"), s, "a FOR", None)?;
                 let ty = self.vars[var.index()].ty;
-                if !matches!(ty, Type::Int | Type::Dint) {
+                if !ty.is_int() {
                     return Err(LoadError::invalid(
                         rid,
                         &fp.with(".var"),
                         Invalid::Type {
                             what: "a FOR index",
-                            expected: "INT or DINT".into(),
+                            expected: "an integer (SINT … LINT, USINT … ULINT)".into(),
                             operand: self.vars[var.index()].name.clone(),
                             found: ty.to_string(),
                         },
@@ -341,22 +341,13 @@ impl<'a> Builder<'a> {
     ) -> Result<Element> {
         let out = self.writable(name, &at.key("out"), s, "an arithmetic box", None)?;
         let ty = self.vars[out.index()].ty;
-        let ok = match op {
-            ArithOp::Add | ArithOp::Sub => ty.is_numeric(),
-            ArithOp::Mul | ArithOp::Div => matches!(ty, Type::Int | Type::Dint | Type::Real),
-            ArithOp::Mod => matches!(ty, Type::Int | Type::Dint),
-        };
-        if !ok {
+        if !op.accepts(ty) {
             return Err(LoadError::invalid(
                 Some(s.rung_id),
                 &at.with(".out"),
                 Invalid::Type {
                     what: "this arithmetic box",
-                    expected: if op == ArithOp::Mod {
-                        "INT or DINT".into()
-                    } else {
-                        "a numeric type".into()
-                    },
+                    expected: op.expected().into(),
                     operand: self.vars[out.index()].name.clone(),
                     found: ty.to_string(),
                 },

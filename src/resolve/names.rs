@@ -168,7 +168,6 @@ impl<'a> Builder<'a> {
         at: &At,
         s: &Scope,
         what: &'static str,
-        accept: fn(Type) -> bool,
     ) -> Result<(Operand, Operand)> {
         let (pa, pb) = (at.key("a"), at.key("b"));
         let ua = self.untyped(a, &pa, s)?;
@@ -177,7 +176,7 @@ impl<'a> Builder<'a> {
             .ty()
             .or(ub.ty())
             .unwrap_or_else(|| operand::default_type(&ua).max_numeric(operand::default_type(&ub)));
-        if !ty.is_numeric() || !accept(ty) {
+        if !ty.is_comparable() {
             let (p, j) = if ua.ty().is_some() {
                 (&pa, a)
             } else {
@@ -189,7 +188,7 @@ impl<'a> Builder<'a> {
                 j.origin,
                 Invalid::Type {
                     what,
-                    expected: "INT, DINT, REAL or TIME".into(),
+                    expected: crate::model::COMPARABLE.into(),
                     operand: j.value.display(),
                     found: ty.to_string(),
                 },

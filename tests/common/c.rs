@@ -190,7 +190,17 @@ pub fn random_csv(p: &Program, rng: &mut Rng, rows: usize) -> String {
                     Type::Int => (rng.below(200) as i64 - 100).to_string(),
                     Type::Dint => (rng.below(2_000_000) as i64 - 1_000_000).to_string(),
                     Type::Real => format!("{}", (rng.below(4000) as f64 - 2000.0) / 8.0),
-                    _ => (rng.below(5000)).to_string(),
+                    Type::Time => (rng.below(5000)).to_string(),
+                    // The other integers: small values, extremes, and now and then the
+                    // based form (`16#…`) the harness and `run` both read.
+                    ty => {
+                        let v = super::random_input(ty, rng);
+                        let i = v.as_i128().expect("an integer input");
+                        match i {
+                            0..=255 if rng.chance(20) => format!("16#{i:X}"),
+                            i => i.to_string(),
+                        }
+                    }
                 }
             })
             .collect();

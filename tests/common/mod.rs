@@ -67,6 +67,7 @@ fn vars() -> Vec<Value> {
         v.push(json!({"name": i, "type": "BOOL", "class": "input"}));
     }
     v.push(json!({"name": "k", "type": "INT", "class": "input"}));
+    v.push(json!({"name": "kl", "type": "LINT", "class": "input"}));
     for b in BOOLS {
         v.push(json!({"name": b, "type": "BOOL"}));
     }
@@ -86,7 +87,115 @@ fn vars() -> Vec<Value> {
     v.push(json!({"name": "e0", "type": "R_TRIG"}));
     v.push(json!({"name": "e1", "type": "F_TRIG"}));
     v.push(json!({"name": "u0", "type": "CTUD"}));
+    for (i, (name, ty, consts)) in typed().into_iter().enumerate() {
+        // Every other one starts at an extreme value, so that the first steps overflow.
+        let init = if i % 2 == 0 {
+            consts[0].clone()
+        } else {
+            json!(0)
+        };
+        v.push(json!({"name": name, "type": ty, "init": init}));
+    }
     v
+}
+
+/// One variable of each elementary type besides BOOL, INT, DINT, REAL and TIME, with the
+/// constants its operations use: the type's extremes first, then small values.
+pub fn typed() -> Vec<(&'static str, &'static str, Vec<Value>)> {
+    vec![
+        (
+            "xs",
+            "SINT",
+            vec![json!(127), json!(-128), json!(-1), json!(3)],
+        ),
+        (
+            "xus",
+            "USINT",
+            vec![json!(255), json!(0), json!(1), json!(7)],
+        ),
+        (
+            "xui",
+            "UINT",
+            vec![json!(65535), json!(1), json!(300), json!("UINT#2")],
+        ),
+        (
+            "xud",
+            "UDINT",
+            vec![json!(4294967295u64), json!(1), json!(70000)],
+        ),
+        (
+            "xl",
+            "LINT",
+            vec![
+                json!(i64::MIN),
+                json!(i64::MAX),
+                json!(-1),
+                json!(5),
+                json!("kl"),
+            ],
+        ),
+        (
+            "xul",
+            "ULINT",
+            vec![json!(u64::MAX), json!(1), json!(1u64 << 40), json!(3)],
+        ),
+        (
+            "xr",
+            "LREAL",
+            vec![json!(1e300), json!(-0.25), json!(0.1), json!(3)],
+        ),
+        (
+            "xb",
+            "BYTE",
+            vec![json!("16#FF"), json!(0), json!("2#1010")],
+        ),
+        ("xw", "WORD", vec![json!("16#FFFF"), json!(0), json!(7)]),
+        (
+            "xd",
+            "DWORD",
+            vec![json!("DWORD#16#FFFFFFFF"), json!(0), json!(9)],
+        ),
+        (
+            "xlw",
+            "LWORD",
+            vec![json!("16#FFFF_FFFF_FFFF_FFFF"), json!(0), json!(1)],
+        ),
+    ]
+}
+
+/// A move, or an arithmetic box the type accepts (none for the bit strings), on one of
+/// [`typed`]'s variables.
+fn typed_action(rng: &mut Rng) -> Value {
+    let all = typed();
+    let (v, ty, consts) = rng.pick(&all);
+    let ops: &[&str] = match *ty {
+        "BYTE" | "WORD" | "DWORD" | "LWORD" => &[],
+        "LREAL" => &["ADD", "SUB", "MUL", "DIV"],
+        _ => &["ADD", "SUB", "MUL", "DIV", "MOD"],
+    };
+    let operand = |rng: &mut Rng| {
+        if rng.chance(40) {
+            json!(v)
+        } else {
+            rng.pick(consts).clone()
+        }
+    };
+    if ops.is_empty() || rng.chance(20) {
+        return json!({"move": operand(rng), "to": v});
+    }
+    json!({"op": rng.pick(ops), "in": [operand(rng), operand(rng)], "out": v})
+}
+
+/// A comparison of one of [`typed`]'s variables with a constant of its type or itself.
+fn typed_compare(rng: &mut Rng) -> Value {
+    let all = typed();
+    let (v, _, consts) = rng.pick(&all);
+    let b = if rng.chance(20) {
+        json!(v)
+    } else {
+        rng.pick(consts).clone()
+    };
+    json!({"compare": rng.pick(&["EQ", "NE", "LT", "LE", "GT", "GE"]), "a": v, "b": b})
 }
 
 fn bool_read(rng: &mut Rng) -> &'static str {
@@ -111,7 +220,8 @@ fn int_operand(rng: &mut Rng) -> Value {
 }
 
 fn condition(rng: &mut Rng, depth: u32) -> Value {
-    match rng.below(if depth > 1 { 8 } else { 10 }) {
+    match rng.below(if depth > 1 { 9 } else { 11 }) {
+        8 => typed_compare(rng),
         0..=3 => json!({"contact": bool_read(rng)}),
         4 => json!({"contact": bool_read(rng), "negated": true}),
         5 => {
@@ -139,7 +249,8 @@ fn condition(rng: &mut Rng, depth: u32) -> Value {
 /// An output, box or control element; `labels` are the jump targets available in this POU.
 fn action(rng: &mut Rng, labels: &[String], subs: &[String], depth: u32) -> Value {
     let w = *rng.pick(BOOLS);
-    match rng.below(if depth > 0 { 21 } else { 23 }) {
+    match rng.below(if depth > 0 { 23 } else { 25 }) {
+        21 | 22 => typed_action(rng),
         0..=2 => json!({"coil": w}),
         3 => json!({"coil": w, "negated": true}),
         4 => json!({"set": w}),
@@ -267,4 +378,21 @@ pub fn example_report(name: &str) -> serde_json::Value {
     let (p, fbd) = plc_deps::load::program_and_fbd_from_json(&text).unwrap();
     let json = render_report(&p, &fbd, ReportFormat::Json, plc_deps::report::View::All);
     serde_json::from_str(&json).unwrap()
+}
+
+/// A random value for an input of type `ty`: BOOL, small integers (often 0: DIV/MOD faults),
+/// for LINT now and then an extreme, REAL halves, TIME milliseconds.
+pub fn random_input(ty: plc_deps::model::Type, rng: &mut Rng) -> PlcValue {
+    use plc_deps::model::{Type, Wide};
+    match ty {
+        Type::Bool => PlcValue::Bool(rng.chance(50)),
+        Type::Int => PlcValue::Int(rng.below(9) as i16 - 3),
+        Type::Dint => PlcValue::Dint(rng.below(9) as i32 - 3),
+        Type::Real => PlcValue::Real(rng.below(9) as f32 * 0.5),
+        Type::Lint if rng.chance(20) => {
+            PlcValue::Lint(Wide::new(*rng.pick(&[i64::MIN, i64::MAX]) as u64))
+        }
+        Type::Lint => PlcValue::Lint(Wide::new((rng.below(9) as i64 - 3) as u64)),
+        _ => PlcValue::Time(rng.below(100) as i32),
+    }
 }

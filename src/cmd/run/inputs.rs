@@ -3,7 +3,9 @@
 
 use super::config::{count, time_refusal};
 use crate::cmd::io::{read_text, CliError, FileRole};
-use crate::model::{parse_time_literal, Program, Type, Value, VarClass, VarId};
+use crate::model::{
+    int_range, parse_int_literal, parse_time_literal, Program, Type, Value, VarClass, VarId, Wide,
+};
 use serde_json::Value as Json;
 use std::path::Path;
 
@@ -61,18 +63,23 @@ fn parse_value(ty: Type, s: &str) -> Result<Value, String> {
             "false" | "0" => Value::Bool(false),
             _ => return Err(format!("`{t}` is not a BOOL (true, false, 1 or 0)")),
         },
-        Type::Int => Value::Int(
-            t.parse()
-                .map_err(|_| format!("`{t}` is not an INT (-32768..32767)"))?,
-        ),
-        Type::Dint => Value::Dint(
-            t.parse()
-                .map_err(|_| format!("`{t}` is not a DINT (32-bit integer)"))?,
-        ),
         Type::Real => Value::Real(t.parse().map_err(|_| bad())?),
+        Type::Lreal => Value::Lreal(Wide::new(t.parse::<f64>().map_err(|_| bad())?.to_bits())),
+        ty if ty.is_int() || ty.is_bits() => {
+            let (lo, hi) = int_range(ty);
+            // "an INT", "an LINT", "a UINT", "a DWORD" (as the names are spoken).
+            let article = if matches!(ty, Type::Int | Type::Lint | Type::Lword) {
+                "an"
+            } else {
+                "a"
+            };
+            let range = || format!("`{t}` is not {article} {ty} ({lo}..{hi})");
+            let v = parse_int_literal(t).ok_or_else(range)?;
+            Value::int_of(ty, v).ok_or_else(range)?
+        }
         Type::Time => {
-            let ms = if let Ok(ms) = t.parse::<i64>() {
-                Some(ms)
+            let ms = if let Some(ms) = parse_int_literal(t).filter(|_| !t.contains('#')) {
+                Some(ms as i64)
             } else {
                 parse_time_literal(t)
             };
@@ -91,7 +98,7 @@ fn parse_value(ty: Type, s: &str) -> Result<Value, String> {
                 }
             }
         }
-        Type::Fb(_) => return Err(bad()),
+        _ => return Err(bad()),
     })
 }
 
@@ -259,14 +266,30 @@ pub fn parse_inputs_json(p: &Program, text: &str, file: &str) -> Result<InputTab
                     (Json::Number(n), Type::Real) => {
                         Ok(Value::Real(n.as_f64().unwrap_or(f64::NAN) as f32))
                     }
-                    (Json::Number(n), Type::Int | Type::Dint | Type::Time) if n.is_i64() => {
+                    (Json::Number(n), Type::Lreal) => Ok(Value::Lreal(Wide::new(
+                        n.as_f64().unwrap_or(f64::NAN).to_bits(),
+                    ))),
+                    // Integers exactly (a ULINT up to 2^64 - 1), range-checked as in the CSV.
+                    (Json::Number(n), t)
+                        if (t.is_int() || t.is_bits() || t == Type::Time)
+                            && (n.is_i64() || n.is_u64()) =>
+                    {
                         parse_value(ty, &n.to_string())
                     }
-                    (Json::String(s), Type::Time) if s.contains('#') => parse_value(ty, s),
+                    // TIME literals, and based or plain integers as strings (`"16#FF"`).
+                    (Json::String(s), t)
+                        if (t == Type::Time && s.contains('#')) || t.is_int() || t.is_bits() =>
+                    {
+                        parse_value(ty, s)
+                    }
                     _ => Err(format!(
                         "{} is not {} {ty}",
                         describe_json(&raw),
-                        if matches!(ty, Type::Int) { "an" } else { "a" }
+                        if matches!(ty, Type::Int | Type::Lint | Type::Lword) {
+                            "an"
+                        } else {
+                            "a"
+                        }
                     )),
                 };
                 let value = value.map_err(|m| {

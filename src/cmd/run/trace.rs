@@ -5,13 +5,16 @@ use crate::exec::{Addr, Machine};
 use crate::model::{Field, Program, Type, Value, VarId, VarRef};
 use std::io::Write;
 
-/// The CSV cell of one traced value: BOOL 1/0, integers and TIME (ms) as numbers, REAL shortest.
+/// The CSV cell of one traced value: BOOL 1/0, integers, bit strings and TIME (ms) as exact
+/// decimal numbers, REAL and LREAL shortest.
 pub(super) fn cell(v: Value) -> String {
     match v {
         Value::Bool(b) => (if b { "1" } else { "0" }).to_string(),
-        Value::Int(i) => i.to_string(),
-        Value::Dint(i) | Value::Time(i) => i.to_string(),
         Value::Real(f) => format!("{f}"),
+        v => match v.as_f64() {
+            Some(f) => format!("{f}"),
+            None => v.as_i128().unwrap_or(0).to_string(),
+        },
     }
 }
 

@@ -82,12 +82,7 @@ const _plc_program _plc_program_desc = {
 ";
 
 fn is_zero(v: Value) -> bool {
-    match v {
-        Value::Bool(b) => !b,
-        Value::Int(i) => i == 0,
-        Value::Dint(i) | Value::Time(i) => i == 0,
-        Value::Real(f) => f.to_bits() == 0,
-    }
+    v.to_bits() == 0
 }
 
 fn field(sh: &Shared, i: usize) -> String {
@@ -102,6 +97,13 @@ fn slot_kind(ty: Type) -> &'static str {
         Type::Dint => "_PLC_K_DINT",
         Type::Time => "_PLC_K_TIME",
         Type::Real => "_PLC_K_REAL",
+        Type::Sint => "_PLC_K_SINT",
+        Type::Lint => "_PLC_K_LINT",
+        Type::Usint | Type::Byte => "_PLC_K_USINT",
+        Type::Uint | Type::Word => "_PLC_K_UINT",
+        Type::Udint | Type::Dword => "_PLC_K_UDINT",
+        Type::Ulint | Type::Lword => "_PLC_K_ULINT",
+        Type::Lreal => "_PLC_K_LREAL",
         Type::Fb(FbKind::Ton | FbKind::Tof | FbKind::Tp) => "_PLC_K_TIMER",
         Type::Fb(FbKind::Ctu | FbKind::Ctd) => "_PLC_K_COUNTER",
         Type::Fb(FbKind::Sr | FbKind::Rs) => "_PLC_K_BISTABLE",

@@ -131,9 +131,16 @@ pub(crate) fn negate(c: &str) -> String {
 pub(crate) fn c_type(ty: Type) -> &'static str {
     match ty {
         Type::Bool => "bool",
+        Type::Sint => "int8_t",
         Type::Int => "int16_t",
         Type::Dint | Type::Time => "int32_t",
+        Type::Lint => "int64_t",
+        Type::Usint | Type::Byte => "uint8_t",
+        Type::Uint | Type::Word => "uint16_t",
+        Type::Udint | Type::Dword => "uint32_t",
+        Type::Ulint | Type::Lword => "uint64_t",
         Type::Real => "float",
+        Type::Lreal => "double",
         Type::Fb(FbKind::Ton | FbKind::Tof | FbKind::Tp) => "_plc_timer",
         Type::Fb(FbKind::Ctu | FbKind::Ctd) => "_plc_counter",
         Type::Fb(FbKind::Sr | FbKind::Rs) => "_plc_bistable",
@@ -142,16 +149,52 @@ pub(crate) fn c_type(ty: Type) -> &'static str {
     }
 }
 
-/// A C constant of a value.
+/// A C constant of a value: an integer literal of the type's C type (`u` for UDINT and DWORD,
+/// `INT64_C`/`UINT64_C` for the 64-bit types; a minimum as `(-MAX - 1)`, since `-N` negates a
+/// literal that may not fit), a real with its suffix or, when negative or not finite, by its
+/// bits.
 pub(crate) fn c_const(v: Value) -> String {
+    let ty = v.ty();
     match v {
         Value::Bool(b) => (if b { "1" } else { "0" }).to_string(),
-        Value::Int(i16::MIN) => "(-32767 - 1)".to_string(),
-        Value::Int(i) => i.to_string(),
-        Value::Dint(i32::MIN) | Value::Time(i32::MIN) => "(-2147483647 - 1)".to_string(),
-        Value::Dint(i) | Value::Time(i) => i.to_string(),
         Value::Real(f) if f.is_finite() && f.is_sign_positive() => format!("{f:?}f"),
         Value::Real(f) => format!("_plc_f32(0x{:08x}u)", f.to_bits()),
+        Value::Lreal(_) => match v.as_f64() {
+            Some(f) if f.is_finite() && f.is_sign_positive() => format!("{f:?}"),
+            _ => format!("_plc_f64(0x{:016x}ull)", v.to_bits()),
+        },
+        v => {
+            let i = v.as_i128().unwrap_or(0);
+            let (lo, _) = int_range(ty);
+            let lit = |n: i128| match ty {
+                Type::Lint => format!("INT64_C({n})"),
+                Type::Ulint | Type::Lword => format!("UINT64_C({n})"),
+                Type::Udint | Type::Dword => format!("{n}u"),
+                _ => n.to_string(),
+            };
+            if i == lo && i < 0 {
+                format!("(-{} - 1)", lit(-(lo + 1)))
+            } else {
+                lit(i)
+            }
+        }
+    }
+}
+
+/// The suffix of the runtime's functions for a number type (`i16` for INT, `u8` for USINT and
+/// BYTE, `f64` for LREAL; TIME is `i32`).
+pub(crate) fn num_suffix(ty: Type) -> &'static str {
+    match ty {
+        Type::Sint => "i8",
+        Type::Int => "i16",
+        Type::Lint => "i64",
+        Type::Usint | Type::Byte => "u8",
+        Type::Uint | Type::Word => "u16",
+        Type::Udint | Type::Dword => "u32",
+        Type::Ulint | Type::Lword => "u64",
+        Type::Real => "f32",
+        Type::Lreal => "f64",
+        _ => "i32",
     }
 }
 
@@ -323,8 +366,8 @@ impl<'a> Body<'a> {
             let ty = self.sh.p.var(*out).ty;
             let a = match target {
                 None => self.operand(a),
-                // REAL steps are infix: the running value in parentheses.
-                Some(_) if ty == Type::Real => format!("({value})"),
+                // REAL and LREAL steps are infix: the running value in parentheses.
+                Some(_) if ty.is_real() => format!("({value})"),
                 Some(_) => value,
             };
             value = self.arith(rung, *op, &a, &self.operand(b), ty);
@@ -339,11 +382,7 @@ impl<'a> Body<'a> {
     /// `out := MAX/MIN/LIMIT(…)` of an output branch with that shape, as one expression.
     fn extreme(&mut self, x: &fold::Extreme, pw: Pw) -> Pw {
         let pw = self.materialize(pw);
-        let w = match self.sh.p.var(x.out).ty {
-            Type::Int => "i16",
-            Type::Real => "f32",
-            _ => "i32",
-        };
+        let w = num_suffix(self.sh.p.var(x.out).ty);
         let mut value = self.operand(&x.first);
         for (pick, o) in &x.steps {
             let f = match pick {
@@ -610,19 +649,17 @@ impl<'a> Body<'a> {
 
     /// `a op b` in type `ty` (operands as C text).
     fn arith(&self, rung: RungId, op: ArithOp, a: &str, b: &str, ty: Type) -> String {
-        let w = match ty {
-            Type::Int => "i16",
-            Type::Real => {
-                return match op {
-                    ArithOp::Add => format!("{a} + {b}"),
-                    ArithOp::Sub => format!("{a} - {b}"),
-                    ArithOp::Mul => format!("{a} * {b}"),
-                    ArithOp::Div => format!("{a} / {b}"),
-                    ArithOp::Mod => format!("fmodf({a}, {b})"),
-                }
-            }
-            _ => "i32",
-        };
+        if ty.is_real() {
+            let fmod = if ty == Type::Real { "fmodf" } else { "fmod" };
+            return match op {
+                ArithOp::Add => format!("{a} + {b}"),
+                ArithOp::Sub => format!("{a} - {b}"),
+                ArithOp::Mul => format!("{a} * {b}"),
+                ArithOp::Div => format!("{a} / {b}"),
+                ArithOp::Mod => format!("{fmod}({a}, {b})"),
+            };
+        }
+        let w = num_suffix(ty);
         let name = op.name().to_ascii_lowercase();
         match op {
             ArithOp::Div | ArithOp::Mod => {
@@ -635,15 +672,12 @@ impl<'a> Body<'a> {
     /// `(a OP b)`; through `_plc_cmp` when a constant sits at its type's limit (where GCC's
     /// `-Wtype-limits` would call the test always true or false).
     fn compare(&self, sym: &str, a: &Operand, b: &Operand) -> String {
-        let at_limit = |o: &Operand| {
-            matches!(
-                o,
-                Operand::Const(
-                    Value::Int(i16::MIN | i16::MAX)
-                        | Value::Dint(i32::MIN | i32::MAX)
-                        | Value::Time(i32::MIN | i32::MAX)
-                )
-            )
+        let at_limit = |o: &Operand| match o {
+            Operand::Const(v) => {
+                let (lo, hi) = int_range(v.ty());
+                v.as_i128().is_some_and(|i| i == lo || i == hi)
+            }
+            Operand::Var(_) => false,
         };
         let (x, y) = (self.operand(a), self.operand(b));
         let relational = sym != "==" && sym != "!=";
@@ -658,8 +692,11 @@ impl<'a> Body<'a> {
                 ">" => "gt",
                 _ => "ge",
             };
-            let real = self.operand_type(a) == Some(Type::Real);
-            let w = if real { "f32" } else { "i64" };
+            let w = match self.operand_type(a) {
+                Some(t @ (Type::Real | Type::Lreal)) => num_suffix(t),
+                Some(t) if t.is_unsigned() || t.is_bits() => "u64",
+                _ => "i64",
+            };
             return format!("_plc_{f}_{w}({x}, {y})");
         }
         format!("({x} {sym} {y})")
@@ -728,13 +765,10 @@ impl<'a> Body<'a> {
                 };
                 let v = self.var(*var);
                 let ctr = self.counter(r);
-                let wrap = match self.sh.p.var(*var).ty {
-                    Type::Int => "_plc_w16",
-                    _ => "_plc_w32",
-                };
+                let w = num_suffix(self.sh.p.var(*var).ty);
                 let no = self.rung_no(r);
                 self.line(&format!("if (!_plc_loop_back(&{ctr}, ctx, {no})) break;"));
-                self.line(&format!("{v} = {wrap}((int64_t){v} + 1);"));
+                self.line(&format!("{v} = _plc_add_{w}({v}, 1);"));
                 self.indent -= 1;
                 self.line("}");
                 self.indent -= 1;

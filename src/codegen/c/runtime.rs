@@ -2,13 +2,14 @@
 //! timer and counter instances, integer arithmetic with the interpreter's wrap-around and
 //! division-by-zero rule, the loop cap, faults, and the CSV/JSON helpers of the harness.
 //!
-//! Each function reproduces one rule of docs/scan.md (and `src/exec/run.rs`) exactly: INT wraps
-//! at 16 bits, DINT and TIME at 32 (computed in a wider type, then converted: GCC and Clang
-//! define the conversion as modulo 2^N); DIV truncates, MOD takes the dividend's sign, an
+//! Each function reproduces one rule of docs/scan.md (and `src/exec/run.rs`) exactly: every
+//! integer type wraps in its width (SINT at 8 bits, INT at 16, DINT and TIME at 32, LINT at 64,
+//! the unsigned types and bit strings modulo 2^N; computed in `uint64_t`, then converted: GCC
+//! and Clang define the conversion as modulo 2^N); DIV truncates, MOD takes the dividend's sign, an
 //! integer DIV or MOD by zero gives 0 and records a fault; TON/TOF/TP and CTU/CTD follow the
 //! interpreter's state machine field by field (a timer's start time and flags, a counter's
 //! previous CU/CD); SR/RS, R_TRIG/F_TRIG and CTUD the bodies of IEC 61131-3 2.5.2.3 as
-//! `src/exec/fb.rs` runs them. REAL is `float` (C11 with `FLT_EVAL_METHOD == 0` on x86-64 and AArch64, and
+//! `src/exec/fb.rs` runs them. REAL is `float`, LREAL `double` (C11 with `FLT_EVAL_METHOD == 0` on x86-64 and AArch64, and
 //! no contraction under `-std=c11`).
 //!
 //! Not here: anything that depends on the program (the generated files have that).
@@ -183,49 +184,56 @@ static inline bool _plc_ctud(_plc_updown *c, int16_t pv, bool cu, bool cd, bool 
     return c->QU;
 }
 
-/* Integer arithmetic: computed wide, wrapped to the type's width (two's complement). */
-static inline int16_t _plc_w16(int64_t v) { return (int16_t)(uint16_t)(uint64_t)v; }
-static inline int32_t _plc_w32(int64_t v) { return (int32_t)(uint32_t)(uint64_t)v; }
-static inline int16_t _plc_add_i16(int16_t a, int16_t b) { return _plc_w16((int64_t)a + b); }
-static inline int16_t _plc_sub_i16(int16_t a, int16_t b) { return _plc_w16((int64_t)a - b); }
-static inline int16_t _plc_mul_i16(int16_t a, int16_t b) { return _plc_w16((int64_t)a * b); }
-static inline int32_t _plc_add_i32(int32_t a, int32_t b) { return _plc_w32((int64_t)a + b); }
-static inline int32_t _plc_sub_i32(int32_t a, int32_t b) { return _plc_w32((int64_t)a - b); }
-static inline int32_t _plc_mul_i32(int32_t a, int32_t b) { return _plc_w32((int64_t)a * b); }
-static inline int16_t _plc_div_i16(int16_t a, int16_t b, _plc_ctx *ctx, uint32_t rung) {
-    if (b == 0) { _plc_fault(ctx, rung, _PLC_DIV_BY_ZERO); return 0; }
-    return _plc_w16((int64_t)a / b);
+/* Integer arithmetic in the type's width: ADD, SUB and MUL computed in uint64_t (modulo 2^64,
+   never signed overflow) and converted back (modulo 2^N: GCC and Clang define the conversion to
+   a signed type so); DIV truncates and MOD takes the dividend's sign, with MIN / -1 wrapping to
+   MIN and MIN % -1 giving 0 (the only signed quotient that overflows); an integer DIV or MOD by
+   zero gives 0 and records a fault. */
+#define _PLC_RING(s, T, U) \
+static inline T _plc_add_##s(T a, T b) { return (T)(U)((uint64_t)a + (uint64_t)b); } \
+static inline T _plc_sub_##s(T a, T b) { return (T)(U)((uint64_t)a - (uint64_t)b); } \
+static inline T _plc_mul_##s(T a, T b) { return (T)(U)((uint64_t)a * (uint64_t)b); }
+#define _PLC_SDIV(s, T, U) _PLC_RING(s, T, U) \
+static inline T _plc_div_##s(T a, T b, _plc_ctx *ctx, uint32_t rung) { \
+    if (b == 0) { _plc_fault(ctx, rung, _PLC_DIV_BY_ZERO); return 0; } \
+    if (b == -1) return (T)(U)(0u - (uint64_t)a); \
+    return (T)(a / b); \
+} \
+static inline T _plc_mod_##s(T a, T b, _plc_ctx *ctx, uint32_t rung) { \
+    if (b == 0) { _plc_fault(ctx, rung, _PLC_DIV_BY_ZERO); return 0; } \
+    if (b == -1) return 0; \
+    return (T)(a % b); \
 }
-static inline int16_t _plc_mod_i16(int16_t a, int16_t b, _plc_ctx *ctx, uint32_t rung) {
-    if (b == 0) { _plc_fault(ctx, rung, _PLC_DIV_BY_ZERO); return 0; }
-    return _plc_w16((int64_t)a % b);
+#define _PLC_UDIV(s, T) _PLC_RING(s, T, T) \
+static inline T _plc_div_##s(T a, T b, _plc_ctx *ctx, uint32_t rung) { \
+    if (b == 0) { _plc_fault(ctx, rung, _PLC_DIV_BY_ZERO); return 0; } \
+    return (T)(a / b); \
+} \
+static inline T _plc_mod_##s(T a, T b, _plc_ctx *ctx, uint32_t rung) { \
+    if (b == 0) { _plc_fault(ctx, rung, _PLC_DIV_BY_ZERO); return 0; } \
+    return (T)(a % b); \
 }
-static inline int32_t _plc_div_i32(int32_t a, int32_t b, _plc_ctx *ctx, uint32_t rung) {
-    if (b == 0) { _plc_fault(ctx, rung, _PLC_DIV_BY_ZERO); return 0; }
-    return _plc_w32((int64_t)a / b);
-}
-static inline int32_t _plc_mod_i32(int32_t a, int32_t b, _plc_ctx *ctx, uint32_t rung) {
-    if (b == 0) { _plc_fault(ctx, rung, _PLC_DIV_BY_ZERO); return 0; }
-    return _plc_w32((int64_t)a % b);
-}
+_PLC_SDIV(i8, int8_t, uint8_t) _PLC_SDIV(i16, int16_t, uint16_t)
+_PLC_SDIV(i32, int32_t, uint32_t) _PLC_SDIV(i64, int64_t, uint64_t)
+_PLC_UDIV(u8, uint8_t) _PLC_UDIV(u16, uint16_t) _PLC_UDIV(u32, uint32_t) _PLC_UDIV(u64, uint64_t)
 /* Compares as functions, where GCC would warn on the operator (see ladder.rs). */
 #define _PLC_CMP(name, T, op) static inline bool name(T a, T b) { return a op b; }
-_PLC_CMP(_plc_eq_i64, int64_t, ==) _PLC_CMP(_plc_ne_i64, int64_t, !=)
-_PLC_CMP(_plc_lt_i64, int64_t, <) _PLC_CMP(_plc_le_i64, int64_t, <=)
-_PLC_CMP(_plc_gt_i64, int64_t, >) _PLC_CMP(_plc_ge_i64, int64_t, >=)
-_PLC_CMP(_plc_eq_f32, float, ==) _PLC_CMP(_plc_ne_f32, float, !=)
-_PLC_CMP(_plc_lt_f32, float, <) _PLC_CMP(_plc_le_f32, float, <=)
-_PLC_CMP(_plc_gt_f32, float, >) _PLC_CMP(_plc_ge_f32, float, >=)
-/* A REAL constant by its bits (NaN and infinities have no literal). */
+#define _PLC_CMPS(s, T) _PLC_CMP(_plc_eq_##s, T, ==) _PLC_CMP(_plc_ne_##s, T, !=) \
+    _PLC_CMP(_plc_lt_##s, T, <) _PLC_CMP(_plc_le_##s, T, <=) \
+    _PLC_CMP(_plc_gt_##s, T, >) _PLC_CMP(_plc_ge_##s, T, >=)
+_PLC_CMPS(i64, int64_t) _PLC_CMPS(u64, uint64_t) _PLC_CMPS(f32, float) _PLC_CMPS(f64, double)
 /* MAX, MIN, LIMIT step by step as the interpreter compares: x replaces the running value m
    when it is greater (smaller); a NaN never does. */
-static inline int16_t _plc_max_i16(int16_t m, int16_t x) { return x > m ? x : m; }
-static inline int16_t _plc_min_i16(int16_t m, int16_t x) { return x < m ? x : m; }
-static inline int32_t _plc_max_i32(int32_t m, int32_t x) { return x > m ? x : m; }
-static inline int32_t _plc_min_i32(int32_t m, int32_t x) { return x < m ? x : m; }
-static inline float _plc_max_f32(float m, float x) { return x > m ? x : m; }
-static inline float _plc_min_f32(float m, float x) { return x < m ? x : m; }
+#define _PLC_EXTREMES(s, T) \
+static inline T _plc_max_##s(T m, T x) { return x > m ? x : m; } \
+static inline T _plc_min_##s(T m, T x) { return x < m ? x : m; }
+_PLC_EXTREMES(i8, int8_t) _PLC_EXTREMES(i16, int16_t) _PLC_EXTREMES(i32, int32_t)
+_PLC_EXTREMES(i64, int64_t) _PLC_EXTREMES(u8, uint8_t) _PLC_EXTREMES(u16, uint16_t)
+_PLC_EXTREMES(u32, uint32_t) _PLC_EXTREMES(u64, uint64_t) _PLC_EXTREMES(f32, float)
+_PLC_EXTREMES(f64, double)
+/* A REAL or LREAL constant by its bits (NaN and infinities have no literal). */
 static inline float _plc_f32(uint32_t bits) { float f; memcpy(&f, &bits, sizeof f); return f; }
+static inline double _plc_f64(uint64_t bits) { double f; memcpy(&f, &bits, sizeof f); return f; }
 
 /* One loop-back of a loop-back rung: allowed up to the cap per scan; the first refusal of a
    scan records a loop-cap fault. */
@@ -289,25 +297,26 @@ _PLC_ROWS_FN _plc_rows2(uint8_t *s, const _plc_row2 *r, size_t n) {
     }
 }
 
-/* JSON output of the harness: REAL in the form `plc-deps run --format json` prints it (the
-   shortest decimal that reads back as the float, written as serde_json writes an f64). */
-static inline void _plc_put_real(FILE *o, float f) {
+/* JSON output of the harness: REAL and LREAL in the form `plc-deps run --format json` prints
+   them (the shortest decimal that reads back as the float, or the double when `dbl`, written as
+   serde_json writes an f64). */
+static inline void _plc_put_float(FILE *o, double f, int dbl) {
     if (!isfinite(f)) { fputs("null", o); return; }
     if (f == 0) { fputs(signbit(f) ? "-0.0" : "0.0", o); return; }
     if (signbit(f)) { fputc('-', o); f = -f; }
-    char buf[40], digits[16];
+    char buf[40], digits[20];
     int prec = 1;
-    for (; prec < 9; prec++) {
-        snprintf(buf, sizeof buf, "%.*e", prec - 1, (double)f);
-        if (strtof(buf, NULL) == f) break;
+    for (; prec < (dbl ? 17 : 9); prec++) {
+        snprintf(buf, sizeof buf, "%.*e", prec - 1, f);
+        if (dbl ? strtod(buf, NULL) == f : strtof(buf, NULL) == (float)f) break;
     }
-    snprintf(buf, sizeof buf, "%.*e", prec - 1, (double)f);
+    snprintf(buf, sizeof buf, "%.*e", prec - 1, f);
     int n = 0, i = 0;
     for (; buf[i] && buf[i] != 'e'; i++) if (buf[i] != '.') digits[n++] = buf[i];
     int kk = atoi(buf + i + 1) + 1; /* the decimal point is kk digits after the first */
     /* printf breaks a tie to even; the shortest form of Rust (and so of `run`) rounds it up. */
     char exact[80], all[72];
-    snprintf(exact, sizeof exact, "%.60e", (double)f);
+    snprintf(exact, sizeof exact, "%.60e", f);
     int m = 0;
     for (int j = 0; exact[j] && exact[j] != 'e'; j++) if (exact[j] != '.') all[m++] = exact[j];
     int tie = m > prec && all[prec] == '5';
@@ -342,6 +351,7 @@ static inline void _plc_put_real(FILE *o, float f) {
         fprintf(o, "e%+d", kk - 1); /* serde_json: e+35, e-7 */
     }
 }
+static inline void _plc_put_real(FILE *o, float f) { _plc_put_float(o, f, 0); }
 static inline void _plc_put_bool(FILE *o, bool b) { fputs(b ? "true" : "false", o); }
 static inline void _plc_put_timer(FILE *o, const _plc_timer *t) {
     fprintf(o, "{\"Q\":%s,\"ET\":%d,\"PT\":%d}", t->Q ? "true" : "false", (int)t->ET, (int)t->PT);
@@ -374,11 +384,54 @@ static inline int _plc_parse_bool(const char *s, bool *out) {
     if (_plc_eq_nocase(s, "false") || !strcmp(s, "0")) { *out = 0; return 1; }
     return 0;
 }
+/* An integer cell as `plc-deps run --inputs` reads it (`parse_int_literal` of the model):
+   decimal with an optional sign, or `2#`, `8#`, `16#` based; `_` between digits. Sets the
+   sign and the magnitude; 0 when the text is not one or the magnitude passes 2^64 - 1. */
+static inline int _plc_parse_lit(const char *s, int *neg, uint64_t *mag) {
+    *neg = 0;
+    if (*s == '-' || *s == '+') { *neg = *s == '-'; s++; }
+    unsigned radix = 10;
+    if (!strncmp(s, "2#", 2)) { radix = 2; s += 2; }
+    else if (!strncmp(s, "8#", 2)) { radix = 8; s += 2; }
+    else if (!strncmp(s, "16#", 3)) { radix = 16; s += 3; }
+    if (radix != 10 && *neg) return 0;
+    if (!*s || *s == '_') return 0;
+    uint64_t v = 0;
+    for (; *s; s++) {
+        if (*s == '_') { if (s[1] == '_' || !s[1]) return 0; continue; }
+        unsigned d;
+        if (*s >= '0' && *s <= '9') d = (unsigned)(*s - '0');
+        else if (*s >= 'a' && *s <= 'f') d = (unsigned)(*s - 'a' + 10);
+        else if (*s >= 'A' && *s <= 'F') d = (unsigned)(*s - 'A' + 10);
+        else return 0;
+        if (d >= radix || v > (UINT64_MAX - d) / radix) return 0;
+        v = v * radix + d;
+    }
+    *mag = v;
+    return 1;
+}
+/* A signed integer cell in lo..hi. */
 static inline int _plc_parse_int(const char *s, long long lo, long long hi, long long *out) {
+    int neg; uint64_t m;
+    if (!_plc_parse_lit(s, &neg, &m)) return 0;
+    if (neg ? m > (uint64_t)INT64_MAX + 1 : m > (uint64_t)INT64_MAX) return 0;
+    long long v = neg ? (long long)(0u - m) : (long long)m;
+    if (v < lo || v > hi) return 0;
+    *out = v;
+    return 1;
+}
+/* An unsigned integer cell in 0..hi. */
+static inline int _plc_parse_uint(const char *s, uint64_t hi, uint64_t *out) {
+    int neg; uint64_t m;
+    if (!_plc_parse_lit(s, &neg, &m) || (neg && m != 0) || m > hi) return 0;
+    *out = m;
+    return 1;
+}
+static inline int _plc_parse_lreal(const char *s, double *out) {
     char *end;
     if (!*s) return 0;
-    long long v = strtoll(s, &end, 10);
-    if (*end || v < lo || v > hi) return 0;
+    double v = strtod(s, &end);
+    if (*end) return 0;
     *out = v;
     return 1;
 }
@@ -393,7 +446,10 @@ static inline int _plc_parse_real(const char *s, float *out) {
 /* TIME: milliseconds, or a literal T#1.5s / TIME#1m30s (d h m s ms; whole milliseconds). */
 static inline int _plc_parse_time(const char *s, int32_t *out) {
     long long ms;
-    if (_plc_parse_int(s, INT32_MIN, INT32_MAX, &ms)) { *out = (int32_t)ms; return 1; }
+    if (!strchr(s, '#') && _plc_parse_int(s, INT32_MIN, INT32_MAX, &ms)) {
+        *out = (int32_t)ms;
+        return 1;
+    }
     const char *p;
     if (!strncmp(s, "T#", 2) || !strncmp(s, "t#", 2)) p = s + 2;
     else if (!strncmp(s, "TIME#", 5) || !strncmp(s, "time#", 5)) p = s + 5;
@@ -432,7 +488,9 @@ static inline int _plc_parse_time(const char *s, int32_t *out) {
    the harness's code does not grow with the program. */
 enum {
     _PLC_K_BOOL, _PLC_K_INT, _PLC_K_DINT, _PLC_K_TIME, _PLC_K_REAL, _PLC_K_TIMER,
-    _PLC_K_COUNTER, _PLC_K_BISTABLE, _PLC_K_TRIGGER, _PLC_K_UPDOWN
+    _PLC_K_COUNTER, _PLC_K_BISTABLE, _PLC_K_TRIGGER, _PLC_K_UPDOWN,
+    /* BYTE, WORD, DWORD, LWORD are USINT, UINT, UDINT, ULINT here. */
+    _PLC_K_SINT, _PLC_K_LINT, _PLC_K_USINT, _PLC_K_UINT, _PLC_K_UDINT, _PLC_K_ULINT, _PLC_K_LREAL
 };
 typedef struct { const char *key; size_t offset; int kind; } _plc_slot;
 
@@ -449,6 +507,13 @@ static inline void _plc_put_slots(FILE *o, const void *state, const _plc_slot *s
         case _PLC_K_INT: fprintf(o, "%d", (int)*(const int16_t *)at); break;
         case _PLC_K_DINT: case _PLC_K_TIME: fprintf(o, "%d", (int)*(const int32_t *)at); break;
         case _PLC_K_REAL: _plc_put_real(o, *(const float *)at); break;
+        case _PLC_K_LREAL: _plc_put_float(o, *(const double *)at, 1); break;
+        case _PLC_K_SINT: fprintf(o, "%d", (int)*(const int8_t *)at); break;
+        case _PLC_K_LINT: fprintf(o, "%lld", (long long)*(const int64_t *)at); break;
+        case _PLC_K_USINT: fprintf(o, "%u", (unsigned)*(const uint8_t *)at); break;
+        case _PLC_K_UINT: fprintf(o, "%u", (unsigned)*(const uint16_t *)at); break;
+        case _PLC_K_UDINT: fprintf(o, "%lu", (unsigned long)*(const uint32_t *)at); break;
+        case _PLC_K_ULINT: fprintf(o, "%llu", (unsigned long long)*(const uint64_t *)at); break;
         case _PLC_K_TIMER: _plc_put_timer(o, at); break;
         case _PLC_K_COUNTER: _plc_put_counter(o, at); break;
         case _PLC_K_BISTABLE: _plc_put_bistable(o, at); break;
@@ -463,6 +528,7 @@ static inline void _plc_put_slots(FILE *o, const void *state, const _plc_slot *s
 static inline int _plc_set_slot(void *state, const _plc_slot *slot, const char *text) {
     void *at = (char *)state + slot->offset;
     long long v;
+    uint64_t u;
     switch (slot->kind) {
     case _PLC_K_BOOL: return _plc_parse_bool(text, at);
     case _PLC_K_INT:
@@ -475,6 +541,31 @@ static inline int _plc_set_slot(void *state, const _plc_slot *slot, const char *
         return 1;
     case _PLC_K_TIME: return _plc_parse_time(text, at);
     case _PLC_K_REAL: return _plc_parse_real(text, at);
+    case _PLC_K_LREAL: return _plc_parse_lreal(text, at);
+    case _PLC_K_SINT:
+        if (!_plc_parse_int(text, INT8_MIN, INT8_MAX, &v)) return 0;
+        *(int8_t *)at = (int8_t)v;
+        return 1;
+    case _PLC_K_LINT:
+        if (!_plc_parse_int(text, INT64_MIN, INT64_MAX, &v)) return 0;
+        *(int64_t *)at = (int64_t)v;
+        return 1;
+    case _PLC_K_USINT:
+        if (!_plc_parse_uint(text, UINT8_MAX, &u)) return 0;
+        *(uint8_t *)at = (uint8_t)u;
+        return 1;
+    case _PLC_K_UINT:
+        if (!_plc_parse_uint(text, UINT16_MAX, &u)) return 0;
+        *(uint16_t *)at = (uint16_t)u;
+        return 1;
+    case _PLC_K_UDINT:
+        if (!_plc_parse_uint(text, UINT32_MAX, &u)) return 0;
+        *(uint32_t *)at = (uint32_t)u;
+        return 1;
+    case _PLC_K_ULINT:
+        if (!_plc_parse_uint(text, UINT64_MAX, &u)) return 0;
+        *(uint64_t *)at = u;
+        return 1;
     default: return 0;
     }
 }

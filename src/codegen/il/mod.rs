@@ -341,15 +341,10 @@ impl<'a> Names<'a> {
     }
 }
 
-/// A constant as an operand: numbers as written, REAL with a point, TIME as `T#…ms`.
+/// A constant as an operand: numbers as written (integers and bit strings in decimal), REAL and
+/// LREAL with a point, TIME as `T#…ms` (the model's `Display`).
 pub(crate) fn constant(v: Value) -> String {
-    match v {
-        Value::Bool(b) => (if b { "TRUE" } else { "FALSE" }).into(),
-        Value::Int(i) => i.to_string(),
-        Value::Dint(i) => i.to_string(),
-        Value::Real(f) => format!("{f:?}"),
-        Value::Time(ms) => format!("T#{ms}ms"),
-    }
+    v.to_string()
 }
 
 /// The declaration sections of the program's variables (`scope` None) or of one subroutine's.

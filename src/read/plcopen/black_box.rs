@@ -291,6 +291,12 @@ fn pick(pins: &[(String, String)], pin: Option<&str>) -> Option<String> {
     }
 }
 
+/// True for the model's integer and bit-string types (BOOL_TO_x is `SEL(b, 0, 1)` and
+/// x_TO_BOOL `x <> 0` on them).
+fn integer(t: &str) -> bool {
+    crate::model::Type::parse(t).is_some_and(|t| t.is_int() || t.is_bits())
+}
+
 /// `A_TO_B` (and `TRUNC`, REAL to DINT): the model types of A and B, when they are elementary.
 fn conversion(ty: &str) -> Option<(Option<String>, Option<String>)> {
     if ty == "TRUNC" {
@@ -355,10 +361,10 @@ pub fn rewrite(
     if let Some((Some(from), Some(to))) = conversion(ty) {
         let input = inputs.pop().map(|(_, i)| i);
         let done = match input {
-            Some(i) if from == "BOOL" && matches!(to.as_str(), "INT" | "DINT") => {
+            Some(i) if from == "BOOL" && integer(&to) => {
                 Some(("SEL", vec![("G", i), ("IN0", num(0)), ("IN1", num(1))]))
             }
-            Some(i) if to == "BOOL" && matches!(from.as_str(), "INT" | "DINT") => {
+            Some(i) if to == "BOOL" && integer(&from) => {
                 Some(("NE", vec![("IN1", i), ("IN2", num(0))]))
             }
             Some(i) if from == to => Some(("MOVE", vec![("IN", i)])),

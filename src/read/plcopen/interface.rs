@@ -7,8 +7,10 @@
 //! declares nothing (names resolve to the program's variables). Located variables take their
 //! class from the address: `%I…` is an input, `%Q…` an output (written by the scan / read by it).
 //!
-//! The elementary types the model lacks (SINT, WORD, LREAL, STRING …) are read as one it has
-//! ([`MAPPED`]), and each such variable is recorded ([`Mapped`]) for the POU's note.
+//! Every elementary type of IEC 61131-3 Table 10 but the strings, LTIME and the dates and
+//! times of day is the model's own (BOOL, SINT … LINT, USINT … ULINT, REAL, LREAL, BYTE …
+//! LWORD, TIME). Those it lacks are read as one it has ([`MAPPED`]), and each such variable is
+//! recorded ([`Mapped`]) for the POU's note.
 //!
 //! A user data type (or a library one, [`super::data_types`]) is read as its base: an alias or
 //! subrange as its elementary type, an enumeration as INT, an array or a structure (named or
@@ -64,22 +66,9 @@ pub struct Mapped {
 }
 
 /// The elementary types of IEC 61131-3 (6.4.2, Table 10) the model lacks, and the model's type
-/// each is read as: the narrower and unsigned integers and the bit strings as INT when every
-/// value fits INT, else DINT; the 64-bit ones as DINT; LREAL as REAL; dates and times of day as
-/// DINT, LTIME as TIME; strings as DINT (a stand-in: analysis only). docs/plcopen.md says what
-/// `run` computes differently.
+/// each is read as: dates and times of day as DINT, LTIME as TIME; strings as DINT (a
+/// stand-in: analysis only). docs/plcopen.md says what `run` computes differently.
 const MAPPED: &[(&str, &str)] = &[
-    ("SINT", "INT"),
-    ("USINT", "INT"),
-    ("BYTE", "INT"),
-    ("UINT", "DINT"),
-    ("WORD", "DINT"),
-    ("UDINT", "DINT"),
-    ("DWORD", "DINT"),
-    ("LINT", "DINT"),
-    ("ULINT", "DINT"),
-    ("LWORD", "DINT"),
-    ("LREAL", "REAL"),
     ("LTIME", "TIME"),
     ("DATE", "DINT"),
     ("TOD", "DINT"),
@@ -105,7 +94,10 @@ const OTHER_STD_FBS: &[&str] = &[
     "CTU_UDINT",
     "CTU_ULINT",
 ];
-const MODEL_ELEMENTARY: &[&str] = &["BOOL", "INT", "DINT", "REAL", "TIME"];
+const MODEL_ELEMENTARY: &[&str] = &[
+    "BOOL", "SINT", "INT", "DINT", "LINT", "USINT", "UINT", "UDINT", "ULINT", "REAL", "LREAL",
+    "BYTE", "WORD", "DWORD", "LWORD", "TIME",
+];
 
 /// True when a TC6 type element's tag is an elementary type (the model's or a mapped one).
 pub fn is_elementary_tag(tag: &str) -> bool {
@@ -494,7 +486,7 @@ pub fn literal(text: &str) -> Option<Scalar<'static>> {
             _ => return None,
         };
         let digits: String = rest.chars().filter(|c| *c != '_').collect();
-        return i64::from_str_radix(&digits, radix)
+        return u64::from_str_radix(&digits, radix)
             .ok()
             .map(|i| Scalar::Number(i.into()));
     }
@@ -502,8 +494,12 @@ pub fn literal(text: &str) -> Option<Scalar<'static>> {
     if !digits.starts_with(|c: char| c.is_ascii_digit() || c == '-' || c == '+') {
         return None;
     }
+    // Exact up to the 64-bit types' ranges (ULINT up to 2^64 - 1).
     if let Ok(i) = digits.parse::<i64>() {
         return Some(Scalar::Number(i.into()));
+    }
+    if let Ok(u) = digits.parse::<u64>() {
+        return Some(Scalar::Number(u.into()));
     }
     let f: f64 = digits.parse().ok()?;
     serde_json::Number::from_f64(f).map(Scalar::Number)
@@ -574,7 +570,7 @@ fn mapped_note(mapped: &[(Option<String>, Mapped)]) -> Option<super::xml::Note> 
         .collect();
     Some(super::xml::Note {
         origin: first.1.origin,
-        message: format!("elementary types the model lacks are read as one it has: {}; `run` computes them at the model's width (INT 16-bit, DINT 32-bit, signed; REAL 32-bit), so it differs from a PLC where a value leaves the declared type's range or needs LREAL precision, and a string has no value (it stands in as a DINT 0)", list.join(", ")),
+        message: format!("elementary types the model lacks are read as one it has: {}; `run` computes them as that type (dates and times of day as DINT, LTIME as 32-bit ms TIME), so it differs from a PLC where a value leaves that type's range, and a string has no value (it stands in as a DINT 0)", list.join(", ")),
     })
 }
 

@@ -45,6 +45,10 @@ pub(crate) fn scalar(s: &str) -> Scalar<'static> {
     if let Ok(i) = t.parse::<i64>() {
         return Scalar::Number(i.into());
     }
+    // Up to ULINT's and LWORD's 2^64 - 1, exactly.
+    if let Ok(u) = t.parse::<u64>() {
+        return Scalar::Number(u.into());
+    }
     if t.bytes()
         .next()
         .is_some_and(|b| b.is_ascii_digit() || b == b'-')

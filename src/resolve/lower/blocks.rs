@@ -96,14 +96,7 @@ impl Cx<'_> {
         let e = |path: &str, k| LoadError::fbd(&net.id, id, path, k);
         let out_ty = self.first_out_type(nx, b)?;
         let ty = numeric_type(&vals, out_ty);
-        let ok = match op {
-            ArithOp::Add | ArithOp::Sub => ty.is_numeric(),
-            ArithOp::Mul | ArithOp::Div => {
-                matches!(ty, Type::Int | Type::Dint | Type::Real)
-            }
-            ArithOp::Mod => matches!(ty, Type::Int | Type::Dint),
-        };
-        if !ok {
+        if !op.accepts(ty) {
             let (v, p) = vals
                 .iter()
                 .find(|(v, _)| v.ty().is_some())
@@ -112,11 +105,7 @@ impl Cx<'_> {
                 p,
                 Invalid::Type {
                     what: "this arithmetic block",
-                    expected: if op == ArithOp::Mod {
-                        "INT or DINT".into()
-                    } else {
-                        "a numeric type".into()
-                    },
+                    expected: op.expected().into(),
                     operand: v.text().to_owned(),
                     found: ty.to_string(),
                 },
@@ -220,7 +209,7 @@ impl Cx<'_> {
                 vals[0].1,
                 Invalid::Type {
                     what: "MOVE",
-                    expected: "a value (BOOL, INT, DINT, REAL or TIME)".into(),
+                    expected: "a value (an elementary type)".into(),
                     operand: vals[0].0.text().to_owned(),
                     found: ty.to_string(),
                 },
@@ -247,7 +236,7 @@ impl Cx<'_> {
                 vals[1].1,
                 Invalid::Type {
                     what: "SEL",
-                    expected: "a value (BOOL, INT, DINT, REAL or TIME)".into(),
+                    expected: "a value (an elementary type)".into(),
                     operand: vals[1].0.text().to_owned(),
                     found: ty.to_string(),
                 },
@@ -531,7 +520,7 @@ fn numeric<'v>(
     what: &'static str,
 ) -> std::result::Result<Type, (&'v str, Invalid)> {
     let ty = numeric_type(vals, fallback);
-    if ty.is_numeric() {
+    if ty.is_comparable() {
         return Ok(ty);
     }
     let (v, p) = vals
@@ -542,7 +531,7 @@ fn numeric<'v>(
         p,
         Invalid::Type {
             what,
-            expected: "INT, DINT, REAL or TIME".into(),
+            expected: COMPARABLE.into(),
             operand: v.text().to_owned(),
             found: ty.to_string(),
         },
