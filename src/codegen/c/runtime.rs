@@ -226,6 +226,45 @@ static inline int32_t _plc_min_i32(int32_t m, int32_t x) { return x < m ? x : m;
 static inline float _plc_max_f32(float m, float x) { return x > m ? x : m; }
 static inline float _plc_min_f32(float m, float x) { return x < m ? x : m; }
 static inline float _plc_f32(uint32_t bits) { float f; memcpy(&f, &bits, sizeof f); return f; }
+/* Standard functions (src/exec/functions.rs): the same C math library calls as the
+   interpreter's, on an argument GCC cannot fold at compile time. */
+static inline float _plc_opaque_f32(float x) { volatile float v = x; return v; }
+static inline float _plc_fn_sqrt(float x) { return sqrtf(_plc_opaque_f32(x)); }
+static inline float _plc_fn_ln(float x) { return logf(_plc_opaque_f32(x)); }
+static inline float _plc_fn_log(float x) { return log10f(_plc_opaque_f32(x)); }
+static inline float _plc_fn_exp(float x) { return expf(_plc_opaque_f32(x)); }
+static inline float _plc_fn_sin(float x) { return sinf(_plc_opaque_f32(x)); }
+static inline float _plc_fn_cos(float x) { return cosf(_plc_opaque_f32(x)); }
+static inline float _plc_fn_tan(float x) { return tanf(_plc_opaque_f32(x)); }
+static inline float _plc_fn_asin(float x) { return asinf(_plc_opaque_f32(x)); }
+static inline float _plc_fn_acos(float x) { return acosf(_plc_opaque_f32(x)); }
+static inline float _plc_fn_atan(float x) { return atanf(_plc_opaque_f32(x)); }
+static inline float _plc_fn_expt(float a, float b) {
+    return powf(_plc_opaque_f32(a), _plc_opaque_f32(b));
+}
+static inline int16_t _plc_fn_abs_i16(int16_t a) { return _plc_w16(a < 0 ? -(int64_t)a : a); }
+static inline int32_t _plc_fn_abs_i32(int32_t a) { return _plc_w32(a < 0 ? -(int64_t)a : a); }
+/* SHL (0), SHR (1), ROL (2), ROR (3) of the low `width` bits: a shift by n outside 0..width-1
+   gives 0, a rotation is by n modulo width. */
+static inline uint64_t _plc_fn_shift(int kind, uint64_t bits, int64_t n, unsigned width) {
+    uint64_t mask = width == 64 ? ~(uint64_t)0 : ((uint64_t)1 << width) - 1, v = bits & mask;
+    if (kind < 2) {
+        if (n < 0 || n >= (int64_t)width) return 0;
+        return (kind == 0 ? v << n : v >> n) & mask;
+    }
+    int64_t r = n % (int64_t)width;
+    unsigned k = (unsigned)(r < 0 ? r + (int64_t)width : r);
+    if (kind == 3) k = (width - k) % width;
+    if (k == 0) return v;
+    return ((v << k) | (v >> (width - k))) & mask;
+}
+/* An integral float as int64_t: NaN is 0, beyond the range the nearest end (Rust's `as`). */
+static inline int64_t _plc_real_to_i64(float r) {
+    if (r != r) return 0;
+    if (r >= 9223372036854775808.0f) return INT64_MAX;
+    if (r < -9223372036854775808.0f) return INT64_MIN;
+    return (int64_t)r;
+}
 
 /* One loop-back of a loop-back rung: allowed up to the cap per scan; the first refusal of a
    scan records a loop-cap fault. */
