@@ -189,6 +189,78 @@ impl Function {
         s.to_owned()
     }
 
+    /// The name as a `&'static str` (conversions among the model's types from a table;
+    /// `TYPE_CONVERSION` for a pair the table lacks).
+    pub fn static_name(self) -> &'static str {
+        const TYPES: [Type; 5] = [Type::Bool, Type::Int, Type::Dint, Type::Real, Type::Time];
+        const CONV: [[&str; 5]; 5] = [
+            [
+                "BOOL_TO_BOOL",
+                "BOOL_TO_INT",
+                "BOOL_TO_DINT",
+                "BOOL_TO_REAL",
+                "BOOL_TO_TIME",
+            ],
+            [
+                "INT_TO_BOOL",
+                "INT_TO_INT",
+                "INT_TO_DINT",
+                "INT_TO_REAL",
+                "INT_TO_TIME",
+            ],
+            [
+                "DINT_TO_BOOL",
+                "DINT_TO_INT",
+                "DINT_TO_DINT",
+                "DINT_TO_REAL",
+                "DINT_TO_TIME",
+            ],
+            [
+                "REAL_TO_BOOL",
+                "REAL_TO_INT",
+                "REAL_TO_DINT",
+                "REAL_TO_REAL",
+                "REAL_TO_TIME",
+            ],
+            [
+                "TIME_TO_BOOL",
+                "TIME_TO_INT",
+                "TIME_TO_DINT",
+                "TIME_TO_REAL",
+                "TIME_TO_TIME",
+            ],
+        ];
+        use Function::*;
+        match self {
+            Abs => "ABS",
+            Sqrt => "SQRT",
+            Ln => "LN",
+            Log => "LOG",
+            Exp => "EXP",
+            Sin => "SIN",
+            Cos => "COS",
+            Tan => "TAN",
+            Asin => "ASIN",
+            Acos => "ACOS",
+            Atan => "ATAN",
+            Expt => "EXPT",
+            Shl => "SHL",
+            Shr => "SHR",
+            Rol => "ROL",
+            Ror => "ROR",
+            Mux => "MUX",
+            Trunc => "TRUNC",
+            Convert { from, to } => {
+                let i = TYPES.iter().position(|t| *t == from);
+                let j = TYPES.iter().position(|t| *t == to);
+                match (i, j) {
+                    (Some(i), Some(j)) => CONV[i][j],
+                    _ => "TYPE_CONVERSION",
+                }
+            }
+        }
+    }
+
     /// True for MUX, whose last input pin repeats (`IN0`, `IN1`, …).
     pub fn extensible(self) -> bool {
         self == Function::Mux
