@@ -41,6 +41,28 @@ fn s7_only(v: &mut Json) {
             // left out of the series they are in.
             const NONE: [&str; 5] = ["sr", "rs", "r_trig", "f_trig", "ctud"];
             a.retain(|e| !NONE.iter().any(|k| e.get(k).is_some()));
+            // The standard functions with an S7-200 instruction stay; the others are left out.
+            const S7: [&str; 14] = [
+                "ADD",
+                "SUB",
+                "MUL",
+                "DIV",
+                "MOD",
+                "SQRT",
+                "LN",
+                "EXP",
+                "SIN",
+                "COS",
+                "TAN",
+                "INT_TO_DINT",
+                "DINT_TO_REAL",
+                "REAL_TO_DINT",
+            ];
+            a.retain(|e| {
+                e.get("op")
+                    .and_then(Json::as_str)
+                    .is_none_or(|op| S7.contains(&op) || e.get("id").is_some())
+            });
             a.iter_mut().for_each(s7_only)
         }
         _ => {}

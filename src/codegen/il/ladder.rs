@@ -455,7 +455,11 @@ impl Emit<'_> {
             self.net.emit(mov, &[&la, target], 0);
         }
         self.net.emit(&format!("-{sfx}"), &[s, target], 0);
-        if b_var {
+        let zero = matches!(b, Operand::Const(Value::Int(0) | Value::Dint(0)));
+        if zero {
+            // A constant zero divisor: the `/` faulted; the MOD gives 0.
+            self.net.emit(mov, &["0", target], 0);
+        } else if b_var {
             let cmp = word_suffix(ty).expect("an integer type");
             self.net.lps();
             self.net
