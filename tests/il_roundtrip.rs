@@ -53,6 +53,28 @@ fn s7_only(v: &mut Json) {
                 let text = e.to_string();
                 !typed.iter().any(|n| text.contains(n.as_str()))
             });
+            // The standard functions with an S7-200 instruction stay; the others are left out.
+            const S7: [&str; 14] = [
+                "ADD",
+                "SUB",
+                "MUL",
+                "DIV",
+                "MOD",
+                "SQRT",
+                "LN",
+                "EXP",
+                "SIN",
+                "COS",
+                "TAN",
+                "INT_TO_DINT",
+                "DINT_TO_REAL",
+                "REAL_TO_DINT",
+            ];
+            a.retain(|e| {
+                e.get("op")
+                    .and_then(Json::as_str)
+                    .is_none_or(|op| S7.contains(&op) || e.get("id").is_some())
+            });
             a.iter_mut().for_each(s7_only)
         }
         _ => {}

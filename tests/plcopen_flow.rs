@@ -177,13 +177,13 @@ fn negated_pins_and_a_wired_eno_in_fbd() {
 
 #[test]
 fn a_function_the_model_lacks_is_a_black_box_with_its_pins() {
-    // y := SHL(IN := a, N := 2): the report sees a read and y written through a stand-in.
+    // y := SHIFT_LEFT(IN := a, N := 2): the report sees a read and y written through a stand-in.
     let fbd = [
         in_var(1, "a"),
         in_var(2, "2"),
         block(
             3,
-            "SHL",
+            "SHIFT_LEFT",
             None,
             &[("IN", &[(1, None)]), ("N", &[(2, None)])],
             &["OUT"],
@@ -194,7 +194,7 @@ fn a_function_the_model_lacks_is_a_black_box_with_its_pins() {
     let v = vars(&[("inputVars", "a", "INT"), ("outputVars", "y", "INT")]);
     let xml = project_in("FBD", &v, &fbd);
     let (r, warnings) = report_and_warnings(&xml);
-    assert!(warnings.contains("SHL is read as a black box (a function block type SHL reading its inputs IN INT, N INT and writing its outputs OUT INT)"), "{warnings}");
+    assert!(warnings.contains("SHIFT_LEFT is read as a black box (a function block type SHIFT_LEFT reading its inputs IN INT, N INT and writing its outputs OUT INT)"), "{warnings}");
     let ins: Vec<&serde_json::Value> = r["rungs"]
         .as_array()
         .unwrap()

@@ -282,6 +282,12 @@ pub(crate) fn rung_accesses(
                 operand(b, reads);
                 writes.push(*out);
             }
+            Element::Function { args, out, .. } => {
+                for a in args.iter() {
+                    operand(a, reads);
+                }
+                writes.push(*out);
+            }
             Element::Jmp { .. } | Element::Ret | Element::End | Element::Next { .. } => {}
             Element::Call { pou } => call(*pou, reads, writes),
             Element::For { var, bounds, .. } => {

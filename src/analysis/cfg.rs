@@ -237,6 +237,7 @@ fn walk_series(
             | Element::Reset(_)
             | Element::Move { .. }
             | Element::Arith { .. }
+            | Element::Function { .. }
             | Element::For { .. }
             | Element::Next { .. } => {}
         }

@@ -68,7 +68,10 @@ fn series_cost(series: &[Element], pou_totals: &[u64]) -> u64 {
             Element::Or(bs) | Element::Branch(bs) => {
                 1 + bs.iter().map(|b| series_cost(b, pou_totals)).sum::<u64>()
             }
-            Element::Move { .. } | Element::Arith { .. } | Element::For { .. } => 2,
+            Element::Move { .. }
+            | Element::Arith { .. }
+            | Element::Function { .. }
+            | Element::For { .. } => 2,
             Element::Timer { .. }
             | Element::Ctu { .. }
             | Element::Ctd { .. }

@@ -365,6 +365,15 @@ fn paper_control_view(p: &Program, control: &[ControlDependence]) -> Vec<PaperCo
                     }
                 }
             }
+            Element::Function { args, .. } => {
+                for o in args.iter() {
+                    if let Operand::Var(v) = o {
+                        if v.field.is_some() {
+                            field_reads.push(v.var);
+                        }
+                    }
+                }
+            }
             Element::Move { from: o, .. } => {
                 if let Operand::Var(v) = o {
                     if v.field.is_some() {

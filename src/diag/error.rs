@@ -11,7 +11,7 @@ use std::fmt;
 
 /// The op names of the FBD format, as the unknown-op message lists them (re-exported by
 /// `crate::fbd`).
-pub const OP_NAMES: &str = "EQ, NE, LT, LE, GT, GE, ADD, SUB, MUL, DIV, MOD, AND, OR, XOR, NOT, MOVE, SEL, MAX, MIN, LIMIT, TON, TOF, TP, CTU, CTD, SR, RS, R_TRIG, F_TRIG, CTUD, JMP, RET, TSTART, TSTOP";
+pub const OP_NAMES: &str = "EQ, NE, LT, LE, GT, GE, ADD, SUB, MUL, DIV, MOD, AND, OR, XOR, NOT, MOVE, SEL, MAX, MIN, LIMIT, TON, TOF, TP, CTU, CTD, SR, RS, R_TRIG, F_TRIG, CTUD, JMP, RET, TSTART, TSTOP, a standard function (ABS … ATAN, EXPT, SHL … ROR, MUX, A_TO_B, TRUNC)";
 
 /// Where in the program file an error is.
 #[derive(Clone, Debug, PartialEq, Eq)]

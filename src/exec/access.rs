@@ -129,6 +129,12 @@ impl Machine {
                     reads.push((from, w));
                     writes.push((to, w));
                 }
+                Op::Func { call } => {
+                    let c = &self.funcs[call.index()];
+                    let width = |t| Repr::of(t).map_or(1, Repr::width);
+                    reads.extend(c.args.iter().map(|&(a, t)| (a, width(t))));
+                    writes.push((c.out, width(c.ty)));
+                }
                 Op::Arith { num, a, b, out, .. } => {
                     let w = num.width();
                     reads.extend([(a, w), (b, w)]);

@@ -41,6 +41,20 @@ index_type!(
     /// A FOR/NEXT loop: index into the machine's loops.
     ForId
 );
+index_type!(
+    /// A standard function call: index into the machine's `funcs`.
+    FuncId
+);
+
+/// The operands of a standard function box (`Element::Function`): each argument's address and
+/// type, the output's.
+#[derive(Clone, Debug)]
+pub(crate) struct FuncCall {
+    pub func: Function,
+    pub args: Box<[(Addr, Type)]>,
+    pub out: Addr,
+    pub ty: Type,
+}
 
 /// Numeric representation of a compare, an arithmetic box or a FOR index.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
@@ -208,6 +222,8 @@ pub(crate) enum Op {
     Ctud { inst: Addr, pins: CtudId },
     /// MOVE box.
     Move { width: Width, from: Addr, to: Addr },
+    /// Standard function box: operands and output in `funcs`.
+    Func { call: FuncId },
     /// Arithmetic box.
     Arith {
         op: ArithOp,
@@ -277,6 +293,7 @@ pub(crate) struct Code {
     pub fors: Vec<ForLoop>,
     /// The operands of each CTUD box but CU.
     pub ctuds: Vec<CtudPins>,
+    pub funcs: Vec<FuncCall>,
     /// The operands of each fused rung.
     pub fused: Vec<FusedRung>,
     /// The fused rungs' truth tables.
@@ -388,6 +405,7 @@ pub(crate) fn lower(p: &Program, layout: &Layout, fuse: bool) -> Result<Code, Lo
             consts: Vec::new(),
             fors: Vec::new(),
             ctuds: Vec::new(),
+            funcs: Vec::new(),
             fused: Vec::new(),
             tables: Vec::new(),
             rung_op: vec![Pc(0); p.rungs.len()],
@@ -752,6 +770,21 @@ impl Lowerer<'_> {
                     out,
                 });
             }
+            Element::Function { func, args, out } => {
+                let args = args
+                    .iter()
+                    .map(|a| (self.operand(a), operand_type(self.p, a)))
+                    .collect();
+                let call = FuncCall {
+                    func: *func,
+                    args,
+                    out: self.layout.start(*out),
+                    ty: self.p.var(*out).ty,
+                };
+                let id = FuncId(self.code.funcs.len() as u32);
+                self.code.funcs.push(call);
+                self.push(Op::Func { call: id });
+            }
             Element::Jmp { target, .. } => {
                 self.jumps.push((self.code.ops.len(), *target));
                 if *target <= rung {
@@ -800,6 +833,17 @@ impl Lowerer<'_> {
 /// The address of a variable or instance field.
 fn var_addr(layout: &Layout, r: VarRef) -> Addr {
     layout.start(r.var).offset(r.field.map_or(0, field_offset))
+}
+
+/// The type of an operand.
+fn operand_type(p: &Program, o: &Operand) -> Type {
+    match o {
+        Operand::Const(v) => v.ty(),
+        Operand::Var(r) => match (p.var(r.var).ty, r.field) {
+            (Type::Fb(fb), Some(f)) => Field::lookup(fb, f.name()).map_or(Type::Bool, |(_, t)| t),
+            (t, _) => t,
+        },
+    }
 }
 
 /// The stored bits of a scalar (to tell constants apart).

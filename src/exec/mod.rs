@@ -119,6 +119,7 @@
 
 mod access;
 mod fb;
+pub mod functions;
 mod fuse;
 #[cfg(test)]
 mod fuse_tests;
@@ -252,6 +253,7 @@ pub struct Machine {
     consts: Vec<(Addr, Value)>,
     fors: Vec<ForLoop>,
     ctuds: Vec<fb::CtudPins>,
+    funcs: Vec<lower::FuncCall>,
     fused: Vec<fuse::FusedRung>,
     tables: Vec<fuse::Table>,
     rung_op: Vec<Pc>,
@@ -302,6 +304,7 @@ impl Machine {
             consts: code.consts,
             fors: code.fors,
             ctuds: code.ctuds,
+            funcs: code.funcs,
             fused: code.fused,
             tables: code.tables,
             rung_op: code.rung_op,

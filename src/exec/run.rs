@@ -9,8 +9,9 @@ use super::fuse::{lookup, FusedId, FusedRung};
 use super::layout::{CV, ET, FLAGS, PREV, PT, PV, Q, START};
 use super::lower::{Num, Op, Width};
 use super::store::{Addr, Word};
+use super::value::{load_value, store_value};
 use super::{Fault, FaultKind, Machine, ScanCtx, Store};
-use crate::model::{ArithOp, CmpOp, RungId, TimerKind};
+use crate::model::{ArithOp, CmpOp, RungId, TimerKind, Type, Value};
 
 /// How a run of instructions ended.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
@@ -194,6 +195,25 @@ where
     st.store(out, r);
 }
 
+impl Machine {
+    /// `out := func(args)` of one standard function box (`super::functions`).
+    #[inline(never)]
+    fn call_function<S: Store + ?Sized>(&self, st: &mut S, c: &super::lower::FuncCall) {
+        let mut buf = [Value::Bool(false); 8];
+        let load = |&(at, ty): &(Addr, Type)| load_value(st, at, ty);
+        let r = if c.args.len() <= buf.len() {
+            for (slot, a) in buf.iter_mut().zip(c.args.iter()) {
+                *slot = load(a);
+            }
+            super::functions::apply(c.func, &buf[..c.args.len()], c.ty)
+        } else {
+            let vals: Vec<Value> = c.args.iter().map(load).collect();
+            super::functions::apply(c.func, &vals, c.ty)
+        };
+        store_value(st, c.out, r);
+    }
+}
+
 /// The FOR index at `at` incremented, wrapping in its representation.
 #[inline]
 fn increment<T: Int, S: Store + ?Sized>(st: &mut S, at: Addr) {
@@ -368,6 +388,11 @@ impl Machine {
                             Width::W4 => copy::<i32, S>(st, from, to),
                             Width::W8 => copy::<u64, S>(st, from, to),
                         }
+                    }
+                }
+                Op::Func { call } => {
+                    if p != 0 {
+                        self.call_function(st, &self.funcs[call.index()]);
                     }
                 }
                 Op::Arith { op, num, a, b, out } => {

@@ -7,7 +7,9 @@
 //! are kept by name or as written ([`Input`]): a function block type's body is read once and
 //! resolved once per instance.
 
-use crate::model::{ArithOp, BistableKind, CmpOp, PouId, RungId, TimerKind, TriggerKind, VarId};
+use crate::model::{
+    ArithOp, BistableKind, CmpOp, Function, PouId, RungId, TimerKind, TriggerKind, VarId,
+};
 use std::ops::Range;
 
 use crate::model::index_type;
@@ -257,6 +259,8 @@ pub enum OpKind {
     TStop,
     /// A user function block type (its pins are the type's).
     Call,
+    /// A standard function (`crate::model::Function`).
+    Function(Function),
 }
 
 /// The operation of a block, with the data only it has.
@@ -320,6 +324,8 @@ pub enum Op {
         fb: String,
         instance: String,
     },
+    /// A standard function: ABS … ATAN, EXPT, SHL … ROR, MUX (`K, IN0, …`), `*_TO_*`, TRUNC.
+    Function(Function),
 }
 
 /// The op names of the format, as the error message lists them.
@@ -358,7 +364,7 @@ impl OpKind {
             "RET" => OpKind::Ret,
             "TSTART" => OpKind::TStart,
             "TSTOP" => OpKind::TStop,
-            _ => return None,
+            _ => return Function::parse(s).map(OpKind::Function),
         })
     }
 
@@ -391,6 +397,7 @@ impl OpKind {
             OpKind::TStart => "TSTART",
             OpKind::TStop => "TSTOP",
             OpKind::Call => return None,
+            OpKind::Function(f) => f.static_name(),
         })
     }
 
@@ -438,6 +445,7 @@ impl OpKind {
             OpKind::Bistable(BistableKind::ResetDominant) => &["S", "R1"],
             OpKind::Trigger(_) => &["CLK"],
             OpKind::Ctud => &["CU", "CD", "R", "LD", "PV"],
+            OpKind::Function(f) => return f.input_names(n),
             OpKind::Jmp
             | OpKind::Ret
             | OpKind::Call
@@ -490,6 +498,7 @@ impl Op {
             Op::TStart => OpKind::TStart,
             Op::TStop => OpKind::TStop,
             Op::Call { .. } => OpKind::Call,
+            Op::Function(f) => OpKind::Function(*f),
         }
     }
 

@@ -17,8 +17,10 @@
 //! It deliberately carries no analysis results: those are separate values computed from it.
 //! Element semantics follow IEC 61131-3 (LD, §4.2) and the S7-200 shapes of Zhao & Yan (2012).
 
+mod function;
 mod tasks;
 mod types;
+pub use function::*;
 pub use tasks::*;
 pub use types::*;
 
@@ -208,6 +210,14 @@ pub enum Element {
         op: ArithOp,
         a: Operand,
         b: Operand,
+        out: VarId,
+    },
+    /// Standard function box (`crate::model::Function`): when powered,
+    /// `out := func(args…)`; power out = power in (ENO). The arguments have the types
+    /// [`Function::types`] gives (boxed: an element stays 32 bytes).
+    Function {
+        func: Function,
+        args: Box<[Operand]>,
         out: VarId,
     },
     /// Jump, taken when powered, to the rung that carries the label.

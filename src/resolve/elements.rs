@@ -230,6 +230,7 @@ impl<'a> Builder<'a> {
                 Element::Move { from, to }
             }
             S::Arith(x) => self.arith(x.op, &x.a, &x.b, &x.out, at, s)?,
+            S::Function(c) => self.function(c, at, s)?,
             S::Jmp(label) => {
                 let target = *self.labels[s.pou.index()]
                     .get(label.as_str())
@@ -358,6 +359,49 @@ impl<'a> Builder<'a> {
         let a = self.operand_of(a, &inp.index(0), s, ty, "an arithmetic box")?;
         let b = self.operand_of(b, &inp.index(1), s, ty, "an arithmetic box")?;
         Ok(Element::Arith { op, a, b, out })
+    }
+
+    /// A standard function box: the output is writable, the arguments typed by the function's
+    /// rule (`Function::types`) from their own types and the output's.
+    fn function(&mut self, c: &syntax::FunctionCall, at: &At, s: &Scope) -> Result<Element> {
+        let what = "a function box";
+        let out = self.writable(&c.out, &at.key("out"), s, what, None)?;
+        let out_ty = self.vars[out.index()].ty;
+        let inp = at.key("in");
+        let mut untyped = Vec::with_capacity(c.args.len());
+        for (i, a) in c.args.iter().enumerate() {
+            untyped.push(self.untyped(a, &inp.index(i), s)?);
+        }
+        let own: Vec<(Option<Type>, bool)> = untyped
+            .iter()
+            .map(|u| (u.ty(), super::operand::default_type(u) == Type::Real))
+            .collect();
+        let typing = c.func.types(&own, Some(out_ty)).map_err(|m| {
+            let (path, origin, operand) = match m.arg {
+                Some(i) => (inp.index(i), c.args[i].origin, c.args[i].value.display()),
+                None => (at.key("out"), c.out.origin, c.out.value.to_string()),
+            };
+            LoadError::invalid(
+                Some(s.rung_id),
+                &path.with(""),
+                Invalid::Type {
+                    what: "this function's operand",
+                    expected: format!("{} ({})", m.expected, c.func.name()),
+                    operand,
+                    found: m.found.to_string(),
+                },
+            )
+            .at(origin)
+        })?;
+        let mut args = Vec::with_capacity(c.args.len());
+        for (i, (a, ty)) in c.args.iter().zip(&typing.args).enumerate() {
+            args.push(self.operand_of(a, &inp.index(i), s, *ty, what)?);
+        }
+        Ok(Element::Function {
+            func: c.func,
+            args: args.into_boxed_slice(),
+            out,
+        })
     }
 
     /// The hidden memory of the next edge contact of the rung in scope (made now, or taken

@@ -307,6 +307,8 @@ pub enum ElementKind<'a> {
     Ctud(Box<Ctud<'a>>),
     Move(Box<Move<'a>>),
     Arith(Box<Arith<'a>>),
+    /// A standard function box (`"op"` naming a function).
+    Function(Box<FunctionCall<'a>>),
     Jmp(Name<'a>),
     Ret,
     End,
@@ -374,6 +376,14 @@ pub struct Arith<'a> {
     pub op: ArithOp,
     pub a: Operand<'a>,
     pub b: Operand<'a>,
+    pub out: Name<'a>,
+}
+
+/// `{"op": FUNC, "in": [A, …], "out": OUT}` of a standard function (`SQRT`, `INT_TO_REAL`, …).
+#[derive(Clone, Debug)]
+pub struct FunctionCall<'a> {
+    pub func: crate::model::Function,
+    pub args: Vec<Operand<'a>>,
     pub out: Name<'a>,
 }
 

@@ -286,6 +286,11 @@ fn element(e: &Element) -> io::Result<Value> {
             "pv": operand(&c.pv.value)
         }),
         K::Move(m) => json!({ "move": operand(&m.from.value), "to": m.to.as_str() }),
+        K::Function(c) => json!({
+            "op": c.func.name(),
+            "in": c.args.iter().map(|a| operand(&a.value)).collect::<Vec<_>>(),
+            "out": c.out.as_str(),
+        }),
         K::Arith(a) => json!({
             "op": a.op.name(), "in": [operand(&a.a.value), operand(&a.b.value)],
             "out": a.out.as_str()

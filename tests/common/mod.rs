@@ -76,6 +76,8 @@ fn vars() -> Vec<Value> {
     }
     v.push(json!({"name": "q", "type": "BOOL", "class": "output"}));
     v.push(json!({"name": "r", "type": "REAL"}));
+    v.push(json!({"name": "d", "type": "DINT"}));
+    v.push(json!({"name": "tm", "type": "TIME"}));
     v.push(json!({"name": "t0", "type": "TON"}));
     v.push(json!({"name": "t1", "type": "TOF"}));
     v.push(json!({"name": "t2", "type": "TP"}));
@@ -180,10 +182,39 @@ fn typed_action(rng: &mut Rng) -> Value {
             rng.pick(consts).clone()
         }
     };
+    if rng.chance(35) {
+        return typed_function(rng, v, ty);
+    }
     if ops.is_empty() || rng.chance(20) {
         return json!({"move": operand(rng), "to": v});
     }
     json!({"op": rng.pick(ops), "in": [operand(rng), operand(rng)], "out": v})
+}
+
+/// A standard function on [`typed`]'s variable `v` of type `ty`: a conversion to another of
+/// them, a shift or rotation of its bit pattern, ABS, or (LREAL) a real function.
+fn typed_function(rng: &mut Rng, v: &str, ty: &str) -> Value {
+    let all = typed();
+    if rng.chance(50) {
+        let (w, wty, _) = rng.pick(&all);
+        return json!({"op": format!("{ty}_TO_{wty}"), "in": [v], "out": w});
+    }
+    match ty {
+        "LREAL" => {
+            let f = *rng.pick(&["SQRT", "LN", "LOG", "EXP", "SIN", "ATAN", "ABS"]);
+            if rng.chance(20) {
+                json!({"op": "EXPT", "in": [v, *rng.pick(&[2, -1, 3])], "out": v})
+            } else {
+                json!({"op": f, "in": [v], "out": v})
+            }
+        }
+        "SINT" | "LINT" if rng.chance(30) => json!({"op": "ABS", "in": [v], "out": v}),
+        _ => {
+            let f = *rng.pick(&["SHL", "SHR", "ROL", "ROR"]);
+            let n = *rng.pick(&[0, 1, 3, 7, 8, 15, 16, 31, 33, 63, 64, -1]);
+            json!({"op": f, "in": [v, n], "out": v})
+        }
+    }
 }
 
 /// A comparison of one of [`typed`]'s variables with a constant of its type or itself.
@@ -246,6 +277,72 @@ fn condition(rng: &mut Rng, depth: u32) -> Value {
     }
 }
 
+/// A standard function box over the REAL `r`, the INTs, the DINT `d` and the TIME `tm`.
+fn function(rng: &mut Rng) -> Value {
+    let i = |rng: &mut Rng| int_operand(rng);
+    let n = *rng.pick(INTS);
+    let (op, args, out): (&str, Vec<Value>, &str) = match rng.below(8) {
+        0 => {
+            let f = *rng.pick(&[
+                "SQRT", "LN", "LOG", "EXP", "SIN", "COS", "TAN", "ASIN", "ACOS", "ATAN", "ABS",
+            ]);
+            (f, vec![json!("r")], "r")
+        }
+        1 => ("EXPT", vec![json!("r"), i(rng)], "r"),
+        2 => (
+            *rng.pick(&["ABS", "SHL", "SHR", "ROL", "ROR"]),
+            vec![i(rng), i(rng)],
+            n,
+        ),
+        3 => {
+            let k = 3 + rng.below(3) as usize;
+            ("MUX", (0..k).map(|_| int_operand(rng)).collect(), n)
+        }
+        4 => (*rng.pick(&["REAL_TO_INT", "TRUNC"]), vec![json!("r")], n),
+        5 => (
+            *rng.pick(&["INT_TO_REAL", "INT_TO_DINT"]),
+            vec![i(rng)],
+            if rng.chance(50) { "r" } else { "d" },
+        ),
+        6 => (
+            *rng.pick(&[
+                "DINT_TO_INT",
+                "DINT_TO_REAL",
+                "DINT_TO_TIME",
+                "DINT_TO_BOOL",
+            ]),
+            vec![json!("d")],
+            n,
+        ),
+        _ => (
+            *rng.pick(&[
+                "REAL_TO_DINT",
+                "REAL_TO_TIME",
+                "TIME_TO_REAL",
+                "BOOL_TO_INT",
+            ]),
+            vec![json!("r")],
+            n,
+        ),
+    };
+    // Fix the pairs the table above leaves loose: ABS takes one input; a conversion's output is
+    // its TO type, its input its FROM type.
+    let (args, out) = match op {
+        "ABS" if out != "r" => (vec![args[0].clone()], out),
+        "INT_TO_REAL" => (args, "r"),
+        "INT_TO_DINT" => (args, "d"),
+        "DINT_TO_REAL" => (args, "r"),
+        "DINT_TO_TIME" => (args, "tm"),
+        "DINT_TO_BOOL" => (args, *rng.pick(BOOLS)),
+        "REAL_TO_DINT" => (args, "d"),
+        "REAL_TO_TIME" => (args, "tm"),
+        "TIME_TO_REAL" => (vec![json!("tm")], "r"),
+        "BOOL_TO_INT" => (vec![json!(bool_read(rng))], out),
+        _ => (args, out),
+    };
+    json!({"op": op, "in": args, "out": out})
+}
+
 /// An output, box or control element; `labels` are the jump targets available in this POU.
 fn action(rng: &mut Rng, labels: &[String], subs: &[String], depth: u32) -> Value {
     let w = *rng.pick(BOOLS);
@@ -264,6 +361,7 @@ fn action(rng: &mut Rng, labels: &[String], subs: &[String], depth: u32) -> Valu
         12 => {
             json!({"op": rng.pick(&["ADD", "SUB", "MUL", "DIV", "MOD"]), "in": [int_operand(rng), int_operand(rng)], "out": rng.pick(INTS)})
         }
+        13 if rng.chance(50) => function(rng),
         13 => json!({"op": rng.pick(&["ADD", "MUL", "DIV"]), "in": ["r", 1.5], "out": "r"}),
         14 if !labels.is_empty() => json!({"jmp": rng.pick(labels)}),
         14 | 15 if !subs.is_empty() => json!({"call": rng.pick(subs)}),

@@ -564,6 +564,18 @@ impl<'a> Body<'a> {
                 pw
             }
             Element::Arith { .. } => self.arith_steps(rung, std::slice::from_ref(e), pw, last),
+            Element::Function { func, args, out } => {
+                let pw = keep(self, pw);
+                let args: Vec<(String, Type)> = args
+                    .iter()
+                    .map(|a| (self.operand(a), self.operand_type(a).unwrap_or(Type::Bool)))
+                    .collect();
+                let ty = self.sh.p.var(*out).ty;
+                let value = super::functions::expr(*func, &args, ty);
+                let stmt = format!("{} = {value};", self.var(*out));
+                self.when(&pw, &stmt);
+                pw
+            }
             Element::Jmp { target, .. } => {
                 let goto = format!("goto _L{};", self.label_no(target.0));
                 if !matches!(pw, Pw::False) {

@@ -26,6 +26,7 @@
 
 mod fbd;
 mod fold;
+mod functions;
 mod harness;
 mod ladder;
 pub mod names;

@@ -234,6 +234,63 @@ _PLC_EXTREMES(f64, double)
 /* A REAL or LREAL constant by its bits (NaN and infinities have no literal). */
 static inline float _plc_f32(uint32_t bits) { float f; memcpy(&f, &bits, sizeof f); return f; }
 static inline double _plc_f64(uint64_t bits) { double f; memcpy(&f, &bits, sizeof f); return f; }
+/* Standard functions (src/exec/functions.rs): the same C math library calls as the
+   interpreter's, on an argument GCC cannot fold at compile time. */
+static inline float _plc_opaque_f32(float x) { volatile float v = x; return v; }
+static inline float _plc_fn_sqrt(float x) { return sqrtf(_plc_opaque_f32(x)); }
+static inline float _plc_fn_ln(float x) { return logf(_plc_opaque_f32(x)); }
+static inline float _plc_fn_log(float x) { return log10f(_plc_opaque_f32(x)); }
+static inline float _plc_fn_exp(float x) { return expf(_plc_opaque_f32(x)); }
+static inline float _plc_fn_sin(float x) { return sinf(_plc_opaque_f32(x)); }
+static inline float _plc_fn_cos(float x) { return cosf(_plc_opaque_f32(x)); }
+static inline float _plc_fn_tan(float x) { return tanf(_plc_opaque_f32(x)); }
+static inline float _plc_fn_asin(float x) { return asinf(_plc_opaque_f32(x)); }
+static inline float _plc_fn_acos(float x) { return acosf(_plc_opaque_f32(x)); }
+static inline float _plc_fn_atan(float x) { return atanf(_plc_opaque_f32(x)); }
+static inline float _plc_fn_expt(float a, float b) {
+    return powf(_plc_opaque_f32(a), _plc_opaque_f32(b));
+}
+/* ABS of a signed integer, wrapped (ABS of the type's MIN is MIN). */
+#define _PLC_ABS(s, T, U) \
+static inline T _plc_fn_abs_##s(T a) { return (T)(U)(a < 0 ? 0u - (uint64_t)a : (uint64_t)a); }
+_PLC_ABS(i8, int8_t, uint8_t) _PLC_ABS(i16, int16_t, uint16_t)
+_PLC_ABS(i32, int32_t, uint32_t) _PLC_ABS(i64, int64_t, uint64_t)
+/* SHL (0), SHR (1), ROL (2), ROR (3) of the low `width` bits: a shift by n outside 0..width-1
+   gives 0, a rotation is by n modulo width. */
+static inline uint64_t _plc_fn_shift(int kind, uint64_t bits, int64_t n, unsigned width) {
+    uint64_t mask = width == 64 ? ~(uint64_t)0 : ((uint64_t)1 << width) - 1, v = bits & mask;
+    if (kind < 2) {
+        if (n < 0 || n >= (int64_t)width) return 0;
+        return (kind == 0 ? v << n : v >> n) & mask;
+    }
+    int64_t r = n % (int64_t)width;
+    unsigned k = (unsigned)(r < 0 ? r + (int64_t)width : r);
+    if (kind == 3) k = (width - k) % width;
+    if (k == 0) return v;
+    return ((v << k) | (v >> (width - k))) & mask;
+}
+/* An integral real as int64_t: NaN is 0, beyond the range the nearest end (Rust's `as`). */
+static inline int64_t _plc_lreal_to_i64(double r) {
+    if (r != r) return 0;
+    if (r >= 9223372036854775808.0) return INT64_MAX;
+    if (r < -9223372036854775808.0) return INT64_MIN;
+    return (int64_t)r;
+}
+/* The LREAL functions: the C library's double functions, as the interpreter's f64 methods. */
+static inline double _plc_opaque_f64(double x) { volatile double v = x; return v; }
+static inline double _plc_fn_sqrt_f64(double x) { return sqrt(_plc_opaque_f64(x)); }
+static inline double _plc_fn_ln_f64(double x) { return log(_plc_opaque_f64(x)); }
+static inline double _plc_fn_log_f64(double x) { return log10(_plc_opaque_f64(x)); }
+static inline double _plc_fn_exp_f64(double x) { return exp(_plc_opaque_f64(x)); }
+static inline double _plc_fn_sin_f64(double x) { return sin(_plc_opaque_f64(x)); }
+static inline double _plc_fn_cos_f64(double x) { return cos(_plc_opaque_f64(x)); }
+static inline double _plc_fn_tan_f64(double x) { return tan(_plc_opaque_f64(x)); }
+static inline double _plc_fn_asin_f64(double x) { return asin(_plc_opaque_f64(x)); }
+static inline double _plc_fn_acos_f64(double x) { return acos(_plc_opaque_f64(x)); }
+static inline double _plc_fn_atan_f64(double x) { return atan(_plc_opaque_f64(x)); }
+static inline double _plc_fn_expt_f64(double a, double b) {
+    return pow(_plc_opaque_f64(a), _plc_opaque_f64(b));
+}
 
 /* One loop-back of a loop-back rung: allowed up to the cap per scan; the first refusal of a
    scan records a loop-cap fault. */

@@ -258,6 +258,7 @@ impl Emit<'_> {
                 self.net.emit(op, &[&n.operand(from), n.var(*to)], 0);
             }
             Element::Arith { op, a, b, out } => self.arith(*op, a, b, *out)?,
+            Element::Function { func, args, out } => self.function(*func, args, *out)?,
             Element::Jmp { label, .. } => self.net.emit("JMP", &[label], 0),
             Element::Ret => match self.kind {
                 PouKind::Main => self.net.emit("END", &[], 0),
@@ -347,6 +348,76 @@ impl Emit<'_> {
         Ok(())
     }
 
+    /// A standard function box: the S7-200 instruction where one computes exactly what the
+    /// model does (SQRT, LN, EXP, SIN, COS, TAN `IN, OUT`; SLW/SRW/RLW/RRW and the D forms
+    /// `OUT, N` after a move of IN for a constant N in 0..=255, the byte count S7-200 takes;
+    /// I_DI, DI_R, ROUND and TRUNC `IN, OUT`); anything else is an error naming the function.
+    fn function(&mut self, func: Function, args: &[Operand], out: VarId) -> Result<(), IlError> {
+        let n = self.names;
+        let ty = n.p.var(out).ty;
+        let target = n.var(out);
+        let unary = match func {
+            Function::Sqrt => Some("SQRT"),
+            Function::Ln => Some("LN"),
+            Function::Exp => Some("EXP"),
+            Function::Sin => Some("SIN"),
+            Function::Cos => Some("COS"),
+            Function::Tan => Some("TAN"),
+            Function::Convert {
+                from: Type::Int,
+                to: Type::Dint,
+            } => Some("I_DI"),
+            Function::Convert {
+                from: Type::Dint,
+                to: Type::Real,
+            } => Some("DI_R"),
+            Function::Convert {
+                from: Type::Real,
+                to: Type::Dint,
+            } => Some("ROUND"),
+            Function::Trunc if ty == Type::Dint => Some("TRUNC"),
+            _ => None,
+        };
+        if let Some(instr) = unary {
+            self.net.emit(instr, &[&n.operand(&args[0]), target], 0);
+            return Ok(());
+        }
+        let shift = match (func, ty) {
+            (Function::Shl, Type::Int) => Some(("SLW", "MOVW")),
+            (Function::Shr, Type::Int) => Some(("SRW", "MOVW")),
+            (Function::Rol, Type::Int) => Some(("RLW", "MOVW")),
+            (Function::Ror, Type::Int) => Some(("RRW", "MOVW")),
+            (Function::Shl, Type::Dint) => Some(("SLD", "MOVD")),
+            (Function::Shr, Type::Dint) => Some(("SRD", "MOVD")),
+            (Function::Rol, Type::Dint) => Some(("RLD", "MOVD")),
+            (Function::Ror, Type::Dint) => Some(("RRD", "MOVD")),
+            _ => None,
+        };
+        let count = match args.get(1) {
+            Some(Operand::Const(Value::Int(k))) => Some(*k as i64),
+            Some(Operand::Const(Value::Dint(k))) => Some(*k as i64),
+            _ => None,
+        };
+        match (shift, count) {
+            (Some((instr, mov)), Some(k)) if (0..=255).contains(&k) => {
+                let is_out = matches!(&args[0], Operand::Var(r) if r.var == out && r.field.is_none());
+                if !is_out {
+                    self.net.emit(mov, &[&n.operand(&args[0]), target], 0);
+                }
+                self.net.emit(instr, &[target, &k.to_string()], 0);
+                Ok(())
+            }
+            (Some(_), _) => self.fail(format!(
+                "{} with a count that is not a constant 0..255 is not expressible in S7-200 IL (its shifts take a byte count)",
+                func.name()
+            )),
+            _ => self.fail(format!(
+                "{} of {ty} is not expressible in S7-200 IL",
+                func.name()
+            )),
+        }
+    }
+
     /// `out := a MOD b` as `a - (a / b) * b` (DIV truncates, so the remainder takes the sign of
     /// `a`, as MOD does), through the scratch word `s`: `MOVW a, s`, `/I b, s`, `*I b, s`,
     /// `MOVW a, out`, `-I s, out`. The `/I` faults on a zero `b` as the MOD does, once; a
@@ -384,7 +455,11 @@ impl Emit<'_> {
             self.net.emit(mov, &[&la, target], 0);
         }
         self.net.emit(&format!("-{sfx}"), &[s, target], 0);
-        if b_var {
+        let zero = matches!(b, Operand::Const(Value::Int(0) | Value::Dint(0)));
+        if zero {
+            // A constant zero divisor: the `/` faulted; the MOD gives 0.
+            self.net.emit(mov, &["0", target], 0);
+        } else if b_var {
             let cmp = word_suffix(ty).expect("an integer type");
             self.net.lps();
             self.net

@@ -114,6 +114,7 @@ pub(super) fn pou(
 fn op_name(op: &Op) -> String {
     match op {
         Op::Compare(c) => c.name().into(),
+        Op::Function(f) => f.name(),
         Op::Arith(a) => a.name().into(),
         Op::And => "AND".into(),
         Op::Or => "OR".into(),

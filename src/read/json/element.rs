@@ -381,21 +381,48 @@ fn contact<'a>(f: &mut Fields<'_, 'a>) -> R<ElementKind<'a>> {
 
 fn arith<'a>(f: &mut Fields<'_, 'a>) -> R<ElementKind<'a>> {
     let name = f.string("op")?;
-    let op = arith_op(&name.value).ok_or_else(|| {
-        Problem::new(
+    let func = crate::model::Function::parse(&name.value);
+    let op = arith_op(&name.value);
+    if op.is_none() && func.is_none() {
+        return Err(Problem::new(
             ".op",
             name.origin,
             Invalid::Shape {
-                expected: "ADD, SUB, MUL, DIV or MOD",
+                expected: "ADD, SUB, MUL, DIV, MOD or a standard function (ABS, SQRT, SHL, MUX, INT_TO_REAL, … docs/format.md)",
                 found: format!("\"{}\"", name.value),
             },
-        )
-    })?;
+        ));
+    }
     let out = f.string("out")?;
     let (inputs, origin) = match f.required("in")? {
         (Slot::List(Ok(list)), origin) => (list, origin),
         (Slot::List(Err(found)), origin) => return Err(shape(".in", origin, "an array", &found)),
         (_, origin) => return Err(shape(".in", origin, "an array", &Scalar::Object)),
+    };
+    let Some(op) = op else {
+        let func = func.expect("checked above");
+        if !func.arity_ok(inputs.len()) {
+            let pins = func.input_names(inputs.len());
+            return Err(Problem::new(
+                ".in",
+                origin,
+                Invalid::Shape {
+                    expected: if func.extensible() {
+                        "K and two or more inputs"
+                    } else if pins.len() == 1 {
+                        "one operand"
+                    } else {
+                        "two operands"
+                    },
+                    found: format!("{} operands", inputs.len()),
+                },
+            ));
+        }
+        return Ok(ElementKind::Function(Box::new(syntax::FunctionCall {
+            func,
+            args: inputs,
+            out,
+        })));
     };
     let [a, b]: [Operand; 2] = inputs.try_into().map_err(|v: Vec<Operand>| {
         Problem::new(

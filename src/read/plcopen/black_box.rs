@@ -1,12 +1,13 @@
-//! Blocks of FBD and LD bodies whose op the model lacks: the type conversions it can express
-//! exactly, and black boxes for the rest (IEC 61131-3 2.5.1.5 functions, user functions of the
-//! project, function blocks of an editor's library that the file does not define).
+//! Blocks of FBD and LD bodies whose op the model lacks under the name the file gives: the type
+//! conversions between types the reader maps onto the model's, and black boxes for the rest
+//! (IEC 61131-3 2.5.1.5 functions the model lacks, user functions of the project, function
+//! blocks of an editor's library that the file does not define).
 //!
-//! A conversion `A_TO_B` (IEC 61131-3 2.5.1.5.1) between the model's types (after the reader's
-//! mapping, docs/plcopen.md *Elementary types*) is rewritten in place, keeping the block's id:
-//! BOOL to a number is `SEL(G := IN, IN0 := 0, IN1 := 1)`, a number to BOOL is `NE(IN, 0)`
-//! (IEC: non-zero is TRUE), and two types the model reads as the same one is `MOVE`. Any other
-//! block the model lacks becomes a call of a stand-in function block type (reading its inputs,
+//! A conversion `A_TO_B` (IEC 61131-3 2.5.1.5.1) between types the reader maps onto the
+//! model's (docs/plcopen.md *Elementary types*) becomes, in place and keeping the block's id,
+//! the model's conversion of the mapped types ([`standard_function`]: `SINT_TO_REAL` is
+//! `INT_TO_REAL`, computed by `run`). The standard functions the model has under their own
+//! names (SQRT, MUX, INT_TO_REAL, …) never come here. Any other block the model lacks becomes a call of a stand-in function block type (reading its inputs,
 //! writing its outputs with their own values, [`super::textual::stand_in`]) on an instance
 //! `<op>__<localId>` added to the POU: the analysis sees exactly the block's inputs read and
 //! its outputs written, and `run` leaves the outputs at their initial values (a note names every
@@ -25,6 +26,7 @@ use super::wiring::{ElemId, Graph};
 use super::xml::{error, origin, R};
 use crate::diag::Origin;
 use crate::fbd::OpKind;
+use crate::model::Function;
 use crate::syntax::fbd::{Block, Connection, Input, Inputs};
 use crate::syntax::Scalar;
 use std::borrow::Cow;
@@ -291,12 +293,6 @@ fn pick(pins: &[(String, String)], pin: Option<&str>) -> Option<String> {
     }
 }
 
-/// True for the model's integer and bit-string types (BOOL_TO_x is `SEL(b, 0, 1)` and
-/// x_TO_BOOL `x <> 0` on them).
-fn integer(t: &str) -> bool {
-    crate::model::Type::parse(t).is_some_and(|t| t.is_int() || t.is_bits())
-}
-
 /// `A_TO_B` (and `TRUNC`, REAL to DINT): the model types of A and B, when they are elementary.
 fn conversion(ty: &str) -> Option<(Option<String>, Option<String>)> {
     if ty == "TRUNC" {
@@ -305,6 +301,27 @@ fn conversion(ty: &str) -> Option<(Option<String>, Option<String>)> {
     let (a, b) = ty.split_once("_TO_")?;
     let (a, b) = (model(a), model(b));
     (a.is_some() && b.is_some()).then_some((a, b))
+}
+
+/// The standard function the model has for block type `ty`: by its name, or a conversion
+/// `A_TO_B` between types the reader maps onto the model's (`SINT_TO_INT` is `INT_TO_INT`).
+pub fn standard_function(ty: &str) -> Option<Function> {
+    if let Some(f) = Function::parse(ty) {
+        return Some(f);
+    }
+    // Only numbers, bit strings, BOOL and TIME: a STRING or a date read as a number is not one.
+    const NUMERIC: &[&str] = &[
+        "BOOL", "SINT", "INT", "DINT", "LINT", "USINT", "UINT", "UDINT", "ULINT", "REAL", "LREAL",
+        "BYTE", "WORD", "DWORD", "LWORD", "TIME",
+    ];
+    let (a, b) = ty.split_once("_TO_")?;
+    if !NUMERIC.contains(&a) || !NUMERIC.contains(&b) {
+        return None;
+    }
+    match conversion(ty)? {
+        (Some(a), Some(b)) => Function::parse(&format!("{a}_TO_{b}")),
+        _ => None,
+    }
 }
 
 /// True for ADD or SUB of inputs of different types, or MUL or DIV of a TIME: the date and
@@ -349,50 +366,16 @@ pub fn rewrite(
 ) -> R<Option<(String, String)>> {
     let el = t.g.get(e);
     let ty = el.node.attribute("typeName").unwrap_or("");
-    let mut inputs = match b.inputs.take() {
+    let inputs = match b.inputs.take() {
         Some(Ok(Inputs::Named(v))) => v,
         _ => Vec::new(),
     };
     let at = b.origin;
-    let num = |n: i64| Input {
-        origin: at,
-        from: Connection::Constant(Scalar::Number(n.into())),
-    };
-    if let Some((Some(from), Some(to))) = conversion(ty) {
-        let input = inputs.pop().map(|(_, i)| i);
-        let done = match input {
-            Some(i) if from == "BOOL" && integer(&to) => {
-                Some(("SEL", vec![("G", i), ("IN0", num(0)), ("IN1", num(1))]))
-            }
-            Some(i) if to == "BOOL" && integer(&from) => {
-                Some(("NE", vec![("IN1", i), ("IN2", num(0))]))
-            }
-            Some(i) if from == to => Some(("MOVE", vec![("IN", i)])),
-            Some(i) => {
-                inputs.push(("IN".into(), i));
-                None
-            }
-            None => None,
-        };
-        if let Some((op, ins)) = done {
-            b.op = Ok(Cow::Borrowed(op));
-            b.inputs = Some(Ok(Inputs::Named(
-                ins.into_iter()
-                    .map(|(p, i)| (Cow::Borrowed(p), i))
-                    .collect(),
-            )));
-            if op != "SEL" {
-                return Ok(None);
-            }
-            // A SEL of constants only would be DINT: its result variable fixes the type.
-            let v = format!("{ty}__{}", el.local_id);
-            let target = crate::syntax::fbd::OutVar {
-                origin: at,
-                name: Cow::Owned(v.clone()),
-            };
-            super::pins::add_target(b, "OUT".to_owned(), target);
-            return Ok(Some((v, to)));
-        }
+    if let Some(f) = standard_function(ty) {
+        // A conversion between types the reader maps onto the model's: the model's own.
+        b.op = Ok(Cow::Owned(f.name()));
+        b.inputs = Some(Ok(Inputs::Named(inputs)));
+        return Ok(None);
     }
     // A black box: its name becomes a function block type's, so it must be an identifier.
     super::xml::identifier(ty, "block type", el.node, place)?;

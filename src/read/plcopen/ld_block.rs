@@ -28,22 +28,26 @@
 use super::ld_power::{Item, Key, Path, Power};
 use super::wiring::ElemId;
 use super::xml::{error, origin, variable_ref, R};
-use crate::model::{ArithOp, BistableKind, CmpOp, TimerKind, TriggerKind};
+use crate::model::{ArithOp, BistableKind, CmpOp, Function, TimerKind, TriggerKind};
 use crate::syntax::{
-    Arith, Bistable, Compare, Counter, Ctud, Element, ElementKind, Located, Move, Name, Operand,
-    Scalar, Timer,
+    Arith, Bistable, Compare, Counter, Ctud, Element, ElementKind, FunctionCall, Located, Move,
+    Name, Operand, Scalar, Timer,
 };
 
 /// The block types an LD rung can hold, with their pins.
 enum Spec {
     Timer(TimerKind),
-    Counter { down: bool },
+    Counter {
+        down: bool,
+    },
     Bistable(BistableKind),
     Trigger(TriggerKind),
     Ctud,
     Arith(ArithOp),
     Move,
     Compare(CmpOp),
+    /// A standard function (EN, its inputs, ENO, OUT).
+    Function(Function),
 }
 
 impl Spec {
@@ -63,7 +67,7 @@ impl Spec {
             _ => match (ArithOp::parse(ty), CmpOp::parse(ty)) {
                 (Some(op), _) => Spec::Arith(op),
                 (_, Some(op)) => Spec::Compare(op),
-                _ => return None,
+                _ => Spec::Function(super::black_box::standard_function(ty)?),
             },
         })
     }
@@ -88,6 +92,15 @@ impl Spec {
             Spec::Arith(_) => ("EN", &["IN1", "IN2"], "ENO", Some("OUT")),
             Spec::Move => ("EN", &["IN"], "ENO", Some("OUT")),
             Spec::Compare(_) => ("EN", &["IN1", "IN2"], "OUT", None),
+            Spec::Function(f) => {
+                let data: &'static [&'static str] = match f {
+                    Function::Expt => &["IN1", "IN2"],
+                    Function::Shl | Function::Shr | Function::Rol | Function::Ror => &["IN", "N"],
+                    Function::Mux => &["K", "IN0", "IN1"],
+                    _ => &["IN"],
+                };
+                ("EN", data, "ENO", Some("OUT"))
+            }
         }
     }
 }
@@ -112,15 +125,24 @@ impl Spec {
             self,
             Spec::Compare(_) | Spec::Arith(ArithOp::Add | ArithOp::Mul)
         );
-        extensible
+        let first = self.first_extension();
+        (extensible || first == 2)
             && pin
                 .strip_prefix("IN")
                 .and_then(|k| k.parse::<u32>().ok())
-                .is_some_and(|k| k >= 3 && pin == format!("IN{k}"))
+                .is_some_and(|k| k >= first && pin == format!("IN{k}"))
+    }
+
+    /// The number k of the first extension input `INk` (MUX: IN2; ADD, MUL, compares: IN3).
+    fn first_extension(&self) -> u32 {
+        match self {
+            Spec::Function(Function::Mux) => 2,
+            _ => 3,
+        }
     }
 }
 
-const SUPPORTED: &str = "TON, TOF, TP, CTU, CTD, SR, RS, R_TRIG, F_TRIG, CTUD, ADD, SUB, MUL, DIV, MOD, MOVE, EQ, NE, LT, LE, GT, GE, AND, OR, XOR, NOT";
+const SUPPORTED: &str = "TON, TOF, TP, CTU, CTD, SR, RS, R_TRIG, F_TRIG, CTUD, ADD, SUB, MUL, DIV, MOD, MOVE, EQ, NE, LT, LE, GT, GE, AND, OR, XOR, NOT, and the standard functions ABS … ATAN, EXPT, SHL … ROR, MUX, *_TO_*, TRUNC";
 
 /// True when out variable `e` is the result of an ADD … MOD or MOVE block (part of its box).
 pub fn absorbed(p: &Power, e: ElemId) -> bool {
@@ -135,7 +157,7 @@ pub fn absorbed(p: &Power, e: ElemId) -> bool {
     src.tag == "block"
         && matches!(
             src.node.attribute("typeName").and_then(Spec::of),
-            Some(Spec::Arith(_) | Spec::Move)
+            Some(Spec::Arith(_) | Spec::Move | Spec::Function(_))
         )
         && s.pin.is_none_or(|p| p == "OUT")
 }
@@ -326,7 +348,7 @@ fn box_kinds(p: &mut Power, e: ElemId, spec: &Spec, ty: &str) -> R<Vec<ElementKi
 /// The inputs `IN3`, `IN4` … of extensible block `e`, in order; an empty list for others.
 fn extended_pins(p: &Power, e: ElemId, spec: &Spec) -> Vec<String> {
     let names: Vec<&str> = p.g.get(e).inputs.iter().filter_map(|x| x.name).collect();
-    (3..)
+    (spec.first_extension()..)
         .map(|k| format!("IN{k}"))
         .take_while(|n| spec.extends(n) && names.contains(&n.as_str()))
         .collect()
@@ -395,6 +417,20 @@ fn box_kind(p: &mut Power, e: ElemId, spec: &Spec, ty: &str) -> R<ElementKind<'s
             a: operand(p, e, "IN1", ty)?,
             b: operand(p, e, "IN2", ty)?,
         })),
+        Spec::Function(func) => {
+            let mut args = Vec::new();
+            for pin in spec.pins().1 {
+                args.push(operand(p, e, pin, ty)?);
+            }
+            for pin in extended_pins(p, e, spec) {
+                args.push(operand(p, e, &pin, ty)?);
+            }
+            ElementKind::Function(Box::new(FunctionCall {
+                func,
+                args,
+                out: result(p, e, ty)?,
+            }))
+        }
     })
 }
 

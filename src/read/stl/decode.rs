@@ -5,7 +5,7 @@
 use super::operand::Context;
 use super::{error, Ins};
 use crate::diag::{LoadError, Origin};
-use crate::model::{ArithOp, CmpOp, TimerKind};
+use crate::model::{ArithOp, CmpOp, Function, TimerKind, Type};
 use crate::syntax::{self, Element, ElementKind, Located, Series};
 use std::borrow::Cow;
 
@@ -202,6 +202,70 @@ pub(super) fn decode(cx: &mut Context, ins: &Ins, empty: bool) -> Result<Op, Loa
             let to = cx.word(b, fam)?;
             let to = name(to.value.as_str().unwrap_or(b.text), b.at);
             Op::Out(kind(ElementKind::Move(Box::new(syntax::Move { from, to }))))
+        }
+        "SQRT" | "LN" | "EXP" | "SIN" | "COS" | "TAN" | "I_DI" | "DI_R" | "ROUND" | "TRUNC" => {
+            // IN, OUT: the standard function (the conversions: INT_TO_DINT, DINT_TO_REAL,
+            // REAL_TO_DINT, TRUNC to a DINT).
+            let (func, fi, fo) = match op {
+                "I_DI" => (
+                    Function::Convert {
+                        from: Type::Int,
+                        to: Type::Dint,
+                    },
+                    'W',
+                    'D',
+                ),
+                "DI_R" => (
+                    Function::Convert {
+                        from: Type::Dint,
+                        to: Type::Real,
+                    },
+                    'D',
+                    'R',
+                ),
+                "ROUND" => (
+                    Function::Convert {
+                        from: Type::Real,
+                        to: Type::Dint,
+                    },
+                    'R',
+                    'D',
+                ),
+                "TRUNC" => (Function::Trunc, 'R', 'D'),
+                _ => (Function::parse(op).unwrap_or(Function::Sqrt), 'R', 'R'),
+            };
+            let (a, b) = (arg(cx, ins, 0, 2)?, arg(cx, ins, 1, 2)?);
+            let inp = cx.word(a, fi)?;
+            let out = cx.word(b, fo)?;
+            let out = name(out.value.as_str().unwrap_or(b.text), b.at);
+            Op::Out(kind(ElementKind::Function(Box::new(
+                syntax::FunctionCall {
+                    func,
+                    args: vec![inp],
+                    out,
+                },
+            ))))
+        }
+        "SLW" | "SRW" | "RLW" | "RRW" | "SLD" | "SRD" | "RLD" | "RRD" => {
+            // OUT, N: OUT := SHL/SHR/ROL/ROR(OUT, N).
+            let func = match &op[..2] {
+                "SL" => Function::Shl,
+                "SR" => Function::Shr,
+                "RL" => Function::Rol,
+                _ => Function::Ror,
+            };
+            let fam = if op.ends_with('W') { 'W' } else { 'D' };
+            let (a, b) = (arg(cx, ins, 0, 2)?, arg(cx, ins, 1, 2)?);
+            let cur = cx.word(a, fam)?;
+            let n = cx.word(b, 'W')?;
+            let out = name(cur.value.as_str().unwrap_or(a.text), a.at);
+            Op::Out(kind(ElementKind::Function(Box::new(
+                syntax::FunctionCall {
+                    func,
+                    args: vec![cur, n],
+                    out,
+                },
+            ))))
         }
         "JMP" => Op::Out(kind(ElementKind::Jmp(name(arg(cx, ins, 0, 1)?.text, at)))),
         "CALL" => Op::Out(kind(ElementKind::Call(name(arg(cx, ins, 0, 1)?.text, at)))),

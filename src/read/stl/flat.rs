@@ -36,6 +36,7 @@ fn writes(e: &E) -> Option<String> {
         }
         ElementKind::Move(m) => m.to.as_str().to_string(),
         ElementKind::Arith(a) => a.out.as_str().to_string(),
+        ElementKind::Function(f) => f.out.as_str().to_string(),
         ElementKind::Timer(t) => t.instance.as_str().to_string(),
         ElementKind::Counter(c) => c.instance.as_str().to_string(),
         ElementKind::For(f) => f.var.as_str().to_string(),

@@ -141,6 +141,13 @@ fn shape(p: &Program, e: &Element) -> Shape {
             op.name().into(),
             format!("{}, {} → {}", operand(p, a), operand(p, b), var(out)),
         ]),
+        Element::Function { func, args, out } => {
+            let args: Vec<String> = args.iter().map(|a| operand(p, a)).collect();
+            boxed(vec![
+                func.name(),
+                format!("{} → {}", args.join(", "), var(out)),
+            ])
+        }
         Element::Jmp { label, .. } => Shape::Coil {
             mark: ">>",
             name: label.clone(),

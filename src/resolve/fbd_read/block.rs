@@ -220,6 +220,15 @@ impl Net<'_, '_, '_> {
                 }
                 d.kind.input_pins(n)
             }
+            // MUX: K, IN0 … INn, n the highest given.
+            None if d.kind == OpKind::Function(crate::model::Function::Mux) => {
+                let n = map
+                    .iter()
+                    .filter_map(|(k, _)| k.strip_prefix("IN").and_then(|x| x.parse::<usize>().ok()))
+                    .max()
+                    .unwrap_or(1);
+                d.kind.input_pins(n + 2)
+            }
             None => d.kind.input_pins(0),
         };
         if let Some((k, _)) = map.iter().find(|(k, _)| !pins.iter().any(|x| x == k)) {
@@ -380,6 +389,7 @@ impl Net<'_, '_, '_> {
             OpKind::Ret => self.plain(d, Op::Ret)?,
             OpKind::TStart => self.plain(d, Op::TStart)?,
             OpKind::TStop => self.plain(d, Op::TStop)?,
+            OpKind::Function(f) => self.plain(d, Op::Function(f))?,
         })
     }
 

@@ -52,6 +52,7 @@ impl Cx<'_> {
             Op::Jmp { .. } | Op::Ret => self.jump(nx, b, labels),
             Op::TStart | Op::TStop => self.accumulate(nx, b),
             Op::Call { fb, instance } => self.call(nx, b, fb, instance),
+            Op::Function(f) => self.function(nx, b, &vals, *f),
         }
     }
 

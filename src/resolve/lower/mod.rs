@@ -22,6 +22,7 @@
 
 mod blocks;
 mod fragments;
+mod functions;
 mod instances;
 mod pins;
 mod standard;

@@ -1,0 +1,224 @@
+//! The standard functions end to end: `convert` against a plain reference (property test),
+//! located type and shape errors in the JSON format (exit 2, one line naming the operand),
+//! the S7-200 IL instructions and the IL error for a function S7-200 cannot express, and a
+//! `convert` round trip of a function box.
+
+mod common;
+
+use plc_deps::exec::functions::convert;
+use plc_deps::model::{Type, Value};
+use proptest::prelude::*;
+
+/// The elementary types a conversion goes between.
+const TYPES: [Type; 16] = [
+    Type::Bool,
+    Type::Sint,
+    Type::Int,
+    Type::Dint,
+    Type::Lint,
+    Type::Usint,
+    Type::Uint,
+    Type::Udint,
+    Type::Ulint,
+    Type::Real,
+    Type::Lreal,
+    Type::Byte,
+    Type::Word,
+    Type::Dword,
+    Type::Lword,
+    Type::Time,
+];
+
+/// An integer wrapped to the width of `to` (signed for the signed types and TIME).
+fn wrap(v: i128, to: Type) -> i128 {
+    let bits = to.bits();
+    let m = 1i128 << bits;
+    let r = v.rem_euclid(m);
+    if (to.is_signed() || to == Type::Time) && r >= m / 2 {
+        r - m
+    } else {
+        r
+    }
+}
+
+/// A real rounded half away from zero, NaN 0, beyond the `i64` range its nearest end.
+fn round_real(x: f64) -> i128 {
+    if x.is_nan() {
+        return 0;
+    }
+    let r = if x >= 0.0 {
+        (x + 0.5).floor()
+    } else {
+        (x - 0.5).ceil()
+    };
+    if r >= 9.223372036854775808e18 {
+        i64::MAX as i128
+    } else if r < -9.223372036854775808e18 {
+        i64::MIN as i128
+    } else {
+        r as i128
+    }
+}
+
+/// The conversion rules of docs/scan.md, written out plainly in f64 and i128.
+fn reference(v: Value, to: Type) -> Value {
+    let real: Option<f64> = v.as_f64();
+    let int: Option<i128> = match v {
+        Value::Bool(b) => Some(b as i128),
+        _ if real.is_some() => None,
+        other => other.as_i128(),
+    };
+    match (to, int, real) {
+        (Type::Bool, Some(i), _) => Value::Bool(i != 0),
+        (Type::Bool, _, Some(x)) => Value::Bool(x != 0.0),
+        (Type::Real, Some(i), _) => Value::Real(i as f32),
+        (Type::Real, _, Some(x)) => Value::Real(x as f32),
+        (Type::Lreal, Some(i), _) => Value::from_bits(Type::Lreal, (i as f64).to_bits()),
+        (Type::Lreal, _, Some(x)) => Value::from_bits(Type::Lreal, x.to_bits()),
+        (_, Some(i), _) => Value::int_of(to, wrap(i, to)).unwrap(),
+        (_, _, Some(x)) => Value::int_of(to, wrap(round_real(x), to)).unwrap(),
+        _ => unreachable!(),
+    }
+}
+
+fn value() -> impl Strategy<Value = Value> {
+    let ints = (0usize..TYPES.len(), any::<u64>()).prop_filter_map("an integer type", |(k, b)| {
+        let t = TYPES[k];
+        (t.is_int() || t.is_bits() || t == Type::Time).then(|| Value::from_bits(t, b))
+    });
+    prop_oneof![
+        any::<bool>().prop_map(Value::Bool),
+        ints,
+        any::<f32>().prop_map(Value::Real),
+        (-70000i32..70000, 0u8..4).prop_map(|(i, q)| Value::Real(i as f32 + q as f32 * 0.25)),
+        any::<f64>().prop_map(|x| Value::from_bits(Type::Lreal, x.to_bits())),
+        (-1i64 << 40..1i64 << 40, 0u8..4).prop_map(|(i, q)| Value::from_bits(
+            Type::Lreal,
+            (i as f64 + q as f64 * 0.25).to_bits()
+        )),
+    ]
+}
+
+fn same(a: Value, b: Value) -> bool {
+    match (a.as_f64(), b.as_f64()) {
+        (Some(x), Some(y)) => a.to_bits() == b.to_bits() || (x.is_nan() && y.is_nan()),
+        _ => a == b,
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(4000))]
+    #[test]
+    fn convert_agrees_with_the_plain_reference(v in value(), k in 0usize..TYPES.len()) {
+        let to = TYPES[k];
+        let (got, want) = (convert(v, to), reference(v, to));
+        prop_assert!(same(got, want), "{v:?} → {to}: {got:?}, reference {want:?}");
+    }
+}
+
+fn program(rung: &str, vars: &str) -> String {
+    format!(r#"{{"program": "p", "vars": [{vars}], "rungs": [{{"id": "R1", "ld": [{rung}]}}]}}"#)
+}
+
+fn load_error(text: &str) -> String {
+    let out = common::cli::run_stdin(&["report", "-"], text.as_bytes());
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    common::cli::one_line(&String::from_utf8_lossy(&out.stderr))
+}
+
+#[test]
+fn a_function_box_of_the_wrong_types_is_a_located_error() {
+    let vars = r#"{"name": "i", "type": "INT"}, {"name": "r", "type": "REAL"}"#;
+    let e = load_error(&program(r#"{"op": "SQRT", "in": ["i"], "out": "r"}"#, vars));
+    assert!(
+        e.contains("needs REAL or LREAL (SQRT), but `i` is INT"),
+        "{e}"
+    );
+    assert!(e.contains("rungs[0].ld[0].in[0]"), "{e}");
+    let e = load_error(&program(
+        r#"{"op": "TRUNC", "in": ["r"], "out": "r"}"#,
+        vars,
+    ));
+    assert!(
+        e.contains("needs an integer type (ANY_INT) (TRUNC), but `r` is REAL"),
+        "{e}"
+    );
+    assert!(e.contains("rungs[0].ld[0].out"), "{e}");
+    let e = load_error(&program(
+        r#"{"op": "INT_TO_REAL", "in": ["r"], "out": "r"}"#,
+        vars,
+    ));
+    assert!(
+        e.contains("needs INT (INT_TO_REAL), but `r` is REAL"),
+        "{e}"
+    );
+    let e = load_error(&program(r#"{"op": "SHL", "in": ["i"], "out": "i"}"#, vars));
+    assert!(e.contains("expected two operands, found 1 operands"), "{e}");
+    let e = load_error(&program(
+        r#"{"op": "MUX", "in": [0, "i"], "out": "i"}"#,
+        vars,
+    ));
+    assert!(e.contains("expected K and two or more inputs"), "{e}");
+    let e = load_error(&program(
+        r#"{"op": "SQRTX", "in": ["r"], "out": "r"}"#,
+        vars,
+    ));
+    assert!(e.contains("a standard function"), "{e}");
+}
+
+#[test]
+fn il_has_the_s7_200_instruction_or_a_clear_error() {
+    let vars = r#"{"name": "i", "type": "INT"}, {"name": "d", "type": "DINT"}, {"name": "r", "type": "REAL"}, {"name": "x", "type": "BOOL", "class": "input"}"#;
+    let rung = r#"{"contact": "x"}, {"op": "SQRT", "in": ["r"], "out": "r"}, {"op": "SHL", "in": ["i", 3], "out": "i"}, {"op": "ROR", "in": ["d", 1], "out": "d"}, {"op": "INT_TO_DINT", "in": ["i"], "out": "d"}, {"op": "REAL_TO_DINT", "in": ["r"], "out": "d"}"#;
+    let out = common::cli::run_stdin(&["il", "-"], program(rung, vars).as_bytes());
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let il = String::from_utf8_lossy(&out.stdout);
+    let il = il.split_whitespace().collect::<Vec<_>>().join(" ");
+    for line in [
+        "SQRT r, r",
+        "SLW i, 3",
+        "RRD d, 1",
+        "I_DI i, d",
+        "ROUND r, d",
+    ] {
+        assert!(il.contains(line), "{line} in {il}");
+    }
+    let out = common::cli::run_stdin(
+        &["il", "-"],
+        program(r#"{"op": "MUX", "in": [0, 1, 2], "out": "i"}"#, vars).as_bytes(),
+    );
+    assert_eq!(out.status.code(), Some(2));
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        e.contains("MUX of INT is not expressible in S7-200 IL") && e.contains("R1"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_function_box_converts_and_reads_back() {
+    let vars = r#"{"name": "k", "type": "INT"}, {"name": "t", "type": "TIME"}"#;
+    let text = program(
+        r#"{"op": "MUX", "in": ["k", "T#1s", "T#2s", "T#3s"], "out": "t"}"#,
+        vars,
+    );
+    let out = common::cli::run_stdin(&["convert", "-"], text.as_bytes());
+    assert_eq!(out.status.code(), Some(0));
+    let json = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        json.contains(r#"{"op":"MUX","in":["k","T#1s","T#2s","T#3s"],"out":"t"}"#),
+        "{json}"
+    );
+    let again = common::cli::run_stdin(&["convert", "-"], json.as_bytes());
+    assert_eq!(String::from_utf8_lossy(&again.stdout), json);
+}
