@@ -53,37 +53,29 @@ pub fn apply(func: Function, args: &[Value], out: Type) -> Value {
     }
 }
 
-/// The REAL function `f` of `x` (one of SQRT … ATAN), in `f32`.
-fn real_fn(f: Function, x: f32) -> f32 {
-    match f {
-        Function::Sqrt => x.sqrt(),
-        Function::Ln => x.ln(),
-        Function::Log => x.log10(),
-        Function::Exp => x.exp(),
-        Function::Sin => x.sin(),
-        Function::Cos => x.cos(),
-        Function::Tan => x.tan(),
-        Function::Asin => x.asin(),
-        Function::Acos => x.acos(),
-        _ => x.atan(),
-    }
+/// The real function `f` (one of SQRT … ATAN) of `x`, in the float type of `x`: `f32` for
+/// REAL, `f64` for LREAL (`real_fn`, `real_fn64`: one body, the C library's float or double
+/// functions).
+macro_rules! real_function {
+    ($name:ident, $t:ty) => {
+        fn $name(f: Function, x: $t) -> $t {
+            match f {
+                Function::Sqrt => x.sqrt(),
+                Function::Ln => x.ln(),
+                Function::Log => x.log10(),
+                Function::Exp => x.exp(),
+                Function::Sin => x.sin(),
+                Function::Cos => x.cos(),
+                Function::Tan => x.tan(),
+                Function::Asin => x.asin(),
+                Function::Acos => x.acos(),
+                _ => x.atan(),
+            }
+        }
+    };
 }
-
-/// The LREAL function `f` of `x`, in `f64` (the C library's double functions).
-fn real_fn64(f: Function, x: f64) -> f64 {
-    match f {
-        Function::Sqrt => x.sqrt(),
-        Function::Ln => x.ln(),
-        Function::Log => x.log10(),
-        Function::Exp => x.exp(),
-        Function::Sin => x.sin(),
-        Function::Cos => x.cos(),
-        Function::Tan => x.tan(),
-        Function::Asin => x.asin(),
-        Function::Acos => x.acos(),
-        _ => x.atan(),
-    }
-}
+real_function!(real_fn, f32);
+real_function!(real_fn64, f64);
 
 /// `bits` (the low `width` bits) shifted or rotated by `n`.
 pub fn shift(f: Function, bits: u64, n: i64, width: u32) -> u64 {
