@@ -7,7 +7,7 @@
 //!
 //! Not here: where the statement goes (`ladder`), the helpers' text (`runtime`, after `_plc_f32`).
 
-use super::ladder::{c_type, num_suffix};
+use super::spelling::{c_type, num_suffix};
 use crate::model::{bit_width, Function, Type};
 
 /// `func(args)` as a C expression of the output type `out`; each argument is its C text and

@@ -32,6 +32,7 @@ mod ladder;
 pub mod names;
 mod rows;
 mod runtime;
+mod spelling;
 mod types;
 
 use crate::fbd::Fbd;
