@@ -135,7 +135,7 @@ pub fn report(c: &ReportConfig) -> Result<(), CliError> {
     };
     // The text places the warnings, which are known only after the analysis. It is kept: a big
     // program file is mapped, not read (`SourceText`), so keeping it costs no memory of ours.
-    let source = || -> &str { &source };
+    let source: &str = &source;
     let parts = fbd_parts(&p, &fbd);
     let drawn = dot_selection(c, &p)?;
     let a = {
@@ -148,7 +148,7 @@ pub fn report(c: &ReportConfig) -> Result<(), CliError> {
             shown.file = file.clone();
             shown
         } else {
-            Shown::warning(code, message, &file, source(), origin)
+            Shown::warning(code, message, &file, source, origin)
         };
         super::errors::warn(&shown);
     };
