@@ -513,6 +513,7 @@ fn error_format(cli: &Cli) -> cmd::errors::Format {
 /// Exit codes (README, docs/diagnostics.md): 0 done, 1 a run that faulted or whose modes
 /// differed, 2 bad input or usage (clap's usage errors are 2 too), 130 stopped by a signal.
 fn main() -> ExitCode {
+    cmd::pages::prefer_small_pages();
     let cli = Cli::parse();
     cmd::errors::set_format(error_format(&cli));
     remove_temp_files_on_signal();

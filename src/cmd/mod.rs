@@ -5,7 +5,7 @@
 //! `main.rs` turns command-line arguments into these configs and calls one function; everything
 //! here returns a [`CliError`] (printed once, by `main`, through [`errors`], which also prints
 //! the warnings) instead of printing an error or exiting. [`io`] reads inputs and writes outputs (atomically, never half-written);
-//! [`progress`] shows long phases on a terminal. This is the top layer: nothing below imports it.
+//! [`progress`] shows long phases on a terminal; [`pages`] chooses the kind of memory pages the process gets. This is the top layer: nothing below imports it.
 
 mod background;
 pub mod c;
@@ -15,6 +15,7 @@ pub mod gen;
 pub mod il;
 pub mod io;
 pub mod order;
+pub mod pages;
 pub mod progress;
 pub mod report;
 pub mod run;

@@ -5,7 +5,10 @@
 //! 223 MB, a tenth of `plc-deps report`'s whole run time (profiled with `perf record`: the page
 //! faults of the read buffer). A mapping reads the page cache's own pages instead, so files from
 //! [`MAP_FROM`] bytes on are mapped (read-only, private); smaller files, standard input and
-//! anything that cannot be mapped are read.
+//! anything that cannot be mapped are read. The mapping is populated when it is made
+//! (`MAP_POPULATE` on Linux): one system call maps every page, instead of one page fault per
+//! 4 KiB page as the reader first touches it (at a million rungs, half the process's page
+//! faults: 23,273 against 11,044 with it, `perf stat -e page-faults`).
 //!
 //! Invariant: the text is UTF-8 (checked once, when it is made) and starts after any byte-order
 //! mark. Caveat, as for every program that maps its input (ripgrep's `--mmap`): the text is the
@@ -52,7 +55,7 @@ impl SourceText {
         // SAFETY: the mapping is read-only and private, and this process never writes the file.
         // What another process does to the file while it is mapped is the caveat of the
         // module's comment; memmap2 documents the same.
-        let map = unsafe { memmap2::Mmap::map(file) }.ok()?;
+        let map = unsafe { memmap2::MmapOptions::new().populate().map(file) }.ok()?;
         Some(check(&map).map(|start| SourceText {
             repr: Repr::Mapped { map, start },
         }))
