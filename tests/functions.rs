@@ -1,4 +1,5 @@
-//! The standard functions end to end: `convert` against a plain reference (property test),
+//! The standard functions end to end: `convert` against a plain reference (property test), the
+//! bitwise AND/OR/XOR/NOT of FBD blocks of WORDs,
 //! located type and shape errors in the JSON format (exit 2, one line naming the operand),
 //! the S7-200 IL instructions and the IL error for a function S7-200 cannot express, and a
 //! `convert` round trip of a function box.
@@ -238,4 +239,62 @@ fn a_function_box_converts_and_reads_back() {
     );
     let again = common::cli::run_stdin(&["convert", "-"], json.as_bytes());
     assert_eq!(String::from_utf8_lossy(&again.stdout), json);
+}
+
+/// FBD AND, OR, XOR and NOT blocks of WORDs are the bitwise functions (a chain of them through
+/// arcs, an extensible XOR, a constant), while the same blocks of BOOLs stay contacts; values
+/// worked out by hand, after each of two scans.
+#[test]
+fn fbd_logic_blocks_of_words_are_bitwise() {
+    use plc_deps::exec::{ExecConfig, Layout, Machine};
+    use plc_deps::model::VarId;
+    let doc = serde_json::json!({"program": "p", "vars": [
+        {"name": "status", "type": "WORD", "class": "input"},
+        {"name": "mask", "type": "WORD", "class": "input"},
+        {"name": "go", "type": "BOOL", "class": "input"},
+        {"name": "stop", "type": "BOOL", "class": "input"},
+        {"name": "bits", "type": "WORD"}, {"name": "flipped", "type": "WORD"},
+        {"name": "run", "type": "BOOL"}
+    ], "fbd": {"networks": [{"id": "N1", "blocks": [
+        {"id": 1, "op": "AND", "in": ["status", "mask"]},
+        {"id": 2, "op": "OR", "in": [{"from": 1}, 32768], "out": "bits"},
+        {"id": 3, "op": "NOT", "in": [{"from": 2}]},
+        {"id": 4, "op": "XOR", "in": [{"from": 3}, "status", 255], "out": "flipped"},
+        {"id": 5, "op": "AND", "in": ["go", {"from": 6}]},
+        {"id": 6, "op": "NOT", "in": ["stop"]},
+        {"id": 7, "op": "OR", "in": [{"from": 5}, "run"], "out": "run"}
+    ]}]}});
+    let p = plc_deps::load::program_from_json(&doc.to_string()).unwrap();
+    let words = p
+        .rungs
+        .iter()
+        .flat_map(|r| r.series.iter())
+        .filter(|e| matches!(e, plc_deps::model::Element::Function { .. }))
+        .count();
+    assert_eq!(words, 4, "the four WORD blocks are functions");
+    let m = Machine::new(&p, Layout::dense(&p), &ExecConfig::default()).unwrap();
+    let id = |n: &str| VarId(p.vars.iter().position(|v| v.name == n).unwrap() as u32);
+    let mut st = m.initial_state();
+    let mut got = Vec::new();
+    for (k, (status, mask, go, stop)) in [
+        (0x1234u16, 0xFFu16, true, false),
+        (0xFFFF, 0x0F0F, false, true),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let set = [
+            (id("status"), Value::Word(status)),
+            (id("mask"), Value::Word(mask)),
+            (id("go"), Value::Bool(go)),
+            (id("stop"), Value::Bool(stop)),
+        ];
+        m.set_inputs(&mut st, &set);
+        m.run_scan(&mut st, k as u64, &mut Vec::new());
+        got.push(["bits", "flipped", "run"].map(|n| m.value(&st, id(n)).to_json().to_string()));
+    }
+    // 0x1234 & 0xFF | 0x8000 = 0x8034; NOT = 0x7FCB; ^ 0x1234 ^ 0xFF = 0x6D00; run latched.
+    assert_eq!(got[0], ["32820", "27904", "true"]);
+    // 0xFFFF & 0x0F0F | 0x8000 = 0x8F0F; NOT = 0x70F0; ^ 0xFFFF ^ 0xFF = 0x8FF0; run holds.
+    assert_eq!(got[1], ["36623", "36848", "true"]);
 }

@@ -168,3 +168,73 @@ fn a_counter_as_a_word_is_its_count() {
     assert_eq!(trace(&abs, ["I0_0", "I0_1", "Q0_0", "VW0", "C5"]), want);
     assert!(want[4].starts_with("true 3 "), "{:?}", want);
 }
+
+/// AND, OR, XOR and NOT of INTs and DINTs are the S7-200's ANDW/ORW/XORW/INVW and the D forms
+/// in their two-operand form (`ANDW IN1, OUT` is `OUT := IN1 AND OUT`): an input that is the
+/// output needs no move. Read back by the STL reader, the program computes the interpreter's
+/// values for inputs of every sign, and the values are the ones worked out by hand.
+#[test]
+fn bitwise_functions_are_the_word_instructions_and_read_back() {
+    let doc = json!({"program": "bits", "vars": [
+        {"name": "go", "type": "BOOL", "class": "input"},
+        {"name": "a", "type": "INT", "class": "input"}, {"name": "b", "type": "INT", "class": "input"},
+        {"name": "r1", "type": "INT"}, {"name": "r2", "type": "INT"}, {"name": "r3", "type": "INT"},
+        {"name": "r4", "type": "INT"}, {"name": "r5", "type": "INT"},
+        {"name": "d", "type": "DINT", "init": 305419896}, {"name": "e", "type": "DINT"}
+    ], "rungs": [
+        {"id": "R1", "ld": [{"contact": "go"}, {"op": "AND", "in": ["a", 255], "out": "r1"}]},
+        {"id": "R2", "ld": [{"op": "OR", "in": ["a", "b", 4096], "out": "r2"}]},
+        {"id": "R3", "ld": [{"op": "XOR", "in": ["b", "r3"], "out": "r3"}]},
+        {"id": "R4", "ld": [{"op": "NOT", "in": ["a"], "out": "r4"}]},
+        {"id": "R5", "ld": [{"op": "NOT", "in": ["r5"], "out": "r5"}]},
+        {"id": "R6", "ld": [{"op": "XOR", "in": ["d", -1], "out": "e"},
+                            {"op": "AND", "in": [65535, "e"], "out": "e"}]}
+    ]});
+    let (p, fbd) = load(&doc);
+    let stl = plc_deps::codegen::il::generate(&p, &fbd).unwrap();
+    for line in [
+        "MOVW   a, r1\nANDW   255, r1",
+        "MOVW   a, r2\nORW    b, r2\nORW    4096, r2",
+        "XORW   b, r3",
+        "MOVW   a, r4\nINVW   r4",
+        "INVW   r5",
+        "MOVD   d, e\nXORD   -1, e\nANDD   65535, e",
+    ] {
+        assert!(stl.contains(line), "{line} in\n{stl}");
+    }
+    assert!(!stl.contains("MOVW   r5, r5"), "{stl}");
+    let (back, _) = plc_deps::load::stl(&stl).unwrap_or_else(|e| panic!("{e:?}\n{stl}"));
+    let scans: Vec<(bool, i16, i16)> = [(true, 0x1234, 0x00F0), (false, -1, 3), (true, -32768, -2)]
+        .into_iter()
+        .collect();
+    let names = ["r1", "r2", "r3", "r4", "r5", "e"];
+    let values = |p: &Program| -> Vec<Vec<String>> {
+        let m = Machine::new(p, Layout::dense(p), &ExecConfig::default()).unwrap();
+        let id = |n: &str| VarId(p.vars.iter().position(|v| v.name == n).unwrap() as u32);
+        let mut st = m.initial_state();
+        let mut out = Vec::new();
+        for (k, &(go, a, b)) in scans.iter().enumerate() {
+            let set = [
+                (id("go"), Value::Bool(go)),
+                (id("a"), Value::Int(a)),
+                (id("b"), Value::Int(b)),
+            ];
+            m.set_inputs(&mut st, &set);
+            m.run_scan(&mut st, k as u64, &mut Vec::new());
+            out.push(
+                names
+                    .iter()
+                    .map(|n| m.value(&st, id(n)).to_json().to_string())
+                    .collect(),
+            );
+        }
+        out
+    };
+    let want = values(&p);
+    assert_eq!(values(&back), want, "\n{stl}");
+    // By hand, scan 1: 0x1234 AND 0xFF = 0x34; 0x1234 OR 0xF0 OR 0x1000 = 0x12F4; 0 XOR 0xF0;
+    // NOT 0x1234 = -0x1235; NOT 0 = -1; 0x12345678 XOR -1 = 0xEDCBA987, AND 0xFFFF = 0xA987.
+    assert_eq!(want[0], ["52", "4852", "240", "-4661", "-1", "43399"]);
+    // Scan 2 (go off: r1 kept): -1 OR 3 = -1; 0xF0 XOR 3 = 0xF3; NOT -1 = 0; NOT -1 = 0.
+    assert_eq!(want[1], ["52", "-1", "243", "0", "0", "43399"]);
+}

@@ -160,3 +160,19 @@ fn set_and_reset_of_n_bits_count_on_from_the_address() {
         "error: tests/stl/set-symbolic.stl:8:8: S of 2 bits needs an absolute bit address (I, Q, M, V) to count from"
     );
 }
+
+/// An FBD network's AND of INTs is a bitwise AND, not a contact: `il` refuses it, naming the
+/// block and the variable, rather than writing `LD status` (which would read a bit).
+#[test]
+fn a_bitwise_fbd_network_is_refused_naming_the_block() {
+    let doc = json!({"program": "p", "vars": [
+        {"name": "status", "type": "INT", "class": "input"}, {"name": "mask", "type": "INT", "class": "input"},
+        {"name": "bits", "type": "INT", "class": "output"}
+    ], "fbd": {"networks": [{"id": "N1", "blocks": [
+        {"id": 1, "op": "AND", "in": ["status", "mask"], "out": "bits"}
+    ]}]}});
+    assert_eq!(
+        il_error(doc, "bitwise-fbd"),
+        "network N1 block 1: `status` is not a BOOL: `plc-deps il` translates FBD networks of boolean AND, OR and NOT (not yet: the bitwise ANDW, ORW, XORW, INVW of a network; a ladder rung's AND box of INTs is translated)"
+    );
+}

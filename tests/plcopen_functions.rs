@@ -177,3 +177,45 @@ fn a_function_box_in_an_ld_rung_runs_when_powered() {
     assert_eq!(got[0], ["0", "3", "3"]);
     assert_eq!(got[1], ["0", "1", "0"]);
 }
+
+/// AND, OR, XOR and NOT of bit strings (IEC 61131-3 2.5.1.5.3) are bitwise: blocks of WORDs
+/// with a based literal, worked out by hand.
+#[test]
+fn bitwise_functions_of_words_run_in_fbd() {
+    let xml = fbd(
+        &[
+            ("inputVars", "status", "WORD"),
+            ("inputVars", "mask", "WORD"),
+            ("outputVars", "a", "WORD"),
+            ("outputVars", "o", "WORD"),
+            ("outputVars", "x", "WORD"),
+            ("outputVars", "n", "BYTE"),
+            ("inputVars", "b", "BYTE"),
+        ],
+        &[
+            ("AND", &[("IN1", "status"), ("IN2", "mask")], "a"),
+            (
+                "OR",
+                &[("IN1", "status"), ("IN2", "16#8000"), ("IN3", "mask")],
+                "o",
+            ),
+            ("XOR", &[("IN1", "status"), ("IN2", "16#00FF")], "x"),
+            ("NOT", &[("IN", "b")], "n"),
+        ],
+    );
+    no_black_box(&xml);
+    let got = trace(
+        "fn-bits",
+        &xml,
+        "status,mask,b\n4660,255,170\n65535,3855,0\n",
+        &["a", "o", "x", "n"],
+    );
+    // 0x1234 AND 0xFF = 0x34; 0xFFFF AND 0x0F0F = 0x0F0F.
+    assert_eq!(got[0], ["52", "3855"]);
+    // 0x1234 OR 0x8000 OR 0xFF = 0x92FF; all ones.
+    assert_eq!(got[1], ["37631", "65535"]);
+    // 0x1234 XOR 0xFF = 0x12CB; 0xFFFF XOR 0xFF = 0xFF00.
+    assert_eq!(got[2], ["4811", "65280"]);
+    // NOT 0xAA = 0x55; NOT 0 = 0xFF.
+    assert_eq!(got[3], ["85", "255"]);
+}

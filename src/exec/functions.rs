@@ -12,6 +12,8 @@
 //!   SHR shift in zeros (SHR is logical) and give 0 for a count < 0 or ≥ the width; ROL and
 //!   ROR rotate by the count modulo the width (a negative count rotates the other way).
 //! - MUX(K, IN0 … INn) is INk; for K outside 0..=n it is the type's zero (0, FALSE, T#0ms).
+//! - AND, OR, XOR (of two or more inputs) and NOT of a bit string or integer work bit by bit
+//!   on its bit pattern of the type's width (IEC 61131-3 2.5.1.5.3; `NOT(INT#0)` is -1).
 //! - [`convert`]: one function from a value to a type (module docs of `convert`).
 //!
 //! Not here: the typing of a call (`crate::model::Function::types`).
@@ -48,6 +50,10 @@ pub fn apply(func: Function, args: &[Value], out: Type) -> Value {
                 None => out.zero(),
             }
         }
+        And => Value::from_bits(out, args.iter().fold(u64::MAX, |m, v| m & v.to_bits())),
+        Or => Value::from_bits(out, args.iter().fold(0, |m, v| m | v.to_bits())),
+        Xor => Value::from_bits(out, args.iter().fold(0, |m, v| m ^ v.to_bits())),
+        Not => Value::from_bits(out, !args[0].to_bits()),
         Convert { .. } => convert(args[0], out),
         Trunc => from_integer(real_to_i64(real64(args[0]).trunc()) as i128, out),
     }

@@ -36,6 +36,14 @@ pub enum Function {
     Ror,
     /// MUX(K, IN0, …, INn): INk (extensible).
     Mux,
+    /// AND(IN1, …, INn) of bit strings, bit by bit (extensible; on BOOLs AND is contacts).
+    And,
+    /// OR(IN1, …, INn) of bit strings, bit by bit (extensible).
+    Or,
+    /// XOR(IN1, …, INn) of bit strings, bit by bit (extensible).
+    Xor,
+    /// NOT(IN) of a bit string: every bit inverted.
+    Not,
     /// `FROM_TO_TO` (IEC 61131-3 2.5.1.5.1).
     Convert {
         from: Type,
@@ -147,6 +155,10 @@ impl Function {
             "ROL" => Rol,
             "ROR" => Ror,
             "MUX" => Mux,
+            "AND" => And,
+            "OR" => Or,
+            "XOR" => Xor,
+            "NOT" => Not,
             "TRUNC" => Trunc,
             _ => {
                 let (a, b) = name.split_once("_TO_")?;
@@ -185,14 +197,22 @@ impl Function {
             Rol => "ROL",
             Ror => "ROR",
             Mux => "MUX",
+            And => "AND",
+            Or => "OR",
+            Xor => "XOR",
+            Not => "NOT",
             Trunc => "TRUNC",
             Convert { from, to } => conversion_name(from, to),
         }
     }
 
-    /// True for MUX, whose last input pin repeats (`IN0`, `IN1`, …).
+    /// True for MUX, AND, OR and XOR, whose last input pin repeats (`IN0`, `IN1`, … for MUX;
+    /// `IN1`, `IN2`, … for the others).
     pub fn extensible(self) -> bool {
-        self == Function::Mux
+        matches!(
+            self,
+            Function::Mux | Function::And | Function::Or | Function::Xor
+        )
     }
 
     /// The fixed input pins: names and typing (MUX: K and the first of its repeated inputs).
@@ -215,29 +235,38 @@ impl Function {
                 ("K", Pin::Own(Class::Int)),
                 ("IN0", Pin::Generic(Class::Elementary)),
             ],
+            And | Or | Xor => &[
+                ("IN1", Pin::Generic(Class::Bit)),
+                ("IN2", Pin::Generic(Class::Bit)),
+            ],
+            Not => &[("IN", Pin::Generic(Class::Bit))],
             Trunc => &[("IN", Pin::Own(Class::Real))],
             // Its `from` is checked by `types` (a pin table is static).
             Convert { .. } => &[("IN", Pin::Own(Class::Elementary))],
         }
     }
 
-    /// The input pin names for `n` inputs (MUX: `K, IN0 … IN(n-2)`; the others: their pins).
+    /// The input pin names for `n` inputs (MUX: `K, IN0 … IN(n-2)`; AND, OR, XOR:
+    /// `IN1 … INn`; the others: their pins).
     pub fn input_names(self, n: usize) -> Vec<String> {
-        if self.extensible() {
+        if self == Function::Mux {
             let k = n.max(3);
             return std::iter::once("K".to_owned())
                 .chain((0..k - 1).map(|i| format!("IN{i}")))
                 .collect();
+        }
+        if self.extensible() {
+            return (1..=n.max(2)).map(|i| format!("IN{i}")).collect();
         }
         self.pins().iter().map(|(n, _)| n.to_string()).collect()
     }
 
     /// The number of inputs a call may have.
     pub fn arity_ok(self, n: usize) -> bool {
-        if self.extensible() {
-            n >= 3
-        } else {
-            n == self.pins().len()
+        match self {
+            Function::Mux => n >= 3,
+            f if f.extensible() => n >= 2,
+            f => n == f.pins().len(),
         }
     }
 

@@ -192,7 +192,8 @@ fn typed_action(rng: &mut Rng) -> Value {
 }
 
 /// A standard function on [`typed`]'s variable `v` of type `ty`: a conversion to another of
-/// them, a shift or rotation of its bit pattern, ABS, or (LREAL) a real function.
+/// them, a shift or rotation of its bit pattern, AND/OR/XOR/NOT of it, ABS, or (LREAL) a real
+/// function.
 fn typed_function(rng: &mut Rng, v: &str, ty: &str) -> Value {
     let all = typed();
     if rng.chance(50) {
@@ -209,6 +210,23 @@ fn typed_function(rng: &mut Rng, v: &str, ty: &str) -> Value {
             }
         }
         "SINT" | "LINT" if rng.chance(30) => json!({"op": "ABS", "in": [v], "out": v}),
+        _ if rng.chance(40) => {
+            // Bit by bit: AND, OR, XOR of two or three inputs, or NOT.
+            let consts = &all
+                .iter()
+                .find(|(w, ..)| *w == v)
+                .expect("a typed variable")
+                .2;
+            match *rng.pick(&["AND", "OR", "XOR", "NOT"]) {
+                "NOT" => json!({"op": "NOT", "in": [v], "out": v}),
+                f if rng.chance(50) => {
+                    json!({"op": f, "in": [v, rng.pick(consts).clone()], "out": v})
+                }
+                f => {
+                    json!({"op": f, "in": [rng.pick(consts).clone(), v, rng.pick(consts).clone()], "out": v})
+                }
+            }
+        }
         _ => {
             let f = *rng.pick(&["SHL", "SHR", "ROL", "ROR"]);
             let n = *rng.pick(&[0, 1, 3, 7, 8, 15, 16, 31, 33, 63, 64, -1]);

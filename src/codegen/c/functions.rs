@@ -64,6 +64,16 @@ pub(crate) fn expr(func: Function, args: &[(String, Type)], out: Type) -> String
             }
             e
         }
+        And | Or | Xor => {
+            let op = match func {
+                And => " & ",
+                Or => " | ",
+                _ => " ^ ",
+            };
+            let bits: Vec<String> = (0..args.len()).map(|i| bits_of(a(i), out)).collect();
+            wrap(&format!("(int64_t)({})", bits.join(op)), out)
+        }
+        Not => wrap(&format!("(int64_t)~{}", bits_of(a(0), out)), out),
         Convert { .. } => convert(a(0), args[0].1, out),
         Trunc => wrap(&format!("{}(trunc((double){}))", TO_I64, a(0)), out),
     }
@@ -99,6 +109,11 @@ fn wrap(e: &str, to: Type) -> String {
         Type::Real | Type::Lreal => format!("({}){e}", c_type(to)),
         t => format!("({})({})(uint64_t)({e})", c_type(t), unsigned(t.bits())),
     }
+}
+
+/// `x`'s bit pattern of `ty`'s width as a `uint64_t` (the upper bits zero).
+fn bits_of(x: &str, ty: Type) -> String {
+    format!("(uint64_t)({})({x})", unsigned(ty.bits()))
 }
 
 /// The unsigned C type of `width` bits.

@@ -61,6 +61,24 @@ fn word_suffix(ty: Type) -> Option<&'static str> {
     }
 }
 
+/// The S7-200 instruction of a bitwise function of an INT or DINT, and the move of its type:
+/// ANDW/ORW/XORW/INVW and the D forms.
+fn bitwise_instruction(func: Function, ty: Type) -> Option<(&'static str, &'static str)> {
+    let word = match ty {
+        Type::Int => true,
+        Type::Dint => false,
+        _ => return None,
+    };
+    let (w, d) = match func {
+        Function::And => ("ANDW", "ANDD"),
+        Function::Or => ("ORW", "ORD"),
+        Function::Xor => ("XORW", "XORD"),
+        Function::Not => ("INVW", "INVD"),
+        _ => return None,
+    };
+    Some(if word { (w, "MOVW") } else { (d, "MOVD") })
+}
+
 impl Emit<'_> {
     fn fail<T>(&self, message: impl Into<String>) -> Result<T, IlError> {
         Err(IlError {
@@ -349,13 +367,18 @@ impl Emit<'_> {
     }
 
     /// A standard function box: the S7-200 instruction where one computes exactly what the
-    /// model does (SQRT, LN, EXP, SIN, COS, TAN `IN, OUT`; SLW/SRW/RLW/RRW and the D forms
+    /// model does (AND, OR, XOR, NOT of an INT or DINT: [`Emit::bitwise`]; SQRT, LN, EXP, SIN,
+    /// COS, TAN `IN, OUT`; SLW/SRW/RLW/RRW and the D forms
     /// `OUT, N` after a move of IN for a constant N in 0..=255, the byte count S7-200 takes;
     /// I_DI, DI_R, ROUND and TRUNC `IN, OUT`); anything else is an error naming the function.
     fn function(&mut self, func: Function, args: &[Operand], out: VarId) -> Result<(), IlError> {
         let n = self.names;
         let ty = n.p.var(out).ty;
         let target = n.var(out);
+        if let Some((instr, mov)) = bitwise_instruction(func, ty) {
+            self.bitwise(instr, mov, args, out);
+            return Ok(());
+        }
         let unary = match func {
             Function::Sqrt => Some("SQRT"),
             Function::Ln => Some("LN"),
@@ -415,6 +438,31 @@ impl Emit<'_> {
                 "{} of {ty} is not expressible in S7-200 IL",
                 func.name()
             )),
+        }
+    }
+
+    /// `out := IN1 op IN2 op …` in the S7-200's two-operand form (`ANDW IN1, OUT` is
+    /// `OUT := IN1 AND OUT`): the operation is commutative, so an input that is `out` itself
+    /// goes first and needs no move (`ANDW a, out` for `out := a AND out`); otherwise
+    /// `MOVW IN1, out`, then `ANDW INk, out` for each further input. NOT: `MOVW IN, out`,
+    /// `INVW out`.
+    fn bitwise(&mut self, instr: &str, mov: &str, args: &[Operand], out: VarId) {
+        let n = self.names;
+        let target = n.var(out);
+        let is_out =
+            |a: &Operand| matches!(a, Operand::Var(r) if r.var == out && r.field.is_none());
+        let first = args.iter().position(is_out).unwrap_or(0);
+        if !is_out(&args[first]) {
+            self.net.emit(mov, &[&n.operand(&args[first]), target], 0);
+        }
+        if instr.starts_with("INV") {
+            self.net.emit(instr, &[target], 0);
+            return;
+        }
+        for (i, a) in args.iter().enumerate() {
+            if i != first {
+                self.net.emit(instr, &[&n.operand(a), target], 0);
+            }
         }
     }
 

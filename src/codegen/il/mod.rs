@@ -321,22 +321,36 @@ impl<'a> Names<'a> {
             Some((b, f)) => (b, Some(f)),
             None => (text, None),
         };
-        let scoped = format!("{}:{base}", self.p.pou(pou).name);
-        let found = self
-            .p
-            .vars
-            .iter()
-            .position(|v| !v.hidden && v.scope == Some(pou) && v.name == scoped)
-            .or_else(|| {
-                self.p
-                    .vars
-                    .iter()
-                    .position(|v| !v.hidden && v.scope.is_none() && v.name == base)
-            });
-        let base = found.map_or(base.to_string(), |i| self.text[i].clone());
+        let base = self
+            .position(base, pou)
+            .map_or(base.to_string(), |i| self.text[i].clone());
         match field {
             None | Some("Q") => base,
             Some(f) => format!("{base}.{f}"),
+        }
+    }
+
+    /// The variable `base` of POU `pou` (its own, else a global), as an index into `p.vars`.
+    fn position(&self, base: &str, pou: PouId) -> Option<usize> {
+        let scoped = format!("{}:{base}", self.p.pou(pou).name);
+        let vars = &self.p.vars;
+        vars.iter()
+            .position(|v| !v.hidden && v.scope == Some(pou) && v.name == scoped)
+            .or_else(|| {
+                vars.iter()
+                    .position(|v| !v.hidden && v.scope.is_none() && v.name == base)
+            })
+    }
+
+    /// False when `text` (a variable or `instance.FIELD` of `pou`, as an FBD network names it)
+    /// is known not to be a BOOL: a variable of another type, or a timer's or counter's
+    /// ET, PT, CV or PV.
+    pub fn may_be_bool(&self, text: &str, pou: PouId) -> bool {
+        match text.split_once('.') {
+            Some((_, f)) => !matches!(f, "ET" | "PT" | "CV" | "PV"),
+            None => self
+                .position(text, pou)
+                .is_none_or(|i| self.p.vars[i].ty == crate::model::Type::Bool),
         }
     }
 }

@@ -168,6 +168,22 @@ impl Tree<'_> {
                         .into(),
                 );
             }
+            let word = blk.inputs.iter().find_map(|pin| match &pin.input {
+                Some(Input::Variable(v)) if !self.names.may_be_bool(v, self.pou) => Some(v),
+                _ => None,
+            });
+            let word = word.or_else(|| {
+                self.writes(b)
+                    .iter()
+                    .map(|(v, _)| v)
+                    .find(|v| !self.names.may_be_bool(v, self.pou))
+            });
+            if let Some(v) = word {
+                return self.fail(
+                    Some(b),
+                    format!("`{v}` is not a BOOL: `plc-deps il` translates FBD networks of boolean AND, OR and NOT (not yet: the bitwise ANDW, ORW, XORW, INVW of a network; a ladder rung's AND box of INTs is translated)"),
+                );
+            }
             for pin in &blk.inputs {
                 match &pin.input {
                     Some(Input::Arc { from, .. }) => self.users[from.index()].push(b),

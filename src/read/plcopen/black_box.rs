@@ -274,8 +274,10 @@ impl Typer<'_, '_, '_, '_> {
             return pick(o, pin);
         }
         match OpKind::parse(ty) {
-            Some(OpKind::Compare(_) | OpKind::And | OpKind::Or | OpKind::Xor | OpKind::Not) => {
-                Some("BOOL".to_owned())
+            Some(OpKind::Compare(_)) => Some("BOOL".to_owned()),
+            // BOOL, or a bit string's AND (bit by bit): the inputs' type.
+            Some(OpKind::And | OpKind::Or | OpKind::Xor | OpKind::Not) => {
+                first_in().or(Some("BOOL".to_owned()))
             }
             Some(_) => first_in(),
             None if matches!(ty, "SHL" | "SHR" | "ROL" | "ROR" | "MUX") => first_in(),

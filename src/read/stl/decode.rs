@@ -267,6 +267,40 @@ pub(super) fn decode(cx: &mut Context, ins: &Ins, empty: bool) -> Result<Op, Loa
                 },
             ))))
         }
+        "ANDW" | "ORW" | "XORW" | "ANDD" | "ORD" | "XORD" => {
+            // IN1, OUT: OUT := AND/OR/XOR(IN1, OUT), bit by bit.
+            let func = match &op[..op.len() - 1] {
+                "AND" => Function::And,
+                "OR" => Function::Or,
+                _ => Function::Xor,
+            };
+            let fam = if op.ends_with('W') { 'W' } else { 'D' };
+            let (a, b) = (arg(cx, ins, 0, 2)?, arg(cx, ins, 1, 2)?);
+            let inp = cx.word(a, fam)?;
+            let cur = cx.word(b, fam)?;
+            let out = name(cur.value.as_str().unwrap_or(b.text), b.at);
+            Op::Out(kind(ElementKind::Function(Box::new(
+                syntax::FunctionCall {
+                    func,
+                    args: vec![inp, cur],
+                    out,
+                },
+            ))))
+        }
+        "INVW" | "INVD" => {
+            // OUT: OUT := NOT(OUT), every bit inverted.
+            let fam = if op.ends_with('W') { 'W' } else { 'D' };
+            let a = arg(cx, ins, 0, 1)?;
+            let cur = cx.word(a, fam)?;
+            let out = name(cur.value.as_str().unwrap_or(a.text), a.at);
+            Op::Out(kind(ElementKind::Function(Box::new(
+                syntax::FunctionCall {
+                    func: Function::Not,
+                    args: vec![cur],
+                    out,
+                },
+            ))))
+        }
         "JMP" => Op::Out(kind(ElementKind::Jmp(name(arg(cx, ins, 0, 1)?.text, at)))),
         "CALL" => Op::Out(kind(ElementKind::Call(name(arg(cx, ins, 0, 1)?.text, at)))),
         "END" => Op::Out(kind(ElementKind::End)),

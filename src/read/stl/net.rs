@@ -119,6 +119,7 @@ fn effect(op: &str) -> Option<(usize, usize, usize)> {
         | "MOVW" | "MOVD" | "MOVR" | "JMP" | "CALL" | "FOR" | "END" => (1, 0, 0),
         "SQRT" | "LN" | "EXP" | "SIN" | "COS" | "TAN" | "I_DI" | "DI_R" | "ROUND" | "TRUNC"
         | "SLW" | "SRW" | "RLW" | "RRW" | "SLD" | "SRD" | "RLD" | "RRD" => (1, 0, 0),
+        "ANDW" | "ORW" | "XORW" | "INVW" | "ANDD" | "ORD" | "XORD" | "INVD" => (1, 0, 0),
         _ if cmp("A") || cmp("O") => (1, 0, 0),
         _ if op.len() == 2 && "+-*/".contains(&op[..1]) && "IDR".contains(&op[1..]) => (1, 0, 0),
         "ALD" | "OLD" | "CTU" | "CTD" => (2, 1, 0),

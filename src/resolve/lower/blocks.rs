@@ -133,8 +133,34 @@ impl Cx<'_> {
         Ok(s)
     }
 
-    /// AND (contacts in series), OR (in parallel), NOT (a negated contact), then coils.
+    /// AND, OR, XOR or NOT of bit strings or integers (an input or the output not a BOOL):
+    /// the standard function, bit by bit ([`Function::And`] …); `None` for BOOLs.
+    fn bitwise(
+        &mut self,
+        nx: &mut Net,
+        b: BlockId,
+        vals: &[(Val, &str)],
+    ) -> Result<Option<Series>> {
+        let func = match nx.net.block(b).op {
+            Op::And => Function::And,
+            Op::Or => Function::Or,
+            Op::Xor => Function::Xor,
+            _ => Function::Not,
+        };
+        let out_ty = self.first_out_type(nx, b)?;
+        let mut types = vals.iter().filter_map(|(v, _)| v.ty()).chain(out_ty);
+        if !types.any(|t| t != Type::Bool) {
+            return Ok(None);
+        }
+        self.function(nx, b, vals, func).map(Some)
+    }
+
+    /// AND (contacts in series), OR (in parallel), NOT (a negated contact), then coils; of bit
+    /// strings, the bitwise function.
     fn logic(&mut self, nx: &mut Net, b: BlockId, vals: &[(Val, &str)]) -> Result<Series> {
+        if let Some(s) = self.bitwise(nx, b, vals)? {
+            return Ok(s);
+        }
         let net = nx.net;
         let blk = net.block(b);
         let id = Some(blk.id);
@@ -155,8 +181,12 @@ impl Cx<'_> {
         Ok(s)
     }
 
-    /// XOR: `[or [[a, b negated], [a negated, b]], coil d]`, one such step per further input.
+    /// XOR: `[or [[a, b negated], [a negated, b]], coil d]`, one such step per further input;
+    /// of bit strings, the bitwise function.
     fn xor(&mut self, nx: &mut Net, b: BlockId, vals: &[(Val, &str)]) -> Result<Series> {
+        if let Some(s) = self.bitwise(nx, b, vals)? {
+            return Ok(s);
+        }
         let net = nx.net;
         let blk = net.block(b);
         let id = Some(blk.id);
