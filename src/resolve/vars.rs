@@ -1,7 +1,7 @@
 //! Variable declarations (`vars`, and a function block's `inputs`/`outputs`/`vars`): names,
 //! types, classes, initial values; instances of user function blocks are recorded for later.
 
-use super::util::check_name;
+use super::util::check_var_name;
 use super::{Builder, InstanceDraft, Result};
 use crate::diag::{Invalid, LoadError};
 use crate::model::*;
@@ -47,7 +47,7 @@ impl<'a> Builder<'a> {
             .at(problem.origin));
         }
         let name: &str = v.name.as_str();
-        check_name(name, || format!("{}.name", p()), None).map_err(|e| e.at(v.name.origin))?;
+        check_var_name(name, || format!("{}.name", p())).map_err(|e| e.at(v.name.origin))?;
         let tname: &str = v.ty.as_str();
         let user_fb = Type::parse(tname).is_none() && self.fb_index.contains_key(tname);
         let ty = match Type::parse(tname) {
@@ -180,6 +180,10 @@ impl<'a> Builder<'a> {
         }
         let id = VarId(self.vars.len() as u32);
         table.insert(name, id);
+        if let Some((root, _)) = name.split_once('.') {
+            let key = scope.as_ref().map_or(u32::MAX, |(p, _)| p.index() as u32);
+            self.structure_roots.insert((key, root.to_owned()));
+        }
         self.vars.push(Var {
             name: display,
             ty,

@@ -195,11 +195,13 @@ pub fn var_list(
 ) -> R<Vec<Var<'static>>> {
     let mut out = Vec::new();
     for v in tc6.children(list, "variable") {
-        out.push(variable(tc6, v, class, place, known, mapped)?);
+        out.extend(variable(tc6, v, class, place, known, mapped)?);
     }
     Ok(out)
 }
 
+/// The variables one declaration `v` makes: itself, or, for a structure, one per leaf field
+/// ([`super::structure`]).
 fn variable(
     tc6: Tc6,
     v: Node,
@@ -207,7 +209,7 @@ fn variable(
     place: &str,
     known: &Known,
     mapped: &mut Vec<Mapped>,
-) -> R<Var<'static>> {
+) -> R<Vec<Var<'static>>> {
     let raw = super::xml::attr(v, "name", place)?;
     let name = identifier(raw, "variable", v, place)?;
     let place = format!("{place}, variable {name}");
@@ -219,11 +221,83 @@ fn variable(
     let ty_node = tc6
         .child(v, "type")
         .ok_or_else(|| error(origin(v), &place, format!("variable `{name}` has no type")))?;
-    let (mut ty, is_fb, data) = match type_name(tc6, ty_node, &name, &place, known)? {
+    let ty = type_name(tc6, ty_node, &name, &place, known)?;
+    let decl = Decl {
+        v,
+        class,
+        ty_node,
+        place: &place,
+    };
+    let Ty::Data(d) = &ty else {
+        let iv = tc6.child(v, "initialValue");
+        return Ok(vec![one(tc6, &decl, name, ty, iv, None, mapped)?]);
+    };
+    let Base::Struct(members) = &d.base else {
+        let iv = tc6.child(v, "initialValue");
+        return Ok(vec![one(tc6, &decl, name, ty, iv, None, mapped)?]);
+    };
+    let mut members = members.clone();
+    if let Some(iv) = tc6.child(v, "initialValue") {
+        let sv = tc6.child(iv, "structValue").ok_or_else(|| {
+            error(
+                origin(iv),
+                &place,
+                format!("the initial value of structure `{name}` is not a structured value"),
+            )
+        })?;
+        super::structure::apply_value(tc6, &mut members, sv, &name, &place)?;
+    }
+    mapped.push(Mapped {
+        var: name.clone(),
+        origin: origin(v),
+        from: d.name.clone(),
+        to: "its fields",
+        text: false,
+        via: Some(d.describe()),
+    });
+    let mut out = Vec::new();
+    for leaf in super::structure::flatten(&name, &members) {
+        let ty = if leaf.elementary {
+            Ty::Elementary(data_base(&leaf.ty))
+        } else {
+            Ty::Data(leaf.ty)
+        };
+        out.push(one(tc6, &decl, leaf.path, ty, None, leaf.init, mapped)?);
+    }
+    Ok(out)
+}
+
+/// Where a declaration is, for the variables it makes.
+struct Decl<'d, 'a, 'i> {
+    v: Node<'a, 'i>,
+    class: VarClass,
+    ty_node: Node<'a, 'i>,
+    place: &'d str,
+}
+
+/// One model variable `name` of type `ty` of declaration `d`, with its initial value: the
+/// declaration's `iv`, else a structure field's `field_init`, else its data type's.
+fn one(
+    tc6: Tc6,
+    d: &Decl,
+    name: String,
+    ty: Ty,
+    iv: Option<Node>,
+    field_init: Option<(String, crate::diag::Origin)>,
+    mapped: &mut Vec<Mapped>,
+) -> R<Var<'static>> {
+    let (v, class, ty_node, place) = (d.v, d.class, d.ty_node, d.place);
+    let (mut ty, is_fb, mut data) = match ty {
         Ty::Elementary(t) => (t, false, None),
         Ty::Fb(t) => (t, true, None),
         Ty::Data(d) => (data_base(&d), false, Some(d)),
     };
+    // A field's own initial value comes before its type's.
+    let mut field_init = field_init;
+    if let (Some(i), Some(d)) = (&field_init, &mut data) {
+        d.init = Some(i.clone());
+        field_init = None;
+    }
     let mut text = data
         .as_ref()
         .is_some_and(|d| matches!(d.base, Base::Whole(_)));
@@ -251,22 +325,26 @@ fn variable(
             via: Some(d.describe()),
         });
     }
-    let init = match (tc6.child(v, "initialValue"), &data) {
+    let init = match (iv, &data) {
         // A string's, array's or structure's initial value has no value in the model (the
         // stand-in starts at 0).
         (Some(_), _) if text => None,
         (Some(iv), _) if is_fb => {
             return Err(error(
                 origin(iv),
-                &place,
+                place,
                 format!("function block instance `{name}` has an initial value"),
             ))
         }
         (Some(iv), Some(d)) if matches!(d.base, Base::Enum(_)) => {
-            Some(Box::new(enum_initial(tc6, iv, d, &name, &place)?))
+            Some(Box::new(enum_initial(tc6, iv, d, &name, place)?))
         }
-        (Some(iv), _) => Some(Box::new(initial_value(tc6, iv, &name, &place)?)),
-        (None, Some(d)) if !text => type_initial(d, &name, &place)?.map(Box::new),
+        (Some(iv), _) => Some(Box::new(initial_value(tc6, iv, &name, place)?)),
+        (None, Some(d)) if !text => type_initial(d, &name, place)?.map(Box::new),
+        (None, None) if !text => match field_init {
+            Some((text, at)) => Some(Box::new(field_literal(&text, at, &name, place)?)),
+            None => None,
+        },
         (None, _) => None,
     };
     // `0` / `1` for a BOOL are FALSE / TRUE (IEC 61131-3 6.3.2: the BOOL literals 0 and 1).
@@ -318,7 +396,7 @@ fn data_base(d: &DataType) -> String {
     match &d.base {
         Base::Elementary(t) => t.clone(),
         Base::Enum(_) => "INT".to_owned(),
-        Base::Whole(_) => "string".to_owned(),
+        Base::Whole(_) | Base::Struct(_) => "string".to_owned(),
     }
 }
 
@@ -354,7 +432,24 @@ fn type_name(tc6: Tc6, ty: Node, var: &str, place: &str, known: &Known) -> R<Ty>
     };
     match tag {
         "array" => return whole(Aggregate::Array, "ARRAY"),
-        "struct" => return whole(Aggregate::Structure, "STRUCT"),
+        "struct" => {
+            let members = super::structure::members(
+                tc6,
+                &std::collections::HashMap::new(),
+                Some(&known.data_types),
+                "STRUCT",
+                t,
+                0,
+                place,
+            )?;
+            return Ok(Ty::Data(DataType {
+                name: "STRUCT".to_owned(),
+                base: Base::Struct(members),
+                range: None,
+                init: None,
+                library: None,
+            }));
+        }
         "derived" => {}
         _ => return Err(error(
             origin(t),
@@ -429,6 +524,23 @@ fn type_initial(d: &DataType, var: &str, place: &str) -> R<Option<Operand<'stati
         )
     })?;
     Ok(Some(Located { value, origin: *at }))
+}
+
+/// The initial value `text` (at `at`) a structure gives its elementary field `var`.
+fn field_literal(
+    text: &str,
+    at: crate::diag::Origin,
+    var: &str,
+    place: &str,
+) -> R<Operand<'static>> {
+    let value = literal(text).ok_or_else(|| {
+        error(
+            at,
+            place,
+            format!("initial value `{text}` of `{var}` is not a boolean, a number or a TIME literal"),
+        )
+    })?;
+    Ok(Located { value, origin: at })
 }
 
 /// `initialValue/simpleValue@value` as an operand (a boolean in any case, a number, a TIME

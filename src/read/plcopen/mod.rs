@@ -32,6 +32,7 @@ mod library;
 mod pins;
 mod project;
 mod st_body;
+mod structure;
 mod textual;
 mod wiring;
 mod xml;
