@@ -669,7 +669,7 @@ fn derived_note(mapped: &[(Option<String>, Mapped)]) -> Option<super::xml::Note>
         .collect();
     Some(super::xml::Note {
         origin: first.1.origin,
-        message: format!("data types are read as the model's types (IEC 61131-3 6.4.4): {}; `run` does not check subranges, and an array or structure is one whole variable (a read or write of any element reads or writes it) with no value", list.join("; ")),
+        message: format!("data types are read as the model's types (IEC 61131-3 6.4.4): {}; `run` does not check subranges, an array is one whole variable (a read or write of any element reads or writes it) with no value, and a structure is one variable per elementary field (`s.f`)", list.join("; ")),
     })
 }
 

@@ -78,6 +78,8 @@ pub fn members(
                 init: None,
                 library: None,
             },
+            // An array declared in place is named as a variable's is (`ARRAY`).
+            "array" => base(tc6, raw, "ARRAY", te, depth + 1, place)?,
             _ => base(tc6, raw, &inner, te, depth + 1, place)?,
         };
         let elementary = super::interface::is_elementary_tag(te.tag_name().name());
