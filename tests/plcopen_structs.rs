@@ -172,3 +172,44 @@ fn st_reads_fields_and_whole_structures() {
         ]
     );
 }
+
+/// A global structure named external by programs of two tasks: the fields are globals, and the
+/// task-sharing list names the one field both tasks touch (`cell.Full`), not `cell.Count`,
+/// which only one task reads and writes. A structure declared in place in a program's locals
+/// is flattened as well (`Fill:pos.Busy`, a subroutine's local).
+#[test]
+fn global_structure_fields_are_shared_between_tasks_field_by_field() {
+    let r = report(&fixture("struct_global"));
+    assert_eq!(
+        r["task_sharing"],
+        json!([{"var": "cell.Full",
+                "readers": [{"task": "Slow", "instance": "e", "program": "Empty"}],
+                "writers": [{"task": "Fast", "instance": "f", "program": "Fill"},
+                            {"task": "Slow", "instance": "e", "program": "Empty"}]}])
+    );
+    let rungs = io(&r);
+    assert!(
+        rungs.contains(&rung("Fill.R1", &["Fill:sensor"], &["cell.Full", "Fill:pos.Busy"])),
+        "{rungs:?}"
+    );
+    assert!(
+        rungs.contains(&rung(
+            "Empty.st1",
+            &["cell.Full", "cell.Count"],
+            &["cell.Full", "cell.Count"]
+        )),
+        "{rungs:?}"
+    );
+}
+
+/// A structure that contains itself is the cycle error of data types, at the type.
+#[test]
+fn a_structure_containing_itself_is_one_located_error() {
+    let xml = fixture("struct_ld").replace(
+        r#"<variable name="On"><type><BOOL/></type></variable>"#,
+        r#"<variable name="On"><type><BOOL/></type></variable><variable name="Self"><type><derived name="MotorT"/></type></variable>"#,
+    );
+    let e = error_line(&run_stdin(&["report", "-"], xml.as_bytes()), "cycle");
+    let at = line_col(&xml, "<dataType name=\"MotorT\"");
+    assert_eq!(e, format!("error: <stdin>:{at}: at types/dataTypes, dataType MotorT: data type `MotorT` is defined through itself (a cycle of derived types)"));
+}
