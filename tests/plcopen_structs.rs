@@ -9,7 +9,7 @@ mod common;
 mod px;
 
 use common::cli::{error_line, run_stdin};
-use px::{io, line_col, report, rung, run_inputs, run_scans, trace};
+use px::{block, in_var, io, line_col, project_in, report, rung, run_inputs, run_scans, trace, var_in};
 use serde_json::json;
 
 fn fixture(name: &str) -> String {
@@ -212,4 +212,30 @@ fn a_structure_containing_itself_is_one_located_error() {
     let e = error_line(&run_stdin(&["report", "-"], xml.as_bytes()), "cycle");
     let at = line_col(&xml, "<dataType name=\"MotorT\"");
     assert_eq!(e, format!("error: <stdin>:{at}: at types/dataTypes, dataType MotorT: data type `MotorT` is defined through itself (a cycle of derived types)"));
+}
+
+/// An FBD counter whose loop closes through an in-out variable on a field (`c.n`, as Beremiz
+/// closes its counter examples): `c.n := ADD(c.n, c.step)`, 3 scans from 10 by 2 (the
+/// structure's declared initial values) give 16.
+#[test]
+fn a_counter_closes_its_loop_through_an_in_out_field() {
+    let body = [
+        in_var(1, "c.step"),
+        block(
+            2,
+            "ADD",
+            None,
+            &[("IN1", &[(3, None)]), ("IN2", &[(1, None)])],
+            &["OUT"],
+        ),
+        var_in("inOutVariable", 3, "c.n", (2, Some("OUT"))),
+    ]
+    .concat();
+    let xml = project_in("FBD", &[("localVars", "c", "CounterT")], &body).replace(
+        "<dataTypes/>",
+        r#"<dataTypes><dataType name="CounterT"><baseType><struct><variable name="n"><type><INT/></type><initialValue><simpleValue value="10"/></initialValue></variable><variable name="step"><type><INT/></type><initialValue><simpleValue value="2"/></initialValue></variable></struct></baseType></dataType></dataTypes>"#,
+    );
+    let v = run_scans(&xml, 3);
+    assert_eq!(v["state"]["c.n"], json!(16));
+    assert_eq!(v["state"]["c.step"], json!(2));
 }
