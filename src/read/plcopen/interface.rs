@@ -13,9 +13,10 @@
 //! recorded ([`Mapped`]) for the POU's note.
 //!
 //! A user data type (or a library one, [`super::data_types`]) is read as its base: an alias or
-//! subrange as its elementary type, an enumeration as INT, an array or a structure (named or
-//! declared in place) as a whole variable without a value; each such variable is recorded
-//! too, with the type's description.
+//! subrange as its elementary type, an enumeration as INT, an array (named or declared in
+//! place) as a whole variable without a value; each such variable is recorded too, with the
+//! type's description. A structure (named or declared in place) is flattened into one variable
+//! per elementary field, `Motor.Speed` ([`super::structure`]), each read as above.
 //!
 //! Deliberately not here: structured initial values of elementary variables and `VAR_IN_OUT`
 //! — each an error naming the variable, until the model has them.
@@ -58,8 +59,8 @@ pub struct Mapped {
     pub origin: crate::diag::Origin,
     pub from: String,
     pub to: &'static str,
-    /// A string, array or structure: the model has no value for it (the variable stands in as
-    /// a DINT 0).
+    /// A string or an array: the model has no value for it (the variable stands in as a DINT
+    /// 0).
     pub text: bool,
     /// The data type's description when `from` is a derived type ([`DataType::describe`]).
     pub via: Option<String>,
@@ -326,8 +327,8 @@ fn one(
         });
     }
     let init = match (iv, &data) {
-        // A string's, array's or structure's initial value has no value in the model (the
-        // stand-in starts at 0).
+        // A string's or array's initial value has no value in the model (the stand-in starts
+        // at 0).
         (Some(_), _) if text => None,
         (Some(iv), _) if is_fb => {
             return Err(error(
@@ -342,7 +343,7 @@ fn one(
         (Some(iv), _) => Some(Box::new(initial_value(tc6, iv, &name, place)?)),
         (None, Some(d)) if !text => type_initial(d, &name, place)?.map(Box::new),
         (None, None) if !text => match field_init {
-            Some((text, at)) => Some(Box::new(field_literal(&text, at, &name, place)?)),
+            Some((text, at)) => Some(Box::new(literal_operand(&text, at, &name, place)?)),
             None => None,
         },
         (None, _) => None,
@@ -391,7 +392,8 @@ enum Ty {
 }
 
 /// The TC6 name of the elementary type a data type is read as (an enumeration as INT; an array
-/// or structure as `string`, the stand-in without a value).
+/// or structure as `string`, the stand-in without a value: a structure's variables are its
+/// fields, this is only for a function's result).
 fn data_base(d: &DataType) -> String {
     match &d.base {
         Base::Elementary(t) => t.clone(),
@@ -526,8 +528,9 @@ fn type_initial(d: &DataType, var: &str, place: &str) -> R<Option<Operand<'stati
     Ok(Some(Located { value, origin: *at }))
 }
 
-/// The initial value `text` (at `at`) a structure gives its elementary field `var`.
-fn field_literal(
+/// Initial value `text` (at `at`) of `var` as an operand (a boolean in any case, a number, a
+/// TIME literal): a variable's own or one a structure gives its elementary field.
+fn literal_operand(
     text: &str,
     at: crate::diag::Origin,
     var: &str,
@@ -543,8 +546,7 @@ fn field_literal(
     Ok(Located { value, origin: at })
 }
 
-/// `initialValue/simpleValue@value` as an operand (a boolean in any case, a number, a TIME
-/// literal).
+/// `initialValue/simpleValue@value` as an operand ([`literal_operand`]).
 fn initial_value(tc6: Tc6, iv: Node, var: &str, place: &str) -> R<Operand<'static>> {
     let simple = tc6.child(iv, "simpleValue").ok_or_else(|| {
         error(
@@ -554,19 +556,7 @@ fn initial_value(tc6: Tc6, iv: Node, var: &str, place: &str) -> R<Operand<'stati
         )
     })?;
     let text = super::xml::attr(simple, "value", place)?;
-    let value = literal(text).ok_or_else(|| {
-        error(
-            origin(simple),
-            place,
-            format!(
-                "initial value `{text}` of `{var}` is not a boolean, a number or a TIME literal"
-            ),
-        )
-    })?;
-    Ok(Located {
-        value,
-        origin: origin(simple),
-    })
+    literal_operand(text, origin(simple), var, place)
 }
 
 /// A literal as IEC 61131-3 writes it (TRUE/FALSE in any case, integers and reals with `_`

@@ -7,7 +7,9 @@
 //! offsets of the file through its CDATA sections, entity and character references and line
 //! ends ([`file_offsets`]). A compound statement (IF, CASE, FOR, WHILE, REPEAT) is one rung with
 //! everything any of its parts reads (conditions and bounds included) and writes. Names resolve
-//! case-insensitively against the POU's declarations ([`Scope`]); a read of a standard function
+//! case-insensitively against the POU's declarations ([`Scope`]); a structure's field
+//! (`s.f`, the ST parser's access path) is its own variable, a structure named whole reads or
+//! writes every field, a field the structure lacks is an error naming the fields it has; a read of a standard function
 //! block instance reads its first output field (`T1.Q`, `B.Q1`, `C.QU`), which the analysis
 //! counts as reading the instance. The values of the project's enumerations are constants. Not seen by the analysis, and named in the POU's note: writes
 //! of instances (only an instance's own box writes it), reads of user function block
