@@ -239,3 +239,40 @@ fn a_counter_closes_its_loop_through_an_in_out_field() {
     assert_eq!(v["state"]["c.n"], json!(16));
     assert_eq!(v["state"]["c.step"], json!(2));
 }
+
+/// The JSON format's dotted variable names (what `convert` writes for fields): a dotted name
+/// whose first part is a variable or an instance of the scope (it would hide `T1.Q`), or a plain
+/// name that is the first part of dotted names, is declared twice; an instance's name is never
+/// dotted. So in a PLCopen POU, `m : MotorT` next to `m : INT` is still a duplicate.
+#[test]
+fn dotted_names_that_would_hide_another_are_declared_twice() {
+    let json = |vars: &str| {
+        format!(r#"{{"program": "x", "vars": [{vars}, {{"name": "a", "type": "BOOL"}}], "rungs": [{{"id": "R1", "ld": [{{"contact": "a"}}, {{"coil": "a"}}]}}]}}"#)
+    };
+    let first_error = |text: &str| {
+        let out = run_stdin(&["report", "-"], text.as_bytes());
+        assert_eq!(out.status.code(), Some(2));
+        String::from_utf8_lossy(&out.stderr).lines().next().unwrap().to_owned()
+    };
+    assert_eq!(
+        first_error(&json(r#"{"name": "T1", "type": "TON"}, {"name": "T1.Q", "type": "BOOL"}"#)),
+        "error[E0203]: variable `T1.Q` is declared twice"
+    );
+    assert_eq!(
+        first_error(&json(r#"{"name": "m.a", "type": "BOOL"}, {"name": "m", "type": "INT"}"#)),
+        "error[E0203]: variable `m` is declared twice"
+    );
+    assert_eq!(
+        first_error(&json(r#"{"name": "g.x", "type": "TON"}"#)),
+        "error[E0105]: `g.x` is not a valid name (letters, digits and _, not starting with a digit)"
+    );
+    let twice = fixture("struct_ld").replace(
+        r#"<variable name="stop"><type><BOOL/></type></variable>"#,
+        r#"<variable name="stop"><type><BOOL/></type></variable><variable name="m"><type><INT/></type></variable>"#,
+    );
+    // The input `m` comes first (inputs before locals), then the local structure's field.
+    assert_eq!(
+        first_error(&twice),
+        "error[E0203]: variable `m.Speed` is declared twice"
+    );
+}
