@@ -48,7 +48,7 @@ fn aliases_subranges_enumerations_and_hmi_types_load_and_run_with_their_defaults
     let (_, err) = report_and_warnings(&xml);
     assert_eq!(
         err.trim_end(),
-        format!("warning: <stdin>:{}: data types are read as the model's types (IEC 61131-3 6.4.4): HMI_BOOL → BOOL (an alias of BOOL, from the Beremiz SVGHMI library): P.go, P.lamp; LEVEL2 → INT (an alias of INT, subrange 0..1000 not enforced): P.lvl; VALVE → INT (an enumeration, read as INT with OPEN = 0, CLOSED = 1): P.v; HMI_INT → INT (an alias of INT, from the Beremiz SVGHMI library): P.n; `run` does not check subranges, and an array or structure is one whole variable (a read or write of any element reads or writes it) with no value", line_col(&xml, "<variable name=\"go\""))
+        format!("warning: <stdin>:{}: data types are read as the model's types (IEC 61131-3 6.4.4): HMI_BOOL → BOOL (an alias of BOOL, from the Beremiz SVGHMI library): P.go, P.lamp; LEVEL2 → INT (an alias of INT, subrange 0..1000 not enforced): P.lvl; VALVE → INT (an enumeration, read as INT with OPEN = 0, CLOSED = 1): P.v; HMI_INT → INT (an alias of INT, from the Beremiz SVGHMI library): P.n; `run` does not check subranges, an array is one whole variable (a read or write of any element reads or writes it) with no value, and a structure is one variable per elementary field (`s.f`)", line_col(&xml, "<variable name=\"go\""))
     );
     let v = run_scans(&xml, 1);
     assert_eq!(

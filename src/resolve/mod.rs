@@ -244,6 +244,10 @@ struct Builder<'a> {
     /// The variable of the next edge contact, when it was made before the rung was resolved
     /// (a rung resolved after the rungs read after it: [`stream`]).
     edge_reserved: Option<u32>,
+    /// The first parts of the dotted variable names (a structure flattened into its fields,
+    /// `Motor` of `Motor.Speed`) by scope (a POU's index, `u32::MAX` for the program's), so
+    /// that an unknown field of a structure is named as such.
+    structure_roots: FastSet<(u32, String)>,
 }
 
 /// A ladder rung after pass 1: its id, its syntax and its (prefixed) id text.

@@ -55,7 +55,7 @@ impl<'a> Builder<'a> {
         if r.field.is_some() {
             return fail("instance fields are written only by their function block");
         }
-        if text.contains('.') {
+        if text.contains('.') && !self.is_own_variable(text, pou) {
             return fail("it belongs to a function block instance (only the instance writes it)");
         }
         if var.class == VarClass::Input {
@@ -108,6 +108,9 @@ impl<'a> Builder<'a> {
         }
     }
 
+    /// The variable or field `text` names in the scope of `pou`. A dotted name is first the
+    /// variable of that exact name (a structure's field, `Motor.Speed`), then a field of a
+    /// variable or member of an instance (`T1.Q`, `G1.OUT`); locals before the program's.
     pub(super) fn lookup(
         &self,
         text: &str,
@@ -117,26 +120,64 @@ impl<'a> Builder<'a> {
             Some((b, f)) => (b, Some(f)),
             None => (text, None),
         };
+        let exact = |id: VarId| {
+            Ok((
+                VarRef {
+                    var: id,
+                    field: None,
+                },
+                self.vars[id.index()].ty,
+            ))
+        };
+        if field.is_some() {
+            if let Some(&id) = self.locals[pou.index()].get(text) {
+                return exact(id);
+            }
+        }
         let id = match self.locals[pou.index()].get(base) {
             Some(&id) => id,
             None => {
                 if let Some(&i) = self.local_instances[pou.index()].get(base) {
                     return self.member(i, base, field);
                 }
+                if field.is_some() {
+                    if let Some(&id) = self.globals.get(text) {
+                        return exact(id);
+                    }
+                }
                 match self.globals.get(base) {
                     Some(&id) => id,
                     None => match self.global_instances.get(base) {
                         Some(&i) => return self.member(i, base, field),
-                        None => {
-                            return Err(Invalid::UndefinedVar {
-                                name: base.to_owned(),
-                            })
-                        }
+                        None => return Err(self.undefined(text, base, pou)),
                     },
                 }
             }
         };
         operand::field_ref(id, text, self.vars[id.index()].ty, field)
+    }
+
+    /// The error of name `text` (first part `base`) that names nothing: the whole name when
+    /// `base` is a structure (its field is unknown), else `base`.
+    fn undefined(&self, text: &str, base: &str, pou: PouId) -> Invalid {
+        let root = |scope: u32| {
+            self.structure_roots
+                .contains(&(scope, base.to_owned()))
+        };
+        let name = if text.len() > base.len() && (root(pou.index() as u32) || root(u32::MAX)) {
+            text
+        } else {
+            base
+        };
+        Invalid::UndefinedVar {
+            name: name.to_owned(),
+        }
+    }
+
+    /// True when `text` is the name of a variable of `pou`'s scope or the program's as it is
+    /// (a structure's field), not a field of a variable or a member of an instance.
+    fn is_own_variable(&self, text: &str, pou: PouId) -> bool {
+        self.locals[pou.index()].contains_key(text) || self.globals.contains_key(text)
     }
 
     pub(super) fn var_ref(&self, name: &Name, at: &At, s: &Scope) -> Result<(VarRef, Type)> {

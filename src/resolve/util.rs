@@ -59,6 +59,23 @@ pub(super) fn check_name(
     }
 }
 
+/// A valid variable name: an identifier, or identifiers joined by `.` (a structure's field
+/// flattened into its own variable, `Motor.Speed`); else the error at the path `path` renders.
+pub(super) fn check_var_name(name: &str, path: impl FnOnce() -> String) -> Result<()> {
+    if !name.contains('.') {
+        return check_name(name, path, None);
+    }
+    if name.split('.').all(|part| check_name(part, String::new, None).is_ok()) {
+        Ok(())
+    } else {
+        Err(LoadError::invalid(
+            None,
+            &path(),
+            Invalid::BadName { name: name.into() },
+        ))
+    }
+}
+
 /// A fast, non-cryptographic hasher for the resolver's name tables (the multiply-rotate hash of
 /// Firefox and rustc): names come from one trusted file, and SipHash's resistance to chosen
 /// collisions is not worth its cost on millions of lookups.

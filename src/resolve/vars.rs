@@ -1,7 +1,7 @@
 //! Variable declarations (`vars`, and a function block's `inputs`/`outputs`/`vars`): names,
 //! types, classes, initial values; instances of user function blocks are recorded for later.
 
-use super::util::check_name;
+use super::util::check_var_name;
 use super::{Builder, InstanceDraft, Result};
 use crate::diag::{Invalid, LoadError};
 use crate::model::*;
@@ -47,7 +47,7 @@ impl<'a> Builder<'a> {
             .at(problem.origin));
         }
         let name: &str = v.name.as_str();
-        check_name(name, || format!("{}.name", p()), None).map_err(|e| e.at(v.name.origin))?;
+        check_var_name(name, || format!("{}.name", p())).map_err(|e| e.at(v.name.origin))?;
         let tname: &str = v.ty.as_str();
         let user_fb = Type::parse(tname).is_none() && self.fb_index.contains_key(tname);
         let ty = match Type::parse(tname) {
@@ -79,6 +79,15 @@ impl<'a> Builder<'a> {
                 .at(v.ty.origin))
             }
         };
+        // Only an elementary variable may have a dotted name (a structure's field).
+        if name.contains('.') && matches!(ty, Type::Fb(_)) {
+            return Err(LoadError::invalid(
+                None,
+                &format!("{}.name", p()),
+                Invalid::BadName { name: name.into() },
+            )
+            .at(v.name.origin));
+        }
         if elementary && matches!(ty, Type::Fb(_)) {
             return Err(LoadError::invalid(
                 None,
@@ -143,6 +152,11 @@ impl<'a> Builder<'a> {
                 }
             }
         };
+        // A plain name that is the first part of declared dotted names (a structure's fields).
+        let scope_key = scope.as_ref().map_or(u32::MAX, |(p, _)| p.index() as u32);
+        let structure = !self.structure_roots.is_empty()
+            && !name.contains('.')
+            && self.structure_roots.contains(&(scope_key, name.to_owned()));
         let (table, instances) = match scope {
             None => (&mut self.globals, &mut self.global_instances),
             Some((p, _)) => (
@@ -150,7 +164,11 @@ impl<'a> Builder<'a> {
                 &mut self.local_instances[p.index()],
             ),
         };
-        if table.contains_key(name) || instances.contains_key(name) {
+        // A dotted name whose first part is a variable or an instance of the scope would hide
+        // its field or member (`T1.Q`), and the other way round: both are declared twice.
+        let root = name.split_once('.').map(|(r, _)| r);
+        let hides = root.is_some_and(|r| table.contains_key(r) || instances.contains_key(r));
+        if table.contains_key(name) || instances.contains_key(name) || hides || structure {
             return Err(LoadError::invalid(
                 None,
                 &format!("{}.name", p()),
@@ -180,6 +198,9 @@ impl<'a> Builder<'a> {
         }
         let id = VarId(self.vars.len() as u32);
         table.insert(name, id);
+        if let Some(root) = root {
+            self.structure_roots.insert((scope_key, root.to_owned()));
+        }
         self.vars.push(Var {
             name: display,
             ty,

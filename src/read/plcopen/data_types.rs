@@ -10,9 +10,11 @@
 //! - an enumeration as INT, its values numbered 0, 1, … in declaration order (as Beremiz's
 //!   compiler matiec numbers them); a value's name is a constant wherever a literal is read
 //!   (an initial value, an ST expression);
-//! - an array or a structure as one whole variable: a read or write of any element is a read or
-//!   write of the variable. It has no value (it stands in as a DINT 0, like a string), so it may
-//!   appear only in bodies `run` does not execute.
+//! - a structure as its members ([`super::structure`]): a variable of it is flattened into one
+//!   variable per elementary leaf field (`Motor.Speed`), nested structures recursively;
+//! - an array as one whole variable: a read or write of any element is a read or write of the
+//!   variable. It has no value (it stands in as a DINT 0, like a string), so it may appear only
+//!   in bodies `run` does not execute.
 //!
 //! Beremiz's SVGHMI extension declares HMI_BOOL, HMI_INT, HMI_REAL, HMI_STRING and HMI_NODE
 //! (and, in older versions, HMI_CLASS and HMI_LABEL) in its own library (`svghmi/pous.xml`),
@@ -23,8 +25,7 @@
 //! `dataType` (an unknown base, a cycle of aliases, a malformed range or enumeration); names are
 //! IEC identifiers.
 //!
-//! Deliberately not here: range checks, element-wise arrays and structures, pointers and
-//! references (errors).
+//! Deliberately not here: range checks, element-wise arrays, pointers and references (errors).
 
 use super::xml::{attr, error, identifier, origin, Tc6, R};
 use crate::diag::Origin;
@@ -38,28 +39,39 @@ pub enum Base {
     Elementary(String),
     /// An enumeration: its value names; value `k` (0-based) is the integer `k`.
     Enum(Vec<String>),
-    /// An array or a structure, analysed as one whole variable.
+    /// An array, analysed as one whole variable (a structure is always [`Base::Struct`]).
     Whole(Aggregate),
+    /// A structure: its members in declaration order.
+    Struct(Vec<Member>),
 }
 
-/// The aggregate kinds of IEC 61131-3 6.4.4.
+/// A member of a structure (IEC 61131-3 6.4.4.3): its type and its initial value (the
+/// member's own `initialValue`, or one a structured initial value gave it).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Member {
+    pub name: String,
+    pub ty: DataType,
+    pub init: Option<(String, Origin)>,
+    /// The member's type is an elementary type as written (not a data type).
+    pub elementary: bool,
+}
+
+/// The aggregate kinds of IEC 61131-3 6.4.4 read as one whole variable.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Aggregate {
     Array,
-    Structure,
 }
 
 impl Aggregate {
     pub fn word(self) -> &'static str {
         match self {
             Aggregate::Array => "an array",
-            Aggregate::Structure => "a structure",
         }
     }
 }
 
 /// A data type as read.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct DataType {
     pub name: String,
     pub base: Base,
@@ -85,6 +97,14 @@ impl DataType {
                 format!("an enumeration, read as INT with {}", vals.join(", "))
             }
             Base::Whole(a) => format!("{}, read as one whole variable without a value", a.word()),
+            Base::Struct(m) => format!(
+                "a structure, read as one variable per field: {}",
+                super::structure::leaves(m)
+                    .iter()
+                    .map(|(path, t)| format!("{path} {t}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
         };
         if let Some((lo, hi)) = self.range {
             d.push_str(&format!(", subrange {lo}..{hi} not enforced"));
@@ -185,7 +205,7 @@ impl DataTypes {
 
 /// Type `name` (its `dataType` element `dt`), resolved to its base; `depth` counts the aliases
 /// followed (more than there are types is a cycle).
-fn resolve(
+pub(super) fn resolve(
     tc6: Tc6,
     raw: &HashMap<String, Node>,
     name: &str,
@@ -200,10 +220,12 @@ fn resolve(
             format!("data type `{name}` is defined through itself (a cycle of derived types)"),
         ));
     }
-    let init = match tc6.child(dt, "initialValue") {
+    let iv = tc6.child(dt, "initialValue");
+    let init = match iv {
         Some(iv) => match tc6.child(iv, "simpleValue") {
             Some(s) => Some((attr(s, "value", &place)?.to_owned(), origin(s))),
-            // An array or structure value initialises a variable that has no value anyway.
+            // An array value initialises a variable that has no value anyway; a structure's is
+            // given to its members below.
             None => None,
         },
         None => None,
@@ -222,11 +244,16 @@ fn resolve(
     if init.is_some() {
         t.init = init;
     }
+    if let (Some(sv), Base::Struct(members)) =
+        (iv.and_then(|iv| tc6.child(iv, "structValue")), &mut t.base)
+    {
+        super::structure::apply_value(tc6, members, sv, name, &place)?;
+    }
     Ok(t)
 }
 
 /// The base type element `bt` of type `name`.
-fn base(
+pub(super) fn base(
     tc6: Tc6,
     raw: &HashMap<String, Node>,
     name: &str,
@@ -315,7 +342,9 @@ fn base(
             Ok(plain(Base::Enum(vals)))
         }
         "array" => Ok(plain(Base::Whole(Aggregate::Array))),
-        "struct" => Ok(plain(Base::Whole(Aggregate::Structure))),
+        "struct" => Ok(plain(Base::Struct(super::structure::members(
+            tc6, raw, None, name, bt, depth, place,
+        )?))),
         other => Err(error(
             origin(bt),
             place,

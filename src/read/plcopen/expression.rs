@@ -8,8 +8,8 @@
 //! as the blocks do (literals typed by their use).
 //!
 //! A function block instance's output (`t.Q`) is the field reference the model has for it; a
-//! structure's field (`s.f`) is passed on as such and refused by the resolver (the model has no
-//! structures). An array element
+//! structure's field (`s.f`, `s.inner.f`) is passed on as such: it is the name of the field's
+//! own variable ([`super::structure`]). An array element
 //! (`a[i]`) reads the whole array and the variables of its subscripts: the model holds an array
 //! as one value of its element type (docs/plcopen.md, "Data types"), so the element stands in as
 //! `SEL(NE(i, i), a, a)` — the value `a`, with `i` read — and `run` refuses the body (the

@@ -13,9 +13,10 @@
 //! recorded ([`Mapped`]) for the POU's note.
 //!
 //! A user data type (or a library one, [`super::data_types`]) is read as its base: an alias or
-//! subrange as its elementary type, an enumeration as INT, an array or a structure (named or
-//! declared in place) as a whole variable without a value; each such variable is recorded
-//! too, with the type's description.
+//! subrange as its elementary type, an enumeration as INT, an array (named or declared in
+//! place) as a whole variable without a value; each such variable is recorded too, with the
+//! type's description. A structure (named or declared in place) is flattened into one variable
+//! per elementary field, `Motor.Speed` ([`super::structure`]), each read as above.
 //!
 //! Deliberately not here: structured initial values of elementary variables and `VAR_IN_OUT`
 //! — each an error naming the variable, until the model has them.
@@ -58,8 +59,8 @@ pub struct Mapped {
     pub origin: crate::diag::Origin,
     pub from: String,
     pub to: &'static str,
-    /// A string, array or structure: the model has no value for it (the variable stands in as
-    /// a DINT 0).
+    /// A string or an array: the model has no value for it (the variable stands in as a DINT
+    /// 0).
     pub text: bool,
     /// The data type's description when `from` is a derived type ([`DataType::describe`]).
     pub via: Option<String>,
@@ -195,11 +196,13 @@ pub fn var_list(
 ) -> R<Vec<Var<'static>>> {
     let mut out = Vec::new();
     for v in tc6.children(list, "variable") {
-        out.push(variable(tc6, v, class, place, known, mapped)?);
+        out.extend(variable(tc6, v, class, place, known, mapped)?);
     }
     Ok(out)
 }
 
+/// The variables one declaration `v` makes: itself, or, for a structure, one per leaf field
+/// ([`super::structure`]).
 fn variable(
     tc6: Tc6,
     v: Node,
@@ -207,7 +210,7 @@ fn variable(
     place: &str,
     known: &Known,
     mapped: &mut Vec<Mapped>,
-) -> R<Var<'static>> {
+) -> R<Vec<Var<'static>>> {
     let raw = super::xml::attr(v, "name", place)?;
     let name = identifier(raw, "variable", v, place)?;
     let place = format!("{place}, variable {name}");
@@ -219,11 +222,83 @@ fn variable(
     let ty_node = tc6
         .child(v, "type")
         .ok_or_else(|| error(origin(v), &place, format!("variable `{name}` has no type")))?;
-    let (mut ty, is_fb, data) = match type_name(tc6, ty_node, &name, &place, known)? {
+    let ty = type_name(tc6, ty_node, &name, &place, known)?;
+    let decl = Decl {
+        v,
+        class,
+        ty_node,
+        place: &place,
+    };
+    let Ty::Data(d) = &ty else {
+        let iv = tc6.child(v, "initialValue");
+        return Ok(vec![one(tc6, &decl, name, ty, iv, None, mapped)?]);
+    };
+    let Base::Struct(members) = &d.base else {
+        let iv = tc6.child(v, "initialValue");
+        return Ok(vec![one(tc6, &decl, name, ty, iv, None, mapped)?]);
+    };
+    let mut members = members.clone();
+    if let Some(iv) = tc6.child(v, "initialValue") {
+        let sv = tc6.child(iv, "structValue").ok_or_else(|| {
+            error(
+                origin(iv),
+                &place,
+                format!("the initial value of structure `{name}` is not a structured value"),
+            )
+        })?;
+        super::structure::apply_value(tc6, &mut members, sv, &name, &place)?;
+    }
+    mapped.push(Mapped {
+        var: name.clone(),
+        origin: origin(v),
+        from: d.name.clone(),
+        to: "its fields",
+        text: false,
+        via: Some(d.describe()),
+    });
+    let mut out = Vec::new();
+    for leaf in super::structure::flatten(&name, &members) {
+        let ty = if leaf.elementary {
+            Ty::Elementary(data_base(&leaf.ty))
+        } else {
+            Ty::Data(leaf.ty)
+        };
+        out.push(one(tc6, &decl, leaf.path, ty, None, leaf.init, mapped)?);
+    }
+    Ok(out)
+}
+
+/// Where a declaration is, for the variables it makes.
+struct Decl<'d, 'a, 'i> {
+    v: Node<'a, 'i>,
+    class: VarClass,
+    ty_node: Node<'a, 'i>,
+    place: &'d str,
+}
+
+/// One model variable `name` of type `ty` of declaration `d`, with its initial value: the
+/// declaration's `iv`, else a structure field's `field_init`, else its data type's.
+fn one(
+    tc6: Tc6,
+    d: &Decl,
+    name: String,
+    ty: Ty,
+    iv: Option<Node>,
+    field_init: Option<(String, crate::diag::Origin)>,
+    mapped: &mut Vec<Mapped>,
+) -> R<Var<'static>> {
+    let (v, class, ty_node, place) = (d.v, d.class, d.ty_node, d.place);
+    let (mut ty, is_fb, mut data) = match ty {
         Ty::Elementary(t) => (t, false, None),
         Ty::Fb(t) => (t, true, None),
         Ty::Data(d) => (data_base(&d), false, Some(d)),
     };
+    // A field's own initial value comes before its type's.
+    let mut field_init = field_init;
+    if let (Some(i), Some(d)) = (&field_init, &mut data) {
+        d.init = Some(i.clone());
+        field_init = None;
+    }
     let mut text = data
         .as_ref()
         .is_some_and(|d| matches!(d.base, Base::Whole(_)));
@@ -251,22 +326,26 @@ fn variable(
             via: Some(d.describe()),
         });
     }
-    let init = match (tc6.child(v, "initialValue"), &data) {
-        // A string's, array's or structure's initial value has no value in the model (the
-        // stand-in starts at 0).
+    let init = match (iv, &data) {
+        // A string's or array's initial value has no value in the model (the stand-in starts
+        // at 0).
         (Some(_), _) if text => None,
         (Some(iv), _) if is_fb => {
             return Err(error(
                 origin(iv),
-                &place,
+                place,
                 format!("function block instance `{name}` has an initial value"),
             ))
         }
         (Some(iv), Some(d)) if matches!(d.base, Base::Enum(_)) => {
-            Some(Box::new(enum_initial(tc6, iv, d, &name, &place)?))
+            Some(Box::new(enum_initial(tc6, iv, d, &name, place)?))
         }
-        (Some(iv), _) => Some(Box::new(initial_value(tc6, iv, &name, &place)?)),
-        (None, Some(d)) if !text => type_initial(d, &name, &place)?.map(Box::new),
+        (Some(iv), _) => Some(Box::new(initial_value(tc6, iv, &name, place)?)),
+        (None, Some(d)) if !text => type_initial(d, &name, place)?.map(Box::new),
+        (None, None) if !text => match field_init {
+            Some((text, at)) => Some(Box::new(literal_operand(&text, at, &name, place)?)),
+            None => None,
+        },
         (None, _) => None,
     };
     // `0` / `1` for a BOOL are FALSE / TRUE (IEC 61131-3 6.3.2: the BOOL literals 0 and 1).
@@ -313,12 +392,13 @@ enum Ty {
 }
 
 /// The TC6 name of the elementary type a data type is read as (an enumeration as INT; an array
-/// or structure as `string`, the stand-in without a value).
+/// or structure as `string`, the stand-in without a value: a structure's variables are its
+/// fields, this is only for a function's result).
 fn data_base(d: &DataType) -> String {
     match &d.base {
         Base::Elementary(t) => t.clone(),
         Base::Enum(_) => "INT".to_owned(),
-        Base::Whole(_) => "string".to_owned(),
+        Base::Whole(_) | Base::Struct(_) => "string".to_owned(),
     }
 }
 
@@ -354,7 +434,24 @@ fn type_name(tc6: Tc6, ty: Node, var: &str, place: &str, known: &Known) -> R<Ty>
     };
     match tag {
         "array" => return whole(Aggregate::Array, "ARRAY"),
-        "struct" => return whole(Aggregate::Structure, "STRUCT"),
+        "struct" => {
+            let members = super::structure::members(
+                tc6,
+                &std::collections::HashMap::new(),
+                Some(&known.data_types),
+                "STRUCT",
+                t,
+                0,
+                place,
+            )?;
+            return Ok(Ty::Data(DataType {
+                name: "STRUCT".to_owned(),
+                base: Base::Struct(members),
+                range: None,
+                init: None,
+                library: None,
+            }));
+        }
         "derived" => {}
         _ => return Err(error(
             origin(t),
@@ -431,8 +528,25 @@ fn type_initial(d: &DataType, var: &str, place: &str) -> R<Option<Operand<'stati
     Ok(Some(Located { value, origin: *at }))
 }
 
-/// `initialValue/simpleValue@value` as an operand (a boolean in any case, a number, a TIME
-/// literal).
+/// Initial value `text` (at `at`) of `var` as an operand (a boolean in any case, a number, a
+/// TIME literal): a variable's own or one a structure gives its elementary field.
+fn literal_operand(
+    text: &str,
+    at: crate::diag::Origin,
+    var: &str,
+    place: &str,
+) -> R<Operand<'static>> {
+    let value = literal(text).ok_or_else(|| {
+        error(
+            at,
+            place,
+            format!("initial value `{text}` of `{var}` is not a boolean, a number or a TIME literal"),
+        )
+    })?;
+    Ok(Located { value, origin: at })
+}
+
+/// `initialValue/simpleValue@value` as an operand ([`literal_operand`]).
 fn initial_value(tc6: Tc6, iv: Node, var: &str, place: &str) -> R<Operand<'static>> {
     let simple = tc6.child(iv, "simpleValue").ok_or_else(|| {
         error(
@@ -442,19 +556,7 @@ fn initial_value(tc6: Tc6, iv: Node, var: &str, place: &str) -> R<Operand<'stati
         )
     })?;
     let text = super::xml::attr(simple, "value", place)?;
-    let value = literal(text).ok_or_else(|| {
-        error(
-            origin(simple),
-            place,
-            format!(
-                "initial value `{text}` of `{var}` is not a boolean, a number or a TIME literal"
-            ),
-        )
-    })?;
-    Ok(Located {
-        value,
-        origin: origin(simple),
-    })
+    literal_operand(text, origin(simple), var, place)
 }
 
 /// A literal as IEC 61131-3 writes it (TRUE/FALSE in any case, integers and reals with `_`
@@ -557,7 +659,7 @@ fn derived_note(mapped: &[(Option<String>, Mapped)]) -> Option<super::xml::Note>
         .collect();
     Some(super::xml::Note {
         origin: first.1.origin,
-        message: format!("data types are read as the model's types (IEC 61131-3 6.4.4): {}; `run` does not check subranges, and an array or structure is one whole variable (a read or write of any element reads or writes it) with no value", list.join("; ")),
+        message: format!("data types are read as the model's types (IEC 61131-3 6.4.4): {}; `run` does not check subranges, an array is one whole variable (a read or write of any element reads or writes it) with no value, and a structure is one variable per elementary field (`s.f`)", list.join("; ")),
     })
 }
 

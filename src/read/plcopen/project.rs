@@ -286,7 +286,7 @@ fn scope(iface: &Interface, globals: &[(&str, &str)], known: &Known) -> st_body:
         s.declare(v.name.as_str(), v.ty.as_str());
     }
     for e in &iface.externals {
-        if let Some((n, t)) = globals.iter().find(|(n, _)| n.eq_ignore_ascii_case(e)) {
+        for (n, t) in globals.iter().filter(|(n, _)| is_external(n, e)) {
             s.declare(n, t);
         }
     }
@@ -464,13 +464,18 @@ fn body(
                 .chain(&iface.locals)
                 .chain(&iface.globals)
                 .collect();
+            let externals: Vec<String> = iface
+                .externals
+                .iter()
+                .flat_map(|e| scope.fields_of(e))
+                .collect();
             Body::Rungs(textual::through_interface(
                 tag,
                 lang,
                 name,
                 &reads,
                 &writes,
-                &iface.externals,
+                &externals,
                 notes,
             ))
         }
@@ -697,7 +702,7 @@ fn pou_ctx(base: &Ctx, iface: &Interface, globals: &[(&str, &str)]) -> Ctx {
         );
     }
     for (n, t) in globals {
-        if iface.externals.iter().any(|e| e.eq_ignore_ascii_case(n)) {
+        if iface.externals.iter().any(|e| is_external(n, e)) {
             vars.insert(n.to_ascii_lowercase(), t.to_string());
         }
     }
@@ -707,6 +712,15 @@ fn pou_ctx(base: &Ctx, iface: &Interface, globals: &[(&str, &str)]) -> Ctx {
         fb_inputs: base.fb_inputs.clone(),
         vars,
     }
+}
+
+/// True when global variable `global` is external declaration `e` or, `e` being a structure
+/// flattened into its fields, one of them (`Motor.Speed` of `Motor`).
+fn is_external(global: &str, e: &str) -> bool {
+    global.eq_ignore_ascii_case(e)
+        || (global.len() > e.len()
+            && global.as_bytes()[e.len()] == b'.'
+            && global[..e.len()].eq_ignore_ascii_case(e))
 }
 
 /// The first `inVariable` of a graphical body whose expression is a string literal (`'…'`).

@@ -7,7 +7,9 @@
 //! offsets of the file through its CDATA sections, entity and character references and line
 //! ends ([`file_offsets`]). A compound statement (IF, CASE, FOR, WHILE, REPEAT) is one rung with
 //! everything any of its parts reads (conditions and bounds included) and writes. Names resolve
-//! case-insensitively against the POU's declarations ([`Scope`]); a read of a standard function
+//! case-insensitively against the POU's declarations ([`Scope`]); a structure's field
+//! (`s.f`, the ST parser's access path) is its own variable, a structure named whole reads or
+//! writes every field, a field the structure lacks is an error naming the fields it has; a read of a standard function
 //! block instance reads its first output field (`T1.Q`, `B.Q1`, `C.QU`), which the analysis
 //! counts as reading the instance. The values of the project's enumerations are constants. Not seen by the analysis, and named in the POU's note: writes
 //! of instances (only an instance's own box writes it), reads of user function block
@@ -41,6 +43,9 @@ pub enum Decl {
     },
     /// A value of an enumeration data type (a constant: reading it reads no variable).
     Constant,
+    /// A structure (or a structure inside one) flattened into its fields: its leaf fields'
+    /// names and types. Reading or writing it whole reads or writes every one.
+    Structure { leaves: Vec<(String, String)> },
 }
 
 /// The declarations an ST body sees, by lower-case name.
@@ -67,6 +72,19 @@ impl Scope {
             }
         };
         self.names.insert(name.to_ascii_lowercase(), decl);
+        // A structure's field (`Plant.Motor.Speed`) makes its structures (`Plant`,
+        // `Plant.Motor`) known as the sets of their fields.
+        let mut at = name.len();
+        while let Some(dot) = name[..at].rfind('.') {
+            at = dot;
+            let entry = self
+                .names
+                .entry(name[..at].to_ascii_lowercase())
+                .or_insert(Decl::Structure { leaves: Vec::new() });
+            if let Decl::Structure { leaves } = entry {
+                leaves.push((name.to_owned(), ty.to_owned()));
+            }
+        }
     }
 
     /// Declares an enumeration value (a constant), unless a variable has its name.
@@ -76,8 +94,41 @@ impl Scope {
             .or_insert(Decl::Constant);
     }
 
+    /// `name` as it is, or, when it is a structure, the names of its fields.
+    pub fn fields_of(&self, name: &str) -> Vec<String> {
+        match self.get(name) {
+            Some(Decl::Structure { leaves }) => leaves.iter().map(|(n, _)| n.clone()).collect(),
+            _ => vec![name.to_owned()],
+        }
+    }
+
     fn get(&self, name: &str) -> Option<&Decl> {
         self.names.get(&name.to_ascii_lowercase())
+    }
+
+    /// What access path `path` (`s`, `s.f`, `T1.Q`) names: the declaration of the path, else
+    /// of its longest declared prefix, with `true` when that is the whole path. A field of a
+    /// structure that has no such field is `Err` with the message.
+    fn find(&self, path: &str) -> Result<Option<(&Decl, bool)>, String> {
+        let mut at = path.len();
+        loop {
+            if let Some(d) = self.get(&path[..at]) {
+                if let (Decl::Structure { leaves }, false) = (d, at == path.len()) {
+                    let fields: Vec<&str> = leaves.iter().map(|(n, _)| &n[at + 1..]).collect();
+                    return Err(format!(
+                        "`{path}`: structure `{}` has no field `{}` (its fields: {})",
+                        &path[..at],
+                        &path[at + 1..],
+                        fields.join(", ")
+                    ));
+                }
+                return Ok(Some((d, at == path.len())));
+            }
+            match path[..at].rfind('.') {
+                Some(dot) => at = dot,
+                None => return Ok(None),
+            }
+        }
     }
 }
 
@@ -132,8 +183,8 @@ pub fn rungs(node: Node, pou: &str, scope: &Scope, notes: &mut Notes) -> R<Vec<R
                 continue;
             }
             let here = at(s.at);
-            let (reads, writes) = resolve(&st::accesses(s), scope, &mut unseen)
-                .map_err(|n| error(here, &place, format!("`{n}` is not a variable of POU `{pou}` (nor a global it declares external), nor a function it calls")))?;
+            let (reads, writes) = resolve(&st::accesses(s), scope, &mut unseen, pou)
+                .map_err(|m| error(here, &place, m))?;
             out.extend(stand_in(format!("{pou}.st{k}"), here, &reads, &writes));
         }
     }
@@ -171,14 +222,21 @@ fn message(pou: &str, statements: usize, unseen: &Unseen) -> String {
     m
 }
 
-/// The reads and writes of a statement as stand-in operands, or the first name that is neither
-/// declared nor called.
+/// The reads and writes of a statement as stand-in operands, or the message of the first name
+/// that is neither declared nor called (or a structure's field it does not have).
 fn resolve(
     a: &st::Accesses,
     scope: &Scope,
     unseen: &mut Unseen,
+    pou: &str,
 ) -> Result<(Vec<Read>, Vec<String>), String> {
     let called = |n: &str| a.calls.iter().any(|c| c.eq_ignore_ascii_case(n));
+    // Named by its first part, the variable that is not declared.
+    let undeclared = |n: &str| {
+        let n = if n.starts_with('%') { n } else { n.split('.').next().unwrap_or(n) };
+        format!("`{n}` is not a variable of POU `{pou}` (nor a global it declares external), nor a function it calls")
+    };
+    let called = |n: &str| called(n.split('.').next().unwrap_or(n));
     for c in &a.calls {
         if scope.get(c).is_none() {
             push_once(&mut unseen.functions, c);
@@ -186,35 +244,55 @@ fn resolve(
     }
     let mut reads = Vec::new();
     for n in &a.reads {
-        match scope.get(n) {
-            Some(Decl::Elementary { name, ty }) => reads.push(Read {
+        let found = scope.find(n)?;
+        // A field written whole keeps nothing of its structure: no read.
+        let kept = a.kept.iter().any(|k| k.eq_ignore_ascii_case(n));
+        match found {
+            Some((Decl::Elementary { .. }, true)) if kept => {}
+            Some((Decl::Elementary { name, ty }, _)) => reads.push(Read {
                 name: name.clone(),
                 bool: ty == "BOOL",
             }),
-            Some(Decl::Instance { read: Some(r), .. }) => reads.push(Read {
+            Some((Decl::Instance { read: Some(r), .. }, _)) => reads.push(Read {
                 name: r.name.clone(),
                 bool: r.bool,
             }),
-            Some(Decl::Instance { name, read: None }) => {
+            Some((Decl::Instance { name, read: None }, _)) => {
                 push_once(&mut unseen.instances_read, name)
             }
-            Some(Decl::Constant) => {}
+            Some((Decl::Structure { leaves }, _)) => {
+                reads.extend(leaves.iter().map(|(name, ty)| Read {
+                    name: name.clone(),
+                    bool: ty == "BOOL",
+                }))
+            }
+            Some((Decl::Constant, _)) => {}
             None if n.starts_with('%') => push_once(&mut unseen.addresses, n),
             None if called(n) => {}
-            None => return Err(n.clone()),
+            None => return Err(undeclared(n)),
         }
     }
     let mut writes = Vec::new();
     for n in &a.writes {
-        match scope.get(n) {
-            Some(Decl::Elementary { name, .. }) => writes.push(name.clone()),
-            Some(Decl::Instance { name, .. }) => push_once(&mut unseen.instances_written, name),
-            Some(Decl::Constant) => return Err(n.clone()),
+        match scope.find(n)? {
+            Some((Decl::Elementary { name, .. }, _)) => writes.push(name.clone()),
+            Some((Decl::Instance { name, .. }, _)) => {
+                push_once(&mut unseen.instances_written, name)
+            }
+            Some((Decl::Structure { leaves }, _)) => {
+                writes.extend(leaves.iter().map(|(name, _)| name.clone()))
+            }
+            Some((Decl::Constant, _)) => return Err(undeclared(n)),
             None if n.starts_with('%') => push_once(&mut unseen.addresses, n),
             None if called(n) => {}
-            None => return Err(n.clone()),
+            None => return Err(undeclared(n)),
         }
     }
+    // A structure read whole and one of its fields read too: each field once.
+    let mut seen = std::collections::HashSet::new();
+    reads.retain(|r| seen.insert(r.name.clone()));
+    seen.clear();
+    writes.retain(|w| seen.insert(w.clone()));
     Ok((reads, writes))
 }
 

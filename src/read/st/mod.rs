@@ -4,7 +4,10 @@
 //! each top-level statement reads and writes ([`accesses`]), so that a POU written in ST is
 //! analysed with its statements as units — an ST statement plays the part of a rung.
 //!
-//! Accesses are at whole-variable granularity: `a.b[i] := x` writes `a` and reads `i` and `x`;
+//! Accesses name the variable and the fields selected in it up to the first subscript or
+//! dereference (its access path: `a.b[i].c := x` writes `a.b` and reads `a.b`, `i` and `x`;
+//! a partial write reads what it keeps), so that a caller that flattens structures into their
+//! fields can resolve a field exactly and one that does not can take the first part;
 //! a compound statement (IF, CASE, a loop) is one unit that reads and writes what any of its
 //! parts may (its conditions and bounds read, its loop variable written). A call of a function
 //! block instance `T1(IN := x, Q => y)` reads `x` and `T1` (its state), writes `T1` and `y`;
@@ -30,11 +33,23 @@ pub struct Accesses {
     pub writes: Vec<String>,
     /// Functions and function block instances called (an instance is also read and written).
     pub calls: Vec<String>,
+    /// The reads that only stand for the rest of a variable a field write keeps
+    /// (`s.f := 1` reads `s.f` as a part of `s`): where `s.f` is a variable of its own (a
+    /// flattened structure's field), the write is whole and this read is not one.
+    pub kept: Vec<String>,
 }
 
 impl Accesses {
     fn read(&mut self, name: &str) {
         push_once(&mut self.reads, name);
+        self.kept.retain(|k| !k.eq_ignore_ascii_case(name));
+    }
+    /// A read of what a write of part of `name` keeps.
+    fn read_kept(&mut self, name: &str) {
+        if !self.reads.iter().any(|n| n.eq_ignore_ascii_case(name)) {
+            self.reads.push(name.to_owned());
+            push_once(&mut self.kept, name);
+        }
     }
     fn write(&mut self, name: &str) {
         push_once(&mut self.writes, name);
@@ -140,21 +155,40 @@ fn indices(p: &Place, a: &mut Accesses) {
     }
 }
 
+/// `p`'s access path: its base and the fields selected before any subscript or dereference.
+fn path(p: &Place) -> String {
+    let mut out = p.base.clone();
+    for s in &p.selectors {
+        match s {
+            Selector::Field(f) => {
+                out.push('.');
+                out.push_str(f);
+            }
+            Selector::Index(_) | Selector::Deref => break,
+        }
+    }
+    out
+}
+
 fn read_place(p: &Place, a: &mut Accesses) {
     indices(p, a);
-    a.read(&p.base);
+    a.read(&path(p));
 }
 
 fn write_place(p: &Place, a: &mut Accesses) {
     indices(p, a);
-    // Writing through a pointer reads the pointer; writing a part of a variable keeps the rest.
+    // Writing through a pointer reads the pointer; writing a part of a variable keeps the rest
+    // (a field path names the part when the selectors are fields only).
+    let whole = path(p);
     if p.selectors
         .iter()
-        .any(|s| matches!(s, Selector::Deref | Selector::Index(_) | Selector::Field(_)))
+        .any(|s| matches!(s, Selector::Deref | Selector::Index(_)))
     {
-        a.read(&p.base);
+        a.read(&whole);
+    } else if !p.selectors.is_empty() {
+        a.read_kept(&whole);
     }
-    a.write(&p.base);
+    a.write(&whole);
 }
 
 fn expr(e: &Expr, a: &mut Accesses) {
@@ -203,8 +237,9 @@ mod tests {
         assert_eq!(a[4].reads, names(&["a", "z"]));
         assert_eq!(a[4].writes, names(&["y"]));
         assert_eq!(a[4].calls, names(&["MAX", "LIMIT"]));
-        assert_eq!(a[5].reads, names(&["cfg"]));
-        assert_eq!(a[5].writes, names(&["cfg"]));
+        assert_eq!(a[5].reads, names(&["cfg.speed"]));
+        assert_eq!(a[5].writes, names(&["cfg.speed"]));
+        assert_eq!(a[5].kept, names(&["cfg.speed"]));
     }
 
     #[test]
