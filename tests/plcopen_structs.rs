@@ -9,7 +9,9 @@ mod common;
 mod px;
 
 use common::cli::{error_line, run_stdin};
-use px::{block, in_var, io, line_col, project_in, report, rung, run_inputs, run_scans, trace, var_in};
+use px::{
+    block, in_var, io, line_col, project_in, report, run_inputs, run_scans, rung, trace, var_in,
+};
 use serde_json::json;
 
 fn fixture(name: &str) -> String {
@@ -98,9 +100,18 @@ fn a_structure_in_a_function_block_interface_is_a_field_of_each_instance() {
     let xml = fixture("struct_fb");
     let r = report(&xml);
     let rungs = io(&r);
-    assert!(rungs.contains(&rung("d:Drive.2", &["d.go"], &["d.st.On"])), "{rungs:?}");
-    assert!(rungs.contains(&rung("d:Drive.4", &["d.cmd.Speed"], &["d.st.Speed"])), "{rungs:?}");
-    assert!(rungs.contains(&rung("P.4", &["d.st.On"], &["lamp"])), "{rungs:?}");
+    assert!(
+        rungs.contains(&rung("d:Drive.2", &["d.go"], &["d.st.On"])),
+        "{rungs:?}"
+    );
+    assert!(
+        rungs.contains(&rung("d:Drive.4", &["d.cmd.Speed"], &["d.st.Speed"])),
+        "{rungs:?}"
+    );
+    assert!(
+        rungs.contains(&rung("P.4", &["d.st.On"], &["lamp"])),
+        "{rungs:?}"
+    );
     // start → d.go → d.st.On → lamp in the same scan; d.st.Speed copies the input structure's
     // field, which nothing wires: its declared 5. The instance's outputs are outputs too.
     let v = run_inputs("struct-fb", &xml, "start\n1\n", &[]);
@@ -119,13 +130,19 @@ fn an_unknown_field_is_one_located_error() {
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     let at = line_col(&xml, "<contact localId=\"7\"");
-    assert!(err.starts_with("error[E0204]: undefined variable `m.Onn`\n"), "{err}");
+    assert!(
+        err.starts_with("error[E0204]: undefined variable `m.Onn`\n"),
+        "{err}"
+    );
     assert!(err.contains(&format!("--> <stdin>:{at}\n")), "{err}");
     assert!(err.contains("did you mean `m.On`?"), "{err}");
     assert_eq!(err.matches("error").count(), 1, "{err}");
 
     let st = fixture("struct_st").replace("n := a.Speed + 1;", "n := a.Sped + 1;");
-    let e = error_line(&run_stdin(&["report", "-"], st.as_bytes()), "unknown ST field");
+    let e = error_line(
+        &run_stdin(&["report", "-"], st.as_bytes()),
+        "unknown ST field",
+    );
     let at = line_col(&st, "n := a.Sped");
     assert_eq!(e, format!("error: <stdin>:{at}: at pou P, ST: `a.Sped`: structure `a` has no field `Sped` (its fields: Speed, On, Hist)"));
 }
@@ -189,7 +206,11 @@ fn global_structure_fields_are_shared_between_tasks_field_by_field() {
     );
     let rungs = io(&r);
     assert!(
-        rungs.contains(&rung("Fill.R1", &["Fill:sensor"], &["cell.Full", "Fill:pos.Busy"])),
+        rungs.contains(&rung(
+            "Fill.R1",
+            &["Fill:sensor"],
+            &["cell.Full", "Fill:pos.Busy"]
+        )),
         "{rungs:?}"
     );
     assert!(
@@ -247,19 +268,29 @@ fn a_counter_closes_its_loop_through_an_in_out_field() {
 #[test]
 fn dotted_names_that_would_hide_another_are_declared_twice() {
     let json = |vars: &str| {
-        format!(r#"{{"program": "x", "vars": [{vars}, {{"name": "a", "type": "BOOL"}}], "rungs": [{{"id": "R1", "ld": [{{"contact": "a"}}, {{"coil": "a"}}]}}]}}"#)
+        format!(
+            r#"{{"program": "x", "vars": [{vars}, {{"name": "a", "type": "BOOL"}}], "rungs": [{{"id": "R1", "ld": [{{"contact": "a"}}, {{"coil": "a"}}]}}]}}"#
+        )
     };
     let first_error = |text: &str| {
         let out = run_stdin(&["report", "-"], text.as_bytes());
         assert_eq!(out.status.code(), Some(2));
-        String::from_utf8_lossy(&out.stderr).lines().next().unwrap().to_owned()
+        String::from_utf8_lossy(&out.stderr)
+            .lines()
+            .next()
+            .unwrap()
+            .to_owned()
     };
     assert_eq!(
-        first_error(&json(r#"{"name": "T1", "type": "TON"}, {"name": "T1.Q", "type": "BOOL"}"#)),
+        first_error(&json(
+            r#"{"name": "T1", "type": "TON"}, {"name": "T1.Q", "type": "BOOL"}"#
+        )),
         "error[E0203]: variable `T1.Q` is declared twice"
     );
     assert_eq!(
-        first_error(&json(r#"{"name": "m.a", "type": "BOOL"}, {"name": "m", "type": "INT"}"#)),
+        first_error(&json(
+            r#"{"name": "m.a", "type": "BOOL"}, {"name": "m", "type": "INT"}"#
+        )),
         "error[E0203]: variable `m` is declared twice"
     );
     assert_eq!(
@@ -275,4 +306,36 @@ fn dotted_names_that_would_hide_another_are_declared_twice() {
         first_error(&twice),
         "error[E0203]: variable `m.Speed` is declared twice"
     );
+}
+
+/// The generated C of the structure fixtures (each field a member of the C state, its name
+/// mangled) computes the interpreter's state after every scan: the project converted to the
+/// JSON format, then compiled and compared scan by scan, with inputs that set and drop the
+/// latch.
+#[test]
+fn the_c_of_structure_fields_agrees_with_the_interpreter() {
+    let mut batch = common::c::Batch::default();
+    for (name, csv) in [
+        ("struct_ld", "start,stop\n1,0\n0,0\n0,1\n0,0\n1,1\n"),
+        ("struct_fbd", ""),
+        ("struct_nested", ""),
+        ("struct_fb", ""),
+    ] {
+        let out = run_stdin(&["convert", "-"], fixture(name).as_bytes());
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{name}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let json = String::from_utf8(out.stdout).unwrap();
+        batch.add(
+            json,
+            csv.into(),
+            6,
+            plc_deps::codegen::c::CConfig::default(),
+            name.into(),
+        );
+    }
+    batch.check(1, "plcopen-structs");
 }
