@@ -197,6 +197,57 @@ fn outputs_that_are_also_inputs_are_computed_through_a_temp() {
     assert!(s.p.vars.iter().any(|v| v.hidden && v.name == "_1_OUT"));
 }
 
+/// EQ, GT, GE, LT, LE of n inputs compare each neighbouring pair (IEC 61131-3 2.5.1.5.4:
+/// `GT(a, b, c)` is `a > b AND b > c`); NE takes exactly two.
+#[test]
+fn extensible_comparisons_compare_neighbours() {
+    let mut vars = int_vars(&["a", "b", "c"]);
+    for n in ["gt", "ge", "eq", "lt", "le"] {
+        vars.push(json!({"name": n, "type": "BOOL"}));
+    }
+    let mut s = Sim::new(program(
+        json!(vars),
+        json!([
+            {"id": 1, "op": "GT", "in": ["a", "b", "c"], "out": "gt"},
+            {"id": 2, "op": "GE", "in": ["a", "b", "c", 0], "out": "ge"},
+            {"id": 3, "op": "EQ", "in": ["a", "b", "c"], "out": "eq"},
+            {"id": 4, "op": "LT", "in": ["a", "b", "c"], "out": "lt"},
+            {"id": 5, "op": "LE", "in": [{"from": 6}, "b", "c"], "out": "le"},
+            {"id": 6, "op": "ADD", "in": ["a", 0]}
+        ]),
+    ));
+    for (a, b, c) in [
+        (3, 2, 1),
+        (3, 2, 2),
+        (2, 2, 2),
+        (1, 2, 3),
+        (1, 2, 2),
+        (2, 1, -1),
+    ] {
+        s.step(&[
+            ("a", Value::Int(a)),
+            ("b", Value::Int(b)),
+            ("c", Value::Int(c)),
+        ]);
+        assert_eq!(
+            ["gt", "ge", "eq", "lt", "le"].map(|n| s.bool(n)),
+            [
+                a > b && b > c,
+                a >= b && b >= c && c >= 0,
+                a == b && b == c,
+                a < b && b < c,
+                a <= b && b <= c
+            ],
+            "a={a} b={b} c={c}"
+        );
+    }
+    let e = err(program(
+        json!([{"name": "a", "type": "INT"}, {"name": "q", "type": "BOOL"}]),
+        json!([{"id": 1, "op": "NE", "in": ["a", 1, 2], "out": "q"}]),
+    ));
+    assert!(e.contains("NE takes 2 inputs (IN1, IN2), found 3"), "{e}");
+}
+
 #[test]
 fn logic_ops_with_variables_constants_and_arcs() {
     let vars: Vec<Json> = ["x", "y", "z", "and", "or", "xor2", "xor3", "not", "andc"]

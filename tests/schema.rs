@@ -99,7 +99,10 @@ fn converted_plcopen_projects_validate_with_their_configuration() {
     let v = validator();
     let mut with_configuration = 0;
     let dirs = ["tests/plcopen", "tests/plcopen_structs"];
-    for entry in dirs.iter().flat_map(|d| std::fs::read_dir(root().join(d)).unwrap()) {
+    for entry in dirs
+        .iter()
+        .flat_map(|d| std::fs::read_dir(root().join(d)).unwrap())
+    {
         let path = entry.unwrap().path();
         if path.extension().is_none_or(|e| e != "xml") {
             continue;

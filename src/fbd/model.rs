@@ -401,11 +401,13 @@ impl OpKind {
         })
     }
 
-    /// True for ops that take two or more inputs `IN1..INn`.
+    /// True for ops that take two or more inputs `IN1..INn` (the comparisons but NE too:
+    /// `GT(IN1, IN2, IN3)` is `IN1 > IN2 AND IN2 > IN3`, IEC 61131-3 2.5.1.5.4).
     pub fn extensible(self) -> bool {
         matches!(
             self,
             OpKind::Arith(ArithOp::Add | ArithOp::Mul)
+                | OpKind::Compare(CmpOp::Eq | CmpOp::Gt | CmpOp::Ge | CmpOp::Lt | CmpOp::Le)
                 | OpKind::And
                 | OpKind::Or
                 | OpKind::Xor
@@ -431,10 +433,10 @@ impl OpKind {
     /// Input pin names of a built-in op given `n` positional inputs (extensible ops: `IN1..INn`).
     pub fn input_pins(self, n: usize) -> Vec<String> {
         let fixed: &[&str] = match self {
+            _ if self.extensible() => return (1..=n.max(2)).map(|i| format!("IN{i}")).collect(),
             OpKind::Compare(_) | OpKind::Arith(ArithOp::Sub | ArithOp::Div | ArithOp::Mod) => {
                 &["IN1", "IN2"]
             }
-            _ if self.extensible() => return (1..=n.max(2)).map(|i| format!("IN{i}")).collect(),
             OpKind::Not | OpKind::Move | OpKind::TStart | OpKind::TStop => &["IN"],
             OpKind::Sel => &["G", "IN0", "IN1"],
             OpKind::Limit => &["MN", "IN", "MX"],

@@ -65,7 +65,10 @@ pub(super) fn check_var_name(name: &str, path: impl FnOnce() -> String) -> Resul
     if !name.contains('.') {
         return check_name(name, path, None);
     }
-    if name.split('.').all(|part| check_name(part, String::new, None).is_ok()) {
+    if name
+        .split('.')
+        .all(|part| check_name(part, String::new, None).is_ok())
+    {
         Ok(())
     } else {
         Err(LoadError::invalid(

@@ -540,7 +540,9 @@ fn literal_operand(
         error(
             at,
             place,
-            format!("initial value `{text}` of `{var}` is not a boolean, a number or a TIME literal"),
+            format!(
+                "initial value `{text}` of `{var}` is not a boolean, a number or a TIME literal"
+            ),
         )
     })?;
     Ok(Located { value, origin: at })

@@ -470,13 +470,7 @@ fn body(
                 .flat_map(|e| scope.fields_of(e))
                 .collect();
             Body::Rungs(textual::through_interface(
-                tag,
-                lang,
-                name,
-                &reads,
-                &writes,
-                &externals,
-                notes,
+                tag, lang, name, &reads, &writes, &externals, notes,
             ))
         }
         other => {

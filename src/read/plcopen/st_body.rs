@@ -45,7 +45,9 @@ pub enum Decl {
     Constant,
     /// A structure (or a structure inside one) flattened into its fields: its leaf fields'
     /// names and types. Reading or writing it whole reads or writes every one.
-    Structure { leaves: Vec<(String, String)> },
+    Structure {
+        leaves: Vec<(String, String)>,
+    },
 }
 
 /// The declarations an ST body sees, by lower-case name.
@@ -233,7 +235,11 @@ fn resolve(
     let called = |n: &str| a.calls.iter().any(|c| c.eq_ignore_ascii_case(n));
     // Named by its first part, the variable that is not declared.
     let undeclared = |n: &str| {
-        let n = if n.starts_with('%') { n } else { n.split('.').next().unwrap_or(n) };
+        let n = if n.starts_with('%') {
+            n
+        } else {
+            n.split('.').next().unwrap_or(n)
+        };
         format!("`{n}` is not a variable of POU `{pou}` (nor a global it declares external), nor a function it calls")
     };
     let called = |n: &str| called(n.split('.').next().unwrap_or(n));

@@ -143,13 +143,7 @@ fn count(members: &[Member]) -> usize {
 /// `value@member` elements holding a `simpleValue`, a nested `structValue`, or an
 /// `arrayValue`, which an array member ignores since it has no value). `what` names the
 /// structure or variable for messages.
-pub fn apply_value(
-    tc6: Tc6,
-    members: &mut [Member],
-    sv: Node,
-    what: &str,
-    place: &str,
-) -> R<()> {
+pub fn apply_value(tc6: Tc6, members: &mut [Member], sv: Node, what: &str, place: &str) -> R<()> {
     for v in tc6.children(sv, "value") {
         let m = attr(v, "member", place)?;
         let Some(member) = members
@@ -195,7 +189,9 @@ pub fn apply_value(
                 return Err(error(
                     origin(content),
                     place,
-                    format!("the initial value of `{inner}` is a `{other}`, which plc-deps does not read"),
+                    format!(
+                    "the initial value of `{inner}` is a `{other}`, which plc-deps does not read"
+                ),
                 ))
             }
         }

@@ -56,7 +56,8 @@ impl Cx<'_> {
         }
     }
 
-    /// EQ … GE: `[compare OP a b, coil d]`.
+    /// EQ … GE: `[compare OP a b, coil d]`; of n inputs the comparisons of each neighbouring
+    /// pair in series (`GT(a, b, c)`: `[compare GT a b, compare GT b c, coil d]`).
     fn compare(
         &mut self,
         nx: &mut Net,
@@ -69,16 +70,23 @@ impl Cx<'_> {
         let id = Some(blk.id);
         let e = |path: &str, k| LoadError::fbd(&net.id, id, path, k);
         let ty = numeric(&vals, None, "a comparison").map_err(|(p, k)| e(p, k))?;
-        let a = self.coerce(nx, &vals[0].0, ty, "a comparison", vals[0].1, id)?;
-        let bb = self.coerce(nx, &vals[1].0, ty, "a comparison", vals[1].1, id)?;
+        let mut ops = Vec::with_capacity(vals.len());
+        for (v, path) in vals {
+            ops.push(self.coerce(nx, v, ty, "a comparison", path, id)?);
+        }
         let (d, rest) = self.dest(nx, b, 0, Type::Bool, &[])?;
-        let mut s = vec![
-            Element::Compare { op: c, a, b: bb },
-            Element::Coil {
-                var: d,
-                negated: false,
-            },
-        ];
+        let mut s: Series = ops
+            .windows(2)
+            .map(|w| Element::Compare {
+                op: c,
+                a: w[0],
+                b: w[1],
+            })
+            .collect();
+        s.push(Element::Coil {
+            var: d,
+            negated: false,
+        });
         s.extend(coils(&rest));
         Ok(s)
     }
