@@ -82,6 +82,7 @@
 //! the same cache line in one phase; loop counters have a line each; decisions and fault
 //! buffers are padded per worker.
 
+mod backoff;
 mod barrier;
 mod calibrate;
 mod calls;
