@@ -16,7 +16,7 @@
 
 use super::backoff::{wait_until, Pace};
 use super::barrier::SpinBarrier;
-use super::pad::Padded;
+use crate::exec::parallel::pad::Padded;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Duration;
 

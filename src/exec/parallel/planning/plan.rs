@@ -12,24 +12,24 @@
 //! against the lowered code (see `check`).
 
 use super::calls::{call_closure, is_loop_back, rung_callees, uncovered_refusal};
-use super::config::{PlanConfig, PlanKind, Strategy};
-use super::ids::{DecisionSlot, Next, TaskId};
 use super::movement::Movement;
 use super::ready::{Ready, Wait};
 use super::rung_cost::interpreter_costs;
 use super::slicing::{slice_levels, worker_makespan, LevelPlan};
 use super::tasks::{Item, Tasks};
 use crate::analysis::{Analysis, EdgeKind, Successor};
+use crate::exec::parallel::config::{PlanConfig, PlanKind, Strategy};
+use crate::exec::parallel::ids::{DecisionSlot, Next, TaskId};
 use crate::model::{PouId, Program, RungId, VarId};
 use std::collections::HashMap;
 use std::ops::Range;
 
 /// Decision slots per 64-byte line.
-pub(super) const DECISION_LINE: usize = 16;
+pub(in crate::exec::parallel) const DECISION_LINE: usize = 16;
 
 /// Whether a phase runs on all workers or on worker 0 alone.
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub(super) enum PhaseKind {
+pub(in crate::exec::parallel) enum PhaseKind {
     /// One slice of items per worker.
     Parallel(Vec<Vec<Item>>),
     /// Worker 0 runs these items, in task order.
@@ -38,18 +38,18 @@ pub(super) enum PhaseKind {
 
 /// One phase of a scan.
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub(super) struct Phase {
-    pub(super) kind: PhaseKind,
+pub(in crate::exec::parallel) struct Phase {
+    pub(in crate::exec::parallel) kind: PhaseKind,
     /// The levels it runs.
-    pub(super) levels: Range<usize>,
+    pub(in crate::exec::parallel) levels: Range<usize>,
     /// Meet at the barrier before running it.
-    pub(super) barrier_before: bool,
+    pub(in crate::exec::parallel) barrier_before: bool,
 }
 
 impl Phase {
     /// The items worker `w` runs in this phase.
     #[inline]
-    pub(super) fn items_of(&self, w: usize) -> &[Item] {
+    pub(in crate::exec::parallel) fn items_of(&self, w: usize) -> &[Item] {
         match &self.kind {
             PhaseKind::Parallel(slices) => slices.get(w).map_or(&[], |s| s.as_slice()),
             PhaseKind::Sequential(items) if w == 0 => items,
@@ -57,12 +57,12 @@ impl Phase {
         }
     }
 
-    pub(super) fn is_parallel(&self) -> bool {
+    pub(in crate::exec::parallel) fn is_parallel(&self) -> bool {
         matches!(self.kind, PhaseKind::Parallel(_))
     }
 
     /// Every (worker, item) of the phase.
-    pub(super) fn all_items(&self) -> impl Iterator<Item = (usize, &Item)> {
+    pub(in crate::exec::parallel) fn all_items(&self) -> impl Iterator<Item = (usize, &Item)> {
         let slices: Vec<(usize, &[Item])> = match &self.kind {
             PhaseKind::Parallel(s) => s.iter().map(|v| v.as_slice()).enumerate().collect(),
             PhaseKind::Sequential(items) => vec![(0, items.as_slice())],
@@ -77,40 +77,40 @@ impl Phase {
 /// Built once per program, thread count and configuration.
 #[derive(Clone, Debug)]
 pub struct Plan {
-    pub(super) threads: usize,
-    pub(super) config: PlanConfig,
+    pub(in crate::exec::parallel) threads: usize,
+    pub(in crate::exec::parallel) config: PlanConfig,
     /// `Some(reason)` when the whole program runs as the sequential scan.
-    pub(super) sequential: Option<String>,
-    pub(super) phases: Vec<Phase>,
-    pub(super) end_barrier: bool,
-    pub(super) levels: Vec<LevelPlan>,
+    pub(in crate::exec::parallel) sequential: Option<String>,
+    pub(in crate::exec::parallel) phases: Vec<Phase>,
+    pub(in crate::exec::parallel) end_barrier: bool,
+    pub(in crate::exec::parallel) levels: Vec<LevelPlan>,
     /// Task of each rung (main-program rungs that run).
-    pub(super) task_of_rung: Vec<Option<TaskId>>,
+    pub(in crate::exec::parallel) task_of_rung: Vec<Option<TaskId>>,
     /// The rungs of each task (the schedule's).
-    pub(super) task_rungs: Vec<Vec<RungId>>,
+    pub(in crate::exec::parallel) task_rungs: Vec<Vec<RungId>>,
     /// Guard disjuncts: (decision slot of the controller, where it must have led).
-    pub(super) guards: Vec<(DecisionSlot, Next)>,
+    pub(in crate::exec::parallel) guards: Vec<(DecisionSlot, Next)>,
     /// Decision slots of entry predecessors.
-    pub(super) entry_slots: Vec<DecisionSlot>,
-    pub(super) decision_slots: usize,
+    pub(in crate::exec::parallel) entry_slots: Vec<DecisionSlot>,
+    pub(in crate::exec::parallel) decision_slots: usize,
     /// Per variable: the (phase, worker) pairs of parallel phases that write it.
-    pub(super) write_keys: Vec<Vec<(u32, u32)>>,
+    pub(in crate::exec::parallel) write_keys: Vec<Vec<(u32, u32)>>,
     /// Per phase and worker: the cache lines it reads that another worker wrote last
     /// (`movement`; empty when no level runs in parallel).
-    pub(super) phase_lines: Vec<Vec<u64>>,
+    pub(in crate::exec::parallel) phase_lines: Vec<Vec<u64>>,
     /// Modelled scan costs: sequential, and this plan's (data movement included).
-    pub(super) est_sequential: u64,
-    pub(super) est_plan: u64,
+    pub(in crate::exec::parallel) est_sequential: u64,
+    pub(in crate::exec::parallel) est_plan: u64,
     /// The waits of the items of a dependence-driven plan (`Item::waits` index it).
-    pub(super) waits: Vec<Wait>,
+    pub(in crate::exec::parallel) waits: Vec<Wait>,
     /// `Some` for a dependence-driven plan (`deps_plan`): one parallel phase whose workers
     /// order their items by ready flags; the plan check then proves the order instead of the
     /// disjointness of the workers (`order_check`).
-    pub(super) ready: Option<Ready>,
+    pub(in crate::exec::parallel) ready: Option<Ready>,
 }
 
 impl Plan {
-    pub(super) fn build(p: &Program, a: &Analysis, config: &PlanConfig) -> Plan {
+    pub(in crate::exec::parallel) fn build(p: &Program, a: &Analysis, config: &PlanConfig) -> Plan {
         let sched = &a.schedule;
         let threads = config.threads.max(1);
         let task_of_rung: Vec<Option<TaskId>> = sched.task_of.clone();
@@ -173,7 +173,7 @@ impl Plan {
 
     /// Decision slots, grouped per (phase, worker) and padded to a line; then each item's
     /// decision, guard and entries.
-    pub(super) fn place_decisions(&mut self, a: &Analysis, info: &Tasks<'_>) {
+    pub(in crate::exec::parallel) fn place_decisions(&mut self, a: &Analysis, info: &Tasks<'_>) {
         let sched = &a.schedule;
         let mut slot_of_task: Vec<Option<DecisionSlot>> = vec![None; sched.tasks.len()];
         let mut next = 0usize;
@@ -281,7 +281,7 @@ impl Plan {
 
 /// Costs, only successors, decisions and entry predecessors of the tasks, from the main
 /// program's live CFG edges condensed to tasks.
-pub(super) fn task_facts<'a>(
+pub(in crate::exec::parallel) fn task_facts<'a>(
     p: &Program,
     a: &'a Analysis,
     task_of: &[Option<TaskId>],
@@ -359,7 +359,7 @@ pub(super) fn task_facts<'a>(
 }
 
 /// Per level: why it must not run in parallel (tasks sharing a subroutine's loop counters).
-pub(super) fn level_conflicts(p: &Program, a: &Analysis) -> Vec<Option<String>> {
+pub(in crate::exec::parallel) fn level_conflicts(p: &Program, a: &Analysis) -> Vec<Option<String>> {
     let sched = &a.schedule;
     let closure = call_closure(p);
     let pou_loops: Vec<bool> = (0..p.pous.len())
@@ -397,7 +397,7 @@ pub(super) fn level_conflicts(p: &Program, a: &Analysis) -> Vec<Option<String>> 
 }
 
 /// Why the whole program runs as the sequential scan, if it does.
-pub(super) fn sequential_reason(
+pub(in crate::exec::parallel) fn sequential_reason(
     p: &Program,
     a: &Analysis,
     config: &PlanConfig,
@@ -638,7 +638,7 @@ fn write_keys(p: &Program, a: &Analysis, phases: &[Phase]) -> Vec<Vec<(u32, u32)
 /// Layout groups for several plans run on one state: variables keyed by every (plan, phase,
 /// worker) that writes them, one group per distinct key, groups ordered by their first writer.
 /// Variables of different groups never share a line once the layout aligns each group.
-pub(super) fn layout_groups(plans: &[&Plan], vars: usize) -> Vec<Vec<VarId>> {
+pub(in crate::exec::parallel) fn layout_groups(plans: &[&Plan], vars: usize) -> Vec<Vec<VarId>> {
     let mut group_of: HashMap<Vec<(u32, u32, u32)>, usize> = HashMap::new();
     let mut order: Vec<((u32, u32, u32), usize)> = Vec::new();
     let mut groups: Vec<Vec<VarId>> = Vec::new();
@@ -678,7 +678,10 @@ pub(super) fn layout_groups(plans: &[&Plan], vars: usize) -> Vec<Vec<VarId>> {
 /// its writer set, so no line gets a second writer; it costs at most a line of padding per
 /// group. On gen 100k (188 KB of state) the plain order put the inputs after 64 KiB and left
 /// most rungs without fused contacts: 1.6–1.8× the sequential walk's time per rung.
-pub(super) fn bools_first(p: &Program, groups: Vec<Vec<VarId>>) -> Vec<Vec<VarId>> {
+pub(in crate::exec::parallel) fn bools_first(
+    p: &Program,
+    groups: Vec<Vec<VarId>>,
+) -> Vec<Vec<VarId>> {
     let mut written = vec![false; p.vars.len()];
     for &v in groups.iter().flatten() {
         written[v.index()] = true;

@@ -22,7 +22,7 @@
 
 use super::backoff::{wait_until, Pace};
 use super::barrier::SpinBarrier;
-use super::pad::Padded;
+use crate::exec::parallel::pad::Padded;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::OnceLock;
 use std::thread::Thread;

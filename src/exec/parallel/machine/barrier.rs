@@ -9,7 +9,7 @@
 //! `std::thread::park`/`unpark` (a futex on Linux): no crate is needed for one flag per worker.
 
 use super::backoff::{wait_until, Pace};
-use super::pad::Padded;
+use crate::exec::parallel::pad::Padded;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::OnceLock;
 use std::thread::Thread;
