@@ -26,6 +26,8 @@ const PARALLEL: Order = &[
     &["planning", "movement"],
     &["planning", "slicing"],
     &["planning", "ready"],
+    &["planning", "phase"],
+    &["planning", "merge"],
     &["planning", "plan"],
     &["planning", "deps_plan"],
     &["planning", "candidates"],

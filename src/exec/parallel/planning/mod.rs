@@ -16,7 +16,8 @@
 //! interpreter, fused or not), `calls` (call closures, loop-backs), `tasks` (task facts, items,
 //! contiguous and LPT cuts), `partition` (the locality partition of one level), `movement`
 //! (lines moved between workers), `slicing` (each level's slices and modelled makespan),
-//! `ready` (the dependence-driven plan's waits), `plan` (phases on the cost model), `deps_plan`
+//! `ready` (the dependence-driven plan's waits), `phase` (a phase's items), `merge` (consecutive parallel levels in one
+//! phase where each worker reads only its own writes), `plan` (phases on the cost model), `deps_plan`
 //! (the dependence-driven plan), `candidates` (the plans a run chooses from), `order_check`
 //! (the dependence-driven order against the lowered code), `check` (every plan against the
 //! lowered code).
@@ -26,9 +27,11 @@ mod calls;
 mod candidates;
 mod check;
 mod deps_plan;
+mod merge;
 mod movement;
 mod order_check;
 mod partition;
+mod phase;
 mod plan;
 mod ready;
 mod rung_cost;
@@ -42,5 +45,6 @@ pub use slicing::LevelPlan;
 
 pub(super) use candidates::candidate_plans;
 pub(super) use check::check_plan;
-pub(super) use plan::{bools_first, layout_groups, Phase};
+pub(super) use phase::Phase;
+pub(super) use plan::{bools_first, layout_groups};
 pub(super) use tasks::{Item, Region};

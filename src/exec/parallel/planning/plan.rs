@@ -6,13 +6,17 @@
 //!
 //! Follows Zhao & Yan's data levelling (levels run one after another, the rungs of a level in
 //! parallel) on the *combined* schedule: data and control dependences together, loops kept whole.
-//! Invariants: every task of the schedule is in exactly one phase; in a parallel phase each
-//! worker's items are ascending in task order; a task has a decision slot iff a later guard or
+//! With `merge_levels`, consecutive parallel levels share a phase where no worker reads or
+//! writes what another writes in it (`merge`). Invariants: every task of the schedule is in exactly one phase; in a
+//! parallel phase each worker's items are ascending in task order within each of its levels,
+//! the levels in order; a task has a decision slot iff a later guard or
 //! entry reads it. It does not measure anything (see `choice`) and does not check the plan
 //! against the lowered code (see `check`).
 
 use super::calls::{call_closure, is_loop_back, rung_callees, uncovered_refusal};
+use super::merge::merge_phases;
 use super::movement::Movement;
+pub(in crate::exec::parallel) use super::phase::{Phase, PhaseKind};
 use super::ready::{Ready, Wait};
 use super::rung_cost::interpreter_costs;
 use super::slicing::{slice_levels, worker_makespan, LevelPlan};
@@ -22,56 +26,9 @@ use crate::exec::parallel::config::{PlanConfig, PlanKind, Strategy};
 use crate::exec::parallel::ids::{DecisionSlot, Next, TaskId};
 use crate::model::{PouId, Program, RungId, VarId};
 use std::collections::HashMap;
-use std::ops::Range;
 
 /// Decision slots per 64-byte line.
 pub(in crate::exec::parallel) const DECISION_LINE: usize = 16;
-
-/// Whether a phase runs on all workers or on worker 0 alone.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub(in crate::exec::parallel) enum PhaseKind {
-    /// One slice of items per worker.
-    Parallel(Vec<Vec<Item>>),
-    /// Worker 0 runs these items, in task order.
-    Sequential(Vec<Item>),
-}
-
-/// One phase of a scan.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub(in crate::exec::parallel) struct Phase {
-    pub(in crate::exec::parallel) kind: PhaseKind,
-    /// The levels it runs.
-    pub(in crate::exec::parallel) levels: Range<usize>,
-    /// Meet at the barrier before running it.
-    pub(in crate::exec::parallel) barrier_before: bool,
-}
-
-impl Phase {
-    /// The items worker `w` runs in this phase.
-    #[inline]
-    pub(in crate::exec::parallel) fn items_of(&self, w: usize) -> &[Item] {
-        match &self.kind {
-            PhaseKind::Parallel(slices) => slices.get(w).map_or(&[], |s| s.as_slice()),
-            PhaseKind::Sequential(items) if w == 0 => items,
-            PhaseKind::Sequential(_) => &[],
-        }
-    }
-
-    pub(in crate::exec::parallel) fn is_parallel(&self) -> bool {
-        matches!(self.kind, PhaseKind::Parallel(_))
-    }
-
-    /// Every (worker, item) of the phase.
-    pub(in crate::exec::parallel) fn all_items(&self) -> impl Iterator<Item = (usize, &Item)> {
-        let slices: Vec<(usize, &[Item])> = match &self.kind {
-            PhaseKind::Parallel(s) => s.iter().map(|v| v.as_slice()).enumerate().collect(),
-            PhaseKind::Sequential(items) => vec![(0, items.as_slice())],
-        };
-        slices
-            .into_iter()
-            .flat_map(|(w, items)| items.iter().map(move |it| (w, it)))
-    }
-}
 
 /// A static plan: phases, slices, decision slots and the variables each (phase, worker) writes.
 /// Built once per program, thread count and configuration.
@@ -122,7 +79,12 @@ impl Plan {
         let (choice, _) = choose_phases(&level_plans, config);
         let any_parallel = choice.contains(&true);
         let mut phases = if any_parallel {
-            build_phases(a, &info, config, &choice, &mut level_slices)
+            let built = build_phases(a, &info, config, &choice, &mut level_slices);
+            if config.merge_levels {
+                merge_phases(p, a, &info, config, threads, built)
+            } else {
+                built
+            }
         } else {
             Vec::new()
         };
@@ -457,7 +419,8 @@ fn phase_movement(p: &Program, a: &Analysis, phases: &[Phase], threads: usize) -
 
 /// The modelled scan of the phases as built: Σ parallel makespans (data movement included) +
 /// Σ sequential levels' costs and their moved lines + barriers. Sets each parallel level's
-/// lines and makespan to those of its phase.
+/// lines and makespan (a merged phase's lines on its first level) and says why a level has no
+/// barrier of its own.
 fn modelled_scan(
     phases: &[Phase],
     phase_lines: &[Vec<u64>],
@@ -468,12 +431,41 @@ fn modelled_scan(
     let mut est = 0;
     for (ph, lines) in phases.iter().zip(phase_lines) {
         est += if ph.barrier_before { b } else { 0 };
-        if ph.is_parallel() {
+        let item_costs = |items: &[Item]| items.iter().map(|it| it.cost).sum::<u64>();
+        if ph.is_parallel() && ph.levels.len() > 1 {
+            // A merged phase: each worker runs its share of every level in one go; the lines
+            // it moves are read in the phase's first level (the later ones read its own writes).
+            let workers: Vec<(usize, usize, u64)> = (0..lines.len())
+                .map(|w| {
+                    let items = ph.items_of(w);
+                    let tasks = items.iter().map(|it| it.tasks().count()).sum();
+                    (tasks, items.len(), item_costs(items))
+                })
+                .collect();
+            est += worker_makespan(&workers, lines, config.line_cost);
+            for (k, lp) in levels[ph.levels.clone()].iter_mut().enumerate() {
+                lp.lines = if k == 0 {
+                    lines.clone()
+                } else {
+                    vec![0; lines.len()]
+                };
+                lp.makespan = Some(worker_makespan(&lp.workers, &lp.lines, config.line_cost));
+                if k > 0 {
+                    lp.reason = format!(
+                        "in one phase with level {} (no barrier: each worker reads only its own \
+                         writes of the phase; the tasks that would read another's run after it)",
+                        ph.levels.start + 1
+                    );
+                }
+            }
+        } else if ph.is_parallel() {
             let lp = &mut levels[ph.levels.start];
             lp.lines = lines.clone();
             let m = worker_makespan(&lp.workers, lines, config.line_cost);
             lp.makespan = Some(m);
             est += m;
+        } else if ph.halo {
+            est += item_costs(ph.items_of(0)) + lines.iter().sum::<u64>() * config.line_cost;
         } else {
             let own: u64 = levels[ph.levels.clone()]
                 .iter()
@@ -592,6 +584,7 @@ fn build_phases(
                 kind: PhaseKind::Parallel(items),
                 levels: l..l + 1,
                 barrier_before: true,
+                halo: false,
             });
             l += 1;
         } else {
@@ -605,6 +598,7 @@ fn build_phases(
                 kind: PhaseKind::Sequential(info.items(&tasks, config.item_cost)),
                 levels: start..l,
                 barrier_before: start > 0, // after a parallel phase
+                halo: false,
             });
         }
     }
