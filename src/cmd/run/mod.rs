@@ -16,8 +16,13 @@
 //! 128-bit digest; the parallel run's digest of each scan is compared with the sequential one's.
 //! On the first mismatch both runs are replayed in lockstep, exactly, up to that scan to name the
 //! first difference (variable and both values).
-
-// Bottom to top; each module uses only the ones before it.
+//!
+//! # Modules, bottom to top
+//! Each uses only the ones before it (checked by tests/par_layers.rs): `config` (the
+//! arguments and warnings), `trace` (the trace file's columns), `inputs` (the input table),
+//! `compare` (digests and the lockstep replay to the first difference), `engine` (preparing
+//! and running the scans), `output` (the text, JSON and HTML renderings of a report), then this
+//! module (declared alphabetically below: rustfmt sorts them).
 mod compare;
 mod config;
 mod engine;

@@ -172,6 +172,11 @@ pub struct PlanConfig {
     pub strategy: Strategy,
     /// How parallel levels are sliced.
     pub slicing: Slicing,
+    /// Merge consecutive parallel levels into one phase plus a sequential halo where the model
+    /// gains (`planning::merge`). Off by default, and not among the candidates of
+    /// [`PlanKind::Auto`]: measured on 2 shared vCPUs it did not beat one phase per level
+    /// (docs/scan.md).
+    pub merge_levels: bool,
     /// Which plans a run may use (the library's default is [`PlanKind::Model`]: one plan,
     /// decided by the model; `plc-deps run` defaults to [`PlanKind::Auto`]).
     pub kind: PlanKind,
@@ -207,6 +212,7 @@ impl PlanConfig {
             line_cost_source: LineCostSource::Default,
             strategy: Strategy::Auto,
             slicing: Slicing::Auto,
+            merge_levels: false,
             kind: PlanKind::Model,
             measure: Measure::default(),
         }

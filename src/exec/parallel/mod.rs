@@ -59,18 +59,17 @@
 //!   plan checks that every way on after a refusal is an edge the schedule already knows, and
 //!   otherwise runs the program sequentially.
 //!
-//! # Modules, bottom to top
-//! Each depends only on the ones above it in this list: `ids` (typed indices and decisions),
-//! `config`, `calibrate` (the per-line and hand-over costs measured), `pad`, `rung_cost` (what
-//! a rung costs the interpreter, fused or not), `calls` (call closures,
-//! loop-backs), `tasks` (task facts, items, contiguous and LPT cuts), `partition` (the
-//! locality partition of one level), `movement` (lines moved between workers), `slicing`
-//! (each level's slices and modelled makespan), `plan` (phases on the cost model: the
-//! planning, the candidate plans), `check` (a plan against the lowered code),
-//! `choice` (the measured choice among candidates), `driver` (the per-scan callbacks and the
-//! sequential loop), `barrier`, `units` (claimed units, the window bell), `shared` (lock-free
-//! shared memory), `machine` (the running machine; `machine::claimed` runs a levelled plan's
-//! scans as units), `explain`.
+//! # Layers, bottom to top
+//! Each layer uses only the ones below it, never one above (checked by tests/par_layers.rs; the
+//! `mod` lines below are alphabetical, as rustfmt sorts them):
+//! 1. the basics: `ids` (typed indices and decisions), `config` (what the caller asks for),
+//!    `pad` (a value on its own cache lines);
+//! 2. `planning` (the candidate plans, the cost model, the partition, the check of every plan
+//!    against the lowered code; its own `//!` lists its modules in order);
+//! 3. `choice` (the measured choice among the candidates: which runs the next window of scans);
+//! 4. `machine` (the running machine: the wait loop, the barrier, the ready flags, the claimed
+//!    units, the shared memory, the workers' runs of the chosen plans);
+//! 5. `explain` (what `--explain` and the JSON say of the plans and the run).
 //!
 //! # Memory
 //! The state is one block of bytes, each value in its type's width (`exec::Layout`), starting
@@ -82,40 +81,19 @@
 //! the same cache line in one phase; loop counters have a line each; decisions and fault
 //! buffers are padded per worker.
 
-mod barrier;
-mod calibrate;
-mod calls;
-mod candidates;
-mod check;
 mod choice;
 mod config;
-mod deps_plan;
-mod driver;
 mod explain;
-mod flags;
 mod ids;
 mod machine;
-mod movement;
-mod order_check;
 mod pad;
-mod partition;
-mod plan;
-mod ready;
-mod rung_cost;
-mod shared;
-mod slicing;
-mod tasks;
-mod units;
+mod planning;
 
-pub use barrier::SpinBarrier;
-pub use calibrate::{measure_handover, measure_line_cost, LineTiming};
 pub use choice::{Chooser, Switch, Window};
 pub use config::{LineCostSource, Measure, PlanConfig, PlanKind, Slicing, Strategy};
-pub use driver::{run_sequential, ScanDriver};
 pub use explain::{ns_text, run_log_json};
 pub use ids::{Decision, DecisionSlot, Next, TaskId};
-pub use machine::{Candidate, ParallelMachine, RunLog};
-pub use plan::Plan;
-pub use ready::Ready;
-pub use shared::SharedSlots;
-pub use slicing::LevelPlan;
+pub use machine::{
+    run_sequential, Candidate, ParallelMachine, RunLog, ScanDriver, SharedSlots, SpinBarrier,
+};
+pub use planning::{measure_handover, measure_line_cost, LevelPlan, LineTiming, Plan, Ready};

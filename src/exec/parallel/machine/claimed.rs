@@ -10,10 +10,10 @@
 //! It does not choose (the leader in `machine` does) and does not run dependence-driven plans
 //! (their ready flags name the worker that runs an item: they keep the barrier).
 
+use super::shared::Shared;
+use super::units::WindowNote;
 use super::{Buffers, ParallelMachine, ScanDriver, Timing};
-use crate::exec::parallel::plan::{Phase, Plan};
-use crate::exec::parallel::shared::Shared;
-use crate::exec::parallel::units::WindowNote;
+use crate::exec::parallel::planning::{Phase, Plan};
 use std::ops::Range;
 use std::time::Instant;
 
@@ -140,7 +140,7 @@ impl ParallelMachine {
         ph: &Phase,
         at: usize,
         first: u64,
-        store: &mut crate::exec::parallel::SharedSlots,
+        store: &mut super::shared::SharedSlots,
         ctx: &mut crate::exec::ScanCtx<'_>,
         sh: &Shared<'_>,
     ) -> u64 {

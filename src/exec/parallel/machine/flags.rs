@@ -11,18 +11,20 @@
 //! and the barrier's poison in between), so that a worker without a core of its own never costs
 //! the others a time slice per wait. Unlike the barrier it is not woken by the producer:
 //! a publish stays one plain store, and the bounded park only matters when a producer is
-//! descheduled for longer than the yield period. Depends on the barrier (for its poison) and
-//! the padding; knows nothing of plans.
+//! descheduled for longer than the yield period. Depends on the barrier (for its poison), the
+//! backoff (the wait loop) and the padding; knows nothing of plans.
 
+use super::backoff::{wait_until, Pace};
 use super::barrier::SpinBarrier;
-use super::pad::Padded;
+use crate::exec::parallel::pad::Padded;
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
-/// Spin-loop hints before a waiter yields.
-const SPINS: u32 = 1 << 10;
-/// How long a waiter yields before it parks in bounded sleeps.
-const YIELD_FOR: Duration = Duration::from_micros(200);
+/// A waiter spins 2^10 hints, then yields for 200 µs, then parks in bounded sleeps.
+const PACE: Pace = Pace {
+    spins: 1 << 10,
+    yield_for: Duration::from_micros(200),
+};
 /// One bounded park.
 const PARK: Duration = Duration::from_micros(20);
 
@@ -60,22 +62,15 @@ impl ReadyFlags {
 
     #[cold]
     fn wait_slow(&self, flag: &AtomicU64, need: u64, barrier: &SpinBarrier) -> bool {
-        let mut spins = 0u32;
-        let mut yielding: Option<Instant> = None;
-        while flag.load(Ordering::Acquire) < need {
-            if spins < SPINS {
-                std::hint::spin_loop();
-                spins += 1;
-            } else if yielding.get_or_insert_with(Instant::now).elapsed() < YIELD_FOR {
-                std::thread::yield_now();
-            } else {
-                if barrier.is_poisoned() {
-                    return false;
-                }
-                std::thread::park_timeout(PARK);
+        let reached = || (flag.load(Ordering::Acquire) >= need).then_some(());
+        let park = || {
+            if barrier.is_poisoned() {
+                return false;
             }
-        }
-        true
+            std::thread::park_timeout(PARK);
+            true
+        };
+        wait_until(PACE, reached, park).is_some()
     }
 }
 

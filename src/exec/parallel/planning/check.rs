@@ -29,7 +29,7 @@ fn bytes((at, w): Span) -> std::ops::Range<usize> {
 
 /// Checks `plan` against `machine`'s lowered code; the error names the phase, the workers and
 /// the byte. A dependence-driven plan is checked for order instead (`order_check`).
-pub(super) fn check_plan(machine: &Machine, plan: &Plan) -> Result<(), String> {
+pub(in crate::exec::parallel) fn check_plan(machine: &Machine, plan: &Plan) -> Result<(), String> {
     if plan.ready.is_some() {
         return check_ordered(machine, plan);
     }

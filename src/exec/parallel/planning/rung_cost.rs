@@ -13,14 +13,18 @@
 //! It does not measure anything (the constants are `config`'s) and does not know the layout:
 //! where a rung's bytes are (cache lines moved between workers) is `movement`'s business.
 
-use super::config::PlanConfig;
 use crate::analysis::Analysis;
 use crate::exec::fuse::{self, Tables};
+use crate::exec::parallel::config::PlanConfig;
 use crate::exec::Addr;
 use crate::model::{Element, Program, RungId};
 
 /// The interpreter's cost of every rung, in steps, at least 1.
-pub(super) fn interpreter_costs(p: &Program, a: &Analysis, config: &PlanConfig) -> Vec<u64> {
+pub(in crate::exec::parallel) fn interpreter_costs(
+    p: &Program,
+    a: &Analysis,
+    config: &PlanConfig,
+) -> Vec<u64> {
     let mut tables = Tables::default();
     let scaled = |steps: u64| (steps * config.step_tenths).div_ceil(10);
     (0..p.rungs.len())

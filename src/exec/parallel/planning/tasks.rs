@@ -6,14 +6,14 @@
 //! only to the next (one walk of the interpreter visits exactly them, in the sequential order).
 //! Depends only on the analysis and the typed indices; it does not choose phases (see `plan`).
 
-use super::ids::{DecisionSlot, TaskId};
 use crate::analysis::Analysis;
+use crate::exec::parallel::ids::{DecisionSlot, TaskId};
 use crate::model::RungId;
 use std::ops::Range;
 
 /// Which rungs a walk of the interpreter may visit.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
-pub(super) enum Region {
+pub(in crate::exec::parallel) enum Region {
     /// Rungs `lo..hi` (the run's rungs are exactly this range).
     Rungs(u32, u32),
     /// Rungs whose task is in `lo..=hi`.
@@ -23,54 +23,54 @@ pub(super) enum Region {
 /// One call into the interpreter: a run of tasks `first..=last`, or one guarded or
 /// multi-entry task.
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub(super) struct Item {
-    pub(super) first: TaskId,
-    pub(super) last: TaskId,
+pub(in crate::exec::parallel) struct Item {
+    pub(in crate::exec::parallel) first: TaskId,
+    pub(in crate::exec::parallel) last: TaskId,
     /// The entry rung (single-entry tasks).
-    pub(super) start: RungId,
-    pub(super) region: Region,
+    pub(in crate::exec::parallel) start: RungId,
+    pub(in crate::exec::parallel) region: Region,
     /// Guard disjuncts: range into `Plan::guards`; empty: always runs.
-    pub(super) guard: Range<u32>,
+    pub(in crate::exec::parallel) guard: Range<u32>,
     /// Entry predecessors' decision slots (multi-entry loop tasks): range into
     /// `Plan::entry_slots`; empty: enter at `start`.
-    pub(super) entries: Range<u32>,
+    pub(in crate::exec::parallel) entries: Range<u32>,
     /// Decision slot of `last`, if a later task reads where control left it.
-    pub(super) decision: Option<DecisionSlot>,
+    pub(in crate::exec::parallel) decision: Option<DecisionSlot>,
     /// Ready flags to wait for before it runs (dependence-driven plans): range into
     /// `Plan::waits`; empty in levelled plans.
-    pub(super) waits: Range<u32>,
+    pub(in crate::exec::parallel) waits: Range<u32>,
     /// Publish the worker's ready flag after it (a later item of another worker waits for it).
-    pub(super) publish: bool,
+    pub(in crate::exec::parallel) publish: bool,
     /// Modelled cost (tasks + item overhead).
-    pub(super) cost: u64,
+    pub(in crate::exec::parallel) cost: u64,
 }
 
 impl Item {
     /// The tasks of the item, in order.
-    pub(super) fn tasks(&self) -> impl Iterator<Item = TaskId> {
+    pub(in crate::exec::parallel) fn tasks(&self) -> impl Iterator<Item = TaskId> {
         (self.first.0..=self.last.0).map(TaskId)
     }
 }
 
 /// Facts about the tasks the planner needs.
-pub(super) struct Tasks<'a> {
-    pub(super) a: &'a Analysis,
-    pub(super) cost: Vec<u64>,
+pub(in crate::exec::parallel) struct Tasks<'a> {
+    pub(in crate::exec::parallel) a: &'a Analysis,
+    pub(in crate::exec::parallel) cost: Vec<u64>,
     /// The only condensed successor, if there is exactly one and it is a task.
-    pub(super) only_succ: Vec<Option<TaskId>>,
-    pub(super) needs_decision: Vec<bool>,
+    pub(in crate::exec::parallel) only_succ: Vec<Option<TaskId>>,
+    pub(in crate::exec::parallel) needs_decision: Vec<bool>,
     /// Tasks with a CFG edge into each multi-entry task.
-    pub(super) entry_preds: Vec<Vec<TaskId>>,
+    pub(in crate::exec::parallel) entry_preds: Vec<Vec<TaskId>>,
 }
 
 impl Tasks<'_> {
-    pub(super) fn unguarded_single(&self, t: TaskId) -> bool {
+    pub(in crate::exec::parallel) fn unguarded_single(&self, t: TaskId) -> bool {
         let task = &self.a.schedule.tasks[t.index()];
         task.guard.is_empty() && task.entries.len() == 1
     }
 
     /// Whether `t` and `t + 1` can be one walk.
-    pub(super) fn chains(&self, t: TaskId) -> bool {
+    pub(in crate::exec::parallel) fn chains(&self, t: TaskId) -> bool {
         let next = TaskId(t.0 + 1);
         self.only_succ[t.index()] == Some(next)
             && !self.needs_decision[t.index()]
@@ -78,7 +78,7 @@ impl Tasks<'_> {
     }
 
     /// The items of a slice (tasks ascending).
-    pub(super) fn items(&self, tasks: &[TaskId], item_cost: u64) -> Vec<Item> {
+    pub(in crate::exec::parallel) fn items(&self, tasks: &[TaskId], item_cost: u64) -> Vec<Item> {
         let mut out = Vec::new();
         let mut i = 0;
         while i < tasks.len() {
@@ -132,7 +132,7 @@ impl Tasks<'_> {
 }
 
 /// Contiguous slices of `weights` into at most `p` parts minimising the heaviest part.
-pub(super) fn contiguous(weights: &[u64], p: usize) -> Vec<Range<usize>> {
+pub(in crate::exec::parallel) fn contiguous(weights: &[u64], p: usize) -> Vec<Range<usize>> {
     let total: u64 = weights.iter().sum();
     let max = weights.iter().copied().max().unwrap_or(0);
     let parts = |cap: u64| -> Vec<Range<usize>> {
@@ -162,7 +162,11 @@ pub(super) fn contiguous(weights: &[u64], p: usize) -> Vec<Range<usize>> {
 }
 
 /// LPT: tasks (with weights) to `p` workers; each worker's tasks ascending.
-pub(super) fn lpt(tasks: &[TaskId], weights: &[u64], p: usize) -> Vec<Vec<TaskId>> {
+pub(in crate::exec::parallel) fn lpt(
+    tasks: &[TaskId],
+    weights: &[u64],
+    p: usize,
+) -> Vec<Vec<TaskId>> {
     let mut order: Vec<usize> = (0..tasks.len()).collect();
     order.sort_by(|&a, &b| weights[b].cmp(&weights[a]).then(a.cmp(&b)));
     let mut load = vec![0u64; p];

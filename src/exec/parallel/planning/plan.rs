@@ -6,111 +6,68 @@
 //!
 //! Follows Zhao & Yan's data levelling (levels run one after another, the rungs of a level in
 //! parallel) on the *combined* schedule: data and control dependences together, loops kept whole.
-//! Invariants: every task of the schedule is in exactly one phase; in a parallel phase each
-//! worker's items are ascending in task order; a task has a decision slot iff a later guard or
+//! With `merge_levels`, consecutive parallel levels share a phase where no worker reads or
+//! writes what another writes in it (`merge`). Invariants: every task of the schedule is in exactly one phase; in a
+//! parallel phase each worker's items are ascending in task order within each of its levels,
+//! the levels in order; a task has a decision slot iff a later guard or
 //! entry reads it. It does not measure anything (see `choice`) and does not check the plan
 //! against the lowered code (see `check`).
 
 use super::calls::{call_closure, is_loop_back, rung_callees, uncovered_refusal};
-use super::config::{PlanConfig, PlanKind, Strategy};
-use super::ids::{DecisionSlot, Next, TaskId};
+use super::merge::merge_phases;
 use super::movement::Movement;
+pub(in crate::exec::parallel) use super::phase::{Phase, PhaseKind};
 use super::ready::{Ready, Wait};
 use super::rung_cost::interpreter_costs;
 use super::slicing::{slice_levels, worker_makespan, LevelPlan};
 use super::tasks::{Item, Tasks};
 use crate::analysis::{Analysis, EdgeKind, Successor};
+use crate::exec::parallel::config::{PlanConfig, PlanKind, Strategy};
+use crate::exec::parallel::ids::{DecisionSlot, Next, TaskId};
 use crate::model::{PouId, Program, RungId, VarId};
 use std::collections::HashMap;
-use std::ops::Range;
 
 /// Decision slots per 64-byte line.
-pub(super) const DECISION_LINE: usize = 16;
-
-/// Whether a phase runs on all workers or on worker 0 alone.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub(super) enum PhaseKind {
-    /// One slice of items per worker.
-    Parallel(Vec<Vec<Item>>),
-    /// Worker 0 runs these items, in task order.
-    Sequential(Vec<Item>),
-}
-
-/// One phase of a scan.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub(super) struct Phase {
-    pub(super) kind: PhaseKind,
-    /// The levels it runs.
-    pub(super) levels: Range<usize>,
-    /// Meet at the barrier before running it.
-    pub(super) barrier_before: bool,
-}
-
-impl Phase {
-    /// The items worker `w` runs in this phase.
-    #[inline]
-    pub(super) fn items_of(&self, w: usize) -> &[Item] {
-        match &self.kind {
-            PhaseKind::Parallel(slices) => slices.get(w).map_or(&[], |s| s.as_slice()),
-            PhaseKind::Sequential(items) if w == 0 => items,
-            PhaseKind::Sequential(_) => &[],
-        }
-    }
-
-    pub(super) fn is_parallel(&self) -> bool {
-        matches!(self.kind, PhaseKind::Parallel(_))
-    }
-
-    /// Every (worker, item) of the phase.
-    pub(super) fn all_items(&self) -> impl Iterator<Item = (usize, &Item)> {
-        let slices: Vec<(usize, &[Item])> = match &self.kind {
-            PhaseKind::Parallel(s) => s.iter().map(|v| v.as_slice()).enumerate().collect(),
-            PhaseKind::Sequential(items) => vec![(0, items.as_slice())],
-        };
-        slices
-            .into_iter()
-            .flat_map(|(w, items)| items.iter().map(move |it| (w, it)))
-    }
-}
+pub(in crate::exec::parallel) const DECISION_LINE: usize = 16;
 
 /// A static plan: phases, slices, decision slots and the variables each (phase, worker) writes.
 /// Built once per program, thread count and configuration.
 #[derive(Clone, Debug)]
 pub struct Plan {
-    pub(super) threads: usize,
-    pub(super) config: PlanConfig,
+    pub(in crate::exec::parallel) threads: usize,
+    pub(in crate::exec::parallel) config: PlanConfig,
     /// `Some(reason)` when the whole program runs as the sequential scan.
-    pub(super) sequential: Option<String>,
-    pub(super) phases: Vec<Phase>,
-    pub(super) end_barrier: bool,
-    pub(super) levels: Vec<LevelPlan>,
+    pub(in crate::exec::parallel) sequential: Option<String>,
+    pub(in crate::exec::parallel) phases: Vec<Phase>,
+    pub(in crate::exec::parallel) end_barrier: bool,
+    pub(in crate::exec::parallel) levels: Vec<LevelPlan>,
     /// Task of each rung (main-program rungs that run).
-    pub(super) task_of_rung: Vec<Option<TaskId>>,
+    pub(in crate::exec::parallel) task_of_rung: Vec<Option<TaskId>>,
     /// The rungs of each task (the schedule's).
-    pub(super) task_rungs: Vec<Vec<RungId>>,
+    pub(in crate::exec::parallel) task_rungs: Vec<Vec<RungId>>,
     /// Guard disjuncts: (decision slot of the controller, where it must have led).
-    pub(super) guards: Vec<(DecisionSlot, Next)>,
+    pub(in crate::exec::parallel) guards: Vec<(DecisionSlot, Next)>,
     /// Decision slots of entry predecessors.
-    pub(super) entry_slots: Vec<DecisionSlot>,
-    pub(super) decision_slots: usize,
+    pub(in crate::exec::parallel) entry_slots: Vec<DecisionSlot>,
+    pub(in crate::exec::parallel) decision_slots: usize,
     /// Per variable: the (phase, worker) pairs of parallel phases that write it.
-    pub(super) write_keys: Vec<Vec<(u32, u32)>>,
+    pub(in crate::exec::parallel) write_keys: Vec<Vec<(u32, u32)>>,
     /// Per phase and worker: the cache lines it reads that another worker wrote last
     /// (`movement`; empty when no level runs in parallel).
-    pub(super) phase_lines: Vec<Vec<u64>>,
+    pub(in crate::exec::parallel) phase_lines: Vec<Vec<u64>>,
     /// Modelled scan costs: sequential, and this plan's (data movement included).
-    pub(super) est_sequential: u64,
-    pub(super) est_plan: u64,
+    pub(in crate::exec::parallel) est_sequential: u64,
+    pub(in crate::exec::parallel) est_plan: u64,
     /// The waits of the items of a dependence-driven plan (`Item::waits` index it).
-    pub(super) waits: Vec<Wait>,
+    pub(in crate::exec::parallel) waits: Vec<Wait>,
     /// `Some` for a dependence-driven plan (`deps_plan`): one parallel phase whose workers
     /// order their items by ready flags; the plan check then proves the order instead of the
     /// disjointness of the workers (`order_check`).
-    pub(super) ready: Option<Ready>,
+    pub(in crate::exec::parallel) ready: Option<Ready>,
 }
 
 impl Plan {
-    pub(super) fn build(p: &Program, a: &Analysis, config: &PlanConfig) -> Plan {
+    pub(in crate::exec::parallel) fn build(p: &Program, a: &Analysis, config: &PlanConfig) -> Plan {
         let sched = &a.schedule;
         let threads = config.threads.max(1);
         let task_of_rung: Vec<Option<TaskId>> = sched.task_of.clone();
@@ -122,7 +79,12 @@ impl Plan {
         let (choice, _) = choose_phases(&level_plans, config);
         let any_parallel = choice.contains(&true);
         let mut phases = if any_parallel {
-            build_phases(a, &info, config, &choice, &mut level_slices)
+            let built = build_phases(a, &info, config, &choice, &mut level_slices);
+            if config.merge_levels {
+                merge_phases(p, a, &info, config, threads, built)
+            } else {
+                built
+            }
         } else {
             Vec::new()
         };
@@ -173,7 +135,7 @@ impl Plan {
 
     /// Decision slots, grouped per (phase, worker) and padded to a line; then each item's
     /// decision, guard and entries.
-    pub(super) fn place_decisions(&mut self, a: &Analysis, info: &Tasks<'_>) {
+    pub(in crate::exec::parallel) fn place_decisions(&mut self, a: &Analysis, info: &Tasks<'_>) {
         let sched = &a.schedule;
         let mut slot_of_task: Vec<Option<DecisionSlot>> = vec![None; sched.tasks.len()];
         let mut next = 0usize;
@@ -281,7 +243,7 @@ impl Plan {
 
 /// Costs, only successors, decisions and entry predecessors of the tasks, from the main
 /// program's live CFG edges condensed to tasks.
-pub(super) fn task_facts<'a>(
+pub(in crate::exec::parallel) fn task_facts<'a>(
     p: &Program,
     a: &'a Analysis,
     task_of: &[Option<TaskId>],
@@ -359,7 +321,7 @@ pub(super) fn task_facts<'a>(
 }
 
 /// Per level: why it must not run in parallel (tasks sharing a subroutine's loop counters).
-pub(super) fn level_conflicts(p: &Program, a: &Analysis) -> Vec<Option<String>> {
+pub(in crate::exec::parallel) fn level_conflicts(p: &Program, a: &Analysis) -> Vec<Option<String>> {
     let sched = &a.schedule;
     let closure = call_closure(p);
     let pou_loops: Vec<bool> = (0..p.pous.len())
@@ -397,7 +359,7 @@ pub(super) fn level_conflicts(p: &Program, a: &Analysis) -> Vec<Option<String>> 
 }
 
 /// Why the whole program runs as the sequential scan, if it does.
-pub(super) fn sequential_reason(
+pub(in crate::exec::parallel) fn sequential_reason(
     p: &Program,
     a: &Analysis,
     config: &PlanConfig,
@@ -457,7 +419,8 @@ fn phase_movement(p: &Program, a: &Analysis, phases: &[Phase], threads: usize) -
 
 /// The modelled scan of the phases as built: Σ parallel makespans (data movement included) +
 /// Σ sequential levels' costs and their moved lines + barriers. Sets each parallel level's
-/// lines and makespan to those of its phase.
+/// lines and makespan (a merged phase's lines on its first level) and says why a level has no
+/// barrier of its own.
 fn modelled_scan(
     phases: &[Phase],
     phase_lines: &[Vec<u64>],
@@ -468,12 +431,41 @@ fn modelled_scan(
     let mut est = 0;
     for (ph, lines) in phases.iter().zip(phase_lines) {
         est += if ph.barrier_before { b } else { 0 };
-        if ph.is_parallel() {
+        let item_costs = |items: &[Item]| items.iter().map(|it| it.cost).sum::<u64>();
+        if ph.is_parallel() && ph.levels.len() > 1 {
+            // A merged phase: each worker runs its share of every level in one go; the lines
+            // it moves are read in the phase's first level (the later ones read its own writes).
+            let workers: Vec<(usize, usize, u64)> = (0..lines.len())
+                .map(|w| {
+                    let items = ph.items_of(w);
+                    let tasks = items.iter().map(|it| it.tasks().count()).sum();
+                    (tasks, items.len(), item_costs(items))
+                })
+                .collect();
+            est += worker_makespan(&workers, lines, config.line_cost);
+            for (k, lp) in levels[ph.levels.clone()].iter_mut().enumerate() {
+                lp.lines = if k == 0 {
+                    lines.clone()
+                } else {
+                    vec![0; lines.len()]
+                };
+                lp.makespan = Some(worker_makespan(&lp.workers, &lp.lines, config.line_cost));
+                if k > 0 {
+                    lp.reason = format!(
+                        "in one phase with level {} (no barrier: each worker reads only its own \
+                         writes of the phase; the tasks that would read another's run after it)",
+                        ph.levels.start + 1
+                    );
+                }
+            }
+        } else if ph.is_parallel() {
             let lp = &mut levels[ph.levels.start];
             lp.lines = lines.clone();
             let m = worker_makespan(&lp.workers, lines, config.line_cost);
             lp.makespan = Some(m);
             est += m;
+        } else if ph.halo {
+            est += item_costs(ph.items_of(0)) + lines.iter().sum::<u64>() * config.line_cost;
         } else {
             let own: u64 = levels[ph.levels.clone()]
                 .iter()
@@ -592,6 +584,7 @@ fn build_phases(
                 kind: PhaseKind::Parallel(items),
                 levels: l..l + 1,
                 barrier_before: true,
+                halo: false,
             });
             l += 1;
         } else {
@@ -605,6 +598,7 @@ fn build_phases(
                 kind: PhaseKind::Sequential(info.items(&tasks, config.item_cost)),
                 levels: start..l,
                 barrier_before: start > 0, // after a parallel phase
+                halo: false,
             });
         }
     }
@@ -638,7 +632,7 @@ fn write_keys(p: &Program, a: &Analysis, phases: &[Phase]) -> Vec<Vec<(u32, u32)
 /// Layout groups for several plans run on one state: variables keyed by every (plan, phase,
 /// worker) that writes them, one group per distinct key, groups ordered by their first writer.
 /// Variables of different groups never share a line once the layout aligns each group.
-pub(super) fn layout_groups(plans: &[&Plan], vars: usize) -> Vec<Vec<VarId>> {
+pub(in crate::exec::parallel) fn layout_groups(plans: &[&Plan], vars: usize) -> Vec<Vec<VarId>> {
     let mut group_of: HashMap<Vec<(u32, u32, u32)>, usize> = HashMap::new();
     let mut order: Vec<((u32, u32, u32), usize)> = Vec::new();
     let mut groups: Vec<Vec<VarId>> = Vec::new();
@@ -678,7 +672,10 @@ pub(super) fn layout_groups(plans: &[&Plan], vars: usize) -> Vec<Vec<VarId>> {
 /// its writer set, so no line gets a second writer; it costs at most a line of padding per
 /// group. On gen 100k (188 KB of state) the plain order put the inputs after 64 KiB and left
 /// most rungs without fused contacts: 1.6–1.8× the sequential walk's time per rung.
-pub(super) fn bools_first(p: &Program, groups: Vec<Vec<VarId>>) -> Vec<Vec<VarId>> {
+pub(in crate::exec::parallel) fn bools_first(
+    p: &Program,
+    groups: Vec<Vec<VarId>>,
+) -> Vec<Vec<VarId>> {
     let mut written = vec![false; p.vars.len()];
     for &v in groups.iter().flatten() {
         written[v.index()] = true;

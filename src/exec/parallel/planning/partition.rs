@@ -26,7 +26,7 @@
 //! runs in parallel (see `plan`).
 
 /// The balance bound's slack: heaviest load ≤ reference + reference / `SLACK`.
-pub(super) const SLACK: u64 = 16;
+pub(in crate::exec::parallel) const SLACK: u64 = 16;
 
 /// Breaks of items per worker the affinity path may make for free (as many as the reference
 /// makes, up to this).
@@ -40,28 +40,28 @@ const MAX_UNITS: usize = 4096;
 const UNITS_PER_WORKER: u64 = 16;
 
 /// One level as the partition sees it (`n` tasks in task order, `p` workers).
-pub(super) struct Level<'a> {
+pub(in crate::exec::parallel) struct Level<'a> {
     /// Cost of each task (steps).
-    pub(super) weights: &'a [u64],
+    pub(in crate::exec::parallel) weights: &'a [u64],
     /// `affinity[i * p + w]`: the bytes task `i` reads that worker `w` wrote last.
-    pub(super) affinity: &'a [u64],
+    pub(in crate::exec::parallel) affinity: &'a [u64],
     /// `joins[i]`: tasks `i` and `i + 1` are one item when they run on one worker.
-    pub(super) joins: &'a [bool],
+    pub(in crate::exec::parallel) joins: &'a [bool],
     /// The reference partition: the worker of each task.
-    pub(super) reference: &'a [usize],
+    pub(in crate::exec::parallel) reference: &'a [usize],
 }
 
 /// The costs the partition trades, in steps.
 #[derive(Copy, Clone, Debug)]
-pub(super) struct Costs {
+pub(in crate::exec::parallel) struct Costs {
     /// One cache line moved between workers.
-    pub(super) line_cost: u64,
+    pub(in crate::exec::parallel) line_cost: u64,
     /// One more item (a call into the interpreter).
-    pub(super) item_cost: u64,
+    pub(in crate::exec::parallel) item_cost: u64,
 }
 
 /// The heaviest load of `assign` (worker per task) over `p` workers.
-pub(super) fn makespan(weights: &[u64], assign: &[usize], p: usize) -> u64 {
+pub(in crate::exec::parallel) fn makespan(weights: &[u64], assign: &[usize], p: usize) -> u64 {
     loads(weights, assign, p).into_iter().max().unwrap_or(0)
 }
 
@@ -74,12 +74,12 @@ fn loads(weights: &[u64], assign: &[usize], p: usize) -> Vec<u64> {
 }
 
 /// The bound on the heaviest load, given the reference's.
-pub(super) fn bound(reference: u64) -> u64 {
+pub(in crate::exec::parallel) fn bound(reference: u64) -> u64 {
     reference + reference / SLACK
 }
 
 /// The locality partition of `level` over `p` workers: the worker of each task.
-pub(super) fn locality(level: &Level<'_>, p: usize, costs: Costs) -> Vec<usize> {
+pub(in crate::exec::parallel) fn locality(level: &Level<'_>, p: usize, costs: Costs) -> Vec<usize> {
     let n = level.weights.len();
     if n == 0 || p < 2 {
         return level.reference.to_vec();

@@ -24,13 +24,13 @@
 //! code by `order_check` before it runs; this module does not check anything.
 
 use super::calls::{call_closure, is_loop_back, rung_callees};
-use super::config::PlanConfig;
-use super::ids::TaskId;
 use super::plan::{level_conflicts, sequential_reason, task_facts, Phase, PhaseKind, Plan};
 use super::ready::{item_order, Ready, Wait};
 use super::slicing::{slice_levels, LevelPlan, Slices};
 use super::tasks::{Item, Tasks};
 use crate::analysis::Analysis;
+use crate::exec::parallel::config::PlanConfig;
+use crate::exec::parallel::ids::TaskId;
 use crate::model::{PouId, Program};
 
 /// The assignment: each task's worker and position in its worker's list, and the lists.
@@ -41,7 +41,7 @@ struct Assignment {
 }
 
 /// Builds the dependence-driven plan of `config` (its kind is not looked at).
-pub(super) fn build(p: &Program, a: &Analysis, config: &PlanConfig) -> Plan {
+pub(in crate::exec::parallel) fn build(p: &Program, a: &Analysis, config: &PlanConfig) -> Plan {
     let sched = &a.schedule;
     let threads = config.threads.max(1);
     let info = task_facts(p, a, &sched.task_of, config);
@@ -105,6 +105,7 @@ pub(super) fn build(p: &Program, a: &Analysis, config: &PlanConfig) -> Plan {
         kind: PhaseKind::Parallel(items),
         levels: 0..sched.levels.len(),
         barrier_before: true,
+        halo: false,
     }];
     plan.end_barrier = true;
     plan.waits = waits;

@@ -17,20 +17,23 @@
 //! Invariants: ids only grow (the window's base is the count of units issued before it), so a
 //! claim for a unit of a finished scan always fails and a late worker never runs a stale unit;
 //! completion is a Release increment and waits are Acquire loads of the counter, which orders a
-//! unit's state writes before any later phase's reads. Depends on the barrier (its poison) and
-//! the padding; knows nothing of plans.
+//! unit's state writes before any later phase's reads. Depends on the barrier (its poison), the
+//! backoff (the wait loop) and the padding; knows nothing of plans.
 
+use super::backoff::{wait_until, Pace};
 use super::barrier::SpinBarrier;
-use super::pad::Padded;
+use crate::exec::parallel::pad::Padded;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::OnceLock;
 use std::thread::Thread;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
-/// Spin-loop hints before a waiter yields.
-const SPINS: u32 = 1 << 11;
-/// How long a waiter yields before it sleeps in bounded parks.
-const YIELD_FOR: Duration = Duration::from_micros(200);
+/// A waiter (on the completion counter or the bell) spins 2^11 hints, then yields for 200 µs,
+/// then parks.
+const PACE: Pace = Pace {
+    spins: 1 << 11,
+    yield_for: Duration::from_micros(200),
+};
 /// One bounded park of a waiter on the completion counter.
 const PARK: Duration = Duration::from_micros(50);
 
@@ -83,22 +86,15 @@ impl Units {
 
     #[cold]
     fn wait_slow(&self, target: u64, poison: &SpinBarrier, give_up: impl Fn() -> bool) -> bool {
-        let mut spins = 0u32;
-        let mut yielding: Option<Instant> = None;
-        while self.completed() < target {
-            if spins < SPINS {
-                std::hint::spin_loop();
-                spins += 1;
-            } else if yielding.get_or_insert_with(Instant::now).elapsed() < YIELD_FOR {
-                std::thread::yield_now();
-            } else {
-                if poison.is_poisoned() || give_up() {
-                    return false;
-                }
-                std::thread::park_timeout(PARK);
+        let reached = || (self.completed() >= target).then_some(());
+        let park = || {
+            if poison.is_poisoned() || give_up() {
+                return false;
             }
-        }
-        true
+            std::thread::park_timeout(PARK);
+            true
+        };
+        wait_until(PACE, reached, park).is_some()
     }
 }
 
@@ -202,31 +198,21 @@ impl WindowBell {
     /// Worker `w` waits for window `k` (1-based) or a later one: its number and note; `None` if
     /// the barrier was poisoned.
     pub(super) fn wait(&self, w: usize, k: u64, poison: &SpinBarrier) -> Option<(u64, WindowNote)> {
-        let mut spins = 0u32;
-        let mut yielding: Option<Instant> = None;
-        loop {
-            if let Some(got) = self.read(k) {
-                return Some(got);
+        let park = || {
+            if poison.is_poisoned() {
+                return false;
             }
-            if spins < SPINS {
-                std::hint::spin_loop();
-                spins += 1;
-            } else if yielding.get_or_insert_with(Instant::now).elapsed() < YIELD_FOR {
-                std::thread::yield_now();
-            } else {
-                if poison.is_poisoned() {
-                    return None;
-                }
-                let me = &self.seats[w].0;
-                me.0.store(true, Ordering::SeqCst);
-                if self.seq.0.load(Ordering::SeqCst) / 2 < k && !poison.is_poisoned() {
-                    // Woken by `ring` (or the poison's unpark of the barrier's seats, which
-                    // are these threads); bounded anyway, as the poison check above needs.
-                    std::thread::park_timeout(Duration::from_millis(5));
-                }
-                me.0.store(false, Ordering::SeqCst);
+            let me = &self.seats[w].0;
+            me.0.store(true, Ordering::SeqCst);
+            if self.seq.0.load(Ordering::SeqCst) / 2 < k && !poison.is_poisoned() {
+                // Woken by `ring` (or the poison's unpark of the barrier's seats, which
+                // are these threads); bounded anyway, as the poison check above needs.
+                std::thread::park_timeout(Duration::from_millis(5));
             }
-        }
+            me.0.store(false, Ordering::SeqCst);
+            true
+        };
+        wait_until(PACE, || self.read(k), park)
     }
 }
 

@@ -51,7 +51,10 @@ fn worker_items(plan: &Plan) -> Result<Vec<&[Item]>, String> {
 
 /// Checks the dependence-driven `plan` against `machine`'s lowered code; the error names the
 /// workers, items and the byte, line or decision.
-pub(super) fn check_ordered(machine: &Machine, plan: &Plan) -> Result<(), String> {
+pub(in crate::exec::parallel) fn check_ordered(
+    machine: &Machine,
+    plan: &Plan,
+) -> Result<(), String> {
     let items = worker_items(plan)?;
     let waits_of = |w: usize, i: usize| -> Vec<Wait> {
         let r = &items[w][i].waits;
@@ -230,7 +233,7 @@ impl Seen {
 mod tests {
     use super::*;
     use crate::exec::parallel::config::{PlanConfig, PlanKind, Slicing, Strategy};
-    use crate::exec::parallel::{deps_plan, plan::layout_groups};
+    use crate::exec::parallel::planning::{deps_plan, plan::layout_groups};
     use crate::exec::{ExecConfig, Layout};
     use crate::model::Program;
     use proptest::prelude::*;

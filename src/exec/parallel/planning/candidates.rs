@@ -3,10 +3,10 @@
 //! under each slicing and the dependence-driven plan, those the cost model says may gain.
 //! Above both planners; it builds plans and keeps or drops them, nothing else.
 
-use super::config::{PlanConfig, PlanKind, Slicing};
 use super::deps_plan;
 use super::plan::Plan;
 use crate::analysis::Analysis;
+use crate::exec::parallel::config::{PlanConfig, PlanKind, Slicing};
 use crate::model::Program;
 
 /// The plans of `config.kind`: the model's plan (model, seq, par), the dependence-driven plan
@@ -16,7 +16,11 @@ use crate::model::Program;
 /// and the model sees any gain over the contiguous plan (in data movement, what it is for); the
 /// dependence-driven plan when its modelled scan beats the sequential one: the measurement then
 /// decides.
-pub(super) fn candidate_plans(p: &Program, a: &Analysis, config: &PlanConfig) -> Vec<Plan> {
+pub(in crate::exec::parallel) fn candidate_plans(
+    p: &Program,
+    a: &Analysis,
+    config: &PlanConfig,
+) -> Vec<Plan> {
     if config.kind == PlanKind::Deps {
         return vec![deps_plan::build(p, a, config)];
     }

@@ -21,17 +21,17 @@
 //! worker 0 writes at the start of every scan), the writer's cost of taking a line back that
 //! others read (an invalidation, next scan), lines evicted by capacity, and prefetching.
 
-use super::ids::TaskId;
 use crate::analysis::Analysis;
+use crate::exec::parallel::ids::TaskId;
 use crate::model::{Program, Type, VarClass, VarId};
 use std::collections::HashMap;
 
 /// Bytes of a cache line (the state's, [`crate::exec::LINE_BYTES`]).
-pub(super) const LINE_BYTES: u64 = crate::exec::LINE_BYTES as u64;
+pub(in crate::exec::parallel) const LINE_BYTES: u64 = crate::exec::LINE_BYTES as u64;
 
 /// The bytes of a variable of type `ty`, as the compact state stores it
 /// ([`crate::exec::type_size`]: BOOL 1, INT 2, DINT/REAL/TIME 4, a timer or counter its fields).
-pub(super) fn var_bytes(ty: Type) -> u64 {
+pub(in crate::exec::parallel) fn var_bytes(ty: Type) -> u64 {
     u64::from(crate::exec::type_size(ty))
 }
 
@@ -44,7 +44,7 @@ struct Written {
 }
 
 /// The walk over a plan's phases, in scan order.
-pub(super) struct Movement<'a> {
+pub(in crate::exec::parallel) struct Movement<'a> {
     p: &'a Program,
     a: &'a Analysis,
     threads: usize,
@@ -61,7 +61,11 @@ fn bit(w: usize) -> u64 {
 
 impl<'a> Movement<'a> {
     /// The start of a scan: worker 0 has written the inputs (one group); nothing else counts.
-    pub(super) fn new(p: &'a Program, a: &'a Analysis, threads: usize) -> Movement<'a> {
+    pub(in crate::exec::parallel) fn new(
+        p: &'a Program,
+        a: &'a Analysis,
+        threads: usize,
+    ) -> Movement<'a> {
         let mut m = Movement {
             p,
             a,
@@ -93,7 +97,7 @@ impl<'a> Movement<'a> {
 
     /// Per task and worker (`affinity[i * threads + w]`): the bytes task `tasks[i]` reads that
     /// worker `w` wrote last.
-    pub(super) fn affinity(&self, tasks: &[TaskId]) -> Vec<u64> {
+    pub(in crate::exec::parallel) fn affinity(&self, tasks: &[TaskId]) -> Vec<u64> {
         let sched = &self.a.schedule;
         let mut out = vec![0u64; tasks.len() * self.threads];
         for (i, t) in tasks.iter().enumerate() {
@@ -130,12 +134,12 @@ impl<'a> Movement<'a> {
     }
 
     /// How many lines worker `w` fetches running `tasks` ([`fetched`](Self::fetched)).
-    pub(super) fn lines(&self, tasks: &[TaskId], w: usize) -> u64 {
+    pub(in crate::exec::parallel) fn lines(&self, tasks: &[TaskId], w: usize) -> u64 {
         self.fetched(tasks, w).len() as u64
     }
 
     /// Per worker of a phase (`slices[w]`), the lines it moves ([`lines`](Self::lines)).
-    pub(super) fn phase_lines(&self, slices: &[Vec<TaskId>]) -> Vec<u64> {
+    pub(in crate::exec::parallel) fn phase_lines(&self, slices: &[Vec<TaskId>]) -> Vec<u64> {
         slices
             .iter()
             .enumerate()
@@ -145,7 +149,7 @@ impl<'a> Movement<'a> {
 
     /// The phase `slices` ran (`slices[w]` on worker `w`): the lines they fetched are now in
     /// their caches, and their writes become the last ones.
-    pub(super) fn commit(&mut self, slices: &[Vec<TaskId>]) {
+    pub(in crate::exec::parallel) fn commit(&mut self, slices: &[Vec<TaskId>]) {
         let sched = &self.a.schedule;
         for (w, s) in slices.iter().enumerate() {
             for line in self.fetched(s, w) {

@@ -9,9 +9,9 @@
 /// Before an item: wait until worker `worker` has finished its first `done` items (its ready
 /// flag reads at least `done` in this scan).
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
-pub(super) struct Wait {
-    pub(super) worker: u32,
-    pub(super) done: u32,
+pub(in crate::exec::parallel) struct Wait {
+    pub(in crate::exec::parallel) worker: u32,
+    pub(in crate::exec::parallel) done: u32,
 }
 
 /// What the dependence-driven plan is, besides its items (for `--explain` and the JSON).
@@ -41,7 +41,7 @@ impl Ready {
 /// wait (an item comes after the items its waits name): (worker, item index) pairs. `Err`
 /// names a worker whose next item can never run (the waits form a cycle, or name an item that
 /// does not exist): the plan would deadlock.
-pub(super) fn item_order(
+pub(in crate::exec::parallel) fn item_order(
     items_per_worker: &[usize],
     waits_of: impl Fn(usize, usize) -> Vec<Wait>,
 ) -> Result<Vec<(usize, usize)>, String> {

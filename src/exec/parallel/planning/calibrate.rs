@@ -16,7 +16,7 @@
 //! rounds counted (a busy machine), the measurement gives up and the plan keeps the default. It does not pin threads: the operating system
 //! places them, as it places the workers.
 
-use super::config::{LineCostSource, PlanConfig};
+use crate::exec::parallel::config::{LineCostSource, PlanConfig};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 

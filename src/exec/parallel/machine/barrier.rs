@@ -1,23 +1,27 @@
 //! The barrier the workers meet at between the phases of a scan: spin briefly, then yield, then
 //! park, so that it is fast when every worker owns a core and costs no scheduler time slice per
-//! barrier when one does not (another process on the core, or more workers than cores).
+//! barrier when one does not (another process on the core, or more workers than cores): the
+//! wait loop is `backoff`'s, parked here until an arriving worker unparks the waiter.
 //!
 //! Invariants: every worker calls [`SpinBarrier::wait`] the same number of times per run, with
 //! its own epoch counter, and [`SpinBarrier::register`]s its thread before its first wait. It
-//! depends only on the padding below it and knows nothing of plans. Parking uses
+//! depends only on the padding and the backoff below it and knows nothing of plans. Parking uses
 //! `std::thread::park`/`unpark` (a futex on Linux): no crate is needed for one flag per worker.
 
-use super::pad::Padded;
+use super::backoff::{wait_until, Pace};
+use crate::exec::parallel::pad::Padded;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::OnceLock;
 use std::thread::Thread;
 
-/// Spin-loop hints before a waiter starts yielding (a few µs: what a balanced phase needs).
-const SPINS: u32 = 1 << 11;
-/// How long a waiter yields before it parks: long enough to cover worker 0's work between two
-/// scans (the driver's digest of a large state) without a wake-up latency, short enough that a
-/// descheduled worker costs the others a sleep, not a time slice of spinning.
-const YIELD_FOR: std::time::Duration = std::time::Duration::from_micros(200);
+/// A waiter spins 2^11 hints (a few µs: what a balanced phase needs), then yields for 200 µs:
+/// long enough to cover worker 0's work between two scans (the driver's digest of a large
+/// state) without a wake-up latency, short enough that a descheduled worker costs the others a
+/// sleep, not a time slice of spinning.
+const PACE: Pace = Pace {
+    spins: 1 << 11,
+    yield_for: std::time::Duration::from_micros(200),
+};
 
 /// One worker's seat: the barriers it has reached, whether it is parked, and its thread.
 #[derive(Debug, Default)]
@@ -77,37 +81,26 @@ impl SpinBarrier {
     /// Waits until `other` has reached barrier `e`; false if the barrier was poisoned.
     #[inline]
     fn wait_for(&self, w: usize, other: &Seat, e: u64) -> bool {
-        let mut spins = 0u32;
-        let mut yielding: Option<std::time::Instant> = None;
-        while other.epoch.load(Ordering::Acquire) < e {
-            if spins < SPINS {
-                std::hint::spin_loop();
-            } else if yielding
-                .get_or_insert_with(std::time::Instant::now)
-                .elapsed()
-                < YIELD_FOR
-            {
-                std::thread::yield_now();
-            } else {
-                if self.poisoned.load(Ordering::SeqCst) {
-                    return false;
-                }
-                let me = &self.seats[w].0;
-                me.parked.store(true, Ordering::SeqCst);
-                if other.epoch.load(Ordering::SeqCst) < e && !self.poisoned.load(Ordering::SeqCst) {
-                    // A registered worker is woken by `unpark`; an unregistered one (a caller
-                    // that skipped `register`) still wakes up: park_timeout bounds its sleep.
-                    if me.thread.get().is_some() {
-                        std::thread::park();
-                    } else {
-                        std::thread::park_timeout(std::time::Duration::from_micros(50));
-                    }
-                }
-                me.parked.store(false, Ordering::SeqCst);
+        let reached = || (other.epoch.load(Ordering::Acquire) >= e).then_some(());
+        let park = || {
+            if self.poisoned.load(Ordering::SeqCst) {
+                return false;
             }
-            spins = spins.saturating_add(1);
-        }
-        true
+            let me = &self.seats[w].0;
+            me.parked.store(true, Ordering::SeqCst);
+            if other.epoch.load(Ordering::SeqCst) < e && !self.poisoned.load(Ordering::SeqCst) {
+                // A registered worker is woken by `unpark`; an unregistered one (a caller
+                // that skipped `register`) still wakes up: park_timeout bounds its sleep.
+                if me.thread.get().is_some() {
+                    std::thread::park();
+                } else {
+                    std::thread::park_timeout(std::time::Duration::from_micros(50));
+                }
+            }
+            me.parked.store(false, Ordering::SeqCst);
+            true
+        };
+        wait_until(PACE, reached, park).is_some()
     }
 
     /// Whether a worker panicked (every waiter is released for good).

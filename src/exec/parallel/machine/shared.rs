@@ -9,9 +9,9 @@
 
 use super::barrier::SpinBarrier;
 use super::flags::ReadyFlags;
-use super::ids::{Decision, DecisionSlot};
-use super::pad::Padded;
 use super::units::{Units, WindowBell};
+use crate::exec::parallel::ids::{Decision, DecisionSlot};
+use crate::exec::parallel::pad::Padded;
 use crate::exec::{Addr, Fault, Store, Word};
 use std::cell::UnsafeCell;
 use std::sync::atomic::{AtomicU32, Ordering};

@@ -9,12 +9,12 @@
 //! decided afterwards, by `plan`'s dynamic programme; `plan` then models the movement of the
 //! phases it actually built). It does not choose phases or place decisions.
 
-use super::config::{PlanConfig, Slicing, Strategy};
-use super::ids::TaskId;
 use super::movement::Movement;
 use super::partition::{self, Costs};
 use super::tasks::{contiguous, lpt, Tasks};
 use crate::analysis::Analysis;
+use crate::exec::parallel::config::{PlanConfig, Slicing, Strategy};
+use crate::exec::parallel::ids::TaskId;
 use crate::model::Program;
 
 /// What the plan decided for one level (for `--explain`).
@@ -43,7 +43,7 @@ pub struct LevelPlan {
 }
 
 /// Slices of one level: the tasks of each worker, ascending.
-pub(super) type Slices = Vec<Vec<TaskId>>;
+pub(in crate::exec::parallel) type Slices = Vec<Vec<TaskId>>;
 
 /// One way to cut a level, evaluated.
 struct Cut {
@@ -56,7 +56,7 @@ struct Cut {
 
 /// Per level: its plan for `--explain`, and its parallel slices (`None`: it cannot run in
 /// parallel).
-pub(super) fn slice_levels(
+pub(in crate::exec::parallel) fn slice_levels(
     p: &Program,
     a: &Analysis,
     info: &Tasks<'_>,
@@ -178,7 +178,7 @@ fn evaluate(
 }
 
 /// The heaviest worker: its items' steps plus its moved lines at `line_cost`.
-pub(super) fn worker_makespan(
+pub(in crate::exec::parallel) fn worker_makespan(
     workers: &[(usize, usize, u64)],
     lines: &[u64],
     line_cost: u64,
@@ -248,7 +248,7 @@ fn locality(
 #[cfg(test)]
 mod tests {
     use crate::exec::parallel::config::{PlanConfig, Slicing, Strategy};
-    use crate::exec::parallel::plan::Plan;
+    use crate::exec::parallel::planning::plan::Plan;
 
     /// Four independent chains (`n` rungs each per level) over three levels; the second level
     /// lists the chains in the order 2, 3, 0, 1, the others 0, 1, 2, 3. Rung `x_k_l_j` reads

@@ -5,12 +5,12 @@
 //! Pure functions of the program and its analysis (CALL/SBR and JMP/LBL as sources of control
 //! dependence, Zhao & Yan); depends only on the typed indices below it. It does not plan.
 
-use super::ids::TaskId;
 use crate::analysis::{Analysis, EdgeKind};
+use crate::exec::parallel::ids::TaskId;
 use crate::model::{Element, PouId, Program, RungId};
 
 /// Subroutines (transitively) called from each POU, and whether each POU has loop-back rungs.
-pub(super) fn call_closure(p: &Program) -> Vec<Vec<u32>> {
+pub(in crate::exec::parallel) fn call_closure(p: &Program) -> Vec<Vec<u32>> {
     let direct: Vec<Vec<u32>> = (0..p.pous.len())
         .map(|pou| {
             let mut calls = Vec::new();
@@ -47,7 +47,11 @@ pub(super) fn call_closure(p: &Program) -> Vec<Vec<u32>> {
 }
 
 /// Subroutines called (transitively) from a rung.
-pub(super) fn rung_callees(p: &Program, closure: &[Vec<u32>], r: RungId) -> Vec<u32> {
+pub(in crate::exec::parallel) fn rung_callees(
+    p: &Program,
+    closure: &[Vec<u32>],
+    r: RungId,
+) -> Vec<u32> {
     let mut out = Vec::new();
     crate::model::walk_elements(&p.rung(r).series, &mut |e| {
         if let Element::Call { pou } = e {
@@ -61,7 +65,7 @@ pub(super) fn rung_callees(p: &Program, closure: &[Vec<u32>], r: RungId) -> Vec<
 }
 
 /// Whether rung `r` holds a loop-back (a NEXT, or a backward jump).
-pub(super) fn is_loop_back(p: &Program, r: RungId) -> bool {
+pub(in crate::exec::parallel) fn is_loop_back(p: &Program, r: RungId) -> bool {
     let mut found = false;
     crate::model::walk_elements(&p.rung(r).series, &mut |e| match e {
         Element::Next { .. } => found = true,
@@ -73,7 +77,7 @@ pub(super) fn is_loop_back(p: &Program, r: RungId) -> bool {
 
 /// The first main-program rung whose loop-cap refusal could lead where the schedule does not
 /// expect control to go, with the reason; `None` if there is none.
-pub(super) fn uncovered_refusal(
+pub(in crate::exec::parallel) fn uncovered_refusal(
     p: &Program,
     a: &Analysis,
     task_of: &[Option<TaskId>],

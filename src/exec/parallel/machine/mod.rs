@@ -8,32 +8,48 @@
 //! Invariants: worker 0 alone talks to the driver and the chooser, between barriers; every
 //! candidate works on the same state layout, so a switch between scans needs no copy; the
 //! results are those of [`Machine::run_scan`], byte for byte and fault for fault, whichever
-//! candidates ran. It does not plan (`plan`) nor check plans (`check`); it runs what
+//! candidates ran. It does not plan nor check plans (`planning`); it runs what
 //! [`ParallelMachine::new`] kept.
+//!
+//! # Modules, bottom to top
+//! Each uses only the ones before it (and the layers below the machine: the basics, `planning`,
+//! `choice`): `backoff` (the one wait loop: spin, yield, park), `barrier`, `flags` (ready
+//! flags), `units` (claimed units, the window bell), `shared` (lock-free shared memory),
+//! `driver` (the per-scan callbacks and the sequential loop), `claimed` (a levelled plan's
+//! scans as units: the second half of [`ParallelMachine`]'s implementation, so it uses this
+//! module's types as this module uses its functions), this module.
 
+mod backoff;
+mod barrier;
 mod claimed;
+mod driver;
+mod flags;
+mod shared;
+mod units;
 
-use super::barrier::SpinBarrier;
-use super::candidates::candidate_plans;
-use super::check::check_plan;
-use super::choice::{Chooser, Switch, Window};
-use super::config::{Measure, PlanConfig, PlanKind};
-use super::driver::{run_sequential, ScanDriver};
-use super::flags::ReadyFlags;
-use super::ids::{Decision, Next};
-use super::pad::Padded;
-use super::plan::{bools_first, layout_groups, Plan};
-use super::shared::{Decisions, FaultBuffer, Shared, SharedSlots};
-use super::tasks::{Item, Region};
-use super::units::{Units, WindowBell, WindowNote};
+pub use barrier::SpinBarrier;
+pub use driver::{run_sequential, ScanDriver};
+pub use shared::SharedSlots;
+
 use crate::analysis::Analysis;
+use crate::exec::parallel::choice::{Chooser, Switch, Window};
+use crate::exec::parallel::config::{Measure, PlanConfig, PlanKind};
+use crate::exec::parallel::ids::{Decision, Next};
+use crate::exec::parallel::pad::Padded;
+use crate::exec::parallel::planning::candidate_plans;
+use crate::exec::parallel::planning::check_plan;
+use crate::exec::parallel::planning::{bools_first, layout_groups, Plan};
+use crate::exec::parallel::planning::{Item, Region};
 use crate::exec::{
     ExecConfig, Exit, Fault, Layout, LowerError, Machine, ScanCtx, State, LINE_BYTES,
 };
 use crate::model::{Program, RungId, VarId};
+use flags::ReadyFlags;
+use shared::{Decisions, FaultBuffer, Shared};
 use std::cell::UnsafeCell;
 use std::ops::Range;
 use std::time::{Duration, Instant};
+use units::{Units, WindowBell, WindowNote};
 
 /// One way to run a scan.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]

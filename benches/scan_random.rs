@@ -1,0 +1,23 @@
+//! Scan speed on one shape, random reads: `gen --rungs 20000 --width 1000 --reads random`: the sequential interpreter and the parallel executor (see
+//! `scan_shapes`). Run with `cargo bench --bench scan_random` (well under a minute).
+
+mod scan_shapes;
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use plc_deps::synth::Reads;
+use scan_shapes::{bench_program, generated, quick};
+
+fn scan(c: &mut Criterion) {
+    bench_program(
+        c,
+        "random-reads-20000x20-levels",
+        &generated(20_000, 1000, Reads::Random),
+    );
+}
+
+criterion_group! {
+    name = benches;
+    config = quick();
+    targets = scan
+}
+criterion_main!(benches);

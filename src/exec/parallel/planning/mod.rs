@@ -1,0 +1,50 @@
+//! Planning: what the parallel scan will run, decided before the first scan from the program,
+//! its analysis and the cost model, and checked against the lowered code. The candidates
+//! ([`candidate_plans`]: the sequential walk, the levelled plan under each slicing, the
+//! dependence-driven plan), the cost model (`rung_cost`, `movement`, the calibrated line cost
+//! of `calibrate`), the partition of each level (`tasks`' contiguous and LPT cuts, `partition`'s
+//! locality partition, `slicing`), the phases (`plan`, `deps_plan`) and the check of every plan
+//! (`check`, `order_check`).
+//!
+//! Invariants: planning reads the program, the analysis and the lowered code, and writes
+//! nothing a run reads but the plans; it never runs a scan (the measured choice and the running
+//! machine are the layers above it, which it does not know).
+//!
+//! # Modules, bottom to top
+//! Each uses only the ones before it (and the basics below planning: `ids`, `config`, `pad`):
+//! `calibrate` (the per-line and hand-over costs measured), `rung_cost` (what a rung costs the
+//! interpreter, fused or not), `calls` (call closures, loop-backs), `tasks` (task facts, items,
+//! contiguous and LPT cuts), `partition` (the locality partition of one level), `movement`
+//! (lines moved between workers), `slicing` (each level's slices and modelled makespan),
+//! `ready` (the dependence-driven plan's waits), `phase` (a phase's items), `merge` (consecutive parallel levels in one
+//! phase where each worker reads only its own writes), `plan` (phases on the cost model), `deps_plan`
+//! (the dependence-driven plan), `candidates` (the plans a run chooses from), `order_check`
+//! (the dependence-driven order against the lowered code), `check` (every plan against the
+//! lowered code).
+
+mod calibrate;
+mod calls;
+mod candidates;
+mod check;
+mod deps_plan;
+mod merge;
+mod movement;
+mod order_check;
+mod partition;
+mod phase;
+mod plan;
+mod ready;
+mod rung_cost;
+mod slicing;
+mod tasks;
+
+pub use calibrate::{measure_handover, measure_line_cost, LineTiming};
+pub use plan::Plan;
+pub use ready::Ready;
+pub use slicing::LevelPlan;
+
+pub(super) use candidates::candidate_plans;
+pub(super) use check::check_plan;
+pub(super) use phase::Phase;
+pub(super) use plan::{bools_first, layout_groups};
+pub(super) use tasks::{Item, Region};
