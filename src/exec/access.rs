@@ -1,5 +1,5 @@
 //! The bytes each rung's lowered instructions actually read and write: the ground truth a
-//! parallel plan is checked against (`parallel::check`), independent of the analysis' IN/OUT
+//! parallel plan is checked against (`parallel::planning::check`), independent of the analysis' IN/OUT
 //! sets the plan was built from.
 //!
 //! A rung's instructions run from its `Rung` marker to the next marker (or the end of its POU);
