@@ -66,9 +66,13 @@ fn a_mod_by_a_variable_is_a_division_a_product_a_difference_and_a_zero_test() {
 
 /// The state of the program's variables and the faults (rung id, kind) after each scan.
 fn run(p: &Program, scans: &[(bool, i16, i16)]) -> Vec<String> {
+    run_named(p, &["r1", "r2", "r3", "r4", "r5", "d", "e"], scans)
+}
+
+/// [`run`] showing the variables `names`.
+fn run_named(p: &Program, names: &[&str], scans: &[(bool, i16, i16)]) -> Vec<String> {
     let m = Machine::new(p, Layout::dense(p), &ExecConfig::default()).unwrap();
     let id = |n: &str| VarId(p.vars.iter().position(|v| v.name == n).unwrap() as u32);
-    let names = ["r1", "r2", "r3", "r4", "r5", "d", "e"];
     let mut st = m.initial_state();
     let mut out = Vec::new();
     for (k, &(go, a, b)) in scans.iter().enumerate() {
@@ -208,33 +212,11 @@ fn bitwise_functions_are_the_word_instructions_and_read_back() {
         .into_iter()
         .collect();
     let names = ["r1", "r2", "r3", "r4", "r5", "e"];
-    let values = |p: &Program| -> Vec<Vec<String>> {
-        let m = Machine::new(p, Layout::dense(p), &ExecConfig::default()).unwrap();
-        let id = |n: &str| VarId(p.vars.iter().position(|v| v.name == n).unwrap() as u32);
-        let mut st = m.initial_state();
-        let mut out = Vec::new();
-        for (k, &(go, a, b)) in scans.iter().enumerate() {
-            let set = [
-                (id("go"), Value::Bool(go)),
-                (id("a"), Value::Int(a)),
-                (id("b"), Value::Int(b)),
-            ];
-            m.set_inputs(&mut st, &set);
-            m.run_scan(&mut st, k as u64, &mut Vec::new());
-            out.push(
-                names
-                    .iter()
-                    .map(|n| m.value(&st, id(n)).to_json().to_string())
-                    .collect(),
-            );
-        }
-        out
-    };
-    let want = values(&p);
-    assert_eq!(values(&back), want, "\n{stl}");
+    let want = run_named(&p, &names, &scans);
+    assert_eq!(run_named(&back, &names, &scans), want, "\n{stl}");
     // By hand, scan 1: 0x1234 AND 0xFF = 0x34; 0x1234 OR 0xF0 OR 0x1000 = 0x12F4; 0 XOR 0xF0;
     // NOT 0x1234 = -0x1235; NOT 0 = -1; 0x12345678 XOR -1 = 0xEDCBA987, AND 0xFFFF = 0xA987.
-    assert_eq!(want[0], ["52", "4852", "240", "-4661", "-1", "43399"]);
+    assert_eq!(want[0], "r1=52 r2=4852 r3=240 r4=-4661 r5=-1 e=43399");
     // Scan 2 (go off: r1 kept): -1 OR 3 = -1; 0xF0 XOR 3 = 0xF3; NOT -1 = 0; NOT -1 = 0.
-    assert_eq!(want[1], ["52", "-1", "243", "0", "0", "43399"]);
+    assert_eq!(want[1], "r1=52 r2=-1 r3=243 r4=0 r5=0 e=43399");
 }
