@@ -219,3 +219,45 @@ fn bitwise_functions_of_words_run_in_fbd() {
     // NOT 0xAA = 0x55; NOT 0 = 0xFF.
     assert_eq!(got[3], ["85", "255"]);
 }
+
+/// LD: `en → AND(EN, IN1 := w, IN2 := m) → done`, OUT to `r`: an AND box of WORDs in a rung is
+/// the bitwise function, run when powered.
+#[test]
+fn a_bitwise_and_box_in_an_ld_rung_runs_when_powered() {
+    let ld = [
+        rail(1),
+        contact(2, "en", &[1], ""),
+        in_var(3, "w"),
+        in_var(7, "m"),
+        block(
+            4,
+            "AND",
+            None,
+            &[("EN", &[(2, None)]), ("IN1", &[(3, None)]), ("IN2", &[(7, None)])],
+            &["ENO", "OUT"],
+        ),
+        var_in("outVariable", 5, "r", (4, Some("OUT"))),
+        "<coil localId=\"6\"><connectionPointIn><connection refLocalId=\"4\" formalParameter=\"ENO\"/></connectionPointIn><connectionPointOut/><variable>done</variable></coil>".to_string(),
+    ]
+    .concat();
+    let xml = project(
+        &[
+            ("inputVars", "en", "BOOL"),
+            ("inputVars", "w", "WORD"),
+            ("inputVars", "m", "WORD"),
+            ("outputVars", "r", "WORD"),
+            ("outputVars", "done", "BOOL"),
+        ],
+        &ld,
+    );
+    no_black_box(&xml);
+    let got = trace(
+        "fn-ld-and",
+        &xml,
+        "en,w,m\n0,4660,255\n1,4660,255\n1,65535,3855\n",
+        &["r", "done"],
+    );
+    // Unpowered: r keeps 0; then 0x1234 AND 0xFF = 0x34, 0xFFFF AND 0x0F0F = 0x0F0F.
+    assert_eq!(got[0], ["0", "52", "3855"]);
+    assert_eq!(got[1], ["0", "1", "1"]);
+}
