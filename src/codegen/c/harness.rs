@@ -41,15 +41,19 @@ pub(crate) fn program_source(p: &Program, sh: &Shared, extra: &[String], cfg: &C
         s.extend(inits);
         s.push_str("};\n\n");
     }
-    // The BOOLs are the struct's first members, one byte each (the rows' tables hold offsets).
-    if let Some((i, at)) = (0..p.vars.len()).filter_map(|i| Some((i, sh.bool_at[i]?))).last() {
-        push(
-            &mut s,
-            format_args!(
-                "_Static_assert(offsetof(_plc_state, {}) == {at}, \"the BOOLs come first\");\n\n",
-                field(sh, i)
-            ),
-        );
+    // The BOOLs, then the INTs, are the struct's first members (the rows' tables hold their
+    // offsets): the last of each where the generator put it.
+    for ty in [Type::Bool, Type::Int] {
+        let last = (0..p.vars.len()).filter(|&i| p.vars[i].ty == ty).filter_map(|i| Some((i, sh.at[i]?))).last();
+        if let Some((i, at)) = last {
+            push(
+                &mut s,
+                format_args!(
+                    "_Static_assert(offsetof(_plc_state, {}) == {at}, \"the rows' offsets\");\n",
+                    field(sh, i)
+                ),
+            );
+        }
     }
     s.push_str("void _plc_scan(_plc_state *self, _plc_ctx *ctx) {\n");
     if sh.counters.iter().any(Option::is_some) {

@@ -54,9 +54,9 @@ pub(crate) struct Shared<'a> {
     /// Per variable: held in a local of an FBD function only (an arc or a run flag), so no
     /// struct has a member for it.
     pub local_only: Vec<bool>,
-    /// Per variable: its byte offset in `_plc_state` if it is a BOOL member of it (the BOOLs
-    /// come first in the struct, in variable order).
-    pub bool_at: Vec<Option<u32>>,
+    /// Per variable: its byte offset in `_plc_state` if it is a BOOL or INT member of it
+    /// (they come first in the struct, `member_offsets`).
+    pub at: Vec<Option<u32>>,
     /// Per rung: its row, if it is written as one (`rows`).
     pub rows: Vec<Option<super::rows::Row>>,
 }

@@ -9,12 +9,14 @@
 //! struct member) is one struct `_plc_state` passed to every POU function as `self`; each POU is a function `_pou_<name>(self, ctx)`
 //! (`ctx`: virtual time, scan, loop cap, fault sink). Ladder rungs are one block of statements
 //! each (`ladder`); FBD networks are nested `if` blocks following their fragment trees, with
-//! one local per data arc (`fbd`). A ladder POU of more than [`CConfig::chunk_rungs`] rungs is
-//! cut into functions of about that many rungs at boundaries no jump and no FOR loop crosses,
-//! in part files whose number is bounded (16, plus one per further large POU:
-//! `chunks_per_file`), so the C compiler's time grows linearly with the program. With
-//! [`CConfig::rows`], a ladder POU's rungs of contacts and coils are rows of constant tables run
-//! by a loop of the runtime (`rows`): a third to a half of the compile time, slower rungs.
+//! one local per data arc (`fbd`). A ladder POU's rungs of contacts and coils are rows of
+//! tables of byte offsets, each run by a small loop specialised for the rung's shape (`rows`;
+//! [`CConfig::rows`], the default), emitted in an order that groups them by dependence level
+//! and shape within straight-line regions (`order`); the other rungs are statements. A ladder
+//! POU of more than [`CConfig::chunk_rungs`] units (a rung of statements, a run of rows) is cut
+//! into functions at boundaries no jump and no FOR loop crosses, in part files whose number is
+//! bounded (`parts`), so the C compiler's time grows linearly with the program: at 100,000
+//! rungs a build takes seconds with rows, minutes with every rung as statements (docs/c.md).
 //!
 //! Invariants: the generated program computes after every scan exactly the state and the faults
 //! of the sequential interpreter (`crate::exec::Machine`) given the same inputs (tests:
@@ -38,7 +40,7 @@ mod spelling;
 mod types;
 
 use crate::fbd::Fbd;
-use crate::model::{walk_elements, Element, PouKind, Program, VarId};
+use crate::model::{walk_elements, Element, PouKind, Program, Type, VarId};
 use ladder::{c_type, Body, Shared};
 use parts::{chunks_per_file, ladder_files};
 use std::collections::HashMap;
@@ -54,8 +56,9 @@ pub struct CConfig {
     pub loop_cap: u32,
     /// Rungs per function of a large ladder POU.
     pub chunk_rungs: usize,
-    /// Rungs of contacts and coils as rows of tables (`rows`): `cc` time falls to a third to
-    /// a half, the rungs run 1.5–3 times slower (docs/c.md).
+    /// Rungs of contacts and coils as rows of tables run by kernels specialised by shape
+    /// (`rows`; `plc-deps c --statements` turns it off): `cc` takes seconds instead of minutes
+    /// at 100,000 rungs, and the rows run as fast as the statements or faster (docs/c.md).
     pub rows: bool,
 }
 
@@ -65,7 +68,7 @@ impl Default for CConfig {
             cycle_ms: 10,
             loop_cap: 100_000,
             chunk_rungs: 64,
-            rows: false,
+            rows: true,
         }
     }
 }
@@ -83,7 +86,7 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
     let mut sh = shared(p, fbd, &lay);
     let copies = fbd_copies(p, fbd);
     sh.local_only = local_only(p, fbd, &copies);
-    sh.bool_at = bool_offsets(p, &lay, &sh.local_only);
+    sh.at = member_offsets(p, &lay, &sh.local_only);
     let fbd_of: HashMap<usize, usize> = copies.iter().map(|(&k, (fp, _))| (k, *fp)).collect();
     // The function block types first (nested types before their owners: a call names the
     // function its callee's type got).
@@ -147,7 +150,10 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
         .collect();
     let per_file = chunks_per_file(p, &plans, cfg.chunk_rungs);
     let (mut objects, mut parts) = (Vec::new(), Vec::new());
-    let mut data_files = Vec::new();
+    let mut data = parts::DataFiles {
+        entry: kernels.entry_type(),
+        files: Vec::new(),
+    };
     for (i, pou) in p.pous.iter().enumerate() {
         let Some(stem) = &stems[i] else { continue };
         let f = &sh.pou_fns[i];
@@ -158,7 +164,7 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
                 (vec![(String::new(), text)], String::new())
             }
             (None, Some(plan)) => {
-                ladder_files(p, &sh, i, cfg, per_file, plan, &mut data_files)
+                ladder_files(p, &sh, i, cfg, per_file, plan, &mut data)
             }
             (None, None) => unreachable!("a POU with a stem is FBD or ladder"),
         };
@@ -181,9 +187,9 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
         }
     }
     if !kernels.is_empty() {
-        data_files.push(("plc_rows".to_string(), kernels.source()));
+        data.files.push(("plc_rows".to_string(), kernels.source()));
     }
-    for (stem, text) in data_files.into_iter().chain(type_files) {
+    for (stem, text) in data.files.into_iter().chain(type_files) {
         files.push(CFile {
             name: format!("{stem}.c"),
             text,
@@ -258,27 +264,32 @@ fn shared<'a>(p: &'a Program, fbd: &Fbd, lay: &types::Layout) -> Shared<'a> {
         labels,
         counters,
         local_only: vec![false; p.vars.len()],
-        bool_at: Vec::new(),
+        at: Vec::new(),
         rows: vec![None; p.rungs.len()],
     }
 }
 
-/// Per variable: its byte offset in `_plc_state` if it is a BOOL member of the struct itself
-/// (not a member of an instance's struct, not a local of an FBD function). The struct lists
-/// these BOOLs first, in variable order: C lays members out in order from offset 0 without
-/// padding between members of size and alignment 1 (`plc_program.h` asserts that `bool` is
-/// one byte, `plc_program.c` the offset of the last BOOL).
-fn bool_offsets(p: &Program, lay: &types::Layout, local_only: &[bool]) -> Vec<Option<u32>> {
+/// Per variable: its byte offset in `_plc_state` if it is a BOOL or an INT member of the
+/// struct itself (not a member of an instance's struct, not a local of an FBD function). The
+/// struct lists these BOOLs first, then these INTs, in variable order: C lays members out in
+/// order from offset 0, with no padding between members whose size is their alignment (1 for
+/// `bool`, 2 for `int16_t`) and the INTs starting at the first even offset after the BOOLs
+/// (`plc_program.h` asserts the sizes and alignments, `plc_program.c` the offsets of the last
+/// BOOL and the last INT).
+fn member_offsets(p: &Program, lay: &types::Layout, local_only: &[bool]) -> Vec<Option<u32>> {
+    let member = |i: usize| lay.vars[i].1.is_none() && !local_only[i];
+    let mut out = vec![None; p.vars.len()];
     let mut next = 0u32;
-    (0..p.vars.len())
-        .map(|i| {
-            let member = lay.vars[i].1.is_none() && !local_only[i];
-            (member && p.vars[i].ty == crate::model::Type::Bool).then(|| {
-                next += 1;
-                next - 1
-            })
-        })
-        .collect()
+    for (ty, size) in [(Type::Bool, 1), (Type::Int, 2)] {
+        next = next.next_multiple_of(size);
+        for i in 0..p.vars.len() {
+            if member(i) && p.vars[i].ty == ty {
+                out[i] = Some(next);
+                next += size;
+            }
+        }
+    }
+    out
 }
 
 /// The program's hidden variables (the FBD lowering's arcs and run flags) by name.
@@ -329,12 +340,13 @@ fn program_header(p: &Program, sh: &Shared, h: &Header) -> String {
     s.push_str(&h.structs);
     s.push_str("struct _plc_state {\n");
     let mut fields = 0;
-    // The BOOLs first, at the offsets `bool_offsets` gives (the rows' tables hold them).
-    let bools = (0..p.vars.len()).filter(|&i| sh.bool_at[i].is_some());
-    let others = (0..p.vars.len()).filter(|&i| {
-        sh.bool_at[i].is_none() && h.lay.vars[i].1.is_none() && !sh.local_only[i]
-    });
-    for i in bools.chain(others) {
+    // The BOOLs and INTs first, at the offsets `member_offsets` gives (the rows' tables hold
+    // them).
+    let mut known: Vec<usize> = (0..p.vars.len()).filter(|&i| sh.at[i].is_some()).collect();
+    known.sort_by_key(|&i| sh.at[i]);
+    let others = (0..p.vars.len())
+        .filter(|&i| sh.at[i].is_none() && h.lay.vars[i].1.is_none() && !sh.local_only[i]);
+    for i in known.into_iter().chain(others) {
         let v = &p.vars[i];
         let field = sh.vars[i].trim_start_matches("self->");
         let ty = c_type(v.ty);
@@ -368,7 +380,7 @@ fn program_header(p: &Program, sh: &Shared, h: &Header) -> String {
     if fields == 0 && k == 0 {
         s.push_str("    char _empty;\n");
     }
-    s.push_str("};\n\n_Static_assert(sizeof(bool) == 1, \"a BOOL is one byte\");\n");
+    s.push_str("};\n\n_Static_assert(sizeof(bool) == 1 && sizeof(int16_t) == 2 && _Alignof(int16_t) == 2, \"the rows' offsets\");\n");
     s.push_str("extern const _plc_state _plc_initial;\n");
     s.push_str("void _plc_scan(_plc_state *self, _plc_ctx *ctx);\n");
     s.push_str(&h.type_decls);

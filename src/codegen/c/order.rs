@@ -3,7 +3,8 @@
 //!
 //! Rungs keep sequential semantics. The rungs of a straight-line region — no jump, label a
 //! jump targets, FOR, NEXT, CALL, RET or END inside, and no rung that may record a fault (an
-//! integer DIV or MOD, a standard function, whose faults must keep their order) — are levelled
+//! integer DIV or MOD by a variable or zero; a standard function), whose faults must keep their
+//! order — are levelled
 //! by their data dependences (flow, anti and output, from the rungs' IN and OUT sets,
 //! `crate::analysis::accesses`, with the ASAP levelling `crate::analysis::dependences::Leveller`
 //! — the levelling the parallel scan relies on, Zhao & Yan 2012): two rungs of one level have
@@ -20,7 +21,7 @@ use super::ladder::Shared;
 use super::rows::{Kernels, Row};
 use crate::analysis::dependences::Leveller;
 use crate::analysis::Accesses;
-use crate::model::{walk_elements, ArithOp, Element, Program, RungId};
+use crate::model::{walk_elements, ArithOp, Element, Operand, Program, RungId};
 
 /// A POU's emission order and, per position, the weight of its rung in a chunk function (a
 /// rung written as statements: 1; a row: 1 when it starts a run, else 0).
@@ -99,7 +100,11 @@ fn bounds_region(p: &Program, labels: &[bool], r: RungId) -> bool {
             | Element::For { .. }
             | Element::Next { .. }
             | Element::Function { .. } => true,
-            Element::Arith { op, .. } => matches!(op, ArithOp::Div | ArithOp::Mod),
+            // DIV or MOD by a non-zero constant never records a fault.
+            Element::Arith { op, b, .. } => {
+                matches!(op, ArithOp::Div | ArithOp::Mod)
+                    && !matches!(b, Operand::Const(v) if v.to_bits() != 0)
+            }
             _ => false,
         }
     });

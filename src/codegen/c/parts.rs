@@ -80,9 +80,15 @@ const MIN_CHUNKS_PER_FILE: usize = 16;
 /// The most part files of a program before they grow instead of multiplying.
 const MAX_PART_FILES: usize = 16;
 
+/// The data files of the rows (`(stem, text)`) and the C type of their entries.
+pub(crate) struct DataFiles {
+    pub entry: &'static str,
+    pub files: Vec<(String, String)>,
+}
+
 /// The C of a ladder POU: its function and, for a large POU, the part files of its chunks
 /// (`(file suffix, text)`; the first has no suffix), and the declarations for its header. The
-/// data files of the rows are appended to `data` (`(stem, text)`).
+/// data files of the rows are appended to `data`.
 pub(crate) fn ladder_files(
     p: &Program,
     sh: &Shared,
@@ -90,18 +96,18 @@ pub(crate) fn ladder_files(
     cfg: &CConfig,
     per_file: usize,
     plan: &Plan,
-    data: &mut Vec<(String, String)>,
+    data: &mut DataFiles,
 ) -> (Vec<(String, String)>, String) {
     let f = &sh.pou_fns[pou];
     let groups = chunks(p, pou, plan, cfg.chunk_rungs.max(1));
     let name = names::comment(&p.pous[pou].name);
     let head = "#include \"plc_program.h\"\n\n";
     // A new source file's rows, in the data file numbered after those written so far.
-    let tables = |data: &Vec<(String, String)>| cfg.rows.then(|| Tables::new(data.len()));
+    let tables = |data: &DataFiles| cfg.rows.then(|| Tables::new(data.files.len(), data.entry));
     // The rows' declarations, and their data file into `data`.
-    let close = |t: Option<Tables>, data: &mut Vec<(String, String)>| {
+    let close = |t: Option<Tables>, data: &mut DataFiles| {
         let t = t?;
-        data.extend(t.data_file());
+        data.files.extend(t.data_file());
         Some(t.declarations())
     };
     // Generated names made from the function's (`_pou_` + the POU's encoded name, which starts

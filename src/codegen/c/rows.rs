@@ -40,8 +40,10 @@
 //! the files (`mod`).
 
 use super::ladder::{push, Shared};
-use crate::model::{ContactKind, Element, RungId, Series, Type, VarId, VarRef};
-use std::collections::{BTreeMap, HashMap};
+use crate::model::{
+    ArithOp, CmpOp, ContactKind, Element, Operand, RungId, Series, Type, Value, VarId, VarRef,
+};
+use std::collections::{BTreeSet, HashMap};
 
 /// A condition item of a shape, in its canonical order (derived `Ord`: positive contacts,
 /// negated contacts, rising edges, falling edges, ORs).
@@ -51,17 +53,32 @@ enum Item {
     Lit(bool),
     /// An edge contact: falling (true) or rising (false).
     Edge(bool),
+    /// A comparison of two INTs (`==`, `<` …), each a variable or a constant (true).
+    Cmp(&'static str, bool, bool),
     /// An OR of ANDs (each with at least one item).
     Or(Vec<Vec<Item>>),
 }
 
-/// An output of a shape.
+/// An output of a shape, or a box before or beside the outputs (which passes power on).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 enum Out {
-    Coil,
-    NegCoil,
-    Set,
-    Reset,
+    /// A coil, negated coil, set or reset of a BOOL: which one is data (slots: the BOOL, the
+    /// kind 0–3, looked up in `_pou__bit` with the power and the old value).
+    Bit,
+    /// An INT move from a variable or a constant (true).
+    Move(bool),
+    /// INT `+`, `-` or `*` (wrapping, `_plc_add_i16` …) of variables or constants (true).
+    Arith(&'static str, bool, bool),
+}
+
+impl Out {
+    /// Its slots: the target, then the operands.
+    fn slots(self) -> usize {
+        match self {
+            Out::Bit | Out::Move(_) => 2,
+            Out::Arith(..) => 3,
+        }
+    }
 }
 
 /// The shape of a row: what its kernel computes.
@@ -82,12 +99,16 @@ impl Shape {
                 .iter()
                 .map(|i| match i {
                     Item::Lit(_) => 1,
-                    Item::Edge(_) => 2,
+                    Item::Edge(_) | Item::Cmp(..) => 2,
                     Item::Or(bs) => bs.iter().map(|b| count(b)).sum(),
                 })
                 .sum()
         }
-        self.outs.len() + self.lits + usize::from(self.lits > 0) + count(&self.cond)
+        self.out_slots() + self.lits + usize::from(self.lits > 0) + count(&self.cond)
+    }
+
+    fn out_slots(&self) -> usize {
+        self.outs.iter().map(|o| o.slots()).sum()
     }
 }
 
@@ -103,6 +124,8 @@ pub(crate) struct Row {
 pub(crate) struct Kernels {
     ids: HashMap<Shape, u32>,
     shapes: Vec<Shape>,
+    /// Some slot of some row is 65,536 or more: the tables hold `uint32_t`, not `uint16_t`.
+    wide: bool,
 }
 
 impl Kernels {
@@ -114,7 +137,18 @@ impl Kernels {
         if kernel == next {
             self.shapes.push(shape);
         }
+        self.wide |= slots.iter().any(|&v| v > u32::from(u16::MAX));
         Some(Row { kernel, slots })
+    }
+
+    /// The C type of the tables' entries: 16 bits when every slot fits (half the bytes a
+    /// scan reads from the tables), else 32.
+    pub fn entry_type(&self) -> &'static str {
+        if self.wide {
+            "uint32_t"
+        } else {
+            "uint16_t"
+        }
     }
 
     pub fn is_empty(&self) -> bool {
@@ -125,29 +159,33 @@ impl Kernels {
     pub fn source(&self) -> String {
         let mut s = String::from(
             "/* plc_rows.c: the loops that run the rows of the tables, one per rung shape \
-             (docs/c.md). */\n#include \"plc_runtime.h\"\n\n",
+             (docs/c.md). */\n#include \"plc_runtime.h\"\n\n\
+             /* A BOOL output's new value: _pou__bit[kind | power << 2 | old << 3], kind 0 coil, \
+             1 negated coil, 2 set, 3 reset. */\n\
+             static const uint8_t _pou__bit[16] = {0, 1, 0, 0, 1, 0, 1, 0, 0, 1, 1, 1, 1, 0, 1, 0};\n\n",
         );
         for (k, shape) in self.shapes.iter().enumerate() {
-            s.push_str(&kernel(k, shape));
+            s.push_str(&kernel(k, shape, self.entry_type()));
         }
         s
     }
 }
 
-/// The declaration of kernel `k`.
-fn kernel_decl(k: u32) -> String {
-    format!("void _pou__k{k}(uint8_t *s, const uint32_t *t, size_t n)")
+/// The declaration of kernel `k` over tables of `ty`.
+fn kernel_decl(k: u32, ty: &str) -> String {
+    format!("void _pou__k{k}(uint8_t *s, const {ty} *t, size_t n)")
 }
 
 /// The C of kernel `k`: one loop over `n` rows of `shape`.
-fn kernel(k: usize, shape: &Shape) -> String {
+fn kernel(k: usize, shape: &Shape, ty: &str) -> String {
     let mut pre = String::new();
-    let mut next = shape.outs.len() + shape.lits + usize::from(shape.lits > 0);
+    let mut next = shape.out_slots() + shape.lits + usize::from(shape.lits > 0);
     let mut cond = and_expr(&shape.cond, &mut next, &mut pre);
     if shape.lits > 0 {
         // The contacts' bytes as the bits of a word, compared with the pattern the row's
-        // contacts pass on (bit i set: contact i is Normal).
-        let o = shape.outs.len();
+        // contacts pass on (entry bit i set: contact i is Normal) where they count (bit 8 + i
+        // set: contact i is one of the rung's, not padding).
+        let o = shape.out_slots();
         let bits: Vec<String> = (0..shape.lits)
             .map(|i| match i {
                 0 => format!("(unsigned)s[t[{o}]]"),
@@ -155,25 +193,45 @@ fn kernel(k: usize, shape: &Shape) -> String {
             })
             .collect();
         push(&mut pre, format_args!("        unsigned q = {};\n", bits.join(" | ")));
-        let eq = format!("(q == t[{}])", o + shape.lits);
+        let e = format!("t[{}]", o + shape.lits);
+        let eq = format!("(((q ^ {e}) & ({e} >> 8)) == 0)");
         cond = if shape.cond.is_empty() { eq } else { format!("{eq} & {cond}") };
     }
     let mut body = pre;
     push(&mut body, format_args!("        unsigned p = {cond};\n"));
-    for (i, o) in shape.outs.iter().enumerate() {
-        let stmt = match o {
-            Out::Coil => format!("s[t[{i}]] = p;"),
-            Out::NegCoil => format!("s[t[{i}]] = p ^ 1;"),
-            Out::Set => format!("s[t[{i}]] |= p;"),
-            Out::Reset => format!("s[t[{i}]] &= p ^ 1;"),
+    let mut i = 0;
+    for o in &shape.outs {
+        let int = |k: usize| format!("*(int16_t *)(s + t[{k}])");
+        let stmt = match *o {
+            Out::Bit => format!(
+                "s[t[{i}]] = _pou__bit[t[{}] | p << 2 | (unsigned)s[t[{i}]] << 3];",
+                i + 1
+            ),
+            Out::Move(c) => format!("{0} = p ? {1} : {0};", int(i), int_operand(i + 1, c)),
+            Out::Arith(f, ca, cb) => format!(
+                "{0} = p ? _plc_{f}_i16({1}, {2}) : {0};",
+                int(i),
+                int_operand(i + 1, ca),
+                int_operand(i + 2, cb)
+            ),
         };
+        i += o.slots();
         push(&mut body, format_args!("        {stmt}\n"));
     }
     format!(
         "_PLC_KERNEL {} {{\n    for (; n; n--, t += {}) {{\n{body}    }}\n}}\n\n",
-        kernel_decl(k as u32).trim_start_matches("void "),
+        kernel_decl(k as u32, ty).trim_start_matches("void "),
         shape.slots()
     )
+}
+
+/// The INT in slot `k`: a constant (`c`, its bits) or a variable's offset.
+fn int_operand(k: usize, c: bool) -> String {
+    if c {
+        format!("(int16_t)(uint16_t)t[{k}]")
+    } else {
+        format!("*(int16_t *)(s + t[{k}])")
+    }
 }
 
 /// The C expression of an AND of items whose slots start at `*next`; edge pulses are computed
@@ -207,6 +265,11 @@ fn and_expr(items: &[Item], next: &mut usize, pre: &mut String) -> String {
                 );
                 format!("e{v}")
             }
+            Item::Cmp(op, ca, cb) => {
+                *next += 2;
+                let (a, b) = (int_operand(*next - 2, *ca), int_operand(*next - 1, *cb));
+                format!("({a} {op} {b})")
+            }
             Item::Or(branches) => {
                 let bs: Vec<String> = branches
                     .iter()
@@ -224,13 +287,19 @@ fn and_expr(items: &[Item], next: &mut usize, pre: &mut String) -> String {
 
 /// The shape of `series` and its slots, if it is a row.
 fn shape(sh: &Shared, series: &Series) -> Option<(Shape, Vec<u32>)> {
-    let (out, cond) = series.split_last()?;
-    let mut outs = Vec::new();
+    let (out, rest) = series.split_last()?;
+    // The boxes directly before the output run, when powered, before it.
+    let n = rest.iter().rposition(|e| int_box(sh, e).is_none()).map_or(0, |i| i + 1);
+    let (cond, boxes) = rest.split_at(n);
+    let mut outs: Vec<(Out, Vec<u32>)> = Vec::new();
+    for e in boxes {
+        outs.push(int_box(sh, e)?);
+    }
     match out {
         Element::Branch(paths) => {
             for path in paths {
                 match path.as_slice() {
-                    [e] => outs.push(output(sh, e)?),
+                    [e] => outs.push(output(sh, e).or_else(|| int_box(sh, e))?),
                     _ => return None,
                 }
             }
@@ -241,16 +310,17 @@ fn shape(sh: &Shared, series: &Series) -> Option<(Shape, Vec<u32>)> {
         return None;
     }
     let items = and_items(sh, cond, true)?;
-    let mut slots: Vec<u32> = outs.iter().map(|o| o.1).collect();
+    let out_slots = outs.iter().map(|o| o.1.len()).sum::<usize>();
+    let mut slots: Vec<u32> = outs.iter().flat_map(|o| o.1.clone()).collect();
     let (mut cond, mut rest) = (Vec::new(), Vec::new());
     let mut pattern = 0u32;
     for (item, s) in items {
         match item {
             Item::Lit(neg) => {
-                if slots.len() - outs.len() == 32 {
+                if slots.len() - out_slots == 8 {
                     return None; // more contacts than the pattern word has bits
                 }
-                pattern |= u32::from(!neg) << (slots.len() - outs.len());
+                pattern |= u32::from(!neg) << (slots.len() - out_slots);
                 slots.extend(s);
             }
             item => {
@@ -259,9 +329,19 @@ fn shape(sh: &Shared, series: &Series) -> Option<(Shape, Vec<u32>)> {
             }
         }
     }
-    let lits = slots.len() - outs.len();
+    let real = slots.len() - out_slots;
+    // Padded to a class of 4, 6 or 8 contacts (fewer kernels, longer runs): a padded contact
+    // reads the first output's byte and is masked out of the comparison.
+    let lits = match real {
+        0 => 0,
+        1..=4 => 4,
+        5 | 6 => 6,
+        _ => 8,
+    };
+    let care = (1u32 << real) - 1;
+    slots.resize(out_slots + lits, slots[0]);
     if lits > 0 {
-        slots.push(pattern);
+        slots.push(pattern | care << 8);
     }
     slots.extend(rest);
     let outs = outs.into_iter().map(|o| o.0).collect();
@@ -287,12 +367,24 @@ fn item(sh: &Shared, e: &Element, top: bool) -> Option<(Item, Vec<u32>)> {
                 ContactKind::Normal => Some((Item::Lit(false), vec![v])),
                 ContactKind::Negated => Some((Item::Lit(true), vec![v])),
                 ContactKind::Rising { memory } | ContactKind::Falling { memory } if top => {
-                    let m = sh.bool_at[memory.index()]?;
+                    let m = bool_at(sh, *memory)?;
                     let falling = matches!(kind, ContactKind::Falling { .. });
                     Some((Item::Edge(falling), vec![v, m]))
                 }
                 _ => None,
             }
+        }
+        Element::Compare { op, a, b } => {
+            let (a, b) = (int_slot(sh, a)?, int_slot(sh, b)?);
+            let sym = match op {
+                CmpOp::Eq => "==",
+                CmpOp::Ne => "!=",
+                CmpOp::Lt => "<",
+                CmpOp::Le => "<=",
+                CmpOp::Gt => ">",
+                CmpOp::Ge => ">=",
+            };
+            Some((Item::Cmp(sym, a.1, b.1), vec![a.0, b.0]))
         }
         Element::Or(branches) if !branches.is_empty() => {
             let mut bs = Vec::with_capacity(branches.len());
@@ -318,25 +410,58 @@ fn item(sh: &Shared, e: &Element, top: bool) -> Option<(Item, Vec<u32>)> {
     }
 }
 
+/// An INT move or `+`, `-`, `*` box as a row output (its slots: target, operands).
+fn int_box(sh: &Shared, e: &Element) -> Option<(Out, Vec<u32>)> {
+    let target = |v: VarId| (sh.p.var(v).ty == Type::Int).then(|| sh.at[v.index()])?;
+    match e {
+        Element::Move { from, to } => {
+            let (f, c) = int_slot(sh, from)?;
+            Some((Out::Move(c), vec![target(*to)?, f]))
+        }
+        Element::Arith { op, a, b, out } => {
+            let f = match op {
+                ArithOp::Add => "add",
+                ArithOp::Sub => "sub",
+                ArithOp::Mul => "mul",
+                ArithOp::Div | ArithOp::Mod => return None, // they may record a fault
+            };
+            let ((a, ca), (b, cb)) = (int_slot(sh, a)?, int_slot(sh, b)?);
+            Some((Out::Arith(f, ca, cb), vec![target(*out)?, a, b]))
+        }
+        _ => None,
+    }
+}
+
+/// An INT operand's slot: a variable's offset (false) or a constant's bits (true).
+fn int_slot(sh: &Shared, o: &Operand) -> Option<(u32, bool)> {
+    match *o {
+        Operand::Const(Value::Int(v)) => Some((u32::from(v as u16), true)),
+        Operand::Var(VarRef { var, field: None }) if sh.p.var(var).ty == Type::Int => {
+            Some((sh.at[var.index()]?, false))
+        }
+        _ => None,
+    }
+}
+
 /// An output element as a row output.
-fn output(sh: &Shared, e: &Element) -> Option<(Out, u32)> {
-    let (var, out) = match *e {
+fn output(sh: &Shared, e: &Element) -> Option<(Out, Vec<u32>)> {
+    let (var, kind) = match *e {
         Element::Coil {
             var,
             negated: false,
-        } => (var, Out::Coil),
-        Element::Coil { var, negated: true } => (var, Out::NegCoil),
-        Element::Set(var) => (var, Out::Set),
-        Element::Reset(var) => (var, Out::Reset),
+        } => (var, 0),
+        Element::Coil { var, negated: true } => (var, 1),
+        Element::Set(var) => (var, 2),
+        Element::Reset(var) => (var, 3),
         _ => return None,
     };
-    Some((out, bool_at(sh, var)?))
+    Some((Out::Bit, vec![bool_at(sh, var)?, kind]))
 }
 
 /// The offset of a BOOL variable of the state.
 fn bool_at(sh: &Shared, v: VarId) -> Option<u32> {
     (sh.p.var(v).ty == Type::Bool).then_some(())?;
-    sh.bool_at[v.index()]
+    sh.at[v.index()]
 }
 
 /// The offset of a contact's BOOL (a whole BOOL variable of the state; fields of instances
@@ -348,26 +473,28 @@ fn contact(sh: &Shared, r: VarRef) -> Option<u32> {
     }
 }
 
-/// The rows of the functions of one source file: a table per kernel (data file
-/// `plc_table{file}.c`), and the run not yet called (its kernel and first row).
+/// The rows of the functions of one source file: one table (data file `plc_table{file}.c`)
+/// that holds them in the order they run, whatever their kernels, so a scan reads it front to
+/// back (with a table per kernel, every short run started on a cache line of its own); the
+/// kernels used, and the run not yet called (its kernel, first entry, rows).
 pub(crate) struct Tables {
     file: usize,
-    tables: BTreeMap<u32, Table>,
-    run: Option<(u32, usize)>,
-}
-
-/// One table: the initializer text of its rows, how many, the slots per row.
-struct Table {
+    /// The C type of the entries (`Kernels::entry_type`).
+    ty: &'static str,
     text: String,
-    count: usize,
-    stride: usize,
+    entries: usize,
+    used: BTreeSet<u32>,
+    run: Option<(u32, usize, usize)>,
 }
 
 impl Tables {
-    pub fn new(file: usize) -> Tables {
+    pub fn new(file: usize, ty: &'static str) -> Tables {
         Tables {
             file,
-            tables: BTreeMap::new(),
+            ty,
+            text: String::new(),
+            entries: 0,
+            used: BTreeSet::new(),
             run: None,
         }
     }
@@ -375,71 +502,56 @@ impl Tables {
     /// Adds `row` (rung `id`); the call of the run it ends, if it starts another.
     pub fn push(&mut self, row: &Row, id: &str) -> Option<String> {
         let call = match self.run {
-            Some((k, _)) if k != row.kernel => self.take_call(),
+            Some((k, _, _)) if k != row.kernel => self.take_call(),
             _ => None,
         };
-        let t = self.tables.entry(row.kernel).or_insert_with(|| Table {
-            text: String::new(),
-            count: 0,
-            stride: row.slots.len(),
-        });
-        if self.run.is_none() {
-            self.run = Some((row.kernel, t.count));
+        match &mut self.run {
+            Some((_, _, n)) => *n += 1,
+            None => self.run = Some((row.kernel, self.entries, 1)),
         }
+        self.used.insert(row.kernel);
         let nums: Vec<String> = row.slots.iter().map(u32::to_string).collect();
         push(
-            &mut t.text,
+            &mut self.text,
             format_args!("    {}, /* {id} */\n", nums.join(", ")),
         );
-        t.count += 1;
+        self.entries += row.slots.len();
         call
     }
 
     /// The call of the run of rows pushed since the last call, if any.
     pub fn take_call(&mut self) -> Option<String> {
-        let (k, first) = self.run.take()?;
-        let t = &self.tables[&k];
+        let (k, first, n) = self.run.take()?;
         Some(format!(
-            "_pou__k{k}((uint8_t *)self, _pou__t{}_{k} + {}, {});",
-            self.file,
-            first * t.stride,
-            t.count - first
+            "_pou__k{k}((uint8_t *)self, _pou__t{} + {first}, {n});",
+            self.file
         ))
     }
 
     /// The declarations the functions' C needs (empty: no rows).
     pub fn declarations(&self) -> String {
-        let mut s = String::new();
-        for &k in self.tables.keys() {
-            push(
-                &mut s,
-                format_args!(
-                    "extern const uint32_t _pou__t{}_{k}[];\n{};\n",
-                    self.file,
-                    kernel_decl(k)
-                ),
-            );
+        if self.entries == 0 {
+            return String::new();
+        }
+        let mut s = format!("extern const {} _pou__t{}[];\n", self.ty, self.file);
+        for &k in &self.used {
+            push(&mut s, format_args!("{};\n", kernel_decl(k, self.ty)));
         }
         s
     }
 
     /// The data file (name stem, text), if there are rows.
     pub fn data_file(&self) -> Option<(String, String)> {
-        if self.tables.is_empty() {
+        if self.entries == 0 {
             return None;
         }
-        let mut s = String::from("/* Rows of contacts and coils: byte offsets (docs/c.md). */\n#include <stdint.h>\n\n");
-        for (k, t) in &self.tables {
-            push(
-                &mut s,
-                format_args!(
-                    "const uint32_t _pou__t{}_{k}[{}] = {{\n{}}};\n",
-                    self.file,
-                    t.count * t.stride,
-                    t.text
-                ),
-            );
-        }
-        Some((format!("plc_table{}", self.file), s))
+        Some((
+            format!("plc_table{}", self.file),
+            format!(
+                "/* Rows of contacts and coils: byte offsets (docs/c.md). */\n#include <stdint.h>\n\n\
+                 const {} _pou__t{}[{}] = {{\n{}}};\n",
+                self.ty, self.file, self.entries, self.text
+            ),
+        ))
     }
 }
