@@ -367,7 +367,10 @@ fn missing_kinds(
         ("a rising edge", edge("]] & (s[t[")),
         ("a falling edge", edge("]] ^ 1) & s[t[")),
         ("a compare", kernels.contains("(*(int16_t *)(s + t[")),
-        ("a move", kernels.contains("= p ? *(int16_t *)") || kernels.contains("= p ? (int16_t)")),
+        (
+            "a move",
+            kernels.contains("= p ? *(int16_t *)") || kernels.contains("= p ? (int16_t)"),
+        ),
         ("arithmetic", kernels.contains("= p ? _plc_")),
         ("two outputs", kernels.contains("s[t[2]] = _pou__bit[")),
         ("a coil", outs[0]),
@@ -392,9 +395,14 @@ fn row_ids(tables: &str) -> Vec<String> {
 
 /// Whether some row comes before a row of an earlier rung (`p`'s rung order).
 fn reordered(p: &plc_deps::model::Program, ids: &[String]) -> bool {
-    let at: std::collections::HashMap<&str, usize> =
-        p.rungs.iter().enumerate().map(|(i, r)| (r.id.as_str(), i)).collect();
-    ids.windows(2).any(|w| at[w[0].as_str()] > at[w[1].as_str()])
+    let at: std::collections::HashMap<&str, usize> = p
+        .rungs
+        .iter()
+        .enumerate()
+        .map(|(i, r)| (r.id.as_str(), i))
+        .collect();
+    ids.windows(2)
+        .any(|w| at[w[0].as_str()] > at[w[1].as_str()])
 }
 
 /// By default the rungs of contacts and coils of a generated program (ORs, edges, set/reset,
@@ -473,6 +481,9 @@ fn random_ladder_programs_have_rows_of_every_kind() {
         let text = plc_deps::synth::generate_string(&gc);
         let (p, fbd) = plc_deps::load::program_and_fbd_from_json(&text).unwrap();
         let (t, _) = rows_text(&generate(&p, &fbd, &CConfig::default()));
-        assert!(reordered(&p, &row_ids(&t)), "gen-{seed}: rows in program order");
+        assert!(
+            reordered(&p, &row_ids(&t)),
+            "gen-{seed}: rows in program order"
+        );
     }
 }

@@ -44,7 +44,10 @@ pub(crate) fn program_source(p: &Program, sh: &Shared, extra: &[String], cfg: &C
     // The BOOLs, then the INTs, are the struct's first members (the rows' tables hold their
     // offsets): the last of each where the generator put it.
     for ty in [Type::Bool, Type::Int] {
-        let last = (0..p.vars.len()).filter(|&i| p.vars[i].ty == ty).filter_map(|i| Some((i, sh.at[i]?))).last();
+        let last = (0..p.vars.len())
+            .filter(|&i| p.vars[i].ty == ty)
+            .filter_map(|i| Some((i, sh.at[i]?)))
+            .next_back();
         if let Some((i, at)) = last {
             push(
                 &mut s,

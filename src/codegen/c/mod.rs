@@ -163,9 +163,7 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
                 let text = format!("#include \"plc_program.h\"\n\n{body}");
                 (vec![(String::new(), text)], String::new())
             }
-            (None, Some(plan)) => {
-                ladder_files(p, &sh, i, cfg, per_file, plan, &mut data)
-            }
+            (None, Some(plan)) => ladder_files(p, &sh, i, cfg, per_file, plan, &mut data),
             (None, None) => unreachable!("a POU with a stem is FBD or ladder"),
         };
         files.push(CFile {
@@ -282,9 +280,9 @@ fn member_offsets(p: &Program, lay: &types::Layout, local_only: &[bool]) -> Vec<
     let mut next = 0u32;
     for (ty, size) in [(Type::Bool, 1), (Type::Int, 2)] {
         next = next.next_multiple_of(size);
-        for i in 0..p.vars.len() {
+        for (i, at) in out.iter_mut().enumerate() {
             if member(i) && p.vars[i].ty == ty {
-                out[i] = Some(next);
+                *at = Some(next);
                 next += size;
             }
         }
@@ -439,4 +437,3 @@ fn fbd_function(
         b.finish()
     )
 }
-

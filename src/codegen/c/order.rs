@@ -73,7 +73,10 @@ pub(crate) fn plan(
         }
         let mut idx: Vec<usize> = (0..order.len()).collect();
         idx.sort_by_key(|&i| key[i]);
-        order = idx.into_iter().map(|i| RungId(range.start + i as u32)).collect();
+        order = idx
+            .into_iter()
+            .map(|i| RungId(range.start + i as u32))
+            .collect();
     }
     let mut weight = Vec::with_capacity(order.len());
     let mut prev = None;

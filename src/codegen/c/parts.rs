@@ -45,9 +45,10 @@ pub(crate) fn chunks(
         });
     }
     let mut out = Vec::new();
-    let (mut start, mut depth, mut units) = (0usize, 0i32, plan.weight.first().copied().unwrap_or(0));
-    for i in 1..n {
-        depth += diff[i];
+    let (mut start, mut depth, mut units) =
+        (0usize, 0i32, plan.weight.first().copied().unwrap_or(0));
+    for (i, d) in diff.iter().enumerate().take(n).skip(1) {
+        depth += d;
         if depth == 0 && units >= chunk {
             out.push(start..i);
             start = i;

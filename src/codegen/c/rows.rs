@@ -192,10 +192,17 @@ fn kernel(k: usize, shape: &Shape, ty: &str) -> String {
                 _ => format!("(unsigned)s[t[{}]] << {i}", o + i),
             })
             .collect();
-        push(&mut pre, format_args!("        unsigned q = {};\n", bits.join(" | ")));
+        push(
+            &mut pre,
+            format_args!("        unsigned q = {};\n", bits.join(" | ")),
+        );
         let e = format!("t[{}]", o + shape.lits);
         let eq = format!("(((q ^ {e}) & ({e} >> 8)) == 0)");
-        cond = if shape.cond.is_empty() { eq } else { format!("{eq} & {cond}") };
+        cond = if shape.cond.is_empty() {
+            eq
+        } else {
+            format!("{eq} & {cond}")
+        };
     }
     let mut body = pre;
     push(&mut body, format_args!("        unsigned p = {cond};\n"));
@@ -261,7 +268,9 @@ fn and_expr(items: &[Item], next: &mut usize, pre: &mut String) -> String {
                 };
                 push(
                     pre,
-                    format_args!("        unsigned e{v} = {pulse};\n        s[t[{m}]] = s[t[{v}]];\n"),
+                    format_args!(
+                        "        unsigned e{v} = {pulse};\n        s[t[{m}]] = s[t[{v}]];\n"
+                    ),
                 );
                 format!("e{v}")
             }
@@ -289,7 +298,10 @@ fn and_expr(items: &[Item], next: &mut usize, pre: &mut String) -> String {
 fn shape(sh: &Shared, series: &Series) -> Option<(Shape, Vec<u32>)> {
     let (out, rest) = series.split_last()?;
     // The boxes directly before the output run, when powered, before it.
-    let n = rest.iter().rposition(|e| int_box(sh, e).is_none()).map_or(0, |i| i + 1);
+    let n = rest
+        .iter()
+        .rposition(|e| int_box(sh, e).is_none())
+        .map_or(0, |i| i + 1);
     let (cond, boxes) = rest.split_at(n);
     let mut outs: Vec<(Out, Vec<u32>)> = Vec::new();
     for e in boxes {
