@@ -1,36 +1,42 @@
-//! Rungs of contacts and coils as data: each such rung is a row of plain byte offsets in a
-//! table, run by a small loop generated for its exact *shape* (a kernel), instead of C
-//! statements per rung.
+//! Rungs of contacts and coils as data: each such rung is a row of plain numbers (byte offsets,
+//! a pattern word, output kinds, INT constants) in a table, run by a small loop generated for
+//! its *shape* (a kernel), instead of C statements per rung.
 //!
 //! Why: `cc -O2` spends about a millisecond of CPU on each rung written as statements (spread
 //! over all its passes), so 100,000 rungs as statements take minutes to build however they are
 //! written. A row costs only the parsing of a few integers, and a kernel is a loop of a few
-//! lines, compiled once for every rung of its shape. Because the kernel is specialised — its
-//! contacts, negations, ORs, edge and outputs are C code, only the offsets are data — a row runs
-//! about as fast as the statements (docs/c.md).
+//! lines, compiled once for every rung of its shape. Because the kernel is specialised (its
+//! contact count, ORs, edges, compares and boxes are C code) a row runs about as fast as the
+//! statements (docs/c.md).
 //!
 //! A rung is a row when its series is a condition of Normal, Negated, Rising and Falling
-//! contacts on BOOL variables of the state (ORs of series of Normal and Negated contacts, no
-//! empty branch; edge contacts only outside the ORs) followed by one output, or an output
-//! branch of single outputs: coil, negated coil, set or reset of BOOL variables of the state.
-//! Its shape is that tree in a canonical form: the items of every AND sorted (positive
-//! contacts, negated contacts, edge contacts, ORs), the branches of every OR too — exact since
-//! contacts have no side effects, and an edge contact's only effect is on its own hidden memory,
-//! which no other contact reads; so rungs that differ only in the order of their contacts share
-//! one kernel. The row's slots are the outputs' offsets, then the contacts' offsets in the
-//! canonical order (an edge contact: its BOOL, then its memory).
+//! contacts on BOOL variables of the state and compares of INTs (variables of the state or
+//! INT constants), with ORs of series of those (no edge inside an OR, no empty branch), then
+//! optionally INT moves and ADD/SUB/MUL boxes, then one output or an output branch of single
+//! outputs or INT boxes: coil, negated coil, set or reset of BOOL variables of the state.
+//! Its shape is that tree in a canonical form: the top-level Normal and Negated contacts are a
+//! count, padded to 4, 6 or 8 (which are negated is the row's pattern word, and padded slots
+//! are masked out by its care bits); the other items of every AND are sorted, the branches of
+//! every OR too — exact since contacts and compares have no side effects, and an edge contact's
+//! only effect is on its own hidden memory, which no other contact reads; so rungs that differ
+//! only in the order or the negations of their contacts share one kernel. A BOOL output's kind
+//! (coil, negated coil, set, reset) is data too: the new value is looked up in a table of 16
+//! bytes by kind, power and old value. The row's slots are the outputs' (the BOOL and its kind;
+//! a box's target and operands), then the contacts' offsets and the pattern word, then the
+//! other items' (an edge contact: its BOOL, then its memory; a compare: its two operands).
 //!
 //! The kernel evaluates as the interpreter does (docs/scan.md): every edge contact computes its
-//! pulse (rising `v & !m`, falling `!v & m`) and its memory takes `v` before the outputs are
-//! written, all contacts are read before the first output is written, and the outputs are
-//! written in order: coil `p`, negated coil `!p`, set `old | p`, reset `old & !p`. BOOLs are the
-//! bytes 0 and 1 of C `bool`s, read and written through `uint8_t`, which may alias anything; a
-//! BOOL's offset is its index among the state's BOOL members, which `_plc_state` lists first
-//! (`mod`, checked by `_Static_assert`s in `plc_program.c`), so table files need no struct and
-//! no `offsetof`: they are data only.
+//! pulse (rising `v & !m`, falling `!v & m`) and its memory takes `v`, and every contact and
+//! compare is read, before the first output is written; the outputs and boxes are written in
+//! order (coil `p`, negated coil `!p`, set `old | p`, reset `old & !p`; a box only when
+//! powered). BOOLs are the bytes 0 and 1 of C `bool`s, read and written through `uint8_t`,
+//! which may alias anything; INTs are read and written as `int16_t`. Offsets are the
+//! generator's own (`mod::member_offsets`: the BOOLs, then the INTs, first in `_plc_state`,
+//! checked by `_Static_assert`s), so table files need no struct and no `offsetof`: they are
+//! data only.
 //!
 //! Consecutive rows of one kernel in a function make one run, one call
-//! `_pou__kK((uint8_t *)self, _pou__tF_K + first, count)`; any other line of C (a rung that is no
+//! `_pou__kK((uint8_t *)self, _pou__tF + first, count)`; any other line of C (a rung that is no
 //! row, a label, the function's end) ends the run first, so rows run in the order they are
 //! emitted. Only ladder functions of POUs use rows (not FBD bodies or function block types,
 //! whose variables may be locals or another struct's members). The emission order itself (rungs
