@@ -15,8 +15,9 @@
 //!
 //! Shapes (docs/gen.md): `wide` is `gen --rungs N` (100 rungs per stage, local reads),
 //! `levels20` is `gen --rungs N --levels 20` (local reads), `levels20-random` adds
-//! `--reads random`; a shape with `+rows` (`wide+rows`) is the same program (the same JSON and
-//! inputs) generated with `plc-deps c --rows`. It uses the `plc-deps` binary beside this example's folder
+//! `--reads random`; a shape with `+statements` (`wide+statements`) is the same program (the
+//! same JSON and inputs) generated with `plc-deps c --statements` (every rung as C statements,
+//! not the default rows). It uses the `plc-deps` binary beside this example's folder
 //! (`target/release/plc-deps`; `PLC_DEPS=path` to choose another) and `make`, `cc` and
 //! `/usr/bin/time` from the PATH. It times things: run it on a quiet machine.
 
@@ -88,13 +89,13 @@ impl Options {
 }
 
 fn usage(why: &str) -> ! {
-    eprintln!("c_speed: {why}\nusage: c_speed [--sizes N,N] [--shapes wide,levels20,levels20-random,wide+rows,…] [--runs R] [--dir DIR]");
+    eprintln!("c_speed: {why}\nusage: c_speed [--sizes N,N] [--shapes wide,levels20,levels20-random,wide+statements,…] [--runs R] [--dir DIR]");
     std::process::exit(2);
 }
 
 /// The `gen` arguments of a shape.
 fn shape_args(shape: &str) -> Option<&'static [&'static str]> {
-    match shape.strip_suffix("+rows").unwrap_or(shape) {
+    match shape.strip_suffix("+statements").unwrap_or(shape) {
         "wide" => Some(&[]),
         "levels20" => Some(&["--levels", "20"]),
         "levels20-random" => Some(&["--levels", "20", "--reads", "random"]),
@@ -145,7 +146,7 @@ fn measure(bin: &Path, o: &Options, rungs: usize, shape: &str) -> String {
     let rungs_s = rungs.to_string();
     let json = o.dir.join(format!(
         "{}-{rungs}.json",
-        shape.strip_suffix("+rows").unwrap_or(shape)
+        shape.strip_suffix("+statements").unwrap_or(shape)
     ));
     let mut gen = Command::new(bin);
     gen.args(["gen", "--rungs", &rungs_s])
@@ -159,7 +160,7 @@ fn measure(bin: &Path, o: &Options, rungs: usize, shape: &str) -> String {
         .arg("-o")
         .arg(&cdir)
         .arg("--force")
-        .args(shape.ends_with("+rows").then_some("--rows")));
+        .args(shape.ends_with("+statements").then_some("--statements")));
     let scans = scans_for(rungs);
     write_inputs(&json, &csv, scans);
     eprintln!("{shape} {rungs}: building");

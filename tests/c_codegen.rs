@@ -293,9 +293,11 @@ fn a_large_pou_is_cut_into_at_most_sixteen_part_files_and_stays_exact() {
     };
     let text = plc_deps::synth::generate_string(&gc);
     let (p, fbd) = plc_deps::load::program_and_fbd_from_json(&text).unwrap();
-    // One rung per function: 600 functions, 38 per file (600 / 16 rounded up), so 16 files.
+    // One rung per function: 600 functions, 38 per file (600 / 16 rounded up), so 16 files
+    // (the rungs as statements: with rows, a run of rows of one kernel is one unit).
     let cfg = CConfig {
         chunk_rungs: 1,
+        rows: false,
         ..CConfig::default()
     };
     let files = generate(&p, &fbd, &cfg);
@@ -316,8 +318,97 @@ fn a_large_pou_is_cut_into_at_most_sixteen_part_files_and_stays_exact() {
     batch.check(1, "parts");
 }
 
-/// With `rows`, the rungs of contacts and coils of a generated program (ORs, edges, set/reset,
-/// two-coil outputs) become rows of the two tables, and the C still matches the interpreter.
+/// The rows' data files (`plc_table*.c`) and kernels (`plc_rows.c`) of `files`.
+fn rows_text(files: &[plc_deps::codegen::c::CFile]) -> (String, String) {
+    let pick = |f: &dyn Fn(&str) -> bool| -> String {
+        files
+            .iter()
+            .filter(|x| f(&x.name))
+            .map(|x| x.text.as_str())
+            .collect()
+    };
+    (
+        pick(&|n| n.starts_with("plc_table")),
+        pick(&|n| n == "plc_rows.c"),
+    )
+}
+
+/// The kinds of row none of `kernels` (and none of the rows `ids` of `p`) is: contacts (their
+/// negations in the pattern word), ORs, rising and falling edges, INT compares, INT moves and
+/// arithmetic, two outputs, and (data, not code) coil, negated coil, set and reset.
+fn missing_kinds(
+    kernels: &str,
+    p: &plc_deps::model::Program,
+    ids: &std::collections::HashSet<String>,
+) -> Vec<&'static str> {
+    use plc_deps::model::Element;
+    let edge = |needle: &str| {
+        kernels
+            .lines()
+            .any(|l| l.trim_start().starts_with("unsigned e") && l.contains(needle))
+    };
+    let mut outs = [false; 4];
+    for r in p.rungs.iter().filter(|r| ids.contains(&r.id)) {
+        let mut see = |e: &Element| match e {
+            Element::Coil { negated, .. } => outs[usize::from(*negated)] = true,
+            Element::Set(_) => outs[2] = true,
+            Element::Reset(_) => outs[3] = true,
+            _ => {}
+        };
+        match r.series.last() {
+            Some(Element::Branch(paths)) => paths.iter().flatten().for_each(&mut see),
+            Some(e) => see(e),
+            None => {}
+        }
+    }
+    [
+        ("contacts", kernels.contains("(((q ^ t[")),
+        ("an OR", kernels.contains(" | s[t[")),
+        ("a rising edge", edge("]] & (s[t[")),
+        ("a falling edge", edge("]] ^ 1) & s[t[")),
+        ("a compare", kernels.contains("(*(int16_t *)(s + t[")),
+        (
+            "a move",
+            kernels.contains("= p ? *(int16_t *)") || kernels.contains("= p ? (int16_t)"),
+        ),
+        ("arithmetic", kernels.contains("= p ? _plc_")),
+        ("two outputs", kernels.contains("s[t[2]] = _pou__bit[")),
+        ("a coil", outs[0]),
+        ("a negated coil", outs[1]),
+        ("a set", outs[2]),
+        ("a reset", outs[3]),
+    ]
+    .into_iter()
+    .filter(|k| !k.1)
+    .map(|k| k.0)
+    .collect()
+}
+
+/// The rung ids of the rows of a data file, in table order (`    12, 5, 3, /* R1 */`).
+fn row_ids(tables: &str) -> Vec<String> {
+    tables
+        .lines()
+        .filter_map(|l| Some(l.split("/* ").nth(1)?.strip_suffix(" */")?.to_string()))
+        .filter(|id| !id.starts_with("Rows of"))
+        .collect()
+}
+
+/// Whether some row comes before a row of an earlier rung (`p`'s rung order).
+fn reordered(p: &plc_deps::model::Program, ids: &[String]) -> bool {
+    let at: std::collections::HashMap<&str, usize> = p
+        .rungs
+        .iter()
+        .enumerate()
+        .map(|(i, r)| (r.id.as_str(), i))
+        .collect();
+    ids.windows(2)
+        .any(|w| at[w[0].as_str()] > at[w[1].as_str()])
+}
+
+/// By default the rungs of contacts and coils of a generated program (ORs, edges, set/reset,
+/// negated coils, two-coil outputs) become rows of kernels specialised by shape, reordered
+/// within their dependence levels so that rows of one kernel run together, and the C still
+/// matches the interpreter; `rows: false` writes every rung as statements.
 #[test]
 fn rows_carry_the_contact_and_coil_rungs_and_stay_exact() {
     let gc = plc_deps::synth::GenConfig {
@@ -328,34 +419,71 @@ fn rows_carry_the_contact_and_coil_rungs_and_stay_exact() {
     };
     let text = plc_deps::synth::generate_string(&gc);
     let (p, fbd) = plc_deps::load::program_and_fbd_from_json(&text).unwrap();
-    let cfg = CConfig {
-        rows: true,
-        ..CConfig::default()
-    };
+    let cfg = CConfig::default();
+    assert!(cfg.rows, "rows are the default");
     let files = generate(&p, &fbd, &cfg);
-    let c: String = files.iter().map(|f| f.text.as_str()).collect();
-    // A row ends with its rung's comment; a rung written as C starts with it.
-    let rows = c.matches("}, /* R").count();
-    let plain = c.matches("static const _plc_row _pou__r").count();
-    let general = c.matches("static const _plc_row2 _pou__s").count();
+    let (tables, kernels) = rows_text(&files);
+    let ids = row_ids(&tables);
     assert!(
-        rows * 10 >= p.rungs.len() * 9,
-        "{rows} rows of {} rungs",
+        ids.len() * 100 >= p.rungs.len() * 95,
+        "{} rows of {} rungs",
+        ids.len(),
         p.rungs.len()
     );
-    assert!(
-        plain > 0 && general > 0,
-        "{plain} plain tables, {general} general"
-    );
-    assert!(c.contains("_plc_rows2((uint8_t *)self, _pou__s"));
-    // Without the option there is no row.
-    let files = generate(&p, &fbd, &CConfig::default());
-    assert!(files
-        .iter()
-        .all(|f| !f.text.contains("_plc_rows((uint8_t *)self")));
+    assert!(reordered(&p, &ids), "rows in program order");
+    let set = ids.iter().cloned().collect();
+    assert_eq!(missing_kinds(&kernels, &p, &set), Vec::<&str>::new());
+    // Without rows there is none.
+    let stmts = CConfig {
+        rows: false,
+        ..CConfig::default()
+    };
+    let plain = generate(&p, &fbd, &stmts);
+    assert_eq!(rows_text(&plain), (String::new(), String::new()));
     let mut rng = Rng::new(5);
     let csv = random_csv(&p, &mut rng, 30);
     let mut batch = Batch::default();
-    batch.add(text, csv, 40, cfg, "rows".into());
+    batch.add(text.clone(), csv.clone(), 40, cfg, "rows".into());
+    batch.add(text, csv, 40, stmts, "statements".into());
     batch.check(1, "rows");
+}
+
+/// The random ladder programs the differential test compiles with rows have rows of every
+/// kind (so that test exercises them), and rows are reordered in some of them and in every
+/// generated program that test compiles with rows.
+#[test]
+fn random_ladder_programs_have_rows_of_every_kind() {
+    let (mut kernels, mut count) = (String::new(), 0);
+    let mut missing: Option<Vec<&str>> = None;
+    for seed in (1..700).step_by(2) {
+        let Ok((p, fbd)) =
+            plc_deps::load::program_and_fbd_from_json(&common::random_program(seed, 24))
+        else {
+            continue;
+        };
+        let (t, k) = rows_text(&generate(&p, &fbd, &CConfig::default()));
+        let ids = row_ids(&t);
+        count += usize::from(reordered(&p, &ids));
+        kernels.push_str(&k);
+        // A kind counts when some program has it (the outputs: in its rows).
+        let m = missing_kinds(&kernels, &p, &ids.iter().cloned().collect());
+        missing = Some(match missing {
+            None => m,
+            Some(old) => old.into_iter().filter(|k| m.contains(k)).collect(),
+        });
+    }
+    assert_eq!(missing.unwrap_or_default(), Vec::<&str>::new());
+    assert!(count >= 1, "{count} programs with reordered rows");
+    // The generated programs the differential test compiles with rows (the odd seeds) all
+    // have reordered rows.
+    for seed in (1..6).step_by(2) {
+        let gc = plc_deps::synth::GenConfig::all_features(400, 20, seed);
+        let text = plc_deps::synth::generate_string(&gc);
+        let (p, fbd) = plc_deps::load::program_and_fbd_from_json(&text).unwrap();
+        let (t, _) = rows_text(&generate(&p, &fbd, &CConfig::default()));
+        assert!(
+            reordered(&p, &row_ids(&t)),
+            "gen-{seed}: rows in program order"
+        );
+    }
 }

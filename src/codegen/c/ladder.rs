@@ -54,6 +54,11 @@ pub(crate) struct Shared<'a> {
     /// Per variable: held in a local of an FBD function only (an arc or a run flag), so no
     /// struct has a member for it.
     pub local_only: Vec<bool>,
+    /// Per variable: its byte offset in `_plc_state` if it is a BOOL or INT member of it
+    /// (they come first in the struct, `member_offsets`).
+    pub at: Vec<Option<u32>>,
+    /// Per rung: its row, if it is written as one (`rows`).
+    pub rows: Vec<Option<super::rows::Row>>,
 }
 
 /// The statements of one C function being written.
@@ -72,8 +77,8 @@ pub(crate) struct Body<'a> {
     pub inst: Option<InstanceCtx>,
     /// Whether each rung gets a comment with its id (off to compare instances' code).
     pub comments: bool,
-    /// Set where rungs of contacts and one coil become rows of a table (`rows`).
-    pub rows: Option<super::rows::Rows>,
+    /// Set where rungs of contacts and coils become rows of tables (`rows`).
+    pub rows: Option<super::rows::Tables>,
 }
 
 /// The instance whose lowered rungs a function block type's function is written from: its
@@ -176,9 +181,11 @@ impl<'a> Body<'a> {
         self.raw_line(text);
     }
 
-    /// Writes one line without ending the run of rows before it.
-    pub(crate) fn line_before_rows(&mut self, text: &str) {
-        self.raw_line(text);
+    /// Writes the call of the run of rows not yet called, if any.
+    pub fn flush_rows(&mut self) {
+        if let Some(call) = self.rows.as_mut().and_then(|r| r.take_call()) {
+            self.raw_line(&call);
+        }
     }
 
     fn raw_line(&mut self, text: &str) {
@@ -199,11 +206,6 @@ impl<'a> Body<'a> {
             Some(l) => l.clone(),
             None => self.place(&self.sh.vars[v.index()]),
         }
-    }
-
-    /// The C lvalue of `r` (a variable or a field of one).
-    pub fn var_ref_text(&self, r: VarRef) -> String {
-        self.var_ref(r)
     }
 
     fn var_ref(&self, r: VarRef) -> String {
@@ -654,8 +656,13 @@ impl<'a> Body<'a> {
     pub fn rung(&mut self, r: RungId) {
         let rung = self.sh.p.rung(r);
         self.label(r);
-        if super::rows::push_rung(self, r) {
-            return;
+        if self.inst.is_none() && self.locals.is_empty() {
+            if let (Some(t), Some(row)) = (self.rows.as_mut(), &self.sh.rows[r.index()]) {
+                if let Some(call) = t.push(row, &names::comment(&rung.id)) {
+                    self.raw_line(&call);
+                }
+                return;
+            }
         }
         if self.comments {
             self.line(&format!("/* {} */", names::comment(&rung.id)));
@@ -720,9 +727,7 @@ impl<'a> Body<'a> {
 
     /// The function body, without the labels no `goto` names.
     pub fn finish(mut self) -> String {
-        if let Some(call) = self.rows.as_mut().and_then(|r| r.take_call()) {
-            self.raw_line(&call);
-        }
+        self.flush_rows();
         let mut out = String::with_capacity(self.out.len());
         for line in self.out.lines() {
             let t = line.trim_start();

@@ -9,12 +9,14 @@
 //! struct member) is one struct `_plc_state` passed to every POU function as `self`; each POU is a function `_pou_<name>(self, ctx)`
 //! (`ctx`: virtual time, scan, loop cap, fault sink). Ladder rungs are one block of statements
 //! each (`ladder`); FBD networks are nested `if` blocks following their fragment trees, with
-//! one local per data arc (`fbd`). A ladder POU of more than [`CConfig::chunk_rungs`] rungs is
-//! cut into functions of about that many rungs at boundaries no jump and no FOR loop crosses,
-//! in part files whose number is bounded (16, plus one per further large POU:
-//! `chunks_per_file`), so the C compiler's time grows linearly with the program. With
-//! [`CConfig::rows`], a ladder POU's rungs of contacts and coils are rows of constant tables run
-//! by a loop of the runtime (`rows`): a third to a half of the compile time, slower rungs.
+//! one local per data arc (`fbd`). A ladder POU's rungs of contacts and coils are rows of
+//! tables of byte offsets, each run by a small loop specialised for the rung's shape (`rows`;
+//! [`CConfig::rows`], the default), emitted in an order that groups them by dependence level
+//! and shape within straight-line regions (`order`); the other rungs are statements. A ladder
+//! POU of more than [`CConfig::chunk_rungs`] units (a rung of statements, a run of rows) is cut
+//! into functions at boundaries no jump and no FOR loop crosses, in part files whose number is
+//! bounded (`parts`), so the C compiler's time grows linearly with the program: at 100,000
+//! rungs a build takes seconds with rows, minutes with every rung as statements (docs/c.md).
 //!
 //! Invariants: the generated program computes after every scan exactly the state and the faults
 //! of the sequential interpreter (`crate::exec::Machine`) given the same inputs (tests:
@@ -30,15 +32,17 @@ mod functions;
 mod harness;
 mod ladder;
 pub mod names;
+mod order;
+mod parts;
 mod rows;
 mod runtime;
 mod spelling;
 mod types;
 
 use crate::fbd::Fbd;
-use crate::model::{walk_elements, Element, PouKind, Program, RungId, VarId};
+use crate::model::{walk_elements, Element, PouKind, Program, Type, VarId};
 use ladder::{c_type, Body, Shared};
-use rows::Rows;
+use parts::{chunks_per_file, ladder_files};
 use std::collections::HashMap;
 
 pub use runtime::RUNTIME_H;
@@ -52,8 +56,9 @@ pub struct CConfig {
     pub loop_cap: u32,
     /// Rungs per function of a large ladder POU.
     pub chunk_rungs: usize,
-    /// Rungs of contacts and coils as rows of tables (`rows`): `cc` time falls to a third to
-    /// a half, the rungs run 1.5–3 times slower (docs/c.md).
+    /// Rungs of contacts and coils as rows of tables run by kernels specialised by shape
+    /// (`rows`; `plc-deps c --statements` turns it off): `cc` takes seconds instead of minutes
+    /// at 100,000 rungs, and the rows run as fast as the statements or faster (docs/c.md).
     pub rows: bool,
 }
 
@@ -63,7 +68,7 @@ impl Default for CConfig {
             cycle_ms: 10,
             loop_cap: 100_000,
             chunk_rungs: 64,
-            rows: false,
+            rows: true,
         }
     }
 }
@@ -81,6 +86,7 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
     let mut sh = shared(p, fbd, &lay);
     let copies = fbd_copies(p, fbd);
     sh.local_only = local_only(p, fbd, &copies);
+    sh.at = member_offsets(p, &lay, &sh.local_only);
     let fbd_of: HashMap<usize, usize> = copies.iter().map(|(&k, (fp, _))| (k, *fp)).collect();
     // The function block types first (nested types before their owners: a call names the
     // function its callee's type got).
@@ -130,18 +136,35 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
             text: harness::PLC_MAIN_H.into(),
         },
     ];
-    let per_file = chunks_per_file(p, &stems, &copies, cfg.chunk_rungs);
+    // The ladder POUs (those with a function of their own, not written from an FBD body).
+    let ladder: Vec<bool> = (0..p.pous.len())
+        .map(|i| stems[i].is_some() && !copies.contains_key(&i))
+        .collect();
+    let mut kernels = rows::Kernels::default();
+    let acc = cfg.rows.then(|| crate::analysis::accesses(p));
+    if cfg.rows {
+        sh.rows = order::rows(&sh, &ladder, &mut kernels);
+    }
+    let plans: Vec<Option<order::Plan>> = (0..p.pous.len())
+        .map(|i| ladder[i].then(|| order::plan(p, acc.as_ref(), &sh.rows, &sh.labels, i)))
+        .collect();
+    let per_file = chunks_per_file(p, &plans, cfg.chunk_rungs);
     let (mut objects, mut parts) = (Vec::new(), Vec::new());
+    let mut data = parts::DataFiles {
+        entry: kernels.entry_type(),
+        files: Vec::new(),
+    };
     for (i, pou) in p.pous.iter().enumerate() {
         let Some(stem) = &stems[i] else { continue };
         let f = &sh.pou_fns[i];
-        let (sources, decls) = match copies.get(&i) {
-            Some((fp, prefix)) => {
+        let (sources, decls) = match (copies.get(&i), &plans[i]) {
+            (Some((fp, prefix)), _) => {
                 let body = fbd_function(p, &sh, fbd, *fp, prefix, i);
                 let text = format!("#include \"plc_program.h\"\n\n{body}");
                 (vec![(String::new(), text)], String::new())
             }
-            None => ladder_files(p, &sh, i, cfg, per_file),
+            (None, Some(plan)) => ladder_files(p, &sh, i, cfg, per_file, plan, &mut data),
+            (None, None) => unreachable!("a POU with a stem is FBD or ladder"),
         };
         files.push(CFile {
             name: format!("{stem}.h"),
@@ -161,7 +184,10 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
             });
         }
     }
-    for (stem, text) in type_files {
+    if !kernels.is_empty() {
+        data.files.push(("plc_rows".to_string(), kernels.source()));
+    }
+    for (stem, text) in data.files.into_iter().chain(type_files) {
         files.push(CFile {
             name: format!("{stem}.c"),
             text,
@@ -236,7 +262,32 @@ fn shared<'a>(p: &'a Program, fbd: &Fbd, lay: &types::Layout) -> Shared<'a> {
         labels,
         counters,
         local_only: vec![false; p.vars.len()],
+        at: Vec::new(),
+        rows: vec![None; p.rungs.len()],
     }
+}
+
+/// Per variable: its byte offset in `_plc_state` if it is a BOOL or an INT member of the
+/// struct itself (not a member of an instance's struct, not a local of an FBD function). The
+/// struct lists these BOOLs first, then these INTs, in variable order: C lays members out in
+/// order from offset 0, with no padding between members whose size is their alignment (1 for
+/// `bool`, 2 for `int16_t`) and the INTs starting at the first even offset after the BOOLs
+/// (`plc_program.h` asserts the sizes and alignments, `plc_program.c` the offsets of the last
+/// BOOL and the last INT).
+fn member_offsets(p: &Program, lay: &types::Layout, local_only: &[bool]) -> Vec<Option<u32>> {
+    let member = |i: usize| lay.vars[i].1.is_none() && !local_only[i];
+    let mut out = vec![None; p.vars.len()];
+    let mut next = 0u32;
+    for (ty, size) in [(Type::Bool, 1), (Type::Int, 2)] {
+        next = next.next_multiple_of(size);
+        for (i, at) in out.iter_mut().enumerate() {
+            if member(i) && p.vars[i].ty == ty {
+                *at = Some(next);
+                next += size;
+            }
+        }
+    }
+    out
 }
 
 /// The program's hidden variables (the FBD lowering's arcs and run flags) by name.
@@ -287,10 +338,14 @@ fn program_header(p: &Program, sh: &Shared, h: &Header) -> String {
     s.push_str(&h.structs);
     s.push_str("struct _plc_state {\n");
     let mut fields = 0;
-    for (i, v) in p.vars.iter().enumerate() {
-        if h.lay.vars[i].1.is_some() || sh.local_only[i] {
-            continue; // a member of an instance's struct, or a local of an FBD function
-        }
+    // The BOOLs and INTs first, at the offsets `member_offsets` gives (the rows' tables hold
+    // them).
+    let mut known: Vec<usize> = (0..p.vars.len()).filter(|&i| sh.at[i].is_some()).collect();
+    known.sort_by_key(|&i| sh.at[i]);
+    let others = (0..p.vars.len())
+        .filter(|&i| sh.at[i].is_none() && h.lay.vars[i].1.is_none() && !sh.local_only[i]);
+    for i in known.into_iter().chain(others) {
+        let v = &p.vars[i];
         let field = sh.vars[i].trim_start_matches("self->");
         let ty = c_type(v.ty);
         fields += 1;
@@ -323,7 +378,8 @@ fn program_header(p: &Program, sh: &Shared, h: &Header) -> String {
     if fields == 0 && k == 0 {
         s.push_str("    char _empty;\n");
     }
-    s.push_str("};\n\nextern const _plc_state _plc_initial;\n");
+    s.push_str("};\n\n_Static_assert(sizeof(bool) == 1 && sizeof(int16_t) == 2 && _Alignof(int16_t) == 2, \"the rows' offsets\");\n");
+    s.push_str("extern const _plc_state _plc_initial;\n");
     s.push_str("void _plc_scan(_plc_state *self, _plc_ctx *ctx);\n");
     s.push_str(&h.type_decls);
     s.push_str(harness::HEADER_DECLS);
@@ -380,163 +436,4 @@ fn fbd_function(
         names::comment(&fpou.name),
         b.finish()
     )
-}
-
-/// Cut points of a ladder POU's rungs: groups of about `chunk` rungs that no jump or FOR
-/// crosses.
-fn chunks(p: &Program, pou: usize, chunk: usize) -> Vec<std::ops::Range<u32>> {
-    let range = p.pous[pou].rungs.clone();
-    let n = (range.end - range.start) as usize;
-    // blocked[i]: the boundary before rung start + i is crossed by a jump or a loop.
-    let mut diff = vec![0i32; n + 1];
-    let mut span = |a: u32, b: u32| {
-        let (lo, hi) = (a.min(b) - range.start, a.max(b) - range.start);
-        if lo < hi {
-            diff[lo as usize + 1] += 1;
-            diff[hi as usize + 1] -= 1;
-        }
-    };
-    for r in range.clone() {
-        walk_elements(&p.rungs[r as usize].series, &mut |e| match e {
-            Element::Jmp { target, .. } => span(r, target.0),
-            Element::For { next, .. } => span(r, next.0),
-            _ => {}
-        });
-    }
-    let mut out = Vec::new();
-    let (mut start, mut depth) = (range.start, 0i32);
-    for i in 1..n {
-        depth += diff[i];
-        let at = range.start + i as u32;
-        if depth == 0 && (at - start) as usize >= chunk {
-            out.push(start..at);
-            start = at;
-        }
-    }
-    out.push(start..range.end);
-    out
-}
-
-/// Chunk functions per part file (`pou_X_partN.c`) of the large ladder POUs: at least
-/// [`MIN_CHUNKS_PER_FILE`], more when the program has more than [`MAX_PART_FILES`] files' worth,
-/// so that the parts stay few. Every translation unit parses the whole state struct (about
-/// 0.3 s of `cc` at 100,000 rungs, and the struct's members cost again in the optimiser), so
-/// parts of a fixed size would make the build quadratic in the program; a bounded number of
-/// parts keeps it linear, and still enough of them for `make -j` to use every core.
-fn chunks_per_file(
-    p: &Program,
-    stems: &[Option<String>],
-    copies: &HashMap<usize, (usize, String)>,
-    chunk: usize,
-) -> usize {
-    let total: usize = (0..p.pous.len())
-        .filter(|i| stems[*i].is_some() && !copies.contains_key(i))
-        .map(|i| chunks(p, i, chunk.max(1)).len())
-        .filter(|&n| n > 1)
-        .sum();
-    MIN_CHUNKS_PER_FILE.max(total.div_ceil(MAX_PART_FILES))
-}
-
-/// The fewest chunk functions in a part file (1,024 rungs of 64).
-const MIN_CHUNKS_PER_FILE: usize = 16;
-/// The most part files of a program before they grow instead of multiplying.
-const MAX_PART_FILES: usize = 16;
-
-/// The C of a ladder POU: its function and, for a large POU, the part files of its chunks
-/// (`(file suffix, text)`; the first has no suffix), and the declarations for its header.
-fn ladder_files(
-    p: &Program,
-    sh: &Shared,
-    pou: usize,
-    cfg: &CConfig,
-    per_file: usize,
-) -> (Vec<(String, String)>, String) {
-    let f = &sh.pou_fns[pou];
-    let groups = chunks(p, pou, cfg.chunk_rungs.max(1));
-    let rows = |b: &mut Body, names: [String; 2]| {
-        if cfg.rows {
-            b.rows = Some(Rows::new(names));
-        }
-    };
-    let name = names::comment(&p.pous[pou].name);
-    let head = "#include \"plc_program.h\"\n\n";
-    // Generated names made from the function's (`_pou_` + the POU's encoded name, which starts
-    // with a letter or `_u`): `_pou__c3_X` (chunk 3), `_pou__r_X`, `_pou__s3_X` … (row tables)
-    // meet no POU's function.
-    let enc = f.trim_start_matches("_pou_");
-    if groups.len() == 1 {
-        let mut b = Body::new(sh, "return;", 1);
-        rows(&mut b, [format!("_pou__r_{enc}"), format!("_pou__s_{enc}")]);
-        b.line("(void)self; (void)ctx;");
-        for r in groups[0].clone() {
-            b.rung(RungId(r));
-        }
-        let table = table_of(&b);
-        let text = format!(
-            "{head}{table}/* ladder POU {name} */\nvoid {f}(_plc_state *self, _plc_ctx *ctx) {{\n{}}}\n",
-            b.finish()
-        );
-        return (vec![(String::new(), text)], String::new());
-    }
-    // A chunk function takes the state as `void *`: with `_plc_state *`, GCC's interprocedural
-    // passes spent time per function that grew with the whole struct (a 64-rung function of
-    // the 100,000-rung program took 0.12 s of `cc -O2` with rows, 0.02 s with `void *`).
-    let mut files = Vec::new();
-    let mut decls = String::new();
-    for (n, part) in groups.chunks(per_file).enumerate() {
-        let mut s = format!("{head}/* ladder POU {name}, part {n} */\n");
-        for (j, g) in part.iter().enumerate() {
-            let k = n * per_file + j;
-            let mut b = Body::new(sh, "return 1;", 1);
-            rows(
-                &mut b,
-                [format!("_pou__r{k}_{enc}"), format!("_pou__s{k}_{enc}")],
-            );
-            b.line("(void)self; (void)ctx;");
-            for r in g.clone() {
-                b.rung(RungId(r));
-            }
-            b.line("return 0;");
-            s.push_str(&table_of(&b));
-            ladder::push(
-                &mut s,
-                format_args!(
-                    "bool _pou__c{k}_{enc}(void *_self, _plc_ctx *ctx) {{\n    _plc_state *self = _self;\n{}}}\n\n",
-                    b.finish()
-                ),
-            );
-            ladder::push(
-                &mut decls,
-                format_args!("bool _pou__c{k}_{enc}(void *_self, _plc_ctx *ctx);\n"),
-            );
-        }
-        files.push((format!("_part{n}"), s));
-    }
-    let mut s = format!(
-        "{head}/* ladder POU {name}, in {} functions */\n",
-        groups.len()
-    );
-    ladder::push(
-        &mut s,
-        format_args!("void {f}(_plc_state *self, _plc_ctx *ctx) {{\n"),
-    );
-    for k in 0..groups.len() {
-        ladder::push(
-            &mut s,
-            format_args!("    if (_pou__c{k}_{enc}(self, ctx)) return;\n"),
-        );
-    }
-    s.push_str("}\n");
-    files.insert(0, (String::new(), s));
-    (files, decls)
-}
-
-/// The row table of the function `b` wrote (empty: none), with a blank line after it.
-fn table_of(b: &Body) -> String {
-    let t = b.rows.as_ref().map_or(String::new(), Rows::definitions);
-    if t.is_empty() {
-        t
-    } else {
-        t + "\n"
-    }
 }

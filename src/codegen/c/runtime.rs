@@ -301,58 +301,17 @@ static inline bool _plc_loop_back(uint64_t *ctr, _plc_ctx *ctx, uint32_t rung) {
     return 0;
 }
 
-/* Rungs of contacts and coils as data (docs/c.md). _plc_row: the byte offsets in the state of
-   up to six contacts (a shorter rung repeats its first) and of the coil, each contact's
-   negation, the coil's kind as the masks of new = ((old & keep) | ((p ^ inv) & put)) & ~(p & clr).
-   _plc_row2: six ORs of two contacts, an edge contact (value ev, memory em: pulse
-   (v ^ ef) & (m ^ er), or 1 when none), two outputs. _plc_rows and _plc_rows2 run n rows in
-   order; BOOLs are the bytes 0 and 1. */
-#define _PLC_AT(member) ((uint32_t)offsetof(_plc_state, member))
-typedef struct {
-    uint32_t at[6];
-    uint32_t coil;
-    uint8_t neg[6];
-    uint8_t mask[4]; /* keep, inv, put, clr */
-} _plc_row;
-typedef struct {
-    uint32_t at[6][2];
-    uint32_t coil[2];
-    uint32_t ev, em;
-    uint8_t neg[6][2];
-    uint8_t ef, er, none;
-    uint8_t mask[2][4];
-} _plc_row2;
-/* Out of line and opaque: one loop per file, not one per call (GCC would otherwise inline it,
-   and its interprocedural constant propagation, which looks at every call's constant table,
-   took 9 of the 12 s of a 6,000-rung part file). */
+/* The kernels of the rows of contacts and coils (plc_rows.c, docs/c.md): one loop per rung
+   shape over a table of byte offsets. Out of line and opaque, so that a call is a call even
+   when every file is compiled as one unit (GCC's interprocedural constant propagation would
+   otherwise look at every call's constant table). */
 #if defined(__GNUC__) && !defined(__clang__)
-#define _PLC_ROWS_FN __attribute__((noipa, unused)) static void
+#define _PLC_KERNEL __attribute__((noipa)) void
 #elif defined(__GNUC__)
-#define _PLC_ROWS_FN __attribute__((noinline, unused)) static void
+#define _PLC_KERNEL __attribute__((noinline)) void
 #else
-#define _PLC_ROWS_FN static inline void
+#define _PLC_KERNEL void
 #endif
-static inline unsigned _plc_coil(unsigned old, unsigned p, const uint8_t m[4]) {
-    return ((old & m[0]) | ((p ^ m[1]) & m[2])) & ~(p & m[3]);
-}
-_PLC_ROWS_FN _plc_rows(uint8_t *s, const _plc_row *r, size_t n) {
-    for (const _plc_row *end = r + n; r != end; r++) {
-        unsigned p = (s[r->at[0]] ^ r->neg[0]) & (s[r->at[1]] ^ r->neg[1])
-                   & (s[r->at[2]] ^ r->neg[2]) & (s[r->at[3]] ^ r->neg[3])
-                   & (s[r->at[4]] ^ r->neg[4]) & (s[r->at[5]] ^ r->neg[5]);
-        s[r->coil] = (uint8_t)_plc_coil(s[r->coil], p, r->mask);
-    }
-}
-_PLC_ROWS_FN _plc_rows2(uint8_t *s, const _plc_row2 *r, size_t n) {
-    for (const _plc_row2 *end = r + n; r != end; r++) {
-        unsigned p = r->none | ((s[r->ev] ^ r->ef) & (s[r->em] ^ r->er));
-        for (int k = 0; k < 6; k++)
-            p &= (s[r->at[k][0]] ^ r->neg[k][0]) | (s[r->at[k][1]] ^ r->neg[k][1]);
-        s[r->em] = s[r->ev];
-        s[r->coil[0]] = (uint8_t)_plc_coil(s[r->coil[0]], p, r->mask[0]);
-        s[r->coil[1]] = (uint8_t)_plc_coil(s[r->coil[1]], p, r->mask[1]);
-    }
-}
 
 /* JSON output of the harness: REAL and LREAL in the form `plc-deps run --format json` prints
    them (the shortest decimal that reads back as the float, or the double when `dbl`, written as
