@@ -363,7 +363,13 @@ fn missing_kinds(
     }
     [
         ("contacts", kernels.contains("(((q ^ t[")),
-        ("an OR", kernels.contains(" | s[t[")),
+        (
+            "an OR",
+            // In the power's expression, whatever its branches start with.
+            kernels
+                .lines()
+                .any(|l| l.trim_start().starts_with("unsigned p =") && l.contains(" | ")),
+        ),
         ("a rising edge", edge("]] & (s[t[")),
         ("a falling edge", edge("]] ^ 1) & s[t[")),
         ("a compare", kernels.contains("(*(int16_t *)(s + t[")),
