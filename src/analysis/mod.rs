@@ -81,17 +81,7 @@ fn idle_rungs(p: &Program, acc: &Accesses) -> (Vec<RungId>, Vec<RungId>) {
             continue;
         }
         let mut transfers = false;
-        walk_elements(&rung.series, &mut |e| {
-            transfers |= matches!(
-                e,
-                Element::Jmp { .. }
-                    | Element::Ret
-                    | Element::End
-                    | Element::Call { .. }
-                    | Element::For { .. }
-                    | Element::Next { .. }
-            )
-        });
+        walk_elements(&rung.series, &mut |e| transfers |= e.transfers_control());
         if !transfers && acc.outs(r).is_empty() {
             no_effect.push(r);
         }

@@ -240,6 +240,22 @@ pub enum Element {
     Next { head: RungId },
 }
 
+impl Element {
+    /// True for the elements that send control elsewhere than the next rung: a jump, a return,
+    /// an end, a call, and the two ends of a FOR loop.
+    pub fn transfers_control(&self) -> bool {
+        matches!(
+            self,
+            Element::Jmp { .. }
+                | Element::Ret
+                | Element::End
+                | Element::Call { .. }
+                | Element::For { .. }
+                | Element::Next { .. }
+        )
+    }
+}
+
 /// The inputs of an up-down counter besides CU (its power in).
 #[derive(Clone, Debug)]
 pub struct CtudInputs {

@@ -344,15 +344,7 @@ impl<'a> Body<'a> {
                 }
             }
             Element::Compare { op, a, b } => {
-                let sym = match op {
-                    CmpOp::Eq => "==",
-                    CmpOp::Ne => "!=",
-                    CmpOp::Lt => "<",
-                    CmpOp::Le => "<=",
-                    CmpOp::Gt => ">",
-                    CmpOp::Ge => ">=",
-                };
-                let t = self.compare(sym, a, b);
+                let t = self.compare(super::spelling::cmp_symbol(*op), a, b);
                 and(pw, t)
             }
             Element::Or(branches) => self.or(rung, branches, pw),

@@ -96,13 +96,8 @@ fn bounds_region(p: &Program, labels: &[bool], r: RungId) -> bool {
     let mut bound = false;
     walk_elements(&p.rung(r).series, &mut |e| {
         bound |= match e {
-            Element::Jmp { .. }
-            | Element::Ret
-            | Element::End
-            | Element::Call { .. }
-            | Element::For { .. }
-            | Element::Next { .. }
-            | Element::Function { .. } => true,
+            e if e.transfers_control() => true,
+            Element::Function { .. } => true,
             // DIV or MOD by a non-zero constant never records a fault.
             Element::Arith { op, b, .. } => {
                 matches!(op, ArithOp::Div | ArithOp::Mod)

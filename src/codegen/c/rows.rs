@@ -47,7 +47,7 @@
 
 use super::ladder::{push, Shared};
 use crate::model::{
-    ArithOp, CmpOp, ContactKind, Element, Operand, RungId, Series, Type, Value, VarId, VarRef,
+    ArithOp, ContactKind, Element, Operand, RungId, Series, Type, Value, VarId, VarRef,
 };
 use std::collections::{BTreeSet, HashMap};
 
@@ -394,14 +394,7 @@ fn item(sh: &Shared, e: &Element, top: bool) -> Option<(Item, Vec<u32>)> {
         }
         Element::Compare { op, a, b } => {
             let (a, b) = (int_slot(sh, a)?, int_slot(sh, b)?);
-            let sym = match op {
-                CmpOp::Eq => "==",
-                CmpOp::Ne => "!=",
-                CmpOp::Lt => "<",
-                CmpOp::Le => "<=",
-                CmpOp::Gt => ">",
-                CmpOp::Ge => ">=",
-            };
+            let sym = super::spelling::cmp_symbol(*op);
             Some((Item::Cmp(sym, a.1, b.1), vec![a.0, b.0]))
         }
         Element::Or(branches) if !branches.is_empty() => {

@@ -8,6 +8,18 @@
 
 use crate::model::*;
 
+/// The C operator of a comparison.
+pub(crate) fn cmp_symbol(op: CmpOp) -> &'static str {
+    match op {
+        CmpOp::Eq => "==",
+        CmpOp::Ne => "!=",
+        CmpOp::Lt => "<",
+        CmpOp::Le => "<=",
+        CmpOp::Gt => ">",
+        CmpOp::Ge => ">=",
+    }
+}
+
 /// `!c`, without a double negation of a simple name.
 pub(crate) fn negate(c: &str) -> String {
     let atom = |s: &str| {
