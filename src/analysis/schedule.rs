@@ -261,7 +261,14 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
     // Readers of each variable since its last write, as linked lists in one flat array:
     // `first_reader[x]` → (task, next) in `reader_nodes`.
     let mut first_reader: Vec<Option<u32>> = vec![None; var_count];
-    let mut reader_nodes: Vec<(u32, Option<u32>)> = Vec::new();
+    // At most one node per read of a live rung: sized once, so that growing it never holds
+    // two copies (at a million rungs it is tens of MB).
+    let read_count: usize = tasks
+        .iter()
+        .flat_map(|t| t.rungs.iter())
+        .map(|&r| acc.ins(r).len())
+        .sum();
+    let mut reader_nodes: Vec<(u32, Option<u32>)> = Vec::with_capacity(read_count);
     let mut reads = Vec::new();
     let mut writes = Vec::new();
     for i in 0..t as usize {
