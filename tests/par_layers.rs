@@ -5,9 +5,9 @@
 //! `crate::exec::parallel::…` / `crate::cmd::run::…` path outside comments and test modules is
 //! resolved to the module it names, and must name one that comes earlier in the order.
 //!
-//! One exception, named here: `machine::claimed` is the second half of `ParallelMachine`'s
-//! implementation (the levelled plan's units), so it uses its parent's types as the parent uses
-//! its functions.
+//! One exception, named here: `machine::items` and `machine::claimed` are the second half of
+//! `ParallelMachine`'s implementation (one plan item; the levelled plan's units), so they use
+//! their parent's types as the parent uses their functions.
 
 use std::path::Path;
 
@@ -41,6 +41,7 @@ const PARALLEL: Order = &[
     &["machine", "units"],
     &["machine", "shared"],
     &["machine", "driver"],
+    &["machine", "items"],
     &["machine", "claimed"],
     &["machine"],
     &["explain"],
@@ -163,7 +164,8 @@ fn upward_uses(root: &Path, order: Order, absolute: &str) -> Vec<String> {
         for path in named_paths(&code(&text), &me, absolute) {
             let used = module_of(order, &path);
             let own_parent = m.len() == order[used].len() + 1 && m.starts_with(order[used]);
-            let exception = *m == ["machine", "claimed"] && order[used] == ["machine"];
+            let exception = (*m == ["machine", "claimed"] || *m == ["machine", "items"])
+                && order[used] == ["machine"];
             if used == pos || exception {
                 continue;
             }

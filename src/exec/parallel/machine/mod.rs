@@ -15,7 +15,8 @@
 //! Each uses only the ones before it (and the layers below the machine: the basics, `planning`,
 //! `choice`): `backoff` (the one wait loop: spin, yield, park), `barrier`, `flags` (ready
 //! flags), `units` (claimed units, the window bell), `shared` (lock-free shared memory),
-//! `driver` (the per-scan callbacks and the sequential loop), `claimed` (a levelled plan's
+//! `driver` (the per-scan callbacks and the sequential loop), `items` (one plan item on the
+//! shared state, the merged faults), `claimed` (a levelled plan's
 //! scans as units: the second half of [`ParallelMachine`]'s implementation, so it uses this
 //! module's types as this module uses its functions), this module.
 
@@ -24,6 +25,7 @@ mod barrier;
 mod claimed;
 mod driver;
 mod flags;
+mod items;
 mod shared;
 mod units;
 
@@ -34,16 +36,12 @@ pub use shared::SharedSlots;
 use crate::analysis::Analysis;
 use crate::exec::parallel::choice::{Chooser, Switch, Window};
 use crate::exec::parallel::config::{Measure, PlanConfig, PlanKind};
-use crate::exec::parallel::ids::{Decision, Next};
 use crate::exec::parallel::pad::Padded;
 use crate::exec::parallel::planning::candidate_plans;
 use crate::exec::parallel::planning::check_plan;
 use crate::exec::parallel::planning::{bools_first, layout_groups, Plan};
-use crate::exec::parallel::planning::{Item, Region};
-use crate::exec::{
-    ExecConfig, Exit, Fault, Layout, LowerError, Machine, ScanCtx, State, LINE_BYTES,
-};
-use crate::model::{Program, RungId, VarId};
+use crate::exec::{ExecConfig, Fault, Layout, LowerError, Machine, State, LINE_BYTES};
+use crate::model::{Program, VarId};
 use flags::ReadyFlags;
 use shared::{Decisions, FaultBuffer, Shared};
 use std::cell::UnsafeCell;
@@ -672,104 +670,6 @@ impl ParallelMachine {
             }
         }
         true
-    }
-
-    /// The faults of every worker's buffer in sequential order (by task; a task's faults keep
-    /// their order), the buffers emptied. Worker 0 only, when no other worker runs a unit or
-    /// item of the scan.
-    fn merged_faults<'b>(&self, sh: &Shared<'_>, b: &'b mut Buffers) -> &'b [Fault] {
-        b.merged.clear();
-        for f in sh.faults.iter() {
-            // SAFETY: no other worker touches its buffer until the next scan starts (the
-            // caller's condition); no other reference to it exists now.
-            let buf = unsafe { &mut *f.0.get() };
-            b.merged.append(buf);
-        }
-        b.merged.sort_by_key(|&(t, _)| t);
-        b.out.clear();
-        b.out.extend(b.merged.iter().map(|&(_, f)| f));
-        &b.out
-    }
-
-    /// Where a decision leads: the task holding the rung control went to, or the end of the
-    /// scan; `None` if the task did not run.
-    #[inline]
-    fn successor_of(plan: &Plan, d: Decision) -> Option<Next> {
-        match d {
-            Decision::NotRun => None,
-            Decision::Stop => Some(Next::Stop),
-            Decision::Rung(r) | Decision::ForTest(r) => {
-                plan.task_of_rung[r.index()].map(Next::Task)
-            }
-        }
-    }
-
-    /// Where item `it` starts this scan; `None` if the sequential scan would not run it.
-    #[inline]
-    fn entry(plan: &Plan, it: &Item, sh: &Shared<'_>) -> Option<Exit> {
-        if !it.guard.is_empty() {
-            let holds = plan.guards[it.guard.start as usize..it.guard.end as usize]
-                .iter()
-                .any(|&(slot, succ)| {
-                    Self::successor_of(plan, sh.decisions.get(slot)) == Some(succ)
-                });
-            if !holds {
-                return None;
-            }
-        }
-        if it.entries.is_empty() {
-            return Some(Exit::Rung(it.start));
-        }
-        let mut at = None;
-        for &slot in &plan.entry_slots[it.entries.start as usize..it.entries.end as usize] {
-            let d = sh.decisions.get(slot);
-            if Self::successor_of(plan, d) == Some(Next::Task(it.first)) {
-                debug_assert!(at.is_none(), "task {} entered twice", it.first.0);
-                at = match d {
-                    Decision::ForTest(h) => Some(Exit::ForTest(h)),
-                    Decision::Rung(r) => Some(Exit::Rung(r)),
-                    Decision::Stop | Decision::NotRun => at,
-                };
-            }
-        }
-        // None: no predecessor led here, so the sequential scan does not run it either.
-        at
-    }
-
-    #[inline]
-    fn run_item(
-        &self,
-        plan: &Plan,
-        it: &Item,
-        store: &mut SharedSlots,
-        ctx: &mut ScanCtx<'_>,
-        sh: &Shared<'_>,
-    ) {
-        let Some(at) = Self::entry(plan, it, sh) else {
-            if let Some(slot) = it.decision {
-                sh.decisions.set(slot, Decision::NotRun);
-            }
-            return;
-        };
-        let exit = match it.region {
-            Region::Rungs(lo, hi) => self
-                .machine
-                .resume(store, ctx, at, |r| lo <= r.0 && r.0 < hi),
-            Region::Tasks(lo, hi) => {
-                let task_of = &plan.task_of_rung;
-                self.machine.resume(store, ctx, at, |r: RungId| {
-                    task_of[r.index()].is_some_and(|t| lo <= t && t <= hi)
-                })
-            }
-        };
-        if let Some(slot) = it.decision {
-            let d = match exit {
-                Exit::Stop => Decision::Stop,
-                Exit::Rung(r) => Decision::Rung(r),
-                Exit::ForTest(h) => Decision::ForTest(h),
-            };
-            sh.decisions.set(slot, d);
-        }
     }
 }
 
