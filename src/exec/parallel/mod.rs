@@ -89,7 +89,7 @@ mod machine;
 mod pad;
 mod planning;
 
-pub use choice::{Chooser, Switch, Window};
+pub use choice::{Chooser, Switch, Window, WindowRecord};
 pub use config::{LineCostSource, Measure, PlanConfig, PlanKind, Slicing, Strategy};
 pub use explain::{ns_text, run_log_json};
 pub use ids::{Decision, DecisionSlot, Next, TaskId};

@@ -26,6 +26,7 @@ mod claimed;
 mod driver;
 mod flags;
 mod items;
+mod pin;
 mod shared;
 mod units;
 
@@ -34,7 +35,7 @@ pub use driver::{run_sequential, ScanDriver};
 pub use shared::SharedSlots;
 
 use crate::analysis::Analysis;
-use crate::exec::parallel::choice::{Chooser, Switch, Window};
+use crate::exec::parallel::choice::{Chooser, Switch, Window, WindowRecord};
 use crate::exec::parallel::config::{Measure, PlanConfig, PlanKind};
 use crate::exec::parallel::pad::Padded;
 use crate::exec::parallel::planning::candidate_plans;
@@ -78,6 +79,11 @@ pub struct RunLog {
     pub segments: Vec<(u64, usize)>,
     /// Per candidate: the waits per scan of a dependence-driven plan (`None` for the others).
     pub waits: Vec<Option<u64>>,
+    /// The windows of scans as they ran, with their times: the first 64, then those of every
+    /// measurement that ended in a switch (bounded: `choice`).
+    pub windows: Vec<WindowRecord>,
+    /// Windows run but not in `windows`.
+    pub windows_unlogged: u64,
 }
 
 impl RunLog {
@@ -337,6 +343,8 @@ impl ParallelMachine {
                     Candidate::Sequential => None,
                 })
                 .collect(),
+            windows: Vec::new(),
+            windows_unlogged: 0,
         };
         let threads = self
             .plans
@@ -392,6 +400,14 @@ impl ParallelMachine {
         };
         let shared = &shared;
         let mut chooser = Chooser::new(allowed.len(), self.measure, scans.start);
+        // Worker i on the i-th allowed CPU for the run, when each worker can have one.
+        let cpus = pin::allowed_cpus();
+        let pin_env = std::env::var("PLC_DEPS_PIN")
+            .map(|v| v != "0")
+            .unwrap_or(true);
+        let pins: Option<&[usize]> =
+            (pin_env && threads > 1 && threads <= cpus.len()).then_some(&cpus[..threads]);
+        let pin = |w: usize| pins.and_then(|c| pin::pin_to(c[w]));
         if threads == 1 {
             self.leader(shared, scans, driver, &mut chooser, &allowed, &mut log);
         } else {
@@ -409,8 +425,12 @@ impl ParallelMachine {
             );
             pool.in_place_scope(|s| {
                 for w in 1..threads {
-                    s.spawn(move |_| self.follower(w, shared));
+                    s.spawn(move |_| {
+                        let _pinned = pin(w);
+                        self.follower(w, shared)
+                    });
                 }
+                let _pinned = pin(0);
                 self.leader(shared, scans, driver, &mut chooser, &allowed, &mut log);
             });
         }
@@ -427,6 +447,15 @@ impl ParallelMachine {
             })
             .collect();
         log.last = allowed[chooser.current()];
+        log.windows = chooser
+            .windows()
+            .iter()
+            .map(|w| WindowRecord {
+                candidate: allowed[w.candidate],
+                ..w.clone()
+            })
+            .collect();
+        log.windows_unlogged = chooser.windows_unlogged();
         log
     }
 
