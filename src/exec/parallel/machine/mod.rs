@@ -117,6 +117,8 @@ pub struct ParallelMachine {
     pub(super) layout_groups: usize,
     /// Why plans were dropped (a failed check), for the user.
     pub(super) warnings: Vec<String>,
+    /// Pin the workers to CPUs during a run ([`PlanConfig::pin_workers`]).
+    pub(super) pin_workers: bool,
 }
 
 impl ParallelMachine {
@@ -183,6 +185,7 @@ impl ParallelMachine {
             measure: config.measure,
             layout_groups: groups,
             warnings,
+            pin_workers: config.pin_workers,
         })
     }
 
@@ -400,13 +403,13 @@ impl ParallelMachine {
         };
         let shared = &shared;
         let mut chooser = Chooser::new(allowed.len(), self.measure, scans.start);
-        // Worker i on the i-th allowed CPU for the run, when each worker can have one.
-        let cpus = pin::allowed_cpus();
-        let pin_env = std::env::var("PLC_DEPS_PIN")
-            .map(|v| v != "0")
-            .unwrap_or(true);
-        let pins: Option<&[usize]> =
-            (pin_env && threads > 1 && threads <= cpus.len()).then_some(&cpus[..threads]);
+        // Worker i on the i-th allowed CPU for the run, when asked and each worker can have one.
+        let cpus = if self.pin_workers {
+            pin::allowed_cpus()
+        } else {
+            Vec::new()
+        };
+        let pins: Option<&[usize]> = (threads > 1 && threads <= cpus.len()).then(|| &cpus[..threads]);
         let pin = |w: usize| pins.and_then(|c| pin::pin_to(c[w]));
         if threads == 1 {
             self.leader(shared, scans, driver, &mut chooser, &allowed, &mut log);
