@@ -409,7 +409,8 @@ impl ParallelMachine {
         } else {
             Vec::new()
         };
-        let pins: Option<&[usize]> = (threads > 1 && threads <= cpus.len()).then(|| &cpus[..threads]);
+        let pins: Option<&[usize]> =
+            (threads > 1 && threads <= cpus.len()).then(|| &cpus[..threads]);
         let pin = |w: usize| pins.and_then(|c| pin::pin_to(c[w]));
         if threads == 1 {
             self.leader(shared, scans, driver, &mut chooser, &allowed, &mut log);
