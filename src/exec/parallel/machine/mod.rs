@@ -13,7 +13,7 @@
 //!
 //! # Modules, bottom to top
 //! Each uses only the ones before it (and the layers below the machine: the basics, `planning`,
-//! `choice`): `backoff` (the one wait loop: spin, yield, park), `barrier`, `flags` (ready
+//! `choice`): `pin` (workers pinned to CPUs), `backoff` (the one wait loop: spin, yield, park), `barrier`, `flags` (ready
 //! flags), `units` (claimed units, the window bell), `shared` (lock-free shared memory),
 //! `driver` (the per-scan callbacks and the sequential loop), `items` (one plan item on the
 //! shared state, the merged faults), `claimed` (a levelled plan's
