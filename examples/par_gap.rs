@@ -9,7 +9,11 @@
 //! next scan's first barrier for as long as it lasts. This example times, per plan kind (`seq`,
 //! `par`, `deps`), the scans of a run whose driver does nothing between scans (`idle`) and of
 //! one that reads every byte of the state after each scan as the digest does (`read`), in
-//! alternating rounds, and prints the medians and ranges. Nothing here is used by the tool.
+//! alternating rounds, and prints the medians and ranges. `par+pin` and `deps+pin` are the same
+//! plans with each worker pinned to its own CPU (`PlanConfig::pin_workers`). The host's speed
+//! drifts from round to round, so the last column is each plan's time against seq's in the
+//! *same* round (the median of those per-round ratios, and their range). Nothing here is used by
+//! the tool.
 
 use plc_deps::analysis::analyse;
 use plc_deps::exec::parallel::{ParallelMachine, PlanConfig, PlanKind, ScanDriver};
@@ -54,12 +58,19 @@ fn main() {
         .num_threads(threads.saturating_sub(1).max(1))
         .build()
         .expect("a pool");
-    let kinds = [PlanKind::Seq, PlanKind::Par, PlanKind::Deps];
+    let kinds = [
+        (PlanKind::Seq, false),
+        (PlanKind::Par, false),
+        (PlanKind::Deps, false),
+        (PlanKind::Par, true),
+        (PlanKind::Deps, true),
+    ];
     let machines: Vec<ParallelMachine> = kinds
         .iter()
-        .map(|&kind| {
+        .map(|&(kind, pin_workers)| {
             let config = PlanConfig {
                 kind,
+                pin_workers,
                 ..PlanConfig::new(threads)
             };
             ParallelMachine::new(&program, &analysis, &ExecConfig::default(), &config)
@@ -93,18 +104,20 @@ fn main() {
         v.sort_by(f64::total_cmp);
         (v[v.len() / 2], v[0], v[v.len() - 1])
     };
-    let seq = [med(&results[0][0]).0, med(&results[0][1]).0];
-    for (k, kind) in kinds.iter().enumerate() {
+    for (k, &(kind, pin)) in kinds.iter().enumerate() {
         for read in [false, true] {
-            let (m, lo, hi) = med(&results[k][read as usize]);
+            let r = read as usize;
+            let (m, lo, hi) = med(&results[k][r]);
+            let paired: Vec<f64> = results[0][r]
+                .iter()
+                .zip(&results[k][r])
+                .map(|(s, p)| s / p)
+                .collect();
+            let (pm, plo, phi) = med(&paired);
+            let name = format!("{}{}", kind.name(), if pin { "+pin" } else { "" });
             println!(
-                "  {:4} {:5} {:9.1} ({:.1}–{:.1})  {:.2}x seq",
-                kind.name(),
+                "  {name:8} {:5} {m:9.1} ({lo:.1}–{hi:.1})  {pm:.2}x seq ({plo:.2}–{phi:.2})",
                 if read { "read" } else { "idle" },
-                m,
-                lo,
-                hi,
-                seq[read as usize] / m
             );
         }
     }

@@ -35,6 +35,7 @@ const PARALLEL: Order = &[
     &["planning", "check"],
     &["planning"],
     &["choice"],
+    &["machine", "pin"],
     &["machine", "backoff"],
     &["machine", "barrier"],
     &["machine", "flags"],

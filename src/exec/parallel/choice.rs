@@ -36,6 +36,35 @@ pub struct Switch {
     pub why: String,
 }
 
+/// One window as it ran, for the run's log ([`Chooser::windows`]): its candidate, its scans and
+/// what its timed scans took.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct WindowRecord {
+    /// The window's first scan.
+    pub scan: u64,
+    /// Candidate index.
+    pub candidate: usize,
+    /// Scans run.
+    pub scans: u64,
+    /// Whether it was part of a measurement (a visit's scan) rather than a run of the chosen
+    /// candidate.
+    pub measuring: bool,
+    /// Timed scans (every scan of a measurement; every `sample_every`-th otherwise).
+    pub timed: usize,
+    /// Lower median and minimum of the timed scans, ns (`None` when none was timed).
+    pub median_ns: Option<u64>,
+    /// See `median_ns`.
+    pub min_ns: Option<u64>,
+}
+
+/// The log keeps the first this many windows of a run whole ...
+const LOG_FIRST: usize = 64;
+/// ... then the windows of each measurement that ends in a switch (at most this many of each)
+/// ...
+const LOG_PER_SWITCH: usize = 48;
+/// ... and never more than this many in all (the rest are counted, not kept).
+const LOG_MAX: usize = 512;
+
 /// The next scans to run.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub struct Window {
@@ -198,6 +227,12 @@ pub struct Chooser {
     switches: Vec<Switch>,
     scans_on: Vec<u64>,
     measurements: u64,
+    /// The windows logged (the first ones, then those of measurements that switched).
+    log: Vec<WindowRecord>,
+    /// The windows of the measurement in progress, once past the first ones.
+    pending: Vec<WindowRecord>,
+    /// Windows run but not logged.
+    unlogged: u64,
 }
 
 impl Chooser {
@@ -222,6 +257,9 @@ impl Chooser {
             switches: Vec::new(),
             scans_on: vec![0; n],
             measurements: 0,
+            log: Vec::new(),
+            pending: Vec::new(),
+            unlogged: 0,
         }
     }
 
@@ -243,6 +281,7 @@ impl Chooser {
 
     /// The window `w` ran; `times` are the ns of its timed scans (any number, maybe none).
     pub fn record(&mut self, w: Window, times: &[u64]) {
+        self.log_window(w, times);
         self.scans_on[w.candidate] += w.scans;
         self.scan += w.scans;
         match &mut self.stage {
@@ -275,6 +314,29 @@ impl Chooser {
                     self.remeasure(None);
                 }
             }
+        }
+    }
+
+    /// Logs window `w` (bounded: the first [`LOG_FIRST`] whole, then a measurement's windows
+    /// when it ends in a switch, see [`decide`](Self::decide)).
+    fn log_window(&mut self, w: Window, times: &[u64]) {
+        let measuring = matches!(self.stage, Stage::Measure(_));
+        let mut sorted = times.to_vec();
+        let rec = WindowRecord {
+            scan: self.scan,
+            candidate: w.candidate,
+            scans: w.scans,
+            measuring,
+            timed: times.len(),
+            median_ns: (!sorted.is_empty()).then(|| lower_median(&mut sorted)),
+            min_ns: times.iter().copied().min(),
+        };
+        if self.log.len() < LOG_FIRST {
+            self.log.push(rec);
+        } else if measuring && self.pending.len() < LOG_PER_SWITCH {
+            self.pending.push(rec);
+        } else {
+            self.unlogged += 1;
         }
     }
 
@@ -376,6 +438,12 @@ impl Chooser {
             }
         }
         let best = m.who[verdict.pick];
+        let pending = std::mem::take(&mut self.pending);
+        if best != self.current && self.log.len() + pending.len() <= LOG_MAX {
+            self.log.extend(pending);
+        } else {
+            self.unlogged += pending.len() as u64;
+        }
         if best != self.current {
             let est = |c: usize| self.estimate[c].unwrap_or(0);
             let mut why = format!(
@@ -437,6 +505,18 @@ impl Chooser {
     /// Scans run on each candidate.
     pub fn scans_on(&self) -> &[u64] {
         &self.scans_on
+    }
+
+    /// The windows logged: the first 64 of the run, then the windows of every measurement
+    /// that ended in a switch (at most 48 each, 512 in all), in order.
+    pub fn windows(&self) -> &[WindowRecord] {
+        &self.log
+    }
+
+    /// Windows run but not in [`windows`](Self::windows) (the measurement in progress at the
+    /// end of the run included).
+    pub fn windows_unlogged(&self) -> u64 {
+        self.unlogged + self.pending.len() as u64
     }
 }
 
@@ -685,6 +765,57 @@ mod tests {
         assert_eq!(gaps.len(), 5, "{gaps:?}");
         assert_eq!(gaps[..4], [128 + 3, 256 + 3, 512 + 3, 1024 + 3]);
         assert_eq!(ch.switches().len(), 1);
+    }
+
+    #[test]
+    fn the_log_keeps_the_first_windows_and_the_measurements_that_switch() {
+        // Parallel faster until scan 2000, then 5x slower: one switch to it at the start, one
+        // back after the jump.
+        let mut ch = Chooser::new(2, measure(), 0);
+        let ns = |c: usize, s: u64, _: bool| match (c, s < 2000) {
+            (0, _) => 100_000,
+            (_, true) => 60_000,
+            (_, false) => 300_000,
+        };
+        drive(&mut ch, 2, 4000, ns);
+        let log = ch.windows();
+        assert_eq!(ch.switches().len(), 2, "{:?}", ch.switches());
+        // The first measurement: 3 rounds of two visits of 3 one-scan windows, each timed.
+        assert!(log[..18]
+            .iter()
+            .all(|w| w.measuring && w.scans == 1 && w.timed == 1));
+        assert_eq!(
+            (
+                log[0].candidate,
+                log[0].median_ns,
+                log[3].candidate,
+                log[3].median_ns
+            ),
+            (0, Some(100_000), 1, Some(60_000))
+        );
+        // Then runs of 32 scans on the parallel plan, every 8th timed.
+        assert_eq!(
+            (
+                log[18].scan,
+                log[18].candidate,
+                log[18].scans,
+                log[18].measuring
+            ),
+            (18, 1, 32, false)
+        );
+        assert_eq!((log[18].timed, log[18].median_ns), (4, Some(60_000)));
+        // The windows of every scan are accounted for; the log is contiguous up to the first
+        // 64 and then holds the measurement that switched back (it began on the quiet machine
+        // and saw the 300 µs visits).
+        let logged: u64 = log.len() as u64;
+        assert!(logged + ch.windows_unlogged() > 64);
+        assert!(
+            log[64..].iter().all(|w| w.measuring && w.scan > 1900),
+            "{:?}",
+            &log[64..]
+        );
+        assert!(log[64..].iter().any(|w| w.median_ns == Some(300_000)));
+        assert!(log.windows(2).all(|p| p[0].scan < p[1].scan));
     }
 
     #[test]

@@ -182,6 +182,10 @@ pub struct PlanConfig {
     pub kind: PlanKind,
     /// How [`PlanKind::Auto`] measures.
     pub measure: Measure,
+    /// Pin worker `i` to the `i`-th CPU the process may run on, for each run, when there are
+    /// at least as many such CPUs as workers (Linux; `machine::pin`). Off by default: measured
+    /// on 2 shared vCPUs it made no difference beyond the host's noise (docs/scan.md).
+    pub pin_workers: bool,
 }
 
 impl PlanConfig {
@@ -215,6 +219,7 @@ impl PlanConfig {
             merge_levels: false,
             kind: PlanKind::Model,
             measure: Measure::default(),
+            pin_workers: false,
         }
     }
 }

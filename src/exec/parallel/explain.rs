@@ -261,6 +261,7 @@ impl ParallelMachine {
                 sw.scan, log.candidates[sw.from], log.candidates[sw.to], sw.why
             );
         }
+        explain_windows(&mut s, log);
         s
     }
 
@@ -306,6 +307,49 @@ impl ParallelMachine {
     }
 }
 
+/// The run's logged windows, one line each: a measurement's runs of one-scan windows of one
+/// candidate are joined into one line (the visit: its scans' times in order, the first a warm-up).
+fn explain_windows(s: &mut String, log: &RunLog) {
+    if log.windows.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        s,
+        "  windows (first scan, candidate, scans: median / min of the timed scans){}:",
+        if log.windows_unlogged > 0 {
+            format!(", {} more not logged", log.windows_unlogged)
+        } else {
+            String::new()
+        }
+    );
+    let mut i = 0;
+    while i < log.windows.len() {
+        let w = &log.windows[i];
+        let name = &log.candidates[w.candidate];
+        if w.measuring {
+            let mut j = i;
+            let mut times = Vec::new();
+            while j < log.windows.len()
+                && log.windows[j].measuring
+                && log.windows[j].candidate == w.candidate
+                && log.windows[j].scan == w.scan + (j - i) as u64
+            {
+                times.extend(log.windows[j].median_ns.map(ns_text));
+                j += 1;
+            }
+            let _ = writeln!(s, "    {:>6} {name} measured: {}", w.scan, times.join(", "));
+            i = j;
+        } else {
+            let t = match (w.median_ns, w.min_ns) {
+                (Some(m), Some(n)) => format!("{} / {}", ns_text(m), ns_text(n)),
+                _ => "not timed".to_string(),
+            };
+            let _ = writeln!(s, "    {:>6} {name} x{}: {t}", w.scan, w.scans);
+            i += 1;
+        }
+    }
+}
+
 /// A time in ns as text (`850 ns`, `12.3 µs`, `4.56 ms`).
 pub fn ns_text(ns: u64) -> String {
     let f = ns as f64;
@@ -321,7 +365,8 @@ pub fn ns_text(ns: u64) -> String {
 /// The run log as JSON (the `plan_run` of `plc-deps run --format json`); `deterministic`
 /// zeroes what depends on timing (measured times; scans per candidate and switches when there
 /// is more than one candidate). With a dependence-driven candidate, `waits_per_scan` gives its
-/// waits per scan (a property of the plan, not of timing).
+/// waits per scan (a property of the plan, not of timing). Not deterministic: `windows` and
+/// `windows_unlogged`, the windows of scans as they ran with their times.
 pub fn run_log_json(log: &RunLog, deterministic: bool) -> serde_json::Value {
     let timed = deterministic && log.candidates.len() > 1;
     let mut doc = json!({
@@ -339,6 +384,23 @@ pub fn run_log_json(log: &RunLog, deterministic: bool) -> serde_json::Value {
             })).collect::<Vec<_>>()
         },
     });
+    // Timing only: left out of the deterministic form.
+    if !deterministic {
+        doc["windows"] = json!(log
+            .windows
+            .iter()
+            .map(|w| json!({
+                "scan": w.scan,
+                "candidate": log.candidates[w.candidate],
+                "scans": w.scans,
+                "measuring": w.measuring,
+                "timed": w.timed,
+                "median_ns": w.median_ns,
+                "min_ns": w.min_ns,
+            }))
+            .collect::<Vec<_>>());
+        doc["windows_unlogged"] = json!(log.windows_unlogged);
+    }
     // Only with a dependence-driven candidate: the waits per scan of each such candidate.
     let waits: serde_json::Map<String, serde_json::Value> = log
         .candidates

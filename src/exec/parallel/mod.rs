@@ -73,9 +73,10 @@
 //!
 //! # Memory
 //! The state is one block of bytes, each value in its type's width (`exec::Layout`), starting
-//! on a 64-byte line and shared by all workers without locks ([`SharedSlots`]: Relaxed atomic
-//! loads and stores of each value's width, plain moves on x86-64 and aarch64; disjointness is
-//! the schedule's guarantee above, ordering comes from the barrier's release/acquire). Its
+//! on a 64-byte line and shared by all workers without locks ([`SharedSlots`]: plain
+//! loads and stores of each value's bytes; disjointness is the schedule's guarantee above,
+//! checked on the lowered code of every plan before it runs, ordering comes from the
+//! release/acquire hand-overs between phases). Its
 //! layout ([`Layout::from_groups`](crate::exec::Layout::from_groups) on 64-byte lines) groups
 //! the variables by the set of (phase, worker) pairs that write them, so two workers never write
 //! the same cache line in one phase; loop counters have a line each; decisions and fault
@@ -89,7 +90,7 @@ mod machine;
 mod pad;
 mod planning;
 
-pub use choice::{Chooser, Switch, Window};
+pub use choice::{Chooser, Switch, Window, WindowRecord};
 pub use config::{LineCostSource, Measure, PlanConfig, PlanKind, Slicing, Strategy};
 pub use explain::{ns_text, run_log_json};
 pub use ids::{Decision, DecisionSlot, Next, TaskId};

@@ -2,7 +2,7 @@
 //! padded block, that says "I have finished my first k items of the scan of barrier epoch e"
 //! as `e << 32 | k`. The owner publishes with a Release store after an item that another
 //! worker waits for; a waiter reads with Acquire until the value reaches what it needs: these
-//! two are the synchronisation points that order the producer's state writes (Relaxed atomics,
+//! two are the synchronisation points that order the producer's state writes (plain stores,
 //! `shared`) before the consumer's reads. Values only grow during a run (the epoch is the
 //! barrier's, the same on every worker after the scan's first barrier), so a flag needs no
 //! reset between scans or plans.

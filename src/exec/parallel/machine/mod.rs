@@ -13,7 +13,7 @@
 //!
 //! # Modules, bottom to top
 //! Each uses only the ones before it (and the layers below the machine: the basics, `planning`,
-//! `choice`): `backoff` (the one wait loop: spin, yield, park), `barrier`, `flags` (ready
+//! `choice`): `pin` (workers pinned to CPUs), `backoff` (the one wait loop: spin, yield, park), `barrier`, `flags` (ready
 //! flags), `units` (claimed units, the window bell), `shared` (lock-free shared memory),
 //! `driver` (the per-scan callbacks and the sequential loop), `items` (one plan item on the
 //! shared state, the merged faults), `claimed` (a levelled plan's
@@ -26,6 +26,7 @@ mod claimed;
 mod driver;
 mod flags;
 mod items;
+mod pin;
 mod shared;
 mod units;
 
@@ -34,7 +35,7 @@ pub use driver::{run_sequential, ScanDriver};
 pub use shared::SharedSlots;
 
 use crate::analysis::Analysis;
-use crate::exec::parallel::choice::{Chooser, Switch, Window};
+use crate::exec::parallel::choice::{Chooser, Switch, Window, WindowRecord};
 use crate::exec::parallel::config::{Measure, PlanConfig, PlanKind};
 use crate::exec::parallel::pad::Padded;
 use crate::exec::parallel::planning::candidate_plans;
@@ -78,6 +79,11 @@ pub struct RunLog {
     pub segments: Vec<(u64, usize)>,
     /// Per candidate: the waits per scan of a dependence-driven plan (`None` for the others).
     pub waits: Vec<Option<u64>>,
+    /// The windows of scans as they ran, with their times: the first 64, then those of every
+    /// measurement that ended in a switch (bounded: `choice`).
+    pub windows: Vec<WindowRecord>,
+    /// Windows run but not in `windows`.
+    pub windows_unlogged: u64,
 }
 
 impl RunLog {
@@ -111,6 +117,8 @@ pub struct ParallelMachine {
     pub(super) layout_groups: usize,
     /// Why plans were dropped (a failed check), for the user.
     pub(super) warnings: Vec<String>,
+    /// Pin the workers to CPUs during a run ([`PlanConfig::pin_workers`]).
+    pub(super) pin_workers: bool,
 }
 
 impl ParallelMachine {
@@ -177,6 +185,7 @@ impl ParallelMachine {
             measure: config.measure,
             layout_groups: groups,
             warnings,
+            pin_workers: config.pin_workers,
         })
     }
 
@@ -337,6 +346,8 @@ impl ParallelMachine {
                     Candidate::Sequential => None,
                 })
                 .collect(),
+            windows: Vec::new(),
+            windows_unlogged: 0,
         };
         let threads = self
             .plans
@@ -392,6 +403,15 @@ impl ParallelMachine {
         };
         let shared = &shared;
         let mut chooser = Chooser::new(allowed.len(), self.measure, scans.start);
+        // Worker i on the i-th allowed CPU for the run, when asked and each worker can have one.
+        let cpus = if self.pin_workers {
+            pin::allowed_cpus()
+        } else {
+            Vec::new()
+        };
+        let pins: Option<&[usize]> =
+            (threads > 1 && threads <= cpus.len()).then(|| &cpus[..threads]);
+        let pin = |w: usize| pins.and_then(|c| pin::pin_to(c[w]));
         if threads == 1 {
             self.leader(shared, scans, driver, &mut chooser, &allowed, &mut log);
         } else {
@@ -409,8 +429,12 @@ impl ParallelMachine {
             );
             pool.in_place_scope(|s| {
                 for w in 1..threads {
-                    s.spawn(move |_| self.follower(w, shared));
+                    s.spawn(move |_| {
+                        let _pinned = pin(w);
+                        self.follower(w, shared)
+                    });
                 }
+                let _pinned = pin(0);
                 self.leader(shared, scans, driver, &mut chooser, &allowed, &mut log);
             });
         }
@@ -427,6 +451,15 @@ impl ParallelMachine {
             })
             .collect();
         log.last = allowed[chooser.current()];
+        log.windows = chooser
+            .windows()
+            .iter()
+            .map(|w| WindowRecord {
+                candidate: allowed[w.candidate],
+                ..w.clone()
+            })
+            .collect();
+        log.windows_unlogged = chooser.windows_unlogged();
         log
     }
 
