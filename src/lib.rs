@@ -10,7 +10,7 @@
 //! interpreter and the parallel executor) and [`codegen`] (C and S7-200 Instruction List).
 //! [`cmd`] holds the commands (`report`, `order`, `run`, `schema`, `convert`, `c`, `il`, `gen`)
 //! on top. Beside the pipeline: [`diag`] the diagnostics every stage reports and their one
-//! renderer (below everything), [`fbd`] the FBD model and its pure ordering and fragment
+//! renderer (below everything), [`hint`] the cache prefetch hints (below everything too), [`fbd`] the FBD model and its pure ordering and fragment
 //! algorithms, [`graph`] the generic graph algorithms (CSR, SCCs, Semi-NCA dominators), and
 //! [`synth`] the synthetic programs of `plc-deps gen`; [`write`] the surface syntax back out as
 //! the JSON program format (`plc-deps convert`).
@@ -21,6 +21,7 @@ pub mod diag;
 pub mod exec;
 pub mod fbd;
 pub mod graph;
+pub mod hint;
 pub mod load;
 pub mod model;
 pub mod read;

@@ -33,6 +33,7 @@ const PARALLEL: Order = &[
     &["planning", "candidates"],
     &["planning", "order_check"],
     &["planning", "check"],
+    &["planning", "remote"],
     &["planning"],
     &["choice"],
     &["machine", "pin"],

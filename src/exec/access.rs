@@ -15,7 +15,7 @@ use super::layout::{Repr, COUNTER_BYTES, CTUD_BYTES, TIMER_BYTES, TRIGGER_BYTES}
 use super::lower::{Op, Pc};
 use super::store::Addr;
 use super::Machine;
-use crate::model::RungId;
+use crate::model::{RungId, VarClass, VarId};
 
 /// A span of bytes an instruction reads or writes: (first byte, width).
 pub type Span = (Addr, u32);
@@ -32,6 +32,17 @@ impl Machine {
             self.op_accesses(pous[i].index(), false, reads, writes, &mut pous);
             i += 1;
         }
+    }
+
+    /// The byte spans of the program's inputs: what a driver writes before every scan.
+    pub fn input_spans(&self) -> Vec<Span> {
+        (self.vars.iter().enumerate())
+            .filter(|(_, v)| v.class == VarClass::Input)
+            .map(|(i, v)| {
+                let at = self.layout.start(VarId(i as u32));
+                (at, super::layout::type_size(v.ty))
+            })
+            .collect()
     }
 
     /// One past the last byte any instruction (of any POU) reads or writes.

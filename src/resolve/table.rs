@@ -138,7 +138,7 @@ impl<V: Copy> NameTable<V> {
             return;
         }
         let i = hash(name).0 as usize & (self.slots.len() - 1);
-        prefetch(self.slots.as_ptr().wrapping_add(i).cast());
+        crate::hint::prefetch_read(self.slots.as_ptr().wrapping_add(i).cast());
     }
 
     pub(crate) fn contains_key(&self, name: &str) -> bool {
@@ -214,7 +214,7 @@ impl IndexSet {
     pub(crate) fn prefetch(&self, name: &str) {
         if !self.slots.is_empty() {
             let i = Self::home(hash(name).1, self.slots.len() - 1);
-            prefetch(self.slots.as_ptr().wrapping_add(i).cast());
+            crate::hint::prefetch_read(self.slots.as_ptr().wrapping_add(i).cast());
         }
     }
 
@@ -258,20 +258,6 @@ impl IndexSet {
             }
         }
     }
-}
-
-/// Asks the CPU to start loading the cache line at `at` (a hint; nothing else happens where
-/// the target has no such instruction).
-#[inline]
-fn prefetch(at: *const i8) {
-    #[cfg(target_arch = "x86_64")]
-    // SAFETY: `_mm_prefetch` needs SSE, which every x86_64 CPU has (it is in the target's
-    // baseline); it never faults and reads nothing into the program: any address is allowed.
-    unsafe {
-        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(at)
-    };
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = at;
 }
 
 // One cache line holds two slots of a variable table.

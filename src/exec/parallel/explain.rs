@@ -160,6 +160,13 @@ impl ParallelMachine {
                 m.loop_counters().len(),
                 plan.decision_slots
             );
+            let (reads, writes) = plan.remote_lines();
+            let _ = writeln!(
+                s,
+                "prefetched when a slice starts, per scan: {} another core wrote, to read; {} another core holds, to write",
+                count(reads, "line"),
+                count(writes, "line")
+            );
         } else {
             let _ = writeln!(s, "padding: none (dense layout)");
         }
@@ -292,6 +299,7 @@ impl ParallelMachine {
             "state_bytes": self.machine.state_size(),
             "layout_groups": self.layout_groups,
             "decision_slots": plan.decision_slots,
+            "remote_lines": {"reads": plan.remote_lines().0, "writes": plan.remote_lines().1},
             "deps": self.deps_json(),
             "levels": plan.levels.iter().map(|lp| json!({
                 "tasks": lp.tasks,

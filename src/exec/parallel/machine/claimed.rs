@@ -17,6 +17,16 @@ use crate::exec::parallel::planning::{Phase, Plan};
 use std::ops::Range;
 use std::time::Instant;
 
+/// A phase of a scan as units: the phase, its index, its first unit's position in the scan and
+/// that unit's id.
+#[derive(Copy, Clone)]
+struct PhaseUnits<'p> {
+    ph: &'p Phase,
+    pi: usize,
+    at: usize,
+    first: u64,
+}
+
 /// Where each phase's units start in a scan of `plan` (position 0 is the scan's start), and
 /// the units per scan.
 pub(super) fn unit_layout(plan: &Plan) -> (Vec<usize>, usize) {
@@ -70,12 +80,13 @@ impl ParallelMachine {
             self.machine.begin_scan(&mut store);
             units.done();
             let mut ctx = self.machine.context(scan, &mut b.scratch);
-            for (ph, &at) in plan.phases.iter().zip(&starts) {
+            for (pi, (ph, &at)) in plan.phases.iter().zip(&starts).enumerate() {
                 let first = s0 + at as u64;
                 if !units.wait(first, &sh.barrier, || false) {
                     return None;
                 }
-                taken += self.take_units(0, plan, ph, at, first, &mut store, &mut ctx, sh);
+                let unit = PhaseUnits { ph, pi, at, first };
+                taken += self.take_units(0, plan, unit, &mut store, &mut ctx, sh);
             }
             if !units.wait(s0 + per_scan as u64, &sh.barrier, || false) {
                 return None;
@@ -112,7 +123,7 @@ impl ParallelMachine {
         for i in 0..note.scans {
             let s0 = note.base + i * per_scan as u64;
             let mut ctx = self.machine.context(note.first + i, &mut b.scratch);
-            for (ph, &at) in plan.phases.iter().zip(&starts) {
+            for (pi, (ph, &at)) in plan.phases.iter().zip(&starts).enumerate() {
                 let first = s0 + at as u64;
                 if !ph.is_parallel() {
                     continue;
@@ -123,7 +134,8 @@ impl ParallelMachine {
                 if units.completed() >= first + plan.threads as u64 {
                     continue;
                 }
-                self.take_units(w, plan, ph, at, first, &mut store, &mut ctx, sh);
+                let unit = PhaseUnits { ph, pi, at, first };
+                self.take_units(w, plan, unit, &mut store, &mut ctx, sh);
             }
         }
         true
@@ -132,24 +144,25 @@ impl ParallelMachine {
     /// Runs the units of phase `ph` (at position `at`, first unit id above `first`) that worker
     /// `w` claims: its own slice first, then the others in turn (a sequential phase: worker 0
     /// only). The number it ran that were not its own.
-    #[allow(clippy::too_many_arguments)]
     fn take_units(
         &self,
         w: usize,
         plan: &Plan,
-        ph: &Phase,
-        at: usize,
-        first: u64,
+        u: PhaseUnits<'_>,
         store: &mut super::shared::SharedSlots,
         ctx: &mut crate::exec::ScanCtx<'_>,
         sh: &Shared<'_>,
     ) -> u64 {
+        let PhaseUnits { ph, pi, at, first } = u;
         let (n, units) = (units_of(plan, ph), sh.units);
         let mut taken = 0;
         for j in 0..n {
             let slice = (w + j) % n;
             if !units.claim(at + slice, first + slice as u64 + 1) {
                 continue;
+            }
+            if let Some(lines) = plan.remote.get(pi).and_then(|r| r.get(slice)) {
+                store.prefetch(lines);
             }
             for it in ph.items_of(slice) {
                 self.run_item(plan, it, store, ctx, sh);

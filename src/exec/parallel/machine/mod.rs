@@ -39,8 +39,8 @@ use crate::exec::parallel::choice::{Chooser, Switch, Window, WindowRecord};
 use crate::exec::parallel::config::{Measure, PlanConfig, PlanKind};
 use crate::exec::parallel::pad::Padded;
 use crate::exec::parallel::planning::candidate_plans;
-use crate::exec::parallel::planning::check_plan;
 use crate::exec::parallel::planning::{bools_first, layout_groups, Plan};
+use crate::exec::parallel::planning::{check_plan, find_remote_lines};
 use crate::exec::{ExecConfig, Fault, Layout, LowerError, Machine, State, LINE_BYTES};
 use crate::model::{Program, VarId};
 use flags::ReadyFlags;
@@ -153,6 +153,8 @@ impl ParallelMachine {
                     "the parallel plan failed its check against the lowered code ({e}); running sequentially instead"
                 ));
                 plan.sequential = Some(format!("the plan failed its check: {e}"));
+            } else {
+                find_remote_lines(&machine, plan);
             }
         }
         let mut candidates = Vec::new();

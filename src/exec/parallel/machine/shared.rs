@@ -17,7 +17,8 @@ use super::flags::ReadyFlags;
 use super::units::{Units, WindowBell};
 use crate::exec::parallel::ids::{Decision, DecisionSlot};
 use crate::exec::parallel::pad::Padded;
-use crate::exec::{Addr, Fault, Store, Word};
+use crate::exec::parallel::planning::RemoteLines;
+use crate::exec::{Addr, Fault, Store, Word, LINE_BYTES};
 use std::cell::UnsafeCell;
 use std::sync::atomic::{AtomicU32, Ordering};
 
@@ -56,6 +57,19 @@ impl SharedSlots {
         }
         // SAFETY: in bounds of the allocation (checked just above).
         unsafe { self.ptr.add(at.index()) }
+    }
+
+    /// Starts bringing a slice's remote lines into this core's cache: the ones it will write
+    /// exclusive, the ones it will read shared (`planning::remote`; a hint, nothing else).
+    #[inline]
+    pub(super) fn prefetch(&self, lines: &RemoteLines) {
+        let line = |l: u32| self.ptr.wrapping_add(l as usize * LINE_BYTES as usize);
+        for &l in &lines.writes {
+            crate::hint::prefetch_write(line(l));
+        }
+        for &l in &lines.reads {
+            crate::hint::prefetch_read(line(l));
+        }
     }
 
     /// The memory as a slice, for worker 0 while every other worker waits at a barrier.

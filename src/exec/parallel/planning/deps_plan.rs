@@ -85,6 +85,7 @@ pub(in crate::exec::parallel) fn build(p: &Program, a: &Analysis, config: &PlanC
         sequential,
         phases: Vec::new(),
         end_barrier: false,
+        remote: Vec::new(),
         levels,
         task_of_rung: sched.task_of.clone(),
         task_rungs: sched.tasks.iter().map(|t| t.rungs.clone()).collect(),

@@ -20,7 +20,7 @@
 //! phase where each worker reads only its own writes), `plan` (phases on the cost model), `deps_plan`
 //! (the dependence-driven plan), `candidates` (the plans a run chooses from), `order_check`
 //! (the dependence-driven order against the lowered code), `check` (every plan against the
-//! lowered code).
+//! lowered code), `remote` (the lines each slice finds in another core's cache, to prefetch).
 
 mod calibrate;
 mod calls;
@@ -34,6 +34,7 @@ mod partition;
 mod phase;
 mod plan;
 mod ready;
+mod remote;
 mod rung_cost;
 mod slicing;
 mod tasks;
@@ -45,6 +46,7 @@ pub use slicing::LevelPlan;
 
 pub(super) use candidates::candidate_plans;
 pub(super) use check::check_plan;
-pub(super) use phase::Phase;
+pub(super) use phase::{Phase, RemoteLines};
 pub(super) use plan::{bools_first, layout_groups};
+pub(super) use remote::find_remote_lines;
 pub(super) use tasks::{Item, Region};

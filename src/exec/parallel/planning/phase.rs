@@ -15,6 +15,18 @@ pub(in crate::exec::parallel) enum PhaseKind {
     Sequential(Vec<Item>),
 }
 
+/// The state's lines a worker's slice of a parallel phase finds in another core's cache
+/// (`remote`): line numbers (byte address / 64), ascending. Only a hint to the machine, which
+/// prefetches them when the slice starts.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub(in crate::exec::parallel) struct RemoteLines {
+    /// Lines the slice reads whose latest value another worker wrote.
+    pub(in crate::exec::parallel) reads: Vec<u32>,
+    /// Lines the slice writes that another worker has read or written since this worker last
+    /// wrote them (a copy of them is in another core's cache).
+    pub(in crate::exec::parallel) writes: Vec<u32>,
+}
+
 /// One phase of a scan.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub(in crate::exec::parallel) struct Phase {
@@ -43,13 +55,17 @@ impl Phase {
         matches!(self.kind, PhaseKind::Parallel(_))
     }
 
-    /// Every (worker, item) of the phase.
-    pub(in crate::exec::parallel) fn all_items(&self) -> impl Iterator<Item = (usize, &Item)> {
-        let slices: Vec<(usize, &[Item])> = match &self.kind {
+    /// Every (worker, slice of items) of the phase.
+    pub(in crate::exec::parallel) fn slices(&self) -> Vec<(usize, &[Item])> {
+        match &self.kind {
             PhaseKind::Parallel(s) => s.iter().map(|v| v.as_slice()).enumerate().collect(),
             PhaseKind::Sequential(items) => vec![(0, items.as_slice())],
-        };
-        slices
+        }
+    }
+
+    /// Every (worker, item) of the phase.
+    pub(in crate::exec::parallel) fn all_items(&self) -> impl Iterator<Item = (usize, &Item)> {
+        self.slices()
             .into_iter()
             .flat_map(|(w, items)| items.iter().map(move |it| (w, it)))
     }

@@ -16,7 +16,7 @@
 use super::calls::{call_closure, is_loop_back, rung_callees, uncovered_refusal};
 use super::merge::merge_phases;
 use super::movement::Movement;
-pub(in crate::exec::parallel) use super::phase::{Phase, PhaseKind};
+pub(in crate::exec::parallel) use super::phase::{Phase, PhaseKind, RemoteLines};
 use super::ready::{Ready, Wait};
 use super::rung_cost::interpreter_costs;
 use super::slicing::{slice_levels, worker_makespan, LevelPlan};
@@ -40,6 +40,9 @@ pub struct Plan {
     pub(in crate::exec::parallel) sequential: Option<String>,
     pub(in crate::exec::parallel) phases: Vec<Phase>,
     pub(in crate::exec::parallel) end_barrier: bool,
+    /// Per phase, per worker: the lines its slice finds in another core's cache (empty until
+    /// the machine that runs the plan finds them: they depend on its layout; `remote`).
+    pub(in crate::exec::parallel) remote: Vec<Vec<RemoteLines>>,
     pub(in crate::exec::parallel) levels: Vec<LevelPlan>,
     /// Task of each rung (main-program rungs that run).
     pub(in crate::exec::parallel) task_of_rung: Vec<Option<TaskId>>,
@@ -67,6 +70,12 @@ pub struct Plan {
 }
 
 impl Plan {
+    /// The remote lines of a scan, summed over every slice: (to read, to write).
+    pub(in crate::exec::parallel) fn remote_lines(&self) -> (usize, usize) {
+        let slices = self.remote.iter().flatten();
+        slices.fold((0, 0), |(r, w), l| (r + l.reads.len(), w + l.writes.len()))
+    }
+
     pub(in crate::exec::parallel) fn build(p: &Program, a: &Analysis, config: &PlanConfig) -> Plan {
         let sched = &a.schedule;
         let threads = config.threads.max(1);
@@ -111,6 +120,7 @@ impl Plan {
             sequential,
             phases,
             end_barrier: false,
+            remote: Vec::new(),
             levels: level_plans,
             task_of_rung,
             task_rungs: sched.tasks.iter().map(|t| t.rungs.clone()).collect(),
