@@ -41,11 +41,11 @@ pub(crate) fn program_source(p: &Program, sh: &Shared, extra: &[String], cfg: &C
         s.extend(inits);
         s.push_str("};\n\n");
     }
-    // The BOOLs, then the INTs, are the struct's first members (the rows' tables hold their
-    // offsets): the last of each where the generator put it.
-    for ty in [Type::Bool, Type::Int] {
+    // The BOOLs, the INTs, the counters and the timers are the struct's first members (the
+    // rows' tables hold their offsets): the last of each class where the generator put it.
+    for (is, _, _) in super::CLASSES {
         let last = (0..p.vars.len())
-            .filter(|&i| p.vars[i].ty == ty)
+            .filter(|&i| is(p.vars[i].ty))
             .filter_map(|i| Some((i, sh.at[i]?)))
             .next_back();
         if let Some((i, at)) = last {
