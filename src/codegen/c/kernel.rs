@@ -174,6 +174,10 @@ fn and_expr(items: &[Item], next: &mut usize, pre: &mut String) -> String {
                 *next += 1;
                 format!("(s[t[{}]] ^ 1)", *next - 1)
             }
+            Item::Contact => {
+                *next += 2;
+                format!("(s[t[{}]] ^ t[{}])", *next - 2, *next - 1)
+            }
             Item::Edge => {
                 let (v, m, f) = (*next, *next + 1, *next + 2);
                 *next += 3;

@@ -56,11 +56,14 @@ use crate::model::{
 use std::collections::{BTreeSet, HashMap};
 
 /// A condition item of a shape, in its canonical order (derived `Ord`: positive contacts,
-/// negated contacts, edges, compares, ORs).
+/// negated contacts, contacts inside ORs, edges, compares, ORs).
 #[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub(super) enum Item {
-    /// A Normal (false) or Negated (true) contact (slot: the BOOL).
+    /// A Normal (false) or Negated (true) contact of the top-level AND (slot: the BOOL; which
+    /// one it is goes into the row's pattern word).
     Lit(bool),
+    /// A contact inside an OR (slots: the BOOL, 0 Normal or 1 Negated).
+    Contact,
     /// An edge contact (slots: the BOOL, its memory, 0 rising or 1 falling).
     Edge,
     /// A comparison of two INTs, each a variable or a constant (true) (slots: the operands,
@@ -74,6 +77,7 @@ impl Item {
     fn slots(&self) -> usize {
         match self {
             Item::Lit(_) => 1,
+            Item::Contact => 2,
             Item::Edge | Item::Cmp(..) => 3,
             Item::Or(bs) => bs.iter().flatten().map(Item::slots).sum(),
         }
@@ -232,7 +236,7 @@ fn shape(sh: &Shared, r: RungId) -> Option<(Shape, Vec<u32>)> {
     if outs.is_empty() {
         return None;
     }
-    let items = and_items(sh, cond)?;
+    let items = and_items(sh, cond, true)?;
     let out_slots = outs.iter().map(|o| o.1.len()).sum::<usize>();
     let mut slots: Vec<u32> = outs.iter().flat_map(|o| o.1.clone()).collect();
     let (mut cond, mut rest) = (Vec::new(), Vec::new());
@@ -278,24 +282,26 @@ impl Out {
     }
 }
 
-/// The items of an AND (sorted, each with its slots).
-fn and_items(sh: &Shared, series: &[Element]) -> Option<Vec<(Item, Vec<u32>)>> {
+/// The items of an AND (sorted, each with its slots); `top`: the rung's top-level AND.
+fn and_items(sh: &Shared, series: &[Element], top: bool) -> Option<Vec<(Item, Vec<u32>)>> {
     let mut items = Vec::with_capacity(series.len());
     for e in series {
-        items.push(item(sh, e)?);
+        items.push(item(sh, e, top)?);
     }
     // Stable: equal items keep their order (their slots then differ only by variable).
     items.sort_by(|a, b| a.0.cmp(&b.0));
     Some(items)
 }
 
-fn item(sh: &Shared, e: &Element) -> Option<(Item, Vec<u32>)> {
+fn item(sh: &Shared, e: &Element, top: bool) -> Option<(Item, Vec<u32>)> {
     match e {
         Element::Contact { var, kind } => {
             let v = contact(sh, *var)?;
             match kind {
-                ContactKind::Normal => Some((Item::Lit(false), vec![v])),
-                ContactKind::Negated => Some((Item::Lit(true), vec![v])),
+                ContactKind::Normal if top => Some((Item::Lit(false), vec![v])),
+                ContactKind::Negated if top => Some((Item::Lit(true), vec![v])),
+                ContactKind::Normal => Some((Item::Contact, vec![v, 0])),
+                ContactKind::Negated => Some((Item::Contact, vec![v, 1])),
                 ContactKind::Rising { memory } | ContactKind::Falling { memory } => {
                     let m = bool_at(sh, *memory)?;
                     let falling = matches!(kind, ContactKind::Falling { .. });
@@ -305,12 +311,19 @@ fn item(sh: &Shared, e: &Element) -> Option<(Item, Vec<u32>)> {
         }
         Element::Compare { op, a, b } => {
             let (a, b) = (int_slot(sh, a)?, int_slot(sh, b)?);
-            Some((Item::Cmp(a.1, b.1), vec![a.0, b.0, cmp_mask(*op)]))
+            let mask = cmp_mask(*op);
+            if a.1 && !b.1 {
+                // A constant before a variable: the mirrored compare (`<` for `>`), so that
+                // both orders share a kernel.
+                let mirrored = (mask & 0b100) | (mask & 1) << 1 | (mask & 2) >> 1;
+                return Some((Item::Cmp(false, true), vec![b.0, a.0, mirrored]));
+            }
+            Some((Item::Cmp(a.1, b.1), vec![a.0, b.0, mask]))
         }
         Element::Or(branches) if !branches.is_empty() => {
             let mut bs = Vec::with_capacity(branches.len());
             for b in branches {
-                let items = and_items(sh, b)?;
+                let items = and_items(sh, b, false)?;
                 if items.is_empty() {
                     return None; // an empty branch passes power: left to the statements
                 }
