@@ -326,7 +326,7 @@ static inline bool _plc_loop_back(uint64_t *ctr, _plc_ctx *ctx, uint32_t rung) {
     return 0;
 }
 
-/* The kernels of the rows of contacts and coils (plc_rows.c, docs/c.md): one loop per rung
+/* The kernels of the rows of contacts and coils (plc_rows*.c, docs/c.md): one loop per rung
    shape over a table of byte offsets. Out of line and opaque, so that a call is a call even
    when every file is compiled as one unit (GCC's interprocedural constant propagation would
    otherwise look at every call's constant table). */
