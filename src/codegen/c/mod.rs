@@ -266,19 +266,37 @@ fn shared<'a>(p: &'a Program, fbd: &Fbd, lay: &types::Layout) -> Shared<'a> {
     }
 }
 
-/// The classes of members whose offsets the generator computes, in the order `_plc_state` lists
-/// them: BOOLs, INTs, counter instances (`_plc_counter`: CTU and CTD), timer instances
-/// (`_plc_timer`: TON, TOF, TP); with each class's size and alignment in bytes (x86-64 and
-/// AArch64; `plc_runtime.h` and `plc_program.h` assert them).
-pub(crate) const CLASSES: [(fn(Type) -> bool, u32, u32); 4] = [
-    (|t| t == Type::Bool, 1, 1),
-    (|t| t == Type::Int, 2, 2),
-    (|t| matches!(t, Type::Fb(FbKind::Ctu | FbKind::Ctd)), 8, 2),
-    (
-        |t| matches!(t, Type::Fb(FbKind::Ton | FbKind::Tof | FbKind::Tp)),
-        32,
-        8,
-    ),
+/// A class of members whose offsets the generator computes: which types, their size and
+/// alignment in bytes (x86-64 and AArch64; `plc_runtime.h` and `plc_program.h` assert them).
+pub(crate) struct Class {
+    pub is: fn(Type) -> bool,
+    pub size: u32,
+    pub align: u32,
+}
+
+/// The classes in the order `_plc_state` lists them: BOOLs, INTs, counter instances
+/// (`_plc_counter`: CTU and CTD), timer instances (`_plc_timer`: TON, TOF, TP).
+pub(crate) const CLASSES: [Class; 4] = [
+    Class {
+        is: |t| t == Type::Bool,
+        size: 1,
+        align: 1,
+    },
+    Class {
+        is: |t| t == Type::Int,
+        size: 2,
+        align: 2,
+    },
+    Class {
+        is: |t| matches!(t, Type::Fb(FbKind::Ctu | FbKind::Ctd)),
+        size: 8,
+        align: 2,
+    },
+    Class {
+        is: |t| matches!(t, Type::Fb(FbKind::Ton | FbKind::Tof | FbKind::Tp)),
+        size: 32,
+        align: 8,
+    },
 ];
 
 /// Per variable: its byte offset in `_plc_state` if it is a member of the struct itself (not a
@@ -292,12 +310,12 @@ fn member_offsets(p: &Program, lay: &types::Layout, local_only: &[bool]) -> Vec<
     let member = |i: usize| lay.vars[i].1.is_none() && !local_only[i];
     let mut out = vec![None; p.vars.len()];
     let mut next = 0u32;
-    for (is, size, align) in CLASSES {
-        next = next.next_multiple_of(align);
+    for c in CLASSES {
+        next = next.next_multiple_of(c.align);
         for (i, at) in out.iter_mut().enumerate() {
-            if member(i) && is(p.vars[i].ty) {
+            if member(i) && (c.is)(p.vars[i].ty) {
                 *at = Some(next);
-                next += size;
+                next += c.size;
             }
         }
     }

@@ -116,6 +116,11 @@ impl Out {
             Out::DivMod(..) => 5,
         }
     }
+
+    /// Whether the power after it is the box's Q (not the power before it).
+    pub(super) fn takes_q(self) -> bool {
+        matches!(self, Out::Timer | Out::Counter(..))
+    }
 }
 
 /// The shape of a row: what its kernel computes.
@@ -273,13 +278,6 @@ fn shape(sh: &Shared, r: RungId) -> Option<(Shape, Vec<u32>)> {
     slots.extend(rest);
     let outs = outs.into_iter().map(|o| o.0).collect();
     Some((Shape { lits, cond, outs }, slots))
-}
-
-impl Out {
-    /// Whether the power after it is the box's Q (not the power before it).
-    pub(super) fn takes_q(self) -> bool {
-        matches!(self, Out::Timer | Out::Counter(..))
-    }
 }
 
 /// The items of an AND (sorted, each with its slots); `top`: the rung's top-level AND.
