@@ -9,8 +9,8 @@
 //! struct member) is one struct `_plc_state` passed to every POU function as `self`; each POU is a function `_pou_<name>(self, ctx)`
 //! (`ctx`: virtual time, scan, loop cap, fault sink). Ladder rungs are one block of statements
 //! each (`ladder`); FBD networks are nested `if` blocks following their fragment trees, with
-//! one local per data arc (`fbd`). A ladder POU's rungs of contacts and coils are rows of
-//! tables of byte offsets, each run by a small loop specialised for the rung's shape (`rows`;
+//! one local per data arc (`fbd`). A ladder POU's rungs of contacts, coils and simple boxes are rows of
+//! tables of byte offsets, each run by a small loop specialised for the rung's shape (`rows`, `kernel`;
 //! [`CConfig::rows`], the default), emitted in an order that groups them by dependence level
 //! and shape within straight-line regions (`order`); the other rungs are statements. A ladder
 //! POU of more than [`CConfig::chunk_rungs`] units (a rung of statements, a run of rows) is cut
@@ -370,7 +370,7 @@ fn program_header(p: &Program, sh: &Shared, h: &Header) -> String {
     s.push_str(&h.structs);
     s.push_str("struct _plc_state {\n");
     let mut fields = 0;
-    // The BOOLs and INTs first, at the offsets `member_offsets` gives (the rows' tables hold
+    // The BOOLs, INTs, counters and timers first, at the offsets `member_offsets` gives (the rows' tables hold
     // them).
     let mut known: Vec<usize> = (0..p.vars.len()).filter(|&i| sh.at[i].is_some()).collect();
     known.sort_by_key(|&i| sh.at[i]);
