@@ -54,8 +54,8 @@ pub(crate) struct Shared<'a> {
     /// Per variable: held in a local of an FBD function only (an arc or a run flag), so no
     /// struct has a member for it.
     pub local_only: Vec<bool>,
-    /// Per variable: its byte offset in `_plc_state` if it is a BOOL or INT member of it
-    /// (they come first in the struct, `member_offsets`).
+    /// Per variable: its byte offset in `_plc_state` if it is a BOOL, INT, counter or timer
+    /// member of it (they come first in the struct, `member_offsets`).
     pub at: Vec<Option<u32>>,
     /// Per rung: its row, if it is written as one (`rows`).
     pub rows: Vec<Option<super::rows::Row>>,

@@ -9,8 +9,8 @@
 //! struct member) is one struct `_plc_state` passed to every POU function as `self`; each POU is a function `_pou_<name>(self, ctx)`
 //! (`ctx`: virtual time, scan, loop cap, fault sink). Ladder rungs are one block of statements
 //! each (`ladder`); FBD networks are nested `if` blocks following their fragment trees, with
-//! one local per data arc (`fbd`). A ladder POU's rungs of contacts and coils are rows of
-//! tables of byte offsets, each run by a small loop specialised for the rung's shape (`rows`;
+//! one local per data arc (`fbd`). A ladder POU's rungs of contacts, coils and simple boxes are rows of
+//! tables of byte offsets, each run by a small loop specialised for the rung's shape (`rows`, `kernel`;
 //! [`CConfig::rows`], the default), emitted in an order that groups them by dependence level
 //! and shape within straight-line regions (`order`); the other rungs are statements. A ladder
 //! POU of more than [`CConfig::chunk_rungs`] units (a rung of statements, a run of rows) is cut
@@ -30,6 +30,7 @@ mod fbd;
 mod fold;
 mod functions;
 mod harness;
+mod kernel;
 mod ladder;
 pub mod names;
 mod order;
@@ -40,7 +41,7 @@ mod spelling;
 mod types;
 
 use crate::fbd::Fbd;
-use crate::model::{walk_elements, Element, PouKind, Program, Type, VarId};
+use crate::model::{walk_elements, Element, FbKind, PouKind, Program, Type, VarId};
 use ladder::{c_type, Body, Shared};
 use parts::{chunks_per_file, ladder_files};
 use std::collections::HashMap;
@@ -184,9 +185,7 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
             });
         }
     }
-    if !kernels.is_empty() {
-        data.files.push(("plc_rows".to_string(), kernels.source()));
-    }
+    data.files.extend(kernels.sources());
     for (stem, text) in data.files.into_iter().chain(type_files) {
         files.push(CFile {
             name: format!("{stem}.c"),
@@ -267,23 +266,56 @@ fn shared<'a>(p: &'a Program, fbd: &Fbd, lay: &types::Layout) -> Shared<'a> {
     }
 }
 
-/// Per variable: its byte offset in `_plc_state` if it is a BOOL or an INT member of the
-/// struct itself (not a member of an instance's struct, not a local of an FBD function). The
-/// struct lists these BOOLs first, then these INTs, in variable order: C lays members out in
-/// order from offset 0, with no padding between members whose size is their alignment (1 for
-/// `bool`, 2 for `int16_t`) and the INTs starting at the first even offset after the BOOLs
-/// (`plc_program.h` asserts the sizes and alignments, `plc_program.c` the offsets of the last
-/// BOOL and the last INT).
+/// A class of members whose offsets the generator computes: which types, their size and
+/// alignment in bytes (x86-64 and AArch64; `plc_runtime.h` and `plc_program.h` assert them).
+pub(crate) struct Class {
+    pub is: fn(Type) -> bool,
+    pub size: u32,
+    pub align: u32,
+}
+
+/// The classes in the order `_plc_state` lists them: BOOLs, INTs, counter instances
+/// (`_plc_counter`: CTU and CTD), timer instances (`_plc_timer`: TON, TOF, TP).
+pub(crate) const CLASSES: [Class; 4] = [
+    Class {
+        is: |t| t == Type::Bool,
+        size: 1,
+        align: 1,
+    },
+    Class {
+        is: |t| t == Type::Int,
+        size: 2,
+        align: 2,
+    },
+    Class {
+        is: |t| matches!(t, Type::Fb(FbKind::Ctu | FbKind::Ctd)),
+        size: 8,
+        align: 2,
+    },
+    Class {
+        is: |t| matches!(t, Type::Fb(FbKind::Ton | FbKind::Tof | FbKind::Tp)),
+        size: 32,
+        align: 8,
+    },
+];
+
+/// Per variable: its byte offset in `_plc_state` if it is a member of the struct itself (not a
+/// member of an instance's struct, not a local of an FBD function) of one of the [`CLASSES`].
+/// The struct lists these members first, class by class, in variable order within a class: C
+/// lays members out in order from offset 0, with no padding between members whose size is a
+/// multiple of their alignment, and each class starting at the first offset after the class
+/// before it that is a multiple of its alignment (`plc_program.h` asserts the sizes and
+/// alignments, `plc_program.c` the offset of the last member of each class).
 fn member_offsets(p: &Program, lay: &types::Layout, local_only: &[bool]) -> Vec<Option<u32>> {
     let member = |i: usize| lay.vars[i].1.is_none() && !local_only[i];
     let mut out = vec![None; p.vars.len()];
     let mut next = 0u32;
-    for (ty, size) in [(Type::Bool, 1), (Type::Int, 2)] {
-        next = next.next_multiple_of(size);
+    for c in CLASSES {
+        next = next.next_multiple_of(c.align);
         for (i, at) in out.iter_mut().enumerate() {
-            if member(i) && p.vars[i].ty == ty {
+            if member(i) && (c.is)(p.vars[i].ty) {
                 *at = Some(next);
-                next += size;
+                next += c.size;
             }
         }
     }
@@ -338,7 +370,7 @@ fn program_header(p: &Program, sh: &Shared, h: &Header) -> String {
     s.push_str(&h.structs);
     s.push_str("struct _plc_state {\n");
     let mut fields = 0;
-    // The BOOLs and INTs first, at the offsets `member_offsets` gives (the rows' tables hold
+    // The BOOLs, INTs, counters and timers first, at the offsets `member_offsets` gives (the rows' tables hold
     // them).
     let mut known: Vec<usize> = (0..p.vars.len()).filter(|&i| sh.at[i].is_some()).collect();
     known.sort_by_key(|&i| sh.at[i]);
@@ -378,7 +410,10 @@ fn program_header(p: &Program, sh: &Shared, h: &Header) -> String {
     if fields == 0 && k == 0 {
         s.push_str("    char _empty;\n");
     }
-    s.push_str("};\n\n_Static_assert(sizeof(bool) == 1 && sizeof(int16_t) == 2 && _Alignof(int16_t) == 2, \"the rows' offsets\");\n");
+    s.push_str(
+        "};\n\n_Static_assert(sizeof(bool) == 1 && sizeof(int16_t) == 2 && _Alignof(int16_t) == 2, \"the rows' offsets\");\n\
+         _Static_assert(sizeof(_plc_counter) == 8 && _Alignof(_plc_counter) == 2 && sizeof(_plc_timer) == 32 && _Alignof(_plc_timer) == 8, \"the rows' offsets\");\n",
+    );
     s.push_str("extern const _plc_state _plc_initial;\n");
     s.push_str("void _plc_scan(_plc_state *self, _plc_ctx *ctx);\n");
     s.push_str(&h.type_decls);

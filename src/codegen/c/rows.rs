@@ -10,33 +10,35 @@
 //! statements (docs/c.md).
 //!
 //! A rung is a row when its series is a condition of Normal, Negated, Rising and Falling
-//! contacts on BOOL variables of the state and compares of INTs (variables of the state or
-//! INT constants), with ORs of series of those (no edge inside an OR, no empty branch), then
-//! optionally INT moves and ADD/SUB/MUL boxes, then one output or an output branch of single
-//! outputs or INT boxes: coil, negated coil, set or reset of BOOL variables of the state.
+//! contacts on BOOLs of the state (variables, or the Q of a timer or counter instance of the
+//! state) and compares of INTs (variables of the state, a counter's CV or PV, or INT
+//! constants), with ORs of series of those (no empty branch), then outputs and boxes in series:
+//! coil, negated coil, set or reset of a BOOL variable of the state; INT moves and INT ADD,
+//! SUB, MUL, DIV and MOD boxes; TON, TOF and TP with a constant preset of 0 to 65,535 ms, and
+//! CTU and CTD whose PV is an INT and whose reset or load a BOOL of the state or a constant
+//! (their Q is the power after them); the last may be an output branch whose paths are one
+//! output or INT box each. Jumps, FOR/NEXT, calls, returns, SR/RS, R_TRIG/F_TRIG, CTUD,
+//! variable presets, standard functions and arithmetic on other types stay statements.
 //! Its shape is that tree in a canonical form: the top-level Normal and Negated contacts are a
 //! count, padded to 4, 6 or 8 (which are negated is the row's pattern word, and padded slots
 //! are masked out by its care bits); the other items of every AND are sorted, the branches of
 //! every OR too — exact since contacts and compares have no side effects, and an edge contact's
 //! only effect is on its own hidden memory, which no other contact reads; so rungs that differ
-//! only in the order or the negations of their contacts share one kernel. A BOOL output's kind
-//! (coil, negated coil, set, reset) is data too: the new value is looked up in a table of 16
-//! bytes by kind, power and old value. The row's slots are the outputs' (the BOOL and its kind;
-//! a box's target and operands), then the contacts' offsets and the pattern word, then the
-//! other items' (an edge contact: its BOOL, then its memory; a compare: its two operands).
+//! only in the order or the negations of their contacts share one kernel. What is data, not
+//! shape: a BOOL output's kind (coil, negated coil, set, reset: the new value is looked up in a
+//! table of 16 bytes by kind, power and old value), an edge's direction, a compare's operator,
+//! the operator of an arithmetic or DIV/MOD box and the kind of a timer or counter. The row's
+//! slots are the outputs' (the BOOL and its kind; a box's target, kind and operands; a DIV or
+//! MOD's rung), then the contacts' offsets and the pattern word, then the other items' (an edge
+//! contact: its BOOL, its memory, its direction; a compare: its two operands and operator).
 //!
-//! The kernel evaluates as the interpreter does (docs/scan.md): every edge contact computes its
-//! pulse (rising `v & !m`, falling `!v & m`) and its memory takes `v`, and every contact and
-//! compare is read, before the first output is written; the outputs and boxes are written in
-//! order (coil `p`, negated coil `!p`, set `old | p`, reset `old & !p`; a box only when
-//! powered). BOOLs are the bytes 0 and 1 of C `bool`s, read and written through `uint8_t`,
-//! which may alias anything; INTs are read and written as `int16_t`. Offsets are the
-//! generator's own (`mod::member_offsets`: the BOOLs, then the INTs, first in `_plc_state`,
-//! checked by `_Static_assert`s), so table files need no struct and no `offsetof`: they are
-//! data only.
+//! The kernels (`kernel`) evaluate as the interpreter does. Offsets are the generator's own
+//! (`mod::member_offsets`: the BOOLs, the INTs, the counters, then the timers, first in
+//! `_plc_state`, checked by `_Static_assert`s), so table files need no struct and no
+//! `offsetof`: they are data only.
 //!
 //! Consecutive rows of one kernel in a function make one run, one call
-//! `_pou__kK((uint8_t *)self, _pou__tF + first, count)`; any other line of C (a rung that is no
+//! `_pou__kK((uint8_t *)self, _pou__tF + first, count, ctx)`; any other line of C (a rung that is no
 //! row, a label, the function's end) ends the run first, so rows run in the order they are
 //! emitted. Only ladder functions of POUs use rows (not FBD bodies or function block types,
 //! whose variables may be locals or another struct's members). The emission order itself (rungs
@@ -45,75 +47,104 @@
 //! Not here: the C of the rungs that are no row (`ladder`), the order of the rungs (`order`),
 //! the files (`mod`).
 
+use super::kernel;
 use super::ladder::{push, Shared};
 use crate::model::{
-    ArithOp, ContactKind, Element, Operand, RungId, Series, Type, Value, VarId, VarRef,
+    ArithOp, CmpOp, ContactKind, Element, FbKind, Field, Operand, RungId, TimerKind, Type, Value,
+    VarId, VarRef,
 };
 use std::collections::{BTreeSet, HashMap};
 
 /// A condition item of a shape, in its canonical order (derived `Ord`: positive contacts,
-/// negated contacts, rising edges, falling edges, ORs).
+/// negated contacts, contacts inside ORs, edges, compares, ORs).
 #[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-enum Item {
-    /// A Normal (false) or Negated (true) contact.
+pub(super) enum Item {
+    /// A Normal (false) or Negated (true) contact of the top-level AND (slot: the BOOL; which
+    /// one it is goes into the row's pattern word).
     Lit(bool),
-    /// An edge contact: falling (true) or rising (false).
-    Edge(bool),
-    /// A comparison of two INTs (`==`, `<` …), each a variable or a constant (true).
-    Cmp(&'static str, bool, bool),
+    /// A contact inside an OR (slots: the BOOL, 0 Normal or 1 Negated).
+    Contact,
+    /// An edge contact (slots: the BOOL, its memory, 0 rising or 1 falling).
+    Edge,
+    /// A comparison of two INTs, each a variable or a constant (true) (slots: the operands,
+    /// the operator's mask, [`cmp_mask`]).
+    Cmp(bool, bool),
     /// An OR of ANDs (each with at least one item).
     Or(Vec<Vec<Item>>),
 }
 
-/// An output of a shape, or a box before or beside the outputs (which passes power on).
+impl Item {
+    fn slots(&self) -> usize {
+        match self {
+            Item::Lit(_) => 1,
+            Item::Contact => 2,
+            Item::Edge | Item::Cmp(..) => 3,
+            Item::Or(bs) => bs.iter().flatten().map(Item::slots).sum(),
+        }
+    }
+}
+
+/// An output of a shape, or a box (which passes power on, or its Q for a timer or counter).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-enum Out {
+pub(super) enum Out {
     /// A coil, negated coil, set or reset of a BOOL: which one is data (slots: the BOOL, the
     /// kind 0–3, looked up in `_pou__bit` with the power and the old value).
     Bit,
-    /// An INT move from a variable or a constant (true).
+    /// An INT move from a variable or a constant (true) (slots: target, source).
     Move(bool),
-    /// INT `+`, `-` or `*` (wrapping, `_plc_add_i16` …) of variables or constants (true).
-    Arith(&'static str, bool, bool),
+    /// INT ADD, SUB or MUL (wrapping) of variables or constants (true) (slots: target, the
+    /// operator 0–2, the operands).
+    Arith(bool, bool),
+    /// INT DIV or MOD of variables or constants (true) (slots: target, the operator 0–1, the
+    /// operands, the rung a division by zero names in its fault).
+    DivMod(bool, bool),
+    /// A TON, TOF or TP with a constant preset; its Q is the power on (slots: the instance,
+    /// the kind 0–2, the preset in ms).
+    Timer,
+    /// A CTU or CTD with a PV and a reset (CTU) or load (CTD) that are variables or constants
+    /// (true); its Q is the power on (slots: the instance, the kind 0–1, PV, reset or load).
+    Counter(bool, bool),
 }
 
 impl Out {
-    /// Its slots: the target, then the operands.
-    fn slots(self) -> usize {
+    /// Its slots: the target, then the rest.
+    pub(super) fn slots(self) -> usize {
         match self {
             Out::Bit | Out::Move(_) => 2,
-            Out::Arith(..) => 3,
+            Out::Timer => 3,
+            Out::Arith(..) | Out::Counter(..) => 4,
+            Out::DivMod(..) => 5,
         }
+    }
+
+    /// Whether the power after it is the box's Q (not the power before it).
+    pub(super) fn takes_q(self) -> bool {
+        matches!(self, Out::Timer | Out::Counter(..))
     }
 }
 
 /// The shape of a row: what its kernel computes.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
-struct Shape {
+pub(super) struct Shape {
     /// The contacts of the top-level AND (Normal or Negated: which ones is data, the row's
     /// pattern word).
-    lits: usize,
+    pub lits: usize,
     /// The other items of the top-level AND, sorted.
-    cond: Vec<Item>,
-    outs: Vec<Out>,
+    pub cond: Vec<Item>,
+    /// The outputs and boxes in order (an output branch's paths are outputs that keep the
+    /// power, so in order too).
+    pub outs: Vec<Out>,
 }
 
 impl Shape {
-    fn slots(&self) -> usize {
-        fn count(items: &[Item]) -> usize {
-            items
-                .iter()
-                .map(|i| match i {
-                    Item::Lit(_) => 1,
-                    Item::Edge(_) | Item::Cmp(..) => 2,
-                    Item::Or(bs) => bs.iter().map(|b| count(b)).sum(),
-                })
-                .sum()
-        }
-        self.out_slots() + self.lits + usize::from(self.lits > 0) + count(&self.cond)
+    pub(super) fn slots(&self) -> usize {
+        self.out_slots()
+            + self.lits
+            + usize::from(self.lits > 0)
+            + self.cond.iter().map(Item::slots).sum::<usize>()
     }
 
-    fn out_slots(&self) -> usize {
+    pub(super) fn out_slots(&self) -> usize {
         self.outs.iter().map(|o| o.slots()).sum()
     }
 }
@@ -137,7 +168,7 @@ pub(crate) struct Kernels {
 impl Kernels {
     /// Rung `r` as a row (its shape's kernel registered), if it has a row's form.
     pub fn row(&mut self, sh: &Shared, r: RungId) -> Option<Row> {
-        let (shape, slots) = shape(sh, &sh.p.rung(r).series)?;
+        let (shape, slots) = shape(sh, r)?;
         let next = self.shapes.len() as u32;
         let kernel = *self.ids.entry(shape.clone()).or_insert_with(|| next);
         if kernel == next {
@@ -157,172 +188,55 @@ impl Kernels {
         }
     }
 
-    pub fn is_empty(&self) -> bool {
-        self.shapes.is_empty()
-    }
-
-    /// `plc_rows.c`: every kernel's function.
-    pub fn source(&self) -> String {
-        let mut s = String::from(
-            "/* plc_rows.c: the loops that run the rows of the tables, one per rung shape \
-             (docs/c.md). */\n#include \"plc_runtime.h\"\n\n\
-             /* A BOOL output's new value: _pou__bit[kind | power << 2 | old << 3], kind 0 coil, \
-             1 negated coil, 2 set, 3 reset. */\n\
-             static const uint8_t _pou__bit[16] = {0, 1, 0, 0, 1, 0, 1, 0, 0, 1, 1, 1, 1, 0, 1, 0};\n\n",
-        );
-        for (k, shape) in self.shapes.iter().enumerate() {
-            s.push_str(&kernel(k, shape, self.entry_type()));
-        }
-        s
+    /// The kernels' source files (name stem, text): `plc_rows.c`, or with more than
+    /// [`kernel::PER_FILE`] kernels `plc_rows0.c`, `plc_rows1.c` … (`make -j` compiles them in
+    /// parallel).
+    pub fn sources(&self) -> Vec<(String, String)> {
+        kernel::sources(&self.shapes, self.entry_type())
     }
 }
 
-/// The declaration of kernel `k` over tables of `ty`.
-fn kernel_decl(k: u32, ty: &str) -> String {
-    format!("void _pou__k{k}(uint8_t *s, const {ty} *t, size_t n)")
-}
-
-/// The C of kernel `k`: one loop over `n` rows of `shape`.
-fn kernel(k: usize, shape: &Shape, ty: &str) -> String {
-    let mut pre = String::new();
-    let mut next = shape.out_slots() + shape.lits + usize::from(shape.lits > 0);
-    let mut cond = and_expr(&shape.cond, &mut next, &mut pre);
-    if shape.lits > 0 {
-        // The contacts' bytes as the bits of a word, compared with the pattern the row's
-        // contacts pass on (entry bit i set: contact i is Normal) where they count (bit 8 + i
-        // set: contact i is one of the rung's, not padding).
-        let o = shape.out_slots();
-        let bits: Vec<String> = (0..shape.lits)
-            .map(|i| match i {
-                0 => format!("(unsigned)s[t[{o}]]"),
-                _ => format!("(unsigned)s[t[{}]] << {i}", o + i),
-            })
-            .collect();
-        push(
-            &mut pre,
-            format_args!("        unsigned q = {};\n", bits.join(" | ")),
-        );
-        let e = format!("t[{}]", o + shape.lits);
-        let eq = format!("(((q ^ {e}) & ({e} >> 8)) == 0)");
-        cond = if shape.cond.is_empty() {
-            eq
-        } else {
-            format!("{eq} & {cond}")
-        };
-    }
-    let mut body = pre;
-    push(&mut body, format_args!("        unsigned p = {cond};\n"));
-    let mut i = 0;
-    for o in &shape.outs {
-        let int = |k: usize| format!("*(int16_t *)(s + t[{k}])");
-        let stmt = match *o {
-            Out::Bit => format!(
-                "s[t[{i}]] = _pou__bit[t[{}] | p << 2 | (unsigned)s[t[{i}]] << 3];",
-                i + 1
-            ),
-            Out::Move(c) => format!("{0} = p ? {1} : {0};", int(i), int_operand(i + 1, c)),
-            Out::Arith(f, ca, cb) => format!(
-                "{0} = p ? _plc_{f}_i16({1}, {2}) : {0};",
-                int(i),
-                int_operand(i + 1, ca),
-                int_operand(i + 2, cb)
-            ),
-        };
-        i += o.slots();
-        push(&mut body, format_args!("        {stmt}\n"));
-    }
-    format!(
-        "_PLC_KERNEL {} {{\n    for (; n; n--, t += {}) {{\n{body}    }}\n}}\n\n",
-        kernel_decl(k as u32, ty).trim_start_matches("void "),
-        shape.slots()
-    )
-}
-
-/// The INT in slot `k`: a constant (`c`, its bits) or a variable's offset.
-fn int_operand(k: usize, c: bool) -> String {
-    if c {
-        format!("(int16_t)(uint16_t)t[{k}]")
-    } else {
-        format!("*(int16_t *)(s + t[{k}])")
+/// The mask of a compare's operator over `(a < b) | (a == b) << 1` (bit 0: a > b, bit 1:
+/// a < b, bit 2: a == b).
+fn cmp_mask(op: CmpOp) -> u32 {
+    match op {
+        CmpOp::Eq => 0b100,
+        CmpOp::Ne => 0b011,
+        CmpOp::Lt => 0b010,
+        CmpOp::Le => 0b110,
+        CmpOp::Gt => 0b001,
+        CmpOp::Ge => 0b101,
     }
 }
 
-/// The C expression of an AND of items whose slots start at `*next`; edge pulses are computed
-/// into locals by statements appended to `pre`.
-fn and_expr(items: &[Item], next: &mut usize, pre: &mut String) -> String {
-    if items.is_empty() {
-        return "1u".into();
-    }
-    let parts: Vec<String> = items
+/// Rung `r`'s shape and its slots, if it is a row: a condition (contacts, compares, ORs),
+/// then outputs and boxes in series, the last of which may be an output branch whose paths are
+/// one output or INT box each.
+fn shape(sh: &Shared, r: RungId) -> Option<(Shape, Vec<u32>)> {
+    let series = &sh.p.rung(r).series;
+    let n = series
         .iter()
-        .map(|item| match item {
-            Item::Lit(false) => {
-                *next += 1;
-                format!("s[t[{}]]", *next - 1)
-            }
-            Item::Lit(true) => {
-                *next += 1;
-                format!("(s[t[{}]] ^ 1)", *next - 1)
-            }
-            Item::Edge(falling) => {
-                let (v, m) = (*next, *next + 1);
-                *next += 2;
-                let pulse = if *falling {
-                    format!("(s[t[{v}]] ^ 1) & s[t[{m}]]")
-                } else {
-                    format!("s[t[{v}]] & (s[t[{m}]] ^ 1)")
-                };
-                push(
-                    pre,
-                    format_args!(
-                        "        unsigned e{v} = {pulse};\n        s[t[{m}]] = s[t[{v}]];\n"
-                    ),
-                );
-                format!("e{v}")
-            }
-            Item::Cmp(op, ca, cb) => {
-                *next += 2;
-                let (a, b) = (int_operand(*next - 2, *ca), int_operand(*next - 1, *cb));
-                format!("({a} {op} {b})")
-            }
-            Item::Or(branches) => {
-                let bs: Vec<String> = branches
-                    .iter()
-                    .map(|b| match b.len() {
-                        1 => and_expr(b, next, pre),
-                        _ => format!("({})", and_expr(b, next, pre)),
-                    })
-                    .collect();
-                format!("({})", bs.join(" | "))
-            }
+        .position(|e| {
+            !matches!(
+                e,
+                Element::Contact { .. } | Element::Compare { .. } | Element::Or(_)
+            )
         })
-        .collect();
-    parts.join(" & ")
-}
-
-/// The shape of `series` and its slots, if it is a row.
-fn shape(sh: &Shared, series: &Series) -> Option<(Shape, Vec<u32>)> {
-    let (out, rest) = series.split_last()?;
-    // The boxes directly before the output run, when powered, before it.
-    let n = rest
-        .iter()
-        .rposition(|e| int_box(sh, e).is_none())
-        .map_or(0, |i| i + 1);
-    let (cond, boxes) = rest.split_at(n);
+        .unwrap_or(series.len());
+    let (cond, acts) = series.split_at(n);
     let mut outs: Vec<(Out, Vec<u32>)> = Vec::new();
-    for e in boxes {
-        outs.push(int_box(sh, e)?);
-    }
-    match out {
-        Element::Branch(paths) => {
-            for path in paths {
-                match path.as_slice() {
-                    [e] => outs.push(output(sh, e).or_else(|| int_box(sh, e))?),
-                    _ => return None,
+    for (i, e) in acts.iter().enumerate() {
+        match e {
+            Element::Branch(paths) if i + 1 == acts.len() => {
+                for path in paths {
+                    match path.as_slice() {
+                        [e] => outs.push(action(sh, r, e).filter(|o| !o.0.takes_q())?),
+                        _ => return None,
+                    }
                 }
             }
+            e => outs.push(action(sh, r, e)?),
         }
-        e => outs.push(output(sh, e)?),
     }
     if outs.is_empty() {
         return None;
@@ -366,7 +280,7 @@ fn shape(sh: &Shared, series: &Series) -> Option<(Shape, Vec<u32>)> {
     Some((Shape { lits, cond, outs }, slots))
 }
 
-/// The items of an AND (sorted, each with its slots); `top`: edge contacts are allowed.
+/// The items of an AND (sorted, each with its slots); `top`: the rung's top-level AND.
 fn and_items(sh: &Shared, series: &[Element], top: bool) -> Option<Vec<(Item, Vec<u32>)>> {
     let mut items = Vec::with_capacity(series.len());
     for e in series {
@@ -382,20 +296,27 @@ fn item(sh: &Shared, e: &Element, top: bool) -> Option<(Item, Vec<u32>)> {
         Element::Contact { var, kind } => {
             let v = contact(sh, *var)?;
             match kind {
-                ContactKind::Normal => Some((Item::Lit(false), vec![v])),
-                ContactKind::Negated => Some((Item::Lit(true), vec![v])),
-                ContactKind::Rising { memory } | ContactKind::Falling { memory } if top => {
+                ContactKind::Normal if top => Some((Item::Lit(false), vec![v])),
+                ContactKind::Negated if top => Some((Item::Lit(true), vec![v])),
+                ContactKind::Normal => Some((Item::Contact, vec![v, 0])),
+                ContactKind::Negated => Some((Item::Contact, vec![v, 1])),
+                ContactKind::Rising { memory } | ContactKind::Falling { memory } => {
                     let m = bool_at(sh, *memory)?;
                     let falling = matches!(kind, ContactKind::Falling { .. });
-                    Some((Item::Edge(falling), vec![v, m]))
+                    Some((Item::Edge, vec![v, m, u32::from(falling)]))
                 }
-                _ => None,
             }
         }
         Element::Compare { op, a, b } => {
             let (a, b) = (int_slot(sh, a)?, int_slot(sh, b)?);
-            let sym = super::spelling::cmp_symbol(*op);
-            Some((Item::Cmp(sym, a.1, b.1), vec![a.0, b.0]))
+            let mask = cmp_mask(*op);
+            if a.1 && !b.1 {
+                // A constant before a variable: the mirrored compare (`<` for `>`), so that
+                // both orders share a kernel.
+                let mirrored = (mask & 0b100) | (mask & 1) << 1 | (mask & 2) >> 1;
+                return Some((Item::Cmp(false, true), vec![b.0, a.0, mirrored]));
+            }
+            Some((Item::Cmp(a.1, b.1), vec![a.0, b.0, mask]))
         }
         Element::Or(branches) if !branches.is_empty() => {
             let mut bs = Vec::with_capacity(branches.len());
@@ -421,52 +342,99 @@ fn item(sh: &Shared, e: &Element, top: bool) -> Option<(Item, Vec<u32>)> {
     }
 }
 
-/// An INT move or `+`, `-`, `*` box as a row output (its slots: target, operands).
-fn int_box(sh: &Shared, e: &Element) -> Option<(Out, Vec<u32>)> {
+/// An output or a box of rung `r` as a row output (its slots: target, then the rest).
+fn action(sh: &Shared, r: RungId, e: &Element) -> Option<(Out, Vec<u32>)> {
     let target = |v: VarId| (sh.p.var(v).ty == Type::Int).then(|| sh.at[v.index()])?;
-    match e {
+    let bit = |var: VarId, kind: u32| Some((Out::Bit, vec![bool_at(sh, var)?, kind]));
+    match *e {
+        Element::Coil {
+            var,
+            negated: false,
+        } => bit(var, 0),
+        Element::Coil { var, negated: true } => bit(var, 1),
+        Element::Set(var) => bit(var, 2),
+        Element::Reset(var) => bit(var, 3),
         Element::Move { from, to } => {
-            let (f, c) = int_slot(sh, from)?;
-            Some((Out::Move(c), vec![target(*to)?, f]))
+            let (f, c) = int_slot(sh, &from)?;
+            Some((Out::Move(c), vec![target(to)?, f]))
         }
         Element::Arith { op, a, b, out } => {
-            let f = match op {
-                ArithOp::Add => "add",
-                ArithOp::Sub => "sub",
-                ArithOp::Mul => "mul",
-                ArithOp::Div | ArithOp::Mod => return None, // they may record a fault
+            let ((a, ca), (b, cb)) = (int_slot(sh, &a)?, int_slot(sh, &b)?);
+            let to = target(out)?;
+            Some(match op {
+                ArithOp::Add => (Out::Arith(ca, cb), vec![to, 0, a, b]),
+                ArithOp::Sub => (Out::Arith(ca, cb), vec![to, 1, a, b]),
+                ArithOp::Mul => (Out::Arith(ca, cb), vec![to, 2, a, b]),
+                ArithOp::Div => (Out::DivMod(ca, cb), vec![to, 0, a, b, r.0]),
+                ArithOp::Mod => (Out::DivMod(ca, cb), vec![to, 1, a, b, r.0]),
+            })
+        }
+        Element::Timer { kind, instance, pt } => {
+            let Operand::Const(Value::Time(ms)) = pt else {
+                return None; // a variable preset: left to the statements
             };
-            let ((a, ca), (b, cb)) = (int_slot(sh, a)?, int_slot(sh, b)?);
-            Some((Out::Arith(f, ca, cb), vec![target(*out)?, a, b]))
+            let ms = u16::try_from(ms).ok()?;
+            let kind = match kind {
+                TimerKind::Ton => 0,
+                TimerKind::Tof => 1,
+                TimerKind::Tp => 2,
+            };
+            let at = fb_at(sh, instance, &[FbKind::Ton, FbKind::Tof, FbKind::Tp])?;
+            Some((Out::Timer, vec![at, kind, u32::from(ms)]))
+        }
+        Element::Ctu {
+            instance,
+            pv,
+            reset: r,
+        }
+        | Element::Ctd {
+            instance,
+            pv,
+            load: r,
+        } => {
+            let kind = u32::from(matches!(e, Element::Ctd { .. }));
+            let at = fb_at(sh, instance, &[FbKind::Ctu, FbKind::Ctd])?;
+            let ((pv, cp), (r, cr)) = (int_slot(sh, &pv)?, bool_slot(sh, &r)?);
+            Some((Out::Counter(cp, cr), vec![at, kind, pv, r]))
         }
         _ => None,
     }
 }
 
-/// An INT operand's slot: a variable's offset (false) or a constant's bits (true).
+/// The offset of an instance of one of the kinds `kinds` in the state.
+fn fb_at(sh: &Shared, v: VarId, kinds: &[FbKind]) -> Option<u32> {
+    match sh.p.var(v).ty {
+        Type::Fb(k) if kinds.contains(&k) => sh.at[v.index()],
+        _ => None,
+    }
+}
+
+/// An INT operand's slot: a variable's offset (false) or a constant's bits (true). A counter's
+/// CV and PV are INTs of the state too (at 2 and 4 in `_plc_counter`).
 fn int_slot(sh: &Shared, o: &Operand) -> Option<(u32, bool)> {
     match *o {
         Operand::Const(Value::Int(v)) => Some((u32::from(v as u16), true)),
         Operand::Var(VarRef { var, field: None }) if sh.p.var(var).ty == Type::Int => {
             Some((sh.at[var.index()]?, false))
         }
+        Operand::Var(VarRef {
+            var,
+            field: Some(f @ (Field::Cv | Field::Pv)),
+        }) => {
+            let at = fb_at(sh, var, &[FbKind::Ctu, FbKind::Ctd])?;
+            Some((at + if f == Field::Cv { 2 } else { 4 }, false))
+        }
         _ => None,
     }
 }
 
-/// An output element as a row output.
-fn output(sh: &Shared, e: &Element) -> Option<(Out, Vec<u32>)> {
-    let (var, kind) = match *e {
-        Element::Coil {
-            var,
-            negated: false,
-        } => (var, 0),
-        Element::Coil { var, negated: true } => (var, 1),
-        Element::Set(var) => (var, 2),
-        Element::Reset(var) => (var, 3),
-        _ => return None,
-    };
-    Some((Out::Bit, vec![bool_at(sh, var)?, kind]))
+/// A BOOL operand's slot: a BOOL's offset (false) or a constant 0 or 1 (true).
+fn bool_slot(sh: &Shared, o: &Operand) -> Option<(u32, bool)> {
+    match *o {
+        Operand::Const(Value::Bool(b)) => Some((u32::from(b), true)),
+        Operand::Var(r) => Some((contact(sh, r)?, false)),
+        Operand::Const(_) => None,
+    }
 }
 
 /// The offset of a BOOL variable of the state.
@@ -475,11 +443,22 @@ fn bool_at(sh: &Shared, v: VarId) -> Option<u32> {
     sh.at[v.index()]
 }
 
-/// The offset of a contact's BOOL (a whole BOOL variable of the state; fields of instances
-/// are no rows).
+/// The offset of a contact's BOOL: a BOOL variable of the state, or the Q of a timer or
+/// counter of the state (at 0 in `_plc_timer` and `_plc_counter`).
 fn contact(sh: &Shared, r: VarRef) -> Option<u32> {
     match r.field {
         None => bool_at(sh, r.var),
+        Some(Field::Q) => fb_at(
+            sh,
+            r.var,
+            &[
+                FbKind::Ton,
+                FbKind::Tof,
+                FbKind::Tp,
+                FbKind::Ctu,
+                FbKind::Ctd,
+            ],
+        ),
         Some(_) => None,
     }
 }
@@ -534,7 +513,7 @@ impl Tables {
     pub fn take_call(&mut self) -> Option<String> {
         let (k, first, n) = self.run.take()?;
         Some(format!(
-            "_pou__k{k}((uint8_t *)self, _pou__t{} + {first}, {n});",
+            "_pou__k{k}((uint8_t *)self, _pou__t{} + {first}, {n}, ctx);",
             self.file
         ))
     }
@@ -546,7 +525,7 @@ impl Tables {
         }
         let mut s = format!("extern const {} _pou__t{}[];\n", self.ty, self.file);
         for &k in &self.used {
-            push(&mut s, format_args!("{};\n", kernel_decl(k, self.ty)));
+            push(&mut s, format_args!("{};\n", kernel::decl(k, self.ty)));
         }
         s
     }

@@ -60,6 +60,8 @@ static inline void _plc_fault(_plc_ctx *ctx, uint32_t rung, int kind) {
 typedef struct { bool Q; int32_t ET; int32_t PT; int64_t start; uint8_t flags; } _plc_timer;
 /* A CTU/CTD instance: the readable fields, then CU/CD of the previous evaluation. */
 typedef struct { bool Q; int16_t CV; int16_t PV; bool prev; } _plc_counter;
+/* The rows read these fields at these offsets (docs/c.md, Rows). */
+_Static_assert(offsetof(_plc_timer, Q) == 0 && offsetof(_plc_counter, Q) == 0 && offsetof(_plc_counter, CV) == 2 && offsetof(_plc_counter, PV) == 4, "the rows' field offsets");
 
 /* An SR/RS instance. */
 typedef struct { bool Q1; } _plc_bistable;
@@ -216,6 +218,29 @@ static inline T _plc_mod_##s(T a, T b, _plc_ctx *ctx, uint32_t rung) { \
 _PLC_SDIV(i8, int8_t, uint8_t) _PLC_SDIV(i16, int16_t, uint16_t)
 _PLC_SDIV(i32, int32_t, uint32_t) _PLC_SDIV(i64, int64_t, uint64_t)
 _PLC_UDIV(u8, uint8_t) _PLC_UDIV(u16, uint16_t) _PLC_UDIV(u32, uint32_t) _PLC_UDIV(u64, uint64_t)
+/* The rows' boxes whose kind is data (docs/c.md, Rows): a timer (0 TON, 1 TOF, 2 TP), a counter
+   (0 CTU, 1 CTD), INT ADD/SUB/MUL (0, 1, 2) and INT DIV/MOD (0, 1), each the statements' function
+   of that kind; a compare's operator as a mask over (a < b) | (a == b) << 1. */
+static inline bool _plc_timer_row(_plc_timer *t, int64_t now, unsigned kind, int32_t pt, bool in) {
+    switch (kind) {
+    case 0: return _plc_ton(t, now, pt, in);
+    case 1: return _plc_tof(t, now, pt, in);
+    default: return _plc_tp(t, now, pt, in);
+    }
+}
+static inline bool _plc_counter_row(_plc_counter *c, unsigned kind, int16_t pv, bool in, bool r) {
+    return kind ? _plc_ctd(c, pv, in, r) : _plc_ctu(c, pv, in, r);
+}
+static inline int16_t _plc_ring_row_i16(unsigned op, int16_t a, int16_t b) {
+    uint64_t x = (uint64_t)a, y = (uint64_t)b;
+    return (int16_t)(uint16_t)(op == 0 ? x + y : op == 1 ? x - y : x * y);
+}
+static inline int16_t _plc_divmod_row_i16(unsigned op, int16_t a, int16_t b, _plc_ctx *ctx, uint32_t rung) {
+    return op ? _plc_mod_i16(a, b, ctx, rung) : _plc_div_i16(a, b, ctx, rung);
+}
+static inline unsigned _plc_cmp_row_i16(unsigned mask, int16_t a, int16_t b) {
+    return (mask >> ((unsigned)(a < b) | (unsigned)(a == b) << 1)) & 1u;
+}
 /* Compares as functions, where GCC would warn on the operator (see ladder.rs). */
 #define _PLC_CMP(name, T, op) static inline bool name(T a, T b) { return a op b; }
 #define _PLC_CMPS(s, T) _PLC_CMP(_plc_eq_##s, T, ==) _PLC_CMP(_plc_ne_##s, T, !=) \
@@ -301,7 +326,7 @@ static inline bool _plc_loop_back(uint64_t *ctr, _plc_ctx *ctx, uint32_t rung) {
     return 0;
 }
 
-/* The kernels of the rows of contacts and coils (plc_rows.c, docs/c.md): one loop per rung
+/* The kernels of the rows of contacts and coils (plc_rows*.c, docs/c.md): one loop per rung
    shape over a table of byte offsets. Out of line and opaque, so that a call is a call even
    when every file is compiled as one unit (GCC's interprocedural constant propagation would
    otherwise look at every call's constant table). */
