@@ -210,6 +210,42 @@ fn fixtures_once() -> &'static [(String, String)] {
     FIXTURES.get_or_init(fixtures)
 }
 
+/// Mutants found by the random test that sent the LD reader into an endless recursion (a wire
+/// renumbered so that the power into a contact comes from its own output through contacts and
+/// coils only): now one located error.
+#[test]
+fn a_loop_of_contacts_and_coils_is_a_located_error_not_a_stack_overflow() {
+    let fixtures = fixtures_once();
+    let cases: [(&str, &[Edit]); 2] = [
+        (
+            "assemblyarea__plc.xml",
+            &[Edit::Number { at: 411, with: 39 }],
+        ),
+        (
+            "mixer-with-lld__plc.xml",
+            &[
+                Edit::Number { at: 381, with: 173 },
+                Edit::Number { at: 919, with: 27 },
+            ],
+        ),
+    ];
+    for (file, edits) in cases {
+        let (name, text) = fixtures
+            .iter()
+            .find(|(n, _)| n == file)
+            .expect("the fixture is there");
+        let mut text = text.clone();
+        for e in edits {
+            apply(&mut text, e);
+        }
+        assert!(
+            plc_deps::load::plcopen(&text).is_err(),
+            "{name}: the mutant loads"
+        );
+        check(name, &text).unwrap_or_else(|e| panic!("{name}: {e}"));
+    }
+}
+
 /// Through the command line: exit 0 and an output file, or exit 2, errors with a line and a
 /// column, and no output file.
 #[test]

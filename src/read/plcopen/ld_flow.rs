@@ -39,7 +39,7 @@ use crate::syntax::fbd::{Block, Connection, Input, Inputs, Network, OutVar, Outp
 use crate::syntax::{FbdBody, Scalar};
 use roxmltree::Node;
 use std::borrow::Cow;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 /// The elements read here: the rung reader's, and in-out variables.
 const FLOW_TAGS: &[&str] = &[
@@ -81,6 +81,7 @@ pub fn body(tc6: Tc6, node: Node, pou: &str, ctx: &Ctx, notes: &mut Notes) -> R<
         done: HashMap::new(),
         ctx,
         boxes: std::mem::take(&mut notes.black_boxes),
+        tracing: HashSet::new(),
     };
     // Networks in the order of their first statement; rungs of blocks only after the others.
     let mut order: Vec<usize> = Vec::new();
@@ -162,6 +163,8 @@ struct Flow<'g, 'a, 'i> {
     ctx: &'g Ctx,
     /// The project's black boxes so far ([`super::black_box`]).
     boxes: Vec<BlackBox>,
+    /// Contacts, coils and ENOs whose power is being followed (`through`).
+    tracing: HashSet<ElemId>,
 }
 
 fn var_input(v: &str, at: Origin) -> Input<'static> {
@@ -222,7 +225,7 @@ impl Flow<'_, '_, '_> {
             }
             "contact" => {
                 let lid = el.local_id;
-                let p = self.power(e)?;
+                let p = self.through(e, at, |f| f.power(e))?;
                 let v = variable_ref(&self.expression(e)?, el.node, &self.at(e))?;
                 let term = match (el.node.attribute("negated"), el.node.attribute("edge")) {
                     (Some("true" | "1"), _) => {
@@ -235,14 +238,16 @@ impl Flow<'_, '_, '_> {
                 };
                 self.a.and(p, term, at)
             }
-            "coil" => self.power(e)?,
+            "coil" => self.through(e, at, |f| f.power(e))?,
             "block" => {
                 if s.pin == Some("ENO") {
                     let en = el.inputs.iter().position(|p| p.name == Some("EN"));
-                    return Ok(match en {
-                        Some(k) => self.pin(e, k)?.unwrap_or_else(|| konst(false, at)),
-                        None => konst(true, at),
-                    });
+                    return match en {
+                        Some(k) => self.through(e, at, |f| {
+                            Ok(f.pin(e, k)?.unwrap_or_else(|| konst(false, at)))
+                        }),
+                        None => Ok(konst(true, at)),
+                    };
                 }
                 let id = self.block(e)?;
                 let arc = Input {
@@ -269,6 +274,33 @@ impl Flow<'_, '_, '_> {
                 ))
             }
         })
+    }
+
+    /// Runs `follow`, which follows the power into element `e` (a contact, a coil, or a block's
+    /// EN for its ENO). A wiring that leads back to `e` before it reaches a rail, a variable or a
+    /// block's output has no value to start from: an error naming the element, not an endless
+    /// recursion. (A block's outputs are arcs, emitted once: a loop through a block is a
+    /// feedback arc, which the FBD order reads as the previous scan's value.)
+    fn through<T>(
+        &mut self,
+        e: ElemId,
+        at: Origin,
+        follow: impl FnOnce(&mut Self) -> R<T>,
+    ) -> R<T> {
+        if !self.tracing.insert(e) {
+            let el = self.g.get(e);
+            return Err(error(
+                at,
+                &self.at(e),
+                format!(
+                    "the power into this {} (localId {}) comes back from its own output through contacts and coils only: a loop with no value to start from",
+                    el.tag, el.local_id
+                ),
+            ));
+        }
+        let out = follow(self);
+        self.tracing.remove(&e);
+        out
     }
 
     /// The text of element `e`'s `variable` (contacts, coils) or `expression` (variables).
