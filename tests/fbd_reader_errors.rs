@@ -348,6 +348,18 @@ const CASES: &[(&str, &str, &str)] = &[
         r###"{"vars": [{"name": "A", "type": "INT"}, {"name": "B", "type": "INT"}, {"name": "X", "type": "BOOL"}, {"name": "T1", "type": "TON"}, {"name": "TV", "type": "TIME"}, {"name": "C1", "type": "CTU"}, {"name": "g", "type": "G"}], "function_blocks": {"G": {"inputs": [{"name": "I", "type": "INT"}], "outputs": [{"name": "O", "type": "INT"}], "fbd": {"networks": [{"id": "N1", "blocks": [{"id": 1, "op": "MOVE", "in": ["I"], "out": "O"}]}]}}}}"###,
         r###"network N1 block 1 at fbd.networks[0].blocks[0].in: G takes at most 1 inputs (I), found 2"###,
     ),
+    // A pin number far beyond the inputs given is a gap, found before any pin is made (it
+    // once asked for a trillion-byte allocation).
+    (
+        r###"{"networks": [{"id": "N1", "blocks": [{"id": 1, "op": "ADD", "in": {"IN1": "A", "IN42949672961": 1}, "out": "B"}]}]}"###,
+        r###"{}"###,
+        r###"network N1 block 1 at fbd.networks[0].blocks[0].in: ADD needs its input `IN2` connected"###,
+    ),
+    (
+        r###"{"networks": [{"id": "N1", "blocks": [{"id": 1, "op": "MUX", "in": {"K": "A", "IN0": 1, "IN99999999999": 2}, "out": "B"}]}]}"###,
+        r###"{}"###,
+        r###"network N1 block 1 at fbd.networks[0].blocks[0].in: MUX needs its input `IN1` connected"###,
+    ),
     (
         r###"{"networks": [{"id": "N1", "blocks": [{"id": 1, "op": "ADD", "in": ["A", 1], "out": "B"}]}]}"###,
         r###"{"function_blocks": {"G": {"fbd": {"networks": 5}}}}"###,

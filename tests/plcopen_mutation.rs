@@ -210,16 +210,28 @@ fn fixtures_once() -> &'static [(String, String)] {
     FIXTURES.get_or_init(fixtures)
 }
 
-/// Mutants found by the random test that sent the LD reader into an endless recursion (a wire
-/// renumbered so that the power into a contact comes from its own output through contacts and
-/// coils only): now one located error.
+/// Mutants found by the random test that crashed the process: an LD wire renumbered so that the
+/// power into a contact comes from its own output through contacts and coils only (an endless
+/// recursion), and an extensible block's pin renumbered past 4 billion (an allocation of that
+/// many pins). Each is now one located error.
 #[test]
-fn a_loop_of_contacts_and_coils_is_a_located_error_not_a_stack_overflow() {
+fn mutants_that_crashed_the_reader_are_located_errors() {
     let fixtures = fixtures_once();
-    let cases: [(&str, &[Edit]); 2] = [
+    let cases: [(&str, &[Edit]); 3] = [
         (
             "assemblyarea__plc.xml",
             &[Edit::Number { at: 411, with: 39 }],
+        ),
+        // `IN1` of an XOR renumbered `IN42949672961`: a gap in its inputs, not 43 billion pins.
+        (
+            "sail-plant-automation__plc.xml",
+            &[
+                Edit::Insert {
+                    at: 593,
+                    snippet: 23,
+                },
+                Edit::Number { at: 114, with: 92 },
+            ],
         ),
         (
             "mixer-with-lld__plc.xml",

@@ -218,6 +218,22 @@ impl Net<'_, '_, '_> {
                         None => return Err(unknown(k, "IN1, IN2, …".into())),
                     }
                 }
+                if n > map.len() {
+                    // A gap in IN1 … INn (checked here, before n pins are made: the number may
+                    // be anything a file says).
+                    let missing = (1..=n)
+                        .map(|i| format!("IN{i}"))
+                        .find(|pin| !map.iter().any(|(k, _)| *k == *pin))
+                        .expect("n pins, fewer given: one is missing");
+                    return Err(self.err(
+                        d,
+                        &format!("{p}.in"),
+                        Invalid::Unconnected {
+                            op: d.op.to_owned(),
+                            pin: missing,
+                        },
+                    ));
+                }
                 d.kind.input_pins(n)
             }
             // MUX: K, IN0 … INn, n the highest given.
@@ -227,6 +243,22 @@ impl Net<'_, '_, '_> {
                     .filter_map(|(k, _)| k.strip_prefix("IN").and_then(|x| x.parse::<usize>().ok()))
                     .max()
                     .unwrap_or(1);
+                // IN0 … INn: more than given is a gap (checked before n pins are made).
+                let given = map.iter().filter(|(k, _)| k.starts_with("IN")).count();
+                if n >= given {
+                    let missing = (0..=n)
+                        .map(|i| format!("IN{i}"))
+                        .find(|pin| !map.iter().any(|(k, _)| *k == *pin))
+                        .unwrap_or_else(|| format!("IN{}", n + 1));
+                    return Err(self.err(
+                        d,
+                        &format!("{p}.in"),
+                        Invalid::Unconnected {
+                            op: d.op.to_owned(),
+                            pin: missing,
+                        },
+                    ));
+                }
                 d.kind.input_pins(n + 2)
             }
             None => d.kind.input_pins(0),
