@@ -181,7 +181,9 @@ fn upward_uses(root: &Path, order: Order, absolute: &str) -> Vec<String> {
     bad
 }
 
-/// Every module file of the tree is in the order (a new module must be placed in it).
+/// Every module file of the tree is in the order (a new module must be placed in it), but for
+/// test modules in a file of their own (`tests.rs`), which are left out as an inline
+/// `#[cfg(test)]` module is (`code`).
 fn unlisted(root: &Path, order: Order) -> Vec<String> {
     let mut found = Vec::new();
     let mut stack = vec![root.to_path_buf()];
@@ -190,7 +192,9 @@ fn unlisted(root: &Path, order: Order) -> Vec<String> {
             let p = e.expect("an entry").path();
             if p.is_dir() {
                 stack.push(p);
-            } else if p.extension().is_some_and(|x| x == "rs") {
+            } else if p.extension().is_some_and(|x| x == "rs")
+                && p.file_name().is_some_and(|n| n != "tests.rs")
+            {
                 found.push(p);
             }
         }

@@ -1,0 +1,331 @@
+//! The measured choice on made-up timings: the verdict of one measurement, the schedule of
+//! re-measurements, switches under a changing load, and the run's log of windows.
+
+use super::*;
+
+fn measure() -> Measure {
+    Measure::default()
+}
+
+/// Runs `scans` scans through the chooser's windows, timing candidate `c`'s scan `s` with
+/// `ns(c, s, cold)`, `cold` for the first scan after a change of candidate (every scan of a
+/// timed window, else every 8th, as the machine does). Returns the candidate of every scan.
+fn drive(
+    ch: &mut Chooser,
+    candidates: usize,
+    scans: u64,
+    ns: impl Fn(usize, u64, bool) -> u64,
+) -> Vec<usize> {
+    let mut ran: Vec<usize> = Vec::new();
+    let mut scan = 0;
+    while scan < scans {
+        let w = ch.next();
+        assert!(w.scans >= 1 && w.candidate < candidates);
+        let times: Vec<u64> = (scan..scan + w.scans)
+            .map(|s| {
+                let before = if s == scan {
+                    ran.last()
+                } else {
+                    Some(&w.candidate)
+                };
+                ns(w.candidate, s, before != Some(&w.candidate))
+            })
+            .zip(scan..)
+            .filter(|&(_, s)| w.timed || s % 8 == 0)
+            .map(|(t, _)| t)
+            .collect();
+        ran.extend(std::iter::repeat_n(w.candidate, w.scans as usize));
+        ch.record(w, &times);
+        scan += w.scans;
+    }
+    ran
+}
+
+fn table(rows: &[&[u64]]) -> Vec<Vec<Option<u64>>> {
+    rows.iter()
+        .map(|r| r.iter().map(|&t| (t > 0).then_some(t)).collect())
+        .collect()
+}
+
+#[test]
+fn choose_needs_a_majority_of_rounds_and_a_three_percent_gain() {
+    // Faster in 2 of 3 rounds by 10 %: switch; the outlier round does not matter.
+    let v = choose(&table(&[&[100, 100, 100], &[90, 300, 90]]));
+    assert_eq!(
+        v,
+        Verdict {
+            pick: 1,
+            ratio_permille: 900,
+            wins: 2,
+            rounds: 3,
+            decisive: false
+        }
+    );
+    // Faster in only 1 of 3 rounds (one lucky round): no switch.
+    assert_eq!(choose(&table(&[&[100, 100, 100], &[50, 120, 110]])).pick, 0);
+    // 2 % faster in every round: noise, no switch.
+    assert_eq!(choose(&table(&[&[100, 100, 100], &[98, 98, 98]])).pick, 0);
+    // The lowest median ratio wins among several; rounds a candidate missed are not paired.
+    let v = choose(&table(&[
+        &[100, 200, 100],
+        &[80, 160, 80],
+        &[50, 0, 0],
+        &[60, 110, 60],
+    ]));
+    assert_eq!(
+        (v.pick, v.ratio_permille, v.rounds, v.decisive),
+        (2, 500, 1, true)
+    );
+    // The current one when nothing else was measured.
+    assert_eq!(choose(&table(&[&[100], &[0]])).pick, 0);
+}
+
+#[test]
+fn a_cold_first_scan_does_not_make_the_sequential_walk_lose() {
+    // The sequential walk takes 1.03 ms once warm but 1.62 ms on its first scan after the
+    // parallel plan ran (its state and code come back from the other core); the parallel
+    // plan takes 1.25 ms warm. Timing the cold scan would keep the slower plan.
+    let ns = |c: usize, _: u64, cold: bool| match (c, cold) {
+        (0, true) => 1_620_000,
+        (0, false) => 1_030_000,
+        (_, true) => 1_400_000,
+        (_, false) => 1_250_000,
+    };
+    let mut ch = Chooser::new(2, measure(), 0);
+    let ran = drive(&mut ch, 2, 1000, ns);
+    assert_eq!(ch.current(), 0);
+    assert!(ch.switches().is_empty());
+    assert_eq!(ch.estimates(), &[Some(1_030_000), Some(1_250_000)]);
+    // Three rounds of two visits of 3 scans, then the sequential walk until the first
+    // re-measurement.
+    assert_eq!(
+        ran[..18],
+        [0, 0, 0, 1, 1, 1, 1, 1, 1, 0, 0, 0, 0, 0, 0, 1, 1, 1]
+    );
+    assert!(ran[18..18 + 128].iter().all(|&c| c == 0));
+    let on_par = ran.iter().filter(|&&c| c == 1).count();
+    assert!(on_par <= 40, "{on_par} of 1000 scans on the slower plan");
+}
+
+#[test]
+fn the_first_rounds_time_each_candidate_and_the_fastest_runs() {
+    let mut ch = Chooser::new(3, measure(), 0);
+    let ns = |c: usize, _: u64, _: bool| [100_000, 60_000, 70_000][c];
+    let ran = drive(&mut ch, 3, 27, ns);
+    // Round 0: 0, 1, 2; round 1: 1, 2, 0; round 2: 2, 0, 1 (3 scans a visit).
+    let visits: Vec<usize> = ran.chunks(3).map(|v| v[0]).collect();
+    assert_eq!(visits, [0, 1, 2, 1, 2, 0, 2, 0, 1]);
+    assert_eq!(ch.current(), 1);
+    assert_eq!(ch.estimates(), &[Some(100_000), Some(60_000), Some(70_000)]);
+    assert_eq!(ch.switches().len(), 1);
+    assert_eq!(ch.switches()[0].scan, 27);
+    assert_eq!(
+        ch.switches()[0].why,
+        "measured 60000 ns per scan against 100000 ns (faster in 3 of 3 rounds)"
+    );
+    assert_eq!(
+        ch.next(),
+        Window {
+            candidate: 1,
+            scans: 32,
+            timed: false
+        }
+    );
+}
+
+#[test]
+fn a_measurement_runs_until_successive_choices_agree() {
+    // Rounds alternate which of the two looks faster, 20 % apart: the choice never settles,
+    // so the measurement runs its 8 rounds and keeps the default (won 4 of 8: no majority).
+    let mut ch = Chooser::new(2, measure(), 0);
+    let ns = |c: usize, s: u64, _: bool| {
+        let round = s / 6;
+        if (c == 1) == (round.is_multiple_of(2)) {
+            80_000
+        } else {
+            100_000
+        }
+    };
+    let ran = drive(&mut ch, 2, 48 + 10, ns);
+    assert!(ran[48..].iter().all(|&c| c == 0), "{:?}", &ran[40..]);
+    assert!(ch.switches().is_empty());
+}
+
+#[test]
+fn a_skipped_candidate_never_runs_in_that_measurement_and_the_others_decide() {
+    let mut ch = Chooser::new(3, measure(), 0);
+    let mut ran = Vec::new();
+    while ran.len() < 40 {
+        if ch.next().candidate == 2 {
+            assert!(ch.measuring_other());
+            ch.skip();
+            continue;
+        }
+        let w = ch.next();
+        let t = [100_000, 50_000, 10_000][w.candidate];
+        ran.extend(std::iter::repeat_n(w.candidate, w.scans as usize));
+        ch.record(w, &vec![t; w.scans as usize]);
+    }
+    assert!(!ran.contains(&2), "{ran:?}");
+    assert_eq!(ch.current(), 1, "the faster of the two measured");
+    assert_eq!(ch.estimates()[2], None);
+    // Not measuring another candidate: skip does nothing.
+    assert!(!ch.measuring_other());
+    let before = ch.next();
+    ch.skip();
+    assert_eq!(ch.next(), before);
+}
+
+#[test]
+fn a_hopeless_candidate_is_dropped_after_one_scan_and_the_default_kept() {
+    let mut ch = Chooser::new(3, measure(), 0);
+    let ns = |c: usize, _: u64, _: bool| [100_000, 1_000_000, 101_000][c];
+    let ran = drive(&mut ch, 3, 30, ns);
+    assert_eq!(ran.iter().filter(|&&c| c == 1).count(), 1, "{ran:?}");
+    assert_eq!(ch.current(), 0);
+    assert!(ch.switches().is_empty());
+}
+
+#[test]
+fn a_busy_machine_switches_to_sequential_and_back_when_it_calms_down() {
+    let mut ch = Chooser::new(2, measure(), 0);
+    // Quiet until scan 200, busy (parallel 5x slower) until 1000, quiet again.
+    let ns = |c: usize, s: u64, _: bool| match (c, (200..1000).contains(&s)) {
+        (0, _) => 100_000,
+        (_, false) => 60_000,
+        (_, true) => 300_000,
+    };
+    let ran = drive(&mut ch, 2, 4000, ns);
+    let sw = ch.switches();
+    assert!(sw.len() >= 3, "{sw:?}");
+    assert_eq!((sw[0].from, sw[0].to), (0, 1));
+    assert_eq!((sw[1].from, sw[1].to), (1, 0));
+    assert!(
+        sw[1].scan >= 200 && sw[1].scan < 300,
+        "reacts within a window: {sw:?}"
+    );
+    assert!(sw[1]
+        .why
+        .starts_with("scan time rose from 60000 ns to 300000 ns; measured 100000"));
+    assert!(sw[2].scan > 1000 && sw[2].scan < 1000 + 2048 + 32, "{sw:?}");
+    assert_eq!(ch.current(), 1);
+    // While busy, the parallel candidate ran only its probes.
+    let busy_par = ran[300..1000].iter().filter(|&&c| c == 1).count();
+    assert!(busy_par < 40, "{busy_par} busy scans on the parallel plan");
+}
+
+#[test]
+fn re_measurements_compare_with_the_default_and_the_runner_up_and_the_interval_doubles() {
+    let mut ch = Chooser::new(4, measure(), 0);
+    let ns = |c: usize, _: u64, _: bool| [100_000, 60_000, 70_000, 90_000][c];
+    let ran = drive(&mut ch, 4, 4000, ns);
+    // After the first measurement, the default (candidate 0) and the runner-up (2) are
+    // timed again, after 128, 256, 512 and 1024 scans on candidate 1; candidate 3 is not.
+    let after: Vec<usize> = ran[36..].to_vec();
+    assert!(
+        !after.contains(&3),
+        "a slower candidate is not measured again"
+    );
+    for c in [0, 2] {
+        let probes = after.iter().filter(|&&x| x == c).count();
+        assert_eq!(
+            probes,
+            4 * 3 * 3,
+            "three visits in each of four re-measurements"
+        );
+    }
+    let gaps: Vec<usize> = after
+        .split(|&c| c != 1)
+        .map(<[usize]>::len)
+        .filter(|&n| n > 100)
+        .collect();
+    // Scans on candidate 1 between two re-measurements (the interval, and the visit of
+    // candidate 1 that opens the re-measurement).
+    assert_eq!(gaps.len(), 5, "{gaps:?}");
+    assert_eq!(gaps[..4], [128 + 3, 256 + 3, 512 + 3, 1024 + 3]);
+    assert_eq!(ch.switches().len(), 1);
+}
+
+#[test]
+fn a_candidate_twice_as_slow_is_looked_at_four_times_less_often() {
+    // The sequential walk 3.7 µs, the parallel plan 10.4 µs (gen 1k on 2 vCPUs): the
+    // intervals grow 4x from the first measurement (512, then the cap), not 128, 256 …
+    let mut ch = Chooser::new(2, measure(), 0);
+    let ns = |c: usize, _: u64, _: bool| [3_700, 10_400][c];
+    let ran = drive(&mut ch, 2, 5000, ns);
+    assert!(ch.switches().is_empty());
+    let gaps: Vec<usize> = ran
+        .split(|&c| c != 0)
+        .map(<[usize]>::len)
+        .filter(|&n| n > 100)
+        .collect();
+    assert_eq!(gaps[..2], [512 + 3, 2048 + 3], "{gaps:?}");
+    // The parallel plan ran only in measurements (three visits of 3 scans each): the first
+    // and three looks in 5,000 scans, where doubling intervals would have taken five.
+    let visits = ran.iter().filter(|&&c| c == 1).count();
+    assert_eq!(visits, 4 * 9, "scans on the slow plan");
+}
+
+#[test]
+fn the_log_keeps_the_first_windows_and_the_measurements_that_switch() {
+    // Parallel faster until scan 2000, then 5x slower: one switch to it at the start, one
+    // back after the jump.
+    let mut ch = Chooser::new(2, measure(), 0);
+    let ns = |c: usize, s: u64, _: bool| match (c, s < 2000) {
+        (0, _) => 100_000,
+        (_, true) => 60_000,
+        (_, false) => 300_000,
+    };
+    drive(&mut ch, 2, 4000, ns);
+    let log = ch.windows();
+    assert_eq!(ch.switches().len(), 2, "{:?}", ch.switches());
+    // The first measurement: 3 rounds of two visits of 3 one-scan windows, each timed.
+    assert!(log[..18]
+        .iter()
+        .all(|w| w.measuring && w.scans == 1 && w.timed == 1));
+    assert_eq!(
+        (
+            log[0].candidate,
+            log[0].median_ns,
+            log[3].candidate,
+            log[3].median_ns
+        ),
+        (0, Some(100_000), 1, Some(60_000))
+    );
+    // Then runs of 32 scans on the parallel plan, every 8th timed.
+    assert_eq!(
+        (
+            log[18].scan,
+            log[18].candidate,
+            log[18].scans,
+            log[18].measuring
+        ),
+        (18, 1, 32, false)
+    );
+    assert_eq!((log[18].timed, log[18].median_ns), (4, Some(60_000)));
+    // The windows of every scan are accounted for; the log is contiguous up to the first
+    // 64 and then holds the measurement that switched back (it began on the quiet machine
+    // and saw the 300 µs visits).
+    let logged: u64 = log.len() as u64;
+    assert!(logged + ch.windows_unlogged() > 64);
+    assert!(
+        log[64..].iter().all(|w| w.measuring && w.scan > 1900),
+        "{:?}",
+        &log[64..]
+    );
+    assert!(log[64..].iter().any(|w| w.median_ns == Some(300_000)));
+    assert!(log.windows(2).all(|p| p[0].scan < p[1].scan));
+}
+
+#[test]
+fn one_candidate_never_measures() {
+    let ch = Chooser::new(1, measure(), 5);
+    assert_eq!(
+        ch.next(),
+        Window {
+            candidate: 0,
+            scans: 32,
+            timed: false
+        }
+    );
+}
