@@ -184,6 +184,25 @@ impl Net<'_, '_, '_> {
         Ok(inputs)
     }
 
+    /// The error for the first of the numbered `pins` that `map` leaves out: a gap, found
+    /// before any pin is made (a file may give any number). `pins` are more than `map` gives.
+    fn gap(
+        &self,
+        d: &Draft,
+        map: &[(Text, syn::Input)],
+        mut pins: impl Iterator<Item = String>,
+    ) -> LoadError {
+        let pin = pins
+            .find(|pin| !map.iter().any(|(k, _)| *k == *pin))
+            .expect("more pins than given: one is missing");
+        let op = d.op.to_owned();
+        self.err(
+            d,
+            &format!("{}.in", d.path),
+            Invalid::Unconnected { op, pin },
+        )
+    }
+
     /// `"in": {PIN: A, …}`: extensible ops have `IN1..INn`, n the highest given.
     fn named(
         &self,
@@ -219,20 +238,7 @@ impl Net<'_, '_, '_> {
                     }
                 }
                 if n > map.len() {
-                    // A gap in IN1 … INn (checked here, before n pins are made: the number may
-                    // be anything a file says).
-                    let missing = (1..=n)
-                        .map(|i| format!("IN{i}"))
-                        .find(|pin| !map.iter().any(|(k, _)| *k == *pin))
-                        .expect("n pins, fewer given: one is missing");
-                    return Err(self.err(
-                        d,
-                        &format!("{p}.in"),
-                        Invalid::Unconnected {
-                            op: d.op.to_owned(),
-                            pin: missing,
-                        },
-                    ));
+                    return Err(self.gap(d, map, (1..=n).map(|i| format!("IN{i}"))));
                 }
                 d.kind.input_pins(n)
             }
@@ -243,21 +249,9 @@ impl Net<'_, '_, '_> {
                     .filter_map(|(k, _)| k.strip_prefix("IN").and_then(|x| x.parse::<usize>().ok()))
                     .max()
                     .unwrap_or(1);
-                // IN0 … INn: more than given is a gap (checked before n pins are made).
                 let given = map.iter().filter(|(k, _)| k.starts_with("IN")).count();
                 if n >= given {
-                    let missing = (0..=n)
-                        .map(|i| format!("IN{i}"))
-                        .find(|pin| !map.iter().any(|(k, _)| *k == *pin))
-                        .unwrap_or_else(|| format!("IN{}", n + 1));
-                    return Err(self.err(
-                        d,
-                        &format!("{p}.in"),
-                        Invalid::Unconnected {
-                            op: d.op.to_owned(),
-                            pin: missing,
-                        },
-                    ));
+                    return Err(self.gap(d, map, (0..=n).map(|i| format!("IN{i}"))));
                 }
                 d.kind.input_pins(n + 2)
             }
