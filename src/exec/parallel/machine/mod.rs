@@ -392,10 +392,7 @@ impl ParallelMachine {
             .map(|_| Padded(UnsafeCell::new(Vec::new())))
             .collect();
         let shared = Shared {
-            slots: SharedSlots {
-                len: state.bytes().len(),
-                ptr: state.bytes_mut().as_mut_ptr(),
-            },
+            slots: SharedSlots::new(state.bytes_mut(), &self.machine),
             decisions: &decisions,
             faults: &faults,
             barrier: SpinBarrier::new(threads),
