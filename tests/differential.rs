@@ -16,7 +16,7 @@ use common::Recorder;
 
 use plc_deps::analysis::analyse;
 use plc_deps::exec::parallel::{
-    Candidate, Measure, ParallelMachine, PlanConfig, PlanKind, Slicing, Strategy,
+    Candidate, DepsPartition, Measure, ParallelMachine, PlanConfig, PlanKind, Slicing, Strategy,
 };
 use plc_deps::exec::{ExecConfig, FaultKind, Machine};
 use plc_deps::model::{Program, Value, VarClass, VarId};
@@ -61,6 +61,8 @@ struct Stats {
     /// Cases that ran a dependence-driven plan, and its waits per scan.
     deps_cases: u64,
     deps_waits: u64,
+    /// Dependence-driven plans on the one-way partition.
+    one_way_cases: u64,
 }
 
 /// Runs one program under one plan configuration and compares every scan.
@@ -144,6 +146,7 @@ fn check_with(
     {
         stats.deps_cases += 1;
         stats.deps_waits += r.waits();
+        stats.one_way_cases += (r.partition == DepsPartition::OneWay) as u64;
     }
     for scan in 0..scans {
         let mut faults = Vec::new();
@@ -284,9 +287,14 @@ fn dependence_driven_plan_equals_sequential_scan_on_random_programs() {
         for threads in [1, 2, 4, 8] {
             let mut config = configs(threads, seed + threads as u64);
             config.kind = PlanKind::Deps;
+            config.deps_partition = match (seed / 2) % 3 {
+                0 => DepsPartition::Levels,
+                1 => DepsPartition::OneWay,
+                _ => DepsPartition::Auto,
+            };
             let label = format!(
-                "seed {seed}, {threads} threads, --plan deps, {:?}/{:?}",
-                config.strategy, config.slicing
+                "seed {seed}, {threads} threads, --plan deps, {:?}/{:?}/{:?}",
+                config.strategy, config.slicing, config.deps_partition
             );
             check(&p, &label, &config, &exec, SCANS, seed, &pool, &mut stats);
         }
@@ -303,6 +311,12 @@ fn dependence_driven_plan_equals_sequential_scan_on_random_programs() {
         stats.cases
     );
     assert!(stats.deps_waits > stats.deps_cases, "waits are exercised");
+    assert!(
+        stats.one_way_cases >= stats.deps_cases / 4,
+        "too few one-way partitions: {} of {}",
+        stats.one_way_cases,
+        stats.deps_cases
+    );
     assert!(
         stats.loop_cap_faults > 0 && stats.div_faults > 0,
         "faults are exercised"

@@ -80,6 +80,32 @@ impl Default for Measure {
     }
 }
 
+/// Which tasks run on which worker in the dependence-driven plan ([`PlanKind::Deps`]).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum DepsPartition {
+    /// The one-way partition when its modelled scan is at most 1/32 longer than the level
+    /// slices' (the model prices a wait, not the lockstep of workers that wait for each other
+    /// at every level), else the level slices (the default).
+    Auto,
+    /// Each level cut as the levelled plan cuts it ([`Slicing`]): dependences cross between
+    /// the workers both ways.
+    Levels,
+    /// A chain of workers, each task on a worker no earlier than the workers of everything it
+    /// depends on (`planning::one_way`): worker 0 never waits, the others follow it.
+    OneWay,
+}
+
+impl DepsPartition {
+    /// `auto`, `levels`, `one-way`.
+    pub fn name(self) -> &'static str {
+        match self {
+            DepsPartition::Auto => "auto",
+            DepsPartition::Levels => "levels",
+            DepsPartition::OneWay => "one-way",
+        }
+    }
+}
+
 /// How levels are turned into phases.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub enum Strategy {
@@ -172,6 +198,8 @@ pub struct PlanConfig {
     pub strategy: Strategy,
     /// How parallel levels are sliced.
     pub slicing: Slicing,
+    /// Which tasks run on which worker in the dependence-driven plan.
+    pub deps_partition: DepsPartition,
     /// Merge consecutive parallel levels into one phase plus a sequential halo where the model
     /// gains (`planning::merge`). Off by default, and not among the candidates of
     /// [`PlanKind::Auto`]: measured on 2 shared vCPUs it did not beat one phase per level
@@ -216,6 +244,7 @@ impl PlanConfig {
             line_cost_source: LineCostSource::Default,
             strategy: Strategy::Auto,
             slicing: Slicing::Auto,
+            deps_partition: DepsPartition::Auto,
             merge_levels: false,
             kind: PlanKind::Model,
             measure: Measure::default(),

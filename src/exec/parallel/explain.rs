@@ -1,7 +1,7 @@
 //! `plc-deps run --explain`: the plan in words and as JSON. The top of the parallel module:
 //! it reads the machine and its plan and changes nothing.
 
-use super::config::LineCostSource;
+use super::config::{DepsPartition, LineCostSource};
 use super::machine::{Candidate, ParallelMachine, RunLog};
 use crate::model::Program;
 use serde_json::json;
@@ -198,7 +198,8 @@ impl ParallelMachine {
             .collect();
         let _ = writeln!(
             s,
-            "dependence-driven plan (par-deps): {} per scan instead of a barrier per level ({} cross-worker dependences, the latest producer per worker kept): {}",
+            "dependence-driven plan (par-deps, {}): {} per scan instead of a barrier per level ({} cross-worker dependences, the latest producer per worker kept): {}",
+            partition_words(r.partition),
             count(r.waits(), "wait"),
             r.cross_dependences,
             per.join(", ")
@@ -232,6 +233,7 @@ impl ParallelMachine {
             "publishing_per_worker": r.publishing_per_worker,
             "cross_dependences": r.cross_dependences,
             "critical_path": r.critical_path,
+            "partition": r.partition.name(),
             "wait_cost": plan.config.wait_cost,
             "modelled_steps": {"sequential": plan.est_sequential, "plan": plan.est_plan},
         })
@@ -445,4 +447,14 @@ fn line_source(src: LineCostSource) -> String {
 fn count(n: impl TryInto<u64>, one: &str) -> String {
     let n: u64 = n.try_into().unwrap_or(u64::MAX);
     format!("{n} {one}{}", if n == 1 { "" } else { "s" })
+}
+
+/// The dependence-driven plan's partition, in words.
+fn partition_words(p: DepsPartition) -> &'static str {
+    match p {
+        DepsPartition::OneWay => {
+            "one-way partition: each worker depends only on the workers before it"
+        }
+        DepsPartition::Levels | DepsPartition::Auto => "each level sliced as the levelled plan",
+    }
 }

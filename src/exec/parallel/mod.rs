@@ -91,7 +91,7 @@ mod pad;
 mod planning;
 
 pub use choice::{Chooser, Switch, Window, WindowRecord};
-pub use config::{LineCostSource, Measure, PlanConfig, PlanKind, Slicing, Strategy};
+pub use config::{DepsPartition, LineCostSource, Measure, PlanConfig, PlanKind, Slicing, Strategy};
 pub use explain::{ns_text, run_log_json};
 pub use ids::{Decision, DecisionSlot, Next, TaskId};
 pub use machine::{

@@ -1,18 +1,29 @@
-//! The dependence-driven plan: ready flags instead of a barrier per level. Every task keeps
-//! the worker its level's slicing gives it (`slicing`: contiguous, LPT or locality, as for the
-//! levelled plan); each worker runs its tasks of all levels in level order, in one parallel
-//! phase per scan, and before a task waits only for the tasks it depends on that run on
-//! another worker — the latest of them per other worker, and only when no earlier wait of the
-//! worker already implies it (a vector clock per worker, in the manner of Lamport's
-//! happened-before). A worker publishes "I have finished my k-th item of this scan" as one
-//! counter (`flags`); a wait reads it.
+//! The dependence-driven plan: ready flags instead of a barrier per level. Each worker runs
+//! its tasks of all levels in level order, in one parallel phase per scan, and before a task
+//! waits only for the tasks it depends on that run on another worker — the latest of them per
+//! other worker, and only when no earlier wait of the worker already implies it (a vector clock
+//! per worker, in the manner of Lamport's happened-before). A worker publishes "I have finished
+//! my k-th item of this scan" as one counter (`flags`); a wait reads it.
+//!
+//! Which worker runs a task ([`DepsPartition`]): the levelled plan's slice of its level
+//! (`slicing`: contiguous, LPT or locality), where dependences cross between the workers both
+//! ways, so that at every level each worker may wait for the other (a lockstep of round trips
+//! between the cores); or the one-way partition (`one_way`), where a worker depends only on the
+//! workers before it in a chain, worker 0 never waits and the others follow it. Under
+//! [`DepsPartition::Auto`] the one-way partition is taken when its modelled scan is at most
+//! 1/32 longer (the model prices each wait, not the lockstep): on `plc-deps gen` programs it is
+//! as balanced as the slices and has a quarter of their waits; on programs whose tasks read from
+//! across the whole level before (random reads) it piles up on the last worker and loses. In
+//! the one-way partition a wait for one of a level's exports waits for all of them (they run
+//! first), and items end after every task a wait names, so that it is published at once.
 //!
 //! Which pairs are ordered: the schedule's `preds` (flow, anti and output dependences over the
 //! task accesses, the guards' controllers and the entry predecessors of multi-entry loops: what
 //! the levels respect), plus, for tasks that call one subroutine with loops (whose loop
 //! counters they share), each user after the previous one in level order. Levels that the
 //! levelled plan cannot slice (one task, or tasks sharing such counters) go to one worker: a
-//! single task to the worker of its latest predecessor, several to worker 0.
+//! single task to the worker of its latest predecessor, several to worker 0 (in the one-way
+//! partition: all to the latest worker of their predecessors).
 //!
 //! The cost model, deliberately simple: the critical path over the items with this assignment
 //! (each item's steps and item overhead, the lines its level's slice moves at the start of the
@@ -24,12 +35,13 @@
 //! code by `order_check` before it runs; this module does not check anything.
 
 use super::calls::{call_closure, is_loop_back, rung_callees};
+use super::one_way::{one_way, OneWay};
 use super::plan::{level_conflicts, sequential_reason, task_facts, Phase, PhaseKind, Plan};
 use super::ready::{item_order, Ready, Wait};
-use super::slicing::{slice_levels, LevelPlan, Slices};
+use super::slicing::{evaluate_levels, slice_levels, LevelPlan, Slices};
 use super::tasks::{Item, Tasks};
 use crate::analysis::Analysis;
-use crate::exec::parallel::config::PlanConfig;
+use crate::exec::parallel::config::{DepsPartition, PlanConfig};
 use crate::exec::parallel::ids::TaskId;
 use crate::model::{PouId, Program};
 
@@ -47,18 +59,45 @@ pub(in crate::exec::parallel) fn build(p: &Program, a: &Analysis, config: &PlanC
     let info = task_facts(p, a, &sched.task_of, config);
     let est_sequential: u64 = info.cost.iter().sum();
     let conflicts = level_conflicts(p, a);
-    let (mut levels, slices) = slice_levels(p, a, &info, config, &conflicts);
+    let (levels, slices) = slice_levels(p, a, &info, config, &conflicts);
     let preds = task_preds(p, a);
-    let asg = assign(a, threads, &slices, &preds);
-    let (items, waits, cross) = items_and_waits(&info, config, &asg, &preds);
+    let by_levels = || {
+        let asg = assign(a, threads, &slices, &preds);
+        partitioned(&info, config, asg, &preds, None, levels.clone())
+    };
+    let by_chain = || {
+        let whole: Vec<bool> = slices.iter().map(Option::is_none).collect();
+        let ow = one_way(&sched.levels, &info.cost, &preds, &whole, threads);
+        let chain: Vec<Option<Slices>> = ow.slices.iter().cloned().map(Some).collect();
+        let asg = assign(a, threads, &chain, &preds);
+        let round = export_ends(&asg, &ow);
+        let chain_levels = evaluate_levels(p, a, &info, config, &ow.slices, "one-way", &levels);
+        partitioned(&info, config, asg, &preds, Some(&round), chain_levels)
+    };
+    let part = match config.deps_partition {
+        DepsPartition::Levels => by_levels(),
+        DepsPartition::OneWay => by_chain(),
+        DepsPartition::Auto if threads < 2 => by_levels(),
+        DepsPartition::Auto => {
+            let (l, c) = (by_levels(), by_chain());
+            if c.est_plan * 32 <= l.est_plan * 33 {
+                c
+            } else {
+                l
+            }
+        }
+    };
+    let Partitioned {
+        partition,
+        mut levels,
+        asg,
+        items,
+        waits,
+        cross,
+        critical_path,
+        est_plan,
+    } = part;
     let any_parallel = items.iter().skip(1).any(|s| !s.is_empty());
-    let (critical_path, est_plan) = model(
-        &items,
-        &waits,
-        |t| sched.task(t).level as usize,
-        &levels,
-        config,
-    );
     let sequential = sequential_reason(p, a, config, any_parallel, est_plan, est_sequential);
     for (l, lp) in levels.iter_mut().enumerate() {
         lp.parallel = sequential.is_none() && slices[l].is_some();
@@ -78,6 +117,7 @@ pub(in crate::exec::parallel) fn build(p: &Program, a: &Analysis, config: &PlanC
             .collect(),
         cross_dependences: cross,
         critical_path,
+        partition,
     };
     let mut plan = Plan {
         threads,
@@ -119,6 +159,76 @@ pub(in crate::exec::parallel) fn build(p: &Program, a: &Analysis, config: &PlanC
     plan.place_decisions(a, &info);
     plan.write_keys = write_keys(p, a, &asg);
     plan
+}
+
+/// One partition of the tasks, its items and waits, and its modelled scan.
+struct Partitioned {
+    partition: DepsPartition,
+    /// The levels as this partition cuts them (for the model's moved lines and `--explain`).
+    levels: Vec<LevelPlan>,
+    asg: Assignment,
+    items: Vec<Vec<Item>>,
+    waits: Vec<Wait>,
+    cross: u64,
+    critical_path: u64,
+    est_plan: u64,
+}
+
+/// The items, waits and modelled scan of assignment `asg` (`round`: see `items_and_waits`).
+fn partitioned(
+    info: &Tasks<'_>,
+    config: &PlanConfig,
+    asg: Assignment,
+    preds: &[Vec<TaskId>],
+    round: Option<&[Vec<u32>]>,
+    levels: Vec<LevelPlan>,
+) -> Partitioned {
+    let sched = &info.a.schedule;
+    let (items, waits, cross) = items_and_waits(info, config, &asg, preds, round);
+    let (critical_path, est_plan) = model(
+        &items,
+        &waits,
+        |t| sched.task(t).level as usize,
+        &levels,
+        config,
+    );
+    Partitioned {
+        levels,
+        partition: if round.is_some() {
+            DepsPartition::OneWay
+        } else {
+            DepsPartition::Levels
+        },
+        asg,
+        items,
+        waits,
+        cross,
+        critical_path,
+        est_plan,
+    }
+}
+
+/// Per worker and position in its list, the count of its tasks a waiter on that position
+/// waits for instead: the end of the block of exports the position is in (the one-way
+/// partition puts a level's exports first, so one wait covers all of them), else the
+/// position itself plus one.
+fn export_ends(asg: &Assignment, ow: &OneWay) -> Vec<Vec<u32>> {
+    let mut round: Vec<Vec<u32>> = asg
+        .lists
+        .iter()
+        .map(|l| (1..=l.len() as u32).collect())
+        .collect();
+    let mut at = vec![0u32; asg.lists.len()];
+    for (slices, exports) in ow.slices.iter().zip(&ow.exports) {
+        for (w, (s, &e)) in slices.iter().zip(exports).enumerate() {
+            let start = at[w];
+            for p in start..start + e {
+                round[w][p as usize] = start + e;
+            }
+            at[w] += s.len() as u32;
+        }
+    }
+    round
 }
 
 /// Per task, the earlier tasks it must follow: the schedule's, and the previous user (in level
@@ -207,6 +317,7 @@ fn items_and_waits(
     config: &PlanConfig,
     asg: &Assignment,
     preds: &[Vec<TaskId>],
+    round: Option<&[Vec<u32>]>,
 ) -> (Vec<Vec<Item>>, Vec<Wait>, u64) {
     let threads = asg.lists.len();
     let nt = asg.worker.len();
@@ -215,14 +326,29 @@ fn items_and_waits(
     let mut known: Vec<Vec<u32>> = vec![vec![0; threads]; threads];
     let mut task_waits: Vec<Vec<(usize, u32)>> = vec![Vec::new(); nt];
     let mut cross = 0u64;
-    for &t in info.a.schedule.levels.iter().flatten() {
+    // Level by level, each worker's tasks of the level in its list's order (the order it runs
+    // them in: the one-way partition reorders a level's tasks); tasks of one level are
+    // independent, so how the workers interleave within a level does not matter.
+    let sched = &info.a.schedule;
+    let mut next = vec![0usize; threads];
+    let mut order = Vec::with_capacity(nt);
+    for l in 0..sched.levels.len() {
+        for (w, list) in asg.lists.iter().enumerate() {
+            while next[w] < list.len() && sched.task(list[next[w]]).level as usize == l {
+                order.push(list[next[w]]);
+                next[w] += 1;
+            }
+        }
+    }
+    for &t in &order {
         let w = asg.worker[t.index()] as usize;
         let mut need = vec![0u32; threads];
         for q in &preds[t.index()] {
             let wq = asg.worker[q.index()] as usize;
             if wq != w {
                 cross += 1;
-                let k = asg.pos[q.index()] + 1;
+                let p = asg.pos[q.index()];
+                let k = round.map_or(p + 1, |r| r[wq][p as usize]);
                 if known[w][wq] < k {
                     need[wq] = need[wq].max(k);
                 }
@@ -240,14 +366,25 @@ fn items_and_waits(
         known[w][w] = asg.pos[t.index()] + 1;
         after[t.index()] = known[w].clone();
     }
-    // Items: a new segment at every task that waits; the segment's first item carries them.
+    // Items: a new segment at every task that waits, and after every task a wait waits for
+    // (so that it is published as soon as it is done); a segment's first item carries its
+    // waits.
+    let mut published: Vec<Vec<bool>> = asg.lists.iter().map(|l| vec![false; l.len()]).collect();
+    for ws in &task_waits {
+        for &(wq, k) in ws {
+            published[wq][k as usize - 1] = true;
+        }
+    }
     let mut items: Vec<Vec<Item>> = vec![Vec::new(); threads];
     let mut item_of_pos: Vec<Vec<u32>> = vec![Vec::new(); threads];
     for (w, list) in asg.lists.iter().enumerate() {
         let mut start = 0;
         while start < list.len() {
             let mut end = start + 1;
-            while end < list.len() && task_waits[list[end].index()].is_empty() {
+            while end < list.len()
+                && task_waits[list[end].index()].is_empty()
+                && !published[w][end - 1]
+            {
                 end += 1;
             }
             for it in info.items(&list[start..end], config.item_cost) {

@@ -16,7 +16,8 @@
 //! interpreter, fused or not), `calls` (call closures, loop-backs), `tasks` (task facts, items,
 //! contiguous and LPT cuts), `partition` (the locality partition of one level), `movement`
 //! (lines moved between workers), `slicing` (each level's slices and modelled makespan),
-//! `ready` (the dependence-driven plan's waits), `phase` (a phase's items), `merge` (consecutive parallel levels in one
+//! `ready` (the dependence-driven plan's waits), `one_way` (the chain partition of the
+//! dependence-driven plan), `phase` (a phase's items), `merge` (consecutive parallel levels in one
 //! phase where each worker reads only its own writes), `plan` (phases on the cost model), `deps_plan`
 //! (the dependence-driven plan), `candidates` (the plans a run chooses from), `order_check`
 //! (the dependence-driven order against the lowered code), `check` (every plan against the
@@ -29,6 +30,7 @@ mod check;
 mod deps_plan;
 mod merge;
 mod movement;
+mod one_way;
 mod order_check;
 mod partition;
 mod phase;

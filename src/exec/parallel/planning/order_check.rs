@@ -232,7 +232,7 @@ impl Seen {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::exec::parallel::config::{PlanConfig, PlanKind, Slicing, Strategy};
+    use crate::exec::parallel::config::{DepsPartition, PlanConfig, PlanKind, Slicing, Strategy};
     use crate::exec::parallel::planning::{deps_plan, plan::layout_groups};
     use crate::exec::{ExecConfig, Layout};
     use crate::model::Program;
@@ -260,6 +260,7 @@ mod tests {
             strategy: Strategy::AllParallel,
             slicing,
             kind: PlanKind::Deps,
+            deps_partition: DepsPartition::Levels,
             ..PlanConfig::new(threads)
         }
     }
@@ -383,13 +384,19 @@ mod tests {
             seed in 0u64..1000,
             threads in 2usize..5,
             slicing in prop_oneof![Just(Slicing::Contiguous), Just(Slicing::Lpt), Just(Slicing::Locality)],
+            one_way in any::<bool>(),
         ) {
             let json = crate::synth::generate_string(
                 &crate::synth::GenConfig::all_features(rungs, width, seed));
             let p = crate::load::program_from_json(&json).unwrap();
             let a = crate::analysis::analyse(&p);
-            let plan = deps_plan::build(&p, &a, &config(threads, slicing));
+            let partition = if one_way { DepsPartition::OneWay } else { DepsPartition::Levels };
+            let plan = deps_plan::build(&p, &a, &PlanConfig {
+                deps_partition: partition,
+                ..config(threads, slicing)
+            });
             prop_assume!(plan.sequential().is_none());
+            prop_assert_eq!(plan.ready().map(|r| r.partition), Some(partition));
             let m = machine(&p, &plan);
             prop_assert_eq!(check_ordered(&m, &plan), Ok(()));
             let items = worker_items(&plan).unwrap();

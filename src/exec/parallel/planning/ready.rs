@@ -6,6 +6,8 @@
 //! Invariant: a wait before item `i` of worker `w` names another worker and a count of at
 //! least 1; the waited-for item publishes its worker's flag. Nothing here plans or runs.
 
+use crate::exec::parallel::config::DepsPartition;
+
 /// Before an item: wait until worker `worker` has finished its first `done` items (its ready
 /// flag reads at least `done` in this scan).
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
@@ -28,6 +30,8 @@ pub struct Ready {
     /// The modelled critical path over the task graph with this assignment and the per-wait
     /// cost (steps; the scan's two barriers not included).
     pub critical_path: u64,
+    /// Which partition the plan uses ([`DepsPartition::Levels`] or [`DepsPartition::OneWay`]).
+    pub partition: DepsPartition,
 }
 
 impl Ready {

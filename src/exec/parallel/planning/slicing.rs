@@ -141,7 +141,10 @@ fn best_cut(
             Slicing::Locality => locality(level, weights, info, config, movement, &contig, &by_lpt),
             Slicing::Contiguous | Slicing::Auto => contig.clone(),
         };
-        let cut = evaluate(kind, slices, info, config, movement);
+        let cut = Cut {
+            slicing: kind,
+            ..evaluate(slices, info, config, movement)
+        };
         compared.push((kind.name(), cut.makespan));
         if best.as_ref().is_none_or(|b| cut.makespan < b.makespan) {
             best = Some(cut);
@@ -150,9 +153,9 @@ fn best_cut(
     (best.expect("at least one slicing"), compared)
 }
 
-/// A cut's per-worker items, costs and lines, and its makespan.
+/// A cut's per-worker items, costs and lines, and its makespan (named contiguous: the caller
+/// names it).
 fn evaluate(
-    slicing: Slicing,
     mut slices: Slices,
     info: &Tasks<'_>,
     config: &PlanConfig,
@@ -169,12 +172,42 @@ fn evaluate(
     let lines = movement.phase_lines(&slices);
     let makespan = worker_makespan(&workers, &lines, config.line_cost);
     Cut {
-        slicing,
+        slicing: Slicing::Contiguous,
         slices,
         workers,
         lines,
         makespan,
     }
+}
+
+/// The plans of levels cut by a partition made elsewhere (`slices`: per level, each worker's
+/// tasks), evaluated as [`slice_levels`] evaluates its own cuts, in scan order, and named
+/// `name`; `base` gives each level's tasks, cost and reason.
+pub(in crate::exec::parallel) fn evaluate_levels(
+    p: &Program,
+    a: &Analysis,
+    info: &Tasks<'_>,
+    config: &PlanConfig,
+    slices: &[Slices],
+    name: &'static str,
+    base: &[LevelPlan],
+) -> Vec<LevelPlan> {
+    let mut movement = Movement::new(p, a, config.threads.max(1));
+    base.iter()
+        .zip(slices)
+        .map(|(lp, s)| {
+            let cut = evaluate(s.clone(), info, config, &movement);
+            movement.commit(&cut.slices);
+            LevelPlan {
+                makespan: Some(cut.makespan),
+                slicing: name,
+                workers: cut.workers,
+                lines: cut.lines,
+                compared: Vec::new(),
+                ..lp.clone()
+            }
+        })
+        .collect()
 }
 
 /// The heaviest worker: its items' steps plus its moved lines at `line_cost`.
