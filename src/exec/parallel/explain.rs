@@ -163,7 +163,7 @@ impl ParallelMachine {
             let (reads, writes) = plan.remote_lines();
             let _ = writeln!(
                 s,
-                "prefetched when a slice starts, per scan: {} another core wrote, to read; {} another core holds, to write",
+                "prefetched when a slice starts (an item of the dependence-driven plan: one item ahead), per scan: {} another core wrote, to read; {} another core holds, to write",
                 count(reads, "line"),
                 count(writes, "line")
             );

@@ -663,7 +663,14 @@ impl ParallelMachine {
                 if ph.barrier_before && !sh.barrier.wait(w, epoch) {
                     return false;
                 }
+                let ahead = plan.item_remote.get(w).map_or(&[][..], Vec::as_slice);
+                if let Some(lines) = ahead.first() {
+                    store.prefetch(lines);
+                }
                 for (i, it) in ph.items_of(w).iter().enumerate() {
+                    if let Some(lines) = ahead.get(i + 1) {
+                        store.prefetch(lines);
+                    }
                     for x in &plan.waits[it.waits.start as usize..it.waits.end as usize] {
                         if !sh
                             .ready

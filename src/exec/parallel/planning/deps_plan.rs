@@ -126,6 +126,7 @@ pub(in crate::exec::parallel) fn build(p: &Program, a: &Analysis, config: &PlanC
         phases: Vec::new(),
         end_barrier: false,
         remote: Vec::new(),
+        item_remote: Vec::new(),
         levels,
         task_of_rung: sched.task_of.clone(),
         task_rungs: sched.tasks.iter().map(|t| t.rungs.clone()).collect(),

@@ -43,6 +43,9 @@ pub struct Plan {
     /// Per phase, per worker: the lines its slice finds in another core's cache (empty until
     /// the machine that runs the plan finds them: they depend on its layout; `remote`).
     pub(in crate::exec::parallel) remote: Vec<Vec<RemoteLines>>,
+    /// A dependence-driven plan's: per worker, per item, the lines the item writes that
+    /// another core holds (`remote`; reads left empty), prefetched one item ahead.
+    pub(in crate::exec::parallel) item_remote: Vec<Vec<RemoteLines>>,
     pub(in crate::exec::parallel) levels: Vec<LevelPlan>,
     /// Task of each rung (main-program rungs that run).
     pub(in crate::exec::parallel) task_of_rung: Vec<Option<TaskId>>,
@@ -72,7 +75,7 @@ pub struct Plan {
 impl Plan {
     /// The remote lines of a scan, summed over every slice: (to read, to write).
     pub(in crate::exec::parallel) fn remote_lines(&self) -> (usize, usize) {
-        let slices = self.remote.iter().flatten();
+        let slices = self.remote.iter().chain(&self.item_remote).flatten();
         slices.fold((0, 0), |(r, w), l| (r + l.reads.len(), w + l.writes.len()))
     }
 
@@ -121,6 +124,7 @@ impl Plan {
             phases,
             end_barrier: false,
             remote: Vec::new(),
+            item_remote: Vec::new(),
             levels: level_plans,
             task_of_rung,
             task_rungs: sched.tasks.iter().map(|t| t.rungs.clone()).collect(),

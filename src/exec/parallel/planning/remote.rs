@@ -25,12 +25,18 @@
 //! its lines; the hint is then only less useful. Accesses come from the lowered instructions
 //! (`Machine::rung_accesses`), with the real layout: the same ground truth as the plan check.
 //!
+//! A dependence-driven plan has one phase whose items wait for each other one by one: its
+//! items are walked in one order that respects every wait (`ready::item_order`), and only the
+//! lines an item writes are kept (reads at the start would fetch lines not written yet); the
+//! machine prefetches them one item ahead. The items of different workers run at the same time
+//! in any interleaving the waits allow, so these lines are a guess from one of them.
+//!
 //! Cost: one pass over every rung's accesses per walk, O(accesses + lines) time and memory.
-//! Not here: dependence-driven plans (their items wait on ready flags one by one; prefetching
-//! at the start would fetch lines not written yet), and any decision (the lines are a hint).
+//! Not here: any decision (the lines are a hint).
 
 use super::phase::{Phase, PhaseKind, RemoteLines};
 use super::plan::Plan;
+use super::ready::item_order;
 use crate::exec::{Machine, Span, LINE_BYTES};
 
 /// What the walk knows of one line.
@@ -75,10 +81,14 @@ fn slice_lines(machine: &Machine, plan: &Plan, items: &[super::tasks::Item]) -> 
     [rl, wl]
 }
 
-/// Fills `plan.remote` for `machine`'s layout (nothing for a dependence-driven or sequential
-/// plan).
+/// Fills `plan.remote` (a levelled plan) or `plan.item_remote` (a dependence-driven plan) for
+/// `machine`'s layout (nothing for a sequential plan).
 pub(in crate::exec::parallel) fn find_remote_lines(machine: &Machine, plan: &mut Plan) {
-    if plan.sequential.is_some() || plan.ready.is_some() {
+    if plan.sequential.is_some() {
+        return;
+    }
+    if plan.ready.is_some() {
+        plan.item_remote = item_remote_lines(machine, plan);
         return;
     }
     let mut lines =
@@ -129,6 +139,65 @@ pub(in crate::exec::parallel) fn find_remote_lines(machine: &Machine, plan: &mut
     plan.remote = remote;
 }
 
+/// Per worker, per item of a dependence-driven plan's phase: the lines it writes that another
+/// core holds, from two walks of the items in one order its waits allow.
+fn item_remote_lines(machine: &Machine, plan: &Plan) -> Vec<Vec<RemoteLines>> {
+    let Some(ph) = plan.phases.first() else {
+        return Vec::new();
+    };
+    let slices = ph.slices();
+    let counts: Vec<usize> = slices.iter().map(|(_, items)| items.len()).collect();
+    let waits_of = |w: usize, i: usize| {
+        let r = &slices[w].1[i].waits;
+        plan.waits[r.start as usize..r.end as usize].to_vec()
+    };
+    let Ok(order) = item_order(&counts, waits_of) else {
+        return Vec::new();
+    };
+    let touched: Vec<Vec<[Vec<u32>; 2]>> = slices
+        .iter()
+        .map(|(_, items)| {
+            items
+                .iter()
+                .map(|it| slice_lines(machine, plan, std::slice::from_ref(it)))
+                .collect()
+        })
+        .collect();
+    let mut lines =
+        vec![Line::default(); (machine.state_size() as usize).div_ceil(LINE_BYTES as usize)];
+    let mut inputs = Vec::new();
+    lines_of(&machine.input_spans(), &mut inputs);
+    let mut out: Vec<Vec<RemoteLines>> = counts
+        .iter()
+        .map(|&n| vec![RemoteLines::default(); n])
+        .collect();
+    for walk in 0..2 {
+        for &l in &inputs {
+            lines[l as usize] = Line {
+                writer: Some(0),
+                readers: 0,
+            };
+        }
+        for &(w, i) in &order {
+            let [rl, wl] = &touched[w][i];
+            if walk == 1 {
+                out[w][i].writes = remote_of(&lines, w as u32, rl, wl).writes;
+            }
+            for &l in rl {
+                lines[l as usize].readers |= bit(w as u32);
+            }
+            for &l in wl {
+                lines[l as usize] = Line {
+                    writer: Some(w as u32),
+                    readers: 0,
+                };
+            }
+        }
+        lines.iter_mut().for_each(|l| l.readers |= bit(0));
+    }
+    out
+}
+
 /// The remote lines of worker `w`'s slice reading `rl` and writing `wl`, given `lines`.
 fn remote_of(lines: &[Line], w: u32, rl: &[u32], wl: &[u32]) -> RemoteLines {
     let other_writer = |x: &Line| x.writer.is_some_and(|v| v != w);
@@ -161,6 +230,13 @@ mod tests {
     /// Level 1: R1 `a → x`, R2 `b → y`; level 2: R3 and R4 both read x and y (so whoever runs
     /// them reads one line the other worker wrote). Every variable on its own line.
     fn machine_and_plan() -> (Machine, Plan) {
+        machine_and(|p, a, config| Plan::build(p, a, config))
+    }
+
+    /// The same program under `build`.
+    fn machine_and(
+        build: impl Fn(&crate::model::Program, &crate::analysis::Analysis, &PlanConfig) -> Plan,
+    ) -> (Machine, Plan) {
         let p = crate::load::program_from_json(
             r#"{"program": "p", "vars": [
                 {"name": "a", "type": "BOOL", "class": "input"},
@@ -179,7 +255,7 @@ mod tests {
             strategy: Strategy::AllParallel,
             ..PlanConfig::new(2)
         };
-        let plan = Plan::build(&p, &crate::analysis::analyse(&p), &config);
+        let plan = build(&p, &crate::analysis::analyse(&p), &config);
         let layout = Layout::from_starts(&p, (0..6).map(|i| i * 64).collect(), 6 * 64).unwrap();
         (
             Machine::new(&p, layout, &ExecConfig::default()).unwrap(),
@@ -212,6 +288,30 @@ mod tests {
                 .collect::<std::collections::BTreeSet<u32>>(),
             [2, 3].into()
         );
+    }
+
+    /// The dependence-driven plan on the level slices: worker 0 runs R1 then R3, worker 1 R2
+    /// then R4. Per item, the lines it writes that the other core holds: x (line 2, read by R4
+    /// on worker 1) and y (3, read by R3 on worker 0), and u (5): worker 1's output, read by
+    /// the driver on worker 0 after the previous scan; not z (4), worker 0's own.
+    #[test]
+    fn a_dependence_driven_plans_items_write_lines_the_other_core_holds() {
+        let (m, mut plan) = machine_and(|p, a, config| {
+            let config = PlanConfig {
+                deps_partition: crate::exec::parallel::config::DepsPartition::Levels,
+                slicing: crate::exec::parallel::config::Slicing::Contiguous,
+                ..*config
+            };
+            super::super::deps_plan::build(p, a, &config)
+        });
+        assert!(plan.sequential.is_none());
+        find_remote_lines(&m, &mut plan);
+        assert!(plan.remote.is_empty());
+        let writes: Vec<Vec<Vec<u32>>> = (plan.item_remote.iter())
+            .map(|w| w.iter().map(|it| it.writes.clone()).collect())
+            .collect();
+        assert_eq!(writes, vec![vec![vec![2], vec![]], vec![vec![3], vec![5]]]);
+        assert_eq!(plan.remote_lines(), (0, 3));
     }
 
     #[test]
