@@ -230,7 +230,7 @@ mod tests {
     /// Level 1: R1 `a → x`, R2 `b → y`; level 2: R3 and R4 both read x and y (so whoever runs
     /// them reads one line the other worker wrote). Every variable on its own line.
     fn machine_and_plan() -> (Machine, Plan) {
-        machine_and(|p, a, config| Plan::build(p, a, config))
+        machine_and(Plan::build)
     }
 
     /// The same program under `build`.
