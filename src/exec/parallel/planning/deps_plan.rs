@@ -87,16 +87,9 @@ pub(in crate::exec::parallel) fn build(p: &Program, a: &Analysis, config: &PlanC
             }
         }
     };
-    let Partitioned {
-        partition,
-        mut levels,
-        asg,
-        items,
-        waits,
-        cross,
-        critical_path,
-        est_plan,
-    } = part;
+    let (partition, mut levels, asg) = (part.partition, part.levels, part.asg);
+    let (items, waits, cross) = (part.items, part.waits, part.cross);
+    let (critical_path, est_plan) = (part.critical_path, part.est_plan);
     let any_parallel = items.iter().skip(1).any(|s| !s.is_empty());
     let sequential = sequential_reason(p, a, config, any_parallel, est_plan, est_sequential);
     for (l, lp) in levels.iter_mut().enumerate() {
