@@ -25,6 +25,7 @@ const PARALLEL: Order = &[
     &["planning", "partition"],
     &["planning", "movement"],
     &["planning", "slicing"],
+    &["planning", "one_way"],
     &["planning", "ready"],
     &["planning", "phase"],
     &["planning", "merge"],
