@@ -96,8 +96,9 @@ impl Store for SharedSlots {
     #[inline(always)]
     fn load<T: Word>(&self, at: Addr) -> T {
         let p = self.at::<T>(at);
-        // SAFETY: `p..p + T::SIZE` is in bounds (`at`: an address of the machine's code) of the state's memory,
-        // initialised bytes borrowed for the whole run. No other worker writes these bytes
+        // SAFETY: `p..p + T::SIZE` is in bounds of the state's memory (`at`: an address of the
+        // machine's code, and `new` checked the size), initialised bytes borrowed for the whole
+        // run. No other worker writes these bytes
         // while this read runs: in this phase they are written by this worker or by nobody
         // (the plan's check against the lowered code), and writes of earlier phases happen
         // before this phase starts (the Release/Acquire hand-over between phases); worker 0's
