@@ -199,7 +199,8 @@ enum Command {
         /// Which plans the parallel executor may use: measured among the sequential walk and
         /// the levelled plans (auto), the cost model's choice (model), always the sequential
         /// walk (seq), always the levelled plan (par), always the dependence-driven plan (deps:
-        /// ready flags instead of a barrier per level).
+        /// ready flags instead of a barrier per level), always the levelled plan on private
+        /// states handing over packed writes after each phase (exchange).
         #[arg(long, value_enum, default_value_t = PlanArg::Auto)]
         plan: PlanArg,
         /// Loop-backs allowed per loop-back rung and scan (the iteration cap).
@@ -222,6 +223,7 @@ enum PlanArg {
     Seq,
     Par,
     Deps,
+    Exchange,
 }
 
 #[derive(Copy, Clone, ValueEnum)]
@@ -477,6 +479,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
                 PlanArg::Seq => plc_deps::exec::parallel::PlanKind::Seq,
                 PlanArg::Par => plc_deps::exec::parallel::PlanKind::Par,
                 PlanArg::Deps => plc_deps::exec::parallel::PlanKind::Deps,
+                PlanArg::Exchange => plc_deps::exec::parallel::PlanKind::Exchange,
             };
             config.loop_cap = loop_cap;
             config.output = output;

@@ -63,6 +63,8 @@ struct Stats {
     deps_waits: u64,
     /// Dependence-driven plans on the one-way partition.
     one_way_cases: u64,
+    /// Cases that ran scans on private states (`par-exchange`).
+    exchange_cases: u64,
 }
 
 /// Runs one program under one plan configuration and compares every scan.
@@ -126,6 +128,9 @@ fn check_with(
         stats.mixed_runs += 1;
     }
     stats.switches += log.switches.len() as u64;
+    stats.exchange_cases += (0..log.candidates.len())
+        .any(|i| matches!(par.candidates()[i], Candidate::Exchange(_)) && log.scans_on[i] > 0)
+        as u64;
     assert_eq!(
         rec.states.len() as u64,
         scans,
@@ -323,6 +328,55 @@ fn dependence_driven_plan_equals_sequential_scan_on_random_programs() {
     );
 }
 
+/// The levelled plan on private states (`--plan exchange`: each worker hands the others what
+/// it wrote after each phase, BOOLs packed as bits) on random programs with 2, 3, 4 and 8
+/// workers, under each slicing, with and without merged levels: the state after every scan and
+/// the faults are the sequential scan's, and most cases really run that way.
+#[test]
+fn exchange_plan_equals_sequential_scan_on_random_programs() {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(7)
+        .build()
+        .unwrap();
+    let exec = ExecConfig {
+        cycle_ms: 10,
+        loop_cap: 12,
+    };
+    let mut stats = Stats::default();
+    let mut loaded = 0;
+    for seed in 0..500u64 {
+        let json = common::random_program(seed + 130_000, 24);
+        let Ok(p) = plc_deps::load::program_from_json(&json) else {
+            continue;
+        };
+        loaded += 1;
+        for threads in [2, 3, 4, 8] {
+            let mut config = configs(threads, seed + threads as u64);
+            config.kind = PlanKind::Exchange;
+            let label = format!(
+                "seed {seed}, {threads} threads, --plan exchange, {:?}/{:?}, merged {}",
+                config.strategy, config.slicing, config.merge_levels
+            );
+            check(&p, &label, &config, &exec, SCANS, seed, &pool, &mut stats);
+        }
+    }
+    eprintln!(
+        "{loaded} programs, {} cases, {} on private states, faults: {} loop-cap, {} div-by-zero",
+        stats.cases, stats.exchange_cases, stats.loop_cap_faults, stats.div_faults
+    );
+    assert!(loaded >= 370, "only {loaded} random programs loaded");
+    assert!(
+        stats.exchange_cases >= stats.cases / 3,
+        "too few runs on private states: {} of {}",
+        stats.exchange_cases,
+        stats.cases
+    );
+    assert!(
+        stats.loop_cap_faults > 0 && stats.div_faults > 0,
+        "faults are exercised"
+    );
+}
+
 /// Measuring that re-measures every few scans: the run switches between the sequential walk
 /// and the levelled plans all the time, whichever is faster.
 fn restless() -> Measure {
@@ -360,6 +414,7 @@ fn every_plan_kind_with_up_to_eight_workers_equals_the_sequential_scan() {
                 PlanKind::Model,
                 PlanKind::Par,
                 PlanKind::Deps,
+                PlanKind::Exchange,
                 PlanKind::Auto,
             ] {
                 let mut config = configs(threads, seed);
@@ -407,10 +462,16 @@ fn parallel_scan_equals_sequential_scan_on_generated_programs() {
                 configs(threads, 1),
                 configs(threads, 2),
                 configs(threads, 4),
+                PlanConfig {
+                    kind: PlanKind::Exchange,
+                    ..configs(threads, 3)
+                },
             ] {
                 let label = format!(
-                    "gen {rungs}/{width}/{seed}, {threads} threads, {:?}/{:?}",
-                    config.strategy, config.slicing
+                    "gen {rungs}/{width}/{seed}, {threads} threads, --plan {}, {:?}/{:?}",
+                    config.kind.name(),
+                    config.strategy,
+                    config.slicing
                 );
                 check(&p, &label, &config, &exec, 60, seed, &pool, &mut stats);
             }
@@ -423,6 +484,8 @@ fn parallel_scan_equals_sequential_scan_on_generated_programs() {
         stats.parallel_cases,
         stats.cases
     );
+    // Every program with every thread count also ran on private states.
+    assert_eq!(stats.exchange_cases, 8, "runs on private states");
 }
 
 #[test]
@@ -695,7 +758,13 @@ fn the_measured_plan_times_the_locality_partition_and_stays_exact() {
         .collect();
     assert_eq!(
         names,
-        ["seq", "par-contiguous", "par-locality", "par-deps"],
+        [
+            "seq",
+            "par-contiguous",
+            "par-exchange",
+            "par-locality",
+            "par-deps"
+        ],
         "{}",
         par.explain(&p)
     );

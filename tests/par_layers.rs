@@ -5,9 +5,10 @@
 //! `crate::exec::parallel::…` / `crate::cmd::run::…` path outside comments and test modules is
 //! resolved to the module it names, and must name one that comes earlier in the order.
 //!
-//! One exception, named here: `machine::items` and `machine::claimed` are the second half of
-//! `ParallelMachine`'s implementation (one plan item; the levelled plan's units), so they use
-//! their parent's types as the parent uses their functions.
+//! One exception, named here: `machine::items`, `machine::exchange` and `machine::claimed` are
+//! the second half of `ParallelMachine`'s implementation (one plan item; the levelled plan on
+//! private states; the levelled plan's units), so they use their parent's types as the parent
+//! uses their functions.
 
 use std::path::Path;
 
@@ -34,17 +35,21 @@ const PARALLEL: Order = &[
     &["planning", "candidates"],
     &["planning", "order_check"],
     &["planning", "check"],
+    &["planning", "exchange"],
     &["planning", "remote"],
     &["planning"],
     &["choice"],
+    &["machine", "run_log"],
     &["machine", "pin"],
     &["machine", "backoff"],
     &["machine", "barrier"],
     &["machine", "flags"],
     &["machine", "units"],
+    &["machine", "xlines"],
     &["machine", "shared"],
     &["machine", "driver"],
     &["machine", "items"],
+    &["machine", "exchange"],
     &["machine", "claimed"],
     &["machine"],
     &["explain"],
@@ -167,7 +172,9 @@ fn upward_uses(root: &Path, order: Order, absolute: &str) -> Vec<String> {
         for path in named_paths(&code(&text), &me, absolute) {
             let used = module_of(order, &path);
             let own_parent = m.len() == order[used].len() + 1 && m.starts_with(order[used]);
-            let exception = (*m == ["machine", "claimed"] || *m == ["machine", "items"])
+            let exception = (*m == ["machine", "claimed"]
+                || *m == ["machine", "items"]
+                || *m == ["machine", "exchange"])
                 && order[used] == ["machine"];
             if used == pos || exception {
                 continue;

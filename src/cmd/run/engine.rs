@@ -357,7 +357,7 @@ pub(super) fn prepare(c: &RunConfig, progress: &Progress) -> Result<Prepared, Cl
                 && pm
                     .candidates()
                     .iter()
-                    .any(|k| matches!(k, Candidate::Levelled(_))) =>
+                    .any(|k| matches!(k, Candidate::Levelled(_) | Candidate::Exchange(_))) =>
         {
             Some(
                 rayon::ThreadPoolBuilder::new()

@@ -23,10 +23,14 @@ pub enum PlanKind {
     /// level in order and waits, before a task, only for the tasks it depends on that run on
     /// another worker (ready flags instead of a barrier per level).
     Deps,
+    /// Always the levelled plan (as `Par`) with every worker on a private copy of the state,
+    /// handing the others what it wrote after each phase, BOOLs packed as bits (`par-exchange`);
+    /// the levelled plan on the shared state when its phases cannot run that way.
+    Exchange,
 }
 
 impl PlanKind {
-    /// `auto`, `model`, `seq`, `par`, `deps`.
+    /// `auto`, `model`, `seq`, `par`, `deps`, `exchange`.
     pub fn name(self) -> &'static str {
         match self {
             PlanKind::Auto => "auto",
@@ -34,6 +38,7 @@ impl PlanKind {
             PlanKind::Seq => "seq",
             PlanKind::Par => "par",
             PlanKind::Deps => "deps",
+            PlanKind::Exchange => "exchange",
         }
     }
 }

@@ -42,8 +42,8 @@ impl ParallelMachine {
             plan.phase_lines.iter().flatten().sum::<u64>()
         );
         for (i, c) in self.candidates.iter().enumerate() {
-            if let Candidate::Levelled(k) = *c {
-                if k > 0 {
+            match *c {
+                Candidate::Levelled(k) if k > 0 => {
                     let other = &self.plans[k];
                     let _ = writeln!(
                         s,
@@ -53,6 +53,26 @@ impl ParallelMachine {
                         other.phase_lines.iter().flatten().sum::<u64>()
                     );
                 }
+                Candidate::Exchange(k) => {
+                    if let Some(x) = &self.exchanges[k] {
+                        let of = match self
+                            .candidates
+                            .iter()
+                            .position(|&c| c == Candidate::Levelled(k))
+                        {
+                            Some(j) => format!("{}'s plan", self.names[j]),
+                            None => "the levelled plan".to_string(),
+                        };
+                        let _ = writeln!(
+                            s,
+                            "  candidate {}: {of} with each worker on a private state, handing over {} words in {} lines per scan (BOOLs as bits; each line carries its scan's number)",
+                            self.names[i],
+                            x.words(),
+                            x.lines()
+                        );
+                    }
+                }
+                _ => {}
             }
         }
         self.explain_deps(&mut s);
@@ -303,6 +323,10 @@ impl ParallelMachine {
             "decision_slots": plan.decision_slots,
             "remote_lines": {"reads": plan.remote_lines().0, "writes": plan.remote_lines().1},
             "deps": self.deps_json(),
+            "exchange": self.exchanges.iter().flatten().next().map(|x| json!({
+                "words": x.words(),
+                "lines": x.lines(),
+            })),
             "levels": plan.levels.iter().map(|lp| json!({
                 "tasks": lp.tasks,
                 "cost": lp.cost,

@@ -3,35 +3,44 @@
 //! entered once per run; worker 0 (the calling thread) asks the measured choice (`choice`)
 //! which candidate runs the next window of scans, runs sequential windows alone while the
 //! others sleep on the window bell, and runs parallel windows with them: a levelled plan's as
-//! claimed units (`claimed`), a dependence-driven plan's meeting at the barrier.
+//! claimed units (`claimed`), a dependence-driven plan's meeting at the barrier, a levelled
+//! plan on private states handing over packed writes (`exchange`).
 //!
 //! Invariants: worker 0 alone talks to the driver and the chooser, between barriers; every
-//! candidate works on the same state layout, so a switch between scans needs no copy; the
+//! candidate works on the same state layout, so a switch between scans needs no copy (but the
+//! private states of `par-exchange`'s other workers, copied from the shared state when its
+//! window follows another candidate's); the
 //! results are those of [`Machine::run_scan`], byte for byte and fault for fault, whichever
 //! candidates ran. It does not plan nor check plans (`planning`); it runs what
 //! [`ParallelMachine::new`] kept.
 //!
 //! # Modules, bottom to top
 //! Each uses only the ones before it (and the layers below the machine: the basics, `planning`,
-//! `choice`): `pin` (workers pinned to CPUs), `backoff` (the one wait loop: spin, yield, park), `barrier`, `flags` (ready
-//! flags), `units` (claimed units, the window bell), `shared` (lock-free shared memory),
-//! `driver` (the per-scan callbacks and the sequential loop), `items` (one plan item on the
-//! shared state, the merged faults), `claimed` (a levelled plan's
-//! scans as units: the second half of [`ParallelMachine`]'s implementation, so it uses this
-//! module's types as this module uses its functions), this module.
+//! `choice`): `pin` (workers pinned to CPUs), `backoff` (the one wait loop: spin, yield, park),
+//! `barrier`, `flags` (ready flags), `units` (claimed units, the window bell), `xlines`
+//! (exchange lines), `shared` (lock-free shared memory), `driver` (the per-scan callbacks and
+//! the sequential loop), `items` (one plan item on the shared state, the merged faults),
+//! `exchange` (a levelled plan's scans on private states), `claimed` (a levelled plan's scans
+//! as units), this module. `items`, `exchange` and `claimed` are the second half of
+//! [`ParallelMachine`]'s implementation, so they use this module's types as this module uses
+//! their functions.
 
 mod backoff;
 mod barrier;
 mod claimed;
 mod driver;
+mod exchange;
 mod flags;
 mod items;
 mod pin;
+mod run_log;
 mod shared;
 mod units;
+mod xlines;
 
 pub use barrier::SpinBarrier;
 pub use driver::{run_sequential, ScanDriver};
+pub use run_log::{Candidate, RunLog};
 pub use shared::SharedSlots;
 
 use crate::analysis::Analysis;
@@ -40,7 +49,7 @@ use crate::exec::parallel::config::{Measure, PlanConfig, PlanKind};
 use crate::exec::parallel::pad::Padded;
 use crate::exec::parallel::planning::candidate_plans;
 use crate::exec::parallel::planning::{bools_first, layout_groups, Plan};
-use crate::exec::parallel::planning::{check_plan, find_remote_lines};
+use crate::exec::parallel::planning::{check_plan, exchange_plan, find_remote_lines, Exchange};
 use crate::exec::{ExecConfig, Fault, Layout, LowerError, Machine, State, LINE_BYTES};
 use crate::model::{Program, VarId};
 use flags::ReadyFlags;
@@ -49,58 +58,7 @@ use std::cell::UnsafeCell;
 use std::ops::Range;
 use std::time::{Duration, Instant};
 use units::{Units, WindowBell, WindowNote};
-
-/// One way to run a scan.
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
-pub enum Candidate {
-    /// The sequential walk ([`Machine::run_scan`]) on worker 0.
-    Sequential,
-    /// The plan `plans[i]` on all workers: a levelled plan, or the dependence-driven one
-    /// (named `par-deps`).
-    Levelled(usize),
-}
-
-/// What a run did: which candidates ran how many scans, their last measured times, and every
-/// switch between them.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct RunLog {
-    /// Candidate names (`seq`, `par`, `par-contiguous`, `par-lpt`, `par-locality`, `par-deps`), by candidate
-    /// index.
-    pub candidates: Vec<String>,
-    /// Scans run on each candidate.
-    pub scans_on: Vec<u64>,
-    /// The last measured ns per scan of each candidate (`None`: never measured).
-    pub estimates: Vec<Option<u64>>,
-    /// Every change of the running candidate.
-    pub switches: Vec<Switch>,
-    /// The candidate that ran last.
-    pub last: usize,
-    /// Runs of scans on one candidate: (first scan, candidate), ascending.
-    pub segments: Vec<(u64, usize)>,
-    /// Per candidate: the waits per scan of a dependence-driven plan (`None` for the others).
-    pub waits: Vec<Option<u64>>,
-    /// The windows of scans as they ran, with their times: the first 64, then those of every
-    /// measurement that ended in a switch (bounded: `choice`).
-    pub windows: Vec<WindowRecord>,
-    /// Windows run but not in `windows`.
-    pub windows_unlogged: u64,
-}
-
-impl RunLog {
-    /// The candidate that ran scan `scan` (the first if the log does not cover it).
-    pub fn candidate_at(&self, scan: u64) -> usize {
-        match self.segments.partition_point(|&(s, _)| s <= scan) {
-            0 => 0,
-            i => self.segments[i - 1].1,
-        }
-    }
-
-    fn push_segment(&mut self, first: u64, candidate: usize) {
-        if self.segments.last().map(|s| s.1) != Some(candidate) {
-            self.segments.push((first, candidate));
-        }
-    }
-}
+use xlines::XBuffer;
 
 /// A program lowered for the parallel scan: a [`Machine`] on the candidates' common padded
 /// layout, the plans, and the candidates a run chooses from. Immutable and `Sync`.
@@ -109,6 +67,8 @@ pub struct ParallelMachine {
     pub(super) machine: Machine,
     /// `plans[0]` is the primary plan ([`plan`](Self::plan)).
     pub(super) plans: Vec<Plan>,
+    /// Per plan: its exchange, for the plan a `par-exchange` candidate runs.
+    pub(super) exchanges: Vec<Option<Exchange>>,
     pub(super) candidates: Vec<Candidate>,
     pub(super) names: Vec<String>,
     pub(super) kind: PlanKind,
@@ -157,6 +117,20 @@ impl ParallelMachine {
                 find_remote_lines(&machine, plan);
             }
         }
+        let mut exchanges: Vec<Option<Exchange>> = vec![None; plans.len()];
+        let wants_exchange = matches!(config.kind, PlanKind::Auto | PlanKind::Exchange);
+        let twin = plans
+            .iter()
+            .position(|p| p.sequential.is_none() && p.ready.is_none() && p.threads > 1);
+        if let Some(i) = twin.filter(|_| wants_exchange) {
+            match exchange_plan(program, &machine, &plans[i]) {
+                Ok(x) => exchanges[i] = Some(x),
+                Err(why) if config.kind == PlanKind::Exchange => warnings.push(format!(
+                    "the levelled plan cannot run on private states ({why}); running it on the shared state"
+                )),
+                Err(_) => {}
+            }
+        }
         let mut candidates = Vec::new();
         if config.kind == PlanKind::Auto || plans.iter().all(|p| p.sequential.is_some()) {
             candidates.push(Candidate::Sequential);
@@ -167,7 +141,11 @@ impl ParallelMachine {
             .count();
         let mut names: Vec<String> = candidates.iter().map(|_| "seq".to_string()).collect();
         for (i, plan) in plans.iter().enumerate() {
-            if plan.sequential.is_none() {
+            if plan.sequential.is_some() {
+                continue;
+            }
+            let only_exchange = config.kind == PlanKind::Exchange && exchanges[i].is_some();
+            if !only_exchange {
                 candidates.push(Candidate::Levelled(i));
                 names.push(if plan.ready.is_some() {
                     "par-deps".to_string()
@@ -177,10 +155,15 @@ impl ParallelMachine {
                     "par".to_string()
                 });
             }
+            if exchanges[i].is_some() {
+                candidates.push(Candidate::Exchange(i));
+                names.push("par-exchange".to_string());
+            }
         }
         Ok(ParallelMachine {
             machine,
             plans,
+            exchanges,
             candidates,
             names,
             kind: config.kind,
@@ -345,7 +328,7 @@ impl ParallelMachine {
                 .iter()
                 .map(|c| match *c {
                     Candidate::Levelled(i) => self.plans[i].ready.as_ref().map(|r| r.waits()),
-                    Candidate::Sequential => None,
+                    Candidate::Sequential | Candidate::Exchange(_) => None,
                 })
                 .collect(),
             windows: Vec::new(),
@@ -391,6 +374,11 @@ impl ParallelMachine {
         let faults: Vec<FaultBuffer> = (0..threads)
             .map(|_| Padded(UnsafeCell::new(Vec::new())))
             .collect();
+        let xbufs: Vec<Option<XBuffer>> = self
+            .exchanges
+            .iter()
+            .map(|x| x.as_ref().map(XBuffer::new))
+            .collect();
         let shared = Shared {
             slots: SharedSlots::new(state.bytes_mut(), &self.machine),
             decisions: &decisions,
@@ -399,6 +387,7 @@ impl ParallelMachine {
             ready: &ready,
             units: &units,
             bell: &bell,
+            xbufs: &xbufs,
         };
         let shared = &shared;
         let mut chooser = Chooser::new(allowed.len(), self.measure, scans.start);
@@ -485,20 +474,23 @@ impl ParallelMachine {
             // (they were not on a core): a dependence-driven plan, which must wait for them,
             // is then not worth measuring.
             let mut others_away = false;
+            // The `par-exchange` plan whose private states are current (its window was last).
+            let mut private_current: Option<usize> = None;
             while scan < scans.end {
                 let mut win = chooser.next();
                 while others_away
                     && chooser.measuring_other()
-                    && self.is_deps(allowed[win.candidate])
+                    && self.waits_for_all(allowed[win.candidate])
                 {
                     chooser.skip();
                     win = chooser.next();
                 }
                 let c = allowed[win.candidate];
-                let deps = self.is_deps(c);
-                // A dependence-driven window is short and timed whole: its waits cost a time
-                // slice each when another worker loses its core, so the chooser must see that
-                // within a few scans (it cannot take the other worker's items, as units can).
+                let deps = self.waits_for_all(c);
+                // A dependence-driven or exchange window is short and timed whole: its waits
+                // cost a time slice each when another worker loses its core, so the chooser must
+                // see that within a few scans (it cannot take the other worker's items, as
+                // units can).
                 let cap = if deps { DEPS_WINDOW } else { u64::MAX };
                 let n = win.scans.min(scans.end - scan).min(cap);
                 log.scans_on[c] += n;
@@ -508,9 +500,34 @@ impl ParallelMachine {
                     all: win.timed || deps || driver.wants_time(),
                     every: self.measure.sample_every.max(1),
                 };
+                let was_current = std::mem::take(&mut private_current);
                 match self.candidates[c] {
                     Candidate::Sequential => {
                         self.sequential_window(sh, scan..scan + n, driver, timing, &mut times)
+                    }
+                    Candidate::Exchange(i) => {
+                        let copy = was_current != Some(i);
+                        sh.bell.ring(WindowNote {
+                            plan: i,
+                            first: scan,
+                            scans: n,
+                            base,
+                            exchange: Some(copy),
+                        });
+                        // The followers copy the shared state between the two barriers.
+                        for _ in 0..1 + copy as usize {
+                            if !sh.barrier.wait(0, &mut epoch) {
+                                return;
+                            }
+                        }
+                        let d = Some((&mut *driver, timing, &mut times));
+                        let x = self.exchange_of(i, sh);
+                        let r = scan..scan + n;
+                        if !self.exchange_scans(0, &self.plans[i], x, sh, r, sh.slots, d, &mut bufs)
+                        {
+                            return;
+                        }
+                        private_current = Some(i);
                     }
                     Candidate::Levelled(i) => {
                         let plan = &self.plans[i];
@@ -519,6 +536,7 @@ impl ParallelMachine {
                             first: scan,
                             scans: n,
                             base,
+                            exchange: None,
                         });
                         if plan.ready.is_some() {
                             if !sh.barrier.wait(0, &mut epoch) {
@@ -559,6 +577,7 @@ impl ParallelMachine {
                 first: scan,
                 scans: 0,
                 base,
+                exchange: None,
             });
         });
         if let Err(panic) = std::panic::catch_unwind(body) {
@@ -567,9 +586,23 @@ impl ParallelMachine {
         }
     }
 
-    /// Whether candidate `c` is a dependence-driven plan.
-    fn is_deps(&self, c: usize) -> bool {
-        matches!(self.candidates[c], Candidate::Levelled(i) if self.plans[i].ready.is_some())
+    /// Whether candidate `c` needs every worker on a core at every phase: a dependence-driven
+    /// plan, or a levelled plan on private states (neither can give a late worker's items to
+    /// another).
+    fn waits_for_all(&self, c: usize) -> bool {
+        match self.candidates[c] {
+            Candidate::Levelled(i) => self.plans[i].ready.is_some(),
+            Candidate::Exchange(_) => true,
+            Candidate::Sequential => false,
+        }
+    }
+
+    /// Plan `i`'s exchange and its lines in this run.
+    fn exchange_of<'s>(&'s self, i: usize, sh: &'s Shared<'_>) -> (&'s Exchange, &'s XBuffer) {
+        match (&self.exchanges[i], &sh.xbufs[i]) {
+            (Some(x), Some(b)) => (x, b),
+            _ => unreachable!("a par-exchange candidate has an exchange and its lines"),
+        }
     }
 
     /// Workers 1..: wait for a window, run their part of it, until the run is over.
@@ -579,6 +612,8 @@ impl ParallelMachine {
             sh.bell.register(w);
             let mut epoch = 0u64;
             let mut bufs = Buffers::default();
+            // This worker's state in `par-exchange` windows.
+            let mut private: Option<State> = None;
             let mut k = 1;
             loop {
                 let Some((got, note)) = sh.bell.wait(w, k, &sh.barrier) else {
@@ -590,7 +625,22 @@ impl ParallelMachine {
                 }
                 let plan = &self.plans[note.plan];
                 let scans = note.first..note.first + note.scans;
-                let ok = if plan.ready.is_some() {
+                let ok = if let Some(copy) = note.exchange {
+                    let x = self.exchange_of(note.plan, sh);
+                    let mut ok = sh.barrier.wait(w, &mut epoch);
+                    let state = private.get_or_insert_with(|| self.machine.initial_state());
+                    if ok && copy {
+                        // SAFETY: worker 0 waits at the barrier below and the other workers
+                        // only read: nobody writes the shared state meanwhile.
+                        state
+                            .bytes_mut()
+                            .copy_from_slice(unsafe { sh.slots.bytes() });
+                        ok = sh.barrier.wait(w, &mut epoch);
+                    }
+                    let store = SharedSlots::new(state.bytes_mut(), &self.machine);
+                    ok && self
+                        .exchange_scans::<NoDriver>(w, plan, x, sh, scans, store, None, &mut bufs)
+                } else if plan.ready.is_some() {
                     sh.barrier.wait(w, &mut epoch)
                         && self
                             .plan_scans::<NoDriver>(w, plan, sh, scans, &mut epoch, None, &mut bufs)

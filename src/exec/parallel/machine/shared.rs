@@ -90,6 +90,15 @@ impl SharedSlots {
         // the caller guarantees exclusive access while the slice lives.
         unsafe { std::slice::from_raw_parts_mut(self.ptr, self.len) }
     }
+
+    /// The memory as a shared slice, for workers that only read it while no thread writes it.
+    ///
+    /// # Safety
+    /// No thread writes the memory while the slice lives, and it does not outlive the run.
+    pub(super) unsafe fn bytes<'a>(self) -> &'a [u8] {
+        // SAFETY: as in `bytes_mut`; the caller guarantees that nobody writes meanwhile.
+        unsafe { std::slice::from_raw_parts(self.ptr, self.len) }
+    }
 }
 
 impl Store for SharedSlots {
@@ -156,6 +165,8 @@ pub(super) struct Shared<'a> {
     pub(super) units: &'a Units,
     /// Worker 0's announcements of windows.
     pub(super) bell: &'a WindowBell,
+    /// Per plan: the exchange lines of its `par-exchange` candidate.
+    pub(super) xbufs: &'a [Option<super::xlines::XBuffer>],
 }
 
 // SAFETY: the fault buffers are each used by one worker during a scan and by worker 0 between

@@ -109,6 +109,9 @@ pub(super) struct WindowNote {
     pub(super) scans: u64,
     /// Units issued before the window (the ids of its units start above it).
     pub(super) base: u64,
+    /// A `par-exchange` window; `Some(true)` when the workers' private states must first be
+    /// copied from the shared state (another candidate ran since their last window).
+    pub(super) exchange: Option<bool>,
 }
 
 /// A worker waiting on the bell: whether it is parked, and its thread.
@@ -122,6 +125,8 @@ pub(super) struct WindowBell {
     first: AtomicU64,
     scans: AtomicU64,
     base: AtomicU64,
+    /// `exchange`: 0 none, 1 without copies, 2 with.
+    exchange: AtomicU64,
     seats: Box<[Seat]>,
 }
 
@@ -133,6 +138,7 @@ impl WindowBell {
             first: AtomicU64::new(0),
             scans: AtomicU64::new(0),
             base: AtomicU64::new(0),
+            exchange: AtomicU64::new(0),
             seats: (0..workers)
                 .map(|_| Padded((AtomicBool::new(false), OnceLock::new())))
                 .collect(),
@@ -159,6 +165,8 @@ impl WindowBell {
         self.first.store(note.first, Ordering::Relaxed);
         self.scans.store(note.scans, Ordering::Relaxed);
         self.base.store(note.base, Ordering::Relaxed);
+        let x = note.exchange.map_or(0, |copy| 1 + copy as u64);
+        self.exchange.store(x, Ordering::Relaxed);
         // SeqCst, then SeqCst loads of the parked flags; a parking waiter stores its flag then
         // loads `seq` (SeqCst): one of the two sees the other, no wake-up is lost.
         self.seq.0.store(s + 2, Ordering::SeqCst);
@@ -187,6 +195,10 @@ impl WindowBell {
                 first: self.first.load(Ordering::Relaxed),
                 scans: self.scans.load(Ordering::Relaxed),
                 base: self.base.load(Ordering::Relaxed),
+                exchange: match self.exchange.load(Ordering::Relaxed) {
+                    0 => None,
+                    x => Some(x == 2),
+                },
             };
             std::sync::atomic::fence(Ordering::Acquire);
             if self.seq.0.load(Ordering::Relaxed) == s {
@@ -262,6 +274,7 @@ mod tests {
                 first: 10 * k as u64,
                 scans: 5,
                 base: 100 * k as u64,
+                exchange: None,
             });
         }
         let (n, note) = bell.wait(1, 1, &poison).expect("announced");
@@ -274,6 +287,7 @@ mod tests {
                     first: 0,
                     scans: 0,
                     base: 0,
+                    exchange: None,
                 });
             });
             bell.register(1);

@@ -21,13 +21,15 @@
 //! phase where each worker reads only its own writes), `plan` (phases on the cost model), `deps_plan`
 //! (the dependence-driven plan), `candidates` (the plans a run chooses from), `order_check`
 //! (the dependence-driven order against the lowered code), `check` (every plan against the
-//! lowered code), `remote` (the lines each slice finds in another core's cache, to prefetch).
+//! lowered code), `exchange` (what each worker of a levelled plan on private states hands the
+//! others after each phase, from the lowered code's writes), `remote` (the lines each slice finds in another core's cache, to prefetch).
 
 mod calibrate;
 mod calls;
 mod candidates;
 mod check;
 mod deps_plan;
+mod exchange;
 mod merge;
 mod movement;
 mod one_way;
@@ -42,12 +44,14 @@ mod slicing;
 mod tasks;
 
 pub use calibrate::{measure_handover, measure_line_cost, LineTiming};
+pub use exchange::Exchange;
 pub use plan::Plan;
 pub use ready::Ready;
 pub use slicing::LevelPlan;
 
 pub(super) use candidates::candidate_plans;
 pub(super) use check::check_plan;
+pub(super) use exchange::{exchange_plan, Key, LINE_WORDS};
 pub(super) use phase::{Phase, RemoteLines};
 pub(super) use plan::{bools_first, layout_groups};
 pub(super) use remote::find_remote_lines;

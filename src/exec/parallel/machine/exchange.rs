@@ -1,0 +1,116 @@
+//! A levelled plan's scans on private states (`par-exchange`): worker 0 runs its slices on the
+//! shared state (the driver's), every other worker on a copy of its own, and after each phase
+//! each worker packs what it wrote (the plan's [`Exchange`] key: BOOLs as bits) into its lines
+//! of an exchange buffer; before the next phase every worker waits for the others' lines of the
+//! phase and unpacks them into its state. Worker 0 hands over the driver's inputs the same way
+//! before each scan, and unpacks the last phase's keys after it, so the state the driver sees is
+//! whole. Only the exchanged lines move between the cores; no line of any state is shared.
+//!
+//! The lines (`xlines`) carry the data and its readiness together; waiting for all the others'
+//! lines of a phase is the phase's barrier. Two sets of lines alternate by scan parity, so a
+//! writer one scan ahead never overwrites lines a late reader has not read (it cannot get two
+//! scans ahead: each scan starts with worker 0's inputs, which it hands over only after it has
+//! read every worker's last phase of the scan before).
+//!
+//! The results are the sequential walk's for the reason `planning::exchange` gives; faults and
+//! decisions travel as in the other plans (per-worker buffers, shared decision slots), ordered
+//! by the same Release/Acquire pairs. It does not steal slices (a worker's private state holds
+//! only what it was handed), so its windows are short, as a dependence-driven plan's.
+
+use super::shared::{Shared, SharedSlots};
+use super::xlines::XBuffer;
+use super::{Buffers, ParallelMachine, ScanDriver, Timing};
+use crate::exec::parallel::planning::{Exchange, Plan};
+use std::time::Instant;
+
+impl ParallelMachine {
+    /// Waits for and unpacks every other worker's key of `phase` into `state`.
+    fn take_phase(
+        &self,
+        w: usize,
+        (x, buf): (&Exchange, &XBuffer),
+        phase: usize,
+        state: SharedSlots,
+        seq: u64,
+        sh: &Shared<'_>,
+    ) -> bool {
+        for o in (0..x.threads).filter(|&o| o != w) {
+            let key = x.key(phase, o);
+            if !buf.wait(key, seq, &sh.barrier) {
+                return false;
+            }
+            // SAFETY: `state` is worker `w`'s own for the window (the shared slots for worker
+            // 0, whose followers touch only their private states; a private state for the
+            // others); no other reference to its bytes is alive here.
+            buf.unpack(key, unsafe { state.bytes_mut() }, seq);
+        }
+        true
+    }
+
+    /// Worker `w`'s part of `scans` on `plan` with exchange `x`, on `state` (worker 0: the
+    /// shared slots, and the driver); false if a worker panicked.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn exchange_scans<D: ScanDriver + ?Sized>(
+        &self,
+        w: usize,
+        plan: &Plan,
+        (x, buf): (&Exchange, &XBuffer),
+        sh: &Shared<'_>,
+        scans: std::ops::Range<u64>,
+        mut store: SharedSlots,
+        mut driver: Option<(&mut D, Timing, &mut Vec<u64>)>,
+        b: &mut Buffers,
+    ) -> bool {
+        let last = plan.phases.len() - 1;
+        for scan in scans {
+            let seq = scan + 1;
+            let mut t0 = None;
+            if let Some((d, timing, _)) = driver.as_mut() {
+                // SAFETY: worker 0's state; the others read only the exchange lines.
+                let slots = unsafe { store.bytes_mut() };
+                d.before_scan(&self.machine, scan, slots);
+                t0 = timing.wants(scan).then(Instant::now);
+                buf.pack(&x.inputs, slots, seq);
+            } else {
+                if !buf.wait(&x.inputs, seq, &sh.barrier) {
+                    return false;
+                }
+                // SAFETY: as in `take_phase`.
+                buf.unpack(&x.inputs, unsafe { store.bytes_mut() }, seq);
+            }
+            self.machine.begin_scan(&mut store);
+            let mut ctx = self.machine.context(scan, &mut b.scratch);
+            for (pi, ph) in plan.phases.iter().enumerate() {
+                if pi > 0 && !self.take_phase(w, (x, buf), pi - 1, store, seq, sh) {
+                    return false;
+                }
+                for it in ph.items_of(w) {
+                    self.run_item(plan, it, &mut store, &mut ctx, sh);
+                    if !ctx.faults.is_empty() {
+                        // SAFETY: only worker `w` touches its fault buffer during a scan;
+                        // worker 0 reads it after it has waited for every worker's last phase,
+                        // and `w` does not start the next scan before worker 0's inputs.
+                        let fb = unsafe { &mut *sh.faults[w].0.get() };
+                        fb.extend(ctx.faults.drain(..).map(|f| (it.first.0, f)));
+                    }
+                }
+                // SAFETY: as in `take_phase`.
+                buf.pack(x.key(pi, w), unsafe { store.bytes_mut() }, seq);
+            }
+            if !self.take_phase(w, (x, buf), last, store, seq, sh) {
+                return false;
+            }
+            if let Some((d, _, times)) = driver.as_mut() {
+                let elapsed = t0.map(|t| t.elapsed()).unwrap_or_default();
+                if t0.is_some() {
+                    times.push(elapsed.as_nanos() as u64);
+                }
+                let faults = self.merged_faults(sh, b);
+                // SAFETY: worker 0's state, as above.
+                let slots: &[u8] = unsafe { store.bytes_mut() };
+                d.after_scan(&self.machine, scan, slots, faults, elapsed);
+            }
+        }
+        true
+    }
+}

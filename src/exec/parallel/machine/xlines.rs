@@ -1,0 +1,191 @@
+//! The exchange lines of a `par-exchange` run (`exchange`): per key of the plan's
+//! [`Exchange`], lines of seven data words and a sequence number (the scan + 1), stored with
+//! Release after the data and waited for with Acquire, so the data and its readiness travel in
+//! one line and waiting for all the others' lines of a phase is the phase's barrier. Two sets of
+//! lines alternate by scan parity (why that suffices: `exchange`). Packing: a run of BOOL bytes
+//! (each 0 or 1) as bits, 64 to a word; other bytes 8 to a word, a partial word copying only its
+//! bytes. Knows nothing of plans beyond the keys.
+
+use super::backoff::{wait_until, Pace};
+use super::barrier::SpinBarrier;
+use crate::exec::parallel::planning::{Exchange, Key, LINE_WORDS};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Duration;
+
+/// One exchange line: seven data words and the sequence number of the scan that wrote them.
+#[repr(align(64))]
+struct XLine([AtomicU64; 8]);
+
+/// The exchange lines of a run: two sets (by scan parity) of a plan's [`Exchange::lines`].
+pub(super) struct XBuffer {
+    lines: Box<[XLine]>,
+    per_set: usize,
+}
+
+const PACE: Pace = Pace {
+    spins: 20_000,
+    yield_for: Duration::from_micros(200),
+};
+const PARK: Duration = Duration::from_micros(20);
+
+/// Bytes 0 or 1 of a little-endian word packed into its 8 low bits (byte j → bit j): each byte's
+/// bit lands at a distinct position of the top byte, no two terms overlap, so nothing carries.
+#[inline(always)]
+fn pack8(v: u64) -> u64 {
+    v.wrapping_mul(0x0102_0408_1020_4080) >> 56
+}
+
+/// 64 BOOL bytes as a word (byte i → bit i).
+#[inline(always)]
+fn pack64(c: &[u8; 64]) -> u64 {
+    let mut w = 0;
+    for (j, b) in c.as_chunks::<8>().0.iter().enumerate() {
+        w |= pack8(u64::from_le_bytes(*b)) << (8 * j);
+    }
+    w
+}
+
+/// Bit i of the index → byte i (0 or 1) of the word.
+const SPREAD: [u64; 256] = {
+    let mut t = [0u64; 256];
+    let mut i = 0;
+    while i < 256 {
+        let mut b = 0;
+        while b < 8 {
+            if i & (1 << b) != 0 {
+                t[i] |= 1 << (8 * b);
+            }
+            b += 1;
+        }
+        i += 1;
+    }
+    t
+};
+
+/// A word of bits as 64 BOOL bytes.
+#[inline(always)]
+fn unpack64(w: u64, c: &mut [u8; 64]) {
+    for (j, b) in c.as_chunks_mut::<8>().0.iter_mut().enumerate() {
+        *b = SPREAD[((w >> (8 * j)) & 0xff) as usize].to_le_bytes();
+    }
+}
+
+impl XBuffer {
+    pub(super) fn new(x: &Exchange) -> XBuffer {
+        let per_set = x.lines as usize;
+        let lines = (0..2 * per_set)
+            .map(|_| XLine(Default::default()))
+            .collect();
+        XBuffer { lines, per_set }
+    }
+
+    #[inline(always)]
+    fn line(&self, seq: u64, key: &Key, l: usize) -> &XLine {
+        &self.lines[(seq & 1) as usize * self.per_set + key.first_line as usize + l]
+    }
+
+    #[inline(always)]
+    fn word(&self, seq: u64, key: &Key, i: u32) -> &AtomicU64 {
+        let i = i as usize;
+        &self.line(seq, key, i / LINE_WORDS).0[i % LINE_WORDS]
+    }
+
+    /// Packs `key`'s bytes of `state` into its lines and marks them as scan `seq − 1`'s.
+    pub(super) fn pack(&self, key: &Key, state: &[u8], seq: u64) {
+        let put = |i: u32, v: u64| self.word(seq, key, i).store(v, Ordering::Relaxed);
+        for s in &key.segments {
+            let bytes = &state[s.at as usize..(s.at + s.len) as usize];
+            if s.bools {
+                let (chunks, tail) = bytes.as_chunks::<64>();
+                for (i, c) in chunks.iter().enumerate() {
+                    put(s.word + i as u32, pack64(c));
+                }
+                if !tail.is_empty() {
+                    let mut c = [0u8; 64];
+                    c[..tail.len()].copy_from_slice(tail);
+                    put(s.word + chunks.len() as u32, pack64(&c));
+                }
+            } else {
+                for (i, c) in bytes.chunks(8).enumerate() {
+                    let mut b = [0u8; 8];
+                    b[..c.len()].copy_from_slice(c);
+                    put(s.word + i as u32, u64::from_le_bytes(b));
+                }
+            }
+        }
+        for l in 0..key.lines as usize {
+            self.line(seq, key, l).0[LINE_WORDS].store(seq, Ordering::Release);
+        }
+    }
+
+    /// Waits until every line of `key` is scan `seq − 1`'s; false if a worker panicked.
+    pub(super) fn wait(&self, key: &Key, seq: u64, barrier: &SpinBarrier) -> bool {
+        for l in 0..key.lines as usize {
+            let flag = &self.line(seq, key, l).0[LINE_WORDS];
+            if flag.load(Ordering::Acquire) == seq {
+                continue;
+            }
+            let ready = || (flag.load(Ordering::Acquire) == seq).then_some(());
+            let park = || {
+                if barrier.is_poisoned() {
+                    return false;
+                }
+                std::thread::park_timeout(PARK);
+                true
+            };
+            if wait_until(PACE, ready, park).is_none() {
+                return false;
+            }
+        }
+        true
+    }
+
+    /// Unpacks `key`'s lines (waited for) into `state`.
+    pub(super) fn unpack(&self, key: &Key, state: &mut [u8], seq: u64) {
+        let get = |i: u32| self.word(seq, key, i).load(Ordering::Relaxed);
+        for s in &key.segments {
+            let bytes = &mut state[s.at as usize..(s.at + s.len) as usize];
+            if s.bools {
+                let (chunks, tail) = bytes.as_chunks_mut::<64>();
+                let n = chunks.len() as u32;
+                for (i, c) in chunks.iter_mut().enumerate() {
+                    unpack64(get(s.word + i as u32), c);
+                }
+                if !tail.is_empty() {
+                    let mut c = [0u8; 64];
+                    unpack64(get(s.word + n), &mut c);
+                    let k = tail.len();
+                    tail.copy_from_slice(&c[..k]);
+                }
+            } else {
+                for (i, c) in bytes.chunks_mut(8).enumerate() {
+                    let k = c.len();
+                    c.copy_from_slice(&get(s.word + i as u32).to_le_bytes()[..k]);
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bools_round_trip_through_a_word() {
+        let mut c = [0u8; 64];
+        for (i, b) in c.iter_mut().enumerate() {
+            *b = ((i * 7 + i / 5) % 3 == 0) as u8;
+        }
+        let w = pack64(&c);
+        for (i, b) in c.iter().enumerate() {
+            assert_eq!((w >> i) & 1, *b as u64, "bit {i}");
+        }
+        let mut back = [9u8; 64];
+        unpack64(w, &mut back);
+        assert_eq!(back, c);
+        for v in 0..=255u64 {
+            assert_eq!(pack8(SPREAD[v as usize]), v);
+        }
+    }
+}
