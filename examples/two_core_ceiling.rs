@@ -30,7 +30,8 @@
 //! lines and unpacks them into its own state. A level's 500 BOOLs cross the cores as one line
 //! instead of the eight a shared byte-per-BOOL state moves, and no line of the state itself is
 //! ever shared. `ceiling` for it is the measured speed-up over the sequential walk (warm-up scans
-//! included on both sides).
+//! included on both sides). (The executor's `par-exchange` candidate is this, built on the
+//! planner's slices and the lowered code's writes; here it is the two halves of each level.)
 //!
 //! Rounds alternate the two, and the median and range over the rounds are printed, because the
 //! host is shared and noisy. Nothing here is used by the tool: it explains the speed-up figures
