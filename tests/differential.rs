@@ -686,27 +686,41 @@ fn one_scan_at_a_time_equals_a_run() {
     let p = plc_deps::load::program_from_json(&json).unwrap();
     let a = analyse(&p);
     let pool = pool();
-    let par = ParallelMachine::new(&p, &a, &ExecConfig::default(), &PlanConfig::new(2)).unwrap();
-    let inputs = input_table(&p, 9, 40);
-    let mut rec = Recorder {
-        inputs: &inputs,
-        states: Vec::new(),
-        faults: Vec::new(),
-    };
-    let mut whole = par.initial_state();
-    par.run(Some(&pool), &mut whole, 0..40, &mut rec);
-    let mut single = par.initial_state();
-    for scan in 0..40u64 {
-        let mut faults = Vec::new();
-        par.scan(
-            Some(&pool),
-            &mut single,
-            scan,
-            &inputs[scan as usize],
-            &mut faults,
-        );
-        assert_eq!(single.bytes(), rec.states[scan as usize]);
-        assert_eq!(faults, rec.faults[scan as usize]);
+    // The cost model's plan, and the levelled plan on private states (each one-scan run copies
+    // the state into the other workers' private states first).
+    for kind in [PlanKind::Model, PlanKind::Exchange] {
+        let config = match kind {
+            PlanKind::Exchange => PlanConfig {
+                kind,
+                ..configs(2, 3) // every level parallel: the model finds them too small
+            },
+            _ => PlanConfig::new(2),
+        };
+        let par = ParallelMachine::new(&p, &a, &ExecConfig::default(), &config).unwrap();
+        if kind == PlanKind::Exchange {
+            assert_eq!(par.candidate_name(0), "par-exchange");
+        }
+        let inputs = input_table(&p, 9, 40);
+        let mut rec = Recorder {
+            inputs: &inputs,
+            states: Vec::new(),
+            faults: Vec::new(),
+        };
+        let mut whole = par.initial_state();
+        par.run(Some(&pool), &mut whole, 0..40, &mut rec);
+        let mut single = par.initial_state();
+        for scan in 0..40u64 {
+            let mut faults = Vec::new();
+            par.scan(
+                Some(&pool),
+                &mut single,
+                scan,
+                &inputs[scan as usize],
+                &mut faults,
+            );
+            assert_eq!(single.bytes(), rec.states[scan as usize], "{kind:?}");
+            assert_eq!(faults, rec.faults[scan as usize], "{kind:?}");
+        }
     }
 }
 
