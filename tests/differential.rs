@@ -387,6 +387,7 @@ fn restless() -> Measure {
         max_rounds: 2,
         min_interval: 1,
         max_interval: 3,
+        budget_permille: 0,
         chunk: 2,
         sample_every: 1,
     }

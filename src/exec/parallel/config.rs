@@ -61,6 +61,11 @@ pub struct Measure {
     /// The longest stretch between re-measurements (the interval doubles while the choice
     /// holds).
     pub max_interval: u64,
+    /// What a re-measurement may cost, per mille of the time the scans between two of them
+    /// take on the chosen candidate: the interval is at least the number of scans that makes
+    /// the next re-measurement's expected extra time (its visits of slower candidates, priced at
+    /// their last measurement) this fraction of theirs (capped at `max_interval`). 0: no floor.
+    pub budget_permille: u64,
     /// Scans per window while a parallel candidate runs (the machine looks at the scan times
     /// after each window, to re-measure when they jump).
     pub chunk: u64,
@@ -70,7 +75,8 @@ pub struct Measure {
 
 impl Default for Measure {
     /// Visits of 1 warm-up and 2 timed scans, 3 to 8 rounds, re-measure after 128 scans
-    /// doubling up to 2048, windows of 32 scans, every 8th scan timed.
+    /// doubling up to 2048 (and no sooner than a re-measurement costs 1.5 % of the time between
+    /// them), windows of 32 scans, every 8th scan timed.
     fn default() -> Self {
         Measure {
             warm_scans: 1,
@@ -79,6 +85,7 @@ impl Default for Measure {
             max_rounds: 8,
             min_interval: 128,
             max_interval: 2048,
+            budget_permille: 15,
             chunk: 32,
             sample_every: 8,
         }

@@ -2,8 +2,9 @@
 //! mode (Frigo & Johnson): the first scans of a run time the candidates — real scans of the
 //! run, their results kept — and the fastest runs; cheap re-measurements every N scans (N
 //! doubling while the choice holds, quadrupling when every other candidate took twice its time
-//! or more, up to a cap) or as soon as the scan time jumps keep the
-//! choice right when the machine gets busy or calms down.
+//! or more, up to a cap, and never so small that the next re-measurement's visits of slower
+//! candidates would cost more than a budget, 1.5 % by default, of the scans between) or as soon
+//! as the scan time jumps keep the choice right when the machine gets busy or calms down.
 //!
 //! A measurement is made of *rounds*; a round *visits* each measured candidate once (the order
 //! rotating from round to round), and a visit runs a few untimed-for-the-choice warm-up scans
@@ -408,25 +409,65 @@ impl Chooser {
             self.estimate[self.current] = Some(lower_median(&mut self.recent.clone()));
         }
         self.recent.clear();
-        let others = (0..self.n).filter(|&c| c != self.current);
-        let runner_up = others
-            .clone()
-            .filter(|&c| self.estimate[c].is_some())
-            .min_by_key(|&c| self.estimate[c]);
         let mut who = vec![self.current];
-        match (&jump, runner_up) {
-            (None, Some(r)) => {
-                if self.current != 0 && r != 0 {
-                    who.push(0);
-                }
-                who.push(r);
-            }
-            _ => who.extend(others),
+        match (&jump, self.runner_up()) {
+            (None, Some(_)) => who.extend(self.routine_visits()),
+            _ => who.extend((0..self.n).filter(|&c| c != self.current)),
         }
         if jump.is_some() {
             self.interval = self.measure.min_interval.max(1);
         }
         self.stage = Stage::Measure(Box::new(Measurement::new(who, jump)));
+    }
+
+    /// The fastest candidate other than the current one at their last measurements.
+    fn runner_up(&self) -> Option<usize> {
+        (0..self.n)
+            .filter(|&c| c != self.current && self.estimate[c].is_some())
+            .min_by_key(|&c| self.estimate[c])
+    }
+
+    /// The candidates besides the current one that a routine re-measurement visits: the
+    /// default (candidate 0) and the runner-up.
+    fn routine_visits(&self) -> Vec<usize> {
+        let mut who = Vec::new();
+        if let Some(r) = self.runner_up() {
+            if self.current != 0 && r != 0 {
+                who.push(0);
+            }
+            who.push(r);
+        }
+        who
+    }
+
+    /// The fewest scans between re-measurements that keeps the next routine one within the
+    /// budget: its expected extra time (each visited candidate's last time per scan above the
+    /// current one's, times its scans: all rounds' visits, or one scan when it will be found
+    /// hopeless) over `budget_permille` of the current candidate's time per scan. 0 when
+    /// nothing is known or there is no budget.
+    fn budget_interval(&self) -> u64 {
+        let m = self.measure;
+        let Some(cur) = self.estimate[self.current].filter(|&c| c > 0) else {
+            return 0;
+        };
+        if m.budget_permille == 0 {
+            return 0;
+        }
+        let visit = m.warm_scans + m.probe_scans.max(1);
+        let extra: u64 = self
+            .routine_visits()
+            .into_iter()
+            .filter_map(|c| self.estimate[c])
+            .map(|e| {
+                let scans = if e > cur.saturating_mul(4) {
+                    1
+                } else {
+                    visit * m.min_rounds.max(1)
+                };
+                e.saturating_sub(cur).saturating_mul(scans)
+            })
+            .sum();
+        extra.saturating_mul(1000) / m.budget_permille.saturating_mul(cur)
     }
 
     /// A measurement is over: run what `verdict` picked.
@@ -482,6 +523,11 @@ impl Chooser {
             };
             self.interval = (self.interval * factor).min(self.measure.max_interval.max(1));
         }
+        let floor = self.budget_interval();
+        self.interval = self
+            .interval
+            .max(floor)
+            .min(self.measure.max_interval.max(1));
         self.stage = Stage::Exploit {
             left: self.interval,
         };

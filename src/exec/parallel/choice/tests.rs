@@ -7,6 +7,14 @@ fn measure() -> Measure {
     Measure::default()
 }
 
+/// The default measuring without the budget's floor under the interval.
+fn unbudgeted() -> Measure {
+    Measure {
+        budget_permille: 0,
+        ..Measure::default()
+    }
+}
+
 /// Runs `scans` scans through the chooser's windows, timing candidate `c`'s scan `s` with
 /// `ns(c, s, cold)`, `cold` for the first scan after a change of candidate (every scan of a
 /// timed window, else every 8th, as the machine does). Returns the candidate of every scan.
@@ -216,7 +224,7 @@ fn a_busy_machine_switches_to_sequential_and_back_when_it_calms_down() {
 
 #[test]
 fn re_measurements_compare_with_the_default_and_the_runner_up_and_the_interval_doubles() {
-    let mut ch = Chooser::new(4, measure(), 0);
+    let mut ch = Chooser::new(4, unbudgeted(), 0);
     let ns = |c: usize, _: u64, _: bool| [100_000, 60_000, 70_000, 90_000][c];
     let ran = drive(&mut ch, 4, 4000, ns);
     // After the first measurement, the default (candidate 0) and the runner-up (2) are
@@ -250,7 +258,7 @@ fn re_measurements_compare_with_the_default_and_the_runner_up_and_the_interval_d
 fn a_candidate_twice_as_slow_is_looked_at_four_times_less_often() {
     // The sequential walk 3.7 µs, the parallel plan 10.4 µs (gen 1k on 2 vCPUs): the
     // intervals grow 4x from the first measurement (512, then the cap), not 128, 256 …
-    let mut ch = Chooser::new(2, measure(), 0);
+    let mut ch = Chooser::new(2, unbudgeted(), 0);
     let ns = |c: usize, _: u64, _: bool| [3_700, 10_400][c];
     let ran = drive(&mut ch, 2, 5000, ns);
     assert!(ch.switches().is_empty());
@@ -264,6 +272,52 @@ fn a_candidate_twice_as_slow_is_looked_at_four_times_less_often() {
     // and three looks in 5,000 scans, where doubling intervals would have taken five.
     let visits = ran.iter().filter(|&&c| c == 1).count();
     assert_eq!(visits, 4 * 9, "scans on the slow plan");
+}
+
+#[test]
+fn the_budget_spaces_re_measurements_by_what_they_cost() {
+    // The chosen plan 60 µs, the default 100 µs and the runner-up 70 µs: a routine
+    // re-measurement visits both in 3 rounds of 3 scans, 9 × 40 + 9 × 10 = 450 µs more than
+    // on the chosen plan, which is 1.5 % of 500 scans of it; the interval starts there and
+    // doubles while the choice holds.
+    let mut ch = Chooser::new(4, measure(), 0);
+    let ns = |c: usize, _: u64, _: bool| [100_000, 60_000, 70_000, 90_000][c];
+    let ran = drive(&mut ch, 4, 4000, ns);
+    let gaps: Vec<usize> = ran[36..]
+        .split(|&c| c != 1)
+        .map(<[usize]>::len)
+        .filter(|&n| n > 100)
+        .collect();
+    assert_eq!(gaps[..3], [500 + 3, 1000 + 3, 2000 + 3], "{gaps:?}");
+    let scans_elsewhere = ran[36..].iter().filter(|&&c| c != 1).count();
+    assert_eq!(
+        scans_elsewhere,
+        3 * 2 * 9,
+        "three re-measurements in 4,000 scans"
+    );
+    // The cost the budget allows: the extra time of the re-measurements over the time of the
+    // scans between them.
+    let extra: u64 = ran[36..].iter().map(|&c| ns(c, 0, false) - 60_000).sum();
+    let between = (4000 - 36 - scans_elsewhere) as u64 * 60_000;
+    assert!(
+        extra * 1000 <= 15 * between,
+        "{extra} ns extra over {between} ns"
+    );
+    // A candidate that will be found hopeless costs one scan, not a visit of every round:
+    // the sequential walk at 5x the chosen plan's time, 240 µs more for one scan, is 1.5 %
+    // of 266 scans of 60 µs (where a visit of every round would ask for 2,400); the interval
+    // then grows fourfold, the walk taking more than twice the chosen plan's time.
+    let mut ch = Chooser::new(2, measure(), 0);
+    let ran = drive(&mut ch, 2, 3000, |c, _, _| [300_000, 60_000][c]);
+    let gaps: Vec<usize> = ran
+        .split(|&c| c != 1)
+        .map(<[usize]>::len)
+        .filter(|&n| n > 100)
+        .collect();
+    assert_eq!(gaps[..2], [266 + 3, 4 * 266 + 3], "{gaps:?}");
+    // On the walk: a whole visit and a hopeless one in the first measurement, then one scan
+    // in each of the two re-measurements.
+    assert_eq!(ran.iter().filter(|&&c| c == 0).count(), 3 + 1 + 2);
 }
 
 #[test]
