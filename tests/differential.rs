@@ -65,6 +65,8 @@ struct Stats {
     one_way_cases: u64,
     /// Cases that ran scans on private states (`par-exchange`).
     exchange_cases: u64,
+    /// Of those, cases whose plan runs some work before its phase's hand-over.
+    early_cases: u64,
 }
 
 /// Runs one program under one plan configuration and compares every scan.
@@ -128,9 +130,11 @@ fn check_with(
         stats.mixed_runs += 1;
     }
     stats.switches += log.switches.len() as u64;
-    stats.exchange_cases += (0..log.candidates.len())
-        .any(|i| matches!(par.candidates()[i], Candidate::Exchange(_)) && log.scans_on[i] > 0)
-        as u64;
+    let on_private_states = (0..log.candidates.len())
+        .any(|i| matches!(par.candidates()[i], Candidate::Exchange(_)) && log.scans_on[i] > 0);
+    stats.exchange_cases += on_private_states as u64;
+    let early = &par.explain_json()["exchange"]["early_items"];
+    stats.early_cases += (on_private_states && early.as_u64() > Some(0)) as u64;
     assert_eq!(
         rec.states.len() as u64,
         scans,
@@ -353,16 +357,28 @@ fn exchange_plan_equals_sequential_scan_on_random_programs() {
         for threads in [2, 3, 4, 8] {
             let mut config = configs(threads, seed + threads as u64);
             config.kind = PlanKind::Exchange;
+            // Half of the cases cut early work from items at any task, not only in runs of 16.
+            config.early_min_tasks = if seed % 2 == 1 { 1 } else { 16 };
             let label = format!(
-                "seed {seed}, {threads} threads, --plan exchange, {:?}/{:?}, merged {}",
-                config.strategy, config.slicing, config.merge_levels
+                "seed {seed}, {threads} threads, --plan exchange, {:?}/{:?}, merged {}, early pieces of {}+ tasks",
+                config.strategy, config.slicing, config.merge_levels, config.early_min_tasks
             );
             check(&p, &label, &config, &exec, SCANS, seed, &pool, &mut stats);
         }
     }
     eprintln!(
-        "{loaded} programs, {} cases, {} on private states, faults: {} loop-cap, {} div-by-zero",
-        stats.cases, stats.exchange_cases, stats.loop_cap_faults, stats.div_faults
+        "{loaded} programs, {} cases, {} on private states ({} with early work), faults: {} loop-cap, {} div-by-zero",
+        stats.cases,
+        stats.exchange_cases,
+        stats.early_cases,
+        stats.loop_cap_faults,
+        stats.div_faults
+    );
+    assert!(
+        stats.early_cases >= stats.exchange_cases / 4,
+        "too few runs with work before the hand-over: {} of {}",
+        stats.early_cases,
+        stats.exchange_cases
     );
     assert!(loaded >= 370, "only {loaded} random programs loaded");
     assert!(

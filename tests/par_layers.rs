@@ -35,6 +35,7 @@ const PARALLEL: Order = &[
     &["planning", "candidates"],
     &["planning", "order_check"],
     &["planning", "check"],
+    &["planning", "early"],
     &["planning", "exchange"],
     &["planning", "remote"],
     &["planning"],

@@ -222,6 +222,10 @@ pub struct PlanConfig {
     pub kind: PlanKind,
     /// How [`PlanKind::Auto`] measures.
     pub measure: Measure,
+    /// The fewest tasks of a piece `par-exchange` cuts from an item to run it before the
+    /// hand-over of the phase before (`planning::early`; 16: a walk of its own costs about as
+    /// much as a few tasks). At least 1.
+    pub early_min_tasks: u32,
     /// Pin worker `i` to the `i`-th CPU the process may run on, for each run, when there are
     /// at least as many such CPUs as workers (Linux; `machine::pin`). Off by default: measured
     /// on 2 shared vCPUs it made no difference beyond the host's noise (docs/scan.md).
@@ -260,6 +264,7 @@ impl PlanConfig {
             merge_levels: false,
             kind: PlanKind::Model,
             measure: Measure::default(),
+            early_min_tasks: 16,
             pin_workers: false,
         }
     }

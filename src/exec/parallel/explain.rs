@@ -65,10 +65,12 @@ impl ParallelMachine {
                         };
                         let _ = writeln!(
                             s,
-                            "  candidate {}: {of} with each worker on a private state, handing over {} words in {} lines per scan (BOOLs as bits; each line carries its scan's number)",
+                            "  candidate {}: {of} with each worker on a private state, handing over {} words in {} lines per scan (BOOLs as bits; each line carries its scan's number); {} of {} items run before their phase's hand-over (they touch nothing the others wrote in the phase before)",
                             self.names[i],
                             x.words(),
-                            x.lines()
+                            x.lines(),
+                            x.early_items().0,
+                            x.early_items().1
                         );
                     }
                 }
@@ -326,6 +328,8 @@ impl ParallelMachine {
             "exchange": self.exchanges.iter().flatten().next().map(|x| json!({
                 "words": x.words(),
                 "lines": x.lines(),
+                "early_items": x.early_items().0,
+                "items": x.early_items().1,
             })),
             "levels": plan.levels.iter().map(|lp| json!({
                 "tasks": lp.tasks,

@@ -20,7 +20,8 @@
 use super::shared::{Shared, SharedSlots};
 use super::xlines::XBuffer;
 use super::{Buffers, ParallelMachine, ScanDriver, Timing};
-use crate::exec::parallel::planning::{Exchange, Plan};
+use crate::exec::parallel::planning::{Exchange, Item, Plan};
+use crate::exec::ScanCtx;
 use std::time::Instant;
 
 impl ParallelMachine {
@@ -45,6 +46,27 @@ impl ParallelMachine {
             buf.unpack(key, unsafe { state.bytes_mut() }, seq);
         }
         true
+    }
+
+    /// Runs item `it` of worker `w` and keeps its faults in the worker's buffer.
+    #[inline]
+    fn run_exchange_item(
+        &self,
+        w: usize,
+        plan: &Plan,
+        it: &Item,
+        store: &mut SharedSlots,
+        ctx: &mut ScanCtx<'_>,
+        sh: &Shared<'_>,
+    ) {
+        self.run_item(plan, it, store, ctx, sh);
+        if !ctx.faults.is_empty() {
+            // SAFETY: only worker `w` touches its fault buffer during a scan; worker 0 reads it
+            // after it has waited for every worker's last phase, and `w` does not start the
+            // next scan before worker 0's inputs.
+            let fb = unsafe { &mut *sh.faults[w].0.get() };
+            fb.extend(ctx.faults.drain(..).map(|f| (it.first.0, f)));
+        }
     }
 
     /// Worker `w`'s part of `scans` on `plan` with exchange `x`, on `state` (worker 0: the
@@ -80,19 +102,23 @@ impl ParallelMachine {
             }
             self.machine.begin_scan(&mut store);
             let mut ctx = self.machine.context(scan, &mut b.scratch);
-            for (pi, ph) in plan.phases.iter().enumerate() {
+            for pi in 0..plan.phases.len() {
+                let split = x.split(pi, w);
+                buf.prefetch_write(x.key(pi, w), seq);
+                let (early, late) = split.items.split_at(split.early as usize);
+                for (i, it) in early.iter().enumerate() {
+                    self.run_exchange_item(w, plan, it, &mut store, &mut ctx, sh);
+                    if split.prefetch_after == Some(i as u32 + 1) {
+                        for o in (0..x.threads).filter(|&o| o != w) {
+                            buf.prefetch_read(x.key(pi - 1, o), seq);
+                        }
+                    }
+                }
                 if pi > 0 && !self.take_phase(w, (x, buf), pi - 1, store, seq, sh) {
                     return false;
                 }
-                for it in ph.items_of(w) {
-                    self.run_item(plan, it, &mut store, &mut ctx, sh);
-                    if !ctx.faults.is_empty() {
-                        // SAFETY: only worker `w` touches its fault buffer during a scan;
-                        // worker 0 reads it after it has waited for every worker's last phase,
-                        // and `w` does not start the next scan before worker 0's inputs.
-                        let fb = unsafe { &mut *sh.faults[w].0.get() };
-                        fb.extend(ctx.faults.drain(..).map(|f| (it.first.0, f)));
-                    }
+                for it in late {
+                    self.run_exchange_item(w, plan, it, &mut store, &mut ctx, sh);
                 }
                 // SAFETY: as in `take_phase`.
                 buf.pack(x.key(pi, w), unsafe { store.bytes_mut() }, seq);

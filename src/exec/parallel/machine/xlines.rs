@@ -90,6 +90,22 @@ impl XBuffer {
         &self.line(seq, key, i / LINE_WORDS).0[i % LINE_WORDS]
     }
 
+    /// Asks the CPU to fetch `key`'s lines of scan `seq − 1` for reading (a hint: a reader
+    /// that expects them written soon overlaps their transfer with its work).
+    pub(super) fn prefetch_read(&self, key: &Key, seq: u64) {
+        for l in 0..key.lines as usize {
+            crate::hint::prefetch_read(std::ptr::from_ref(self.line(seq, key, l)).cast());
+        }
+    }
+
+    /// Asks the CPU to take `key`'s lines of scan `seq − 1` for writing (a hint: the writer
+    /// takes them from the reader's cache now, not when it packs).
+    pub(super) fn prefetch_write(&self, key: &Key, seq: u64) {
+        for l in 0..key.lines as usize {
+            crate::hint::prefetch_write(std::ptr::from_ref(self.line(seq, key, l)).cast());
+        }
+    }
+
     /// Packs `key`'s bytes of `state` into its lines and marks them as scan `seq − 1`'s.
     pub(super) fn pack(&self, key: &Key, state: &[u8], seq: u64) {
         let put = |i: u32, v: u64| self.word(seq, key, i).store(v, Ordering::Relaxed);

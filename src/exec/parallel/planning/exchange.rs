@@ -17,6 +17,7 @@
 //! (the running side's `exchange` does). A sequential phase of the plan is worker 0's alone:
 //! the other workers' keys of it are empty.
 
+use super::early::{Split, Splitter};
 use super::plan::Plan;
 use crate::exec::{Layout, Machine, Span};
 use crate::model::{Program, Type, VarId};
@@ -65,6 +66,8 @@ pub(in crate::exec::parallel) struct Key {
 pub struct Exchange {
     pub(in crate::exec::parallel) threads: usize,
     pub(in crate::exec::parallel) keys: Vec<Key>,
+    /// Per (phase, worker), as `keys`: its work in the order it runs it (`early`).
+    pub(in crate::exec::parallel) splits: Vec<Split>,
     pub(in crate::exec::parallel) inputs: Key,
     /// Lines of all keys (one set of buffers).
     pub(in crate::exec::parallel) lines: u32,
@@ -74,6 +77,19 @@ impl Exchange {
     /// The key of worker `w` after phase `phase`.
     pub(in crate::exec::parallel) fn key(&self, phase: usize, w: usize) -> &Key {
         &self.keys[phase * self.threads + w]
+    }
+
+    /// Worker `w`'s work of phase `phase`, in the order it runs it.
+    pub(in crate::exec::parallel) fn split(&self, phase: usize, w: usize) -> &Split {
+        &self.splits[phase * self.threads + w]
+    }
+
+    /// Items run before their phase's hand-over, and items in all, once the plan's items are
+    /// cut into pieces (for `--explain`).
+    pub fn early_items(&self) -> (u64, u64) {
+        let early = self.splits.iter().map(|s| s.early as u64).sum();
+        let all = self.splits.iter().map(|s| s.items.len() as u64).sum();
+        (early, all)
     }
 
     /// Data words a scan hands over, over all keys (for `--explain`).
@@ -152,27 +168,32 @@ pub(in crate::exec::parallel) fn exchange_plan(
     let is_bool = bool_bytes(p, machine.layout(), size);
     let mut written = vec![false; size];
     let mut mine = vec![false; size];
+    let mut sp = Splitter::new(size);
+    let mut before: Vec<Vec<u32>> = vec![Vec::new(); plan.threads];
     let (mut reads, mut writes): (Vec<Span>, Vec<Span>) = (Vec::new(), Vec::new());
     let mut keys = Vec::with_capacity(plan.phases.len() * plan.threads);
+    let mut splits = Vec::with_capacity(keys.capacity());
     let mut line = 0;
-    for ph in &plan.phases {
+    for (pi, ph) in plan.phases.iter().enumerate() {
+        let mut now: Vec<Vec<u32>> = Vec::with_capacity(plan.threads);
         for w in 0..plan.threads {
             let mut bytes: Vec<u32> = Vec::new();
             for it in ph.items_of(w) {
+                reads.clear();
+                writes.clear();
                 for r in super::check::item_rungs(plan, it) {
-                    reads.clear();
-                    writes.clear();
                     machine.rung_accesses(r, &mut reads, &mut writes);
-                    for &(at, n) in &writes {
-                        for b in at.0..at.0 + n {
-                            if !std::mem::replace(&mut mine[b as usize], true) {
-                                bytes.push(b);
-                            }
-                            written[b as usize] = true;
+                }
+                for &(at, n) in &writes {
+                    for b in at.0..at.0 + n {
+                        if !std::mem::replace(&mut mine[b as usize], true) {
+                            bytes.push(b);
                         }
+                        written[b as usize] = true;
                     }
                 }
             }
+            splits.push(sp.split(machine, plan, w, ph.items_of(w), pi == 0));
             bytes.sort_unstable();
             for &b in &bytes {
                 mine[b as usize] = false;
@@ -180,7 +201,10 @@ pub(in crate::exec::parallel) fn exchange_plan(
             let key = key_of(&bytes, &is_bool, line);
             line += key.lines;
             keys.push(key);
+            now.push(bytes);
         }
+        sp.next_phase(&before, &now);
+        before = now;
     }
     let mut inputs: Vec<u32> = Vec::new();
     for (at, n) in machine.input_spans() {
@@ -198,6 +222,7 @@ pub(in crate::exec::parallel) fn exchange_plan(
     Ok(Exchange {
         threads: plan.threads,
         keys,
+        splits,
         inputs,
         lines: line,
     })

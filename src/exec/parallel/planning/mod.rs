@@ -29,6 +29,7 @@ mod calls;
 mod candidates;
 mod check;
 mod deps_plan;
+mod early;
 mod exchange;
 mod merge;
 mod movement;
