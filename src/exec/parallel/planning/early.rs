@@ -380,8 +380,8 @@ mod tests {
     fn a_slice_that_reads_only_its_own_writes_runs_before_the_hand_over() {
         let (plan, splits) = plan_of(false, 16);
         // The first phase has no phase before: all late.
-        for w in 0..2 {
-            let (early, late) = tasks(&splits[w]);
+        for (w, split) in splits.iter().enumerate().take(2) {
+            let (early, late) = tasks(split);
             assert!(early.is_empty());
             assert_eq!(
                 late,
