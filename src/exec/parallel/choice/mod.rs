@@ -137,6 +137,12 @@ pub fn choose(table: &[Vec<Option<u64>>]) -> Verdict {
     best
 }
 
+/// Whether a candidate that took `ns` per scan is hopeless against one that took `best`: more
+/// than 4× its time (a visit of it ends after one scan).
+fn hopeless(ns: u64, best: u64) -> bool {
+    ns > best.saturating_mul(4)
+}
+
 /// The lower median of `v` (sorts it); 0 when empty.
 fn lower_median(v: &mut [u64]) -> u64 {
     if v.is_empty() {
@@ -354,7 +360,7 @@ impl Chooser {
         }
         let last = m.visit.last().copied().unwrap_or(0);
         let best = m.best_this_round().or(self.estimate[self.current]);
-        best.is_some_and(|b| last > b.saturating_mul(4))
+        best.is_some_and(|b| hopeless(last, b))
     }
 
     /// Closes the visit in progress: its median into the table; the round and the measurement
@@ -459,7 +465,7 @@ impl Chooser {
             .into_iter()
             .filter_map(|c| self.estimate[c])
             .map(|e| {
-                let scans = if e > cur.saturating_mul(4) {
+                let scans = if hopeless(e, cur) {
                     1
                 } else {
                     visit * m.min_rounds.max(1)

@@ -97,10 +97,7 @@ pub(in crate::exec::parallel) fn check_plan(machine: &Machine, plan: &Plan) -> R
 }
 
 /// The rungs of an item's tasks.
-pub(super) fn item_rungs<'a>(
-    plan: &'a Plan,
-    it: &'a super::tasks::Item,
-) -> impl Iterator<Item = RungId> + 'a {
+fn item_rungs<'a>(plan: &'a Plan, it: &'a super::tasks::Item) -> impl Iterator<Item = RungId> + 'a {
     it.tasks()
         .flat_map(move |t| plan.task_rungs[t.index()].iter().copied())
 }

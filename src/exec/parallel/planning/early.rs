@@ -142,14 +142,15 @@ impl Splitter {
         }
     }
 
-    /// Worker `w`'s split of `items`, its items of phase `phase` (`first`: the first phase).
+    /// Worker `w`'s split of `items`, its items of one phase (`first`: the plan's first);
+    /// every task's byte writes go to `on_writes` on the way (the caller's key).
     pub(super) fn split(
         &mut self,
         machine: &Machine,
         plan: &Plan,
-        w: usize,
-        items: &[Item],
+        (w, items): (usize, &[Item]),
         first: bool,
+        mut on_writes: impl FnMut(&[Span]),
     ) -> Split {
         let min = plan.config.early_min_tasks.max(1);
         let (mut early, mut late) = (Vec::new(), Vec::new());
@@ -158,6 +159,7 @@ impl Splitter {
             let mut runs: Vec<Piece> = Vec::new();
             for t in it.tasks() {
                 self.task_accesses(machine, plan, t);
+                on_writes(&self.writes);
                 let free = !whole && self.may_go_first(w);
                 let cut = !whole && t != it.first && plan.task_rungs[t.index()].len() == 1;
                 match runs.last_mut() {

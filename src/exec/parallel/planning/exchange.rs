@@ -19,7 +19,7 @@
 
 use super::early::{Split, Splitter};
 use super::plan::Plan;
-use crate::exec::{Layout, Machine, Span};
+use crate::exec::{Layout, Machine};
 use crate::model::{Program, Type, VarId};
 
 /// Data words per exchange line; the eighth word of a line is its sequence number.
@@ -170,7 +170,6 @@ pub(in crate::exec::parallel) fn exchange_plan(
     let mut mine = vec![false; size];
     let mut sp = Splitter::new(size);
     let mut before: Vec<Vec<u32>> = vec![Vec::new(); plan.threads];
-    let (mut reads, mut writes): (Vec<Span>, Vec<Span>) = (Vec::new(), Vec::new());
     let mut keys = Vec::with_capacity(plan.phases.len() * plan.threads);
     let mut splits = Vec::with_capacity(keys.capacity());
     let mut line = 0;
@@ -178,13 +177,8 @@ pub(in crate::exec::parallel) fn exchange_plan(
         let mut now: Vec<Vec<u32>> = Vec::with_capacity(plan.threads);
         for w in 0..plan.threads {
             let mut bytes: Vec<u32> = Vec::new();
-            for it in ph.items_of(w) {
-                reads.clear();
-                writes.clear();
-                for r in super::check::item_rungs(plan, it) {
-                    machine.rung_accesses(r, &mut reads, &mut writes);
-                }
-                for &(at, n) in &writes {
+            let split = sp.split(machine, plan, (w, ph.items_of(w)), pi == 0, |writes| {
+                for &(at, n) in writes {
                     for b in at.0..at.0 + n {
                         if !std::mem::replace(&mut mine[b as usize], true) {
                             bytes.push(b);
@@ -192,8 +186,8 @@ pub(in crate::exec::parallel) fn exchange_plan(
                         written[b as usize] = true;
                     }
                 }
-            }
-            splits.push(sp.split(machine, plan, w, ph.items_of(w), pi == 0));
+            });
+            splits.push(split);
             bytes.sort_unstable();
             for &b in &bytes {
                 mine[b as usize] = false;
