@@ -99,13 +99,23 @@ impl FaultTally {
     }
 }
 
+/// What a pass does with the per-scan digests of the state (the hash of every value and fault
+/// that checks seq == par): a pass that no other pass is compared with computes none (`run
+/// --mode seq` or `--mode par` spend no time on them between the scans).
+enum Digests {
+    /// No other pass to compare with.
+    Skip,
+    /// Record them for the pass that follows.
+    Record(Vec<u128>),
+    /// Check them against the pass before's.
+    Check(Vec<u128>),
+}
+
 /// Per-scan bookkeeping shared by both modes.
 struct Driver<'a> {
     inputs: &'a InputTable,
     canon: Vec<(Addr, u32)>,
-    /// Digests of the reference run (filled), or to check against.
-    digests: Vec<u128>,
-    check: bool,
+    digests: Digests,
     first_mismatch: Option<u64>,
     total: Duration,
     faults: Vec<(u64, u32, FaultKind)>,
@@ -119,16 +129,17 @@ impl<'a> Driver<'a> {
     fn new(
         inputs: &'a InputTable,
         m: &Machine,
-        digests: Vec<u128>,
-        check: bool,
+        digests: Digests,
         trace: Option<Trace<'a>>,
         bar: Bar,
     ) -> Driver<'a> {
         Driver {
             inputs,
-            canon: canonical_slots(m),
+            canon: match digests {
+                Digests::Skip => Vec::new(),
+                _ => canonical_slots(m),
+            },
             digests,
-            check,
             first_mismatch: None,
             total: Duration::ZERO,
             faults: Vec::new(),
@@ -154,13 +165,16 @@ impl ScanDriver for Driver<'_> {
         elapsed: Duration,
     ) {
         self.total += elapsed;
-        let d = digest(slots, &self.canon, faults);
-        if self.check {
-            if self.first_mismatch.is_none() && self.digests.get(scan as usize) != Some(&d) {
-                self.first_mismatch = Some(scan);
+        match &mut self.digests {
+            Digests::Skip => {}
+            Digests::Record(ds) => ds.push(digest(slots, &self.canon, faults)),
+            Digests::Check(ds) => {
+                if self.first_mismatch.is_none()
+                    && ds.get(scan as usize) != Some(&digest(slots, &self.canon, faults))
+                {
+                    self.first_mismatch = Some(scan);
+                }
             }
-        } else {
-            self.digests.push(d);
         }
         self.fault_count += faults.len() as u64;
         for f in faults {
@@ -401,7 +415,10 @@ impl Pass {
     fn of(d: Driver<'_>, state: State, log: Option<RunLog>) -> Pass {
         Pass {
             total: d.total,
-            digests: d.digests,
+            digests: match d.digests {
+                Digests::Record(ds) => ds,
+                Digests::Skip | Digests::Check(_) => Vec::new(),
+            },
             first_mismatch: d.first_mismatch,
             faults: d.faults,
             fault_count: d.fault_count,
@@ -443,7 +460,11 @@ pub(super) fn execute(
             _ => None,
         };
         let bar = progress.bar("seq", scans, "scans");
-        let mut d = Driver::new(inputs, m, Vec::new(), false, t, bar);
+        let digests = match run_par {
+            Some(_) => Digests::Record(Vec::new()),
+            None => Digests::Skip,
+        };
+        let mut d = Driver::new(inputs, m, digests, t, bar);
         let mut st = m.initial_state();
         run_sequential(m, &mut st, 0..scans, &mut d);
         Pass::of(d, st, None)
@@ -459,10 +480,12 @@ pub(super) fn execute(
             (Some(cols), Some(out)) => Some(Trace::new(m, cols, out)),
             _ => None,
         };
-        let check = seq.is_some();
-        let digests = seq.as_mut().map(|s| std::mem::take(&mut s.digests));
+        let digests = match seq.as_mut() {
+            Some(s) => Digests::Check(std::mem::take(&mut s.digests)),
+            None => Digests::Skip,
+        };
         let bar = progress.bar("par", scans, "scans");
-        let mut d = Driver::new(inputs, m, digests.unwrap_or_default(), check, t, bar);
+        let mut d = Driver::new(inputs, m, digests, t, bar);
         let mut st = pm.initial_state();
         let log = pm.run(pr.pool.as_ref(), &mut st, 0..scans, &mut d);
         Pass::of(d, st, Some(log))
