@@ -2,7 +2,9 @@
 //! *lowered instructions'* byte reads and writes (`Machine::rung_accesses`), every two items of
 //! different workers that touch a common byte, one of them writing, are ordered by a chain of
 //! waits and program order (happened-before, Lamport); two workers never write one 64-byte line
-//! unordered; every decision a guard or entry reads was written by an item ordered before the
+//! unordered, unless every written byte of the line is written on several workers (those bytes'
+//! writes are ordered by the byte rule, and such a line crosses between the cores whatever it
+//! holds: the layout puts the variables written on several workers together); every decision a guard or entry reads was written by an item ordered before the
 //! reader; and the waits cannot deadlock.
 //!
 //! How: the items are walked in one order that respects every worker's order and every wait
@@ -127,12 +129,74 @@ fn check_decisions(plan: &Plan, items: &[&[Item]], clocks: &Clocks) -> Result<()
 }
 
 /// Per byte: the last writer and the latest reader of each worker since; per line: the last
-/// writer.
+/// writer, and whether the line rule applies to it.
 struct Seen {
     workers: usize,
     writer: Vec<Option<At>>,
     readers: Vec<Option<usize>>,
     line_writer: Vec<Option<At>>,
+    /// Lines whose every written byte is written on several workers: exempt from the line rule.
+    several_lines: Vec<bool>,
+}
+
+/// Calls `f` with every rung's lowered accesses, item by item in `order`.
+fn each_rung(
+    machine: &Machine,
+    plan: &Plan,
+    items: &[&[Item]],
+    order: &[At],
+    mut f: impl FnMut(At, u32, &[Span], &[Span]) -> Result<(), String>,
+) -> Result<(), String> {
+    let (mut reads, mut writes) = (Vec::new(), Vec::new());
+    for &at in order {
+        let it = &items[at.0][at.1];
+        for t in it.tasks() {
+            for &r in &plan.task_rungs[t.index()] {
+                reads.clear();
+                writes.clear();
+                machine.rung_accesses(r, &mut reads, &mut writes);
+                f(at, r.0, &reads, &writes)?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Per line of a state of `n` bytes: whether it holds a written byte and every written byte of
+/// it is written on two workers or more.
+fn several_lines(
+    machine: &Machine,
+    plan: &Plan,
+    items: &[&[Item]],
+    order: &[At],
+    n: usize,
+) -> Result<Vec<bool>, String> {
+    #[derive(Copy, Clone, PartialEq)]
+    enum Writers {
+        None,
+        One(usize),
+        Several,
+    }
+    let mut writers = vec![Writers::None; n];
+    each_rung(machine, plan, items, order, |at, _, _, writes| {
+        for b in writes.iter().flat_map(|&s| bytes(s)).filter(|&b| b < n) {
+            writers[b] = match writers[b] {
+                Writers::None => Writers::One(at.0),
+                Writers::One(w) if w == at.0 => Writers::One(w),
+                _ => Writers::Several,
+            };
+        }
+        Ok(())
+    })?;
+    Ok(writers
+        .chunks(LINE_BYTES as usize)
+        .map(|line| {
+            line.contains(&Writers::Several)
+                && line
+                    .iter()
+                    .all(|&w| matches!(w, Writers::None | Writers::Several))
+        })
+        .collect())
 }
 
 /// The byte and line discipline, over the items in walk order.
@@ -150,25 +214,17 @@ fn check_bytes(
         writer: vec![None; n],
         readers: vec![None; n * p],
         line_writer: vec![None; n.div_ceil(LINE_BYTES as usize)],
+        several_lines: several_lines(machine, plan, items, order, n)?,
     };
-    let (mut reads, mut writes) = (Vec::new(), Vec::new());
-    for &at in order {
-        let it = &items[at.0][at.1];
-        for t in it.tasks() {
-            for &r in &plan.task_rungs[t.index()] {
-                reads.clear();
-                writes.clear();
-                machine.rung_accesses(r, &mut reads, &mut writes);
-                for b in reads.iter().flat_map(|&s| bytes(s)) {
-                    seen.read(b, at, clocks, r.0)?;
-                }
-                for b in writes.iter().flat_map(|&s| bytes(s)) {
-                    seen.write(b, at, clocks, r.0)?;
-                }
-            }
+    each_rung(machine, plan, items, order, |at, rung, reads, writes| {
+        for b in reads.iter().flat_map(|&s| bytes(s)) {
+            seen.read(b, at, clocks, rung)?;
         }
-    }
-    Ok(())
+        for b in writes.iter().flat_map(|&s| bytes(s)) {
+            seen.write(b, at, clocks, rung)?;
+        }
+        Ok(())
+    })
 }
 
 /// The bytes of a span.
@@ -215,7 +271,11 @@ impl Seen {
             }
         }
         self.writer[b] = Some(at);
-        let line = &mut self.line_writer[b / LINE_BYTES as usize];
+        let l = b / LINE_BYTES as usize;
+        if self.several_lines[l] {
+            return Ok(());
+        }
+        let line = &mut self.line_writer[l];
         if let Some(x) = *line {
             if x.0 != at.0 && !clocks.before(x, at) {
                 return Err(format!(
@@ -318,6 +378,54 @@ mod tests {
             check_ordered(&m, &plan),
             Err("worker 0 item 0 waits for items that can never finish (a cycle of waits)".into())
         );
+    }
+
+    /// x and y are each written on both workers (R1 and R4, R2 and R3), and worker 0's write
+    /// of x (R1) and worker 1's of y (R2) are unordered: on one line they pass, as a line of
+    /// variables written on several workers; with z (written by R1 only) on that line too,
+    /// the line rule applies and refuses it.
+    #[test]
+    fn a_line_of_variables_written_on_several_workers_is_exempt_from_the_line_rule() {
+        let program = |z: bool| {
+            let coil_z = if z { r#", {"coil": "z"}"# } else { "" };
+            crate::load::program_from_json(&format!(
+                r#"{{"program": "p", "vars": [
+                    {{"name": "a", "type": "BOOL", "class": "input"}},
+                    {{"name": "b", "type": "BOOL", "class": "input"}},
+                    {{"name": "x", "type": "BOOL", "class": "output"}},
+                    {{"name": "y", "type": "BOOL", "class": "output"}},
+                    {{"name": "z", "type": "BOOL", "class": "output"}}],
+                  "rungs": [{{"id": "R1", "ld": [{{"contact": "a"}}, {{"coil": "x"}}{coil_z}]}},
+                            {{"id": "R2", "ld": [{{"contact": "b"}}, {{"coil": "y"}}]}},
+                            {{"id": "R3", "ld": [{{"contact": "a"}}, {{"coil": "y"}}]}},
+                            {{"id": "R4", "ld": [{{"contact": "b"}}, {{"coil": "x"}}]}}]}}"#
+            ))
+            .unwrap()
+        };
+        for z in [false, true] {
+            let p = program(z);
+            let a = crate::analysis::analyse(&p);
+            let plan = deps_plan::build(&p, &a, &config(2, Slicing::Contiguous));
+            let items = worker_items(&plan).unwrap();
+            let rungs = |w: usize| -> Vec<u32> {
+                (items[w].iter().flat_map(|it| it.tasks()))
+                    .flat_map(|t| plan.task_rungs[t.index()].iter().map(|r| r.0))
+                    .collect()
+            };
+            assert_eq!((rungs(0), rungs(1)), (vec![0, 2], vec![1, 3]));
+            // Every variable on one line.
+            let m = Machine::new(&p, Layout::dense(&p), &ExecConfig::default()).unwrap();
+            let x = m.layout().start(crate::model::VarId(2)).index();
+            let y = m.layout().start(crate::model::VarId(3)).index();
+            assert_eq!(x / LINE_BYTES as usize, y / LINE_BYTES as usize);
+            let got = check_ordered(&m, &plan);
+            if z {
+                let e = got.unwrap_err();
+                assert!(e.contains("both write the line of byte"), "{e}");
+            } else {
+                assert_eq!(got, Ok(()));
+            }
+        }
     }
 
     /// The items of the plan's parallel phase, mutable.
