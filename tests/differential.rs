@@ -16,10 +16,12 @@ use common::Recorder;
 
 use plc_deps::analysis::analyse;
 use plc_deps::exec::parallel::{
-    Candidate, DepsPartition, Measure, ParallelMachine, PlanConfig, PlanKind, Slicing, Strategy,
+    Candidate, DepsPartition, Measure, ParallelMachine, PlanConfig, PlanKind, ScanDriver, Slicing,
+    Strategy,
 };
-use plc_deps::exec::{ExecConfig, FaultKind, Machine};
+use plc_deps::exec::{ExecConfig, Fault, FaultKind, Machine};
 use plc_deps::model::{Program, Value, VarClass, VarId};
+use std::time::Duration;
 
 const PROGRAMS: u64 = 2000;
 const SCANS: u64 = 30;
@@ -67,6 +69,24 @@ struct Stats {
     exchange_cases: u64,
     /// Of those, cases whose plan runs some work before its phase's hand-over.
     early_cases: u64,
+    /// Cases whose `par-exchange` candidate has a layout of its own (the state moved between
+    /// two layouts).
+    own_layout_cases: u64,
+}
+
+/// A driver that writes the inputs and reads nothing back: the parallel executor may leave the
+/// caller's state behind while a plan runs on its own layout, and must bring it up to date by
+/// the end of the run.
+struct Blind<'a>(&'a [Vec<(VarId, Value)>]);
+
+impl ScanDriver for Blind<'_> {
+    fn before_scan(&mut self, m: &Machine, scan: u64, slots: &mut [u8]) {
+        m.set_inputs_in(slots, &self.0[scan as usize]);
+    }
+    fn after_scan(&mut self, _: &Machine, _: u64, _: &[u8], _: &[Fault], _: Duration) {}
+    fn wants_state(&self) -> bool {
+        false
+    }
 }
 
 /// Runs one program under one plan configuration and compares every scan.
@@ -135,6 +155,8 @@ fn check_with(
     stats.exchange_cases += on_private_states as u64;
     let early = &par.explain_json()["exchange"]["early_items"];
     stats.early_cases += (on_private_states && early.as_u64() > Some(0)) as u64;
+    let own_layout = !par.explain_json()["exchange"]["own_layout"].is_null();
+    stats.own_layout_cases += own_layout as u64;
     assert_eq!(
         rec.states.len() as u64,
         scans,
@@ -186,6 +208,47 @@ fn check_with(
             .iter()
             .filter(|f| f.kind == FaultKind::DivByZero)
             .count() as u64;
+    }
+    if own_layout {
+        // The same run for a driver that does not read the state: the same final state.
+        let mut blind = par.initial_state();
+        par.run(Some(pool), &mut blind, 0..scans, &mut Blind(inputs));
+        assert!(
+            blind.bytes() == s.bytes(),
+            "{label}: final state of a run whose driver does not read the state"
+        );
+        // Scans one at a time, two on `par-exchange` (its own layout) and one on the
+        // sequential walk (the common one), the state moved at every call.
+        let x = (par.candidates().iter())
+            .position(|c| matches!(c, Candidate::Exchange(_)))
+            .expect("an exchange candidate");
+        let walk = (par.candidates().iter())
+            .position(|c| *c == Candidate::Sequential)
+            .expect("the sequential walk among auto's candidates");
+        // Windows of 4 scans alternating between the two for a driver that does not read the
+        // state: the caller's state is brought up to date at the end of each.
+        let mut blind = par.initial_state();
+        for (k, first) in (0..scans).step_by(4).enumerate() {
+            let on = if k % 2 == 0 { x } else { walk };
+            let r = first..(first + 4).min(scans);
+            par.run_on(on, Some(pool), &mut blind, r, &mut Blind(inputs));
+        }
+        assert!(
+            blind.bytes() == s.bytes(),
+            "{label}: final state of windows alternating between the layouts"
+        );
+        let (mut a, mut b) = (par.initial_state(), seq.initial_state());
+        for scan in 0..scans {
+            let on = if scan % 3 == 2 { walk } else { x };
+            let (mut fa, mut fb) = (Vec::new(), Vec::new());
+            let input = &inputs[scan as usize];
+            par.scan_on(on, Some(pool), &mut a, scan, input, &mut fa);
+            seq.scan(&mut b, scan, input, &mut fb);
+            assert!(
+                a.bytes() == b.bytes() && fa == fb,
+                "{label}: scan {scan} on candidate {on}, one scan at a time"
+            );
+        }
     }
 }
 
@@ -450,13 +513,20 @@ fn every_plan_kind_with_up_to_eight_workers_equals_the_sequential_scan() {
         }
     }
     eprintln!(
-        "{} cases, {} mixing the sequential walk and a levelled plan, {} switches",
-        stats.cases, stats.mixed_runs, stats.switches
+        "{} cases, {} mixing the sequential walk and a levelled plan, {} switches, {} on private states ({} with an own layout)",
+        stats.cases, stats.mixed_runs, stats.switches, stats.exchange_cases, stats.own_layout_cases
     );
     assert!(
         stats.mixed_runs >= 100,
         "switching is exercised: {}",
         stats.mixed_runs
+    );
+    // `--plan auto` with several levelled candidates runs `par-exchange` on its own layout,
+    // the state moved between the layouts at every switch.
+    assert!(
+        stats.own_layout_cases >= 100,
+        "own layouts are exercised: {}",
+        stats.own_layout_cases
     );
 }
 

@@ -49,6 +49,7 @@ const PARALLEL: Order = &[
     &["machine", "xlines"],
     &["machine", "shared"],
     &["machine", "driver"],
+    &["machine", "relayout"],
     &["machine", "items"],
     &["machine", "exchange"],
     &["machine", "claimed"],

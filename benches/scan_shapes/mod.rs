@@ -96,6 +96,9 @@ struct Nothing;
 impl ScanDriver for Nothing {
     fn before_scan(&mut self, _: &Machine, _: u64, _: &mut [u8]) {}
     fn after_scan(&mut self, _: &Machine, _: u64, _: &[u8], _: &[Fault], _: Duration) {}
+    fn wants_state(&self) -> bool {
+        false
+    }
     fn wants_time(&self) -> bool {
         false
     }

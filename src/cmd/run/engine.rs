@@ -203,6 +203,10 @@ impl ScanDriver for Driver<'_> {
         }
         self.bar.inc();
     }
+
+    fn wants_state(&self) -> bool {
+        !matches!(self.digests, Digests::Skip) || self.trace.is_some()
+    }
 }
 
 /// Untimed warm-up scans before each timed pass.
@@ -217,6 +221,9 @@ impl ScanDriver for Inputs<'_> {
     }
     fn after_scan(&mut self, _: &Machine, _: u64, _: &[u8], _: &[Fault], _: Duration) {}
     fn wants_time(&self) -> bool {
+        false
+    }
+    fn wants_state(&self) -> bool {
         false
     }
 }

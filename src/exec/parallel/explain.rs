@@ -63,9 +63,18 @@ impl ParallelMachine {
                             Some(j) => format!("{}'s plan", self.names[j]),
                             None => "the levelled plan".to_string(),
                         };
+                        let layout = match &self.own[k] {
+                            Some(o) => format!(
+                                ", on a layout of its own ({} variable groups, {} bytes; {} runs of bytes move the state to and from the common layout)",
+                                o.groups,
+                                o.machine.state_size(),
+                                o.relayout.runs()
+                            ),
+                            None => String::new(),
+                        };
                         let _ = writeln!(
                             s,
-                            "  candidate {}: {of} with each worker on a private state, handing over {} words in {} lines per scan (BOOLs as bits; each line carries its scan's number); {} of {} items run before their phase's hand-over (they touch nothing the others wrote in the phase before)",
+                            "  candidate {}: {of} with each worker on a private state{layout}, handing over {} words in {} lines per scan (BOOLs as bits; each line carries its scan's number); {} of {} items run before their phase's hand-over (they touch nothing the others wrote in the phase before)",
                             self.names[i],
                             x.words(),
                             x.lines(),
@@ -325,12 +334,16 @@ impl ParallelMachine {
             "decision_slots": plan.decision_slots,
             "remote_lines": {"reads": plan.remote_lines().0, "writes": plan.remote_lines().1},
             "deps": self.deps_json(),
-            "exchange": self.exchanges.iter().flatten().next().map(|x| json!({
+            "exchange": self.exchanges.iter().zip(&self.own).find_map(|(x, o)| x.as_ref().map(|x| json!({
                 "words": x.words(),
                 "lines": x.lines(),
                 "early_items": x.early_items().0,
                 "items": x.early_items().1,
-            })),
+                "own_layout": o.as_ref().map(|o| json!({
+                    "layout_groups": o.groups,
+                    "state_bytes": o.machine.state_size(),
+                })),
+            }))),
             "levels": plan.levels.iter().map(|lp| json!({
                 "tasks": lp.tasks,
                 "cost": lp.cost,

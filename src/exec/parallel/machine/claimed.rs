@@ -165,7 +165,7 @@ impl ParallelMachine {
                 store.prefetch(lines);
             }
             for it in ph.items_of(slice) {
-                self.run_item(plan, it, store, ctx, sh);
+                self.run_item(&self.machine, plan, it, store, ctx, sh);
                 if !ctx.faults.is_empty() {
                     // SAFETY: only worker `w` touches its fault buffer during a scan; worker 0
                     // reads it after every unit of the scan is done.

@@ -26,6 +26,13 @@ pub trait ScanDriver {
     fn wants_time(&self) -> bool {
         true
     }
+    /// Whether `after_scan` reads the state. When false, the parallel executor may leave the
+    /// caller's state behind while a plan runs on a layout of its own (`slots` is then the
+    /// state as it was before those scans), and brings it up to date between windows and at
+    /// the end of the run.
+    fn wants_state(&self) -> bool {
+        true
+    }
 }
 
 /// Runs scans `scans` of the sequential interpreter on `state`, timing each one.

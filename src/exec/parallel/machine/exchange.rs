@@ -1,5 +1,6 @@
 //! A levelled plan's scans on private states (`par-exchange`): worker 0 runs its slices on the
-//! shared state (the driver's), every other worker on a copy of its own, and after each phase
+//! shared state (the driver's, or its own layout's copy of it: `relayout`), every other worker
+//! on a copy of its own, and after each phase
 //! each worker packs what it wrote (the plan's [`Exchange`] key: BOOLs as bits) into its lines
 //! of an exchange buffer; before the next phase every worker waits for the others' lines of the
 //! phase and unpacks them into its state. Worker 0 hands over the driver's inputs the same way
@@ -17,19 +18,33 @@
 //! by the same Release/Acquire pairs. It does not steal slices (a worker's private state holds
 //! only what it was handed), so its windows are short, as a dependence-driven plan's.
 
+use super::relayout::Relayout;
 use super::shared::{Shared, SharedSlots};
 use super::xlines::XBuffer;
 use super::{Buffers, ParallelMachine, ScanDriver, Timing};
 use crate::exec::parallel::planning::{Exchange, Item, Plan};
-use crate::exec::ScanCtx;
+use crate::exec::{Machine, ScanCtx};
 use std::time::Instant;
+
+/// What a `par-exchange` window runs: the plan's exchange, its lines, and the machine whose
+/// layout its states have (its own, or the common one).
+pub(super) type XRun<'s> = (&'s Exchange, &'s XBuffer, &'s Machine);
+
+/// Worker 0's side of a `par-exchange` window: the driver, which scans it times, and, when the
+/// plan runs on its own layout, the caller's state (common layout) and the moves between them.
+pub(super) struct Lead<'d, D: ScanDriver + ?Sized> {
+    pub(super) driver: &'d mut D,
+    pub(super) timing: Timing,
+    pub(super) times: &'d mut Vec<u64>,
+    pub(super) home: Option<(&'d Relayout, SharedSlots)>,
+}
 
 impl ParallelMachine {
     /// Waits for and unpacks every other worker's key of `phase` into `state`.
     fn take_phase(
         &self,
         w: usize,
-        (x, buf): (&Exchange, &XBuffer),
+        (x, buf, _): XRun<'_>,
         phase: usize,
         state: SharedSlots,
         seq: u64,
@@ -50,8 +65,10 @@ impl ParallelMachine {
 
     /// Runs item `it` of worker `w` and keeps its faults in the worker's buffer.
     #[inline]
+    #[allow(clippy::too_many_arguments)]
     fn run_exchange_item(
         &self,
+        m: &Machine,
         w: usize,
         plan: &Plan,
         it: &Item,
@@ -59,7 +76,7 @@ impl ParallelMachine {
         ctx: &mut ScanCtx<'_>,
         sh: &Shared<'_>,
     ) {
-        self.run_item(plan, it, store, ctx, sh);
+        self.run_item(m, plan, it, store, ctx, sh);
         if !ctx.faults.is_empty() {
             // SAFETY: only worker `w` touches its fault buffer during a scan; worker 0 reads it
             // after it has waited for every worker's last phase, and `w` does not start the
@@ -69,29 +86,41 @@ impl ParallelMachine {
         }
     }
 
-    /// Worker `w`'s part of `scans` on `plan` with exchange `x`, on `state` (worker 0: the
-    /// shared slots, and the driver); false if a worker panicked.
+    /// Worker `w`'s part of `scans` on `plan` with exchange `xr`, on `store` (worker 0: the
+    /// shared slots or its own layout's home, and the driver); false if a worker panicked.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn exchange_scans<D: ScanDriver + ?Sized>(
         &self,
         w: usize,
         plan: &Plan,
-        (x, buf): (&Exchange, &XBuffer),
+        xr: XRun<'_>,
         sh: &Shared<'_>,
         scans: std::ops::Range<u64>,
         mut store: SharedSlots,
-        mut driver: Option<(&mut D, Timing, &mut Vec<u64>)>,
+        mut lead: Option<Lead<'_, D>>,
         b: &mut Buffers,
     ) -> bool {
+        let (x, buf, m) = xr;
         let last = plan.phases.len() - 1;
+        let wants_state = lead.as_ref().is_some_and(|l| l.driver.wants_state());
         for scan in scans {
             let seq = scan + 1;
             let mut t0 = None;
-            if let Some((d, timing, _)) = driver.as_mut() {
-                // SAFETY: worker 0's state; the others read only the exchange lines.
+            if let Some(l) = lead.as_mut() {
+                // SAFETY: worker 0's states (the caller's and its own layout's); the others read
+                // only the exchange lines.
                 let slots = unsafe { store.bytes_mut() };
-                d.before_scan(&self.machine, scan, slots);
-                t0 = timing.wants(scan).then(Instant::now);
+                match l.home {
+                    Some((r, home)) => {
+                        // SAFETY: the caller's state, worker 0's alone during the window (the
+                        // others copied from the own layout's state, not this one).
+                        let common = unsafe { home.bytes_mut() };
+                        l.driver.before_scan(&self.machine, scan, common);
+                        r.inputs_to_own(common, slots);
+                    }
+                    None => l.driver.before_scan(&self.machine, scan, slots),
+                }
+                t0 = l.timing.wants(scan).then(Instant::now);
                 buf.pack(&x.inputs, slots, seq);
             } else {
                 if !buf.wait(&x.inputs, seq, &sh.barrier) {
@@ -100,41 +129,53 @@ impl ParallelMachine {
                 // SAFETY: as in `take_phase`.
                 buf.unpack(&x.inputs, unsafe { store.bytes_mut() }, seq);
             }
-            self.machine.begin_scan(&mut store);
-            let mut ctx = self.machine.context(scan, &mut b.scratch);
+            m.begin_scan(&mut store);
+            let mut ctx = m.context(scan, &mut b.scratch);
             for pi in 0..plan.phases.len() {
                 let split = x.split(pi, w);
                 buf.prefetch_write(x.key(pi, w), seq);
                 let (early, late) = split.items.split_at(split.early as usize);
                 for (i, it) in early.iter().enumerate() {
-                    self.run_exchange_item(w, plan, it, &mut store, &mut ctx, sh);
+                    self.run_exchange_item(m, w, plan, it, &mut store, &mut ctx, sh);
                     if split.prefetch_after == Some(i as u32 + 1) {
                         for o in (0..x.threads).filter(|&o| o != w) {
                             buf.prefetch_read(x.key(pi - 1, o), seq);
                         }
                     }
                 }
-                if pi > 0 && !self.take_phase(w, (x, buf), pi - 1, store, seq, sh) {
+                if pi > 0 && !self.take_phase(w, xr, pi - 1, store, seq, sh) {
                     return false;
                 }
                 for it in late {
-                    self.run_exchange_item(w, plan, it, &mut store, &mut ctx, sh);
+                    self.run_exchange_item(m, w, plan, it, &mut store, &mut ctx, sh);
                 }
                 // SAFETY: as in `take_phase`.
                 buf.pack(x.key(pi, w), unsafe { store.bytes_mut() }, seq);
             }
-            if !self.take_phase(w, (x, buf), last, store, seq, sh) {
+            if !self.take_phase(w, xr, last, store, seq, sh) {
                 return false;
             }
-            if let Some((d, _, times)) = driver.as_mut() {
+            if let Some(l) = lead.as_mut() {
                 let elapsed = t0.map(|t| t.elapsed()).unwrap_or_default();
                 if t0.is_some() {
-                    times.push(elapsed.as_nanos() as u64);
+                    l.times.push(elapsed.as_nanos() as u64);
                 }
                 let faults = self.merged_faults(sh, b);
-                // SAFETY: worker 0's state, as above.
-                let slots: &[u8] = unsafe { store.bytes_mut() };
-                d.after_scan(&self.machine, scan, slots, faults, elapsed);
+                // SAFETY: worker 0's states, as above.
+                let slots: &[u8] = unsafe { store.bytes() };
+                let slots = match l.home {
+                    Some((r, home)) => {
+                        // SAFETY: as before the scan.
+                        let common = unsafe { home.bytes_mut() };
+                        if wants_state {
+                            r.to_common(slots, common);
+                        }
+                        &*common
+                    }
+                    None => slots,
+                };
+                l.driver
+                    .after_scan(&self.machine, scan, slots, faults, elapsed);
             }
         }
         true

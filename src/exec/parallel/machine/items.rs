@@ -12,7 +12,7 @@ use super::shared::Shared;
 use super::{Buffers, ParallelMachine, SharedSlots};
 use crate::exec::parallel::ids::{Decision, Next};
 use crate::exec::parallel::planning::{Item, Plan, Region};
-use crate::exec::{Exit, Fault, ScanCtx};
+use crate::exec::{Exit, Fault, Machine, ScanCtx};
 use crate::model::RungId;
 
 impl ParallelMachine {
@@ -78,9 +78,12 @@ impl ParallelMachine {
         at
     }
 
+    /// Runs item `it` of `plan` on `store` with `m`'s lowered code (the common layout's machine,
+    /// or a `par-exchange` plan's own), and records where it left.
     #[inline]
     pub(super) fn run_item(
         &self,
+        m: &Machine,
         plan: &Plan,
         it: &Item,
         store: &mut SharedSlots,
@@ -94,12 +97,10 @@ impl ParallelMachine {
             return;
         };
         let exit = match it.region {
-            Region::Rungs(lo, hi) => self
-                .machine
-                .resume(store, ctx, at, |r| lo <= r.0 && r.0 < hi),
+            Region::Rungs(lo, hi) => m.resume(store, ctx, at, |r| lo <= r.0 && r.0 < hi),
             Region::Tasks(lo, hi) => {
                 let task_of = &plan.task_of_rung;
-                self.machine.resume(store, ctx, at, |r: RungId| {
+                m.resume(store, ctx, at, |r: RungId| {
                     task_of[r.index()].is_some_and(|t| lo <= t && t <= hi)
                 })
             }

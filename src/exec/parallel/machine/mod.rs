@@ -7,9 +7,11 @@
 //! plan on private states handing over packed writes (`exchange`).
 //!
 //! Invariants: worker 0 alone talks to the driver and the chooser, between barriers; every
-//! candidate works on the same state layout, so a switch between scans needs no copy (but the
-//! private states of `par-exchange`'s other workers, copied from the shared state when its
-//! window follows another candidate's); the
+//! candidate but `par-exchange` works on the same state layout, so a switch between them needs
+//! no copy. `par-exchange` runs on its plan's own layout when that differs (`relayout`): worker
+//! 0 moves the state into it when its window follows another candidate's, the other workers
+//! copy it into their private states, and worker 0 moves it back before another candidate's
+//! window, at the end of the run, and after every scan whose driver wants the state; the
 //! results are those of [`Machine::run_scan`], byte for byte and fault for fault, whichever
 //! candidates ran. It does not plan nor check plans (`planning`); it runs what
 //! [`ParallelMachine::new`] kept.
@@ -19,7 +21,7 @@
 //! `choice`): `pin` (workers pinned to CPUs), `backoff` (the one wait loop: spin, yield, park),
 //! `barrier`, `flags` (ready flags), `units` (claimed units, the window bell), `xlines`
 //! (exchange lines), `shared` (lock-free shared memory), `driver` (the per-scan callbacks and
-//! the sequential loop), `items` (one plan item on the shared state, the merged faults),
+//! the sequential loop), `relayout` (a state between the common layout and an own one), `items` (one plan item on the shared state, the merged faults),
 //! `exchange` (a levelled plan's scans on private states), `claimed` (a levelled plan's scans
 //! as units), this module. `items`, `exchange` and `claimed` are the second half of
 //! [`ParallelMachine`]'s implementation, so they use this module's types as this module uses
@@ -33,6 +35,7 @@ mod exchange;
 mod flags;
 mod items;
 mod pin;
+mod relayout;
 mod run_log;
 mod shared;
 mod units;
@@ -52,7 +55,9 @@ use crate::exec::parallel::planning::{bools_first, layout_groups, Plan};
 use crate::exec::parallel::planning::{check_plan, exchange_plan, find_remote_lines, Exchange};
 use crate::exec::{ExecConfig, Fault, Layout, LowerError, Machine, State, LINE_BYTES};
 use crate::model::{Program, VarId};
+use exchange::{Lead, XRun};
 use flags::ReadyFlags;
+use relayout::Relayout;
 use shared::{Decisions, FaultBuffer, Shared};
 use std::cell::UnsafeCell;
 use std::ops::Range;
@@ -69,6 +74,9 @@ pub struct ParallelMachine {
     pub(super) plans: Vec<Plan>,
     /// Per plan: its exchange, for the plan a `par-exchange` candidate runs.
     pub(super) exchanges: Vec<Option<Exchange>>,
+    /// Per plan: the own layout its `par-exchange` candidate runs on, when it differs from the
+    /// common one (the exchange is then planned on it).
+    pub(super) own: Vec<Option<OwnLayout>>,
     pub(super) candidates: Vec<Candidate>,
     pub(super) names: Vec<String>,
     pub(super) kind: PlanKind,
@@ -118,13 +126,25 @@ impl ParallelMachine {
             }
         }
         let mut exchanges: Vec<Option<Exchange>> = vec![None; plans.len()];
+        let mut own: Vec<Option<OwnLayout>> = plans.iter().map(|_| None).collect();
         let wants_exchange = matches!(config.kind, PlanKind::Auto | PlanKind::Exchange);
         let twin = plans
             .iter()
             .position(|p| p.sequential.is_none() && p.ready.is_none() && p.threads > 1);
         if let Some(i) = twin.filter(|_| wants_exchange) {
-            match exchange_plan(program, &machine, &plans[i]) {
-                Ok(x) => exchanges[i] = Some(x),
+            let others = plans
+                .iter()
+                .enumerate()
+                .any(|(k, p)| k != i && p.sequential.is_none());
+            let mine = others
+                .then(|| OwnLayout::new(program, exec, &machine, &plans[i]))
+                .flatten();
+            let on = mine.as_ref().map_or(&machine, |o| &o.machine);
+            match exchange_plan(program, on, &plans[i]) {
+                Ok(x) => {
+                    exchanges[i] = Some(x);
+                    own[i] = mine;
+                }
                 Err(why) if config.kind == PlanKind::Exchange => warnings.push(format!(
                     "the levelled plan cannot run on private states ({why}); running it on the shared state"
                 )),
@@ -164,6 +184,7 @@ impl ParallelMachine {
             machine,
             plans,
             exchanges,
+            own,
             candidates,
             names,
             kind: config.kind,
@@ -299,6 +320,19 @@ impl ParallelMachine {
         self.run_with(pool, state, scans, driver, None)
     }
 
+    /// Runs scans `scans` on candidate `candidate` alone (e.g. a segment of a [`RunLog`]), as
+    /// [`run`](Self::run) does.
+    pub fn run_on<D: ScanDriver + ?Sized>(
+        &self,
+        candidate: usize,
+        pool: Option<&rayon::ThreadPool>,
+        state: &mut State,
+        scans: Range<u64>,
+        driver: &mut D,
+    ) -> RunLog {
+        self.run_with(pool, state, scans, driver, Some(candidate))
+    }
+
     fn run_with<D: ScanDriver + ?Sized>(
         &self,
         pool: Option<&rayon::ThreadPool>,
@@ -379,6 +413,16 @@ impl ParallelMachine {
             .iter()
             .map(|x| x.as_ref().map(XBuffer::new))
             .collect();
+        // Worker 0's state in each own layout, for the run.
+        let mut homes: Vec<Option<State>> = (self.own.iter())
+            .map(|o| o.as_ref().map(|o| o.machine.initial_state()))
+            .collect();
+        let xhomes: Vec<Option<SharedSlots>> = (homes.iter_mut().zip(&self.own))
+            .map(|(s, o)| match (s, o) {
+                (Some(s), Some(o)) => Some(SharedSlots::new(s.bytes_mut(), &o.machine)),
+                _ => None,
+            })
+            .collect();
         let shared = Shared {
             slots: SharedSlots::new(state.bytes_mut(), &self.machine),
             decisions: &decisions,
@@ -388,6 +432,7 @@ impl ParallelMachine {
             units: &units,
             bell: &bell,
             xbufs: &xbufs,
+            xhomes: &xhomes,
         };
         let shared = &shared;
         let mut chooser = Chooser::new(allowed.len(), self.measure, scans.start);
@@ -476,6 +521,8 @@ impl ParallelMachine {
             let mut others_away = false;
             // The `par-exchange` plan whose private states are current (its window was last).
             let mut private_current: Option<usize> = None;
+            // The `par-exchange` plan on its own layout whose state the caller's lags behind.
+            let mut home_behind: Option<usize> = None;
             while scan < scans.end {
                 let mut win = chooser.next();
                 while others_away
@@ -486,6 +533,12 @@ impl ParallelMachine {
                     win = chooser.next();
                 }
                 let c = allowed[win.candidate];
+                if let Some(k) =
+                    home_behind.filter(|&k| self.candidates[c] != Candidate::Exchange(k))
+                {
+                    self.home_from_own(k, sh);
+                    home_behind = None;
+                }
                 let deps = self.waits_for_all(c);
                 // A dependence-driven or exchange window is short and timed whole: its waits
                 // cost a time slice each when another worker loses its core, so the chooser must
@@ -507,6 +560,13 @@ impl ParallelMachine {
                     }
                     Candidate::Exchange(i) => {
                         let copy = was_current != Some(i);
+                        let own = self.own[i].as_ref().zip(sh.xhomes[i]);
+                        if let Some((o, home)) = own.filter(|_| copy) {
+                            // SAFETY: the other workers wait for the bell (rung below): worker 0
+                            // alone touches the two states.
+                            let (from, to) = unsafe { (sh.slots.bytes(), home.bytes_mut()) };
+                            o.relayout.to_own(from, to);
+                        }
                         sh.bell.ring(WindowNote {
                             plan: i,
                             first: scan,
@@ -520,11 +580,20 @@ impl ParallelMachine {
                                 return;
                             }
                         }
-                        let d = Some((&mut *driver, timing, &mut times));
+                        if own.is_some() && !driver.wants_state() {
+                            home_behind = Some(i);
+                        }
+                        let lead = Lead {
+                            driver: &mut *driver,
+                            timing,
+                            times: &mut times,
+                            home: own.map(|(o, _)| (&o.relayout, sh.slots)),
+                        };
                         let x = self.exchange_of(i, sh);
                         let r = scan..scan + n;
-                        if !self.exchange_scans(0, &self.plans[i], x, sh, r, sh.slots, d, &mut bufs)
-                        {
+                        let store = own.map_or(sh.slots, |(_, home)| home);
+                        let b = &mut bufs;
+                        if !self.exchange_scans(0, &self.plans[i], x, sh, r, store, Some(lead), b) {
                             return;
                         }
                         private_current = Some(i);
@@ -572,6 +641,9 @@ impl ParallelMachine {
                 chooser.record(Window { scans: n, ..win }, &times);
                 scan += n;
             }
+            if let Some(k) = home_behind {
+                self.home_from_own(k, sh);
+            }
             sh.bell.ring(WindowNote {
                 plan: 0,
                 first: scan,
@@ -597,11 +669,23 @@ impl ParallelMachine {
         }
     }
 
-    /// Plan `i`'s exchange and its lines in this run.
-    fn exchange_of<'s>(&'s self, i: usize, sh: &'s Shared<'_>) -> (&'s Exchange, &'s XBuffer) {
+    /// Plan `i`'s exchange, its lines in this run, and the machine of its states' layout.
+    fn exchange_of<'s>(&'s self, i: usize, sh: &'s Shared<'_>) -> XRun<'s> {
+        let m = self.own[i].as_ref().map_or(&self.machine, |o| &o.machine);
         match (&self.exchanges[i], &sh.xbufs[i]) {
-            (Some(x), Some(b)) => (x, b),
+            (Some(x), Some(b)) => (x, b, m),
             _ => unreachable!("a par-exchange candidate has an exchange and its lines"),
+        }
+    }
+
+    /// Moves the state of plan `k`'s own layout back into the caller's (worker 0, between
+    /// windows).
+    fn home_from_own(&self, k: usize, sh: &Shared<'_>) {
+        if let (Some(o), Some(home)) = (&self.own[k], sh.xhomes[k]) {
+            // SAFETY: between windows: the other workers wait for the bell and touch neither
+            // state; worker 0 holds no other reference to them.
+            let (from, to) = unsafe { (home.bytes(), sh.slots.bytes_mut()) };
+            o.relayout.to_common(from, to);
         }
     }
 
@@ -627,17 +711,21 @@ impl ParallelMachine {
                 let scans = note.first..note.first + note.scans;
                 let ok = if let Some(copy) = note.exchange {
                     let x = self.exchange_of(note.plan, sh);
+                    let m = x.2;
                     let mut ok = sh.barrier.wait(w, &mut epoch);
-                    let state = private.get_or_insert_with(|| self.machine.initial_state());
+                    let size = m.state_size() as usize;
+                    let state = match &mut private {
+                        Some(s) if s.bytes().len() == size => s,
+                        p => p.insert(m.initial_state()),
+                    };
                     if ok && copy {
+                        let from = sh.xhomes[note.plan].unwrap_or(sh.slots);
                         // SAFETY: worker 0 waits at the barrier below and the other workers
-                        // only read: nobody writes the shared state meanwhile.
-                        state
-                            .bytes_mut()
-                            .copy_from_slice(unsafe { sh.slots.bytes() });
+                        // only read: nobody writes worker 0's state meanwhile.
+                        state.bytes_mut().copy_from_slice(unsafe { from.bytes() });
                         ok = sh.barrier.wait(w, &mut epoch);
                     }
-                    let store = SharedSlots::new(state.bytes_mut(), &self.machine);
+                    let store = SharedSlots::new(state.bytes_mut(), m);
                     ok && self
                         .exchange_scans::<NoDriver>(w, plan, x, sh, scans, store, None, &mut bufs)
                 } else if plan.ready.is_some() {
@@ -729,7 +817,7 @@ impl ParallelMachine {
                             return false;
                         }
                     }
-                    self.run_item(plan, it, &mut store, &mut ctx, sh);
+                    self.run_item(&self.machine, plan, it, &mut store, &mut ctx, sh);
                     if it.publish {
                         sh.ready.publish(w, *epoch, i as u32 + 1);
                     }
@@ -795,4 +883,35 @@ struct NoDriver;
 impl ScanDriver for NoDriver {
     fn before_scan(&mut self, _: &Machine, _: u64, _: &mut [u8]) {}
     fn after_scan(&mut self, _: &Machine, _: u64, _: &[u8], _: &[Fault], _: Duration) {}
+}
+
+/// A `par-exchange` plan's own layout: the plan's writer groups alone, its machine, and the
+/// moves between it and the common layout.
+#[derive(Debug)]
+pub(super) struct OwnLayout {
+    pub(super) machine: Machine,
+    pub(super) relayout: Relayout,
+    /// Padding groups of the layout (for `--explain`).
+    pub(super) groups: usize,
+}
+
+impl OwnLayout {
+    /// The layout of `plan`'s writers alone; `None` if it cannot be built or the plan fails its
+    /// check on it (the plan then runs on the common layout).
+    fn new(
+        program: &Program,
+        exec: &ExecConfig,
+        common: &Machine,
+        plan: &Plan,
+    ) -> Option<OwnLayout> {
+        let groups = bools_first(program, layout_groups(&[plan], program.vars.len()));
+        let layout = Layout::from_groups(program, &groups, LINE_BYTES).ok()?;
+        let machine = Machine::new(program, layout, exec).ok()?;
+        check_plan(&machine, plan).ok()?;
+        Some(OwnLayout {
+            relayout: Relayout::new(common, &machine),
+            machine,
+            groups: groups.len(),
+        })
+    }
 }

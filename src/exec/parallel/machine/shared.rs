@@ -167,6 +167,9 @@ pub(super) struct Shared<'a> {
     pub(super) bell: &'a WindowBell,
     /// Per plan: the exchange lines of its `par-exchange` candidate.
     pub(super) xbufs: &'a [Option<super::xlines::XBuffer>],
+    /// Per plan: worker 0's state in its `par-exchange` candidate's own layout, if it has one
+    /// (the other workers copy it into their private states when a window starts).
+    pub(super) xhomes: &'a [Option<SharedSlots>],
 }
 
 // SAFETY: the fault buffers are each used by one worker during a scan and by worker 0 between
