@@ -180,4 +180,15 @@ impl ParallelMachine {
         }
         true
     }
+
+    /// Moves the state of plan `k`'s own layout back into the caller's (worker 0, between
+    /// windows).
+    pub(super) fn home_from_own(&self, k: usize, sh: &Shared<'_>) {
+        if let (Some(o), Some(home)) = (&self.own[k], sh.xhomes[k]) {
+            // SAFETY: between windows: the other workers wait for the bell and touch neither
+            // state; worker 0 holds no other reference to them.
+            let (from, to) = unsafe { (home.bytes(), sh.slots.bytes_mut()) };
+            o.relayout.to_common(from, to);
+        }
+    }
 }

@@ -21,7 +21,9 @@
 //! `choice`): `pin` (workers pinned to CPUs), `backoff` (the one wait loop: spin, yield, park),
 //! `barrier`, `flags` (ready flags), `units` (claimed units, the window bell), `xlines`
 //! (exchange lines), `shared` (lock-free shared memory), `driver` (the per-scan callbacks and
-//! the sequential loop), `relayout` (a state between the common layout and an own one), `items` (one plan item on the shared state, the merged faults),
+//! the sequential loop), `relayout` (a `par-exchange` plan's own layout, and a state moved
+//! between it and the common one), `items` (one plan item on the shared state, the merged
+//! faults),
 //! `exchange` (a levelled plan's scans on private states), `claimed` (a levelled plan's scans
 //! as units), this module. `items`, `exchange` and `claimed` are the second half of
 //! [`ParallelMachine`]'s implementation, so they use this module's types as this module uses
@@ -57,7 +59,7 @@ use crate::exec::{ExecConfig, Fault, Layout, LowerError, Machine, State, LINE_BY
 use crate::model::{Program, VarId};
 use exchange::{Lead, XRun};
 use flags::ReadyFlags;
-use relayout::Relayout;
+use relayout::OwnLayout;
 use shared::{Decisions, FaultBuffer, Shared};
 use std::cell::UnsafeCell;
 use std::ops::Range;
@@ -678,17 +680,6 @@ impl ParallelMachine {
         }
     }
 
-    /// Moves the state of plan `k`'s own layout back into the caller's (worker 0, between
-    /// windows).
-    fn home_from_own(&self, k: usize, sh: &Shared<'_>) {
-        if let (Some(o), Some(home)) = (&self.own[k], sh.xhomes[k]) {
-            // SAFETY: between windows: the other workers wait for the bell and touch neither
-            // state; worker 0 holds no other reference to them.
-            let (from, to) = unsafe { (home.bytes(), sh.slots.bytes_mut()) };
-            o.relayout.to_common(from, to);
-        }
-    }
-
     /// Workers 1..: wait for a window, run their part of it, until the run is over.
     fn follower(&self, w: usize, sh: &Shared<'_>) {
         let body = std::panic::AssertUnwindSafe(|| {
@@ -883,35 +874,4 @@ struct NoDriver;
 impl ScanDriver for NoDriver {
     fn before_scan(&mut self, _: &Machine, _: u64, _: &mut [u8]) {}
     fn after_scan(&mut self, _: &Machine, _: u64, _: &[u8], _: &[Fault], _: Duration) {}
-}
-
-/// A `par-exchange` plan's own layout: the plan's writer groups alone, its machine, and the
-/// moves between it and the common layout.
-#[derive(Debug)]
-pub(super) struct OwnLayout {
-    pub(super) machine: Machine,
-    pub(super) relayout: Relayout,
-    /// Padding groups of the layout (for `--explain`).
-    pub(super) groups: usize,
-}
-
-impl OwnLayout {
-    /// The layout of `plan`'s writers alone; `None` if it cannot be built or the plan fails its
-    /// check on it (the plan then runs on the common layout).
-    fn new(
-        program: &Program,
-        exec: &ExecConfig,
-        common: &Machine,
-        plan: &Plan,
-    ) -> Option<OwnLayout> {
-        let groups = bools_first(program, layout_groups(&[plan], program.vars.len()));
-        let layout = Layout::from_groups(program, &groups, LINE_BYTES).ok()?;
-        let machine = Machine::new(program, layout, exec).ok()?;
-        check_plan(&machine, plan).ok()?;
-        Some(OwnLayout {
-            relayout: Relayout::new(common, &machine),
-            machine,
-            groups: groups.len(),
-        })
-    }
 }

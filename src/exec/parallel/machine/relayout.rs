@@ -11,9 +11,13 @@
 //! counters), consecutive values that are consecutive in both layouts merged into one run; and
 //! the inputs alone, which the caller writes into the common layout before each scan.
 //! Constants and padding are not moved (each layout's machine puts its own constants into its
-//! initial state; padding is never read). It does not run anything.
+//! initial state; padding is never read). An [`OwnLayout`] is such a layout with its machine:
+//! the plan's writer groups alone, lowered once more, the plan checked on it. It does not run
+//! anything.
 
-use crate::exec::{Addr, Machine};
+use crate::exec::parallel::planning::{bools_first, check_plan, layout_groups, Plan};
+use crate::exec::{Addr, ExecConfig, Layout, Machine, LINE_BYTES};
+use crate::model::Program;
 
 /// Runs of bytes between two layouts of one program's state.
 #[derive(Clone, Debug)]
@@ -79,6 +83,37 @@ fn copy(runs: &[(u32, u32, u32)], src: &[u8], dst: &mut [u8], back: bool) {
         let (from, to) = if back { (o, c) } else { (c, o) };
         let (from, to, n) = (from as usize, to as usize, n as usize);
         dst[to..to + n].copy_from_slice(&src[from..from + n]);
+    }
+}
+
+/// A `par-exchange` plan's own layout: the plan's writer groups alone, its machine, and the
+/// moves between it and the common layout.
+#[derive(Debug)]
+pub(in crate::exec::parallel) struct OwnLayout {
+    pub(in crate::exec::parallel) machine: Machine,
+    pub(in crate::exec::parallel) relayout: Relayout,
+    /// Padding groups of the layout (for `--explain`).
+    pub(in crate::exec::parallel) groups: usize,
+}
+
+impl OwnLayout {
+    /// The layout of `plan`'s writers alone; `None` if it cannot be built or the plan fails its
+    /// check on it (the plan then runs on the common layout).
+    pub(super) fn new(
+        program: &Program,
+        exec: &ExecConfig,
+        common: &Machine,
+        plan: &Plan,
+    ) -> Option<OwnLayout> {
+        let groups = bools_first(program, layout_groups(&[plan], program.vars.len()));
+        let layout = Layout::from_groups(program, &groups, LINE_BYTES).ok()?;
+        let machine = Machine::new(program, layout, exec).ok()?;
+        check_plan(&machine, plan).ok()?;
+        Some(OwnLayout {
+            relayout: Relayout::new(common, &machine),
+            machine,
+            groups: groups.len(),
+        })
     }
 }
 
