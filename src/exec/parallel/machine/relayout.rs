@@ -120,7 +120,6 @@ impl OwnLayout {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::exec::{ExecConfig, Layout, LINE_BYTES};
     use crate::model::VarId;
 
     /// A state moved to a padded layout and back is the state it was, value for value, and the
