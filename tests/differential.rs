@@ -74,6 +74,34 @@ struct Stats {
     own_layout_cases: u64,
 }
 
+/// A driver that reads the state only through the machine it is given, in whichever layout:
+/// records every scan's canonical values and faults.
+struct Canonical<'a> {
+    inputs: &'a [Vec<(VarId, Value)>],
+    values: Vec<Vec<u8>>,
+    faults: Vec<Vec<Fault>>,
+}
+
+/// The bytes of `m`'s canonical values in `slots` (a state of `m`'s layout), in order.
+fn canonical_bytes(m: &Machine, slots: &[u8]) -> Vec<u8> {
+    (m.canonical_values().iter())
+        .flat_map(|&(at, w)| slots[at.index()..at.index() + w as usize].iter().copied())
+        .collect()
+}
+
+impl ScanDriver for Canonical<'_> {
+    fn before_scan(&mut self, m: &Machine, scan: u64, slots: &mut [u8]) {
+        m.set_inputs_in(slots, &self.inputs[scan as usize]);
+    }
+    fn after_scan(&mut self, m: &Machine, _: u64, slots: &[u8], faults: &[Fault], _: Duration) {
+        self.values.push(canonical_bytes(m, slots));
+        self.faults.push(faults.to_vec());
+    }
+    fn reads_any_layout(&self) -> bool {
+        true
+    }
+}
+
 /// A driver that writes the inputs and reads nothing back: the parallel executor may leave the
 /// caller's state behind while a plan runs on its own layout, and must bring it up to date by
 /// the end of the run.
@@ -226,17 +254,45 @@ fn check_with(
             .position(|c| *c == Candidate::Sequential)
             .expect("the sequential walk among auto's candidates");
         // Windows of 4 scans alternating between the two for a driver that does not read the
-        // state: the caller's state is brought up to date at the end of each.
+        // state (the caller's state is brought up to date at the end of each), and for one that
+        // reads any layout (it sees the own one, value for value the sequential walk's).
         let mut blind = par.initial_state();
+        let mut direct = par.initial_state();
+        let mut canon = Canonical {
+            inputs,
+            values: Vec::new(),
+            faults: Vec::new(),
+        };
         for (k, first) in (0..scans).step_by(4).enumerate() {
             let on = if k % 2 == 0 { x } else { walk };
             let r = first..(first + 4).min(scans);
-            par.run_on(on, Some(pool), &mut blind, r, &mut Blind(inputs));
+            par.run_on(on, Some(pool), &mut blind, r.clone(), &mut Blind(inputs));
+            par.run_on(on, Some(pool), &mut direct, r, &mut canon);
         }
         assert!(
-            blind.bytes() == s.bytes(),
+            blind.bytes() == s.bytes() && direct.bytes() == s.bytes(),
             "{label}: final state of windows alternating between the layouts"
         );
+        let mut auto = par.initial_state();
+        let mut canon_auto = Canonical {
+            inputs,
+            values: Vec::new(),
+            faults: Vec::new(),
+        };
+        par.run(Some(pool), &mut auto, 0..scans, &mut canon_auto);
+        assert!(
+            auto.bytes() == s.bytes(),
+            "{label}: final state, any layout"
+        );
+        for (scan, state) in rec.states.iter().enumerate() {
+            let want = canonical_bytes(par.machine(), state);
+            for (what, c) in [("windows", &canon), ("auto", &canon_auto)] {
+                assert!(
+                    c.values[scan] == want && c.faults[scan] == rec.faults[scan],
+                    "{label}: scan {scan} seen by a driver that reads any layout ({what})"
+                );
+            }
+        }
         let (mut a, mut b) = (par.initial_state(), seq.initial_state());
         for scan in 0..scans {
             let on = if scan % 3 == 2 { walk } else { x };

@@ -114,7 +114,11 @@ enum Digests {
 /// Per-scan bookkeeping shared by both modes.
 struct Driver<'a> {
     inputs: &'a InputTable,
+    /// The canonical values' addresses in the layout of the machine last seen (its address), and
+    /// in the other one seen (a parallel plan on a layout of its own): computed once each.
     canon: Vec<(Addr, u32)>,
+    canon_of: usize,
+    canon_other: Option<(usize, Vec<(Addr, u32)>)>,
     digests: Digests,
     first_mismatch: Option<u64>,
     total: Duration,
@@ -139,6 +143,8 @@ impl<'a> Driver<'a> {
                 Digests::Skip => Vec::new(),
                 _ => canonical_slots(m),
             },
+            canon_of: std::ptr::from_ref(m) as usize,
+            canon_other: None,
             digests,
             first_mismatch: None,
             total: Duration::ZERO,
@@ -165,6 +171,16 @@ impl ScanDriver for Driver<'_> {
         elapsed: Duration,
     ) {
         self.total += elapsed;
+        let of = std::ptr::from_ref(m) as usize;
+        if of != self.canon_of && !matches!(self.digests, Digests::Skip) {
+            let other = match self.canon_other.take() {
+                Some((o, c)) if o == of => c,
+                _ => canonical_slots(m),
+            };
+            let last = std::mem::replace(&mut self.canon, other);
+            self.canon_other = Some((self.canon_of, last));
+            self.canon_of = of;
+        }
         match &mut self.digests {
             Digests::Skip => {}
             Digests::Record(ds) => ds.push(digest(slots, &self.canon, faults)),
@@ -207,6 +223,12 @@ impl ScanDriver for Driver<'_> {
     fn wants_state(&self) -> bool {
         !matches!(self.digests, Digests::Skip) || self.trace.is_some()
     }
+
+    /// The digests read the state through the machine's canonical values (any layout); the
+    /// trace's columns are addresses of the first machine's layout.
+    fn reads_any_layout(&self) -> bool {
+        self.trace.is_none()
+    }
 }
 
 /// Untimed warm-up scans before each timed pass.
@@ -225,6 +247,9 @@ impl ScanDriver for Inputs<'_> {
     }
     fn wants_state(&self) -> bool {
         false
+    }
+    fn reads_any_layout(&self) -> bool {
+        true
     }
 }
 

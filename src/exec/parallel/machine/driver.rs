@@ -33,6 +33,13 @@ pub trait ScanDriver {
     fn wants_state(&self) -> bool {
         true
     }
+    /// Whether the driver reads and writes the state only through the [`Machine`] it is given
+    /// (its layout: `set_inputs_in`, `canonical_values`, `addr_of`), whichever machine that is.
+    /// The parallel executor then hands it a plan's own layout's machine and state directly,
+    /// instead of moving the state into the caller's layout around every scan.
+    fn reads_any_layout(&self) -> bool {
+        false
+    }
 }
 
 /// Runs scans `scans` of the sequential interpreter on `state`, timing each one.

@@ -31,7 +31,9 @@ use std::time::Instant;
 pub(super) type XRun<'s> = (&'s Exchange, &'s XBuffer, &'s Machine);
 
 /// Worker 0's side of a `par-exchange` window: the driver, which scans it times, and, when the
-/// plan runs on its own layout, the caller's state (common layout) and the moves between them.
+/// plan runs on its own layout and the driver reads only the caller's layout, the caller's state
+/// and the moves between them (a driver that reads any layout is given the own layout's machine
+/// and state).
 pub(super) struct Lead<'d, D: ScanDriver + ?Sized> {
     pub(super) driver: &'d mut D,
     pub(super) timing: Timing,
@@ -118,7 +120,7 @@ impl ParallelMachine {
                         l.driver.before_scan(&self.machine, scan, common);
                         r.inputs_to_own(common, slots);
                     }
-                    None => l.driver.before_scan(&self.machine, scan, slots),
+                    None => l.driver.before_scan(m, scan, slots),
                 }
                 t0 = l.timing.wants(scan).then(Instant::now);
                 buf.pack(&x.inputs, slots, seq);
@@ -163,19 +165,18 @@ impl ParallelMachine {
                 let faults = self.merged_faults(sh, b);
                 // SAFETY: worker 0's states, as above.
                 let slots: &[u8] = unsafe { store.bytes() };
-                let slots = match l.home {
+                let (m, slots) = match l.home {
                     Some((r, home)) => {
                         // SAFETY: as before the scan.
                         let common = unsafe { home.bytes_mut() };
                         if wants_state {
                             r.to_common(slots, common);
                         }
-                        &*common
+                        (&self.machine, &*common)
                     }
-                    None => slots,
+                    None => (m, slots),
                 };
-                l.driver
-                    .after_scan(&self.machine, scan, slots, faults, elapsed);
+                l.driver.after_scan(m, scan, slots, faults, elapsed);
             }
         }
         true

@@ -582,14 +582,19 @@ impl ParallelMachine {
                                 return;
                             }
                         }
-                        if own.is_some() && !driver.wants_state() {
+                        // A driver that reads any layout sees the own one; otherwise the caller's
+                        // state is kept up to date after every scan if the driver reads it.
+                        let direct = driver.reads_any_layout();
+                        if own.is_some() && (direct || !driver.wants_state()) {
                             home_behind = Some(i);
                         }
                         let lead = Lead {
                             driver: &mut *driver,
                             timing,
                             times: &mut times,
-                            home: own.map(|(o, _)| (&o.relayout, sh.slots)),
+                            home: own
+                                .filter(|_| !direct)
+                                .map(|(o, _)| (&o.relayout, sh.slots)),
                         };
                         let x = self.exchange_of(i, sh);
                         let r = scan..scan + n;
