@@ -5,10 +5,10 @@
 //! `crate::exec::parallel::…` / `crate::cmd::run::…` path outside comments and test modules is
 //! resolved to the module it names, and must name one that comes earlier in the order.
 //!
-//! One exception, named here: `machine::items`, `machine::exchange` and `machine::claimed` are
-//! the second half of `ParallelMachine`'s implementation (one plan item; the levelled plan on
-//! private states; the levelled plan's units), so they use their parent's types as the parent
-//! uses their functions.
+//! One exception, named here: `machine::items`, `machine::exchange`, `machine::claimed` and
+//! `machine::workers` are the second half of `ParallelMachine`'s implementation (one plan item;
+//! the levelled plan on private states; the levelled plan's units; the workers' loops), so they
+//! use their parent's types as the parent uses their functions.
 
 use std::path::Path;
 
@@ -53,6 +53,7 @@ const PARALLEL: Order = &[
     &["machine", "items"],
     &["machine", "exchange"],
     &["machine", "claimed"],
+    &["machine", "workers"],
     &["machine"],
     &["explain"],
     &[],
@@ -176,7 +177,8 @@ fn upward_uses(root: &Path, order: Order, absolute: &str) -> Vec<String> {
             let own_parent = m.len() == order[used].len() + 1 && m.starts_with(order[used]);
             let exception = (*m == ["machine", "claimed"]
                 || *m == ["machine", "items"]
-                || *m == ["machine", "exchange"])
+                || *m == ["machine", "exchange"]
+                || *m == ["machine", "workers"])
                 && order[used] == ["machine"];
             if used == pos || exception {
                 continue;

@@ -1,0 +1,369 @@
+//! The workers' loops of a run: worker 0 (the calling thread) asks the measured choice which
+//! candidate runs the next window of scans, runs sequential windows alone and parallel windows
+//! with the others (announced on the window bell), and moves the state between the common
+//! layout and `par-exchange`'s own one around its windows; workers 1.. wait for a window and
+//! run their part of it, until the run is over. The top of the running side: it uses `items`,
+//! `exchange` and `claimed` for the scans themselves, and `mod` uses it for `run`.
+
+use super::claimed;
+use super::exchange::{Lead, XRun};
+use super::shared::{Shared, SharedSlots};
+use super::units::WindowNote;
+use super::{Buffers, Candidate, NoDriver, ParallelMachine, RunLog, ScanDriver, Timing};
+use crate::exec::parallel::choice::{Chooser, Window};
+use crate::exec::parallel::planning::Plan;
+use crate::exec::State;
+use std::ops::Range;
+use std::time::Instant;
+
+/// Scans at most per window of a dependence-driven plan.
+const DEPS_WINDOW: u64 = 4;
+
+impl ParallelMachine {
+    /// Worker 0: chooses, runs sequential windows alone and parallel windows with the others
+    /// (announced on the bell: a levelled plan's scans as claimed units, a dependence-driven
+    /// plan's behind the barrier), then tells them the run is over.
+    pub(super) fn leader<D: ScanDriver + ?Sized>(
+        &self,
+        sh: &Shared<'_>,
+        scans: Range<u64>,
+        driver: &mut D,
+        chooser: &mut Chooser,
+        allowed: &[usize],
+        log: &mut RunLog,
+    ) {
+        let body = std::panic::AssertUnwindSafe(|| {
+            sh.barrier.register(0);
+            let mut epoch = 0u64;
+            let mut base = 0u64;
+            let mut times: Vec<u64> = Vec::new();
+            let mut bufs = Buffers::default();
+            let mut scan = scans.start;
+            // Whether the last levelled window ran most of the other workers' slices itself
+            // (they were not on a core): a dependence-driven plan, which must wait for them,
+            // is then not worth measuring.
+            let mut others_away = false;
+            // The `par-exchange` plan whose private states are current (its window was last).
+            let mut private_current: Option<usize> = None;
+            // The `par-exchange` plan on its own layout whose state the caller's lags behind.
+            let mut home_behind: Option<usize> = None;
+            while scan < scans.end {
+                let mut win = chooser.next();
+                while others_away
+                    && chooser.measuring_other()
+                    && self.waits_for_all(allowed[win.candidate])
+                {
+                    chooser.skip();
+                    win = chooser.next();
+                }
+                let c = allowed[win.candidate];
+                if let Some(k) =
+                    home_behind.filter(|&k| self.candidates[c] != Candidate::Exchange(k))
+                {
+                    self.home_from_own(k, sh);
+                    home_behind = None;
+                }
+                let deps = self.waits_for_all(c);
+                // A dependence-driven or exchange window is short and timed whole: its waits
+                // cost a time slice each when another worker loses its core, so the chooser must
+                // see that within a few scans (it cannot take the other worker's items, as
+                // units can).
+                let cap = if deps { DEPS_WINDOW } else { u64::MAX };
+                let n = win.scans.min(scans.end - scan).min(cap);
+                log.scans_on[c] += n;
+                log.push_segment(scan, c);
+                times.clear();
+                let timing = Timing {
+                    all: win.timed || deps || driver.wants_time(),
+                    every: self.measure.sample_every.max(1),
+                };
+                let was_current = std::mem::take(&mut private_current);
+                match self.candidates[c] {
+                    Candidate::Sequential => {
+                        self.sequential_window(sh, scan..scan + n, driver, timing, &mut times)
+                    }
+                    Candidate::Exchange(i) => {
+                        let copy = was_current != Some(i);
+                        let own = self.own[i].as_ref().zip(sh.xhomes[i]);
+                        if let Some((o, home)) = own.filter(|_| copy) {
+                            // SAFETY: the other workers wait for the bell (rung below): worker 0
+                            // alone touches the two states.
+                            let (from, to) = unsafe { (sh.slots.bytes(), home.bytes_mut()) };
+                            o.relayout.to_own(from, to);
+                        }
+                        sh.bell.ring(WindowNote {
+                            plan: i,
+                            first: scan,
+                            scans: n,
+                            base,
+                            exchange: Some(copy),
+                        });
+                        // The followers copy the shared state between the two barriers.
+                        for _ in 0..1 + copy as usize {
+                            if !sh.barrier.wait(0, &mut epoch) {
+                                return;
+                            }
+                        }
+                        // A driver that reads any layout sees the own one; otherwise the caller's
+                        // state is kept up to date after every scan if the driver reads it.
+                        let direct = driver.reads_any_layout();
+                        if own.is_some() && (direct || !driver.wants_state()) {
+                            home_behind = Some(i);
+                        }
+                        let lead = Lead {
+                            driver: &mut *driver,
+                            timing,
+                            times: &mut times,
+                            home: own
+                                .filter(|_| !direct)
+                                .map(|(o, _)| (&o.relayout, sh.slots)),
+                        };
+                        let x = self.exchange_of(i, sh);
+                        let r = scan..scan + n;
+                        let store = own.map_or(sh.slots, |(_, home)| home);
+                        let b = &mut bufs;
+                        if !self.exchange_scans(0, &self.plans[i], x, sh, r, store, Some(lead), b) {
+                            return;
+                        }
+                        private_current = Some(i);
+                    }
+                    Candidate::Levelled(i) => {
+                        let plan = &self.plans[i];
+                        sh.bell.ring(WindowNote {
+                            plan: i,
+                            first: scan,
+                            scans: n,
+                            base,
+                            exchange: None,
+                        });
+                        if plan.ready.is_some() {
+                            if !sh.barrier.wait(0, &mut epoch) {
+                                return;
+                            }
+                            let d = Some((&mut *driver, timing, &mut times));
+                            if !self.plan_scans(
+                                0,
+                                plan,
+                                sh,
+                                scan..scan + n,
+                                &mut epoch,
+                                d,
+                                &mut bufs,
+                            ) {
+                                return;
+                            }
+                        } else {
+                            let r = scan..scan + n;
+                            let b = &mut bufs;
+                            let Some(taken) =
+                                self.leader_units(plan, sh, base, r, driver, timing, &mut times, b)
+                            else {
+                                return;
+                            };
+                            let others =
+                                n * (plan.threads as u64 - 1) * plan.parallel_phases() as u64;
+                            others_away = others > 0 && taken * 2 > others;
+                            base += n * claimed::unit_layout(plan).1 as u64;
+                        }
+                    }
+                }
+                chooser.record(Window { scans: n, ..win }, &times);
+                scan += n;
+            }
+            if let Some(k) = home_behind {
+                self.home_from_own(k, sh);
+            }
+            sh.bell.ring(WindowNote {
+                plan: 0,
+                first: scan,
+                scans: 0,
+                base,
+                exchange: None,
+            });
+        });
+        if let Err(panic) = std::panic::catch_unwind(body) {
+            sh.barrier.poison();
+            std::panic::resume_unwind(panic);
+        }
+    }
+
+    /// Whether candidate `c` needs every worker on a core at every phase: a dependence-driven
+    /// plan, or a levelled plan on private states (neither can give a late worker's items to
+    /// another).
+    fn waits_for_all(&self, c: usize) -> bool {
+        match self.candidates[c] {
+            Candidate::Levelled(i) => self.plans[i].ready.is_some(),
+            Candidate::Exchange(_) => true,
+            Candidate::Sequential => false,
+        }
+    }
+
+    /// Plan `i`'s exchange, its lines in this run, and the machine of its states' layout.
+    fn exchange_of<'s>(&'s self, i: usize, sh: &'s Shared<'_>) -> XRun<'s> {
+        let m = self.own[i].as_ref().map_or(&self.machine, |o| &o.machine);
+        match (&self.exchanges[i], &sh.xbufs[i]) {
+            (Some(x), Some(b)) => (x, b, m),
+            _ => unreachable!("a par-exchange candidate has an exchange and its lines"),
+        }
+    }
+
+    /// Workers 1..: wait for a window, run their part of it, until the run is over.
+    pub(super) fn follower(&self, w: usize, sh: &Shared<'_>) {
+        let body = std::panic::AssertUnwindSafe(|| {
+            sh.barrier.register(w);
+            sh.bell.register(w);
+            let mut epoch = 0u64;
+            let mut bufs = Buffers::default();
+            // This worker's state in `par-exchange` windows.
+            let mut private: Option<State> = None;
+            let mut k = 1;
+            loop {
+                let Some((got, note)) = sh.bell.wait(w, k, &sh.barrier) else {
+                    return;
+                };
+                k = got + 1;
+                if note.scans == 0 {
+                    return;
+                }
+                let plan = &self.plans[note.plan];
+                let scans = note.first..note.first + note.scans;
+                let ok = if let Some(copy) = note.exchange {
+                    let x = self.exchange_of(note.plan, sh);
+                    let m = x.2;
+                    let mut ok = sh.barrier.wait(w, &mut epoch);
+                    let size = m.state_size() as usize;
+                    let state = match &mut private {
+                        Some(s) if s.bytes().len() == size => s,
+                        p => p.insert(m.initial_state()),
+                    };
+                    if ok && copy {
+                        let from = sh.xhomes[note.plan].unwrap_or(sh.slots);
+                        // SAFETY: worker 0 waits at the barrier below and the other workers
+                        // only read: nobody writes worker 0's state meanwhile.
+                        state.bytes_mut().copy_from_slice(unsafe { from.bytes() });
+                        ok = sh.barrier.wait(w, &mut epoch);
+                    }
+                    let store = SharedSlots::new(state.bytes_mut(), m);
+                    ok && self
+                        .exchange_scans::<NoDriver>(w, plan, x, sh, scans, store, None, &mut bufs)
+                } else if plan.ready.is_some() {
+                    sh.barrier.wait(w, &mut epoch)
+                        && self
+                            .plan_scans::<NoDriver>(w, plan, sh, scans, &mut epoch, None, &mut bufs)
+                } else {
+                    self.follower_units(w, plan, sh, got, note, &mut bufs)
+                };
+                if !ok {
+                    return;
+                }
+            }
+        });
+        if let Err(panic) = std::panic::catch_unwind(body) {
+            sh.barrier.poison();
+            std::panic::resume_unwind(panic);
+        }
+    }
+
+    /// Worker 0 alone runs `scans` as the sequential walk on the shared slots.
+    fn sequential_window<D: ScanDriver + ?Sized>(
+        &self,
+        sh: &Shared<'_>,
+        scans: Range<u64>,
+        driver: &mut D,
+        timing: Timing,
+        times: &mut Vec<u64>,
+    ) {
+        // SAFETY: the other workers wait at the window barrier (or have not started) and touch
+        // no slot until worker 0 reaches it: worker 0 has the slots to itself for this window.
+        let slots = unsafe { sh.slots.bytes_mut() };
+        let mut faults = Vec::new();
+        for scan in scans {
+            driver.before_scan(&self.machine, scan, slots);
+            faults.clear();
+            let t0 = timing.wants(scan).then(Instant::now);
+            self.machine.run_scan_in(slots, scan, &mut faults);
+            let elapsed = t0.map(|t| t.elapsed()).unwrap_or_default();
+            if t0.is_some() {
+                times.push(elapsed.as_nanos() as u64);
+            }
+            driver.after_scan(&self.machine, scan, slots, &faults, elapsed);
+        }
+    }
+
+    /// Worker `w`'s part of `scans` on `plan`; worker 0 also talks to the driver. False if a
+    /// worker panicked.
+    #[allow(clippy::too_many_arguments)]
+    fn plan_scans<D: ScanDriver + ?Sized>(
+        &self,
+        w: usize,
+        plan: &Plan,
+        sh: &Shared<'_>,
+        scans: Range<u64>,
+        epoch: &mut u64,
+        mut driver: Option<(&mut D, Timing, &mut Vec<u64>)>,
+        b: &mut Buffers,
+    ) -> bool {
+        let mut store = sh.slots;
+        for scan in scans {
+            let mut t0 = None;
+            if let Some((d, timing, _)) = driver.as_mut() {
+                // SAFETY: the other workers wait at the next barrier (or have not started):
+                // worker 0 has the slots to itself until it reaches that barrier.
+                let slots = unsafe { sh.slots.bytes_mut() };
+                d.before_scan(&self.machine, scan, slots);
+                t0 = timing.wants(scan).then(Instant::now);
+                self.machine.begin_scan(&mut store);
+            }
+            let mut ctx = self.machine.context(scan, &mut b.scratch);
+            for ph in &plan.phases {
+                if ph.barrier_before && !sh.barrier.wait(w, epoch) {
+                    return false;
+                }
+                let ahead = plan.item_remote.get(w).map_or(&[][..], Vec::as_slice);
+                if let Some(lines) = ahead.first() {
+                    store.prefetch(lines);
+                }
+                for (i, it) in ph.items_of(w).iter().enumerate() {
+                    if let Some(lines) = ahead.get(i + 1) {
+                        store.prefetch(lines);
+                    }
+                    for x in &plan.waits[it.waits.start as usize..it.waits.end as usize] {
+                        if !sh
+                            .ready
+                            .wait(x.worker as usize, *epoch, x.done, &sh.barrier)
+                        {
+                            return false;
+                        }
+                    }
+                    self.run_item(&self.machine, plan, it, &mut store, &mut ctx, sh);
+                    if it.publish {
+                        sh.ready.publish(w, *epoch, i as u32 + 1);
+                    }
+                    if !ctx.faults.is_empty() {
+                        // SAFETY: only worker `w` touches its fault buffer during a scan;
+                        // worker 0 reads it after the scan's last barrier.
+                        let buf = unsafe { &mut *sh.faults[w].0.get() };
+                        buf.extend(ctx.faults.drain(..).map(|f| (it.first.0, f)));
+                    }
+                }
+            }
+            if plan.end_barrier && !sh.barrier.wait(w, epoch) {
+                return false;
+            }
+            if let Some((d, _, times)) = driver.as_mut() {
+                let elapsed = t0.map(|t| t.elapsed()).unwrap_or_default();
+                if t0.is_some() {
+                    times.push(elapsed.as_nanos() as u64);
+                }
+                // Every other worker has passed the scan's last barrier and waits at the next
+                // one: worker 0 has the buffers and slots to itself.
+                let faults = self.merged_faults(sh, b);
+                // SAFETY: as above: nobody writes the slots until worker 0 reaches the next
+                // barrier, after the driver returned.
+                let slots: &[u8] = unsafe { sh.slots.bytes_mut() };
+                d.after_scan(&self.machine, scan, slots, faults, elapsed);
+            }
+        }
+        true
+    }
+}
