@@ -1,11 +1,11 @@
 //! A levelled plan's scans on private states (`par-exchange`): worker 0 runs its slices on the
 //! shared state (the driver's, or its own layout's copy of it: `relayout`), every other worker
-//! on a copy of its own, and after each phase
-//! each worker packs what it wrote (the plan's [`Exchange`] key: BOOLs as bits) into its lines
-//! of an exchange buffer; before the next phase every worker waits for the others' lines of the
-//! phase and unpacks them into its state. Worker 0 hands over the driver's inputs the same way
-//! before each scan, and unpacks the last phase's keys after it, so the state the driver sees is
-//! whole. Only the exchanged lines move between the cores; no line of any state is shared.
+//! on a copy of its own, and after each phase each worker packs what it wrote (the plan's
+//! [`Exchange`] key: BOOLs as bits) into its lines of an exchange buffer; before the next
+//! phase every worker waits for the others' lines of the phase and unpacks them into its state.
+//! Worker 0 hands over the driver's inputs the same way before each scan, and unpacks the last
+//! phase's keys after it, so the state the driver sees is whole. Only the exchanged lines move
+//! between the cores; no line of any state is shared.
 //!
 //! The lines (`xlines`) carry the data and its readiness together; waiting for all the others'
 //! lines of a phase is the phase's barrier. Two sets of lines alternate by scan parity, so a

@@ -4,8 +4,9 @@
 //! waits and program order (happened-before, Lamport); two workers never write one 64-byte line
 //! unordered, unless every written byte of the line is written on several workers (those bytes'
 //! writes are ordered by the byte rule, and such a line crosses between the cores whatever it
-//! holds: the layout puts the variables written on several workers together); every decision a guard or entry reads was written by an item ordered before the
-//! reader; and the waits cannot deadlock.
+//! holds: the layout puts the variables written on several workers together); every decision
+//! a guard or entry reads was written by an item ordered before the reader; and the waits
+//! cannot deadlock.
 //!
 //! How: the items are walked in one order that respects every worker's order and every wait
 //! (`ready::item_order`; none exists when the waits form a cycle). Each item gets a vector
