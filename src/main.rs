@@ -206,6 +206,11 @@ enum Command {
         /// Loop-backs allowed per loop-back rung and scan (the iteration cap).
         #[arg(long, default_value_t = 100_000)]
         loop_cap: u32,
+        /// With --mode both, the scans of each mode's turn: the two passes alternate in blocks
+        /// of this many scans, so that a change of the machine's speed hits both [default:
+        /// about 20 ms of the sequential walk's scans, and at least a 64th of the run].
+        #[arg(long, value_name = "N")]
+        alternate: Option<u64>,
         /// Run only this program of a PLCopen project [default: every program instance, in
         /// task order].
         #[arg(long)]
@@ -449,12 +454,14 @@ fn run(cli: Cli) -> Result<(), CliError> {
             explain,
             plan,
             loop_cap,
+            alternate,
             pou,
             output,
         } => {
             use plc_deps::cmd::run::{self, RunConfig, RunFormat, RunMode};
             let mut config = RunConfig::new(file);
             config.scans = scans;
+            config.alternate = alternate;
             config.inputs = inputs;
             config.cycle_ms = run::parse_cycle(&cycle)?;
             if let Some(t) = threads {

@@ -54,6 +54,9 @@ pub struct RunConfig {
     pub plan: PlanKind,
     /// Loop-backs per loop-back rung and scan.
     pub loop_cap: u32,
+    /// With both modes, the scans of each one's turn (`--alternate`); `None`: about 20 ms of
+    /// the sequential walk's scans, and at least a 64th of the run.
+    pub alternate: Option<u64>,
     /// Write the report here instead of standard output.
     pub output: Option<PathBuf>,
     /// Show progress on standard error (default: when it is a terminal); a phase appears once it
@@ -84,6 +87,7 @@ impl RunConfig {
             explain: false,
             plan: PlanKind::Auto,
             loop_cap: ExecConfig::default().loop_cap,
+            alternate: None,
             output: None,
             progress: std::io::stderr().is_terminal(),
             calibrate: true,

@@ -23,7 +23,7 @@ use serde_json::Value as Json;
 use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::io::Write;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 /// Faults kept in the report (the count covers all).
 const FAULTS_KEPT: usize = 1000;
@@ -56,6 +56,9 @@ pub struct RunReport {
     pub plan_run: Option<RunLog>,
     /// `Some(why)` when every scan of the parallel pass was the sequential walk.
     pub sequential_fallback: Option<String>,
+    /// When both modes ran: the scans of each one's turn (they alternate in blocks of this
+    /// many scans, the last maybe shorter, so that a change of the machine's speed hits both).
+    pub block_scans: Option<u64>,
     /// `Some` when both modes ran.
     pub identical: Option<bool>,
     pub first_difference: Option<Json>,
@@ -234,6 +237,23 @@ impl ScanDriver for Driver<'_> {
 /// Untimed warm-up scans before each timed pass.
 const WARM_UP: u64 = 16;
 
+/// With both modes, each takes turns of at least this long (by the sequential warm-up's time
+/// per scan) ...
+const BLOCK_TIME: Duration = Duration::from_millis(20);
+/// ... and the run is cut into at most this many turns of each.
+const BLOCKS_MAX: u64 = 64;
+
+/// The scans of each mode's turn when both run: as many as take [`BLOCK_TIME`] on the
+/// sequential walk (`warm_time` over `warm` scans), and no fewer than a [`BLOCKS_MAX`]-th of
+/// the run. A turn costs the parallel pass a wake-up of its workers and both passes cold caches
+/// for a scan, a few tens of µs: under 0.5 % of a turn this long.
+fn compare_block(warm_time: Duration, warm: u64, scans: u64) -> u64 {
+    let per_scan = warm_time.as_nanos() / u128::from(warm.max(1));
+    let by_time = (BLOCK_TIME.as_nanos() / per_scan.max(1)).max(1);
+    let by_count = scans.div_ceil(BLOCKS_MAX).max(1);
+    u64::try_from(by_time).unwrap_or(u64::MAX).max(by_count)
+}
+
 /// A driver that only writes the inputs (warm-up).
 struct Inputs<'a>(&'a InputTable);
 
@@ -287,6 +307,9 @@ fn check_arguments(c: &RunConfig) -> Result<(), CliError> {
     }
     if c.scans == Some(0) {
         return Err(CliError::Usage("--scans must be at least 1".into()));
+    }
+    if c.alternate == Some(0) {
+        return Err(CliError::Usage("--alternate must be at least 1".into()));
     }
     if c.trace_vars.is_some() && c.trace.is_none() {
         return Err(CliError::Usage(
@@ -432,7 +455,6 @@ pub(super) fn prepare(c: &RunConfig, progress: &Progress) -> Result<Prepared, Cl
 /// What one pass (one mode) leaves for the report.
 struct Pass {
     total: Duration,
-    digests: Vec<u128>,
     first_mismatch: Option<u64>,
     faults: Vec<(u64, u32, FaultKind)>,
     fault_count: u64,
@@ -447,10 +469,6 @@ impl Pass {
     fn of(d: Driver<'_>, state: State, log: Option<RunLog>) -> Pass {
         Pass {
             total: d.total,
-            digests: match d.digests {
-                Digests::Record(ds) => ds,
-                Digests::Skip | Digests::Check(_) => Vec::new(),
-            },
             first_mismatch: d.first_mismatch,
             faults: d.faults,
             fault_count: d.fault_count,
@@ -479,13 +497,17 @@ pub(super) fn execute(
     };
     let mut trace = trace;
     // Untimed warm-up scans on a throwaway state before each timed pass, so that neither mode
-    // pays for cold caches and branch predictors (or for the other mode's warm ones).
+    // pays for cold caches and branch predictors (or for the other mode's warm ones); the
+    // sequential one also says how long a scan takes, for the turns below.
     let warm = scans.min(WARM_UP);
+    let mut seq_warm = Duration::ZERO;
     let mut seq = pr.seq.as_ref().map(|m| {
         {
             let _phase = progress.phase("seq: warm-up scans");
             let mut st = m.initial_state();
+            let t = Instant::now();
             run_sequential(m, &mut st, 0..warm, &mut Inputs(inputs));
+            seq_warm = t.elapsed();
         }
         let t = match (&pr.trace_cols, trace.take()) {
             (Some(cols), Some(out)) => Some(Trace::new(m, cols, out)),
@@ -496,12 +518,13 @@ pub(super) fn execute(
             Some(_) => Digests::Record(Vec::new()),
             None => Digests::Skip,
         };
-        let mut d = Driver::new(inputs, m, digests, t, bar);
-        let mut st = m.initial_state();
-        run_sequential(m, &mut st, 0..scans, &mut d);
-        Pass::of(d, st, None)
+        (
+            m,
+            Driver::new(inputs, m, digests, t, bar),
+            m.initial_state(),
+        )
     });
-    let par = run_par.map(|pm| {
+    let mut par = run_par.map(|pm| {
         {
             let _phase = progress.phase("par: warm-up scans");
             let mut st = pm.initial_state();
@@ -512,16 +535,42 @@ pub(super) fn execute(
             (Some(cols), Some(out)) => Some(Trace::new(m, cols, out)),
             _ => None,
         };
-        let digests = match seq.as_mut() {
-            Some(s) => Digests::Check(std::mem::take(&mut s.digests)),
+        let digests = match seq {
+            Some(_) => Digests::Check(Vec::new()),
             None => Digests::Skip,
         };
         let bar = progress.bar("par", scans, "scans");
-        let mut d = Driver::new(inputs, m, digests, t, bar);
-        let mut st = pm.initial_state();
-        let log = pm.run(pr.pool.as_ref(), &mut st, 0..scans, &mut d);
-        Pass::of(d, st, Some(log))
+        let d = Driver::new(inputs, m, digests, t, bar);
+        (pm, d, pm.initial_state(), pm.start_run(0))
     });
+    // The two passes take turns, block by block, so that a change of the machine's speed
+    // during the run (another process, the host) hits both alike; the parallel pass goes on
+    // with one measured choice across its turns.
+    let block = match (&seq, &par) {
+        (Some(_), Some(_)) => c
+            .alternate
+            .unwrap_or_else(|| compare_block(seq_warm, warm, scans)),
+        _ => scans.max(1),
+    };
+    let mut at = 0;
+    while at < scans {
+        let end = scans.min(at + block);
+        if let Some((m, d, st)) = &mut seq {
+            run_sequential(m, st, at..end, d);
+            // The turn's digests move to the parallel pass, which checks them by scan.
+            if let (Digests::Record(ds), Some((_, pd, ..))) = (&mut d.digests, &mut par) {
+                if let Digests::Check(check) = &mut pd.digests {
+                    check.append(ds);
+                }
+            }
+        }
+        if let Some((pm, d, st, run)) = &mut par {
+            pm.run_more(pr.pool.as_ref(), st, run, end, d);
+        }
+        at = end;
+    }
+    let seq = seq.map(|(_, d, st)| Pass::of(d, st, None));
+    let par = par.map(|(_, d, st, run)| Pass::of(d, st, Some(run.into_log())));
     let (identical, first_difference) = match (&pr.seq, run_par, &par) {
         (Some(s), Some(pm), Some(pass)) => match pass.first_mismatch {
             None => (Some(true), None),
@@ -570,8 +619,10 @@ pub(super) fn execute(
         (Some(pm), Some(log)) => fallback_reason(pm, log),
         _ => None,
     };
+    let both = modes.len() == 2;
     let extra = Extra {
         modes,
+        block_scans: both.then_some(block),
         identical,
         first_difference,
         explain,
@@ -586,6 +637,7 @@ pub(super) fn execute(
 /// What the report adds to the pass it shows.
 struct Extra {
     modes: Vec<(&'static str, Duration)>,
+    block_scans: Option<u64>,
     identical: Option<bool>,
     first_difference: Option<Json>,
     explain: Option<(String, Json)>,
@@ -624,6 +676,7 @@ fn report(pr: &Prepared, c: &RunConfig, m: &Machine, pass: Pass, extra: Extra) -
     let p = &pr.p;
     let Extra {
         modes,
+        block_scans,
         identical,
         first_difference,
         explain,
@@ -681,6 +734,7 @@ fn report(pr: &Prepared, c: &RunConfig, m: &Machine, pass: Pass, extra: Extra) -
         plan_kind: c.plan,
         plan_run,
         sequential_fallback,
+        block_scans,
         identical,
         first_difference,
         explain,

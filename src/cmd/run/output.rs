@@ -124,6 +124,7 @@ pub fn render_json(r: &RunReport, deterministic: bool) -> String {
         "speedup_scans".into(),
         if both { json!(r.scans) } else { Json::Null },
     );
+    doc.insert("speedup_block_scans".into(), json!(r.block_scans));
     doc.insert("plan_kind".into(), json!(r.plan_kind.name()));
     doc.insert("sequential_fallback".into(), json!(r.sequential_fallback));
     doc.insert(
@@ -143,6 +144,18 @@ pub fn render_json(r: &RunReport, deterministic: bool) -> String {
     let mut s = serde_json::to_string_pretty(&Json::Object(doc)).expect("JSON");
     s.push('\n');
     s
+}
+
+/// How the two passes took turns, when they did more than once: `; seq and par alternated
+/// every 84 scans`.
+fn turns_text(r: &RunReport) -> String {
+    match r.block_scans {
+        Some(b) if b < r.scans => format!(
+            "; seq and par alternated every {}",
+            count(b, "scan", "scans")
+        ),
+        _ => String::new(),
+    }
 }
 
 fn time_text(ns: f64) -> String {
@@ -298,10 +311,11 @@ pub fn render_text(r: &RunReport) -> String {
                 None if !total.is_zero() => {
                     let _ = write!(
                         s,
-                        "  ({:.2}x seq over {}{})",
+                        "  ({:.2}x seq over {}{}{})",
                         st.as_secs_f64() / total.as_secs_f64(),
                         count(r.scans, "scan", "scans"),
-                        mix_text(r)
+                        mix_text(r),
+                        turns_text(r)
                     );
                 }
                 None => {}

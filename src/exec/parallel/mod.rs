@@ -95,6 +95,7 @@ pub use config::{DepsPartition, LineCostSource, Measure, PlanConfig, PlanKind, S
 pub use explain::{ns_text, run_log_json};
 pub use ids::{Decision, DecisionSlot, Next, TaskId};
 pub use machine::{
-    run_sequential, Candidate, ParallelMachine, RunLog, ScanDriver, SharedSlots, SpinBarrier,
+    run_sequential, Candidate, ParallelMachine, RunCursor, RunLog, ScanDriver, SharedSlots,
+    SpinBarrier,
 };
 pub use planning::{measure_handover, measure_line_cost, LevelPlan, LineTiming, Plan, Ready};

@@ -343,16 +343,25 @@ impl ParallelMachine {
         driver: &mut D,
         only: Option<usize>,
     ) -> RunLog {
-        assert_eq!(
-            state.bytes().len(),
-            self.machine.state_size() as usize,
-            "state of another machine"
-        );
+        let mut run = self.cursor(scans.start, only);
+        self.run_more(pool, state, &mut run, scans.end, driver);
+        run.log
+    }
+
+    /// A run starting at scan `first` that [`run_more`](Self::run_more) goes on with, call
+    /// after call: the measured choice and the log carry over, so a run may be cut into parts
+    /// with other work between them (`plc-deps run --mode both` interleaves the sequential
+    /// pass's scans with them) and choose as one run would.
+    pub fn start_run(&self, first: u64) -> RunCursor {
+        self.cursor(first, None)
+    }
+
+    fn cursor(&self, first: u64, only: Option<usize>) -> RunCursor {
         let allowed: Vec<usize> = match only {
             Some(c) => vec![c],
             None => (0..self.candidates.len()).collect(),
         };
-        let mut log = RunLog {
+        let log = RunLog {
             candidates: self.names.clone(),
             scans_on: vec![0; self.candidates.len()],
             estimates: vec![None; self.candidates.len()],
@@ -370,13 +379,52 @@ impl ParallelMachine {
             windows: Vec::new(),
             windows_unlogged: 0,
         };
+        RunCursor {
+            chooser: Chooser::new(allowed.len(), self.measure, first),
+            allowed,
+            log,
+            next: first,
+        }
+    }
+
+    /// Runs the scans of `run` from where it stands to `end` (exclusive) on `state`, as
+    /// [`run`](Self::run) does; the caller's `state` is in this machine's layout when it
+    /// returns, as after a whole run. Nothing when `end` is not past where `run` stands.
+    ///
+    /// # Panics
+    /// As [`run`](Self::run).
+    pub fn run_more<D: ScanDriver + ?Sized>(
+        &self,
+        pool: Option<&rayon::ThreadPool>,
+        state: &mut State,
+        run: &mut RunCursor,
+        end: u64,
+        driver: &mut D,
+    ) {
+        assert_eq!(
+            state.bytes().len(),
+            self.machine.state_size() as usize,
+            "state of another machine"
+        );
+        if end <= run.next {
+            return;
+        }
+        let scans = run.next..end;
+        run.next = end;
+        let RunCursor {
+            allowed,
+            chooser,
+            log,
+            ..
+        } = run;
+        let allowed: &[usize] = allowed;
         let threads = self
             .plans
             .iter()
             .filter(|p| p.sequential.is_none())
             .map(|p| p.threads)
             .max();
-        let threads = match (threads, allowed.as_slice()) {
+        let threads = match (threads, allowed) {
             (Some(t), _)
                 if allowed
                     .iter()
@@ -385,10 +433,10 @@ impl ParallelMachine {
                 t
             }
             _ => {
-                log.scans_on[allowed[0]] = scans.end.saturating_sub(scans.start);
+                log.scans_on[allowed[0]] += scans.end - scans.start;
                 log.push_segment(scans.start, allowed[0]);
                 run_sequential(&self.machine, state, scans, driver);
-                return log;
+                return;
             }
         };
         let decision_slots = self
@@ -437,7 +485,6 @@ impl ParallelMachine {
             xhomes: &xhomes,
         };
         let shared = &shared;
-        let mut chooser = Chooser::new(allowed.len(), self.measure, scans.start);
         // Worker i on the i-th allowed CPU for the run, when asked and each worker can have one.
         let cpus = if self.pin_workers {
             pin::allowed_cpus()
@@ -448,7 +495,7 @@ impl ParallelMachine {
             (threads > 1 && threads <= cpus.len()).then(|| &cpus[..threads]);
         let pin = |w: usize| pins.and_then(|c| pin::pin_to(c[w]));
         if threads == 1 {
-            self.leader(shared, scans, driver, &mut chooser, &allowed, &mut log);
+            self.leader(shared, scans, driver, chooser, allowed, log);
         } else {
             let pool = pool.expect("a thread pool for more than one worker");
             assert!(
@@ -470,7 +517,7 @@ impl ParallelMachine {
                     });
                 }
                 let _pinned = pin(0);
-                self.leader(shared, scans, driver, &mut chooser, &allowed, &mut log);
+                self.leader(shared, scans, driver, chooser, allowed, log);
             });
         }
         for (i, &c) in allowed.iter().enumerate() {
@@ -495,7 +542,33 @@ impl ParallelMachine {
             })
             .collect();
         log.windows_unlogged = chooser.windows_unlogged();
-        log
+    }
+}
+
+/// Where a run cut into parts stands between them ([`ParallelMachine::start_run`]): the
+/// measured choice, the log so far and the next scan.
+#[derive(Clone, Debug)]
+pub struct RunCursor {
+    allowed: Vec<usize>,
+    chooser: Chooser,
+    log: RunLog,
+    next: u64,
+}
+
+impl RunCursor {
+    /// What the run did so far.
+    pub fn log(&self) -> &RunLog {
+        &self.log
+    }
+
+    /// The next scan to run.
+    pub fn next_scan(&self) -> u64 {
+        self.next
+    }
+
+    /// What the run did.
+    pub fn into_log(self) -> RunLog {
+        self.log
     }
 }
 
