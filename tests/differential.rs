@@ -284,9 +284,31 @@ fn check_with(
             auto.bytes() == s.bytes(),
             "{label}: final state, any layout"
         );
+        // The auto run cut into parts of 1 to 7 scans (`run --mode both` takes turns so), one
+        // measured choice across them: every scan as the walk's, and every scan run once.
+        let mut parts = par.initial_state();
+        let mut canon_parts = Canonical {
+            inputs,
+            values: Vec::new(),
+            faults: Vec::new(),
+        };
+        let mut run = par.start_run(0);
+        let mut end = 0;
+        while end < scans {
+            end = scans.min(end + 1 + (end * 7 + scans) % 7);
+            par.run_more(Some(pool), &mut parts, &mut run, end, &mut canon_parts);
+        }
+        assert!(
+            parts.bytes() == s.bytes() && run.log().scans_on.iter().sum::<u64>() == scans,
+            "{label}: final state of an auto run cut into parts"
+        );
         for (scan, state) in rec.states.iter().enumerate() {
             let want = canonical_bytes(par.machine(), state);
-            for (what, c) in [("windows", &canon), ("auto", &canon_auto)] {
+            for (what, c) in [
+                ("windows", &canon),
+                ("auto", &canon_auto),
+                ("parts", &canon_parts),
+            ] {
                 assert!(
                     c.values[scan] == want && c.faults[scan] == rec.faults[scan],
                     "{label}: scan {scan} seen by a driver that reads any layout ({what})"
