@@ -13,9 +13,12 @@
 //! makes a change of the machine's load hit them alike, and the choice compares each candidate
 //! with the current one *round by round* ([`choose`]): it replaces the current one only if it
 //! was faster in more than half the rounds, by at least 3 % at the median of the per-round
-//! ratios. The measurement stops once it has its minimum of rounds and the choice after the
-//! last round is the choice after the round before (successive choices agree), or when a
-//! candidate is at least twice as fast in every round, or at its maximum of rounds.
+//! ratios. A candidate other than the current one that took more than 1.5× the best time of a
+//! round sits out the later rounds (4× the best after one scan: the rest of its visit too).
+//! The measurement stops once it has its minimum of rounds and the choice after the last round
+//! is the choice after the round before (successive choices agree), or when a candidate is at
+//! least twice as fast in every round, or when every other candidate sits out, or at its
+//! maximum of rounds.
 //!
 //! A pure state machine over nanoseconds: [`Chooser::next`] says which candidate runs the next
 //! window of scans, [`Chooser::record`] takes the times of a window's scans. It neither runs nor
@@ -141,6 +144,14 @@ pub fn choose(table: &[Vec<Option<u64>>]) -> Verdict {
 /// than 4× its time (a visit of it ends after one scan).
 fn hopeless(ns: u64, best: u64) -> bool {
     ns > best.saturating_mul(4)
+}
+
+/// Whether a candidate that took `ns` per scan in a round is out of the race against the
+/// round's best, `best`: more than 1.5× its time. Noise between rounds is a few per cent; a
+/// candidate this far behind would need to gain a third to be picked, so it is left out of the
+/// measurement's later rounds (each visit of it costs half a scan or more per scan).
+fn outpaced(ns: u64, best: u64) -> bool {
+    ns.saturating_mul(2) > best.saturating_mul(3)
 }
 
 /// The lower median of `v` (sorts it); 0 when empty.
@@ -394,6 +405,16 @@ impl Chooser {
         for row in m.table.iter_mut() {
             row.resize(m.round, None);
         }
+        // Candidates other than the current one that were outpaced in this round sit out the
+        // later ones (the current one is what the others are compared with).
+        let r = m.round - 1;
+        if let Some(best) = m.table.iter().filter_map(|row| row[r]).min() {
+            for i in 1..m.who.len() {
+                if m.table[i][r].is_some_and(|t| outpaced(t, best)) {
+                    m.dropped[i] = true;
+                }
+            }
+        }
         let verdict = choose(&m.table);
         let others_left = m.dropped.iter().skip(1).any(|&d| !d);
         let stable =
@@ -467,6 +488,8 @@ impl Chooser {
             .map(|e| {
                 let scans = if hopeless(e, cur) {
                     1
+                } else if outpaced(e, cur) {
+                    visit
                 } else {
                     visit * m.min_rounds.max(1)
                 };
