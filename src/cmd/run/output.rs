@@ -367,6 +367,7 @@ pub fn run_figures(r: &RunReport, warnings: &[RunWarning]) -> RunFigures {
             switches: log.switches.len(),
             fallback: r.sequential_fallback.clone(),
         }),
+        block_scans: r.block_scans,
         identical: r.identical,
         first_difference: r.first_difference.as_ref().map(|d| d.to_string()),
         outputs: r

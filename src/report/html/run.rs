@@ -69,6 +69,8 @@ pub struct RunFigures {
     pub modes: Vec<ModeFigures>,
     /// `None` when the parallel executor did not run.
     pub plan: Option<PlanFigures>,
+    /// When both modes ran: the scans of each one's turn (they alternate in blocks).
+    pub block_scans: Option<u64>,
     /// `Some` when both modes ran: was every scan's full state identical.
     pub identical: Option<bool>,
     /// The first difference, in words.
@@ -160,7 +162,7 @@ pub(super) fn write_run(out: &mut impl Write, doc: &Report, run: &RunFigures) ->
 
 /// The measured rates, one row per mode; the parallel row says how it compares or why it fell
 /// back, and which plan ran.
-fn write_rates(out: &mut impl Write, run: &RunFigures) -> io::Result<()> {
+pub(super) fn write_rates(out: &mut impl Write, run: &RunFigures) -> io::Result<()> {
     out.write_all("<div>\n<h3>Measured</h3>\n<table class=\"rates\"><tr><th>mode</th><th>µs/scan</th><th>scans/s</th><th>M rungs/s</th><th>against seq</th></tr>\n".as_bytes())?;
     for m in &run.modes {
         let per_s = if m.ns_per_scan > 0.0 {
@@ -178,8 +180,15 @@ fn write_rates(out: &mut impl Write, run: &RunFigures) -> io::Result<()> {
                 }),
             ) => format!("sequential fallback ({})", esc(why)),
             ("par", Some(x), _) => format!(
-                "<b class=\"ratio\">×{x:.2}</b> over {} scans",
-                thousands(run.scans as usize)
+                "<b class=\"ratio\">×{x:.2}</b> over {} scans{}",
+                thousands(run.scans as usize),
+                match run.block_scans {
+                    Some(b) if b < run.scans => format!(
+                        ", seq and par alternating every {} scans",
+                        thousands(b as usize)
+                    ),
+                    _ => String::new(),
+                }
             ),
             _ => String::new(),
         };

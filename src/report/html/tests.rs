@@ -231,6 +231,7 @@ fn example_a_run() -> RunFigures {
             switches: 1,
             fallback: None,
         }),
+        block_scans: Some(1000),
         identical: Some(true),
         first_difference: None,
         outputs: vec![("Q1".into(), "TRUE".into()), ("Y".into(), "FALSE".into())],
@@ -293,6 +294,16 @@ fn a_run_page_is_the_report_page_with_the_run_beside_the_model() {
         ]
     );
     assert!(html.contains("plan chosen (<code>--plan auto</code>): <b>par-lpt</b>; ran <code>seq</code> 40 scans, <code>par-lpt</code> 960 scans, 1 switch."));
+    // Modes that took turns say how.
+    let mut turns = example_a_run();
+    turns.block_scans = Some(250);
+    let mut buf = Vec::new();
+    run::write_rates(&mut buf, &turns).unwrap();
+    let section = String::from_utf8(buf).unwrap();
+    assert!(
+        section.contains("×2.00</b> over 1,000 scans, seq and par alternating every 250 scans<"),
+        "{section}"
+    );
     // Example A: W = 10, S = 6; makespans 10, 6, 6, 6 and level by level 10, 8, 6, 6.
     assert_eq!(
         rows(&html, "ideal"),
