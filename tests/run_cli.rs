@@ -16,6 +16,21 @@ fn write(name: &str, text: &str) -> String {
     path.to_str().unwrap().to_owned()
 }
 
+/// A program of `plc-deps gen ARGS` in the temporary folder, as `name`.
+fn generated(name: &str, args: &[&str]) -> std::path::PathBuf {
+    let path = tmp(name);
+    let mut all = vec!["gen"];
+    all.extend_from_slice(args);
+    all.extend_from_slice(&["-o", path.to_str().unwrap()]);
+    let out = run(&all);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    path
+}
+
 fn json_of(out: &Output) -> Value {
     assert!(
         out.status.success(),
@@ -312,20 +327,10 @@ fn both_modes_are_identical_on_programs_with_jumps_loops_and_calls() {
 /// sequential pass's whole, and the report says how they alternated.
 #[test]
 fn both_modes_take_turns_and_every_scan_is_still_compared() {
-    let wide = tmp("alternate_wide.json");
-    assert!(run(&[
-        "gen",
-        "--rungs",
-        "600",
-        "--levels",
-        "6",
-        "--reads",
-        "random",
-        "-o",
-        wide.to_str().unwrap()
-    ])
-    .status
-    .success());
+    let wide = generated(
+        "alternate_wide.json",
+        &["--rungs", "600", "--levels", "6", "--reads", "random"],
+    );
     let wide = wide.to_str().unwrap().to_owned();
     let alone = json_of(&run(&[
         "run", &wide, "--scans", "40", "--mode", "seq", "--format", "json",
@@ -437,20 +442,10 @@ fn a_sequential_walk_says_so_instead_of_a_ratio_and_every_ratio_its_scans() {
         .unwrap();
     assert!(par.contains("  sequential fallback ("), "{par}");
     assert!(!par.contains("x seq"), "{par}");
-    let wide = tmp("wide_plans.json");
-    assert!(run(&[
-        "gen",
-        "--rungs",
-        "2000",
-        "--levels",
-        "4",
-        "--reads",
-        "random",
-        "-o",
-        wide.to_str().unwrap()
-    ])
-    .status
-    .success());
+    let wide = generated(
+        "wide_plans.json",
+        &["--rungs", "2000", "--levels", "4", "--reads", "random"],
+    );
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     for (plan, candidates, fallback) in [
         (
@@ -557,18 +552,7 @@ fn more_threads_than_cores_is_a_warning_and_plans_for_the_cores() {
 
 #[test]
 fn text_report_and_explain() {
-    let wide = tmp("wide.json");
-    assert!(run(&[
-        "gen",
-        "--rungs",
-        "4000",
-        "--width",
-        "400",
-        "-o",
-        wide.to_str().unwrap()
-    ])
-    .status
-    .success());
+    let wide = generated("wide.json", &["--rungs", "4000", "--width", "400"]);
     let out = run(&[
         "run",
         wide.to_str().unwrap(),
