@@ -343,7 +343,7 @@ fn pou_selects_the_same_program_of_the_converted_json() {
                     Ok(v) => v,
                     Err(_) => return s.to_owned(),
                 };
-                for timed in ["modes", "speedup", "plan_run"] {
+                for timed in ["modes", "speedup", "speedup_block_scans", "plan_run"] {
                     v.as_object_mut().unwrap().remove(timed);
                 }
                 v.to_string()
