@@ -4,24 +4,13 @@
 
 mod common;
 
-use common::cli::{run, tmp};
+use common::cli::{generated, run};
 
 fn generate(rungs: usize, extra: &[&str]) -> std::path::PathBuf {
-    let file = tmp(&format!("size-{rungs}-{}.json", extra.join("")));
     let rungs_arg = rungs.to_string();
-    let mut args = vec![
-        "gen", "--rungs", &rungs_arg, "--width", "50", "--jumps", "--loops",
-    ];
+    let mut args = vec!["--rungs", &rungs_arg, "--width", "50", "--jumps", "--loops"];
     args.extend_from_slice(extra);
-    let path = file.to_str().unwrap().to_owned();
-    args.extend_from_slice(&["-o", &path]);
-    let out = run(&args);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    file
+    generated(&format!("size-{rungs}-{}.json", extra.join("")), &args)
 }
 
 fn report_size(file: &std::path::Path, args: &[&str]) -> usize {

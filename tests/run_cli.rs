@@ -16,21 +16,6 @@ fn write(name: &str, text: &str) -> String {
     path.to_str().unwrap().to_owned()
 }
 
-/// A program of `plc-deps gen ARGS` in the temporary folder, as `name`.
-fn generated(name: &str, args: &[&str]) -> std::path::PathBuf {
-    let path = tmp(name);
-    let mut all = vec!["gen"];
-    all.extend_from_slice(args);
-    all.extend_from_slice(&["-o", path.to_str().unwrap()]);
-    let out = run(&all);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    path
-}
-
 fn json_of(out: &Output) -> Value {
     assert!(
         out.status.success(),

@@ -1,9 +1,25 @@
 //! Running the `plc-deps` binary from tests: the checkout root, a run (with or without standard
-//! input), the one-line form of a failure's diagnostics, scratch files and leftover temporary files, and the
-//! Graphviz check that DOT output renders without warnings.
+//! input), the one-line form of a failure's diagnostics, scratch files (a generated program among
+//! them) and leftover temporary files, and the Graphviz check that DOT output renders without
+//! warnings.
 
 use std::path::PathBuf;
 use std::process::{Command, Output, Stdio};
+
+/// A program written by `plc-deps gen ARGS` into the scratch folder as `name`.
+pub fn generated(name: &str, args: &[&str]) -> PathBuf {
+    let path = tmp(name);
+    let mut all = vec!["gen"];
+    all.extend_from_slice(args);
+    all.extend_from_slice(&["-o", path.to_str().unwrap()]);
+    let out = run(&all);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    path
+}
 
 /// The checkout (the directory of Cargo.toml).
 pub fn root() -> PathBuf {
