@@ -636,18 +636,17 @@ fn levels_of<'a>(p: &'a Program, a: &'a Analysis) -> Levels<'a> {
                 .collect()
         })
         .collect();
-    let levels = Levels {
+    Levels {
         data: groups(&a.data_levels),
         control: groups(&a.control_levels),
         combined,
-    };
-    levels
+    }
 }
 
 /// The cost model's figures of the combined schedule.
 fn cost_of(a: &Analysis) -> Cost {
     let c = &a.cost;
-    let cost = Cost {
+    Cost {
         work: c.work,
         span: c.span,
         ideal_speedup: if c.span == 0 {
@@ -657,8 +656,7 @@ fn cost_of(a: &Analysis) -> Cost {
         },
         makespan: PerCores(c.makespan.clone()),
         level_makespan: PerCores(c.level_makespan.clone()),
-    };
-    cost
+    }
 }
 
 /// The FBD section and the levels without the lowering's landing rungs (`None` without FBD).

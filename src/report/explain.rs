@@ -131,10 +131,8 @@ impl<'a> Explainer<'a> {
                 self.ids(data_preds.iter().take(4).map(|&c| s.head(c)))
             ));
         }
-        if level < cl {
-            if self.instance_read[r.index()] {
-                reasons.push("reads a timer or counter: the paper counts that as a control dependence, here it is the data dependence on the instance".into());
-            }
+        if level < cl && self.instance_read[r.index()] {
+            reasons.push("reads a timer or counter: the paper counts that as a control dependence, here it is the data dependence on the instance".into());
         }
         if reasons.is_empty() {
             reasons.push(if level > dl.max(cl) {

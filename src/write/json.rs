@@ -33,7 +33,7 @@ pub fn program(p: &Program, w: &mut impl Write) -> io::Result<()> {
     write!(w, ",\n\"vars\": ")?;
     vars(&p.vars, w, "")?;
     if let Some(b) = &p.body {
-        write!(w, ",\n")?;
+        writeln!(w, ",")?;
         body(b, w, "")?;
     }
     for (key, kind) in [
@@ -149,7 +149,7 @@ fn malformed(p: &Problem) -> io::Error {
     )
 }
 
-fn read<'r, T>(r: &'r Read<T>) -> io::Result<&'r T> {
+fn read<T>(r: &Read<T>) -> io::Result<&T> {
     r.as_ref().map_err(|p| malformed(p))
 }
 
@@ -216,7 +216,7 @@ fn series(s: &Series) -> io::Result<Value> {
 
 fn branches(bs: &[Series]) -> io::Result<Value> {
     bs.iter()
-        .map(|b| series(b))
+        .map(series)
         .collect::<io::Result<Vec<_>>>()
         .map(Value::Array)
 }

@@ -69,7 +69,7 @@ impl Cx<'_> {
         let blk = net.block(b);
         let id = Some(blk.id);
         let e = |path: &str, k| LoadError::fbd(&net.id, id, path, k);
-        let ty = numeric(&vals, None, "a comparison").map_err(|(p, k)| e(p, k))?;
+        let ty = numeric(vals, None, "a comparison").map_err(|(p, k)| e(p, k))?;
         let mut ops = Vec::with_capacity(vals.len());
         for (v, path) in vals {
             ops.push(self.coerce(nx, v, ty, "a comparison", path, id)?);
@@ -104,7 +104,7 @@ impl Cx<'_> {
         let id = Some(blk.id);
         let e = |path: &str, k| LoadError::fbd(&net.id, id, path, k);
         let out_ty = self.first_out_type(nx, b)?;
-        let ty = numeric_type(&vals, out_ty);
+        let ty = numeric_type(vals, out_ty);
         if !op.accepts(ty) {
             let (v, p) = vals
                 .iter()
@@ -120,7 +120,7 @@ impl Cx<'_> {
                 },
             ));
         }
-        let ops = self.typed_all(nx, &vals, ty, "an arithmetic block", id)?;
+        let ops = self.typed_all(nx, vals, ty, "an arithmetic block", id)?;
         let avoid: &[Operand] = if ops.len() > 2 { &ops[2..] } else { &[] };
         let (d, rest) = self.dest(nx, b, 0, ty, avoid)?;
         let mut s = vec![Element::Arith {
@@ -172,7 +172,7 @@ impl Cx<'_> {
         let net = nx.net;
         let blk = net.block(b);
         let id = Some(blk.id);
-        let ops = self.typed_all(nx, &vals, Type::Bool, "a logic block", id)?;
+        let ops = self.typed_all(nx, vals, Type::Bool, "a logic block", id)?;
         let (d, rest) = self.dest(nx, b, 0, Type::Bool, &[])?;
         let mut s: Series = match blk.op {
             Op::And => ops.iter().flat_map(|o| condition(*o, false)).collect(),
@@ -198,7 +198,7 @@ impl Cx<'_> {
         let net = nx.net;
         let blk = net.block(b);
         let id = Some(blk.id);
-        let ops = self.typed_all(nx, &vals, Type::Bool, "a logic block", id)?;
+        let ops = self.typed_all(nx, vals, Type::Bool, "a logic block", id)?;
         let (d, rest) = self.dest(
             nx,
             b,
@@ -300,8 +300,8 @@ impl Cx<'_> {
         let id = Some(blk.id);
         let e = |path: &str, k| LoadError::fbd(&net.id, id, path, k);
         let out_ty = self.first_out_type(nx, b)?;
-        let ty = numeric(&vals, out_ty, "this block").map_err(|(p, k)| e(p, k))?;
-        let ops = self.typed_all(nx, &vals, ty, blk.op.name_static(), id)?;
+        let ty = numeric(vals, out_ty, "this block").map_err(|(p, k)| e(p, k))?;
+        let ops = self.typed_all(nx, vals, ty, blk.op.name_static(), id)?;
         let (d, rest) = self.dest(nx, b, 0, ty, &ops)?;
         let dv = var_op(d);
         let cmp_move = |op: CmpOp, x: Operand| {
