@@ -845,6 +845,62 @@ fn unconditional_backward_jump_refusal_is_a_cfg_edge_and_runs_in_parallel() {
 }
 
 #[test]
+fn a_refused_loop_back_followed_by_an_unconditional_jump_runs_in_parallel() {
+    // R2's jump back to L sits in a branch; after it the rung jumps to F unconditionally. When
+    // the iteration cap refuses the loop-back, the rest of the rung runs and takes that jump:
+    // control never falls through to R3, so the CFG has no edge R2 -> R3 and the plan needs
+    // none (a check that assumed one would fall back to the sequential walk).
+    let json = r#"{
+      "program": "loop-then-jump",
+      "vars": [{"name": "n", "type": "DINT"}, {"name": "m", "type": "DINT"},
+               {"name": "a", "type": "BOOL", "class": "input"}, {"name": "x", "type": "BOOL"},
+               {"name": "skipped", "type": "BOOL"}, {"name": "after", "type": "BOOL"}],
+      "rungs": [
+        {"id": "R0", "ld": [{"contact": "a"}, {"coil": "x"}]},
+        {"id": "R1", "label": "L", "ld": [{"op": "ADD", "in": ["n", 1], "out": "n"}]},
+        {"id": "R2", "ld": [{"branch": [[{"jmp": "L"}], [{"op": "ADD", "in": ["m", 1], "out": "m"}]]},
+                            {"jmp": "F"}]},
+        {"id": "R3", "ld": [{"contact": "x"}, {"coil": "skipped"}]},
+        {"id": "R4", "label": "F", "ld": [{"contact": "x"}, {"coil": "after"}]}
+      ]
+    }"#;
+    let p = plc_deps::load::program_from_json(json).unwrap();
+    let a = analyse(&p);
+    let mut from_r2: Vec<u32> = a
+        .cfg
+        .edges
+        .iter()
+        .filter(|e| e.from.0 == 2)
+        .map(|e| e.to.0)
+        .collect();
+    from_r2.sort_unstable();
+    assert_eq!(from_r2, [1, 4]);
+    let exec = ExecConfig {
+        cycle_ms: 10,
+        loop_cap: 5,
+    };
+    let mut stats = Stats::default();
+    for kind in [PlanKind::Par, PlanKind::Deps, PlanKind::Exchange] {
+        let mut config = PlanConfig::new(2);
+        config.strategy = Strategy::AllParallel;
+        config.kind = kind;
+        let par = ParallelMachine::new(&p, &a, &exec, &config).unwrap();
+        assert_eq!(par.plan().sequential(), None, "{kind:?}");
+        check(
+            &p,
+            "loop-then-jump",
+            &config,
+            &exec,
+            4,
+            11,
+            &pool(),
+            &mut stats,
+        );
+    }
+    assert_eq!(stats.loop_cap_faults, 3 * 4);
+}
+
+#[test]
 fn one_scan_at_a_time_equals_a_run() {
     let json =
         plc_deps::synth::generate_string(&plc_deps::synth::GenConfig::all_features(800, 50, 9));

@@ -159,11 +159,19 @@ pub(crate) fn transfers(series: &[Element], out: &mut Vec<(Transfer, bool)>) -> 
     transfers_refusing(series, None, out)
 }
 
+/// Whether transfers found by [`transfers`] (`terminated`: its result) end the rung of `r` in
+/// an unconditional jump back to `r` itself or an earlier rung: a loop-back the iteration cap
+/// may refuse, after which the rest of the rung runs ([`transfers_refusing`]).
+pub(crate) fn ends_in_loop_back(found: &[(Transfer, bool)], terminated: bool, r: RungId) -> bool {
+    terminated && matches!(found.last(), Some(&(Transfer::Jump(t), true)) if t.0 <= r.0)
+}
+
 /// [`transfers`] of rung `refused`'s series when the iteration cap refuses its backward jumps
 /// (those to `refused` itself or an earlier rung): each is listed, as it may be taken before
 /// the cap is reached, and then acts as a jump without power, so the walk goes on past it with
-/// power no longer constantly TRUE.
-fn transfers_refusing(
+/// power no longer constantly TRUE. Returns whether the rung still ends in an unconditional
+/// transfer (a later jump, RET or END); if not, control goes on to the next rung.
+pub(crate) fn transfers_refusing(
     series: &[Element],
     refused: Option<RungId>,
     out: &mut Vec<(Transfer, bool)>,
@@ -356,8 +364,7 @@ pub fn control_flow_graph(p: &Program) -> Cfg {
         let mut terminated = transfers(&rung.series, &mut found);
         // An unconditional backward jump ends the rung only until the iteration cap refuses it:
         // then the rest of the rung runs, and control may go on past it.
-        let capped =
-            terminated && matches!(found.last(), Some(&(Transfer::Jump(t), true)) if t.0 <= r.0);
+        let capped = ends_in_loop_back(&found, terminated, r);
         if capped {
             found.clear();
             terminated = transfers_refusing(&rung.series, Some(r), &mut found);

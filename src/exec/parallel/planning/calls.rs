@@ -5,6 +5,7 @@
 //! Pure functions of the program and its analysis (CALL/SBR and JMP/LBL as sources of control
 //! dependence, Zhao & Yan); depends only on the typed indices below it. It does not plan.
 
+use crate::analysis::cfg::{self, Transfer};
 use crate::analysis::{Analysis, EdgeKind};
 use crate::exec::parallel::ids::TaskId;
 use crate::model::{Element, PouId, Program, RungId};
@@ -108,20 +109,25 @@ pub(in crate::exec::parallel) fn uncovered_refusal(
             Some(Element::Next { .. }) => vec![next],
             _ => {
                 found.clear();
-                crate::analysis::cfg::transfers(&rung.series, &mut found);
-                let unconditional_back = found.iter().any(|&(tr, always)| {
-                    always && matches!(tr, crate::analysis::cfg::Transfer::Jump(x) if x.0 <= r)
-                });
-                if !unconditional_back {
+                let terminated = cfg::transfers(&rung.series, &mut found);
+                if !cfg::ends_in_loop_back(&found, terminated, RungId(r)) {
                     continue; // a conditional backward jump's "not taken" paths are CFG edges
                 }
-                // After a refusal the rest of the rung runs: any of its transfers, or onwards.
-                let mut ts = vec![next];
-                crate::model::walk_elements(&rung.series, &mut |e| match e {
-                    Element::Jmp { target, .. } => ts.push(target.0),
-                    Element::Ret | Element::End => ts.push(stop),
-                    _ => {}
-                });
+                // After a refusal the rest of the rung runs: its transfers up to the next
+                // unconditional one, or onwards when there is none.
+                found.clear();
+                let ends = cfg::transfers_refusing(&rung.series, Some(RungId(r)), &mut found);
+                let mut ts: Vec<u32> = found
+                    .iter()
+                    .filter_map(|&(tr, _)| match tr {
+                        Transfer::Jump(x) => Some(x.0),
+                        Transfer::Ret | Transfer::End => Some(stop),
+                        Transfer::Call(_) => None,
+                    })
+                    .collect();
+                if !ends {
+                    ts.push(next);
+                }
                 ts
             }
         };
