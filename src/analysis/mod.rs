@@ -364,13 +364,10 @@ fn paper_control_view(p: &Program, control: &[ControlDependence]) -> Vec<PaperCo
                     }
                 }
             }
-            Element::Move { from: o, .. } => {
-                if let Operand::Var(v) = o {
-                    if v.field.is_some() {
-                        field_reads.push(v.var);
-                    }
-                }
-            }
+            Element::Move {
+                from: Operand::Var(v),
+                ..
+            } if v.field.is_some() => field_reads.push(v.var),
             _ => {}
         });
         field_reads.sort_unstable();

@@ -79,10 +79,8 @@ pub(crate) fn pou(b: &mut Body, p: &Program, pou: &FbdPou, copy: &LoweredCopy) {
 }
 
 fn network(b: &mut Body, p: &Program, plan: &Plan, start: u32, blocks: &[RungId]) {
-    let mut cursor = start;
-    for step in &plan.steps {
+    for (cursor, step) in (start..).zip(&plan.steps) {
         let r = RungId(cursor);
-        cursor += 1;
         match *step {
             Step::Enter(f) => {
                 b.label(r);
