@@ -243,18 +243,20 @@ const BLOCK_TIME: Duration = Duration::from_millis(20);
 /// ... and the run is cut into at most this many turns of each.
 const BLOCKS_MAX: u64 = 64;
 
-/// The scans of each mode's turn when both run: as many as take [`BLOCK_TIME`] on the
-/// sequential walk (`warm_time` over `warm` scans), no fewer than a [`BLOCKS_MAX`]-th of
-/// the run and no more than the run (a run shorter than a turn is one turn of each). A turn costs the parallel pass a wake-up of its workers and both passes cold caches
-/// for a scan, a few tens of µs: under 0.5 % of a turn this long.
-fn compare_block(warm_time: Duration, warm: u64, scans: u64) -> u64 {
-    let per_scan = warm_time.as_nanos() / u128::from(warm.max(1));
-    let by_time = (BLOCK_TIME.as_nanos() / per_scan.max(1)).max(1);
-    let by_count = scans.div_ceil(BLOCKS_MAX).max(1);
-    u64::try_from(by_time)
-        .unwrap_or(u64::MAX)
-        .max(by_count)
-        .min(scans.max(1))
+/// The scans of each mode's turn when both run: `alternate` (`--alternate N`) if given, else as
+/// many as take [`BLOCK_TIME`] on the sequential walk (`warm_time` over `warm` scans) and no
+/// fewer than a [`BLOCKS_MAX`]-th of the run; never more than the run (a run shorter than a
+/// turn is one turn of each) nor fewer than 1. A turn costs the parallel pass a wake-up of its
+/// workers and both passes cold caches for a scan, a few tens of µs: under 0.5 % of a turn of
+/// 20 ms.
+fn turn_scans(alternate: Option<u64>, warm_time: Duration, warm: u64, scans: u64) -> u64 {
+    let by_default = || {
+        let per_scan = warm_time.as_nanos() / u128::from(warm.max(1));
+        let by_time = (BLOCK_TIME.as_nanos() / per_scan.max(1)).max(1);
+        let by_count = scans.div_ceil(BLOCKS_MAX);
+        u64::try_from(by_time).unwrap_or(u64::MAX).max(by_count)
+    };
+    alternate.unwrap_or_else(by_default).clamp(1, scans.max(1))
 }
 
 /// A driver that only writes the inputs (warm-up).
@@ -550,10 +552,7 @@ pub(super) fn execute(
     // during the run (another process, the host) hits both alike; the parallel pass goes on
     // with one measured choice across its turns.
     let block = match (&seq, &par) {
-        (Some(_), Some(_)) => c.alternate.map_or_else(
-            || compare_block(seq_warm, warm, scans),
-            |b| b.min(scans.max(1)),
-        ),
+        (Some(_), Some(_)) => turn_scans(c.alternate, seq_warm, warm, scans),
         _ => scans.max(1),
     };
     let mut at = 0;
@@ -747,19 +746,22 @@ fn report(pr: &Prepared, c: &RunConfig, m: &Machine, pass: Pass, extra: Extra) -
 
 #[cfg(test)]
 mod tests {
-    use super::compare_block;
+    use super::turn_scans;
     use std::time::Duration;
 
     #[test]
     fn a_turn_is_about_twenty_ms_of_the_sequential_walk_within_the_run() {
         let us = Duration::from_micros;
         // 100 µs a scan (10 warm-up scans in 1 ms): 200 scans make 20 ms.
-        assert_eq!(compare_block(us(1_000), 10, 10_000), 200);
+        assert_eq!(turn_scans(None, us(1_000), 10, 10_000), 200);
         // ... but never fewer than a 64th of the run: 1,000,000 / 64.
-        assert_eq!(compare_block(us(1_000), 10, 1_000_000), 15_625);
+        assert_eq!(turn_scans(None, us(1_000), 10, 1_000_000), 15_625);
         // 0.4 µs a scan would make 50,000 scans a turn: a run of 1,000 is one turn.
-        assert_eq!(compare_block(us(4), 10, 1_000), 1_000);
-        // No scans, or a zero warm-up: still a positive block.
-        assert_eq!(compare_block(Duration::ZERO, 0, 0), 1);
+        assert_eq!(turn_scans(None, us(4), 10, 1_000), 1_000);
+        // No scans, or a zero warm-up: still a positive turn.
+        assert_eq!(turn_scans(None, Duration::ZERO, 0, 0), 1);
+        // --alternate N is taken as it is, within the run.
+        assert_eq!(turn_scans(Some(7), us(1_000), 10, 10_000), 7);
+        assert_eq!(turn_scans(Some(5_000), us(1_000), 10, 1_000), 1_000);
     }
 }
