@@ -14,7 +14,9 @@
 //! with the current one *round by round* ([`choose`]): it replaces the current one only if it
 //! was faster in more than half the rounds, by at least 3 % at the median of the per-round
 //! ratios. A candidate other than the current one that took more than 1.5× the best time of a
-//! round sits out the later rounds (4× the best after one scan: the rest of its visit too).
+//! round sits out the later rounds (4× the best after one scan: the rest of its visit too);
+//! one the machine skips (its workers are away from their cores) misses that round only, and a
+//! candidate without a time yet is visited again at the next routine re-measurement.
 //! The measurement stops once it has its minimum of rounds and the choice after the last round
 //! is the choice after the round before (successive choices agree), or when a candidate is at
 //! least twice as fast in every round, or when every other candidate sits out, or at its
@@ -391,12 +393,15 @@ impl Chooser {
         let median = (!timed.is_empty()).then(|| lower_median(&mut timed));
         m.table[i].resize(m.round + 1, None);
         m.table[i][m.round] = median;
-        if !complete && i != 0 {
+        if !complete && m.visit_scans > 0 && i != 0 {
+            // Hopeless after a scan: out of the measurement, and so out of the order (`at`
+            // already points at the next visit). A skipped visit (no scan) is not.
             m.dropped[i] = true;
+        } else {
+            m.at += 1;
         }
         m.visit.clear();
         m.visit_scans = 0;
-        m.at += 1;
         if m.at < m.order().len() {
             return;
         }
@@ -455,7 +460,8 @@ impl Chooser {
     }
 
     /// The candidates besides the current one that a routine re-measurement visits: the
-    /// default (candidate 0) and the runner-up.
+    /// default (candidate 0), the runner-up, and any not measured yet (skipped in every round
+    /// so far while the other workers were away).
     fn routine_visits(&self) -> Vec<usize> {
         let mut who = Vec::new();
         if let Some(r) = self.runner_up() {
@@ -463,6 +469,12 @@ impl Chooser {
                 who.push(0);
             }
             who.push(r);
+        }
+        let unmeasured = (0..self.n).filter(|&c| c != self.current && self.estimate[c].is_none());
+        for c in unmeasured {
+            if !who.contains(&c) {
+                who.push(c);
+            }
         }
         who
     }
@@ -568,9 +580,10 @@ impl Chooser {
         matches!(&self.stage, Stage::Measure(m) if m.order()[m.at] != 0)
     }
 
-    /// Leaves the next visit's candidate out of this measurement without running it, as if it
-    /// were hopeless (the machine knows it cannot gain now: its workers are not on a core).
-    /// Nothing when [`measuring_other`](Self::measuring_other) is false.
+    /// Leaves the next visit's candidate out of this round of the measurement without running it
+    /// (the machine knows it cannot gain now: its workers are not on a core); the measurement's
+    /// later rounds visit it again. Nothing when [`measuring_other`](Self::measuring_other) is
+    /// false.
     pub fn skip(&mut self) {
         if self.measuring_other() {
             self.end_visit();

@@ -185,6 +185,72 @@ fn a_skipped_candidate_never_runs_in_that_measurement_and_the_others_decide() {
 }
 
 #[test]
+fn a_candidate_skipped_in_one_round_is_visited_in_the_next_ones() {
+    // The machine skips candidate 2 once (its workers were away at the start of the run); it
+    // is the fastest, and the measurement's later rounds find that.
+    let mut ch = Chooser::new(3, measure(), 0);
+    let mut ran = Vec::new();
+    let mut skipped = false;
+    while ran.len() < 40 {
+        if ch.next().candidate == 2 && !skipped {
+            ch.skip();
+            skipped = true;
+            continue;
+        }
+        let w = ch.next();
+        let t = [100_000, 50_000, 10_000][w.candidate];
+        ran.extend(std::iter::repeat_n(w.candidate, w.scans as usize));
+        ch.record(w, &vec![t; w.scans as usize]);
+    }
+    assert!(skipped);
+    // Round 0: 0, 1, (2 skipped); round 1: 1, 2, 0, in which 2 takes a tenth of 0's time:
+    // decisive after two rounds, so 2 runs from then on.
+    let visits: Vec<usize> = ran[..15].chunks(3).map(|v| v[0]).collect();
+    assert_eq!(visits, [0, 1, 1, 2, 0]);
+    assert!(ran[15..].iter().all(|&c| c == 2), "{ran:?}");
+    assert_eq!(ch.current(), 2);
+    assert_eq!(ch.estimates()[2], Some(10_000));
+}
+
+#[test]
+fn a_candidate_never_measured_is_visited_at_the_next_re_measurement() {
+    // Candidate 2 is skipped in every round of the first measurement (its workers away), so
+    // it has no time; the first routine re-measurement visits it, and it wins.
+    let mut ch = Chooser::new(3, unbudgeted(), 0);
+    let mut ran = Vec::new();
+    while ran.len() < 400 {
+        if ch.next().candidate == 2 && ran.len() < 20 {
+            ch.skip();
+            continue;
+        }
+        let w = ch.next();
+        let t = [100_000, 50_000, 10_000][w.candidate];
+        ran.extend(std::iter::repeat_n(w.candidate, w.scans as usize));
+        ch.record(w, &vec![t; w.scans as usize]);
+    }
+    let first_on_2 = ran
+        .iter()
+        .position(|&c| c == 2)
+        .expect("candidate 2 never ran");
+    assert!(
+        first_on_2 > 20 && first_on_2 < 200,
+        "first ran at scan {first_on_2}"
+    );
+    assert_eq!(ch.current(), 2);
+    assert_eq!(ch.switches().len(), 2, "{:?}", ch.switches());
+}
+
+#[test]
+fn a_hopeless_candidate_does_not_cost_the_next_one_its_visit() {
+    // Round 0 visits 0, then 1 (hopeless: out after one scan), then 2 and 3: 2 must not lose
+    // its visit because 1 left the order.
+    let mut ch = Chooser::new(4, measure(), 0);
+    let ns = |c: usize, _: u64, _: bool| [100_000, 1_000_000, 60_000, 70_000][c];
+    let ran = drive(&mut ch, 4, 10, ns);
+    assert_eq!(ran, [0, 0, 0, 1, 2, 2, 2, 3, 3, 3]);
+}
+
+#[test]
 fn a_hopeless_candidate_is_dropped_after_one_scan_and_the_default_kept() {
     let mut ch = Chooser::new(3, measure(), 0);
     let ns = |c: usize, _: u64, _: bool| [100_000, 1_000_000, 101_000][c];
