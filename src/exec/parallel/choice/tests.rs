@@ -159,21 +159,34 @@ fn a_measurement_runs_until_successive_choices_agree() {
     assert!(ch.switches().is_empty());
 }
 
-#[test]
-fn a_skipped_candidate_never_runs_in_that_measurement_and_the_others_decide() {
-    let mut ch = Chooser::new(3, measure(), 0);
+/// Runs at least `scans` scans of three candidates taking 100, 50 and 10 µs a scan, skipping
+/// (as the machine does when the other workers are away) every visit for which `skip(scan,
+/// candidate)` says so, which must be a visit of another candidate than the current one.
+/// Returns the candidate of every scan run.
+fn drive_skipping(
+    ch: &mut Chooser,
+    scans: usize,
+    mut skip: impl FnMut(usize, usize) -> bool,
+) -> Vec<usize> {
     let mut ran = Vec::new();
-    while ran.len() < 40 {
-        if ch.next().candidate == 2 {
+    while ran.len() < scans {
+        let w = ch.next();
+        if skip(ran.len(), w.candidate) {
             assert!(ch.measuring_other());
             ch.skip();
             continue;
         }
-        let w = ch.next();
         let t = [100_000, 50_000, 10_000][w.candidate];
         ran.extend(std::iter::repeat_n(w.candidate, w.scans as usize));
         ch.record(w, &vec![t; w.scans as usize]);
     }
+    ran
+}
+
+#[test]
+fn a_skipped_candidate_never_runs_in_that_measurement_and_the_others_decide() {
+    let mut ch = Chooser::new(3, measure(), 0);
+    let ran = drive_skipping(&mut ch, 40, |_, c| c == 2);
     assert!(!ran.contains(&2), "{ran:?}");
     assert_eq!(ch.current(), 1, "the faster of the two measured");
     assert_eq!(ch.estimates()[2], None);
@@ -189,19 +202,12 @@ fn a_candidate_skipped_in_one_round_is_visited_in_the_next_ones() {
     // The machine skips candidate 2 once (its workers were away at the start of the run); it
     // is the fastest, and the measurement's later rounds find that.
     let mut ch = Chooser::new(3, measure(), 0);
-    let mut ran = Vec::new();
     let mut skipped = false;
-    while ran.len() < 40 {
-        if ch.next().candidate == 2 && !skipped {
-            ch.skip();
-            skipped = true;
-            continue;
-        }
-        let w = ch.next();
-        let t = [100_000, 50_000, 10_000][w.candidate];
-        ran.extend(std::iter::repeat_n(w.candidate, w.scans as usize));
-        ch.record(w, &vec![t; w.scans as usize]);
-    }
+    let ran = drive_skipping(&mut ch, 40, |_, c| {
+        let skip = c == 2 && !skipped;
+        skipped |= skip;
+        skip
+    });
     assert!(skipped);
     // Round 0: 0, 1, (2 skipped); round 1: 1, 2, 0, in which 2 takes a tenth of 0's time:
     // decisive after two rounds, so 2 runs from then on.
@@ -217,17 +223,7 @@ fn a_candidate_never_measured_is_visited_at_the_next_re_measurement() {
     // Candidate 2 is skipped in every round of the first measurement (its workers away), so
     // it has no time; the first routine re-measurement visits it, and it wins.
     let mut ch = Chooser::new(3, unbudgeted(), 0);
-    let mut ran = Vec::new();
-    while ran.len() < 400 {
-        if ch.next().candidate == 2 && ran.len() < 20 {
-            ch.skip();
-            continue;
-        }
-        let w = ch.next();
-        let t = [100_000, 50_000, 10_000][w.candidate];
-        ran.extend(std::iter::repeat_n(w.candidate, w.scans as usize));
-        ch.record(w, &vec![t; w.scans as usize]);
-    }
+    let ran = drive_skipping(&mut ch, 400, |scan, c| c == 2 && scan < 20);
     let first_on_2 = ran
         .iter()
         .position(|&c| c == 2)
