@@ -15,6 +15,7 @@
 //! in callee-first order (the call graph is acyclic, checked by the reader).
 
 use crate::model::*;
+use std::ops::Range;
 
 /// Flat per-unit variable lists: `list(i)` is the sorted set of unit `i`.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -90,7 +91,9 @@ pub fn accesses(p: &Program) -> Accesses {
     // Summaries of called subroutines, callees first (the call graph is acyclic).
     let mut summary: Vec<(Vec<VarId>, Vec<VarId>)> = vec![(Vec::new(), Vec::new()); p.pous.len()];
     // Per rung, in POU order; rungs are stored in listing order afterwards.
-    let mut per_rung: Vec<(u32, u32, u32, u32)> = vec![(0, 0, 0, 0); p.rungs.len()];
+    // Per rung, where its reads and its writes lie in `all_reads` and `all_writes`.
+    let mut read_at: Vec<Range<u32>> = vec![0..0; p.rungs.len()];
+    let mut write_at: Vec<Range<u32>> = vec![0..0; p.rungs.len()];
     let (mut all_reads, mut all_writes) = (Vec::new(), Vec::new());
     let mut reads = Vec::new();
     let mut writes = Vec::new();
@@ -106,7 +109,8 @@ pub fn accesses(p: &Program) -> Accesses {
             let (rs, ws) = (all_reads.len() as u32, all_writes.len() as u32);
             all_reads.extend_from_slice(&reads);
             all_writes.extend_from_slice(&writes);
-            per_rung[r.index()] = (rs, all_reads.len() as u32, ws, all_writes.len() as u32);
+            read_at[r.index()] = rs..all_reads.len() as u32;
+            write_at[r.index()] = ws..all_writes.len() as u32;
         }
         if is_sub {
             for l in [&mut sub_r, &mut sub_w] {
@@ -117,22 +121,22 @@ pub fn accesses(p: &Program) -> Accesses {
         }
     }
     // Main first in listing order, and the callee-first order puts main last: re-lay in rung order.
-    let gather = |all: &[VarId], range: fn(&(u32, u32, u32, u32)) -> (u32, u32)| {
+    let gather = |all: &[VarId], at: &[Range<u32>]| {
         let mut s = VarSets {
-            offsets: Vec::with_capacity(per_rung.len() + 1),
+            offsets: Vec::with_capacity(at.len() + 1),
             vars: Vec::with_capacity(all.len()),
         };
         s.offsets.push(0);
-        for r in &per_rung {
-            let (a, b) = range(r);
-            s.vars.extend_from_slice(&all[a as usize..b as usize]);
+        for r in at {
+            s.vars
+                .extend_from_slice(&all[r.start as usize..r.end as usize]);
             s.offsets.push(s.vars.len() as u32);
         }
         s
     };
     Accesses {
-        reads: gather(&all_reads, |r| (r.0, r.1)),
-        writes: gather(&all_writes, |r| (r.2, r.3)),
+        reads: gather(&all_reads, &read_at),
+        writes: gather(&all_writes, &write_at),
     }
 }
 

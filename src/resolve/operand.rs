@@ -41,11 +41,11 @@ impl Untyped {
     }
 }
 
+/// Resolves a variable name to its reference and type (the scope an operand is parsed in).
+pub(crate) type Lookup<'a> = dyn Fn(&str) -> Result<(VarRef, Type), Invalid> + 'a;
+
 /// Parses an operand; `lookup` resolves a variable name to its reference and type.
-pub(crate) fn parse(
-    s: &Scalar,
-    lookup: &dyn Fn(&str) -> Result<(VarRef, Type), Invalid>,
-) -> Result<Untyped, Invalid> {
+pub(crate) fn parse(s: &Scalar, lookup: &Lookup<'_>) -> Result<Untyped, Invalid> {
     match s {
         Scalar::Bool(b) => Ok(Untyped::Bool(*b)),
         Scalar::Number(n) => Ok(match (n.as_i64(), n.as_u64()) {

@@ -40,6 +40,13 @@ enum Drawing<'a> {
     Block(&'a Network, BlockId),
 }
 
+/// The frame drawn around a loop task's cards: its left edge, top and height.
+struct Frame {
+    x: f64,
+    y: f64,
+    h: f64,
+}
+
 struct Card<'a> {
     rung: RungId,
     col: usize,
@@ -124,7 +131,7 @@ fn blocks<'a>(input: &HtmlInput<'_, 'a>) -> HashMap<RungId, (&'a Network, BlockI
 fn place<'a>(
     input: &HtmlInput<'_, 'a>,
     cols: &[Column],
-) -> (Vec<Option<Card<'a>>>, Vec<(f64, f64, f64)>, Size) {
+) -> (Vec<Option<Card<'a>>>, Vec<Frame>, Size) {
     let p = input.program;
     let ids: HashMap<&str, RungId> = p.rung_ids().map(|r| (p.rung(r).id.as_str(), r)).collect();
     let blocks = blocks(input);
@@ -164,7 +171,11 @@ fn place<'a>(
                 y += h + 8.0;
             }
             if framed {
-                frames.push((x - 4.0, top, y - top));
+                frames.push(Frame {
+                    x: x - 4.0,
+                    y: top,
+                    h: y - top,
+                });
                 y += 8.0;
             }
         }
@@ -213,7 +224,7 @@ pub(super) fn write_levels(out: &mut impl Write, input: &HtmlInput) -> io::Resul
             esc(&col.title)
         )?;
     }
-    for (x, y, h) in frames {
+    for Frame { x, y, h } in frames {
         writeln!(
             out,
             r#"<rect class="loop" x="{x:.1}" y="{y:.1}" width="{:.1}" height="{h:.1}" rx="6"/><text class="looplbl" x="{:.1}" y="{:.1}">loop task (one sequential task)</text>"#,
