@@ -3,6 +3,10 @@
 //! control dependences against set-based fixpoints, and the combined schedule against the
 //! pairwise conditions that make it safe.
 
+// The references index node-by-node matrices (`sets[b][a]`: a post-dominates b), as the
+// definitions are written.
+#![allow(clippy::needless_range_loop)]
+
 mod common;
 
 use plc_deps::analysis::accesses::VarSets;

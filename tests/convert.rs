@@ -6,7 +6,6 @@
 mod common;
 
 #[path = "plcopen_common/mod.rs"]
-#[allow(dead_code)]
 mod px;
 
 use common::cli::{error_line, run, tmp};

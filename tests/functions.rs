@@ -55,9 +55,11 @@ fn round_real(x: f64) -> i128 {
     } else {
         t
     };
-    if r >= 9.223372036854775808e18 {
+    // 2^63, exactly representable: the first real beyond `i64::MAX`.
+    let two_63 = 2f64.powi(63);
+    if r >= two_63 {
         i64::MAX as i128
-    } else if r < -9.223372036854775808e18 {
+    } else if r < -two_63 {
         i64::MIN as i128
     } else {
         r as i128

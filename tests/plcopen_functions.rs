@@ -7,11 +7,15 @@ mod common;
 mod px;
 
 use px::{
-    block, contact, in_var, io, project, project_in, rail, report_and_warnings, rung, trace, var_in,
+    block, contact, in_var, io, project, project_in, rail, report_and_warnings, rung, trace,
+    var_in, Source,
 };
 
-/// FBD: `out := op(ins…)` for each `(op, [(pin, input expression)], out)`.
-fn fbd(vars: &[(&str, &str, &str)], calls: &[(&str, &[(&str, &str)], &str)]) -> String {
+/// One function call of [`fbd`]: `(op, [(pin, input expression)], out)`.
+type Call<'a> = (&'a str, &'a [(&'a str, &'a str)], &'a str);
+
+/// FBD: `out := op(ins…)` for each call.
+fn fbd(vars: &[(&str, &str, &str)], calls: &[Call]) -> String {
     let mut body = String::new();
     let mut id = 1;
     for (op, ins, out) in calls {
@@ -21,13 +25,12 @@ fn fbd(vars: &[(&str, &str, &str)], calls: &[(&str, &[(&str, &str)], &str)]) -> 
             wires.push(id);
             id += 1;
         }
-        let pins: Vec<(&str, Vec<(u32, Option<&str>)>)> = ins
+        let pins: Vec<(&str, Vec<Source>)> = ins
             .iter()
             .zip(&wires)
             .map(|((pin, _), w)| (*pin, vec![(*w, None)]))
             .collect();
-        let pins: Vec<(&str, &[(u32, Option<&str>)])> =
-            pins.iter().map(|(p, w)| (*p, w.as_slice())).collect();
+        let pins: Vec<(&str, &[Source])> = pins.iter().map(|(p, w)| (*p, w.as_slice())).collect();
         body.push_str(&block(id, op, None, &pins, &["OUT"]));
         body.push_str(&var_in("outVariable", id + 1, out, (id, Some("OUT"))));
         id += 2;
@@ -147,7 +150,7 @@ fn ld_sqrt() -> String {
         in_var(3, "x"),
         block(4, "SQRT", None, &[("EN", &[(2, None)]), ("IN", &[(3, None)])], &["ENO", "OUT"]),
         var_in("outVariable", 5, "r", (4, Some("OUT"))),
-        format!("<coil localId=\"6\"><connectionPointIn><connection refLocalId=\"4\" formalParameter=\"ENO\"/></connectionPointIn><connectionPointOut/><variable>done</variable></coil>"),
+        "<coil localId=\"6\"><connectionPointIn><connection refLocalId=\"4\" formalParameter=\"ENO\"/></connectionPointIn><connectionPointOut/><variable>done</variable></coil>".to_string(),
     ]
     .concat();
     project(

@@ -7,12 +7,12 @@ mod common;
 mod px;
 
 use common::cli::run_stdin;
-use px::{block, coil, contact, io, project, rail, report, rung, trace};
+use px::{block, coil, contact, io, project, rail, report, rung, trace, Source};
 
 fn on(op: &str, id: u32, ins: &[u32]) -> String {
     let pins: Vec<String> = (1..=ins.len()).map(|k| format!("IN{k}")).collect();
-    let wires: Vec<(u32, Option<&str>)> = ins.iter().map(|&i| (i, None)).collect();
-    let inputs: Vec<(&str, &[(u32, Option<&str>)])> = if op == "NOT" {
+    let wires: Vec<Source> = ins.iter().map(|&i| (i, None)).collect();
+    let inputs: Vec<(&str, &[Source])> = if op == "NOT" {
         vec![("IN", &wires[..1])]
     } else {
         pins.iter()

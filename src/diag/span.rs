@@ -190,7 +190,7 @@ pub fn offset_of(text: &str, line: usize, column: usize) -> usize {
 mod tests {
     use super::*;
 
-    fn token<'t>(text: &'t str, at: usize) -> &'t str {
+    fn token(text: &str, at: usize) -> &str {
         &text[token_at(text, at)]
     }
 

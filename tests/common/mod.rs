@@ -249,11 +249,11 @@ fn typed_compare(rng: &mut Rng) -> Value {
 
 fn bool_read(rng: &mut Rng) -> &'static str {
     match rng.below(10) {
-        0..=3 => *rng.pick(BOOLS),
-        4..=6 => *rng.pick(INPUTS),
+        0..=3 => rng.pick::<&str>(BOOLS),
+        4..=6 => rng.pick::<&str>(INPUTS),
         7 => "t0.Q",
         8 => "c0.Q",
-        _ => *rng.pick(&[
+        _ => rng.pick::<&str>(&[
             "t1.Q", "t2.Q", "c1.Q", "q", "s0.Q1", "s1.Q1", "e0.Q", "e1.Q", "u0.QU", "u0.QD",
         ]),
     }

@@ -80,8 +80,11 @@ pub fn in_var(id: u32, expr: &str) -> String {
     format!("<inVariable localId=\"{id}\"><connectionPointOut/><expression>{expr}</expression></inVariable>")
 }
 
-/// A block's inputs: `(pin, sources)`, a source `(localId, Some(output pin))`.
-pub type Wires<'a> = &'a [(&'a str, &'a [(u32, Option<&'a str>)])];
+/// A source of a block's input: `(localId, Some(output pin))`.
+pub type Source<'a> = (u32, Option<&'a str>);
+
+/// A block's inputs: `(pin, sources)`.
+pub type Wires<'a> = &'a [(&'a str, &'a [Source<'a>])];
 
 /// An FBD block: `(pin, sources)` inputs (a source `(localId, Some(pin))`), output pin names.
 pub fn block(id: u32, ty: &str, instance: Option<&str>, inputs: Wires, outputs: &[&str]) -> String {
