@@ -3,6 +3,7 @@
 
 use super::config::{DepsPartition, LineCostSource};
 use super::machine::{Candidate, ParallelMachine, RunLog};
+use super::planning::Plan;
 use crate::model::Program;
 use serde_json::json;
 use std::fmt::Write as _;
@@ -41,6 +42,30 @@ impl ParallelMachine {
             seq as f64 / est.max(1) as f64,
             plan.phase_lines.iter().flatten().sum::<u64>()
         );
+        self.explain_candidates(&mut s);
+        self.explain_deps(&mut s);
+        if let Some(why) = &plan.sequential {
+            let _ = writeln!(
+                s,
+                "decision: the whole program runs as the sequential scan: {why}"
+            );
+        } else {
+            let _ = writeln!(
+                s,
+                "decision: {} per scan ({} parallel), {} per scan",
+                count(plan.phase_count(), "phase"),
+                plan.parallel_phases(),
+                count(plan.barriers_per_scan(), "barrier")
+            );
+        }
+        explain_levels(plan, &mut s);
+        self.explain_layout(p, &mut s);
+        s
+    }
+
+    /// Every candidate besides the primary plan: its modelled scan, and for `par-exchange`
+    /// its plan, layout and hand-over.
+    fn explain_candidates(&self, s: &mut String) {
         for (i, c) in self.candidates.iter().enumerate() {
             match *c {
                 Candidate::Levelled(k) if k > 0 => {
@@ -86,76 +111,11 @@ impl ParallelMachine {
                 _ => {}
             }
         }
-        self.explain_deps(&mut s);
-        if let Some(why) = &plan.sequential {
-            let _ = writeln!(
-                s,
-                "decision: the whole program runs as the sequential scan: {why}"
-            );
-        } else {
-            let _ = writeln!(
-                s,
-                "decision: {} per scan ({} parallel), {} per scan",
-                count(plan.phase_count(), "phase"),
-                plan.parallel_phases(),
-                count(plan.barriers_per_scan(), "barrier")
-            );
-        }
-        let shown = plan.levels.len().min(500);
-        for (l, lp) in plan.levels.iter().take(shown).enumerate() {
-            let kind = if lp.parallel {
-                "parallel"
-            } else {
-                "sequential"
-            };
-            let _ = write!(
-                s,
-                "  level {:>3}: {:>6} task{}, cost {:>8}, {kind}",
-                l + 1,
-                lp.tasks,
-                if lp.tasks == 1 { " " } else { "s" },
-                lp.cost
-            );
-            if let (true, Some(m)) = (lp.parallel, lp.makespan) {
-                let moved: u64 = lp.lines.iter().sum();
-                let others: Vec<String> = lp
-                    .compared
-                    .iter()
-                    .filter(|(name, _)| *name != lp.slicing)
-                    .map(|(name, m)| format!("{name} {m}"))
-                    .collect();
-                let others = if others.is_empty() {
-                    String::new()
-                } else {
-                    format!(" [{}]", others.join(", "))
-                };
-                let _ = write!(
-                    s,
-                    " ({}, makespan {m}{others}, {} moved):",
-                    lp.slicing,
-                    count(moved, "line")
-                );
-                for (w, (tasks, items, cost)) in lp.workers.iter().enumerate() {
-                    let _ = write!(
-                        s,
-                        " w{w} {}/{}/{cost}+{}",
-                        count(*tasks, "task"),
-                        count(*items, "item"),
-                        count(lp.lines.get(w).copied().unwrap_or(0), "line")
-                    );
-                    if w + 1 < lp.workers.len() {
-                        s.push(',');
-                    }
-                }
-            }
-            if !lp.reason.is_empty() {
-                let _ = write!(s, " — {}", lp.reason);
-            }
-            s.push('\n');
-        }
-        if shown < plan.levels.len() {
-            let _ = writeln!(s, "  ... {} more levels", plan.levels.len() - shown);
-        }
+    }
+
+    /// The primary plan's phases (merged, halo and sequential ones) and the state's padding.
+    fn explain_layout(&self, p: &Program, s: &mut String) {
+        let plan = &self.plans[0];
         if plan.sequential.is_none() {
             for (i, ph) in plan.phases.iter().enumerate() {
                 let moved = plan
@@ -201,7 +161,6 @@ impl ParallelMachine {
         } else {
             let _ = writeln!(s, "padding: none (dense layout)");
         }
-        s
     }
 
     /// The dependence-driven plan, if one was built: its waits per worker and modelled scan.
@@ -497,5 +456,65 @@ fn partition_words(p: DepsPartition) -> &'static str {
             "one-way partition: each worker depends only on the workers before it"
         }
         DepsPartition::Levels | DepsPartition::Auto => "each level sliced as the levelled plan",
+    }
+}
+
+/// The primary plan's levels (the first 500): tasks, cost, and for a parallel level its
+/// slicing, makespan, moved lines and each worker's share.
+fn explain_levels(plan: &Plan, s: &mut String) {
+    let shown = plan.levels.len().min(500);
+    for (l, lp) in plan.levels.iter().take(shown).enumerate() {
+        let kind = if lp.parallel {
+            "parallel"
+        } else {
+            "sequential"
+        };
+        let _ = write!(
+            s,
+            "  level {:>3}: {:>6} task{}, cost {:>8}, {kind}",
+            l + 1,
+            lp.tasks,
+            if lp.tasks == 1 { " " } else { "s" },
+            lp.cost
+        );
+        if let (true, Some(m)) = (lp.parallel, lp.makespan) {
+            let moved: u64 = lp.lines.iter().sum();
+            let others: Vec<String> = lp
+                .compared
+                .iter()
+                .filter(|(name, _)| *name != lp.slicing)
+                .map(|(name, m)| format!("{name} {m}"))
+                .collect();
+            let others = if others.is_empty() {
+                String::new()
+            } else {
+                format!(" [{}]", others.join(", "))
+            };
+            let _ = write!(
+                s,
+                " ({}, makespan {m}{others}, {} moved):",
+                lp.slicing,
+                count(moved, "line")
+            );
+            for (w, (tasks, items, cost)) in lp.workers.iter().enumerate() {
+                let _ = write!(
+                    s,
+                    " w{w} {}/{}/{cost}+{}",
+                    count(*tasks, "task"),
+                    count(*items, "item"),
+                    count(lp.lines.get(w).copied().unwrap_or(0), "line")
+                );
+                if w + 1 < lp.workers.len() {
+                    s.push(',');
+                }
+            }
+        }
+        if !lp.reason.is_empty() {
+            let _ = write!(s, " — {}", lp.reason);
+        }
+        s.push('\n');
+    }
+    if shown < plan.levels.len() {
+        let _ = writeln!(s, "  ... {} more levels", plan.levels.len() - shown);
     }
 }
