@@ -535,6 +535,39 @@ fn more_threads_than_cores_is_a_warning_and_plans_for_the_cores() {
     assert_eq!(j["identical"], true);
 }
 
+/// `--plan` with only the sequential walk, and `--alternate` with one mode, are warned about
+/// once each and the run goes on; with both modes (or `--explain`) they are used, no warning.
+#[test]
+fn an_option_the_run_does_not_use_is_a_warning() {
+    let prog = "analyses/example-a/program.json";
+    let warned = |args: &[&str]| -> String {
+        let mut all = vec!["run", prog, "--scans", "5"];
+        all.extend_from_slice(args);
+        let out = run(&all);
+        assert!(out.status.success(), "{args:?}");
+        String::from_utf8(out.stderr).unwrap()
+    };
+    assert_eq!(
+        warned(&["--mode", "seq", "--plan", "exchange"]),
+        "warning[W0105]: --plan exchange has no effect with --mode seq: only the sequential walk \
+         runs (give --mode par or both)\n\n"
+    );
+    assert_eq!(
+        warned(&["--mode", "par", "--alternate", "2"]),
+        "warning[W0105]: --alternate 2 has no effect unless both modes run (--mode both): it sets \
+         the scans of each one's turn\n\n"
+    );
+    let both = warned(&["--mode", "seq", "--plan", "deps", "--alternate", "3"]);
+    assert_eq!(both.matches("W0105").count(), 2, "{both}");
+    for used in [
+        &["--mode", "both", "--plan", "exchange", "--alternate", "2"][..],
+        &["--mode", "seq", "--plan", "par", "--explain"],
+        &["--mode", "seq"],
+    ] {
+        assert_eq!(warned(used), "", "{used:?}");
+    }
+}
+
 #[test]
 fn text_report_and_explain() {
     let wide = generated("wide.json", &["--rungs", "4000", "--width", "400"]);

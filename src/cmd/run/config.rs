@@ -124,6 +124,10 @@ pub enum RunWarning {
     /// The program has an interrupt routine, which the scans never run.
     #[error("interrupt routine {0} never runs here: plc-deps run raises no interrupt events (`plc-deps report` lists what it shares with the main program)")]
     InterruptNotRun(String),
+    /// An option given that the run does not use (`--plan` with `--mode seq`, `--alternate`
+    /// unless both modes run).
+    #[error("{option} has no effect {why}")]
+    Unused { option: String, why: &'static str },
 }
 
 impl RunWarning {
@@ -134,6 +138,7 @@ impl RunWarning {
             RunWarning::PlanDropped(_) => "W0102",
             RunWarning::NoInputRows { .. } => "W0103",
             RunWarning::InterruptNotRun(_) => "W0104",
+            RunWarning::Unused { .. } => "W0105",
         }
     }
 }

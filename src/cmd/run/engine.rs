@@ -234,6 +234,25 @@ impl ScanDriver for Driver<'_> {
     }
 }
 
+/// The options given that this run does not use: `--plan` (other than the default) when only
+/// the sequential walk runs and nothing is explained, `--alternate` unless both modes run.
+fn unused_options(c: &RunConfig) -> Vec<RunWarning> {
+    let mut out = Vec::new();
+    if c.mode == RunMode::Seq && c.plan != PlanKind::Auto && !c.explain {
+        out.push(RunWarning::Unused {
+            option: format!("--plan {}", c.plan.name()),
+            why: "with --mode seq: only the sequential walk runs (give --mode par or both)",
+        });
+    }
+    if let (Some(n), false) = (c.alternate, c.mode == RunMode::Both) {
+        out.push(RunWarning::Unused {
+            option: format!("--alternate {n}"),
+            why: "unless both modes run (--mode both): it sets the scans of each one's turn",
+        });
+    }
+    out
+}
+
 /// Untimed warm-up scans before each timed pass.
 const WARM_UP: u64 = 16;
 
@@ -398,6 +417,7 @@ pub(super) fn prepare(c: &RunConfig, progress: &Progress) -> Result<Prepared, Cl
             cores,
         });
     }
+    warnings.extend(unused_options(c));
     let html = c.format == RunFormat::Html;
     let needs_par = c.mode != RunMode::Seq || c.explain;
     let analysis = (needs_par || html).then(|| analyse(&p));
