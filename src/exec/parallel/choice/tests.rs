@@ -49,6 +49,15 @@ fn drive(
     ran
 }
 
+/// The runs of more than 100 consecutive scans on candidate `c` in `ran`: the stretches
+/// between two measurements.
+fn gaps(ran: &[usize], c: usize) -> Vec<usize> {
+    ran.split(|&x| x != c)
+        .map(<[usize]>::len)
+        .filter(|&n| n > 100)
+        .collect()
+}
+
 fn table(rows: &[&[u64]]) -> Vec<Vec<Option<u64>>> {
     rows.iter()
         .map(|r| r.iter().map(|&t| (t > 0).then_some(t)).collect())
@@ -297,11 +306,7 @@ fn re_measurements_compare_with_the_runner_up_and_the_interval_doubles() {
         let got = after.iter().filter(|&&x| x == c).count();
         assert_eq!(got, probes, "candidate {c}: four re-measurements");
     }
-    let gaps: Vec<usize> = after
-        .split(|&c| c != 1)
-        .map(<[usize]>::len)
-        .filter(|&n| n > 100)
-        .collect();
+    let gaps = gaps(&after, 1);
     // Scans on candidate 1 between two re-measurements: the interval and the visit of
     // candidate 1 that opens the re-measurement (the runner-up's visit closes each one: the
     // order of two candidates is 1 2, 2 1, 1 2).
@@ -340,11 +345,7 @@ fn a_candidate_twice_as_slow_is_looked_at_four_times_less_often() {
     let ns = |c: usize, _: u64, _: bool| [3_700, 10_400][c];
     let ran = drive(&mut ch, 2, 5000, ns);
     assert!(ch.switches().is_empty());
-    let gaps: Vec<usize> = ran
-        .split(|&c| c != 0)
-        .map(<[usize]>::len)
-        .filter(|&n| n > 100)
-        .collect();
+    let gaps = gaps(&ran, 0);
     assert_eq!(gaps[..2], [512 + 3, 2048 + 3], "{gaps:?}");
     // The parallel plan ran only in measurements, one visit of 3 scans each (outpaced in the
     // first round, it sits out the others, and the measurement ends there): the first and
@@ -364,11 +365,7 @@ fn the_budget_spaces_re_measurements_by_what_they_cost() {
     let mut ch = Chooser::new(4, measure(), 0);
     let ns = |c: usize, _: u64, _: bool| [85_000, 60_000, 70_000, 90_000][c];
     let ran = drive(&mut ch, 4, 4000, ns);
-    let gaps: Vec<usize> = ran[36..]
-        .split(|&c| c != 1)
-        .map(<[usize]>::len)
-        .filter(|&n| n > 100)
-        .collect();
+    let gaps = gaps(&ran[36..], 1);
     assert_eq!(gaps[..3], [350 + 3, 700 + 3, 1400 + 3], "{gaps:?}");
     let scans_elsewhere = ran[36..].iter().filter(|&&c| c != 1).count();
     assert_eq!(
