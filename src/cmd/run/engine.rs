@@ -244,7 +244,7 @@ fn unused_options(c: &RunConfig) -> Vec<RunWarning> {
             why: "with --mode seq: only the sequential walk runs (give --mode par or both)",
         });
     }
-    if let (Some(n), false) = (c.alternate, c.mode == RunMode::Both) {
+    if let Some(n) = c.alternate.filter(|_| c.mode != RunMode::Both) {
         out.push(RunWarning::Unused {
             option: format!("--alternate {n}"),
             why: "unless both modes run (--mode both): it sets the scans of each one's turn",

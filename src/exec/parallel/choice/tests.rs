@@ -58,6 +58,16 @@ fn gaps(ran: &[usize], c: usize) -> Vec<usize> {
         .collect()
 }
 
+/// The timings of two candidates: the sequential walk (0) 100 µs a scan, the parallel plan (1)
+/// `before` ns until scan `at` and `after` ns from then on.
+fn parallel_changes_at(at: u64, before: u64, after: u64) -> impl Fn(usize, u64, bool) -> u64 {
+    move |c, s, _| match (c, s < at) {
+        (0, _) => 100_000,
+        (_, true) => before,
+        (_, false) => after,
+    }
+}
+
 fn table(rows: &[&[u64]]) -> Vec<Vec<Option<u64>>> {
     rows.iter()
         .map(|r| r.iter().map(|&t| (t > 0).then_some(t)).collect())
@@ -321,12 +331,7 @@ fn the_default_comes_back_into_reach_when_the_plan_slows_down() {
     // scan 1000 on it takes 80 µs (a third more: no jump), past 2/3 of the walk's time, so
     // the next routine look visits the walk again.
     let mut ch = Chooser::new(2, unbudgeted(), 0);
-    let ns = |c: usize, s: u64, _: bool| match (c, s < 1000) {
-        (0, _) => 100_000,
-        (_, true) => 60_000,
-        (_, false) => 80_000,
-    };
-    let ran = drive(&mut ch, 2, 3000, ns);
+    let ran = drive(&mut ch, 2, 3000, parallel_changes_at(1000, 60_000, 80_000));
     let walk_before = ran[18..1000].iter().filter(|&&c| c == 0).count();
     let walk_after = ran[1000..].iter().filter(|&&c| c == 0).count();
     assert_eq!(walk_before, 0, "the walk is out of reach");
@@ -386,9 +391,22 @@ fn the_budget_spaces_re_measurements_by_what_they_cost() {
     // routine look with nothing else to visit runs no measurement at all.
     let mut ch = Chooser::new(2, measure(), 0);
     let ran = drive(&mut ch, 2, 3000, |c, _, _| [300_000, 60_000][c]);
-    assert_eq!(ran.iter().filter(|&&c| c == 0).count(), 3 + 1);
     // The first measurement: 0 0 0 1 1 1 (round 1), 1 1 1 0 (round 2, the walk hopeless).
+    assert_eq!(ran[..10], [0, 0, 0, 1, 1, 1, 1, 1, 1, 0]);
     assert!(!ran[10..].contains(&0));
+    // A runner-up that will be found hopeless costs one scan, not a visit of every round: the
+    // chosen plan 60 µs, the walk out of reach at 400 µs, the runner-up at 300 µs (5x), 240 µs
+    // more for one scan, which is 1.5 % of 266 scans of 60 µs (where a visit of every round
+    // would ask for 2,400); the interval then grows fourfold, the runner-up taking more than
+    // twice the chosen plan's time.
+    let mut ch = Chooser::new(3, measure(), 0);
+    let ran = drive(&mut ch, 3, 3000, |c, _, _| [400_000, 60_000, 300_000][c]);
+    let stretches = super::tests::gaps(&ran, 1);
+    assert_eq!(stretches[..2], [266 + 3, 4 * 266 + 3], "{stretches:?}");
+    // The runner-up: one scan in the first measurement and in each of two re-measurements;
+    // the walk: a whole visit and a hopeless one in the first measurement only.
+    let on = |c: usize| ran.iter().filter(|&&x| x == c).count();
+    assert_eq!((on(2), on(0)), (3, 3 + 1));
 }
 
 #[test]
@@ -396,12 +414,7 @@ fn the_log_keeps_the_first_windows_and_the_measurements_that_switch() {
     // Parallel faster until scan 2000, then 5x slower: one switch to it at the start, one
     // back after the jump.
     let mut ch = Chooser::new(2, measure(), 0);
-    let ns = |c: usize, s: u64, _: bool| match (c, s < 2000) {
-        (0, _) => 100_000,
-        (_, true) => 60_000,
-        (_, false) => 300_000,
-    };
-    drive(&mut ch, 2, 4000, ns);
+    drive(&mut ch, 2, 4000, parallel_changes_at(2000, 60_000, 300_000));
     let log = ch.windows();
     assert_eq!(ch.switches().len(), 2, "{:?}", ch.switches());
     // The first measurement: 3 rounds of two visits of 3 one-scan windows, each timed.
