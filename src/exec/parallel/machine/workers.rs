@@ -19,6 +19,26 @@ use std::time::Instant;
 /// Scans at most per window of a dependence-driven plan.
 const DEPS_WINDOW: u64 = 4;
 
+/// What worker 0 carries from one window to the next.
+#[derive(Default)]
+struct LeaderState {
+    /// Barriers worker 0 has passed.
+    epoch: u64,
+    /// Units issued before the next window.
+    base: u64,
+    /// The timed scans of the window in progress, ns.
+    times: Vec<u64>,
+    bufs: Buffers,
+    /// Whether the last levelled window ran most of the other workers' slices itself (they
+    /// were not on a core): a dependence-driven plan, which must wait for them, is then not
+    /// worth measuring.
+    others_away: bool,
+    /// The `par-exchange` plan whose private states are current (its window was last).
+    private_current: Option<usize>,
+    /// The `par-exchange` plan on its own layout whose state the caller's lags behind.
+    home_behind: Option<usize>,
+}
+
 impl ParallelMachine {
     /// Worker 0: chooses, runs sequential windows alone and parallel windows with the others
     /// (announced on the bell: a levelled plan's scans as claimed units, a dependence-driven
@@ -34,22 +54,11 @@ impl ParallelMachine {
     ) {
         let body = std::panic::AssertUnwindSafe(|| {
             sh.barrier.register(0);
-            let mut epoch = 0u64;
-            let mut base = 0u64;
-            let mut times: Vec<u64> = Vec::new();
-            let mut bufs = Buffers::default();
+            let mut ls = LeaderState::default();
             let mut scan = scans.start;
-            // Whether the last levelled window ran most of the other workers' slices itself
-            // (they were not on a core): a dependence-driven plan, which must wait for them,
-            // is then not worth measuring.
-            let mut others_away = false;
-            // The `par-exchange` plan whose private states are current (its window was last).
-            let mut private_current: Option<usize> = None;
-            // The `par-exchange` plan on its own layout whose state the caller's lags behind.
-            let mut home_behind: Option<usize> = None;
             while scan < scans.end {
                 let mut win = chooser.next();
-                while others_away
+                while ls.others_away
                     && chooser.measuring_other()
                     && self.waits_for_all(allowed[win.candidate])
                 {
@@ -57,11 +66,12 @@ impl ParallelMachine {
                     win = chooser.next();
                 }
                 let c = allowed[win.candidate];
-                if let Some(k) =
-                    home_behind.filter(|&k| self.candidates[c] != Candidate::Exchange(k))
+                if let Some(k) = ls
+                    .home_behind
+                    .filter(|&k| self.candidates[c] != Candidate::Exchange(k))
                 {
                     self.home_from_own(k, sh);
-                    home_behind = None;
+                    ls.home_behind = None;
                 }
                 let deps = self.waits_for_all(c);
                 // A dependence-driven or exchange window is short and timed whole: its waits
@@ -72,112 +82,39 @@ impl ParallelMachine {
                 let n = win.scans.min(scans.end - scan).min(cap);
                 log.scans_on[c] += n;
                 log.push_segment(scan, c);
-                times.clear();
+                ls.times.clear();
                 let timing = Timing {
                     all: win.timed || deps || driver.wants_time(),
                     every: self.measure.sample_every.max(1),
                 };
-                let was_current = std::mem::take(&mut private_current);
-                match self.candidates[c] {
+                let r = scan..scan + n;
+                let ok = match self.candidates[c] {
                     Candidate::Sequential => {
-                        self.sequential_window(sh, scan..scan + n, driver, timing, &mut times)
+                        ls.private_current = None;
+                        self.sequential_window(sh, r, driver, timing, &mut ls.times);
+                        true
                     }
                     Candidate::Exchange(i) => {
-                        let copy = was_current != Some(i);
-                        let own = self.own[i].as_ref().zip(sh.xhomes[i]);
-                        if let Some((o, home)) = own.filter(|_| copy) {
-                            // SAFETY: the other workers wait for the bell (rung below): worker 0
-                            // alone touches the two states.
-                            let (from, to) = unsafe { (sh.slots.bytes(), home.bytes_mut()) };
-                            o.relayout.to_own(from, to);
-                        }
-                        sh.bell.ring(WindowNote {
-                            plan: i,
-                            first: scan,
-                            scans: n,
-                            base,
-                            exchange: Some(copy),
-                        });
-                        // The followers copy the shared state between the two barriers.
-                        for _ in 0..1 + copy as usize {
-                            if !sh.barrier.wait(0, &mut epoch) {
-                                return;
-                            }
-                        }
-                        // A driver that reads any layout sees the own one; otherwise the caller's
-                        // state is kept up to date after every scan if the driver reads it.
-                        let direct = driver.reads_any_layout();
-                        if own.is_some() && (direct || !driver.wants_state()) {
-                            home_behind = Some(i);
-                        }
-                        let lead = Lead {
-                            driver: &mut *driver,
-                            timing,
-                            times: &mut times,
-                            home: own
-                                .filter(|_| !direct)
-                                .map(|(o, _)| (&o.relayout, sh.slots)),
-                        };
-                        let x = self.exchange_of(i, sh);
-                        let r = scan..scan + n;
-                        let store = own.map_or(sh.slots, |(_, home)| home);
-                        let b = &mut bufs;
-                        if !self.exchange_scans(0, &self.plans[i], x, sh, r, store, Some(lead), b) {
-                            return;
-                        }
-                        private_current = Some(i);
+                        self.exchange_window(i, sh, r, driver, timing, &mut ls)
                     }
                     Candidate::Levelled(i) => {
-                        let plan = &self.plans[i];
-                        sh.bell.ring(WindowNote {
-                            plan: i,
-                            first: scan,
-                            scans: n,
-                            base,
-                            exchange: None,
-                        });
-                        if plan.ready.is_some() {
-                            if !sh.barrier.wait(0, &mut epoch) {
-                                return;
-                            }
-                            let d = Some((&mut *driver, timing, &mut times));
-                            if !self.plan_scans(
-                                0,
-                                plan,
-                                sh,
-                                scan..scan + n,
-                                &mut epoch,
-                                d,
-                                &mut bufs,
-                            ) {
-                                return;
-                            }
-                        } else {
-                            let r = scan..scan + n;
-                            let b = &mut bufs;
-                            let Some(taken) =
-                                self.leader_units(plan, sh, base, r, driver, timing, &mut times, b)
-                            else {
-                                return;
-                            };
-                            let others =
-                                n * (plan.threads as u64 - 1) * plan.parallel_phases() as u64;
-                            others_away = others > 0 && taken * 2 > others;
-                            base += n * claimed::unit_layout(plan).1 as u64;
-                        }
+                        self.levelled_window(i, sh, r, driver, timing, &mut ls)
                     }
+                };
+                if !ok {
+                    return;
                 }
-                chooser.record(Window { scans: n, ..win }, &times);
+                chooser.record(Window { scans: n, ..win }, &ls.times);
                 scan += n;
             }
-            if let Some(k) = home_behind {
+            if let Some(k) = ls.home_behind {
                 self.home_from_own(k, sh);
             }
             sh.bell.ring(WindowNote {
                 plan: 0,
                 first: scan,
                 scans: 0,
-                base,
+                base: ls.base,
                 exchange: None,
             });
         });
@@ -185,6 +122,104 @@ impl ParallelMachine {
             sh.barrier.poison();
             std::panic::resume_unwind(panic);
         }
+    }
+
+    /// Worker 0's window of `scans` on `par-exchange` plan `i`: moves the state into the plan's
+    /// private states (unless its window was the last one), announces the window, and runs its
+    /// part. False if a worker panicked.
+    fn exchange_window<D: ScanDriver + ?Sized>(
+        &self,
+        i: usize,
+        sh: &Shared<'_>,
+        scans: Range<u64>,
+        driver: &mut D,
+        timing: Timing,
+        ls: &mut LeaderState,
+    ) -> bool {
+        let copy = std::mem::take(&mut ls.private_current) != Some(i);
+        let own = self.own[i].as_ref().zip(sh.xhomes[i]);
+        if let Some((o, home)) = own.filter(|_| copy) {
+            // SAFETY: the other workers wait for the bell (rung below): worker 0 alone touches
+            // the two states.
+            let (from, to) = unsafe { (sh.slots.bytes(), home.bytes_mut()) };
+            o.relayout.to_own(from, to);
+        }
+        sh.bell.ring(WindowNote {
+            plan: i,
+            first: scans.start,
+            scans: scans.end - scans.start,
+            base: ls.base,
+            exchange: Some(copy),
+        });
+        // The followers copy the shared state between the two barriers.
+        for _ in 0..1 + copy as usize {
+            if !sh.barrier.wait(0, &mut ls.epoch) {
+                return false;
+            }
+        }
+        // A driver that reads any layout sees the own one; otherwise the caller's state is kept
+        // up to date after every scan if the driver reads it.
+        let direct = driver.reads_any_layout();
+        if own.is_some() && (direct || !driver.wants_state()) {
+            ls.home_behind = Some(i);
+        }
+        let lead = Lead {
+            driver,
+            timing,
+            times: &mut ls.times,
+            home: own
+                .filter(|_| !direct)
+                .map(|(o, _)| (&o.relayout, sh.slots)),
+        };
+        let x = self.exchange_of(i, sh);
+        let store = own.map_or(sh.slots, |(_, home)| home);
+        let (plan, b) = (&self.plans[i], &mut ls.bufs);
+        if !self.exchange_scans(0, plan, x, sh, scans, store, Some(lead), b) {
+            return false;
+        }
+        ls.private_current = Some(i);
+        true
+    }
+
+    /// Worker 0's window of `scans` on levelled plan `i`: announces it and runs its part, behind
+    /// the barrier for a dependence-driven plan, as claimed units otherwise (noting whether the
+    /// other workers were away). False if a worker panicked.
+    fn levelled_window<D: ScanDriver + ?Sized>(
+        &self,
+        i: usize,
+        sh: &Shared<'_>,
+        scans: Range<u64>,
+        driver: &mut D,
+        timing: Timing,
+        ls: &mut LeaderState,
+    ) -> bool {
+        ls.private_current = None;
+        let plan = &self.plans[i];
+        let n = scans.end - scans.start;
+        sh.bell.ring(WindowNote {
+            plan: i,
+            first: scans.start,
+            scans: n,
+            base: ls.base,
+            exchange: None,
+        });
+        let b = &mut ls.bufs;
+        if plan.ready.is_some() {
+            if !sh.barrier.wait(0, &mut ls.epoch) {
+                return false;
+            }
+            let d = Some((driver, timing, &mut ls.times));
+            return self.plan_scans(0, plan, sh, scans, &mut ls.epoch, d, b);
+        }
+        let Some(taken) =
+            self.leader_units(plan, sh, ls.base, scans, driver, timing, &mut ls.times, b)
+        else {
+            return false;
+        };
+        let others = n * (plan.threads as u64 - 1) * plan.parallel_phases() as u64;
+        ls.others_away = others > 0 && taken * 2 > others;
+        ls.base += n * claimed::unit_layout(plan).1 as u64;
+        true
     }
 
     /// Whether candidate `c` needs every worker on a core at every phase: a dependence-driven
