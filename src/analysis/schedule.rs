@@ -93,13 +93,90 @@ impl Schedule {
     }
 }
 
-/// Builds the combined schedule from the program, its CFG and its accesses.
+/// Builds the combined schedule from the program, its CFG and its accesses: the live main
+/// program's CFG, its strongly connected parts as tasks in a topological order, the condensed
+/// CFG's control dependences as guards, then the levels.
 pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
     let main = p.main().rungs.clone();
     let n = cfg.node_count();
     let (start, stop) = (cfg.start().0, cfg.stop().0);
+    let live = live_main_cfg(cfg, main.clone());
+    let unreachable: Vec<RungId> = main
+        .clone()
+        .filter(|&r| !live.reach[r as usize])
+        .map(RungId)
+        .collect();
+    let g = Csr::from_edges(n, &live.edges);
+    let sccs = strongly_connected_components(&g);
+    let comps = task_components(&sccs, &live, main.clone());
+    let mut tasks: Vec<Task> = comps
+        .iter()
+        .map(|&c| Task {
+            rungs: sccs.members(c).iter().map(|&m| RungId(m)).collect(),
+            is_loop: sccs.is_cyclic(c, &g),
+            entries: Vec::new(),
+            guard: Vec::new(),
+            level: 0,
+        })
+        .collect();
+    let mut task_of_comp: Vec<Option<TaskId>> = vec![None; sccs.len()];
+    for (i, &c) in comps.iter().enumerate() {
+        task_of_comp[c as usize] = Some(TaskId(i as u32));
+    }
+    let mut task_of: Vec<Option<TaskId>> = vec![None; p.rungs.len()];
+    for r in main.filter(|&r| live.reach[r as usize]) {
+        task_of[r as usize] = task_of_comp[sccs.component_of(r) as usize];
+    }
+    // Condensed CFG over tasks: nodes 0..t, START = t, STOP = t + 1.
+    let t = tasks.len() as u32;
+    let node = |v: u32| -> u32 {
+        if v == start {
+            t
+        } else if v == stop {
+            t + 1
+        } else {
+            task_of[v as usize].expect("live rung").0
+        }
+    };
+    let condensed = condense(&live.edges, node, &mut tasks);
+    let endless = guard_tasks(&condensed.edges, &mut tasks);
+    let preds = level_tasks(&mut tasks, &condensed.entry_preds, acc, p.vars.len());
+    let mut levels: Vec<Vec<TaskId>> = Vec::new();
+    for (i, task) in tasks.iter().enumerate() {
+        let l = task.level as usize;
+        if levels.len() <= l {
+            levels.resize(l + 1, Vec::new());
+        }
+        levels[l].push(TaskId(i as u32));
+    }
+    for task in &mut tasks {
+        task.entries.sort_unstable();
+        task.guard.sort_unstable();
+    }
+    Schedule {
+        tasks,
+        task_of,
+        levels,
+        unreachable,
+        preds,
+        endless,
+    }
+}
+
+/// The main program's own CFG (no call or return edges) cut down to what START reaches.
+struct LiveCfg {
+    /// Per CFG node: whether START reaches it.
+    reach: Vec<bool>,
+    /// The edges leaving reached nodes.
+    edges: Vec<(u32, u32)>,
+}
+
+/// The live part of the main program's CFG: its edges without calls and returns, from the
+/// nodes START reaches. O(nodes + edges).
+fn live_main_cfg(cfg: &Cfg, main: std::ops::Range<u32>) -> LiveCfg {
+    let n = cfg.node_count();
+    let (start, stop) = (cfg.start().0, cfg.stop().0);
     let in_main = |v: u32| main.contains(&v) || v == start || v == stop;
-    // The main program's own CFG: no call or return edges.
     let edges: Vec<(u32, u32)> = cfg
         .edges
         .iter()
@@ -110,33 +187,32 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
         })
         .map(|e| (e.from.0, e.to.0))
         .collect();
-    let g = Csr::from_edges(n, &edges);
-    let reach = crate::graph::reachable(&g, start);
-    let unreachable: Vec<RungId> = main
-        .clone()
-        .filter(|&r| !reach[r as usize])
-        .map(RungId)
-        .collect();
-    let live_edges: Vec<(u32, u32)> = edges
-        .iter()
-        .copied()
+    let reach = crate::graph::reachable(&Csr::from_edges(n, &edges), start);
+    let edges = edges
+        .into_iter()
         .filter(|&(a, _)| reach[a as usize])
         .collect();
-    let live = Csr::from_edges(n, &live_edges);
-    let sccs = strongly_connected_components(&live);
+    LiveCfg { reach, edges }
+}
 
-    // Components of live rungs become tasks, ordered topologically, program order first.
+/// The components of live main rungs (the tasks-to-be), in a topological order of the
+/// condensed CFG that keeps program order: by first rung when every condensed edge goes forward
+/// in program order (the usual case, O(V)), otherwise Kahn's algorithm preferring the earliest
+/// first rung (O(V log V)).
+fn task_components(
+    sccs: &crate::graph::Sccs,
+    live: &LiveCfg,
+    main: std::ops::Range<u32>,
+) -> Vec<u32> {
     let comp_count = sccs.len();
     let mut comp_is_task = vec![false; comp_count];
-    for r in main.clone() {
-        if reach[r as usize] {
-            comp_is_task[sccs.component_of(r) as usize] = true;
-        }
+    for r in main.clone().filter(|&r| live.reach[r as usize]) {
+        comp_is_task[sccs.component_of(r) as usize] = true;
     }
     let mut indeg = vec![0u32; comp_count];
     // At most one per live edge (sized once: see `direct_dependences`).
-    let mut comp_edges: Vec<(u32, u32)> = Vec::with_capacity(live_edges.len());
-    for &(a, b) in &live_edges {
+    let mut comp_edges: Vec<(u32, u32)> = Vec::with_capacity(live.edges.len());
+    for &(a, b) in &live.edges {
         let (ca, cb) = (sccs.component_of(a), sccs.component_of(b));
         if ca != cb && comp_is_task[ca as usize] && comp_is_task[cb as usize] {
             comp_edges.push((ca, cb));
@@ -144,84 +220,72 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
         }
     }
     let first = |c: u32| sccs.members(c)[0];
-    // Task order: components by first rung when that is topological (every condensed edge goes
-    // forward in program order — the usual case, O(V)); otherwise Kahn's algorithm preferring
-    // the earliest first rung (O(V log V)).
-    let forward = comp_edges.iter().all(|&(a, b)| first(a) < first(b));
-    let order: Vec<u32> = if forward {
-        main.clone()
-            .filter(|&r| reach[r as usize] && first(sccs.component_of(r)) == r)
+    if comp_edges.iter().all(|&(a, b)| first(a) < first(b)) {
+        return main
+            .filter(|&r| live.reach[r as usize] && first(sccs.component_of(r)) == r)
             .map(|r| sccs.component_of(r))
-            .collect()
-    } else {
-        let comp_graph = Csr::from_edges(comp_count, &comp_edges);
-        let mut heap: BinaryHeap<Reverse<(u32, u32)>> = (0..comp_count as u32)
-            .filter(|&c| comp_is_task[c as usize] && indeg[c as usize] == 0)
-            .map(|c| Reverse((first(c), c)))
             .collect();
-        let mut order = Vec::new();
-        while let Some(Reverse((_, c))) = heap.pop() {
-            order.push(c);
-            for &d in comp_graph.successors(c) {
-                indeg[d as usize] -= 1;
-                if indeg[d as usize] == 0 {
-                    heap.push(Reverse((first(d), d)));
-                }
+    }
+    let comp_graph = Csr::from_edges(comp_count, &comp_edges);
+    let mut heap: BinaryHeap<Reverse<(u32, u32)>> = (0..comp_count as u32)
+        .filter(|&c| comp_is_task[c as usize] && indeg[c as usize] == 0)
+        .map(|c| Reverse((first(c), c)))
+        .collect();
+    let mut order = Vec::new();
+    while let Some(Reverse((_, c))) = heap.pop() {
+        order.push(c);
+        for &d in comp_graph.successors(c) {
+            indeg[d as usize] -= 1;
+            if indeg[d as usize] == 0 {
+                heap.push(Reverse((first(d), d)));
             }
         }
-        order
-    };
-    let mut task_of_comp: Vec<Option<TaskId>> = vec![None; comp_count];
-    let mut tasks: Vec<Task> = Vec::with_capacity(order.len());
-    for c in order {
-        task_of_comp[c as usize] = Some(TaskId(tasks.len() as u32));
-        let members = sccs.members(c);
-        tasks.push(Task {
-            rungs: members.iter().map(|&m| RungId(m)).collect(),
-            is_loop: sccs.is_cyclic(c, &live),
-            entries: Vec::new(),
-            guard: Vec::new(),
-            level: 0,
-        });
     }
-    let mut task_of: Vec<Option<TaskId>> = vec![None; p.rungs.len()];
-    for r in main.clone() {
-        if reach[r as usize] {
-            task_of[r as usize] = task_of_comp[sccs.component_of(r) as usize];
+    order
+}
+
+/// The CFG condensed over tasks.
+struct Condensed {
+    /// Its edges, sorted, without duplicates or self-loops.
+    edges: Vec<(u32, u32)>,
+    /// Per task, the tasks with an edge into one of its entries.
+    entry_preds: Vec<Vec<u32>>,
+}
+
+/// Condenses the live edges over tasks (`node` maps a CFG node to its task, START to `t` and
+/// STOP to `t + 1` for `t` tasks) and records each task's entries.
+fn condense(live_edges: &[(u32, u32)], node: impl Fn(u32) -> u32, tasks: &mut [Task]) -> Condensed {
+    let t = tasks.len() as u32;
+    let mut edges: Vec<(u32, u32)> = Vec::with_capacity(live_edges.len());
+    let mut entry_preds: Vec<Vec<u32>> = vec![Vec::new(); t as usize];
+    for &(a, b) in live_edges {
+        let (ca, cb) = (node(a), node(b));
+        if ca == cb {
+            continue;
+        }
+        edges.push((ca, cb));
+        if cb < t {
+            let task = &mut tasks[cb as usize];
+            if !task.entries.contains(&RungId(b)) {
+                task.entries.push(RungId(b));
+            }
+            if ca < t {
+                entry_preds[cb as usize].push(ca);
+            }
         }
     }
-    // Condensed CFG over tasks: nodes 0..t, START = t, STOP = t + 1.
+    edges.sort_unstable();
+    edges.dedup();
+    Condensed { edges, entry_preds }
+}
+
+/// Gives each task its guard: the control dependences (Ferrante, Ottenstein & Warren) of the
+/// condensed CFG `cedges` (START = `t`, STOP = `t + 1` for `t` tasks), each "task A ran and left
+/// towards successor B". Returns the regions that can never reach STOP, as rungs.
+fn guard_tasks(cedges: &[(u32, u32)], tasks: &mut [Task]) -> Vec<Vec<RungId>> {
     let t = tasks.len() as u32;
     let (cstart, cstop) = (t, t + 1);
-    let node = |v: u32| -> u32 {
-        if v == start {
-            cstart
-        } else if v == stop {
-            cstop
-        } else {
-            task_of[v as usize].expect("live rung").0
-        }
-    };
-    let mut cedges: Vec<(u32, u32)> = Vec::with_capacity(live_edges.len());
-    let mut entry_preds: Vec<Vec<u32>> = vec![Vec::new(); t as usize];
-    for &(a, b) in &live_edges {
-        let (ca, cb) = (node(a), node(b));
-        if ca != cb {
-            cedges.push((ca, cb));
-            if cb < t {
-                let task = &mut tasks[cb as usize];
-                if !task.entries.contains(&RungId(b)) {
-                    task.entries.push(RungId(b));
-                }
-                if ca < t {
-                    entry_preds[cb as usize].push(ca);
-                }
-            }
-        }
-    }
-    cedges.sort_unstable();
-    cedges.dedup();
-    let pdom: PostDominators = post_dominators(t as usize + 2, &cedges, cstop);
+    let pdom: PostDominators = post_dominators(t as usize + 2, cedges, cstop);
     let endless: Vec<Vec<RungId>> = pdom
         .endless
         .iter()
@@ -234,7 +298,7 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
         })
         .filter(|r: &Vec<RungId>| !r.is_empty())
         .collect();
-    for d in control_dependences(&cedges, &pdom, |_| true) {
+    for d in control_dependences(cedges, &pdom, |_| true) {
         let (a, b) = cedges[d.edge as usize];
         if a == cstart || d.dependent >= t || d.dependent == a {
             continue;
@@ -253,10 +317,22 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
             task.guard.push(guard);
         }
     }
-    // Levels: data (over task accesses in task order) and control floors.
-    let var_count = p.vars.len();
+    endless
+}
+
+/// Levels the tasks in task order: each at the lowest level that its data dependences (over
+/// the tasks' accesses) and its control floor (after every guarding task and, for a loop
+/// entered at several rungs, every task that may enter it) allow. Returns each task's earlier
+/// tasks it must wait for. O(accesses + dependences).
+fn level_tasks(
+    tasks: &mut [Task],
+    entry_preds: &[Vec<u32>],
+    acc: &Accesses,
+    var_count: usize,
+) -> Vec<Vec<TaskId>> {
+    let t = tasks.len();
     let mut leveller = Leveller::new(var_count);
-    let mut preds: Vec<Vec<TaskId>> = vec![Vec::new(); t as usize];
+    let mut preds: Vec<Vec<TaskId>> = vec![Vec::new(); t];
     let mut last_writer: Vec<Option<u32>> = vec![None; var_count];
     // Readers of each variable since its last write, as linked lists in one flat array:
     // `first_reader[x]` → (task, next) in `reader_nodes`.
@@ -271,7 +347,7 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
     let mut reader_nodes: Vec<(u32, Option<u32>)> = Vec::with_capacity(read_count);
     let mut reads = Vec::new();
     let mut writes = Vec::new();
-    for i in 0..t as usize {
+    for i in 0..t {
         reads.clear();
         writes.clear();
         for &r in &tasks[i].rungs {
@@ -310,8 +386,7 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
             .map(|&q| tasks[q as usize].level + 1)
             .max()
             .unwrap_or(0);
-        let level = leveller.place(&reads, &writes, floor);
-        tasks[i].level = level;
+        tasks[i].level = leveller.place(&reads, &writes, floor);
         for &x in &reads {
             reader_nodes.push((i as u32, first_reader[x.index()]));
             first_reader[x.index()] = Some(reader_nodes.len() as u32 - 1);
@@ -326,24 +401,5 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
             .map(TaskId)
             .collect();
     }
-    let mut levels: Vec<Vec<TaskId>> = Vec::new();
-    for (i, task) in tasks.iter().enumerate() {
-        let l = task.level as usize;
-        if levels.len() <= l {
-            levels.resize(l + 1, Vec::new());
-        }
-        levels[l].push(TaskId(i as u32));
-    }
-    for task in &mut tasks {
-        task.entries.sort_unstable();
-        task.guard.sort_unstable();
-    }
-    Schedule {
-        tasks,
-        task_of,
-        levels,
-        unreachable,
-        preds,
-        endless,
-    }
+    preds
 }
