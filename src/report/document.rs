@@ -357,20 +357,7 @@ pub fn document<'a>(p: &'a Program, a: &'a Analysis) -> Report<'a> {
 
 /// Builds the report document; `fbd` says which rungs the FBD lowering made.
 pub fn document_with<'a>(p: &'a Program, a: &'a Analysis, fbd: Option<&'a FbdParts>) -> Report<'a> {
-    let id = move |r: RungId| p.rung(r).id.as_str();
-    let var = move |v: VarId| p.var(v).name.as_str();
-    let names = move |vs: &[VarId]| vs.iter().map(|&v| var(v)).collect::<Vec<_>>();
-    let node = move |n: u32| super::node_name(p, n);
-    let edge_ref = move |i: CfgEdgeId| {
-        let e = a.cfg.edge(i);
-        EdgeRef {
-            from: node(e.from.0),
-            to: node(e.to.0),
-            label: label_name(e.label),
-            kind: e.kind.name(),
-        }
-    };
-
+    let id = move |r: RungId| rung_id(p, r);
     let rungs = Lazy::new(p.rungs.len(), move || {
         p.rung_ids().map(move |r| {
             let rung = p.rung(r);
@@ -378,163 +365,25 @@ pub fn document_with<'a>(p: &'a Program, a: &'a Analysis, fbd: Option<&'a FbdPar
                 id: id(r),
                 pou: p.pou(rung.pou).name.as_str(),
                 label: rung.label.as_deref(),
-                ins: names(a.accesses.ins(r)),
-                out: names(a.accesses.outs(r)),
+                ins: var_names(p, a.accesses.ins(r)),
+                out: var_names(p, a.accesses.outs(r)),
                 cost: a.rung_costs[r.index()],
             }
         })
     });
-
-    let control_pairs = super::paper_control_pairs(a);
-    let control_count = control_pairs.len();
-    let control_pairs = std::rc::Rc::new(control_pairs);
-    let dependences = {
-        let pairs = control_pairs.clone();
-        Lazy::new(a.data.len() + pairs.len(), move || {
-            let data = a.data.iter().map(move |d| DependenceEntry::Data {
-                kind: d.kind.name(),
-                from: id(RungId(d.from)),
-                to: id(RungId(d.to)),
-                var: var(d.var),
-            });
-            let pairs = pairs.clone();
-            let control = (0..pairs.len()).map(move |i| {
-                let (from, to, cause) = pairs[i];
-                let (cause, edge, v) = match cause {
-                    ControlCause::Branch { edge } => ("branch", Some(edge_ref(edge)), None),
-                    ControlCause::Instance { var: v } => ("instance", None, Some(var(v))),
-                };
-                DependenceEntry::Control {
-                    kind: "control",
-                    from: id(from),
-                    to: id(to),
-                    cause,
-                    edge,
-                    var: v,
-                }
-            });
-            data.chain(control)
-        })
-    };
-
-    let counts = &a.counts;
-    let dependence_counts = DependenceCounts {
-        flow: counts.flow,
-        anti: counts.anti,
-        output: counts.output,
-        control: control_count as u64,
-        by_var: Lazy::new(counts.by_var.len(), move || {
-            counts
-                .by_var
-                .iter()
-                .map(move |&(v, flow, anti, output)| VarCount {
-                    var: var(v),
-                    flow,
-                    anti,
-                    output,
-                })
-        }),
-    };
-
+    let (dependences, control_count) = dependences_of(p, a);
     let edges = Lazy::new(a.cfg.edges.len(), move || {
-        a.cfg.edges.iter().map(move |e| CfgEdgeEntry {
-            from: node(e.from.0),
-            to: node(e.to.0),
-            label: label_name(e.label),
-            kind: e.kind.name(),
-        })
+        a.cfg.edges.iter().map(move |e| cfg_edge(p, e))
     });
-
-    let m = p.rungs.len() as u32;
-    let with_ipdom = move || {
-        std::iter::once(a.cfg.start().0)
-            .chain(0..m)
-            .filter_map(move |n| a.post_dominators.immediate(n).map(|d| (node(n), node(d))))
-    };
-    let ipdom = Ipdom(Lazy::new(with_ipdom().count(), with_ipdom));
-    let post_dominator_tree = Lazy::new(m as usize + 2, move || {
-        std::iter::once(a.cfg.start().0)
-            .chain(0..m)
-            .chain(std::iter::once(a.cfg.stop().0))
-            .map(move |n| TreeNode {
-                node: node(n),
-                ipdom: a.post_dominators.immediate(n).map(node),
-                children: a
-                    .post_dominators
-                    .children(n)
-                    .iter()
-                    .map(|&k| node(k))
-                    .collect(),
-            })
-    });
-
     let levels = levels_of(p, a);
     let count = |levels: &[u32]| levels.iter().map(|&l| l as usize + 1).max().unwrap_or(0);
-    let s = &a.schedule;
     let cycles = Cycles {
         before: p.rungs.len(),
         data: count(&a.data_levels),
         control: count(&a.control_levels),
-        combined: s.levels.len(),
+        combined: a.schedule.levels.len(),
     };
-    let cost = cost_of(a);
-    let task_entry = move |t: &'a crate::analysis::Task| TaskEntry {
-        rungs: t.rungs.iter().map(|&r| id(r)).collect(),
-        is_loop: t.is_loop,
-        level: t.level + 1,
-        entries: t.entries.iter().map(|&r| id(r)).collect(),
-        guard: t
-            .guard
-            .iter()
-            .map(|g| GuardEntry {
-                controller: id(s.head(g.controller)),
-                successor: match g.successor {
-                    Successor::Task(x) => id(s.head(x)),
-                    Successor::Stop => "STOP",
-                },
-            })
-            .collect(),
-    };
-    let tasks = Lazy::new(s.tasks.len(), move || s.tasks.iter().map(task_entry));
-    let order = std::rc::Rc::new(s.levels.concat());
-    let tasks_by_level = Lazy::new(s.tasks.len(), move || {
-        let order = order.clone();
-        (0..order.len()).map(move |i| task_entry(s.task(order[i])))
-    });
-    let loops = s
-        .tasks
-        .iter()
-        .filter(|t| t.is_loop)
-        .map(|t| LoopEntry {
-            head: id(t.rungs[0]),
-            rungs: t.rungs.iter().map(|&r| id(r)).collect(),
-        })
-        .collect();
-
-    let explainer = std::rc::Rc::new(Explainer::new(p, a));
-    let differing = explainer.differing();
-    let differences = {
-        let differing = std::rc::Rc::new(differing);
-        Lazy::new(differing.len(), move || {
-            let explainer = explainer.clone();
-            let differing = differing.clone();
-            (0..differing.len()).map(move |i| explainer.difference(differing[i]))
-        })
-    };
-
-    let networks = super::networks(p, a)
-        .into_iter()
-        .map(|n| NetworkEntry {
-            pou: p.pou(n.pou).name.as_str(),
-            id: p.rung(n.rungs[0]).network().unwrap_or_default(),
-            rungs: n.rungs.iter().map(|&r| id(r)).collect(),
-            ins: names(&n.ins),
-            out: names(&n.outs),
-        })
-        .collect();
-
     let (fbd_section, shown_levels) = fbd_of(p, fbd, &levels);
-
     Report {
         program: &p.name,
         rungs,
@@ -543,44 +392,29 @@ pub fn document_with<'a>(p: &'a Program, a: &'a Analysis, fbd: Option<&'a FbdPar
             Listed::All => "all",
             Listed::Direct => "direct",
         },
-        dependence_counts,
+        dependence_counts: dependence_counts_of(p, a, control_count),
         self_control: super::self_controlled(a).into_iter().map(id).collect(),
         cfg: CfgSection { edges },
-        ipdom,
+        ipdom: ipdom_of(p, a),
         levels,
         cycles,
-        cost,
+        cost: cost_of(a),
         schedule: ScheduleSection {
-            tasks,
-            unreachable: s.unreachable.iter().map(|&r| id(r)).collect(),
+            tasks: Lazy::new(a.schedule.tasks.len(), move || {
+                a.schedule.tasks.iter().map(move |t| task_entry(p, a, t))
+            }),
+            unreachable: a.schedule.unreachable.iter().map(|&r| id(r)).collect(),
         },
-        loops,
-        differences,
+        loops: loops_of(p, a),
+        differences: differences_of(p, a),
         warnings: a
             .warnings
             .iter()
             .map(|w| super::warning_text(p, w))
             .collect(),
         warning_codes: a.warnings.iter().map(super::warning_code).collect(),
-        networks,
-        interrupts: a
-            .interrupts
-            .iter()
-            .map(|i| InterruptEntry {
-                pou: &p.pou(i.pou).name,
-                shared: i
-                    .shared
-                    .iter()
-                    .map(|s| SharedVarEntry {
-                        var: &p.var(s.var).name,
-                        interrupt_reads: s.interrupt_reads,
-                        interrupt_writes: s.interrupt_writes,
-                        main_readers: s.main_readers.iter().map(|&r| id(r)).collect(),
-                        main_writers: s.main_writers.iter().map(|&r| id(r)).collect(),
-                    })
-                    .collect(),
-            })
-            .collect(),
+        networks: networks_of(p, a),
+        interrupts: interrupts_of(p, a),
         configuration: p
             .configuration
             .as_ref()
@@ -598,10 +432,228 @@ pub fn document_with<'a>(p: &'a Program, a: &'a Analysis, fbd: Option<&'a FbdPar
             rungs: p.rungs.len(),
             main_rungs: p.main().rungs.len(),
         },
-        post_dominator_tree,
+        post_dominator_tree: post_dominator_tree_of(p, a),
         control_count,
-        tasks_by_level,
+        tasks_by_level: tasks_by_level_of(p, a),
     }
+}
+
+/// Rung `r`'s id.
+fn rung_id(p: &Program, r: RungId) -> &str {
+    p.rung(r).id.as_str()
+}
+
+/// The names of variables `vs`.
+fn var_names<'a>(p: &'a Program, vs: &[VarId]) -> Vec<&'a str> {
+    vs.iter().map(|&v| p.var(v).name.as_str()).collect()
+}
+
+/// CFG edge `e` by its ends' names.
+fn cfg_edge<'a>(p: &'a Program, e: &crate::analysis::CfgEdge) -> CfgEdgeEntry<'a> {
+    CfgEdgeEntry {
+        from: super::node_name(p, e.from.0),
+        to: super::node_name(p, e.to.0),
+        label: label_name(e.label),
+        kind: e.kind.name(),
+    }
+}
+
+/// The dependences (data, then the paper's control pairs) and the number of control pairs.
+fn dependences_of<'a>(p: &'a Program, a: &'a Analysis) -> (Lazy<'a, DependenceEntry<'a>>, usize) {
+    let id = move |r: RungId| rung_id(p, r);
+    let var = move |v: VarId| p.var(v).name.as_str();
+    let pairs = std::rc::Rc::new(super::paper_control_pairs(a));
+    let control_count = pairs.len();
+    let dependences = Lazy::new(a.data.len() + control_count, move || {
+        let data = a.data.iter().map(move |d| DependenceEntry::Data {
+            kind: d.kind.name(),
+            from: id(RungId(d.from)),
+            to: id(RungId(d.to)),
+            var: var(d.var),
+        });
+        let pairs = pairs.clone();
+        let control = (0..pairs.len()).map(move |i| {
+            let (from, to, cause) = pairs[i];
+            let (cause, edge, v) = match cause {
+                ControlCause::Branch { edge } => ("branch", Some(edge_ref(p, a, edge)), None),
+                ControlCause::Instance { var: v } => ("instance", None, Some(var(v))),
+            };
+            DependenceEntry::Control {
+                kind: "control",
+                from: id(from),
+                to: id(to),
+                cause,
+                edge,
+                var: v,
+            }
+        });
+        data.chain(control)
+    });
+    (dependences, control_count)
+}
+
+/// CFG edge `i` as a control dependence's cause.
+fn edge_ref<'a>(p: &'a Program, a: &'a Analysis, i: CfgEdgeId) -> EdgeRef<'a> {
+    let e = cfg_edge(p, a.cfg.edge(i));
+    EdgeRef {
+        from: e.from,
+        to: e.to,
+        label: e.label,
+        kind: e.kind,
+    }
+}
+
+/// The pair counts of the every-pair definition, per kind and per variable.
+fn dependence_counts_of<'a>(
+    p: &'a Program,
+    a: &'a Analysis,
+    control_count: usize,
+) -> DependenceCounts<'a> {
+    let counts = &a.counts;
+    DependenceCounts {
+        flow: counts.flow,
+        anti: counts.anti,
+        output: counts.output,
+        control: control_count as u64,
+        by_var: Lazy::new(counts.by_var.len(), move || {
+            counts
+                .by_var
+                .iter()
+                .map(move |&(v, flow, anti, output)| VarCount {
+                    var: p.var(v).name.as_str(),
+                    flow,
+                    anti,
+                    output,
+                })
+        }),
+    }
+}
+
+/// START and the rungs of `p`: the CFG nodes whose post-dominators are listed.
+fn listed_nodes(p: &Program, a: &Analysis) -> impl Iterator<Item = u32> {
+    std::iter::once(a.cfg.start().0).chain(0..p.rungs.len() as u32)
+}
+
+/// Each listed node's immediate post-dominator, by name.
+fn ipdom_of<'a>(p: &'a Program, a: &'a Analysis) -> Ipdom<'a> {
+    let node = move |n: u32| super::node_name(p, n);
+    let with_ipdom = move || {
+        listed_nodes(p, a)
+            .filter_map(move |n| a.post_dominators.immediate(n).map(|d| (node(n), node(d))))
+    };
+    Ipdom(Lazy::new(with_ipdom().count(), with_ipdom))
+}
+
+/// The post-dominator tree, node by node (START, the rungs, STOP).
+fn post_dominator_tree_of<'a>(p: &'a Program, a: &'a Analysis) -> Lazy<'a, TreeNode<'a>> {
+    let node = move |n: u32| super::node_name(p, n);
+    Lazy::new(p.rungs.len() + 2, move || {
+        listed_nodes(p, a)
+            .chain(std::iter::once(a.cfg.stop().0))
+            .map(move |n| TreeNode {
+                node: node(n),
+                ipdom: a.post_dominators.immediate(n).map(node),
+                children: a
+                    .post_dominators
+                    .children(n)
+                    .iter()
+                    .map(|&k| node(k))
+                    .collect(),
+            })
+    })
+}
+
+/// Task `t` of the combined schedule, by its rungs' ids.
+fn task_entry<'a>(p: &'a Program, a: &'a Analysis, t: &'a crate::analysis::Task) -> TaskEntry<'a> {
+    let s = &a.schedule;
+    let id = move |r: RungId| rung_id(p, r);
+    TaskEntry {
+        rungs: t.rungs.iter().map(|&r| id(r)).collect(),
+        is_loop: t.is_loop,
+        level: t.level + 1,
+        entries: t.entries.iter().map(|&r| id(r)).collect(),
+        guard: t
+            .guard
+            .iter()
+            .map(|g| GuardEntry {
+                controller: id(s.head(g.controller)),
+                successor: match g.successor {
+                    Successor::Task(x) => id(s.head(x)),
+                    Successor::Stop => "STOP",
+                },
+            })
+            .collect(),
+    }
+}
+
+/// The tasks level by level, in sequential order inside a level.
+fn tasks_by_level_of<'a>(p: &'a Program, a: &'a Analysis) -> Lazy<'a, TaskEntry<'a>> {
+    let s = &a.schedule;
+    let order = std::rc::Rc::new(s.levels.concat());
+    Lazy::new(s.tasks.len(), move || {
+        let order = order.clone();
+        (0..order.len()).map(move |i| task_entry(p, a, s.task(order[i])))
+    })
+}
+
+/// The loops of the combined schedule, each named by its first rung.
+fn loops_of<'a>(p: &'a Program, a: &'a Analysis) -> Vec<LoopEntry<'a>> {
+    a.schedule
+        .tasks
+        .iter()
+        .filter(|t| t.is_loop)
+        .map(|t| LoopEntry {
+            head: rung_id(p, t.rungs[0]),
+            rungs: t.rungs.iter().map(|&r| rung_id(p, r)).collect(),
+        })
+        .collect()
+}
+
+/// Why each rung whose combined level differs from a paper view's does.
+fn differences_of<'a>(p: &'a Program, a: &'a Analysis) -> Lazy<'a, DifferenceEntry> {
+    let explainer = std::rc::Rc::new(Explainer::new(p, a));
+    let differing = std::rc::Rc::new(explainer.differing());
+    Lazy::new(differing.len(), move || {
+        let explainer = explainer.clone();
+        let differing = differing.clone();
+        (0..differing.len()).map(move |i| explainer.difference(differing[i]))
+    })
+}
+
+/// The networks of the program (ladder networks, FBD networks) with their IN/OUT.
+fn networks_of<'a>(p: &'a Program, a: &'a Analysis) -> Vec<NetworkEntry<'a>> {
+    super::networks(p, a)
+        .into_iter()
+        .map(|n| NetworkEntry {
+            pou: p.pou(n.pou).name.as_str(),
+            id: p.rung(n.rungs[0]).network().unwrap_or_default(),
+            rungs: n.rungs.iter().map(|&r| rung_id(p, r)).collect(),
+            ins: var_names(p, &n.ins),
+            out: var_names(p, &n.outs),
+        })
+        .collect()
+}
+
+/// What each interrupt routine shares with the main program.
+fn interrupts_of<'a>(p: &'a Program, a: &'a Analysis) -> Vec<InterruptEntry<'a>> {
+    let ids = |rs: &[RungId]| rs.iter().map(|&r| rung_id(p, r)).collect();
+    a.interrupts
+        .iter()
+        .map(|i| InterruptEntry {
+            pou: &p.pou(i.pou).name,
+            shared: i
+                .shared
+                .iter()
+                .map(|s| SharedVarEntry {
+                    var: &p.var(s.var).name,
+                    interrupt_reads: s.interrupt_reads,
+                    interrupt_writes: s.interrupt_writes,
+                    main_readers: ids(&s.main_readers),
+                    main_writers: ids(&s.main_writers),
+                })
+                .collect(),
+        })
+        .collect()
 }
 
 /// The ids of the lowering's landing rungs.
