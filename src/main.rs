@@ -6,7 +6,7 @@
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
-use clap::{Parser, Subcommand, ValueEnum};
+use clap::{Args, Parser, Subcommand, ValueEnum};
 use plc_deps::analysis::{AnalysisConfig, DependenceListing};
 use plc_deps::cmd::report::{ReportConfig, ReportFormat};
 use plc_deps::cmd::{self, CliError};
@@ -25,39 +25,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Analyse a program: dependences, control flow, post-dominators, levels, cycles, cost.
-    Report {
-        /// The program (JSON program format, see docs/format.md; `-`: standard input).
-        file: PathBuf,
-        /// Output format.
-        #[arg(long, value_enum, default_value_t = ReportFormatArg::Text)]
-        format: ReportFormatArg,
-        /// Which levellings the output shows (JSON and HTML always have all of them) [default:
-        /// all for text, combined for DOT, which draws one levelling].
-        #[arg(long, value_enum)]
-        view: Option<ViewArg>,
-        /// Print every row of every text section (by default each shows its first rows).
-        #[arg(long)]
-        full: bool,
-        /// Which data dependences are listed: every pair of the definition, or only the direct
-        /// ones (last writer → reader, reader → next writer, writer → next writer), which imply
-        /// the rest [default: all up to --max-pairs, direct beyond].
-        #[arg(long, value_enum)]
-        dependences: Option<DependencesArg>,
-        /// The most data dependence pairs listed before the report lists the direct ones instead.
-        #[arg(long, default_value_t = plc_deps::analysis::DEFAULT_MAX_PAIRS)]
-        max_pairs: u64,
-        /// DOT: draw the rungs of this POU (the program, a subroutine or an FB instance). Text,
-        /// JSON, HTML: analyse only this program of a PLCopen project [default: every program
-        /// instance, in task order].
-        #[arg(long, conflicts_with = "rungs")]
-        pou: Option<String>,
-        /// DOT only: draw the rungs from FIRST to LAST in file order (`R10..R50`, or one id).
-        #[arg(long, value_name = "FIRST..LAST")]
-        rungs: Option<String>,
-        /// Write to this file instead of standard output.
-        #[arg(short, long)]
-        output: Option<PathBuf>,
-    },
+    Report(ReportArgs),
     /// Print each FBD network's execution order and conditional fragment tree (the FBD text-generation paper).
     Order {
         /// The program (JSON program format with FBD bodies, see docs/fbd.md; `-`: standard
@@ -80,30 +48,7 @@ enum Command {
         output: Option<PathBuf>,
     },
     /// Generate C for every POU, a runtime header, main.c and a Makefile (docs/c.md).
-    C {
-        /// The program (JSON program format; `-`: standard input).
-        file: PathBuf,
-        /// The folder to write (all files or none).
-        #[arg(short, long)]
-        output: PathBuf,
-        /// Replace an existing folder that is not empty.
-        #[arg(long)]
-        force: bool,
-        /// The scan cycle of the harness (a TIME: 10ms, T#1s).
-        #[arg(long, default_value = "10ms")]
-        cycle: String,
-        /// Loop-backs per loop-back rung and scan.
-        #[arg(long, default_value_t = 100_000)]
-        loop_cap: u32,
-        /// Write every rung as C statements, not the rungs of contacts and coils as rows of
-        /// tables run by loops specialised by shape (the default; docs/c.md): `cc` takes about
-        /// 1 ms of CPU per rung written as statements, minutes at 100,000 rungs.
-        #[arg(long)]
-        statements: bool,
-        /// Accepted for compatibility: rows are the default.
-        #[arg(long, hide = true)]
-        rows: bool,
-    },
+    C(CArgs),
     /// Write the program as S7-200 Instruction List (STL), as STEP 7-Micro/WIN shows it (docs/il.md).
     Il {
         /// The program (JSON program format, PLCopen XML or STL; `-`: standard input).
@@ -119,106 +64,173 @@ enum Command {
         output: Option<PathBuf>,
     },
     /// Generate a synthetic program (shape documented in docs/gen.md).
-    Gen {
-        /// Number of rungs of the main program (at least 1).
-        #[arg(long)]
-        rungs: usize,
-        /// Rungs per stage: the program has about rungs / width data levels.
-        #[arg(long, default_value_t = 100, conflicts_with = "levels")]
-        width: usize,
-        /// Data levels instead of --width: width = ceil(rungs / levels) (at least 1).
-        #[arg(long, value_name = "L")]
-        levels: Option<usize>,
-        /// Which lanes of the previous stage a rung reads: 3-5 nearby ones (local) or 3-6 drawn
-        /// at random from the whole stage (random).
-        #[arg(long, value_enum, default_value_t = ReadsArg::Local)]
-        reads: ReadsArg,
-        /// Seed of the pseudo-random choices (same seed, same program).
-        #[arg(long, default_value_t = 1)]
-        seed: u64,
-        /// Add timer boxes (TON, TOF, TP), counter boxes (CTU, CTD), and reads of their Q and of
-        /// the counters' CV.
-        #[arg(long)]
-        timers: bool,
-        /// Add FOR/NEXT loops (about 1 in 200 rungs starts one).
-        #[arg(long)]
-        loops: bool,
-        /// With --loops: every FOR body has exactly N rungs (at least 1), and the first loop
-        /// starts as early as it fits (default: 2 to 4 body rungs).
-        #[arg(long, value_name = "N", requires = "loops")]
-        for_body: Option<usize>,
-        /// A hot variable: about F * rungs main rungs (0 < F <= 1) also set the BOOL FAULT and
-        /// a tenth as many read it, spread evenly over the program.
-        #[arg(long, value_name = "F")]
-        hot_fraction: Option<f64>,
-        /// Add conditional forward jumps.
-        #[arg(long)]
-        jumps: bool,
-        /// Add subroutines and calls.
-        #[arg(long)]
-        calls: bool,
-        /// Write to this file instead of standard output.
-        #[arg(short, long)]
-        output: Option<PathBuf>,
-    },
+    Gen(GenArgs),
     /// Run the PLC scan cycle on virtual time: sequentially, in parallel, or both (checked equal).
-    Run {
-        /// The program (JSON program format, see docs/format.md; `-`: standard input).
-        file: PathBuf,
-        /// Number of scans [default: the rows of --inputs, or 1000].
-        #[arg(long)]
-        scans: Option<u64>,
-        /// Input values per scan: CSV (header of input names, one row per scan) or JSON
-        /// (`[{"start": true, "temp": 40}, ...]`); see docs/scan.md.
-        #[arg(long)]
-        inputs: Option<PathBuf>,
-        /// Virtual scan period, a TIME of whole milliseconds (scan k runs at k × cycle).
-        #[arg(long, default_value = "10ms")]
-        cycle: String,
-        /// Workers of the parallel executor [default: the number of cores].
-        #[arg(long)]
-        threads: Option<usize>,
-        /// Which executors run.
-        #[arg(long, value_enum, default_value_t = ModeArg::Both)]
-        mode: ModeArg,
-        /// Write the traced variables after every scan to this CSV file (checked before the
-        /// first scan, complete or not at all).
-        #[arg(long)]
-        trace: Option<PathBuf>,
-        /// Variables to trace with --trace (comma-separated; instance fields as T1.Q; each
-        /// column once) [default: all].
-        #[arg(long, value_delimiter = ',')]
-        trace_vars: Option<Vec<String>>,
-        /// Output format.
-        #[arg(long, value_enum, default_value_t = RunFormatArg::Text)]
-        format: RunFormatArg,
-        /// Explain the parallel plan: levels, costs, slices, merges and padding, and what the
-        /// run chose (measured times, switches).
-        #[arg(long)]
-        explain: bool,
-        /// Which plans the parallel executor may use: measured among the sequential walk and
-        /// the levelled plans (auto), the cost model's choice (model), always the sequential
-        /// walk (seq), always the levelled plan (par), always the dependence-driven plan (deps:
-        /// ready flags instead of a barrier per level), always the levelled plan on private
-        /// states handing over packed writes after each phase (exchange).
-        #[arg(long, value_enum, default_value_t = PlanArg::Auto)]
-        plan: PlanArg,
-        /// Loop-backs allowed per loop-back rung and scan (the iteration cap).
-        #[arg(long, default_value_t = 100_000)]
-        loop_cap: u32,
-        /// With --mode both, the scans of each mode's turn: the two passes alternate in blocks
-        /// of this many scans, so that a change of the machine's speed hits both [default:
-        /// about 20 ms of the sequential walk's scans, and at least a 64th of the run].
-        #[arg(long, value_name = "N")]
-        alternate: Option<u64>,
-        /// Run only this program of a PLCopen project [default: every program instance, in
-        /// task order].
-        #[arg(long)]
-        pou: Option<String>,
-        /// Write the report to this file instead of standard output.
-        #[arg(short, long)]
-        output: Option<PathBuf>,
-    },
+    Run(RunArgs),
+}
+
+#[derive(Args)]
+struct ReportArgs {
+    /// The program (JSON program format, see docs/format.md; `-`: standard input).
+    file: PathBuf,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = ReportFormatArg::Text)]
+    format: ReportFormatArg,
+    /// Which levellings the output shows (JSON and HTML always have all of them) [default:
+    /// all for text, combined for DOT, which draws one levelling].
+    #[arg(long, value_enum)]
+    view: Option<ViewArg>,
+    /// Print every row of every text section (by default each shows its first rows).
+    #[arg(long)]
+    full: bool,
+    /// Which data dependences are listed: every pair of the definition, or only the direct
+    /// ones (last writer → reader, reader → next writer, writer → next writer), which imply
+    /// the rest [default: all up to --max-pairs, direct beyond].
+    #[arg(long, value_enum)]
+    dependences: Option<DependencesArg>,
+    /// The most data dependence pairs listed before the report lists the direct ones instead.
+    #[arg(long, default_value_t = plc_deps::analysis::DEFAULT_MAX_PAIRS)]
+    max_pairs: u64,
+    /// DOT: draw the rungs of this POU (the program, a subroutine or an FB instance). Text,
+    /// JSON, HTML: analyse only this program of a PLCopen project [default: every program
+    /// instance, in task order].
+    #[arg(long, conflicts_with = "rungs")]
+    pou: Option<String>,
+    /// DOT only: draw the rungs from FIRST to LAST in file order (`R10..R50`, or one id).
+    #[arg(long, value_name = "FIRST..LAST")]
+    rungs: Option<String>,
+    /// Write to this file instead of standard output.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+}
+
+#[derive(Args)]
+struct GenArgs {
+    /// Number of rungs of the main program (at least 1).
+    #[arg(long)]
+    rungs: usize,
+    /// Rungs per stage: the program has about rungs / width data levels.
+    #[arg(long, default_value_t = 100, conflicts_with = "levels")]
+    width: usize,
+    /// Data levels instead of --width: width = ceil(rungs / levels) (at least 1).
+    #[arg(long, value_name = "L")]
+    levels: Option<usize>,
+    /// Which lanes of the previous stage a rung reads: 3-5 nearby ones (local) or 3-6 drawn
+    /// at random from the whole stage (random).
+    #[arg(long, value_enum, default_value_t = ReadsArg::Local)]
+    reads: ReadsArg,
+    /// Seed of the pseudo-random choices (same seed, same program).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Add timer boxes (TON, TOF, TP), counter boxes (CTU, CTD), and reads of their Q and of
+    /// the counters' CV.
+    #[arg(long)]
+    timers: bool,
+    /// Add FOR/NEXT loops (about 1 in 200 rungs starts one).
+    #[arg(long)]
+    loops: bool,
+    /// With --loops: every FOR body has exactly N rungs (at least 1), and the first loop
+    /// starts as early as it fits (default: 2 to 4 body rungs).
+    #[arg(long, value_name = "N", requires = "loops")]
+    for_body: Option<usize>,
+    /// A hot variable: about F * rungs main rungs (0 < F <= 1) also set the BOOL FAULT and
+    /// a tenth as many read it, spread evenly over the program.
+    #[arg(long, value_name = "F")]
+    hot_fraction: Option<f64>,
+    /// Add conditional forward jumps.
+    #[arg(long)]
+    jumps: bool,
+    /// Add subroutines and calls.
+    #[arg(long)]
+    calls: bool,
+    /// Write to this file instead of standard output.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+}
+
+#[derive(Args)]
+struct RunArgs {
+    /// The program (JSON program format, see docs/format.md; `-`: standard input).
+    file: PathBuf,
+    /// Number of scans [default: the rows of --inputs, or 1000].
+    #[arg(long)]
+    scans: Option<u64>,
+    /// Input values per scan: CSV (header of input names, one row per scan) or JSON
+    /// (`[{"start": true, "temp": 40}, ...]`); see docs/scan.md.
+    #[arg(long)]
+    inputs: Option<PathBuf>,
+    /// Virtual scan period, a TIME of whole milliseconds (scan k runs at k × cycle).
+    #[arg(long, default_value = "10ms")]
+    cycle: String,
+    /// Workers of the parallel executor [default: the number of cores].
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Which executors run.
+    #[arg(long, value_enum, default_value_t = ModeArg::Both)]
+    mode: ModeArg,
+    /// Write the traced variables after every scan to this CSV file (checked before the
+    /// first scan, complete or not at all).
+    #[arg(long)]
+    trace: Option<PathBuf>,
+    /// Variables to trace with --trace (comma-separated; instance fields as T1.Q; each
+    /// column once) [default: all].
+    #[arg(long, value_delimiter = ',')]
+    trace_vars: Option<Vec<String>>,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = RunFormatArg::Text)]
+    format: RunFormatArg,
+    /// Explain the parallel plan: levels, costs, slices, merges and padding, and what the
+    /// run chose (measured times, switches).
+    #[arg(long)]
+    explain: bool,
+    /// Which plans the parallel executor may use: measured among the sequential walk and
+    /// the levelled plans (auto), the cost model's choice (model), always the sequential
+    /// walk (seq), always the levelled plan (par), always the dependence-driven plan (deps:
+    /// ready flags instead of a barrier per level), always the levelled plan on private
+    /// states handing over packed writes after each phase (exchange).
+    #[arg(long, value_enum, default_value_t = PlanArg::Auto)]
+    plan: PlanArg,
+    /// Loop-backs allowed per loop-back rung and scan (the iteration cap).
+    #[arg(long, default_value_t = 100_000)]
+    loop_cap: u32,
+    /// With --mode both, the scans of each mode's turn: the two passes alternate in blocks
+    /// of this many scans, so that a change of the machine's speed hits both [default:
+    /// about 20 ms of the sequential walk's scans, and at least a 64th of the run].
+    #[arg(long, value_name = "N")]
+    alternate: Option<u64>,
+    /// Run only this program of a PLCopen project [default: every program instance, in
+    /// task order].
+    #[arg(long)]
+    pou: Option<String>,
+    /// Write the report to this file instead of standard output.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+}
+
+#[derive(Args)]
+struct CArgs {
+    /// The program (JSON program format; `-`: standard input).
+    file: PathBuf,
+    /// The folder to write (all files or none).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Replace an existing folder that is not empty.
+    #[arg(long)]
+    force: bool,
+    /// The scan cycle of the harness (a TIME: 10ms, T#1s).
+    #[arg(long, default_value = "10ms")]
+    cycle: String,
+    /// Loop-backs per loop-back rung and scan.
+    #[arg(long, default_value_t = 100_000)]
+    loop_cap: u32,
+    /// Write every rung as C statements, not the rungs of contacts and coils as rows of
+    /// tables run by loops specialised by shape (the default; docs/c.md): `cc` takes about
+    /// 1 ms of CPU per rung written as statements, minutes at 100,000 rungs.
+    #[arg(long)]
+    statements: bool,
+    /// Accepted for compatibility: rows are the default.
+    #[arg(long, hide = true)]
+    rows: bool,
 }
 
 #[derive(Copy, Clone, ValueEnum)]
@@ -284,79 +296,7 @@ enum DependencesArg {
 
 fn run(cli: Cli) -> Result<(), CliError> {
     match cli.command {
-        Command::Report {
-            file,
-            format,
-            view,
-            full,
-            dependences,
-            max_pairs,
-            pou,
-            rungs,
-            output,
-        } => {
-            let format = match format {
-                ReportFormatArg::Text => ReportFormat::Text,
-                ReportFormatArg::Json => ReportFormat::Json,
-                ReportFormatArg::Dot => ReportFormat::Dot,
-                ReportFormatArg::Html => ReportFormat::Html,
-            };
-            // Outside DOT, --pou selects the PLCopen program to analyse.
-            let (pou, program) = match format {
-                ReportFormat::Dot => (pou, None),
-                _ => (None, pou),
-            };
-            let selection = match (pou, rungs) {
-                (Some(name), _) => Selection::Pou(name),
-                (None, Some(range)) => match range.split_once("..") {
-                    Some((first, last)) => Selection::Rungs {
-                        first: first.trim().to_owned(),
-                        last: last.trim().to_owned(),
-                    },
-                    None => Selection::Rungs {
-                        first: range.trim().to_owned(),
-                        last: range.trim().to_owned(),
-                    },
-                },
-                (None, None) => Selection::Whole,
-            };
-            if selection != Selection::Whole && format != ReportFormat::Dot {
-                return Err(CliError::Usage(
-                    "--rungs chooses what the DOT report draws; add --format dot (the text and JSON reports cover the whole program)".into(),
-                ));
-            }
-            let view = match (view, format) {
-                (Some(ViewArg::Paper), _) => View::Paper,
-                (Some(ViewArg::Combined), _) | (None, ReportFormat::Dot) => View::Combined,
-                (Some(ViewArg::All), ReportFormat::Dot) => {
-                    return Err(CliError::Usage(
-                        "--view all: the DOT report draws one levelling; use --view combined (the default) or --view paper".into(),
-                    ))
-                }
-                (Some(ViewArg::All), _) | (None, _) => View::All,
-            };
-            let config = ReportConfig {
-                input: file,
-                format,
-                view,
-                rows: if full {
-                    Rows::All
-                } else {
-                    Rows::First(plc_deps::report::text::DEFAULT_ROWS)
-                },
-                analysis: AnalysisConfig {
-                    dependences: match dependences {
-                        Some(DependencesArg::All) => DependenceListing::All,
-                        Some(DependencesArg::Direct) => DependenceListing::Direct,
-                        None => DependenceListing::UpTo(max_pairs),
-                    },
-                },
-                selection,
-                program,
-                output,
-            };
-            cmd::report::report(&config)
-        }
+        Command::Report(args) => cmd::report::report(&args.config()?),
         Command::Order {
             file,
             format,
@@ -377,28 +317,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
             input: file,
             output,
         }),
-        Command::C {
-            file,
-            output,
-            force,
-            cycle,
-            loop_cap,
-            statements,
-            rows: _,
-        } => {
-            let cycle_ms = cmd::run::parse_cycle(&cycle)?;
-            cmd::c::c(&cmd::c::CCommand {
-                input: file,
-                output,
-                force,
-                config: plc_deps::codegen::c::CConfig {
-                    cycle_ms,
-                    loop_cap,
-                    rows: !statements,
-                    ..Default::default()
-                },
-            })
-        }
+        Command::C(args) => cmd::c::c(&args.command()?),
         Command::Il { file, output } => cmd::il::il(&cmd::il::IlCommand {
             input: file,
             output,
@@ -406,93 +325,157 @@ fn run(cli: Cli) -> Result<(), CliError> {
         Command::Schema { output } => {
             cmd::io::write_output(output.as_deref(), cmd::schema::PROGRAM_SCHEMA)
         }
-        Command::Gen {
-            rungs,
-            width,
-            levels,
-            reads,
-            seed,
-            timers,
-            loops,
-            jumps,
-            calls,
-            for_body,
-            hot_fraction,
-            output,
-        } => {
-            let config = plc_deps::synth::GenConfig {
-                rungs,
-                width,
-                seed,
-                timers,
-                loops,
-                jumps,
-                calls,
-                for_body,
-                hot_fraction,
-                reads: match reads {
+        Command::Gen(args) => cmd::gen::gen(&args.command()),
+        Command::Run(args) => plc_deps::cmd::run::run(&args.config()?),
+    }
+}
+
+impl ReportArgs {
+    /// The report's configuration; a usage error for options that do not go together.
+    fn config(self) -> Result<ReportConfig, CliError> {
+        let format = match self.format {
+            ReportFormatArg::Text => ReportFormat::Text,
+            ReportFormatArg::Json => ReportFormat::Json,
+            ReportFormatArg::Dot => ReportFormat::Dot,
+            ReportFormatArg::Html => ReportFormat::Html,
+        };
+        // Outside DOT, --pou selects the PLCopen program to analyse.
+        let (pou, program) = match format {
+            ReportFormat::Dot => (self.pou, None),
+            _ => (None, self.pou),
+        };
+        let selection = match (pou, self.rungs) {
+            (Some(name), _) => Selection::Pou(name),
+            (None, Some(range)) => match range.split_once("..") {
+                Some((first, last)) => Selection::Rungs {
+                    first: first.trim().to_owned(),
+                    last: last.trim().to_owned(),
+                },
+                None => Selection::Rungs {
+                    first: range.trim().to_owned(),
+                    last: range.trim().to_owned(),
+                },
+            },
+            (None, None) => Selection::Whole,
+        };
+        if selection != Selection::Whole && format != ReportFormat::Dot {
+            return Err(CliError::Usage(
+                "--rungs chooses what the DOT report draws; add --format dot (the text and JSON reports cover the whole program)".into(),
+            ));
+        }
+        let view = match (self.view, format) {
+            (Some(ViewArg::Paper), _) => View::Paper,
+            (Some(ViewArg::Combined), _) | (None, ReportFormat::Dot) => View::Combined,
+            (Some(ViewArg::All), ReportFormat::Dot) => {
+                return Err(CliError::Usage(
+                    "--view all: the DOT report draws one levelling; use --view combined (the default) or --view paper".into(),
+                ))
+            }
+            (Some(ViewArg::All), _) | (None, _) => View::All,
+        };
+        Ok(ReportConfig {
+            input: self.file,
+            format,
+            view,
+            rows: if self.full {
+                Rows::All
+            } else {
+                Rows::First(plc_deps::report::text::DEFAULT_ROWS)
+            },
+            analysis: AnalysisConfig {
+                dependences: match self.dependences {
+                    Some(DependencesArg::All) => DependenceListing::All,
+                    Some(DependencesArg::Direct) => DependenceListing::Direct,
+                    None => DependenceListing::UpTo(self.max_pairs),
+                },
+            },
+            selection,
+            program,
+            output: self.output,
+        })
+    }
+}
+
+impl CArgs {
+    /// The C generator's command; a usage error for a cycle that is not a TIME.
+    fn command(self) -> Result<cmd::c::CCommand, CliError> {
+        Ok(cmd::c::CCommand {
+            input: self.file,
+            output: self.output,
+            force: self.force,
+            config: plc_deps::codegen::c::CConfig {
+                cycle_ms: cmd::run::parse_cycle(&self.cycle)?,
+                loop_cap: self.loop_cap,
+                rows: !self.statements,
+                ..Default::default()
+            },
+        })
+    }
+}
+
+impl GenArgs {
+    /// The generator's command.
+    fn command(self) -> cmd::gen::GenCommand {
+        cmd::gen::GenCommand {
+            config: plc_deps::synth::GenConfig {
+                rungs: self.rungs,
+                width: self.width,
+                seed: self.seed,
+                timers: self.timers,
+                loops: self.loops,
+                jumps: self.jumps,
+                calls: self.calls,
+                for_body: self.for_body,
+                hot_fraction: self.hot_fraction,
+                reads: match self.reads {
                     ReadsArg::Local => plc_deps::synth::Reads::Local,
                     ReadsArg::Random => plc_deps::synth::Reads::Random,
                 },
-            };
-            cmd::gen::gen(&cmd::gen::GenCommand {
-                config,
-                levels,
-                output,
-            })
+            },
+            levels: self.levels,
+            output: self.output,
         }
-        Command::Run {
-            file,
-            scans,
-            inputs,
-            cycle,
-            threads,
-            mode,
-            trace,
-            trace_vars,
-            format,
-            explain,
-            plan,
-            loop_cap,
-            alternate,
-            pou,
-            output,
-        } => {
-            use plc_deps::cmd::run::{self, RunConfig, RunFormat, RunMode};
-            let mut config = RunConfig::new(file);
-            config.scans = scans;
-            config.alternate = alternate;
-            config.inputs = inputs;
-            config.cycle_ms = run::parse_cycle(&cycle)?;
-            if let Some(t) = threads {
-                config.threads = t;
-            }
-            config.mode = match mode {
-                ModeArg::Seq => RunMode::Seq,
-                ModeArg::Par => RunMode::Par,
-                ModeArg::Both => RunMode::Both,
-            };
-            config.trace = trace;
-            config.trace_vars = trace_vars;
-            config.format = match format {
-                RunFormatArg::Text => RunFormat::Text,
-                RunFormatArg::Json => RunFormat::Json,
-                RunFormatArg::Html => RunFormat::Html,
-            };
-            config.explain = explain;
-            config.plan = match plan {
-                PlanArg::Auto => plc_deps::exec::parallel::PlanKind::Auto,
-                PlanArg::Model => plc_deps::exec::parallel::PlanKind::Model,
-                PlanArg::Seq => plc_deps::exec::parallel::PlanKind::Seq,
-                PlanArg::Par => plc_deps::exec::parallel::PlanKind::Par,
-                PlanArg::Deps => plc_deps::exec::parallel::PlanKind::Deps,
-                PlanArg::Exchange => plc_deps::exec::parallel::PlanKind::Exchange,
-            };
-            config.loop_cap = loop_cap;
-            config.output = output;
-            config.program = pou;
-            run::run(&config)
+    }
+}
+
+impl RunArgs {
+    /// The run's configuration; a usage error for a cycle that is not a TIME.
+    fn config(self) -> Result<plc_deps::cmd::run::RunConfig, CliError> {
+        use plc_deps::cmd::run::{self, RunConfig, RunFormat, RunMode};
+        use plc_deps::exec::parallel::PlanKind;
+        let mut config = RunConfig::new(self.file);
+        config.scans = self.scans;
+        config.alternate = self.alternate;
+        config.inputs = self.inputs;
+        config.cycle_ms = run::parse_cycle(&self.cycle)?;
+        if let Some(t) = self.threads {
+            config.threads = t;
         }
+        config.mode = match self.mode {
+            ModeArg::Seq => RunMode::Seq,
+            ModeArg::Par => RunMode::Par,
+            ModeArg::Both => RunMode::Both,
+        };
+        config.trace = self.trace;
+        config.trace_vars = self.trace_vars;
+        config.format = match self.format {
+            RunFormatArg::Text => RunFormat::Text,
+            RunFormatArg::Json => RunFormat::Json,
+            RunFormatArg::Html => RunFormat::Html,
+        };
+        config.explain = self.explain;
+        config.plan = match self.plan {
+            PlanArg::Auto => PlanKind::Auto,
+            PlanArg::Model => PlanKind::Model,
+            PlanArg::Seq => PlanKind::Seq,
+            PlanArg::Par => PlanKind::Par,
+            PlanArg::Deps => PlanKind::Deps,
+            PlanArg::Exchange => PlanKind::Exchange,
+        };
+        config.loop_cap = self.loop_cap;
+        config.output = self.output;
+        config.program = self.pou;
+        Ok(config)
     }
 }
 
@@ -513,9 +496,9 @@ fn remove_temp_files_on_signal() {
 /// How errors and warnings are printed: as JSON lines when the command was given `--format json`.
 fn error_format(cli: &Cli) -> cmd::errors::Format {
     let json = match &cli.command {
-        Command::Report { format, .. } => matches!(format, ReportFormatArg::Json),
+        Command::Report(args) => matches!(args.format, ReportFormatArg::Json),
         Command::Order { format, .. } => matches!(format, FormatArg::Json),
-        Command::Run { format, .. } => matches!(format, RunFormatArg::Json),
+        Command::Run(args) => matches!(args.format, RunFormatArg::Json),
         _ => false,
     };
     if json {
