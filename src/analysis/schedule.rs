@@ -279,9 +279,9 @@ fn condense(live_edges: &[(u32, u32)], node: impl Fn(u32) -> u32, tasks: &mut [T
     Condensed { edges, entry_preds }
 }
 
-/// Gives each task its guard: the control dependences (Ferrante, Ottenstein & Warren) of the
-/// condensed CFG `cedges` (START = `t`, STOP = `t + 1` for `t` tasks), each "task A ran and left
-/// towards successor B". Returns the regions that can never reach STOP, as rungs.
+/// Gives each task its guard: the control dependences (Ferrante, Ottenstein & Warren, 1987)
+/// of the condensed CFG `cedges` (START = `t`, STOP = `t + 1` for `t` tasks), each "task A ran
+/// and left towards successor B". Returns the regions that can never reach STOP, as rungs.
 fn guard_tasks(cedges: &[(u32, u32)], tasks: &mut [Task]) -> Vec<Vec<RungId>> {
     let t = tasks.len() as u32;
     let (cstart, cstop) = (t, t + 1);
