@@ -362,27 +362,38 @@ fn configs(threads: usize, seed: u64) -> PlanConfig {
     c
 }
 
-fn pool() -> rayon::ThreadPool {
+/// A pool of `threads` threads for the checks.
+fn pool(threads: usize) -> rayon::ThreadPool {
     rayon::ThreadPoolBuilder::new()
-        .num_threads(3)
+        .num_threads(threads)
         .build()
         .unwrap()
 }
 
+/// The scans of the random-program tests: a loop cap low enough that their loops reach it.
+const RANDOM_EXEC: ExecConfig = ExecConfig {
+    cycle_ms: 10,
+    loop_cap: 12,
+};
+
+/// The random programs (24 rungs at most) of seeds `base + seed` for `seed` in `0..count` that
+/// load, with `seed`.
+fn random_programs(base: u64, count: u64) -> impl Iterator<Item = (u64, Program)> {
+    (0..count).filter_map(move |seed| {
+        let json = common::random_program(base + seed, 24);
+        plc_deps::load::program_from_json(&json)
+            .ok()
+            .map(|p| (seed, p))
+    })
+}
+
 #[test]
 fn parallel_scan_equals_sequential_scan_on_random_programs() {
-    let pool = pool();
-    let exec = ExecConfig {
-        cycle_ms: 10,
-        loop_cap: 12,
-    };
+    let pool = pool(3);
+    let exec = RANDOM_EXEC;
     let mut stats = Stats::default();
     let mut loaded = 0;
-    for seed in 0..PROGRAMS {
-        let json = common::random_program(seed, 24);
-        let Ok(p) = plc_deps::load::program_from_json(&json) else {
-            continue;
-        };
+    for (seed, p) in random_programs(0, PROGRAMS) {
         loaded += 1;
         for threads in THREADS {
             let config = configs(threads, seed + threads as u64);
@@ -418,21 +429,11 @@ fn parallel_scan_equals_sequential_scan_on_random_programs() {
 /// and the faults are the sequential scan's, and most cases really run with waits.
 #[test]
 fn dependence_driven_plan_equals_sequential_scan_on_random_programs() {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(7)
-        .build()
-        .unwrap();
-    let exec = ExecConfig {
-        cycle_ms: 10,
-        loop_cap: 12,
-    };
+    let pool = pool(7);
+    let exec = RANDOM_EXEC;
     let mut stats = Stats::default();
     let mut loaded = 0;
-    for seed in 0..800u64 {
-        let json = common::random_program(seed + 90_000, 24);
-        let Ok(p) = plc_deps::load::program_from_json(&json) else {
-            continue;
-        };
+    for (seed, p) in random_programs(90_000, 800) {
         loaded += 1;
         for threads in [1, 2, 4, 8] {
             let mut config = configs(threads, seed + threads as u64);
@@ -479,21 +480,11 @@ fn dependence_driven_plan_equals_sequential_scan_on_random_programs() {
 /// the faults are the sequential scan's, and most cases really run that way.
 #[test]
 fn exchange_plan_equals_sequential_scan_on_random_programs() {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(7)
-        .build()
-        .unwrap();
-    let exec = ExecConfig {
-        cycle_ms: 10,
-        loop_cap: 12,
-    };
+    let pool = pool(7);
+    let exec = RANDOM_EXEC;
     let mut stats = Stats::default();
     let mut loaded = 0;
-    for seed in 0..500u64 {
-        let json = common::random_program(seed + 130_000, 24);
-        let Ok(p) = plc_deps::load::program_from_json(&json) else {
-            continue;
-        };
+    for (seed, p) in random_programs(130_000, 500) {
         loaded += 1;
         for threads in [2, 3, 4, 8] {
             let mut config = configs(threads, seed + threads as u64);
@@ -552,20 +543,10 @@ fn restless() -> Measure {
 
 #[test]
 fn every_plan_kind_with_up_to_eight_workers_equals_the_sequential_scan() {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(7)
-        .build()
-        .unwrap();
-    let exec = ExecConfig {
-        cycle_ms: 10,
-        loop_cap: 12,
-    };
+    let pool = pool(7);
+    let exec = RANDOM_EXEC;
     let mut stats = Stats::default();
-    for seed in 0..400u64 {
-        let json = common::random_program(seed + 50_000, 24);
-        let Ok(p) = plc_deps::load::program_from_json(&json) else {
-            continue;
-        };
+    for (seed, p) in random_programs(50_000, 400) {
         for threads in [2, 8] {
             for kind in [
                 PlanKind::Seq,
@@ -612,7 +593,7 @@ fn every_plan_kind_with_up_to_eight_workers_equals_the_sequential_scan() {
 fn parallel_scan_equals_sequential_scan_on_generated_programs() {
     // Larger programs of the generator with every knob on (timers, counters, FOR loops, forward
     // jumps, END, calls), under the default cost model and forced parallelism.
-    let pool = pool();
+    let pool = pool(3);
     let exec = ExecConfig::default();
     let mut stats = Stats::default();
     for (rungs, width, seed) in [(600, 40, 1), (2000, 100, 2), (300, 300, 3), (1500, 8, 4)] {
@@ -655,7 +636,7 @@ fn parallel_scan_equals_sequential_scan_on_generated_programs() {
 
 #[test]
 fn worked_examples_with_their_inputs_under_forced_parallel_plans() {
-    let pool = pool();
+    let pool = pool(3);
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("analyses");
     let mut stats = Stats::default();
     for dir in [
@@ -713,10 +694,7 @@ fn worked_examples_with_their_inputs_under_forced_parallel_plans() {
 /// plans merge, and every scan equals the sequential scan with 1, 2, 4 and 8 workers.
 #[test]
 fn merged_levels_equal_the_sequential_scan() {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(7)
-        .build()
-        .unwrap();
+    let pool = pool(7);
     let exec = ExecConfig::default();
     let mut stats = Stats::default();
     for (rungs, width, seed, all) in [
@@ -840,7 +818,7 @@ fn unconditional_backward_jump_refusal_is_a_cfg_edge_and_runs_in_parallel() {
     let par = ParallelMachine::new(&p, &a, &exec, &config).unwrap();
     assert_eq!(par.plan().sequential(), None);
     let mut stats = Stats::default();
-    check(&p, "endless", &config, &exec, 5, 7, &pool(), &mut stats);
+    check(&p, "endless", &config, &exec, 5, 7, &pool(3), &mut stats);
     assert_eq!(stats.loop_cap_faults, 5);
 }
 
@@ -893,7 +871,7 @@ fn a_refused_loop_back_followed_by_an_unconditional_jump_runs_in_parallel() {
             &exec,
             4,
             11,
-            &pool(),
+            &pool(3),
             &mut stats,
         );
     }
@@ -906,7 +884,7 @@ fn one_scan_at_a_time_equals_a_run() {
         plc_deps::synth::generate_string(&plc_deps::synth::GenConfig::all_features(800, 50, 9));
     let p = plc_deps::load::program_from_json(&json).unwrap();
     let a = analyse(&p);
-    let pool = pool();
+    let pool = pool(3);
     // The cost model's plan, and the levelled plan on private states (each one-scan run copies
     // the state into the other workers' private states first).
     for kind in [PlanKind::Model, PlanKind::Exchange] {
@@ -1006,7 +984,7 @@ fn the_measured_plan_times_the_locality_partition_and_stays_exact() {
     let (_, contiguous) = par.plans()[0].estimates();
     let (_, locality) = par.plans()[1].estimates();
     assert!(locality < contiguous, "{contiguous} vs {locality}");
-    let pool = pool();
+    let pool = pool(3);
     let mut stats = Stats::default();
     check(
         &p,
