@@ -52,9 +52,9 @@ pub use slicing::LevelPlan;
 
 pub(super) use candidates::candidate_plans;
 pub(super) use check::check_plan;
-pub(super) use exchange::{exchange_plan, Key, LINE_WORDS};
 #[cfg(test)]
 pub(super) use exchange::Segment;
+pub(super) use exchange::{exchange_plan, Key, LINE_WORDS};
 pub(super) use phase::{Phase, RemoteLines};
 pub(super) use plan::{bools_first, layout_groups};
 pub(super) use remote::find_remote_lines;
