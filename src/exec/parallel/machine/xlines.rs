@@ -227,15 +227,28 @@ impl XBuffer {
                     unpack64(get(s.word + i as u32), c);
                 }
                 if !tail.is_empty() {
-                    let mut c = [0u8; 64];
-                    unpack64(get(s.word + n), &mut c);
-                    let k = tail.len();
-                    tail.copy_from_slice(&c[..k]);
+                    // The partial word in place: its whole groups of 8, then the rest.
+                    let w = get(s.word + n);
+                    let (groups, rest) = tail.as_chunks_mut::<8>();
+                    for (j, g) in groups.iter_mut().enumerate() {
+                        *g = SPREAD[((w >> (8 * j)) & 0xff) as usize].to_le_bytes();
+                    }
+                    if !rest.is_empty() {
+                        let j = groups.len();
+                        let g = SPREAD[((w >> (8 * j)) & 0xff) as usize].to_le_bytes();
+                        let k = rest.len();
+                        rest.copy_from_slice(&g[..k]);
+                    }
                 }
             } else {
-                for (i, c) in bytes.chunks_mut(8).enumerate() {
-                    let k = c.len();
-                    c.copy_from_slice(&get(s.word + i as u32).to_le_bytes()[..k]);
+                let (words, rest) = bytes.as_chunks_mut::<8>();
+                for (i, c) in words.iter_mut().enumerate() {
+                    *c = get(s.word + i as u32).to_le_bytes();
+                }
+                if !rest.is_empty() {
+                    let k = rest.len();
+                    let w = get(s.word + words.len() as u32).to_le_bytes();
+                    rest.copy_from_slice(&w[..k]);
                 }
             }
         }
