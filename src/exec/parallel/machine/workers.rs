@@ -88,14 +88,17 @@ impl ParallelMachine {
                     every: self.measure.sample_every.max(1),
                 };
                 let r = scan..scan + n;
+                // Private states stay current only while one plan's exchange windows follow
+                // each other.
+                let was_current = ls.private_current.take();
                 let ok = match self.candidates[c] {
                     Candidate::Sequential => {
-                        ls.private_current = None;
                         self.sequential_window(sh, r, driver, timing, &mut ls.times);
                         true
                     }
                     Candidate::Exchange(i) => {
-                        self.exchange_window(i, sh, r, driver, timing, &mut ls)
+                        let copy = was_current != Some(i);
+                        self.exchange_window(i, copy, sh, r, driver, timing, &mut ls)
                     }
                     Candidate::Levelled(i) => {
                         self.levelled_window(i, sh, r, driver, timing, &mut ls)
@@ -125,18 +128,19 @@ impl ParallelMachine {
     }
 
     /// Worker 0's window of `scans` on `par-exchange` plan `i`: moves the state into the plan's
-    /// private states (unless its window was the last one), announces the window, and runs its
-    /// part. False if a worker panicked.
+    /// private states when `copy` (another candidate ran since its last window), announces the
+    /// window, and runs its part. False if a worker panicked.
+    #[allow(clippy::too_many_arguments)]
     fn exchange_window<D: ScanDriver + ?Sized>(
         &self,
         i: usize,
+        copy: bool,
         sh: &Shared<'_>,
         scans: Range<u64>,
         driver: &mut D,
         timing: Timing,
         ls: &mut LeaderState,
     ) -> bool {
-        let copy = std::mem::take(&mut ls.private_current) != Some(i);
         let own = self.own[i].as_ref().zip(sh.xhomes[i]);
         if let Some((o, home)) = own.filter(|_| copy) {
             // SAFETY: the other workers wait for the bell (rung below): worker 0 alone touches
@@ -193,7 +197,6 @@ impl ParallelMachine {
         timing: Timing,
         ls: &mut LeaderState,
     ) -> bool {
-        ls.private_current = None;
         let plan = &self.plans[i];
         let n = scans.end - scans.start;
         sh.bell.ring(WindowNote {

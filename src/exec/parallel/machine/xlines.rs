@@ -35,7 +35,6 @@ const PARK: Duration = Duration::from_micros(20);
 /// with only bit 0 of each byte kept, each byte's bit lands at a distinct position of the top
 /// byte, no two terms overlap, so nothing carries.
 #[inline(always)]
-#[cfg_attr(target_arch = "x86_64", allow(dead_code))]
 fn pack8(v: u64) -> u64 {
     (v & 0x0101_0101_0101_0101).wrapping_mul(0x0102_0408_1020_4080) >> 56
 }
