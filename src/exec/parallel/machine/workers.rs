@@ -19,6 +19,28 @@ use std::time::Instant;
 /// Scans at most per window of a dependence-driven plan.
 const DEPS_WINDOW: u64 = 4;
 
+/// One window of scans as worker 0 runs it: which scans, the driver that feeds and reads them,
+/// and which of them are timed.
+struct WindowRun<'d, D: ?Sized> {
+    scans: Range<u64>,
+    driver: &'d mut D,
+    timing: Timing,
+}
+
+impl<D: ?Sized> WindowRun<'_, D> {
+    /// The bell's note announcing this window of plan `plan`, whose units are numbered from
+    /// `base`; `exchange` as `WindowNote` has it.
+    fn note(&self, plan: usize, base: u64, exchange: Option<bool>) -> WindowNote {
+        WindowNote {
+            plan,
+            first: self.scans.start,
+            scans: self.scans.end - self.scans.start,
+            base,
+            exchange,
+        }
+    }
+}
+
 /// What worker 0 carries from one window to the next.
 #[derive(Default)]
 struct LeaderState {
@@ -87,22 +109,24 @@ impl ParallelMachine {
                     all: win.timed || deps || driver.wants_time(),
                     every: self.measure.sample_every.max(1),
                 };
-                let r = scan..scan + n;
+                let run = WindowRun {
+                    scans: scan..scan + n,
+                    driver: &mut *driver,
+                    timing,
+                };
                 // Private states stay current only while one plan's exchange windows follow
                 // each other.
                 let was_current = ls.private_current.take();
                 let ok = match self.candidates[c] {
                     Candidate::Sequential => {
-                        self.sequential_window(sh, r, driver, timing, &mut ls.times);
+                        self.sequential_window(sh, run, &mut ls.times);
                         true
                     }
                     Candidate::Exchange(i) => {
                         let copy = was_current != Some(i);
-                        self.exchange_window(i, copy, sh, r, driver, timing, &mut ls)
+                        self.exchange_window(i, copy, sh, run, &mut ls)
                     }
-                    Candidate::Levelled(i) => {
-                        self.levelled_window(i, sh, r, driver, timing, &mut ls)
-                    }
+                    Candidate::Levelled(i) => self.levelled_window(i, sh, run, &mut ls),
                 };
                 if !ok {
                     return;
@@ -130,15 +154,12 @@ impl ParallelMachine {
     /// Worker 0's window of `scans` on `par-exchange` plan `i`: moves the state into the plan's
     /// private states when `copy` (another candidate ran since its last window), announces the
     /// window, and runs its part. False if a worker panicked.
-    #[allow(clippy::too_many_arguments)]
     fn exchange_window<D: ScanDriver + ?Sized>(
         &self,
         i: usize,
         copy: bool,
         sh: &Shared<'_>,
-        scans: Range<u64>,
-        driver: &mut D,
-        timing: Timing,
+        run: WindowRun<'_, D>,
         ls: &mut LeaderState,
     ) -> bool {
         let own = self.own[i].as_ref().zip(sh.xhomes[i]);
@@ -148,13 +169,7 @@ impl ParallelMachine {
             let (from, to) = unsafe { (sh.slots.bytes(), home.bytes_mut()) };
             o.relayout.to_own(from, to);
         }
-        sh.bell.ring(WindowNote {
-            plan: i,
-            first: scans.start,
-            scans: scans.end - scans.start,
-            base: ls.base,
-            exchange: Some(copy),
-        });
+        sh.bell.ring(run.note(i, ls.base, Some(copy)));
         // The followers copy the shared state between the two barriers.
         for _ in 0..1 + copy as usize {
             if !sh.barrier.wait(0, &mut ls.epoch) {
@@ -163,13 +178,13 @@ impl ParallelMachine {
         }
         // A driver that reads any layout sees the own one; otherwise the caller's state is kept
         // up to date after every scan if the driver reads it.
-        let direct = driver.reads_any_layout();
-        if own.is_some() && (direct || !driver.wants_state()) {
+        let direct = run.driver.reads_any_layout();
+        if own.is_some() && (direct || !run.driver.wants_state()) {
             ls.home_behind = Some(i);
         }
         let lead = Lead {
-            driver,
-            timing,
+            driver: run.driver,
+            timing: run.timing,
             times: &mut ls.times,
             home: own
                 .filter(|_| !direct)
@@ -178,7 +193,7 @@ impl ParallelMachine {
         let x = self.exchange_of(i, sh);
         let store = own.map_or(sh.slots, |(_, home)| home);
         let (plan, b) = (&self.plans[i], &mut ls.bufs);
-        if !self.exchange_scans(0, plan, x, sh, scans, store, Some(lead), b) {
+        if !self.exchange_scans(0, plan, x, sh, run.scans, store, Some(lead), b) {
             return false;
         }
         ls.private_current = Some(i);
@@ -192,31 +207,30 @@ impl ParallelMachine {
         &self,
         i: usize,
         sh: &Shared<'_>,
-        scans: Range<u64>,
-        driver: &mut D,
-        timing: Timing,
+        run: WindowRun<'_, D>,
         ls: &mut LeaderState,
     ) -> bool {
         let plan = &self.plans[i];
-        let n = scans.end - scans.start;
-        sh.bell.ring(WindowNote {
-            plan: i,
-            first: scans.start,
-            scans: n,
-            base: ls.base,
-            exchange: None,
-        });
+        let n = run.scans.end - run.scans.start;
+        sh.bell.ring(run.note(i, ls.base, None));
         let b = &mut ls.bufs;
         if plan.ready.is_some() {
             if !sh.barrier.wait(0, &mut ls.epoch) {
                 return false;
             }
-            let d = Some((driver, timing, &mut ls.times));
-            return self.plan_scans(0, plan, sh, scans, &mut ls.epoch, d, b);
+            let d = Some((run.driver, run.timing, &mut ls.times));
+            return self.plan_scans(0, plan, sh, run.scans, &mut ls.epoch, d, b);
         }
-        let Some(taken) =
-            self.leader_units(plan, sh, ls.base, scans, driver, timing, &mut ls.times, b)
-        else {
+        let Some(taken) = self.leader_units(
+            plan,
+            sh,
+            ls.base,
+            run.scans,
+            run.driver,
+            run.timing,
+            &mut ls.times,
+            b,
+        ) else {
             return false;
         };
         let others = n * (plan.threads as u64 - 1) * plan.parallel_phases() as u64;
@@ -306,11 +320,14 @@ impl ParallelMachine {
     fn sequential_window<D: ScanDriver + ?Sized>(
         &self,
         sh: &Shared<'_>,
-        scans: Range<u64>,
-        driver: &mut D,
-        timing: Timing,
+        run: WindowRun<'_, D>,
         times: &mut Vec<u64>,
     ) {
+        let WindowRun {
+            scans,
+            driver,
+            timing,
+        } = run;
         // SAFETY: the other workers wait at the window barrier (or have not started) and touch
         // no slot until worker 0 reaches it: worker 0 has the slots to itself for this window.
         let slots = unsafe { sh.slots.bytes_mut() };
