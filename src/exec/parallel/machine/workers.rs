@@ -28,13 +28,18 @@ struct WindowRun<'d, D: ?Sized> {
 }
 
 impl<D: ?Sized> WindowRun<'_, D> {
+    /// How many scans the window has.
+    fn len(&self) -> u64 {
+        self.scans.end - self.scans.start
+    }
+
     /// The bell's note announcing this window of plan `plan`, whose units are numbered from
     /// `base`; `exchange` as `WindowNote` has it.
     fn note(&self, plan: usize, base: u64, exchange: Option<bool>) -> WindowNote {
         WindowNote {
             plan,
             first: self.scans.start,
-            scans: self.scans.end - self.scans.start,
+            scans: self.len(),
             base,
             exchange,
         }
@@ -151,7 +156,7 @@ impl ParallelMachine {
         }
     }
 
-    /// Worker 0's window of `scans` on `par-exchange` plan `i`: moves the state into the plan's
+    /// Worker 0's window `run` on `par-exchange` plan `i`: moves the state into the plan's
     /// private states when `copy` (another candidate ran since its last window), announces the
     /// window, and runs its part. False if a worker panicked.
     fn exchange_window<D: ScanDriver + ?Sized>(
@@ -200,7 +205,7 @@ impl ParallelMachine {
         true
     }
 
-    /// Worker 0's window of `scans` on levelled plan `i`: announces it and runs its part, behind
+    /// Worker 0's window `run` on levelled plan `i`: announces it and runs its part, behind
     /// the barrier for a dependence-driven plan, as claimed units otherwise (noting whether the
     /// other workers were away). False if a worker panicked.
     fn levelled_window<D: ScanDriver + ?Sized>(
@@ -211,7 +216,7 @@ impl ParallelMachine {
         ls: &mut LeaderState,
     ) -> bool {
         let plan = &self.plans[i];
-        let n = run.scans.end - run.scans.start;
+        let n = run.len();
         sh.bell.ring(run.note(i, ls.base, None));
         let b = &mut ls.bufs;
         if plan.ready.is_some() {
@@ -316,7 +321,7 @@ impl ParallelMachine {
         }
     }
 
-    /// Worker 0 alone runs `scans` as the sequential walk on the shared slots.
+    /// Worker 0 alone runs the window `run` as the sequential walk on the shared slots.
     fn sequential_window<D: ScanDriver + ?Sized>(
         &self,
         sh: &Shared<'_>,
