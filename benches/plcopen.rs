@@ -12,7 +12,7 @@ use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 #[allow(dead_code)]
-#[path = "../tests/plcopen_common/generated.rs"]
+#[path = "../tests/it/plcopen_common/generated.rs"]
 mod px;
 
 fn plcopen(c: &mut Criterion) {

@@ -4,7 +4,7 @@
 //! XML export, say), so that what plc-deps understood of a file can be read, diffed and edited.
 //!
 //! Invariant: a program that loads, written and read back, resolves to the same model
-//! (`tests/convert.rs` checks it on every committed PLCopen file and every worked example).
+//! (`tests/it/convert.rs` checks it on every committed PLCopen file and every worked example).
 //!
 //! Deliberately not here: checking the program (the caller loads it first: a syntax tree with
 //! problems in it is refused, not written), and writing the model or the analysis (those are

@@ -18,7 +18,7 @@
 //! first difference (variable and both values).
 //!
 //! # Modules, bottom to top
-//! Each uses only the ones before it (checked by tests/par_layers.rs): `config` (the
+//! Each uses only the ones before it (checked by tests/it/par_layers.rs): `config` (the
 //! arguments and warnings), `trace` (the trace file's columns), `inputs` (the input table),
 //! `compare` (digests and the lockstep replay to the first difference), `engine` (preparing
 //! and running the scans), `output` (the text, JSON and HTML renderings of a report), then this

@@ -13,7 +13,7 @@
 //! Invariants: every emitted network needs at most [`STACK_LEVELS`] levels of the logic stack
 //! (counted from the network's start; a network that would need more is an error naming it),
 //! every LPS is closed by an LPP in the same network, and the reader `crate::read::stl` reads
-//! the text back into a program with the same scan behaviour (tests/il_roundtrip.rs).
+//! the text back into a program with the same scan behaviour (tests/it/il_roundtrip.rs).
 //!
 //! Deliberately not here: what has no S7-200 instruction (TP timers, `b := a MOD b`, XOR blocks,
 //! FBD networks with non-boolean blocks, conditional arcs, function block types) is one error

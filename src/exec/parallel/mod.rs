@@ -60,7 +60,7 @@
 //!   otherwise runs the program sequentially.
 //!
 //! # Layers, bottom to top
-//! Each layer uses only the ones below it, never one above (checked by tests/par_layers.rs; the
+//! Each layer uses only the ones below it, never one above (checked by tests/it/par_layers.rs; the
 //! `mod` lines below are alphabetical, as rustfmt sorts them):
 //! 1. the basics: `ids` (typed indices and decisions), `config` (what the caller asks for),
 //!    `pad` (a value on its own cache lines);

@@ -1,7 +1,7 @@
 //! Structural tests of the HTML report: the page parses as XML, every rung has its card, every
 //! dependence its edge, nothing points outside the file, and the Gantt chart's makespans are the
 //! cost model's; the run page shows the run's figures beside the model's. (The browser test is
-//! tests/html_browser.rs; the run page from the command line is tested in tests/html_run.rs.)
+//! tests/it/html_browser.rs; the run page from the command line is tested in tests/it/html_run.rs.)
 
 use super::*;
 use crate::analysis::{analyse, cost};

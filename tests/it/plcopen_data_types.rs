@@ -1,0 +1,120 @@
+//! PLCopen TC6 data types (`types/dataTypes`) and Beremiz SVGHMI's HMI_* types, hand-written:
+//! aliases and subranges read as their base type (the type's initial value the variable's
+//! default; the range not enforced), enumerations as INT with their values numbered from 0,
+//! arrays and structures as whole variables without a value (only where `run` does not execute
+//! the body), one note naming them; a cycle or an unknown base is one located error.
+
+use crate::common;
+use crate::plcopen_common as px;
+
+use common::cli::{error_line, run_stdin};
+use px::{coil, contact, io, line_col, project_in, rail, report_and_warnings, run_scans, rung};
+use serde_json::json;
+
+const TYPES: &str = r#"<dataTypes>
+  <dataType name="LEVEL"><baseType><subrangeSigned><range lower="0" upper="1000"/><baseType><INT/></baseType></subrangeSigned></baseType><initialValue><simpleValue value="10"/></initialValue></dataType>
+  <dataType name="LEVEL2"><baseType><derived name="LEVEL"/></baseType></dataType>
+  <dataType name="VALVE"><baseType><enum><values><value name="OPEN"/><value name="CLOSED"/></values></enum></baseType><initialValue><simpleValue value="CLOSED"/></initialValue></dataType>
+  <dataType name="TABLE"><baseType><array><dimension lower="1" upper="8"/><baseType><INT/></baseType></array></baseType></dataType>
+</dataTypes>"#;
+
+fn with_types(lang: &str, vars: &[(&str, &str, &str)], body: &str) -> String {
+    project_in(lang, vars, body).replace("<dataTypes/>", TYPES)
+}
+
+fn ld() -> String {
+    [
+        rail(1),
+        contact(2, "go", &[1], ""),
+        coil(3, "lamp", &[2], ""),
+    ]
+    .concat()
+}
+
+#[test]
+fn aliases_subranges_enumerations_and_hmi_types_load_and_run_with_their_defaults() {
+    let xml = with_types(
+        "LD",
+        &[
+            ("inputVars", "go", "HMI_BOOL"),
+            ("outputVars", "lamp", "HMI_BOOL"),
+            ("outputVars", "lvl", "LEVEL2"),
+            ("outputVars", "v", "VALVE"),
+            ("outputVars", "n", "HMI_INT"),
+        ],
+        &ld(),
+    );
+    let (_, err) = report_and_warnings(&xml);
+    assert_eq!(
+        err.trim_end(),
+        format!("warning: <stdin>:{}: data types are read as the model's types (IEC 61131-3 6.4.4): HMI_BOOL → BOOL (an alias of BOOL, from the Beremiz SVGHMI library): P.go, P.lamp; LEVEL2 → INT (an alias of INT, subrange 0..1000 not enforced): P.lvl; VALVE → INT (an enumeration, read as INT with OPEN = 0, CLOSED = 1): P.v; HMI_INT → INT (an alias of INT, from the Beremiz SVGHMI library): P.n; `run` does not check subranges, an array is one whole variable (a read or write of any element reads or writes it) with no value, and a structure is one variable per elementary field (`s.f`)", line_col(&xml, "<variable name=\"go\""))
+    );
+    let v = run_scans(&xml, 1);
+    assert_eq!(
+        v["outputs"],
+        json!({"lamp": false, "lvl": 10, "v": 1, "n": 0})
+    );
+}
+
+#[test]
+fn st_reads_enumeration_values_as_constants_and_array_elements_as_the_whole_array() {
+    let body = "<xhtml:p xmlns:xhtml=\"http://www.w3.org/1999/xhtml\"><![CDATA[v := OPEN;\ntab[i] := tab[2] + 1;\nIF v = CLOSED THEN i := 1; END_IF;]]></xhtml:p>";
+    let xml = with_types(
+        "ST",
+        &[
+            ("localVars", "v", "VALVE"),
+            ("localVars", "i", "INT"),
+            ("localVars", "tab", "TABLE"),
+        ],
+        body,
+    );
+    let (r, _) = report_and_warnings(&xml);
+    assert_eq!(
+        io(&r),
+        vec![
+            rung("P.st1", &["v"], &["v"]),
+            rung("P.st2", &["i", "tab"], &["tab"]),
+            rung("P.st3", &["v", "i"], &["i"]),
+        ]
+    );
+}
+
+#[test]
+fn an_array_is_analysed_and_run_refuses_it_where_it_would_execute_the_body() {
+    let xml = with_types(
+        "LD",
+        &[
+            ("inputVars", "go", "BOOL"),
+            ("outputVars", "lamp", "BOOL"),
+            ("localVars", "tab", "TABLE"),
+        ],
+        &ld(),
+    );
+    assert!(run_stdin(&["report", "-"], xml.as_bytes()).status.success());
+    let e = error_line(
+        &run_stdin(&["run", "-", "--scans", "1"], xml.as_bytes()),
+        "array in LD",
+    );
+    let at = line_col(&xml, "<variable name=\"tab\"");
+    assert_eq!(e, format!("error: <stdin>:{at}: at run: pou P: variable `tab` is a TABLE, for which plc-deps has no values: the analysis reads it as a whole variable, but `run` cannot execute the LD body of `P`"));
+}
+
+#[test]
+fn a_cycle_of_data_types_is_one_located_error() {
+    let xml = project_in("LD", &[("inputVars", "go", "BOOL")], &ld()).replace(
+        "<dataTypes/>",
+        r#"<dataTypes><dataType name="A"><baseType><derived name="B"/></baseType></dataType><dataType name="B"><baseType><derived name="A"/></baseType></dataType></dataTypes>"#,
+    );
+    let e = error_line(&run_stdin(&["report", "-"], xml.as_bytes()), "cycle");
+    assert!(
+        e.contains("is defined through itself (a cycle of derived types)"),
+        "{e}"
+    );
+    let unknown = project_in("LD", &[("inputVars", "go", "BOOL")], &ld()).replace(
+        "<dataTypes/>",
+        r#"<dataTypes><dataType name="A"><baseType><derived name="NOPE"/></baseType></dataType></dataTypes>"#,
+    );
+    let e = error_line(&run_stdin(&["report", "-"], unknown.as_bytes()), "unknown");
+    let at = line_col(&unknown, "<derived name=\"NOPE\"");
+    assert_eq!(e, format!("error: <stdin>:{at}: at types/dataTypes, dataType A: data type `A` derives from `NOPE`, which is neither an elementary type nor a data type of the project"));
+}
