@@ -70,7 +70,7 @@ impl ReadyFlags {
             std::thread::park_timeout(PARK);
             true
         };
-        wait_until(PACE, reached, park).is_some()
+        wait_until(barrier.pace(PACE), reached, park).is_some()
     }
 }
 

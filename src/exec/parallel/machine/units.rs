@@ -94,7 +94,7 @@ impl Units {
             std::thread::park_timeout(PARK);
             true
         };
-        wait_until(PACE, reached, park).is_some()
+        wait_until(poison.pace(PACE), reached, park).is_some()
     }
 }
 
@@ -224,7 +224,7 @@ impl WindowBell {
             me.0.store(false, Ordering::SeqCst);
             true
         };
-        wait_until(PACE, || self.read(k), park)
+        wait_until(poison.pace(PACE), || self.read(k), park)
     }
 }
 

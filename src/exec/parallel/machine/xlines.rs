@@ -207,7 +207,7 @@ impl XBuffer {
                 std::thread::park_timeout(PARK);
                 true
             };
-            if wait_until(PACE, ready, park).is_none() {
+            if wait_until(barrier.pace(PACE), ready, park).is_none() {
                 return false;
             }
         }
