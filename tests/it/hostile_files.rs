@@ -129,9 +129,10 @@ fn o_fifo_gets_the_output_from_a_reader_thread() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    assert_eq!(reader.join().unwrap(), report_text());
+    // Checked first: had the FIFO been replaced, the reader would wait for a writer forever.
     let meta = std::fs::symlink_metadata(&fifo).unwrap();
     assert!(meta.file_type().is_fifo(), "the FIFO was replaced");
+    assert_eq!(reader.join().unwrap(), report_text());
     assert!(temp_files_in(&dir).is_empty());
 }
 
