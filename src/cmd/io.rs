@@ -1,16 +1,24 @@
 //! The commands' files: reading a program or an input file (standard input for `-`), checking
 //! output paths before any work, and writing outputs atomically.
 //!
-//! Files are read by [`read_text`]: `-` is standard input, a folder, a file over
-//! [`MAX_INPUT_BYTES`], binary data (a NUL byte) or text that is not UTF-8 is refused before
-//! parsing (naming the byte offset), and a UTF-8 byte-order mark is dropped. Output paths can be
-//! checked before any work with [`check_output_path`]. An output file is written under a
-//! temporary name beside it and renamed into place only when the whole output is ready, so a
-//! failure never leaves a half-written file; temporary files in the making are listed in a
-//! registry that [`remove_temp_files`] empties (the binary calls it on SIGINT/SIGTERM), so a
-//! stopped command leaves none behind. A program is recognised by its content ([`load_text`]:
-//! S7-200 STL, PLCopen TC6 XML or JSON). Nothing here prints but the STL and PLCopen readers'
-//! warnings (through [`super::errors`]).
+//! Files are read by [`read_text`]: `-` is standard input, a folder, anything over
+//! [`MAX_INPUT_BYTES`] (every read is capped, a device or FIFO too), binary data (a NUL byte)
+//! or text that is not UTF-8 is refused before parsing (naming the byte offset), and a UTF-8
+//! byte-order mark is dropped. Output paths can be checked before any work with
+//! [`check_output_path`]. An output file is written by what its path names
+//! ([`write_file_as`]): a new or regular file under a fresh, unpredictable temporary name beside
+//! it (created exclusively, never through a symbolic link) and renamed into place only when the
+//! whole output is ready, so a failure never leaves a half-written file; a device or FIFO
+//! directly; a symbolic link is refused. Temporary files and folders in the making are listed in
+//! a registry that [`remove_temp_files`] empties (the binary calls it on SIGINT/SIGTERM), so a
+//! stopped command leaves none behind. Standard output is written by [`write_stream`], the one
+//! place that does: a write error is an error, a closed pipe is not. A program is recognised by
+//! its content ([`load_text`]: S7-200 STL, PLCopen TC6 XML or JSON). Nothing here prints but the
+//! STL and PLCopen readers' warnings (through [`super::errors`]) and the output itself.
+//!
+//! Not here: an output that is atomic on a device or FIFO (it cannot be), or following a
+//! symbolic link at `-o` (refused: replacing the link would not write its target, writing
+//! through it could not be atomic).
 
 use super::source::{SourceText, MAP_FROM};
 use crate::diag::Shown;
