@@ -493,6 +493,28 @@ fn remove_temp_files_on_signal() {
     });
 }
 
+/// The command line, or the exit code once `--help` or `--version` has been printed. Printed to
+/// a terminal by clap itself (in colour); to anything else through `cmd::io::write_stream`, so
+/// that a failed write is an error (exit code 2) and not ignored as clap does. Usage errors are
+/// clap's (standard error, exit code 2).
+fn parse_cli() -> Result<Cli, ExitCode> {
+    use std::io::IsTerminal;
+    match Cli::try_parse() {
+        Ok(cli) => Ok(cli),
+        Err(e) if !e.use_stderr() && !std::io::stdout().is_terminal() => {
+            let text = e.render().to_string();
+            match cmd::io::write_stream(cmd::io::Stream::Stdout, |w| w.write_all(text.as_bytes())) {
+                Ok(()) => Err(ExitCode::SUCCESS),
+                Err(err) => {
+                    cmd::errors::print_error(&err);
+                    Err(ExitCode::from(err.exit_code()))
+                }
+            }
+        }
+        Err(e) => e.exit(),
+    }
+}
+
 /// How errors and warnings are printed: as JSON lines when the command was given `--format json`.
 fn error_format(cli: &Cli) -> cmd::errors::Format {
     let json = match &cli.command {
@@ -512,7 +534,10 @@ fn error_format(cli: &Cli) -> cmd::errors::Format {
 /// differed, 2 bad input or usage (clap's usage errors are 2 too), 130 stopped by a signal.
 fn main() -> ExitCode {
     cmd::pages::prefer_small_pages();
-    let cli = Cli::parse();
+    let cli = match parse_cli() {
+        Ok(cli) => cli,
+        Err(code) => return code,
+    };
     cmd::errors::set_format(error_format(&cli));
     remove_temp_files_on_signal();
     match run(cli) {

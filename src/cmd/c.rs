@@ -1,16 +1,24 @@
 //! `plc-deps c FILE -o DIR`: writes the C of a program (`crate::codegen::c`) into a folder,
 //! all files or none.
 //!
-//! Atomicity: the files are written into a fresh temporary folder `.DIR.tmp-PID` beside DIR and
-//! renamed to DIR only when every file is written. An existing DIR is refused unless it is
-//! empty or `--force` is given; with `--force` the old DIR is first renamed aside
-//! (`.DIR.old-PID`), the new one renamed in, then the old one removed — so DIR is always either
-//! the old folder, absent for the instant between the two renames, or the complete new one.
+//! Atomicity: the files are written into a fresh temporary folder `.DIR.tmp-` + 16 random hex
+//! digits beside DIR (made by `mkdir`, which never reuses an existing name or follows a symbolic
+//! link; its files are created exclusively too) and renamed to DIR only when every file is
+//! written. An existing DIR is refused unless it is empty or `--force` is given; with `--force`
+//! the old DIR is first renamed aside (`.DIR.old-` + random digits), the new one renamed in,
+//! then the old one removed — so DIR is always either the old folder, absent for the instant
+//! between the two renames, or the complete new one. The temporary folders are in the registry
+//! of `super::io`: a command stopped by SIGINT or SIGTERM removes them with all they hold. A
+//! DIR that is a symbolic link is refused, as for every `-o`.
 
-use super::io::{load_program_and_fbd, CliError, FileRole};
+use super::io::{
+    create_new_file, create_temp_folder, discard_temp, load_program_and_fbd, put_folder_in_place,
+    CliError, FileRole, SYMLINK_REFUSED,
+};
 use crate::codegen::c::{generate, CConfig};
 use std::fs;
-use std::path::{Path, PathBuf};
+use std::io::Write;
+use std::path::PathBuf;
 
 /// A validated `plc-deps c` invocation.
 #[derive(Clone, Debug)]
@@ -21,32 +29,29 @@ pub struct CCommand {
     pub config: CConfig,
 }
 
-fn sibling(dir: &Path, what: &str) -> PathBuf {
-    let name = dir
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "out".into());
-    let parent = dir.parent().filter(|p| !p.as_os_str().is_empty());
-    let file = format!(".{name}.{what}-{}", std::process::id());
-    match parent {
-        Some(p) => p.join(file),
-        None => PathBuf::from(file),
-    }
-}
-
 /// `plc-deps c`: generates and writes the files.
 pub fn c(cmd: &CCommand) -> Result<(), CliError> {
     let (p, fbd) = load_program_and_fbd(&cmd.input)?;
     let dir = &cmd.output;
     let io = |e| CliError::io(FileRole::Output, dir, e);
-    let exists = dir.exists();
-    if exists {
-        if !dir.is_dir() {
+    let exists = match fs::symlink_metadata(dir) {
+        Ok(meta) if meta.file_type().is_symlink() => {
+            return Err(io(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                SYMLINK_REFUSED,
+            )))
+        }
+        Ok(meta) if !meta.is_dir() => {
             return Err(CliError::Usage(format!(
                 "-o {}: exists and is not a folder",
                 dir.display()
-            )));
+            )))
         }
+        Ok(_) => true,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => false,
+        Err(e) => return Err(io(e)),
+    };
+    if exists {
         let nonempty = fs::read_dir(dir).map_err(io)?.next().is_some();
         if nonempty && !cmd.force {
             return Err(CliError::Usage(format!(
@@ -65,28 +70,24 @@ pub fn c(cmd: &CCommand) -> Result<(), CliError> {
         }
     }
     let files = generate(&p, &fbd, &cmd.config);
-    let tmp = sibling(dir, "tmp");
+    let tmp = create_temp_folder(dir).map_err(io)?;
     let write_all = || -> std::io::Result<()> {
-        fs::create_dir(&tmp)?;
         for f in &files {
-            fs::write(tmp.join(&f.name), &f.text)?;
+            create_new_file(&tmp.join(&f.name))?.write_all(f.text.as_bytes())?;
         }
         Ok(())
     };
-    if let Err(e) = write_all() {
-        let _ = fs::remove_dir_all(&tmp);
-        return Err(io(e));
+    let old = write_all().and_then(|()| put_folder_in_place(&tmp, dir, exists));
+    match old {
+        Ok(old) => {
+            if let Some(old) = old {
+                discard_temp(&old);
+            }
+            Ok(())
+        }
+        Err(e) => {
+            discard_temp(&tmp);
+            Err(io(e))
+        }
     }
-    let result = if exists {
-        let old = sibling(dir, "old");
-        fs::rename(dir, &old)
-            .and_then(|()| fs::rename(&tmp, dir))
-            .and_then(|()| fs::remove_dir_all(&old))
-    } else {
-        fs::rename(&tmp, dir)
-    };
-    result.map_err(|e| {
-        let _ = fs::remove_dir_all(&tmp);
-        io(e)
-    })
 }

@@ -1,16 +1,24 @@
 //! The commands' files: reading a program or an input file (standard input for `-`), checking
 //! output paths before any work, and writing outputs atomically.
 //!
-//! Files are read by [`read_text`]: `-` is standard input, a folder, a file over
-//! [`MAX_INPUT_BYTES`], binary data (a NUL byte) or text that is not UTF-8 is refused before
-//! parsing (naming the byte offset), and a UTF-8 byte-order mark is dropped. Output paths can be
-//! checked before any work with [`check_output_path`]. An output file is written under a
-//! temporary name beside it and renamed into place only when the whole output is ready, so a
-//! failure never leaves a half-written file; temporary files in the making are listed in a
-//! registry that [`remove_temp_files`] empties (the binary calls it on SIGINT/SIGTERM), so a
-//! stopped command leaves none behind. A program is recognised by its content ([`load_text`]:
-//! S7-200 STL, PLCopen TC6 XML or JSON). Nothing here prints but the STL and PLCopen readers'
-//! warnings (through [`super::errors`]).
+//! Files are read by [`read_text`]: `-` is standard input, a folder, anything over
+//! [`MAX_INPUT_BYTES`] (every read is capped, a device or FIFO too), binary data (a NUL byte)
+//! or text that is not UTF-8 is refused before parsing (naming the byte offset), and a UTF-8
+//! byte-order mark is dropped. Output paths can be checked before any work with
+//! [`check_output_path`]. An output file is written by what its path names
+//! ([`write_file_as`]): a new or regular file under a fresh, unpredictable temporary name beside
+//! it (created exclusively, never through a symbolic link) and renamed into place only when the
+//! whole output is ready, so a failure never leaves a half-written file; a device or FIFO
+//! directly; a symbolic link is refused. Temporary files and folders in the making are listed in
+//! a registry that [`remove_temp_files`] empties (the binary calls it on SIGINT/SIGTERM), so a
+//! stopped command leaves none behind. Standard output is written by [`write_stream`], the one
+//! place that does: a write error is an error, a closed pipe is not. A program is recognised by
+//! its content ([`load_text`]: S7-200 STL, PLCopen TC6 XML or JSON). Nothing here prints but the
+//! STL and PLCopen readers' warnings (through [`super::errors`]) and the output itself.
+//!
+//! Not here: an output that is atomic on a device or FIFO (it cannot be), or following a
+//! symbolic link at `-o` (refused: replacing the link would not write its target, writing
+//! through it could not be atomic).
 
 use super::source::{SourceText, MAP_FROM};
 use crate::diag::Shown;
@@ -82,6 +90,14 @@ pub enum CliError {
         #[source]
         source: std::io::Error,
     },
+    /// A standard stream could not be written: `cannot write <stdout>: reason` (a closed pipe
+    /// is not an error: see [`write_stream`]).
+    #[error("cannot write {stream}: {}", io_reason(source))]
+    Stream {
+        stream: &'static str,
+        #[source]
+        source: std::io::Error,
+    },
     /// An argument is not valid.
     #[error("{0}")]
     Usage(String),
@@ -125,8 +141,22 @@ impl CliError {
     }
 }
 
-/// Largest file (or standard input) read whole: 2 GiB. Larger ones are refused before reading.
+/// Largest file (or standard input, device or FIFO) read whole: 2 GiB. A larger regular file is
+/// refused on its size, before reading; anything else is refused once it has given one byte more.
 pub const MAX_INPUT_BYTES: u64 = 2 << 30;
+
+/// The environment variable that lowers [`MAX_INPUT_BYTES`] (to a number of bytes), so that
+/// tests can reach the limit without reading 2 GiB. It cannot raise the limit; it is not a
+/// user's option and the user documentation does not list it.
+const MAX_INPUT_VAR: &str = "PLC_DEPS_MAX_INPUT_BYTES";
+
+/// The limit on what is read whole: [`MAX_INPUT_BYTES`], or less with [`MAX_INPUT_VAR`].
+fn max_input_bytes() -> u64 {
+    std::env::var(MAX_INPUT_VAR)
+        .ok()
+        .and_then(|v| v.parse::<u64>().ok())
+        .map_or(MAX_INPUT_BYTES, |v| v.min(MAX_INPUT_BYTES))
+}
 
 /// How a path is named in messages: `<stdin>` for `-`.
 pub(crate) fn display_name(path: &Path) -> String {
@@ -177,57 +207,82 @@ fn utf8_text(bytes: Vec<u8>) -> Result<String, String> {
     Ok(text)
 }
 
-/// Reads a whole text file (`-`: standard input) for `role`, refusing folders, files over
-/// [`MAX_INPUT_BYTES`] (checked on the metadata, before reading), binary data and text that is
-/// not UTF-8; a UTF-8 byte-order mark is dropped. A large regular file is mapped rather than
-/// read ([`SourceText`]).
+/// The message of a file over `cap` bytes (`len`, its size, when known).
+fn too_large_text(cap: u64, len: Option<u64>) -> String {
+    let limit = if cap.is_multiple_of(1 << 30) {
+        format!("{} GiB", cap >> 30)
+    } else {
+        format!("{cap} bytes")
+    };
+    match len {
+        Some(len) => format!("the file is larger than the limit of {limit} ({len} bytes)"),
+        None => format!("the file is larger than the limit of {limit}"),
+    }
+}
+
+/// What is read at a time by [`read_capped`] (and checked for a NUL byte).
+const READ_CHUNK: u64 = 1 << 20;
+
+/// Reads `from` to its end, but never more than `cap + 1` bytes (more than `cap` means too
+/// large: an endless device or FIFO stops there), and stops after the first chunk that holds a
+/// NUL byte: such bytes are binary data, and [`check_text`] names the same first bad byte in
+/// them as in the whole. `expected` is the size to reserve (a regular file's length).
+fn read_capped(from: &mut impl Read, cap: u64, expected: u64) -> std::io::Result<Vec<u8>> {
+    let mut bytes = Vec::with_capacity(expected.min(cap) as usize + 1);
+    let mut from = from.take(cap + 1);
+    loop {
+        let before = bytes.len();
+        let n = (&mut from).take(READ_CHUNK).read_to_end(&mut bytes)?;
+        if n == 0 || bytes[before..].contains(&0) {
+            return Ok(bytes);
+        }
+    }
+}
+
+/// Reads a whole text file (`-`: standard input) for `role`, refusing folders, anything over
+/// [`MAX_INPUT_BYTES`] (a regular file on its size, before reading; a device, FIFO or standard
+/// input once it gave more: every read is capped), binary data and text that is not UTF-8; a
+/// UTF-8 byte-order mark is dropped. A large regular file is mapped rather than read
+/// ([`SourceText`]).
 pub fn read_text(path: &Path, role: FileRole) -> Result<SourceText, CliError> {
     use std::io::ErrorKind;
     let err = |e| CliError::io(role, path, e);
-    let too_large = |len: u64| {
-        err(invalid(
-            ErrorKind::FileTooLarge,
-            format!(
-                "the file is larger than the limit of {} GiB{}",
-                MAX_INPUT_BYTES >> 30,
-                if len > MAX_INPUT_BYTES {
-                    format!(" ({len} bytes)")
-                } else {
-                    String::new()
-                }
-            ),
-        ))
-    };
+    let cap = max_input_bytes();
+    let too_large = |len| err(invalid(ErrorKind::FileTooLarge, too_large_text(cap, len)));
     let bytes = if is_stdin(path) {
-        let mut bytes = Vec::new();
-        std::io::stdin()
-            .lock()
-            .take(MAX_INPUT_BYTES + 1)
-            .read_to_end(&mut bytes)
-            .map_err(err)?;
-        if bytes.len() as u64 > MAX_INPUT_BYTES {
-            return Err(too_large(0));
-        }
-        bytes
+        read_capped(&mut std::io::stdin().lock(), cap, 0).map_err(err)?
     } else {
-        let meta = std::fs::metadata(path).map_err(err)?;
+        // The checks are on the file opened (fstat), not on the path, which may change meanwhile.
+        let mut file = std::fs::File::open(path).map_err(err)?;
+        let meta = file.metadata().map_err(err)?;
         if meta.is_dir() {
             return Err(err(invalid(
                 ErrorKind::IsADirectory,
                 "it is a folder, not a file".into(),
             )));
         }
-        if meta.len() > MAX_INPUT_BYTES {
-            return Err(too_large(meta.len()));
-        }
-        if meta.is_file() && meta.len() >= MAP_FROM {
-            let file = std::fs::File::open(path).map_err(err)?;
-            if let Some(text) = SourceText::mapped(&file, check_text) {
-                return text.map_err(|m| err(invalid(ErrorKind::InvalidData, m)));
+        let mut expected = 0;
+        if meta.is_file() {
+            if meta.len() > cap {
+                return Err(too_large(Some(meta.len())));
             }
+            if meta.len() >= MAP_FROM {
+                // The mapping's length is the file's when it is made, which may have grown.
+                let check = |bytes: &[u8]| match bytes.len() as u64 {
+                    len if len > cap => Err(too_large_text(cap, Some(len))),
+                    _ => check_text(bytes),
+                };
+                if let Some(text) = SourceText::mapped(&file, check) {
+                    return text.map_err(|m| err(invalid(ErrorKind::InvalidData, m)));
+                }
+            }
+            expected = meta.len();
         }
-        std::fs::read(path).map_err(err)?
+        read_capped(&mut file, cap, expected).map_err(err)?
     };
+    if bytes.len() as u64 > cap {
+        return Err(too_large(None));
+    }
     utf8_text(bytes)
         .map(SourceText::owned)
         .map_err(|m| err(invalid(ErrorKind::InvalidData, m)))
@@ -340,33 +395,100 @@ fn warn_notes(code: &'static str, file: &str, text: &str, notes: &[crate::read::
     }
 }
 
-/// Checks, before any work, that an output file can be written at `path`: not a folder, in a
-/// folder that exists and lets us create a file (probed with the temporary name, then removed).
-pub fn check_output_path(path: &Path, role: FileRole) -> Result<(), CliError> {
-    if path.is_dir() {
-        return Err(CliError::io(
-            role,
-            path,
-            invalid(
-                std::io::ErrorKind::IsADirectory,
-                "it is a folder, not a file".into(),
-            ),
-        ));
+/// What an output path names now, which decides how it is written (see [`output_target`]).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+enum Target {
+    /// Nothing yet, or a regular file: written under a temporary name, renamed over it.
+    Replace,
+    /// A character or block device or a FIFO (`/dev/null`, a named pipe): written directly, as
+    /// replacing it would put a regular file in its place.
+    Special,
+    /// The process's own standard output or error, named `/dev/stdout`, `/dev/fd/1`,
+    /// `/dev/stderr` or `/dev/fd/2` (symbolic links into `/proc`): written to the stream.
+    Stream(Stream),
+}
+
+/// A standard stream that output can go to.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum Stream {
+    Stdout,
+    Stderr,
+}
+
+impl Stream {
+    /// How the stream is named in messages.
+    fn name(self) -> &'static str {
+        match self {
+            Stream::Stdout => "<stdout>",
+            Stream::Stderr => "<stderr>",
+        }
     }
-    let tmp = temp_name(path);
-    let probe = std::fs::OpenOptions::new()
-        .write(true)
-        .create_new(true)
-        .open(&tmp);
-    match probe {
-        Ok(f) => {
-            drop(f);
-            let _ = std::fs::remove_file(&tmp);
+}
+
+/// How output to `path` is written, or why it cannot be: a folder, a socket, or a symbolic link
+/// (never followed: a link cannot be replaced atomically, and writing through it would write
+/// wherever it points) other than the standard streams' names.
+fn output_target(path: &Path) -> std::io::Result<Target> {
+    use std::io::ErrorKind;
+    match path.to_str() {
+        Some("/dev/stdout" | "/dev/fd/1") => return Ok(Target::Stream(Stream::Stdout)),
+        Some("/dev/stderr" | "/dev/fd/2") => return Ok(Target::Stream(Stream::Stderr)),
+        _ => {}
+    }
+    let meta = match std::fs::symlink_metadata(path) {
+        Ok(meta) => meta,
+        Err(e) if e.kind() == ErrorKind::NotFound => return Ok(Target::Replace),
+        Err(e) => return Err(e),
+    };
+    let kind = meta.file_type();
+    if kind.is_file() {
+        Ok(Target::Replace)
+    } else if kind.is_dir() {
+        Err(invalid(
+            ErrorKind::IsADirectory,
+            "it is a folder, not a file".into(),
+        ))
+    } else if kind.is_symlink() {
+        Err(invalid(ErrorKind::InvalidInput, SYMLINK_REFUSED.into()))
+    } else if is_special(&kind) {
+        Ok(Target::Special)
+    } else {
+        Err(invalid(
+            ErrorKind::InvalidInput,
+            "it is neither a file nor a device nor a FIFO".into(),
+        ))
+    }
+}
+
+/// Why a symbolic link is not written through (docs/scan.md, "Files").
+pub(crate) const SYMLINK_REFUSED: &str =
+    "it is a symbolic link, which is not followed (name the file it points to)";
+
+/// A character or block device or a FIFO.
+#[cfg(unix)]
+fn is_special(kind: &std::fs::FileType) -> bool {
+    use std::os::unix::fs::FileTypeExt;
+    kind.is_char_device() || kind.is_block_device() || kind.is_fifo()
+}
+
+#[cfg(not(unix))]
+fn is_special(_: &std::fs::FileType) -> bool {
+    false
+}
+
+/// Checks, before any work, that an output file can be written at `path`: not a folder, a
+/// symbolic link or a socket ([`output_target`]); a file to replace must be in a folder that
+/// exists and lets us create a file (probed with a temporary file, then removed). A device or
+/// FIFO is not opened here (opening a FIFO waits for its reader).
+pub fn check_output_path(path: &Path, role: FileRole) -> Result<(), CliError> {
+    match output_target(path).map_err(|e| CliError::io(role, path, e))? {
+        Target::Replace => {
+            let (probe, tmp) = create_temp_file(path).map_err(|e| output_error(path, role, e))?;
+            drop(probe);
+            discard_temp(&tmp);
             Ok(())
         }
-        // Our own leftover (same process id) cannot be: create_new failed on someone else's.
-        Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => Ok(()),
-        Err(e) => Err(output_error(path, role, e)),
+        Target::Special | Target::Stream(_) => Ok(()),
     }
 }
 
@@ -394,33 +516,166 @@ fn folder_of(path: &Path) -> &Path {
     }
 }
 
-/// The temporary name beside `path`: `.NAME.tmp-PID`.
-fn temp_name(path: &Path) -> PathBuf {
-    let mut tmp = path.to_path_buf();
-    tmp.set_file_name(format!(
-        ".{}.tmp-{}",
-        path.file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default(),
-        std::process::id()
-    ));
-    tmp
+/// Longest file name most file systems take (`NAME_MAX`).
+const NAME_MAX: usize = 255;
+/// What a temporary name adds to the stem: `.` before, `.tmp-` and 16 hex digits after.
+const TEMP_NAME_EXTRA: usize = 1 + ".tmp-".len() + 16;
+
+/// A temporary name beside `path`: `.NAME.tmp-` and 16 hex digits of `random`, NAME cut (at a
+/// character boundary) so that the whole fits in [`NAME_MAX`] bytes (a 255-byte NAME works).
+/// `what` is `tmp`, or `old` for a folder renamed aside.
+fn temp_name(path: &Path, what: &str, random: u64) -> PathBuf {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "out".into());
+    let mut cut = name.len().min(NAME_MAX - TEMP_NAME_EXTRA);
+    while !name.is_char_boundary(cut) {
+        cut -= 1;
+    }
+    path.with_file_name(format!(".{}.{what}-{random:016x}", &name[..cut]))
 }
 
-/// Temporary files being written now (removed by [`remove_temp_files`] on a signal).
-static TEMP_FILES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+/// 64 unpredictable bits for a temporary name: SipHash, keyed by the standard library's
+/// `RandomState` (seeded from the operating system's random source once per thread, then
+/// changed for every new state), of a counter, the process id and the time. The names need not
+/// be secret, only not guessable in advance: they are created exclusively anyway.
+fn random_suffix() -> u64 {
+    use std::hash::{BuildHasher, Hasher};
+    use std::sync::atomic::{AtomicU64, Ordering};
+    static COUNT: AtomicU64 = AtomicU64::new(0);
+    let mut h = std::collections::hash_map::RandomState::new().build_hasher();
+    h.write_u64(COUNT.fetch_add(1, Ordering::Relaxed));
+    h.write_u32(std::process::id());
+    if let Ok(t) = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH) {
+        h.write_u128(t.as_nanos());
+    }
+    h.finish()
+}
 
-fn temp_files() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+/// Creates a new file at `path` for writing, exclusively: never an existing file, nor through a
+/// symbolic link (`O_CREAT | O_EXCL`, and `O_NOFOLLOW` on Unix).
+pub(crate) fn create_new_file(path: &Path) -> std::io::Result<std::fs::File> {
+    let mut options = std::fs::OpenOptions::new();
+    options.write(true).create_new(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        options.custom_flags(libc::O_NOFOLLOW);
+    }
+    options.open(path)
+}
+
+/// A temporary file or folder being written now.
+#[derive(Debug, PartialEq, Eq)]
+enum Temp {
+    File(PathBuf),
+    /// Removed with all it holds.
+    Folder(PathBuf),
+}
+
+impl Temp {
+    fn path(&self) -> &Path {
+        match self {
+            Temp::File(p) | Temp::Folder(p) => p,
+        }
+    }
+
+    fn remove(&self) {
+        let _ = match self {
+            Temp::File(p) => std::fs::remove_file(p),
+            Temp::Folder(p) => std::fs::remove_dir_all(p),
+        };
+    }
+}
+
+/// Temporary files and folders being written now (removed by [`remove_temp_files`] on a
+/// signal). Invariant: an entry is added in the same critical section that creates it, and
+/// dropped in the one that renames or removes it, so the signal's cleanup, which takes the lock
+/// for good, removes exactly what this process made and has not yet put in place.
+static TEMP_FILES: Mutex<Vec<Temp>> = Mutex::new(Vec::new());
+
+fn temp_files() -> std::sync::MutexGuard<'static, Vec<Temp>> {
     TEMP_FILES.lock().unwrap_or_else(|e| e.into_inner())
 }
 
-/// Removes every temporary file in the making and keeps the registry locked, so that no new one
-/// is started and none is renamed into place: call it only right before exiting (the binary
-/// does on SIGINT/SIGTERM).
+/// Creates a temporary entry beside `path` with `create` (given a fresh unpredictable name; it
+/// must fail with `AlreadyExists` when the name is taken, then another name is tried) and
+/// registers it with `temp`.
+fn create_temp<T>(
+    path: &Path,
+    create: impl Fn(&Path) -> std::io::Result<T>,
+    temp: impl Fn(PathBuf) -> Temp,
+) -> std::io::Result<(T, PathBuf)> {
+    let mut last = None;
+    for _ in 0..16 {
+        let tmp = temp_name(path, "tmp", random_suffix());
+        let mut files = temp_files();
+        match create(&tmp) {
+            Ok(made) => {
+                files.push(temp(tmp.clone()));
+                return Ok((made, tmp));
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => last = Some(e),
+            Err(e) => return Err(e),
+        }
+    }
+    Err(last.expect("tried at least once"))
+}
+
+/// A new temporary file beside `path` ([`create_new_file`], [`temp_name`]), registered.
+fn create_temp_file(path: &Path) -> std::io::Result<(std::fs::File, PathBuf)> {
+    create_temp(path, create_new_file, Temp::File)
+}
+
+/// A new temporary folder beside `dir` (`mkdir` fails on any existing name, a symbolic link
+/// included), registered: removed with its contents on a signal.
+pub(crate) fn create_temp_folder(dir: &Path) -> std::io::Result<PathBuf> {
+    create_temp(dir, |p| std::fs::create_dir(p), Temp::Folder).map(|((), tmp)| tmp)
+}
+
+/// Removes a registered temporary file or folder and drops it from the registry.
+pub(crate) fn discard_temp(tmp: &Path) {
+    let mut files = temp_files();
+    if let Some(i) = files.iter().position(|t| t.path() == tmp) {
+        files.remove(i).remove();
+    }
+}
+
+/// Renames the folder `from` (a registered temporary folder) to `to`; when `to` is an existing
+/// folder it is first renamed aside and returned, registered as temporary: the caller removes it
+/// with [`discard_temp`]. All under the registry's lock, so a signal's cleanup comes before or
+/// after, never between the renames.
+pub(crate) fn put_folder_in_place(
+    from: &Path,
+    to: &Path,
+    replace: bool,
+) -> std::io::Result<Option<PathBuf>> {
+    let mut files = temp_files();
+    let old = if replace {
+        let old = temp_name(to, "old", random_suffix());
+        std::fs::rename(to, &old)?;
+        if let Err(e) = std::fs::rename(from, to) {
+            let _ = std::fs::rename(&old, to);
+            return Err(e);
+        }
+        files.push(Temp::Folder(old.clone()));
+        Some(old)
+    } else {
+        std::fs::rename(from, to)?;
+        None
+    };
+    files.retain(|t| t.path() != from);
+    Ok(old)
+}
+
+/// Removes every temporary file and folder in the making and keeps the registry locked, so that
+/// no new one is started and none is renamed into place: call it only right before exiting (the
+/// binary does on SIGINT/SIGTERM).
 pub fn remove_temp_files() {
     let files = temp_files();
     for f in files.iter() {
-        let _ = std::fs::remove_file(f);
+        f.remove();
     }
     std::mem::forget(files);
 }
@@ -430,54 +685,100 @@ pub fn write_output(out: Option<&Path>, contents: &str) -> Result<(), CliError> 
     write_output_with(out, |w| w.write_all(contents.as_bytes()))
 }
 
-/// Streams output produced by `write` to `out` or to standard output. A file is written under a
-/// temporary name beside `out` and renamed into place only when `write` succeeded, so a failure
-/// never leaves a partial file.
+/// Streams output produced by `write` to `out` ([`write_file_as`]) or to standard output
+/// ([`write_stream`]).
 pub fn write_output_with(
     out: Option<&Path>,
     write: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>,
 ) -> Result<(), CliError> {
-    use std::io::Write;
     match out {
-        None => {
-            let mut stdout = std::io::BufWriter::new(std::io::stdout().lock());
-            // A closed pipe (`| head`) is not an error worth reporting.
-            let _ = write(&mut stdout).and_then(|_| stdout.flush());
-            Ok(())
-        }
+        None => write_stream(Stream::Stdout, write),
         Some(path) => write_file_as(path, FileRole::Output, write),
     }
 }
 
-/// Writes the file `path` (for `role`, which errors name) from `write`: under a temporary name
-/// beside it, registered for removal on a signal, then renamed into place; on any error the
-/// temporary file is removed and nothing is left.
+/// Writes output produced by `write` to a standard stream, buffered. Every write of the crate to
+/// standard output goes through here. A closed pipe (`| head`: `BrokenPipe`) ends the output
+/// quietly; any other error (a full disk) is `cannot write <stdout>: reason`.
+pub fn write_stream(
+    stream: Stream,
+    write: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>,
+) -> Result<(), CliError> {
+    use std::io::Write;
+    fn to(
+        mut w: std::io::BufWriter<impl Write>,
+        write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+    ) -> std::io::Result<()> {
+        write(&mut w)?;
+        w.flush()
+    }
+    let result = match stream {
+        Stream::Stdout => to(std::io::BufWriter::new(std::io::stdout().lock()), write),
+        Stream::Stderr => to(std::io::BufWriter::new(std::io::stderr().lock()), write),
+    };
+    match result {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(CliError::Stream {
+            stream: stream.name(),
+            source: e,
+        }),
+        _ => Ok(()),
+    }
+}
+
+/// Writes the file `path` (for `role`, which errors name) from `write`, by what `path` names
+/// ([`output_target`]): a new or regular file under a fresh temporary name beside it
+/// (registered for removal on a signal), renamed into place once complete, so that on any error
+/// nothing is left and an existing file is unchanged; a device or FIFO directly; a standard
+/// stream's name as [`write_stream`]. A folder, symbolic link or socket is refused.
 pub fn write_file_as(
     path: &Path,
     role: FileRole,
     write: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>,
 ) -> Result<(), CliError> {
-    let tmp = temp_name(path);
-    temp_files().push(tmp.clone());
-    let unregister = |tmp: &Path| temp_files().retain(|t| t != tmp);
-    let file = match std::fs::File::create(&tmp) {
-        Ok(f) => f,
-        Err(e) => {
-            unregister(&tmp);
-            return Err(output_error(path, role, e));
+    let err = |e| CliError::io(role, path, e);
+    match output_target(path).map_err(err)? {
+        Target::Stream(stream) => write_stream(stream, write),
+        Target::Special => {
+            let mut file = open_special(path).map_err(err)?;
+            super::background::write_in_background(&mut file, write).map_err(err)
         }
-    };
-    let mut file = file;
-    let result = super::background::write_in_background(&mut file, write);
-    drop(file);
-    let mut files = temp_files();
-    let result = result.and_then(|_| std::fs::rename(&tmp, path));
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
+        Target::Replace => {
+            let (mut file, tmp) =
+                create_temp_file(path).map_err(|e| output_error(path, role, e))?;
+            let result = super::background::write_in_background(&mut file, write);
+            drop(file);
+            let mut files = temp_files();
+            let result = result.and_then(|_| std::fs::rename(&tmp, path));
+            if result.is_err() {
+                let _ = std::fs::remove_file(&tmp);
+            }
+            files.retain(|t| t.path() != tmp);
+            drop(files);
+            result.map_err(err)
+        }
     }
-    files.retain(|t| *t != tmp);
-    drop(files);
-    result.map_err(|e| CliError::io(role, path, e))
+}
+
+/// Opens the device or FIFO `path` for writing, without following a symbolic link, and checks
+/// that it still is one (not a regular file put there since it was looked at, which would be
+/// written in place).
+fn open_special(path: &Path) -> std::io::Result<std::fs::File> {
+    let mut options = std::fs::OpenOptions::new();
+    options.write(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        options.custom_flags(libc::O_NOFOLLOW);
+    }
+    let file = options.open(path)?;
+    if is_special(&file.metadata()?.file_type()) {
+        Ok(file)
+    } else {
+        Err(invalid(
+            std::io::ErrorKind::InvalidInput,
+            "it was replaced by a file while it was opened".into(),
+        ))
+    }
 }
 
 #[cfg(test)]
@@ -521,12 +822,55 @@ mod tests {
     }
 
     #[test]
-    fn temporary_names_sit_beside_the_file() {
-        let t = temp_name(Path::new("out/r.json"));
-        assert_eq!(
-            t,
-            PathBuf::from(format!("out/.r.json.tmp-{}", std::process::id()))
-        );
+    fn temporary_names_sit_beside_the_file_and_fit_in_255_bytes() {
+        let t = temp_name(Path::new("out/r.json"), "tmp", 0xab);
+        assert_eq!(t, PathBuf::from("out/.r.json.tmp-00000000000000ab"));
         assert_eq!(folder_of(Path::new("r.json")), Path::new("."));
+        assert_eq!(
+            temp_name(Path::new("r.json"), "old", 1),
+            PathBuf::from(".r.json.old-0000000000000001")
+        );
+        // A 255-byte name is cut, at a character boundary (é is two bytes).
+        let long = format!("{}a", "é".repeat(127));
+        assert_eq!(long.len(), 255);
+        let t = temp_name(Path::new(&long), "tmp", u64::MAX);
+        let name = t.file_name().unwrap().to_str().unwrap();
+        assert_eq!(name, format!(".{}.tmp-ffffffffffffffff", "é".repeat(116)));
+        assert_eq!(name.len(), 254);
+    }
+
+    #[test]
+    fn temporary_names_are_not_predictable() {
+        let a = random_suffix();
+        let b = random_suffix();
+        assert_ne!(a, b);
+    }
+
+    #[test]
+    fn reads_stop_at_the_cap_and_after_the_first_nul() {
+        let endless = std::io::repeat(b'a');
+        let bytes = read_capped(&mut { endless }, 10, 0).unwrap();
+        assert_eq!(
+            bytes.len(),
+            11,
+            "one byte over the cap tells it is too large"
+        );
+        // /dev/zero: stops after the first chunk, long before the cap.
+        let bytes = read_capped(&mut std::io::repeat(0), MAX_INPUT_BYTES, 0).unwrap();
+        assert_eq!(bytes.len() as u64, READ_CHUNK);
+        assert_eq!(
+            check_text(&bytes).unwrap_err(),
+            "binary data, not text (a NUL byte at offset 0)"
+        );
+        let bytes = read_capped(&mut &b"{}"[..], 10, 2).unwrap();
+        assert_eq!(bytes, b"{}");
+        assert_eq!(
+            too_large_text(1 << 20, None),
+            "the file is larger than the limit of 1048576 bytes"
+        );
+        assert_eq!(
+            too_large_text(MAX_INPUT_BYTES, Some(3 << 30)),
+            "the file is larger than the limit of 2 GiB (3221225472 bytes)"
+        );
     }
 }
