@@ -10,6 +10,7 @@ mod c_codegen;
 mod c_codegen_cli;
 mod cli;
 mod convert;
+mod csv_inputs;
 mod diagnostics;
 mod differential;
 mod docs_examples;
