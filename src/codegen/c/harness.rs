@@ -239,7 +239,8 @@ pub(crate) const MAIN_C: &str =
 int main(int argc, char **argv) { return _plc_main(&_plc_program_desc, argc, argv); }
 ";
 
-/// The `Makefile`: every object `stems` with `CFLAGS`, the part files `parts` with `PARTFLAGS` too.
+/// The `Makefile`: every object `stems` with `CSTD` (the C standard, not replaced by a user's
+/// `CFLAGS`) and `CFLAGS`, the part files `parts` with `PARTFLAGS` too.
 pub(crate) fn makefile(stems: &[String], parts: &[String]) -> String {
     let objs: Vec<String> = stems.iter().map(|s| format!("{s}.o")).collect();
     let parts: Vec<String> = parts.iter().map(|s| format!("{s}.o")).collect();
@@ -250,11 +251,12 @@ pub(crate) fn makefile(stems: &[String], parts: &[String]) -> String {
          # PARTFLAGS: extra flags for the part files of large ladder POUs (PARTS), the rungs\n\
          # written as statements: with `plc-deps c --statements`, `make PARTFLAGS=-O1` builds in\n\
          # about two thirds of the CPU time, and the rungs run about a fifth slower (docs/c.md).\n\
-         CC ?= cc\nCFLAGS ?= -std=c11 -Wall -Wextra -Werror -O2\nPARTFLAGS ?=\n\
+         # CSTD: the C standard, kept apart from CFLAGS so that `make CFLAGS=-O1` keeps it.\n\
+         CC ?= cc\nCSTD = -std=c11\nCFLAGS ?= -Wall -Wextra -Werror -O2\nPARTFLAGS ?=\n\
          OBJS = main.o plc_program.o {}\nPARTS = {}\n\n\
-         plc_program: $(OBJS)\n\t$(CC) $(CFLAGS) -o $@ $(OBJS) -lm\n\n\
+         plc_program: $(OBJS)\n\t$(CC) $(CSTD) $(CFLAGS) -o $@ $(OBJS) -lm\n\n\
          $(PARTS): EXTRA = $(PARTFLAGS)\n\n\
-         %.o: %.c plc_program.h plc_runtime.h plc_main.h\n\t$(CC) $(CFLAGS) $(EXTRA) -c -o $@ $<\n\n\
+         %.o: %.c plc_program.h plc_runtime.h plc_main.h\n\t$(CC) $(CSTD) $(CFLAGS) $(EXTRA) -c -o $@ $<\n\n\
          clean:\n\trm -f plc_program $(OBJS)\n\n.PHONY: clean\n",
         objs.join(" "),
         parts.join(" ")
