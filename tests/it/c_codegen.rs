@@ -164,26 +164,26 @@ fn example_c_has_the_shape_the_paper_prints() {
         code[start..].to_vec(),
         vec![
             "_run0_3 = 0;",
-            "_3_0 = (self->Var1 == 1);",
-            "_4_0 = (self->Var1 == 2);",
+            "_3_0 = (self->_v_Var1 == 1);",
+            "_4_0 = (self->_v_Var1 == 2);",
             "if (_3_0) {",
             "_run0_3 = 1;",
-            "self->LVar = _plc_add_i16(self->Var2, 10);",
+            "self->_v_LVar = _plc_add_i16(self->_v_Var2, 10);",
             "}",
             "if (_4_0) {",
             "_run0_3 = 1;",
-            "_10_0 = _plc_mul_i16(self->Var2, 3);",
-            "self->LVar = _10_0;",
+            "_10_0 = _plc_mul_i16(self->_v_Var2, 3);",
+            "self->_v_LVar = _10_0;",
             "_27_0 = (_10_0 > 0);",
             "if (_27_0) {",
-            "self->Var3 = _plc_mul_i16(self->Var3, _10_0);",
+            "self->_v_Var3 = _plc_mul_i16(self->_v_Var3, _10_0);",
             "}",
             "}",
             "if (_run0_3) {",
-            "_15_0 = _plc_sub_i16(self->LVar, 1);",
-            "self->WriteValue_17.IVal = _15_0;",
-            "_fb_WriteValue_body(&self->WriteValue_17, self, ctx);",
-            "self->Written = self->WriteValue_17.OVal;",
+            "_15_0 = _plc_sub_i16(self->_v_LVar, 1);",
+            "self->_v_WriteValue_17._v_IVal = _15_0;",
+            "_fb_WriteValue_body(&self->_v_WriteValue_17, self, ctx);",
+            "self->_v_Written = self->_v_WriteValue_17._v_OVal;",
             "}",
             "}",
         ]
@@ -219,10 +219,10 @@ fn n_input_blocks_are_one_statement() {
     let files = generate(&p, &fbd, &CConfig::default());
     let body = &files.iter().find(|f| f.name == "pou_nin.c").unwrap().text;
     for line in [
-        "self->s = _plc_add_i16(_plc_add_i16(self->a, self->b), self->c);",
-        "self->m = _plc_max_i16(_plc_max_i16(self->a, self->b), self->c);",
-        "self->l = _plc_min_i16(_plc_max_i16(self->a, -5), 10);",
-        "self->r = ((self->x * 0.1f) * self->x) * 3.0f;",
+        "self->_v_s = _plc_add_i16(_plc_add_i16(self->_v_a, self->_v_b), self->_v_c);",
+        "self->_v_m = _plc_max_i16(_plc_max_i16(self->_v_a, self->_v_b), self->_v_c);",
+        "self->_v_l = _plc_min_i16(_plc_max_i16(self->_v_a, -5), 10);",
+        "self->_v_r = ((self->_v_x * 0.1f) * self->_v_x) * 3.0f;",
     ] {
         assert!(body.lines().any(|l| l.trim() == line), "{line}\n{body}");
     }

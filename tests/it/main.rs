@@ -6,10 +6,12 @@ mod plcopen_common;
 
 mod analyses;
 mod analysis_props;
+mod c_build;
 mod c_codegen;
 mod c_codegen_cli;
 mod cli;
 mod convert;
+mod csv_inputs;
 mod diagnostics;
 mod differential;
 mod docs_examples;

@@ -1,7 +1,6 @@
 //! PLCopen TC6 XML LD bodies, hand-written: the rungs the reader rebuilds from the wiring, as
 //! the report shows them (IN/OUT, dependences, levels), and a run of one of them.
 
-
 use serde_json::{json, Value};
 
 use crate::plcopen_common as px;

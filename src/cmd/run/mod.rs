@@ -33,7 +33,7 @@ mod trace;
 pub use crate::cmd::progress::Progress;
 pub use config::{parse_cycle, RunConfig, RunFormat, RunMode, RunWarning};
 pub use engine::{FaultSummary, RunReport};
-pub use inputs::{load_inputs, parse_inputs_csv, parse_inputs_json, InputTable};
+pub use inputs::{integer_cell, load_inputs, parse_inputs_csv, parse_inputs_json, InputTable};
 pub use output::{render_json, render_text, run_figures, write_html};
 
 use crate::cmd::io::{write_file_as, write_output, write_output_with, CliError, FileRole};

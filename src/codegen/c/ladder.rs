@@ -19,6 +19,7 @@
 pub(crate) use super::spelling::{c_const, c_type, negate, num_suffix};
 use super::{fold, names};
 use crate::model::*;
+use std::borrow::Cow;
 use std::collections::HashMap;
 use std::fmt::Write as _;
 
@@ -79,6 +80,9 @@ pub(crate) struct Body<'a> {
     pub comments: bool,
     /// Set where rungs of contacts and coils become rows of tables (`rows`).
     pub rows: Option<super::rows::Tables>,
+    /// The power locals (`bool _pN = …;`) whose value is a box's call: [`Body::finish`] keeps
+    /// the call of one that nothing reads (every other power local is a pure expression).
+    calls: std::collections::HashSet<String>,
 }
 
 /// The instance whose lowered rungs a function block type's function is written from: its
@@ -133,6 +137,7 @@ impl<'a> Body<'a> {
             inst: None,
             comments: true,
             rows: None,
+            calls: Default::default(),
         }
     }
 
@@ -535,6 +540,7 @@ impl<'a> Body<'a> {
         }
         let l = self.fresh("p");
         self.line(&format!("bool {l} = {call};"));
+        self.calls.insert(l.clone());
         Pw::Local(l)
     }
 
@@ -717,11 +723,47 @@ impl<'a> Body<'a> {
         }
     }
 
-    /// The function body, without the labels no `goto` names.
+    /// The function body, without the labels no `goto` names and without power locals nothing
+    /// reads (a rung whose branches end without an output, a contact after a box: `-Wall
+    /// -Werror` refuses an unused variable). Such a local's line goes, or becomes its call
+    /// (`_plc_ton(…);`) when it holds a box's Q; a local read only by a removed one goes too.
     pub fn finish(mut self) -> String {
         self.flush_rows();
+        let mut lines: Vec<Option<Cow<str>>> = self.out.lines().map(|l| Some(l.into())).collect();
+        let mut reads: HashMap<&str, usize> = HashMap::new();
+        for id in power_locals(&self.out) {
+            *reads.entry(id).or_default() += 1;
+        }
+        // Backwards: a local's readers come after its declaration, so they are settled first.
+        for line in lines.iter_mut().rev() {
+            let Some(text) = line.as_deref() else {
+                continue;
+            };
+            let t = text.trim_start();
+            let Some((name, init)) = t
+                .strip_prefix("bool ")
+                .and_then(|d| d.strip_suffix(';'))
+                .and_then(|d| d.split_once(" = "))
+            else {
+                continue;
+            };
+            if reads.get(name) != Some(&1) {
+                continue;
+            }
+            if self.calls.contains(name) {
+                let indent = &text[..text.len() - t.len()];
+                *line = Some(format!("{indent}{init};").into());
+            } else {
+                for id in power_locals(init) {
+                    if let Some(n) = reads.get_mut(id) {
+                        *n -= 1;
+                    }
+                }
+                *line = None;
+            }
+        }
         let mut out = String::with_capacity(self.out.len());
-        for line in self.out.lines() {
+        for line in lines.iter().flatten() {
             let t = line.trim_start();
             if let Some(n) = t.strip_prefix("_L").and_then(|x| x.strip_suffix(": ;")) {
                 if n.parse().is_ok_and(|n: u32| !self.used_labels.contains(&n)) {
@@ -743,6 +785,17 @@ impl<'a> Body<'a> {
         let pw = self.series(r, body, Pw::True, false).0;
         Self::text(&pw)
     }
+}
+
+/// The power locals (`_p12`, as [`Body::materialize`] and [`Body::boxed`] name them) that `text`
+/// names, once per occurrence. No other name has that form (a program's names that start with
+/// `_` are encoded: `names`).
+fn power_locals(text: &str) -> impl Iterator<Item = &str> {
+    text.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+        .filter(|id| {
+            id.strip_prefix("_p")
+                .is_some_and(|n| !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()))
+        })
 }
 
 /// The power at the end of a series.

@@ -3,143 +3,20 @@
 //! or write outside the output folder.
 //!
 //! Invariants:
-//! - a user name is kept as written only when it is a C identifier that does not start with `_`
-//!   and is neither a C keyword nor a name the included standard headers may define as a macro;
-//!   any other name becomes `_u` + [`encode_ident`] of it (injective, so two names never meet);
-//! - every name the generator makes up starts with `_` and never with `_u`, so it meets neither
-//!   a kept user name nor an encoded one;
+//! - every user name gets a prefix: a C identifier that does not start with `_` becomes `_v_` +
+//!   the name as written (`self->_v_Start`), any other `_u` + [`encode_ident`] of it (injective,
+//!   so two names never meet). An identifier that starts with `_` and a lower-case letter is
+//!   never a macro of a C library header (the C standard leaves that space to programs outside
+//!   file scope, and user names are only struct members), so no header, whatever its feature
+//!   macros (`P_tmpdir`, `WNOHANG`, `M_PI`, `errno`, `stdin`, `NULL` without `-std=c11`), and no
+//!   keyword can change the C's meaning;
+//! - every name the generator makes up starts with `_` and never with `_u` or `_v`, so it meets
+//!   no user name;
 //! - file names use [`encode_file`]: lower-case letters, digits and `_` only (case-folded, so two
 //!   POUs never share a file on a case-insensitive file system), no `.`/`/`, at most 80 bytes.
 //!
 //! Not here: what a name denotes (the emitters decide), C string literals ([`c_string`]) which
 //! quote any text byte by byte.
-
-/// C11/C23 keywords and the macros of `<stdbool.h> <stdint.h> <stdio.h> <stdlib.h> <string.h>
-/// <math.h>` that a struct member or local could collide with, plus the parameter names of the
-/// generated functions.
-const RESERVED: &[&str] = &[
-    "auto",
-    "break",
-    "case",
-    "char",
-    "const",
-    "continue",
-    "default",
-    "do",
-    "double",
-    "else",
-    "enum",
-    "extern",
-    "float",
-    "for",
-    "goto",
-    "if",
-    "inline",
-    "int",
-    "long",
-    "register",
-    "restrict",
-    "return",
-    "short",
-    "signed",
-    "sizeof",
-    "static",
-    "struct",
-    "switch",
-    "typedef",
-    "union",
-    "unsigned",
-    "void",
-    "volatile",
-    "while",
-    "bool",
-    "true",
-    "false",
-    "alignas",
-    "alignof",
-    "constexpr",
-    "nullptr",
-    "static_assert",
-    "thread_local",
-    "typeof",
-    "typeof_unqual",
-    "asm",
-    "fortran",
-    "NULL",
-    "EOF",
-    "BUFSIZ",
-    "FILENAME_MAX",
-    "FOPEN_MAX",
-    "L_tmpnam",
-    "TMP_MAX",
-    "SEEK_SET",
-    "SEEK_CUR",
-    "SEEK_END",
-    "stdin",
-    "stdout",
-    "stderr",
-    "EXIT_SUCCESS",
-    "EXIT_FAILURE",
-    "RAND_MAX",
-    "MB_CUR_MAX",
-    "errno",
-    "assert",
-    "offsetof",
-    "HUGE_VAL",
-    "HUGE_VALF",
-    "HUGE_VALL",
-    "INFINITY",
-    "NAN",
-    "FP_NAN",
-    "FP_INFINITE",
-    "FP_ZERO",
-    "FP_SUBNORMAL",
-    "FP_NORMAL",
-    "FP_FAST_FMA",
-    "FP_FAST_FMAF",
-    "FP_ILOGB0",
-    "FP_ILOGBNAN",
-    "MATH_ERRNO",
-    "MATH_ERREXCEPT",
-    "math_errhandling",
-    "fpclassify",
-    "isfinite",
-    "isinf",
-    "isnan",
-    "isnormal",
-    "signbit",
-    "isgreater",
-    "isgreaterequal",
-    "isless",
-    "islessequal",
-    "islessgreater",
-    "isunordered",
-    "getc",
-    "putc",
-    "getchar",
-    "putchar",
-    "self",
-    "ctx",
-    "main",
-    "unix",
-    "linux",
-    "i386",
-];
-
-fn is_reserved(s: &str) -> bool {
-    RESERVED.contains(&s)
-        || s.starts_with("INT")
-        || s.starts_with("UINT")
-        || s.starts_with("SIZE_")
-        || s.starts_with("PTRDIFF_")
-        || s.starts_with("WCHAR_")
-        || s.starts_with("WINT_")
-        || s.starts_with("SIG_ATOMIC_")
-        || s.starts_with("PRI")
-        || s.starts_with("SCN")
-        || s.starts_with("M_")
-        || s.starts_with("__")
-}
 
 /// True for `[A-Za-z][A-Za-z0-9_]*`.
 fn is_plain_identifier(s: &str) -> bool {
@@ -161,11 +38,11 @@ pub fn encode_ident(s: &str) -> String {
     out
 }
 
-/// The C identifier of a user name (a variable, a struct member): the name itself when that is
-/// safe, else `_u` + its encoding.
+/// The C identifier of a user name (a struct member): `_v_` + the name when it is a plain
+/// identifier, else `_u` + its encoding.
 pub fn user_ident(name: &str) -> String {
-    if is_plain_identifier(name) && !is_reserved(name) {
-        name.to_string()
+    if is_plain_identifier(name) {
+        format!("_v_{name}")
     } else {
         format!("_u{}", encode_ident(name))
     }
@@ -230,11 +107,12 @@ mod tests {
 
     #[test]
     fn identifiers() {
-        assert_eq!(user_ident("Var1"), "Var1");
-        assert_eq!(user_ident("int"), "_uint");
+        assert_eq!(user_ident("Var1"), "_v_Var1");
+        assert_eq!(user_ident("int"), "_v_int");
+        assert_eq!(user_ident("P_tmpdir"), "_v_P_tmpdir");
         assert_eq!(user_ident("_x"), "_u__x");
         assert_eq!(user_ident("a.b"), "_ua_046b");
-        assert_eq!(user_ident("INT16_MAX"), "_uINT16__MAX");
+        assert_eq!(user_ident("INT16_MAX"), "_v_INT16_MAX");
         assert_ne!(user_ident("a_b"), user_ident("a.b"));
     }
 

@@ -47,6 +47,11 @@ typedef struct _plc_program {
     int (*set_input)(void *self, unsigned input, const char *text);
     void (*print)(const void *self, FILE *out);
     const char *const *input_names;
+    /* Per input, its type as the inputs reader names it (plc_main.h); the names of the outputs
+       and of the other variables (NULL-terminated). */
+    const char *const *input_types;
+    const char *const *output_names;
+    const char *const *memory_names;
     const char *const *rung_ids;
     int64_t cycle_ms;
     uint64_t loop_cap;
