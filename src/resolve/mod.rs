@@ -55,7 +55,7 @@ use elements::{Place, Scope};
 use lowering::relocate_jumps;
 use path::At;
 use table::NameTable;
-use util::{check_name, rung_path};
+use util::{check_name, check_printable, rung_path};
 
 type Result<T> = std::result::Result<T, LoadError>;
 
@@ -67,6 +67,10 @@ pub fn resolve(text: &str, syn: &syntax::Program<'_>) -> Result<(Program, Fbd)> 
 
 fn resolve_syntax(syn: &syntax::Program<'_>) -> Result<(Program, Fbd)> {
     let mut b = Builder::default();
+    let name = check_printable("program name", &syn.name, || "program".into(), None);
+    if let Err(e) = name {
+        b.report(e.at(syn.name_origin.or(syn.origin)));
+    }
     for p in &syn.problems {
         b.report(LoadError::invalid(None, &p.at, p.kind.clone()).at(p.origin));
     }
@@ -578,6 +582,12 @@ impl<'a> Builder<'a> {
                     let e =
                         LoadError::invalid(rung, &format!("{}{}", path(), p.at), p.kind.clone());
                     errors.push(e.at(p.origin).at(r.origin));
+                    continue;
+                }
+                if let Err(e) =
+                    check_printable("rung id", &r.id.value, || format!("{}.id", path()), None)
+                {
+                    errors.push(e.at(r.id.origin).at(r.origin));
                     continue;
                 }
                 if let Some(first) = ids.get(key.as_ref()).copied().or_else(|| main_id(&key)) {

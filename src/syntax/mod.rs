@@ -150,6 +150,8 @@ pub struct Program<'a> {
     /// Where the program object starts.
     pub origin: Origin,
     pub name: Text<'a>,
+    /// Where the name is written (none when a reader made it up or does not say).
+    pub name_origin: Origin,
     pub comment: Option<Text<'a>>,
     /// The program-wide variables.
     pub vars: Vec<Var<'a>>,

@@ -62,8 +62,14 @@ pub struct HtmlInput<'r, 'a> {
 }
 
 /// Escapes text for an HTML (and XML) text node or a quoted attribute.
+/// A control character but line feed, tab and carriage return (which XML does not allow, even
+/// as a reference) is written as its Rust escape (`\u{1b}`), as text.
 pub(crate) fn esc(s: &str) -> Cow<'_, str> {
-    if !s.contains(['&', '<', '>', '"', '\'']) {
+    let special = |c: char| {
+        matches!(c, '&' | '<' | '>' | '"' | '\'')
+            || (c.is_control() && !matches!(c, '\n' | '\t' | '\r'))
+    };
+    if !s.contains(special) {
         return Cow::Borrowed(s);
     }
     let mut o = String::with_capacity(s.len() + 8);
@@ -74,6 +80,7 @@ pub(crate) fn esc(s: &str) -> Cow<'_, str> {
             '>' => o.push_str("&gt;"),
             '"' => o.push_str("&quot;"),
             '\'' => o.push_str("&#39;"),
+            c if special(c) => o.extend(c.escape_default()),
             c => o.push(c),
         }
     }
