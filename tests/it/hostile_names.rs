@@ -308,3 +308,129 @@ fn gen_refuses_sizes_it_could_not_read_back_naming_the_flag() {
         );
     }
 }
+
+/// A PLCopen project whose program `P` has an ST body (two statements), and where it starts.
+fn st_project() -> (String, String) {
+    let xml = px::project_in(
+        "ST",
+        &[
+            ("inputVars", "start", "BOOL"),
+            ("outputVars", "run", "BOOL"),
+            ("localVars", "count", "INT"),
+        ],
+        "<xhtml:p xmlns:xhtml=\"http://www.w3.org/1999/xhtml\"><![CDATA[count := count + 1;\nrun := start;]]></xhtml:p>",
+    );
+    let at = px::line_col(&xml, "<ST>");
+    (xml, at)
+}
+
+#[test]
+fn run_c_and_il_refuse_an_st_body_they_do_not_execute_unless_allowed() {
+    let (xml, at) = st_project();
+    let refused = |what: &str| {
+        format!("error: <stdin>:{at}: pou P: its ST body is not executed (it is read only as stand-in rungs that keep every value); {what}")
+    };
+    // The reader's warning W0501 comes first: the error is the last line.
+    let error_line = |out: &std::process::Output, what: &str| {
+        assert_eq!(out.status.code(), Some(2), "{what}");
+        assert!(out.stdout.is_empty(), "{what}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            stderr.starts_with("warning[W0501]: pou P: its ST body"),
+            "{what}: {stderr}"
+        );
+        stderr.trim_end().lines().last().unwrap().to_string()
+    };
+    let out = run_stdin(&["run", "-", "--scans", "2"], xml.as_bytes());
+    assert_eq!(
+        error_line(&out, "run"),
+        refused("give --allow-skipped to run the rest of the project without it")
+    );
+    let dir = tmp("hostile-st-c");
+    let _ = std::fs::remove_dir_all(&dir);
+    let c = ["c", "-", "-o", dir.to_str().unwrap()];
+    let out = run_stdin(&c, xml.as_bytes());
+    assert_eq!(
+        error_line(&out, "c"),
+        refused("give --allow-skipped to write the C without it")
+    );
+    assert!(!dir.exists(), "nothing written");
+    let out = run_stdin(&["il", "-"], xml.as_bytes());
+    assert_eq!(error_line(&out, "il"), refused("its STL cannot be written"));
+
+    // Allowed: the outputs list the POU.
+    let (line, column) = at.split_once(':').unwrap();
+    let listed = format!("P (ST body at {at})");
+    let out = run_stdin(
+        &["run", "-", "--scans", "2", "--allow-skipped"],
+        xml.as_bytes(),
+    );
+    assert_eq!(out.status.code(), Some(0));
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        text.contains(&format!(
+            "\nnot executed (--allow-skipped; stand-in rungs keep every value): {listed}\n"
+        )),
+        "{text}"
+    );
+    let args = [
+        "run",
+        "-",
+        "--scans",
+        "2",
+        "--allow-skipped",
+        "--format",
+        "json",
+    ];
+    let (r, _) = px::json_output(&args, &xml);
+    let expected = serde_json::json!([{"pou": "P", "language": "ST", "line": line.parse::<u32>().unwrap(), "column": column.parse::<u32>().unwrap()}]);
+    assert_eq!(r["skipped_pous"], expected);
+    let args = [
+        "run",
+        "-",
+        "--scans",
+        "2",
+        "--allow-skipped",
+        "--format",
+        "html",
+    ];
+    let out = run_stdin(&args, xml.as_bytes());
+    assert!(String::from_utf8_lossy(&out.stdout).contains(&format!("<li>{listed}</li>")));
+    let c = ["c", "-", "-o", dir.to_str().unwrap(), "--allow-skipped"];
+    let out = run_stdin(&c, xml.as_bytes());
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let marked: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| {
+            std::fs::read_to_string(p)
+                .unwrap()
+                .contains("/* NOT EXECUTED: the ST body of POU P is not translated")
+        })
+        .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(marked.len(), 2, "the POU's header and source: {marked:?}");
+}
+
+#[test]
+fn report_says_which_bodies_it_analysed_only_through_stand_ins() {
+    let (xml, at) = st_project();
+    let out = run_stdin(&["report", "-"], xml.as_bytes());
+    assert_eq!(out.status.code(), Some(0));
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains(&format!("\nBodies not read as logic\n  P (ST body at {at})\n  each analysed through stand-in rungs that read and write whole variables")), "{text}");
+    let (r, _) = px::report_and_warnings(&xml);
+    assert_eq!(r["skipped_pous"][0]["pou"], "P");
+    assert_eq!(r["skipped_pous"][0]["language"], "ST");
+    // A program without such bodies has no key (the report JSON is unchanged).
+    let (plain, _) = px::json_output(
+        &["report", "-", "--format", "json"],
+        &json_program("P", "R1", ""),
+    );
+    assert!(plain.get("skipped_pous").is_none());
+}

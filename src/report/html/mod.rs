@@ -102,11 +102,28 @@ pub fn render_run_html(
     write_page(input, Some(run), out)
 }
 
+/// The POUs whose bodies were not read as logic, and what that means, when there are any.
+fn write_skipped(out: &mut impl Write, r: &Report) -> io::Result<()> {
+    if r.skipped_pous.is_empty() {
+        return Ok(());
+    }
+    out.write_all(b"<section id=\"skipped\">\n<h2>Bodies not read as logic</h2>\n<ul>\n")?;
+    for s in &r.skipped_pous {
+        writeln!(out, "<li>{}</li>", esc(&s.text()))?;
+    }
+    writeln!(
+        out,
+        "</ul>\n<p>Each is {}.</p>\n</section>",
+        esc(super::document::SKIPPED_MEANING)
+    )
+}
+
 /// The page, with the run section when there is a run.
 fn write_page(input: &HtmlInput, run: Option<&RunFigures>, out: &mut impl Write) -> io::Result<()> {
     let r = input.doc;
     page::write_head(out, r.program, if run.is_some() { "run" } else { "report" })?;
     page::write_summary(out, r)?;
+    write_skipped(out, r)?;
     if let Some(run) = run {
         run::write_run(out, r, run)?;
     }
