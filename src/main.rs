@@ -202,6 +202,11 @@ struct RunArgs {
     /// task order].
     #[arg(long)]
     pou: Option<String>,
+    /// Go on when a POU's body is not executed (a PLCopen ST, IL or SFC body, read only as
+    /// stand-in rungs that keep every value): the output lists those POUs. Without it, such
+    /// a POU is an error.
+    #[arg(long)]
+    allow_skipped: bool,
     /// Write the report to this file instead of standard output.
     #[arg(short, long)]
     output: Option<PathBuf>,
@@ -228,6 +233,11 @@ struct CArgs {
     /// 1 ms of CPU per rung written as statements, minutes at 100,000 rungs.
     #[arg(long)]
     statements: bool,
+    /// Go on when a POU's body is not executed (a PLCopen ST, IL or SFC body, read only as
+    /// stand-in rungs that keep every value): the output lists those POUs. Without it, such
+    /// a POU is an error.
+    #[arg(long)]
+    allow_skipped: bool,
     /// Accepted for compatibility: rows are the default.
     #[arg(long, hide = true)]
     rows: bool,
@@ -403,6 +413,7 @@ impl CArgs {
             input: self.file,
             output: self.output,
             force: self.force,
+            allow_skipped: self.allow_skipped,
             config: plc_deps::codegen::c::CConfig {
                 cycle_ms: cmd::run::parse_cycle(&self.cycle)?,
                 loop_cap: self.loop_cap,
@@ -475,6 +486,7 @@ impl RunArgs {
         config.loop_cap = self.loop_cap;
         config.output = self.output;
         config.program = self.pou;
+        config.allow_skipped = self.allow_skipped;
         Ok(config)
     }
 }

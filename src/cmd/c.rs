@@ -26,12 +26,16 @@ pub struct CCommand {
     pub input: PathBuf,
     pub output: PathBuf,
     pub force: bool,
+    /// `--allow-skipped`: write C for a program some of whose POU bodies are not executed
+    /// (each such function says so in a comment); false: such a program is refused.
+    pub allow_skipped: bool,
     pub config: CConfig,
 }
 
 /// `plc-deps c`: generates and writes the files.
 pub fn c(cmd: &CCommand) -> Result<(), CliError> {
     let (p, fbd) = load_program_and_fbd(&cmd.input)?;
+    super::skipped::refuse_skipped(&p, &cmd.input, cmd.allow_skipped, Some("write the C"))?;
     let dir = &cmd.output;
     let io = |e| CliError::io(FileRole::Output, dir, e);
     let exists = match fs::symlink_metadata(dir) {

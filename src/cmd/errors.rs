@@ -53,7 +53,7 @@ pub fn error_text(e: &CliError, format: Format, colour: bool) -> String {
         (CliError::Load { shown, .. }, Format::Text) if !shown.is_empty() => {
             shown.iter().map(|s| s.text(colour)).collect()
         }
-        (other, Format::Text) => format!("error: {other}\n"),
+        (other, Format::Text) => format!("error: {}\n", crate::diag::printable(&other.to_string())),
         (_, Format::Json) => shown_of(e).iter().map(|s| s.json() + "\n").collect(),
     }
 }

@@ -3,7 +3,7 @@
 
 use super::io::write_output_with;
 use super::CliError;
-use crate::synth::{write_program, ConfigError, GenConfig};
+use crate::synth::{write_program, ConfigError, GenConfig, MAX_RUNGS};
 use std::path::PathBuf;
 
 /// A `plc-deps gen` invocation.
@@ -37,6 +37,12 @@ pub fn gen(c: &GenCommand) -> Result<(), CliError> {
                 "--rungs must be at least 1 (a program has at least one rung)".into()
             }
             ConfigError::EmptyForBody => "--for-body must be at least 1".into(),
+            ConfigError::TooManyRungs(n) => format!(
+                "--rungs must be at most {MAX_RUNGS} (a larger program would pass the 2 GiB the readers read), not {n}"
+            ),
+            ConfigError::ForBodyTooLong(n) => format!(
+                "--for-body must be at most {MAX_RUNGS} (the most rungs a program has), not {n}"
+            ),
             ConfigError::HotFraction(f) => {
                 format!("--hot-fraction must be in (0, 1] (a fraction of the rungs), not {f}")
             }

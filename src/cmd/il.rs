@@ -19,6 +19,7 @@ pub fn il(cmd: &IlCommand) -> Result<(), CliError> {
         check_output_path(out, FileRole::Output)?;
     }
     let (p, fbd) = load_program_and_fbd(&cmd.input)?;
+    super::skipped::refuse_skipped(&p, &cmd.input, false, None)?;
     let text = generate(&p, &fbd).map_err(|e| {
         let file = if cmd.input.as_os_str() == "-" {
             "<stdin>".to_string()

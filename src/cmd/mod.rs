@@ -20,6 +20,7 @@ pub mod progress;
 pub mod report;
 pub mod run;
 pub mod schema;
+pub mod skipped;
 pub mod source;
 
 pub use io::{CliError, FileRole};

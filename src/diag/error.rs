@@ -161,6 +161,15 @@ pub enum Invalid {
     BadTime { text: String },
     #[error("`{text}` is not a valid literal (write e.g. \"16#FF\", \"2#1010\", \"UINT#5\", \"LREAL#1.5\")")]
     BadLiteral { text: String },
+    /// A name or id that holds a control character (C0, DEL or C1): it would break the DOT,
+    /// STL and C the tool writes and put escape sequences on a terminal. `text` is the name
+    /// with its control characters escaped (`"R\u{1b}1"`), `code` the first one (`U+001B`).
+    #[error("{what} {text} holds the control character {code} (names and ids are printable text)")]
+    ControlChar {
+        what: &'static str,
+        text: String,
+        code: String,
+    },
     #[error("{what} is not allowed {place}")]
     Misplaced {
         what: &'static str,

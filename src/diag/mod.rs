@@ -90,6 +90,7 @@ impl Invalid {
             Misplaced { .. } => "E0107",
             Empty => "E0108",
             BadLiteral { .. } => "E0109",
+            ControlChar { .. } => "E0110",
             UnknownType { .. } => "E0201",
             UnknownTypeOrFb { .. } => "E0202",
             DuplicateVar { .. } => "E0203",
@@ -125,5 +126,58 @@ impl Invalid {
             AccumulatedTwice { .. } => "E0414",
             PlcOpen { .. } => "E0501",
         }
+    }
+}
+
+impl Invalid {
+    /// The error of `text`, named `what` (`"rung id"`), when it holds a control character (C0,
+    /// DEL or C1: [`char::is_control`]); `None` when it is printable.
+    pub fn control_char(what: &'static str, text: &str) -> Option<Invalid> {
+        let c = text.chars().find(|c| c.is_control())?;
+        Some(Invalid::ControlChar {
+            what,
+            text: format!("{text:?}"),
+            code: format!("U+{:04X}", c as u32),
+        })
+    }
+}
+
+/// `text` with every control character (C0, DEL, C1) but line feed and tab written as its Rust
+/// escape (`\u{1b}`), so that file text quoted in a message cannot drive a terminal.
+pub fn printable(text: &str) -> std::borrow::Cow<'_, str> {
+    let escaped = |c: char| c.is_control() && c != '\n' && c != '\t';
+    if !text.contains(escaped) {
+        return std::borrow::Cow::Borrowed(text);
+    }
+    let mut out = String::with_capacity(text.len() + 8);
+    for c in text.chars() {
+        if escaped(c) {
+            out.extend(c.escape_default());
+        } else {
+            out.push(c);
+        }
+    }
+    std::borrow::Cow::Owned(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn control_characters_are_named_and_escaped() {
+        assert_eq!(
+            printable("a\u{1b}[2Jb\n\tc\u{9b}\u{7f}"),
+            "a\\u{1b}[2Jb\n\tc\\u{9b}\\u{7f}"
+        );
+        assert!(matches!(
+            printable("plain"),
+            std::borrow::Cow::Borrowed("plain")
+        ));
+        assert_eq!(
+            Invalid::control_char("rung id", "R\u{7}1").unwrap().to_string(),
+            "rung id \"R\\u{7}1\" holds the control character U+0007 (names and ids are printable text)"
+        );
+        assert_eq!(Invalid::control_char("rung id", "R 1 ü"), None);
     }
 }

@@ -47,6 +47,8 @@ pub struct Shown {
     pub span: Option<Range<usize>>,
     pub hint: Option<String>,
     excerpt: Option<Excerpt>,
+    /// `file` as the text rendering shows it ([`super::printable`]).
+    file_shown: String,
 }
 
 impl Shown {
@@ -112,6 +114,7 @@ impl Shown {
             span: None,
             hint: None,
             excerpt: None,
+            file_shown: String::new(),
         }
     }
 
@@ -132,9 +135,14 @@ impl Shown {
             place: None,
             file: file.to_owned(),
             position: position.filter(|_| span.is_some()),
-            excerpt: span.clone().map(|s| span::excerpt(text, s)),
+            excerpt: span.clone().map(|s| {
+                let mut e = span::excerpt(text, s);
+                e.text = same_width(&e.text);
+                e
+            }),
             span,
             hint: None,
+            file_shown: super::printable(file).into_owned(),
         }
     }
 
@@ -145,7 +153,7 @@ impl Shown {
             Severity::Error => cs::Severity::Error,
             Severity::Warning => cs::Severity::Warning,
         })
-        .with_message(&self.message);
+        .with_message(super::printable(&self.message));
         if !self.code.is_empty() {
             d = d.with_code(self.code);
         }
@@ -154,18 +162,22 @@ impl Shown {
             (Some(e), Some(_)) => {
                 let label = cs::Label::primary((), e.span.clone());
                 d = d.with_label(match &self.place {
-                    Some(p) => label.with_message(p),
+                    Some(p) => label.with_message(super::printable(p)),
                     None => label,
                 });
             }
             _ if !self.file.is_empty() => notes.push(match &self.place {
-                Some(p) => format!("in {}: {p}", self.file),
-                None => format!("in {}", self.file),
+                Some(p) => format!(
+                    "in {}: {}",
+                    super::printable(&self.file),
+                    super::printable(p)
+                ),
+                None => format!("in {}", super::printable(&self.file)),
             }),
             _ => {}
         }
         if let Some(h) = &self.hint {
-            notes.push(format!("help: {h}"));
+            notes.push(format!("help: {}", super::printable(h)));
         }
         let d = d.with_notes(notes);
         let files = OneLine { shown: self };
@@ -210,6 +222,21 @@ impl Shown {
     }
 }
 
+/// The excerpt line with each control character but tab (a terminal escape in the file) as `?`,
+/// one per byte, so that the byte span of the caret still fits the line.
+fn same_width(line: &str) -> String {
+    line.chars()
+        .flat_map(|c| {
+            let (shown, n) = if c.is_control() && c != '\t' {
+                ('?', c.len_utf8())
+            } else {
+                (c, 1)
+            };
+            std::iter::repeat_n(shown, n)
+        })
+        .collect()
+}
+
 impl Diagnostic {
     /// This diagnostic with `hint` (shown as `help:`).
     pub fn with_hint(mut self, hint: Option<String>) -> Diagnostic {
@@ -230,7 +257,7 @@ impl<'a> Files<'a> for OneLine<'_> {
     type Source = &'a str;
 
     fn name(&'a self, (): ()) -> Result<&'a str, FilesError> {
-        Ok(&self.shown.file)
+        Ok(&self.shown.file_shown)
     }
 
     fn source(&'a self, (): ()) -> Result<&'a str, FilesError> {

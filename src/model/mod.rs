@@ -77,6 +77,19 @@ pub struct Pou {
     pub kind: PouKind,
     /// The POU's rungs, contiguous in [`Program::rungs`].
     pub rungs: Range<u32>,
+    /// `Some` when the POU's body was not read as logic (a PLCopen ST, IL or SFC body): its
+    /// rungs are stand-ins that read and write what the body does, for the analyses, and keep
+    /// every value when run. `run` and `c` refuse such a POU unless told to skip it.
+    pub skipped: Option<Box<SkippedBody>>,
+}
+
+/// A POU body that no command executes (see [`Pou::skipped`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SkippedBody {
+    /// The body's language as the file names it (`ST`, `IL`, `SFC`).
+    pub language: String,
+    /// Line and column (1-based) of the body in the program file.
+    pub position: Option<(u32, u32)>,
 }
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]

@@ -97,6 +97,10 @@ pub struct Report<'a> {
     /// For programs with FBD bodies: the program as written, in blocks and networks.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub fbd: Option<FbdSection<'a>>,
+    /// The POUs whose bodies were not read as logic (PLCopen ST, IL, SFC): the analyses see
+    /// their stand-in rungs, and no command executes them ([`Pou::skipped`]).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub skipped_pous: Vec<SkippedPouEntry<'a>>,
     /// The levels without the lowering's empty landing rungs (what the text report shows).
     #[serde(skip)]
     pub shown_levels: Option<Levels<'a>>,
@@ -296,6 +300,45 @@ pub struct GuardEntry<'a> {
     pub successor: &'a str,
 }
 
+/// A POU whose body is a stand-in (see [`Report::skipped_pous`]).
+#[derive(serde::Serialize)]
+pub struct SkippedPouEntry<'a> {
+    pub pou: &'a str,
+    /// `ST`, `IL`, `SFC`.
+    pub language: &'a str,
+    /// Where the body is in the program file (1-based), when known.
+    pub line: Option<u32>,
+    pub column: Option<u32>,
+}
+
+impl SkippedPouEntry<'_> {
+    /// `CounterST (ST body at 483:11)`.
+    pub fn text(&self) -> String {
+        match (self.line, self.column) {
+            (Some(l), Some(c)) => format!("{} ({} body at {l}:{c})", self.pou, self.language),
+            _ => format!("{} ({} body)", self.pou, self.language),
+        }
+    }
+}
+
+/// What the dependences of a stand-in body are, as the reports say it.
+pub const SKIPPED_MEANING: &str = "analysed through stand-in rungs that read and write whole variables (ST: one per top-level statement; IL, SFC: one for the body, through its interface): its dependences are over-approximated at the grain of whole variables, except the writes of function block instances that warning W0501 names, which are not seen; `run` and `c` do not execute it (they refuse it without --allow-skipped)";
+
+fn skipped_of(p: &Program) -> Vec<SkippedPouEntry<'_>> {
+    p.pous
+        .iter()
+        .filter_map(|pou| {
+            let s = pou.skipped.as_deref()?;
+            Some(SkippedPouEntry {
+                pou: &pou.name,
+                language: &s.language,
+                line: s.position.map(|p| p.0),
+                column: s.position.map(|p| p.1),
+            })
+        })
+        .collect()
+}
+
 #[derive(serde::Serialize)]
 pub struct LoopEntry<'a> {
     /// The loop's name: its first rung.
@@ -427,6 +470,7 @@ pub fn document_with<'a>(p: &'a Program, a: &'a Analysis, fbd: Option<&'a FbdPar
             .collect(),
         task_sharing: super::configuration::task_shared_entries(p, a),
         fbd: fbd_section,
+        skipped_pous: skipped_of(p),
         shown_levels,
         summary: Summary {
             rungs: p.rungs.len(),

@@ -27,8 +27,25 @@ use std::io::{self, Write};
 /// The largest program the DOT report draws.
 pub const MAX_RUNGS: usize = 2000;
 
+/// `s` as a DOT string: quotes and backslashes escaped, and every control character but the
+/// line feed (which callers turn into `\n`) written as its Rust escape (`\u{1b}`, shown as
+/// text), so that no file text can end the string or reach a terminal raw.
 fn quote(s: &str) -> String {
-    format!("\"{}\"", s.replace('\\', "\\\\").replace('"', "\\\""))
+    let s = s.replace('\\', "\\\\").replace('"', "\\\"");
+    let mut out = String::with_capacity(s.len() + 2);
+    out.push('"');
+    for c in s.chars() {
+        if c.is_control() && c != '\n' {
+            out.extend(c.escape_default().flat_map(|e| {
+                let doubled = if e == '\\' { Some('\\') } else { None };
+                std::iter::once(e).chain(doubled)
+            }));
+        } else {
+            out.push(c);
+        }
+    }
+    out.push('"');
+    out
 }
 
 /// The part of a program the DOT report draws.
@@ -289,4 +306,15 @@ pub fn render_dot(
     }
     out.write_all(b"  legend [shape=note, style=\"\", label=\"flow: black, solid\\lanti: blue, dashed\\loutput: red, dotted\\lcontrol: green, bold\\l\"];\n")?;
     out.write_all(b"}\n")
+}
+
+#[cfg(test)]
+mod quote_tests {
+    #[test]
+    fn quoted_text_keeps_no_control_character() {
+        assert_eq!(
+            super::quote("a\"b\\c\u{1b}d\ne"),
+            "\"a\\\"b\\\\c\\\\u{1b}d\ne\""
+        );
+    }
 }

@@ -97,6 +97,10 @@ pub fn render_json(report: &Report, out: &mut impl Write) -> io::Result<()> {
         key(out, "fbd")?;
         value(out, fbd)?;
     }
+    if !report.skipped_pous.is_empty() {
+        key(out, "skipped_pous")?;
+        value(out, &report.skipped_pous)?;
+    }
     out.write_all(b"\n}\n")
 }
 

@@ -289,6 +289,13 @@ pub fn render_text(r: &Report, o: &TextOptions, out: &mut impl Write) -> io::Res
             differences(r, o, out)?;
         }
     }
+    if !r.skipped_pous.is_empty() {
+        writeln!(out, "\nBodies not read as logic")?;
+        for s in &r.skipped_pous {
+            writeln!(out, "  {}", s.text())?;
+        }
+        writeln!(out, "  each {}", super::document::SKIPPED_MEANING)?;
+    }
     if !r.warnings.is_empty() {
         writeln!(out, "\nWarnings")?;
         for (w, code) in r.warnings.iter().zip(&r.warning_codes) {

@@ -55,18 +55,40 @@ use elements::{Place, Scope};
 use lowering::relocate_jumps;
 use path::At;
 use table::NameTable;
-use util::{check_name, rung_path};
+use util::{check_name, check_printable, rung_path};
 
 type Result<T> = std::result::Result<T, LoadError>;
 
 /// Resolves a program read from `text` (the text gives the line and column of nodes for errors,
 /// computed only when there are errors).
 pub fn resolve(text: &str, syn: &syntax::Program<'_>) -> Result<(Program, Fbd)> {
-    resolve_syntax(syn).map_err(|e| e.locate(text))
+    let (mut program, fbd) = resolve_syntax(syn).map_err(|e| e.locate(text))?;
+    mark_skipped(&mut program, &fbd, &syn.skipped, text);
+    Ok((program, fbd))
+}
+
+/// Marks each POU whose body was `skipped` (by its own name, or its function block type's for
+/// an instance's POU), with the line and column of the body in `text`.
+fn mark_skipped(program: &mut Program, fbd: &Fbd, skipped: &[syntax::SkippedBody], text: &str) {
+    for s in skipped {
+        for (i, pou) in program.pous.iter_mut().enumerate() {
+            let of_type = |inst: &crate::fbd::FbInstance| inst.pou.index() == i && inst.fb == s.pou;
+            if pou.skipped.is_none() && (pou.name == s.pou || fbd.instances.iter().any(of_type)) {
+                pou.skipped = Some(Box::new(SkippedBody {
+                    language: s.language.clone(),
+                    position: s.origin.line_column(text),
+                }));
+            }
+        }
+    }
 }
 
 fn resolve_syntax(syn: &syntax::Program<'_>) -> Result<(Program, Fbd)> {
     let mut b = Builder::default();
+    let name = check_printable("program name", &syn.name, || "program".into(), None);
+    if let Err(e) = name {
+        b.report(e.at(syn.name_origin.or(syn.origin)));
+    }
     for p in &syn.problems {
         b.report(LoadError::invalid(None, &p.at, p.kind.clone()).at(p.origin));
     }
@@ -429,6 +451,7 @@ impl<'a> Builder<'a> {
                 name: pou.name.clone(),
                 kind: pou.kind,
                 rungs: start..end,
+                skipped: None,
             });
             start = end;
         }
@@ -578,6 +601,12 @@ impl<'a> Builder<'a> {
                     let e =
                         LoadError::invalid(rung, &format!("{}{}", path(), p.at), p.kind.clone());
                     errors.push(e.at(p.origin).at(r.origin));
+                    continue;
+                }
+                if let Err(e) =
+                    check_printable("rung id", &r.id.value, || format!("{}.id", path()), None)
+                {
+                    errors.push(e.at(r.id.origin).at(r.origin));
                     continue;
                 }
                 if let Some(first) = ids.get(key.as_ref()).copied().or_else(|| main_id(&key)) {

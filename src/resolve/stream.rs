@@ -158,6 +158,7 @@ impl<'t> Stream<'t> {
             || !empty_body
             || !syn.problems.is_empty()
             || !syn.function_blocks.is_empty()
+            || syn.name.contains(char::is_control)
         {
             return None;
         }
@@ -178,7 +179,8 @@ impl<'a> Builder<'a> {
         let s = self.streamed.as_mut()?;
         let index = s.rungs.len();
         let text = |i: u32| s.rungs[i as usize].id.as_str();
-        if r.problem.is_some() || !s.ids.insert(r.id.as_str(), index as u32, text) {
+        let printable = !r.id.as_str().contains(char::is_control);
+        if r.problem.is_some() || !printable || !s.ids.insert(r.id.as_str(), index as u32, text) {
             return None;
         }
         let id = r.id.value.to_string();

@@ -59,6 +59,21 @@ pub(super) fn check_name(
     }
 }
 
+/// Printable text for a free-form name or id (`what`: `"rung id"`, `"program name"`): no
+/// control character (C0, DEL, C1), which would break the DOT, STL and C written from it and
+/// drive a terminal; else the error at the path `path` renders.
+pub(super) fn check_printable(
+    what: &'static str,
+    text: &str,
+    path: impl FnOnce() -> String,
+    rung: Option<&str>,
+) -> Result<()> {
+    match Invalid::control_char(what, text) {
+        None => Ok(()),
+        Some(kind) => Err(LoadError::invalid(rung, &path(), kind)),
+    }
+}
+
 /// A valid variable name: an identifier, or identifiers joined by `.` (a structure's field
 /// flattened into its own variable, `Motor.Speed`); else the error at the path `path` renders.
 pub(super) fn check_var_name(name: &str, path: impl FnOnce() -> String) -> Result<()> {

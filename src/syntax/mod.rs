@@ -150,6 +150,8 @@ pub struct Program<'a> {
     /// Where the program object starts.
     pub origin: Origin,
     pub name: Text<'a>,
+    /// Where the name is written (none when a reader made it up or does not say).
+    pub name_origin: Origin,
     pub comment: Option<Text<'a>>,
     /// The program-wide variables.
     pub vars: Vec<Var<'a>>,
@@ -161,6 +163,22 @@ pub struct Program<'a> {
     pub configuration: Option<crate::model::Configuration>,
     /// Problems of the program object itself and of its non-rung parts, with absolute paths.
     pub problems: Vec<Problem>,
+    /// The bodies the reader did not read as logic (it wrote stand-in rungs for them), by the
+    /// name of their POU (a program, or a function block type), in file order.
+    pub skipped: Vec<SkippedBody>,
+}
+
+/// A POU body a reader could not read as executable logic (PLCopen ST, IL, SFC): it stands in
+/// the program as rungs that read and write what the body does (the analyses see them), but
+/// nothing executes it ([`crate::model::Pou::skipped`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SkippedBody {
+    /// The POU's name (a program's, or a function block type's).
+    pub pou: String,
+    /// `ST`, `IL`, `SFC`.
+    pub language: String,
+    /// Where the body starts.
+    pub origin: Origin,
 }
 
 /// A POU's body: ladder rungs or an FBD body.

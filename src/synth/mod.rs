@@ -94,7 +94,8 @@
 //! INT arithmetic is not bounded: over many scans accumulators may wrap (16-bit INT), so an
 //! interpreter should use wrapping arithmetic.
 //!
-//! `rungs = 0` is refused (a program has at least one rung), as are `for_body = 0` and a
+//! `rungs = 0` is refused (a program has at least one rung), as are `rungs` or `for_body` above
+//! [`MAX_RUNGS`] (a program the readers could not read back), `for_body = 0` and a
 //! `hot_fraction` outside `(0, 1]`: `GenConfig::validate` says why, `write_program` returns an
 //! `InvalidInput` error without writing anything, and `plc-deps gen --rungs 0` exits with status 2
 //! and `error: --rungs must be at least 1 (a program has at least one rung)`. The CLI also refuses
@@ -110,6 +111,12 @@ use emit::*;
 use hot::{HotDuty, HotPlan};
 use std::io::{self, Write};
 use subs::SubPlan;
+
+/// The most main rungs [`write_program`] writes: the largest such program (every knob on,
+/// one stage as wide as the program, random reads) is about 500 bytes a rung, under the 2 GiB
+/// the program readers read (`plc-deps` refuses a larger file), so whatever `gen` writes loads
+/// back. Measured: 4,000,000 rungs of that shape (`--width 4000000`) are 1,958,606,542 bytes.
+pub const MAX_RUNGS: usize = 4_000_000;
 
 /// Shape knobs for [`write_program`]; see the module documentation for the exact shape.
 #[derive(Debug, Clone, PartialEq)]
@@ -186,14 +193,21 @@ impl GenConfig {
         }
     }
 
-    /// Checks what [`write_program`] needs: `rungs ≥ 1` (a program has at least one rung),
-    /// `for_body ≥ 1`, and `0 < hot_fraction ≤ 1`. `width` is clamped, never refused.
+    /// Checks what [`write_program`] needs: `1 ≤ rungs ≤` [`MAX_RUNGS`] (a program has at least
+    /// one rung, and one the readers can read back), `1 ≤ for_body ≤` [`MAX_RUNGS`] (a longer
+    /// body fits no program, and rung numbers plus a body length cannot overflow), and
+    /// `0 < hot_fraction ≤ 1`. `width` is clamped, never refused.
     pub fn validate(&self) -> Result<(), ConfigError> {
         if self.rungs == 0 {
             return Err(ConfigError::NoRungs);
         }
-        if self.for_body == Some(0) {
-            return Err(ConfigError::EmptyForBody);
+        if self.rungs > MAX_RUNGS {
+            return Err(ConfigError::TooManyRungs(self.rungs));
+        }
+        match self.for_body {
+            Some(0) => return Err(ConfigError::EmptyForBody),
+            Some(b) if b > MAX_RUNGS => return Err(ConfigError::ForBodyTooLong(b)),
+            _ => {}
         }
         match self.hot_fraction {
             Some(f) if !(f > 0.0 && f <= 1.0) => Err(ConfigError::HotFraction(f)),
@@ -211,6 +225,12 @@ pub enum ConfigError {
     /// `for_body = Some(0)`.
     #[error("for_body must be at least 1")]
     EmptyForBody,
+    /// `rungs > MAX_RUNGS`.
+    #[error("rungs must be at most {MAX_RUNGS}, not {0}")]
+    TooManyRungs(usize),
+    /// `for_body > MAX_RUNGS`.
+    #[error("for_body must be at most {MAX_RUNGS}, not {0}")]
+    ForBodyTooLong(usize),
     /// `hot_fraction` outside `(0, 1]` (or NaN).
     #[error("hot_fraction must be in (0, 1], not {0}")]
     HotFraction(f64),

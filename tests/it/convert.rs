@@ -22,6 +22,11 @@ fn model_of(text: &str) -> Option<String> {
         for r in &mut p.rungs {
             r.origin = plc_deps::diag::Origin::NONE;
         }
+        // Which bodies the XML reader read only as stand-in rungs (ST, IL, SFC) is its own
+        // knowledge: the JSON has the stand-in rungs, not the language they stand for.
+        for pou in &mut p.pous {
+            pou.skipped = None;
+        }
         for n in f.pous.iter_mut().flat_map(|pou| &mut pou.networks) {
             n.origin = plc_deps::diag::Origin::NONE;
             for b in &mut n.blocks {

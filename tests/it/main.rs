@@ -1,9 +1,7 @@
 //! The integration tests, one binary: each module is the tests of one command, reader or
 //! property (one binary links the crate once; 57 binaries linked it 57 times).
-
 mod common;
 mod plcopen_common;
-
 mod analyses;
 mod analysis_props;
 mod c_build;
@@ -27,6 +25,7 @@ mod functions;
 mod gen_shape;
 mod graph_props;
 mod hostile_files;
+mod hostile_names;
 mod html_browser;
 mod html_run;
 mod html_size;

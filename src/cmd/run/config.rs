@@ -65,6 +65,9 @@ pub struct RunConfig {
     /// The program of a PLCopen project to run (`--pou`); `None`: every program instance, in
     /// task order.
     pub program: Option<String>,
+    /// `--allow-skipped`: run a project whose ST, IL or SFC bodies are not executed (the
+    /// report lists them); false: such a project is refused.
+    pub allow_skipped: bool,
     /// Measure the cost of a moved cache line before planning (a few ms; default on), instead
     /// of the built-in default.
     pub calibrate: bool,
@@ -92,6 +95,7 @@ impl RunConfig {
             progress: std::io::stderr().is_terminal(),
             calibrate: true,
             program: None,
+            allow_skipped: false,
         }
     }
 }

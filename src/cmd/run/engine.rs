@@ -32,6 +32,8 @@ const FAULTS_KEPT: usize = 1000;
 #[derive(Clone, Debug)]
 pub struct RunReport {
     pub program: String,
+    /// The POUs whose bodies were not executed (`--allow-skipped`), in POU order.
+    pub skipped: Vec<crate::cmd::skipped::SkippedPou>,
     pub scans: u64,
     pub cycle_ms: u32,
     pub threads: usize,
@@ -368,6 +370,8 @@ pub(super) fn prepare(c: &RunConfig, progress: &Progress) -> Result<Prepared, Cl
         let _phase = progress.phase(&format!("reading {}", c.input.display()));
         load_program_for_run_selecting(&c.input, c.program.as_deref())?
     };
+    let what = Some("run the rest of the project");
+    crate::cmd::skipped::refuse_skipped(&p, &c.input, c.allow_skipped, what)?;
     let mut warnings: Vec<RunWarning> = p
         .pous
         .iter()
@@ -723,6 +727,7 @@ fn report(pr: &Prepared, c: &RunConfig, m: &Machine, pass: Pass, extra: Extra) -
     let rung_id = |r: u32| p.rungs[r as usize].id.clone();
     RunReport {
         program: p.name.clone(),
+        skipped: crate::cmd::skipped::skipped_pous(p),
         instances: p.program_runs(),
         configured_instances: p
             .configuration

@@ -47,6 +47,10 @@ pub fn render_json(r: &RunReport, deterministic: bool) -> String {
         let runs: Vec<_> = r.instances.iter().map(run_entry).collect();
         doc.insert("programs".into(), json!(runs));
     }
+    if !r.skipped.is_empty() {
+        let skipped: Vec<Json> = r.skipped.iter().map(|s| s.json()).collect();
+        doc.insert("skipped_pous".into(), Json::Array(skipped));
+    }
     doc.insert("scans".into(), json!(r.scans));
     doc.insert("cycle_ms".into(), json!(r.cycle_ms));
     doc.insert("threads".into(), json!(r.threads));
@@ -278,6 +282,14 @@ pub fn render_text(r: &RunReport) -> String {
     );
     if let Some(line) = instances_text(r) {
         let _ = writeln!(s, "{line}");
+    }
+    if !r.skipped.is_empty() {
+        let names: Vec<String> = r.skipped.iter().map(|p| p.text()).collect();
+        let _ = writeln!(
+            s,
+            "not executed (--allow-skipped; stand-in rungs keep every value): {}",
+            names.join(", ")
+        );
     }
     if let Some((text, _)) = &r.explain {
         s.push('\n');

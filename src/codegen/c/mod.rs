@@ -95,9 +95,22 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
     let (mut type_files, mut type_decls) = (Vec::new(), String::new());
     for &t in &order {
         let (text, decls) = types::functions(&mut sh, fbd, t, &fbd_of);
+        let ty = &fbd.types[t].name;
+        // A type whose body is not translated (its instances' POUs are skipped) says so.
+        let skipped = fbd.instances.iter().find_map(|i| {
+            let pou = p.pous.get(i.pou.index())?;
+            (i.fb == *ty).then_some(pou.skipped.as_deref()?)
+        });
+        let note = skipped.map_or(String::new(), |s| {
+            format!(
+                "/* NOT EXECUTED: the {} body of function block {} is not translated; its functions run its stand-in rungs, which keep every value (plc-deps c --allow-skipped). */\n",
+                names::comment(&s.language),
+                names::comment(ty)
+            )
+        });
         type_files.push((
-            format!("fb_{}", names::encode_file(&fbd.types[t].name, t)),
-            text,
+            format!("fb_{}", names::encode_file(ty, t)),
+            format!("{note}{text}"),
         ));
         type_decls.push_str(&decls);
     }
@@ -167,10 +180,19 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
             (None, Some(plan)) => ladder_files(p, &sh, i, cfg, per_file, plan, &mut data),
             (None, None) => unreachable!("a POU with a stem is FBD or ladder"),
         };
+        // A body that is not translated (`plc-deps c --allow-skipped`) says so where its
+        // function is declared and defined.
+        let note = pou.skipped.as_deref().map_or(String::new(), |s| {
+            format!(
+                "/* NOT EXECUTED: the {} body of POU {} is not translated; this function runs its stand-in rungs, which keep every value (plc-deps c --allow-skipped). */\n",
+                names::comment(&s.language),
+                names::comment(&pou.name)
+            )
+        });
         files.push(CFile {
             name: format!("{stem}.h"),
             text: format!(
-                "/* POU {} */\nvoid {f}(_plc_state *self, _plc_ctx *ctx);\n{decls}",
+                "/* POU {} */\n{note}void {f}(_plc_state *self, _plc_ctx *ctx);\n{decls}",
                 names::comment(&pou.name)
             ),
         });
@@ -181,7 +203,7 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
             objects.push(format!("{stem}{suffix}"));
             files.push(CFile {
                 name: format!("{stem}{suffix}.c"),
-                text,
+                text: format!("{note}{text}"),
             });
         }
     }

@@ -332,7 +332,10 @@ impl<'a, 'r> Reader<'a, 'r> {
                     what: "the program",
                 },
             }),
-            Some((Scalar::Str(s), _)) => p.name = s,
+            Some((Scalar::Str(s), o)) => {
+                p.name = s;
+                p.name_origin = o;
+            }
             Some((other, o)) => problems.push(Problem {
                 at: "program".into(),
                 origin: o,

@@ -66,8 +66,9 @@ pub fn parse_selected(
     let doc = xml::parse(text)?;
     let ns = xml::project_namespace(&doc).map_err(|e| e.locate(text))?;
     let mut notes = Notes::default();
-    let program =
+    let mut program =
         project::program(xml::Tc6 { ns }, &doc, select, &mut notes).map_err(|e| e.locate(text))?;
+    program.skipped = std::mem::take(&mut notes.skipped);
     Ok((program, notes))
 }
 

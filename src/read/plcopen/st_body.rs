@@ -194,6 +194,11 @@ pub fn rungs(node: Node, pou: &str, scope: &Scope, notes: &mut Notes) -> R<Vec<R
         origin: origin(node),
         message: message(pou, k, &unseen),
     });
+    notes.skipped.push(crate::syntax::SkippedBody {
+        pou: pou.to_owned(),
+        language: "ST".into(),
+        origin: origin(node),
+    });
     Ok(out)
 }
 

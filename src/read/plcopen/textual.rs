@@ -129,5 +129,10 @@ pub fn through_interface(
         origin: at,
         message,
     });
+    notes.skipped.push(crate::syntax::SkippedBody {
+        pou: pou.to_owned(),
+        language: lang.to_owned(),
+        origin: at,
+    });
     rung.into_iter().collect()
 }

@@ -78,6 +78,8 @@ pub struct Notes {
     /// name and the reason, in file order; `run` refuses the project for the first one whose POU
     /// it runs.
     pub no_run: Vec<(String, Note)>,
+    /// The bodies read only as stand-in rungs (ST, IL, SFC), moved into the syntax tree.
+    pub skipped: Vec<crate::syntax::SkippedBody>,
 }
 
 impl Notes {

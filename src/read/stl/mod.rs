@@ -221,6 +221,7 @@ pub fn parse(text: &str) -> Result<syntax::Program<'static>, LoadError> {
                 }
                 main_seen = true;
                 program.name = Cow::Owned(name.to_string());
+                program.name_origin = Origin::at(name_at);
                 program.body = Some(Body::Rungs(rungs));
             }
             _ => {

@@ -62,8 +62,14 @@ pub struct HtmlInput<'r, 'a> {
 }
 
 /// Escapes text for an HTML (and XML) text node or a quoted attribute.
+/// A control character but line feed, tab and carriage return (which XML does not allow, even
+/// as a reference) is written as its Rust escape (`\u{1b}`), as text.
 pub(crate) fn esc(s: &str) -> Cow<'_, str> {
-    if !s.contains(['&', '<', '>', '"', '\'']) {
+    let special = |c: char| {
+        matches!(c, '&' | '<' | '>' | '"' | '\'')
+            || (c.is_control() && !matches!(c, '\n' | '\t' | '\r'))
+    };
+    if !s.contains(special) {
         return Cow::Borrowed(s);
     }
     let mut o = String::with_capacity(s.len() + 8);
@@ -74,6 +80,7 @@ pub(crate) fn esc(s: &str) -> Cow<'_, str> {
             '>' => o.push_str("&gt;"),
             '"' => o.push_str("&quot;"),
             '\'' => o.push_str("&#39;"),
+            c if special(c) => o.extend(c.escape_default()),
             c => o.push(c),
         }
     }
@@ -95,11 +102,28 @@ pub fn render_run_html(
     write_page(input, Some(run), out)
 }
 
+/// The POUs whose bodies were not read as logic, and what that means, when there are any.
+fn write_skipped(out: &mut impl Write, r: &Report) -> io::Result<()> {
+    if r.skipped_pous.is_empty() {
+        return Ok(());
+    }
+    out.write_all(b"<section id=\"skipped\">\n<h2>Bodies not read as logic</h2>\n<ul>\n")?;
+    for s in &r.skipped_pous {
+        writeln!(out, "<li>{}</li>", esc(&s.text()))?;
+    }
+    writeln!(
+        out,
+        "</ul>\n<p>Each is {}.</p>\n</section>",
+        esc(super::document::SKIPPED_MEANING)
+    )
+}
+
 /// The page, with the run section when there is a run.
 fn write_page(input: &HtmlInput, run: Option<&RunFigures>, out: &mut impl Write) -> io::Result<()> {
     let r = input.doc;
     page::write_head(out, r.program, if run.is_some() { "run" } else { "report" })?;
     page::write_summary(out, r)?;
+    write_skipped(out, r)?;
     if let Some(run) = run {
         run::write_run(out, r, run)?;
     }

@@ -149,6 +149,9 @@ fn network(
         Ok(id) => id.to_string(),
         Err(p) => return Err(reported(p, path, |q, k| LoadError::invalid(None, q, k))),
     };
+    if let Some(kind) = Invalid::control_char("network id", &id) {
+        return Err(LoadError::invalid(None, &format!("{path}.id"), kind).at(n.origin));
+    }
     let e = |q: &str, k| LoadError::fbd(&id, None, q, k);
     if let Some(p) = &n.problem {
         return Err(reported(p, path, e));

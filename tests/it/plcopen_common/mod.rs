@@ -181,10 +181,12 @@ pub fn rung(
     )
 }
 
-/// The JSON output of `plc-deps run` of the XML text for `scans` scans (from standard input).
+/// The JSON output of `plc-deps run` of the XML text for `scans` scans (from standard input;
+/// `--allow-skipped`: an ST body runs as its stand-in rungs).
 pub fn run_scans(xml: &str, scans: u32) -> serde_json::Value {
     let n = scans.to_string();
-    json_output(&["run", "-", "--scans", &n, "--format", "json"], xml).0
+    let args = ["run", "-", "--scans", &n, "--format", "json", "--allow-skipped"];
+    json_output(&args, xml).0
 }
 
 /// The JSON output of `plc-deps run` of the XML text (written to the scratch file `tag.xml`),
@@ -201,6 +203,7 @@ pub fn run_inputs(tag: &str, xml: &str, inputs: &str, extra: &[&str]) -> serde_j
         csv.to_str().unwrap(),
         "--format",
         "json",
+        "--allow-skipped",
     ];
     args.extend(extra);
     json_output(&args, "").0
