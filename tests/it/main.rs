@@ -1,7 +1,9 @@
 //! The integration tests, one binary: each module is the tests of one command, reader or
 //! property (one binary links the crate once; 57 binaries linked it 57 times).
+
 mod common;
 mod plcopen_common;
+
 mod analyses;
 mod analysis_props;
 mod c_build;
