@@ -374,6 +374,7 @@ fn pool(threads: usize) -> rayon::ThreadPool {
 const RANDOM_EXEC: ExecConfig = ExecConfig {
     cycle_ms: 10,
     loop_cap: 12,
+    scan_budget: plc_deps::exec::DEFAULT_SCAN_BUDGET,
 };
 
 /// The random programs (24 rungs at most) of seeds `base + seed` for `seed` in `0..count` that
@@ -663,10 +664,12 @@ fn worked_examples_with_their_inputs_under_forced_parallel_plans() {
             ExecConfig {
                 cycle_ms: 1000,
                 loop_cap: 100_000,
+                scan_budget: plc_deps::exec::DEFAULT_SCAN_BUDGET,
             },
             ExecConfig {
                 cycle_ms: 10,
                 loop_cap: 2,
+                scan_budget: plc_deps::exec::DEFAULT_SCAN_BUDGET,
             },
         ] {
             for threads in [2, 4] {
@@ -812,6 +815,7 @@ fn unconditional_backward_jump_refusal_is_a_cfg_edge_and_runs_in_parallel() {
     let exec = ExecConfig {
         cycle_ms: 10,
         loop_cap: 7,
+        scan_budget: plc_deps::exec::DEFAULT_SCAN_BUDGET,
     };
     let mut config = PlanConfig::new(2);
     config.strategy = Strategy::AllParallel;
@@ -856,6 +860,7 @@ fn a_refused_loop_back_followed_by_an_unconditional_jump_runs_in_parallel() {
     let exec = ExecConfig {
         cycle_ms: 10,
         loop_cap: 5,
+        scan_budget: plc_deps::exec::DEFAULT_SCAN_BUDGET,
     };
     let mut stats = Stats::default();
     for kind in [PlanKind::Par, PlanKind::Deps, PlanKind::Exchange] {

@@ -59,6 +59,7 @@ pub(crate) fn program_source(p: &Program, sh: &Shared, extra: &[String], cfg: &C
         }
     }
     s.push_str("void _plc_scan(_plc_state *self, _plc_ctx *ctx) {\n");
+    s.push_str("    ctx->budget_task = 0;\n    ctx->budget_rungs = 0;\n");
     if sh.counters.iter().any(Option::is_some) {
         s.push_str("    memset(self->_ctr, 0, sizeof self->_ctr);\n");
     }
@@ -247,8 +248,10 @@ static double seconds(void) {
 
 static void on_fault(_plc_ctx *ctx, uint32_t rung, int kind) {
     const _plc_program *prog = ctx->user;
+    const char *name = kind == _PLC_DIV_BY_ZERO ? "div-by-zero"
+                       : kind == _PLC_LOOP_CAP ? "loop-cap" : "scan-budget";
     fprintf(stderr, "{\"scan\":%llu,\"rung\":%s,\"kind\":\"%s\"}\n", (unsigned long long)ctx->scan,
-            prog->rung_ids[rung], kind == _PLC_DIV_BY_ZERO ? "div-by-zero" : "loop-cap");
+            prog->rung_ids[rung], name);
 }
 
 /* Splits one CSV line into cells (double quotes as in RFC 4180); returns the count. */
@@ -336,7 +339,7 @@ static int _plc_main(const _plc_program *prog, int argc, char **argv) {
     void *state = malloc(prog->size);
     if (!state) return 2;
     memcpy(state, prog->initial, prog->size);
-    _plc_ctx ctx = {0, 0, prog->loop_cap, on_fault, (void *)prog};
+    _plc_ctx ctx = {0, 0, prog->loop_cap, on_fault, (void *)prog, 0, 0};
     for (unsigned long long k = 0; k < scans; k++) {
         if (k < rows) {
             int n = split(lines[k + 1], cells, MAX_COLS);
