@@ -70,6 +70,8 @@ fn random_programs(
             chunk_rungs: chunk_rungs(&mut rng),
             // Every other program with its rungs of contacts and coils as table rows.
             rows: seed % 2 == 1,
+            // Budgets that the random loops and calls reach now and then (scan-budget faults).
+            scan_budget: 10 + rng.below(300),
         };
         batch.add(text, csv, 40, cfg, format!("{tag}-{seed}"));
     }

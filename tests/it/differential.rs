@@ -57,6 +57,7 @@ struct Stats {
     parallel_phases: u64,
     loop_cap_faults: u64,
     div_faults: u64,
+    budget_faults: u64,
     /// Cases where the run mixed the sequential walk and a levelled plan.
     mixed_runs: u64,
     switches: u64,
@@ -236,6 +237,10 @@ fn check_with(
             .iter()
             .filter(|f| f.kind == FaultKind::DivByZero)
             .count() as u64;
+        stats.budget_faults += faults
+            .iter()
+            .filter(|f| f.kind == FaultKind::ScanBudget)
+            .count() as u64;
     }
     if own_layout {
         // The same run for a driver that does not read the state: the same final state.
@@ -370,11 +375,12 @@ fn pool(threads: usize) -> rayon::ThreadPool {
         .unwrap()
 }
 
-/// The scans of the random-program tests: a loop cap low enough that their loops reach it.
+/// The scans of the random-program tests: a loop cap low enough that their loops reach it,
+/// and a scan budget that their nested loops and calls reach now and then.
 const RANDOM_EXEC: ExecConfig = ExecConfig {
     cycle_ms: 10,
     loop_cap: 12,
-    scan_budget: plc_deps::exec::DEFAULT_SCAN_BUDGET,
+    scan_budget: 200,
 };
 
 /// The random programs (24 rungs at most) of seeds `base + seed` for `seed` in `0..count` that
@@ -406,8 +412,8 @@ fn parallel_scan_equals_sequential_scan_on_random_programs() {
         }
     }
     eprintln!(
-        "{loaded} programs, {} cases ({} with parallel phases, {} parallel phases), faults: {} loop-cap, {} div-by-zero",
-        stats.cases, stats.parallel_cases, stats.parallel_phases, stats.loop_cap_faults, stats.div_faults
+        "{loaded} programs, {} cases ({} with parallel phases, {} parallel phases), faults: {} loop-cap, {} div-by-zero, {} scan-budget",
+        stats.cases, stats.parallel_cases, stats.parallel_phases, stats.loop_cap_faults, stats.div_faults, stats.budget_faults
     );
     assert!(
         loaded >= PROGRAMS * 3 / 4,
@@ -420,7 +426,7 @@ fn parallel_scan_equals_sequential_scan_on_random_programs() {
         stats.cases
     );
     assert!(
-        stats.loop_cap_faults > 0 && stats.div_faults > 0,
+        stats.loop_cap_faults > 0 && stats.div_faults > 0 && stats.budget_faults > 0,
         "faults are exercised"
     );
 }

@@ -864,4 +864,42 @@ mod tests {
         assert_eq!(turn_scans(Some(7), us(1_000), 10, 10_000), 7);
         assert_eq!(turn_scans(Some(5_000), us(1_000), 10, 1_000), 1_000);
     }
+
+    #[test]
+    fn a_turn_keeps_at_most_digests_kept_whatever_its_length() {
+        for scans in [1u64, 4096, 4097, 1_000_000, 1 << 32] {
+            let (mut rec, mut check) = (TurnDigests::default(), TurnDigests::default());
+            rec.start_turn(scans);
+            // Feed the first million scans (or all): the chunks recorded so far stay within
+            // the bound, and a whole turn of `scans` would end at exactly the bound or less.
+            let fed = scans.min(1_000_000);
+            for k in 0..fed {
+                if let Some(c) = rec.fold(u128::from(k) * 7 + 1) {
+                    rec.chunks.push(c);
+                }
+            }
+            assert!(rec.chunks.len() as u64 <= DIGESTS_KEPT, "{scans}");
+            assert_eq!(rec.chunks.len() as u64, fed / rec.per, "{scans}");
+            assert!(scans.div_ceil(rec.per) <= DIGESTS_KEPT, "{scans}");
+            // The same digests check; one changed digest fails its chunk only.
+            check.start_turn(scans);
+            std::mem::swap(&mut check.chunks, &mut rec.chunks);
+            let bad = fed / 2;
+            let mut failed = Vec::new();
+            for k in 0..fed {
+                let d = u128::from(k) * 7 + 1 + u128::from(k == bad);
+                if let Some(c) = check.fold(d) {
+                    if !check.matches(c) {
+                        failed.push(k);
+                    }
+                }
+            }
+            let want: Vec<u64> = if fed / check.per > bad / check.per {
+                vec![(bad / check.per + 1) * check.per - 1]
+            } else {
+                Vec::new()
+            };
+            assert_eq!(failed, want, "{scans}");
+        }
+    }
 }
