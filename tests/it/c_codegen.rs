@@ -184,7 +184,8 @@ fn example_c_has_the_shape_the_paper_prints() {
             "if (_run0_3) {",
             "_15_0 = _plc_sub_i16(self->LVar, 1);",
             "self->WriteValue_17.IVal = _15_0;",
-            "_fb_WriteValue_body(&self->WriteValue_17, self, ctx);",
+            // The call charges the block's two rungs to its task's scan budget (docs/scan.md).
+            "if (_plc_charge(ctx, 19, 2, PLC_SCAN_BUDGET, 14)) _fb_WriteValue_body(&self->WriteValue_17, self, ctx);",
             "self->Written = self->WriteValue_17.OVal;",
             "}",
             "}",
