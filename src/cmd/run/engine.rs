@@ -846,7 +846,7 @@ fn report(pr: &Prepared, c: &RunConfig, m: &Machine, pass: Pass, extra: Extra) -
 
 #[cfg(test)]
 mod tests {
-    use super::turn_scans;
+    use super::{turn_scans, TurnDigests, DIGESTS_KEPT};
     use std::time::Duration;
 
     #[test]
