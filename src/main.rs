@@ -193,6 +193,11 @@ struct RunArgs {
     /// Loop-backs allowed per loop-back rung and scan (the iteration cap).
     #[arg(long, default_value_t = 100_000)]
     loop_cap: u32,
+    /// Rungs each task of a scan (a main-program rung or loop, with what it calls) may
+    /// charge with its calls and loop-backs before they are refused with a scan-budget fault
+    /// (docs/scan.md).
+    #[arg(long, value_name = "N", default_value_t = plc_deps::exec::DEFAULT_SCAN_BUDGET)]
+    scan_budget: u64,
     /// With --mode both, the scans of each mode's turn: the two passes alternate in blocks
     /// of this many scans, so that a change of the machine's speed hits both [default:
     /// about 20 ms of the sequential walk's scans, and at least a 64th of the run].
@@ -228,6 +233,10 @@ struct CArgs {
     /// Loop-backs per loop-back rung and scan.
     #[arg(long, default_value_t = 100_000)]
     loop_cap: u32,
+    /// Rungs each task of a scan may charge with its calls and loop-backs (as `run
+    /// --scan-budget`; the generated C's PLC_SCAN_BUDGET).
+    #[arg(long, value_name = "N", default_value_t = plc_deps::exec::DEFAULT_SCAN_BUDGET)]
+    scan_budget: u64,
     /// Write every rung as C statements, not the rungs of contacts and coils as rows of
     /// tables run by loops specialised by shape (the default; docs/c.md): `cc` takes about
     /// 1 ms of CPU per rung written as statements, minutes at 100,000 rungs.
@@ -417,6 +426,7 @@ impl CArgs {
             config: plc_deps::codegen::c::CConfig {
                 cycle_ms: cmd::run::parse_cycle(&self.cycle)?,
                 loop_cap: self.loop_cap,
+                scan_budget: self.scan_budget,
                 rows: !self.statements,
                 ..Default::default()
             },
@@ -484,6 +494,7 @@ impl RunArgs {
             PlanArg::Exchange => PlanKind::Exchange,
         };
         config.loop_cap = self.loop_cap;
+        config.scan_budget = self.scan_budget;
         config.output = self.output;
         config.program = self.pou;
         config.allow_skipped = self.allow_skipped;

@@ -17,6 +17,11 @@ use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
 /// Cost of every rung (calls included), before loop multipliers.
+/// The most a rung's cost, a multiplier or a rung's cost times its multiplier is taken to be:
+/// nested loops and calls multiply (100 nested FOR loops of two trips: 2^100), and sums of up
+/// to 2^23 such costs must still fit in a `u64`.
+pub const COST_MAX: u64 = 1 << 40;
+
 pub fn rung_costs(p: &Program) -> Vec<u64> {
     // Callee-first: a POU's total is needed by its callers. POUs have no cycles.
     let mut total: Vec<Option<u64>> = vec![None; p.pous.len()];
@@ -50,13 +55,17 @@ pub fn rung_costs(p: &Program) -> Vec<u64> {
         let t = p
             .pou_rungs(pou)
             .zip(mult)
-            .map(|(r, m)| cost[r.index()] * m)
-            .sum();
+            .map(|(r, m)| cost[r.index()].saturating_mul(m))
+            .fold(0, u64::saturating_add)
+            .min(COST_MAX);
         total[pou.index()] = Some(t);
         t
     }
     for pou in 0..p.pous.len() {
         pou_total(p, PouId(pou as u32), &mut total, &mut cost);
+    }
+    for c in &mut cost {
+        *c = (*c).min(COST_MAX);
     }
     cost
 }
@@ -65,9 +74,10 @@ fn series_cost(series: &[Element], pou_totals: &[u64]) -> u64 {
     series
         .iter()
         .map(|e| match e {
-            Element::Or(bs) | Element::Branch(bs) => {
-                1 + bs.iter().map(|b| series_cost(b, pou_totals)).sum::<u64>()
-            }
+            Element::Or(bs) | Element::Branch(bs) => bs
+                .iter()
+                .map(|b| series_cost(b, pou_totals))
+                .fold(1, u64::saturating_add),
             Element::Move { .. }
             | Element::Arith { .. }
             | Element::Function { .. }
@@ -77,10 +87,10 @@ fn series_cost(series: &[Element], pou_totals: &[u64]) -> u64 {
             | Element::Ctd { .. }
             | Element::Ctud { .. } => 4,
             Element::Bistable { .. } | Element::Trigger { .. } => 2,
-            Element::Call { pou } => 1 + pou_totals[pou.index()],
+            Element::Call { pou } => pou_totals[pou.index()].saturating_add(1),
             _ => 1,
         })
-        .sum()
+        .fold(0, u64::saturating_add)
 }
 
 /// Constant trip count of a FOR head, if its bounds are constants.
@@ -109,7 +119,9 @@ pub fn multipliers(p: &Program, pou: PouId) -> Vec<u64> {
         if let Some(e @ Element::For { next, .. }) = p.rungs[r as usize].series.last() {
             let trips = trip_count(e).unwrap_or(1);
             for b in r + 1..=next.0 {
-                mult[(b - base) as usize] = mult[(b - base) as usize].saturating_mul(trips);
+                mult[(b - base) as usize] = mult[(b - base) as usize]
+                    .saturating_mul(trips)
+                    .min(COST_MAX);
             }
         }
     }

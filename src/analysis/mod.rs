@@ -235,7 +235,7 @@ pub fn analyse_with(p: &Program, config: &AnalysisConfig) -> Analysis {
         for pou in 0..p.pous.len() {
             let pou = PouId(pou as u32);
             for (r, m) in p.pou_rungs(pou).zip(cost::multipliers(p, pou)) {
-                rung_costs[r.index()] = base[r.index()] * m;
+                rung_costs[r.index()] = base[r.index()].saturating_mul(m).min(cost::COST_MAX);
             }
         }
         let task_costs = cost::task_costs(&schedule, &rung_costs);

@@ -155,7 +155,7 @@ impl Machine {
                     reads.push((ctr, 8));
                     writes.push((ctr, 8));
                 }
-                Op::Call { to } => {
+                Op::Call { to, .. } => {
                     if !pous.contains(&to) {
                         pous.push(to);
                     }

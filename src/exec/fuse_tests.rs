@@ -14,6 +14,7 @@ fn compare(p: &Program, scans: u64, seed: u64) -> usize {
     let cfg = ExecConfig {
         cycle_ms: 10,
         loop_cap: 50,
+        scan_budget: crate::exec::DEFAULT_SCAN_BUDGET,
     };
     let fused = Machine::new(p, Layout::dense(p), &cfg).expect("lowers");
     let plain = Machine::new_unfused(p, Layout::dense(p), &cfg).expect("lowers");

@@ -83,6 +83,14 @@
 //!   (control can come back through another loop-back rung) are silent. The rule is local to one
 //!   rung and deterministic, so a parallel scan reproduces it exactly; a scan performs at most
 //!   `loop_cap` × (number of loop-back rungs) loop-backs and never hangs.
+//! - **Scan budget** ([`ExecConfig::scan_budget`], default [`DEFAULT_SCAN_BUDGET`]): a CALL
+//!   charges the callee's rung count, a loop-back (after the cap allowed it) the rungs it goes
+//!   back over, to the *task* of the scan it runs in (a main-program rung, or a main-program
+//!   loop, with all they call; the `budget` module). The charge that takes a task past the
+//!   budget records [`FaultKind::ScanBudget`] and is refused, as is every later charge of the
+//!   task in the scan: a refused CALL does not run the subroutine (the rung goes on with the
+//!   same power), a refused loop-back acts as one the cap refused. Counted per task, it is the
+//!   same whichever worker of a parallel scan runs the task.
 //! - **Faults** are data ([`Fault`]: scan, rung, kind), appended to a caller-owned `Vec` (no
 //!   allocation when there are none, or when its capacity is reused).
 //!
@@ -118,6 +126,7 @@
 #![warn(clippy::undocumented_unsafe_blocks)]
 
 mod access;
+pub(crate) mod budget;
 mod fb;
 pub mod functions;
 mod fuse;
@@ -132,6 +141,7 @@ mod store;
 mod value;
 
 pub use access::Span;
+pub use budget::DEFAULT_SCAN_BUDGET;
 pub use layout::{
     field_offset, parts, type_align, type_size, Layout, LayoutError, Repr, COUNTER_BYTES,
     TIMER_BYTES,
@@ -152,14 +162,18 @@ pub struct ExecConfig {
     pub cycle_ms: u32,
     /// Loop-backs allowed per loop-back rung (a NEXT, or a rung with a backward jump) per scan.
     pub loop_cap: u32,
+    /// Rungs each task of a scan may charge with its calls and loop-backs
+    /// ([`DEFAULT_SCAN_BUDGET`]; see the scan semantics above).
+    pub scan_budget: u64,
 }
 
 impl Default for ExecConfig {
-    /// 10 ms cycle, 100 000 loop-backs per loop-back rung and scan.
+    /// 10 ms cycle, 100 000 loop-backs per loop-back rung and scan, [`DEFAULT_SCAN_BUDGET`].
     fn default() -> Self {
         ExecConfig {
             cycle_ms: 10,
             loop_cap: 100_000,
+            scan_budget: DEFAULT_SCAN_BUDGET,
         }
     }
 }
@@ -192,14 +206,18 @@ pub enum FaultKind {
     DivByZero,
     /// A loop-back rung was refused a loop-back past the iteration cap (the loop was left there).
     LoopCap,
+    /// A call or loop-back would have taken its task of the scan past the scan budget: it was
+    /// refused, and so is every later one of the task in the scan.
+    ScanBudget,
 }
 
 impl FaultKind {
-    /// Short name (`div-by-zero`, `loop-cap`).
+    /// Short name (`div-by-zero`, `loop-cap`, `scan-budget`).
     pub fn name(self) -> &'static str {
         match self {
             FaultKind::DivByZero => "div-by-zero",
             FaultKind::LoopCap => "loop-cap",
+            FaultKind::ScanBudget => "scan-budget",
         }
     }
 }
@@ -237,6 +255,16 @@ pub struct ScanCtx<'f> {
     pub now: i64,
     /// Where faults are appended.
     pub faults: &'f mut Vec<Fault>,
+    /// What the task running now has charged to the scan budget.
+    budget: BudgetSpent,
+}
+
+/// The scan budget a task has spent: the budget task of the last charge (none yet in this
+/// context) and the rungs charged since that task's first charge.
+#[derive(Copy, Clone, Debug, Default)]
+struct BudgetSpent {
+    task: Option<u32>,
+    rungs: u64,
 }
 
 #[derive(Copy, Clone, Debug)]
@@ -260,6 +288,8 @@ pub struct Machine {
     for_of_head: Vec<Option<ForId>>,
     pou_entry: Vec<Pc>,
     counters: Vec<(RungId, Addr)>,
+    /// The budget task of each rung (`budget::tasks`).
+    budget_task: Vec<Option<u32>>,
     size: u32,
     main_first: RungId,
     vars: Vec<VarInfo>,
@@ -311,6 +341,7 @@ impl Machine {
             for_of_head: code.for_of_head,
             pou_entry: code.pou_entry,
             counters: code.counters,
+            budget_task: budget::tasks(program),
             size: code.size,
             vars: program
                 .vars
@@ -452,6 +483,7 @@ impl Machine {
             scan,
             now: (scan as i64).wrapping_mul(self.config.cycle_ms as i64),
             faults,
+            budget: BudgetSpent::default(),
         }
     }
 

@@ -10,7 +10,7 @@ use super::layout::{CV, ET, FLAGS, PREV, PT, PV, Q, START};
 use super::lower::{Num, Op, Width};
 use super::store::{Addr, Word};
 use super::value::{load_value, store_value};
-use super::{Fault, FaultKind, Machine, ScanCtx, Store};
+use super::{BudgetSpent, Fault, FaultKind, Machine, ScanCtx, Store};
 use crate::model::{ArithOp, CmpOp, RungId, TimerKind, Type, Value};
 
 /// How a run of instructions ended.
@@ -415,9 +415,9 @@ impl Machine {
                         pc = to.index();
                     }
                 }
-                Op::JmpBack { to, ctr } => {
+                Op::JmpBack { to, ctr, charge } => {
                     if p != 0 {
-                        if self.loop_back(st, ctx, ctr, rung) {
+                        if self.loop_back(st, ctx, ctr, rung) && self.charge(ctx, rung, charge) {
                             pc = to.index();
                         } else {
                             // Refused: the jump acts as if it had no power.
@@ -435,8 +435,11 @@ impl Machine {
                         return Flow::Stop;
                     }
                 }
-                Op::Call { to } => {
-                    if p != 0 && self.exec(st, ctx, to.index(), rung, &everywhere) != Flow::Return {
+                Op::Call { to, charge } => {
+                    if p != 0
+                        && self.charge(ctx, rung, charge)
+                        && self.exec(st, ctx, to.index(), rung, &everywhere) != Flow::Return
+                    {
                         return Flow::Stop;
                     }
                 }
@@ -456,7 +459,7 @@ impl Machine {
                 }
                 Op::Next { f } => {
                     let l = &self.fors[f.index()];
-                    if !self.loop_back(st, ctx, l.ctr, rung) {
+                    if !(self.loop_back(st, ctx, l.ctr, rung) && self.charge(ctx, rung, l.charge)) {
                         pc = l.exit.index();
                         continue;
                     }
@@ -526,6 +529,41 @@ impl Machine {
                 scan: ctx.scan,
                 rung,
                 kind: FaultKind::LoopCap,
+            });
+        }
+        false
+    }
+}
+
+impl Machine {
+    /// Charges `charge` rungs of the scan budget for a call or a loop-back at `rung`; returns
+    /// whether it may go ahead. A charge at a main-program rung of another budget task than the
+    /// previous charge starts that task's count from zero (`budget`). The charge that takes a
+    /// task past the budget records [`FaultKind::ScanBudget`]; it and every later charge of the
+    /// task in the scan are refused. Out of line: it runs only at calls and loop-backs, and
+    /// `exec`'s loop stays smaller without it.
+    #[inline(never)]
+    fn charge(&self, ctx: &mut ScanCtx<'_>, rung: RungId, charge: u32) -> bool {
+        if let Some(task) = self.budget_task[rung.index()] {
+            if ctx.budget.task != Some(task) {
+                ctx.budget = BudgetSpent {
+                    task: Some(task),
+                    rungs: 0,
+                };
+            }
+        }
+        let before = ctx.budget.rungs;
+        let after = before.saturating_add(charge as u64);
+        ctx.budget.rungs = after;
+        let budget = self.config.scan_budget;
+        if after <= budget {
+            return true;
+        }
+        if before <= budget {
+            ctx.faults.push(Fault {
+                scan: ctx.scan,
+                rung,
+                kind: FaultKind::ScanBudget,
             });
         }
         false

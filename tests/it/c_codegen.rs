@@ -70,6 +70,8 @@ fn random_programs(
             chunk_rungs: chunk_rungs(&mut rng),
             // Every other program with its rungs of contacts and coils as table rows.
             rows: seed % 2 == 1,
+            // Budgets that the random loops and calls reach now and then (scan-budget faults).
+            scan_budget: 10 + rng.below(300),
         };
         batch.add(text, csv, 40, cfg, format!("{tag}-{seed}"));
     }
@@ -182,7 +184,8 @@ fn example_c_has_the_shape_the_paper_prints() {
             "if (_run0_3) {",
             "_15_0 = _plc_sub_i16(self->_v_LVar, 1);",
             "self->_v_WriteValue_17._v_IVal = _15_0;",
-            "_fb_WriteValue_body(&self->_v_WriteValue_17, self, ctx);",
+            // The call charges the block's two rungs to its task's scan budget (docs/scan.md).
+            "if (_plc_charge(ctx, 19, 2, PLC_SCAN_BUDGET, 14)) _fb_WriteValue_body(&self->_v_WriteValue_17, self, ctx);",
             "self->_v_Written = self->_v_WriteValue_17._v_OVal;",
             "}",
             "}",

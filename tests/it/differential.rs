@@ -57,6 +57,7 @@ struct Stats {
     parallel_phases: u64,
     loop_cap_faults: u64,
     div_faults: u64,
+    budget_faults: u64,
     /// Cases where the run mixed the sequential walk and a levelled plan.
     mixed_runs: u64,
     switches: u64,
@@ -236,6 +237,10 @@ fn check_with(
             .iter()
             .filter(|f| f.kind == FaultKind::DivByZero)
             .count() as u64;
+        stats.budget_faults += faults
+            .iter()
+            .filter(|f| f.kind == FaultKind::ScanBudget)
+            .count() as u64;
     }
     if own_layout {
         // The same run for a driver that does not read the state: the same final state.
@@ -370,10 +375,12 @@ fn pool(threads: usize) -> rayon::ThreadPool {
         .unwrap()
 }
 
-/// The scans of the random-program tests: a loop cap low enough that their loops reach it.
+/// The scans of the random-program tests: a loop cap low enough that their loops reach it,
+/// and a scan budget that their nested loops and calls reach now and then.
 const RANDOM_EXEC: ExecConfig = ExecConfig {
     cycle_ms: 10,
     loop_cap: 12,
+    scan_budget: 200,
 };
 
 /// The random programs (24 rungs at most) of seeds `base + seed` for `seed` in `0..count` that
@@ -405,8 +412,8 @@ fn parallel_scan_equals_sequential_scan_on_random_programs() {
         }
     }
     eprintln!(
-        "{loaded} programs, {} cases ({} with parallel phases, {} parallel phases), faults: {} loop-cap, {} div-by-zero",
-        stats.cases, stats.parallel_cases, stats.parallel_phases, stats.loop_cap_faults, stats.div_faults
+        "{loaded} programs, {} cases ({} with parallel phases, {} parallel phases), faults: {} loop-cap, {} div-by-zero, {} scan-budget",
+        stats.cases, stats.parallel_cases, stats.parallel_phases, stats.loop_cap_faults, stats.div_faults, stats.budget_faults
     );
     assert!(
         loaded >= PROGRAMS * 3 / 4,
@@ -419,7 +426,7 @@ fn parallel_scan_equals_sequential_scan_on_random_programs() {
         stats.cases
     );
     assert!(
-        stats.loop_cap_faults > 0 && stats.div_faults > 0,
+        stats.loop_cap_faults > 0 && stats.div_faults > 0 && stats.budget_faults > 0,
         "faults are exercised"
     );
 }
@@ -663,10 +670,12 @@ fn worked_examples_with_their_inputs_under_forced_parallel_plans() {
             ExecConfig {
                 cycle_ms: 1000,
                 loop_cap: 100_000,
+                scan_budget: plc_deps::exec::DEFAULT_SCAN_BUDGET,
             },
             ExecConfig {
                 cycle_ms: 10,
                 loop_cap: 2,
+                scan_budget: plc_deps::exec::DEFAULT_SCAN_BUDGET,
             },
         ] {
             for threads in [2, 4] {
@@ -812,6 +821,7 @@ fn unconditional_backward_jump_refusal_is_a_cfg_edge_and_runs_in_parallel() {
     let exec = ExecConfig {
         cycle_ms: 10,
         loop_cap: 7,
+        scan_budget: plc_deps::exec::DEFAULT_SCAN_BUDGET,
     };
     let mut config = PlanConfig::new(2);
     config.strategy = Strategy::AllParallel;
@@ -856,6 +866,7 @@ fn a_refused_loop_back_followed_by_an_unconditional_jump_runs_in_parallel() {
     let exec = ExecConfig {
         cycle_ms: 10,
         loop_cap: 5,
+        scan_budget: plc_deps::exec::DEFAULT_SCAN_BUDGET,
     };
     let mut stats = Stats::default();
     for kind in [PlanKind::Par, PlanKind::Deps, PlanKind::Exchange] {

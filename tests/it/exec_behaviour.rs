@@ -864,6 +864,7 @@ fn loop_cap_ends_an_endless_backward_jump() {
         ExecConfig {
             cycle_ms: 10,
             loop_cap: 1000,
+            scan_budget: plc_deps::exec::DEFAULT_SCAN_BUDGET,
         },
     );
     s.step(&[]);
@@ -908,6 +909,7 @@ fn loop_cap_is_per_rung_and_faults_once_per_rung_and_scan() {
         ExecConfig {
             cycle_ms: 10,
             loop_cap: 10,
+            scan_budget: plc_deps::exec::DEFAULT_SCAN_BUDGET,
         },
     );
     s.step(&[]);
@@ -944,6 +946,7 @@ fn loop_cap_of_a_subroutine_counts_over_all_its_calls() {
         ExecConfig {
             cycle_ms: 10,
             loop_cap: 5,
+            scan_budget: plc_deps::exec::DEFAULT_SCAN_BUDGET,
         },
     );
     s.step(&[]);
@@ -973,6 +976,7 @@ fn loop_cap_ends_an_endless_for_loop() {
         ExecConfig {
             cycle_ms: 10,
             loop_cap: 1000,
+            scan_budget: plc_deps::exec::DEFAULT_SCAN_BUDGET,
         },
     );
     s.step(&[]);

@@ -77,6 +77,7 @@ fn parallel_scan_equals_sequential_scan_on_random_fbd_programs() {
     let exec = ExecConfig {
         cycle_ms: 10,
         loop_cap: 6,
+        scan_budget: plc_deps::exec::DEFAULT_SCAN_BUDGET,
     };
     let (mut loaded, mut parallel, mut cases, mut fragments, mut faults_seen) =
         (0u64, 0u64, 0u64, 0usize, 0usize);

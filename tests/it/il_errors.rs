@@ -99,6 +99,7 @@ fn blocks_subroutines_interrupts_and_the_first_scan_bit() {
         &ExecConfig {
             cycle_ms: 10,
             loop_cap: 10,
+            scan_budget: plc_deps::exec::DEFAULT_SCAN_BUDGET,
         },
     )
     .unwrap();
@@ -135,6 +136,7 @@ fn set_and_reset_of_n_bits_count_on_from_the_address() {
         &ExecConfig {
             cycle_ms: 10,
             loop_cap: 10,
+            scan_budget: plc_deps::exec::DEFAULT_SCAN_BUDGET,
         },
     )
     .unwrap();

@@ -46,6 +46,7 @@ fn truth_table(p: &Program, outs: &[&str]) -> Vec<Vec<bool>> {
         &ExecConfig {
             cycle_ms: 10,
             loop_cap: 10,
+            scan_budget: plc_deps::exec::DEFAULT_SCAN_BUDGET,
         },
     )
     .unwrap();

@@ -39,6 +39,7 @@ fn states(
         &ExecConfig {
             cycle_ms: 1000,
             loop_cap: 100,
+            scan_budget: plc_deps::exec::DEFAULT_SCAN_BUDGET,
         },
     )
     .unwrap();

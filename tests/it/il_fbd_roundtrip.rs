@@ -69,6 +69,7 @@ fn states(p: &Program, names: &[&str], inputs: &[Vec<bool>]) -> Vec<String> {
         &ExecConfig {
             cycle_ms: 10,
             loop_cap: 10,
+            scan_budget: plc_deps::exec::DEFAULT_SCAN_BUDGET,
         },
     )
     .unwrap();

@@ -87,6 +87,7 @@ fn states(p: &Program, names: &[String], inputs: &[Vec<(String, Value)>]) -> Vec
     let exec = ExecConfig {
         cycle_ms: 10,
         loop_cap: 12,
+        scan_budget: plc_deps::exec::DEFAULT_SCAN_BUDGET,
     };
     let m = Machine::new(p, Layout::dense(p), &exec).unwrap();
     let id = |n: &str| {

@@ -63,5 +63,6 @@ mod report_networks;
 mod report_size;
 mod report_warnings;
 mod run_cli;
+mod scan_budget;
 mod schema;
 mod standard_fbs;

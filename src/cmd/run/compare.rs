@@ -54,6 +54,7 @@ pub(super) fn digest(mem: &[u8], canon: &[(Addr, u32)], faults: &[Fault]) -> u12
         let kind = match f.kind {
             FaultKind::DivByZero => 1,
             FaultKind::LoopCap => 2,
+            FaultKind::ScanBudget => 3,
         };
         feed(u64::MAX - i as u64, (f.rung.0 as u64) << 8 | kind);
     }
@@ -147,6 +148,7 @@ mod tests {
             &ExecConfig {
                 cycle_ms: 10,
                 loop_cap: 10,
+                scan_budget: crate::exec::DEFAULT_SCAN_BUDGET,
             },
         )
         .unwrap();
@@ -156,6 +158,7 @@ mod tests {
             &ExecConfig {
                 cycle_ms: 20,
                 loop_cap: 10,
+                scan_budget: crate::exec::DEFAULT_SCAN_BUDGET,
             },
             &PlanConfig::new(1),
         )

@@ -54,6 +54,8 @@ pub struct RunConfig {
     pub plan: PlanKind,
     /// Loop-backs per loop-back rung and scan.
     pub loop_cap: u32,
+    /// Rungs each task of a scan may charge (`--scan-budget`).
+    pub scan_budget: u64,
     /// With both modes, the scans of each one's turn (`--alternate`); `None`: about 20 ms of
     /// the sequential walk's scans, and at least a 64th of the run.
     pub alternate: Option<u64>,
@@ -90,6 +92,7 @@ impl RunConfig {
             explain: false,
             plan: PlanKind::Auto,
             loop_cap: ExecConfig::default().loop_cap,
+            scan_budget: ExecConfig::default().scan_budget,
             alternate: None,
             output: None,
             progress: std::io::stderr().is_terminal(),

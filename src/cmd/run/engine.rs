@@ -110,10 +110,69 @@ impl FaultTally {
 enum Digests {
     /// No other pass to compare with.
     Skip,
-    /// Record them for the pass that follows.
-    Record(Vec<u128>),
-    /// Check them against the pass before's.
-    Check(Vec<u128>),
+    /// Record them for the pass that follows (one turn's).
+    Record(TurnDigests),
+    /// Check them against the pass before's (the same turn's).
+    Check(TurnDigests),
+}
+
+/// The most digests a turn keeps: a turn of more scans folds consecutive scans' digests into
+/// one per chunk of `ceil(turn / DIGESTS_KEPT)` scans, so the memory of a run does not grow
+/// with its scans or its turns (16 bytes × 4096 at most).
+const DIGESTS_KEPT: u64 = 4096;
+
+/// One turn's digests, folded by chunks of `per` consecutive scans (one scan per chunk when the
+/// turn has at most [`DIGESTS_KEPT`] scans: every scan's digest, as before). The sequential pass
+/// records them; the parallel pass, which runs the same turn next, folds its own the same way
+/// and compares chunk by chunk. A chunk that differs gives its last scan as the mismatch: the
+/// replay (`first_difference`) then finds the first scan that differs, which is no later.
+#[derive(Default)]
+struct TurnDigests {
+    /// Scans per chunk in this turn.
+    per: u64,
+    /// The fold of the current chunk's digests, and how many it holds.
+    acc: u128,
+    in_acc: u64,
+    /// Recorded chunks (recording), or the other pass's chunks (checking).
+    chunks: Vec<u128>,
+    /// Checking: the next chunk to compare.
+    next: usize,
+}
+
+impl TurnDigests {
+    /// Starts a turn of `scans` scans (the recorded chunks of the last turn are dropped).
+    fn start_turn(&mut self, scans: u64) {
+        self.per = scans.div_ceil(DIGESTS_KEPT).max(1);
+        self.acc = 0;
+        self.in_acc = 0;
+        self.chunks.clear();
+        self.next = 0;
+    }
+
+    /// Folds one scan's digest in; the chunk's fold when it is complete.
+    fn fold(&mut self, d: u128) -> Option<u128> {
+        // Order-sensitive: an odd multiplier, then the next digest (a chunk of one is `d`).
+        self.acc = self
+            .acc
+            .wrapping_mul(0x9e37_79b9_7f4a_7c15_f39c_c060_5ced_c835)
+            ^ d;
+        self.in_acc += 1;
+        (self.in_acc == self.per).then(|| self.take())
+    }
+
+    /// The fold of the (partial) chunk so far, which starts a new chunk.
+    fn take(&mut self) -> u128 {
+        let acc = self.acc;
+        (self.acc, self.in_acc) = (0, 0);
+        acc
+    }
+
+    /// Checking: whether `chunk` equals the other pass's next chunk.
+    fn matches(&mut self, chunk: u128) -> bool {
+        let ok = self.chunks.get(self.next) == Some(&chunk);
+        self.next += 1;
+        ok
+    }
 }
 
 /// Per-scan bookkeeping shared by both modes.
@@ -188,12 +247,16 @@ impl ScanDriver for Driver<'_> {
         }
         match &mut self.digests {
             Digests::Skip => {}
-            Digests::Record(ds) => ds.push(digest(slots, &self.canon, faults)),
+            Digests::Record(ds) => {
+                if let Some(chunk) = ds.fold(digest(slots, &self.canon, faults)) {
+                    ds.chunks.push(chunk);
+                }
+            }
             Digests::Check(ds) => {
-                if self.first_mismatch.is_none()
-                    && ds.get(scan as usize) != Some(&digest(slots, &self.canon, faults))
-                {
-                    self.first_mismatch = Some(scan);
+                if let Some(chunk) = ds.fold(digest(slots, &self.canon, faults)) {
+                    if !ds.matches(chunk) && self.first_mismatch.is_none() {
+                        self.first_mismatch = Some(scan);
+                    }
                 }
             }
         }
@@ -405,6 +468,7 @@ pub(super) fn prepare(c: &RunConfig, progress: &Progress) -> Result<Prepared, Cl
     let exec = ExecConfig {
         cycle_ms: c.cycle_ms,
         loop_cap: c.loop_cap,
+        scan_budget: c.scan_budget,
     };
     let lower_error =
         |e: crate::exec::LowerError| CliError::Usage(format!("{}: {e}", c.input.display()));
@@ -544,7 +608,7 @@ pub(super) fn execute(
         };
         let bar = progress.bar("seq", scans, "scans");
         let digests = match run_par {
-            Some(_) => Digests::Record(Vec::new()),
+            Some(_) => Digests::Record(TurnDigests::default()),
             None => Digests::Skip,
         };
         (
@@ -565,7 +629,7 @@ pub(super) fn execute(
             _ => None,
         };
         let digests = match seq {
-            Some(_) => Digests::Check(Vec::new()),
+            Some(_) => Digests::Check(TurnDigests::default()),
             None => Digests::Skip,
         };
         let bar = progress.bar("par", scans, "scans");
@@ -581,18 +645,34 @@ pub(super) fn execute(
     };
     let mut at = 0;
     while at < scans {
-        let end = scans.min(at + block);
+        let end = scans.min(at.saturating_add(block));
         if let Some((m, d, st)) = &mut seq {
+            if let Digests::Record(ds) = &mut d.digests {
+                ds.start_turn(end - at);
+            }
             run_sequential(m, st, at..end, d);
-            // The turn's digests move to the parallel pass, which checks them by scan.
+            // The turn's digests move to the parallel pass, which checks them chunk by chunk.
             if let (Digests::Record(ds), Some((_, pd, ..))) = (&mut d.digests, &mut par) {
+                if ds.in_acc > 0 {
+                    let last = ds.take();
+                    ds.chunks.push(last);
+                }
                 if let Digests::Check(check) = &mut pd.digests {
-                    check.append(ds);
+                    check.start_turn(end - at);
+                    std::mem::swap(&mut check.chunks, &mut ds.chunks);
                 }
             }
         }
         if let Some((pm, d, st, run)) = &mut par {
             pm.run_more(pr.pool.as_ref(), st, run, end, d);
+            if let Digests::Check(ds) = &mut d.digests {
+                if ds.in_acc > 0 {
+                    let last = ds.take();
+                    if !ds.matches(last) && d.first_mismatch.is_none() {
+                        d.first_mismatch = Some(end - 1);
+                    }
+                }
+            }
         }
         at = end;
     }
@@ -771,7 +851,7 @@ fn report(pr: &Prepared, c: &RunConfig, m: &Machine, pass: Pass, extra: Extra) -
 
 #[cfg(test)]
 mod tests {
-    use super::turn_scans;
+    use super::{turn_scans, TurnDigests, DIGESTS_KEPT};
     use std::time::Duration;
 
     #[test]
@@ -788,5 +868,43 @@ mod tests {
         // --alternate N is taken as it is, within the run.
         assert_eq!(turn_scans(Some(7), us(1_000), 10, 10_000), 7);
         assert_eq!(turn_scans(Some(5_000), us(1_000), 10, 1_000), 1_000);
+    }
+
+    #[test]
+    fn a_turn_keeps_at_most_digests_kept_whatever_its_length() {
+        for scans in [1u64, 4096, 4097, 1_000_000, 1 << 32] {
+            let (mut rec, mut check) = (TurnDigests::default(), TurnDigests::default());
+            rec.start_turn(scans);
+            // Feed the first million scans (or all): the chunks recorded so far stay within
+            // the bound, and a whole turn of `scans` would end at exactly the bound or less.
+            let fed = scans.min(1_000_000);
+            for k in 0..fed {
+                if let Some(c) = rec.fold(u128::from(k) * 7 + 1) {
+                    rec.chunks.push(c);
+                }
+            }
+            assert!(rec.chunks.len() as u64 <= DIGESTS_KEPT, "{scans}");
+            assert_eq!(rec.chunks.len() as u64, fed / rec.per, "{scans}");
+            assert!(scans.div_ceil(rec.per) <= DIGESTS_KEPT, "{scans}");
+            // The same digests check; one changed digest fails its chunk only.
+            check.start_turn(scans);
+            std::mem::swap(&mut check.chunks, &mut rec.chunks);
+            let bad = fed / 2;
+            let mut failed = Vec::new();
+            for k in 0..fed {
+                let d = u128::from(k) * 7 + 1 + u128::from(k == bad);
+                if let Some(c) = check.fold(d) {
+                    if !check.matches(c) {
+                        failed.push(k);
+                    }
+                }
+            }
+            let want: Vec<u64> = if fed / check.per > bad / check.per {
+                vec![(bad / check.per + 1) * check.per - 1]
+            } else {
+                Vec::new()
+            };
+            assert_eq!(failed, want, "{scans}");
+        }
     }
 }

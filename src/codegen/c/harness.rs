@@ -59,6 +59,7 @@ pub(crate) fn program_source(p: &Program, sh: &Shared, extra: &[String], cfg: &C
         }
     }
     s.push_str("void _plc_scan(_plc_state *self, _plc_ctx *ctx) {\n");
+    s.push_str("    ctx->budget_task = 0;\n    ctx->budget_rungs = 0;\n");
     if sh.counters.iter().any(Option::is_some) {
         s.push_str("    memset(self->_ctr, 0, sizeof self->_ctr);\n");
     }
@@ -289,8 +290,10 @@ static double seconds(void) {
 
 static void on_fault(_plc_ctx *ctx, uint32_t rung, int kind) {
     const _plc_program *prog = ctx->user;
+    const char *name = kind == _PLC_DIV_BY_ZERO ? "div-by-zero"
+                       : kind == _PLC_LOOP_CAP ? "loop-cap" : "scan-budget";
     fprintf(stderr, "{\"scan\":%llu,\"rung\":%s,\"kind\":\"%s\"}\n", (unsigned long long)ctx->scan,
-            prog->rung_ids[rung], kind == _PLC_DIV_BY_ZERO ? "div-by-zero" : "loop-cap");
+            prog->rung_ids[rung], name);
 }
 
 /* The inputs text: bytes without the byte-order mark, and `out`, where each cell's value is
@@ -651,7 +654,7 @@ static int _plc_main(const _plc_program *prog, int argc, char **argv) {
     if (argc > 1) scans = strtoull(argv[1], NULL, 10);
     int timing = argc > 2 && !strcmp(argv[2], "--time");
     double spent = 0;
-    _plc_ctx ctx = {0, 0, prog->loop_cap, on_fault, (void *)prog};
+    _plc_ctx ctx = {0, 0, prog->loop_cap, on_fault, (void *)prog, 0, 0};
     for (unsigned long long k = 0; k < scans; k++) {
         if (k < nrows)
             for (size_t v = rows[k].first; v < rows[k].first + rows[k].count; v++)

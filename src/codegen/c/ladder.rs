@@ -60,6 +60,8 @@ pub(crate) struct Shared<'a> {
     pub at: Vec<Option<u32>>,
     /// Per rung: its row, if it is written as one (`rows`).
     pub rows: Vec<Option<super::rows::Row>>,
+    /// Per rung: its scan budget task (`crate::exec::budget::tasks`).
+    pub budget_task: Vec<Option<u32>>,
 }
 
 /// The statements of one C function being written.
@@ -171,6 +173,14 @@ impl<'a> Body<'a> {
             Some(c) if r.0 == c.rung0 => "self->_rung0".to_string(),
             Some(c) => format!("self->_rung0 + {}", r.0 - c.rung0),
         }
+    }
+
+    /// The test that charges `charge` rungs of the scan budget at rung `r` (`_plc_charge`;
+    /// task 0 for a subroutine's rung: charged to the task that called it).
+    fn charge(&self, r: RungId, charge: u32) -> String {
+        let task = self.sh.budget_task[r.index()].map_or(0, |t| t + 1);
+        let no = self.rung_no(r);
+        format!("_plc_charge(ctx, {task}, {charge}, PLC_SCAN_BUDGET, {no})")
     }
 
     /// The number of rung `r`'s label (`_L<n>`).
@@ -500,7 +510,9 @@ impl<'a> Body<'a> {
                 if target.0 <= rung.0 {
                     let ctr = self.counter(rung);
                     let no = self.rung_no(rung);
-                    let stmt = format!("if (_plc_loop_back(&{ctr}, ctx, {no})) {goto}");
+                    let charge =
+                        self.charge(rung, crate::exec::budget::jump_back_charge(rung, *target));
+                    let stmt = format!("if (_plc_loop_back(&{ctr}, ctx, {no}) && {charge}) {goto}");
                     self.when(&pw, &stmt);
                 } else {
                     self.when(&pw, &goto);
@@ -523,6 +535,8 @@ impl<'a> Body<'a> {
                     ),
                     None => format!("{}({g}, ctx);", self.sh.pou_fns[pou.index()]),
                 };
+                let charge = self.charge(rung, crate::exec::budget::call_charge(self.sh.p, *pou));
+                let stmt = format!("if ({charge}) {stmt}");
                 self.when(&pw, &stmt);
                 pw
             }
@@ -701,7 +715,10 @@ impl<'a> Body<'a> {
                 let ctr = self.counter(r);
                 let w = num_suffix(self.sh.p.var(*var).ty);
                 let no = self.rung_no(r);
-                self.line(&format!("if (!_plc_loop_back(&{ctr}, ctx, {no})) break;"));
+                let charge = self.charge(r, crate::exec::budget::next_charge(*head, r));
+                self.line(&format!(
+                    "if (!(_plc_loop_back(&{ctr}, ctx, {no}) && {charge})) break;"
+                ));
                 self.line(&format!("{v} = _plc_add_{w}({v}, 1);"));
                 self.indent -= 1;
                 self.line("}");

@@ -223,14 +223,16 @@ pub(crate) enum Op {
     /// Forward jump to the instruction `to` (a `Rung`).
     Jmp { to: Pc },
     /// Backward (or same-rung) jump: a loop-back. Counts one iteration in the rung's loop counter
-    /// at `ctr`; past the cap the jump is refused: it acts as an unpowered jump (power := 0).
-    JmpBack { to: Pc, ctr: Addr },
+    /// at `ctr`, then charges `charge` rungs to the scan budget (`budget`); past the cap or the
+    /// budget the jump is refused: it acts as an unpowered jump (power := 0).
+    JmpBack { to: Pc, ctr: Addr, charge: u32 },
     /// RET.
     Ret,
     /// END.
     End,
-    /// CALL: run the POU whose first instruction is `to`.
-    Call { to: Pc },
+    /// CALL: charge `charge` rungs to the scan budget, then (unless refused) run the POU whose
+    /// first instruction is `to`.
+    Call { to: Pc, charge: u32 },
     /// FOR head (after the head rung's conditions): when powered, `var := from` and on to the
     /// [`Op::ForTest`] that always follows; otherwise to the loop's exit.
     For { f: ForId },
@@ -271,6 +273,8 @@ pub(crate) struct ForLoop {
     pub head: RungId,
     /// The loop counter of the NEXT rung.
     pub ctr: Addr,
+    /// What a loop-back charges to the scan budget (`budget::next_charge`).
+    pub charge: u32,
 }
 
 /// The lowered program.

@@ -163,7 +163,7 @@ pub(crate) fn lower(p: &Program, layout: &Layout, fuse: bool) -> Result<Code, Lo
         }
     }
     for (at, pou) in calls {
-        if let Op::Call { to } = &mut code.ops[at] {
+        if let Op::Call { to, .. } = &mut code.ops[at] {
             *to = code.pou_entry[pou.index()];
         }
     }
@@ -196,7 +196,7 @@ fn check(code: &Code) {
     let pcs = code.rung_op.iter().chain(&code.pou_entry);
     let loops = code.fors.iter().flat_map(|l| [l.test, l.exit]);
     let jumps = code.ops.iter().filter_map(|op| match *op {
-        Op::Jmp { to } | Op::JmpBack { to, .. } | Op::Call { to } => Some(to),
+        Op::Jmp { to } | Op::JmpBack { to, .. } | Op::Call { to, .. } => Some(to),
         _ => None,
     });
     for pc in pcs.copied().chain(loops).chain(jumps) {
@@ -483,7 +483,12 @@ impl Lowerer<'_> {
                 self.jumps.push((self.code.ops.len(), *target));
                 if *target <= rung {
                     let ctr = self.counter(rung);
-                    self.push(Op::JmpBack { to: Pc(0), ctr });
+                    let charge = crate::exec::budget::jump_back_charge(rung, *target);
+                    self.push(Op::JmpBack {
+                        to: Pc(0),
+                        ctr,
+                        charge,
+                    });
                 } else {
                     self.push(Op::Jmp { to: Pc(0) });
                 }
@@ -492,7 +497,8 @@ impl Lowerer<'_> {
             Element::End => self.push(Op::End),
             Element::Call { pou } => {
                 self.calls.push((self.code.ops.len(), *pou));
-                self.push(Op::Call { to: Pc(0) });
+                let charge = crate::exec::budget::call_charge(self.p, *pou);
+                self.push(Op::Call { to: Pc(0), charge });
             }
             Element::For { var, bounds, next } => {
                 let f = ForId(self.code.fors.len() as u32);
@@ -507,6 +513,7 @@ impl Lowerer<'_> {
                     exit: Pc(0),
                     head: rung,
                     ctr: Addr(0),
+                    charge: crate::exec::budget::next_charge(rung, *next),
                 });
                 self.code.for_of_head[rung.index()] = Some(f);
                 self.for_nexts.push((f, *next));

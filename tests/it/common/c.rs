@@ -126,6 +126,7 @@ pub fn run_interpreter(
     let exec = ExecConfig {
         cycle_ms: cfg.cycle_ms,
         loop_cap: cfg.loop_cap,
+        scan_budget: cfg.scan_budget,
     };
     let m = Machine::new(&p, Layout::dense(&p), &exec).unwrap();
     let table = plc_deps::cmd::run::parse_inputs_csv(&p, csv, "inputs.csv").unwrap();
@@ -247,7 +248,7 @@ const HARNESS_SYMBOLS: &[&str] = &[
 ];
 
 /// Macros a program's files define (undefined before the next program's).
-const HARNESS_MACROS: &[&str] = &["PLC_PROGRAM_H"];
+const HARNESS_MACROS: &[&str] = &["PLC_PROGRAM_H", "PLC_SCAN_BUDGET"];
 
 /// Every identifier in `text` that a program defines and others would too.
 fn program_symbols(text: &str, out: &mut std::collections::BTreeSet<String>) {
