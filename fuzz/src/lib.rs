@@ -107,19 +107,23 @@ pub fn program(format: Format, text: &str) {
     pipeline(&p, &fbd);
     // `convert`: the syntax written as JSON loads again.
     let mut out = Vec::new();
-    let written = match format {
-        Format::Json => plc_deps::read::json::parse(text)
-            .map(|s| plc_deps::write::json::program(&s, &mut out)),
-        Format::PlcOpen => plc_deps::read::plcopen::parse(text)
-            .map(|(s, _)| plc_deps::write::json::program(&s, &mut out)),
-        Format::Stl => plc_deps::read::stl::parse(text)
-            .map(|s| plc_deps::write::json::program(&s, &mut out)),
-    }
-    .expect("a text that loads parses again");
+    let written =
+        match format {
+            Format::Json => plc_deps::read::json::parse(text)
+                .map(|s| plc_deps::write::json::program(&s, &mut out)),
+            Format::PlcOpen => plc_deps::read::plcopen::parse(text)
+                .map(|(s, _)| plc_deps::write::json::program(&s, &mut out)),
+            Format::Stl => plc_deps::read::stl::parse(text)
+                .map(|s| plc_deps::write::json::program(&s, &mut out)),
+        }
+        .expect("a text that loads parses again");
     if written.is_ok() {
         let json = String::from_utf8(out).expect("convert writes UTF-8");
         if let Err(e) = plc_deps::load::program_and_fbd_from_json(&json) {
-            panic!("convert's output does not load: {}", e.locate(&json).in_file("converted"));
+            panic!(
+                "convert's output does not load: {}",
+                e.locate(&json).in_file("converted")
+            );
         }
     }
 }
