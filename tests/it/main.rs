@@ -24,6 +24,7 @@ mod fbd_lowering;
 mod fbd_reader_errors;
 mod fbd_types;
 mod functions;
+mod fuzz_readers;
 mod gen_shape;
 mod graph_props;
 mod hostile_files;

@@ -7,7 +7,6 @@
 
 use crate::common;
 
-use plc_deps::read::LoadError;
 use proptest::prelude::*;
 use std::path::PathBuf;
 
@@ -34,7 +33,7 @@ fn fixtures() -> Vec<(String, String)> {
 }
 
 /// Stray markup a mutant may gain: structure, references, entities, numbers.
-const SNIPPETS: &[&str] = &[
+pub(crate) const SNIPPETS: &[&str] = &[
     "<",
     ">",
     "\"",
@@ -156,32 +155,10 @@ fn check(name: &str, text: &str) -> Result<(), TestCaseError> {
                 }
             }
         }
+        // Located as every reader's errors are (the fuzz harness's check).
         Err(e) => {
-            let e = e.locate(text);
-            let shown = e.to_string();
-            prop_assert!(!shown.is_empty(), "{name}: an empty error");
-            let places: Vec<Option<(u32, u32)>> = match &e {
-                LoadError::Syntax { line, column, .. } => {
-                    vec![Some((*line as u32, *column as u32))]
-                }
-                other => other
-                    .diagnostics()
-                    .iter()
-                    .map(|d| d.location.position)
-                    .collect(),
-            };
-            let lines = text.split('\n').count() as u32;
-            for place in places {
-                prop_assert!(
-                    place.is_some(),
-                    "{name}: an error without line and column: {shown}"
-                );
-                let (line, column) = place.unwrap();
-                prop_assert!(
-                    (1..=lines.max(1)).contains(&line) && column >= 1,
-                    "{name}: {line}:{column} is outside the file ({lines} lines): {shown}"
-                );
-            }
+            let located = crate::fuzz_readers::check_load_error(name, text, &e);
+            prop_assert!(located.is_ok(), "{name}: {}", located.unwrap_err());
         }
     }
     Ok(())
