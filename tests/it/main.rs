@@ -25,6 +25,7 @@ mod fbd_reader_errors;
 mod fbd_types;
 mod functions;
 mod fuzz_readers;
+mod fuzz_regressions;
 mod gen_shape;
 mod graph_props;
 mod hostile_files;

@@ -279,7 +279,7 @@ impl Fbd<'_, '_, '_> {
         };
         self.a
             .borrow_mut()
-            .compare(&mut b, &|i: &Input| t.input(i, 0));
+            .compare(&mut b, el.inputs.len(), &|i: &Input| t.input(i, 0));
         if !black_box::is_known(self.ctx, ty) || black_box::mixed_arithmetic(&t, ty, &b) {
             let mut boxes = self.boxes.borrow_mut();
             if let Some((inst, bt)) = black_box::rewrite(&t, e, &mut b, &mut boxes, &here)? {

@@ -127,8 +127,16 @@ impl Added {
     /// 31: `IN1 op IN2 AND IN2 op IN3 …`), it becomes the AND of a new comparison per
     /// neighbouring pair, keeping its id and outputs; EQ and NE of BOOLs (which IEC allows, the
     /// model's comparison does not) become `NOT (a XOR b)` and `a XOR b`. An unconnected input
-    /// is 0, a function input's default (IEC 61131-3 2.5.1.1).
-    pub fn compare(&mut self, b: &mut Block<'static>, ty: &dyn Fn(&Input) -> Option<String>) {
+    /// is 0, a function input's default (IEC 61131-3 2.5.1.1). `declared` is the number of
+    /// input pins the element lists in the file: a pin numbered past it (`IN2147483647`) is no
+    /// unconnected pin of the element, and the block is left as it is, for the resolver to
+    /// refuse its gap, instead of filling every number up to it.
+    pub fn compare(
+        &mut self,
+        b: &mut Block<'static>,
+        declared: usize,
+        ty: &dyn Fn(&Input) -> Option<String>,
+    ) {
         let is_bool = |i: &Input| ty(i).as_deref() == Some("BOOL");
         let op = match &b.op {
             Ok(op) if crate::model::CmpOp::parse(op).is_some() => op.to_string(),
@@ -139,6 +147,9 @@ impl Added {
         };
         let index = |p: &str| p.strip_prefix("IN").and_then(|k| k.parse::<usize>().ok());
         let n = ins.iter().filter_map(|(p, _)| index(p)).max().unwrap_or(0);
+        if n > declared {
+            return;
+        }
         let ins: Vec<Input<'static>> = (1..=n)
             .map(|k| {
                 ins.iter()
