@@ -24,6 +24,7 @@ mod fbd_types;
 mod functions;
 mod gen_shape;
 mod graph_props;
+mod hostile_readers;
 mod html_browser;
 mod html_run;
 mod html_size;

@@ -56,7 +56,7 @@ const LD_TAGS: &[&str] = &[
 /// Reads LD body `node` of POU `pou` into rungs `<pou>.R1`, `<pou>.R2` … in execution order.
 pub fn rungs(tc6: Tc6, node: Node, pou: &str, notes: &mut Notes) -> R<Vec<Rung<'static>>> {
     let place = format!("pou {pou}, LD");
-    let g = graph(tc6, node, &place)?;
+    let g = graph(tc6, node, &place, notes)?;
     g.only(LD_TAGS, "LD", &place)?;
     for el in &g.elems {
         if let Some(x) = el.node.attribute("executionOrderId") {

@@ -237,7 +237,9 @@ impl<'g, 'a, 'i> Power<'g, 'a, 'i> {
         for s in sources {
             paths.push(self.out(s.elem, s.pin)?);
         }
-        let common = (0..)
+        // Bounded by the shortest path: two equal paths agree on every index.
+        let shortest = paths.iter().map(Vec::len).min().unwrap_or(0);
+        let common = (0..shortest)
             .take_while(|&i| {
                 paths
                     .iter()
