@@ -423,7 +423,7 @@ impl Fbd<'_, '_, '_> {
                         ids.push(ids[0].clone());
                         return Err(LoadError::invalid(
                             None,
-                            &self.at(s.elem),
+                            &self.at(cur),
                             Invalid::Cycle {
                                 blocks: ids.join(" → "),
                             },

@@ -11,8 +11,10 @@
 //! is one error naming the localIds. Two branches that are the same series make the `or`
 //! moot and are an error too, rather than a dropped read.
 //!
-//! Invariants: every element's series is computed once ([`Power::out`] memoises it); a loop in
-//! the wiring is an error naming its localIds; nothing is dropped.
+//! Invariants: every element's series is computed once ([`Power::out`] memoises it, but for
+//! the contacts and coils inside a plain series, which only their one consumer reads, walked
+//! in a loop by [`Power::series`]); a loop in the wiring is an error naming its localIds;
+//! nothing is dropped; the recursion goes one call deep per join or block, not per element.
 //!
 //! Deliberately not here: which elements end a rung and in what order rungs run (`super::ld`),
 //! what blocks become (`super::ld_block`).
@@ -115,34 +117,7 @@ impl<'g, 'a, 'i> Power<'g, 'a, 'i> {
         };
         match el.tag {
             "leftPowerRail" => Ok(Vec::new()),
-            "contact" => {
-                let var = self.variable(e)?;
-                let negated = super::xml::flag(node, "negated", &here)?;
-                let edge = match node.attribute("edge") {
-                    None | Some("none") => None,
-                    Some("rising") => Some(Edge::Rising),
-                    Some("falling") => Some(Edge::Falling),
-                    Some(o) => {
-                        return Err(error(origin(node), &here, format!("unknown edge `{o}`")))
-                    }
-                };
-                if negated && edge.is_some() {
-                    return Err(error(
-                        origin(node),
-                        &here,
-                        "a contact both negated and edge-qualified is not supported (Beremiz would ignore the edge)",
-                    ));
-                }
-                let mut p = self.input(e, 0)?;
-                p.push(item(ElementKind::Contact { var, negated, edge }));
-                Ok(p)
-            }
-            "coil" | "outVariable" => {
-                let kind = self.coil(e)?;
-                let mut p = self.input(e, 0)?;
-                p.push(item(kind));
-                Ok(p)
-            }
+            "contact" | "coil" | "outVariable" => self.series(e),
             "inVariable" => {
                 let text = self.expression(e)?;
                 if text.trim().eq_ignore_ascii_case("TRUE") {
@@ -165,6 +140,82 @@ impl<'g, 'a, 'i> Power<'g, 'a, 'i> {
                 format!("a {other} cannot bring power to an element in LD"),
             )),
         }
+    }
+
+    /// The path out of contact or coil `e`: the contacts and coils in series behind it (each
+    /// fed by one connection from the next, and feeding nothing else) are followed in a loop,
+    /// not a call per element, so a rung of 20,000 contacts in series does not go 20,000 calls
+    /// deep; only the path into the first of them is computed by [`Power::input`]. Their
+    /// errors come in the order the recursion would give them (`e`'s first); the ones in
+    /// between are marked as being computed meanwhile, so a loop back to one is the loop error.
+    fn series(&mut self, e: ElemId) -> R<Path> {
+        let mut items = vec![self.own_item(e)?];
+        let mut chain = Vec::new();
+        let mut cur = e;
+        let base = loop {
+            let sources = self
+                .g
+                .get(cur)
+                .inputs
+                .first()
+                .map_or(&[][..], |p| p.sources.as_slice());
+            match sources {
+                [s] if s.pin.is_none()
+                    && matches!(self.g.get(s.elem).tag, "contact" | "coil")
+                    && !self.memo.contains_key(&s.elem)
+                    && !self.visiting[s.elem.0 as usize]
+                    && self.g.consumers[s.elem.0 as usize].len() == 1 =>
+                {
+                    match self.own_item(s.elem) {
+                        Ok(item) => items.push(item),
+                        Err(err) => break Err(err),
+                    }
+                    self.visiting[s.elem.0 as usize] = true;
+                    chain.push(s.elem);
+                    cur = s.elem;
+                }
+                _ => break self.input(cur, 0),
+            }
+        };
+        for c in chain {
+            self.visiting[c.0 as usize] = false;
+        }
+        let mut p = base?;
+        p.extend(items.into_iter().rev());
+        Ok(p)
+    }
+
+    /// Contact or coil `e` as the element of a path (without what feeds it).
+    fn own_item(&self, e: ElemId) -> R<Item> {
+        let node = self.g.get(e).node;
+        let here = self.at(e);
+        let kind = if self.g.get(e).tag == "contact" {
+            let var = self.variable(e)?;
+            let negated = super::xml::flag(node, "negated", &here)?;
+            let edge = match node.attribute("edge") {
+                None | Some("none") => None,
+                Some("rising") => Some(Edge::Rising),
+                Some("falling") => Some(Edge::Falling),
+                Some(o) => return Err(error(origin(node), &here, format!("unknown edge `{o}`"))),
+            };
+            if negated && edge.is_some() {
+                return Err(error(
+                    origin(node),
+                    &here,
+                    "a contact both negated and edge-qualified is not supported (Beremiz would ignore the edge)",
+                ));
+            }
+            ElementKind::Contact { var, negated, edge }
+        } else {
+            self.coil(e)?
+        };
+        Ok(Item {
+            key: Key::Elem(e),
+            element: Element {
+                origin: origin(node),
+                kind,
+            },
+        })
     }
 
     /// The coil (or an out variable fed by power) as an element.
