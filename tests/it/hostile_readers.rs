@@ -590,11 +590,16 @@ fn a_chain_of_twenty_thousand_fbd_blocks_goes_through_every_command_but_il() {
         })
         .collect();
     let contacts = vec!["{\"contact\": \"a\"}"; CHAIN].join(", ");
-    let json = format!(
-        "{{\"program\": \"p\", \"vars\": [{{\"name\": \"a\", \"type\": \"BOOL\", \"class\": \"input\"}}, {{\"name\": \"b\", \"type\": \"BOOL\", \"class\": \"input\"}}, {{\"name\": \"x\", \"type\": \"BOOL\", \"class\": \"output\"}}, {{\"name\": \"y\", \"type\": \"BOOL\", \"class\": \"output\"}}], \"rungs\": [{{\"id\": \"R1\", \"ld\": [{contacts}, {{\"coil\": \"y\"}}]}}], \"fbd\": {{\"networks\": [{{\"id\": \"N1\", \"blocks\": [{}]}}]}}}}",
+    let vars = "\"vars\": [{\"name\": \"a\", \"type\": \"BOOL\", \"class\": \"input\"}, {\"name\": \"b\", \"type\": \"BOOL\", \"class\": \"input\"}, {\"name\": \"x\", \"type\": \"BOOL\", \"class\": \"output\"}]";
+    let fbd = format!(
+        "{{\"program\": \"p\", {vars}, \"fbd\": {{\"networks\": [{{\"id\": \"N1\", \"blocks\": [{}]}}]}}}}",
         blocks.join(", ")
     );
-    every_command_but_succeeds(&file("hostile-chain.json", &json), "chain-json", &["il"]);
+    every_command_but_succeeds(&file("hostile-chain.json", &fbd), "chain-json", &["il"]);
+    let ld = format!(
+        "{{\"program\": \"p\", {vars}, \"rungs\": [{{\"id\": \"R1\", \"ld\": [{contacts}, {{\"coil\": \"x\"}}]}}]}}"
+    );
+    every_command_succeeds(&file("hostile-series.json", &ld), "series-json");
 }
 
 #[test]
