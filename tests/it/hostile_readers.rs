@@ -612,3 +612,48 @@ fn an_ld_rung_of_twenty_thousand_contacts_in_series_goes_through_every_command()
     let text = px::project(&bools(&["a", "x"]), &body);
     every_command_succeeds(&file("hostile-series.xml", &text), "series");
 }
+
+/// An LD body of `stages` stages from the rail: each stage is two contacts `a` and `b` fed by
+/// the stage before, joined into one contact `a` (`nested`: only the `a` side is fed by the
+/// stage before, the `b` side by the rail, so the `or`s nest one in the other).
+fn ld_stages(stages: u32, nested: bool) -> String {
+    let mut body = px::rail(1);
+    let mut prev = 1;
+    for k in 0..stages {
+        let (a, b, j) = (2 + 3 * k, 3 + 3 * k, 4 + 3 * k);
+        body += &px::contact(a, "a", &[prev], "");
+        body += &px::contact(b, "b", &[if nested { 1 } else { prev }], "");
+        body += &px::contact(j, "a", &[a, b], "");
+        prev = j;
+    }
+    body += &px::coil(2 + 3 * stages, "x", &[prev], "");
+    px::project(&bools(&["a", "b", "x"]), &body)
+}
+
+#[test]
+fn ld_wiring_past_the_power_depth_is_an_error_not_a_stack_overflow() {
+    // 100 OR sections in series are read as one rung; 300 pass more joins than the reader
+    // follows, and 5,000 nested ORs too: one error each, at once (the rung reader's, after
+    // the data-flow reading gives up as early).
+    let path = file("hostile-or-100.xml", &ld_stages(100, false));
+    let report = report_json(&path);
+    assert_eq!(reads_of(&report, "P.R1"), ["a", "b"]);
+    for (name, text) in [
+        ("hostile-or-300.xml", ld_stages(300, false)),
+        ("hostile-or-nested.xml", ld_stages(5_000, true)),
+    ] {
+        let path = file(name, &text);
+        let line = error_line(&run_watched(&["report", &path], b""), name);
+        assert!(
+            line.contains("joins or blocks on its way from the left rail (the most plc-deps follows; docs/plcopen.md)"),
+            "{line}"
+        );
+    }
+    // ORs nested past 40 (as deep as the JSON format holds them) are read as a data-flow
+    // network instead, with the reason.
+    let path = file("hostile-or-nested-50.xml", &ld_stages(50, true));
+    let out = run_watched(&["report", &path], b"");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+    assert!(stderr.contains("are nested more than 40 deep (the most the JSON program format holds; docs/plcopen.md)"), "{stderr}");
+}

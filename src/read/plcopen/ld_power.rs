@@ -48,6 +48,32 @@ pub struct Item {
 /// A series from the left rail to an element's output.
 pub type Path = Vec<Item>;
 
+/// The most joins and blocks the power into one element may pass on its way from the rail:
+/// [`Power::out`] recurses once per join or block, and this keeps it well within a thread's
+/// stack (a debug build takes several KiB a level).
+pub const MAX_POWER_DEPTH: usize = 256;
+
+/// The most `or`s a join may be nested in: as deep as the JSON program format holds them
+/// (its 128 levels of JSON), so every later stage walks such a rung and `convert`'s output
+/// loads back.
+pub const MAX_OR_NESTING: usize = 40;
+
+/// How many `or`s deep `kind` nests (0 for an element that is no `or`). Bounded by
+/// [`MAX_OR_NESTING`] for every `or` the reader built, so its recursion is bounded too.
+fn or_nesting(kind: &ElementKind) -> usize {
+    match kind {
+        ElementKind::Or(branches) => {
+            1 + branches
+                .iter()
+                .flatten()
+                .map(|e| or_nesting(&e.kind))
+                .max()
+                .unwrap_or(0)
+        }
+        _ => 0,
+    }
+}
+
 /// The power computation of one body.
 pub struct Power<'g, 'a, 'i> {
     pub g: &'g Graph<'a, 'i>,
@@ -55,6 +81,8 @@ pub struct Power<'g, 'a, 'i> {
     pub place: String,
     memo: HashMap<ElemId, Path>,
     visiting: Vec<bool>,
+    /// Calls of [`Power::out`] open (at most [`MAX_POWER_DEPTH`]).
+    depth: usize,
     /// Series that must run before a box in its rung: each writes the contact network feeding a
     /// data pin of the block into a variable of [`Power::vars`] (`super::ld` places them).
     pub feeds: Vec<(ElemId, Path)>,
@@ -69,6 +97,7 @@ impl<'g, 'a, 'i> Power<'g, 'a, 'i> {
             place,
             memo: HashMap::new(),
             visiting: vec![false; g.elems.len()],
+            depth: 0,
             feeds: Vec::new(),
             vars: Vec::new(),
         }
@@ -96,8 +125,20 @@ impl<'g, 'a, 'i> Power<'g, 'a, 'i> {
                 ),
             ));
         }
+        if self.depth >= MAX_POWER_DEPTH {
+            return Err(error(
+                origin(self.g.get(e).node),
+                &self.at(e),
+                format!(
+                    "the power into localId {} passes more than {MAX_POWER_DEPTH} joins or blocks on its way from the left rail (the most plc-deps follows; docs/plcopen.md)",
+                    self.g.get(e).local_id
+                ),
+            ));
+        }
         self.visiting[e.0 as usize] = true;
+        self.depth += 1;
         let path = self.compute(e, pin);
+        self.depth -= 1;
         self.visiting[e.0 as usize] = false;
         let path = path?;
         self.memo.insert(e, path.clone());
@@ -312,6 +353,22 @@ impl<'g, 'a, 'i> Power<'g, 'a, 'i> {
                 return Err(self.not_sp(e, sources, &format!("the parallel branch through {what} holds an output or a block, which a parallel (OR) branch cannot")));
             }
             branches.push(rest.iter().map(|x| x.element.clone()).collect());
+        }
+        let inner = branches
+            .iter()
+            .flatten()
+            .map(|x| or_nesting(&x.kind))
+            .max()
+            .unwrap_or(0);
+        if inner >= MAX_OR_NESTING {
+            return Err(error(
+                origin(self.g.get(e).node),
+                &self.at(e),
+                format!(
+                    "the parallel (OR) branches into localId {} are nested more than {MAX_OR_NESTING} deep (the most the JSON program format holds; docs/plcopen.md)",
+                    self.g.get(e).local_id
+                ),
+            ));
         }
         let mut keys: Vec<ElemId> = sources.iter().map(|s| s.elem).collect();
         keys.sort_unstable();
