@@ -1,14 +1,14 @@
-//! `plc-deps convert`: any program file the tool reads (a PLCopen TC6 XML export, or the JSON
-//! format itself) written as the JSON program format (docs/format.md), through the surface
+//! `plc-deps convert`: any program file the tool reads (an S7-200 STL listing, a PLCopen TC6
+//! XML export, or the JSON format itself) written as the JSON program format (docs/format.md), through the surface
 //! syntax: what plc-deps understood of the file, in a form to read, diff and edit.
 //!
 //! The file is loaded first (so a file that does not load is refused with its errors, exit 2,
 //! and nothing is written), then read into the syntax and written ([`crate::write::json`]);
 //! the output reads back to the same model.
 
-use super::io::{load_text, read_program_text, write_output_with};
+use super::io::{format_of, load_text, read_program_text, write_output_with, Format};
 use super::CliError;
-use crate::read::plcopen;
+use crate::read::{json, plcopen, stl};
 use std::path::PathBuf;
 
 /// A validated `plc-deps convert` invocation.
@@ -18,20 +18,18 @@ pub struct ConvertConfig {
     pub output: Option<PathBuf>,
 }
 
-/// `plc-deps convert`: the program as the JSON program format.
+/// `plc-deps convert`: the program as the JSON program format. The file's format is recognised
+/// as every command recognises it ([`format_of`]: STL, PLCopen TC6 XML or JSON).
 pub fn convert(c: &ConvertConfig) -> Result<(), CliError> {
     let (file, text) = read_program_text(&c.input)?;
     load_text(file.clone(), &text)?;
-    let load_error = |error| CliError::load(file.clone(), &text, error);
-    if plcopen::looks_like_xml(&text) {
-        let (syntax, _) = plcopen::parse(&text).map_err(load_error)?;
-        write_output_with(c.output.as_deref(), |mut w| {
-            crate::write::json::program(&syntax, &mut w)
-        })
-    } else {
-        let syntax = crate::read::json::parse(&text).map_err(load_error)?;
-        write_output_with(c.output.as_deref(), |mut w| {
-            crate::write::json::program(&syntax, &mut w)
-        })
+    let syntax = match format_of(&file, &text) {
+        Format::Stl => stl::parse(&text),
+        Format::PlcOpen => plcopen::parse(&text).map(|(syntax, _)| syntax),
+        Format::Json => json::parse(&text),
     }
+    .map_err(|error| CliError::load(file.clone(), &text, error))?;
+    write_output_with(c.output.as_deref(), |mut w| {
+        crate::write::json::program(&syntax, &mut w)
+    })
 }

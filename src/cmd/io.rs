@@ -346,15 +346,35 @@ enum Purpose {
     Run,
 }
 
+/// The formats a program file is read in.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum Format {
+    Stl,
+    PlcOpen,
+    Json,
+}
+
+/// The format of program text `text` of file `file`, recognised as [`load_text`] says.
+pub fn format_of(file: &str, text: &str) -> Format {
+    use crate::read::{plcopen, stl};
+    let lower = file.to_ascii_lowercase();
+    if stl::looks_like_stl(text) || lower.ends_with(".stl") || lower.ends_with(".awl") {
+        Format::Stl
+    } else if plcopen::looks_like_xml(text) {
+        Format::PlcOpen
+    } else {
+        Format::Json
+    }
+}
+
 fn load_text_for(
     file: String,
     text: &str,
     purpose: Purpose,
     select: Option<&str>,
 ) -> Result<(Program, Fbd), CliError> {
-    use crate::read::{plcopen, stl};
-    let lower = file.to_ascii_lowercase();
-    if stl::looks_like_stl(text) || lower.ends_with(".stl") || lower.ends_with(".awl") {
+    let format = format_of(&file, text);
+    if format == Format::Stl {
         if let Some(name) = select {
             return Err(CliError::Usage(format!(
                 "{file}: --pou {name} selects a program of a PLCopen project or of a JSON program with a configuration, and this is an STL program (the DOT report's --pou draws one POU of any program: add --format dot)"
@@ -362,7 +382,7 @@ fn load_text_for(
         }
         return crate::load::stl(text).map_err(|error| CliError::load(file, text, error));
     }
-    if plcopen::looks_like_xml(text) {
+    if format == Format::PlcOpen {
         let load = match purpose {
             Purpose::Analyse => crate::load::plcopen_selected,
             Purpose::Run => crate::load::plcopen_for_run_selected,

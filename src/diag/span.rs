@@ -139,7 +139,10 @@ pub fn excerpt(text: &str, span: Range<usize>) -> Excerpt {
     let line = text[start..end]
         .strip_suffix('\r')
         .unwrap_or(&text[start..end]);
-    let (s, e) = (span.start - start, (span.end - start).min(line.len()));
+    // A span may start past the shown line: on the `\r` stripped from its end (or at the end
+    // of a CR-only file, which is one line); it is then shown at the line's end.
+    let s = (span.start - start).min(line.len());
+    let e = (span.end - start).clamp(s, line.len());
     if line.chars().count() <= MAX_SHOWN {
         return Excerpt {
             text: line.to_owned(),
@@ -226,6 +229,25 @@ mod tests {
         assert_eq!(&e.text[e.span.clone()], "\"bad\"");
         assert_eq!(e.text.len(), 3 + CONTEXT + 5 + CONTEXT + 3);
         assert!(e.text.starts_with("...1,") && e.text.ends_with(",2..."));
+    }
+
+    #[test]
+    fn a_span_after_the_trailing_cr_of_a_line_is_shown_at_its_end() {
+        // CR-only line endings (old Mac files): the whole file is one line for the renderer.
+        let long = format!("{{\r{}\r", "\"k\": 1,\r".repeat(30));
+        for at in [long.len() - 1, long.len()] {
+            let e = excerpt(&long, token_at(&long, at));
+            assert_eq!(e.span, e.text.len()..e.text.len());
+            assert_eq!(e.text.len(), 3 + CONTEXT);
+            assert!(
+                e.text.starts_with("...") && e.text.ends_with("1,\r"),
+                "{:?}",
+                e.text
+            );
+        }
+        let short = "{\r\"k\": 1\r";
+        let e = excerpt(short, token_at(short, short.len()));
+        assert_eq!((e.text.as_str(), e.span), ("{\r\"k\": 1", 8..8));
     }
 
     #[test]

@@ -55,7 +55,7 @@ use elements::{Place, Scope};
 use lowering::relocate_jumps;
 use path::At;
 use table::NameTable;
-use util::{check_name, check_printable, rung_path};
+use util::{check_label, check_name, check_printable, rung_path};
 
 type Result<T> = std::result::Result<T, LoadError>;
 
@@ -638,7 +638,7 @@ impl<'a> Builder<'a> {
                 next_id += 1;
                 if let Some(l) = &r.label {
                     let lp = format!("{}.label", path());
-                    if let Err(e) = check_name(l.as_str(), || lp.clone(), Some(&id)) {
+                    if let Err(e) = check_label(l.as_str(), || lp.clone(), Some(&id)) {
                         errors.push(e.at(l.origin));
                     } else if let Some(prev) = labels.insert(l.value.to_string(), rid) {
                         let first = pou_heads

@@ -19,7 +19,7 @@
 use super::elements::edge_var;
 use super::structure::{loop_end, Loops};
 use super::table::{IndexSet, NameTable};
-use super::util::{check_name, FastMap};
+use super::util::{check_label, FastMap};
 use super::Builder;
 use crate::fbd::Fbd;
 use crate::model::*;
@@ -185,7 +185,7 @@ impl<'a> Builder<'a> {
         }
         let id = r.id.value.to_string();
         if let Some(l) = &r.label {
-            check_name(l.as_str(), String::new, None).ok()?;
+            check_label(l.as_str(), String::new, None).ok()?;
             if s.labels
                 .insert(l.value.to_string(), RungId(index as u32))
                 .is_some()

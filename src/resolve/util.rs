@@ -74,6 +74,19 @@ pub(super) fn check_printable(
     }
 }
 
+/// A valid rung label: a name, or a number as S7-200 Micro/WIN numbers its labels (`LBL 4`);
+/// else the error at the path `path` renders (only then).
+pub(super) fn check_label(
+    label: &str,
+    path: impl FnOnce() -> String,
+    rung: Option<&str>,
+) -> Result<()> {
+    if !label.is_empty() && label.bytes().all(|b| b.is_ascii_digit()) {
+        return Ok(());
+    }
+    check_name(label, path, rung)
+}
+
 /// A valid variable name: an identifier, or identifiers joined by `.` (a structure's field
 /// flattened into its own variable, `Motor.Speed`); else the error at the path `path` renders.
 pub(super) fn check_var_name(name: &str, path: impl FnOnce() -> String) -> Result<()> {

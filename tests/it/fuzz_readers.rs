@@ -22,9 +22,8 @@
 //!
 //! Budget: [`CASES`] cases (counted, not timed; `PLC_DEPS_FUZZ_CASES=N` for a longer campaign,
 //! `PLC_DEPS_FUZZ_SEED=S` for other cases; docs/fuzzing.md). The counts per reader and outcome are
-//! printed. Failures already known and being fixed elsewhere are recognised only by their exact
-//! symptom ([`known`]) and counted, not failed; everything else fails the test with the case's
-//! number, seed, mutations and the saved input.
+//! printed. Any failure fails the test with the case's number, seed, mutations and the saved
+//! input (an input worth keeping goes to `tests/fuzz-regressions/`, run by `fuzz_regressions`).
 //!
 //! It does not compile the generated C, and does not judge whether a loaded mutant means what
 //! its author wanted: only that the tool stays well behaved.
@@ -1073,38 +1072,6 @@ struct Failure {
     saved: PathBuf,
 }
 
-/// Whether a failure is one already known and being fixed elsewhere, by its exact symptom: the
-/// name of the known finding.
-fn known(f: &Failure, mutations: &[Mutation], text: &str) -> Option<&'static str> {
-    let m = &f.message;
-    let nested = mutations.iter().any(|m| matches!(m, Mutation::Nest { .. }));
-    match f.kind.as_str() {
-        "panic" if m.contains("src/diag/span.rs") && text.contains('\r') => {
-            Some("span.rs panic on CR-only line endings")
-        }
-        "panic" if m.contains("src/read/stl/net.rs") && m.contains("char boundary") => {
-            Some("STL multibyte mnemonic panic (read/stl/net.rs)")
-        }
-        "crash" if m.contains("has overflowed its stack") && nested && f.reader != "stl" => {
-            Some("deep nesting stack overflow in ST/FBD")
-        }
-        "hang" if f.reader == "plcopen" && m.contains("Some(Load)") => {
-            Some("PLCopen reader hang (duplicate connection in ld_power.rs / FBD EN/ENO cycle in fbd.rs)")
-        }
-        "hang" if m.contains("Some(Scan)") => Some("unbounded scans (nested calls/loops)"),
-        // Found by this harness, reported, not yet fixed (src/cmd/run/inputs.rs): serde_json's
-        // column 0 (an error at the start of a line) is passed on as it is.
-        "fail"
-            if f.reader == "inputs-json"
-                && m.starts_with("Some(Inputs): not located inside the file: inputs.json:")
-                && m.split(':').nth(4) == Some("0") =>
-        {
-            Some("NEW, unfixed: an inputs JSON error at column 0 (cmd/run/inputs.rs)")
-        }
-        _ => None,
-    }
-}
-
 /// Runs cases `0..cases` of base seed `base` in worker processes (restarted after a case that
 /// ends one), and returns the results' lines and the failures whose process died.
 fn run_workers(base: u64, cases: u64, dir: &Path) -> (Vec<String>, Vec<Failure>) {
@@ -1256,20 +1223,15 @@ fn every_reader_survives_mutated_files() {
         }
     }
     let mut new = Vec::new();
-    let mut known_hits: BTreeMap<&str, Vec<u64>> = BTreeMap::new();
     for mut f in failures {
         let case = make_case(&seeds, base, f.case);
         f.reader = case.seed.reader.name().into();
         let saved = dir.join(format!("case-{}.{}", f.case, case.seed.reader.extension()));
         std::fs::write(&saved, &case.text).unwrap();
         f.saved = saved;
-        match known(&f, &case.mutations, &case.text) {
-            Some(k) => known_hits.entry(k).or_default().push(f.case),
-            None => new.push((f, case.seed.name.clone(), case.mutations)),
-        }
+        new.push((f, case.seed.name.clone(), case.mutations));
     }
     let executed: u64 = counts.values().sum::<u64>()
-        + known_hits.values().flatten().count() as u64
         + new.len() as u64
         - counts
             .iter()
@@ -1280,13 +1242,6 @@ fn every_reader_survives_mutated_files() {
         "fuzz_readers: {executed} executions of {cases} cases (seed {base:#x}): {:?}",
         counts
     );
-    for (k, cases) in &known_hits {
-        println!(
-            "fuzz_readers: known, not failed: {k}: {} cases, e.g. {:?}",
-            cases.len(),
-            &cases[..cases.len().min(5)]
-        );
-    }
     let report: Vec<String> = new
         .iter()
         .map(|(f, seed, mutations)| {

@@ -30,6 +30,7 @@ mod gen_shape;
 mod graph_props;
 mod hostile_files;
 mod hostile_names;
+mod hostile_readers;
 mod html_browser;
 mod html_run;
 mod html_size;

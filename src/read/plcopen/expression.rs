@@ -35,15 +35,19 @@ pub fn block_input(a: &mut Added, node: Node, place: &str, at: Origin) -> R<Inpu
         return Ok(simple);
     }
     let text = expression_text(node);
-    let bad = |why: String| {
-        error(
-            origin(node),
-            place,
-            format!("expression `{}`: {why}", text.trim()),
-        )
-    };
+    let shown = shortened(text.trim());
+    let bad = |why: String| error(origin(node), place, format!("expression `{shown}`: {why}"));
     let e = crate::read::st::parser::expression(text).map_err(|e| bad(e.message))?;
     Lower { a, at, bad: &bad }.expr(&e)
+}
+
+/// An expression as an error quotes it: whole up to 60 characters, else its first 60 and `…`
+/// (an expression of 10,000 parentheses is not repeated in its error).
+fn shortened(text: &str) -> Cow<'_, str> {
+    match text.char_indices().nth(60) {
+        Some((i, _)) => Cow::Owned(format!("{}…", &text[..i])),
+        None => Cow::Borrowed(text),
+    }
 }
 
 /// The text of `node`'s `expression` (empty without one).

@@ -25,12 +25,13 @@ use super::black_box::{self, BlackBox, Ctx};
 use super::pins::{add_target, bool_literal, konst, output_negated, pin_modifiers, pin_of, Added};
 use super::wiring::{graph, ElemId, Graph, Source};
 use super::xml::{attr, error, identifier, origin, variable_ref, ExecOrder, Note, Notes, Tc6, R};
-use crate::diag::Origin;
+use crate::diag::{Invalid, LoadError, Origin};
 use crate::syntax::fbd::{Block, Connection, Input, Inputs, Network, OutVar, Outputs, Targets};
 use crate::syntax::{FbdBody, Scalar};
 use roxmltree::Node;
 use std::borrow::Cow;
 use std::cell::RefCell;
+use std::collections::HashMap;
 
 const FBD_TAGS: &[&str] = &[
     "block",
@@ -48,7 +49,7 @@ const FBD_TAGS: &[&str] = &[
 /// Reads FBD body `node` of POU `pou`.
 pub fn body(tc6: Tc6, node: Node, pou: &str, ctx: &Ctx, notes: &mut Notes) -> R<FbdBody<'static>> {
     let place = format!("pou {pou}, FBD");
-    let g = graph(tc6, node, &place)?;
+    let g = graph(tc6, node, &place, notes)?;
     g.only(FBD_TAGS, "FBD", &place)?;
     let mut ordered = Vec::new();
     for el in &g.elems {
@@ -70,6 +71,7 @@ pub fn body(tc6: Tc6, node: Node, pou: &str, ctx: &Ctx, notes: &mut Notes) -> R<
         ctx,
         boxes: RefCell::new(std::mem::take(&mut notes.black_boxes)),
         notes: RefCell::new(Vec::new()),
+        eno_ends: RefCell::new(HashMap::new()),
     };
     let mut networks: Vec<Network<'static>> = Vec::new();
     let mut current: Vec<Block<'static>> = Vec::new();
@@ -180,6 +182,8 @@ struct Fbd<'g, 'a, 'i> {
     /// The project's black boxes so far ([`black_box`]).
     boxes: RefCell<Vec<BlackBox>>,
     notes: RefCell<Vec<Note>>,
+    /// For a block, the block at the end of its chain of ENO → EN wires ([`Fbd::eno`]).
+    eno_ends: RefCell<HashMap<ElemId, ElemId>>,
 }
 
 impl Fbd<'_, '_, '_> {
@@ -381,17 +385,64 @@ impl Fbd<'_, '_, '_> {
         self.notes.borrow_mut().extend(notes);
     }
 
-    /// The ENO of block `e`: what feeds its EN, TRUE without one.
+    /// The ENO of block `e`: what feeds its EN, TRUE without one. An EN fed by another block's
+    /// ENO is that block's ENO: the chain is followed without recursion (a long chain of
+    /// ENO → EN wires is a loop, not a deep call), each block's end of chain is remembered
+    /// (so n blocks cost n steps in all), and a chain that comes back to a block of it is a
+    /// cycle of arcs (E0409) naming the blocks' localIds.
     fn eno(&self, e: ElemId, at: Origin) -> R<Input<'static>> {
-        let el = self.g.get(e);
-        match el
-            .inputs
-            .iter()
-            .find(|p| p.name == Some("EN"))
-            .map(|p| p.sources.as_slice())
-        {
-            Some([s]) => self.input(e, s),
-            _ => Ok(konst(true, at)),
+        let en_source = |b: ElemId| {
+            self.g
+                .get(b)
+                .inputs
+                .iter()
+                .find(|p| p.name == Some("EN"))
+                .and_then(|p| match p.sources.as_slice() {
+                    [s] => Some(s),
+                    _ => None,
+                })
+        };
+        let enos = |s: &Source| self.g.get(s.elem).tag == "block" && s.pin == Some("ENO");
+        let mut chain = vec![e];
+        let mut on_chain = std::collections::HashSet::from([e]);
+        let mut ends = self.eno_ends.borrow_mut();
+        let end = loop {
+            let cur = *chain.last().expect("starts with e");
+            if let Some(&end) = ends.get(&cur) {
+                break end;
+            }
+            match en_source(cur) {
+                Some(s) if enos(s) => {
+                    if !on_chain.insert(s.elem) {
+                        let from = chain.iter().position(|&b| b == s.elem).expect("on it");
+                        let mut ids: Vec<String> = chain[from..]
+                            .iter()
+                            .map(|&b| self.g.get(b).local_id.to_string())
+                            .collect();
+                        ids.reverse();
+                        ids.push(ids[0].clone());
+                        return Err(LoadError::invalid(
+                            None,
+                            &self.at(cur),
+                            Invalid::Cycle {
+                                blocks: ids.join(" → "),
+                            },
+                        )
+                        .at(s.origin)
+                        .with_hint("each block's EN is wired to the ENO of the block before it"));
+                    }
+                    chain.push(s.elem);
+                }
+                _ => break cur,
+            }
+        };
+        for &b in &chain {
+            ends.insert(b, end);
+        }
+        drop(ends);
+        match en_source(end) {
+            Some(s) => self.input(end, s),
+            None => Ok(konst(true, at)),
         }
     }
 

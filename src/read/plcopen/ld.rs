@@ -56,7 +56,7 @@ const LD_TAGS: &[&str] = &[
 /// Reads LD body `node` of POU `pou` into rungs `<pou>.R1`, `<pou>.R2` … in execution order.
 pub fn rungs(tc6: Tc6, node: Node, pou: &str, notes: &mut Notes) -> R<Vec<Rung<'static>>> {
     let place = format!("pou {pou}, LD");
-    let g = graph(tc6, node, &place)?;
+    let g = graph(tc6, node, &place, notes)?;
     g.only(LD_TAGS, "LD", &place)?;
     for el in &g.elems {
         if let Some(x) = el.node.attribute("executionOrderId") {
@@ -218,20 +218,24 @@ fn with_feeds(p: &mut Power, paths: Vec<Path>) -> Vec<Path> {
 
 /// The order [`merge`] evaluates the paths in: those that end first, then each group of paths
 /// with the same next key, groups in the order of their first path.
+/// A loop over a stack of groups, not a call per key: a path of 20,000 elements is 20,000
+/// steps, not 20,000 nested calls.
 fn merged_order(paths: &[Path], idx: Vec<usize>, depth: usize, out: &mut Vec<usize>) {
-    let (ended, rest): (Vec<usize>, Vec<usize>) =
-        idx.into_iter().partition(|&i| paths[i].len() <= depth);
-    out.extend(ended);
-    let mut groups: Vec<(&Key, Vec<usize>)> = Vec::new();
-    for i in rest {
-        let k = &paths[i][depth].key;
-        match groups.iter_mut().find(|(g, _)| *g == k) {
-            Some((_, g)) => g.push(i),
-            None => groups.push((k, vec![i])),
+    let mut work = vec![(idx, depth)];
+    while let Some((idx, depth)) = work.pop() {
+        let (ended, rest): (Vec<usize>, Vec<usize>) =
+            idx.into_iter().partition(|&i| paths[i].len() <= depth);
+        out.extend(ended);
+        let mut groups: Vec<(&Key, Vec<usize>)> = Vec::new();
+        for i in rest {
+            let k = &paths[i][depth].key;
+            match groups.iter_mut().find(|(g, _)| *g == k) {
+                Some((_, g)) => g.push(i),
+                None => groups.push((k, vec![i])),
+            }
         }
-    }
-    for (_, g) in groups {
-        merged_order(paths, g, depth + 1, out);
+        // The first group on top: groups are taken in order, each whole before the next.
+        work.extend(groups.into_iter().rev().map(|(_, g)| (g, depth + 1)));
     }
 }
 

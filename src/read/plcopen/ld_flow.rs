@@ -62,7 +62,7 @@ const FLOW_TAGS: &[&str] = &[
 /// Reads LD body `node` of POU `pou` as a data-flow network.
 pub fn body(tc6: Tc6, node: Node, pou: &str, ctx: &Ctx, notes: &mut Notes) -> R<FbdBody<'static>> {
     let place = format!("pou {pou}, LD");
-    let g = graph(tc6, node, &place)?;
+    let g = graph(tc6, node, &place, notes)?;
     g.only(FLOW_TAGS, "LD", &place)?;
     if let Some(i) = g.elems.iter().position(|el| el.tag == "label") {
         let e = ElemId(i as u32);
@@ -82,6 +82,7 @@ pub fn body(tc6: Tc6, node: Node, pou: &str, ctx: &Ctx, notes: &mut Notes) -> R<
         ctx,
         boxes: std::mem::take(&mut notes.black_boxes),
         tracing: HashSet::new(),
+        depth: 0,
     };
     // Networks in the order of their first statement; rungs of blocks only after the others.
     let mut order: Vec<usize> = Vec::new();
@@ -165,6 +166,9 @@ struct Flow<'g, 'a, 'i> {
     boxes: Vec<BlackBox>,
     /// Contacts, coils and ENOs whose power is being followed (`through`).
     tracing: HashSet<ElemId>,
+    /// Calls of [`Flow::value`] open: at most [`super::ld_power::MAX_POWER_DEPTH`], so that a
+    /// long wiring is an error, not a stack overflow.
+    depth: usize,
 }
 
 fn var_input(v: &str, at: Origin) -> Input<'static> {
@@ -212,8 +216,24 @@ impl Flow<'_, '_, '_> {
         Ok(self.pin(e, 0)?.unwrap_or_else(|| konst(false, at)))
     }
 
-    /// What output `s.pin` of element `s.elem` gives.
+    /// What output `s.pin` of element `s.elem` gives (at most
+    /// [`super::ld_power::MAX_POWER_DEPTH`] elements deep).
     fn value(&mut self, s: &Source) -> R<Input<'static>> {
+        let most = super::ld_power::MAX_POWER_DEPTH;
+        if self.depth >= most {
+            return Err(error(
+                s.origin,
+                &self.at(s.elem),
+                format!("the value into this pin passes more than {most} elements on its way from the left rail (the most plc-deps follows; docs/plcopen.md)"),
+            ));
+        }
+        self.depth += 1;
+        let v = self.value_of(s);
+        self.depth -= 1;
+        v
+    }
+
+    fn value_of(&mut self, s: &Source) -> R<Input<'static>> {
         let e = s.elem;
         let el = self.g.get(e);
         let at = s.origin;

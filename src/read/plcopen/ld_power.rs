@@ -11,8 +11,10 @@
 //! is one error naming the localIds. Two branches that are the same series make the `or`
 //! moot and are an error too, rather than a dropped read.
 //!
-//! Invariants: every element's series is computed once ([`Power::out`] memoises it); a loop in
-//! the wiring is an error naming its localIds; nothing is dropped.
+//! Invariants: every element's series is computed once ([`Power::out`] memoises it, but for
+//! the contacts and coils inside a plain series, which only their one consumer reads, walked
+//! in a loop by [`Power::series`]); a loop in the wiring is an error naming its localIds;
+//! nothing is dropped; the recursion goes one call deep per join or block, not per element.
 //!
 //! Deliberately not here: which elements end a rung and in what order rungs run (`super::ld`),
 //! what blocks become (`super::ld_block`).
@@ -46,6 +48,32 @@ pub struct Item {
 /// A series from the left rail to an element's output.
 pub type Path = Vec<Item>;
 
+/// The most joins and blocks the power into one element may pass on its way from the rail:
+/// [`Power::out`] recurses once per join or block, and this keeps it well within a thread's
+/// stack (a debug build takes several KiB a level).
+pub const MAX_POWER_DEPTH: usize = 256;
+
+/// The most `or`s a join may be nested in: as deep as the JSON program format holds them
+/// (its 128 levels of JSON), so every later stage walks such a rung and `convert`'s output
+/// loads back.
+pub const MAX_OR_NESTING: usize = 40;
+
+/// How many `or`s deep `kind` nests (0 for an element that is no `or`). Bounded by
+/// [`MAX_OR_NESTING`] for every `or` the reader built, so its recursion is bounded too.
+fn or_nesting(kind: &ElementKind) -> usize {
+    match kind {
+        ElementKind::Or(branches) => {
+            1 + branches
+                .iter()
+                .flatten()
+                .map(|e| or_nesting(&e.kind))
+                .max()
+                .unwrap_or(0)
+        }
+        _ => 0,
+    }
+}
+
 /// The power computation of one body.
 pub struct Power<'g, 'a, 'i> {
     pub g: &'g Graph<'a, 'i>,
@@ -53,6 +81,8 @@ pub struct Power<'g, 'a, 'i> {
     pub place: String,
     memo: HashMap<ElemId, Path>,
     visiting: Vec<bool>,
+    /// Calls of [`Power::out`] open (at most [`MAX_POWER_DEPTH`]).
+    depth: usize,
     /// Series that must run before a box in its rung: each writes the contact network feeding a
     /// data pin of the block into a variable of [`Power::vars`] (`super::ld` places them).
     pub feeds: Vec<(ElemId, Path)>,
@@ -67,6 +97,7 @@ impl<'g, 'a, 'i> Power<'g, 'a, 'i> {
             place,
             memo: HashMap::new(),
             visiting: vec![false; g.elems.len()],
+            depth: 0,
             feeds: Vec::new(),
             vars: Vec::new(),
         }
@@ -94,8 +125,20 @@ impl<'g, 'a, 'i> Power<'g, 'a, 'i> {
                 ),
             ));
         }
+        if self.depth >= MAX_POWER_DEPTH {
+            return Err(error(
+                origin(self.g.get(e).node),
+                &self.at(e),
+                format!(
+                    "the power into localId {} passes more than {MAX_POWER_DEPTH} joins or blocks on its way from the left rail (the most plc-deps follows; docs/plcopen.md)",
+                    self.g.get(e).local_id
+                ),
+            ));
+        }
         self.visiting[e.0 as usize] = true;
+        self.depth += 1;
         let path = self.compute(e, pin);
+        self.depth -= 1;
         self.visiting[e.0 as usize] = false;
         let path = path?;
         self.memo.insert(e, path.clone());
@@ -115,34 +158,7 @@ impl<'g, 'a, 'i> Power<'g, 'a, 'i> {
         };
         match el.tag {
             "leftPowerRail" => Ok(Vec::new()),
-            "contact" => {
-                let var = self.variable(e)?;
-                let negated = super::xml::flag(node, "negated", &here)?;
-                let edge = match node.attribute("edge") {
-                    None | Some("none") => None,
-                    Some("rising") => Some(Edge::Rising),
-                    Some("falling") => Some(Edge::Falling),
-                    Some(o) => {
-                        return Err(error(origin(node), &here, format!("unknown edge `{o}`")))
-                    }
-                };
-                if negated && edge.is_some() {
-                    return Err(error(
-                        origin(node),
-                        &here,
-                        "a contact both negated and edge-qualified is not supported (Beremiz would ignore the edge)",
-                    ));
-                }
-                let mut p = self.input(e, 0)?;
-                p.push(item(ElementKind::Contact { var, negated, edge }));
-                Ok(p)
-            }
-            "coil" | "outVariable" => {
-                let kind = self.coil(e)?;
-                let mut p = self.input(e, 0)?;
-                p.push(item(kind));
-                Ok(p)
-            }
+            "contact" | "coil" | "outVariable" => self.series(e),
             "inVariable" => {
                 let text = self.expression(e)?;
                 if text.trim().eq_ignore_ascii_case("TRUE") {
@@ -165,6 +181,82 @@ impl<'g, 'a, 'i> Power<'g, 'a, 'i> {
                 format!("a {other} cannot bring power to an element in LD"),
             )),
         }
+    }
+
+    /// The path out of contact or coil `e`: the contacts and coils in series behind it (each
+    /// fed by one connection from the next, and feeding nothing else) are followed in a loop,
+    /// not a call per element, so a rung of 20,000 contacts in series does not go 20,000 calls
+    /// deep; only the path into the first of them is computed by [`Power::input`]. Their
+    /// errors come in the order the recursion would give them (`e`'s first); the ones in
+    /// between are marked as being computed meanwhile, so a loop back to one is the loop error.
+    fn series(&mut self, e: ElemId) -> R<Path> {
+        let mut items = vec![self.own_item(e)?];
+        let mut chain = Vec::new();
+        let mut cur = e;
+        let base = loop {
+            let sources = self
+                .g
+                .get(cur)
+                .inputs
+                .first()
+                .map_or(&[][..], |p| p.sources.as_slice());
+            match sources {
+                [s] if s.pin.is_none()
+                    && matches!(self.g.get(s.elem).tag, "contact" | "coil")
+                    && !self.memo.contains_key(&s.elem)
+                    && !self.visiting[s.elem.0 as usize]
+                    && self.g.consumers[s.elem.0 as usize].len() == 1 =>
+                {
+                    match self.own_item(s.elem) {
+                        Ok(item) => items.push(item),
+                        Err(err) => break Err(err),
+                    }
+                    self.visiting[s.elem.0 as usize] = true;
+                    chain.push(s.elem);
+                    cur = s.elem;
+                }
+                _ => break self.input(cur, 0),
+            }
+        };
+        for c in chain {
+            self.visiting[c.0 as usize] = false;
+        }
+        let mut p = base?;
+        p.extend(items.into_iter().rev());
+        Ok(p)
+    }
+
+    /// Contact or coil `e` as the element of a path (without what feeds it).
+    fn own_item(&self, e: ElemId) -> R<Item> {
+        let node = self.g.get(e).node;
+        let here = self.at(e);
+        let kind = if self.g.get(e).tag == "contact" {
+            let var = self.variable(e)?;
+            let negated = super::xml::flag(node, "negated", &here)?;
+            let edge = match node.attribute("edge") {
+                None | Some("none") => None,
+                Some("rising") => Some(Edge::Rising),
+                Some("falling") => Some(Edge::Falling),
+                Some(o) => return Err(error(origin(node), &here, format!("unknown edge `{o}`"))),
+            };
+            if negated && edge.is_some() {
+                return Err(error(
+                    origin(node),
+                    &here,
+                    "a contact both negated and edge-qualified is not supported (Beremiz would ignore the edge)",
+                ));
+            }
+            ElementKind::Contact { var, negated, edge }
+        } else {
+            self.coil(e)?
+        };
+        Ok(Item {
+            key: Key::Elem(e),
+            element: Element {
+                origin: origin(node),
+                kind,
+            },
+        })
     }
 
     /// The coil (or an out variable fed by power) as an element.
@@ -237,7 +329,9 @@ impl<'g, 'a, 'i> Power<'g, 'a, 'i> {
         for s in sources {
             paths.push(self.out(s.elem, s.pin)?);
         }
-        let common = (0..)
+        // Bounded by the shortest path: two equal paths agree on every index.
+        let shortest = paths.iter().map(Vec::len).min().unwrap_or(0);
+        let common = (0..shortest)
             .take_while(|&i| {
                 paths
                     .iter()
@@ -259,6 +353,22 @@ impl<'g, 'a, 'i> Power<'g, 'a, 'i> {
                 return Err(self.not_sp(e, sources, &format!("the parallel branch through {what} holds an output or a block, which a parallel (OR) branch cannot")));
             }
             branches.push(rest.iter().map(|x| x.element.clone()).collect());
+        }
+        let inner = branches
+            .iter()
+            .flatten()
+            .map(|x| or_nesting(&x.kind))
+            .max()
+            .unwrap_or(0);
+        if inner >= MAX_OR_NESTING {
+            return Err(error(
+                origin(self.g.get(e).node),
+                &self.at(e),
+                format!(
+                    "the parallel (OR) branches into localId {} are nested more than {MAX_OR_NESTING} deep (the most the JSON program format holds; docs/plcopen.md)",
+                    self.g.get(e).local_id
+                ),
+            ));
         }
         let mut keys: Vec<ElemId> = sources.iter().map(|s| s.elem).collect();
         keys.sort_unstable();

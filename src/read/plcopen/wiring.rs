@@ -7,14 +7,16 @@
 //! (else one error naming both); a `continuation` is replaced, in every pin that reads it, by
 //! what feeds its `connector` of the same name (exactly one connector per continuation, and
 //! every connector read by a continuation). Several connections into one pin stay several
-//! sources: their OR in LD, an error in FBD (the caller decides). Elements keep file order.
+//! sources: their OR in LD, an error in FBD (the caller decides); the same producer pin listed
+//! twice in one pin (directly or through a continuation) is read once, with a note (Beremiz
+//! ORs that power with itself, which is that power). Elements keep file order.
 //!
 //! Deliberately not here: what the elements mean (`super::ld`, `super::fbd`).
 
-use super::xml::{attr, error, origin, Tc6, R};
+use super::xml::{attr, error, origin, Note, Notes, Tc6, R};
 use crate::diag::Origin;
 use roxmltree::Node;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 /// Index of an element of a body, in file order.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -115,8 +117,14 @@ impl<'a, 'i> Graph<'a, 'i> {
 /// Elements that are not wired: read by their callers directly (labels, comments).
 const UNWIRED: &[&str] = &["label", "comment", "leftPowerRail"];
 
-/// Reads the elements of `body` (an `LD` or `FBD` node); `place` names the body in errors.
-pub fn graph<'a, 'i>(tc6: Tc6, body: Node<'a, 'i>, place: &str) -> R<Graph<'a, 'i>> {
+/// Reads the elements of `body` (an `LD` or `FBD` node); `place` names the body in errors and
+/// notes.
+pub fn graph<'a, 'i>(
+    tc6: Tc6,
+    body: Node<'a, 'i>,
+    place: &str,
+    notes: &mut Notes,
+) -> R<Graph<'a, 'i>> {
     let doc = body.document();
     let mut elems: Vec<Elem> = Vec::new();
     let mut by_id: HashMap<u32, ElemId> = HashMap::new();
@@ -172,6 +180,7 @@ pub fn graph<'a, 'i>(tc6: Tc6, body: Node<'a, 'i>, place: &str) -> R<Graph<'a, '
     };
     resolve_refs(&mut g, &by_id, place)?;
     splice_continuations(tc6, &mut g, place)?;
+    drop_repeated_sources(&mut g, place, notes);
     let mut consumers = vec![Vec::new(); g.elems.len()];
     for (i, el) in g.elems.iter().enumerate() {
         for (k, pin) in el.inputs.iter().enumerate() {
@@ -237,6 +246,39 @@ fn connections<'a>(tc6: Tc6, cp: Node<'a, '_>, place: &str) -> R<Vec<Source<'a>>
         });
     }
     Ok(out)
+}
+
+/// Keeps the first of several connections of one pin to the same producer pin, with a note at
+/// each one dropped: reading a power or value twice into one pin is reading it once (Beremiz's
+/// `FactorizePaths` makes `A OR A` of it), and the LD join wants distinct branches.
+fn drop_repeated_sources(g: &mut Graph, place: &str, notes: &mut Notes) {
+    let local_ids: Vec<u32> = g.elems.iter().map(|el| el.local_id).collect();
+    for el in &mut g.elems {
+        for pin in &mut el.inputs {
+            if pin.sources.len() < 2 {
+                continue;
+            }
+            let mut seen = HashSet::new();
+            pin.sources.retain(|s| {
+                if seen.insert((s.elem, s.pin)) {
+                    return true;
+                }
+                let what = match pin.name {
+                    Some(p) => format!("input {p} of {} localId {}", el.tag, el.local_id),
+                    None => format!("the input of {} localId {}", el.tag, el.local_id),
+                };
+                let from = match s.pin {
+                    Some(p) => format!("output {p} of localId {}", local_ids[s.elem.0 as usize]),
+                    None => format!("localId {}", local_ids[s.elem.0 as usize]),
+                };
+                notes.push(Note {
+                    origin: s.origin,
+                    message: format!("{place}: {what} is connected to {from} more than once; it is read once (as Beremiz ORs a power with itself)"),
+                });
+                false
+            });
+        }
+    }
 }
 
 fn resolve_refs(g: &mut Graph, by_id: &HashMap<u32, ElemId>, place: &str) -> R<()> {

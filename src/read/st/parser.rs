@@ -7,11 +7,24 @@
 //! as editors do. The first error stops the
 //! parse, at the offset of the token that was not expected.
 //!
+//! Invariant: no tree it returns nests deeper than [`MAX_NESTING`] levels, so that the parser
+//! and every later walk over the tree (accesses, lowering, dropping it) recurse a bounded depth
+//! whatever the text (10,000 parentheses or a chain of 10,000 `+` are an error at the token that
+//! goes past the limit, not a stack overflow).
+//!
 //! Deliberately not here: declarations (`VAR … END_VAR`: a PLCopen file declares them in the
 //! POU's interface), types, and whether a name exists (the caller's).
 
 use super::ast::*;
 use super::lexer::{tokens, LexError, Tok, Token};
+
+/// The deepest nesting an ST body or expression may have. Each statement list inside a
+/// compound statement, each parenthesised expression, argument list or subscript, each unary
+/// operator and each binary operator above its operands (`a + b + c` is two levels) counts one
+/// level; going past it is an error at the token that does (docs/plcopen.md, "ST bodies").
+/// 128 as the JSON format's reader allows (serde_json's recursion limit); it keeps a debug
+/// build's parse within a 2 MiB thread stack (about 12 KiB a level there).
+pub const MAX_NESTING: usize = 128;
 
 /// Parses an ST body into its statements.
 pub fn statements(text: &str) -> Result<Vec<Statement>, LexError> {
@@ -20,6 +33,7 @@ pub fn statements(text: &str) -> Result<Vec<Statement>, LexError> {
         toks,
         i: 0,
         end: text.len(),
+        depth: 0,
     };
     let body = p.list(false)?;
     match p.peek() {
@@ -35,6 +49,7 @@ pub fn expression(text: &str) -> Result<Expr, LexError> {
         toks,
         i: 0,
         end: text.len(),
+        depth: 0,
     };
     let e = p.expr()?;
     match p.peek() {
@@ -47,6 +62,49 @@ struct Parser<'a> {
     toks: Vec<Token<'a>>,
     i: usize,
     end: usize,
+    /// Nesting levels open at the current token (statement lists, expressions, unary
+    /// operators), at most [`MAX_NESTING`].
+    depth: usize,
+}
+
+/// The error of a text nested past [`MAX_NESTING`] levels, at byte `at`.
+fn too_deep(at: usize) -> LexError {
+    LexError {
+        at,
+        message: format!("nested more than {MAX_NESTING} levels deep (parentheses, operators, calls and compound statements each count one; docs/plcopen.md)"),
+    }
+}
+
+/// The height of `e` in levels as [`MAX_NESTING`] counts them (a name or literal is 1). The
+/// parser calls it only on trees it has already bounded, so its recursion is bounded too.
+fn height(e: &Expr) -> usize {
+    let place = |p: &Place| {
+        p.selectors
+            .iter()
+            .filter_map(|s| match s {
+                Selector::Index(ix) => ix.iter().map(height).max(),
+                _ => None,
+            })
+            .max()
+            .map_or(1, |h| h + 1)
+    };
+    match e {
+        Expr::Literal(_) => 1,
+        Expr::Var(p) => place(p),
+        Expr::Unary(_, x) => height(x) + 1,
+        Expr::Binary(_, l, r) => height(l).max(height(r)) + 1,
+        Expr::Call { callee, args } => {
+            args.iter()
+                .map(|a| match a {
+                    Arg::Input { value, .. } => height(value),
+                    Arg::Output { target, .. } => place(target),
+                })
+                .max()
+                .unwrap_or(0)
+                .max(place(callee))
+                + 1
+        }
+    }
 }
 
 type P<T> = Result<T, LexError>;
@@ -144,11 +202,22 @@ impl<'a> Parser<'a> {
             && matches!(self.peek_at(first + 1), Some(Tok::Sym(":" | "," | "..")))
     }
 
+    /// Opens one nesting level at the current token (an error past [`MAX_NESTING`]).
+    fn enter(&mut self) -> P<()> {
+        self.depth += 1;
+        if self.depth > MAX_NESTING {
+            return Err(too_deep(self.at()));
+        }
+        Ok(())
+    }
+
     fn list(&mut self, in_case: bool) -> P<Vec<Statement>> {
+        self.enter()?;
         let mut out = Vec::new();
         while !self.at_close(in_case) {
             out.push(self.statement()?);
         }
+        self.depth -= 1;
         Ok(out)
     }
 
@@ -387,17 +456,30 @@ impl<'a> Parser<'a> {
     }
 
     fn expr(&mut self) -> P<Expr> {
-        self.binary(0)
+        self.enter()?;
+        let e = self.binary(0)?;
+        self.depth -= 1;
+        Ok(e)
     }
 
+    /// Operators of precedence `min` and up. A chain of them builds a tree as tall as the chain
+    /// is long (`a + b + c` is `(a + b) + c`), which the recursion does not see: its height is
+    /// counted and bounded here.
     fn binary(&mut self, min: u8) -> P<Expr> {
         let mut left = self.unary()?;
+        let mut tall: Option<usize> = None;
         while let Some(op) = self.binary_op() {
             if op.precedence() < min {
                 break;
             }
+            let at = self.at();
             self.i += 1;
             let right = self.binary(op.precedence() + 1)?;
+            let h = tall.unwrap_or_else(|| height(&left)).max(height(&right)) + 1;
+            if self.depth + h > MAX_NESTING {
+                return Err(too_deep(at));
+            }
+            tall = Some(h);
             left = Expr::Binary(op, Box::new(left), Box::new(right));
         }
         Ok(left)
@@ -433,16 +515,20 @@ impl<'a> Parser<'a> {
     }
 
     fn unary(&mut self) -> P<Expr> {
-        if self.eat_kw("NOT") {
-            return Ok(Expr::Unary(UnaryOp::Not, Box::new(self.unary()?)));
-        }
-        if self.eat_sym("-") {
-            return Ok(Expr::Unary(UnaryOp::Neg, Box::new(self.unary()?)));
-        }
-        if self.eat_sym("+") {
-            return Ok(Expr::Unary(UnaryOp::Plus, Box::new(self.unary()?)));
-        }
-        self.primary()
+        let op = if self.is_kw("NOT") {
+            UnaryOp::Not
+        } else if self.is_sym("-") {
+            UnaryOp::Neg
+        } else if self.is_sym("+") {
+            UnaryOp::Plus
+        } else {
+            return self.primary();
+        };
+        self.enter()?;
+        self.i += 1;
+        let x = self.unary()?;
+        self.depth -= 1;
+        Ok(Expr::Unary(op, Box::new(x)))
     }
 
     fn primary(&mut self) -> P<Expr> {
@@ -549,6 +635,37 @@ mod tests {
             ["if", "case", "for", "while", "repeat", "call", "assign", "return"]
         );
         assert_eq!(&text[s[1].at..s[1].at + 4], "CASE");
+    }
+
+    #[test]
+    fn nesting_past_the_limit_is_an_error_at_the_token_that_goes_past_it() {
+        let at_limit = |open: &str, close: &str, n: usize| {
+            format!("x := {}a{};", open.repeat(n), close.repeat(n))
+        };
+        // `x := (…(a)…);`: the statement list and the assignment's expression are two levels.
+        assert!(statements(&at_limit("(", ")", MAX_NESTING - 2)).is_ok());
+        let e = statements(&at_limit("(", ")", 10_000)).unwrap_err();
+        assert_eq!(e.at, 5 + MAX_NESTING - 1);
+        assert!(
+            e.message.starts_with("nested more than 128 levels deep"),
+            "{}",
+            e.message
+        );
+        assert!(statements(&at_limit("-", "", MAX_NESTING - 2)).is_ok());
+        let e = statements(&at_limit("-", "", 20_000)).unwrap_err();
+        assert_eq!(e.at, 5 + MAX_NESTING - 2);
+        assert!(statements(&at_limit("NOT ", "", 20_000)).is_err());
+        // A chain of binary operators is as tall as it is long.
+        let chain = |n: usize| format!("x := a{};", " + a".repeat(n));
+        assert!(statements(&chain(MAX_NESTING - 3)).is_ok());
+        let e = statements(&chain(20_000)).unwrap_err();
+        assert_eq!(e.at, 5 + 1 + 4 * (MAX_NESTING - 3) + 1);
+        // Compound statements count one level each.
+        let ifs = |n: usize| format!("{}x := 1;{}", "IF c THEN ".repeat(n), " END_IF;".repeat(n));
+        assert!(statements(&ifs(MAX_NESTING - 2)).is_ok());
+        let e = statements(&ifs(5_000)).unwrap_err();
+        assert_eq!(e.at, 10 * (MAX_NESTING - 1) + 3);
+        assert!(expression(&"(".repeat(10_000)).is_err());
     }
 
     #[test]

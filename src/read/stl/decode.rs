@@ -20,6 +20,27 @@ pub(super) fn name(s: &str, at: usize) -> syntax::Name<'static> {
     }
 }
 
+/// The largest label number Micro/WIN gives (`LBL 0` … `LBL 255`).
+pub(super) const MAX_LABEL: u32 = 255;
+
+/// The label operand of an LBL or JMP: a number `0..=MAX_LABEL`, as Micro/WIN writes labels,
+/// or a name (as `plc-deps il` writes the labels of other formats).
+pub(super) fn label(text: &str, t: super::Tok) -> Result<syntax::Name<'static>, LoadError> {
+    if t.text.bytes().all(|b| b.is_ascii_digit()) {
+        if t.text.parse::<u32>().map_or(true, |n| n > MAX_LABEL) {
+            return Err(error(
+                text,
+                t.at,
+                format!(
+                    "label {} is out of range (S7-200 labels are numbered 0 to {MAX_LABEL})",
+                    t.text
+                ),
+            ));
+        }
+    }
+    Ok(name(t.text, t.at))
+}
+
 pub(super) fn el(kind: ElementKind<'static>, at: usize) -> E {
     Element {
         origin: Origin::at(at),
@@ -301,7 +322,10 @@ pub(super) fn decode(cx: &mut Context, ins: &Ins, empty: bool) -> Result<Op, Loa
                 },
             ))))
         }
-        "JMP" => Op::Out(kind(ElementKind::Jmp(name(arg(cx, ins, 0, 1)?.text, at)))),
+        "JMP" => {
+            let l = label(cx.text, arg(cx, ins, 0, 1)?)?;
+            Op::Out(kind(ElementKind::Jmp(name(&l.value, at))))
+        }
         "CALL" => Op::Out(kind(ElementKind::Call(name(arg(cx, ins, 0, 1)?.text, at)))),
         "END" => Op::Out(kind(ElementKind::End)),
         "MEND" if empty => Op::Alone(kind(ElementKind::End)),

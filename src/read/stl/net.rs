@@ -14,7 +14,8 @@
 //! error). Zhou & Zhang 2015 give the stack shapes; S7-200 system manual, chapter 6.
 
 use super::decode::{
-    contact, counter_aux, decode, edge, el, is_pure, name, negate, or, Op, LEVELS,
+    contact, counter_aux, decode, edge, el, is_pure, label as label_operand, name, negate, or, Op,
+    LEVELS,
 };
 use super::flat::flat;
 use super::operand::Context;
@@ -69,7 +70,7 @@ pub(super) fn rungs(
             let Some(l) = first.args.first() else {
                 return Err(error(cx.text, first.at, "LBL needs a label"));
             };
-            label = Some(Box::new(name(l.text, l.at)));
+            label = Some(Box::new(label_operand(cx.text, *l)?));
             code = &code[1..];
         }
         if let Some(l) = code.iter().find(|i| i.op == "LBL") {
@@ -121,7 +122,13 @@ fn effect(op: &str) -> Option<(usize, usize, usize)> {
         | "SLW" | "SRW" | "RLW" | "RRW" | "SLD" | "SRD" | "RLD" | "RRD" => (1, 0, 0),
         "ANDW" | "ORW" | "XORW" | "INVW" | "ANDD" | "ORD" | "XORD" | "INVD" => (1, 0, 0),
         _ if cmp("A") || cmp("O") => (1, 0, 0),
-        _ if op.len() == 2 && "+-*/".contains(&op[..1]) && "IDR".contains(&op[1..]) => (1, 0, 0),
+        _ if matches!(
+            op.as_bytes(),
+            [b'+' | b'-' | b'*' | b'/', b'I' | b'D' | b'R']
+        ) =>
+        {
+            (1, 0, 0)
+        }
         "ALD" | "OLD" | "CTU" | "CTD" => (2, 1, 0),
         "LPP" => (1, 1, 0),
         "CRET" | "RET" | "CRETI" | "RETI" | "MEND" | "NEXT" | "LBL" => (0, 0, 0),
