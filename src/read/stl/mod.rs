@@ -294,6 +294,15 @@ fn block<'a>(
             let Some(&number) = number.first() else {
                 return Err(error(text, at, "NETWORK needs its number"));
             };
+            // `NETWORK 4` (its title, if any, is the `//` comment): anything else after the
+            // keyword would become the rung's id.
+            if number.text.is_empty() || !number.text.bytes().all(|b| b.is_ascii_digit()) {
+                return Err(error(
+                    text,
+                    number.at,
+                    format!("NETWORK needs its number, not `{}` (a title goes after `//`)", number.text),
+                ));
+            }
             nets.push(RawNet {
                 number,
                 title: comment.filter(|c| !c.is_empty()),
