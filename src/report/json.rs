@@ -312,9 +312,10 @@ mod tests {
             }
         }
         assert!(checked >= 10, "{checked} examples");
-        // Strings that need escaping, a label, control dependences with edges.
+        // Strings that need escaping (a control character is refused in names: E0110), a
+        // label, control dependences with edges.
         check(
-            r#"{"program": "P\"\u0001\\", "vars": [{"name": "A", "type": "BOOL"}],
+            r#"{"program": "P\"\\/", "vars": [{"name": "A", "type": "BOOL"}],
                 "rungs": [{"id": "R\\1", "ld": [{"contact": "A"}, {"jmp": "L"}]},
                           {"id": "R2é", "ld": [{"coil": "A"}]},
                           {"id": "R3", "label": "L", "ld": [{"contact": "A"}, {"coil": "A"}]}]}"#,

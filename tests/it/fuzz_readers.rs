@@ -721,6 +721,11 @@ fn line_count(text: &str) -> u32 {
     text.split('\n').count() as u32
 }
 
+/// Lines of an inputs file as its errors count them (LF, CRLF and CR each end a line).
+fn input_line_count(text: &str) -> u32 {
+    text.replace("\r\n", "\n").split(['\n', '\r']).count() as u32
+}
+
 /// A load error must be located: every diagnostic with a line and column inside the text, and
 /// the command line's rendering of it (with its excerpt) must not panic.
 pub(crate) fn check_load_error(file: &str, text: &str, e: &LoadError) -> Result<(), String> {
@@ -763,7 +768,7 @@ fn check_inputs_error(file: &str, text: &str, e: &CliError) -> Result<(), String
     let column = parts.next().and_then(|c| c.parse::<u32>().ok());
     match (line, column, parts.next()) {
         (Some(l), Some(c), Some(m))
-            if l >= 1 && l <= line_count(text) && c >= 1 && !m.trim().is_empty() =>
+            if l >= 1 && l <= input_line_count(text) && c >= 1 && !m.trim().is_empty() =>
         {
             Ok(())
         }
