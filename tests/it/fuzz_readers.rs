@@ -1236,8 +1236,7 @@ fn every_reader_survives_mutated_files() {
         f.saved = saved;
         new.push((f, case.seed.name.clone(), case.mutations));
     }
-    let executed: u64 = counts.values().sum::<u64>()
-        + new.len() as u64
+    let executed: u64 = counts.values().sum::<u64>() + new.len() as u64
         - counts
             .iter()
             .filter(|((_, o), _)| o == "fail" || o == "panic")

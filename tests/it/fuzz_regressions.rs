@@ -58,7 +58,14 @@ fn an_inputs_json_error_at_the_start_of_a_line_has_a_1_based_column() {
     ] {
         let file = format!("tests/fuzz-regressions/inputs-json/{name}");
         let out = run_within(
-            &["run", "analyses/example-a/program.json", "--scans", "1", "--inputs", &file],
+            &[
+                "run",
+                "analyses/example-a/program.json",
+                "--scans",
+                "1",
+                "--inputs",
+                &file,
+            ],
             LIMIT,
         );
         assert_eq!(located(&out, &file), want, "{name}");
@@ -72,7 +79,10 @@ fn a_comparison_pin_numbered_past_the_declared_pins_is_refused_at_once() {
         let out = run_within(&[cmd, file], LIMIT);
         let (line, _) = located(&out, file);
         let err = String::from_utf8_lossy(&out.stderr);
-        assert!(err.contains("GT needs its input `IN2` connected"), "{cmd}: {err}");
+        assert!(
+            err.contains("GT needs its input `IN2` connected"),
+            "{cmd}: {err}"
+        );
         assert!(line > 1, "{cmd}: {err}");
     }
 }
@@ -86,6 +96,9 @@ fn a_network_whose_number_is_not_a_number_is_refused_by_every_command() {
         let out = run_within(&[cmd, file], LIMIT);
         assert_eq!(located(&out, file), (3, 9), "{cmd}");
         let err = String::from_utf8_lossy(&out.stderr);
-        assert!(err.contains("NETWORK needs its number, not `1+I VW0`"), "{cmd}: {err}");
+        assert!(
+            err.contains("NETWORK needs its number, not `1+I VW0`"),
+            "{cmd}: {err}"
+        );
     }
 }

@@ -280,6 +280,7 @@ fn the_default_budget_is_documented_and_shown() {
 
 /// The peak resident memory of `plc-deps ARGS` in KiB (its own, from `wait4`).
 #[cfg(target_os = "linux")]
+#[allow(clippy::zombie_processes)] // reaped by `wait4`, which also gives its peak memory
 fn peak_kib(args: &[&str]) -> i64 {
     let child = Command::new(env!("CARGO_BIN_EXE_plc-deps"))
         .args(args)

@@ -137,7 +137,7 @@ fn parse_time_cell(t: &str) -> TimeCell {
         let ms = units / UNIT;
         // An exact value just past the bound is out of range even when not whole.
         let limit = if neg { MAX + 1 } else { MAX };
-        ms < limit || (ms == limit && units % UNIT == 0)
+        ms < limit || (ms == limit && units.is_multiple_of(UNIT))
     };
     if !t.contains('#') {
         let (neg, body) = match t.as_bytes().first() {
@@ -387,7 +387,8 @@ pub fn parse_inputs_csv(p: &Program, text: &str, file: &str) -> Result<InputTabl
     let mut record = csv::ByteRecord::new();
     let mut at = 0;
     // The next non-blank record: the checker's cell offsets with the crate's cells.
-    let mut next = || -> Result<Option<(Vec<usize>, Vec<String>)>, CliError> {
+    type Cells = (Vec<usize>, Vec<String>);
+    let mut next = || -> Result<Option<Cells>, CliError> {
         loop {
             let cells = check_record(text, &mut at).map_err(|(i, m)| err(i, m.to_string()))?;
             let read = reader.read_byte_record(&mut record).unwrap_or(false);

@@ -395,7 +395,8 @@ impl Flow<'_, '_, '_> {
             ctx: self.ctx,
             g: self.g,
         };
-        self.a.compare(&mut b, el.inputs.len(), &|i: &Input| t.input(i, 0));
+        self.a
+            .compare(&mut b, el.inputs.len(), &|i: &Input| t.input(i, 0));
         self.a.blocks[idx] = b;
         let t = black_box::Typer {
             ctx: self.ctx,

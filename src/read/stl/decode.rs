@@ -26,17 +26,17 @@ pub(super) const MAX_LABEL: u32 = 255;
 /// The label operand of an LBL or JMP: a number `0..=MAX_LABEL`, as Micro/WIN writes labels,
 /// or a name (as `plc-deps il` writes the labels of other formats).
 pub(super) fn label(text: &str, t: super::Tok) -> Result<syntax::Name<'static>, LoadError> {
-    if t.text.bytes().all(|b| b.is_ascii_digit()) {
-        if t.text.parse::<u32>().map_or(true, |n| n > MAX_LABEL) {
-            return Err(error(
-                text,
-                t.at,
-                format!(
-                    "label {} is out of range (S7-200 labels are numbered 0 to {MAX_LABEL})",
-                    t.text
-                ),
-            ));
-        }
+    if t.text.bytes().all(|b| b.is_ascii_digit())
+        && t.text.parse::<u32>().map_or(true, |n| n > MAX_LABEL)
+    {
+        return Err(error(
+            text,
+            t.at,
+            format!(
+                "label {} is out of range (S7-200 labels are numbered 0 to {MAX_LABEL})",
+                t.text
+            ),
+        ));
     }
     Ok(name(t.text, t.at))
 }

@@ -300,7 +300,10 @@ fn block<'a>(
                 return Err(error(
                     text,
                     number.at,
-                    format!("NETWORK needs its number, not `{}` (a title goes after `//`)", number.text),
+                    format!(
+                        "NETWORK needs its number, not `{}` (a title goes after `//`)",
+                        number.text
+                    ),
                 ));
             }
             nets.push(RawNet {

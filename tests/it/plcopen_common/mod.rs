@@ -185,7 +185,15 @@ pub fn rung(
 /// `--allow-skipped`: an ST body runs as its stand-in rungs).
 pub fn run_scans(xml: &str, scans: u32) -> serde_json::Value {
     let n = scans.to_string();
-    let args = ["run", "-", "--scans", &n, "--format", "json", "--allow-skipped"];
+    let args = [
+        "run",
+        "-",
+        "--scans",
+        &n,
+        "--format",
+        "json",
+        "--allow-skipped",
+    ];
     json_output(&args, xml).0
 }
 

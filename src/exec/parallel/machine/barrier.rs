@@ -145,7 +145,10 @@ mod tests {
     fn waits_skip_spinning_only_with_more_workers_than_cores() {
         let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
         assert_eq!(SpinBarrier::new(cores + 1).pace(PACE).spins, 0);
-        assert_eq!(SpinBarrier::new(cores + 1).pace(PACE).yield_for, PACE.yield_for);
+        assert_eq!(
+            SpinBarrier::new(cores + 1).pace(PACE).yield_for,
+            PACE.yield_for
+        );
         assert_eq!(SpinBarrier::new(cores).pace(PACE), PACE);
         assert_eq!(SpinBarrier::new(1).pace(PACE), PACE);
     }
