@@ -546,9 +546,9 @@ fn convert_reads_stl_and_plcopen_and_its_output_reports_the_same() {
 const CHAIN: usize = 20_000;
 
 #[test]
-fn a_chain_of_twenty_thousand_fbd_blocks_goes_through_every_command_but_il() {
-    // `il` is left out: its FBD-to-IL trees (src/codegen/il/tree.rs, `Tree::fork_input`)
-    // recurse once per block of a chain, a finding of its own.
+fn a_chain_of_twenty_thousand_fbd_blocks_goes_through_every_command_and_il_refuses_it() {
+    // `il` builds its N-ary trees by recursion along a chain: it refuses chains past 256 blocks
+    // with one error naming the block (checked by an explicit stack), and translates 256.
     // PLCopen: AND blocks, each ANDing `a` with the one before.
     let mut body = px::in_var(1, "a");
     for k in 0..CHAIN as u32 {
@@ -572,11 +572,9 @@ fn a_chain_of_twenty_thousand_fbd_blocks_goes_through_every_command_but_il() {
         (CHAIN as u32 + 1, Some("OUT")),
     );
     let vars = [("localVars", "x", "BOOL"), ("localVars", "a", "BOOL")];
-    every_command_but_succeeds(
-        &file("hostile-chain.xml", &px::project_in("FBD", &vars, &body)),
-        "chain-xml",
-        &["il"],
-    );
+    let chain_xml = file("hostile-chain.xml", &px::project_in("FBD", &vars, &body));
+    every_command_but_succeeds(&chain_xml, "chain-xml", &["il"]);
+    il_refuses_the_chain(&chain_xml);
     // The JSON format: the same chain as AND blocks, and a rung of as many contacts in series.
     let blocks: Vec<String> = (1..=CHAIN)
         .map(|k| {
@@ -595,11 +593,50 @@ fn a_chain_of_twenty_thousand_fbd_blocks_goes_through_every_command_but_il() {
         "{{\"program\": \"p\", {vars}, \"fbd\": {{\"networks\": [{{\"id\": \"N1\", \"blocks\": [{}]}}]}}}}",
         blocks.join(", ")
     );
-    every_command_but_succeeds(&file("hostile-chain.json", &fbd), "chain-json", &["il"]);
+    let chain_json = file("hostile-chain.json", &fbd);
+    every_command_but_succeeds(&chain_json, "chain-json", &["il"]);
+    il_refuses_the_chain(&chain_json);
+    // 256 blocks chained: translated, and the STL loads back.
+    let short = format!(
+        "{{\"program\": \"p\", {vars}, \"fbd\": {{\"networks\": [{{\"id\": \"N1\", \"blocks\": [{}]}}]}}}}",
+        blocks[..255]
+            .iter()
+            .cloned()
+            .chain([format!("{{\"id\": 256, \"op\": \"AND\", \"in\": [{{\"from\": 255}}, \"b\"], \"out\": \"x\"}}")])
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    let out = run_watched(&["il", &file("chain-256.json", &short)], b"");
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stl = file("chain-256.stl", &String::from_utf8_lossy(&out.stdout));
+    let back = run_watched(&["report", &stl], b"");
+    assert_eq!(
+        back.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&back.stderr)
+    );
     let ld = format!(
         "{{\"program\": \"p\", {vars}, \"rungs\": [{{\"id\": \"R1\", \"ld\": [{contacts}, {{\"coil\": \"x\"}}]}}]}}"
     );
     every_command_succeeds(&file("hostile-series.json", &ld), "series-json");
+}
+
+/// `il` on a chain of [`CHAIN`] blocks: exit 2, one error at the 257th block of the chain.
+fn il_refuses_the_chain(path: &str) {
+    let out = run_watched(&["il", path], b"");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("its inputs come through a chain of more than 256 blocks"),
+        "{err}"
+    );
+    assert_eq!(err.matches("error").count(), 1, "{err}");
 }
 
 #[test]

@@ -15,13 +15,17 @@
 //! Invariants: every block is emitted exactly once; the order in which the network reads and
 //! writes each variable is the FBD execution order's (checked; a network where it would differ
 //! is an error). Not here: ops other than AND, OR, NOT, constants, conditional or control arcs,
-//! a block fed by two forks (that needs a scratch bit): each an error naming the network and
-//! block.
+//! a block fed by two forks (that needs a scratch bit), blocks chained more than [`MAX_DEPTH`]
+//! deep (the tree is built and walked by recursion): each an error naming the network and block.
 
 use super::{check, IlError, Names, Net};
 use crate::fbd::{BlockId, FbdPou, Input, Network, Op};
 use crate::model::{PouId, Program};
 use std::collections::HashMap;
+
+/// The longest chain of blocks (each feeding the next) a network may have: the tree's builders
+/// and walks recurse along such chains, and the S7-200's own logic stack is 9 bits deep.
+const MAX_DEPTH: u32 = 256;
 
 /// A node of the N-ary tree: its kind, first child and next sibling.
 #[derive(Clone, Debug)]
@@ -193,6 +197,47 @@ impl Tree<'_> {
                         "a constant input has no S7-200 form (not yet: use SM0.0 or a variable)"
                             .into(),
                     ),
+                }
+            }
+        }
+        self.check_depth()
+    }
+
+    /// No chain of blocks longer than [`MAX_DEPTH`]: each block's depth (1 + its deepest arc
+    /// input's) found by an explicit stack, not by recursion (arcs form no cycle: the resolver
+    /// refuses one).
+    fn check_depth(&self) -> Result<(), IlError> {
+        let n = self.net.blocks.len();
+        let mut depth: Vec<Option<u32>> = vec![None; n];
+        let arcs = |b: BlockId| {
+            self.net
+                .block(b)
+                .inputs
+                .iter()
+                .filter_map(|pin| match &pin.input {
+                    Some(Input::Arc { from, .. }) => Some(*from),
+                    _ => None,
+                })
+        };
+        for i in 0..n {
+            let mut stack = vec![(BlockId(i as u32), false)];
+            while let Some((b, inputs_done)) = stack.pop() {
+                if depth[b.index()].is_some() {
+                    continue;
+                }
+                if inputs_done {
+                    let d = 1 + arcs(b).filter_map(|f| depth[f.index()]).max().unwrap_or(0);
+                    if d > MAX_DEPTH {
+                        return self.fail(Some(b), format!("its inputs come through a chain of more than {MAX_DEPTH} blocks: `plc-deps il` translates networks whose blocks chain at most {MAX_DEPTH} deep (not yet: longer ones)"));
+                    }
+                    depth[b.index()] = Some(d);
+                } else {
+                    stack.push((b, true));
+                    stack.extend(
+                        arcs(b)
+                            .filter(|f| depth[f.index()].is_none())
+                            .map(|f| (f, false)),
+                    );
                 }
             }
         }
