@@ -12,8 +12,8 @@
 //! DIR that is a symbolic link is refused, as for every `-o`.
 
 use super::io::{
-    create_new_file, create_temp_folder, discard_temp, load_program_and_fbd, put_folder_in_place,
-    CliError, FileRole, SYMLINK_REFUSED,
+    create_in_temp_folder, create_temp_folder, discard_temp, load_program_and_fbd,
+    put_folder_in_place, CliError, FileRole, SYMLINK_REFUSED,
 };
 use crate::codegen::c::{generate, CConfig};
 use std::fs;
@@ -77,7 +77,7 @@ pub fn c(cmd: &CCommand) -> Result<(), CliError> {
     let tmp = create_temp_folder(dir).map_err(io)?;
     let write_all = || -> std::io::Result<()> {
         for f in &files {
-            create_new_file(&tmp.join(&f.name))?.write_all(f.text.as_bytes())?;
+            create_in_temp_folder(&tmp, &f.name)?.write_all(f.text.as_bytes())?;
         }
         Ok(())
     };

@@ -654,6 +654,15 @@ pub(crate) fn create_temp_folder(dir: &Path) -> std::io::Result<PathBuf> {
     create_temp(dir, |p| std::fs::create_dir(p), Temp::Folder).map(|((), tmp)| tmp)
 }
 
+/// A new file `name` in the registered temporary folder `folder`, created under the registry's
+/// lock: a signal's cleanup, which takes the lock for good, never removes the folder while a
+/// file is being added to it (its `remove_dir_all` would then find the folder not empty and
+/// leave it behind).
+pub(crate) fn create_in_temp_folder(folder: &Path, name: &str) -> std::io::Result<std::fs::File> {
+    let _files = temp_files();
+    create_new_file(&folder.join(name))
+}
+
 /// Removes a registered temporary file or folder and drops it from the registry.
 pub(crate) fn discard_temp(tmp: &Path) {
     let mut files = temp_files();
