@@ -602,7 +602,7 @@ fn a_chain_of_twenty_thousand_fbd_blocks_goes_through_every_command_and_il_refus
         blocks[..255]
             .iter()
             .cloned()
-            .chain([format!("{{\"id\": 256, \"op\": \"AND\", \"in\": [{{\"from\": 255}}, \"b\"], \"out\": \"x\"}}")])
+            .chain([r#"{"id": 256, "op": "AND", "in": [{"from": 255}, "b"], "out": "x"}"#.to_string()])
             .collect::<Vec<_>>()
             .join(", ")
     );
