@@ -41,8 +41,14 @@ enum Command {
     /// Write a program file (PLCopen TC6 XML, or JSON) as the JSON program format: what
     /// plc-deps understood of it (docs/format.md).
     Convert {
-        /// The program (PLCopen TC6 XML or the JSON program format; `-`: standard input).
+        /// The program (S7-200 STL, PLCopen TC6 XML or the JSON program format; `-`: standard
+        /// input).
         file: PathBuf,
+        /// Write the JSON even when a POU's body is not executed (a PLCopen ST, IL or SFC
+        /// body, read only as stand-in rungs): the JSON holds the stand-ins as ordinary rungs.
+        /// Without it, such a POU is an error.
+        #[arg(long)]
+        allow_skipped: bool,
         /// Write to this file instead of standard output.
         #[arg(short, long)]
         output: Option<PathBuf>,
@@ -332,8 +338,13 @@ fn run(cli: Cli) -> Result<(), CliError> {
                 output,
             })
         }
-        Command::Convert { file, output } => cmd::convert::convert(&cmd::convert::ConvertConfig {
+        Command::Convert {
+            file,
+            allow_skipped,
+            output,
+        } => cmd::convert::convert(&cmd::convert::ConvertConfig {
             input: file,
+            allow_skipped,
             output,
         }),
         Command::C(args) => cmd::c::c(&args.command()?),

@@ -4,7 +4,9 @@
 //!
 //! The file is loaded first (so a file that does not load is refused with its errors, exit 2,
 //! and nothing is written), then read into the syntax and written ([`crate::write::json`]);
-//! the output reads back to the same model.
+//! the output reads back to the same model. A POU whose body the tool does not execute (an ST,
+//! IL or SFC body read as stand-in rungs) is refused unless `--allow-skipped`: the JSON format
+//! has no mark for a stand-in, so a run of the converted file could not know it skips code.
 
 use super::io::{format_of, load_text, read_program_text, write_output_with, Format};
 use super::CliError;
@@ -15,6 +17,8 @@ use std::path::PathBuf;
 #[derive(Clone, Debug)]
 pub struct ConvertConfig {
     pub input: PathBuf,
+    /// Write the JSON even when a POU's body is only stand-in rungs.
+    pub allow_skipped: bool,
     pub output: Option<PathBuf>,
 }
 
@@ -22,7 +26,8 @@ pub struct ConvertConfig {
 /// as every command recognises it ([`format_of`]: STL, PLCopen TC6 XML or JSON).
 pub fn convert(c: &ConvertConfig) -> Result<(), CliError> {
     let (file, text) = read_program_text(&c.input)?;
-    load_text(file.clone(), &text)?;
+    let (p, _) = load_text(file.clone(), &text)?;
+    super::skipped::refuse_skipped(&p, &c.input, c.allow_skipped, Some("write the JSON"))?;
     let syntax = match format_of(&file, &text) {
         Format::Stl => stl::parse(&text),
         Format::PlcOpen => plcopen::parse(&text).map(|(syntax, _)| syntax),

@@ -43,9 +43,11 @@ fn converted(path: &Path) -> String {
         "{}.json",
         path.file_name().unwrap().to_string_lossy()
     ));
+    // Projects with ST, IL or SFC bodies convert with their stand-in rungs.
     let r = run(&[
         "convert",
         path.to_str().unwrap(),
+        "--allow-skipped",
         "-o",
         out.to_str().unwrap(),
     ]);

@@ -357,6 +357,15 @@ fn run_c_and_il_refuse_an_st_body_they_do_not_execute_unless_allowed() {
     assert!(!dir.exists(), "nothing written");
     let out = run_stdin(&["il", "-"], xml.as_bytes());
     assert_eq!(error_line(&out, "il"), refused("its STL cannot be written"));
+    // The JSON format has no mark for a stand-in: `convert` refuses too, unless allowed.
+    let out = run_stdin(&["convert", "-"], xml.as_bytes());
+    assert_eq!(
+        error_line(&out, "convert"),
+        refused("give --allow-skipped to write the JSON without it")
+    );
+    let out = run_stdin(&["convert", "-", "--allow-skipped"], xml.as_bytes());
+    assert_eq!(out.status.code(), Some(0), "convert --allow-skipped");
+    assert!(!out.stdout.is_empty());
 
     // Allowed: the outputs list the POU.
     let (line, column) = at.split_once(':').unwrap();
