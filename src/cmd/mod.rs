@@ -22,5 +22,6 @@ pub mod run;
 pub mod schema;
 pub mod skipped;
 pub mod source;
+mod temp;
 
 pub use io::{CliError, FileRole};
