@@ -1,4 +1,4 @@
-//! `plc-deps c FILE -o DIR`: writes the C of a program (`crate::codegen::c`) into a folder,
+//! `plc-deps c FILE -o DIR`: writes the C of a program (`plc_codegen::c`) into a folder,
 //! all files or none.
 //!
 //! Atomicity: the files are written into a fresh temporary folder `.DIR.tmp-` + 16 random hex
@@ -15,7 +15,7 @@ use super::io::{
     create_in_temp_folder, create_temp_folder, discard_temp, load_program_and_fbd,
     put_folder_in_place, CliError, FileRole, SYMLINK_REFUSED,
 };
-use crate::codegen::c::{generate, CConfig};
+use plc_codegen::c::{generate, CConfig};
 use std::fs;
 use std::io::Write;
 use std::path::PathBuf;

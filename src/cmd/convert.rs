@@ -3,14 +3,14 @@
 //! syntax: what plc-deps understood of the file, in a form to read, diff and edit.
 //!
 //! The file is loaded first (so a file that does not load is refused with its errors, exit 2,
-//! and nothing is written), then read into the syntax and written ([`crate::write::json`]);
+//! and nothing is written), then read into the syntax and written ([`plc_write::json`]);
 //! the output reads back to the same model. A POU whose body the tool does not execute (an ST,
 //! IL or SFC body read as stand-in rungs) is refused unless `--allow-skipped`: the JSON format
 //! has no mark for a stand-in, so a run of the converted file could not know it skips code.
 
 use super::io::{format_of, load_text, read_program_text, write_output_with, Format};
 use super::CliError;
-use crate::read::{json, plcopen, stl};
+use plc_read::{json, plcopen, stl};
 use std::path::PathBuf;
 
 /// A validated `plc-deps convert` invocation.
@@ -35,6 +35,6 @@ pub fn convert(c: &ConvertConfig) -> Result<(), CliError> {
     }
     .map_err(|error| CliError::load(file.clone(), &text, error))?;
     write_output_with(c.output.as_deref(), |mut w| {
-        crate::write::json::program(&syntax, &mut w)
+        plc_write::json::program(&syntax, &mut w)
     })
 }

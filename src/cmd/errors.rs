@@ -1,6 +1,6 @@
 //! How the command line shows what went wrong, and what it warns about, on standard error.
 //!
-//! Two formats: text (a load error in the style of rustc, see [`crate::diag::render`]; any
+//! Two formats: text (a load error in the style of rustc, see [`plc_diag::render`]; any
 //! other error as one `error: message` line) and JSON (one object per line, the keys of
 //! docs/diagnostics.md), chosen once per process by [`set_format`] (the binary does, from the
 //! command's `--format json`), so warnings printed in the middle of a command (a reader's
@@ -9,7 +9,7 @@
 //! plain. The exit code is not decided here but by [`CliError::exit_code`].
 
 use super::io::CliError;
-use crate::diag::{Severity, Shown};
+use plc_diag::{Severity, Shown};
 use std::io::Write;
 use std::sync::OnceLock;
 
@@ -53,7 +53,7 @@ pub fn error_text(e: &CliError, format: Format, colour: bool) -> String {
         (CliError::Load { shown, .. }, Format::Text) if !shown.is_empty() => {
             shown.iter().map(|s| s.text(colour)).collect()
         }
-        (other, Format::Text) => format!("error: {}\n", crate::diag::printable(&other.to_string())),
+        (other, Format::Text) => format!("error: {}\n", plc_diag::printable(&other.to_string())),
         (_, Format::Json) => shown_of(e).iter().map(|s| s.json() + "\n").collect(),
     }
 }

@@ -3,7 +3,7 @@
 
 use super::io::write_output_with;
 use super::CliError;
-use crate::synth::{write_program, ConfigError, GenConfig, MAX_RUNGS};
+use plc_synth::{write_program, ConfigError, GenConfig, MAX_RUNGS};
 use std::path::PathBuf;
 
 /// A `plc-deps gen` invocation.

@@ -1,9 +1,9 @@
-//! `plc-deps il FILE [-o OUT]`: the S7-200 STL of a program (`crate::codegen::il`), to standard
+//! `plc-deps il FILE [-o OUT]`: the S7-200 STL of a program (`plc_codegen::il`), to standard
 //! output or written atomically to OUT. A construct with no S7-200 instruction is one error
 //! naming the file and the rung or block (exit code 2); nothing is written then.
 
 use super::io::{check_output_path, load_program_and_fbd, write_output, CliError, FileRole};
-use crate::codegen::il::generate;
+use plc_codegen::il::generate;
 use std::path::PathBuf;
 
 /// A validated `plc-deps il` invocation.

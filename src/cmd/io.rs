@@ -28,10 +28,10 @@ pub(crate) use super::temp::{
 use super::temp::{create_temp_file, put_file_in_place};
 #[cfg(test)]
 use super::temp::{random_suffix, temp_name};
-use crate::diag::Shown;
-use crate::fbd::Fbd;
-use crate::model::Program;
-use crate::read::LoadError;
+use plc_diag::Shown;
+use plc_fbd::Fbd;
+use plc_model::Program;
+use plc_read::LoadError;
 use std::io::Read;
 use std::path::Path;
 #[cfg(test)]
@@ -315,7 +315,7 @@ pub fn load_program_for_run(path: &Path) -> Result<(Program, Fbd), CliError> {
 }
 
 /// [`load_program_for_run`] keeping, with `select` (`--pou`), only that program of a PLCopen
-/// project ([`crate::load::plcopen_selected`]); `select` on another kind of file is an error.
+/// project ([`plc_load::plcopen_selected`]); `select` on another kind of file is an error.
 pub fn load_program_for_run_selecting(
     path: &Path,
     select: Option<&str>,
@@ -364,7 +364,7 @@ pub enum Format {
 
 /// The format of program text `text` of file `file`, recognised as [`load_text`] says.
 pub fn format_of(file: &str, text: &str) -> Format {
-    use crate::read::{plcopen, stl};
+    use plc_read::{plcopen, stl};
     let lower = file.to_ascii_lowercase();
     if stl::looks_like_stl(text) || lower.ends_with(".stl") || lower.ends_with(".awl") {
         Format::Stl
@@ -388,12 +388,12 @@ fn load_text_for(
                 "{file}: --pou {name} selects a program of a PLCopen project or of a JSON program with a configuration, and this is an STL program (the DOT report's --pou draws one POU of any program: add --format dot)"
             )));
         }
-        return crate::load::stl(text).map_err(|error| CliError::load(file, text, error));
+        return plc_load::stl(text).map_err(|error| CliError::load(file, text, error));
     }
     if format == Format::PlcOpen {
         let load = match purpose {
-            Purpose::Analyse => crate::load::plcopen_selected,
-            Purpose::Run => crate::load::plcopen_for_run_selected,
+            Purpose::Analyse => plc_load::plcopen_selected,
+            Purpose::Run => plc_load::plcopen_for_run_selected,
         };
         let (p, f, notes) =
             load(text, select).map_err(|error| CliError::load(file.clone(), text, error))?;
@@ -401,8 +401,8 @@ fn load_text_for(
         return Ok((p, f));
     }
     match select {
-        Some(name) => crate::load::program_and_fbd_from_json_selected(text, name),
-        None => crate::load::program_and_fbd_from_json(text),
+        Some(name) => plc_load::program_and_fbd_from_json_selected(text, name),
+        None => plc_load::program_and_fbd_from_json(text),
     }
     .map_err(|error| CliError::load(file, text, error))
 }
@@ -411,7 +411,7 @@ fn load_text_for(
 /// ordered otherwise than the file).
 pub const PLCOPEN_NOTE: &str = "W0501";
 /// Prints a reader's notes as warnings with `code`.
-fn warn_notes(code: &'static str, file: &str, text: &str, notes: &[crate::read::plcopen::Note]) {
+fn warn_notes(code: &'static str, file: &str, text: &str, notes: &[plc_read::plcopen::Note]) {
     for n in notes {
         super::errors::warn(&Shown::warning(
             code,

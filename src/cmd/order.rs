@@ -1,9 +1,9 @@
 //! `plc-deps order`: each FBD network's execution order and conditional fragment tree, as
-//! text, JSON or DOT (the renderers are in `crate::report::order`).
+//! text, JSON or DOT (the renderers are in `plc_report::order`).
 
 use super::io::{read_program_text, write_output};
 use super::CliError;
-use crate::model::Program;
+use plc_model::Program;
 use std::path::PathBuf;
 
 /// Output format of `order`.
@@ -23,11 +23,11 @@ pub struct OrderConfig {
 }
 
 /// Renders the execution order and fragment trees of a program's FBD networks.
-pub fn render_order(p: &Program, fbd: &crate::fbd::Fbd, format: OrderFormat) -> String {
+pub fn render_order(p: &Program, fbd: &plc_fbd::Fbd, format: OrderFormat) -> String {
     match format {
-        OrderFormat::Text => crate::report::order::render_order_text(p, fbd),
-        OrderFormat::Json => crate::report::order::render_order_json(p, fbd),
-        OrderFormat::Dot => crate::report::order::render_order_dot(p, fbd),
+        OrderFormat::Text => plc_report::order::render_order_text(p, fbd),
+        OrderFormat::Json => plc_report::order::render_order_json(p, fbd),
+        OrderFormat::Dot => plc_report::order::render_order_dot(p, fbd),
     }
 }
 

@@ -8,11 +8,11 @@ use super::io::{
 };
 use super::progress::Progress;
 use super::CliError;
-use crate::analysis::{analyse, analyse_with, Analysis, AnalysisConfig, DependenceListing, Listed};
-use crate::diag::{Origin, Severity, Shown};
-use crate::fbd::Fbd;
-use crate::model::Program;
-use crate::report::{
+use plc_analysis::{analyse, analyse_with, Analysis, AnalysisConfig, DependenceListing, Listed};
+use plc_diag::{Origin, Severity, Shown};
+use plc_fbd::Fbd;
+use plc_model::Program;
+use plc_report::{
     document_with, fbd_parts, render_dot, render_html, render_json, render_text, select_rungs,
     warning_code, warning_origin, warning_text, FbdParts, HtmlInput, Rows, Selection, TextOptions,
     View, DIRECT_PAIRS_ONLY, DOT_MAX_RUNGS,
@@ -158,8 +158,8 @@ pub fn report(c: &ReportConfig) -> Result<(), CliError> {
     if a.listed == Listed::Direct && c.analysis.dependences != DependenceListing::Direct {
         warn(DIRECT_PAIRS_ONLY, format!(
             "{} data dependence pairs are more than --max-pairs allows; listing the {} direct ones (they imply the rest; --dependences all lists every pair)",
-            crate::report::text::thousands(a.counts.total() as usize),
-            crate::report::text::thousands(a.data.len())
+            plc_report::text::thousands(a.counts.total() as usize),
+            plc_report::text::thousands(a.data.len())
         ), Origin::NONE);
     }
     let text = TextOptions {
@@ -184,7 +184,7 @@ pub fn report(c: &ReportConfig) -> Result<(), CliError> {
 
 /// The rungs the DOT report of `p` draws (`None`: all), refused above [`DOT_MAX_RUNGS`].
 fn dot_selection(c: &ReportConfig, p: &Program) -> Result<Option<HashSet<String>>, CliError> {
-    use crate::report::text::thousands;
+    use plc_report::text::thousands;
     if c.format != ReportFormat::Dot {
         return Ok(None);
     }

@@ -1,12 +1,12 @@
 //! POUs whose bodies no command executes (a PLCopen ST, IL or SFC body, read only as stand-in
-//! rungs that keep every value: [`crate::model::Pou::skipped`]): `run` and `c` refuse them
+//! rungs that keep every value: [`plc_model::Pou::skipped`]): `run` and `c` refuse them
 //! unless given `--allow-skipped`, and then list them in their output. The analyses (`report`)
 //! keep them: the reader's warning W0501 says what each stand-in reads and writes.
 //!
 //! It does not decide what a stand-in is (the reader does) nor how an output shows the list.
 
 use super::CliError;
-use crate::model::{Pou, Program};
+use plc_model::{Pou, Program};
 use std::path::Path;
 
 /// One skipped POU as the outputs list it.

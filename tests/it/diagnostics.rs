@@ -36,6 +36,7 @@ fn codes_in(dir: &std::path::Path, out: &mut Vec<String>) {
 fn every_code_the_source_defines_is_documented_with_an_example() {
     let mut codes = Vec::new();
     codes_in(&root().join("src"), &mut codes);
+    codes_in(&root().join("crates"), &mut codes);
     codes.sort();
     codes.dedup();
     assert!(codes.len() >= 47, "found {codes:?}");

@@ -2,7 +2,7 @@
 //! the modules below it in the order its `mod.rs` documents (`exec/parallel`: the basics, then
 //! planning, the measured choice, the running machine, the explanation; `cmd/run`: config,
 //! trace, inputs, compare, engine, output). Read from the sources: every `super::…` and
-//! `crate::exec::parallel::…` / `crate::cmd::run::…` path outside comments and test modules is
+//! `crate::parallel::…` (in the executor crate) / `crate::cmd::run::…` path outside comments and test modules is
 //! resolved to the module it names, and must name one that comes earlier in the order.
 //!
 //! One exception, named here: `machine::items`, `machine::exchange`, `machine::claimed` and
@@ -220,10 +220,10 @@ fn unlisted(root: &Path, order: Order) -> Vec<String> {
 
 #[test]
 fn the_parallel_scan_s_modules_use_only_the_ones_below_them() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/exec/parallel");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("crates/plc-exec/src/parallel");
     assert_eq!(unlisted(&root, PARALLEL), Vec::<String>::new());
     assert_eq!(
-        upward_uses(&root, PARALLEL, "crate::exec::parallel::"),
+        upward_uses(&root, PARALLEL, "crate::parallel::"),
         Vec::<String>::new()
     );
 }
@@ -244,7 +244,7 @@ fn an_upward_use_is_found() {
     let paths = named_paths(
         "use super::{plan::Plan, ready};\nlet x = super::super::choice::Chooser::new();",
         &["planning", "tasks"],
-        "crate::exec::parallel::",
+        "crate::parallel::",
     );
     let used: Vec<usize> = paths.iter().map(|p| module_of(PARALLEL, p)).collect();
     let names: Vec<&[&str]> = used.iter().map(|&i| PARALLEL[i]).collect();

@@ -3,9 +3,9 @@
 //! difference.
 
 use super::inputs::InputTable;
-use crate::exec::parallel::{ParallelMachine, RunLog};
-use crate::exec::{load_bits, parts, Addr, Fault, FaultKind, Machine};
-use crate::model::{Program, VarId};
+use plc_exec::parallel::{ParallelMachine, RunLog};
+use plc_exec::{load_bits, parts, Addr, Fault, FaultKind, Machine};
+use plc_model::{Program, VarId};
 use serde_json::{json, Value as Json};
 
 /// Stored values in an order independent of the layout (`Machine::canonical_values`): every
@@ -130,13 +130,13 @@ pub(super) fn first_difference(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::analysis::analyse;
-    use crate::exec::parallel::PlanConfig;
-    use crate::exec::{ExecConfig, Layout};
+    use plc_analysis::analyse;
+    use plc_exec::parallel::PlanConfig;
+    use plc_exec::{ExecConfig, Layout};
     #[test]
     fn first_difference_names_the_variable_and_both_values() {
         // The same program on two clocks: the timer's ET differs from scan 1 on.
-        let p = crate::load::program_from_json(
+        let p = plc_load::program_from_json(
             r#"{"program": "t", "vars": [{"name": "go", "type": "BOOL", "class": "input", "init": true},
                 {"name": "T1", "type": "TON"}], "rungs": [{"id": "R1", "ld": [{"contact": "go"}, {"ton": "T1", "pt": "T#1s"}]}]}"#,
         )
@@ -148,7 +148,7 @@ mod tests {
             &ExecConfig {
                 cycle_ms: 10,
                 loop_cap: 10,
-                scan_budget: crate::exec::DEFAULT_SCAN_BUDGET,
+                scan_budget: plc_exec::DEFAULT_SCAN_BUDGET,
             },
         )
         .unwrap();
@@ -158,7 +158,7 @@ mod tests {
             &ExecConfig {
                 cycle_ms: 20,
                 loop_cap: 10,
-                scan_budget: crate::exec::DEFAULT_SCAN_BUDGET,
+                scan_budget: plc_exec::DEFAULT_SCAN_BUDGET,
             },
             &PlanConfig::new(1),
         )
@@ -189,7 +189,7 @@ mod tests {
         assert_ne!(base, digest(&state(1, 2, 3 << 16), &canon, &[]));
         let f = Fault {
             scan: 0,
-            rung: crate::model::RungId(0),
+            rung: plc_model::RungId(0),
             kind: FaultKind::DivByZero,
         };
         assert_ne!(base, digest(&state(1, 2, 3), &canon, &[f]));

@@ -3,9 +3,9 @@
 //! uses. The bottom of the command: it depends on nothing else in it.
 
 use crate::cmd::io::CliError;
-use crate::exec::parallel::PlanKind;
-use crate::exec::ExecConfig;
-use crate::model::parse_time_literal;
+use plc_exec::parallel::PlanKind;
+use plc_exec::ExecConfig;
+use plc_model::parse_time_literal;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 

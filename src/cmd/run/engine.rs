@@ -7,18 +7,16 @@ use super::compare::{canonical_slots, digest, first_difference};
 use super::config::{RunConfig, RunFormat, RunMode, RunWarning};
 use super::inputs::{load_inputs, InputTable};
 use super::trace::{cell, trace_columns, Trace};
-use crate::analysis::{analyse, Analysis};
 use crate::cmd::io::{check_output_path, load_program_for_run_selecting, CliError, FileRole};
 use crate::cmd::progress::{Bar, Progress};
-use crate::exec::parallel::{
+use plc_analysis::{analyse, Analysis};
+use plc_exec::parallel::{
     run_sequential, Candidate, ParallelMachine, PlanConfig, PlanKind, RunLog, ScanDriver,
 };
-use crate::exec::{
-    load_value, Addr, ExecConfig, Fault, FaultKind, Layout, Machine, State, VarValue,
-};
-use crate::fbd::Fbd;
-use crate::model::{PouKind, Program, ProgramRun, Type, VarClass, VarId, VarRef};
-use crate::report::configuration::configuration_entry;
+use plc_exec::{load_value, Addr, ExecConfig, Fault, FaultKind, Layout, Machine, State, VarValue};
+use plc_fbd::Fbd;
+use plc_model::{PouKind, Program, ProgramRun, Type, VarClass, VarId, VarRef};
+use plc_report::configuration::configuration_entry;
 use serde_json::Value as Json;
 use std::collections::HashMap;
 use std::fmt::Write as _;
@@ -471,7 +469,7 @@ pub(super) fn prepare(c: &RunConfig, progress: &Progress) -> Result<Prepared, Cl
         scan_budget: c.scan_budget,
     };
     let lower_error =
-        |e: crate::exec::LowerError| CliError::Usage(format!("{}: {e}", c.input.display()));
+        |e: plc_exec::LowerError| CliError::Usage(format!("{}: {e}", c.input.display()));
     let seq = if c.mode != RunMode::Par {
         Some(Machine::new(&p, Layout::dense(&p), &exec).map_err(lower_error)?)
     } else {
@@ -715,7 +713,7 @@ pub(super) fn execute(
             if let Some(log) = &plan_run {
                 text.push('\n');
                 text.push_str(&pm.explain_run(log));
-                json["run"] = crate::exec::parallel::run_log_json(log, false);
+                json["run"] = plc_exec::parallel::run_log_json(log, false);
             }
             (text, json)
         })

@@ -3,7 +3,7 @@
 
 use super::config::count;
 use crate::cmd::io::{read_text, CliError, FileRole};
-use crate::model::{int_range, parse_int_literal, Program, Type, Value, VarClass, VarId, Wide};
+use plc_model::{integer_cell, parse_int_literal, Program, Type, Value, VarClass, VarId, Wide};
 use serde_json::Value as Json;
 use std::path::Path;
 
@@ -54,22 +54,6 @@ fn input_var(p: &Program, name: &str) -> Result<VarId, String> {
 /// What the cells of the CSV are trimmed of: spaces and tabs (the C harness trims the same).
 fn trim_cell(s: &str) -> &str {
     s.trim_matches([' ', '\t'])
-}
-
-/// "an" or "a" before a type's name, as the names are spoken ("an INT", "a UINT").
-fn article(ty: Type) -> &'static str {
-    if matches!(ty, Type::Int | Type::Lint | Type::Lword) {
-        "an"
-    } else {
-        "a"
-    }
-}
-
-/// What a cell of an integer or bit string type must be, as errors say it: `an INT
-/// (-32768..32767)`, `a BYTE (0..255)` (the C harness prints the same, generated from this).
-pub fn integer_cell(ty: Type) -> String {
-    let (lo, hi) = int_range(ty);
-    format!("{} {ty} ({lo}..{hi})", article(ty))
 }
 
 /// Whether `t` is a REAL or LREAL cell: `[+-]` then digits with an optional `.` and fraction
@@ -617,7 +601,7 @@ pub fn load_inputs(p: &Program, path: &Path) -> Result<InputTable, CliError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::parse_time_literal;
+    use plc_model::parse_time_literal;
 
     #[test]
     fn time_cells_accept_the_program_literals_values() {

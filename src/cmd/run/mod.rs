@@ -33,7 +33,7 @@ mod trace;
 pub use crate::cmd::progress::Progress;
 pub use config::{parse_cycle, RunConfig, RunFormat, RunMode, RunWarning};
 pub use engine::{FaultSummary, RunReport};
-pub use inputs::{integer_cell, load_inputs, parse_inputs_csv, parse_inputs_json, InputTable};
+pub use inputs::{load_inputs, parse_inputs_csv, parse_inputs_json, InputTable};
 pub use output::{render_json, render_text, run_figures, write_html};
 
 use crate::cmd::io::{write_file_as, write_output, write_output_with, CliError, FileRole};
@@ -87,8 +87,8 @@ fn run_kept(
 pub fn run(c: &RunConfig) -> Result<(), CliError> {
     let progress = Progress::new(c.progress);
     let (pr, r) = run_kept(c, &progress, &mut |w| {
-        crate::cmd::errors::warn(&crate::diag::Shown::unplaced(
-            crate::diag::Severity::Warning,
+        crate::cmd::errors::warn(&plc_diag::Shown::unplaced(
+            plc_diag::Severity::Warning,
             w.code(),
             w.to_string(),
         ))

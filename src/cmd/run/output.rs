@@ -4,13 +4,13 @@
 
 use super::config::{count, RunWarning};
 use super::engine::RunReport;
-use crate::analysis::Analysis;
-use crate::exec::parallel::run_log_json;
-use crate::exec::VarValue;
-use crate::fbd::Fbd;
-use crate::model::{Program, Value};
-use crate::report::configuration::{run_entry, run_label};
-use crate::report::{
+use plc_analysis::Analysis;
+use plc_exec::parallel::run_log_json;
+use plc_exec::VarValue;
+use plc_fbd::Fbd;
+use plc_model::{Program, Value};
+use plc_report::configuration::{run_entry, run_label};
+use plc_report::{
     document_with, fbd_parts, render_run_html, FaultRow, HtmlInput, ModeFigures, PlanFigures,
     RunFigures,
 };

@@ -1,8 +1,8 @@
 //! The `--trace` CSV: the traced columns (`--trace-vars`), the header and one line per scan.
 
 use crate::cmd::io::CliError;
-use crate::exec::{Addr, Machine};
-use crate::model::{Field, Program, Type, Value, VarId, VarRef};
+use plc_exec::{Addr, Machine};
+use plc_model::{Field, Program, Type, Value, VarId, VarRef};
 use std::io::Write;
 
 /// The CSV cell of one traced value: BOOL 1/0, integers, bit strings and TIME (ms) as exact

@@ -1,0 +1,371 @@
+//! The program model: one resolved, type-checked representation of a ladder program that every
+//! analysis and every output works from.
+//!
+//! Readers (`plc_read`) turn the JSON program format into a [`Program`]; nothing downstream
+//! ever sees names that are not resolved. Invariants a `Program` always holds (the reader checks
+//! them and refuses anything else):
+//! - variables, rungs and POUs live in dense `Vec`s indexed by the newtypes [`VarId`], [`RungId`]
+//!   and [`PouId`]; `pous[0]` is the main program; the rungs of a POU are a contiguous
+//!   [`RungId`] range, POUs in file order (main first, then subroutines);
+//! - every operand has a known IEC type and every element's operands have the types it needs;
+//! - every `jmp` names a rung of the same POU, every FOR has its NEXT in the same POU (properly
+//!   nested) and no jump enters a FOR body from outside it; no subroutine calls itself, directly or
+//!   through others, and `end` appears only in the main program;
+//! - each edge contact owns a hidden BOOL memory variable (named `R3:edge1`), so edge state is
+//!   an ordinary variable for the analyses and the scan.
+//!
+//! It deliberately carries no analysis results: those are separate values computed from it.
+//! Element semantics follow IEC 61131-3 (LD, §4.2) and the S7-200 shapes of Zhao & Yan (2012).
+
+mod function;
+mod tasks;
+mod types;
+pub use function::*;
+pub use tasks::*;
+pub use types::*;
+
+use plc_diag::Origin;
+use std::ops::Range;
+
+/// Declares a typed dense index (also used by the FBD, analysis and executor crates for theirs).
+#[macro_export]
+macro_rules! index_type {
+    ($(#[$m:meta])* $name:ident) => {
+        $(#[$m])*
+        #[derive(Copy, Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+        pub struct $name(pub u32);
+        impl $name {
+            /// The index into the owning `Vec`.
+            #[inline]
+            pub fn index(self) -> usize {
+                self.0 as usize
+            }
+        }
+    };
+}
+
+index_type!(
+    /// A variable: index into [`Program::vars`].
+    VarId
+);
+index_type!(
+    /// A rung of any POU: index into [`Program::rungs`], in listing order.
+    RungId
+);
+index_type!(
+    /// A program organisation unit: index into [`Program::pous`]; 0 is the main program.
+    PouId
+);
+
+/// A whole resolved program.
+#[derive(Clone, Debug)]
+pub struct Program {
+    pub name: String,
+    pub vars: Vec<Var>,
+    pub pous: Vec<Pou>,
+    pub rungs: Vec<Rung>,
+    /// The PLCopen configuration that runs the program's POUs (tasks and program instances);
+    /// `None` for programs without one (JSON, STL, a project without instances).
+    pub configuration: Option<Configuration>,
+}
+
+/// The main program or one subroutine.
+#[derive(Clone, Debug)]
+pub struct Pou {
+    pub name: String,
+    pub kind: PouKind,
+    /// The POU's rungs, contiguous in [`Program::rungs`].
+    pub rungs: Range<u32>,
+    /// `Some` when the POU's body was not read as logic (a PLCopen ST, IL or SFC body): its
+    /// rungs are stand-ins that read and write what the body does, for the analyses, and keep
+    /// every value when run. `run` and `c` refuse such a POU unless told to skip it.
+    pub skipped: Option<Box<SkippedBody>>,
+}
+
+/// A POU body that no command executes (see [`Pou::skipped`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SkippedBody {
+    /// The body's language as the file names it (`ST`, `IL`, `SFC`).
+    pub language: String,
+    /// Line and column (1-based) of the body in the program file.
+    pub position: Option<(u32, u32)>,
+}
+
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum PouKind {
+    Main,
+    Subroutine,
+    /// An interrupt routine: nothing calls it; it runs when its event occurs, which may be
+    /// between any two rungs of the scan. `plc-deps run` raises no interrupt events.
+    Interrupt,
+}
+
+/// A declared (or hidden) variable.
+#[derive(Clone, Debug)]
+pub struct Var {
+    /// Display name: the declared name for globals, `SBR_0:name` for subroutine locals,
+    /// `R3:edge1` for the hidden memory of an edge contact.
+    pub name: String,
+    pub ty: Type,
+    pub class: VarClass,
+    pub init: Value,
+    /// The subroutine that declared it, `None` for program-wide variables.
+    pub scope: Option<PouId>,
+    /// True for variables the reader made up (edge memories).
+    pub hidden: bool,
+}
+
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum VarClass {
+    Input,
+    Output,
+    Memory,
+}
+
+/// One rung: a series of elements through which power flows left to right.
+#[derive(Clone, Debug)]
+pub struct Rung {
+    pub id: String,
+    pub label: Option<String>,
+    pub comment: Option<String>,
+    pub pou: PouId,
+    pub series: Series,
+    /// For a rung lowered from an FBD block (or a fragment guard of it): what it was lowered
+    /// from. Ladder rungs have none (and pay one pointer for it): the resolver renders their
+    /// path (`rungs[3]`) from where they are, only when an error names them.
+    pub lowered: Option<Box<LoweredFrom>>,
+    /// Where the rung starts in the program's text (for a rung lowered from FBD: its block, or
+    /// its network for a fragment's guard and landing); none for a rung the tool made up. It
+    /// places the analysis warnings about the rung.
+    pub origin: Origin,
+}
+
+/// Where a rung lowered from an FBD body comes from.
+#[derive(Clone, Debug)]
+pub struct LoweredFrom {
+    /// The path of the block it was lowered from (`fbd.networks[0].blocks[2]`).
+    pub block_path: String,
+    /// The id of its network, once the network is lowered. The rungs of one network are
+    /// contiguous.
+    pub network: Option<String>,
+}
+
+impl Rung {
+    /// For a rung lowered from an FBD block: the path of that block.
+    pub fn block_path(&self) -> Option<&str> {
+        self.lowered.as_ref().map(|l| l.block_path.as_str())
+    }
+    /// For a rung lowered from an FBD network: the network's id.
+    pub fn network(&self) -> Option<&str> {
+        self.lowered.as_ref().and_then(|l| l.network.as_deref())
+    }
+}
+
+/// A series of elements; power flows through them in order.
+pub type Series = Vec<Element>;
+
+/// A ladder element after resolution.
+#[derive(Clone, Debug)]
+pub enum Element {
+    /// A contact on a BOOL (variable or field).
+    Contact { var: VarRef, kind: ContactKind },
+    /// A comparison of two numeric operands of the same type; passes power when true.
+    Compare { op: CmpOp, a: Operand, b: Operand },
+    /// Parallel condition branches: power out is the OR of each branch's power out.
+    Or(Vec<Series>),
+    /// Output coil: writes the power (or its negation) to a BOOL.
+    Coil { var: VarId, negated: bool },
+    /// Set coil: writes TRUE when powered.
+    Set(VarId),
+    /// Reset coil: writes FALSE when powered.
+    Reset(VarId),
+    /// Output branches: each series receives the same power (LPS/LRD/LPP); power out is unchanged.
+    Branch(Vec<Series>),
+    /// TON/TOF/TP instance call; power in is IN, power out is Q.
+    Timer {
+        kind: TimerKind,
+        instance: VarId,
+        pt: Operand,
+    },
+    /// Up counter; power in is CU, power out is Q.
+    Ctu {
+        instance: VarId,
+        pv: Operand,
+        reset: Operand,
+    },
+    /// Down counter; power in is CD, power out is Q.
+    Ctd {
+        instance: VarId,
+        pv: Operand,
+        load: Operand,
+    },
+    /// SR/RS bistable (IEC 61131-3 2.5.2.3.1); power in is S1 (SR) or S (RS), `reset` is R (SR)
+    /// or R1 (RS), power out is Q1.
+    Bistable {
+        kind: BistableKind,
+        instance: VarId,
+        reset: Operand,
+    },
+    /// R_TRIG/F_TRIG edge detector (IEC 61131-3 2.5.2.3.2); power in is CLK, power out is Q.
+    Trigger { kind: TriggerKind, instance: VarId },
+    /// Up-down counter (IEC 61131-3 2.5.2.3.3); power in is CU, power out is QU. Its four other
+    /// inputs are boxed: the counter is rare, and inline they would make every element 56 bytes
+    /// instead of 32.
+    Ctud {
+        instance: VarId,
+        inputs: Box<CtudInputs>,
+    },
+    /// MOVE box: when powered, `to := from`; power out = power in (ENO).
+    Move { from: Operand, to: VarId },
+    /// Arithmetic box: when powered, `out := a op b`; power out = power in (ENO).
+    Arith {
+        op: ArithOp,
+        a: Operand,
+        b: Operand,
+        out: VarId,
+    },
+    /// Standard function box (`crate::Function`): when powered,
+    /// `out := func(args…)`; power out = power in (ENO). The arguments have the types
+    /// [`Function::types`] gives (boxed: an element stays 32 bytes).
+    Function {
+        func: Function,
+        args: Box<[Operand]>,
+        out: VarId,
+    },
+    /// Jump, taken when powered, to the rung that carries the label.
+    Jmp { label: String, target: RungId },
+    /// Return: when powered, ends this POU for this scan.
+    Ret,
+    /// End: when powered, ends the scan (main program only).
+    End,
+    /// Subroutine call, when powered.
+    Call { pou: PouId },
+    /// FOR head (last element of its rung). When powered: `var := from`, then loop while
+    /// `var <= to`; the body is the rungs up to `next`.
+    For {
+        var: VarId,
+        /// `from` and `to`, boxed so that an element stays 32 bytes (loops are rare).
+        bounds: Box<ForBounds>,
+        next: RungId,
+    },
+    /// NEXT (alone in its rung): `var += 1` and back to the FOR head's test.
+    Next { head: RungId },
+}
+
+impl Element {
+    /// True for the elements that send control elsewhere than the next rung: a jump, a return,
+    /// an end, a call, and the two ends of a FOR loop.
+    pub fn transfers_control(&self) -> bool {
+        matches!(
+            self,
+            Element::Jmp { .. }
+                | Element::Ret
+                | Element::End
+                | Element::Call { .. }
+                | Element::For { .. }
+                | Element::Next { .. }
+        )
+    }
+}
+
+/// The inputs of an up-down counter besides CU (its power in).
+#[derive(Clone, Debug)]
+pub struct CtudInputs {
+    pub cd: Operand,
+    pub reset: Operand,
+    pub load: Operand,
+    pub pv: Operand,
+}
+
+impl CtudInputs {
+    /// CD, R, LD and PV, in that order.
+    pub fn operands(&self) -> [&Operand; 4] {
+        [&self.cd, &self.reset, &self.load, &self.pv]
+    }
+}
+
+/// The bounds of a FOR head: `var := from`, loop while `var <= to`.
+#[derive(Clone, Debug)]
+pub struct ForBounds {
+    pub from: Operand,
+    pub to: Operand,
+}
+
+/// How a contact reads its BOOL.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum ContactKind {
+    Normal,
+    Negated,
+    /// Passes power for one evaluation when the BOOL went FALSE→TRUE since the contact's last
+    /// evaluation; `memory` is the hidden variable holding the previous value.
+    Rising {
+        memory: VarId,
+    },
+    Falling {
+        memory: VarId,
+    },
+}
+
+impl Program {
+    /// The main program.
+    pub fn main(&self) -> &Pou {
+        &self.pous[0]
+    }
+    pub fn var(&self, id: VarId) -> &Var {
+        &self.vars[id.index()]
+    }
+    pub fn rung(&self, id: RungId) -> &Rung {
+        &self.rungs[id.index()]
+    }
+    pub fn pou(&self, id: PouId) -> &Pou {
+        &self.pous[id.index()]
+    }
+    /// All rung ids in listing order.
+    pub fn rung_ids(&self) -> impl ExactSizeIterator<Item = RungId> + '_ {
+        (0..self.rungs.len() as u32).map(RungId)
+    }
+    /// The rung ids of one POU, in program order.
+    pub fn pou_rungs(&self, pou: PouId) -> impl ExactSizeIterator<Item = RungId> {
+        self.pous[pou.index()].rungs.clone().map(RungId)
+    }
+    /// Display text of a variable reference (`T1.Q`).
+    pub fn var_ref_name(&self, r: VarRef) -> String {
+        match r.field {
+            None => self.var(r.var).name.clone(),
+            Some(f) => format!("{}.{}", self.var(r.var).name, f.name()),
+        }
+    }
+}
+
+/// Calls `f` on every element of `series`, depth first, in evaluation order.
+pub fn walk_elements<'a>(series: &'a [Element], f: &mut impl FnMut(&'a Element)) {
+    for e in series {
+        f(e);
+        match e {
+            Element::Or(branches) | Element::Branch(branches) => {
+                for b in branches {
+                    walk_elements(b, f);
+                }
+            }
+            _ => {}
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A million-rung program holds about seven million elements: each byte of `Element` is
+    /// seven megabytes of memory to fault in while loading. Rare, large variants are boxed.
+    #[test]
+    fn an_element_is_32_bytes() {
+        assert_eq!(std::mem::size_of::<Element>(), 32);
+    }
+
+    /// The same for rungs: what only FBD-lowered rungs carry is behind one pointer.
+    #[test]
+    fn a_rung_is_112_bytes() {
+        assert_eq!(std::mem::size_of::<Rung>(), 112);
+    }
+}

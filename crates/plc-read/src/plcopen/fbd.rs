@@ -1,0 +1,550 @@
+//! FBD bodies (TC6 `FBD`) → the syntax's FBD body ([`plc_syntax::fbd`]), so that order,
+//! fragments and lowering are the JSON format's (docs/fbd.md).
+//!
+//! Mapping: a `block` is a block with id = its localId, op = its `typeName`, its instance, its
+//! inputs by pin name and its outputs by pin name; `EN` is the conditional arc (`cond`). An
+//! input fed by a block is a data arc (`formalParameter` names the output pin; none: the first
+//! output), by an `inVariable` a variable or a constant, by an `inOutVariable` its variable (so
+//! a feedback loop closes through the variable, as Beremiz closes it). An `outVariable` or
+//! `inOutVariable` fed by a block output is a variable that output writes; fed directly by a
+//! variable it is a MOVE block with the out variable's localId. `jump` and `return` are JMP and
+//! RET blocks whose condition is their input. A `label` starts a new network (networks
+//! `<pou>.N1`, `<pou>.N2` … in file order; one network without labels is `<pou>`).
+//! `connector`/`continuation` pairs are spliced by [`super::wiring`]; the text of the
+//! `comment`s of a network, in file order, is its comment.
+//!
+//! Order: the FBD text-generation paper's depth-first topological sort over the arcs, ties by
+//! localId (docs/fbd.md). Beremiz instead pulls blocks on demand from the out variables in file
+//! order, and runs the blocks with `executionOrderId > 0` first in id order; where a body
+//! carries such ids, a note lists them (`plc-deps order` shows the order plc-deps uses).
+//!
+//! Deliberately not here (errors naming the element): negated or edge-qualified pins, several
+//! wires into one FBD pin, ENO wired on, expressions as in/out variables.
+
+use super::black_box::{self, BlackBox, Ctx};
+use super::pins::{add_target, bool_literal, konst, output_negated, pin_modifiers, pin_of, Added};
+use super::wiring::{graph, ElemId, Graph, Source};
+use super::xml::{attr, error, identifier, origin, variable_ref, ExecOrder, Note, Notes, Tc6, R};
+use plc_diag::{Invalid, LoadError, Origin};
+use plc_syntax::fbd::{Block, Connection, Input, Inputs, Network, OutVar, Outputs, Targets};
+use plc_syntax::{FbdBody, Scalar};
+use roxmltree::Node;
+use std::borrow::Cow;
+use std::cell::RefCell;
+use std::collections::HashMap;
+
+const FBD_TAGS: &[&str] = &[
+    "block",
+    "inVariable",
+    "outVariable",
+    "inOutVariable",
+    "connector",
+    "continuation",
+    "jump",
+    "label",
+    "return",
+    "comment",
+];
+
+/// Reads FBD body `node` of POU `pou`.
+pub fn body(tc6: Tc6, node: Node, pou: &str, ctx: &Ctx, notes: &mut Notes) -> R<FbdBody<'static>> {
+    let place = format!("pou {pou}, FBD");
+    let g = graph(tc6, node, &place, notes)?;
+    g.only(FBD_TAGS, "FBD", &place)?;
+    let mut ordered = Vec::new();
+    for el in &g.elems {
+        if let Some(x) = el
+            .node
+            .attribute("executionOrderId")
+            .and_then(|x| x.trim().parse::<u32>().ok())
+        {
+            if x > 0 {
+                ordered.push((x, el.local_id));
+            }
+        }
+    }
+    ordered.sort_unstable();
+    let f = Fbd {
+        g: &g,
+        place,
+        a: RefCell::new(Added::new(&g)),
+        ctx,
+        boxes: RefCell::new(std::mem::take(&mut notes.black_boxes)),
+        notes: RefCell::new(Vec::new()),
+        eno_ends: RefCell::new(HashMap::new()),
+    };
+    let mut networks: Vec<Network<'static>> = Vec::new();
+    let mut current: Vec<Block<'static>> = Vec::new();
+    let mut label: Option<(String, Node)> = None;
+    let mut labels = 0;
+    let mut comments: Vec<String> = Vec::new();
+    for (i, el) in g.elems.iter().enumerate() {
+        let e = ElemId(i as u32);
+        match el.tag {
+            "label" => {
+                let here = g.place(&f.place, e);
+                let l = identifier(attr(el.node, "label", &here)?, "label", el.node, &here)?;
+                if !current.is_empty() || label.is_some() {
+                    let k = networks.len();
+                    f.close_loops(&mut current);
+                    networks.push(network(
+                        pou,
+                        k,
+                        label.take(),
+                        std::mem::take(&mut current),
+                        std::mem::take(&mut comments),
+                    ));
+                }
+                labels += 1;
+                label = Some((l, el.node));
+            }
+            "comment" => {
+                let t: String = el
+                    .node
+                    .descendants()
+                    .filter(|d| d.is_text())
+                    .filter_map(|d| d.text())
+                    .collect();
+                if !t.trim().is_empty() {
+                    comments.push(t.trim().to_owned());
+                }
+            }
+            "block" => current.push(f.block(e)?),
+            "jump" | "return" => current.push(f.control(e)?),
+            "outVariable" | "inOutVariable" => {
+                if let Some(b) = f.variable_move(e)? {
+                    current.push(b);
+                }
+            }
+            _ => {}
+        }
+        current.append(&mut f.a.borrow_mut().blocks);
+    }
+    let k = networks.len();
+    f.close_loops(&mut current);
+    networks.push(network(pou, k, label, current, comments));
+    if labels == 0 {
+        if let Some(n) = networks.first_mut() {
+            n.id = Ok(Cow::Owned(pou.to_owned()));
+        }
+    }
+    notes.black_boxes = f.boxes.take();
+    notes.list.extend(f.notes.take());
+    let vars = std::mem::take(&mut f.a.borrow_mut().vars);
+    notes
+        .ld_vars
+        .extend(vars.into_iter().map(|v| (pou.to_owned(), v)));
+    if !ordered.is_empty() {
+        notes.exec_orders.push(ExecOrder {
+            networks: networks
+                .iter()
+                .filter_map(|n| n.id.as_ref().ok().map(|i| i.to_string()))
+                .collect(),
+            origin: origin(node),
+            ids: ordered,
+        });
+    }
+    Ok(FbdBody {
+        origin: origin(node),
+        comment: None,
+        networks,
+        problem: None,
+    })
+}
+
+fn network(
+    pou: &str,
+    k: usize,
+    label: Option<(String, Node)>,
+    blocks: Vec<Block<'static>>,
+    comments: Vec<String>,
+) -> Network<'static> {
+    let at = label
+        .as_ref()
+        .map_or(plc_diag::Origin::NONE, |(_, n)| origin(*n));
+    Network {
+        origin: at,
+        id: Ok(Cow::Owned(format!("{pou}.N{}", k + 1))),
+        label: label.map(|(l, _)| Ok(Cow::Owned(l))),
+        comment: (!comments.is_empty()).then(|| Ok(Cow::Owned(comments.join("\n")))),
+        blocks: Ok(blocks),
+        problem: None,
+    }
+}
+
+struct Fbd<'g, 'a, 'i> {
+    g: &'g Graph<'a, 'i>,
+    place: String,
+    /// Blocks the reader adds (NOT of a negated pin, edge detectors), for the current network.
+    a: RefCell<Added>,
+    /// What blocks may call, and the types of the names the body sees.
+    ctx: &'g Ctx,
+    /// The project's black boxes so far ([`black_box`]).
+    boxes: RefCell<Vec<BlackBox>>,
+    notes: RefCell<Vec<Note>>,
+    /// For a block, the block at the end of its chain of ENO → EN wires ([`Fbd::eno`]).
+    eno_ends: RefCell<HashMap<ElemId, ElemId>>,
+}
+
+impl Fbd<'_, '_, '_> {
+    fn at(&self, e: ElemId) -> String {
+        self.g.place(&self.place, e)
+    }
+
+    fn new_block(&self, e: ElemId, op: &str) -> Block<'static> {
+        let el = self.g.get(e);
+        Block {
+            origin: origin(el.node),
+            id: Ok(el.local_id),
+            op: Ok(Cow::Owned(op.to_owned())),
+            inputs: None,
+            outputs: None,
+            instance: None,
+            label: None,
+            cond: None,
+            after: None,
+            comment: None,
+            problem: None,
+        }
+    }
+
+    fn block(&self, e: ElemId) -> R<Block<'static>> {
+        let el = self.g.get(e);
+        let here = self.at(e);
+        let mut ty = attr(el.node, "typeName", &here)?;
+        let declared_type;
+        let mut b = self.new_block(e, ty);
+        if let Some(inst) = el.node.attribute("instanceName") {
+            b.instance = Some(Ok(Cow::Owned(identifier(
+                inst, "instance", el.node, &here,
+            )?)));
+            // Beremiz calls the instance by name, so the instance's type decides what runs.
+            if let Some(declared) = self.ctx.fb_type_of(inst).filter(|d| d != ty) {
+                self.notes.borrow_mut().push(Note {
+                    origin: origin(el.node),
+                    message: format!("{here}: the block is a {ty} but its instance `{inst}` is declared {declared}; it is read as a call of {declared} (Beremiz calls the instance by name)"),
+                });
+                declared_type = declared;
+                ty = &declared_type;
+                b.op = Ok(Cow::Owned(ty.to_owned()));
+            }
+        }
+        let mut inputs = Vec::new();
+        for pin in &el.inputs {
+            let name = pin.name.unwrap_or("");
+            let (negated, edge) = pin_modifiers(pin.node, ty, name, el.local_id, &here)?;
+            let mut input = match pin.sources.as_slice() {
+                // An unconnected BOOL input of a standard function block keeps its initial
+                // value FALSE (nothing in the body sets it, IEC 61131-3 2.5.2.1).
+                [] if black_box::is_standard_fb(ty)
+                    && self.ctx.input_type(ty, name).as_deref() == Some("BOOL") =>
+                {
+                    konst(false, origin(pin.node))
+                }
+                [] => continue,
+                [s] => self.input(e, s)?,
+                _ => {
+                    return Err(error(
+                        origin(pin.node),
+                        &here,
+                        format!("input {name} of {ty} (localId {}) has {} connections; an FBD pin takes one", el.local_id, pin.sources.len()),
+                    ))
+                }
+            };
+            let at = origin(pin.node);
+            let counter_edge = matches!(ty, "CTU" | "CTD" | "CTUD") && matches!(name, "CU" | "CD");
+            let mut a = self.a.borrow_mut();
+            match edge {
+                Some(edge) if !(counter_edge && edge == "rising") => {
+                    input = a.trigger(edge, input, el.local_id, at)
+                }
+                _ => {}
+            }
+            if negated {
+                input = a.not(input, at);
+            }
+            drop(a);
+            if let Connection::Variable(v) = &input.from {
+                if let Some(k) = super::library::library_constant(ty, name, v) {
+                    input.from = Connection::Constant(Scalar::Number(k.into()));
+                }
+            }
+            input = bool_literal(self.ctx, ty, name, input);
+            if name == "EN" {
+                b.cond = Some(input);
+            } else {
+                inputs.push((Cow::Owned(name.to_owned()), input));
+            }
+        }
+        b.inputs = Some(Ok(Inputs::Named(inputs)));
+        let t = black_box::Typer {
+            ctx: self.ctx,
+            g: self.g,
+        };
+        self.a
+            .borrow_mut()
+            .compare(&mut b, el.inputs.len(), &|i: &Input| t.input(i, 0));
+        if !black_box::is_known(self.ctx, ty) || black_box::mixed_arithmetic(&t, ty, &b) {
+            let mut boxes = self.boxes.borrow_mut();
+            if let Some((inst, bt)) = black_box::rewrite(&t, e, &mut b, &mut boxes, &here)? {
+                self.a.borrow_mut().declare(&inst, &bt, b.origin);
+            }
+        }
+        for (pin, pnode) in &el.outputs {
+            let targets = self.targets(e, pin, el.outputs.first().map(|o| o.0) == Some(*pin))?;
+            let negated = matches!(pnode.attribute("negated"), Some("true" | "1"));
+            let targets = if negated && !targets.is_empty() {
+                // The variables a negated output writes get NOT of it.
+                let at = origin(*pnode);
+                let arc = Input {
+                    origin: at,
+                    from: Connection::Arc {
+                        block: el.local_id,
+                        pin: Some(Ok(Cow::Owned(pin_of(pin).to_owned()))),
+                    },
+                };
+                let mut a = self.a.borrow_mut();
+                a.not(arc, at);
+                if let Some(n) = a.blocks.last_mut() {
+                    n.outputs = Some(Ok(Outputs::Named(vec![(
+                        Cow::Borrowed("OUT"),
+                        Ok(Targets::Many(targets.into_iter().map(Ok).collect())),
+                    )])));
+                }
+                Vec::new()
+            } else {
+                targets
+            };
+            if *pin == "ENO" && !targets.is_empty() {
+                // ENO is EN (IEC 61131-3 2.5.1.2: TRUE when the block ran without error).
+                let en = self.eno(e, origin(*pnode))?;
+                let mut a = self.a.borrow_mut();
+                a.add_on("MOVE", None, Inputs::List(vec![en]), origin(*pnode));
+                if let Some(m) = a.blocks.last_mut() {
+                    for t in targets {
+                        add_target(m, "OUT".to_owned(), t);
+                    }
+                }
+                continue;
+            }
+            for t in targets {
+                add_target(&mut b, pin_of(pin).to_owned(), t);
+            }
+        }
+        Ok(b)
+    }
+
+    /// The out and in-out variables output `pin` of block `e` writes (`first`: the block's first
+    /// output, which a connection without `formalParameter` means).
+    fn targets(&self, e: ElemId, pin: &str, first: bool) -> R<Vec<OutVar<'static>>> {
+        let mut out = Vec::new();
+        for &(c, _, p) in &self.g.consumers[e.0 as usize] {
+            let cel = self.g.get(c);
+            let this = match p {
+                Some(p) => p == pin,
+                None => first,
+            };
+            if this && matches!(cel.tag, "outVariable" | "inOutVariable") {
+                out.push(OutVar {
+                    origin: origin(cel.node),
+                    name: Cow::Owned(self.var_name(c)?),
+                });
+            }
+        }
+        Ok(out)
+    }
+
+    fn var_name(&self, e: ElemId) -> R<String> {
+        let el = self.g.get(e);
+        let text = el
+            .node
+            .children()
+            .find(|c| c.is_element() && c.tag_name().name() == "expression")
+            .and_then(|c| c.text())
+            .ok_or_else(|| {
+                error(
+                    origin(el.node),
+                    &self.at(e),
+                    format!("the {} has no expression", el.tag),
+                )
+            })?;
+        variable_ref(text, el.node, &self.at(e))
+    }
+
+    /// Cuts the loops of arcs among `blocks` as Beremiz closes them ([`super::fbd_loops`]).
+    fn close_loops(&self, blocks: &mut [Block<'static>]) {
+        let t = black_box::Typer {
+            ctx: self.ctx,
+            g: self.g,
+        };
+        let ty = |id: u32, pin: Option<&str>| {
+            let e = self.g.elems.iter().position(|el| el.local_id == id)?;
+            t.output(ElemId(e as u32), pin, 0)
+        };
+        let notes = super::fbd_loops::cut(blocks, &mut self.a.borrow_mut(), &ty, &self.place);
+        self.notes.borrow_mut().extend(notes);
+    }
+
+    /// The ENO of block `e`: what feeds its EN, TRUE without one. An EN fed by another block's
+    /// ENO is that block's ENO: the chain is followed without recursion (a long chain of
+    /// ENO → EN wires is a loop, not a deep call), each block's end of chain is remembered
+    /// (so n blocks cost n steps in all), and a chain that comes back to a block of it is a
+    /// cycle of arcs (E0409) naming the blocks' localIds.
+    fn eno(&self, e: ElemId, at: Origin) -> R<Input<'static>> {
+        let en_source = |b: ElemId| {
+            self.g
+                .get(b)
+                .inputs
+                .iter()
+                .find(|p| p.name == Some("EN"))
+                .and_then(|p| match p.sources.as_slice() {
+                    [s] => Some(s),
+                    _ => None,
+                })
+        };
+        let enos = |s: &Source| self.g.get(s.elem).tag == "block" && s.pin == Some("ENO");
+        let mut chain = vec![e];
+        let mut on_chain = std::collections::HashSet::from([e]);
+        let mut ends = self.eno_ends.borrow_mut();
+        let end = loop {
+            let cur = *chain.last().expect("starts with e");
+            if let Some(&end) = ends.get(&cur) {
+                break end;
+            }
+            match en_source(cur) {
+                Some(s) if enos(s) => {
+                    if !on_chain.insert(s.elem) {
+                        let from = chain.iter().position(|&b| b == s.elem).expect("on it");
+                        let mut ids: Vec<String> = chain[from..]
+                            .iter()
+                            .map(|&b| self.g.get(b).local_id.to_string())
+                            .collect();
+                        ids.reverse();
+                        ids.push(ids[0].clone());
+                        return Err(LoadError::invalid(
+                            None,
+                            &self.at(cur),
+                            Invalid::Cycle {
+                                blocks: ids.join(" → "),
+                            },
+                        )
+                        .at(s.origin)
+                        .with_hint("each block's EN is wired to the ENO of the block before it"));
+                    }
+                    chain.push(s.elem);
+                }
+                _ => break cur,
+            }
+        };
+        for &b in &chain {
+            ends.insert(b, end);
+        }
+        drop(ends);
+        match en_source(end) {
+            Some(s) => self.input(end, s),
+            None => Ok(konst(true, at)),
+        }
+    }
+
+    /// What source `s` gives to an input of block `consumer`.
+    fn input(&self, consumer: ElemId, s: &Source) -> R<Input<'static>> {
+        let src = self.g.get(s.elem);
+        match src.tag {
+            "block" if s.pin == Some("ENO") => self.eno(s.elem, s.origin),
+            "block" => {
+                let arc = Input {
+                    origin: s.origin,
+                    from: Connection::Arc {
+                        block: src.local_id,
+                        pin: s.pin.map(|p| Ok(Cow::Owned(pin_of(p).to_owned()))),
+                    },
+                };
+                if output_negated(&src.outputs, s.pin) {
+                    return Ok(self.a.borrow_mut().not(arc, s.origin));
+                }
+                Ok(arc)
+            }
+            "inVariable" | "inOutVariable" => super::expression::block_input(
+                &mut self.a.borrow_mut(),
+                src.node,
+                &self.at(s.elem),
+                s.origin,
+            ),
+            other => Err(error(
+                s.origin,
+                &self.at(consumer),
+                format!(
+                    "a {other} (localId {}) cannot feed an input in FBD",
+                    src.local_id
+                ),
+            )),
+        }
+    }
+
+    /// JMP and RET blocks.
+    fn control(&self, e: ElemId) -> R<Block<'static>> {
+        let el = self.g.get(e);
+        let here = self.at(e);
+        let mut b = self.new_block(e, if el.tag == "jump" { "JMP" } else { "RET" });
+        if el.tag == "jump" {
+            let l = identifier(attr(el.node, "label", &here)?, "label", el.node, &here)?;
+            b.label = Some(Ok(Cow::Owned(l)));
+        }
+        match el.inputs.first().map(|p| p.sources.as_slice()) {
+            Some([s]) => b.cond = Some(self.input(e, s)?),
+            Some([]) | None => {}
+            Some(more) => {
+                return Err(error(
+                    origin(el.node),
+                    &here,
+                    format!(
+                        "the {} has {} connections; it takes one",
+                        el.tag,
+                        more.len()
+                    ),
+                ))
+            }
+        }
+        Ok(b)
+    }
+
+    /// An out or in-out variable fed directly by a variable: a MOVE block (a variable fed by a
+    /// block is one of that block's outputs, `None` here).
+    fn variable_move(&self, e: ElemId) -> R<Option<Block<'static>>> {
+        let el = self.g.get(e);
+        let here = self.at(e);
+        let sources = el
+            .inputs
+            .first()
+            .map(|p| p.sources.as_slice())
+            .unwrap_or(&[]);
+        match sources {
+            [] if el.tag == "inOutVariable" => Ok(None),
+            [] => Err(error(
+                origin(el.node),
+                &here,
+                format!("outVariable localId {} is not connected", el.local_id),
+            )),
+            [s] if self.g.get(s.elem).tag == "block" => Ok(None),
+            [s] => {
+                let mut b = self.new_block(e, "MOVE");
+                b.inputs = Some(Ok(Inputs::List(vec![self.input(e, s)?])));
+                b.outputs = Some(Ok(Outputs::First(OutVar {
+                    origin: origin(el.node),
+                    name: Cow::Owned(self.var_name(e)?),
+                })));
+                Ok(Some(b))
+            }
+            more => Err(error(
+                origin(el.node),
+                &here,
+                format!(
+                    "{} localId {} has {} connections; it takes one",
+                    el.tag,
+                    el.local_id,
+                    more.len()
+                ),
+            )),
+        }
+    }
+}

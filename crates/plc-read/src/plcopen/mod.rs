@@ -1,0 +1,87 @@
+//! PLCopen TC6 XML (the exchange format of IEC 61131-3 editors: Beremiz, OpenPLC Editor,
+//! CODESYS) → the surface syntax ([`plc_syntax`]), so that resolution, checks, analysis and
+//! execution are the JSON format's.
+//!
+//! The text is parsed by `roxmltree` (no DTD, so no entity expansion; at most
+//! [`xml::MAX_XML_BYTES`]; nesting at most [`xml::MAX_DEPTH`]); the project must be in one of
+//! the namespaces tc6_0201, tc6_0200 or the pre-2.0 tc6.xsd ([`xml::NAMESPACES`]), elements
+//! are matched by local name. [`project`] reads the POUs and configurations, [`interface`] the
+//! variable lists ([`data_types`] the data types, [`structure`] a structure flattened into its
+//! fields), [`ld`] (with [`ld_power`], [`ld_block`], [`ld_logic`] and the shared [`wiring`] graph) the
+//! LD bodies ([`ld_flow`]: those that are not series-parallel rungs, as Beremiz's data-flow
+//! network), [`fbd`] the FBD bodies ([`black_box`]: conversions and blocks the model lacks; [`expression`]: in variables' expressions), [`st_body`] the ST bodies (a stand-in rung per statement,
+//! from the ST parser), [`textual`] stands IL and SFC bodies in by their interface. What the reader did that changes meaning or skips vendor data is a [`Note`]
+//! (a warning with its place). The mapping, the order rules and their sources:
+//! docs/plcopen.md; the research behind them: docs/design/plcopen-semantics.md.
+//!
+//! Invariants: every error is one [`LoadError`] located at the XML node it is about (line and
+//! column computed from its byte offset); a construct the reader does not handle is an error,
+//! never dropped; a program loads whole or not at all.
+
+mod black_box;
+mod data_types;
+mod expression;
+mod fbd;
+mod fbd_loops;
+mod interface;
+mod ld;
+mod ld_block;
+mod ld_flow;
+mod ld_logic;
+mod ld_power;
+mod library;
+mod pins;
+mod project;
+mod st_body;
+mod structure;
+mod textual;
+mod wiring;
+mod xml;
+
+pub use xml::{ExecOrder, Note, Notes, MAX_XML_BYTES, NAMESPACES};
+
+use plc_diag::LoadError;
+use plc_syntax as syntax;
+
+/// True when the text is XML rather than JSON: its first non-blank character is `<`.
+pub fn looks_like_xml(text: &str) -> bool {
+    text.trim_start_matches('\u{feff}')
+        .trim_start()
+        .starts_with('<')
+}
+
+/// Reads a PLCopen project into the surface syntax, with the reader's notes (errors carry line
+/// and column).
+pub fn parse(text: &str) -> Result<(syntax::Program<'static>, Notes), LoadError> {
+    parse_selected(text, None)
+}
+
+/// [`parse`], keeping only the program POU named `select` (any case) when it is given: it is
+/// then the main program, as if the project had no other (an error listing the programs when
+/// there is none of that name).
+pub fn parse_selected(
+    text: &str,
+    select: Option<&str>,
+) -> Result<(syntax::Program<'static>, Notes), LoadError> {
+    let doc = xml::parse(text)?;
+    let ns = xml::project_namespace(&doc).map_err(|e| e.locate(text))?;
+    let mut notes = Notes::default();
+    let mut program =
+        project::program(xml::Tc6 { ns }, &doc, select, &mut notes).map_err(|e| e.locate(text))?;
+    program.skipped = std::mem::take(&mut notes.skipped);
+    Ok((program, notes))
+}
+
+/// The error `run` gives for what the reader noted it cannot execute (a string in an LD or FBD
+/// body), located at that place.
+pub fn run_refusal(note: Note, text: &str) -> LoadError {
+    xml::error(note.origin, "run", note.message).locate(text)
+}
+
+/// A note as the command line prints it after `warning: ` (`FILE:LINE:COLUMN: message`).
+pub fn note_text(file: &str, text: &str, n: &Note) -> String {
+    match n.origin.line_column(text) {
+        Some((l, c)) => format!("{file}:{l}:{c}: {}", n.message),
+        None => format!("{file}: {}", n.message),
+    }
+}

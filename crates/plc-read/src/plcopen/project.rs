@@ -1,0 +1,756 @@
+//! The project structure (TC6 `project`: `types/pous`, `types/dataTypes`,
+//! `instances/configurations`) → one syntax [`Program`]: the program POUs, the function block
+//! types, the global variables, and the order in which the tasks run the program instances.
+//!
+//! One program POU (instantiated at most once) is the main program: its variables and the
+//! globals are the program's variables. Several program POUs become subroutines of the same
+//! name, run by a main body of call rungs `<task>.<instance>` in task order — tasks by priority
+//! (0 first, ties in file order), each task's program instances in file order, then the
+//! resource's instances without a task (IEC 61131-3 6.8.2 gives each task its own interval;
+//! plc-deps runs every instance once a scan in that order, and a note says so when there are
+//! several tasks). Function block POUs become function block types.
+//!
+//! A function POU (it has a return type) is not part of the model: its calls in ST are black
+//! boxes (the ST reader reads the arguments and writes what the call assigns), and a note says
+//! its body is not read.
+//!
+//! Deliberately not here (errors naming the POU): a program instantiated twice,
+//! several configurations or resources, POUs with actions or transitions outside SFC.
+
+use super::black_box::{Ctx, Sig};
+use super::data_types::DataTypes;
+use super::interface::{self, name, Interface, Known};
+use super::xml::{add_data_note, attr, error, identifier, origin, Note, Notes, Tc6, R};
+use super::{fbd, ld, ld_flow, library, st_body, textual};
+use plc_diag::LoadError;
+use plc_model::{Configuration, ProgramInstance, Resource, Task};
+use plc_syntax::{
+    Body, Element, ElementKind, FunctionBlock, Program, RoutineKind, Rung, Subroutine, Var,
+};
+use roxmltree::{Document, Node};
+use std::collections::HashSet;
+
+/// A program POU as read.
+struct ProgramPou {
+    name: String,
+    origin: plc_diag::Origin,
+    vars: Vec<Var<'static>>,
+    body: Body<'static>,
+}
+
+/// Reads the whole project.
+/// With `select`, only the program POU of that name (any case) is kept, as the main program.
+pub fn program(
+    tc6: Tc6,
+    doc: &Document,
+    select: Option<&str>,
+    notes: &mut Notes,
+) -> R<Program<'static>> {
+    let root = doc.root_element();
+    add_data_note(tc6, root, notes);
+    if let Some(ch) = tc6.child(root, "contentHeader") {
+        add_data_note(tc6, ch, notes);
+    }
+    let types = tc6.child(root, "types");
+    let known = Known {
+        data_types: DataTypes::read(tc6, types.and_then(|t| tc6.child(t, "dataTypes")))?,
+    };
+    // The interfaces first, then the globals, then the bodies: an ST body resolves its names
+    // against them all.
+    let mut read = Vec::new();
+    let pous = types.and_then(|t| tc6.child(t, "pous"));
+    for pou in pous.into_iter().flat_map(|p| tc6.children(p, "pou")) {
+        let raw = attr(pou, "name", "types/pous")?;
+        let pname = identifier(raw, "POU", pou, "types/pous")?;
+        let place = format!("pou {pname}");
+        let kind = attr(pou, "pouType", &place)?;
+        if !matches!(kind, "program" | "functionBlock" | "function") {
+            return Err(error(
+                origin(pou),
+                &place,
+                format!("unknown pouType `{kind}` of POU `{pname}`"),
+            ));
+        }
+        let iface = interface::interface(tc6, tc6.child(pou, "interface"), &pname, &known)?;
+        read.push((pou, pname, kind, iface));
+    }
+    let mut later = Notes::default();
+    let mut mapped_globals = Vec::new();
+    let (mut globals, order, configuration) =
+        instances(tc6, root, &known, &mut later, &mut mapped_globals)?;
+    undeclared_globals(&read, &mut globals, &mut mapped_globals, notes);
+    let mapped: Vec<(Option<String>, interface::Mapped)> = read
+        .iter()
+        .flat_map(|(_, p, _, i)| i.mapped.iter().map(|m| (Some(p.clone()), m.clone())))
+        .chain(mapped_globals.into_iter().map(|m| (None, m)))
+        .collect();
+    later.list.extend(interface::mapped_notes(&mapped));
+    let global_types: Vec<(&str, &str)> = globals
+        .iter()
+        .chain(read.iter().flat_map(|r| &r.3.globals))
+        .map(|v| (v.name.as_str(), v.ty.as_str()))
+        .collect();
+    let base = base_ctx(&read);
+    let mut bodies = Vec::new();
+    for (pou, pname, kind, iface) in &read {
+        add_data_note(tc6, *pou, notes);
+        check_return(*pou, pname, kind, iface)?;
+        if *kind == "function" {
+            notes.push(function_note(*pou, pname));
+            bodies.push(None);
+            continue;
+        }
+        let scope = scope(iface, &global_types, &known);
+        let ctx = pou_ctx(&base, iface, &global_types);
+        bodies.push(Some(body(tc6, *pou, pname, iface, &scope, &ctx, notes)?));
+    }
+    notes.list.extend(later.list);
+    let (mut programs, mut fbs) = (Vec::new(), Vec::new());
+    for ((pou, pname, kind, iface), body) in read.into_iter().zip(bodies) {
+        let place = format!("pou {pname}");
+        // A function is called, not instantiated: it has no body in the model.
+        let Some(body) = body else { continue };
+        match kind {
+            "program" => {
+                let mut vars = iface.inputs;
+                vars.extend(iface.outputs);
+                vars.extend(iface.locals);
+                vars.extend(iface.globals);
+                vars.extend(notes.take_ld_vars(&pname));
+                programs.push(ProgramPou {
+                    name: pname,
+                    origin: origin(pou),
+                    vars,
+                    body,
+                });
+            }
+            "functionBlock" => {
+                if let Some(g) = iface.globals.first() {
+                    return Err(error(
+                        g.origin,
+                        &place,
+                        format!("function block `{pname}` declares global variables"),
+                    ));
+                }
+                fbs.push(FunctionBlock {
+                    origin: origin(pou),
+                    name: pname.clone().into(),
+                    inputs: iface.inputs,
+                    outputs: iface.outputs,
+                    vars: iface
+                        .locals
+                        .into_iter()
+                        .chain(notes.take_ld_vars(&pname))
+                        .collect(),
+                    body: Some(body),
+                });
+            }
+            // A function (its body is `None`, skipped above).
+            _ => {}
+        }
+    }
+    for b in std::mem::take(&mut notes.black_boxes) {
+        let (fb, note) = library::black_box_type(&b);
+        fbs.push(fb);
+        notes.push(note);
+    }
+    library_fbs(&mut fbs, &programs, &globals, notes);
+    if let Some(s) = select {
+        // `run` runs the selected program alone: the others' bodies do not matter to it.
+        let others: Vec<&str> = programs
+            .iter()
+            .map(|p| p.name.as_str())
+            .filter(|n| !n.eq_ignore_ascii_case(s))
+            .collect();
+        notes
+            .no_run
+            .retain(|(pou, _)| !others.contains(&pou.as_str()));
+    }
+    let (programs, order) = match select {
+        Some(s) => selected(root, programs, order, s)?,
+        None => (programs, order),
+    };
+    let mut program = assemble(root, programs, fbs, globals, order)?;
+    program.configuration = configuration;
+    Ok(program)
+}
+
+/// Adds the stand-in type of each library block ([`super::library`]) that a variable is an
+/// instance of and the project does not define, with its note.
+fn library_fbs(
+    fbs: &mut Vec<FunctionBlock<'static>>,
+    programs: &[ProgramPou],
+    globals: &[Var<'static>],
+    notes: &mut Notes,
+) {
+    let mut uses: Vec<(String, plc_diag::Origin, Vec<String>)> = Vec::new();
+    let fb_vars = fbs.iter().flat_map(|f| {
+        f.inputs
+            .iter()
+            .chain(&f.outputs)
+            .chain(&f.vars)
+            .map(move |v| (f.name.to_string(), v))
+    });
+    let prog_vars = programs
+        .iter()
+        .flat_map(|p| p.vars.iter().map(move |v| (p.name.clone(), v)));
+    let all: Vec<(String, &Var<'static>)> = fb_vars
+        .chain(prog_vars)
+        .chain(globals.iter().map(|v| (String::new(), v)))
+        .collect();
+    for (pou, v) in all {
+        let ty = v.ty.as_str();
+        if !library::is_library_fb(ty) || fbs.iter().any(|f| f.name.as_ref() == ty) {
+            continue;
+        }
+        let who = if pou.is_empty() {
+            v.name.as_str().to_owned()
+        } else {
+            format!("{pou}.{}", v.name.as_str())
+        };
+        match uses.iter_mut().find(|u| u.0 == ty) {
+            Some(u) => u.2.push(who),
+            None => uses.push((ty.to_owned(), v.origin, vec![who])),
+        }
+    }
+    for (ty, at, who) in uses {
+        if let Some((fb, note)) = library::stand_in_fb(&ty, at, &who) {
+            fbs.push(fb);
+            notes.push(note);
+        }
+    }
+}
+
+/// The program POU named `select` (any case) alone, with its instances: an error listing the
+/// project's programs when none has that name.
+fn selected<'a, 'i>(
+    root: Node,
+    programs: Vec<ProgramPou>,
+    order: Order<'a, 'i>,
+    select: &str,
+) -> R<(Vec<ProgramPou>, Order<'a, 'i>)> {
+    let names: Vec<&str> = programs.iter().map(|p| p.name.as_str()).collect();
+    let Some(i) = names.iter().position(|n| n.eq_ignore_ascii_case(select)) else {
+        return Err(error(
+            origin(root),
+            "types/pous",
+            format!(
+                "--pou {select}: the project has no program of that name; its programs are {}",
+                names.join(", ")
+            ),
+        ));
+    };
+    let name = names[i].to_owned();
+    let order = order.into_iter().filter(|o| o.1 == name).collect();
+    let keep = programs.into_iter().nth(i).into_iter().collect();
+    Ok((keep, order))
+}
+
+/// A function must have a return type (IEC 61131-3 6.6.2), and nothing else may have one.
+fn check_return(pou: Node, pname: &str, kind: &str, iface: &Interface) -> R<()> {
+    let place = format!("pou {pname}");
+    match (kind == "function", iface.returns) {
+        (true, Some(_)) | (false, None) => Ok(()),
+        (true, None) => Err(error(
+            origin(pou),
+            &place,
+            format!("function `{pname}` has no return type"),
+        )),
+        (false, Some(at)) => Err(error(
+            at,
+            &format!("{place}, returnType"),
+            format!("POU `{pname}` is a {kind} but has a return type: only a function has one"),
+        )),
+    }
+}
+
+/// The note of a function POU: its calls are black boxes, its body is not read.
+fn function_note(pou: Node, pname: &str) -> Note {
+    Note {
+        origin: origin(pou),
+        message: format!("pou {pname}: a function; its body is not read: a call of it in an ST body is analysed as a black box through its arguments (the inputs it is given read, the result and the outputs assigned written), and `run` does not execute it"),
+    }
+}
+
+/// The names an ST body of a POU with interface `iface` sees: its own variables and the globals
+/// it declares external (`globals`: the name and type of every global of the project).
+fn scope(iface: &Interface, globals: &[(&str, &str)], known: &Known) -> st_body::Scope {
+    let mut s = st_body::Scope::default();
+    for v in iface
+        .inputs
+        .iter()
+        .chain(&iface.outputs)
+        .chain(&iface.locals)
+        .chain(&iface.globals)
+    {
+        s.declare(v.name.as_str(), v.ty.as_str());
+    }
+    for e in &iface.externals {
+        for (n, t) in globals.iter().filter(|(n, _)| is_external(n, e)) {
+            s.declare(n, t);
+        }
+    }
+    for (v, _) in known.data_types.enum_values() {
+        s.constant(&v);
+    }
+    s
+}
+
+/// Puts the POUs together: one program as the main program, several as subroutines called in
+/// task order.
+fn assemble(
+    root: Node,
+    mut programs: Vec<ProgramPou>,
+    fbs: Vec<FunctionBlock<'static>>,
+    mut globals: Vec<Var<'static>>,
+    order: Vec<(String, String, Node)>,
+) -> R<Program<'static>> {
+    let mut seen = HashSet::new();
+    for (_, ty, n) in &order {
+        if !programs.iter().any(|p| &p.name == ty) {
+            return Err(error(
+                origin(*n),
+                "instances",
+                format!("program instance of `{ty}`, which is not a program POU of the project"),
+            ));
+        }
+        if !seen.insert(ty.clone()) {
+            return Err(error(
+                origin(*n),
+                "instances",
+                format!("program `{ty}` is instantiated twice: several instances of one program are not supported yet"),
+            ));
+        }
+    }
+    if programs.is_empty() {
+        return Err(error(
+            origin(root),
+            "types/pous",
+            "the project has no program POU",
+        ));
+    }
+    let mut program = Program {
+        origin: origin(root),
+        name: "project".into(),
+        function_blocks: fbs,
+        ..Program::default()
+    };
+    if programs.len() == 1 {
+        let p = programs.pop().expect("one program");
+        globals.extend(p.vars);
+        program.name = p.name.into();
+        program.vars = globals;
+        program.body = Some(p.body);
+        return Ok(program);
+    }
+    let mut calls = Vec::new();
+    for (task, ty, n) in &order {
+        let at = origin(*n);
+        calls.push(Rung {
+            origin: at,
+            id: name(format!("{task}.{ty}"), at),
+            label: None,
+            comment: None,
+            ld: vec![Element {
+                origin: at,
+                kind: ElementKind::Call(name(ty.clone(), at)),
+            }],
+            ld_origin: at,
+            problem: None,
+            problem_in_rung: false,
+        });
+    }
+    if calls.is_empty() {
+        return Err(error(
+            origin(root),
+            "instances",
+            "the project has several program POUs and no configuration that says which run: add a task with program instances",
+        ));
+    }
+    program.vars = globals;
+    program.body = Some(Body::Rungs(calls));
+    program.subroutines = programs
+        .into_iter()
+        .map(|p| Subroutine {
+            origin: p.origin,
+            kind: RoutineKind::Subroutine,
+            name: p.name.into(),
+            vars: p.vars,
+            body: Some(p.body),
+        })
+        .collect();
+    Ok(program)
+}
+
+/// The body of POU `pou` as syntax: LD rungs, an FBD body, a stand-in rung per ST statement,
+/// or an IL or SFC body through its interface.
+fn body(
+    tc6: Tc6,
+    pou: Node,
+    name: &str,
+    iface: &Interface,
+    scope: &st_body::Scope,
+    ctx: &Ctx,
+    notes: &mut Notes,
+) -> R<Body<'static>> {
+    let place = format!("pou {name}");
+    let Some(b) = tc6.child(pou, "body") else {
+        return Err(error(
+            origin(pou),
+            &place,
+            format!("POU `{name}` has no body"),
+        ));
+    };
+    if tc6.children(pou, "body").count() > 1 {
+        notes.push(Note {
+            origin: origin(b),
+            message: format!("{place}: only the first of its bodies is read (as Beremiz does)"),
+        });
+    }
+    add_data_note(tc6, b, notes);
+    let Some(lang) = tc6
+        .elements(b)
+        .find(|e| e.tag_name().name() != "documentation" && e.tag_name().name() != "addData")
+    else {
+        return Err(error(
+            origin(b),
+            &place,
+            format!("the body of POU `{name}` is empty"),
+        ));
+    };
+    let tag = lang.tag_name().name();
+    if tag != "SFC" {
+        for extra in ["actions", "transitions"] {
+            if let Some(a) = tc6.child(pou, extra) {
+                return Err(error(
+                    origin(a),
+                    &place,
+                    format!("POU `{name}` has {extra} but an {tag} body: actions and transitions are read only as part of SFC (not yet)"),
+                ));
+            }
+        }
+    }
+    if let (Some(m), "LD" | "FBD") = (iface.mapped.iter().find(|m| m.text), tag) {
+        notes.no_run.push((name.to_owned(), Note {
+            origin: m.origin,
+            message: format!("{place}: variable `{}` is a {}, for which plc-deps has no values: the analysis reads it as a whole variable, but `run` cannot execute the {tag} body of `{name}`", m.var, m.from),
+        }));
+    }
+    if let (Some(n), "LD" | "FBD") = (string_literal(lang), tag) {
+        notes.no_run.push((name.to_owned(), Note {
+            origin: origin(n),
+            message: format!("{place}: the {} localId {} is a string literal, for which plc-deps has no values: the analysis reads it as a constant, but `run` cannot execute the {tag} body of `{name}`", n.tag_name().name(), n.attribute("localId").unwrap_or("?")),
+        }));
+    }
+    let array_element = lang.children().find(|n| {
+        matches!(n.tag_name().name(), "inVariable" | "inOutVariable")
+            && super::expression::reads_array_element(*n)
+    });
+    if let (Some(n), "LD" | "FBD") = (array_element, tag) {
+        notes.no_run.push((name.to_owned(), Note {
+            origin: origin(n),
+            message: format!("{place}: the {} localId {} reads an array element, `{}`; the model holds an array as one value, so the analysis reads the whole array (and the subscripts), but `run` cannot execute the {tag} body of `{name}`", n.tag_name().name(), n.attribute("localId").unwrap_or("?"), super::expression::expression_text(n).trim()),
+        }));
+    }
+    Ok(match tag {
+        "LD" => ld_body(tc6, lang, name, ctx, notes)?,
+        "FBD" => Body::Fbd(fbd::body(tc6, lang, name, ctx, notes)?),
+        "ST" => Body::Rungs(st_body::rungs(lang, name, scope, notes)?),
+        "IL" | "SFC" => {
+            let reads: Vec<&Var> = iface.inputs.iter().collect();
+            let writes: Vec<&Var> = iface
+                .outputs
+                .iter()
+                .chain(&iface.locals)
+                .chain(&iface.globals)
+                .collect();
+            let externals: Vec<String> = iface
+                .externals
+                .iter()
+                .flat_map(|e| scope.fields_of(e))
+                .collect();
+            Body::Rungs(textual::through_interface(
+                tag, lang, name, &reads, &writes, &externals, notes,
+            ))
+        }
+        other => {
+            return Err(error(
+                origin(lang),
+                &place,
+                format!("unknown body language `{other}` of POU `{name}`"),
+            ))
+        }
+    })
+}
+
+/// Task order of program instances: the instance's task and type.
+type Order<'a, 'i> = Vec<(String, String, Node<'a, 'i>)>;
+
+/// The global variables of the configuration and its resource, the task order of the program
+/// instances, and the configuration as data.
+type Instances<'a, 'i> = (Vec<Var<'static>>, Order<'a, 'i>, Option<Configuration>);
+
+fn instances<'a, 'i>(
+    tc6: Tc6,
+    root: Node<'a, 'i>,
+    known: &Known,
+    notes: &mut Notes,
+    mapped: &mut Vec<interface::Mapped>,
+) -> R<Instances<'a, 'i>> {
+    let mut globals = Vec::new();
+    let mut order = Vec::new();
+    let Some(confs) = tc6
+        .child(root, "instances")
+        .and_then(|i| tc6.child(i, "configurations"))
+    else {
+        return Ok((globals, order, None));
+    };
+    let configurations: Vec<Node> = tc6.children(confs, "configuration").collect();
+    if configurations.len() > 1 {
+        return Err(error(
+            origin(configurations[1]),
+            "instances",
+            "several configurations are not supported yet",
+        ));
+    }
+    let Some(conf) = configurations.first().copied() else {
+        return Ok((globals, order, None));
+    };
+    add_data_note(tc6, conf, notes);
+    let place = "instances/configuration";
+    let mut configuration = Configuration {
+        name: identifier(attr(conf, "name", place)?, "configuration", conf, place)?,
+        resources: Vec::new(),
+    };
+    // The globals of the configuration, then of its resource.
+    let mut globals_of = |node: Node, globals: &mut Vec<Var<'static>>| -> R<()> {
+        for gv in tc6.children(node, "globalVars") {
+            let class = plc_syntax::VarClass::Default;
+            globals.extend(interface::var_list(tc6, gv, class, place, known, mapped)?);
+        }
+        Ok(())
+    };
+    globals_of(conf, &mut globals)?;
+    let resources: Vec<Node> = tc6.children(conf, "resource").collect();
+    if resources.len() > 1 {
+        return Err(error(
+            origin(resources[1]),
+            place,
+            "several resources are not supported yet",
+        ));
+    }
+    let Some(res) = resources.first().copied() else {
+        return Ok((globals, order, Some(configuration)));
+    };
+    globals_of(res, &mut globals)?;
+    let mut resource = Resource {
+        name: identifier(attr(res, "name", place)?, "resource", res, place)?,
+        ..Resource::default()
+    };
+    let mut tasks: Vec<(u32, Node)> = Vec::new();
+    for t in tc6.children(res, "task") {
+        let pr = t.attribute("priority").unwrap_or("0").trim();
+        let pr: u32 = pr.parse().map_err(|_| {
+            error(
+                origin(t),
+                place,
+                format!("task priority `{pr}` is not a whole number"),
+            )
+        })?;
+        tasks.push((pr, t));
+    }
+    tasks.sort_by_key(|(p, _)| *p);
+    let mut described = Vec::new();
+    for (pr, t) in &tasks {
+        let tname = identifier(attr(*t, "name", place)?, "task", *t, place)?;
+        let when = t
+            .attribute("interval")
+            .or(t.attribute("single"))
+            .unwrap_or("-");
+        described.push(format!("{tname} ({when}, priority {pr})"));
+        let mut task = Task {
+            name: tname.clone(),
+            interval: t.attribute("interval").map(str::to_owned),
+            single: t.attribute("single").map(str::to_owned),
+            priority: *pr,
+            instances: Vec::new(),
+        };
+        for pi in tc6.children(*t, "pouInstance") {
+            task.instances.push(program_instance(pi, place)?);
+            order.push((tname.clone(), instance_type(pi, place)?, pi));
+        }
+        resource.tasks.push(task);
+    }
+    for pi in tc6.children(res, "pouInstance") {
+        resource.instances.push(program_instance(pi, place)?);
+        order.push(("resource".into(), instance_type(pi, place)?, pi));
+    }
+    if tasks.len() > 1 {
+        notes.push(Note {
+            origin: origin(res),
+            message: format!("tasks {} run one after another in every scan (in priority order), not each at its own interval", described.join(", ")),
+        });
+    }
+    configuration.resources.push(resource);
+    Ok((globals, order, Some(configuration)))
+}
+
+/// A `pouInstance` as data: its name (an IEC identifier) and its program.
+fn program_instance(pi: Node, place: &str) -> R<ProgramInstance> {
+    Ok(ProgramInstance {
+        name: identifier(attr(pi, "name", place)?, "program instance", pi, place)?,
+        program: instance_type(pi, place)?,
+    })
+}
+
+/// The program a `pouInstance` runs (`typeName`; `type` in the pre-2.0 namespace).
+fn instance_type(pi: Node, place: &str) -> R<String> {
+    let ty = pi
+        .attribute("typeName")
+        .or(pi.attribute("type"))
+        .ok_or_else(|| error(origin(pi), place, "pouInstance has no typeName"))?;
+    identifier(ty, "program", pi, place)
+}
+
+/// An LD body: its rungs, or, where the rung reader cannot express its wiring as series-parallel
+/// rungs, the data-flow network Beremiz makes of it ([`ld_flow`]), with a note saying why. When
+/// both fail, the rung reader's error.
+fn ld_body(tc6: Tc6, lang: Node, name: &str, ctx: &Ctx, notes: &mut Notes) -> R<Body<'static>> {
+    let (list, vars) = (notes.list.len(), notes.ld_vars.len());
+    let why = match ld::rungs(tc6, lang, name, notes) {
+        Ok(r) => return Ok(Body::Rungs(r)),
+        Err(e) => e,
+    };
+    notes.list.truncate(list);
+    notes.ld_vars.truncate(vars);
+    match ld_flow::body(tc6, lang, name, ctx, notes) {
+        Ok(b) => {
+            let (at, what) = match &why {
+                LoadError::Invalid(d) => (d.location.origin, d.to_string()),
+                other => (origin(lang), other.to_string()),
+            };
+            notes.push(Note {
+                origin: at,
+                message: format!(
+                    "pou {name}: its LD body is read as a data-flow network (FBD networks {name}.N1 …, each rung's power flow as boolean blocks, as Beremiz generates LD) because it is not series-parallel rungs of contacts, coils and boxes: {what}"
+                ),
+            });
+            Ok(Body::Fbd(b))
+        }
+        Err(_) => Err(why),
+    }
+}
+
+/// What any body of the project may call: its user functions (with their pins' types) and the
+/// function block types of the project and of the library (with their outputs' types).
+fn base_ctx(read: &[(Node, String, &str, Interface)]) -> Ctx {
+    let pins = |v: &[Var]| -> Vec<(String, String)> {
+        v.iter()
+            .map(|v| (v.name.as_str().to_owned(), v.ty.as_str().to_owned()))
+            .collect()
+    };
+    let mut ctx = Ctx::default();
+    for (_, name, kind, iface) in read {
+        match *kind {
+            "function" => {
+                let mut outputs = Vec::new();
+                if let Some(t) = &iface.return_ty {
+                    outputs.push(("OUT".to_owned(), t.clone()));
+                }
+                outputs.extend(pins(&iface.outputs));
+                let sig = Sig {
+                    inputs: pins(&iface.inputs),
+                    outputs,
+                };
+                ctx.functions.insert(name.clone(), sig);
+            }
+            "functionBlock" => {
+                ctx.fbs.insert(name.clone(), pins(&iface.outputs));
+                ctx.fb_inputs.insert(name.clone(), pins(&iface.inputs));
+            }
+            _ => {}
+        }
+    }
+    for (name, inputs, outputs) in library::pins() {
+        if !ctx.fbs.contains_key(name) {
+            ctx.fbs.insert(name.to_owned(), outputs);
+            ctx.fb_inputs.insert(name.to_owned(), inputs);
+        }
+    }
+    ctx
+}
+
+/// [`base_ctx`] with the variables a POU sees (its own and the globals it names external).
+fn pou_ctx(base: &Ctx, iface: &Interface, globals: &[(&str, &str)]) -> Ctx {
+    let mut vars = std::collections::HashMap::new();
+    for v in iface
+        .inputs
+        .iter()
+        .chain(&iface.outputs)
+        .chain(&iface.locals)
+        .chain(&iface.globals)
+    {
+        vars.insert(
+            v.name.as_str().to_ascii_lowercase(),
+            v.ty.as_str().to_owned(),
+        );
+    }
+    for (n, t) in globals {
+        if iface.externals.iter().any(|e| is_external(n, e)) {
+            vars.insert(n.to_ascii_lowercase(), t.to_string());
+        }
+    }
+    Ctx {
+        functions: base.functions.clone(),
+        fbs: base.fbs.clone(),
+        fb_inputs: base.fb_inputs.clone(),
+        vars,
+    }
+}
+
+/// True when global variable `global` is external declaration `e` or, `e` being a structure
+/// flattened into its fields, one of them (`Motor.Speed` of `Motor`).
+fn is_external(global: &str, e: &str) -> bool {
+    global.eq_ignore_ascii_case(e)
+        || (global.len() > e.len()
+            && global.as_bytes()[e.len()] == b'.'
+            && global[..e.len()].eq_ignore_ascii_case(e))
+}
+
+/// The first `inVariable` of a graphical body whose expression is a string literal (`'…'`).
+fn string_literal<'a, 'i>(lang: Node<'a, 'i>) -> Option<Node<'a, 'i>> {
+    lang.children()
+        .filter(|n| n.tag_name().name() == "inVariable")
+        .find(|n| {
+            n.children()
+                .find(|c| c.tag_name().name() == "expression")
+                .and_then(|c| c.text())
+                .is_some_and(super::pins::is_string_literal)
+        })
+}
+
+/// Adds, as a global, each external variable whose global the file does not declare: Beremiz's
+/// extensions declare some in code they generate (SVGHMI's `CURRENT_PAGE_0`), so a POU
+/// names them external with their type. A note names them.
+fn undeclared_globals(
+    read: &[(Node, String, &str, Interface)],
+    globals: &mut Vec<Var<'static>>,
+    mapped: &mut Vec<interface::Mapped>,
+    notes: &mut Notes,
+) {
+    for (_, pou, _, iface) in read {
+        for v in &iface.external_decls {
+            let n = v.name.as_str();
+            let known = |g: &Var| g.name.as_str().eq_ignore_ascii_case(n);
+            if globals.iter().any(known) || read.iter().any(|r| r.3.globals.iter().any(known)) {
+                continue;
+            }
+            notes.push(Note {
+                origin: v.origin,
+                message: format!("pou {pou}: external variable `{n}` has no global declaration in the file (an editor extension declares it in code it generates, as Beremiz's SVGHMI does for CURRENT_PAGE_0): read as a global of its declared type {}", v.ty.as_str()),
+            });
+            globals.push(v.clone());
+            mapped.extend(iface.external_mapped.iter().filter(|m| m.var == n).cloned());
+        }
+    }
+}

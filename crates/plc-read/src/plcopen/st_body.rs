@@ -1,0 +1,390 @@
+//! ST bodies (TC6 `ST`, its text in an XHTML element, usually as CDATA) → one stand-in rung per
+//! top-level statement ([`super::textual::stand_in`]), from what the ST parser
+//! ([`crate::st`], IEC 61131-3 7.3) finds each statement reads and writes.
+//!
+//! A statement `k` (1-based, in text order) of POU `P` is rung `P.stk`, located at the
+//! statement's line and column in the XML file: the offsets of the ST text are translated to
+//! offsets of the file through its CDATA sections, entity and character references and line
+//! ends ([`file_offsets`]). A compound statement (IF, CASE, FOR, WHILE, REPEAT) is one rung with
+//! everything any of its parts reads (conditions and bounds included) and writes. Names resolve
+//! case-insensitively against the POU's declarations ([`Scope`]); a structure's field
+//! (`s.f`, the ST parser's access path) is its own variable, a structure named whole reads or
+//! writes every field, a field the structure lacks is an error naming the fields it has; a read of a standard function
+//! block instance reads its first output field (`T1.Q`, `B.Q1`, `C.QU`), which the analysis
+//! counts as reading the instance. The values of the project's enumerations are constants. Not seen by the analysis, and named in the POU's note: writes
+//! of instances (only an instance's own box writes it), reads of user function block
+//! instances, direct addresses (`%IX0.1`); a call of a function (standard, of the project or
+//! unknown) is a black box whose arguments are read and whose result and outputs are written where
+//! the call assigns them. A name that is neither declared nor called (a
+//! function) is an error at its statement; so is an ST syntax error, at its line and column.
+//!
+//! Deliberately not here: executing ST (`run` leaves the values unchanged, and the note says
+//! the body is not executed), IL and SFC (through their interface, [`super::textual`]).
+
+use super::textual::{stand_in, Read};
+use super::xml::{error, origin, Note, Notes, R};
+use crate::st;
+use plc_diag::Origin;
+use plc_syntax::Rung;
+use roxmltree::Node;
+use std::collections::HashMap;
+
+/// What a name of an ST body is: an elementary variable (with its type) or an instance (with
+/// the BOOL-or-not field a read of it stands for, when it has one).
+#[derive(Clone, Debug)]
+pub enum Decl {
+    Elementary {
+        name: String,
+        ty: String,
+    },
+    Instance {
+        name: String,
+        read: Option<Read>,
+    },
+    /// A value of an enumeration data type (a constant: reading it reads no variable).
+    Constant,
+    /// A structure (or a structure inside one) flattened into its fields: its leaf fields'
+    /// names and types. Reading or writing it whole reads or writes every one.
+    Structure {
+        leaves: Vec<(String, String)>,
+    },
+}
+
+/// The declarations an ST body sees, by lower-case name.
+#[derive(Default)]
+pub struct Scope {
+    pub names: HashMap<String, Decl>,
+}
+
+impl Scope {
+    /// Declares `name` of type `ty` (elementary or a function block type).
+    pub fn declare(&mut self, name: &str, ty: &str) {
+        let decl = if super::interface::is_elementary(ty) {
+            Decl::Elementary {
+                name: name.to_owned(),
+                ty: ty.to_owned(),
+            }
+        } else {
+            Decl::Instance {
+                name: name.to_owned(),
+                read: first_output(ty).map(|(f, b)| Read {
+                    name: format!("{name}.{f}"),
+                    bool: b,
+                }),
+            }
+        };
+        self.names.insert(name.to_ascii_lowercase(), decl);
+        // A structure's field (`Plant.Motor.Speed`) makes its structures (`Plant`,
+        // `Plant.Motor`) known as the sets of their fields.
+        let mut at = name.len();
+        while let Some(dot) = name[..at].rfind('.') {
+            at = dot;
+            let entry = self
+                .names
+                .entry(name[..at].to_ascii_lowercase())
+                .or_insert(Decl::Structure { leaves: Vec::new() });
+            if let Decl::Structure { leaves } = entry {
+                leaves.push((name.to_owned(), ty.to_owned()));
+            }
+        }
+    }
+
+    /// Declares an enumeration value (a constant), unless a variable has its name.
+    pub fn constant(&mut self, name: &str) {
+        self.names
+            .entry(name.to_ascii_lowercase())
+            .or_insert(Decl::Constant);
+    }
+
+    /// `name` as it is, or, when it is a structure, the names of its fields.
+    pub fn fields_of(&self, name: &str) -> Vec<String> {
+        match self.get(name) {
+            Some(Decl::Structure { leaves }) => leaves.iter().map(|(n, _)| n.clone()).collect(),
+            _ => vec![name.to_owned()],
+        }
+    }
+
+    fn get(&self, name: &str) -> Option<&Decl> {
+        self.names.get(&name.to_ascii_lowercase())
+    }
+
+    /// What access path `path` (`s`, `s.f`, `T1.Q`) names: the declaration of the path, else
+    /// of its longest declared prefix, with `true` when that is the whole path. A field of a
+    /// structure that has no such field is `Err` with the message.
+    fn find(&self, path: &str) -> Result<Option<(&Decl, bool)>, String> {
+        let mut at = path.len();
+        loop {
+            if let Some(d) = self.get(&path[..at]) {
+                if let (Decl::Structure { leaves }, false) = (d, at == path.len()) {
+                    let fields: Vec<&str> = leaves.iter().map(|(n, _)| &n[at + 1..]).collect();
+                    return Err(format!(
+                        "`{path}`: structure `{}` has no field `{}` (its fields: {})",
+                        &path[..at],
+                        &path[at + 1..],
+                        fields.join(", ")
+                    ));
+                }
+                return Ok(Some((d, at == path.len())));
+            }
+            match path[..at].rfind('.') {
+                Some(dot) => at = dot,
+                None => return Ok(None),
+            }
+        }
+    }
+}
+
+/// The first output of a standard function block (IEC 61131-3 2.5.2.3), and whether it is BOOL.
+fn first_output(ty: &str) -> Option<(&'static str, bool)> {
+    Some(match ty {
+        "TON" | "TOF" | "TP" | "CTU" | "CTD" | "R_TRIG" | "F_TRIG" => ("Q", true),
+        "SR" | "RS" => ("Q1", true),
+        "CTUD" => ("QU", true),
+        _ => return None,
+    })
+}
+
+/// What the statements of a body leave out of the analysis, for the note.
+#[derive(Default)]
+struct Unseen {
+    instances_written: Vec<String>,
+    instances_read: Vec<String>,
+    addresses: Vec<String>,
+    functions: Vec<String>,
+}
+
+fn push_once(v: &mut Vec<String>, s: &str) {
+    if !v.iter().any(|x| x == s) {
+        v.push(s.to_owned());
+    }
+}
+
+/// The rungs of ST body `node` of POU `pou`: one per top-level statement that reads or writes
+/// something.
+pub fn rungs(node: Node, pou: &str, scope: &Scope, notes: &mut Notes) -> R<Vec<Rung<'static>>> {
+    let place = format!("pou {pou}, ST");
+    let source = node.document().input_text();
+    let mut out = Vec::new();
+    let mut unseen = Unseen::default();
+    let mut k = 0;
+    for t in node.descendants().filter(|d| d.is_text()) {
+        let text = t.text().unwrap_or("");
+        if text.trim().is_empty() {
+            continue;
+        }
+        let map = file_offsets(source, t.range().start, text);
+        let at = |off: usize| match &map {
+            Some(m) => Origin::at(m.get(off).copied().unwrap_or(t.range().start)),
+            None => origin(t),
+        };
+        let statements = st::statements(text)
+            .map_err(|e| error(at(e.at), &place, format!("ST syntax error: {}", e.message)))?;
+        for s in &statements {
+            k += 1;
+            if s.kind == st::ast::Stmt::Empty {
+                continue;
+            }
+            let here = at(s.at);
+            let (reads, writes) = resolve(&st::accesses(s), scope, &mut unseen, pou)
+                .map_err(|m| error(here, &place, m))?;
+            out.extend(stand_in(format!("{pou}.st{k}"), here, &reads, &writes));
+        }
+    }
+    notes.push(Note {
+        origin: origin(node),
+        message: message(pou, k, &unseen),
+    });
+    notes.skipped.push(plc_syntax::SkippedBody {
+        pou: pou.to_owned(),
+        language: "ST".into(),
+        origin: origin(node),
+    });
+    Ok(out)
+}
+
+fn message(pou: &str, statements: usize, unseen: &Unseen) -> String {
+    let plural = if statements == 1 { "" } else { "s" };
+    let mut m = format!("pou {pou}: its ST body is analysed per statement ({statements} top-level statement{plural}, rungs {pou}.st1 …, each reading and writing whole variables) and not executed by `run`");
+    let mut add = |what: &str, v: &[String]| {
+        if !v.is_empty() {
+            m.push_str(&format!("; {what}: {}", v.join(", ")));
+        }
+    };
+    add(
+        "the function block instances it calls are not seen as written",
+        &unseen.instances_written,
+    );
+    add(
+        "the user function block instances it reads are not seen",
+        &unseen.instances_read,
+    );
+    add(
+        "the direct addresses it uses are not seen",
+        &unseen.addresses,
+    );
+    add(
+        "the functions it calls are black boxes (the arguments read, the result and outputs written where the call assigns them)",
+        &unseen.functions,
+    );
+    m
+}
+
+/// The reads and writes of a statement as stand-in operands, or the message of the first name
+/// that is neither declared nor called (or a structure's field it does not have).
+fn resolve(
+    a: &st::Accesses,
+    scope: &Scope,
+    unseen: &mut Unseen,
+    pou: &str,
+) -> Result<(Vec<Read>, Vec<String>), String> {
+    let called = |n: &str| a.calls.iter().any(|c| c.eq_ignore_ascii_case(n));
+    // Named by its first part, the variable that is not declared.
+    let undeclared = |n: &str| {
+        let n = if n.starts_with('%') {
+            n
+        } else {
+            n.split('.').next().unwrap_or(n)
+        };
+        format!("`{n}` is not a variable of POU `{pou}` (nor a global it declares external), nor a function it calls")
+    };
+    let called = |n: &str| called(n.split('.').next().unwrap_or(n));
+    for c in &a.calls {
+        if scope.get(c).is_none() {
+            push_once(&mut unseen.functions, c);
+        }
+    }
+    let mut reads = Vec::new();
+    for n in &a.reads {
+        let found = scope.find(n)?;
+        // A field written whole keeps nothing of its structure: no read.
+        let kept = a.kept.iter().any(|k| k.eq_ignore_ascii_case(n));
+        match found {
+            Some((Decl::Elementary { .. }, true)) if kept => {}
+            Some((Decl::Elementary { name, ty }, _)) => reads.push(Read {
+                name: name.clone(),
+                bool: ty == "BOOL",
+            }),
+            Some((Decl::Instance { read: Some(r), .. }, _)) => reads.push(Read {
+                name: r.name.clone(),
+                bool: r.bool,
+            }),
+            Some((Decl::Instance { name, read: None }, _)) => {
+                push_once(&mut unseen.instances_read, name)
+            }
+            Some((Decl::Structure { leaves }, _)) => {
+                reads.extend(leaves.iter().map(|(name, ty)| Read {
+                    name: name.clone(),
+                    bool: ty == "BOOL",
+                }))
+            }
+            Some((Decl::Constant, _)) => {}
+            None if n.starts_with('%') => push_once(&mut unseen.addresses, n),
+            None if called(n) => {}
+            None => return Err(undeclared(n)),
+        }
+    }
+    let mut writes = Vec::new();
+    for n in &a.writes {
+        match scope.find(n)? {
+            Some((Decl::Elementary { name, .. }, _)) => writes.push(name.clone()),
+            Some((Decl::Instance { name, .. }, _)) => {
+                push_once(&mut unseen.instances_written, name)
+            }
+            Some((Decl::Structure { leaves }, _)) => {
+                writes.extend(leaves.iter().map(|(name, _)| name.clone()))
+            }
+            Some((Decl::Constant, _)) => return Err(undeclared(n)),
+            None if n.starts_with('%') => push_once(&mut unseen.addresses, n),
+            None if called(n) => {}
+            None => return Err(undeclared(n)),
+        }
+    }
+    // A structure read whole and one of its fields read too: each field once.
+    let mut seen = std::collections::HashSet::new();
+    reads.retain(|r| seen.insert(r.name.clone()));
+    seen.clear();
+    writes.retain(|w| seen.insert(w.clone()));
+    Ok((reads, writes))
+}
+
+/// For each byte offset of `text` (and its end), the offset in `source` it was read from, when
+/// `text` is what XML makes of `source` from `start` on: CDATA sections taken as they are,
+/// entity and character references decoded, `\r\n` and `\r` read as `\n` (XML 1.0, 2.11).
+/// `None` when the two do not agree (then statements are placed at the text's start).
+pub fn file_offsets(source: &str, start: usize, text: &str) -> Option<Vec<usize>> {
+    let (s, t) = (source.as_bytes(), text.as_bytes());
+    let mut map = Vec::with_capacity(t.len() + 1);
+    let (mut i, mut j, mut cdata) = (start, 0, false);
+    while j < t.len() {
+        let rest = source.get(i..)?;
+        if !cdata && rest.starts_with("<![CDATA[") {
+            (i, cdata) = (i + 9, true);
+        } else if cdata && rest.starts_with("]]>") {
+            (i, cdata) = (i + 3, false);
+        } else if !cdata && rest.starts_with('&') {
+            let end = rest.find(';')?;
+            let c = reference(&rest[1..end])?;
+            let mut buf = [0u8; 4];
+            let bytes = c.encode_utf8(&mut buf).as_bytes();
+            if t.get(j..j + bytes.len())? != bytes {
+                return None;
+            }
+            map.extend(std::iter::repeat_n(i, bytes.len()));
+            (i, j) = (i + end + 1, j + bytes.len());
+        } else if *s.get(i)? == b'\r' {
+            if t[j] != b'\n' {
+                return None;
+            }
+            map.push(i);
+            i += if s.get(i + 1) == Some(&b'\n') { 2 } else { 1 };
+            j += 1;
+        } else if (!cdata && s[i] == b'<') || s[i] != t[j] {
+            return None;
+        } else {
+            map.push(i);
+            (i, j) = (i + 1, j + 1);
+        }
+    }
+    map.push(i);
+    Some(map)
+}
+
+/// The character an entity or character reference (between `&` and `;`) stands for.
+fn reference(r: &str) -> Option<char> {
+    Some(match r {
+        "lt" => '<',
+        "gt" => '>',
+        "amp" => '&',
+        "quot" => '"',
+        "apos" => '\'',
+        _ => {
+            let n = if let Some(h) = r.strip_prefix("#x") {
+                u32::from_str_radix(h, 16).ok()?
+            } else {
+                r.strip_prefix('#')?.parse().ok()?
+            };
+            char::from_u32(n)?
+        }
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn offsets_go_through_cdata_references_and_line_ends() {
+        let src = "<p>a &lt; b;\r\n<![CDATA[x<y]]>&#x41;</p>";
+        let text = "a < b;\nx<yA";
+        let m = file_offsets(src, 3, text).unwrap();
+        assert_eq!(m[0], 3); // a
+        assert_eq!(m[2], 5); // < from &lt;
+        assert_eq!(m[4], 10); // b
+        assert_eq!(m[6], 12); // \n from \r\n
+        assert_eq!(m[7], 23); // x inside CDATA
+        assert_eq!(m[8], 24); // < inside CDATA
+        assert_eq!(m[10], 29); // A from &#x41;
+        assert_eq!(m[11], 35); // the end
+        assert_eq!(file_offsets(src, 3, "a > b"), None);
+    }
+}

@@ -1,0 +1,155 @@
+//! One network → rungs: blocks in execution order, each conditional fragment an `if` block
+//! (guard rung, landing rung), compound fragments tested through their run flags.
+
+use super::{condition, contact, set_jump_target, Cx, Net, Result};
+use plc_diag::LoadError;
+use plc_fbd::model::*;
+use plc_fbd::types::TypedNetwork;
+use plc_model::*;
+use std::collections::HashMap;
+
+impl Cx<'_> {
+    /// Lowers one network; returns the rung of each block and the network's typed form.
+    pub(super) fn network(
+        &mut self,
+        net: &Network,
+        plan: &Plan,
+        labels: &HashMap<&str, usize>,
+        jumps: &mut Vec<(usize, usize)>,
+    ) -> Result<(Vec<u32>, TypedNetwork<VarRef>)> {
+        let n = net.blocks.len();
+        let mut used: Vec<Vec<bool>> = net
+            .blocks
+            .iter()
+            .map(|b| vec![false; b.outputs.len()])
+            .collect();
+        for b in &net.blocks {
+            for i in b
+                .inputs
+                .iter()
+                .filter_map(|p| p.input.as_ref())
+                .chain(b.cond.as_ref())
+            {
+                if let Input::Arc { from, pin } = i {
+                    used[from.index()][*pin as usize] = true;
+                }
+            }
+        }
+        let values = net
+            .blocks
+            .iter()
+            .map(|b| vec![None; b.outputs.len()])
+            .collect();
+        let mut nx = Net {
+            net,
+            used,
+            values,
+            constants: HashMap::new(),
+        };
+        let rp = self.names.rung_prefix.clone();
+        let e_net = |k| LoadError::fbd(&net.id, None, &net.path, k);
+        // Run flags of compound fragments: reset first, set inside each source fragment.
+        let mut flags: HashMap<FragmentId, VarId> = HashMap::new();
+        let mut sets: HashMap<FragmentId, Vec<VarId>> = HashMap::new();
+        let mut pending: Vec<Element> = Vec::new();
+        for (f, frag) in plan.fragments.iter().enumerate() {
+            if let FragmentKind::Compound(mc) = &frag.kind {
+                let name = format!("{}_run_{}_{}", self.names.var_prefix, net.id, frag.name);
+                let flag = self.env.hidden(name, Type::Bool).map_err(e_net)?;
+                flags.insert(FragmentId(f as u32), flag);
+                pending.push(Element::Reset(flag));
+                for m in mc {
+                    sets.entry(*m).or_default().push(flag);
+                }
+            }
+        }
+        let first = self.rungs.len();
+        let mut block_rung: Vec<Option<u32>> = vec![None; n];
+        let mut guards: Vec<usize> = Vec::new();
+        for step in &plan.steps {
+            match *step {
+                Step::Enter(f) => {
+                    let frag = &plan.fragments[f.index()];
+                    let mut series = match &frag.kind {
+                        FragmentKind::Conditional(input) => {
+                            let what = "a condition";
+                            let o = self.bool_input(&mut nx, None, input, &net.path, what)?;
+                            condition(o, true)
+                        }
+                        FragmentKind::Compound(_) => vec![contact(
+                            VarRef {
+                                var: flags[&f],
+                                field: None,
+                            },
+                            true,
+                        )],
+                        FragmentKind::Root => unreachable!("the root is never entered"),
+                    };
+                    let landing = format!("{rp}{}.{}.end", net.id, frag.name);
+                    series.push(Element::Jmp {
+                        label: landing,
+                        target: RungId(u32::MAX),
+                    });
+                    series.splice(0..0, pending.drain(..));
+                    let comment = Some(format!("if {}", frag.condition));
+                    guards.push(self.push(
+                        format!("{rp}{}.{}", net.id, frag.name),
+                        None,
+                        comment,
+                        series,
+                        (&net.path, net.origin),
+                    ));
+                    pending.extend(
+                        sets.get(&f)
+                            .into_iter()
+                            .flatten()
+                            .map(|&flag| Element::Set(flag)),
+                    );
+                }
+                Step::Block(b) => {
+                    let blk = net.block(b);
+                    let mut series = self.block(&mut nx, b, labels)?;
+                    series.splice(0..0, pending.drain(..));
+                    let r = self.push(
+                        format!("{rp}{}.{}", net.id, blk.id),
+                        None,
+                        blk.comment.clone(),
+                        series,
+                        (&blk.path, blk.origin),
+                    );
+                    if let Op::Jmp { label } = &blk.op {
+                        // Checked by the block's lowering: the label is defined.
+                        if let Some(&target) = labels.get(label.as_str()) {
+                            jumps.push((r, target));
+                        }
+                    }
+                    block_rung[b.index()] = Some(r as u32);
+                }
+                Step::Leave(f) => {
+                    let frag = &plan.fragments[f.index()];
+                    let landing = format!("{rp}{}.{}.end", net.id, frag.name);
+                    let r = self.push(
+                        landing.clone(),
+                        Some(landing),
+                        None,
+                        std::mem::take(&mut pending),
+                        (&net.path, net.origin),
+                    );
+                    let g = guards.pop().expect("entered");
+                    set_jump_target(&mut self.rungs[g], RungId(r as u32));
+                }
+            }
+        }
+        debug_assert!(pending.is_empty());
+        let first_rung = &mut self.rungs[first];
+        first_rung.label = net.label.clone();
+        if first_rung.comment.is_none() {
+            first_rung.comment = net.comment.clone();
+        }
+        let block_rung = block_rung
+            .into_iter()
+            .map(|r| r.expect("a plan's steps hold every block of its network once"))
+            .collect();
+        Ok((block_rung, self.typed_network(&nx)))
+    }
+}

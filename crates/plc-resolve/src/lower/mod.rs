@@ -1,0 +1,272 @@
+//! Lowering: an FBD body → ladder [`Rung`]s of the program model, so that the analyses, the
+//! report, the interpreter and the parallel executor run FBD unchanged.
+//!
+//! One rung per block, id `<network>.<block>` (`N1.8`; `G1:N1.8` in the POU of instance `G1`),
+//! in the network's execution order; the network's label goes on its first rung. Every output
+//! that feeds an arc gets a hidden temp variable `_<block>_<pin>` (`_8_OUT`; prefixed `SBR:` in a
+//! subroutine, `G1.` in an instance), written once per run of the block, so arcs are ordinary
+//! flow dependences. Timers and counters are read through their instance (`T1.Q`, `T1.ET`).
+//!
+//! A conditional fragment becomes an `if` block as the FBD text-generation paper generates it: a guard rung
+//! `<network>.<fragment>` = `[contact cond negated, jmp <landing>]` before its body and an empty
+//! landing rung `<network>.<fragment>.end` after it, so the CFG's control dependences inside a
+//! network are exactly the fragment tree. A compound fragment tests a hidden run flag
+//! `_run_<network>_<fragment>` that the network's first rung resets and the first rung inside each
+//! of its source fragments sets. docs/fbd.md gives every block's rung.
+//!
+//! TSTART/TSTOP (KASKAD's TIME accumulation) use three hidden variables per accumulated TIME
+//! variable `V` — `V:acc` (BOOL, accumulating), `V:timer` (TON), `V:last` (TIME, the timer's
+//! elapsed time when `V` was last brought up to date) — and one extra rung `acc:V` at the start of
+//! the POU: `[contact V:acc, branch [[ton V:timer PT], [V := V − V:last], [V := V + V:timer.ET],
+//! [V:last := V:timer.ET]]]`.
+
+mod blocks;
+mod fragments;
+mod functions;
+mod instances;
+mod pins;
+mod standard;
+mod time;
+mod typed;
+
+use crate::operand::Untyped;
+use plc_diag::{Invalid, LoadError, Origin};
+use plc_fbd::model::*;
+use plc_fbd::types::TypedBody;
+use plc_model::*;
+use std::collections::HashMap;
+use std::ops::Range;
+
+type Result<T> = std::result::Result<T, LoadError>;
+
+pub use plc_fbd::ACCUMULATE_PT_MS;
+
+/// What the lowering needs from the reader: names resolved in the POU's scope, new hidden
+/// variables.
+pub(crate) trait Env {
+    /// A name read by a block: variable, instance field (`T1.Q`) or user instance member (`G1.OUT`).
+    fn lookup(&self, text: &str) -> std::result::Result<(VarRef, Type), Invalid>;
+    /// A variable a block writes.
+    fn writable(&self, text: &str, what: &'static str) -> std::result::Result<VarId, Invalid>;
+    /// What a block's `instance` names.
+    fn instance(&self, text: &str) -> std::result::Result<InstanceRef, Invalid>;
+    fn var(&self, v: VarId) -> &Var;
+    /// Adds a hidden variable named `name` (refused if the name is taken).
+    fn hidden(&mut self, name: String, ty: Type) -> std::result::Result<VarId, Invalid>;
+    /// Records that this POU accumulates TIME variable `v` (refused if another POU does).
+    fn claim_accumulator(&mut self, v: VarId) -> std::result::Result<(), Invalid>;
+}
+
+/// What an `instance` names.
+pub(crate) enum InstanceRef {
+    /// A TON/TOF/TP/CTU/CTD instance.
+    Builtin(VarId, FbKind),
+    /// An instance of a user function block type, with its POU and its input and output variables.
+    User {
+        pou: PouId,
+        fb: String,
+        inputs: Vec<(String, VarId)>,
+        outputs: Vec<(String, VarId)>,
+    },
+    /// A variable that is no instance (its type, for the message).
+    Other(Type),
+}
+
+/// Names of the POU being lowered.
+pub(crate) struct Names {
+    /// The POU's name, for messages (`undefined label … in P`).
+    pub pou: String,
+    /// Prepended to rung ids (`G1:` in an instance's POU).
+    pub rung_prefix: String,
+    /// Prepended to hidden temp names (`SBR:` in a subroutine, `G1.` in an instance).
+    pub var_prefix: String,
+}
+
+/// A lowered body: rungs with POU-relative jump targets (`RungId(i)` = the POU's `i`-th rung).
+pub(crate) struct Lowered {
+    pub rungs: Vec<Rung>,
+    /// Per network: its rungs (POU-relative).
+    pub networks: Vec<Range<u32>>,
+    /// Per network, per block: its rung (POU-relative).
+    pub blocks: Vec<Vec<u32>>,
+    /// The body with typed pins, variables as this POU's scope resolves them.
+    pub typed: TypedBody<VarRef>,
+}
+
+/// Lowers `fbd` in the scope `env` gives.
+pub(crate) fn lower(fbd: &FbdPou, env: &mut dyn Env, names: &Names, pou: PouId) -> Result<Lowered> {
+    let mut cx = Cx {
+        env,
+        names,
+        pou,
+        rungs: Vec::new(),
+        accumulators: HashMap::new(),
+    };
+    let labels: HashMap<&str, usize> = fbd
+        .networks
+        .iter()
+        .enumerate()
+        .filter_map(|(i, n)| n.label.as_deref().map(|l| (l, i)))
+        .collect();
+    cx.accumulator_rungs(fbd)?;
+    let mut jumps: Vec<(usize, usize)> = Vec::new();
+    let mut networks = Vec::with_capacity(fbd.networks.len());
+    let mut blocks = Vec::with_capacity(fbd.networks.len());
+    let mut typed = Vec::with_capacity(fbd.networks.len());
+    for (net, plan) in fbd.networks.iter().zip(&fbd.plans) {
+        let start = cx.rungs.len() as u32;
+        let (block_rungs, typed_net) = cx.network(net, plan, &labels, &mut jumps)?;
+        typed.push(typed_net);
+        for rung in &mut cx.rungs[start as usize..] {
+            if let Some(from) = &mut rung.lowered {
+                from.network = Some(net.id.clone());
+            }
+        }
+        networks.push(start..cx.rungs.len() as u32);
+        blocks.push(block_rungs);
+    }
+    for (rung, target) in jumps {
+        let t = RungId(networks[target].start);
+        set_jump_target(&mut cx.rungs[rung], t);
+    }
+    Ok(Lowered {
+        rungs: cx.rungs,
+        networks,
+        blocks,
+        typed: TypedBody { networks: typed },
+    })
+}
+
+fn set_jump_target(rung: &mut Rung, t: RungId) {
+    match rung.series.last_mut() {
+        Some(Element::Jmp { target, .. }) => *target = t,
+        _ => unreachable!("jump rungs end with their jump"),
+    }
+}
+
+struct Acc {
+    acc: VarId,
+    timer: VarId,
+    last: VarId,
+}
+
+struct Cx<'e> {
+    env: &'e mut dyn Env,
+    names: &'e Names,
+    pou: PouId,
+    rungs: Vec<Rung>,
+    accumulators: HashMap<VarId, Acc>,
+}
+
+/// A value connected to an input: typed (variable or arc), or a constant waiting for its type
+/// (with the input pin it is connected to, whose typed value the lowering records).
+#[derive(Clone)]
+enum Val {
+    Typed(Operand, Type, String),
+    Const(Untyped, String, Option<PinSlot>),
+}
+
+/// Input pin `.1` of block `.0`.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
+struct PinSlot(BlockId, usize);
+
+impl Val {
+    fn ty(&self) -> Option<Type> {
+        match self {
+            Val::Typed(_, t, _) => Some(*t),
+            Val::Const(u, ..) => u.ty(),
+        }
+    }
+    fn text(&self) -> &str {
+        match self {
+            Val::Typed(_, _, s) | Val::Const(_, s, _) => s,
+        }
+    }
+}
+
+/// The network being lowered: values of arcs so far.
+struct Net<'n> {
+    net: &'n Network,
+    /// Per block, per output pin: does an arc read it?
+    used: Vec<Vec<bool>>,
+    /// Per block, per output pin: the operand an arc reads.
+    values: Vec<Vec<Option<(Operand, Type)>>>,
+    /// The constants connected to input pins, as typed by their blocks.
+    constants: HashMap<PinSlot, Value>,
+}
+
+fn never() -> Element {
+    Element::Compare {
+        op: CmpOp::Ne,
+        a: Operand::Const(Value::Int(0)),
+        b: Operand::Const(Value::Int(0)),
+    }
+}
+
+fn contact(r: VarRef, negated: bool) -> Element {
+    Element::Contact {
+        var: r,
+        kind: if negated {
+            ContactKind::Negated
+        } else {
+            ContactKind::Normal
+        },
+    }
+}
+
+/// Conditions that pass power when the BOOL `o` is TRUE (FALSE when `negated`).
+fn condition(o: Operand, negated: bool) -> Vec<Element> {
+    match o {
+        Operand::Var(r) => vec![contact(r, negated)],
+        Operand::Const(Value::Bool(b)) if b != negated => Vec::new(),
+        Operand::Const(_) => vec![never()],
+    }
+}
+
+fn var_op(v: VarId) -> Operand {
+    Operand::Var(VarRef {
+        var: v,
+        field: None,
+    })
+}
+
+fn field_op(v: VarId, f: Field) -> Operand {
+    Operand::Var(VarRef {
+        var: v,
+        field: Some(f),
+    })
+}
+
+/// One series, or several run one after another from the same power (a `branch`).
+fn steps(mut s: Vec<Series>) -> Series {
+    if s.len() == 1 {
+        s.pop().expect("one")
+    } else {
+        vec![Element::Branch(s)]
+    }
+}
+
+impl Cx<'_> {
+    fn push(
+        &mut self,
+        id: String,
+        label: Option<String>,
+        comment: Option<String>,
+        series: Series,
+        (path, origin): (&str, Origin),
+    ) -> usize {
+        self.rungs.push(Rung {
+            id,
+            label,
+            comment,
+            pou: self.pou,
+            series,
+            origin,
+            lowered: Some(Box::new(LoweredFrom {
+                block_path: path.to_owned(),
+                network: None,
+            })),
+        });
+        self.rungs.len() - 1
+    }
+}
