@@ -18,6 +18,9 @@
 //!   the parallel executor) → [`codegen`] (C and S7-200 Instruction List);
 //! - [`cmd`], in this crate: the commands (`report`, `order`, `run`, `schema`, `convert`, `c`,
 //!   `il`, `gen`) that `main.rs` parses arguments for.
+// `unsafe` only in the two modules of `cmd` that allow it by name (mapping a file, `prctl`).
+#![deny(unsafe_code)]
+
 pub use plc_analysis as analysis;
 pub use plc_codegen as codegen;
 pub use plc_diag as diag;

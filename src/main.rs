@@ -1,5 +1,6 @@
 //! The `plc-deps` command line: parses arguments into validated configurations and calls the
 //! library (`plc_deps::cmd`). Nothing else happens here.
+#![forbid(unsafe_code)]
 
 // mimalloc: the analyses allocate many small vectors right after the loader frees a large JSON
 // tree; glibc's malloc spends seconds consolidating that heap at 1M rungs, mimalloc does not.

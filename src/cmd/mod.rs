@@ -15,12 +15,16 @@ pub mod gen;
 pub mod il;
 pub mod io;
 pub mod order;
+// `prctl` (the one system call the standard library does not offer).
+#[allow(unsafe_code)]
 pub mod pages;
 pub mod progress;
 pub mod report;
 pub mod run;
 pub mod schema;
 pub mod skipped;
+// Mapping a file (memmap2); its caveat is argued at the call.
+#[allow(unsafe_code)]
 pub mod source;
 mod temp;
 

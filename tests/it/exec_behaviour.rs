@@ -1,5 +1,5 @@
 //! Behaviour of the scan interpreter (`plc_deps::exec`) on small programs whose expected values
-//! are computed by hand from the scan semantics documented in `src/exec/mod.rs`.
+//! are computed by hand from the scan semantics documented in `crates/plc-exec/src/lib.rs`.
 
 use plc_deps::exec::{ExecConfig, Exit, Fault, FaultKind, Layout, Machine, State, VarValue};
 use plc_deps::model::{Program, RungId, Value, VarId};

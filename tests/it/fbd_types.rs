@@ -1,4 +1,4 @@
-//! User function block types kept in the resolved program (src/fbd/types.rs): each type's
+//! User function block types kept in the resolved program (crates/plc-fbd/src/types.rs): each type's
 //! interface, its instances, and its FBD body with typed pins — arcs, variables named relative
 //! to the type (own inputs, outputs and locals, members of nested instances, program
 //! variables) and constants typed by their blocks.

@@ -6,6 +6,7 @@ mod plcopen_common;
 
 mod analyses;
 mod analysis_props;
+mod architecture;
 mod c_build;
 mod c_codegen;
 mod c_codegen_cli;

@@ -10,6 +10,7 @@
 //! - [`cost`]: the cost model, work, span and makespans.
 //!
 //! Nothing here prints or allocates per-rung strings; reports render these values.
+#![forbid(unsafe_code)]
 
 pub mod accesses;
 pub mod cfg;

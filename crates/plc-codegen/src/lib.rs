@@ -6,6 +6,7 @@
 //! - [`il`]: S7-200 Instruction List (Zhou & Zhang 2015); read back by `plc_read::stl`.
 //!
 //! Layer: uses `model`, `fbd`; nothing here imports `cmd`, `exec` or `report`.
+#![forbid(unsafe_code)]
 
 pub mod c;
 pub mod il;

@@ -14,6 +14,7 @@
 //! line shows them in the style of rustc, or as JSON, through [`render::Shown`] (the source
 //! line, a caret under the token at the origin ([`span`]), the hint, e.g. [`suggest`]'s
 //! "did you mean"); every code is documented with an example in docs/diagnostics.md.
+#![forbid(unsafe_code)]
 
 mod error;
 mod origin;

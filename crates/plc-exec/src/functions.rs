@@ -1,5 +1,5 @@
 //! What the standard functions compute (`Element::Function`): one definition, which the
-//! interpreter runs and the C runtime (`src/codegen/c/runtime.rs`, `_plc_fn_*`) mirrors
+//! interpreter runs and the C runtime (`crates/plc-codegen/src/c/runtime.rs`, `_plc_fn_*`) mirrors
 //! operation for operation; docs/scan.md *Standard functions* states the rules.
 //!
 //! - REAL functions are IEEE 754 `f32` operations: SQRT (exact), and LN, LOG, EXP, SIN … ATAN,

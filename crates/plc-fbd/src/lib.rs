@@ -13,6 +13,7 @@
 //! rungs is the resolver's (`plc_resolve`), which calls [`plan`]; `plc-deps order` renders
 //! them (`plc_report::order`). The format and every
 //! lowering rule are in docs/fbd.md.
+#![forbid(unsafe_code)]
 
 pub mod fragments;
 pub mod model;

@@ -10,6 +10,7 @@
 //!   numbered in topological order of the condensation.
 //! * [`dominators`](mod@dominators): dominator trees (Semi-NCA); post-dominators
 //!   are the dominators of [`Csr::reversed`] rooted at the exit node.
+#![forbid(unsafe_code)]
 
 pub mod csr;
 pub mod dominators;

@@ -8,6 +8,7 @@
 //! Invariants: a program loads whole or not at all; every error is one [`LoadError`] located in
 //! the text (line and column, the rung or block). It does not read files or pick the format by
 //! content: the commands do that (`cmd::io`).
+#![forbid(unsafe_code)]
 
 use plc_diag::LoadError;
 use plc_fbd::Fbd;

@@ -16,6 +16,7 @@
 //!
 //! It deliberately carries no analysis results: those are separate values computed from it.
 //! Element semantics follow IEC 61131-3 (LD, §4.2) and the S7-200 shapes of Zhao & Yan (2012).
+#![forbid(unsafe_code)]
 
 mod function;
 mod tasks;

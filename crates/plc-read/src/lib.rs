@@ -9,6 +9,7 @@
 //! column are computed once the load has failed; an error found on the model, which has the
 //! path of every node but not always its offset, is placed at the node its path names). Nothing is half-built: a program either loads
 //! whole or not at all.
+#![forbid(unsafe_code)]
 
 pub mod json;
 pub mod plcopen;

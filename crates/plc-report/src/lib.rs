@@ -8,6 +8,7 @@
 //! file whole or not at all. Adding a renderer touches no other renderer. The naming shared by
 //! every format and the explanation of where the combined schedule differs from the paper's
 //! views (Zhao & Yan, 2012) live here and in `explain`.
+#![forbid(unsafe_code)]
 
 pub mod configuration;
 pub mod document;

@@ -24,6 +24,7 @@
 //! [`syntax::RungSink`]): a million rungs are then never held as syntax. That path gives the
 //! same model or gives up, and the whole tree is resolved instead (which reports the errors):
 //! errors always come from the phases above.
+#![forbid(unsafe_code)]
 
 pub mod configuration;
 mod elements;

@@ -18,6 +18,7 @@
 //!
 //! Deliberately not here: name resolution, types of operands, structural rules (those are the
 //! resolver's), and anything JSON-specific beyond [`Scalar`] (a leaf as written, for messages).
+#![forbid(unsafe_code)]
 
 pub mod fbd;
 pub mod pipe;

@@ -100,6 +100,7 @@
 //! `InvalidInput` error without writing anything, and `plc-deps gen --rungs 0` exits with status 2
 //! and `error: --rungs must be at least 1 (a program has at least one rung)`. The CLI also refuses
 //! `--width 0` (the library clamps `width` to at least 1).
+#![forbid(unsafe_code)]
 
 mod emit;
 mod hot;

@@ -13,7 +13,7 @@
 //! jump through the loop cap), FOR/NEXT is a C `for` (the NEXT asks the loop cap before it
 //! increments), calls are calls, RET and END return.
 //!
-//! Semantics: docs/scan.md, element by element as `src/exec/run.rs` runs them. Not here: the
+//! Semantics: docs/scan.md, element by element as `crates/plc-exec/src/run.rs` runs them. Not here: the
 //! nesting of FBD fragments (`fbd`), files and the harness (`mod`, `harness`).
 
 pub(crate) use super::spelling::{c_const, c_type, negate, num_suffix};

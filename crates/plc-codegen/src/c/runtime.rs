@@ -2,14 +2,14 @@
 //! timer and counter instances, integer arithmetic with the interpreter's wrap-around and
 //! division-by-zero rule, the loop cap, faults, and the CSV/JSON helpers of the harness.
 //!
-//! Each function reproduces one rule of docs/scan.md (and `src/exec/run.rs`) exactly: every
+//! Each function reproduces one rule of docs/scan.md (and `crates/plc-exec/src/run.rs`) exactly: every
 //! integer type wraps in its width (SINT at 8 bits, INT at 16, DINT and TIME at 32, LINT at 64,
 //! the unsigned types and bit strings modulo 2^N; computed in `uint64_t`, then converted: GCC
 //! and Clang define the conversion as modulo 2^N); DIV truncates, MOD takes the dividend's sign, an
 //! integer DIV or MOD by zero gives 0 and records a fault; TON/TOF/TP and CTU/CTD follow the
 //! interpreter's state machine field by field (a timer's start time and flags, a counter's
 //! previous CU/CD); SR/RS, R_TRIG/F_TRIG and CTUD the bodies of IEC 61131-3 2.5.2.3 as
-//! `src/exec/fb.rs` runs them. REAL is `float`, LREAL `double` (C11 with `FLT_EVAL_METHOD == 0` on x86-64 and AArch64, and
+//! `crates/plc-exec/src/fb.rs` runs them. REAL is `float`, LREAL `double` (C11 with `FLT_EVAL_METHOD == 0` on x86-64 and AArch64, and
 //! no contraction under `-std=c11`).
 //!
 //! Not here: anything that depends on the program (the generated files have that).
@@ -267,7 +267,7 @@ _PLC_EXTREMES(f64, double)
 /* A REAL or LREAL constant by its bits (NaN and infinities have no literal). */
 static inline float _plc_f32(uint32_t bits) { float f; memcpy(&f, &bits, sizeof f); return f; }
 static inline double _plc_f64(uint64_t bits) { double f; memcpy(&f, &bits, sizeof f); return f; }
-/* Standard functions (src/exec/functions.rs): the same C math library calls as the
+/* Standard functions (crates/plc-exec/src/functions.rs): the same C math library calls as the
    interpreter's, on an argument GCC cannot fold at compile time. */
 static inline float _plc_opaque_f32(float x) { volatile float v = x; return v; }
 static inline float _plc_fn_sqrt(float x) { return sqrtf(_plc_opaque_f32(x)); }

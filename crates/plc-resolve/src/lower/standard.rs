@@ -3,7 +3,7 @@
 //! takes the rest as operands), then the outputs, read through the instance's fields as for
 //! the timers and counters (docs/fbd.md).
 //!
-//! Not here: the semantics (`src/exec/fb.rs`), the other blocks (`blocks`).
+//! Not here: the semantics (`crates/plc-exec/src/fb.rs`), the other blocks (`blocks`).
 
 use super::{condition, Cx, Net, Result, Val};
 use plc_fbd::model::*;
