@@ -42,6 +42,7 @@ mod il_fbd_roundtrip;
 mod il_roundtrip;
 mod interrupts;
 mod load_errors;
+mod module_cycles;
 mod paper_examples;
 mod par_layers;
 mod plcopen_data_types;
