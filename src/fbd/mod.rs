@@ -15,6 +15,7 @@
 //! lowering rule are in docs/fbd.md.
 
 pub mod fragments;
+mod ids;
 pub mod model;
 pub mod order;
 pub mod types;
