@@ -22,6 +22,7 @@ pub mod run;
 pub mod schema;
 pub mod skipped;
 pub mod source;
+mod stderr;
 mod temp;
 
 pub use io::{CliError, FileRole};
