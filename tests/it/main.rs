@@ -45,6 +45,7 @@ mod load_errors;
 mod module_cycles;
 mod paper_examples;
 mod par_layers;
+mod petgraph_views;
 mod plcopen_data_types;
 mod plcopen_errors;
 mod plcopen_fbd;
