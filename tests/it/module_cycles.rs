@@ -107,7 +107,8 @@ fn crate_dirs(root: &Path) -> Vec<PathBuf> {
     out
 }
 
-/// The crate root files of the package in `dir`: its library, its binary and `src/bin/*.rs`.
+/// The crate root files of the package in `dir`: its library, its binary, `src/bin/*.rs`, and
+/// any other `path = "…"` of its manifest's `[lib]` and `[[bin]]` sections.
 fn crate_roots(dir: &Path) -> Vec<PathBuf> {
     let src = dir.join("src");
     let mut roots: Vec<PathBuf> = ["lib.rs", "main.rs"]
@@ -123,6 +124,27 @@ fn crate_roots(dir: &Path) -> Vec<PathBuf> {
             .collect();
         bins.sort();
         roots.extend(bins);
+    }
+    let manifest = std::fs::read_to_string(dir.join("Cargo.toml")).unwrap_or_default();
+    let mut section = "";
+    for line in manifest.lines().map(str::trim) {
+        if line.starts_with('[') {
+            section = line;
+        } else if section == "[lib]" || section == "[[bin]]" {
+            let value = line
+                .strip_prefix("path")
+                .and_then(|v| v.trim_start().strip_prefix('='))
+                .map(|v| v.trim().trim_matches('"'));
+            if let Some(path) = value.map(|v| dir.join(v)) {
+                if path.is_file()
+                    && !roots
+                        .iter()
+                        .any(|r| r.ends_with(path.strip_prefix(dir).unwrap()))
+                {
+                    roots.push(path);
+                }
+            }
+        }
     }
     roots
 }
@@ -271,10 +293,11 @@ fn attribute_end(c: &[char], from: usize) -> usize {
 
 /// Whether the cleaned text `c` has the word `word` at `i` (not inside a longer identifier).
 fn word_at(c: &[char], i: usize, word: &str) -> bool {
-    let w: Vec<char> = word.chars().collect();
-    c.get(i..i + w.len()) == Some(&w[..])
+    let n = word.len(); // the words looked for are ASCII
+    c.get(i..i + n)
+        .is_some_and(|s| s.iter().copied().eq(word.chars()))
         && (i == 0 || !is_ident(c[i - 1]))
-        && c.get(i + w.len()).is_none_or(|&ch| !is_ident(ch))
+        && c.get(i + n).is_none_or(|&ch| !is_ident(ch))
 }
 
 /// Skips spaces from `i`.
@@ -795,8 +818,14 @@ fn crates_are_found_by_manifest_outside_target_and_fuzz() {
             ("crates/one/Cargo.toml", "[package]\nname = \"one\"\n"),
             ("crates/one/src/lib.rs", "mod a;\n"),
             ("crates/one/src/a.rs", ""),
-            ("crates/two/Cargo.toml", "[package]\nname = \"two\"\n"),
+            (
+                "crates/two/Cargo.toml",
+                "[package]\nname = \"two\"\n[[bin]]\nname = \"t\"\npath = \"src/main.rs\"\n\
+                 [lib]\npath = \"lib/two.rs\"\n[[bench]]\nname = \"b\"\npath = \"benches/b.rs\"\n",
+            ),
             ("crates/two/src/main.rs", "fn main() {}\n"),
+            ("crates/two/lib/two.rs", ""),
+            ("crates/two/benches/b.rs", ""),
             ("fuzz/Cargo.toml", "[package]\nname = \"fuzz\"\n"),
             ("target/x/Cargo.toml", "[package]\nname = \"built\"\n"),
         ],
@@ -810,7 +839,8 @@ fn crates_are_found_by_manifest_outside_target_and_fuzz() {
         found,
         vec![
             PathBuf::from("crates/one/src/lib.rs"),
-            PathBuf::from("crates/two/src/main.rs")
+            PathBuf::from("crates/two/src/main.rs"),
+            PathBuf::from("crates/two/lib/two.rs")
         ]
     );
     let _ = std::fs::remove_dir_all(&dir);
