@@ -13,9 +13,12 @@
 //! edge `a → b` among the children of `p`. Sibling graphs are checked for the top-level modules
 //! of a crate and for the children of each top-level module (deeper levels are not checked).
 //!
-//! What a text scan cannot see: a reference through a re-export (`crate::analysis::Cfg` counts
-//! as a reference to `analysis`, not to `analysis::cfg`), paths written inside macros other than
-//! as plain paths, and inline non-test `mod x { … }` blocks (their text counts as their file's).
+//! A reference to a module's re-export is followed to where the item comes from
+//! (`crate::analysis::Cfg`, re-exported from `analysis::cfg`, is a reference to `analysis::cfg`):
+//! a `pub use` by name or rename, or a glob over a module that declares the name (`fn`,
+//! `struct`, … or the last argument of a macro call such as `index_type!(… Name);`). What a text
+//! scan cannot see: items made by other macros, paths written inside macros other than as plain
+//! paths, and inline non-test `mod x { … }` blocks (their text counts as their file's).
 //! Another crate of the workspace is reached by its crate name, never by `crate::`, so links
 //! between crates are not edges here (Cargo already refuses cycles between crates).
 
@@ -419,10 +422,13 @@ fn crate_modules(root_file: &Path) -> Vec<Module> {
     out
 }
 
+/// A path of a `use` tree and the name it brings in when renamed (`as name`).
+type UsePath = (Vec<String>, Option<String>);
+
 /// The paths of a `use` tree (`a::{b, c::{d, e}}` → `a::b`, `a::c::d`, `a::c::e`), as
-/// segments; `self` inside braces names the prefix itself, `as` renames are dropped.
-fn use_tree_paths(tree: &str) -> Vec<Vec<String>> {
-    fn walk(c: &[char], i: &mut usize, prefix: &[String], out: &mut Vec<Vec<String>>) {
+/// segments; `self` inside braces names the prefix itself.
+fn use_tree_paths(tree: &str) -> Vec<UsePath> {
+    fn walk(c: &[char], i: &mut usize, prefix: &[String], out: &mut Vec<UsePath>) {
         let mut path = prefix.to_vec();
         loop {
             *i = skip_space(c, *i);
@@ -455,8 +461,9 @@ fn use_tree_paths(tree: &str) -> Vec<Vec<String>> {
                     if seg == "as" {
                         // `x as y`: the rename ends the path.
                         let k = (*i..c.len()).find(|&k| !is_ident(c[k])).unwrap_or(c.len());
+                        let alias: String = c[*i..k].iter().collect();
                         *i = k;
-                        out.push(path);
+                        out.push((path, Some(alias)));
                         return;
                     }
                     if seg != "self" || path.is_empty() {
@@ -470,12 +477,12 @@ fn use_tree_paths(tree: &str) -> Vec<Vec<String>> {
                     if word_at(c, *i, "as") {
                         continue;
                     }
-                    out.push(path);
+                    out.push((path, None));
                     return;
                 }
                 _ => {
                     if !path.is_empty() {
-                        out.push(path);
+                        out.push((path, None));
                     }
                     return;
                 }
@@ -507,7 +514,7 @@ fn referenced_paths(text: &str) -> Vec<(Vec<String>, usize)> {
         if word_at(&c, i, "use") {
             let end = item_end(&c, i);
             let tree: String = c[i + 3..end].iter().filter(|&&ch| ch != ';').collect();
-            for p in use_tree_paths(&tree) {
+            for (p, _) in use_tree_paths(&tree) {
                 out.push((p, line_at(i)));
             }
             i = end;
@@ -544,6 +551,84 @@ fn referenced_paths(text: &str) -> Vec<(Vec<String>, usize)> {
     out
 }
 
+/// Whether the `use` at `i` of cleaned text `c` is a re-export: `pub`, `pub(crate)`,
+/// `pub(super)` or `pub(in …)` before it.
+fn is_reexport(c: &[char], i: usize) -> bool {
+    let mut j = i;
+    while j > 0 && c[j - 1].is_whitespace() {
+        j -= 1;
+    }
+    if j > 0 && c[j - 1] == ')' {
+        while j > 0 && c[j - 1] != '(' {
+            j -= 1;
+        }
+        j = j.saturating_sub(1);
+        while j > 0 && c[j - 1].is_whitespace() {
+            j -= 1;
+        }
+    }
+    j >= 3 && word_at(c, j - 3, "pub")
+}
+
+/// The re-exports of a cleaned text: each path as written and the name it is known by here
+/// (its rename, or its last segment; `*` for a glob).
+fn reexports(text: &str) -> Vec<(Vec<String>, String)> {
+    let c: Vec<char> = text.chars().collect();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < c.len() {
+        if word_at(&c, i, "use") && is_reexport(&c, i) {
+            let end = item_end(&c, i);
+            let tree: String = c[i + 3..end].iter().filter(|&&ch| ch != ';').collect();
+            for (path, alias) in use_tree_paths(&tree) {
+                let name = alias.unwrap_or_else(|| path.last().cloned().unwrap_or_default());
+                out.push((path, name));
+            }
+            i = end;
+        } else {
+            i += 1;
+        }
+    }
+    out
+}
+
+/// Whether cleaned text declares an item `name` itself: `fn`, `struct`, `enum`, `const`,
+/// `static`, `type`, `trait`, `union`, `mod` or `macro_rules!` with that name, or a macro call
+/// whose last argument it is (`index_type!(… Name);`, the way the crate declares its ids).
+fn declares(text: &str, name: &str) -> bool {
+    let c: Vec<char> = text.chars().collect();
+    let keywords = [
+        "fn",
+        "struct",
+        "enum",
+        "const",
+        "static",
+        "type",
+        "trait",
+        "union",
+        "mod",
+        "macro_rules!",
+    ];
+    (0..c.len()).any(|i| {
+        if !word_at(&c, i, name) {
+            return false;
+        }
+        let mut j = i;
+        while j > 0 && c[j - 1].is_whitespace() {
+            j -= 1;
+        }
+        let before: String = c[j.saturating_sub(12)..j].iter().collect();
+        let declared = keywords.iter().any(|k| {
+            before.ends_with(k) && {
+                let at = j - k.chars().count();
+                at == 0 || !is_ident(c[at - 1])
+            }
+        });
+        let after = skip_space(&c, i + name.chars().count());
+        declared || (c.get(after) == Some(&')') && c.get(skip_space(&c, after + 1)) == Some(&';'))
+    })
+}
+
 /// The absolute module path (segments from the crate root) of `path` written in module
 /// `here`; `None` for a path into another crate (or one this scan does not follow).
 fn absolute(here: &[String], path: &[String]) -> Option<Vec<String>> {
@@ -573,16 +658,80 @@ fn absolute(here: &[String], path: &[String]) -> Option<Vec<String>> {
 fn crate_cycles(root_file: &Path) -> Vec<Cycle> {
     let modules = crate_modules(root_file);
     let known: BTreeSet<&[String]> = modules.iter().map(|m| &m.path[..]).collect();
+    let text_of: BTreeMap<&[String], &str> = modules
+        .iter()
+        .map(|m| (&m.path[..], m.text.as_str()))
+        .collect();
+    // Per module, its re-exports as (absolute path, name): a bare first segment is a child.
+    let exports: BTreeMap<&[String], Vec<(Vec<String>, String)>> = modules
+        .iter()
+        .map(|m| {
+            let list = reexports(&m.text)
+                .into_iter()
+                .filter_map(|(path, name)| {
+                    let child = [&m.path[..], &path[..1]].concat();
+                    let target = match absolute(&m.path, &path) {
+                        Some(t) => t,
+                        None if known.contains(&child[..]) => [&m.path[..], &path[..]].concat(),
+                        None => return None,
+                    };
+                    Some((target, name))
+                })
+                .collect();
+            (&m.path[..], list)
+        })
+        .collect();
+    let module_part = |t: &[String]| {
+        let mut k = t.len();
+        while k > 0 && !known.contains(&t[..k]) {
+            k -= 1;
+        }
+        k
+    };
+    // Follows re-exports: `a::Name` re-exported by `a` from `a::b` (by name or by a glob over
+    // a module that declares it) is `a::b::Name`. Gives the module the path ends in.
+    let resolve = |mut t: Vec<String>| -> Vec<String> {
+        for _ in 0..8 {
+            let k = module_part(&t);
+            if k == t.len() {
+                break;
+            }
+            let (module, name) = (&t[..k], &t[k]);
+            if declares(text_of[module], name) {
+                break;
+            }
+            let named = exports[module].iter().find(|(_, n)| n == name);
+            let next = if let Some((target, _)) = named {
+                Some([&target[..], &t[k + 1..]].concat())
+            } else {
+                exports[module]
+                    .iter()
+                    .filter(|(_, n)| n == "*")
+                    .map(|(target, _)| &target[..module_part(target)])
+                    .find(|q| {
+                        *q != module
+                            && (declares(text_of[q], name)
+                                || exports[q].iter().any(|(_, n)| n == name))
+                    })
+                    .map(|q| [q, &t[k..]].concat())
+            };
+            match next {
+                Some(next) if next != t => t = next,
+                _ => break,
+            }
+        }
+        let k = module_part(&t);
+        t.truncate(k);
+        t
+    };
     // parent → (from child, to child) → first evidence.
     let mut graphs: BTreeMap<Vec<String>, BTreeMap<(String, String), Evidence>> = BTreeMap::new();
     for m in &modules {
         for (path, line) in referenced_paths(&m.text) {
-            let Some(mut target) = absolute(&m.path, &path) else {
+            let Some(target) = absolute(&m.path, &path) else {
                 continue;
             };
-            while !target.is_empty() && !known.contains(&target[..]) {
-                target.pop();
-            }
+            let target = resolve(target);
             let common = m
                 .path
                 .iter()
@@ -765,6 +914,42 @@ fn the_scan_finds_cycles_by_use_path_and_super_and_names_them() {
             "a → b (src/a.rs:1) → a (src/b.rs:3)".to_string(),
             "c::x → c::y (src/c/x.rs:2) → c::x (src/c/y.rs:3)".to_string(),
         ]
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_scan_follows_reexports_of_the_parent() {
+    let dir = scratch_crate(
+        "reexports",
+        &[
+            ("Cargo.toml", "[package]\nname = \"x\"\n"),
+            ("src/lib.rs", "mod p;\n"),
+            (
+                "src/p/mod.rs",
+                "mod x;\nmod y;\nmod z;\npub use x::Thing as Renamed;\npub(crate) use y::*;\n\
+                 pub fn own() {}\n",
+            ),
+            // x reaches y through the parent's glob, y reaches x through the parent's rename.
+            (
+                "src/p/x.rs",
+                "pub struct Thing;\nfn f(_: super::Other) {}\n",
+            ),
+            (
+                "src/p/y.rs",
+                "pub struct Other;\nuse super::{own, Renamed};\nfn g() { own() }\n",
+            ),
+            // Only what the parent declares itself: no edge.
+            ("src/p/z.rs", "fn h() { super::own() }\n"),
+        ],
+    );
+    let cycles: Vec<String> = crate_cycles(&dir.join("src/lib.rs"))
+        .iter()
+        .map(|c| c.describe(&dir))
+        .collect();
+    assert_eq!(
+        cycles,
+        vec!["p::x → p::y (src/p/x.rs:2) → p::x (src/p/y.rs:2)"]
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
