@@ -6,38 +6,15 @@
 //! command's `--format json`), so warnings printed in the middle of a command (a reader's
 //! notes, a run's warnings) come in the same format as its error. Colour only when standard
 //! error is a terminal and `NO_COLOR` is not set (<https://no-color.org>); piped output is
-//! plain. The exit code is not decided here but by [`CliError::exit_code`].
+//! plain. The exit code is not decided here but by [`CliError::exit_code`]. The format, the
+//! colour and the warnings are `super::stderr`'s (re-exported here), so that `io`, which
+//! warns, does not import this module, which names `io`'s [`CliError`].
 
 use super::io::CliError;
+use super::stderr::format;
+pub use super::stderr::{colour, set_format, warn, Format};
 use plc_diag::{Severity, Shown};
 use std::io::Write;
-use std::sync::OnceLock;
-
-/// How diagnostics are printed.
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
-pub enum Format {
-    /// For people: rustc style, coloured on a terminal.
-    Text,
-    /// For tools: one JSON object per line.
-    Json,
-}
-
-static FORMAT: OnceLock<Format> = OnceLock::new();
-
-/// Sets the format for the rest of the process (the first call wins; the default is text).
-pub fn set_format(format: Format) {
-    let _ = FORMAT.set(format);
-}
-
-fn format() -> Format {
-    *FORMAT.get().unwrap_or(&Format::Text)
-}
-
-/// Colour on standard error: a terminal, and `NO_COLOR` unset or empty.
-pub fn colour() -> bool {
-    use std::io::IsTerminal;
-    std::io::stderr().is_terminal() && std::env::var_os("NO_COLOR").is_none_or(|v| v.is_empty())
-}
 
 /// The diagnostics of an error: its load diagnostics, or one without a place.
 fn shown_of(e: &CliError) -> Vec<Shown> {
@@ -61,13 +38,4 @@ pub fn error_text(e: &CliError, format: Format, colour: bool) -> String {
 /// Prints an error on standard error, in the format set.
 pub fn print_error(e: &CliError) {
     let _ = std::io::stderr().write_all(error_text(e, format(), colour()).as_bytes());
-}
-
-/// Prints a warning on standard error, in the format set.
-pub fn warn(w: &Shown) {
-    let text = match format() {
-        Format::Text => w.text(colour()),
-        Format::Json => w.json() + "\n",
-    };
-    let _ = std::io::stderr().write_all(text.as_bytes());
 }

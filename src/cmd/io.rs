@@ -14,7 +14,7 @@
 //! stopped command leaves none behind. Standard output is written by [`write_stream`], the one
 //! place that does: a write error is an error, a closed pipe is not. A program is recognised by
 //! its content ([`load_text`]: S7-200 STL, PLCopen TC6 XML or JSON). Nothing here prints but the
-//! STL and PLCopen readers' warnings (through [`super::errors`]) and the output itself.
+//! STL and PLCopen readers' warnings (through `super::stderr`) and the output itself.
 //!
 //! Not here: an output that is atomic on a device or FIFO (it cannot be), or following a
 //! symbolic link at `-o` (refused: replacing the link would not write its target, writing
@@ -413,7 +413,7 @@ pub const PLCOPEN_NOTE: &str = "W0501";
 /// Prints a reader's notes as warnings with `code`.
 fn warn_notes(code: &'static str, file: &str, text: &str, notes: &[plc_read::plcopen::Note]) {
     for n in notes {
-        super::errors::warn(&Shown::warning(
+        super::stderr::warn(&Shown::warning(
             code,
             n.message.clone(),
             file,

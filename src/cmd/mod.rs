@@ -26,6 +26,7 @@ pub mod skipped;
 // Mapping a file (memmap2); its caveat is argued at the call.
 #[allow(unsafe_code)]
 pub mod source;
+mod stderr;
 mod temp;
 
 pub use io::{CliError, FileRole};

@@ -7,7 +7,8 @@
 //! - [`control`]: post-dominators and control dependences (FOW);
 //! - [`levels`]: ASAP levelling of any dependence graph (the paper's control view);
 //! - [`schedule`]: the correct combined schedule (data + control, loops whole);
-//! - [`cost`]: the cost model, work, span and makespans.
+//! - [`cost`]: the cost model, work, span and makespans;
+//! - [`graphs`]: these results as `petgraph` graphs, for library users' own algorithms.
 //!
 //! Nothing here prints or allocates per-rung strings; reports render these values.
 #![forbid(unsafe_code)]
@@ -17,6 +18,7 @@ pub mod cfg;
 pub mod control;
 pub mod cost;
 pub mod dependences;
+pub mod graphs;
 pub mod interrupts;
 pub mod levels;
 pub mod schedule;

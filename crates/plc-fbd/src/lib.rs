@@ -16,6 +16,7 @@
 #![forbid(unsafe_code)]
 
 pub mod fragments;
+mod ids;
 pub mod model;
 pub mod order;
 pub mod types;

@@ -12,12 +12,9 @@ use plc_model::{
 };
 use std::ops::Range;
 
+pub use super::ids::BlockId;
 use plc_model::index_type;
 
-index_type!(
-    /// A block of one network: index into [`Network::blocks`] (blocks sorted by id).
-    BlockId
-);
 index_type!(
     /// A conditional fragment of one network: index into [`Plan::fragments`]; 0 is the root.
     FragmentId

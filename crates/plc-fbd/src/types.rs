@@ -14,7 +14,7 @@
 //! resolved per instance only: `body` says so with `typed: None`), and ladder bodies in typed
 //! form (they are kept as rungs per instance).
 
-use super::model::BlockId;
+use super::ids::BlockId;
 use plc_model::{index_type, Field, Type, Value, VarId};
 
 index_type!(
