@@ -1,5 +1,5 @@
 //! Readers: program files in → the surface syntax ([`plc_syntax`]). Nothing here resolves a
-//! name: [`plc_load`] puts a reader and the resolver together.
+//! name: the `plc-load` crate, above this one, puts a reader and the resolver together.
 //!
 //! Three formats: S7-200 STL ([`stl`], docs/il.md), PLCopen TC6 XML ([`plcopen`], docs/plcopen.md) and the JSON program format
 //! (docs/format.md, docs/fbd.md; [`json`]), which

@@ -8,7 +8,7 @@
 //!
 //! Deliberately not here: checking the program (the caller loads it first: a syntax tree with
 //! problems in it is refused, not written), and writing the model or the analysis (those are
-//! reports: [`plc_report`]).
+//! reports: the `plc-report` crate).
 #![forbid(unsafe_code)]
 
 pub mod json;
