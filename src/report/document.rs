@@ -13,6 +13,7 @@
 //! Fields marked `#[serde(skip)]` are for the human renderers (text, DOT) and are not part of
 //! the JSON contract. Nothing here writes output: renderers do (`text`, `json`, `dot`).
 
+pub use super::explain::DifferenceEntry;
 use super::explain::Explainer;
 use super::{FbdParts, RungPart};
 use crate::analysis::{Analysis, Branch, CfgEdgeId, ControlCause, Listed, Successor};
@@ -344,15 +345,6 @@ pub struct LoopEntry<'a> {
     /// The loop's name: its first rung.
     pub head: &'a str,
     pub rungs: Vec<&'a str>,
-}
-
-#[derive(serde::Serialize)]
-pub struct DifferenceEntry {
-    pub rung: String,
-    pub data_level: u32,
-    pub control_level: u32,
-    pub combined_level: Option<u32>,
-    pub reasons: Vec<String>,
 }
 
 #[derive(serde::Serialize)]
