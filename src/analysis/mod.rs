@@ -89,14 +89,19 @@ fn idle_rungs(p: &Program, acc: &Accesses) -> (Vec<RungId>, Vec<RungId>) {
     (empty, no_effect)
 }
 
-/// Which data dependences an [`Analysis`] lists (levels and schedule never depend on it).
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+/// Which data dependences an [`Analysis`] lists (levels and schedule never depend on it;
+/// `report --dependences`: `All` and `Direct` are the command line's values, their doc comments
+/// not its help).
+#[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum DependenceListing {
     /// Every pair of the paper's definition.
+    #[value(help = None::<&str>)]
     All,
     /// Only the direct pairs ([`direct_dependences`]), linear in the accesses.
+    #[value(help = None::<&str>)]
     Direct,
     /// Every pair while there are at most this many, the direct ones beyond.
+    #[value(skip)]
     UpTo(u64),
 }
 

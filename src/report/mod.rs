@@ -29,14 +29,18 @@ pub use text::{render_text, Rows, TextOptions};
 use crate::analysis::{Analysis, ControlCause, Warning};
 use crate::model::*;
 
-/// Which levellings a text or DOT report shows (JSON always carries all of them).
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+/// Which levellings a text or DOT report shows (JSON always carries all of them; `--view`: the
+/// variants are the command line's values, their doc comments not its help).
+#[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum View {
     /// The paper's data and control views.
+    #[value(help = None::<&str>)]
     Paper,
     /// The correct combined schedule.
+    #[value(help = None::<&str>)]
     Combined,
     /// Both.
+    #[value(help = None::<&str>)]
     All,
 }
 

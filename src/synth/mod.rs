@@ -146,15 +146,18 @@ pub struct GenConfig {
     pub reads: Reads,
 }
 
-/// Which lanes of the previous stage a rung reads.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+/// Which lanes of the previous stage a rung reads (`gen --reads`: the variants are the command
+/// line's values, their doc comments not its help).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum Reads {
     /// 3–5 of the nearby lanes `j-2..=j+2` (the default: producers and consumers stay close,
     /// as in real programs laid out by function).
     #[default]
+    #[value(help = None::<&str>)]
     Local,
     /// 3–6 distinct lanes drawn uniformly from all `W` lanes (fewer when `W` is smaller): the
     /// values a level reads are spread over the whole level before it.
+    #[value(help = None::<&str>)]
     Random,
 }
 
