@@ -11,10 +11,10 @@ use plc_deps::analysis::{AnalysisConfig, DependenceListing};
 use plc_deps::cmd::order::OrderFormat;
 use plc_deps::cmd::report::{ReportConfig, ReportFormat};
 use plc_deps::cmd::run::{RunFormat, RunMode};
-use plc_deps::exec::parallel::PlanKind;
-use plc_deps::synth::Reads;
 use plc_deps::cmd::{self, CliError};
+use plc_deps::exec::parallel::PlanKind;
 use plc_deps::report::{Rows, Selection, View};
+use plc_deps::synth::Reads;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
