@@ -2,9 +2,9 @@
 //! model and its [`Analysis`], rendered by every output format.
 //!
 //! The structs here are the JSON report: their `#[derive(Serialize)]` field names are its keys,
-//! which are normative (docs/report.md; add fields, never rename or drop one). `super::json`
-//! writes the top level and the longest lists' entries itself, byte for byte as serialising the
-//! [`Report`] would (its tests check that): a field added here is added there too. Sections whose
+//! which are normative (docs/report.md, docs/report.schema.json; add fields, never rename or drop
+//! one). `super::json` serialises the [`Report`] and nothing else: a field added here is in the
+//! JSON, and must be added to the schema (tests/it/report_schema.rs checks). Sections whose
 //! size grows with the program (rungs, dependences, CFG edges, post-dominators, tasks,
 //! differences) are [`Lazy`] lists: each entry is made when a renderer asks for it, so a
 //! million-rung report costs no second copy of the analysis, and a renderer that shows only the
