@@ -7,11 +7,15 @@
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
-use clap::{Args, Parser, Subcommand, ValueEnum};
+use clap::{Args, Parser, Subcommand};
 use plc_deps::analysis::{AnalysisConfig, DependenceListing};
+use plc_deps::cmd::order::OrderFormat;
 use plc_deps::cmd::report::{ReportConfig, ReportFormat};
+use plc_deps::cmd::run::{RunFormat, RunMode};
 use plc_deps::cmd::{self, CliError};
+use plc_deps::exec::parallel::PlanKind;
 use plc_deps::report::{Rows, Selection, View};
+use plc_deps::synth::Reads;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -33,8 +37,8 @@ enum Command {
         /// input).
         file: PathBuf,
         /// Output format.
-        #[arg(long, value_enum, default_value_t = FormatArg::Text)]
-        format: FormatArg,
+        #[arg(long, value_enum, default_value_t = OrderFormat::Text)]
+        format: OrderFormat,
         /// Write to this file instead of standard output.
         #[arg(short, long)]
         output: Option<PathBuf>,
@@ -81,12 +85,12 @@ struct ReportArgs {
     /// The program (JSON program format, see docs/format.md; `-`: standard input).
     file: PathBuf,
     /// Output format.
-    #[arg(long, value_enum, default_value_t = ReportFormatArg::Text)]
-    format: ReportFormatArg,
+    #[arg(long, value_enum, default_value_t = ReportFormat::Text)]
+    format: ReportFormat,
     /// Which levellings the output shows (JSON and HTML always have all of them) [default:
     /// all for text, combined for DOT, which draws one levelling].
     #[arg(long, value_enum)]
-    view: Option<ViewArg>,
+    view: Option<View>,
     /// Print every row of every text section (by default each shows its first rows).
     #[arg(long)]
     full: bool,
@@ -94,7 +98,7 @@ struct ReportArgs {
     /// ones (last writer → reader, reader → next writer, writer → next writer), which imply
     /// the rest [default: all up to --max-pairs, direct beyond].
     #[arg(long, value_enum)]
-    dependences: Option<DependencesArg>,
+    dependences: Option<DependenceListing>,
     /// The most data dependence pairs listed before the report lists the direct ones instead.
     #[arg(long, default_value_t = plc_deps::analysis::DEFAULT_MAX_PAIRS)]
     max_pairs: u64,
@@ -124,8 +128,8 @@ struct GenArgs {
     levels: Option<usize>,
     /// Which lanes of the previous stage a rung reads: 3-5 nearby ones (local) or 3-6 drawn
     /// at random from the whole stage (random).
-    #[arg(long, value_enum, default_value_t = ReadsArg::Local)]
-    reads: ReadsArg,
+    #[arg(long, value_enum, default_value_t = Reads::Local)]
+    reads: Reads,
     /// Seed of the pseudo-random choices (same seed, same program).
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -173,8 +177,8 @@ struct RunArgs {
     #[arg(long)]
     threads: Option<usize>,
     /// Which executors run.
-    #[arg(long, value_enum, default_value_t = ModeArg::Both)]
-    mode: ModeArg,
+    #[arg(long, value_enum, default_value_t = RunMode::Both)]
+    mode: RunMode,
     /// Write the traced variables after every scan to this CSV file (checked before the
     /// first scan, complete or not at all).
     #[arg(long)]
@@ -184,8 +188,8 @@ struct RunArgs {
     #[arg(long, value_delimiter = ',')]
     trace_vars: Option<Vec<String>>,
     /// Output format.
-    #[arg(long, value_enum, default_value_t = RunFormatArg::Text)]
-    format: RunFormatArg,
+    #[arg(long, value_enum, default_value_t = RunFormat::Text)]
+    format: RunFormat,
     /// Explain the parallel plan: levels, costs, slices, merges and padding, and what the
     /// run chose (measured times, switches).
     #[arg(long)]
@@ -195,8 +199,8 @@ struct RunArgs {
     /// walk (seq), always the levelled plan (par), always the dependence-driven plan (deps:
     /// ready flags instead of a barrier per level), always the levelled plan on private
     /// states handing over packed writes after each phase (exchange).
-    #[arg(long, value_enum, default_value_t = PlanArg::Auto)]
-    plan: PlanArg,
+    #[arg(long, value_enum, default_value_t = PlanKind::Auto)]
+    plan: PlanKind,
     /// Loop-backs allowed per loop-back rung and scan (the iteration cap).
     #[arg(long, default_value_t = 100_000)]
     loop_cap: u32,
@@ -259,67 +263,6 @@ struct CArgs {
     rows: bool,
 }
 
-#[derive(Copy, Clone, ValueEnum)]
-enum PlanArg {
-    Auto,
-    Model,
-    Seq,
-    Par,
-    Deps,
-    Exchange,
-}
-
-#[derive(Copy, Clone, ValueEnum)]
-enum ReadsArg {
-    Local,
-    Random,
-}
-
-#[derive(Copy, Clone, ValueEnum)]
-enum ModeArg {
-    Seq,
-    Par,
-    Both,
-}
-
-#[derive(Copy, Clone, ValueEnum)]
-enum RunFormatArg {
-    Text,
-    Json,
-    /// The report page of the program with the run's figures (docs/html.md).
-    Html,
-}
-
-#[derive(Copy, Clone, ValueEnum)]
-enum FormatArg {
-    Text,
-    Json,
-    Dot,
-}
-
-/// `report --format`: the order formats and the HTML page.
-#[derive(Copy, Clone, ValueEnum)]
-enum ReportFormatArg {
-    Text,
-    Json,
-    Dot,
-    /// One self-contained page (docs/html.md).
-    Html,
-}
-
-#[derive(Copy, Clone, ValueEnum)]
-enum ViewArg {
-    Paper,
-    Combined,
-    All,
-}
-
-#[derive(Copy, Clone, ValueEnum)]
-enum DependencesArg {
-    All,
-    Direct,
-}
-
 fn run(cli: Cli) -> Result<(), CliError> {
     match cli.command {
         Command::Report(args) => cmd::report::report(&args.config()?),
@@ -327,18 +270,11 @@ fn run(cli: Cli) -> Result<(), CliError> {
             file,
             format,
             output,
-        } => {
-            let format = match format {
-                FormatArg::Text => cmd::order::OrderFormat::Text,
-                FormatArg::Json => cmd::order::OrderFormat::Json,
-                FormatArg::Dot => cmd::order::OrderFormat::Dot,
-            };
-            cmd::order::order(&cmd::order::OrderConfig {
-                input: file,
-                format,
-                output,
-            })
-        }
+        } => cmd::order::order(&cmd::order::OrderConfig {
+            input: file,
+            format,
+            output,
+        }),
         Command::Convert {
             file,
             allow_skipped,
@@ -364,12 +300,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
 impl ReportArgs {
     /// The report's configuration; a usage error for options that do not go together.
     fn config(self) -> Result<ReportConfig, CliError> {
-        let format = match self.format {
-            ReportFormatArg::Text => ReportFormat::Text,
-            ReportFormatArg::Json => ReportFormat::Json,
-            ReportFormatArg::Dot => ReportFormat::Dot,
-            ReportFormatArg::Html => ReportFormat::Html,
-        };
+        let format = self.format;
         // Outside DOT, --pou selects the PLCopen program to analyse.
         let (pou, program) = match format {
             ReportFormat::Dot => (self.pou, None),
@@ -395,14 +326,14 @@ impl ReportArgs {
             ));
         }
         let view = match (self.view, format) {
-            (Some(ViewArg::Paper), _) => View::Paper,
-            (Some(ViewArg::Combined), _) | (None, ReportFormat::Dot) => View::Combined,
-            (Some(ViewArg::All), ReportFormat::Dot) => {
+            (Some(View::Paper), _) => View::Paper,
+            (Some(View::Combined), _) | (None, ReportFormat::Dot) => View::Combined,
+            (Some(View::All), ReportFormat::Dot) => {
                 return Err(CliError::Usage(
                     "--view all: the DOT report draws one levelling; use --view combined (the default) or --view paper".into(),
                 ))
             }
-            (Some(ViewArg::All), _) | (None, _) => View::All,
+            (Some(View::All), _) | (None, _) => View::All,
         };
         Ok(ReportConfig {
             input: self.file,
@@ -414,11 +345,9 @@ impl ReportArgs {
                 Rows::First(plc_deps::report::text::DEFAULT_ROWS)
             },
             analysis: AnalysisConfig {
-                dependences: match self.dependences {
-                    Some(DependencesArg::All) => DependenceListing::All,
-                    Some(DependencesArg::Direct) => DependenceListing::Direct,
-                    None => DependenceListing::UpTo(self.max_pairs),
-                },
+                dependences: self
+                    .dependences
+                    .unwrap_or(DependenceListing::UpTo(self.max_pairs)),
             },
             selection,
             program,
@@ -460,10 +389,7 @@ impl GenArgs {
                 calls: self.calls,
                 for_body: self.for_body,
                 hot_fraction: self.hot_fraction,
-                reads: match self.reads {
-                    ReadsArg::Local => plc_deps::synth::Reads::Local,
-                    ReadsArg::Random => plc_deps::synth::Reads::Random,
-                },
+                reads: self.reads,
             },
             levels: self.levels,
             output: self.output,
@@ -474,8 +400,7 @@ impl GenArgs {
 impl RunArgs {
     /// The run's configuration; a usage error for a cycle that is not a TIME.
     fn config(self) -> Result<plc_deps::cmd::run::RunConfig, CliError> {
-        use plc_deps::cmd::run::{self, RunConfig, RunFormat, RunMode};
-        use plc_deps::exec::parallel::PlanKind;
+        use plc_deps::cmd::run::{self, RunConfig};
         let mut config = RunConfig::new(self.file);
         config.scans = self.scans;
         config.alternate = self.alternate;
@@ -484,27 +409,12 @@ impl RunArgs {
         if let Some(t) = self.threads {
             config.threads = t;
         }
-        config.mode = match self.mode {
-            ModeArg::Seq => RunMode::Seq,
-            ModeArg::Par => RunMode::Par,
-            ModeArg::Both => RunMode::Both,
-        };
+        config.mode = self.mode;
         config.trace = self.trace;
         config.trace_vars = self.trace_vars;
-        config.format = match self.format {
-            RunFormatArg::Text => RunFormat::Text,
-            RunFormatArg::Json => RunFormat::Json,
-            RunFormatArg::Html => RunFormat::Html,
-        };
+        config.format = self.format;
         config.explain = self.explain;
-        config.plan = match self.plan {
-            PlanArg::Auto => PlanKind::Auto,
-            PlanArg::Model => PlanKind::Model,
-            PlanArg::Seq => PlanKind::Seq,
-            PlanArg::Par => PlanKind::Par,
-            PlanArg::Deps => PlanKind::Deps,
-            PlanArg::Exchange => PlanKind::Exchange,
-        };
+        config.plan = self.plan;
         config.loop_cap = self.loop_cap;
         config.scan_budget = self.scan_budget;
         config.output = self.output;
@@ -553,9 +463,9 @@ fn parse_cli() -> Result<Cli, ExitCode> {
 /// How errors and warnings are printed: as JSON lines when the command was given `--format json`.
 fn error_format(cli: &Cli) -> cmd::errors::Format {
     let json = match &cli.command {
-        Command::Report(args) => matches!(args.format, ReportFormatArg::Json),
-        Command::Order { format, .. } => matches!(format, FormatArg::Json),
-        Command::Run(args) => matches!(args.format, RunFormatArg::Json),
+        Command::Report(args) => args.format == ReportFormat::Json,
+        Command::Order { format, .. } => *format == OrderFormat::Json,
+        Command::Run(args) => args.format == RunFormat::Json,
         _ => false,
     };
     if json {

@@ -6,8 +6,8 @@ use super::CliError;
 use plc_model::Program;
 use std::path::PathBuf;
 
-/// Output format of `order`.
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+/// Output format of `order` (`--format`: the variants are the command line's values).
+#[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum OrderFormat {
     Text,
     Json,

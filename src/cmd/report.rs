@@ -20,8 +20,9 @@ use plc_report::{
 use std::collections::HashSet;
 use std::path::PathBuf;
 
-/// Output format of `report`.
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+/// Output format of `report` (`--format`: the variants are the command line's values, a
+/// variant's doc comment its help).
+#[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum ReportFormat {
     Text,
     Json,

@@ -66,6 +66,7 @@ mod plcopen_structs;
 mod plcopen_types;
 mod readme;
 mod report_networks;
+mod report_schema;
 mod report_size;
 mod report_warnings;
 mod run_cli;

@@ -159,7 +159,7 @@ fn global_pou(name: &str, read: &str, write: &str) -> String {
 /// Two tasks: Fast runs `fa` (program A: G3 → G1), Slow runs `sb` (B: G1 → G2) and `sc`
 /// (C: G2 → G4); the resource itself runs `rd` (D: G3 → G5). Fast and the resource have the
 /// lowest numbers, Slow priority 2.
-fn two_task_project() -> String {
+pub(crate) fn two_task_project() -> String {
     let pous = [
         global_pou("A", "G3", "G1"),
         global_pou("B", "G1", "G2"),

@@ -92,14 +92,20 @@ fn idle_rungs(p: &Program, acc: &Accesses) -> (Vec<RungId>, Vec<RungId>) {
     (empty, no_effect)
 }
 
-/// Which data dependences an [`Analysis`] lists (levels and schedule never depend on it).
+/// Which data dependences an [`Analysis`] lists (levels and schedule never depend on it;
+/// `report --dependences`: `All` and `Direct` are the command line's values, their doc comments
+/// not its help).
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum DependenceListing {
     /// Every pair of the paper's definition.
+    #[cfg_attr(feature = "clap", value(help = None::<&str>))]
     All,
     /// Only the direct pairs ([`direct_dependences`]), linear in the accesses.
+    #[cfg_attr(feature = "clap", value(help = None::<&str>))]
     Direct,
     /// Every pair while there are at most this many, the direct ones beyond.
+    #[cfg_attr(feature = "clap", value(skip))]
     UpTo(u64),
 }
 

@@ -83,7 +83,7 @@ pub fn topological_order(net: &Network) -> Result<Vec<BlockId>, Vec<BlockId>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use plc_model::*;
+    use crate::model::*;
 
     fn net(edges: &[(u32, u32)], ids: &[u32]) -> Network {
         let index = |id: u32| BlockId(ids.iter().position(|&x| x == id).unwrap() as u32);

@@ -2,9 +2,9 @@
 //! model and its [`Analysis`], rendered by every output format.
 //!
 //! The structs here are the JSON report: their `#[derive(Serialize)]` field names are its keys,
-//! which are normative (docs/report.md; add fields, never rename or drop one). `super::json`
-//! writes the top level and the longest lists' entries itself, byte for byte as serialising the
-//! [`Report`] would (its tests check that): a field added here is added there too. Sections whose
+//! which are normative (docs/report.md, docs/report.schema.json; add fields, never rename or drop
+//! one). `super::json` serialises the [`Report`] and nothing else: a field added here is in the
+//! JSON, and must be added to the schema (tests/it/report_schema.rs checks). Sections whose
 //! size grows with the program (rungs, dependences, CFG edges, post-dominators, tasks,
 //! differences) are [`Lazy`] lists: each entry is made when a renderer asks for it, so a
 //! million-rung report costs no second copy of the analysis, and a renderer that shows only the
@@ -13,6 +13,7 @@
 //! Fields marked `#[serde(skip)]` are for the human renderers (text, DOT) and are not part of
 //! the JSON contract. Nothing here writes output: renderers do (`text`, `json`, `dot`).
 
+pub use super::explain::DifferenceEntry;
 use super::explain::Explainer;
 use super::{FbdParts, RungPart};
 use plc_analysis::{Analysis, Branch, CfgEdgeId, ControlCause, Listed, Successor};
@@ -344,15 +345,6 @@ pub struct LoopEntry<'a> {
     /// The loop's name: its first rung.
     pub head: &'a str,
     pub rungs: Vec<&'a str>,
-}
-
-#[derive(serde::Serialize)]
-pub struct DifferenceEntry {
-    pub rung: String,
-    pub data_level: u32,
-    pub control_level: u32,
-    pub combined_level: Option<u32>,
-    pub reasons: Vec<String>,
 }
 
 #[derive(serde::Serialize)]

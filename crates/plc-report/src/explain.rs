@@ -5,10 +5,24 @@
 //! per-rung comparison of levels); [`Explainer::difference`] builds one rung's reasons when a
 //! renderer asks for them. A loop is named once, by its first rung (`the loop at R5`); its
 //! members are listed in the report's `loops`, not repeated in every member's reason.
+//!
+//! The document (`super::document`) uses this module; this module does not use the document:
+//! [`DifferenceEntry`], an entry of the report's `differences`, is defined here, where it is
+//! made.
 
-use super::document::DifferenceEntry;
 use plc_analysis::{schedule::TaskId, Analysis, ControlCause, EdgeKind};
 use plc_model::*;
+
+/// Why a rung's combined level differs from a paper view's: an entry of the report's
+/// `differences` (its fields are the JSON keys, docs/report.md).
+#[derive(serde::Serialize)]
+pub struct DifferenceEntry {
+    pub rung: String,
+    pub data_level: u32,
+    pub control_level: u32,
+    pub combined_level: Option<u32>,
+    pub reasons: Vec<String>,
+}
 
 /// Precomputed context for explaining differences.
 pub struct Explainer<'a> {

@@ -30,14 +30,19 @@ pub use text::{render_text, Rows, TextOptions};
 use plc_analysis::{Analysis, ControlCause, Warning};
 use plc_model::*;
 
-/// Which levellings a text or DOT report shows (JSON always carries all of them).
+/// Which levellings a text or DOT report shows (JSON always carries all of them; `--view`: the
+/// variants are the command line's values, their doc comments not its help).
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum View {
     /// The paper's data and control views.
+    #[cfg_attr(feature = "clap", value(help = None::<&str>))]
     Paper,
     /// The correct combined schedule.
+    #[cfg_attr(feature = "clap", value(help = None::<&str>))]
     Combined,
     /// Both.
+    #[cfg_attr(feature = "clap", value(help = None::<&str>))]
     All,
 }
 

@@ -8,7 +8,12 @@ use std::io::{self, Write};
 // ---------------------------------------------------------------------------------------------
 // PRNG
 
-/// splitmix64.
+/// splitmix64 (Steele, Lea & Flood 2014), with `below` by the high half of a 64×64-bit product.
+///
+/// Hand-written on purpose: the exact sequence decides every generated program (`gen` output
+/// is byte-identical for a seed, docs/gen.md), and no crate gives both this step and this
+/// mapping to a range (`rand`'s ranges reject and redraw, so every program would change); the
+/// step itself is five lines.
 pub(super) struct Rng(pub(super) u64);
 
 impl Rng {

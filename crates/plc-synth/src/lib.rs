@@ -147,15 +147,19 @@ pub struct GenConfig {
     pub reads: Reads,
 }
 
-/// Which lanes of the previous stage a rung reads.
+/// Which lanes of the previous stage a rung reads (`gen --reads`: the variants are the command
+/// line's values, their doc comments not its help).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Reads {
     /// 3–5 of the nearby lanes `j-2..=j+2` (the default: producers and consumers stay close,
     /// as in real programs laid out by function).
     #[default]
+    #[cfg_attr(feature = "clap", value(help = None::<&str>))]
     Local,
     /// 3–6 distinct lanes drawn uniformly from all `W` lanes (fewer when `W` is smaller): the
     /// values a level reads are spread over the whole level before it.
+    #[cfg_attr(feature = "clap", value(help = None::<&str>))]
     Random,
 }
 

@@ -9,19 +9,24 @@ use plc_model::parse_time_literal;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
-/// Which executors `run` uses.
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+/// Which executors `run` uses (`--mode`: the variants are the command line's values, their doc
+/// comments not its help).
+#[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum RunMode {
     /// The sequential interpreter only.
+    #[value(help = None::<&str>)]
     Seq,
     /// The parallel executor only.
+    #[value(help = None::<&str>)]
     Par,
     /// Both, timed separately, every scan checked seq == par.
+    #[value(help = None::<&str>)]
     Both,
 }
 
-/// Output format of `run`.
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+/// Output format of `run` (`--format`: the variants are the command line's values, a variant's
+/// doc comment its help).
+#[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum RunFormat {
     Text,
     Json,

@@ -3,29 +3,37 @@
 //! ([`PlanKind`]) and how the measured choice among them re-measures ([`Measure`]).
 //! Plain data at the bottom of the parallel module; nothing here decides anything.
 
-/// Which plans a run may use.
+/// Which plans a run may use (`run --plan`: the variants are the command line's values, their
+/// doc comments not its help).
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum PlanKind {
     /// Measured: the sequential walk, the levelled plans (contiguous, LPT and locality
     /// slicing) and the dependence-driven plan that the cost model says may gain are timed on
     /// the run's first scans, the fastest runs, and the choice is re-measured as the run goes
     /// (`plc-deps run --plan auto`, the default).
+    #[cfg_attr(feature = "clap", value(help = None::<&str>))]
     Auto,
     /// The cost model decides, once, with no measurement (the levelled plan if it beats the
     /// sequential scan by a modelled barrier, else the sequential walk).
+    #[cfg_attr(feature = "clap", value(help = None::<&str>))]
     Model,
     /// Always the sequential walk.
+    #[cfg_attr(feature = "clap", value(help = None::<&str>))]
     Seq,
     /// Always the levelled plan of the cost model's phases, even if the model says it does not
     /// pay (the sequential walk only when no level can run in parallel at all).
+    #[cfg_attr(feature = "clap", value(help = None::<&str>))]
     Par,
     /// Always the dependence-driven plan (`deps_plan`): each worker runs its tasks of every
     /// level in order and waits, before a task, only for the tasks it depends on that run on
     /// another worker (ready flags instead of a barrier per level).
+    #[cfg_attr(feature = "clap", value(help = None::<&str>))]
     Deps,
     /// Always the levelled plan (as `Par`) with every worker on a private copy of the state,
     /// handing the others what it wrote after each phase, BOOLs packed as bits (`par-exchange`);
     /// the levelled plan on the shared state when its phases cannot run that way.
+    #[cfg_attr(feature = "clap", value(help = None::<&str>))]
     Exchange,
 }
 
