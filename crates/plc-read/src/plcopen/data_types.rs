@@ -269,7 +269,7 @@ pub(super) fn base(
         library: None,
     };
     let tag = bt.tag_name().name();
-    if super::interface::is_elementary_tag(tag) {
+    if super::elementary::is_elementary_tag(tag) {
         return Ok(plain(Base::Elementary(tag.to_owned())));
     }
     match tag {

@@ -9,7 +9,7 @@
 //!
 //! Every elementary type of IEC 61131-3 Table 10 but the strings, LTIME and the dates and
 //! times of day is the model's own (BOOL, SINT … LINT, USINT … ULINT, REAL, LREAL, BYTE …
-//! LWORD, TIME). Those it lacks are read as one it has ([`MAPPED`]), and each such variable is
+//! LWORD, TIME). Those it lacks are read as one it has ([`super::elementary::MAPPED`]), and each such variable is
 //! recorded ([`Mapped`]) for the POU's note.
 //!
 //! A user data type (or a library one, [`super::data_types`]) is read as its base: an alias or
@@ -22,6 +22,7 @@
 //! — each an error naming the variable, until the model has them.
 
 use super::data_types::{Aggregate, Base, DataType, DataTypes};
+use super::elementary::{is_elementary_tag, model_type_of, MAPPED, MODEL_ELEMENTARY};
 use super::xml::{error, identifier, origin, Tc6, R};
 use plc_syntax::{Located, Name, Operand, Scalar, Var, VarClass};
 use roxmltree::Node;
@@ -66,22 +67,6 @@ pub struct Mapped {
     pub via: Option<String>,
 }
 
-/// The elementary types of IEC 61131-3 (6.4.2, Table 10) the model lacks, and the model's type
-/// each is read as: dates and times of day as DINT, LTIME as TIME; strings as DINT (a
-/// stand-in: analysis only). docs/plcopen.md says what `run` computes differently.
-const MAPPED: &[(&str, &str)] = &[
-    ("LTIME", "TIME"),
-    ("DATE", "DINT"),
-    ("TOD", "DINT"),
-    ("TIME_OF_DAY", "DINT"),
-    ("DT", "DINT"),
-    ("DATE_AND_TIME", "DINT"),
-    ("string", "DINT"),
-    ("wstring", "DINT"),
-    ("STRING", "DINT"),
-    ("WSTRING", "DINT"),
-];
-
 /// Standard function blocks the model has.
 const MODEL_FBS: &[&str] = &[
     "TON", "TOF", "TP", "CTU", "CTD", "SR", "RS", "R_TRIG", "F_TRIG", "CTUD",
@@ -95,31 +80,6 @@ const OTHER_STD_FBS: &[&str] = &[
     "CTU_UDINT",
     "CTU_ULINT",
 ];
-const MODEL_ELEMENTARY: &[&str] = &[
-    "BOOL", "SINT", "INT", "DINT", "LINT", "USINT", "UINT", "UDINT", "ULINT", "REAL", "LREAL",
-    "BYTE", "WORD", "DWORD", "LWORD", "TIME",
-];
-
-/// True when a TC6 type element's tag is an elementary type (the model's or a mapped one).
-pub fn is_elementary_tag(tag: &str) -> bool {
-    MODEL_ELEMENTARY.contains(&tag) || MAPPED.iter().any(|(f, _)| *f == tag)
-}
-
-/// True when a declared type (as the reader writes it into the syntax) is elementary, not a
-/// function block type.
-pub fn is_elementary(ty: &str) -> bool {
-    MODEL_ELEMENTARY.contains(&ty)
-}
-
-/// The model type IEC elementary type `t` is read as (`None`: not an elementary type); a
-/// string as its stand-in DINT.
-pub fn model_type_of(t: &str) -> Option<&'static str> {
-    if let Some(m) = MODEL_ELEMENTARY.iter().find(|m| **m == t) {
-        return Some(m);
-    }
-    MAPPED.iter().find(|(f, _)| *f == t).map(|(_, m)| *m)
-}
-
 /// Reads the interface of POU `pou` (its `interface` element; none is an empty interface).
 pub fn interface(tc6: Tc6, node: Option<Node>, pou: &str, known: &Known) -> R<Interface> {
     let mut out = Interface::default();

@@ -19,7 +19,9 @@
 //! never dropped; a program loads whole or not at all.
 
 mod black_box;
+mod block_types;
 mod data_types;
+mod elementary;
 mod expression;
 mod fbd;
 mod fbd_loops;

@@ -82,7 +82,7 @@ pub fn members(
             "array" => base(tc6, raw, "ARRAY", te, depth + 1, place)?,
             _ => base(tc6, raw, &inner, te, depth + 1, place)?,
         };
-        let elementary = super::interface::is_elementary_tag(te.tag_name().name());
+        let elementary = super::elementary::is_elementary_tag(te.tag_name().name());
         let mut init = None;
         if let Some(iv) = tc6.child(v, "initialValue") {
             init = simple(tc6, iv, place)?;
