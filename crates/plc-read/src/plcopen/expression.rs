@@ -9,7 +9,7 @@
 //!
 //! A function block instance's output (`t.Q`) is the field reference the model has for it; a
 //! structure's field (`s.f`, `s.inner.f`) is passed on as such: it is the name of the field's
-//! own variable ([`super::structure`]). An array element
+//! own variable ([`super::data_types`]). An array element
 //! (`a[i]`) reads the whole array and the variables of its subscripts: the model holds an array
 //! as one value of its element type (docs/plcopen.md, "Data types"), so the element stands in as
 //! `SEL(NE(i, i), a, a)` — the value `a`, with `i` read — and `run` refuses the body (the

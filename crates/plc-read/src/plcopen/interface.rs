@@ -16,7 +16,7 @@
 //! subrange as its elementary type, an enumeration as INT, an array (named or declared in
 //! place) as a whole variable without a value; each such variable is recorded too, with the
 //! type's description. A structure (named or declared in place) is flattened into one variable
-//! per elementary field, `Motor.Speed` ([`super::structure`]), each read as above.
+//! per elementary field, `Motor.Speed` ([`super::data_types`]), each read as above.
 //!
 //! Deliberately not here: structured initial values of elementary variables and `VAR_IN_OUT`
 //! — each an error naming the variable, until the model has them.
@@ -162,7 +162,7 @@ pub fn var_list(
 }
 
 /// The variables one declaration `v` makes: itself, or, for a structure, one per leaf field
-/// ([`super::structure`]).
+/// ([`super::data_types`]).
 fn variable(
     tc6: Tc6,
     v: Node,
@@ -206,7 +206,7 @@ fn variable(
                 format!("the initial value of structure `{name}` is not a structured value"),
             )
         })?;
-        super::structure::apply_value(tc6, &mut members, sv, &name, &place)?;
+        super::data_types::apply_value(tc6, &mut members, sv, &name, &place)?;
     }
     mapped.push(Mapped {
         var: name.clone(),
@@ -217,7 +217,7 @@ fn variable(
         via: Some(d.describe()),
     });
     let mut out = Vec::new();
-    for leaf in super::structure::flatten(&name, &members) {
+    for leaf in super::data_types::flatten(&name, &members) {
         let ty = if leaf.elementary {
             Ty::Elementary(data_base(&leaf.ty))
         } else {
@@ -395,7 +395,7 @@ fn type_name(tc6: Tc6, ty: Node, var: &str, place: &str, known: &Known) -> R<Ty>
     match tag {
         "array" => return whole(Aggregate::Array, "ARRAY"),
         "struct" => {
-            let members = super::structure::members(
+            let members = super::data_types::members(
                 tc6,
                 &std::collections::HashMap::new(),
                 Some(&known.data_types),
