@@ -8,8 +8,9 @@
 //!
 //! Not here: the POUs' code (`ladder`, `fbd`).
 
-use super::ladder::{c_const, push, Shared};
+use super::ladder::{c_const, Shared};
 use super::names::{c_string, json_string};
+use super::text::push;
 use super::CConfig;
 use plc_model::{FbKind, Program, Type, Value, VarClass};
 

@@ -15,10 +15,10 @@
 //!
 //! Files: at most [`PER_FILE`] kernels per file, so `make -j` compiles them in parallel.
 //!
-//! Not here: which rungs are rows and their slots (`rows`).
+//! Not here: which rungs are rows and their slots (`rows`); the shapes as data (`shape`).
 
-use super::ladder::push;
-use super::rows::{Item, Out, Shape};
+use super::shape::{Item, Out, Shape};
+use super::text::push;
 
 /// Kernels per source file.
 pub(super) const PER_FILE: usize = 64;

@@ -21,7 +21,6 @@ use super::{fold, names};
 use plc_model::*;
 use std::borrow::Cow;
 use std::collections::HashMap;
-use std::fmt::Write as _;
 
 /// Power as the emitter holds it.
 #[derive(Clone, Debug)]
@@ -59,7 +58,7 @@ pub(crate) struct Shared<'a> {
     /// member of it (they come first in the struct, `member_offsets`).
     pub at: Vec<Option<u32>>,
     /// Per rung: its row, if it is written as one (`rows`).
-    pub rows: Vec<Option<super::rows::Row>>,
+    pub rows: Vec<Option<super::shape::Row>>,
     /// Per rung: its scan budget task (`plc_exec::budget::tasks`).
     pub budget_task: Vec<Option<u32>>,
 }
@@ -81,7 +80,7 @@ pub(crate) struct Body<'a> {
     /// Whether each rung gets a comment with its id (off to compare instances' code).
     pub comments: bool,
     /// Set where rungs of contacts and coils become rows of tables (`rows`).
-    pub rows: Option<super::rows::Tables>,
+    pub rows: Option<super::table::Tables>,
     /// The power locals (`bool _pN = …;`) whose value is a box's call: [`Body::finish`] keeps
     /// the call of one that nothing reads (every other power local is a pure expression).
     calls: std::collections::HashSet<String>,
@@ -817,8 +816,3 @@ fn power_locals(text: &str) -> impl Iterator<Item = &str> {
 
 /// The power at the end of a series.
 pub(crate) struct PwOut(Pw);
-
-/// Writes `text` into `out` (a `String`, cannot fail).
-pub(crate) fn push(out: &mut String, text: std::fmt::Arguments<'_>) {
-    out.write_fmt(text).expect("writing to a String");
-}

@@ -37,7 +37,10 @@ mod order;
 mod parts;
 mod rows;
 mod runtime;
+mod shape;
 mod spelling;
+mod table;
+mod text;
 mod types;
 
 use ladder::{c_type, Body, Shared};
@@ -394,7 +397,7 @@ fn program_header(p: &Program, sh: &Shared, h: &Header, scan_budget: u64) -> Str
          #ifndef PLC_PROGRAM_H\n#define PLC_PROGRAM_H\n#include \"plc_runtime.h\"\n\n\
          typedef struct _plc_state _plc_state;\n\n",
     );
-    ladder::push(
+    text::push(
         &mut s,
         format_args!(
             "/* Rungs each task of a scan may charge with its calls and loop-backs (docs/scan.md,\n   \
@@ -416,7 +419,7 @@ fn program_header(p: &Program, sh: &Shared, h: &Header, scan_budget: u64) -> Str
         let field = sh.vars[i].trim_start_matches("self->");
         let ty = c_type(v.ty);
         fields += 1;
-        ladder::push(
+        text::push(
             &mut s,
             format_args!("    {ty} {field}; /* {} */\n", names::comment(&v.name)),
         );
@@ -426,7 +429,7 @@ fn program_header(p: &Program, sh: &Shared, h: &Header, scan_budget: u64) -> Str
             let ty = types::struct_name(h.fbd, inst.ty.index());
             let field = h.lay.paths[k].trim_start_matches("self->");
             fields += 1;
-            ladder::push(
+            text::push(
                 &mut s,
                 format_args!(
                     "    {ty} {field}; /* instance {} */\n",
@@ -437,7 +440,7 @@ fn program_header(p: &Program, sh: &Shared, h: &Header, scan_budget: u64) -> Str
     }
     let k = counter_count(sh);
     if k > 0 {
-        ladder::push(
+        text::push(
             &mut s,
             format_args!("    uint64_t _ctr[{k}]; /* loop counters */\n"),
         );
@@ -454,7 +457,7 @@ fn program_header(p: &Program, sh: &Shared, h: &Header, scan_budget: u64) -> Str
     s.push_str(&h.type_decls);
     s.push_str(harness::HEADER_DECLS);
     for stem in &h.stems {
-        ladder::push(&mut s, format_args!("#include \"{stem}.h\"\n"));
+        text::push(&mut s, format_args!("#include \"{stem}.h\"\n"));
     }
     s.push_str("#endif\n");
     s

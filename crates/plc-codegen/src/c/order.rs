@@ -18,7 +18,8 @@
 //! Not here: what a row is (`rows`), the cutting into functions (`mod`).
 
 use super::ladder::Shared;
-use super::rows::{Kernels, Row};
+use super::rows::Kernels;
+use super::shape::Row;
 use plc_analysis::dependences::Leveller;
 use plc_analysis::Accesses;
 use plc_model::{walk_elements, ArithOp, Element, Operand, Program, RungId};

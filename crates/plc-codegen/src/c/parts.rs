@@ -12,9 +12,10 @@
 //!
 //! Not here: the rungs' C (`ladder`), the rows and their kernels (`rows`), the order (`order`).
 
-use super::ladder::{self, Body, Shared};
+use super::ladder::{Body, Shared};
 use super::order::Plan;
-use super::rows::Tables;
+use super::table::Tables;
+use super::text;
 use super::{names, CConfig};
 use plc_model::{walk_elements, Element, Program};
 
@@ -154,14 +155,14 @@ pub(crate) fn ladder_files(
             }
             b.line("return 0;");
             t = b.rows.take();
-            ladder::push(
+            text::push(
                 &mut s,
                 format_args!(
                     "bool _pou__c{k}_{enc}(void *_self, _plc_ctx *ctx) {{\n    _plc_state *self = _self;\n{}}}\n\n",
                     b.finish()
                 ),
             );
-            ladder::push(
+            text::push(
                 &mut decls,
                 format_args!("bool _pou__c{k}_{enc}(void *_self, _plc_ctx *ctx);\n"),
             );
@@ -176,12 +177,12 @@ pub(crate) fn ladder_files(
         "{head}/* ladder POU {name}, in {} functions */\n",
         groups.len()
     );
-    ladder::push(
+    text::push(
         &mut s,
         format_args!("void {f}(_plc_state *self, _plc_ctx *ctx) {{\n"),
     );
     for k in 0..groups.len() {
-        ladder::push(
+        text::push(
             &mut s,
             format_args!("    if (_pou__c{k}_{enc}(self, ctx)) return;\n"),
         );

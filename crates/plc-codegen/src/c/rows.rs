@@ -45,116 +45,16 @@
 //! of one dependence level grouped by kernel) is `order`'s.
 //!
 //! Not here: the C of the rungs that are no row (`ladder`), the order of the rungs (`order`),
-//! the files (`mod`).
+//! the files (`mod`); the shape and row types (`shape`), the tables and their runs (`table`).
 
 use super::kernel;
-use super::ladder::{push, Shared};
+use super::ladder::Shared;
+use super::shape::{Item, Out, Row, Shape};
 use plc_model::{
     ArithOp, CmpOp, ContactKind, Element, FbKind, Field, Operand, RungId, TimerKind, Type, Value,
     VarId, VarRef,
 };
-use std::collections::{BTreeSet, HashMap};
-
-/// A condition item of a shape, in its canonical order (derived `Ord`: positive contacts,
-/// negated contacts, contacts inside ORs, edges, compares, ORs).
-#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub(super) enum Item {
-    /// A Normal (false) or Negated (true) contact of the top-level AND (slot: the BOOL; which
-    /// one it is goes into the row's pattern word).
-    Lit(bool),
-    /// A contact inside an OR (slots: the BOOL, 0 Normal or 1 Negated).
-    Contact,
-    /// An edge contact (slots: the BOOL, its memory, 0 rising or 1 falling).
-    Edge,
-    /// A comparison of two INTs, each a variable or a constant (true) (slots: the operands,
-    /// the operator's mask, [`cmp_mask`]).
-    Cmp(bool, bool),
-    /// An OR of ANDs (each with at least one item).
-    Or(Vec<Vec<Item>>),
-}
-
-impl Item {
-    fn slots(&self) -> usize {
-        match self {
-            Item::Lit(_) => 1,
-            Item::Contact => 2,
-            Item::Edge | Item::Cmp(..) => 3,
-            Item::Or(bs) => bs.iter().flatten().map(Item::slots).sum(),
-        }
-    }
-}
-
-/// An output of a shape, or a box (which passes power on, or its Q for a timer or counter).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub(super) enum Out {
-    /// A coil, negated coil, set or reset of a BOOL: which one is data (slots: the BOOL, the
-    /// kind 0–3, looked up in `_pou__bit` with the power and the old value).
-    Bit,
-    /// An INT move from a variable or a constant (true) (slots: target, source).
-    Move(bool),
-    /// INT ADD, SUB or MUL (wrapping) of variables or constants (true) (slots: target, the
-    /// operator 0–2, the operands).
-    Arith(bool, bool),
-    /// INT DIV or MOD of variables or constants (true) (slots: target, the operator 0–1, the
-    /// operands, the rung a division by zero names in its fault).
-    DivMod(bool, bool),
-    /// A TON, TOF or TP with a constant preset; its Q is the power on (slots: the instance,
-    /// the kind 0–2, the preset in ms).
-    Timer,
-    /// A CTU or CTD with a PV and a reset (CTU) or load (CTD) that are variables or constants
-    /// (true); its Q is the power on (slots: the instance, the kind 0–1, PV, reset or load).
-    Counter(bool, bool),
-}
-
-impl Out {
-    /// Its slots: the target, then the rest.
-    pub(super) fn slots(self) -> usize {
-        match self {
-            Out::Bit | Out::Move(_) => 2,
-            Out::Timer => 3,
-            Out::Arith(..) | Out::Counter(..) => 4,
-            Out::DivMod(..) => 5,
-        }
-    }
-
-    /// Whether the power after it is the box's Q (not the power before it).
-    pub(super) fn takes_q(self) -> bool {
-        matches!(self, Out::Timer | Out::Counter(..))
-    }
-}
-
-/// The shape of a row: what its kernel computes.
-#[derive(Clone, Debug, PartialEq, Eq, Hash)]
-pub(super) struct Shape {
-    /// The contacts of the top-level AND (Normal or Negated: which ones is data, the row's
-    /// pattern word).
-    pub lits: usize,
-    /// The other items of the top-level AND, sorted.
-    pub cond: Vec<Item>,
-    /// The outputs and boxes in order (an output branch's paths are outputs that keep the
-    /// power, so in order too).
-    pub outs: Vec<Out>,
-}
-
-impl Shape {
-    pub(super) fn slots(&self) -> usize {
-        self.out_slots()
-            + self.lits
-            + usize::from(self.lits > 0)
-            + self.cond.iter().map(Item::slots).sum::<usize>()
-    }
-
-    pub(super) fn out_slots(&self) -> usize {
-        self.outs.iter().map(|o| o.slots()).sum()
-    }
-}
-
-/// A rung as a row: its kernel and its slots (the offsets of its BOOLs).
-#[derive(Clone, Debug)]
-pub(crate) struct Row {
-    pub kernel: u32,
-    slots: Vec<u32>,
-}
+use std::collections::HashMap;
 
 /// The kernels of a program: one per shape used.
 #[derive(Default)]
@@ -460,88 +360,5 @@ fn contact(sh: &Shared, r: VarRef) -> Option<u32> {
             ],
         ),
         Some(_) => None,
-    }
-}
-
-/// The rows of the functions of one source file: one table (data file `plc_table{file}.c`)
-/// that holds them in the order they run, whatever their kernels, so a scan reads it front to
-/// back (with a table per kernel, every short run started on a cache line of its own); the
-/// kernels used, and the run not yet called (its kernel, first entry, rows).
-pub(crate) struct Tables {
-    file: usize,
-    /// The C type of the entries (`Kernels::entry_type`).
-    ty: &'static str,
-    text: String,
-    entries: usize,
-    used: BTreeSet<u32>,
-    run: Option<(u32, usize, usize)>,
-}
-
-impl Tables {
-    pub fn new(file: usize, ty: &'static str) -> Tables {
-        Tables {
-            file,
-            ty,
-            text: String::new(),
-            entries: 0,
-            used: BTreeSet::new(),
-            run: None,
-        }
-    }
-
-    /// Adds `row` (rung `id`); the call of the run it ends, if it starts another.
-    pub fn push(&mut self, row: &Row, id: &str) -> Option<String> {
-        let call = match self.run {
-            Some((k, _, _)) if k != row.kernel => self.take_call(),
-            _ => None,
-        };
-        match &mut self.run {
-            Some((_, _, n)) => *n += 1,
-            None => self.run = Some((row.kernel, self.entries, 1)),
-        }
-        self.used.insert(row.kernel);
-        let nums: Vec<String> = row.slots.iter().map(u32::to_string).collect();
-        push(
-            &mut self.text,
-            format_args!("    {}, /* {id} */\n", nums.join(", ")),
-        );
-        self.entries += row.slots.len();
-        call
-    }
-
-    /// The call of the run of rows pushed since the last call, if any.
-    pub fn take_call(&mut self) -> Option<String> {
-        let (k, first, n) = self.run.take()?;
-        Some(format!(
-            "_pou__k{k}((uint8_t *)self, _pou__t{} + {first}, {n}, ctx);",
-            self.file
-        ))
-    }
-
-    /// The declarations the functions' C needs (empty: no rows).
-    pub fn declarations(&self) -> String {
-        if self.entries == 0 {
-            return String::new();
-        }
-        let mut s = format!("extern const {} _pou__t{}[];\n", self.ty, self.file);
-        for &k in &self.used {
-            push(&mut s, format_args!("{};\n", kernel::decl(k, self.ty)));
-        }
-        s
-    }
-
-    /// The data file (name stem, text), if there are rows.
-    pub fn data_file(&self) -> Option<(String, String)> {
-        if self.entries == 0 {
-            return None;
-        }
-        Some((
-            format!("plc_table{}", self.file),
-            format!(
-                "/* Rows of contacts and coils: byte offsets (docs/c.md). */\n#include <stdint.h>\n\n\
-                 const {} _pou__t{}[{}] = {{\n{}}};\n",
-                self.ty, self.file, self.entries, self.text
-            ),
-        ))
     }
 }

@@ -14,7 +14,8 @@
 //! typed body is `None`); a ladder-bodied type gets one function per type too, from its
 //! instance's rungs. Not here: the POUs of the program (`super`), the harness.
 
-use super::ladder::{c_type, push, Body, InstanceCtx, Shared};
+use super::ladder::{c_type, Body, InstanceCtx, Shared};
+use super::text::push;
 use super::{fbd, names};
 use plc_fbd::{Fbd, FbdPouKind};
 use plc_model::{Program, VarId};

@@ -3,12 +3,15 @@
 //! the shape of each field. Names and operands are left to the resolver. The element's keys are
 //! the top of the reader's scratch stack (from `mark` on); they are taken from there.
 
-use super::ladder::{arith_op, cmp_op, edge, timer_kind, ForSlots};
 use plc_diag::Invalid;
-use plc_model::{BistableKind, TriggerKind};
+use plc_model::{ArithOp, BistableKind, CmpOp, TimerKind, TriggerKind};
 use plc_syntax::{
-    self as syntax, ElementKind, Located, Name, Operand, Origin, Problem, Scalar, Series, Text,
+    self as syntax, Edge, ElementKind, Located, Name, Operand, Origin, Problem, Scalar, Series,
+    Text,
 };
+
+/// The keys of a `for` object in file order: (key, its origin, the value).
+pub(super) type ForSlots<'a> = Vec<(Text<'a>, Origin, Operand<'a>)>;
 
 /// The value of one key of an element object.
 pub(super) enum Slot<'a> {
@@ -486,4 +489,30 @@ fn for_loop<'a>(f: &mut Fields<'_, 'a>) -> R<ElementKind<'a>> {
     let from = get("from")?;
     let to = get("to")?;
     Ok(ElementKind::For(Box::new(syntax::For { var, from, to })))
+}
+
+/// Kinds of elements by name (for the classifier).
+fn timer_kind(key: &str) -> Option<TimerKind> {
+    match key {
+        "ton" => Some(TimerKind::Ton),
+        "tof" => Some(TimerKind::Tof),
+        "tp" => Some(TimerKind::Tp),
+        _ => None,
+    }
+}
+
+fn edge(s: &str) -> Option<Edge> {
+    match s {
+        "rising" => Some(Edge::Rising),
+        "falling" => Some(Edge::Falling),
+        _ => None,
+    }
+}
+
+fn cmp_op(s: &str) -> Option<CmpOp> {
+    CmpOp::parse(s)
+}
+
+fn arith_op(s: &str) -> Option<ArithOp> {
+    ArithOp::parse(s)
 }

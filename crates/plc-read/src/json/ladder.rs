@@ -10,12 +10,11 @@
 //! continues with the next element.
 
 use super::cursor::P;
-use super::element::{classify, Slot, SlotEntry};
+use super::element::{classify, ForSlots, Slot, SlotEntry};
 use super::{shape, Reader};
 use plc_diag::Invalid;
-use plc_model::{ArithOp, CmpOp, TimerKind};
 use plc_syntax::{
-    Edge, Element, ElementKind, Located, Name, Operand, Origin, Problem, Rung, Scalar, Series, Text,
+    Element, ElementKind, Located, Name, Operand, Origin, Problem, Rung, Scalar, Series, Text,
 };
 
 fn problem(
@@ -26,9 +25,6 @@ fn problem(
 ) -> Box<Problem> {
     Problem::new(at, origin, shape(expected, found))
 }
-
-/// The keys of a `for` object in file order: (key, its origin, the value).
-pub(super) type ForSlots<'a> = Vec<(Text<'a>, Origin, Operand<'a>)>;
 
 impl<'a> Reader<'a, '_> {
     /// The value of `rungs` at `path`: an array of rungs, or `None` (with a problem).
@@ -281,30 +277,4 @@ impl<'a> Reader<'a, '_> {
         self.slots.truncate(mark);
         Ok(Element { origin, kind })
     }
-}
-
-/// Kinds of elements by name (for the classifier).
-pub(super) fn timer_kind(key: &str) -> Option<TimerKind> {
-    match key {
-        "ton" => Some(TimerKind::Ton),
-        "tof" => Some(TimerKind::Tof),
-        "tp" => Some(TimerKind::Tp),
-        _ => None,
-    }
-}
-
-pub(super) fn edge(s: &str) -> Option<Edge> {
-    match s {
-        "rising" => Some(Edge::Rising),
-        "falling" => Some(Edge::Falling),
-        _ => None,
-    }
-}
-
-pub(super) fn cmp_op(s: &str) -> Option<CmpOp> {
-    CmpOp::parse(s)
-}
-
-pub(super) fn arith_op(s: &str) -> Option<ArithOp> {
-    ArithOp::parse(s)
 }

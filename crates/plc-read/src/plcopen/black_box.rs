@@ -22,6 +22,7 @@
 //!
 //! Deliberately not here: computing what the black boxes compute (`run` does not).
 
+use super::block_types::{BlackBox, Ctx, Sig};
 use super::wiring::{ElemId, Graph};
 use super::xml::{error, origin, R};
 use plc_diag::Origin;
@@ -30,41 +31,10 @@ use plc_model::Function;
 use plc_syntax::fbd::{Block, Connection, Input, Inputs};
 use plc_syntax::Scalar;
 use std::borrow::Cow;
-use std::collections::HashMap;
-
-/// The pins of a black box: (name, model type) of its inputs and outputs.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Sig {
-    pub inputs: Vec<(String, String)>,
-    pub outputs: Vec<(String, String)>,
-}
-
-/// A stand-in function block type the reader made, and the blocks that call it.
-#[derive(Clone, Debug)]
-pub struct BlackBox {
-    pub name: String,
-    pub op: String,
-    pub sig: Sig,
-    pub origin: Origin,
-    pub sites: Vec<String>,
-}
-
-/// What a body's blocks may call, and the types of the names it sees.
-#[derive(Default)]
-pub struct Ctx {
-    /// User functions of the project by name: their pins (the result is `OUT`).
-    pub functions: HashMap<String, Sig>,
-    /// Function block types the model has or the project defines, with their outputs' types.
-    pub fbs: HashMap<String, Vec<(String, String)>>,
-    /// The input pins' types of the function block types of the project and the library.
-    pub fb_inputs: HashMap<String, Vec<(String, String)>>,
-    /// The POU's variables and the globals it sees: lower-case name → model type.
-    pub vars: HashMap<String, String>,
-}
 
 /// The model type an IEC elementary type name is read as (`None`: not elementary).
 fn model(t: &str) -> Option<String> {
-    super::interface::model_type_of(t).map(str::to_owned)
+    super::elementary::model_type_of(t).map(str::to_owned)
 }
 
 /// The standard function blocks' outputs (IEC 61131-3 2.5.2.3).

@@ -9,7 +9,7 @@
 //!
 //! A function block instance's output (`t.Q`) is the field reference the model has for it; a
 //! structure's field (`s.f`, `s.inner.f`) is passed on as such: it is the name of the field's
-//! own variable ([`super::structure`]). An array element
+//! own variable ([`super::data_types`]). An array element
 //! (`a[i]`) reads the whole array and the variables of its subscripts: the model holds an array
 //! as one value of its element type (docs/plcopen.md, "Data types"), so the element stands in as
 //! `SEL(NE(i, i), a, a)` — the value `a`, with `i` read — and `run` refuses the body (the
@@ -19,7 +19,7 @@
 //! direct addresses and dereferences (one error each, naming the expression).
 
 use super::interface::literal;
-use super::pins::Added;
+use super::pins::{expression_text, Added};
 use super::xml::{error, is_identifier, origin, R};
 use crate::st::ast::{BinaryOp, Expr, Place, Selector, UnaryOp};
 use plc_diag::{LoadError, Origin};
@@ -48,14 +48,6 @@ fn shortened(text: &str) -> Cow<'_, str> {
         Some((i, _)) => Cow::Owned(format!("{}…", &text[..i])),
         None => Cow::Borrowed(text),
     }
-}
-
-/// The text of `node`'s `expression` (empty without one).
-pub fn expression_text<'a>(node: Node<'a, '_>) -> &'a str {
-    node.children()
-        .find(|c| c.is_element() && c.tag_name().name() == "expression")
-        .and_then(|c| c.text())
-        .unwrap_or("")
 }
 
 /// Whether in variable `node` reads an array element (its expression has a subscript).

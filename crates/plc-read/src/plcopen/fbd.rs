@@ -21,7 +21,8 @@
 //! Deliberately not here (errors naming the element): negated or edge-qualified pins, several
 //! wires into one FBD pin, ENO wired on, expressions as in/out variables.
 
-use super::black_box::{self, BlackBox, Ctx};
+use super::black_box;
+use super::block_types::{BlackBox, Ctx};
 use super::pins::{add_target, bool_literal, konst, output_negated, pin_modifiers, pin_of, Added};
 use super::wiring::{graph, ElemId, Graph, Source};
 use super::xml::{attr, error, identifier, origin, variable_ref, ExecOrder, Note, Notes, Tc6, R};

@@ -9,19 +9,20 @@
 //!
 //! Every elementary type of IEC 61131-3 Table 10 but the strings, LTIME and the dates and
 //! times of day is the model's own (BOOL, SINT … LINT, USINT … ULINT, REAL, LREAL, BYTE …
-//! LWORD, TIME). Those it lacks are read as one it has ([`MAPPED`]), and each such variable is
+//! LWORD, TIME). Those it lacks are read as one it has ([`super::elementary::MAPPED`]), and each such variable is
 //! recorded ([`Mapped`]) for the POU's note.
 //!
 //! A user data type (or a library one, [`super::data_types`]) is read as its base: an alias or
 //! subrange as its elementary type, an enumeration as INT, an array (named or declared in
 //! place) as a whole variable without a value; each such variable is recorded too, with the
 //! type's description. A structure (named or declared in place) is flattened into one variable
-//! per elementary field, `Motor.Speed` ([`super::structure`]), each read as above.
+//! per elementary field, `Motor.Speed` ([`super::data_types`]), each read as above.
 //!
 //! Deliberately not here: structured initial values of elementary variables and `VAR_IN_OUT`
 //! — each an error naming the variable, until the model has them.
 
 use super::data_types::{Aggregate, Base, DataType, DataTypes};
+use super::elementary::{is_elementary_tag, model_type_of, MAPPED, MODEL_ELEMENTARY};
 use super::xml::{error, identifier, origin, Tc6, R};
 use plc_syntax::{Located, Name, Operand, Scalar, Var, VarClass};
 use roxmltree::Node;
@@ -66,22 +67,6 @@ pub struct Mapped {
     pub via: Option<String>,
 }
 
-/// The elementary types of IEC 61131-3 (6.4.2, Table 10) the model lacks, and the model's type
-/// each is read as: dates and times of day as DINT, LTIME as TIME; strings as DINT (a
-/// stand-in: analysis only). docs/plcopen.md says what `run` computes differently.
-const MAPPED: &[(&str, &str)] = &[
-    ("LTIME", "TIME"),
-    ("DATE", "DINT"),
-    ("TOD", "DINT"),
-    ("TIME_OF_DAY", "DINT"),
-    ("DT", "DINT"),
-    ("DATE_AND_TIME", "DINT"),
-    ("string", "DINT"),
-    ("wstring", "DINT"),
-    ("STRING", "DINT"),
-    ("WSTRING", "DINT"),
-];
-
 /// Standard function blocks the model has.
 const MODEL_FBS: &[&str] = &[
     "TON", "TOF", "TP", "CTU", "CTD", "SR", "RS", "R_TRIG", "F_TRIG", "CTUD",
@@ -95,31 +80,6 @@ const OTHER_STD_FBS: &[&str] = &[
     "CTU_UDINT",
     "CTU_ULINT",
 ];
-const MODEL_ELEMENTARY: &[&str] = &[
-    "BOOL", "SINT", "INT", "DINT", "LINT", "USINT", "UINT", "UDINT", "ULINT", "REAL", "LREAL",
-    "BYTE", "WORD", "DWORD", "LWORD", "TIME",
-];
-
-/// True when a TC6 type element's tag is an elementary type (the model's or a mapped one).
-pub fn is_elementary_tag(tag: &str) -> bool {
-    MODEL_ELEMENTARY.contains(&tag) || MAPPED.iter().any(|(f, _)| *f == tag)
-}
-
-/// True when a declared type (as the reader writes it into the syntax) is elementary, not a
-/// function block type.
-pub fn is_elementary(ty: &str) -> bool {
-    MODEL_ELEMENTARY.contains(&ty)
-}
-
-/// The model type IEC elementary type `t` is read as (`None`: not an elementary type); a
-/// string as its stand-in DINT.
-pub fn model_type_of(t: &str) -> Option<&'static str> {
-    if let Some(m) = MODEL_ELEMENTARY.iter().find(|m| **m == t) {
-        return Some(m);
-    }
-    MAPPED.iter().find(|(f, _)| *f == t).map(|(_, m)| *m)
-}
-
 /// Reads the interface of POU `pou` (its `interface` element; none is an empty interface).
 pub fn interface(tc6: Tc6, node: Option<Node>, pou: &str, known: &Known) -> R<Interface> {
     let mut out = Interface::default();
@@ -202,7 +162,7 @@ pub fn var_list(
 }
 
 /// The variables one declaration `v` makes: itself, or, for a structure, one per leaf field
-/// ([`super::structure`]).
+/// ([`super::data_types`]).
 fn variable(
     tc6: Tc6,
     v: Node,
@@ -246,7 +206,7 @@ fn variable(
                 format!("the initial value of structure `{name}` is not a structured value"),
             )
         })?;
-        super::structure::apply_value(tc6, &mut members, sv, &name, &place)?;
+        super::data_types::apply_value(tc6, &mut members, sv, &name, &place)?;
     }
     mapped.push(Mapped {
         var: name.clone(),
@@ -257,7 +217,7 @@ fn variable(
         via: Some(d.describe()),
     });
     let mut out = Vec::new();
-    for leaf in super::structure::flatten(&name, &members) {
+    for leaf in super::data_types::flatten(&name, &members) {
         let ty = if leaf.elementary {
             Ty::Elementary(data_base(&leaf.ty))
         } else {
@@ -435,7 +395,7 @@ fn type_name(tc6: Tc6, ty: Node, var: &str, place: &str, known: &Known) -> R<Ty>
     match tag {
         "array" => return whole(Aggregate::Array, "ARRAY"),
         "struct" => {
-            let members = super::structure::members(
+            let members = super::data_types::members(
                 tc6,
                 &std::collections::HashMap::new(),
                 Some(&known.data_types),

@@ -68,7 +68,7 @@ pub fn rungs(tc6: Tc6, node: Node, pou: &str, notes: &mut Notes) -> R<Vec<Rung<'
             }
         }
     }
-    let mut power = Power::new(&g, place.clone());
+    let mut power = Power::new(&g, place.clone(), ld_block::BLOCKS);
     let outputs = outputs(&power)?;
     let component = components(&g);
     // Outputs grouped by rung, rungs in the order of their first output.

@@ -25,7 +25,7 @@
 //! input fed by several wires (their OR) or by a contact network is written, before the box in
 //! the same rung, into the BOOL `instance__pin` that the box reads ([`Power::feeds`]).
 
-use super::ld_power::{Item, Key, Path, Power};
+use super::ld_power::{Blocks, Item, Key, Path, Power};
 use super::wiring::ElemId;
 use super::xml::{error, origin, variable_ref, R};
 use plc_model::{ArithOp, BistableKind, CmpOp, Function, TimerKind, TriggerKind};
@@ -208,6 +208,13 @@ fn field(p: &Power, e: ElemId, pin: &str) -> R<String> {
     let instance = super::xml::identifier(raw, "instance", node, &here)?;
     Ok(format!("{instance}.{pin}"))
 }
+
+/// The rules of blocks the power walk calls ([`Power::new`]).
+pub const BLOCKS: Blocks = Blocks {
+    power_out,
+    reads_side,
+    side_output,
+};
 
 /// The series out of block `e`'s power output (`pin`: the output asked for).
 pub fn power_out(p: &mut Power, e: ElemId, pin: Option<&str>) -> R<Path> {

@@ -27,7 +27,8 @@
 //! Deliberately not here: labels (an error here: a jump target would need the rung structure),
 //! and the ops themselves (the FBD resolver checks them, located at the block).
 
-use super::black_box::{self, BlackBox, Ctx};
+use super::black_box;
+use super::block_types::{BlackBox, Ctx};
 use super::ld::components;
 use super::pins::{
     add_target, bool_literal, is_const, konst, output_negated, pin_modifiers, pin_of, Added,

@@ -17,9 +17,9 @@
 //! nothing is dropped; the recursion goes one call deep per join or block, not per element.
 //!
 //! Deliberately not here: which elements end a rung and in what order rungs run (`super::ld`),
-//! what blocks become (`super::ld_block`).
+//! what blocks become (`super::ld_block`, reached through the [`Blocks`] the caller gives, since
+//! a block's rules walk the power into its inputs through [`Power::out`] in turn).
 
-use super::ld_block;
 use super::wiring::{ElemId, Graph, Source};
 use super::xml::{error, origin, variable_ref, R};
 use plc_diag::Origin;
@@ -74,6 +74,18 @@ fn or_nesting(kind: &ElementKind) -> usize {
     }
 }
 
+/// What blocks do to the power: the rules of `super::ld_block`, which `super::ld` gives to
+/// [`Power::new`]. They call back into [`Power::out`] for the power into a block's inputs.
+#[derive(Clone, Copy)]
+pub struct Blocks {
+    /// The series out of block `e`'s power output `pin`.
+    pub power_out: fn(&mut Power, ElemId, Option<&str>) -> R<Path>,
+    /// Whether output `pin` of `e` is a function block's output read after its box.
+    pub reads_side: fn(&Power, ElemId, Option<&str>) -> bool,
+    /// The contact that reads output `pin` of function block `e` after its box.
+    pub side_output: fn(&Power, ElemId, &str) -> R<Item>,
+}
+
 /// The power computation of one body.
 pub struct Power<'g, 'a, 'i> {
     pub g: &'g Graph<'a, 'i>,
@@ -88,10 +100,11 @@ pub struct Power<'g, 'a, 'i> {
     pub feeds: Vec<(ElemId, Path)>,
     /// The variables those series write.
     pub vars: Vec<plc_syntax::Var<'static>>,
+    blocks: Blocks,
 }
 
 impl<'g, 'a, 'i> Power<'g, 'a, 'i> {
-    pub fn new(g: &'g Graph<'a, 'i>, place: String) -> Self {
+    pub fn new(g: &'g Graph<'a, 'i>, place: String, blocks: Blocks) -> Self {
         Power {
             g,
             place,
@@ -100,6 +113,7 @@ impl<'g, 'a, 'i> Power<'g, 'a, 'i> {
             depth: 0,
             feeds: Vec::new(),
             vars: Vec::new(),
+            blocks,
         }
     }
 
@@ -109,8 +123,8 @@ impl<'g, 'a, 'i> Power<'g, 'a, 'i> {
 
     /// The series that brings power out of `e` (through its output pin `pin`).
     pub fn out(&mut self, e: ElemId, pin: Option<&str>) -> R<Path> {
-        if let Some(side) = pin.filter(|&x| ld_block::reads_side(self, e, Some(x))) {
-            return ld_block::side_output(self, e, side).map(|item| vec![item]);
+        if let Some(side) = pin.filter(|&x| (self.blocks.reads_side)(self, e, Some(x))) {
+            return (self.blocks.side_output)(self, e, side).map(|item| vec![item]);
         }
         if let Some(p) = self.memo.get(&e) {
             return Ok(p.clone());
@@ -174,7 +188,7 @@ impl<'g, 'a, 'i> Power<'g, 'a, 'i> {
                     edge: None,
                 })])
             }
-            "block" => ld_block::power_out(self, e, pin),
+            "block" => (self.blocks.power_out)(self, e, pin),
             other => Err(error(
                 origin(node),
                 &here,

@@ -183,7 +183,7 @@ pub fn stand_in_type(
 }
 
 /// The black-box type of a block the model lacks ([`super::black_box`]), with its note.
-pub fn black_box_type(b: &super::black_box::BlackBox) -> (FunctionBlock<'static>, Note) {
+pub fn black_box_type(b: &super::block_types::BlackBox) -> (FunctionBlock<'static>, Note) {
     let fb = stand_in_type(&b.name, &b.sig.inputs, &b.sig.outputs, b.origin);
     let show = |v: &[(String, String)]| {
         v.iter()

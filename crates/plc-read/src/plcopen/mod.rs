@@ -6,8 +6,7 @@
 //! [`xml::MAX_XML_BYTES`]; nesting at most [`xml::MAX_DEPTH`]); the project must be in one of
 //! the namespaces tc6_0201, tc6_0200 or the pre-2.0 tc6.xsd ([`xml::NAMESPACES`]), elements
 //! are matched by local name. [`project`] reads the POUs and configurations, [`interface`] the
-//! variable lists ([`data_types`] the data types, [`structure`] a structure flattened into its
-//! fields), [`ld`] (with [`ld_power`], [`ld_block`], [`ld_logic`] and the shared [`wiring`] graph) the
+//! variable lists ([`data_types`] the data types and structures, a structure flattened into its fields), [`ld`] (with [`ld_power`], [`ld_block`], [`ld_logic`] and the shared [`wiring`] graph) the
 //! LD bodies ([`ld_flow`]: those that are not series-parallel rungs, as Beremiz's data-flow
 //! network), [`fbd`] the FBD bodies ([`black_box`]: conversions and blocks the model lacks; [`expression`]: in variables' expressions), [`st_body`] the ST bodies (a stand-in rung per statement,
 //! from the ST parser), [`textual`] stands IL and SFC bodies in by their interface. What the reader did that changes meaning or skips vendor data is a [`Note`]
@@ -19,7 +18,9 @@
 //! never dropped; a program loads whole or not at all.
 
 mod black_box;
+mod block_types;
 mod data_types;
+mod elementary;
 mod expression;
 mod fbd;
 mod fbd_loops;
@@ -33,7 +34,6 @@ mod library;
 mod pins;
 mod project;
 mod st_body;
-mod structure;
 mod textual;
 mod wiring;
 mod xml;

@@ -9,7 +9,7 @@
 //! Deliberately not here: reading elements (the body readers), ops the model lacks
 //! ([`super::black_box`]).
 
-use super::black_box::Ctx;
+use super::block_types::Ctx;
 use super::interface::{literal, name};
 use super::wiring::Graph;
 use super::xml::{error, origin, variable_ref, R};
@@ -286,10 +286,18 @@ impl Added {
     }
 }
 
+/// The text of `node`'s `expression` (empty without one).
+pub fn expression_text<'a>(node: Node<'a, '_>) -> &'a str {
+    node.children()
+        .find(|c| c.is_element() && c.tag_name().name() == "expression")
+        .and_then(|c| c.text())
+        .unwrap_or("")
+}
+
 /// What an `inVariable` or `inOutVariable` element `node` gives to a pin (at `at`): its
 /// literal, else its variable (an expression: [`super::expression::block_input`]).
 pub fn block_input(node: Node, place: &str, at: Origin) -> R<Input<'static>> {
-    let text = super::expression::expression_text(node);
+    let text = expression_text(node);
     let from = match literal(text) {
         Some(v) => Connection::Constant(v),
         // A string has no value in the model: a stand-in 0 (`run` refuses such a body).

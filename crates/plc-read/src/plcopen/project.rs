@@ -17,7 +17,7 @@
 //! Deliberately not here (errors naming the POU): a program instantiated twice,
 //! several configurations or resources, POUs with actions or transitions outside SFC.
 
-use super::black_box::{Ctx, Sig};
+use super::block_types::{Ctx, Sig};
 use super::data_types::DataTypes;
 use super::interface::{self, name, Interface, Known};
 use super::xml::{add_data_note, attr, error, identifier, origin, Note, Notes, Tc6, R};
@@ -449,7 +449,7 @@ fn body(
     if let (Some(n), "LD" | "FBD") = (array_element, tag) {
         notes.no_run.push((name.to_owned(), Note {
             origin: origin(n),
-            message: format!("{place}: the {} localId {} reads an array element, `{}`; the model holds an array as one value, so the analysis reads the whole array (and the subscripts), but `run` cannot execute the {tag} body of `{name}`", n.tag_name().name(), n.attribute("localId").unwrap_or("?"), super::expression::expression_text(n).trim()),
+            message: format!("{place}: the {} localId {} reads an array element, `{}`; the model holds an array as one value, so the analysis reads the whole array (and the subscripts), but `run` cannot execute the {tag} body of `{name}`", n.tag_name().name(), n.attribute("localId").unwrap_or("?"), super::pins::expression_text(n).trim()),
         }));
     }
     Ok(match tag {

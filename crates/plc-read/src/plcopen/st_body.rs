@@ -59,7 +59,7 @@ pub struct Scope {
 impl Scope {
     /// Declares `name` of type `ty` (elementary or a function block type).
     pub fn declare(&mut self, name: &str, ty: &str) {
-        let decl = if super::interface::is_elementary(ty) {
+        let decl = if super::elementary::is_elementary(ty) {
             Decl::Elementary {
                 name: name.to_owned(),
                 ty: ty.to_owned(),

@@ -12,7 +12,8 @@
 //!
 //! Deliberately not here: parsing IL, SFC steps and transitions (a later step).
 
-use super::interface::{is_elementary, name};
+use super::elementary::is_elementary;
+use super::interface::name;
 use super::xml::{origin, Note, Notes};
 use plc_diag::Origin;
 use plc_model::CmpOp;

@@ -73,7 +73,7 @@ pub struct Notes {
     pub ld_vars: Vec<(String, plc_syntax::Var<'static>)>,
     /// The stand-in function block types of the blocks the model lacks
     /// ([`super::black_box`]).
-    pub black_boxes: Vec<super::black_box::BlackBox>,
+    pub black_boxes: Vec<super::block_types::BlackBox>,
     /// Why `run` cannot execute a POU's body (a string in a body it would execute): the POU's
     /// name and the reason, in file order; `run` refuses the project for the first one whose POU
     /// it runs.

@@ -3,22 +3,14 @@
 //! counter's reset/load bit. The mnemonics are the S7-200 system manual's (chapter 6).
 
 use super::operand::Context;
+use super::tree::{contact, el, name, E};
 use super::{error, Ins};
 use plc_diag::{LoadError, Origin};
 use plc_model::{ArithOp, CmpOp, Function, TimerKind, Type};
 use plc_syntax::{self as syntax, Element, ElementKind, Located, Series};
 use std::borrow::Cow;
 
-pub(super) type E = Element<'static>;
-
 pub(super) const LEVELS: usize = 9;
-
-pub(super) fn name(s: &str, at: usize) -> syntax::Name<'static> {
-    Located {
-        value: Cow::Owned(s.to_string()),
-        origin: Origin::at(at),
-    }
-}
 
 /// The largest label number Micro/WIN gives (`LBL 0` … `LBL 255`).
 pub(super) const MAX_LABEL: u32 = 255;
@@ -39,24 +31,6 @@ pub(super) fn label(text: &str, t: super::Tok) -> Result<syntax::Name<'static>, 
         ));
     }
     Ok(name(t.text, t.at))
-}
-
-pub(super) fn el(kind: ElementKind<'static>, at: usize) -> E {
-    Element {
-        origin: Origin::at(at),
-        kind,
-    }
-}
-
-pub(super) fn contact(var: &str, negated: bool, at: usize) -> E {
-    el(
-        ElementKind::Contact {
-            var: name(var, at),
-            negated,
-            edge: None,
-        },
-        at,
-    )
 }
 
 /// The kinds of instruction the builders share.

@@ -5,8 +5,9 @@
 //! the S7-200 read: a condition re-read after the network wrote its variable, or an edge read
 //! twice, is an error (not yet), never a silently different rung.
 
-use super::decode::{counter_aux, decode, edge, el, name, negate, or, Op, E};
+use super::decode::{counter_aux, decode, edge, negate, or, Op};
 use super::operand::Context;
+use super::tree::{el, name, E};
 use super::{error, Ins};
 use plc_diag::LoadError;
 use plc_syntax::{self as syntax, ElementKind, Series};

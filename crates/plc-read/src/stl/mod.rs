@@ -24,6 +24,7 @@ mod decode;
 mod flat;
 mod net;
 mod operand;
+mod tree;
 
 use plc_diag::{LoadError, Origin};
 use plc_syntax::{self as syntax, Body, Located, RoutineKind, Subroutine, Var, VarClass};

@@ -14,46 +14,15 @@
 //! error). Zhou & Zhang 2015 give the stack shapes; S7-200 system manual, chapter 6.
 
 use super::decode::{
-    contact, counter_aux, decode, edge, el, is_pure, label as label_operand, name, negate, or, Op,
-    LEVELS,
+    counter_aux, decode, edge, is_pure, label as label_operand, negate, or, Op, LEVELS,
 };
 use super::flat::flat;
 use super::operand::Context;
+use super::tree::{el, name};
 use super::{error, Ins, RawNet};
 use plc_diag::{LoadError, Origin};
 use plc_syntax::{self as syntax, Element, ElementKind, Rung, Series};
 use std::borrow::Cow;
-
-/// The first rung of a main program that reads SM0.1: SM0.1 is on until the first scan ends.
-pub(super) fn first_scan_rung(at: usize) -> Rung<'static> {
-    let seen = "SM0_1_seen";
-    let body = vec![el(
-        ElementKind::Branch(vec![
-            vec![
-                contact(seen, true, at),
-                el(
-                    ElementKind::Coil {
-                        var: name("SM0_1", at),
-                        negated: false,
-                    },
-                    at,
-                ),
-            ],
-            vec![el(ElementKind::Set(name(seen, at)), at)],
-        ]),
-        at,
-    )];
-    Rung {
-        origin: Origin::at(at),
-        id: name("SM0_1", at),
-        label: None,
-        comment: Some(Cow::Borrowed("SM0.1: on in the first scan only")),
-        ld: body,
-        ld_origin: Origin::at(at),
-        problem: None,
-        problem_in_rung: false,
-    }
-}
 
 /// The rungs of a block's networks; ids are the network titles (else `N<n>`, prefixed).
 pub(super) fn rungs(

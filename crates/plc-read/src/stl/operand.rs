@@ -8,9 +8,10 @@
 //! bit that a first rung of the main program clears after the first scan, through `SM0_1_seen`).
 //! Not here: byte operands (`VB`, `MB`), accumulators, indirect addressing (`*VD`): errors.
 
+use super::tree::{contact, el, name};
 use super::{error, Block, Tok};
 use plc_diag::{LoadError, Origin};
-use plc_syntax::{self as syntax, Located, Scalar, Var, VarClass};
+use plc_syntax::{self as syntax, ElementKind, Located, Rung, Scalar, Var, VarClass};
 use std::borrow::Cow;
 use std::collections::{BTreeMap, HashMap};
 
@@ -327,7 +328,38 @@ impl<'t> Context<'t> {
             });
         }
         if let (Some(at), Some(syntax::Body::Rungs(rungs))) = (first_scan, program.body.as_mut()) {
-            rungs.insert(0, super::net::first_scan_rung(at));
+            rungs.insert(0, first_scan_rung(at));
         }
+    }
+}
+
+/// The first rung of a main program that reads SM0.1: SM0.1 is on until the first scan ends.
+fn first_scan_rung(at: usize) -> Rung<'static> {
+    let seen = "SM0_1_seen";
+    let body = vec![el(
+        ElementKind::Branch(vec![
+            vec![
+                contact(seen, true, at),
+                el(
+                    ElementKind::Coil {
+                        var: name("SM0_1", at),
+                        negated: false,
+                    },
+                    at,
+                ),
+            ],
+            vec![el(ElementKind::Set(name(seen, at)), at)],
+        ]),
+        at,
+    )];
+    Rung {
+        origin: Origin::at(at),
+        id: name("SM0_1", at),
+        label: None,
+        comment: Some(Cow::Borrowed("SM0.1: on in the first scan only")),
+        ld: body,
+        ld_origin: Origin::at(at),
+        problem: None,
+        problem_in_rung: false,
     }
 }

@@ -1,0 +1,39 @@
+//! The signatures a body's blocks are typed against, as plain data: the pins of a black box
+//! ([`Sig`]), the stand-in function block types the reader made ([`BlackBox`], gathered in
+//! `Notes::black_boxes`) and what a body's blocks may call ([`Ctx`]).
+//!
+//! Data only, below every reader of bodies and below `xml` (whose notes carry the black
+//! boxes); how a block gets its signature and becomes a stand-in is `black_box`'s.
+
+use plc_diag::Origin;
+use std::collections::HashMap;
+
+/// The pins of a black box: (name, model type) of its inputs and outputs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sig {
+    pub inputs: Vec<(String, String)>,
+    pub outputs: Vec<(String, String)>,
+}
+
+/// A stand-in function block type the reader made, and the blocks that call it.
+#[derive(Clone, Debug)]
+pub struct BlackBox {
+    pub name: String,
+    pub op: String,
+    pub sig: Sig,
+    pub origin: Origin,
+    pub sites: Vec<String>,
+}
+
+/// What a body's blocks may call, and the types of the names it sees.
+#[derive(Default)]
+pub struct Ctx {
+    /// User functions of the project by name: their pins (the result is `OUT`).
+    pub functions: HashMap<String, Sig>,
+    /// Function block types the model has or the project defines, with their outputs' types.
+    pub fbs: HashMap<String, Vec<(String, String)>>,
+    /// The input pins' types of the function block types of the project and the library.
+    pub fb_inputs: HashMap<String, Vec<(String, String)>>,
+    /// The POU's variables and the globals it sees: lower-case name → model type.
+    pub vars: HashMap<String, String>,
+}
