@@ -135,6 +135,7 @@ mod fuse_tests;
 mod layout;
 mod lower;
 mod mem;
+mod output_mode;
 pub mod parallel;
 mod run;
 mod store;

@@ -12,14 +12,8 @@ use super::super::layout::Repr;
 use super::super::store::Addr;
 use crate::model::*;
 
-/// Output modes of [`Op::Coil`]: bit 0 = the value written when powered, bit 1 = no write when
-/// unpowered (set/reset), bit 2 = the value written when unpowered otherwise. One instruction
-/// for every output keeps the dispatch after a rung's conditions uniform (set/reset among coils
-/// made it mispredict: −15 % per rung on generated programs).
-pub(crate) const OUT_COIL: u8 = 0b001;
-pub(crate) const OUT_NCOIL: u8 = 0b100;
-pub(crate) const OUT_SET: u8 = 0b011;
-pub(crate) const OUT_RESET: u8 = 0b010;
+/// Output modes of [`Op::Coil`] (the `output_mode` module).
+pub(crate) use super::super::output_mode::{OUT_COIL, OUT_NCOIL, OUT_RESET, OUT_SET};
 
 index_type!(
     /// An instruction: index into the machine's instruction array.
