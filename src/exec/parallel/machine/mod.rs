@@ -18,7 +18,7 @@
 //!
 //! # Modules, bottom to top
 //! Each uses only the ones before it (and the layers below the machine: the basics, `planning`,
-//! `choice`): `pin` (workers pinned to CPUs), `backoff` (the one wait loop: spin, yield, park),
+//! `choice`): `backoff` (the one wait loop: spin, yield, park),
 //! `barrier`, `flags` (ready flags), `units` (claimed units, the window bell), `xlines`
 //! (exchange lines), `shared` (lock-free shared memory), `driver` (the per-scan callbacks and
 //! the sequential loop), `relayout` (a `par-exchange` plan's own layout, and a state moved
@@ -36,7 +36,6 @@ mod driver;
 mod exchange;
 mod flags;
 mod items;
-mod pin;
 mod relayout;
 mod run_log;
 mod shared;
@@ -87,8 +86,6 @@ pub struct ParallelMachine {
     pub(super) layout_groups: usize,
     /// Why plans were dropped (a failed check), for the user.
     pub(super) warnings: Vec<String>,
-    /// Pin the workers to CPUs during a run ([`PlanConfig::pin_workers`]).
-    pub(super) pin_workers: bool,
 }
 
 impl ParallelMachine {
@@ -193,7 +190,6 @@ impl ParallelMachine {
             measure: config.measure,
             layout_groups: groups,
             warnings,
-            pin_workers: config.pin_workers,
         })
     }
 
@@ -485,15 +481,6 @@ impl ParallelMachine {
             xhomes: &xhomes,
         };
         let shared = &shared;
-        // Worker i on the i-th allowed CPU for the run, when asked and each worker can have one.
-        let cpus = if self.pin_workers {
-            pin::allowed_cpus()
-        } else {
-            Vec::new()
-        };
-        let pins: Option<&[usize]> =
-            (threads > 1 && threads <= cpus.len()).then(|| &cpus[..threads]);
-        let pin = |w: usize| pins.and_then(|c| pin::pin_to(c[w]));
         if threads == 1 {
             self.leader(shared, scans, driver, chooser, allowed, log);
         } else {
@@ -511,12 +498,8 @@ impl ParallelMachine {
             );
             pool.in_place_scope(|s| {
                 for w in 1..threads {
-                    s.spawn(move |_| {
-                        let _pinned = pin(w);
-                        self.follower(w, shared)
-                    });
+                    s.spawn(move |_| self.follower(w, shared));
                 }
-                let _pinned = pin(0);
                 self.leader(shared, scans, driver, chooser, allowed, log);
             });
         }
