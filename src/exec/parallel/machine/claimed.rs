@@ -77,7 +77,7 @@ impl ParallelMachine {
             let slots = unsafe { sh.slots.bytes_mut() };
             driver.before_scan(&self.machine, scan, slots);
             let t0 = timing.wants(scan).then(Instant::now);
-            self.machine.begin_scan(&mut store);
+            self.machine.begin_scan(slots);
             units.done();
             let mut ctx = self.machine.context(scan, &mut b.scratch);
             for (pi, (ph, &at)) in plan.phases.iter().zip(&starts).enumerate() {
@@ -97,7 +97,9 @@ impl ParallelMachine {
             }
             // Every unit of the scan is done and none of the next can start before worker 0
             // counts its start: the buffers and slots are worker 0's.
-            let faults = self.merged_faults(sh, b);
+            // SAFETY: as the comment above says: no other worker runs a unit of the scan or
+            // touches its fault buffer before worker 0 counts the next scan's start.
+            let faults = unsafe { self.merged_faults(sh, b) };
             // SAFETY: as above.
             let slots: &[u8] = unsafe { sh.slots.bytes_mut() };
             driver.after_scan(&self.machine, scan, slots, faults, elapsed);
@@ -165,7 +167,12 @@ impl ParallelMachine {
                 store.prefetch(lines);
             }
             for it in ph.items_of(slice) {
-                self.run_item(&self.machine, plan, it, store, ctx, sh);
+                // SAFETY: `plan` is one of the machine's checked plans on the shared state of
+                // `self.machine`, and `it` is an item of unit `slice` of the current phase,
+                // which this worker claimed (no other worker runs it); the phase started after
+                // every unit of the phases before it was done (`units.wait`: Acquire of their
+                // Release `done`).
+                unsafe { self.run_item(&self.machine, plan, it, store, ctx, sh) };
                 if !ctx.faults.is_empty() {
                     // SAFETY: only worker `w` touches its fault buffer during a scan; worker 0
                     // reads it after every unit of the scan is done.

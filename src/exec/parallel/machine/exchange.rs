@@ -78,7 +78,11 @@ impl ParallelMachine {
         ctx: &mut ScanCtx<'_>,
         sh: &Shared<'_>,
     ) {
-        self.run_item(m, plan, it, store, ctx, sh);
+        // SAFETY: `plan` is a checked `par-exchange` plan of `m` (the caller's), `store` is
+        // worker `w`'s own state of `m` for the window, and `it` is an item of `w`'s slice of the
+        // current phase (`exchange_scans`); what other workers wrote before reaches this state
+        // only through `take_phase`, on this thread.
+        unsafe { self.run_item(m, plan, it, store, ctx, sh) };
         if !ctx.faults.is_empty() {
             // SAFETY: only worker `w` touches its fault buffer during a scan; worker 0 reads it
             // after it has waited for every worker's last phase, and `w` does not start the
@@ -131,7 +135,8 @@ impl ParallelMachine {
                 // SAFETY: as in `take_phase`.
                 buf.unpack(&x.inputs, unsafe { store.bytes_mut() }, seq);
             }
-            m.begin_scan(&mut store);
+            // SAFETY: as in `take_phase`: `store` is this worker's own state for the window.
+            m.begin_scan(unsafe { store.bytes_mut() });
             let mut ctx = m.context(scan, &mut b.scratch);
             for pi in 0..plan.phases.len() {
                 let split = x.split(pi, w);
@@ -162,7 +167,10 @@ impl ParallelMachine {
                 if t0.is_some() {
                     l.times.push(elapsed.as_nanos() as u64);
                 }
-                let faults = self.merged_faults(sh, b);
+                // SAFETY: worker 0 has taken every other worker's last phase of the scan
+                // (`take_phase` above), so their items of the scan are done, and none starts
+                // the next scan (or touches its fault buffer) before worker 0's inputs.
+                let faults = unsafe { self.merged_faults(sh, b) };
                 // SAFETY: worker 0's states, as above.
                 let slots: &[u8] = unsafe { store.bytes() };
                 let (m, slots) = match l.home {

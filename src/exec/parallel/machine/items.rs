@@ -8,7 +8,7 @@
 //! Invariant relied on: an item's guard and entries read decisions only of items of earlier
 //! phases (the plan check), so they are final when the item runs.
 
-use super::shared::Shared;
+use super::shared::{ItemStore, Shared};
 use super::{Buffers, ParallelMachine, SharedSlots};
 use crate::exec::parallel::ids::{Decision, Next};
 use crate::exec::parallel::planning::{Item, Plan, Region};
@@ -17,13 +17,21 @@ use crate::model::RungId;
 
 impl ParallelMachine {
     /// The faults of every worker's buffer in sequential order (by task; a task's faults keep
-    /// their order), the buffers emptied. Worker 0 only, when no other worker runs a unit or
-    /// item of the scan.
-    pub(super) fn merged_faults<'b>(&self, sh: &Shared<'_>, b: &'b mut Buffers) -> &'b [Fault] {
+    /// their order), the buffers emptied.
+    ///
+    /// # Safety
+    /// Worker 0 only, when no other worker runs a unit or item of the scan and none touches its
+    /// fault buffer until the next scan starts (every unit of the scan is done, or every worker
+    /// waits at a barrier).
+    pub(super) unsafe fn merged_faults<'b>(
+        &self,
+        sh: &Shared<'_>,
+        b: &'b mut Buffers,
+    ) -> &'b [Fault] {
         b.merged.clear();
         for f in sh.faults.iter() {
-            // SAFETY: no other worker touches its buffer until the next scan starts (the
-            // caller's condition); no other reference to it exists now.
+            // SAFETY: no other worker touches its buffer until the next scan starts (this
+            // function's contract); no other reference to it exists now.
             let buf = unsafe { &mut *f.0.get() };
             b.merged.append(buf);
         }
@@ -80,8 +88,14 @@ impl ParallelMachine {
 
     /// Runs item `it` of `plan` on `store` with `m`'s lowered code (the common layout's machine,
     /// or a `par-exchange` plan's own), and records where it left.
+    ///
+    /// # Safety
+    /// `plan` passed its check against `m`'s code (`planning::check_plan`), `store` is a state of
+    /// `m` (the shared state, or this worker's private one), and `it` is an item of the phase
+    /// the calling worker runs now that the plan gives it (its slice, or a unit it claimed),
+    /// every earlier phase of the scan handed over (Release/Acquire) before it started.
     #[inline]
-    pub(super) fn run_item(
+    pub(super) unsafe fn run_item(
         &self,
         m: &Machine,
         plan: &Plan,
@@ -96,11 +110,15 @@ impl ParallelMachine {
             }
             return;
         };
+        // SAFETY: the store goes only to `m.resume` and is dropped when it returns; the item's
+        // accesses are this worker's in this phase under the checked plan (this function's
+        // contract), which is `ItemStore::new`'s.
+        let mut st = unsafe { ItemStore::new(*store, m) };
         let exit = match it.region {
-            Region::Rungs(lo, hi) => m.resume(store, ctx, at, |r| lo <= r.0 && r.0 < hi),
+            Region::Rungs(lo, hi) => m.resume(&mut st, ctx, at, |r| lo <= r.0 && r.0 < hi),
             Region::Tasks(lo, hi) => {
                 let task_of = &plan.task_of_rung;
-                m.resume(store, ctx, at, |r: RungId| {
+                m.resume(&mut st, ctx, at, |r: RungId| {
                     task_of[r.index()].is_some_and(|t| lo <= t && t <= hi)
                 })
             }

@@ -101,27 +101,79 @@ impl SharedSlots {
     }
 }
 
-impl Store for SharedSlots {
+impl SharedSlots {
+    /// The `T` at `at`.
+    ///
+    /// # Safety
+    /// `at + T::SIZE` is at most the memory's length, and no other thread writes these bytes
+    /// while this read runs (in a phase, the bytes are written by this worker or by nobody;
+    /// writes of earlier phases happen before it by a Release/Acquire hand-over).
+    #[inline(always)]
+    pub(super) unsafe fn load<T: Word>(&self, at: Addr) -> T {
+        let p = self.at::<T>(at);
+        // SAFETY: `p..p + T::SIZE` is inside the state's memory (the caller's bound), initialised
+        // bytes borrowed for the whole run; no other thread writes them meanwhile (the caller's
+        // condition), so this read races with nothing.
+        unsafe { T::read(std::slice::from_raw_parts(p, T::SIZE)) }
+    }
+
+    /// Writes `v` at `at`.
+    ///
+    /// # Safety
+    /// `at + T::SIZE` is at most the memory's length, and no other thread reads or writes these
+    /// bytes while this write runs (in a phase, a byte one worker writes is touched by no other;
+    /// accesses of other phases are ordered against it by the hand-overs between phases).
+    #[inline(always)]
+    pub(super) unsafe fn store<T: Word>(&mut self, at: Addr, v: T) {
+        let p = self.at::<T>(at);
+        // SAFETY: in bounds (the caller's bound); no other access to these bytes races with
+        // this write (the caller's condition).
+        unsafe { v.write(std::slice::from_raw_parts_mut(p, T::SIZE)) }
+    }
+}
+
+/// The shared state as the interpreter's [`Store`] while a worker runs one item of a checked
+/// plan with one machine's code: the only way the workers' interpreter reaches the shared
+/// bytes. It exists for one call of [`Machine::resume`]: every address it is given is then an
+/// address of that machine's code, which `Machine::new` checked to end inside the machine's
+/// state size, and [`new`](Self::new) asserts that the memory holds that many bytes.
+pub(super) struct ItemStore(SharedSlots);
+
+impl ItemStore {
+    /// The shared slots as `m`'s store, for one item.
+    ///
+    /// # Safety
+    /// The store is passed only to `m`'s interpreter ([`Machine::resume`]) and dropped when it
+    /// returns, so it is loaded from and stored to only at addresses of `m`'s code; and the
+    /// accesses of that item are allowed to this worker in this phase by the plan's check (no
+    /// byte it writes is touched by another worker, no byte it reads is written by another),
+    /// ordered after the phases before by a Release/Acquire hand-over.
+    ///
+    /// # Panics
+    /// If the memory is smaller than `m`'s state.
+    #[inline(always)]
+    pub(super) unsafe fn new(slots: SharedSlots, m: &Machine) -> ItemStore {
+        assert!(
+            slots.len >= m.state_size() as usize,
+            "state too small for this machine"
+        );
+        ItemStore(slots)
+    }
+}
+
+impl Store for ItemStore {
     #[inline(always)]
     fn load<T: Word>(&self, at: Addr) -> T {
-        let p = self.at::<T>(at);
-        // SAFETY: `p..p + T::SIZE` is in bounds of the state's memory (`at`: an address of the
-        // machine's code, and `new` checked the size), initialised bytes borrowed for the whole
-        // run. No other worker writes these bytes
-        // while this read runs: in this phase they are written by this worker or by nobody
-        // (the plan's check against the lowered code), and writes of earlier phases happen
-        // before this phase starts (the Release/Acquire hand-over between phases); worker 0's
-        // exclusive slices (`bytes_mut`) exist only while the others wait.
-        unsafe { T::read(std::slice::from_raw_parts(p, T::SIZE)) }
+        // SAFETY: `at` is an address of the code of the machine the store was made for (the
+        // contract of `ItemStore::new`), which ends inside its state size, and `new` asserted
+        // that the memory has at least that many bytes; no other worker writes it meanwhile
+        // (the plan check, by the same contract).
+        unsafe { self.0.load(at) }
     }
     #[inline(always)]
     fn store<T: Word>(&mut self, at: Addr, v: T) {
-        let p = self.at::<T>(at);
-        // SAFETY: in bounds as in `load`. No other worker reads or writes these bytes in this
-        // phase (the plan's check: a byte written by one worker in a phase is touched by no
-        // other), and the accesses of earlier and later phases are ordered against this one by
-        // the hand-overs between phases, so no access races with this write.
-        unsafe { v.write(std::slice::from_raw_parts_mut(p, T::SIZE)) }
+        // SAFETY: as in `load`; no other worker reads or writes these bytes meanwhile.
+        unsafe { self.0.store(at, v) }
     }
 }
 

@@ -372,7 +372,7 @@ impl ParallelMachine {
                 let slots = unsafe { sh.slots.bytes_mut() };
                 d.before_scan(&self.machine, scan, slots);
                 t0 = timing.wants(scan).then(Instant::now);
-                self.machine.begin_scan(&mut store);
+                self.machine.begin_scan(slots);
             }
             let mut ctx = self.machine.context(scan, &mut b.scratch);
             for ph in &plan.phases {
@@ -395,7 +395,11 @@ impl ParallelMachine {
                             return false;
                         }
                     }
-                    self.run_item(&self.machine, plan, it, &mut store, &mut ctx, sh);
+                    // SAFETY: `plan` is one of the machine's checked plans on the shared state
+                    // of `self.machine`, `it` is in worker `w`'s slice of the current phase,
+                    // and every item of another worker it depends on has published its ready
+                    // flag (the waits above, Acquire of their Release).
+                    unsafe { self.run_item(&self.machine, plan, it, &mut store, &mut ctx, sh) };
                     if it.publish {
                         sh.ready.publish(w, *epoch, i as u32 + 1);
                     }
@@ -417,7 +421,9 @@ impl ParallelMachine {
                 }
                 // Every other worker has passed the scan's last barrier and waits at the next
                 // one: worker 0 has the buffers and slots to itself.
-                let faults = self.merged_faults(sh, b);
+                // SAFETY: every other worker has passed the scan's last barrier and waits at the
+                // next one (the comment above).
+                let faults = unsafe { self.merged_faults(sh, b) };
                 // SAFETY: as above: nobody writes the slots until worker 0 reaches the next
                 // barrier, after the driver returned.
                 let slots: &[u8] = unsafe { sh.slots.bytes_mut() };
