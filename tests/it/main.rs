@@ -44,6 +44,7 @@ mod interrupts;
 mod load_errors;
 mod paper_examples;
 mod par_layers;
+mod parallel_house;
 mod plcopen_data_types;
 mod plcopen_errors;
 mod plcopen_fbd;

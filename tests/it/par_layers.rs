@@ -38,6 +38,7 @@ const PARALLEL: Order = &[
     &["planning", "exchange"],
     &["planning", "remote"],
     &["planning"],
+    &["static_plan"],
     &["choice"],
     &["machine", "run_log"],
     &["machine", "backoff"],
