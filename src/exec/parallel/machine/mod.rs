@@ -154,10 +154,6 @@ impl ParallelMachine {
         if config.kind == PlanKind::Auto || plans.iter().all(|p| p.sequential.is_some()) {
             candidates.push(Candidate::Sequential);
         }
-        let levelled = plans
-            .iter()
-            .filter(|p| p.sequential.is_none() && p.ready.is_none())
-            .count();
         let mut names: Vec<String> = candidates.iter().map(|_| "seq".to_string()).collect();
         for (i, plan) in plans.iter().enumerate() {
             if plan.sequential.is_some() {
@@ -166,13 +162,14 @@ impl ParallelMachine {
             let only_exchange = config.kind == PlanKind::Exchange && exchanges[i].is_some();
             if !only_exchange {
                 candidates.push(Candidate::Levelled(i));
-                names.push(if plan.ready.is_some() {
-                    "par-deps".to_string()
-                } else if levelled > 1 {
-                    format!("par-{}", plan.config.slicing.name())
-                } else {
-                    "par".to_string()
-                });
+                names.push(
+                    if plan.ready.is_some() {
+                        "par-deps"
+                    } else {
+                        "par"
+                    }
+                    .to_string(),
+                );
             }
             if exchanges[i].is_some() {
                 candidates.push(Candidate::Exchange(i));

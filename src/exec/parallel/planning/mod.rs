@@ -1,6 +1,6 @@
 //! Planning: what the parallel scan will run, decided before the first scan from the program,
 //! its analysis and the cost model, and checked against the lowered code. The candidates
-//! ([`candidate_plans`]: the sequential walk, the levelled plan under each slicing, the
+//! ([`candidate_plans`]: the sequential walk, the levelled plan under contiguous slicing, the
 //! dependence-driven plan), the cost model (`rung_cost`, `movement`, the calibrated line cost
 //! of `calibrate`), the partition of each level (`tasks`' contiguous and LPT cuts, `partition`'s
 //! locality partition, `slicing`), the phases (`plan`, `deps_plan`) and the check of every plan
