@@ -106,7 +106,8 @@ macro_rules! by_num {
                 type $t = i64;
                 $e
             }
-            Num::U8 => {
+            // `Bool` is never a `Num` (`lower::num_of`); as a byte it would be a `u8`.
+            Num::U8 | Num::Bool => {
                 type $t = u8;
                 $e
             }
