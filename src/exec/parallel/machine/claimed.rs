@@ -176,7 +176,7 @@ impl ParallelMachine {
                 if !ctx.faults.is_empty() {
                     // SAFETY: only worker `w` touches its fault buffer during a scan; worker 0
                     // reads it after every unit of the scan is done.
-                    let buf = unsafe { &mut *sh.faults[w].0.get() };
+                    let buf = unsafe { &mut *sh.faults[w].get() };
                     buf.extend(ctx.faults.drain(..).map(|f| (it.first.0, f)));
                 }
             }

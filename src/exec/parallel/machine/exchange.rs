@@ -87,7 +87,7 @@ impl ParallelMachine {
             // SAFETY: only worker `w` touches its fault buffer during a scan; worker 0 reads it
             // after it has waited for every worker's last phase, and `w` does not start the
             // next scan before worker 0's inputs.
-            let fb = unsafe { &mut *sh.faults[w].0.get() };
+            let fb = unsafe { &mut *sh.faults[w].get() };
             fb.extend(ctx.faults.drain(..).map(|f| (it.first.0, f)));
         }
     }

@@ -32,7 +32,7 @@ impl ParallelMachine {
         for f in sh.faults.iter() {
             // SAFETY: no other worker touches its buffer until the next scan starts (this
             // function's contract); no other reference to it exists now.
-            let buf = unsafe { &mut *f.0.get() };
+            let buf = unsafe { &mut *f.get() };
             b.merged.append(buf);
         }
         b.merged.sort_by_key(|&(t, _)| t);

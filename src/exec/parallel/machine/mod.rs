@@ -449,7 +449,7 @@ impl ParallelMachine {
         let units = Units::new(per_scan);
         let bell = WindowBell::new(threads);
         let faults: Vec<FaultBuffer> = (0..threads)
-            .map(|_| Padded(UnsafeCell::new(Vec::new())))
+            .map(|_| Padded::new(UnsafeCell::new(Vec::new())))
             .collect();
         let xbufs: Vec<Option<XBuffer>> = self
             .exchanges
