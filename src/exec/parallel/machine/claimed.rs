@@ -10,7 +10,7 @@
 //! It does not choose (the leader in `machine` does) and does not run dependence-driven plans
 //! (their ready flags name the worker that runs an item: they keep the barrier).
 
-use super::shared::Shared;
+use super::shared::{faults_of, Shared};
 use super::units::WindowNote;
 use super::{Buffers, ParallelMachine, ScanDriver, Timing};
 use crate::exec::parallel::planning::{Phase, Plan};
@@ -97,9 +97,7 @@ impl ParallelMachine {
             }
             // Every unit of the scan is done and none of the next can start before worker 0
             // counts its start: the buffers and slots are worker 0's.
-            // SAFETY: as the comment above says: no other worker runs a unit of the scan or
-            // touches its fault buffer before worker 0 counts the next scan's start.
-            let faults = unsafe { self.merged_faults(sh, b) };
+            let faults = self.merged_faults(sh, b);
             // SAFETY: as above.
             let slots: &[u8] = unsafe { sh.slots.bytes_mut() };
             driver.after_scan(&self.machine, scan, slots, faults, elapsed);
@@ -174,10 +172,7 @@ impl ParallelMachine {
                 // Release `done`).
                 unsafe { self.run_item(&self.machine, plan, it, store, ctx, sh) };
                 if !ctx.faults.is_empty() {
-                    // SAFETY: only worker `w` touches its fault buffer during a scan; worker 0
-                    // reads it after every unit of the scan is done.
-                    let buf = unsafe { &mut *sh.faults[w].get() };
-                    buf.extend(ctx.faults.drain(..).map(|f| (it.first.0, f)));
+                    faults_of(&sh.faults[w]).extend(ctx.faults.drain(..).map(|f| (it.first.0, f)));
                 }
             }
             units.done();

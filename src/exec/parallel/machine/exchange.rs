@@ -19,7 +19,7 @@
 //! only what it was handed), so its windows are short, as a dependence-driven plan's.
 
 use super::relayout::Relayout;
-use super::shared::{Shared, SharedSlots};
+use super::shared::{faults_of, Shared, SharedSlots};
 use super::xlines::XBuffer;
 use super::{Buffers, ParallelMachine, ScanDriver, Timing};
 use crate::exec::parallel::planning::{Exchange, Item, Plan};
@@ -84,11 +84,7 @@ impl ParallelMachine {
         // only through `take_phase`, on this thread.
         unsafe { self.run_item(m, plan, it, store, ctx, sh) };
         if !ctx.faults.is_empty() {
-            // SAFETY: only worker `w` touches its fault buffer during a scan; worker 0 reads it
-            // after it has waited for every worker's last phase, and `w` does not start the
-            // next scan before worker 0's inputs.
-            let fb = unsafe { &mut *sh.faults[w].get() };
-            fb.extend(ctx.faults.drain(..).map(|f| (it.first.0, f)));
+            faults_of(&sh.faults[w]).extend(ctx.faults.drain(..).map(|f| (it.first.0, f)));
         }
     }
 
@@ -167,10 +163,9 @@ impl ParallelMachine {
                 if t0.is_some() {
                     l.times.push(elapsed.as_nanos() as u64);
                 }
-                // SAFETY: worker 0 has taken every other worker's last phase of the scan
-                // (`take_phase` above), so their items of the scan are done, and none starts
-                // the next scan (or touches its fault buffer) before worker 0's inputs.
-                let faults = unsafe { self.merged_faults(sh, b) };
+                // Worker 0 has taken every other worker's last phase of the scan (`take_phase`
+                // above): their items of the scan are done, and their faults in their buffers.
+                let faults = self.merged_faults(sh, b);
                 // SAFETY: worker 0's states, as above.
                 let slots: &[u8] = unsafe { store.bytes() };
                 let (m, slots) = match l.home {

@@ -8,7 +8,7 @@
 //! Invariant relied on: an item's guard and entries read decisions only of items of earlier
 //! phases (the plan check), so they are final when the item runs.
 
-use super::shared::{ItemStore, Shared};
+use super::shared::{faults_of, ItemStore, Shared};
 use super::{Buffers, ParallelMachine, SharedSlots};
 use crate::exec::parallel::ids::{Decision, Next};
 use crate::exec::parallel::planning::{Item, Plan, Region};
@@ -17,23 +17,13 @@ use crate::model::RungId;
 
 impl ParallelMachine {
     /// The faults of every worker's buffer in sequential order (by task; a task's faults keep
-    /// their order), the buffers emptied.
-    ///
-    /// # Safety
-    /// Worker 0 only, when no other worker runs a unit or item of the scan and none touches its
-    /// fault buffer until the next scan starts (every unit of the scan is done, or every worker
-    /// waits at a barrier).
-    pub(super) unsafe fn merged_faults<'b>(
-        &self,
-        sh: &Shared<'_>,
-        b: &'b mut Buffers,
-    ) -> &'b [Fault] {
+    /// their order), the buffers emptied. Worker 0, when every item of the scan is done (every
+    /// unit done, or every worker past the scan's last barrier or hand-over): then the buffers
+    /// hold every fault of the scan and no other.
+    pub(super) fn merged_faults<'b>(&self, sh: &Shared<'_>, b: &'b mut Buffers) -> &'b [Fault] {
         b.merged.clear();
         for f in sh.faults.iter() {
-            // SAFETY: no other worker touches its buffer until the next scan starts (this
-            // function's contract); no other reference to it exists now.
-            let buf = unsafe { &mut *f.get() };
-            b.merged.append(buf);
+            b.merged.append(&mut faults_of(f));
         }
         b.merged.sort_by_key(|&(t, _)| t);
         b.out.clear();

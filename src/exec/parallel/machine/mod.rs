@@ -60,7 +60,6 @@ use crate::model::{Program, VarId};
 use flags::ReadyFlags;
 use relayout::OwnLayout;
 use shared::{Decisions, FaultBuffer, Shared};
-use std::cell::UnsafeCell;
 use std::ops::Range;
 use std::time::Duration;
 use units::{Units, WindowBell};
@@ -449,7 +448,7 @@ impl ParallelMachine {
         let units = Units::new(per_scan);
         let bell = WindowBell::new(threads);
         let faults: Vec<FaultBuffer> = (0..threads)
-            .map(|_| Padded::new(UnsafeCell::new(Vec::new())))
+            .map(|_| Padded::new(std::sync::Mutex::new(Vec::new())))
             .collect();
         let xbufs: Vec<Option<XBuffer>> = self
             .exchanges

@@ -19,8 +19,8 @@ use crate::exec::parallel::ids::{Decision, DecisionSlot};
 use crate::exec::parallel::pad::Padded;
 use crate::exec::parallel::planning::RemoteLines;
 use crate::exec::{Addr, Fault, Machine, Store, Word, LINE_BYTES};
-use std::cell::UnsafeCell;
 use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::{Mutex, MutexGuard, PoisonError};
 
 /// The state's bytes, shared by all workers without locks.
 #[derive(Copy, Clone, Debug)]
@@ -178,8 +178,15 @@ impl Store for ItemStore {
 }
 
 /// One worker's faults of the current scan, each with the first task of the item that raised it
-/// (the key of the sequential order).
-pub(super) type FaultBuffer = Padded<UnsafeCell<Vec<(u32, Fault)>>>;
+/// (the key of the sequential order). A mutex that is never contended (its worker fills it
+/// during a scan, worker 0 empties it between scans, after the hand-over that ends the scan):
+/// faults are rare, and worker 0 takes each lock once a scan.
+pub(super) type FaultBuffer = Padded<Mutex<Vec<(u32, Fault)>>>;
+
+/// The buffer's faults (a panic while a worker held it leaves its faults as they were).
+pub(super) fn faults_of(buffer: &FaultBuffer) -> MutexGuard<'_, Vec<(u32, Fault)>> {
+    buffer.lock().unwrap_or_else(PoisonError::into_inner)
+}
 
 /// The decisions of one run, one cell per decision slot (lines of them per (phase, worker)).
 pub(super) struct Decisions(Box<[AtomicU32]>);
@@ -223,7 +230,3 @@ pub(super) struct Shared<'a> {
     /// (the other workers copy it into their private states when a window starts).
     pub(super) xhomes: &'a [Option<SharedSlots>],
 }
-
-// SAFETY: the fault buffers are each used by one worker during a scan and by worker 0 between
-// scans, with the barrier ordering the hand-over (see `ParallelMachine::worker`).
-unsafe impl Sync for Shared<'_> {}

@@ -7,7 +7,7 @@
 
 use super::claimed;
 use super::exchange::{Lead, XRun};
-use super::shared::{Shared, SharedSlots};
+use super::shared::{faults_of, Shared, SharedSlots};
 use super::units::WindowNote;
 use super::{Buffers, Candidate, NoDriver, ParallelMachine, RunLog, ScanDriver, Timing};
 use crate::exec::parallel::choice::{Chooser, Window};
@@ -404,10 +404,8 @@ impl ParallelMachine {
                         sh.ready.publish(w, *epoch, i as u32 + 1);
                     }
                     if !ctx.faults.is_empty() {
-                        // SAFETY: only worker `w` touches its fault buffer during a scan;
-                        // worker 0 reads it after the scan's last barrier.
-                        let buf = unsafe { &mut *sh.faults[w].get() };
-                        buf.extend(ctx.faults.drain(..).map(|f| (it.first.0, f)));
+                        faults_of(&sh.faults[w])
+                            .extend(ctx.faults.drain(..).map(|f| (it.first.0, f)));
                     }
                 }
             }
@@ -421,9 +419,7 @@ impl ParallelMachine {
                 }
                 // Every other worker has passed the scan's last barrier and waits at the next
                 // one: worker 0 has the buffers and slots to itself.
-                // SAFETY: every other worker has passed the scan's last barrier and waits at the
-                // next one (the comment above).
-                let faults = unsafe { self.merged_faults(sh, b) };
+                let faults = self.merged_faults(sh, b);
                 // SAFETY: as above: nobody writes the slots until worker 0 reaches the next
                 // barrier, after the driver returned.
                 let slots: &[u8] = unsafe { sh.slots.bytes_mut() };
