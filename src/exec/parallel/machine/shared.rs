@@ -34,7 +34,7 @@ pub struct SharedSlots {
 // holds for the whole run, and only for plans that passed their check: in a phase, no byte
 // one worker writes is read or written by another, and phases are ordered by Release/Acquire
 // hand-overs, so sharing it between threads never lets two accesses to one byte race (the
-// module's argument; `Store` below).
+// module's argument; `ItemStore` below).
 unsafe impl Send for SharedSlots {}
 // SAFETY: as above.
 unsafe impl Sync for SharedSlots {}
@@ -101,37 +101,6 @@ impl SharedSlots {
     }
 }
 
-impl SharedSlots {
-    /// The `T` at `at`.
-    ///
-    /// # Safety
-    /// `at + T::SIZE` is at most the memory's length, and no other thread writes these bytes
-    /// while this read runs (in a phase, the bytes are written by this worker or by nobody;
-    /// writes of earlier phases happen before it by a Release/Acquire hand-over).
-    #[inline(always)]
-    pub(super) unsafe fn load<T: Word>(&self, at: Addr) -> T {
-        let p = self.at::<T>(at);
-        // SAFETY: `p..p + T::SIZE` is inside the state's memory (the caller's bound), initialised
-        // bytes borrowed for the whole run; no other thread writes them meanwhile (the caller's
-        // condition), so this read races with nothing.
-        unsafe { T::read(std::slice::from_raw_parts(p, T::SIZE)) }
-    }
-
-    /// Writes `v` at `at`.
-    ///
-    /// # Safety
-    /// `at + T::SIZE` is at most the memory's length, and no other thread reads or writes these
-    /// bytes while this write runs (in a phase, a byte one worker writes is touched by no other;
-    /// accesses of other phases are ordered against it by the hand-overs between phases).
-    #[inline(always)]
-    pub(super) unsafe fn store<T: Word>(&mut self, at: Addr, v: T) {
-        let p = self.at::<T>(at);
-        // SAFETY: in bounds (the caller's bound); no other access to these bytes races with
-        // this write (the caller's condition).
-        unsafe { v.write(std::slice::from_raw_parts_mut(p, T::SIZE)) }
-    }
-}
-
 /// The shared state as the interpreter's [`Store`] while a worker runs one item of a checked
 /// plan with one machine's code: the only way the workers' interpreter reaches the shared
 /// bytes. It exists for one call of [`Machine::resume`]: every address it is given is then an
@@ -164,16 +133,20 @@ impl ItemStore {
 impl Store for ItemStore {
     #[inline(always)]
     fn load<T: Word>(&self, at: Addr) -> T {
-        // SAFETY: `at` is an address of the code of the machine the store was made for (the
-        // contract of `ItemStore::new`), which ends inside its state size, and `new` asserted
-        // that the memory has at least that many bytes; no other worker writes it meanwhile
-        // (the plan check, by the same contract).
-        unsafe { self.0.load(at) }
+        let p = self.0.at::<T>(at);
+        // SAFETY: `p..p + T::SIZE` is inside the state's memory: `at` is an address of the code
+        // of the machine the store was made for (the contract of `ItemStore::new`), which ends
+        // inside its state size, and `new` asserted that the memory has at least that many
+        // bytes (initialised, borrowed for the whole run). No other worker writes these bytes
+        // meanwhile (the plan check, by the same contract), so this read races with nothing.
+        unsafe { T::read(std::slice::from_raw_parts(p, T::SIZE)) }
     }
     #[inline(always)]
     fn store<T: Word>(&mut self, at: Addr, v: T) {
-        // SAFETY: as in `load`; no other worker reads or writes these bytes meanwhile.
-        unsafe { self.0.store(at, v) }
+        let p = self.0.at::<T>(at);
+        // SAFETY: in bounds as in `load`; no other worker reads or writes these bytes meanwhile
+        // (the plan check, by the contract of `new`), so no access races with this write.
+        unsafe { v.write(std::slice::from_raw_parts_mut(p, T::SIZE)) }
     }
 }
 
