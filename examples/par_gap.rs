@@ -9,8 +9,7 @@
 //! next scan's first barrier for as long as it lasts. This example times, per plan kind (`seq`,
 //! `par`, `deps`), the scans of a run whose driver does nothing between scans (`idle`) and of
 //! one that reads every byte of the state after each scan as the digest does (`read`), in
-//! alternating rounds, and prints the medians and ranges. `par+pin` and `deps+pin` are the same
-//! plans with each worker pinned to its own CPU (`PlanConfig::pin_workers`). The host's speed
+//! alternating rounds, and prints the medians and ranges. The host's speed
 //! drifts from round to round, so the last column is each plan's time against seq's in the
 //! *same* round (the median of those per-round ratios, and their range). Nothing here is used by
 //! the tool.
@@ -58,19 +57,12 @@ fn main() {
         .num_threads(threads.saturating_sub(1).max(1))
         .build()
         .expect("a pool");
-    let kinds = [
-        (PlanKind::Seq, false),
-        (PlanKind::Par, false),
-        (PlanKind::Deps, false),
-        (PlanKind::Par, true),
-        (PlanKind::Deps, true),
-    ];
+    let kinds = [PlanKind::Seq, PlanKind::Par, PlanKind::Deps];
     let machines: Vec<ParallelMachine> = kinds
         .iter()
-        .map(|&(kind, pin_workers)| {
+        .map(|&kind| {
             let config = PlanConfig {
                 kind,
-                pin_workers,
                 ..PlanConfig::new(threads)
             };
             ParallelMachine::new(&program, &analysis, &ExecConfig::default(), &config)
@@ -104,7 +96,7 @@ fn main() {
         v.sort_by(f64::total_cmp);
         (v[v.len() / 2], v[0], v[v.len() - 1])
     };
-    for (k, &(kind, pin)) in kinds.iter().enumerate() {
+    for (k, &kind) in kinds.iter().enumerate() {
         for read in [false, true] {
             let r = read as usize;
             let (m, lo, hi) = med(&results[k][r]);
@@ -114,7 +106,7 @@ fn main() {
                 .map(|(s, p)| s / p)
                 .collect();
             let (pm, plo, phi) = med(&paired);
-            let name = format!("{}{}", kind.name(), if pin { "+pin" } else { "" });
+            let name = kind.name();
             println!(
                 "  {name:8} {:5} {m:9.1} ({lo:.1}–{hi:.1})  {pm:.2}x seq ({plo:.2}–{phi:.2})",
                 if read { "read" } else { "idle" },

@@ -46,6 +46,7 @@ mod load_errors;
 mod module_cycles;
 mod paper_examples;
 mod par_layers;
+mod parallel_house;
 mod petgraph_views;
 mod plcopen_data_types;
 mod plcopen_errors;

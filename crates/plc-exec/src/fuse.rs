@@ -1,8 +1,8 @@
 //! Whole-rung superinstructions: a rung that is only plain contacts (in series and in `or`s of
 //! series, at most [`MAX_CONTACTS`] in all) followed by one output (coil, negated coil, set or
-//! reset) is lowered to one [`Op::Fused`](super::lower::Op) instruction instead of a rung marker,
+//! reset) is lowered to one `Op::Fused` (`lower`) instruction instead of a rung marker,
 //! contact instructions, `or` brackets and an output. Any other rung that starts with such
-//! contacts gets one [`Op::FusedHead`](super::lower::Op) for its marker and those contacts (the
+//! contacts gets one `Op::FusedHead` (`lower`) for its marker and those contacts (the
 //! power they give, from the same kind of table), then the general instructions of the rest.
 //!
 //! At run time such a rung loads its contacts' bytes (always [`MAX_CONTACTS`] loads: slots past
@@ -28,7 +28,7 @@
 //! dispatches for the most frequent instruction sequences). Not here: the general instructions
 //! (`lower`, `run`).
 
-use super::lower::{OUT_COIL, OUT_NCOIL, OUT_RESET, OUT_SET};
+use super::output_mode::{OUT_COIL, OUT_NCOIL, OUT_RESET, OUT_SET};
 use super::store::Addr;
 use plc_model::{index_type, ContactKind, Element, VarId, VarRef};
 use std::collections::HashMap;

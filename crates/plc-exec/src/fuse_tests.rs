@@ -7,7 +7,7 @@ use super::{ExecConfig, Fault, Layout, Machine};
 use plc_model::{Program, Type, Value, VarClass, VarId};
 use plc_synth::{generate_string, GenConfig, Reads};
 
-/// Runs `scans` scans of `p` on both machines with the same xorshift inputs (every BOOL input a
+/// Runs `scans` scans of `p` on both machines with the same pseudo-random inputs (every BOOL input a
 /// fresh 0/1 per scan) and asserts equal states and faults after each; returns how many rungs
 /// the fused machine fused (whole or head), to show the test exercised them.
 fn compare(p: &Program, scans: u64, seed: u64) -> usize {
@@ -24,16 +24,11 @@ fn compare(p: &Program, scans: u64, seed: u64) -> usize {
         .collect();
     let (mut a, mut b) = (fused.initial_state(), plain.initial_state());
     let (mut fa, mut fb): (Vec<Fault>, Vec<Fault>) = (Vec::new(), Vec::new());
-    let mut x = seed | 1;
+    let mut rng = fastrand::Rng::with_seed(seed);
     for scan in 0..scans {
         let row: Vec<(VarId, Value)> = inputs
             .iter()
-            .map(|&v| {
-                x ^= x << 13;
-                x ^= x >> 7;
-                x ^= x << 17;
-                (v, Value::Bool(x >> 63 == 1))
-            })
+            .map(|&v| (v, Value::Bool(rng.bool())))
             .collect();
         fused.scan(&mut a, scan, &row, &mut fa);
         plain.scan(&mut b, scan, &row, &mut fb);

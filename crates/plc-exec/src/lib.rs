@@ -135,6 +135,7 @@ mod fuse_tests;
 mod layout;
 mod lower;
 mod mem;
+mod output_mode;
 pub mod parallel;
 mod run;
 mod store;
@@ -513,13 +514,16 @@ impl Machine {
         let mut mem = unsafe { store::Trusted::new(mem) };
         self.begin_scan(&mut mem);
         let mut ctx = self.context(scan, faults);
-        self.exec(
-            &mut mem,
-            &mut ctx,
-            self.pou_entry[0].index(),
-            self.main_first,
-            &everywhere,
-        );
+        // SAFETY: the main program's entry is an entry of the machine's checked instructions.
+        unsafe {
+            self.exec(
+                &mut mem,
+                &mut ctx,
+                self.pou_entry[0].index(),
+                self.main_first,
+                &everywhere,
+            )
+        };
     }
 
     /// [`set_inputs`](Self::set_inputs) then [`run_scan`](Self::run_scan).
@@ -571,7 +575,10 @@ impl Machine {
                 (self.fors[f.index()].test, h)
             }
         };
-        match self.exec(store, ctx, pc.index(), rung, &inside) {
+        // SAFETY: `pc` is a rung's start (`rung_op`, indexed with a bounds check) or a FOR
+        // loop's test (`fors`, of a rung `for_of_head` names as a head): entries of the checked
+        // instructions.
+        match unsafe { self.exec(store, ctx, pc.index(), rung, &inside) } {
             Flow::Return | Flow::Stop => Exit::Stop,
             Flow::Rung(r) => Exit::Rung(r),
             Flow::ForTest(h) => Exit::ForTest(h),

@@ -106,7 +106,8 @@ macro_rules! by_num {
                 type $t = i64;
                 $e
             }
-            Num::U8 => {
+            // `Bool` is never a `Num` (`lower::num_of`); as a byte it would be a `u8`.
+            Num::U8 | Num::Bool => {
                 type $t = u8;
                 $e
             }
@@ -231,7 +232,14 @@ impl Machine {
     /// Runs instructions from `pc` until the POU ends, the scan stops, or control reaches a rung
     /// (or FOR test) for which `inside` is false. `rung` is the rung `pc` belongs to (for faults
     /// before the first rung marker, i.e. when resuming at a FOR test).
-    pub(crate) fn exec<S, F>(
+    ///
+    /// # Safety
+    /// `pc` is an entry of this machine's instructions: a POU's entry (`pou_entry`), a rung's
+    /// start (`rung_op`) or a FOR test (`fors[_].test`). `Machine::new`, the only constructor,
+    /// ran `lower::check` on these instructions, which are never changed afterwards: every
+    /// entry and jump target is an instruction, and control falls through only from
+    /// instructions before the last, an `EndPou`, which returns.
+    pub(crate) unsafe fn exec<S, F>(
         &self,
         st: &mut S,
         ctx: &mut ScanCtx<'_>,
@@ -248,10 +256,9 @@ impl Machine {
         let mut s: u64 = 0;
         let b = |st: &S, at: Addr| st.load::<u8>(at) as u64;
         loop {
-            // SAFETY: `pc` < `ops.len()`: every entry and target is an instruction, and control
-            // falls through only from instructions before the last, an `EndPou`, which returns
-            // (`lower::check`, run by `Machine::new` on these immutable instructions; callers
-            // pass a POU entry, a rung start or a FOR test).
+            // SAFETY: `pc` < `ops.len()`: it starts at an entry (this function's contract), every
+            // jump target is an instruction, and control falls through only from instructions
+            // before the last, an `EndPou`, which returns (the checked code, same contract).
             let op = *unsafe { ops.get_unchecked(pc) };
             pc += 1;
             match op {
@@ -438,7 +445,10 @@ impl Machine {
                 Op::Call { to, charge } => {
                     if p != 0
                         && self.charge(ctx, rung, charge)
-                        && self.exec(st, ctx, to.index(), rung, &everywhere) != Flow::Return
+                        // SAFETY: `to` is a POU entry of the checked code (`lower::check`
+                        // checks every CALL's target; this function's contract).
+                        && unsafe { self.exec(st, ctx, to.index(), rung, &everywhere) }
+                            != Flow::Return
                     {
                         return Flow::Stop;
                     }

@@ -10,10 +10,6 @@
 //! 1: the interpreter only ever writes those, and relies on it when it reads. This module knows
 //! nothing of types or variables (see `layout`).
 
-use std::sync::atomic::{
-    AtomicI16, AtomicI32, AtomicI64, AtomicI8, AtomicU16, AtomicU32, AtomicU64, AtomicU8, Ordering,
-};
-
 /// A byte address in a state's memory.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Default)]
 pub struct Addr(pub u32);
@@ -46,23 +42,11 @@ pub trait Word: Copy + sealed::Sealed {
     fn read(bytes: &[u8]) -> Self;
     /// Writes the value to exactly `SIZE` bytes.
     fn write(self, bytes: &mut [u8]);
-    /// A Relaxed atomic load of the value at `p`.
-    ///
-    /// # Safety
-    /// `p` is aligned to `SIZE`, valid for reads of `SIZE` bytes, and no access of another size
-    /// to these bytes runs at the same time (`AtomicU8::from_ptr` and friends).
-    unsafe fn load_relaxed(p: *mut u8) -> Self;
-    /// A Relaxed atomic store of the value at `p`.
-    ///
-    /// # Safety
-    /// As [`load_relaxed`](Self::load_relaxed), and valid for writes.
-    unsafe fn store_relaxed(self, p: *mut u8);
 }
 
-/// `Word` for a type `$t` held in an atomic `$a` of the same width through bit casts
-/// `$to`/`$from` (the identity for integers).
+/// `Word` for a type `$t`, in its native-endian bytes.
 macro_rules! word {
-    ($t:ty, $a:ty, $to:expr, $from:expr) => {
+    ($($t:ty),*) => {$(
         impl sealed::Sealed for $t {}
         impl Word for $t {
             const SIZE: usize = std::mem::size_of::<$t>();
@@ -74,33 +58,11 @@ macro_rules! word {
             fn write(self, bytes: &mut [u8]) {
                 bytes.copy_from_slice(&self.to_ne_bytes())
             }
-            #[inline(always)]
-            unsafe fn load_relaxed(p: *mut u8) -> Self {
-                // SAFETY: the caller's contract is `from_ptr`'s: aligned, valid, no mixed-size
-                // access at the same time.
-                let a = unsafe { <$a>::from_ptr(p.cast()) };
-                $from(a.load(Ordering::Relaxed))
-            }
-            #[inline(always)]
-            unsafe fn store_relaxed(self, p: *mut u8) {
-                // SAFETY: as in `load_relaxed`.
-                let a = unsafe { <$a>::from_ptr(p.cast()) };
-                a.store($to(self), Ordering::Relaxed)
-            }
         }
-    };
+    )*};
 }
 
-word!(u8, AtomicU8, |v| v, |v| v);
-word!(i8, AtomicI8, |v| v, |v| v);
-word!(i16, AtomicI16, |v| v, |v| v);
-word!(u16, AtomicU16, |v| v, |v| v);
-word!(i32, AtomicI32, |v| v, |v| v);
-word!(u32, AtomicU32, |v| v, |v| v);
-word!(i64, AtomicI64, |v| v, |v| v);
-word!(u64, AtomicU64, |v| v, |v| v);
-word!(f32, AtomicU32, f32::to_bits, f32::from_bits);
-word!(f64, AtomicU64, f64::to_bits, f64::from_bits);
+word!(u8, i8, i16, u16, i32, u32, i64, u64, f32, f64);
 
 /// Memory read and written by the interpreter.
 ///

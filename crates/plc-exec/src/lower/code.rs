@@ -12,14 +12,8 @@ use super::super::layout::Repr;
 use super::super::store::Addr;
 use plc_model::*;
 
-/// Output modes of [`Op::Coil`]: bit 0 = the value written when powered, bit 1 = no write when
-/// unpowered (set/reset), bit 2 = the value written when unpowered otherwise. One instruction
-/// for every output keeps the dispatch after a rung's conditions uniform (set/reset among coils
-/// made it mispredict: −15 % per rung on generated programs).
-pub(crate) const OUT_COIL: u8 = 0b001;
-pub(crate) const OUT_NCOIL: u8 = 0b100;
-pub(crate) const OUT_SET: u8 = 0b011;
-pub(crate) const OUT_RESET: u8 = 0b010;
+/// Output modes of [`Op::Coil`] (the `output_mode` module).
+pub(crate) use super::super::output_mode::{OUT_COIL, OUT_NCOIL, OUT_RESET, OUT_SET};
 
 index_type!(
     /// An instruction: index into the machine's instruction array.
@@ -44,55 +38,16 @@ pub(crate) struct FuncCall {
     pub ty: Type,
 }
 
-/// Numeric representation of a compare, an arithmetic box or a FOR index.
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
-pub(crate) enum Num {
-    /// SINT: wraps at 8 bits.
-    I8,
-    /// INT: wraps at 16 bits.
-    I16,
-    /// DINT, TIME: wrap at 32 bits.
-    I32,
-    /// LINT: wraps at 64 bits.
-    I64,
-    /// USINT, BYTE: modulo 2^8.
-    U8,
-    /// UINT, WORD: modulo 2^16.
-    U16,
-    /// UDINT, DWORD: modulo 2^32.
-    U32,
-    /// ULINT, LWORD: modulo 2^64.
-    U64,
-    /// REAL.
-    F32,
-    /// LREAL.
-    F64,
-}
+/// Numeric representation of a compare, an arithmetic box or a FOR index: the stored
+/// representation ([`Repr`], one list of variants for both), never `Bool` ([`num_of`]).
+pub(crate) type Num = Repr;
 
-impl Num {
-    pub(super) fn of(ty: Type) -> Num {
-        match Repr::of(ty) {
-            Some(Repr::I8) => Num::I8,
-            Some(Repr::I16) => Num::I16,
-            Some(Repr::I64) => Num::I64,
-            Some(Repr::U8) => Num::U8,
-            Some(Repr::U16) => Num::U16,
-            Some(Repr::U32) => Num::U32,
-            Some(Repr::U64) => Num::U64,
-            Some(Repr::F32) => Num::F32,
-            Some(Repr::F64) => Num::F64,
-            Some(Repr::I32 | Repr::Bool) | None => Num::I32,
-        }
-    }
-
-    /// Bytes of a value of this representation.
-    pub(crate) fn width(self) -> u32 {
-        match self {
-            Num::I8 | Num::U8 => 1,
-            Num::I16 | Num::U16 => 2,
-            Num::I32 | Num::U32 | Num::F32 => 4,
-            Num::I64 | Num::U64 | Num::F64 => 8,
-        }
+/// The numeric representation of an operand of type `ty`: its stored representation; BOOL and
+/// instance types as DINT.
+pub(super) fn num_of(ty: Type) -> Num {
+    match Repr::of(ty) {
+        Some(Repr::Bool) | None => Repr::I32,
+        Some(r) => r,
     }
 }
 

@@ -381,7 +381,7 @@ impl Lowerer<'_> {
                 self.push(op);
             }
             Element::Compare { op, a, b } => {
-                let num = Num::of(self.operand_type(a));
+                let num = num_of(self.operand_type(a));
                 let (a, b) = (self.operand(a), self.operand(b));
                 self.push(Op::Cmp { op: *op, num, a, b });
             }
@@ -453,7 +453,7 @@ impl Lowerer<'_> {
                 self.push(Op::Move { width, from, to });
             }
             Element::Arith { op, a, b, out } => {
-                let num = Num::of(self.p.var(*out).ty);
+                let num = num_of(self.p.var(*out).ty);
                 let (a, b) = (self.operand(a), self.operand(b));
                 let out = self.layout.start(*out);
                 self.push(Op::Arith {
@@ -506,7 +506,7 @@ impl Lowerer<'_> {
                 let test = Pc(self.pc().0 + 1);
                 self.code.fors.push(ForLoop {
                     var: self.layout.start(*var),
-                    num: Num::of(self.p.var(*var).ty),
+                    num: num_of(self.p.var(*var).ty),
                     from,
                     to,
                     test,

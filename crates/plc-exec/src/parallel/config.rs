@@ -220,11 +220,6 @@ pub struct PlanConfig {
     pub slicing: Slicing,
     /// Which tasks run on which worker in the dependence-driven plan.
     pub deps_partition: DepsPartition,
-    /// Merge consecutive parallel levels into one phase plus a sequential halo where the model
-    /// gains (`planning::merge`). Off by default, and not among the candidates of
-    /// [`PlanKind::Auto`]: measured on 2 shared vCPUs it did not beat one phase per level
-    /// (docs/scan.md).
-    pub merge_levels: bool,
     /// Which plans a run may use (the library's default is [`PlanKind::Model`]: one plan,
     /// decided by the model; `plc-deps run` defaults to [`PlanKind::Auto`]).
     pub kind: PlanKind,
@@ -234,10 +229,6 @@ pub struct PlanConfig {
     /// hand-over of the phase before (`planning::early`; 16: a walk of its own costs about as
     /// much as a few tasks). At least 1.
     pub early_min_tasks: u32,
-    /// Pin worker `i` to the `i`-th CPU the process may run on, for each run, when there are
-    /// at least as many such CPUs as workers (Linux; `machine::pin`). Off by default: measured
-    /// on 2 shared vCPUs it made no difference beyond the host's noise (docs/scan.md).
-    pub pin_workers: bool,
 }
 
 impl PlanConfig {
@@ -269,11 +260,9 @@ impl PlanConfig {
             strategy: Strategy::Auto,
             slicing: Slicing::Auto,
             deps_partition: DepsPartition::Auto,
-            merge_levels: false,
             kind: PlanKind::Model,
             measure: Measure::default(),
             early_min_tasks: 16,
-            pin_workers: false,
         }
     }
 }

@@ -113,7 +113,7 @@ impl ParallelMachine {
         }
     }
 
-    /// The primary plan's phases (merged, halo and sequential ones) and the state's padding.
+    /// The primary plan's sequential phases and the state's padding.
     fn explain_layout(&self, p: &Program, s: &mut String) {
         let plan = &self.plans[0];
         if plan.sequential.is_none() {
@@ -124,11 +124,7 @@ impl ParallelMachine {
                     .and_then(|l| l.first())
                     .copied()
                     .unwrap_or(0);
-                if ph.is_parallel() && ph.levels.len() > 1 {
-                    let _ = writeln!(s, "  phase {}: levels {}..={} in one parallel phase (each worker runs its share of each, reading only its own writes of the phase), {} moved by worker 0", i + 1, ph.levels.start + 1, ph.levels.end, count(moved, "line"));
-                } else if ph.halo {
-                    let _ = writeln!(s, "  phase {}: the {} of levels {}..={} that read another worker's writes of the phase before, sequential (worker 0, task order), {} moved", i + 1, count(ph.items_of(0).iter().map(|it| it.tasks().count()).sum::<usize>(), "task"), ph.levels.start + 1, ph.levels.end, count(moved, "line"));
-                } else if !ph.is_parallel() && ph.levels.len() > 1 {
+                if !ph.is_parallel() && ph.levels.len() > 1 {
                     let _ = writeln!(s, "  phase {}: levels {}..={} merged into one sequential phase (worker 0, task order), {} moved", i + 1, ph.levels.start + 1, ph.levels.end, count(moved, "line"));
                 } else if !ph.is_parallel() && moved > 0 {
                     let _ = writeln!(

@@ -66,7 +66,9 @@
 //!    `pad` (a value on its own cache lines);
 //! 2. `planning` (the candidate plans, the cost model, the partition, the check of every plan
 //!    against the lowered code; its own `//!` lists its modules in order);
-//! 3. `choice` (the measured choice among the candidates: which runs the next window of scans);
+//! 3. `static_plan` (the planner as one call for other back ends: [`plan`], the plan as plain
+//!    data, checked against the lowered code); `choice` (the measured choice among the
+//!    candidates: which runs the next window of scans);
 //! 4. `machine` (the running machine: the wait loop, the barrier, the ready flags, the claimed
 //!    units, the shared memory, the workers' runs of the chosen plans);
 //! 5. `explain` (what `--explain` and the JSON say of the plans and the run).
@@ -89,6 +91,7 @@ mod ids;
 mod machine;
 mod pad;
 mod planning;
+mod static_plan;
 
 pub use choice::{Chooser, Switch, Window, WindowRecord};
 pub use config::{DepsPartition, LineCostSource, Measure, PlanConfig, PlanKind, Slicing, Strategy};
@@ -99,3 +102,6 @@ pub use machine::{
     SpinBarrier,
 };
 pub use planning::{measure_handover, measure_line_cost, LevelPlan, LineTiming, Plan, Ready};
+pub use static_plan::{
+    plan, GuardTerm, ItemRegion, ScanItem, ScanPhase, ScanPlan, ScanPlanKind, WaitFor,
+};

@@ -9,6 +9,11 @@
 //! costs one check; parking is the caller's (it re-checks its condition after announcing that
 //! it parks, so no wake-up is lost) and may give up the wait (poison). Knows nothing of plans
 //! or workers; depends on nothing in the parallel module.
+//!
+//! Not `crossbeam_utils::Backoff`: its pace is fixed step counts (spin up to 2^6, yield up to
+//! 2^10 steps, then `is_completed`), while each waiter here passes its own: no spinning at all
+//! when there are more workers than cores (the barrier's pace; 8 workers on 2 cores spent three
+//! quarters of their time spinning, docs/scan.md), and yielding for a *time* before parking.
 
 use std::time::{Duration, Instant};
 

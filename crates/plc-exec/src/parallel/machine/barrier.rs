@@ -48,7 +48,7 @@ impl SpinBarrier {
     /// A barrier for `n` workers.
     pub fn new(n: usize) -> SpinBarrier {
         SpinBarrier {
-            seats: (0..n).map(|_| Padded(Seat::default())).collect(),
+            seats: (0..n).map(|_| Padded::new(Seat::default())).collect(),
             poisoned: AtomicBool::new(false),
             oversubscribed: std::thread::available_parallelism().is_ok_and(|cores| n > cores.get()),
         }
@@ -67,7 +67,7 @@ impl SpinBarrier {
 
     /// Worker `w` runs on the calling thread (call once, before its first [`wait`](Self::wait)).
     pub fn register(&self, w: usize) {
-        let _ = self.seats[w].0.thread.set(std::thread::current());
+        let _ = self.seats[w].thread.set(std::thread::current());
     }
 
     /// Worker `w` arrives (its count in `epoch`) and waits for all; false if a worker panicked.
@@ -77,16 +77,16 @@ impl SpinBarrier {
         let e = *epoch;
         // SeqCst store, then SeqCst loads of the parked flags; a parking waiter stores its flag
         // then loads the epochs (SeqCst): one of the two sees the other, no wake-up is lost.
-        self.seats[w].0.epoch.store(e, Ordering::SeqCst);
+        self.seats[w].epoch.store(e, Ordering::SeqCst);
         for (i, seat) in self.seats.iter().enumerate() {
-            if i != w && seat.0.parked.load(Ordering::SeqCst) {
-                if let Some(t) = seat.0.thread.get() {
+            if i != w && seat.parked.load(Ordering::SeqCst) {
+                if let Some(t) = seat.thread.get() {
                     t.unpark();
                 }
             }
         }
         for (i, other) in self.seats.iter().enumerate() {
-            if i != w && !self.wait_for(w, &other.0, e) {
+            if i != w && !self.wait_for(w, other, e) {
                 return false;
             }
         }
@@ -101,7 +101,7 @@ impl SpinBarrier {
             if self.poisoned.load(Ordering::SeqCst) {
                 return false;
             }
-            let me = &self.seats[w].0;
+            let me = &*self.seats[w];
             me.parked.store(true, Ordering::SeqCst);
             if other.epoch.load(Ordering::SeqCst) < e && !self.poisoned.load(Ordering::SeqCst) {
                 // A registered worker is woken by `unpark`; an unregistered one (a caller
@@ -127,7 +127,7 @@ impl SpinBarrier {
     pub fn poison(&self) {
         self.poisoned.store(true, Ordering::SeqCst);
         for seat in self.seats.iter() {
-            if let Some(t) = seat.0.thread.get() {
+            if let Some(t) = seat.thread.get() {
                 t.unpark();
             }
         }
@@ -192,7 +192,7 @@ mod tests {
             b.register(0);
             let mut e = 0;
             assert!(b.wait(0, &mut e));
-            assert!(b.seats[1].0.epoch.load(Ordering::SeqCst) >= 1);
+            assert!(b.seats[1].epoch.load(Ordering::SeqCst) >= 1);
         });
     }
 

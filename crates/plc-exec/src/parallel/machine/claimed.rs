@@ -10,7 +10,7 @@
 //! It does not choose (the leader in `machine` does) and does not run dependence-driven plans
 //! (their ready flags name the worker that runs an item: they keep the barrier).
 
-use super::shared::Shared;
+use super::shared::{faults_of, Shared};
 use super::units::WindowNote;
 use super::{Buffers, ParallelMachine, ScanDriver, Timing};
 use crate::parallel::planning::{Phase, Plan};
@@ -77,7 +77,7 @@ impl ParallelMachine {
             let slots = unsafe { sh.slots.bytes_mut() };
             driver.before_scan(&self.machine, scan, slots);
             let t0 = timing.wants(scan).then(Instant::now);
-            self.machine.begin_scan(&mut store);
+            self.machine.begin_scan(slots);
             units.done();
             let mut ctx = self.machine.context(scan, &mut b.scratch);
             for (pi, (ph, &at)) in plan.phases.iter().zip(&starts).enumerate() {
@@ -165,12 +165,14 @@ impl ParallelMachine {
                 store.prefetch(lines);
             }
             for it in ph.items_of(slice) {
-                self.run_item(&self.machine, plan, it, store, ctx, sh);
+                // SAFETY: `plan` is one of the machine's checked plans on the shared state of
+                // `self.machine`, and `it` is an item of unit `slice` of the current phase,
+                // which this worker claimed (no other worker runs it); the phase started after
+                // every unit of the phases before it was done (`units.wait`: Acquire of their
+                // Release `done`).
+                unsafe { self.run_item(&self.machine, plan, it, store, ctx, sh) };
                 if !ctx.faults.is_empty() {
-                    // SAFETY: only worker `w` touches its fault buffer during a scan; worker 0
-                    // reads it after every unit of the scan is done.
-                    let buf = unsafe { &mut *sh.faults[w].0.get() };
-                    buf.extend(ctx.faults.drain(..).map(|f| (it.first.0, f)));
+                    faults_of(&sh.faults[w]).extend(ctx.faults.drain(..).map(|f| (it.first.0, f)));
                 }
             }
             units.done();

@@ -19,7 +19,7 @@
 //! only what it was handed), so its windows are short, as a dependence-driven plan's.
 
 use super::relayout::Relayout;
-use super::shared::{Shared, SharedSlots};
+use super::shared::{faults_of, Shared, SharedSlots};
 use super::xlines::XBuffer;
 use super::{Buffers, ParallelMachine, ScanDriver, Timing};
 use crate::parallel::planning::{Exchange, Item, Plan};
@@ -78,13 +78,13 @@ impl ParallelMachine {
         ctx: &mut ScanCtx<'_>,
         sh: &Shared<'_>,
     ) {
-        self.run_item(m, plan, it, store, ctx, sh);
+        // SAFETY: `plan` is a checked `par-exchange` plan of `m` (the caller's), `store` is
+        // worker `w`'s own state of `m` for the window, and `it` is an item of `w`'s slice of the
+        // current phase (`exchange_scans`); what other workers wrote before reaches this state
+        // only through `take_phase`, on this thread.
+        unsafe { self.run_item(m, plan, it, store, ctx, sh) };
         if !ctx.faults.is_empty() {
-            // SAFETY: only worker `w` touches its fault buffer during a scan; worker 0 reads it
-            // after it has waited for every worker's last phase, and `w` does not start the
-            // next scan before worker 0's inputs.
-            let fb = unsafe { &mut *sh.faults[w].0.get() };
-            fb.extend(ctx.faults.drain(..).map(|f| (it.first.0, f)));
+            faults_of(&sh.faults[w]).extend(ctx.faults.drain(..).map(|f| (it.first.0, f)));
         }
     }
 
@@ -131,7 +131,8 @@ impl ParallelMachine {
                 // SAFETY: as in `take_phase`.
                 buf.unpack(&x.inputs, unsafe { store.bytes_mut() }, seq);
             }
-            m.begin_scan(&mut store);
+            // SAFETY: as in `take_phase`: `store` is this worker's own state for the window.
+            m.begin_scan(unsafe { store.bytes_mut() });
             let mut ctx = m.context(scan, &mut b.scratch);
             for pi in 0..plan.phases.len() {
                 let split = x.split(pi, w);
@@ -162,6 +163,8 @@ impl ParallelMachine {
                 if t0.is_some() {
                     l.times.push(elapsed.as_nanos() as u64);
                 }
+                // Worker 0 has taken every other worker's last phase of the scan (`take_phase`
+                // above): their items of the scan are done, and their faults in their buffers.
                 let faults = self.merged_faults(sh, b);
                 // SAFETY: worker 0's states, as above.
                 let slots: &[u8] = unsafe { store.bytes() };

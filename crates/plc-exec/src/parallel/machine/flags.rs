@@ -39,13 +39,17 @@ fn value(epoch: u64, done: u32) -> u64 {
 
 impl ReadyFlags {
     pub(super) fn new(workers: usize) -> ReadyFlags {
-        ReadyFlags((0..workers).map(|_| Padded(AtomicU64::new(0))).collect())
+        ReadyFlags(
+            (0..workers)
+                .map(|_| Padded::new(AtomicU64::new(0)))
+                .collect(),
+        )
     }
 
     /// Worker `w` has finished its first `done` items of the scan of `epoch`.
     #[inline]
     pub(super) fn publish(&self, w: usize, epoch: u64, done: u32) {
-        self.0[w].0.store(value(epoch, done), Ordering::Release);
+        self.0[w].store(value(epoch, done), Ordering::Release);
     }
 
     /// Waits until worker `w` has finished its first `done` items of the scan of `epoch`;
@@ -53,7 +57,7 @@ impl ReadyFlags {
     #[inline]
     pub(super) fn wait(&self, w: usize, epoch: u64, done: u32, barrier: &SpinBarrier) -> bool {
         let need = value(epoch, done);
-        let flag = &self.0[w].0;
+        let flag = &*self.0[w];
         if flag.load(Ordering::Acquire) >= need {
             return true;
         }
@@ -99,7 +103,7 @@ mod tests {
                 assert!(data.load(Ordering::Relaxed) >= k);
             }
         });
-        assert_eq!(flags.0[0].0.load(Ordering::SeqCst), (2 << 32) | 2000);
+        assert_eq!(flags.0[0].load(Ordering::SeqCst), (2 << 32) | 2000);
     }
 
     #[test]

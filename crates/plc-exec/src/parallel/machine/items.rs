@@ -8,7 +8,7 @@
 //! Invariant relied on: an item's guard and entries read decisions only of items of earlier
 //! phases (the plan check), so they are final when the item runs.
 
-use super::shared::Shared;
+use super::shared::{faults_of, ItemStore, Shared};
 use super::{Buffers, ParallelMachine, SharedSlots};
 use crate::parallel::ids::{Decision, Next};
 use crate::parallel::planning::{Item, Plan, Region};
@@ -17,15 +17,13 @@ use plc_model::RungId;
 
 impl ParallelMachine {
     /// The faults of every worker's buffer in sequential order (by task; a task's faults keep
-    /// their order), the buffers emptied. Worker 0 only, when no other worker runs a unit or
-    /// item of the scan.
+    /// their order), the buffers emptied. Worker 0, when every item of the scan is done (every
+    /// unit done, or every worker past the scan's last barrier or hand-over): then the buffers
+    /// hold every fault of the scan and no other.
     pub(super) fn merged_faults<'b>(&self, sh: &Shared<'_>, b: &'b mut Buffers) -> &'b [Fault] {
         b.merged.clear();
         for f in sh.faults.iter() {
-            // SAFETY: no other worker touches its buffer until the next scan starts (the
-            // caller's condition); no other reference to it exists now.
-            let buf = unsafe { &mut *f.0.get() };
-            b.merged.append(buf);
+            b.merged.append(&mut faults_of(f));
         }
         b.merged.sort_by_key(|&(t, _)| t);
         b.out.clear();
@@ -80,8 +78,14 @@ impl ParallelMachine {
 
     /// Runs item `it` of `plan` on `store` with `m`'s lowered code (the common layout's machine,
     /// or a `par-exchange` plan's own), and records where it left.
+    ///
+    /// # Safety
+    /// `plan` passed its check against `m`'s code (`planning::check_plan`), `store` is a state of
+    /// `m` (the shared state, or this worker's private one), and `it` is an item of the phase
+    /// the calling worker runs now that the plan gives it (its slice, or a unit it claimed),
+    /// every earlier phase of the scan handed over (Release/Acquire) before it started.
     #[inline]
-    pub(super) fn run_item(
+    pub(super) unsafe fn run_item(
         &self,
         m: &Machine,
         plan: &Plan,
@@ -96,11 +100,15 @@ impl ParallelMachine {
             }
             return;
         };
+        // SAFETY: the store goes only to `m.resume` and is dropped when it returns; the item's
+        // accesses are this worker's in this phase under the checked plan (this function's
+        // contract), which is `ItemStore::new`'s.
+        let mut st = unsafe { ItemStore::new(*store, m) };
         let exit = match it.region {
-            Region::Rungs(lo, hi) => m.resume(store, ctx, at, |r| lo <= r.0 && r.0 < hi),
+            Region::Rungs(lo, hi) => m.resume(&mut st, ctx, at, |r| lo <= r.0 && r.0 < hi),
             Region::Tasks(lo, hi) => {
                 let task_of = &plan.task_of_rung;
-                m.resume(store, ctx, at, |r: RungId| {
+                m.resume(&mut st, ctx, at, |r: RungId| {
                     task_of[r.index()].is_some_and(|t| lo <= t && t <= hi)
                 })
             }

@@ -18,7 +18,7 @@
 //!
 //! # Modules, bottom to top
 //! Each uses only the ones before it (and the layers below the machine: the basics, `planning`,
-//! `choice`): `pin` (workers pinned to CPUs), `backoff` (the one wait loop: spin, yield, park),
+//! `choice`): `backoff` (the one wait loop: spin, yield, park),
 //! `barrier`, `flags` (ready flags), `units` (claimed units, the window bell), `xlines`
 //! (exchange lines), `shared` (lock-free shared memory), `driver` (the per-scan callbacks and
 //! the sequential loop), `relayout` (a `par-exchange` plan's own layout, and a state moved
@@ -36,7 +36,6 @@ mod driver;
 mod exchange;
 mod flags;
 mod items;
-mod pin;
 mod relayout;
 mod run_log;
 mod shared;
@@ -61,7 +60,6 @@ use plc_analysis::Analysis;
 use plc_model::{Program, VarId};
 use relayout::OwnLayout;
 use shared::{Decisions, FaultBuffer, Shared};
-use std::cell::UnsafeCell;
 use std::ops::Range;
 use std::time::Duration;
 use units::{Units, WindowBell};
@@ -87,8 +85,6 @@ pub struct ParallelMachine {
     pub(super) layout_groups: usize,
     /// Why plans were dropped (a failed check), for the user.
     pub(super) warnings: Vec<String>,
-    /// Pin the workers to CPUs during a run ([`PlanConfig::pin_workers`]).
-    pub(super) pin_workers: bool,
 }
 
 impl ParallelMachine {
@@ -157,10 +153,6 @@ impl ParallelMachine {
         if config.kind == PlanKind::Auto || plans.iter().all(|p| p.sequential.is_some()) {
             candidates.push(Candidate::Sequential);
         }
-        let levelled = plans
-            .iter()
-            .filter(|p| p.sequential.is_none() && p.ready.is_none())
-            .count();
         let mut names: Vec<String> = candidates.iter().map(|_| "seq".to_string()).collect();
         for (i, plan) in plans.iter().enumerate() {
             if plan.sequential.is_some() {
@@ -169,13 +161,14 @@ impl ParallelMachine {
             let only_exchange = config.kind == PlanKind::Exchange && exchanges[i].is_some();
             if !only_exchange {
                 candidates.push(Candidate::Levelled(i));
-                names.push(if plan.ready.is_some() {
-                    "par-deps".to_string()
-                } else if levelled > 1 {
-                    format!("par-{}", plan.config.slicing.name())
-                } else {
-                    "par".to_string()
-                });
+                names.push(
+                    if plan.ready.is_some() {
+                        "par-deps"
+                    } else {
+                        "par"
+                    }
+                    .to_string(),
+                );
             }
             if exchanges[i].is_some() {
                 candidates.push(Candidate::Exchange(i));
@@ -193,7 +186,6 @@ impl ParallelMachine {
             measure: config.measure,
             layout_groups: groups,
             warnings,
-            pin_workers: config.pin_workers,
         })
     }
 
@@ -456,7 +448,7 @@ impl ParallelMachine {
         let units = Units::new(per_scan);
         let bell = WindowBell::new(threads);
         let faults: Vec<FaultBuffer> = (0..threads)
-            .map(|_| Padded(UnsafeCell::new(Vec::new())))
+            .map(|_| Padded::new(std::sync::Mutex::new(Vec::new())))
             .collect();
         let xbufs: Vec<Option<XBuffer>> = self
             .exchanges
@@ -485,15 +477,6 @@ impl ParallelMachine {
             xhomes: &xhomes,
         };
         let shared = &shared;
-        // Worker i on the i-th allowed CPU for the run, when asked and each worker can have one.
-        let cpus = if self.pin_workers {
-            pin::allowed_cpus()
-        } else {
-            Vec::new()
-        };
-        let pins: Option<&[usize]> =
-            (threads > 1 && threads <= cpus.len()).then(|| &cpus[..threads]);
-        let pin = |w: usize| pins.and_then(|c| pin::pin_to(c[w]));
         if threads == 1 {
             self.leader(shared, scans, driver, chooser, allowed, log);
         } else {
@@ -511,12 +494,8 @@ impl ParallelMachine {
             );
             pool.in_place_scope(|s| {
                 for w in 1..threads {
-                    s.spawn(move |_| {
-                        let _pinned = pin(w);
-                        self.follower(w, shared)
-                    });
+                    s.spawn(move |_| self.follower(w, shared));
                 }
-                let _pinned = pin(0);
                 self.leader(shared, scans, driver, chooser, allowed, log);
             });
         }

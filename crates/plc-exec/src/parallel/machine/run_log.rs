@@ -21,8 +21,7 @@ pub enum Candidate {
 /// switch between them.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct RunLog {
-    /// Candidate names (`seq`, `par`, `par-contiguous`, `par-lpt`, `par-locality`, `par-deps`,
-    /// `par-exchange`), by candidate index.
+    /// Candidate names (`seq`, `par`, `par-deps`, `par-exchange`), by candidate index.
     pub candidates: Vec<String>,
     /// Scans run on each candidate.
     pub scans_on: Vec<u64>,

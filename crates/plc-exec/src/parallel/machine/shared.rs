@@ -19,8 +19,8 @@ use crate::parallel::ids::{Decision, DecisionSlot};
 use crate::parallel::pad::Padded;
 use crate::parallel::planning::RemoteLines;
 use crate::{Addr, Fault, Machine, Store, Word, LINE_BYTES};
-use std::cell::UnsafeCell;
 use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::{Mutex, MutexGuard, PoisonError};
 
 /// The state's bytes, shared by all workers without locks.
 #[derive(Copy, Clone, Debug)]
@@ -34,7 +34,7 @@ pub struct SharedSlots {
 // holds for the whole run, and only for plans that passed their check: in a phase, no byte
 // one worker writes is read or written by another, and phases are ordered by Release/Acquire
 // hand-overs, so sharing it between threads never lets two accesses to one byte race (the
-// module's argument; `Store` below).
+// module's argument; `ItemStore` below).
 unsafe impl Send for SharedSlots {}
 // SAFETY: as above.
 unsafe impl Sync for SharedSlots {}
@@ -101,33 +101,65 @@ impl SharedSlots {
     }
 }
 
-impl Store for SharedSlots {
+/// The shared state as the interpreter's [`Store`] while a worker runs one item of a checked
+/// plan with one machine's code: the only way the workers' interpreter reaches the shared
+/// bytes. It exists for one call of [`Machine::resume`]: every address it is given is then an
+/// address of that machine's code, which `Machine::new` checked to end inside the machine's
+/// state size, and [`new`](Self::new) asserts that the memory holds that many bytes.
+pub(super) struct ItemStore(SharedSlots);
+
+impl ItemStore {
+    /// The shared slots as `m`'s store, for one item.
+    ///
+    /// # Safety
+    /// The store is passed only to `m`'s interpreter ([`Machine::resume`]) and dropped when it
+    /// returns, so it is loaded from and stored to only at addresses of `m`'s code; and the
+    /// accesses of that item are allowed to this worker in this phase by the plan's check (no
+    /// byte it writes is touched by another worker, no byte it reads is written by another),
+    /// ordered after the phases before by a Release/Acquire hand-over.
+    ///
+    /// # Panics
+    /// If the memory is smaller than `m`'s state.
+    #[inline(always)]
+    pub(super) unsafe fn new(slots: SharedSlots, m: &Machine) -> ItemStore {
+        assert!(
+            slots.len >= m.state_size() as usize,
+            "state too small for this machine"
+        );
+        ItemStore(slots)
+    }
+}
+
+impl Store for ItemStore {
     #[inline(always)]
     fn load<T: Word>(&self, at: Addr) -> T {
-        let p = self.at::<T>(at);
-        // SAFETY: `p..p + T::SIZE` is in bounds of the state's memory (`at`: an address of the
-        // machine's code, and `new` checked the size), initialised bytes borrowed for the whole
-        // run. No other worker writes these bytes
-        // while this read runs: in this phase they are written by this worker or by nobody
-        // (the plan's check against the lowered code), and writes of earlier phases happen
-        // before this phase starts (the Release/Acquire hand-over between phases); worker 0's
-        // exclusive slices (`bytes_mut`) exist only while the others wait.
+        let p = self.0.at::<T>(at);
+        // SAFETY: `p..p + T::SIZE` is inside the state's memory: `at` is an address of the code
+        // of the machine the store was made for (the contract of `ItemStore::new`), which ends
+        // inside its state size, and `new` asserted that the memory has at least that many
+        // bytes (initialised, borrowed for the whole run). No other worker writes these bytes
+        // meanwhile (the plan check, by the same contract), so this read races with nothing.
         unsafe { T::read(std::slice::from_raw_parts(p, T::SIZE)) }
     }
     #[inline(always)]
     fn store<T: Word>(&mut self, at: Addr, v: T) {
-        let p = self.at::<T>(at);
-        // SAFETY: in bounds as in `load`. No other worker reads or writes these bytes in this
-        // phase (the plan's check: a byte written by one worker in a phase is touched by no
-        // other), and the accesses of earlier and later phases are ordered against this one by
-        // the hand-overs between phases, so no access races with this write.
+        let p = self.0.at::<T>(at);
+        // SAFETY: in bounds as in `load`; no other worker reads or writes these bytes meanwhile
+        // (the plan check, by the contract of `new`), so no access races with this write.
         unsafe { v.write(std::slice::from_raw_parts_mut(p, T::SIZE)) }
     }
 }
 
 /// One worker's faults of the current scan, each with the first task of the item that raised it
-/// (the key of the sequential order).
-pub(super) type FaultBuffer = Padded<UnsafeCell<Vec<(u32, Fault)>>>;
+/// (the key of the sequential order). A mutex that is never contended (its worker fills it
+/// during a scan, worker 0 empties it between scans, after the hand-over that ends the scan):
+/// faults are rare, and worker 0 takes each lock once a scan.
+pub(super) type FaultBuffer = Padded<Mutex<Vec<(u32, Fault)>>>;
+
+/// The buffer's faults (a panic while a worker held it leaves its faults as they were).
+pub(super) fn faults_of(buffer: &FaultBuffer) -> MutexGuard<'_, Vec<(u32, Fault)>> {
+    buffer.lock().unwrap_or_else(PoisonError::into_inner)
+}
 
 /// The decisions of one run, one cell per decision slot (lines of them per (phase, worker)).
 pub(super) struct Decisions(Box<[AtomicU32]>);
@@ -171,7 +203,3 @@ pub(super) struct Shared<'a> {
     /// (the other workers copy it into their private states when a window starts).
     pub(super) xhomes: &'a [Option<SharedSlots>],
 }
-
-// SAFETY: the fault buffers are each used by one worker during a scan and by worker 0 between
-// scans, with the barrier ordering the hand-over (see `ParallelMachine::worker`).
-unsafe impl Sync for Shared<'_> {}

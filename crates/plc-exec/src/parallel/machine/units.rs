@@ -47,29 +47,31 @@ impl Units {
     /// Cells for scans of at most `per_scan` units.
     pub(super) fn new(per_scan: usize) -> Units {
         Units {
-            completed: Padded(AtomicU64::new(0)),
-            claims: (0..per_scan).map(|_| Padded(AtomicU64::new(0))).collect(),
+            completed: Padded::new(AtomicU64::new(0)),
+            claims: (0..per_scan)
+                .map(|_| Padded::new(AtomicU64::new(0)))
+                .collect(),
         }
     }
 
     /// Units completed in the run so far (Acquire).
     #[inline]
     pub(super) fn completed(&self) -> u64 {
-        self.completed.0.load(Ordering::Acquire)
+        self.completed.load(Ordering::Acquire)
     }
 
     /// Claims the unit at position `pos` of its scan, whose id is `id` (at least 1): true for
     /// exactly one caller per id.
     #[inline]
     pub(super) fn claim(&self, pos: usize, id: u64) -> bool {
-        let cell = &self.claims[pos].0;
+        let cell = &*self.claims[pos];
         cell.load(Ordering::Relaxed) < id && cell.fetch_max(id, Ordering::AcqRel) < id
     }
 
     /// A unit is done (Release: its writes are seen by whoever sees the count).
     #[inline]
     pub(super) fn done(&self) {
-        self.completed.0.fetch_add(1, Ordering::Release);
+        self.completed.fetch_add(1, Ordering::Release);
     }
 
     /// Waits until `target` units are done, or `give_up` says so (checked while sleeping), or
@@ -133,33 +135,33 @@ pub(super) struct WindowBell {
 impl WindowBell {
     pub(super) fn new(workers: usize) -> WindowBell {
         WindowBell {
-            seq: Padded(AtomicU64::new(0)),
+            seq: Padded::new(AtomicU64::new(0)),
             plan: AtomicU64::new(0),
             first: AtomicU64::new(0),
             scans: AtomicU64::new(0),
             base: AtomicU64::new(0),
             exchange: AtomicU64::new(0),
             seats: (0..workers)
-                .map(|_| Padded((AtomicBool::new(false), OnceLock::new())))
+                .map(|_| Padded::new((AtomicBool::new(false), OnceLock::new())))
                 .collect(),
         }
     }
 
     /// Worker `w` waits on the calling thread (once, before its first wait).
     pub(super) fn register(&self, w: usize) {
-        let _ = self.seats[w].0 .1.set(std::thread::current());
+        let _ = self.seats[w].1.set(std::thread::current());
     }
 
     /// The number of windows announced so far.
     #[inline]
     pub(super) fn announced(&self) -> u64 {
-        self.seq.0.load(Ordering::Acquire) / 2
+        self.seq.load(Ordering::Acquire) / 2
     }
 
     /// Worker 0 announces the next window and wakes the parked workers.
     pub(super) fn ring(&self, note: WindowNote) {
-        let s = self.seq.0.load(Ordering::Relaxed);
-        self.seq.0.store(s + 1, Ordering::Relaxed);
+        let s = self.seq.load(Ordering::Relaxed);
+        self.seq.store(s + 1, Ordering::Relaxed);
         std::sync::atomic::fence(Ordering::Release);
         self.plan.store(note.plan as u64, Ordering::Relaxed);
         self.first.store(note.first, Ordering::Relaxed);
@@ -169,10 +171,10 @@ impl WindowBell {
         self.exchange.store(x, Ordering::Relaxed);
         // SeqCst, then SeqCst loads of the parked flags; a parking waiter stores its flag then
         // loads `seq` (SeqCst): one of the two sees the other, no wake-up is lost.
-        self.seq.0.store(s + 2, Ordering::SeqCst);
+        self.seq.store(s + 2, Ordering::SeqCst);
         for seat in self.seats.iter() {
-            if seat.0 .0.load(Ordering::SeqCst) {
-                if let Some(t) = seat.0 .1.get() {
+            if seat.0.load(Ordering::SeqCst) {
+                if let Some(t) = seat.1.get() {
                     t.unpark();
                 }
             }
@@ -182,7 +184,7 @@ impl WindowBell {
     /// The note of window number `k` (1-based) or a later one, read whole; `None` if none yet.
     fn read(&self, k: u64) -> Option<(u64, WindowNote)> {
         loop {
-            let s = self.seq.0.load(Ordering::Acquire);
+            let s = self.seq.load(Ordering::Acquire);
             if s / 2 < k {
                 return None;
             }
@@ -201,7 +203,7 @@ impl WindowBell {
                 },
             };
             std::sync::atomic::fence(Ordering::Acquire);
-            if self.seq.0.load(Ordering::Relaxed) == s {
+            if self.seq.load(Ordering::Relaxed) == s {
                 return Some((s / 2, note));
             }
         }
@@ -214,9 +216,9 @@ impl WindowBell {
             if poison.is_poisoned() {
                 return false;
             }
-            let me = &self.seats[w].0;
+            let me = &*self.seats[w];
             me.0.store(true, Ordering::SeqCst);
-            if self.seq.0.load(Ordering::SeqCst) / 2 < k && !poison.is_poisoned() {
+            if self.seq.load(Ordering::SeqCst) / 2 < k && !poison.is_poisoned() {
                 // Woken by `ring` (or the poison's unpark of the barrier's seats, which
                 // are these threads); bounded anyway, as the poison check above needs.
                 std::thread::park_timeout(Duration::from_millis(5));

@@ -7,7 +7,7 @@
 
 use super::claimed;
 use super::exchange::{Lead, XRun};
-use super::shared::{Shared, SharedSlots};
+use super::shared::{faults_of, Shared, SharedSlots};
 use super::units::WindowNote;
 use super::{Buffers, Candidate, NoDriver, ParallelMachine, RunLog, ScanDriver, Timing};
 use crate::parallel::choice::{Chooser, Window};
@@ -372,7 +372,7 @@ impl ParallelMachine {
                 let slots = unsafe { sh.slots.bytes_mut() };
                 d.before_scan(&self.machine, scan, slots);
                 t0 = timing.wants(scan).then(Instant::now);
-                self.machine.begin_scan(&mut store);
+                self.machine.begin_scan(slots);
             }
             let mut ctx = self.machine.context(scan, &mut b.scratch);
             for ph in &plan.phases {
@@ -395,15 +395,17 @@ impl ParallelMachine {
                             return false;
                         }
                     }
-                    self.run_item(&self.machine, plan, it, &mut store, &mut ctx, sh);
+                    // SAFETY: `plan` is one of the machine's checked plans on the shared state
+                    // of `self.machine`, `it` is in worker `w`'s slice of the current phase,
+                    // and every item of another worker it depends on has published its ready
+                    // flag (the waits above, Acquire of their Release).
+                    unsafe { self.run_item(&self.machine, plan, it, &mut store, &mut ctx, sh) };
                     if it.publish {
                         sh.ready.publish(w, *epoch, i as u32 + 1);
                     }
                     if !ctx.faults.is_empty() {
-                        // SAFETY: only worker `w` touches its fault buffer during a scan;
-                        // worker 0 reads it after the scan's last barrier.
-                        let buf = unsafe { &mut *sh.faults[w].0.get() };
-                        buf.extend(ctx.faults.drain(..).map(|f| (it.first.0, f)));
+                        faults_of(&sh.faults[w])
+                            .extend(ctx.faults.drain(..).map(|f| (it.first.0, f)));
                     }
                 }
             }

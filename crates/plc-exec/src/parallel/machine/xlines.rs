@@ -259,15 +259,10 @@ mod tests {
     use super::*;
     use crate::parallel::planning::Segment;
 
-    /// A pseudo-random byte per call (xorshift).
+    /// A pseudo-random byte per call.
     fn bytes(seed: u64) -> impl FnMut() -> u8 {
-        let mut x = seed | 1;
-        move || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            (x >> 24) as u8
-        }
+        let mut rng = fastrand::Rng::with_seed(seed);
+        move || rng.u8(..)
     }
 
     /// `pack64` (and its portable form, which other architectures run) keeps bit 0 of each

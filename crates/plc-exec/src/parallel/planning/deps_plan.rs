@@ -140,7 +140,6 @@ pub(in crate::parallel) fn build(p: &Program, a: &Analysis, config: &PlanConfig)
         kind: PhaseKind::Parallel(items),
         levels: 0..sched.levels.len(),
         barrier_before: true,
-        halo: false,
     }];
     plan.end_barrier = true;
     plan.waits = waits;

@@ -1,6 +1,6 @@
 //! Planning: what the parallel scan will run, decided before the first scan from the program,
 //! its analysis and the cost model, and checked against the lowered code. The candidates
-//! ([`candidate_plans`]: the sequential walk, the levelled plan under each slicing, the
+//! ([`candidate_plans`]: the sequential walk, the levelled plan under contiguous slicing, the
 //! dependence-driven plan), the cost model (`rung_cost`, `movement`, the calibrated line cost
 //! of `calibrate`), the partition of each level (`tasks`' contiguous and LPT cuts, `partition`'s
 //! locality partition, `slicing`), the phases (`plan`, `deps_plan`) and the check of every plan
@@ -17,8 +17,7 @@
 //! contiguous and LPT cuts), `partition` (the locality partition of one level), `movement`
 //! (lines moved between workers), `slicing` (each level's slices and modelled makespan),
 //! `ready` (the dependence-driven plan's waits), `one_way` (the chain partition of the
-//! dependence-driven plan), `phase` (a phase's items), `merge` (consecutive parallel levels in one
-//! phase where each worker reads only its own writes), `plan` (phases on the cost model), `deps_plan`
+//! dependence-driven plan), `phase` (a phase's items), `plan` (phases on the cost model), `deps_plan`
 //! (the dependence-driven plan), `candidates` (the plans a run chooses from), `order_check`
 //! (the dependence-driven order against the lowered code), `check` (every plan against the
 //! lowered code), `exchange` (what each worker of a levelled plan on private states hands the
@@ -31,7 +30,6 @@ mod check;
 mod deps_plan;
 mod early;
 mod exchange;
-mod merge;
 mod movement;
 mod one_way;
 mod order_check;

@@ -1,6 +1,6 @@
 //! A phase of a levelled plan's scan: the items each worker runs between two barriers (a
 //! parallel phase: one slice per worker) or the items worker 0 runs alone (a sequential phase),
-//! and the levels of the schedule it covers. Plain data below the planner (`merge`, `plan`) and
+//! and the levels of the schedule it covers. Plain data below the planner (`plan`) and
 //! the machine that runs it; it decides nothing.
 
 use super::tasks::Item;
@@ -35,9 +35,6 @@ pub(in crate::parallel) struct Phase {
     pub(in crate::parallel) levels: Range<usize>,
     /// Meet at the barrier before running it.
     pub(in crate::parallel) barrier_before: bool,
-    /// A sequential phase of the tasks a merged parallel phase before it left out (`merge`):
-    /// some of the tasks of its levels, not all.
-    pub(in crate::parallel) halo: bool,
 }
 
 impl Phase {

@@ -6,15 +6,13 @@
 //!
 //! Follows Zhao & Yan's data levelling (levels run one after another, the rungs of a level in
 //! parallel) on the *combined* schedule: data and control dependences together, loops kept whole.
-//! With `merge_levels`, consecutive parallel levels share a phase where no worker reads or
-//! writes what another writes in it (`merge`). Invariants: every task of the schedule is in exactly one phase; in a
+//! Invariants: every task of the schedule is in exactly one phase; in a
 //! parallel phase each worker's items are ascending in task order within each of its levels,
 //! the levels in order; a task has a decision slot iff a later guard or
 //! entry reads it. It does not measure anything (see `choice`) and does not check the plan
 //! against the lowered code (see `check`).
 
 use super::calls::{call_closure, is_loop_back, rung_callees, uncovered_refusal};
-use super::merge::merge_phases;
 use super::movement::Movement;
 pub(in crate::parallel) use super::phase::{Phase, PhaseKind, RemoteLines};
 use super::ready::{Ready, Wait};
@@ -91,12 +89,7 @@ impl Plan {
         let (choice, _) = choose_phases(&level_plans, config);
         let any_parallel = choice.contains(&true);
         let mut phases = if any_parallel {
-            let built = build_phases(a, &info, config, &choice, &mut level_slices);
-            if config.merge_levels {
-                merge_phases(p, a, &info, config, threads, built)
-            } else {
-                built
-            }
+            build_phases(a, &info, config, &choice, &mut level_slices)
         } else {
             Vec::new()
         };
@@ -433,8 +426,7 @@ fn phase_movement(p: &Program, a: &Analysis, phases: &[Phase], threads: usize) -
 
 /// The modelled scan of the phases as built: Σ parallel makespans (data movement included) +
 /// Σ sequential levels' costs and their moved lines + barriers. Sets each parallel level's
-/// lines and makespan (a merged phase's lines on its first level) and says why a level has no
-/// barrier of its own.
+/// lines and makespan.
 fn modelled_scan(
     phases: &[Phase],
     phase_lines: &[Vec<u64>],
@@ -445,41 +437,12 @@ fn modelled_scan(
     let mut est = 0;
     for (ph, lines) in phases.iter().zip(phase_lines) {
         est += if ph.barrier_before { b } else { 0 };
-        let item_costs = |items: &[Item]| items.iter().map(|it| it.cost).sum::<u64>();
-        if ph.is_parallel() && ph.levels.len() > 1 {
-            // A merged phase: each worker runs its share of every level in one go; the lines
-            // it moves are read in the phase's first level (the later ones read its own writes).
-            let workers: Vec<(usize, usize, u64)> = (0..lines.len())
-                .map(|w| {
-                    let items = ph.items_of(w);
-                    let tasks = items.iter().map(|it| it.tasks().count()).sum();
-                    (tasks, items.len(), item_costs(items))
-                })
-                .collect();
-            est += worker_makespan(&workers, lines, config.line_cost);
-            for (k, lp) in levels[ph.levels.clone()].iter_mut().enumerate() {
-                lp.lines = if k == 0 {
-                    lines.clone()
-                } else {
-                    vec![0; lines.len()]
-                };
-                lp.makespan = Some(worker_makespan(&lp.workers, &lp.lines, config.line_cost));
-                if k > 0 {
-                    lp.reason = format!(
-                        "in one phase with level {} (no barrier: each worker reads only its own \
-                         writes of the phase; the tasks that would read another's run after it)",
-                        ph.levels.start + 1
-                    );
-                }
-            }
-        } else if ph.is_parallel() {
+        if ph.is_parallel() {
             let lp = &mut levels[ph.levels.start];
             lp.lines = lines.clone();
             let m = worker_makespan(&lp.workers, lines, config.line_cost);
             lp.makespan = Some(m);
             est += m;
-        } else if ph.halo {
-            est += item_costs(ph.items_of(0)) + lines.iter().sum::<u64>() * config.line_cost;
         } else {
             let own: u64 = levels[ph.levels.clone()]
                 .iter()
@@ -598,7 +561,6 @@ fn build_phases(
                 kind: PhaseKind::Parallel(items),
                 levels: l..l + 1,
                 barrier_before: true,
-                halo: false,
             });
             l += 1;
         } else {
@@ -612,7 +574,6 @@ fn build_phases(
                 kind: PhaseKind::Sequential(info.items(&tasks, config.item_cost)),
                 levels: start..l,
                 barrier_before: start > 0, // after a parallel phase
-                halo: false,
             });
         }
     }
