@@ -123,7 +123,7 @@ impl ConfigurationEntry<'_> {
 /// of 4: …`.
 pub fn analysed_text(c: &ConfigurationEntry, programs: &[ProgramRunEntry]) -> String {
     let total = c.instance_count();
-    let plural = crate::text::plural;
+    let plural = crate::words::plural;
     let which = if total == 1 && programs.len() == 1 {
         "the only program instance".to_owned()
     } else if programs.len() == total {

@@ -18,6 +18,7 @@ pub mod html;
 mod json;
 pub mod order;
 pub mod text;
+mod words;
 
 pub use document::{document, document_with, Report};
 pub use dot::{render_dot, select_rungs, Selection, MAX_RUNGS as DOT_MAX_RUNGS};

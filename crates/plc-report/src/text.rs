@@ -10,6 +10,8 @@
 //! column or on the program's size beyond the row limit.
 
 use super::document::{DependenceEntry, Report, TaskName};
+pub(crate) use super::words::plural;
+pub use super::words::thousands;
 use super::View;
 use std::io::{self, Write};
 
@@ -64,24 +66,6 @@ impl TextOptions {
             Rows::All => None,
         }
     }
-}
-
-/// `12345` → `12,345`.
-pub fn thousands(n: usize) -> String {
-    let s = n.to_string();
-    let mut out = String::new();
-    for (i, c) in s.chars().enumerate() {
-        if i > 0 && (s.len() - i).is_multiple_of(3) {
-            out.push(',');
-        }
-        out.push(c);
-    }
-    out
-}
-
-/// `1 rung`, `2 rungs`.
-pub(crate) fn plural(n: usize, one: &str, many: &str) -> String {
-    format!("{} {}", thousands(n), if n == 1 { one } else { many })
 }
 
 /// Words joined by spaces, wrapped into lines of at most `width` characters (a longer word is a
