@@ -89,6 +89,8 @@ mod config;
 mod explain;
 mod ids;
 mod machine;
+#[cfg(test)]
+mod miri_tests;
 mod pad;
 mod planning;
 mod static_plan;
