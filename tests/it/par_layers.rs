@@ -193,7 +193,7 @@ fn upward_uses(root: &Path, order: Order, absolute: &str) -> Vec<String> {
 }
 
 /// Every module file of the tree is in the order (a new module must be placed in it), but for
-/// test modules in a file of their own (`tests.rs`), which are left out as an inline
+/// test modules in a file of their own (`tests.rs`, `*_tests.rs`), which are left out as an inline
 /// `#[cfg(test)]` module is (`code`).
 fn unlisted(root: &Path, order: Order) -> Vec<String> {
     let mut found = Vec::new();
@@ -204,7 +204,8 @@ fn unlisted(root: &Path, order: Order) -> Vec<String> {
             if p.is_dir() {
                 stack.push(p);
             } else if p.extension().is_some_and(|x| x == "rs")
-                && p.file_name().is_some_and(|n| n != "tests.rs")
+                && p.file_name()
+                    .is_some_and(|n| n != "tests.rs" && !n.to_string_lossy().ends_with("_tests.rs"))
             {
                 found.push(p);
             }
