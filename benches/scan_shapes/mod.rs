@@ -29,7 +29,7 @@ use serde_json::json;
 use std::time::{Duration, Instant};
 
 /// A program of `plc-deps gen`: `rungs` rungs in lanes of `width`, reading `reads`.
-pub fn generated(rungs: usize, width: usize, reads: plc_deps::synth::Reads) -> Program {
+pub(crate) fn generated(rungs: usize, width: usize, reads: plc_deps::synth::Reads) -> Program {
     let text = plc_deps::synth::generate_string(&plc_deps::synth::GenConfig {
         rungs,
         width,
@@ -41,7 +41,7 @@ pub fn generated(rungs: usize, width: usize, reads: plc_deps::synth::Reads) -> P
 }
 
 /// Rung i reads the coil of rung i − 1 and an input.
-pub fn chain(n: usize) -> Program {
+pub(crate) fn chain(n: usize) -> Program {
     let mut vars = vec![json!({"name": "go", "type": "BOOL", "class": "input", "init": true})];
     let mut rungs = Vec::new();
     for i in 0..n {
@@ -58,7 +58,7 @@ pub fn chain(n: usize) -> Program {
 }
 
 /// `n` rungs of 6 contacts (inputs, sometimes an earlier coil; a third negated) and a coil.
-pub fn uniform(n: usize) -> Program {
+pub(crate) fn uniform(n: usize) -> Program {
     let mut x = 0x9E37_79B9_7F4A_7C15u64;
     let mut rand = move || {
         x ^= x << 13;
@@ -104,7 +104,7 @@ impl ScanDriver for Nothing {
     }
 }
 
-pub fn bench_program(c: &mut Criterion, name: &str, p: &Program) {
+pub(crate) fn bench_program(c: &mut Criterion, name: &str, p: &Program) {
     let rungs = p.main().rungs.len() as u64;
     let a = analyse(p);
     let exec = ExecConfig::default();
@@ -154,7 +154,7 @@ pub fn bench_program(c: &mut Criterion, name: &str, p: &Program) {
 
 /// A short measurement: 10 samples over 3 s after 1 s of warm-up, so that one shape's bench
 /// (seq and par) takes well under a minute.
-pub fn quick() -> Criterion {
+pub(crate) fn quick() -> Criterion {
     Criterion::default()
         .sample_size(10)
         .warm_up_time(Duration::from_secs(1))

@@ -65,7 +65,7 @@ impl Write for Sender {
 /// Runs `render` with a writer whose buffers a second thread writes to `sink`; returns the
 /// first error of either side, the writing thread's first (it explains a renderer's
 /// `BrokenPipe`). `sink` is flushed at the end.
-pub fn write_in_background<W: Write + Send>(
+pub(super) fn write_in_background<W: Write + Send>(
     sink: &mut W,
     render: impl FnOnce(&mut dyn Write) -> io::Result<()>,
 ) -> io::Result<()> {

@@ -32,7 +32,7 @@ fn dep(kind: &str, from: &str, to: &str, var: &str) -> (String, String, String, 
 }
 
 /// A seal-in latch: (Start OR Motor) AND NOT Stop → Motor; then Motor → Lamp.
-pub fn latch() -> String {
+pub(crate) fn latch() -> String {
     let ld = [
         rail(1),
         contact(2, "Start", &[1], ""),

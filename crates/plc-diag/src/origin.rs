@@ -56,7 +56,7 @@ impl Origin {
 
 /// Line and column of each origin in `text`, in one forward pass over the text up to the
 /// furthest one (the origins may come in any order).
-pub fn line_columns(text: &str, origins: &[Origin]) -> Vec<Option<(u32, u32)>> {
+pub(crate) fn line_columns(text: &str, origins: &[Origin]) -> Vec<Option<(u32, u32)>> {
     let mut order: Vec<(usize, usize)> = origins
         .iter()
         .enumerate()

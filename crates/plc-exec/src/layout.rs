@@ -85,11 +85,11 @@ pub const TIMER_BYTES: u32 = 24;
 pub const COUNTER_BYTES: u32 = 6;
 
 /// Bytes of an SR or RS instance.
-pub const BISTABLE_BYTES: u32 = 1;
+pub(crate) const BISTABLE_BYTES: u32 = 1;
 /// Bytes of an R_TRIG or F_TRIG instance.
-pub const TRIGGER_BYTES: u32 = 2;
+pub(crate) const TRIGGER_BYTES: u32 = 2;
 /// Bytes of a CTUD instance.
-pub const CTUD_BYTES: u32 = 8;
+pub(crate) const CTUD_BYTES: u32 = 8;
 
 /// Offsets inside an instance (the readable fields are also at [`field_offset`]).
 pub(crate) const Q: u32 = 0;

@@ -25,7 +25,7 @@ pub struct DifferenceEntry {
 }
 
 /// Precomputed context for explaining differences.
-pub struct Explainer<'a> {
+pub(crate) struct Explainer<'a> {
     p: &'a Program,
     a: &'a Analysis,
     /// For each POU, the rungs that call it.
@@ -35,7 +35,7 @@ pub struct Explainer<'a> {
 }
 
 impl<'a> Explainer<'a> {
-    pub fn new(p: &'a Program, a: &'a Analysis) -> Self {
+    pub(crate) fn new(p: &'a Program, a: &'a Analysis) -> Self {
         let mut callers: Vec<Vec<RungId>> = vec![Vec::new(); p.pous.len()];
         for e in &a.cfg.edges {
             if e.kind == EdgeKind::Call {
@@ -58,7 +58,7 @@ impl<'a> Explainer<'a> {
     }
 
     /// The rungs whose combined placement differs from a paper view, in program order.
-    pub fn differing(&self) -> Vec<RungId> {
+    pub(crate) fn differing(&self) -> Vec<RungId> {
         let (a, s) = (self.a, &self.a.schedule);
         self.p
             .rung_ids()
@@ -81,7 +81,7 @@ impl<'a> Explainer<'a> {
     }
 
     /// Why `r` (one of [`Explainer::differing`]) is placed as it is.
-    pub fn difference(&self, r: RungId) -> DifferenceEntry {
+    pub(crate) fn difference(&self, r: RungId) -> DifferenceEntry {
         let (p, a, s) = (self.p, self.a, &self.a.schedule);
         let dl = a.data_levels[r.index()];
         let cl = a.control_levels[r.index()];

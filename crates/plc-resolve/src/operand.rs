@@ -30,7 +30,7 @@ pub(crate) enum Untyped {
 
 impl Untyped {
     /// The type, when the operand itself fixes one.
-    pub fn ty(&self) -> Option<Type> {
+    pub(crate) fn ty(&self) -> Option<Type> {
         match self {
             Untyped::Var(_, t) => Some(*t),
             Untyped::Bool(_) => Some(Type::Bool),

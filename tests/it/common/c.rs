@@ -20,10 +20,10 @@ use std::process::{Command, Output, Stdio};
 use std::sync::atomic::{AtomicU32, Ordering};
 
 /// The flags every test compiles the generated C with.
-pub const CFLAGS: &[&str] = &["-std=c11", "-Wall", "-Wextra", "-Werror", "-O2"];
+pub(crate) const CFLAGS: &[&str] = &["-std=c11", "-Wall", "-Wextra", "-Werror", "-O2"];
 
 /// A fresh empty folder under the temporary directory.
-pub fn fresh_dir(tag: &str) -> PathBuf {
+pub(crate) fn fresh_dir(tag: &str) -> PathBuf {
     static N: AtomicU32 = AtomicU32::new(0);
     let d = std::env::temp_dir().join(format!(
         "plc-c-{}-{tag}-{}",
@@ -36,7 +36,7 @@ pub fn fresh_dir(tag: &str) -> PathBuf {
 }
 
 /// Asserts that a child process succeeded, showing its standard error if not.
-pub fn assert_ok(out: &Output, what: &str) {
+pub(crate) fn assert_ok(out: &Output, what: &str) {
     assert!(
         out.status.success(),
         "{what}:\n{}",
@@ -45,7 +45,7 @@ pub fn assert_ok(out: &Output, what: &str) {
 }
 
 /// `cc CFLAGS -o exe sources… -lm` in `dir`.
-pub fn compile(dir: &Path, exe: &str, sources: &[String]) {
+pub(crate) fn compile(dir: &Path, exe: &str, sources: &[String]) {
     let out = Command::new("cc")
         .args(CFLAGS)
         .args(["-I.", "-o", exe])
@@ -75,7 +75,7 @@ fn write(text: &str, cfg: &CConfig, dir: &Path, runtime: bool) -> Vec<String> {
 }
 
 /// Writes the C of `text` into a fresh folder and compiles it into `prog` there.
-pub fn build(text: &str, cfg: &CConfig, tag: &str) -> PathBuf {
+pub(crate) fn build(text: &str, cfg: &CConfig, tag: &str) -> PathBuf {
     let dir = fresh_dir(tag);
     let sources = write(text, cfg, &dir, true);
     compile(&dir, "prog", &sources);
@@ -90,7 +90,7 @@ fn lines(b: &[u8]) -> Vec<String> {
 }
 
 /// Runs `exe` with `args`, `input` on standard input: its output, asserted successful.
-pub fn run_with_input(exe: &Path, args: &[String], input: &[u8]) -> Output {
+pub(crate) fn run_with_input(exe: &Path, args: &[String], input: &[u8]) -> Output {
     use std::io::Write;
     let mut child = Command::new(exe)
         .args(args)
@@ -110,13 +110,13 @@ pub fn run_with_input(exe: &Path, args: &[String], input: &[u8]) -> Output {
 }
 
 /// Runs the built program: its state lines and fault lines.
-pub fn run_c(dir: &Path, csv: &str, scans: u64) -> (Vec<String>, Vec<String>) {
+pub(crate) fn run_c(dir: &Path, csv: &str, scans: u64) -> (Vec<String>, Vec<String>) {
     let out = run_with_input(&dir.join("prog"), &[scans.to_string()], csv.as_bytes());
     (lines(&out.stdout), lines(&out.stderr))
 }
 
 /// What the interpreter gives for the same inputs: the state line after every scan, the faults.
-pub fn run_interpreter(
+pub(crate) fn run_interpreter(
     text: &str,
     csv: &str,
     scans: u64,
@@ -146,7 +146,7 @@ pub fn run_interpreter(
 }
 
 /// The `state` object of `plc-deps run --format json`, as one line.
-pub fn state_line(p: &Program, m: &Machine, st: &plc_deps::exec::State) -> String {
+pub(crate) fn state_line(p: &Program, m: &Machine, st: &plc_deps::exec::State) -> String {
     let mut map = Map::new();
     for (i, v) in p.vars.iter().enumerate() {
         if !v.hidden {
@@ -167,7 +167,7 @@ fn compare(c: (Vec<String>, Vec<String>), i: (Vec<String>, Vec<String>), tag: &s
 }
 
 /// A CSV of random values for the program's inputs, `rows` rows (some cells empty).
-pub fn random_csv(p: &Program, rng: &mut Rng, rows: usize) -> String {
+pub(crate) fn random_csv(p: &Program, rng: &mut Rng, rows: usize) -> String {
     let ins: Vec<_> = p
         .vars
         .iter()
@@ -222,7 +222,7 @@ struct Job {
 
 /// Programs compiled together into one binary per part and compared with the interpreter.
 #[derive(Default)]
-pub struct Batch {
+pub(crate) struct Batch {
     jobs: Vec<Job>,
 }
 
@@ -261,7 +261,7 @@ fn program_symbols(text: &str, out: &mut std::collections::BTreeSet<String>) {
 
 impl Batch {
     /// Adds a program to compare after every one of `scans` scans of `csv`.
-    pub fn add(&mut self, text: String, csv: String, scans: u64, cfg: CConfig, tag: String) {
+    pub(crate) fn add(&mut self, text: String, csv: String, scans: u64, cfg: CConfig, tag: String) {
         self.jobs.push(Job {
             text,
             csv,
@@ -271,13 +271,13 @@ impl Batch {
         });
     }
 
-    pub fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         self.jobs.len()
     }
 
     /// Compiles the programs into `parts` binaries (compiled in parallel), runs them and
     /// compares every program with the interpreter.
-    pub fn check(self, parts: usize, tag: &str) {
+    pub(crate) fn check(self, parts: usize, tag: &str) {
         let per = self.jobs.len().div_ceil(parts.max(1)).max(1);
         std::thread::scope(|s| {
             let handles: Vec<_> = self
@@ -399,7 +399,7 @@ int main(void) {
 "#;
 
 /// Builds, runs and compares one program scan by scan (through a batch of one).
-pub fn check(text: &str, csv: &str, scans: u64, cfg: &CConfig, tag: &str) {
+pub(crate) fn check(text: &str, csv: &str, scans: u64, cfg: &CConfig, tag: &str) {
     let mut b = Batch::default();
     b.add(text.into(), csv.into(), scans, cfg.clone(), tag.into());
     b.check(1, tag);

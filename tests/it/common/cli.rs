@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use std::process::{Command, Output, Stdio};
 
 /// A program written by `plc-deps gen ARGS` into the scratch folder as `name`.
-pub fn generated(name: &str, args: &[&str]) -> PathBuf {
+pub(crate) fn generated(name: &str, args: &[&str]) -> PathBuf {
     let path = tmp(name);
     let mut all = vec!["gen"];
     all.extend_from_slice(args);
@@ -22,12 +22,12 @@ pub fn generated(name: &str, args: &[&str]) -> PathBuf {
 }
 
 /// The checkout (the directory of Cargo.toml).
-pub fn root() -> PathBuf {
+pub(crate) fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
 /// Runs `plc-deps ARGS` in the checkout.
-pub fn run(args: &[&str]) -> Output {
+pub(crate) fn run(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_plc-deps"))
         .current_dir(root())
         .args(args)
@@ -36,7 +36,7 @@ pub fn run(args: &[&str]) -> Output {
 }
 
 /// Runs `plc-deps ARGS` in the checkout with `stdin` as its standard input.
-pub fn run_stdin(args: &[&str], stdin: &[u8]) -> Output {
+pub(crate) fn run_stdin(args: &[&str], stdin: &[u8]) -> Output {
     use std::io::Write;
     let mut child = Command::new(env!("CARGO_BIN_EXE_plc-deps"))
         .current_dir(root())
@@ -55,7 +55,7 @@ pub fn run_stdin(args: &[&str], stdin: &[u8]) -> Output {
 
 /// The error of a failed command with exit code 2 and nothing on stdout, as one line: the
 /// one diagnostic on stderr in its one-line form ([`one_line`]).
-pub fn error_line(out: &Output, what: &str) -> String {
+pub(crate) fn error_line(out: &Output, what: &str) -> String {
     let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
     assert_eq!(out.status.code(), Some(2), "{what}: {stderr}");
     assert!(out.stdout.is_empty(), "{what}: nothing on stdout");
@@ -71,7 +71,7 @@ pub fn error_line(out: &Output, what: &str) -> String {
 /// the carets, or from the keys of a JSON diagnostic (`--format json`); lines that are not
 /// part of a diagnostic (`error: cannot read …`) are kept as they are. The rendering itself is
 /// compared whole in tests/errors/*.err.
-pub fn one_line(stderr: &str) -> String {
+pub(crate) fn one_line(stderr: &str) -> String {
     let mut out = Vec::new();
     let mut lines = stderr.lines().peekable();
     while let Some(line) = lines.next() {
@@ -134,12 +134,12 @@ fn json_one_line(d: &serde_json::Value) -> String {
 }
 
 /// The files of a folder whose name contains `.tmp-` (leftover temporary files).
-pub fn temp_files_in(dir: &std::path::Path) -> Vec<String> {
+pub(crate) fn temp_files_in(dir: &std::path::Path) -> Vec<String> {
     files_in(dir, |n| n.contains(".tmp-"))
 }
 
 /// The names of the entries of a folder that `keep` keeps (none if it cannot be read).
-pub fn files_in(dir: &std::path::Path, keep: impl Fn(&str) -> bool) -> Vec<String> {
+pub(crate) fn files_in(dir: &std::path::Path, keep: impl Fn(&str) -> bool) -> Vec<String> {
     std::fs::read_dir(dir)
         .map(|d| {
             d.filter_map(|e| e.ok())
@@ -151,14 +151,14 @@ pub fn files_in(dir: &std::path::Path, keep: impl Fn(&str) -> bool) -> Vec<Strin
 }
 
 /// A path for a scratch file of this test process.
-pub fn tmp(name: &str) -> PathBuf {
+pub(crate) fn tmp(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("plc-deps-test-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     dir.join(name)
 }
 
 /// Renders `dot` text with Graphviz and fails on an error or any warning.
-pub fn graphviz(dot: &[u8], what: &str) {
+pub(crate) fn graphviz(dot: &[u8], what: &str) {
     let child = Command::new("dot")
         .arg("-Tsvg")
         .stdin(Stdio::piped())

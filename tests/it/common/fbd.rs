@@ -414,7 +414,7 @@ fn fb_ladder(rng: &mut Rng) -> Json {
 /// A random FBD program whose function block FB1 holds two instances of FB2 (FBD) and one of
 /// FB3 (ladder); the main program has two instances of FB1 and one of FB2 (a type instantiated
 /// both at the top and nested).
-pub fn random_nested_fbd_program(seed: u64) -> String {
+pub(crate) fn random_nested_fbd_program(seed: u64) -> String {
     let mut rng = Rng::new(seed ^ 0x0FB5_7E57);
     let mut v: Json = serde_json::from_str(&random_fbd_program(seed)).unwrap();
     let main_scope = main_scope(
@@ -443,7 +443,7 @@ pub fn random_nested_fbd_program(seed: u64) -> String {
 }
 
 /// A random FBD program (main body and a user function block FB1 with two instances).
-pub fn random_fbd_program(seed: u64) -> String {
+pub(crate) fn random_fbd_program(seed: u64) -> String {
     let mut rng = Rng::new(seed ^ 0x5EED_F00D);
     let main = main_scope(
         vec![

@@ -4,9 +4,9 @@
 //! from a seed, so a failing case is reproducible and printable.
 #![allow(dead_code)]
 
-pub mod c;
-pub mod cli;
-pub mod fbd;
+pub(crate) mod c;
+pub(crate) mod cli;
+pub(crate) mod fbd;
 
 use plc_deps::exec::parallel::ScanDriver;
 use plc_deps::exec::{Fault, Machine};
@@ -16,7 +16,7 @@ use std::time::Duration;
 
 /// A scan driver for differential tests: writes each scan's inputs from a table and records the
 /// full state and the faults after every scan.
-pub struct Recorder<'a> {
+pub(crate) struct Recorder<'a> {
     pub inputs: &'a [Vec<(VarId, PlcValue)>],
     pub states: Vec<Vec<u8>>,
     pub faults: Vec<Vec<Fault>>,
@@ -33,33 +33,33 @@ impl ScanDriver for Recorder<'_> {
 }
 
 /// A small deterministic PRNG (splitmix64).
-pub struct Rng(u64);
+pub(crate) struct Rng(u64);
 
 impl Rng {
-    pub fn new(seed: u64) -> Rng {
+    pub(crate) fn new(seed: u64) -> Rng {
         Rng(seed ^ 0x9E37_79B9_7F4A_7C15)
     }
-    pub fn next(&mut self) -> u64 {
+    pub(crate) fn next(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
         z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
         z ^ (z >> 31)
     }
-    pub fn below(&mut self, n: u64) -> u64 {
+    pub(crate) fn below(&mut self, n: u64) -> u64 {
         self.next() % n.max(1)
     }
-    pub fn chance(&mut self, percent: u64) -> bool {
+    pub(crate) fn chance(&mut self, percent: u64) -> bool {
         self.below(100) < percent
     }
-    pub fn pick<'a, T>(&mut self, items: &'a [T]) -> &'a T {
+    pub(crate) fn pick<'a, T>(&mut self, items: &'a [T]) -> &'a T {
         &items[self.below(items.len() as u64) as usize]
     }
 }
 
-pub const BOOLS: &[&str] = &["b0", "b1", "b2", "b3", "b4", "b5"];
-pub const INPUTS: &[&str] = &["i0", "i1", "i2"];
-pub const INTS: &[&str] = &["n0", "n1", "n2"];
+pub(crate) const BOOLS: &[&str] = &["b0", "b1", "b2", "b3", "b4", "b5"];
+pub(crate) const INPUTS: &[&str] = &["i0", "i1", "i2"];
+pub(crate) const INTS: &[&str] = &["n0", "n1", "n2"];
 
 fn vars() -> Vec<Value> {
     let mut v = Vec::new();
@@ -103,7 +103,7 @@ fn vars() -> Vec<Value> {
 
 /// One variable of each elementary type besides BOOL, INT, DINT, REAL and TIME, with the
 /// constants its operations use: the type's extremes first, then small values.
-pub fn typed() -> Vec<(&'static str, &'static str, Vec<Value>)> {
+pub(crate) fn typed() -> Vec<(&'static str, &'static str, Vec<Value>)> {
     vec![
         (
             "xs",
@@ -464,7 +464,7 @@ fn rungs(
 
 /// A random program; it may be rejected by the loader (a jump into a FOR body), so callers
 /// skip those.
-pub fn random_program(seed: u64, max_rungs: usize) -> String {
+pub(crate) fn random_program(seed: u64, max_rungs: usize) -> String {
     let mut rng = Rng::new(seed);
     let nsubs = rng.below(3) as usize;
     let mut subroutines = serde_json::Map::new();
@@ -484,7 +484,7 @@ pub fn random_program(seed: u64, max_rungs: usize) -> String {
 }
 
 /// The JSON report of the worked example `analyses/NAME`, parsed.
-pub fn example_report(name: &str) -> serde_json::Value {
+pub(crate) fn example_report(name: &str) -> serde_json::Value {
     use plc_deps::cmd::report::{render_report, ReportFormat};
     let path = format!(
         "{}/analyses/{name}/program.json",
@@ -498,7 +498,7 @@ pub fn example_report(name: &str) -> serde_json::Value {
 
 /// A random value for an input of type `ty`: BOOL, small integers (often 0: DIV/MOD faults),
 /// for LINT now and then an extreme, REAL halves, TIME milliseconds.
-pub fn random_input(ty: plc_deps::model::Type, rng: &mut Rng) -> PlcValue {
+pub(crate) fn random_input(ty: plc_deps::model::Type, rng: &mut Rng) -> PlcValue {
     use plc_deps::model::{Type, Wide};
     match ty {
         Type::Bool => PlcValue::Bool(rng.chance(50)),

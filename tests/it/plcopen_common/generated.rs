@@ -2,12 +2,12 @@
 //! alone: it needs nothing else of the test helpers).
 
 /// The PLCopen TC6 2.01 namespace.
-pub const NS: &str = "http://www.plcopen.org/xml/tc6_0201";
+pub(crate) const NS: &str = "http://www.plcopen.org/xml/tc6_0201";
 
 /// A generated LD program of about `bytes` bytes (as Beremiz writes positions and relPositions):
 /// rungs `(a OR NOT b) AND c → coil d` over 2,000 BOOL variables, a splitmix sequence picking
 /// them. Returns the text and its number of rungs.
-pub fn generated_ld(bytes: usize) -> (String, usize) {
+pub(crate) fn generated_ld(bytes: usize) -> (String, usize) {
     let nv = 2000u64;
     let mut state = 1u64;
     let mut pick = || {

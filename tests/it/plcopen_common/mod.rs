@@ -3,15 +3,15 @@
 
 mod generated;
 #[allow(unused_imports)]
-pub use generated::{generated_ld, NS};
+pub(crate) use generated::{generated_ld, NS};
 
 /// A project with one program `P` (its variables: `(class, name, type)`) and an LD body.
-pub fn project(vars: &[(&str, &str, &str)], ld: &str) -> String {
+pub(crate) fn project(vars: &[(&str, &str, &str)], ld: &str) -> String {
     project_in("LD", vars, ld)
 }
 
 /// [`project`] with a body in `lang` (`LD`, `FBD`).
-pub fn project_in(lang: &str, vars: &[(&str, &str, &str)], body: &str) -> String {
+pub(crate) fn project_in(lang: &str, vars: &[(&str, &str, &str)], body: &str) -> String {
     let mut lists = String::new();
     for class in ["inputVars", "outputVars", "localVars"] {
         let vs: Vec<String> = vars
@@ -50,7 +50,7 @@ pub fn project_in(lang: &str, vars: &[(&str, &str, &str)], body: &str) -> String
     )
 }
 
-pub fn conn(from: &[u32]) -> String {
+pub(crate) fn conn(from: &[u32]) -> String {
     let c: Vec<String> = from
         .iter()
         .map(|r| format!("<connection refLocalId=\"{r}\"/>"))
@@ -58,36 +58,42 @@ pub fn conn(from: &[u32]) -> String {
     format!("<connectionPointIn>{}</connectionPointIn>", c.concat())
 }
 
-pub fn rail(id: u32) -> String {
+pub(crate) fn rail(id: u32) -> String {
     format!("<leftPowerRail localId=\"{id}\"><connectionPointOut formalParameter=\"\"/></leftPowerRail>")
 }
 
-pub fn contact(id: u32, var: &str, from: &[u32], attrs: &str) -> String {
+pub(crate) fn contact(id: u32, var: &str, from: &[u32], attrs: &str) -> String {
     format!(
         "<contact localId=\"{id}\" {attrs}>{}<connectionPointOut/><variable>{var}</variable></contact>",
         conn(from)
     )
 }
 
-pub fn coil(id: u32, var: &str, from: &[u32], attrs: &str) -> String {
+pub(crate) fn coil(id: u32, var: &str, from: &[u32], attrs: &str) -> String {
     format!(
         "<coil localId=\"{id}\" {attrs}>{}<connectionPointOut/><variable>{var}</variable></coil>",
         conn(from)
     )
 }
 
-pub fn in_var(id: u32, expr: &str) -> String {
+pub(crate) fn in_var(id: u32, expr: &str) -> String {
     format!("<inVariable localId=\"{id}\"><connectionPointOut/><expression>{expr}</expression></inVariable>")
 }
 
 /// A source of a block's input: `(localId, Some(output pin))`.
-pub type Source<'a> = (u32, Option<&'a str>);
+pub(crate) type Source<'a> = (u32, Option<&'a str>);
 
 /// A block's inputs: `(pin, sources)`.
-pub type Wires<'a> = &'a [(&'a str, &'a [Source<'a>])];
+pub(crate) type Wires<'a> = &'a [(&'a str, &'a [Source<'a>])];
 
 /// An FBD block: `(pin, sources)` inputs (a source `(localId, Some(pin))`), output pin names.
-pub fn block(id: u32, ty: &str, instance: Option<&str>, inputs: Wires, outputs: &[&str]) -> String {
+pub(crate) fn block(
+    id: u32,
+    ty: &str,
+    instance: Option<&str>,
+    inputs: Wires,
+    outputs: &[&str],
+) -> String {
     let ins: Vec<String> = inputs
         .iter()
         .map(|(pin, from)| {
@@ -117,7 +123,7 @@ pub fn block(id: u32, ty: &str, instance: Option<&str>, inputs: Wires, outputs: 
 }
 
 /// An out variable (or, with `tag`, an in-out variable) fed by `(localId, pin)`.
-pub fn var_in(tag: &str, id: u32, expr: &str, from: (u32, Option<&str>)) -> String {
+pub(crate) fn var_in(tag: &str, id: u32, expr: &str, from: (u32, Option<&str>)) -> String {
     let c = match from.1 {
         Some(p) => format!(
             "<connection refLocalId=\"{}\" formalParameter=\"{p}\"/>",
@@ -134,18 +140,18 @@ pub fn var_in(tag: &str, id: u32, expr: &str, from: (u32, Option<&str>)) -> Stri
 }
 
 /// The JSON report of an XML text (read from standard input); the command must succeed.
-pub fn report(xml: &str) -> serde_json::Value {
+pub(crate) fn report(xml: &str) -> serde_json::Value {
     report_and_warnings(xml).0
 }
 
 /// [`report`], with the command's standard error (its warnings).
-pub fn report_and_warnings(xml: &str) -> (serde_json::Value, String) {
+pub(crate) fn report_and_warnings(xml: &str) -> (serde_json::Value, String) {
     json_output(&["report", "-", "--format", "json"], xml)
 }
 
 /// The JSON standard output of `plc-deps ARGS` (with `stdin`), which must succeed, and its
 /// standard error.
-pub fn json_output(args: &[&str], stdin: &str) -> (serde_json::Value, String) {
+pub(crate) fn json_output(args: &[&str], stdin: &str) -> (serde_json::Value, String) {
     let out = crate::common::cli::run_stdin(args, stdin.as_bytes());
     let err = crate::common::cli::one_line(&String::from_utf8_lossy(&out.stderr));
     assert_eq!(out.status.code(), Some(0), "{err}");
@@ -153,7 +159,7 @@ pub fn json_output(args: &[&str], stdin: &str) -> (serde_json::Value, String) {
 }
 
 /// Each rung of a JSON report: its id, what it reads (IN) and what it writes (OUT).
-pub fn io(r: &serde_json::Value) -> Vec<(String, serde_json::Value, serde_json::Value)> {
+pub(crate) fn io(r: &serde_json::Value) -> Vec<(String, serde_json::Value, serde_json::Value)> {
     r["rungs"]
         .as_array()
         .unwrap()
@@ -169,7 +175,7 @@ pub fn io(r: &serde_json::Value) -> Vec<(String, serde_json::Value, serde_json::
 }
 
 /// One rung of a JSON report as [`io`] gives it.
-pub fn rung(
+pub(crate) fn rung(
     id: &str,
     ins: &[&str],
     outs: &[&str],
@@ -183,7 +189,7 @@ pub fn rung(
 
 /// The JSON output of `plc-deps run` of the XML text for `scans` scans (from standard input;
 /// `--allow-skipped`: an ST body runs as its stand-in rungs).
-pub fn run_scans(xml: &str, scans: u32) -> serde_json::Value {
+pub(crate) fn run_scans(xml: &str, scans: u32) -> serde_json::Value {
     let n = scans.to_string();
     let args = [
         "run",
@@ -199,7 +205,7 @@ pub fn run_scans(xml: &str, scans: u32) -> serde_json::Value {
 
 /// The JSON output of `plc-deps run` of the XML text (written to the scratch file `tag.xml`),
 /// one scan per row of `inputs` (a CSV with a header of input names), with `extra` arguments.
-pub fn run_inputs(tag: &str, xml: &str, inputs: &str, extra: &[&str]) -> serde_json::Value {
+pub(crate) fn run_inputs(tag: &str, xml: &str, inputs: &str, extra: &[&str]) -> serde_json::Value {
     let path = crate::common::cli::tmp(&format!("{tag}.xml"));
     std::fs::write(&path, xml).unwrap();
     let csv = crate::common::cli::tmp(&format!("{tag}.csv"));
@@ -219,14 +225,14 @@ pub fn run_inputs(tag: &str, xml: &str, inputs: &str, extra: &[&str]) -> serde_j
 
 /// Runs the XML text one scan per row of `inputs` ([`run_inputs`]) and returns, for each of
 /// `columns`, its value after each scan as the trace writes it.
-pub fn trace(tag: &str, xml: &str, inputs: &str, columns: &[&str]) -> Vec<Vec<String>> {
+pub(crate) fn trace(tag: &str, xml: &str, inputs: &str, columns: &[&str]) -> Vec<Vec<String>> {
     let tr = crate::common::cli::tmp(&format!("{tag}-trace.csv"));
     run_inputs(tag, xml, inputs, &["--trace", tr.to_str().unwrap()]);
     trace_columns(&tr, columns)
 }
 
 /// For each of `columns`, its value after each scan in the trace file `tr`.
-pub fn trace_columns(tr: &std::path::Path, columns: &[&str]) -> Vec<Vec<String>> {
+pub(crate) fn trace_columns(tr: &std::path::Path, columns: &[&str]) -> Vec<Vec<String>> {
     let text = std::fs::read_to_string(tr).unwrap();
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
@@ -244,7 +250,7 @@ pub fn trace_columns(tr: &std::path::Path, columns: &[&str]) -> Vec<Vec<String>>
 }
 
 /// The line and column (`L:C`, 1-based) where `needle` first starts in `text`.
-pub fn line_col(text: &str, needle: &str) -> String {
+pub(crate) fn line_col(text: &str, needle: &str) -> String {
     let at = text.find(needle).unwrap();
     let line = text[..at].matches('\n').count() + 1;
     let col = at - text[..at].rfind('\n').map_or(0, |k| k + 1) + 1;

@@ -126,7 +126,7 @@ fn lead(x: String) -> String {
 }
 
 impl<'a> Body<'a> {
-    pub fn new(sh: &'a Shared<'a>, ret: &'static str, indent: usize) -> Body<'a> {
+    pub(super) fn new(sh: &'a Shared<'a>, ret: &'static str, indent: usize) -> Body<'a> {
         Body {
             sh,
             locals: HashMap::new(),
@@ -188,7 +188,7 @@ impl<'a> Body<'a> {
     }
 
     /// Writes one line at the current indentation (after the call of the rows before it).
-    pub fn line(&mut self, text: &str) {
+    pub(super) fn line(&mut self, text: &str) {
         if let Some(call) = self.rows.as_mut().and_then(|r| r.take_call()) {
             self.raw_line(&call);
         }
@@ -196,7 +196,7 @@ impl<'a> Body<'a> {
     }
 
     /// Writes the call of the run of rows not yet called, if any.
-    pub fn flush_rows(&mut self) {
+    pub(super) fn flush_rows(&mut self) {
         if let Some(call) = self.rows.as_mut().and_then(|r| r.take_call()) {
             self.raw_line(&call);
         }
@@ -215,7 +215,7 @@ impl<'a> Body<'a> {
         format!("_{stem}{}", self.tmp)
     }
 
-    pub fn var(&self, v: VarId) -> String {
+    pub(super) fn var(&self, v: VarId) -> String {
         match self.locals.get(&v) {
             Some(l) => l.clone(),
             None => self.place(&self.sh.vars[v.index()]),
@@ -664,7 +664,7 @@ impl<'a> Body<'a> {
 
     /// One rung: its label if a jump targets it, a comment, its statements. A FOR head opens
     /// `if (power) { var = from; for (; var <= to; ) {`, which its NEXT rung closes.
-    pub fn rung(&mut self, r: RungId) {
+    pub(super) fn rung(&mut self, r: RungId) {
         let rung = self.sh.p.rung(r);
         self.label(r);
         if self.inst.is_none() && self.locals.is_empty() {
@@ -732,7 +732,7 @@ impl<'a> Body<'a> {
 
     /// The label of rung `r`, if a jump targets it (removed by [`Body::finish`] if no emitted
     /// `goto` names it).
-    pub fn label(&mut self, r: RungId) {
+    pub(super) fn label(&mut self, r: RungId) {
         if self.sh.labels[r.index()] {
             let l = format!("_L{}: ;", self.label_no(r.0));
             self.line(&l);
@@ -743,7 +743,7 @@ impl<'a> Body<'a> {
     /// reads (a rung whose branches end without an output, a contact after a box: `-Wall
     /// -Werror` refuses an unused variable). Such a local's line goes, or becomes its call
     /// (`_plc_ton(…);`) when it holds a box's Q; a local read only by a removed one goes too.
-    pub fn finish(mut self) -> String {
+    pub(super) fn finish(mut self) -> String {
         self.flush_rows();
         let mut lines: Vec<Option<Cow<str>>> = self.out.lines().map(|l| Some(l.into())).collect();
         let mut reads: HashMap<&str, usize> = HashMap::new();
@@ -793,7 +793,7 @@ impl<'a> Body<'a> {
     }
 
     /// The statements of `series` up to its final jump, and the power that takes the jump.
-    pub fn guard(&mut self, r: RungId, series: &[Element]) -> String {
+    pub(super) fn guard(&mut self, r: RungId, series: &[Element]) -> String {
         let body = match series.last() {
             Some(Element::Jmp { .. }) => &series[..series.len() - 1],
             _ => series,

@@ -67,7 +67,7 @@ pub(crate) struct Kernels {
 
 impl Kernels {
     /// Rung `r` as a row (its shape's kernel registered), if it has a row's form.
-    pub fn row(&mut self, sh: &Shared, r: RungId) -> Option<Row> {
+    pub(super) fn row(&mut self, sh: &Shared, r: RungId) -> Option<Row> {
         let (shape, slots) = shape(sh, r)?;
         let next = self.shapes.len() as u32;
         let kernel = *self.ids.entry(shape.clone()).or_insert_with(|| next);
@@ -80,7 +80,7 @@ impl Kernels {
 
     /// The C type of the tables' entries: 16 bits when every slot fits (half the bytes a
     /// scan reads from the tables), else 32.
-    pub fn entry_type(&self) -> &'static str {
+    pub(super) fn entry_type(&self) -> &'static str {
         if self.wide {
             "uint32_t"
         } else {
@@ -91,7 +91,7 @@ impl Kernels {
     /// The kernels' source files (name stem, text): `plc_rows.c`, or with more than
     /// [`kernel::PER_FILE`] kernels `plc_rows0.c`, `plc_rows1.c` … (`make -j` compiles them in
     /// parallel).
-    pub fn sources(&self) -> Vec<(String, String)> {
+    pub(super) fn sources(&self) -> Vec<(String, String)> {
         kernel::sources(&self.shapes, self.entry_type())
     }
 }

@@ -26,7 +26,7 @@ pub(crate) struct Tables {
 }
 
 impl Tables {
-    pub fn new(file: usize, ty: &'static str) -> Tables {
+    pub(super) fn new(file: usize, ty: &'static str) -> Tables {
         Tables {
             file,
             ty,
@@ -38,7 +38,7 @@ impl Tables {
     }
 
     /// Adds `row` (rung `id`); the call of the run it ends, if it starts another.
-    pub fn push(&mut self, row: &Row, id: &str) -> Option<String> {
+    pub(super) fn push(&mut self, row: &Row, id: &str) -> Option<String> {
         let call = match self.run {
             Some((k, _, _)) if k != row.kernel => self.take_call(),
             _ => None,
@@ -58,7 +58,7 @@ impl Tables {
     }
 
     /// The call of the run of rows pushed since the last call, if any.
-    pub fn take_call(&mut self) -> Option<String> {
+    pub(super) fn take_call(&mut self) -> Option<String> {
         let (k, first, n) = self.run.take()?;
         Some(format!(
             "_pou__k{k}((uint8_t *)self, _pou__t{} + {first}, {n}, ctx);",
@@ -67,7 +67,7 @@ impl Tables {
     }
 
     /// The declarations the functions' C needs (empty: no rows).
-    pub fn declarations(&self) -> String {
+    pub(super) fn declarations(&self) -> String {
         if self.entries == 0 {
             return String::new();
         }
@@ -79,7 +79,7 @@ impl Tables {
     }
 
     /// The data file (name stem, text), if there are rows.
-    pub fn data_file(&self) -> Option<(String, String)> {
+    pub(super) fn data_file(&self) -> Option<(String, String)> {
         if self.entries == 0 {
             return None;
         }

@@ -61,7 +61,7 @@ pub(crate) struct Net {
 
 impl Net {
     /// Emits `op args` changing the stack depth by `delta`.
-    pub fn emit(&mut self, op: &str, args: &[&str], delta: i32) {
+    pub(crate) fn emit(&mut self, op: &str, args: &[&str], delta: i32) {
         self.code.push(Instr {
             op: op.to_string(),
             args: args.iter().map(|s| s.to_string()).collect(),
@@ -69,14 +69,14 @@ impl Net {
         self.depth = (self.depth as i32 + delta).max(0) as u32;
         self.max = self.max.max(self.depth);
     }
-    pub fn lps(&mut self) {
+    pub(crate) fn lps(&mut self) {
         self.emit("LPS", &[], 1);
         self.forks.push(self.depth);
     }
-    pub fn lrd(&mut self) {
+    pub(crate) fn lrd(&mut self) {
         self.emit("LRD", &[], 0);
     }
-    pub fn lpp(&mut self) {
+    pub(crate) fn lpp(&mut self) {
         self.emit("LPP", &[], -1);
         self.forks.pop();
     }
@@ -279,17 +279,17 @@ impl<'a> Names<'a> {
     }
 
     /// The scratch word of type `ty` (one [`scratch_words`] found a use for).
-    pub fn scratch(&self, ty: Type) -> &str {
+    pub(crate) fn scratch(&self, ty: Type) -> &str {
         let found = self.scratch.iter().find(|(t, _)| *t == ty);
         &found.expect("a scratch word of this type was declared").1
     }
 
-    pub fn var(&self, v: VarId) -> &str {
+    pub(crate) fn var(&self, v: VarId) -> &str {
         &self.text[v.index()]
     }
 
     /// A BOOL read as a contact operand: a timer or counter's Q is the instance's own name.
-    pub fn bit(&self, r: VarRef) -> String {
+    pub(crate) fn bit(&self, r: VarRef) -> String {
         match r.field {
             None | Some(Field::Q) => self.var(r.var).to_string(),
             Some(f) => format!("{}.{}", self.var(r.var), f.name()),
@@ -298,7 +298,7 @@ impl<'a> Names<'a> {
 
     /// A word operand: a variable, a field, or a constant. A counter's current value is the
     /// counter itself, as the S7-200 reads `C5` in a word instruction.
-    pub fn operand(&self, o: &plc_model::Operand) -> String {
+    pub(crate) fn operand(&self, o: &plc_model::Operand) -> String {
         let counter = |v: VarId| {
             matches!(
                 self.p.var(v).ty,
@@ -316,7 +316,7 @@ impl<'a> Names<'a> {
     }
 
     /// A name as an FBD body writes it (`T1.Q`, `x`), in the scope of `pou`.
-    pub fn named(&self, text: &str, pou: PouId) -> String {
+    pub(crate) fn named(&self, text: &str, pou: PouId) -> String {
         let (base, field) = match text.split_once('.') {
             Some((b, f)) => (b, Some(f)),
             None => (text, None),
@@ -345,7 +345,7 @@ impl<'a> Names<'a> {
     /// False when `text` (a variable or `instance.FIELD` of `pou`, as an FBD network names it)
     /// is known not to be a BOOL: a variable of another type, or a timer's or counter's
     /// ET, PT, CV or PV.
-    pub fn may_be_bool(&self, text: &str, pou: PouId) -> bool {
+    pub(crate) fn may_be_bool(&self, text: &str, pou: PouId) -> bool {
         match text.split_once('.') {
             Some((_, f)) => !matches!(f, "ET" | "PT" | "CV" | "PV"),
             None => self

@@ -63,19 +63,19 @@ fn standard_bool_input(op: &str, pin: &str) -> bool {
 }
 
 /// True for the standard function blocks the model has.
-pub fn is_standard_fb(ty: &str) -> bool {
+pub(super) fn is_standard_fb(ty: &str) -> bool {
     standard_outputs(ty).is_some()
 }
 
 impl Ctx {
     /// The function block type instance `inst` is declared with, if it is one.
-    pub fn fb_type_of(&self, inst: &str) -> Option<String> {
+    pub(super) fn fb_type_of(&self, inst: &str) -> Option<String> {
         let t = self.vars.get(&inst.to_ascii_lowercase())?;
         (is_standard_fb(t) || self.fbs.contains_key(t)).then(|| t.clone())
     }
 
     /// The type of input `pin` of a block `op`, where it is known.
-    pub fn input_type(&self, op: &str, pin: &str) -> Option<String> {
+    pub(super) fn input_type(&self, op: &str, pin: &str) -> Option<String> {
         if standard_bool_input(op, pin) {
             return Some("BOOL".to_owned());
         }
@@ -127,14 +127,14 @@ impl Ctx {
 }
 
 /// Types what feeds the pins of one body.
-pub struct Typer<'c, 'g, 'a, 'i> {
+pub(super) struct Typer<'c, 'g, 'a, 'i> {
     pub ctx: &'c Ctx,
     pub g: &'g Graph<'a, 'i>,
 }
 
 impl Typer<'_, '_, '_, '_> {
     /// The type of what input `i` reads (an arc from a block the reader added is BOOL).
-    pub fn input(&self, i: &Input, depth: u32) -> Option<String> {
+    pub(super) fn input(&self, i: &Input, depth: u32) -> Option<String> {
         match &i.from {
             Connection::Variable(v) => self.ctx.var_type(v),
             Connection::Constant(c) => Ctx::constant_type(c),
@@ -200,7 +200,7 @@ impl Typer<'_, '_, '_, '_> {
     }
 
     /// The type of output `pin` of element `e`.
-    pub fn output(&self, e: ElemId, pin: Option<&str>, depth: u32) -> Option<String> {
+    pub(super) fn output(&self, e: ElemId, pin: Option<&str>, depth: u32) -> Option<String> {
         let el = self.g.get(e);
         if depth > 32 {
             return None;
@@ -277,7 +277,7 @@ fn conversion(ty: &str) -> Option<(Option<String>, Option<String>)> {
 
 /// The standard function the model has for block type `ty`: by its name, or a conversion
 /// `A_TO_B` between types the reader maps onto the model's (`SINT_TO_INT` is `INT_TO_INT`).
-pub fn standard_function(ty: &str) -> Option<Function> {
+pub(super) fn standard_function(ty: &str) -> Option<Function> {
     if let Some(f) = Function::parse(ty) {
         return Some(f);
     }
@@ -299,7 +299,7 @@ pub fn standard_function(ty: &str) -> Option<Function> {
 /// True for ADD or SUB of inputs of different types, or MUL or DIV of a TIME: the date and
 /// time arithmetic of IEC 61131-3 Table 30 (`SUB(DT, TIME)`, `DIV(TIME, INT)` …), which the
 /// model's arithmetic (one numeric type) lacks, so it is a black box.
-pub fn mixed_arithmetic(t: &Typer, ty: &str, b: &Block) -> bool {
+pub(super) fn mixed_arithmetic(t: &Typer, ty: &str, b: &Block) -> bool {
     if !matches!(ty, "ADD" | "SUB" | "MUL" | "DIV") {
         return false;
     }
@@ -322,14 +322,14 @@ pub fn mixed_arithmetic(t: &Typer, ty: &str, b: &Block) -> bool {
 }
 
 /// True when the model or the project has op `ty` (nothing to do here).
-pub fn is_known(ctx: &Ctx, ty: &str) -> bool {
+pub(super) fn is_known(ctx: &Ctx, ty: &str) -> bool {
     OpKind::parse(ty).is_some() || ctx.fbs.contains_key(ty)
 }
 
 /// Rewrites block `b` (element `e`, op `ty`) that the model lacks: a conversion in place, or a
 /// call of a black box on a new instance. Returns a variable to declare in the POU, with its
 /// type: the new instance, or the result variable of a conversion from BOOL.
-pub fn rewrite(
+pub(super) fn rewrite(
     t: &Typer,
     e: ElemId,
     b: &mut Block<'static>,

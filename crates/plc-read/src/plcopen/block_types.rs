@@ -27,7 +27,7 @@ pub struct BlackBox {
 
 /// What a body's blocks may call, and the types of the names it sees.
 #[derive(Default)]
-pub struct Ctx {
+pub(super) struct Ctx {
     /// User functions of the project by name: their pins (the result is `OUT`).
     pub functions: HashMap<String, Sig>,
     /// Function block types the model has or the project defines, with their outputs' types.

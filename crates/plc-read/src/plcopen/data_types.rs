@@ -60,7 +60,7 @@ use std::collections::HashMap;
 
 /// What a data type stands on.
 #[derive(Clone, Debug, PartialEq)]
-pub enum Base {
+pub(super) enum Base {
     /// An elementary type as TC6 writes it (`INT`, `UINT`, `string`).
     Elementary(String),
     /// An enumeration: its value names; value `k` (0-based) is the integer `k`.
@@ -74,7 +74,7 @@ pub enum Base {
 /// A member of a structure (IEC 61131-3 6.4.4.3): its type and its initial value (the
 /// member's own `initialValue`, or one a structured initial value gave it).
 #[derive(Clone, Debug, PartialEq)]
-pub struct Member {
+pub(super) struct Member {
     pub name: String,
     pub ty: DataType,
     pub init: Option<(String, Origin)>,
@@ -84,12 +84,12 @@ pub struct Member {
 
 /// The aggregate kinds of IEC 61131-3 6.4.4 read as one whole variable.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Aggregate {
+pub(super) enum Aggregate {
     Array,
 }
 
 impl Aggregate {
-    pub fn word(self) -> &'static str {
+    pub(super) fn word(self) -> &'static str {
         match self {
             Aggregate::Array => "an array",
         }
@@ -98,7 +98,7 @@ impl Aggregate {
 
 /// A data type as read.
 #[derive(Clone, Debug, PartialEq)]
-pub struct DataType {
+pub(super) struct DataType {
     pub name: String,
     pub base: Base,
     /// The bounds of a subrange on the way to the base (not enforced).
@@ -111,7 +111,7 @@ pub struct DataType {
 
 impl DataType {
     /// How the note describes what the type was read as.
-    pub fn describe(&self) -> String {
+    pub(super) fn describe(&self) -> String {
         let mut d = match &self.base {
             Base::Elementary(t) => format!("an alias of {}", t.to_ascii_uppercase()),
             Base::Enum(v) => {
@@ -155,13 +155,13 @@ const SVGHMI: &[(&str, &str)] = &[
 
 /// The project's data types by name.
 #[derive(Default)]
-pub struct DataTypes {
+pub(super) struct DataTypes {
     types: HashMap<String, DataType>,
 }
 
 impl DataTypes {
     /// Reads `types/dataTypes` (none: only the library types).
-    pub fn read(tc6: Tc6, data_types: Option<Node>) -> R<Self> {
+    pub(super) fn read(tc6: Tc6, data_types: Option<Node>) -> R<Self> {
         let place = "types/dataTypes";
         let mut raw: HashMap<String, Node> = HashMap::new();
         let mut order = Vec::new();
@@ -189,7 +189,7 @@ impl DataTypes {
     }
 
     /// The type named `name`: the project's, else a library type.
-    pub fn get(&self, name: &str) -> Option<DataType> {
+    pub(super) fn get(&self, name: &str) -> Option<DataType> {
         if let Some(t) = self.types.get(name) {
             return Some(t.clone());
         }
@@ -204,7 +204,7 @@ impl DataTypes {
     }
 
     /// Every enumeration value of the project and its integer.
-    pub fn enum_values(&self) -> Vec<(String, i64)> {
+    pub(super) fn enum_values(&self) -> Vec<(String, i64)> {
         let mut out = Vec::new();
         for t in self.types.values() {
             if let Base::Enum(v) = &t.base {
@@ -215,7 +215,7 @@ impl DataTypes {
     }
 
     /// The integer of value `text` (`CLOSED` or `MYTYPE2#CLOSED`) of enumeration `t`.
-    pub fn enum_value(t: &DataType, text: &str) -> Option<i64> {
+    pub(super) fn enum_value(t: &DataType, text: &str) -> Option<i64> {
         let Base::Enum(v) = &t.base else { return None };
         let text = text.trim();
         let name = match text.split_once('#') {
@@ -380,12 +380,12 @@ pub(super) fn base(
 }
 
 /// The most leaf fields a structure may flatten into.
-pub const MAX_LEAVES: usize = 65_536;
+pub(super) const MAX_LEAVES: usize = 65_536;
 
 /// The members of `struct` element `st` of data type `name`: named types are looked up in
 /// `raw` (the data types being resolved), else in `resolved` (a structure declared in place in
 /// a variable's type, once the data types are read).
-pub fn members(
+pub(super) fn members(
     tc6: Tc6,
     raw: &HashMap<String, Node>,
     resolved: Option<&DataTypes>,
@@ -497,7 +497,13 @@ fn count(members: &[Member]) -> usize {
 /// `value@member` elements holding a `simpleValue`, a nested `structValue`, or an
 /// `arrayValue`, which an array member ignores since it has no value). `what` names the
 /// structure or variable for messages.
-pub fn apply_value(tc6: Tc6, members: &mut [Member], sv: Node, what: &str, place: &str) -> R<()> {
+pub(super) fn apply_value(
+    tc6: Tc6,
+    members: &mut [Member],
+    sv: Node,
+    what: &str,
+    place: &str,
+) -> R<()> {
     for v in tc6.children(sv, "value") {
         let m = attr(v, "member", place)?;
         let Some(member) = members
@@ -555,7 +561,7 @@ pub fn apply_value(tc6: Tc6, members: &mut [Member], sv: Node, what: &str, place
 
 /// One elementary field of a flattened structure.
 #[derive(Clone, Debug)]
-pub struct Leaf {
+pub(super) struct Leaf {
     /// `Motor.Speed`, `Plant.Motor.Speed`.
     pub path: String,
     /// Its type: an elementary type as written (`elementary`), else a data type.
@@ -566,7 +572,7 @@ pub struct Leaf {
 }
 
 /// The leaf fields of a variable `name` of structure `members`, in declaration order.
-pub fn flatten(name: &str, members: &[Member]) -> Vec<Leaf> {
+pub(super) fn flatten(name: &str, members: &[Member]) -> Vec<Leaf> {
     let mut out = Vec::new();
     for m in members {
         let path = format!("{name}.{}", m.name);
@@ -585,7 +591,7 @@ pub fn flatten(name: &str, members: &[Member]) -> Vec<Leaf> {
 
 /// The leaf fields of a structure relative to it (`Speed`, `Motor.Speed`) with their types as
 /// the notes show them (`INT`, `MYTYPE`, an array as `ARRAY`).
-pub fn leaves(members: &[Member]) -> Vec<(String, String)> {
+pub(super) fn leaves(members: &[Member]) -> Vec<(String, String)> {
     flatten("", members)
         .into_iter()
         .map(|l| {

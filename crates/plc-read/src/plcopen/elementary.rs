@@ -28,19 +28,19 @@ pub(super) const MODEL_ELEMENTARY: &[&str] = &[
 ];
 
 /// True when a TC6 type element's tag is an elementary type (the model's or a mapped one).
-pub fn is_elementary_tag(tag: &str) -> bool {
+pub(super) fn is_elementary_tag(tag: &str) -> bool {
     MODEL_ELEMENTARY.contains(&tag) || MAPPED.iter().any(|(f, _)| *f == tag)
 }
 
 /// True when a declared type (as the reader writes it into the syntax) is elementary, not a
 /// function block type.
-pub fn is_elementary(ty: &str) -> bool {
+pub(super) fn is_elementary(ty: &str) -> bool {
     MODEL_ELEMENTARY.contains(&ty)
 }
 
 /// The model type IEC elementary type `t` is read as (`None`: not an elementary type); a
 /// string as its stand-in DINT.
-pub fn model_type_of(t: &str) -> Option<&'static str> {
+pub(super) fn model_type_of(t: &str) -> Option<&'static str> {
     if let Some(m) = MODEL_ELEMENTARY.iter().find(|m| **m == t) {
         return Some(m);
     }

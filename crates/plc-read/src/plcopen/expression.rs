@@ -30,7 +30,7 @@ use std::borrow::Cow;
 
 /// What in variable `node` (in `place`, its pin at `at`) gives: its literal, its variable, or
 /// the output of the blocks its expression is made into.
-pub fn block_input(a: &mut Added, node: Node, place: &str, at: Origin) -> R<Input<'static>> {
+pub(super) fn block_input(a: &mut Added, node: Node, place: &str, at: Origin) -> R<Input<'static>> {
     if let Ok(simple) = super::pins::block_input(node, place, at) {
         return Ok(simple);
     }
@@ -51,7 +51,7 @@ fn shortened(text: &str) -> Cow<'_, str> {
 }
 
 /// Whether in variable `node` reads an array element (its expression has a subscript).
-pub fn reads_array_element(node: Node) -> bool {
+pub(super) fn reads_array_element(node: Node) -> bool {
     expression_text(node).contains('[')
 }
 

@@ -48,7 +48,13 @@ const FBD_TAGS: &[&str] = &[
 ];
 
 /// Reads FBD body `node` of POU `pou`.
-pub fn body(tc6: Tc6, node: Node, pou: &str, ctx: &Ctx, notes: &mut Notes) -> R<FbdBody<'static>> {
+pub(super) fn body(
+    tc6: Tc6,
+    node: Node,
+    pou: &str,
+    ctx: &Ctx,
+    notes: &mut Notes,
+) -> R<FbdBody<'static>> {
     let place = format!("pou {pou}, FBD");
     let g = graph(tc6, node, &place, notes)?;
     g.only(FBD_TAGS, "FBD", &place)?;

@@ -47,7 +47,7 @@ fn arcs(b: &Block) -> Vec<(Option<usize>, u32, Option<String>)> {
 
 /// Cuts the back edges of `blocks` (see the module doc); `ty` gives the type of a producer's
 /// output pin (`None`: its first output). Returns a note per cut.
-pub fn cut(
+pub(super) fn cut(
     blocks: &mut [Block<'static>],
     added: &mut Added,
     ty: &dyn Fn(u32, Option<&str>) -> Option<String>,

@@ -29,13 +29,13 @@ use roxmltree::Node;
 use std::borrow::Cow;
 
 /// The names of the project's own data types, function blocks and functions, for messages.
-pub struct Known {
+pub(super) struct Known {
     pub data_types: DataTypes,
 }
 
 /// The lists of an interface, in the order the standard's keywords name them.
 #[derive(Default)]
-pub struct Interface {
+pub(super) struct Interface {
     pub inputs: Vec<Var<'static>>,
     pub outputs: Vec<Var<'static>>,
     pub locals: Vec<Var<'static>>,
@@ -55,7 +55,7 @@ pub struct Interface {
 
 /// A variable whose IEC 61131-3 elementary type the model lacks, read as one it has.
 #[derive(Clone, Debug)]
-pub struct Mapped {
+pub(super) struct Mapped {
     pub var: String,
     pub origin: plc_diag::Origin,
     pub from: String,
@@ -81,7 +81,7 @@ const OTHER_STD_FBS: &[&str] = &[
     "CTU_ULINT",
 ];
 /// Reads the interface of POU `pou` (its `interface` element; none is an empty interface).
-pub fn interface(tc6: Tc6, node: Option<Node>, pou: &str, known: &Known) -> R<Interface> {
+pub(super) fn interface(tc6: Tc6, node: Option<Node>, pou: &str, known: &Known) -> R<Interface> {
     let mut out = Interface::default();
     let Some(node) = node else { return Ok(out) };
     for list in tc6.elements(node) {
@@ -146,7 +146,7 @@ pub fn interface(tc6: Tc6, node: Option<Node>, pou: &str, known: &Known) -> R<In
 }
 
 /// The variables of one `varList` (`class` for all of them; an address may override it).
-pub fn var_list(
+pub(super) fn var_list(
     tc6: Tc6,
     list: Node,
     class: VarClass,
@@ -523,7 +523,7 @@ fn initial_value(tc6: Tc6, iv: Node, var: &str, place: &str) -> R<Operand<'stati
 
 /// A literal as IEC 61131-3 writes it (TRUE/FALSE in any case, integers and reals with `_`
 /// separators, based integers `16#FF`, typed literals `INT#5`, `T#…`/`TIME#…`), or `None`.
-pub fn literal(text: &str) -> Option<Scalar<'static>> {
+pub(super) fn literal(text: &str) -> Option<Scalar<'static>> {
     let t = text.trim();
     if t.eq_ignore_ascii_case("true") {
         return Some(Scalar::Bool(true));
@@ -570,7 +570,7 @@ pub fn literal(text: &str) -> Option<Scalar<'static>> {
 }
 
 /// A name made from the file (owned), at `origin`.
-pub fn name(s: impl Into<String>, at: plc_diag::Origin) -> Name<'static> {
+pub(super) fn name(s: impl Into<String>, at: plc_diag::Origin) -> Name<'static> {
     Located {
         value: Cow::Owned(s.into()),
         origin: at,
@@ -579,7 +579,7 @@ pub fn name(s: impl Into<String>, at: plc_diag::Origin) -> Name<'static> {
 
 /// The notes of a file whose variables' types were mapped (`mapped`: with the POU, or `None`
 /// for a global): one for the elementary types, one for the data types.
-pub fn mapped_notes(mapped: &[(Option<String>, Mapped)]) -> Vec<super::xml::Note> {
+pub(super) fn mapped_notes(mapped: &[(Option<String>, Mapped)]) -> Vec<super::xml::Note> {
     let (derived, elementary): (Vec<_>, Vec<_>) =
         mapped.iter().cloned().partition(|(_, m)| m.via.is_some());
     mapped_note(&elementary)

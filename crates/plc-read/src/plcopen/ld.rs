@@ -54,7 +54,7 @@ const LD_TAGS: &[&str] = &[
 ];
 
 /// Reads LD body `node` of POU `pou` into rungs `<pou>.R1`, `<pou>.R2` … in execution order.
-pub fn rungs(tc6: Tc6, node: Node, pou: &str, notes: &mut Notes) -> R<Vec<Rung<'static>>> {
+pub(super) fn rungs(tc6: Tc6, node: Node, pou: &str, notes: &mut Notes) -> R<Vec<Rung<'static>>> {
     let place = format!("pou {pou}, LD");
     let g = graph(tc6, node, &place, notes)?;
     g.only(LD_TAGS, "LD", &place)?;
@@ -362,7 +362,7 @@ fn merge(paths: &[&[Item]]) -> Series<'static> {
 }
 
 /// The connected component of every element (rails excluded: they join nothing).
-pub fn components(g: &Graph) -> Vec<usize> {
+pub(super) fn components(g: &Graph) -> Vec<usize> {
     let mut parent: Vec<usize> = (0..g.elems.len()).collect();
     fn find(parent: &mut [usize], mut x: usize) -> usize {
         while parent[x] != x {

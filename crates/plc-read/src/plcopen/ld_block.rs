@@ -145,7 +145,7 @@ impl Spec {
 const SUPPORTED: &str = "TON, TOF, TP, CTU, CTD, SR, RS, R_TRIG, F_TRIG, CTUD, ADD, SUB, MUL, DIV, MOD, MOVE, EQ, NE, LT, LE, GT, GE, AND, OR, XOR, NOT, and the standard functions ABS … ATAN, EXPT, SHL … ROR, MUX, *_TO_*, TRUNC";
 
 /// True when out variable `e` is the result of an ADD … MOD or MOVE block (part of its box).
-pub fn absorbed(p: &Power, e: ElemId) -> bool {
+pub(super) fn absorbed(p: &Power, e: ElemId) -> bool {
     let el = p.g.get(e);
     let [pin] = el.inputs.as_slice() else {
         return false;
@@ -165,7 +165,7 @@ pub fn absorbed(p: &Power, e: ElemId) -> bool {
 /// True when `pin` of block `e` is an output of a function block instance other than its power
 /// output (`QD` or `CV` of a CTUD, `ET` of a timer): it is read after the box, as the instance's
 /// field.
-pub fn reads_side(p: &Power, e: ElemId, pin: Option<&str>) -> bool {
+pub(super) fn reads_side(p: &Power, e: ElemId, pin: Option<&str>) -> bool {
     let el = p.g.get(e);
     let Some(pin) = pin else {
         return false;
@@ -181,7 +181,7 @@ pub fn reads_side(p: &Power, e: ElemId, pin: Option<&str>) -> bool {
 
 /// The contact that reads output `pin` of function block `e` (its field `instance.pin`); the
 /// rung puts it after the box (`super::ld` orders the outputs that read it after the box's).
-pub fn side_output(p: &Power, e: ElemId, pin: &str) -> R<Item> {
+pub(super) fn side_output(p: &Power, e: ElemId, pin: &str) -> R<Item> {
     let node = p.g.get(e).node;
     let name = field(p, e, pin)?;
     Ok(Item {
@@ -210,14 +210,14 @@ fn field(p: &Power, e: ElemId, pin: &str) -> R<String> {
 }
 
 /// The rules of blocks the power walk calls ([`Power::new`]).
-pub const BLOCKS: Blocks = Blocks {
+pub(super) const BLOCKS: Blocks = Blocks {
     power_out,
     reads_side,
     side_output,
 };
 
 /// The series out of block `e`'s power output (`pin`: the output asked for).
-pub fn power_out(p: &mut Power, e: ElemId, pin: Option<&str>) -> R<Path> {
+pub(super) fn power_out(p: &mut Power, e: ElemId, pin: Option<&str>) -> R<Path> {
     let el = p.g.get(e);
     let node = el.node;
     let here = p.at(e);

@@ -61,7 +61,13 @@ const FLOW_TAGS: &[&str] = &[
 ];
 
 /// Reads LD body `node` of POU `pou` as a data-flow network.
-pub fn body(tc6: Tc6, node: Node, pou: &str, ctx: &Ctx, notes: &mut Notes) -> R<FbdBody<'static>> {
+pub(super) fn body(
+    tc6: Tc6,
+    node: Node,
+    pou: &str,
+    ctx: &Ctx,
+    notes: &mut Notes,
+) -> R<FbdBody<'static>> {
     let place = format!("pou {pou}, LD");
     let g = graph(tc6, node, &place, notes)?;
     g.only(FLOW_TAGS, "LD", &place)?;

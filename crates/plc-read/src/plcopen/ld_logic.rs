@@ -20,12 +20,12 @@ use super::xml::{error, origin, R};
 use plc_syntax::{Element, ElementKind, Series};
 
 /// True for the boolean functions this module rewrites.
-pub fn is_logic(ty: &str) -> bool {
+pub(super) fn is_logic(ty: &str) -> bool {
     matches!(ty, "AND" | "OR" | "XOR" | "NOT")
 }
 
 /// The power out of boolean block `e` of type `ty`.
-pub fn power_out(p: &mut Power, e: ElemId, ty: &str) -> R<Path> {
+pub(super) fn power_out(p: &mut Power, e: ElemId, ty: &str) -> R<Path> {
     let el = p.g.get(e);
     let here = p.at(e);
     let fail = |why: String| {

@@ -28,7 +28,7 @@ use std::collections::HashMap;
 
 /// What identifies an element of a path: two paths share a prefix when their keys agree.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
-pub enum Key {
+pub(super) enum Key {
     Elem(ElemId),
     /// An `or` of these sources (sorted).
     Or(Vec<ElemId>),
@@ -40,23 +40,23 @@ pub enum Key {
 
 /// One element of a path from the left rail.
 #[derive(Clone, Debug)]
-pub struct Item {
+pub(super) struct Item {
     pub key: Key,
     pub element: Element<'static>,
 }
 
 /// A series from the left rail to an element's output.
-pub type Path = Vec<Item>;
+pub(super) type Path = Vec<Item>;
 
 /// The most joins and blocks the power into one element may pass on its way from the rail:
 /// [`Power::out`] recurses once per join or block, and this keeps it well within a thread's
 /// stack (a debug build takes several KiB a level).
-pub const MAX_POWER_DEPTH: usize = 256;
+pub(super) const MAX_POWER_DEPTH: usize = 256;
 
 /// The most `or`s a join may be nested in: as deep as the JSON program format holds them
 /// (its 128 levels of JSON), so every later stage walks such a rung and `convert`'s output
 /// loads back.
-pub const MAX_OR_NESTING: usize = 40;
+pub(super) const MAX_OR_NESTING: usize = 40;
 
 /// How many `or`s deep `kind` nests (0 for an element that is no `or`). Bounded by
 /// [`MAX_OR_NESTING`] for every `or` the reader built, so its recursion is bounded too.
@@ -77,7 +77,7 @@ fn or_nesting(kind: &ElementKind) -> usize {
 /// What blocks do to the power: the rules of `super::ld_block`, which `super::ld` gives to
 /// [`Power::new`]. They call back into [`Power::out`] for the power into a block's inputs.
 #[derive(Clone, Copy)]
-pub struct Blocks {
+pub(super) struct Blocks {
     /// The series out of block `e`'s power output `pin`.
     pub power_out: fn(&mut Power, ElemId, Option<&str>) -> R<Path>,
     /// Whether output `pin` of `e` is a function block's output read after its box.
@@ -87,7 +87,7 @@ pub struct Blocks {
 }
 
 /// The power computation of one body.
-pub struct Power<'g, 'a, 'i> {
+pub(super) struct Power<'g, 'a, 'i> {
     pub g: &'g Graph<'a, 'i>,
     /// `pou Main, LD` (for errors).
     pub place: String,
@@ -104,7 +104,7 @@ pub struct Power<'g, 'a, 'i> {
 }
 
 impl<'g, 'a, 'i> Power<'g, 'a, 'i> {
-    pub fn new(g: &'g Graph<'a, 'i>, place: String, blocks: Blocks) -> Self {
+    pub(super) fn new(g: &'g Graph<'a, 'i>, place: String, blocks: Blocks) -> Self {
         Power {
             g,
             place,
@@ -117,12 +117,12 @@ impl<'g, 'a, 'i> Power<'g, 'a, 'i> {
         }
     }
 
-    pub fn at(&self, e: ElemId) -> String {
+    pub(super) fn at(&self, e: ElemId) -> String {
         self.g.place(&self.place, e)
     }
 
     /// The series that brings power out of `e` (through its output pin `pin`).
-    pub fn out(&mut self, e: ElemId, pin: Option<&str>) -> R<Path> {
+    pub(super) fn out(&mut self, e: ElemId, pin: Option<&str>) -> R<Path> {
         if let Some(side) = pin.filter(|&x| (self.blocks.reads_side)(self, e, Some(x))) {
             return (self.blocks.side_output)(self, e, side).map(|item| vec![item]);
         }
@@ -274,7 +274,7 @@ impl<'g, 'a, 'i> Power<'g, 'a, 'i> {
     }
 
     /// The coil (or an out variable fed by power) as an element.
-    pub fn coil(&self, e: ElemId) -> R<ElementKind<'static>> {
+    pub(super) fn coil(&self, e: ElemId) -> R<ElementKind<'static>> {
         let node = self.g.get(e).node;
         let here = self.at(e);
         let var = self.variable(e)?;
@@ -301,7 +301,7 @@ impl<'g, 'a, 'i> Power<'g, 'a, 'i> {
     }
 
     /// The variable a contact, coil or variable element names.
-    pub fn variable(&self, e: ElemId) -> R<plc_syntax::Name<'static>> {
+    pub(super) fn variable(&self, e: ElemId) -> R<plc_syntax::Name<'static>> {
         let el = self.g.get(e);
         let text = self.expression(e)?;
         Ok(plc_syntax::Located {
@@ -311,12 +311,12 @@ impl<'g, 'a, 'i> Power<'g, 'a, 'i> {
     }
 
     /// The text of element `e`'s `variable` (contacts, coils) or `expression` (variables).
-    pub fn expression(&self, e: ElemId) -> R<String> {
+    pub(super) fn expression(&self, e: ElemId) -> R<String> {
         self.g.expression(&self.place, e)
     }
 
     /// The power into input pin `k` of `e`: the OR of its connections.
-    pub fn input(&mut self, e: ElemId, k: usize) -> R<Path> {
+    pub(super) fn input(&mut self, e: ElemId, k: usize) -> R<Path> {
         let el = self.g.get(e);
         let sources: Vec<Source> = el
             .inputs

@@ -67,7 +67,7 @@ const BLOCKS: &[Block] = &[
 
 /// Beremiz's `LOGLEVEL` enumeration (`(CRITICAL, WARNING, INFO, DEBUG)`), numbered as its
 /// compiler numbers enumerations: the value a LOGGER's LEVEL pin fed by `name` reads.
-pub fn library_constant(block: &str, pin: &str, name: &str) -> Option<i64> {
+pub(super) fn library_constant(block: &str, pin: &str, name: &str) -> Option<i64> {
     if block != "LOGGER" || pin != "LEVEL" {
         return None;
     }
@@ -83,7 +83,7 @@ pub fn library_constant(block: &str, pin: &str, name: &str) -> Option<i64> {
 }
 
 /// True when `ty` is a library block this module stands in.
-pub fn is_library_fb(ty: &str) -> bool {
+pub(super) fn is_library_fb(ty: &str) -> bool {
     BLOCKS.iter().any(|b| b.name == ty)
 }
 
@@ -106,7 +106,7 @@ fn var(n: &str, ty: &str, class: VarClass, at: Origin) -> Var<'static> {
 
 /// The stand-in function block type `ty` (an instance of it is declared at `at`, named
 /// `instances` for the note), or `None` when `ty` is not a library block.
-pub fn stand_in_fb(
+pub(super) fn stand_in_fb(
     ty: &str,
     at: Origin,
     instances: &[String],
@@ -138,7 +138,7 @@ type Pins = Vec<(String, String)>;
 
 /// The inputs and outputs (name, model type) of each library block, for typing what they read
 /// and feed.
-pub fn pins() -> impl Iterator<Item = (&'static str, Pins, Pins)> {
+pub(super) fn pins() -> impl Iterator<Item = (&'static str, Pins, Pins)> {
     let own = |v: &[(&str, &str)]| -> Pins {
         v.iter()
             .map(|(n, t)| (n.to_string(), t.to_string()))
@@ -151,7 +151,7 @@ pub fn pins() -> impl Iterator<Item = (&'static str, Pins, Pins)> {
 
 /// A black-box function block type `ty` with `inputs` and `outputs` (name, model type): one
 /// stand-in rung reading every input and writing every output with its own value.
-pub fn stand_in_type(
+pub(super) fn stand_in_type(
     ty: &str,
     inputs: &[(String, String)],
     outputs: &[(String, String)],
@@ -183,7 +183,7 @@ pub fn stand_in_type(
 }
 
 /// The black-box type of a block the model lacks ([`super::black_box`]), with its note.
-pub fn black_box_type(b: &super::block_types::BlackBox) -> (FunctionBlock<'static>, Note) {
+pub(super) fn black_box_type(b: &super::block_types::BlackBox) -> (FunctionBlock<'static>, Note) {
     let fb = stand_in_type(&b.name, &b.sig.inputs, &b.sig.outputs, b.origin);
     let show = |v: &[(String, String)]| {
         v.iter()

@@ -21,7 +21,7 @@ use std::borrow::Cow;
 
 /// A block's output pin as the syntax names it: the unnamed result of a user function
 /// (`formalParameter=""`, old Beremiz files) is `OUT`.
-pub fn pin_of(p: &str) -> &str {
+pub(super) fn pin_of(p: &str) -> &str {
     if p.is_empty() {
         "OUT"
     } else {
@@ -32,26 +32,26 @@ pub fn pin_of(p: &str) -> &str {
 /// Blocks and variables a reader adds to a body: NOT of a negated pin, edge detectors, the
 /// gates of an LD body read as data flow ([`super::ld_flow`]). Their ids count up from above
 /// every localId of the body.
-pub struct Added {
+pub(super) struct Added {
     pub next_id: u32,
     pub blocks: Vec<Block<'static>>,
     /// Edge-detector instances (`R_TRIG__<localId>`), to add to the POU.
     pub vars: Vec<Var<'static>>,
 }
 
-pub fn konst(b: bool, at: Origin) -> Input<'static> {
+pub(super) fn konst(b: bool, at: Origin) -> Input<'static> {
     Input {
         origin: at,
         from: Connection::Constant(Scalar::Bool(b)),
     }
 }
 
-pub fn is_const(i: &Input, b: bool) -> bool {
+pub(super) fn is_const(i: &Input, b: bool) -> bool {
     matches!(i.from, Connection::Constant(Scalar::Bool(x)) if x == b)
 }
 
 impl Added {
-    pub fn new(g: &Graph) -> Added {
+    pub(super) fn new(g: &Graph) -> Added {
         Added {
             next_id: g.elems.iter().map(|el| el.local_id).max().unwrap_or(0) + 1,
             blocks: Vec::new(),
@@ -60,7 +60,7 @@ impl Added {
     }
 
     /// Adds block `op` with `inputs` (by pin name) at `at`: an arc from its first output.
-    pub fn add(
+    pub(super) fn add(
         &mut self,
         op: &str,
         inputs: Vec<(&str, Input<'static>)>,
@@ -74,7 +74,7 @@ impl Added {
     }
 
     /// Adds block `op` (on `instance`) with `inputs` at `at`: an arc from its first output.
-    pub fn add_on(
+    pub(super) fn add_on(
         &mut self,
         op: &str,
         instance: Option<String>,
@@ -106,7 +106,12 @@ impl Added {
         }
     }
 
-    pub fn and(&mut self, a: Input<'static>, b: Input<'static>, at: Origin) -> Input<'static> {
+    pub(super) fn and(
+        &mut self,
+        a: Input<'static>,
+        b: Input<'static>,
+        at: Origin,
+    ) -> Input<'static> {
         if is_const(&a, true) {
             return b;
         }
@@ -116,7 +121,7 @@ impl Added {
         self.add("AND", vec![("IN1", a), ("IN2", b)], at)
     }
 
-    pub fn not(&mut self, a: Input<'static>, at: Origin) -> Input<'static> {
+    pub(super) fn not(&mut self, a: Input<'static>, at: Origin) -> Input<'static> {
         match a.from {
             Connection::Constant(Scalar::Bool(x)) => konst(!x, at),
             _ => self.add("NOT", vec![("IN", a)], at),
@@ -131,7 +136,7 @@ impl Added {
     /// input pins the element lists in the file: a pin numbered past it (`IN2147483647`) is no
     /// unconnected pin of the element, and the block is left as it is, for the resolver to
     /// refuse its gap, instead of filling every number up to it.
-    pub fn compare(
+    pub(super) fn compare(
         &mut self,
         b: &mut Block<'static>,
         declared: usize,
@@ -225,7 +230,7 @@ impl Added {
     /// Gives the last block added (a SEL of constants) a variable of type `ty` to write, so
     /// that its output has that type (a block of constants only would be DINT); the variable
     /// is `<op>__<id>`, declared in the POU.
-    pub fn typed(&mut self, ty: Option<&str>, at: Origin) {
+    pub(super) fn typed(&mut self, ty: Option<&str>, at: Origin) {
         let Some(ty) = ty else { return };
         let Some(b) = self.blocks.last_mut() else {
             return;
@@ -246,7 +251,7 @@ impl Added {
     }
 
     /// Declares instance `inst` of function block type `ty` in the POU.
-    pub fn declare(&mut self, inst: &str, ty: &str, at: Origin) {
+    pub(super) fn declare(&mut self, inst: &str, ty: &str, at: Origin) {
         self.vars.push(Var {
             origin: at,
             name: name(inst, at),
@@ -261,7 +266,7 @@ impl Added {
     }
 
     /// An R_TRIG (`rising`) or F_TRIG of `clk` on a new instance named after `local_id`.
-    pub fn trigger(
+    pub(super) fn trigger(
         &mut self,
         edge: &str,
         clk: Input<'static>,
@@ -287,7 +292,7 @@ impl Added {
 }
 
 /// The text of `node`'s `expression` (empty without one).
-pub fn expression_text<'a>(node: Node<'a, '_>) -> &'a str {
+pub(super) fn expression_text<'a>(node: Node<'a, '_>) -> &'a str {
     node.children()
         .find(|c| c.is_element() && c.tag_name().name() == "expression")
         .and_then(|c| c.text())
@@ -296,7 +301,7 @@ pub fn expression_text<'a>(node: Node<'a, '_>) -> &'a str {
 
 /// What an `inVariable` or `inOutVariable` element `node` gives to a pin (at `at`): its
 /// literal, else its variable (an expression: [`super::expression::block_input`]).
-pub fn block_input(node: Node, place: &str, at: Origin) -> R<Input<'static>> {
+pub(super) fn block_input(node: Node, place: &str, at: Origin) -> R<Input<'static>> {
     let text = expression_text(node);
     let from = match literal(text) {
         Some(v) => Connection::Constant(v),
@@ -309,7 +314,12 @@ pub fn block_input(node: Node, place: &str, at: Origin) -> R<Input<'static>> {
 
 /// A `0` or `1` feeding a BOOL input pin is FALSE or TRUE (IEC 61131-3 6.3.2: literals are
 /// typed by their use).
-pub fn bool_literal(ctx: &Ctx, ty: &str, pin: &str, mut i: Input<'static>) -> Input<'static> {
+pub(super) fn bool_literal(
+    ctx: &Ctx,
+    ty: &str,
+    pin: &str,
+    mut i: Input<'static>,
+) -> Input<'static> {
     if let Connection::Constant(Scalar::Number(n)) = &i.from {
         let b = match n.as_u64() {
             Some(0) => false,
@@ -324,7 +334,7 @@ pub fn bool_literal(ctx: &Ctx, ty: &str, pin: &str, mut i: Input<'static>) -> In
 }
 
 /// Adds `target` to output `pin` of block `b`.
-pub fn add_target(b: &mut Block<'static>, pin: String, target: OutVar<'static>) {
+pub(super) fn add_target(b: &mut Block<'static>, pin: String, target: OutVar<'static>) {
     let mut outs = match b.outputs.take() {
         Some(Ok(Outputs::Named(v))) => v,
         _ => Vec::new(),
@@ -337,7 +347,7 @@ pub fn add_target(b: &mut Block<'static>, pin: String, target: OutVar<'static>) 
 }
 
 /// True when `text` is an IEC 61131-3 string literal (`'…'` or `"…"`, 6.3.3).
-pub fn is_string_literal(text: &str) -> bool {
+pub(super) fn is_string_literal(text: &str) -> bool {
     let t = text.trim();
     t.len() >= 2
         && ((t.starts_with('\'') && t.ends_with('\'')) || (t.starts_with('"') && t.ends_with('"')))
@@ -345,7 +355,7 @@ pub fn is_string_literal(text: &str) -> bool {
 
 /// The qualifiers of input pin `pin` (its `variable` node `pnode`) of block `ty`: negated, and
 /// the edge (`rising`/`falling`). A `storage` qualifier is an error.
-pub fn pin_modifiers<'n>(
+pub(super) fn pin_modifiers<'n>(
     pnode: Node<'n, '_>,
     ty: &str,
     pin: &str,
@@ -372,7 +382,7 @@ pub fn pin_modifiers<'n>(
 }
 
 /// True when output `pin` of block element `node` is negated (`None`: its first output).
-pub fn output_negated(outputs: &[(&str, Node)], pin: Option<&str>) -> bool {
+pub(super) fn output_negated(outputs: &[(&str, Node)], pin: Option<&str>) -> bool {
     let found = match pin {
         Some(p) => outputs.iter().find(|(n, _)| *n == p),
         None => outputs.iter().find(|(n, _)| *n != "ENO"),

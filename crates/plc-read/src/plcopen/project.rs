@@ -40,7 +40,7 @@ struct ProgramPou {
 
 /// Reads the whole project.
 /// With `select`, only the program POU of that name (any case) is kept, as the main program.
-pub fn program(
+pub(super) fn program(
     tc6: Tc6,
     doc: &Document,
     select: Option<&str>,

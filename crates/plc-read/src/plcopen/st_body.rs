@@ -32,7 +32,7 @@ use std::collections::HashMap;
 /// What a name of an ST body is: an elementary variable (with its type) or an instance (with
 /// the BOOL-or-not field a read of it stands for, when it has one).
 #[derive(Clone, Debug)]
-pub enum Decl {
+pub(super) enum Decl {
     Elementary {
         name: String,
         ty: String,
@@ -52,13 +52,13 @@ pub enum Decl {
 
 /// The declarations an ST body sees, by lower-case name.
 #[derive(Default)]
-pub struct Scope {
+pub(super) struct Scope {
     pub names: HashMap<String, Decl>,
 }
 
 impl Scope {
     /// Declares `name` of type `ty` (elementary or a function block type).
-    pub fn declare(&mut self, name: &str, ty: &str) {
+    pub(super) fn declare(&mut self, name: &str, ty: &str) {
         let decl = if super::elementary::is_elementary(ty) {
             Decl::Elementary {
                 name: name.to_owned(),
@@ -90,14 +90,14 @@ impl Scope {
     }
 
     /// Declares an enumeration value (a constant), unless a variable has its name.
-    pub fn constant(&mut self, name: &str) {
+    pub(super) fn constant(&mut self, name: &str) {
         self.names
             .entry(name.to_ascii_lowercase())
             .or_insert(Decl::Constant);
     }
 
     /// `name` as it is, or, when it is a structure, the names of its fields.
-    pub fn fields_of(&self, name: &str) -> Vec<String> {
+    pub(super) fn fields_of(&self, name: &str) -> Vec<String> {
         match self.get(name) {
             Some(Decl::Structure { leaves }) => leaves.iter().map(|(n, _)| n.clone()).collect(),
             _ => vec![name.to_owned()],
@@ -161,7 +161,12 @@ fn push_once(v: &mut Vec<String>, s: &str) {
 
 /// The rungs of ST body `node` of POU `pou`: one per top-level statement that reads or writes
 /// something.
-pub fn rungs(node: Node, pou: &str, scope: &Scope, notes: &mut Notes) -> R<Vec<Rung<'static>>> {
+pub(super) fn rungs(
+    node: Node,
+    pou: &str,
+    scope: &Scope,
+    notes: &mut Notes,
+) -> R<Vec<Rung<'static>>> {
     let place = format!("pou {pou}, ST");
     let source = node.document().input_text();
     let mut out = Vec::new();
@@ -311,7 +316,7 @@ fn resolve(
 /// `text` is what XML makes of `source` from `start` on: CDATA sections taken as they are,
 /// entity and character references decoded, `\r\n` and `\r` read as `\n` (XML 1.0, 2.11).
 /// `None` when the two do not agree (then statements are placed at the text's start).
-pub fn file_offsets(source: &str, start: usize, text: &str) -> Option<Vec<usize>> {
+pub(super) fn file_offsets(source: &str, start: usize, text: &str) -> Option<Vec<usize>> {
     let (s, t) = (source.as_bytes(), text.as_bytes());
     let mut map = Vec::with_capacity(t.len() + 1);
     let (mut i, mut j, mut cdata) = (start, 0, false);

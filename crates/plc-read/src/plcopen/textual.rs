@@ -23,14 +23,14 @@ use std::borrow::Cow;
 
 /// A variable (or a field of an instance) a stand-in rung reads, and whether it is BOOL.
 #[derive(Clone, Debug)]
-pub struct Read {
+pub(super) struct Read {
     pub name: String,
     pub bool: bool,
 }
 
 /// The stand-in rung `id` at `at` reading `reads` and writing `writes` with their own values;
 /// none when it reads and writes nothing.
-pub fn stand_in(
+pub(super) fn stand_in(
     id: String,
     at: Origin,
     reads: &[Read],
@@ -88,7 +88,7 @@ pub fn stand_in(
 
 /// The rungs standing for a body in `lang` (IL, SFC) of POU `pou`: one, or none when the
 /// interface has nothing to read or write.
-pub fn through_interface(
+pub(super) fn through_interface(
     lang: &str,
     body: Node,
     pou: &str,

@@ -20,10 +20,10 @@ use std::collections::{HashMap, HashSet};
 
 /// Index of an element of a body, in file order.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct ElemId(pub u32);
+pub(super) struct ElemId(pub u32);
 
 /// One element of the body.
-pub struct Elem<'a, 'i> {
+pub(super) struct Elem<'a, 'i> {
     pub node: Node<'a, 'i>,
     pub local_id: u32,
     /// Its tag (`contact`, `block`, `inVariable` …).
@@ -35,7 +35,7 @@ pub struct Elem<'a, 'i> {
 }
 
 /// An input pin and what feeds it.
-pub struct Pin<'a, 'i> {
+pub(super) struct Pin<'a, 'i> {
     /// `formalParameter` of a block's pin; `None` for the single input of other elements.
     pub name: Option<&'a str>,
     /// The pin's `variable` node (blocks) or the element itself.
@@ -45,7 +45,7 @@ pub struct Pin<'a, 'i> {
 
 /// A producer feeding a pin.
 #[derive(Clone, Debug)]
-pub struct Source<'a> {
+pub(super) struct Source<'a> {
     pub elem: ElemId,
     /// The producer's output pin (`formalParameter`), if named.
     pub pin: Option<&'a str>,
@@ -54,26 +54,26 @@ pub struct Source<'a> {
 }
 
 /// A body's elements.
-pub struct Graph<'a, 'i> {
+pub(super) struct Graph<'a, 'i> {
     pub elems: Vec<Elem<'a, 'i>>,
     /// For each element, who reads it: (consumer, consumer's input pin index, producer's pin).
     pub consumers: Vec<Vec<(ElemId, usize, Option<&'a str>)>>,
 }
 
 impl<'a, 'i> Graph<'a, 'i> {
-    pub fn get(&self, e: ElemId) -> &Elem<'a, 'i> {
+    pub(super) fn get(&self, e: ElemId) -> &Elem<'a, 'i> {
         &self.elems[e.0 as usize]
     }
 
     /// `pou P, LD, contact localId 5`.
-    pub fn place(&self, body: &str, e: ElemId) -> String {
+    pub(super) fn place(&self, body: &str, e: ElemId) -> String {
         let el = self.get(e);
         format!("{body}, {} localId {}", el.tag, el.local_id)
     }
 
     /// The text of element `e`'s `variable` (contacts, coils) or `expression` (variables); `body`
     /// names the body in errors.
-    pub fn expression(&self, body: &str, e: ElemId) -> R<String> {
+    pub(super) fn expression(&self, body: &str, e: ElemId) -> R<String> {
         let el = self.get(e);
         let tag = if matches!(el.tag, "contact" | "coil") {
             "variable"
@@ -96,7 +96,7 @@ impl<'a, 'i> Graph<'a, 'i> {
 
     /// An error at the first element whose tag is not one of `tags`, the elements a
     /// `language` body (`LD`, `FBD`) may hold; `body` names the body in errors.
-    pub fn only(&self, tags: &[&str], language: &str, body: &str) -> R<()> {
+    pub(super) fn only(&self, tags: &[&str], language: &str, body: &str) -> R<()> {
         match self.elems.iter().position(|el| !tags.contains(&el.tag)) {
             None => Ok(()),
             Some(i) => {
@@ -119,7 +119,7 @@ const UNWIRED: &[&str] = &["label", "comment", "leftPowerRail"];
 
 /// Reads the elements of `body` (an `LD` or `FBD` node); `place` names the body in errors and
 /// notes.
-pub fn graph<'a, 'i>(
+pub(super) fn graph<'a, 'i>(
     tc6: Tc6,
     body: Node<'a, 'i>,
     place: &str,

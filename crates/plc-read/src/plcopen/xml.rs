@@ -23,13 +23,13 @@ pub const NAMESPACES: &[&str] = &[
 /// Largest XML text read: 512 MiB (the parsed tree takes several times the text).
 pub const MAX_XML_BYTES: usize = 512 << 20;
 /// Deepest element nesting accepted (a TC6 project nests about 15 deep).
-pub const MAX_DEPTH: usize = 256;
+pub(super) const MAX_DEPTH: usize = 256;
 
 /// A PLCopen error (one, located at an XML node).
-pub type R<T> = Result<T, LoadError>;
+pub(super) type R<T> = Result<T, LoadError>;
 
 /// A located error: `where` names the element (`pou Main, LD, contact localId 5`).
-pub fn error(origin: Origin, place: &str, message: impl Into<String>) -> LoadError {
+pub(super) fn error(origin: Origin, place: &str, message: impl Into<String>) -> LoadError {
     LoadError::invalid(
         None,
         place,
@@ -41,7 +41,7 @@ pub fn error(origin: Origin, place: &str, message: impl Into<String>) -> LoadErr
 }
 
 /// Where a node starts.
-pub fn origin(n: Node) -> Origin {
+pub(super) fn origin(n: Node) -> Origin {
     Origin::at(n.range().start)
 }
 
@@ -99,7 +99,7 @@ impl Notes {
 
 /// Parses the text as XML: no DTD (so no entity expansion), at most [`MAX_XML_BYTES`], at most
 /// [`MAX_DEPTH`] levels. Errors are syntax errors with line and column.
-pub fn parse(text: &str) -> R<Document<'_>> {
+pub(super) fn parse(text: &str) -> R<Document<'_>> {
     if text.len() > MAX_XML_BYTES {
         return Err(syntax(
             1,
@@ -178,7 +178,7 @@ fn check_depth(doc: &Document, text: &str) -> R<()> {
 }
 
 /// The project's namespace: the root must be `project` in one of [`NAMESPACES`].
-pub fn project_namespace(doc: &Document) -> R<&'static str> {
+pub(super) fn project_namespace(doc: &Document) -> R<&'static str> {
     let root = doc.root_element();
     let tag = root.tag_name();
     let ns = tag.namespace().unwrap_or("");
@@ -210,23 +210,23 @@ pub fn project_namespace(doc: &Document) -> R<&'static str> {
 
 /// The project's XML with its namespace: children by local name.
 #[derive(Copy, Clone)]
-pub struct Tc6 {
+pub(super) struct Tc6 {
     pub ns: &'static str,
 }
 
 impl Tc6 {
     /// True when `n` is the element `name` of the project's namespace.
-    pub fn is(&self, n: Node, name: &str) -> bool {
+    pub(super) fn is(&self, n: Node, name: &str) -> bool {
         n.is_element() && n.tag_name().name() == name && n.tag_name().namespace() == Some(self.ns)
     }
 
     /// The first child element `name`.
-    pub fn child<'a, 'i>(&self, n: Node<'a, 'i>, name: &str) -> Option<Node<'a, 'i>> {
+    pub(super) fn child<'a, 'i>(&self, n: Node<'a, 'i>, name: &str) -> Option<Node<'a, 'i>> {
         n.children().find(|c| self.is(*c, name))
     }
 
     /// Every child element `name`, in file order.
-    pub fn children<'a, 'i: 'a>(
+    pub(super) fn children<'a, 'i: 'a>(
         &self,
         n: Node<'a, 'i>,
         name: &'a str,
@@ -236,7 +236,10 @@ impl Tc6 {
     }
 
     /// The element children of the project's namespace.
-    pub fn elements<'a, 'i: 'a>(&self, n: Node<'a, 'i>) -> impl Iterator<Item = Node<'a, 'i>> + 'a {
+    pub(super) fn elements<'a, 'i: 'a>(
+        &self,
+        n: Node<'a, 'i>,
+    ) -> impl Iterator<Item = Node<'a, 'i>> + 'a {
         let ns = self.ns;
         n.children()
             .filter(move |c| c.is_element() && c.tag_name().namespace() == Some(ns))
@@ -244,7 +247,7 @@ impl Tc6 {
 }
 
 /// A required attribute.
-pub fn attr<'a>(n: Node<'a, '_>, name: &str, place: &str) -> R<&'a str> {
+pub(super) fn attr<'a>(n: Node<'a, '_>, name: &str, place: &str) -> R<&'a str> {
     n.attribute(name).ok_or_else(|| {
         error(
             origin(n),
@@ -255,7 +258,7 @@ pub fn attr<'a>(n: Node<'a, '_>, name: &str, place: &str) -> R<&'a str> {
 }
 
 /// A boolean attribute (`true`/`false`/`1`/`0`; default false).
-pub fn flag(n: Node, name: &str, place: &str) -> R<bool> {
+pub(super) fn flag(n: Node, name: &str, place: &str) -> R<bool> {
     match n.attribute(name) {
         None | Some("false") | Some("0") => Ok(false),
         Some("true") | Some("1") => Ok(true),
@@ -269,7 +272,7 @@ pub fn flag(n: Node, name: &str, place: &str) -> R<bool> {
 
 /// True for an IEC 61131-3 identifier (6.1.2): letters, digits and `_`, not starting with a
 /// digit, no two `_` in a row.
-pub fn is_identifier(s: &str) -> bool {
+pub(super) fn is_identifier(s: &str) -> bool {
     let b = s.as_bytes();
     !b.is_empty()
         && !b[0].is_ascii_digit()
@@ -278,7 +281,7 @@ pub fn is_identifier(s: &str) -> bool {
 }
 
 /// `s` checked as an identifier (`what` names it in the message: "variable", "POU").
-pub fn identifier(s: &str, what: &str, n: Node, place: &str) -> R<String> {
+pub(super) fn identifier(s: &str, what: &str, n: Node, place: &str) -> R<String> {
     if is_identifier(s) {
         Ok(s.to_owned())
     } else {
@@ -292,7 +295,7 @@ pub fn identifier(s: &str, what: &str, n: Node, place: &str) -> R<String> {
 
 /// A variable reference as an LD/FBD element names it: an identifier or a field of one
 /// (`T1.Q`, `G1.RESULT`), trimmed.
-pub fn variable_ref(s: &str, n: Node, place: &str) -> R<String> {
+pub(super) fn variable_ref(s: &str, n: Node, place: &str) -> R<String> {
     let t = s.trim();
     if !t.is_empty() && t.split('.').all(is_identifier) {
         Ok(t.to_owned())
@@ -306,7 +309,7 @@ pub fn variable_ref(s: &str, n: Node, place: &str) -> R<String> {
 }
 
 /// The `addData` children of `n` as one note (their `data@name`s), if any.
-pub fn add_data_note(tc6: Tc6, n: Node, notes: &mut Notes) {
+pub(super) fn add_data_note(tc6: Tc6, n: Node, notes: &mut Notes) {
     for a in tc6.children(n, "addData") {
         let names: Vec<&str> = tc6
             .children(a, "data")

@@ -92,7 +92,7 @@ fn resolution(n: u32) -> Option<i64> {
 }
 
 impl<'t> Context<'t> {
-    pub fn new(text: &'t str) -> Context<'t> {
+    pub(super) fn new(text: &'t str) -> Context<'t> {
         Context {
             text,
             locals: HashMap::new(),
@@ -103,7 +103,7 @@ impl<'t> Context<'t> {
     }
 
     /// Records the declared globals and the type of every absolute timer and counter.
-    pub fn declare(&mut self, vars: &[Var], blocks: &[Block]) {
+    pub(super) fn declare(&mut self, vars: &[Var], blocks: &[Block]) {
         for v in vars {
             self.globals
                 .insert(v.name.value.to_string(), v.ty.value.to_string());
@@ -148,7 +148,7 @@ impl<'t> Context<'t> {
     }
 
     /// A bit operand (contact, coil, set, reset): the variable's name, `T1.Q` for an instance.
-    pub fn bit(&mut self, t: Tok) -> Result<String, LoadError> {
+    pub(super) fn bit(&mut self, t: Tok) -> Result<String, LoadError> {
         if let Some((area, byte, bit)) = bit_address(t.text) {
             let class = match area {
                 "I" => VarClass::Input,
@@ -196,7 +196,11 @@ impl<'t> Context<'t> {
     }
 
     /// A word operand of an instruction of `family` (`W` INT, `D` DINT, `R` REAL).
-    pub fn word(&mut self, t: Tok, family: char) -> Result<syntax::Operand<'static>, LoadError> {
+    pub(super) fn word(
+        &mut self,
+        t: Tok,
+        family: char,
+    ) -> Result<syntax::Operand<'static>, LoadError> {
         let s = scalar(t.text);
         let value = match s {
             Scalar::Str(ref text) if !syntax::is_time_literal(text) => {
@@ -246,7 +250,7 @@ impl<'t> Context<'t> {
     }
 
     /// The instance operand of a TON/TOF/CTU/CTD.
-    pub fn instance(&mut self, t: Tok, ty: &'static str) -> Result<String, LoadError> {
+    pub(super) fn instance(&mut self, t: Tok, ty: &'static str) -> Result<String, LoadError> {
         if box_address(t.text).is_some() && self.declared(t.text).is_none() {
             let up = t.text.to_ascii_uppercase();
             if up.starts_with('T') && resolution(up[1..].parse().unwrap_or(0)).is_none() {
@@ -267,7 +271,7 @@ impl<'t> Context<'t> {
 
     /// The PT of timer `timer`: counted in the timer's resolution for `T37`, ms (or a TIME
     /// literal, or a TIME variable) for a symbolic timer.
-    pub fn pt(&mut self, timer: Tok, t: Tok) -> Result<syntax::Operand<'static>, LoadError> {
+    pub(super) fn pt(&mut self, timer: Tok, t: Tok) -> Result<syntax::Operand<'static>, LoadError> {
         let absolute = box_address(timer.text).filter(|_| self.declared(timer.text).is_none());
         let value = match (absolute, scalar(t.text)) {
             (Some((_, n)), Scalar::Number(v)) => {
@@ -291,7 +295,7 @@ impl<'t> Context<'t> {
     }
 
     /// Declares the implicit variables (and the first-scan rung when SM0.1 is read).
-    pub fn finish(self, program: &mut syntax::Program<'static>) {
+    pub(super) fn finish(self, program: &mut syntax::Program<'static>) {
         let own = |s: &str, at: usize| Located {
             value: Cow::Owned(s.to_string()),
             origin: Origin::at(at),

@@ -87,7 +87,7 @@ pub struct Window {
 
 /// What a measurement concluded ([`choose`]).
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
-pub struct Verdict {
+pub(super) struct Verdict {
     /// The candidate to run (an index of the table: 0 is the current one).
     pub pick: usize,
     /// The median over the rounds of its time per scan over the current one's, per mille
@@ -107,7 +107,7 @@ pub struct Verdict {
 /// median per-round ratio to the current one is at most 0.97; among several, the lowest median
 /// ratio (ties: the lower index). Noise must not flip the choice back and forth, and a plan
 /// slower than the current one never replaces it.
-pub fn choose(table: &[Vec<Option<u64>>]) -> Verdict {
+pub(super) fn choose(table: &[Vec<Option<u64>>]) -> Verdict {
     let mut best = Verdict {
         pick: 0,
         ratio_permille: 1000,

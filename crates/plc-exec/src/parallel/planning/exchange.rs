@@ -40,7 +40,7 @@ pub(in crate::parallel) struct Segment {
 
 impl Segment {
     /// Data words the segment takes.
-    pub fn words(&self) -> u32 {
+    pub(crate) fn words(&self) -> u32 {
         if self.bools {
             self.len.div_ceil(64)
         } else {
@@ -63,7 +63,7 @@ pub(in crate::parallel) struct Key {
 /// The exchange of one plan: a key per (phase, worker), in that order, and the key of the
 /// program's inputs, which worker 0 hands over after the driver wrote them, before each scan.
 #[derive(Clone, Debug)]
-pub struct Exchange {
+pub(crate) struct Exchange {
     pub(in crate::parallel) threads: usize,
     pub(in crate::parallel) keys: Vec<Key>,
     /// Per (phase, worker), as `keys`: its work in the order it runs it (`early`).
@@ -86,14 +86,14 @@ impl Exchange {
 
     /// Items run before their phase's hand-over, and items in all, once the plan's items are
     /// cut into pieces (for `--explain`).
-    pub fn early_items(&self) -> (u64, u64) {
+    pub(crate) fn early_items(&self) -> (u64, u64) {
         let early = self.splits.iter().map(|s| s.early as u64).sum();
         let all = self.splits.iter().map(|s| s.items.len() as u64).sum();
         (early, all)
     }
 
     /// Data words a scan hands over, over all keys (for `--explain`).
-    pub fn words(&self) -> u64 {
+    pub(crate) fn words(&self) -> u64 {
         let segs = self
             .keys
             .iter()
@@ -104,7 +104,7 @@ impl Exchange {
 
     /// Lines of all keys, one set of buffers (a run keeps two: consecutive scans use
     /// different ones).
-    pub fn lines(&self) -> u32 {
+    pub(crate) fn lines(&self) -> u32 {
         self.lines
     }
 }

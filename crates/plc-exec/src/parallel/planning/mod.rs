@@ -43,7 +43,7 @@ mod slicing;
 mod tasks;
 
 pub use calibrate::{measure_handover, measure_line_cost, LineTiming};
-pub use exchange::Exchange;
+pub(super) use exchange::Exchange;
 pub use plan::Plan;
 pub use ready::Ready;
 pub use slicing::LevelPlan;
