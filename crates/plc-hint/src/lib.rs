@@ -11,18 +11,20 @@
 //!   CPUID), it falls back to `PREFETCHT0`; on other architectures both are no-ops.
 //!
 //! What it does not do: decide what to prefetch (its callers know their access patterns).
+//! Under Miri, which runs neither CPUID nor inline assembly, both are no-ops, as they are on
+//! other architectures (a hint changes no value, so the program Miri checks is the same).
 
 /// Asks the CPU to start loading the cache line holding `at` for reading (a hint).
 #[inline(always)]
 pub fn prefetch_read(at: *const u8) {
-    #[cfg(target_arch = "x86_64")]
+    #[cfg(all(target_arch = "x86_64", not(miri)))]
     // SAFETY: `_mm_prefetch` needs SSE, which every x86_64 CPU has (it is in the target's
     // baseline); a prefetch never faults and reads nothing into the program: any address is
     // allowed.
     unsafe {
         std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(at.cast())
     };
-    #[cfg(not(target_arch = "x86_64"))]
+    #[cfg(any(not(target_arch = "x86_64"), miri))]
     let _ = at;
 }
 
@@ -30,7 +32,7 @@ pub fn prefetch_read(at: *const u8) {
 /// this core's cache, invalidated in the others.
 #[inline(always)]
 pub fn prefetch_write(at: *const u8) {
-    #[cfg(target_arch = "x86_64")]
+    #[cfg(all(target_arch = "x86_64", not(miri)))]
     if has_prefetchw() {
         // SAFETY: the CPU implements PREFETCHW (CPUID 8000_0001h ECX bit 8, checked by
         // `has_prefetchw`); like every prefetch it never faults, whatever the address, and
@@ -41,12 +43,12 @@ pub fn prefetch_write(at: *const u8) {
     } else {
         prefetch_read(at);
     }
-    #[cfg(not(target_arch = "x86_64"))]
+    #[cfg(any(not(target_arch = "x86_64"), miri))]
     let _ = at;
 }
 
 /// Whether the CPU has PREFETCHW (read once, then cached).
-#[cfg(target_arch = "x86_64")]
+#[cfg(all(target_arch = "x86_64", not(miri)))]
 #[inline(always)]
 fn has_prefetchw() -> bool {
     use std::sync::atomic::{AtomicU8, Ordering};
@@ -62,7 +64,7 @@ fn has_prefetchw() -> bool {
     }
 }
 
-#[cfg(target_arch = "x86_64")]
+#[cfg(all(target_arch = "x86_64", not(miri)))]
 #[cold]
 fn cpuid_prefetchw() -> bool {
     use std::arch::x86_64::__cpuid;
