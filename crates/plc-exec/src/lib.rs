@@ -124,6 +124,11 @@
 //! several threads, bit-identical to [`Machine::run_scan`].
 #![warn(missing_docs)]
 #![warn(clippy::undocumented_unsafe_blocks)]
+// `unsafe` only where it is allowed by name: the state's memory (`mem`), the sequential walk's
+// unchecked store (`store`), the interpreter (`run`), the two calls into it below, and the
+// parallel machine's shared state (`parallel::machine`'s `shared`, `items`, `claimed`,
+// `workers`, `exchange`, `xlines`).
+#![deny(unsafe_code)]
 
 mod access;
 pub mod budget;
@@ -134,10 +139,13 @@ mod fuse;
 mod fuse_tests;
 mod layout;
 mod lower;
+#[allow(unsafe_code)]
 mod mem;
 mod output_mode;
 pub mod parallel;
+#[allow(unsafe_code)]
 mod run;
+#[allow(unsafe_code)]
 mod store;
 mod value;
 
@@ -502,6 +510,7 @@ impl Machine {
     /// # Panics
     /// If `mem` has fewer than [`Machine::state_size`] bytes.
     #[inline]
+    #[allow(unsafe_code)]
     pub fn run_scan_in(&self, mem: &mut [u8], scan: u64, faults: &mut Vec<Fault>) {
         assert!(
             mem.len() >= self.size as usize,
@@ -557,6 +566,7 @@ impl Machine {
 
     /// Like [`run_from`](Self::run_from), starting where an earlier run left: at a rung, at a FOR
     /// test (without the head rung's conditions), or nowhere (`Exit::Stop` returns `Stop`).
+    #[allow(unsafe_code)]
     pub fn resume<S, F>(&self, store: &mut S, ctx: &mut ScanCtx<'_>, at: Exit, inside: F) -> Exit
     where
         S: Store + ?Sized,

@@ -31,16 +31,22 @@
 
 mod backoff;
 mod barrier;
+#[allow(unsafe_code)]
 mod claimed;
 mod driver;
+#[allow(unsafe_code)]
 mod exchange;
 mod flags;
+#[allow(unsafe_code)]
 mod items;
 mod relayout;
 mod run_log;
+#[allow(unsafe_code)]
 mod shared;
 mod units;
+#[allow(unsafe_code)]
 mod workers;
+#[allow(unsafe_code)]
 mod xlines;
 
 pub use barrier::SpinBarrier;
