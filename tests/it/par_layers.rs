@@ -63,6 +63,7 @@ const RUN: Order = &[
     &["trace"],
     &["inputs"],
     &["compare"],
+    &["bookkeeping"],
     &["engine"],
     &["output"],
     &[],

@@ -3,28 +3,24 @@
 //! parallel passes, with the per-scan bookkeeping (digests, faults and their summary, trace,
 //! progress) and the report they add up to. It prints nothing: warnings are returned as data.
 
-use super::compare::{canonical_slots, digest, first_difference};
+use super::bookkeeping::{Digests, Driver, FaultTally, Inputs, TurnDigests};
+use super::compare::first_difference;
 use super::config::{RunConfig, RunFormat, RunMode, RunWarning};
 use super::inputs::{load_inputs, InputTable};
-use super::trace::{cell, trace_columns, Trace};
+use super::trace::{trace_columns, Trace};
 use crate::cmd::io::{check_output_path, load_program_for_run_selecting, CliError, FileRole};
-use crate::cmd::progress::{Bar, Progress};
+use crate::cmd::progress::Progress;
 use plc_analysis::{analyse, Analysis};
 use plc_exec::parallel::{
-    run_sequential, Candidate, ParallelMachine, PlanConfig, PlanKind, RunLog, ScanDriver,
+    run_sequential, Candidate, ParallelMachine, PlanConfig, PlanKind, RunLog,
 };
-use plc_exec::{load_value, Addr, ExecConfig, Fault, FaultKind, Layout, Machine, State, VarValue};
+use plc_exec::{ExecConfig, FaultKind, Layout, Machine, State, VarValue};
 use plc_fbd::Fbd;
 use plc_model::{PouKind, Program, ProgramRun, Type, VarClass, VarId, VarRef};
 use plc_report::configuration::configuration_entry;
 use serde_json::Value as Json;
-use std::collections::HashMap;
-use std::fmt::Write as _;
 use std::io::Write;
 use std::time::{Duration, Instant};
-
-/// Faults kept in the report (the count covers all).
-const FAULTS_KEPT: usize = 1000;
 
 /// What a run found.
 #[derive(Clone, Debug)]
@@ -81,222 +77,6 @@ pub struct FaultSummary {
     pub last_scan: u64,
 }
 
-/// Counts every fault by (rung, kind), in the order of first occurrence.
-#[derive(Default)]
-struct FaultTally {
-    index: HashMap<(u32, FaultKind), usize>,
-    /// (rung, kind, count, first scan, last scan)
-    rows: Vec<(u32, FaultKind, u64, u64, u64)>,
-}
-
-impl FaultTally {
-    fn add(&mut self, f: &Fault) {
-        let rows = &mut self.rows;
-        let i = *self.index.entry((f.rung.0, f.kind)).or_insert_with(|| {
-            rows.push((f.rung.0, f.kind, 0, f.scan, f.scan));
-            rows.len() - 1
-        });
-        let row = &mut self.rows[i];
-        row.2 += 1;
-        row.4 = f.scan;
-    }
-}
-
-/// What a pass does with the per-scan digests of the state (the hash of every value and fault
-/// that checks seq == par): a pass that no other pass is compared with computes none (`run
-/// --mode seq` or `--mode par` spend no time on them between the scans).
-enum Digests {
-    /// No other pass to compare with.
-    Skip,
-    /// Record them for the pass that follows (one turn's).
-    Record(TurnDigests),
-    /// Check them against the pass before's (the same turn's).
-    Check(TurnDigests),
-}
-
-/// The most digests a turn keeps: a turn of more scans folds consecutive scans' digests into
-/// one per chunk of `ceil(turn / DIGESTS_KEPT)` scans, so the memory of a run does not grow
-/// with its scans or its turns (16 bytes × 4096 at most).
-const DIGESTS_KEPT: u64 = 4096;
-
-/// One turn's digests, folded by chunks of `per` consecutive scans (one scan per chunk when the
-/// turn has at most [`DIGESTS_KEPT`] scans: every scan's digest, as before). The sequential pass
-/// records them; the parallel pass, which runs the same turn next, folds its own the same way
-/// and compares chunk by chunk. A chunk that differs gives its last scan as the mismatch: the
-/// replay (`first_difference`) then finds the first scan that differs, which is no later.
-#[derive(Default)]
-struct TurnDigests {
-    /// Scans per chunk in this turn.
-    per: u64,
-    /// The fold of the current chunk's digests, and how many it holds.
-    acc: u128,
-    in_acc: u64,
-    /// Recorded chunks (recording), or the other pass's chunks (checking).
-    chunks: Vec<u128>,
-    /// Checking: the next chunk to compare.
-    next: usize,
-}
-
-impl TurnDigests {
-    /// Starts a turn of `scans` scans (the recorded chunks of the last turn are dropped).
-    fn start_turn(&mut self, scans: u64) {
-        self.per = scans.div_ceil(DIGESTS_KEPT).max(1);
-        self.acc = 0;
-        self.in_acc = 0;
-        self.chunks.clear();
-        self.next = 0;
-    }
-
-    /// Folds one scan's digest in; the chunk's fold when it is complete.
-    fn fold(&mut self, d: u128) -> Option<u128> {
-        // Order-sensitive: an odd multiplier, then the next digest (a chunk of one is `d`).
-        self.acc = self
-            .acc
-            .wrapping_mul(0x9e37_79b9_7f4a_7c15_f39c_c060_5ced_c835)
-            ^ d;
-        self.in_acc += 1;
-        (self.in_acc == self.per).then(|| self.take())
-    }
-
-    /// The fold of the (partial) chunk so far, which starts a new chunk.
-    fn take(&mut self) -> u128 {
-        let acc = self.acc;
-        (self.acc, self.in_acc) = (0, 0);
-        acc
-    }
-
-    /// Checking: whether `chunk` equals the other pass's next chunk.
-    fn matches(&mut self, chunk: u128) -> bool {
-        let ok = self.chunks.get(self.next) == Some(&chunk);
-        self.next += 1;
-        ok
-    }
-}
-
-/// Per-scan bookkeeping shared by both modes.
-struct Driver<'a> {
-    inputs: &'a InputTable,
-    /// The canonical values' addresses in the layout of the machine last seen (its address), and
-    /// in the other one seen (a parallel plan on a layout of its own): computed once each.
-    canon: Vec<(Addr, u32)>,
-    canon_of: usize,
-    canon_other: Option<(usize, Vec<(Addr, u32)>)>,
-    digests: Digests,
-    first_mismatch: Option<u64>,
-    total: Duration,
-    faults: Vec<(u64, u32, FaultKind)>,
-    fault_count: u64,
-    tally: FaultTally,
-    trace: Option<Trace<'a>>,
-    bar: Bar,
-}
-
-impl<'a> Driver<'a> {
-    fn new(
-        inputs: &'a InputTable,
-        m: &Machine,
-        digests: Digests,
-        trace: Option<Trace<'a>>,
-        bar: Bar,
-    ) -> Driver<'a> {
-        Driver {
-            inputs,
-            canon: match digests {
-                Digests::Skip => Vec::new(),
-                _ => canonical_slots(m),
-            },
-            canon_of: std::ptr::from_ref(m) as usize,
-            canon_other: None,
-            digests,
-            first_mismatch: None,
-            total: Duration::ZERO,
-            faults: Vec::new(),
-            fault_count: 0,
-            tally: FaultTally::default(),
-            trace,
-            bar,
-        }
-    }
-}
-
-impl ScanDriver for Driver<'_> {
-    fn before_scan(&mut self, m: &Machine, scan: u64, slots: &mut [u8]) {
-        m.set_inputs_in(slots, self.inputs.at(scan));
-    }
-
-    fn after_scan(
-        &mut self,
-        m: &Machine,
-        scan: u64,
-        slots: &[u8],
-        faults: &[Fault],
-        elapsed: Duration,
-    ) {
-        self.total += elapsed;
-        let of = std::ptr::from_ref(m) as usize;
-        if of != self.canon_of && !matches!(self.digests, Digests::Skip) {
-            let other = match self.canon_other.take() {
-                Some((o, c)) if o == of => c,
-                _ => canonical_slots(m),
-            };
-            let last = std::mem::replace(&mut self.canon, other);
-            self.canon_other = Some((self.canon_of, last));
-            self.canon_of = of;
-        }
-        match &mut self.digests {
-            Digests::Skip => {}
-            Digests::Record(ds) => {
-                if let Some(chunk) = ds.fold(digest(slots, &self.canon, faults)) {
-                    ds.chunks.push(chunk);
-                }
-            }
-            Digests::Check(ds) => {
-                if let Some(chunk) = ds.fold(digest(slots, &self.canon, faults)) {
-                    if !ds.matches(chunk) && self.first_mismatch.is_none() {
-                        self.first_mismatch = Some(scan);
-                    }
-                }
-            }
-        }
-        self.fault_count += faults.len() as u64;
-        for f in faults {
-            if self.faults.len() < FAULTS_KEPT {
-                self.faults.push((f.scan, f.rung.0, f.kind));
-            }
-            self.tally.add(f);
-        }
-        if let Some(t) = &mut self.trace {
-            if t.error.is_none() {
-                t.line.clear();
-                let _ = write!(
-                    t.line,
-                    "{scan},{}",
-                    (scan as i64).wrapping_mul(m.config().cycle_ms as i64)
-                );
-                for &(at, ty) in &t.cols {
-                    t.line.push(',');
-                    t.line.push_str(&cell(load_value(slots, at, ty)));
-                }
-                t.line.push('\n');
-                if let Err(e) = t.out.write_all(t.line.as_bytes()) {
-                    t.error = Some(e);
-                }
-            }
-        }
-        self.bar.inc();
-    }
-
-    fn wants_state(&self) -> bool {
-        !matches!(self.digests, Digests::Skip) || self.trace.is_some()
-    }
-
-    /// The digests read the state through the machine's canonical values (any layout); the
-    /// trace's columns are addresses of the first machine's layout.
-    fn reads_any_layout(&self) -> bool {
-        self.trace.is_none()
-    }
-}
-
 /// The options given that this run does not use: `--plan` (other than the default) when only
 /// the sequential walk runs and nothing is explained, `--alternate` unless both modes run.
 fn unused_options(c: &RunConfig) -> Vec<RunWarning> {
@@ -339,25 +119,6 @@ fn turn_scans(alternate: Option<u64>, warm_time: Duration, warm: u64, scans: u64
         u64::try_from(by_time).unwrap_or(u64::MAX).max(by_count)
     };
     alternate.unwrap_or_else(by_default).clamp(1, scans.max(1))
-}
-
-/// A driver that only writes the inputs (warm-up).
-struct Inputs<'a>(&'a InputTable);
-
-impl ScanDriver for Inputs<'_> {
-    fn before_scan(&mut self, m: &Machine, scan: u64, slots: &mut [u8]) {
-        m.set_inputs_in(slots, self.0.at(scan));
-    }
-    fn after_scan(&mut self, _: &Machine, _: u64, _: &[u8], _: &[Fault], _: Duration) {}
-    fn wants_time(&self) -> bool {
-        false
-    }
-    fn wants_state(&self) -> bool {
-        false
-    }
-    fn reads_any_layout(&self) -> bool {
-        true
-    }
 }
 
 /// Everything a run needs, checked: nothing after this fails but writing the trace.
@@ -849,7 +610,8 @@ fn report(pr: &Prepared, c: &RunConfig, m: &Machine, pass: Pass, extra: Extra) -
 
 #[cfg(test)]
 mod tests {
-    use super::{turn_scans, TurnDigests, DIGESTS_KEPT};
+    use super::super::bookkeeping::{TurnDigests, DIGESTS_KEPT};
+    use super::turn_scans;
     use std::time::Duration;
 
     #[test]

@@ -23,6 +23,7 @@
 //! `compare` (digests and the lockstep replay to the first difference), `engine` (preparing
 //! and running the scans), `output` (the text, JSON and HTML renderings of a report), then this
 //! module (declared alphabetically below: rustfmt sorts them).
+mod bookkeeping;
 mod compare;
 mod config;
 mod engine;
