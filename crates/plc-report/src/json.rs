@@ -441,17 +441,23 @@ struct Object<'a, W: ?Sized> {
 }
 
 impl<W: ?Sized + Write> Object<'_, W> {
-    /// Writes the separator before a key, the key and `: `.
-    fn key(&mut self, key: &str) -> Result<(), Error> {
+    /// The separator before the next key (and marks the object as no longer empty).
+    #[inline(always)]
+    fn key_separator(&mut self) -> Separator {
         let first = std::mem::take(&mut self.first);
-        let sep = match self.place {
+        match self.place {
             Place::OneLine if first => Separator::Nothing,
             Place::OneLine => Separator::Comma,
             Place::Lines(depth) => Separator::Line {
                 first,
                 depth: depth + 1,
             },
-        };
+        }
+    }
+
+    /// Writes the separator before a key, the key and `: `.
+    fn key(&mut self, key: &str) -> Result<(), Error> {
+        let sep = self.key_separator();
         string(self.out, sep, key, b"\": ")
     }
 
@@ -460,16 +466,7 @@ impl<W: ?Sized + Write> Object<'_, W> {
     #[inline(always)]
     fn static_key(&mut self, key: &'static str) -> Result<(), Error> {
         debug_assert!(plain(key), "a field name needs escaping: {key}");
-        let first = std::mem::take(&mut self.first);
-        let sep = match self.place {
-            Place::OneLine if first => Separator::Nothing,
-            Place::OneLine => Separator::Comma,
-            Place::Lines(depth) => Separator::Line {
-                first,
-                depth: depth + 1,
-            },
-        };
-        sep.write(self.out)?;
+        self.key_separator().write(self.out)?;
         self.out.write_all(b"\"")?;
         self.out.write_all(key.as_bytes())?;
         self.out.write_all(b"\": ")?;
