@@ -220,3 +220,39 @@ fn bitwise_functions_are_the_word_instructions_and_read_back() {
     // Scan 2 (go off: r1 kept): -1 OR 3 = -1; 0xF0 XOR 3 = 0xF3; NOT -1 = 0; NOT -1 = 0.
     assert_eq!(want[1], "r1=52 r2=-1 r3=243 r4=0 r5=0 e=43399");
 }
+
+/// INT_TO_REAL is two S7-200 instructions through a DINT scratch word (`I_DI`, then `DI_R`),
+/// exact for every INT; read back it gives the interpreter's REAL. A conversion S7-200 cannot
+/// do exactly is refused by its name, which says both types (REAL_TO_INT: `ROUND` gives a
+/// DINT, and `DI_I` leaves its output unchanged where an INT cannot hold it).
+#[test]
+fn int_to_real_goes_through_a_dint_and_a_refused_conversion_names_its_types() {
+    let doc = json!({"program": "conv", "vars": [
+        {"name": "go", "type": "BOOL", "class": "input"},
+        {"name": "a", "type": "INT", "class": "input"}, {"name": "b", "type": "INT", "class": "input"},
+        {"name": "x", "type": "REAL"}, {"name": "y", "type": "REAL"}
+    ], "rungs": [
+        {"id": "R1", "ld": [{"contact": "go"}, {"op": "INT_TO_REAL", "in": ["a"], "out": "x"}]},
+        {"id": "R2", "ld": [{"op": "INT_TO_REAL", "in": ["b"], "out": "y"},
+                            {"op": "MUL", "in": ["y", 0.5], "out": "y"}]}
+    ]});
+    let (p, fbd) = load(&doc);
+    let stl = plc_deps::codegen::il::generate(&p, &fbd).unwrap();
+    assert!(stl.contains("LD     go\nI_DI   a, IL_TMP_DINT\nDI_R   IL_TMP_DINT, x\n"), "{stl}");
+    let (back, _) = plc_deps::load::stl(&stl).unwrap_or_else(|e| panic!("{e:?}\n{stl}"));
+    let scans = [(true, -32768, 32767), (false, 5, -3), (true, 12345, 1)];
+    let want = run_named(&p, &["x", "y"], &scans);
+    assert_eq!(run_named(&back, &["x", "y"], &scans), want, "\n{stl}");
+    assert_eq!(want[0], "x=-32768.0 y=16383.5");
+    assert_eq!(want[1], "x=-32768.0 y=-1.5");
+
+    let doc = json!({"program": "conv", "vars": [
+        {"name": "r", "type": "REAL", "class": "input"}, {"name": "n", "type": "INT"}
+    ], "rungs": [{"id": "R1", "ld": [{"op": "REAL_TO_INT", "in": ["r"], "out": "n"}]}]});
+    let (p, fbd) = load(&doc);
+    let err = plc_deps::codegen::il::generate(&p, &fbd).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "rung R1: REAL_TO_INT is not expressible in S7-200 IL"
+    );
+}

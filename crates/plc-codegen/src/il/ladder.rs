@@ -405,6 +405,13 @@ impl Emit<'_> {
             self.net.emit(instr, &[&n.operand(&args[0]), target], 0);
             return Ok(());
         }
+        if func == super::INT_TO_REAL {
+            // Exact: every INT is a DINT, and every DINT of INT's range a REAL.
+            let s = n.scratch(Type::Dint);
+            self.net.emit("I_DI", &[&n.operand(&args[0]), s], 0);
+            self.net.emit("DI_R", &[s, target], 0);
+            return Ok(());
+        }
         let shift = match (func, ty) {
             (Function::Shl, Type::Int) => Some(("SLW", "MOVW")),
             (Function::Shr, Type::Int) => Some(("SRW", "MOVW")),
@@ -434,9 +441,16 @@ impl Emit<'_> {
                 "{} with a count that is not a constant 0..255 is not expressible in S7-200 IL (its shifts take a byte count)",
                 func.name()
             )),
-            _ => self.fail(format!(
-                "{} of {ty} is not expressible in S7-200 IL",
+            // A conversion's name says both types; any other function is named with the
+            // type of what it is given.
+            _ if matches!(func, Function::Convert { .. }) => self.fail(format!(
+                "{} is not expressible in S7-200 IL",
                 func.name()
+            )),
+            _ => self.fail(format!(
+                "{} of {} is not expressible in S7-200 IL",
+                func.name(),
+                args.first().map_or(ty, |a| self.operand_type(a))
             )),
         }
     }

@@ -200,17 +200,25 @@ fn needs_scratch(op: ArithOp, b: &Operand, out: VarId) -> bool {
     op == ArithOp::Mod || (b_is_out && matches!(op, ArithOp::Sub | ArithOp::Div))
 }
 
-/// The scratch words `p`'s arithmetic needs: one per type, named `IL_TMP_<TYPE>` (a number
+/// INT_TO_REAL, which S7-200 does in two steps through a DINT (`I_DI`, then `DI_R`).
+pub(crate) const INT_TO_REAL: plc_model::Function = plc_model::Function::Convert {
+    from: Type::Int,
+    to: Type::Real,
+};
+
+/// The scratch words `p`'s arithmetic and INT_TO_REAL need: one per type, named `IL_TMP_<TYPE>` (a number
 /// added while that names a variable of the program).
 fn scratch_words(p: &Program) -> Vec<(Type, String)> {
     let mut types: Vec<Type> = Vec::new();
     for r in &p.rungs {
         walk_elements(&r.series, &mut |e| {
-            if let Element::Arith { op, b, out, .. } = e {
-                let ty = p.var(*out).ty;
-                if needs_scratch(*op, b, *out) && !types.contains(&ty) {
-                    types.push(ty);
-                }
+            let ty = match e {
+                Element::Arith { op, b, out, .. } if needs_scratch(*op, b, *out) => p.var(*out).ty,
+                Element::Function { func, .. } if *func == INT_TO_REAL => Type::Dint,
+                _ => return,
+            };
+            if !types.contains(&ty) {
+                types.push(ty);
             }
         });
     }
