@@ -19,12 +19,22 @@ impl<'a> Builder<'a> {
     /// `d` with a "did you mean" hint when it is an undefined variable and a declared variable
     /// or instance (of any POU) has a name close to it ([`plc_diag::suggest`]).
     pub(super) fn hinted(&self, d: Diagnostic) -> Diagnostic {
-        let Invalid::UndefinedVar { name } = &d.kind else {
-            return d;
-        };
         if d.hint.is_some() {
             return d;
         }
+        if let Invalid::Type {
+            expected,
+            operand,
+            found,
+            ..
+        } = &d.kind
+        {
+            let hint = instance_output_hint(operand, found, expected);
+            return d.with_hint(hint);
+        }
+        let Invalid::UndefinedVar { name } = &d.kind else {
+            return d;
+        };
         // Display names are `SBR_0:name` for subroutine locals: the declared name is the last part.
         fn declared(n: &str) -> &str {
             n.rsplit(':').next().unwrap_or(n)
@@ -288,4 +298,25 @@ impl MaxNumeric for Type {
             self
         }
     }
+}
+
+/// Where an operand of the wrong type is a standard function block instance (`{"move": "C1"}`
+/// on a CTU): the output of that instance that has the type the element needs (`C1.CV`), in
+/// the words of a hint. IEC 61131-3 6.6.3.2: an instance's outputs are read as
+/// `instance.output`; the instance itself is not a value.
+fn instance_output_hint(operand: &str, found: &str, expected: &str) -> Option<String> {
+    let boolean = expected == "BOOL";
+    let time = expected == "TIME";
+    let output = match found {
+        "CTU" | "CTD" | "CTUD" if !boolean && !time => "CV",
+        "CTU" | "CTD" if boolean => "Q",
+        "CTUD" if boolean => "QU",
+        "TON" | "TOF" | "TP" if time => "ET",
+        "TON" | "TOF" | "TP" | "R_TRIG" | "F_TRIG" if boolean => "Q",
+        "SR" | "RS" if boolean => "Q1",
+        _ => return None,
+    };
+    Some(format!(
+        "`{operand}` is a {found} instance; its output {output} is `{operand}.{output}`"
+    ))
 }

@@ -56,6 +56,14 @@ impl<'a> Builder<'a> {
         check_var_name(name, || format!("{}.name", p())).map_err(|e| e.at(v.name.origin))?;
         let tname: &str = v.ty.as_str();
         let user_fb = Type::parse(tname).is_none() && self.fb_index.contains_key(tname);
+        // A misspelt type (`bool`, `INTT`): the nearest of the types the program can name.
+        let type_hint = || {
+            let standard = plc_model::ELEMENTARY.iter().map(|&(n, _)| n).chain([
+                "TIME", "TON", "TOF", "TP", "CTU", "CTD", "SR", "RS", "R_TRIG", "F_TRIG", "CTUD",
+            ]);
+            let user = self.fb_types.iter().map(|f| f.name.as_str());
+            plc_diag::suggest::did_you_mean(tname, standard.chain(user))
+        };
         let ty = match Type::parse(tname) {
             Some(t) => t,
             None if user_fb => Type::Fb(FbKind::Ton), // placeholder: instances are not variables
@@ -66,7 +74,7 @@ impl<'a> Builder<'a> {
                     .map(|f| f.name.as_str())
                     .collect::<Vec<_>>()
                     .join(", ");
-                return Err(LoadError::invalid(
+                let e = LoadError::invalid(
                     None,
                     &format!("{}.type", p()),
                     Invalid::UnknownTypeOrFb {
@@ -74,15 +82,23 @@ impl<'a> Builder<'a> {
                         fbs,
                     },
                 )
-                .at(v.ty.origin));
+                .at(v.ty.origin);
+                return Err(match type_hint() {
+                    Some(h) => e.with_hint(&h),
+                    None => e,
+                });
             }
             None => {
-                return Err(LoadError::invalid(
+                let e = LoadError::invalid(
                     None,
                     &format!("{}.type", p()),
                     Invalid::UnknownType { name: tname.into() },
                 )
-                .at(v.ty.origin))
+                .at(v.ty.origin);
+                return Err(match type_hint() {
+                    Some(h) => e.with_hint(&h),
+                    None => e,
+                });
             }
         };
         // Only an elementary variable may have a dotted name (a structure's field).

@@ -69,6 +69,9 @@ fn syntax_error(text: &str, start: usize, at: usize) -> LoadError {
             message: "the file is empty (expected a JSON object, the program)".into(),
         },
         Err(e) => {
+            if let Some(error) = trailing_comma(text, start, e.line(), e.column()) {
+                return error;
+            }
             let message = e.to_string();
             let message = match message.rfind(" at line ") {
                 Some(i) => message[..i].to_owned(),
@@ -92,6 +95,38 @@ fn syntax_error(text: &str, start: usize, at: usize) -> LoadError {
             }
         }
     }
+}
+
+/// A comma right before the `]` or `}` where serde_json stopped (at 1-based `line`, `column`
+/// of the text after the byte-order mark): JSON allows none there (RFC 8259 §4, §5), and the
+/// place to show is the comma, which may be lines before the bracket.
+fn trailing_comma(text: &str, start: usize, line: usize, column: usize) -> Option<LoadError> {
+    let body = &text[start..];
+    let line_start = if line <= 1 {
+        0
+    } else {
+        body.match_indices('\n').nth(line - 2)?.0 + 1
+    };
+    let at = line_start + column.max(1) - 1;
+    let close = *body.as_bytes().get(at)?;
+    if close != b']' && close != b'}' {
+        return None;
+    }
+    let before = body[..at].trim_end_matches([' ', '\t', '\n', '\r']);
+    if !before.ends_with(',') {
+        return None;
+    }
+    let comma = start + before.len() - 1;
+    let (line, column) = Origin::at(comma).line_column(text)?;
+    let what = if close == b']' { "array" } else { "object" };
+    Some(LoadError::Syntax {
+        line: line as usize,
+        column: column as usize,
+        message: format!(
+            "trailing comma: a value must follow `,` (JSON allows no comma before the `{}` that ends the {what})",
+            close as char
+        ),
+    })
 }
 
 fn shape(expected: &'static str, found: &Scalar) -> Invalid {
