@@ -103,8 +103,9 @@ struct ReportArgs {
     #[arg(long, default_value_t = plc_deps::analysis::DEFAULT_MAX_PAIRS)]
     max_pairs: u64,
     /// DOT: draw the rungs of this POU (the program, a subroutine or an FB instance). Text,
-    /// JSON, HTML: analyse only this program of a PLCopen project [default: every program
-    /// instance, in task order].
+    /// JSON, HTML: analyse only this program of a PLCopen project or a configuration, or, in a
+    /// program without a configuration, this subroutine and what it calls [default: every
+    /// program instance, in task order].
     #[arg(long, conflicts_with = "rungs")]
     pou: Option<String>,
     /// DOT only: draw the rungs from FIRST to LAST in file order (`R10..R50`, or one id).
@@ -214,8 +215,9 @@ struct RunArgs {
     /// about 20 ms of the sequential walk's scans, and at least a 64th of the run].
     #[arg(long, value_name = "N")]
     alternate: Option<u64>,
-    /// Run only this program of a PLCopen project [default: every program instance, in
-    /// task order].
+    /// Run only this program of a PLCopen project or a configuration, or, in a program
+    /// without a configuration, this subroutine and what it calls [default: every program
+    /// instance, in task order].
     #[arg(long)]
     pou: Option<String>,
     /// Go on when a POU's body is not executed (a PLCopen ST, IL or SFC body, read only as

@@ -383,12 +383,11 @@ fn load_text_for(
 ) -> Result<(Program, Fbd), CliError> {
     let format = format_of(&file, text);
     if format == Format::Stl {
-        if let Some(name) = select {
-            return Err(CliError::Usage(format!(
-                "{file}: --pou {name} selects a program of a PLCopen project or of a JSON program with a configuration, and this is an STL program (the DOT report's --pou draws one POU of any program: add --format dot)"
-            )));
+        return match select {
+            Some(name) => plc_load::stl_selected(text, name),
+            None => plc_load::stl(text),
         }
-        return plc_load::stl(text).map_err(|error| CliError::load(file, text, error));
+        .map_err(|error| CliError::load(file, text, error));
     }
     if format == Format::PlcOpen {
         let load = match purpose {

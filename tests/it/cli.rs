@@ -515,7 +515,7 @@ fn dot_selection_errors_are_clear() {
         (&["report", b, "--format", "dot", "--rungs", "R5..R2"], "error: analyses/example-b/program.json: --rungs R5..R2: `R2` comes before `R5` in the program"),
         (&["report", b, "--format", "dot", "--rungs", "R5..R99"], "error: analyses/example-b/program.json: --rungs: no rung `R99` in the program"),
         (&["report", b, "--rungs", "R5"], "error: --rungs chooses what the DOT report draws; add --format dot (the text and JSON reports cover the whole program)"),
-        (&["report", b, "--pou", "SBR_A"], "error: --pou SBR_A selects a program that a program instance of the configuration runs, and this program has no `configuration` (the DOT report's --pou draws one POU of any program: add --format dot)"),
+        (&["report", b, "--pou", "SBR_X"], "error: --pou SBR_X: the program has no configuration, so --pou selects one of its subroutines, and no subroutine has that name; it has SBR_A, SBR_B"),
         (&["report", path, "--format", "dot", "--rungs", "R1..R2400"], &big),
     ];
     for (args, expected) in cases {
@@ -527,4 +527,35 @@ fn dot_selection_errors_are_clear() {
         assert_eq!(error_line(&out, expected), expected);
         assert!(!out_file.exists());
     }
+}
+
+/// On a program without a configuration, `--pou` of the text, JSON and HTML reports (and of
+/// `run`) selects a subroutine: the report of that routine alone, with what it calls, from the
+/// JSON program and from its STL alike (any case).
+#[test]
+fn pou_on_a_program_without_configuration_reports_that_subroutine() {
+    for file in [
+        "analyses/example-b/program.json",
+        "analyses/example-b/program.stl",
+    ] {
+        let out = run(&["report", file, "--pou", "sbr_a", "--format", "json"]);
+        assert_eq!(out.status.code(), Some(0), "{file}");
+        let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(r["program"], "SBR_A", "{file}");
+        let rungs: Vec<String> = r["rungs"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|r| format!("{} {}", r["id"].as_str().unwrap(), r["pou"].as_str().unwrap()))
+            .collect();
+        assert_eq!(rungs, ["R11 SBR_A"], "{file}");
+    }
+    // A routine that calls another keeps it: the conveyor's main program calls ALARM, so
+    // selecting ALARM gives its two rungs, and nothing of the main program.
+    let out = run(&["report", "analyses/conveyor/program.json", "--pou", "ALARM"]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.starts_with("ALARM: 2 rungs\n"), "{text}");
+    let out = run(&["run", "analyses/conveyor/program.json", "--pou", "ALARM", "--scans", "1"]);
+    assert_eq!(out.status.code(), Some(0));
+    assert!(String::from_utf8(out.stdout).unwrap().starts_with("program ALARM: 1 scan"));
 }

@@ -75,16 +75,10 @@ pub fn program_and_fbd_from_json_selected(
     };
     let syntax = match select_program(read::json::parse(text)?, select) {
         Ok(s) => s,
-        Err(NotSelectable::NoConfiguration) => {
+        Err(NotSelectable::NoConfiguration { subroutines }) => {
             return Err(placed(
                 text,
-                LoadError::invalid(
-                    None,
-                    "",
-                    plc_diag::Invalid::Configuration {
-                        message: format!("--pou {select} selects a program that a program instance of the configuration runs, and this program has no `configuration` (the DOT report's --pou draws one POU of any program: add --format dot)"),
-                    },
-                ),
+                LoadError::invalid(None, "", no_such_routine(select, &subroutines)),
             ))
         }
         Err(NotSelectable::Unknown { programs }) => {
@@ -97,6 +91,17 @@ pub fn program_and_fbd_from_json_selected(
     let (mut p, f) = resolve::resolve(text, &syntax).map_err(|e| placed(text, e))?;
     p.configuration = whole.configuration;
     Ok((p, f))
+}
+
+/// `--pou NAME` on a program without a configuration that has no routine of that name.
+fn no_such_routine(select: &str, subroutines: &[String]) -> plc_diag::Invalid {
+    let has = match subroutines {
+        [] => "it has none".to_owned(),
+        names => format!("it has {}", names.join(", ")),
+    };
+    plc_diag::Invalid::Configuration {
+        message: format!("--pou {select}: the program has no configuration, so --pou selects one of its subroutines, and no subroutine has that name; {has}"),
+    }
 }
 
 /// An error of a JSON program placed at the value its path names.
@@ -215,5 +220,21 @@ fn exec_order_note(f: &Fbd, x: &ExecOrder) -> Option<Note> {
 /// Reads and resolves an STL file: the program and its (empty) FBD bodies.
 pub fn stl(text: &str) -> Result<(Program, Fbd), LoadError> {
     let syntax = read::stl::parse(text)?;
+    resolve::resolve(text, &syntax)
+}
+
+/// [`stl`] with the subroutine or interrupt routine `select` (any case) as the main program
+/// (`--pou SBR_0`), as [`plc_syntax::select::select_program`] gives it.
+pub fn stl_selected(text: &str, select: &str) -> Result<(Program, Fbd), LoadError> {
+    use plc_syntax::select::{select_program, NotSelectable};
+    stl(text)?;
+    let syntax = match select_program(read::stl::parse(text)?, select) {
+        Ok(s) => s,
+        // An STL program has no configuration.
+        Err(NotSelectable::NoConfiguration { subroutines: names })
+        | Err(NotSelectable::Unknown { programs: names }) => {
+            return Err(LoadError::invalid(None, "", no_such_routine(select, &names)))
+        }
+    };
     resolve::resolve(text, &syntax)
 }
