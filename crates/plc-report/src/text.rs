@@ -291,19 +291,7 @@ pub fn render_text(r: &Report, o: &TextOptions, out: &mut impl Write) -> io::Res
 
 fn cycles(r: &Report, paper: bool, combined: bool, out: &mut impl Write) -> io::Result<()> {
     let m = r.cycles.before;
-    // Saved cycles, rounded to a whole percent, except that a saving short of all of them is
-    // never shown as "100 %" (6 cycles out of 3,019 is 99.8 %).
-    let pct = |n: usize| {
-        if m == 0 {
-            return "0 %".to_string();
-        }
-        let saved = (m - n.min(m)) as f64 / m as f64 * 100.0;
-        if saved.round() >= 100.0 && n > 0 {
-            format!("{:.1} %", (saved * 10.0).floor() / 10.0)
-        } else {
-            format!("{saved:.0} %")
-        }
-    };
+    let pct = |n: usize| crate::words::saved_percent(m, n);
     writeln!(
         out,
         "\nScan cycles (one rung per cycle before; one level per cycle after)"

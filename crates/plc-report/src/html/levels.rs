@@ -71,7 +71,11 @@ fn columns<'a>(r: &Report<'a>) -> Vec<Column<'a>> {
         .iter()
         .enumerate()
         .map(|(l, tasks)| Column {
-            title: format!("level {} · {} tasks", l + 1, tasks.len()),
+            title: format!(
+                "level {} · {}",
+                l + 1,
+                crate::words::plural(tasks.len(), "task", "tasks")
+            ),
             level: Some(l + 1),
             items: tasks
                 .iter()

@@ -11,6 +11,7 @@
 //! between visits.
 
 use super::{esc, thousands};
+use crate::words::plural;
 use crate::document::Report;
 use std::io::{self, Write};
 
@@ -144,26 +145,23 @@ fn saved(before: usize, after: usize) -> String {
     if before == 0 {
         return String::new();
     }
-    format!(
-        "{} %",
-        ((before as f64 - after as f64) * 100.0 / before as f64).round()
-    )
+    crate::words::saved_percent(before, after)
 }
 
 /// Writes the summary: sizes, scan cycles per view, cost figures, makespan bars, warnings.
 pub(super) fn write_summary(out: &mut impl Write, r: &Report) -> io::Result<()> {
     out.write_all(b"<section id=\"summary\">\n")?;
     let mut size = format!(
-        "{} rungs ({} in the main program, {} in subroutines)",
-        thousands(r.summary.rungs),
+        "{} ({} in the main program, {} in subroutines)",
+        plural(r.summary.rungs, "rung", "rungs"),
         thousands(r.summary.main_rungs),
         thousands(r.summary.rungs - r.summary.main_rungs)
     );
     if let Some(f) = &r.fbd {
         size.push_str(&format!(
-            "; written as {} FBD blocks in {} networks",
-            thousands(f.blocks),
-            thousands(f.networks)
+            "; written as {} in {}",
+            plural(f.blocks, "FBD block", "FBD blocks"),
+            plural(f.networks, "network", "networks")
         ));
     }
     writeln!(out, "<p>{size}.</p>\n<div class=\"summary\">")?;

@@ -17,6 +17,7 @@
 //! Deliberately not here: running anything, and the cost model itself (the figures come from the
 //! report document, `cost`).
 
+use crate::words::plural;
 use super::{esc, thousands};
 use crate::document::Report;
 use std::io::{self, Write};
@@ -113,19 +114,14 @@ pub(super) fn write_run(out: &mut impl Write, doc: &Report, run: &RunFigures) ->
     out.write_all(b"<section id=\"run\">\n<h2>Run: measured scan rates beside the model</h2>\n")?;
     writeln!(
         out,
-        "<p>{} scans of {} ms (virtual time), {} {}{}.</p>",
-        thousands(run.scans as usize),
+        "<p>{} of {} ms (virtual time), {}{}.</p>",
+        plural(run.scans as usize, "scan", "scans"),
         run.cycle_ms,
-        run.threads,
-        if run.threads == 1 {
-            "thread"
-        } else {
-            "threads"
-        },
+        plural(run.threads, "thread", "threads"),
         if run.workers != run.threads {
             format!(
-                " (planned for {} workers, the cores there are)",
-                run.workers
+                " (planned for {}, the cores there are)",
+                plural(run.workers, "worker", "workers")
             )
         } else {
             String::new()
@@ -180,12 +176,12 @@ pub(super) fn write_rates(out: &mut impl Write, run: &RunFigures) -> io::Result<
                 }),
             ) => format!("sequential fallback ({})", esc(why)),
             ("par", Some(x), _) => format!(
-                "<b class=\"ratio\">×{x:.2}</b> over {} scans{}",
-                thousands(run.scans as usize),
+                "<b class=\"ratio\">×{x:.2}</b> over {}{}",
+                plural(run.scans as usize, "scan", "scans"),
                 match run.block_scans {
                     Some(b) if b < run.scans => format!(
-                        ", seq and par alternating every {} scans",
-                        thousands(b as usize)
+                        ", seq and par alternating every {}",
+                        plural(b as usize, "scan", "scans")
                     ),
                     _ => String::new(),
                 }
@@ -207,7 +203,7 @@ pub(super) fn write_rates(out: &mut impl Write, run: &RunFigures) -> io::Result<
             .scans_on
             .iter()
             .filter(|(_, n)| *n > 0)
-            .map(|(c, n)| format!("<code>{}</code> {} scans", esc(c), thousands(*n as usize)))
+            .map(|(c, n)| format!("<code>{}</code> {}", esc(c), plural(*n as usize, "scan", "scans")))
             .collect();
         writeln!(
             out,
@@ -265,8 +261,8 @@ fn write_ideal(out: &mut impl Write, doc: &Report, run: &RunFigures) -> io::Resu
     if !c.makespan.0.iter().any(|&(p, _)| p as usize == run.workers) {
         writeln!(
             out,
-            "<p class=\"legend\">The model gives P = 1, 2, 4, 8; this run had {} workers.</p>",
-            run.workers
+            "<p class=\"legend\">The model gives P = 1, 2, 4, 8; this run had {}.</p>",
+            plural(run.workers, "worker", "workers")
         )?;
     }
     out.write_all(b"</div>\n")

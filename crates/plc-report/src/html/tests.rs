@@ -463,3 +463,25 @@ fn the_tasks_section_lists_the_tasks_their_instances_and_the_globals_they_share(
     assert!(html.contains("Analysed: all 2 program instances, in task order: Slow.b (B), Slow.c (C).</p>\n<p>One task: nothing is shared between tasks.</p>"));
     assert!(!html.contains("<table class=\"shared\">"));
 }
+
+/// One of a thing is singular everywhere on the page (`1 rung`, `level 1 · 1 task`), and the
+/// saving is rounded as the text report rounds it: a chain of 3 rungs saves nothing; rungs
+/// that all run at once save 2 of 3 cycles, 67 %.
+#[test]
+fn counts_of_one_are_singular_and_savings_round_as_in_the_text_report() {
+    let one = r#"{"program": "one", "vars": [{"name": "a", "type": "BOOL", "class": "input"},
+        {"name": "y", "type": "BOOL", "class": "output"}],
+        "rungs": [{"id": "R1", "ld": [{"contact": "a"}, {"coil": "y"}]}]}"#;
+    let html = page_of_text(one);
+    assert!(html.contains("<p>1 rung (1 in the main program, 0 in subroutines).</p>"), "{html}");
+    assert!(html.contains("level 1 · 1 task<"), "{html}");
+    assert!(!html.contains(" 1 tasks") && !html.contains(" 1 rungs"), "{html}");
+    let three = r#"{"program": "three", "vars": [{"name": "a", "type": "BOOL", "class": "input"},
+        {"name": "x", "type": "BOOL"}, {"name": "y", "type": "BOOL"}, {"name": "z", "type": "BOOL"}],
+        "rungs": [{"id": "R1", "ld": [{"contact": "a"}, {"coil": "x"}]},
+                  {"id": "R2", "ld": [{"contact": "a"}, {"coil": "y"}]},
+                  {"id": "R3", "ld": [{"contact": "a"}, {"coil": "z"}]}]}"#;
+    let html = page_of_text(three);
+    assert!(html.contains("<td>67 %</td>"), "{html}");
+    assert!(html.contains("level 1 · 3 tasks<"), "{html}");
+}
