@@ -43,6 +43,7 @@ fn five_hundred_rungs_are_all_drawn() {
         assert!(html.contains(&format!("id=\"rung-R{i}\"")), "R{i}");
     }
     assert!(!html.contains("this page draws as cards"));
+    assert!(html.contains("<div id=\"info\">Hover or click a rung"));
     assert!(html.len() < 4_000_000, "{} bytes", html.len());
 }
 
@@ -56,6 +57,8 @@ fn a_hundred_thousand_rungs_collapse_to_level_summaries_under_a_few_megabytes() 
     assert!(html.contains("each core's consecutive tasks drawn as one busy bar"));
     // One summary row per level.
     assert_eq!(html.matches("<tr data-level=").count(), 20);
+    // No rung is drawn, so nothing invites the reader to hover one.
+    assert!(!html.contains("Hover or click a rung"));
 }
 
 #[test]

@@ -196,10 +196,15 @@ fn place<'a>(
     )
 }
 
+/// Whether the level view draws the rungs as cards (else it summarises each level).
+pub(super) fn draws_cards(r: &Report) -> bool {
+    r.summary.rungs <= MAX_DETAILED_RUNGS
+}
+
 /// Writes the level view (cards and edges, or the level summaries of a large program).
 pub(super) fn write_levels(out: &mut impl Write, input: &HtmlInput) -> io::Result<()> {
     let r = input.doc;
-    if r.summary.rungs > MAX_DETAILED_RUNGS {
+    if !draws_cards(r) {
         return write_summaries(out, r);
     }
     let cols = columns(r);

@@ -129,7 +129,12 @@ fn write_page(input: &HtmlInput, run: Option<&RunFigures>, out: &mut impl Write)
     }
     tasks::write_tasks(out, r)?;
     out.write_all(b"<section id=\"levels\">\n<h2>Levels of the combined schedule</h2>\n")?;
-    page::write_level_legend(out)?;
+    // Rungs are drawn as cards (which the legend and the info line are about) only up to
+    // a size; a larger program's levels are summaries.
+    let cards = levels::draws_cards(r);
+    if cards {
+        page::write_level_legend(out)?;
+    }
     levels::write_levels(out, input)?;
     out.write_all(b"</section>\n<section id=\"views\">\n<h2>The paper's views beside the combined schedule</h2>\n")?;
     levels::write_views(out, r)?;
@@ -142,7 +147,7 @@ fn write_page(input: &HtmlInput, run: Option<&RunFigures>, out: &mut impl Write)
     )?;
     graphs::write_graphs(out, input.program, input.analysis)?;
     out.write_all(b"</section>\n")?;
-    page::write_foot(out)
+    page::write_foot(out, cards)
 }
 
 #[cfg(test)]

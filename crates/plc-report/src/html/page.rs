@@ -72,6 +72,7 @@ const SCRIPT: &str = r#"
     add(into, e.getAttribute('data-to'), e);
   });
   var info = document.getElementById('info');
+  if (!info) { return; } // a summarised page draws no rung to hover
   var idle = info.textContent;
   var marked = [];
   function mark(list, cls) {
@@ -225,10 +226,12 @@ pub(super) fn write_level_legend(out: &mut impl Write) -> io::Result<()> {
     out.write_all(b"<p class=\"legend\">Columns are levels (rungs of one level may run at the same time). Edges: <span class=\"k flow\"></span>flow <span class=\"k anti\"></span>anti <span class=\"k output\"></span>output <span class=\"k control\"></span>control (the paper's). Hover or click a rung: <b>its dependences</b> in orange, what depends on it in blue.</p>\n")
 }
 
-/// The info line, the script and the end of the page.
-pub(super) fn write_foot(out: &mut impl Write) -> io::Result<()> {
+/// The info line (where rungs are drawn as cards to hover), the script and the end of the page.
+pub(super) fn write_foot(out: &mut impl Write, cards: bool) -> io::Result<()> {
     out.write_all(b"<p class=\"legend\">Made by plc-deps; the definitions and the cost model are in its docs/report.md, this page in docs/html.md.</p>\n")?;
-    out.write_all(b"<div id=\"info\">Hover or click a rung to see what it depends on and what depends on it.</div>\n")?;
+    if cards {
+        out.write_all(b"<div id=\"info\">Hover or click a rung to see what it depends on and what depends on it.</div>\n")?;
+    }
     writeln!(
         out,
         "<script>//<![CDATA[{SCRIPT}//]]></script>\n</body>\n</html>"
