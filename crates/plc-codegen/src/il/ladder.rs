@@ -441,10 +441,15 @@ impl Emit<'_> {
                 "{} with a count that is not a constant 0..255 is not expressible in S7-200 IL (its shifts take a byte count)",
                 func.name()
             )),
-            // A conversion's name says both types; any other function is named with the
-            // type of what it is given.
+            // A conversion's name says both types; MUX is named with the type it selects
+            // (its first input is the selector K); any other function with the type of what
+            // it is given.
             _ if matches!(func, Function::Convert { .. }) => self.fail(format!(
                 "{} is not expressible in S7-200 IL",
+                func.name()
+            )),
+            _ if matches!(func, Function::Mux) => self.fail(format!(
+                "{} of {ty} is not expressible in S7-200 IL",
                 func.name()
             )),
             _ => self.fail(format!(
