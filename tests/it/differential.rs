@@ -149,9 +149,12 @@ fn check_with(
     if let Err(e) = par.verify(p, &a) {
         panic!("{label}: unsafe plan: {e}\n{}", par.explain(p));
     }
-    // A plan that failed its check was dropped with a warning: that is a planner bug here.
+    // A plan that failed its check was dropped with a warning: that is a planner bug here (a
+    // forced plan's "modelled slower" warning is not).
     assert!(
-        par.warnings().is_empty(),
+        par.warnings()
+            .iter()
+            .all(|w| w.contains("forces the levelled plan although")),
         "{label}: {:?}\n{}",
         par.warnings(),
         par.explain(p)

@@ -564,7 +564,45 @@ fn an_option_the_run_does_not_use_is_a_warning() {
         &["--mode", "seq", "--plan", "par", "--explain"],
         &["--mode", "seq"],
     ] {
-        assert_eq!(warned(used), "", "{used:?}");
+        // Used, so not W0105 (a forced plan may still say that the model expects it slower).
+        let said = warned(used);
+        assert!(!said.contains("W0105"), "{used:?}: {said}");
+    }
+}
+
+/// `--plan par` and `--plan exchange` force the levelled plan on a program where the cost model
+/// would run the sequential walk (packaging-line's levels of 3, 4 and 1 tasks save less than a
+/// barrier), say so in a warning, and still end every scan identical to the sequential walk.
+#[test]
+fn a_forced_plan_runs_the_levelled_plan_and_says_the_model_expects_it_slower() {
+    let prog = "analyses/packaging-line/program.json";
+    let auto = run(&["run", prog, "--scans", "30", "--plan", "model", "--explain"]);
+    let auto_text = String::from_utf8_lossy(&auto.stdout);
+    assert!(
+        auto_text.contains("every scan runs the sequential walk"),
+        "{auto_text}"
+    );
+    for (kind, candidate) in [("par", "par"), ("exchange", "par-exchange")] {
+        let out = run(&["run", prog, "--scans", "30", "--plan", kind, "--explain"]);
+        assert!(out.status.success());
+        let text = String::from_utf8_lossy(&out.stdout);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            text.contains(&format!("plan kind: {kind} (1 candidate: {candidate})")),
+            "{text}"
+        );
+        assert!(text.contains("forced (--plan "), "{text}");
+        assert!(!text.contains("sequential fallback"), "{text}");
+        assert!(
+            text.contains("identical: yes, seq == par after every scan"),
+            "{text}"
+        );
+        assert!(
+            err.contains(&format!(
+                "warning[W0102]: --plan {kind} forces the levelled plan although the cost model expects it to be slower ("
+            )),
+            "{err}"
+        );
     }
 }
 

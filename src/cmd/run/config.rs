@@ -118,9 +118,11 @@ pub enum RunWarning {
         if *cores == 1 { "worker" } else { "workers" }
     )]
     Oversubscribed { threads: usize, cores: usize },
-    /// A parallel plan failed its check against the lowered code and is not used.
+    /// What the planner says of the parallel plan: it failed its check against the lowered code
+    /// and is not used, a forced plan (`--plan par|exchange`) is modelled slower than the
+    /// sequential walk, or the exchange plan runs on the shared state.
     #[error("{0}")]
-    PlanDropped(String),
+    Plan(String),
     /// The `--inputs` file has no rows: every input keeps its initial value.
     #[error(
         "--inputs {file} has no rows: every input keeps its initial value{}",
@@ -147,7 +149,7 @@ impl RunWarning {
     pub fn code(&self) -> &'static str {
         match self {
             RunWarning::Oversubscribed { .. } => "W0101",
-            RunWarning::PlanDropped(_) => "W0102",
+            RunWarning::Plan(_) => "W0102",
             RunWarning::NoInputRows { .. } => "W0103",
             RunWarning::InterruptNotRun(_) => "W0104",
             RunWarning::Unused { .. } => "W0105",

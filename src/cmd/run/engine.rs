@@ -269,7 +269,7 @@ pub(super) fn prepare(c: &RunConfig, progress: &Progress) -> Result<Prepared, Cl
         None
     };
     if let Some(pm) = &par {
-        warnings.extend(pm.warnings().iter().cloned().map(RunWarning::PlanDropped));
+        warnings.extend(pm.warnings().iter().cloned().map(RunWarning::Plan));
     }
     let pool = match &par {
         Some(pm)

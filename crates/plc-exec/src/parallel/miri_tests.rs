@@ -66,7 +66,14 @@ fn same_as_sequential(kind: PlanKind, threads: usize, scans: u64) {
         ..PlanConfig::new(threads)
     };
     let par = ParallelMachine::new(&p, &a, &exec, &config).expect("plans");
-    assert!(par.warnings().is_empty(), "{:?}", par.warnings());
+    // A forced plan may be modelled slower (a warning); none may fail its check.
+    assert!(
+        par.warnings()
+            .iter()
+            .all(|w| !w.contains("failed its check")),
+        "{:?}",
+        par.warnings()
+    );
     if threads > 1 {
         assert_eq!(par.plan().sequential(), None, "{kind:?}: a parallel plan");
     }

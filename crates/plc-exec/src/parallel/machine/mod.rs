@@ -129,6 +129,19 @@ impl ParallelMachine {
                 find_remote_lines(&machine, plan);
             }
         }
+        if matches!(config.kind, PlanKind::Par | PlanKind::Exchange) {
+            if let Some(plan) = plans
+                .iter()
+                .find(|p| p.sequential.is_none() && p.est_plan > p.est_sequential)
+            {
+                warnings.push(format!(
+                    "--plan {} forces the levelled plan although the cost model expects it to be slower ({} steps per scan against {} for the sequential walk)",
+                    config.kind.name(),
+                    plan.est_plan,
+                    plan.est_sequential
+                ));
+            }
+        }
         let mut exchanges: Vec<Option<Exchange>> = vec![None; plans.len()];
         let mut own: Vec<Option<OwnLayout>> = plans.iter().map(|_| None).collect();
         let wants_exchange = matches!(config.kind, PlanKind::Auto | PlanKind::Exchange);

@@ -11,11 +11,13 @@
 
 use super::deps_plan;
 use super::plan::Plan;
-use crate::parallel::config::{PlanConfig, PlanKind, Slicing};
+use crate::parallel::config::{PlanConfig, PlanKind, Slicing, Strategy};
 use plc_analysis::Analysis;
 use plc_model::Program;
 
-/// The plans of `config.kind`: the model's plan (model, seq, par), the dependence-driven plan
+/// The plans of `config.kind`: the model's plan (model, seq), the levelled plan forced on every
+/// level that can run in parallel (par, exchange: the planner's strategy becomes
+/// [`Strategy::AllParallel`] unless the caller chose one), the dependence-driven plan
 /// (deps), or — auto, when slicing is left to the planner — the levelled plan of the model's
 /// phases under contiguous slicing (first, whether it runs in parallel or not), and the dependence-driven plan
 /// when its modelled scan beats the sequential one: the measurement then decides.
@@ -26,6 +28,18 @@ pub(in crate::parallel) fn candidate_plans(
 ) -> Vec<Plan> {
     if config.kind == PlanKind::Deps {
         return vec![deps_plan::build(p, a, config)];
+    }
+    if matches!(config.kind, PlanKind::Par | PlanKind::Exchange)
+        && config.strategy == Strategy::Auto
+        && config.threads > 1
+    {
+        // Forced: every level that can run in parallel does, whatever the cost model says
+        // (one worker still runs the sequential walk).
+        let forced = PlanConfig {
+            strategy: Strategy::AllParallel,
+            ..*config
+        };
+        return vec![Plan::build(p, a, &forced)];
     }
     if config.kind != PlanKind::Auto || config.slicing != Slicing::Auto {
         return vec![Plan::build(p, a, config)];

@@ -100,12 +100,7 @@ impl Plan {
             est_sequential
         };
         let sequential = sequential_reason(p, a, config, any_parallel, est_plan, est_sequential);
-        explain_levels(
-            &mut level_plans,
-            &choice,
-            sequential.is_some(),
-            config.barrier_cost,
-        );
+        explain_levels(&mut level_plans, &choice, sequential.is_some(), config);
         if sequential.is_some() {
             phases.clear();
             phase_lines.clear();
@@ -383,6 +378,8 @@ pub(in crate::parallel) fn sequential_reason(
         Some("the sequential walk was asked for (--plan seq)".into())
     } else if config.threads <= 1 && config.strategy != Strategy::AllParallel {
         Some("one worker".into())
+    } else if !any_parallel && config.strategy == Strategy::AllParallel {
+        Some("no level can run in parallel (every level is one task, or its tasks share a subroutine's loop counters)".into())
     } else if !any_parallel {
         Some("no level saves more than the barriers it needs".into())
     } else if config.strategy == Strategy::Auto
@@ -510,13 +507,25 @@ fn choose_phases(level_plans: &[LevelPlan], config: &PlanConfig) -> (Vec<bool>, 
 }
 
 /// The reasons `--explain` gives for each level.
-fn explain_levels(levels: &mut [LevelPlan], choice: &[bool], sequential: bool, b: u64) {
+fn explain_levels(
+    levels: &mut [LevelPlan],
+    choice: &[bool],
+    sequential: bool,
+    config: &PlanConfig,
+) {
+    let b = config.barrier_cost;
+    let forced = config.strategy == Strategy::AllParallel;
     for (l, lp) in levels.iter_mut().enumerate() {
         lp.parallel = !sequential && choice[l];
         if !lp.reason.is_empty() {
             continue;
         }
         lp.reason = match (lp.parallel, lp.makespan) {
+            (true, Some(m)) if forced => format!(
+                "forced (--plan {}): modelled makespan {m} against {} sequential, plus a barrier ({b})",
+                config.kind.name(),
+                lp.cost
+            ),
             (true, Some(m)) => format!(
                 "saves {} steps, more than a barrier ({b})",
                 lp.cost.saturating_sub(m)
