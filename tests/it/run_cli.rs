@@ -425,8 +425,34 @@ fn a_sequential_walk_says_so_instead_of_a_ratio_and_every_ratio_its_scans() {
         .lines()
         .find(|l| l.trim_start().starts_with("par "))
         .unwrap();
-    assert!(par.contains("  sequential fallback ("), "{par}");
+    assert!(par.contains(" sequential fallback ("), "{par}");
+    assert!(
+        par.contains("the same sequential walk as seq, so no ratio"),
+        "{par}"
+    );
     assert!(!par.contains("x seq"), "{par}");
+    // 96 scans in 8 windows of 12: the whole pass's time per scan is the mean of the windows',
+    // so it lies between the fastest and the slowest (0.1 ns of rounding aside).
+    let j = json_of(&run(&[
+        "run",
+        &one,
+        "--scans",
+        "96",
+        "--threads",
+        "2",
+        "--format",
+        "json",
+    ]));
+    for mode in ["seq", "par"] {
+        let m = &j["modes"][mode];
+        assert_eq!(m["timing_windows"], 8, "{m}");
+        let (lo, ns, hi) = (
+            m["ns_per_scan_min"].as_f64().unwrap(),
+            m["ns_per_scan"].as_f64().unwrap(),
+            m["ns_per_scan_max"].as_f64().unwrap(),
+        );
+        assert!(lo > 0.0 && lo <= ns + 0.1 && ns <= hi + 0.1, "{m}");
+    }
     let wide = generated(
         "wide_plans.json",
         &["--rungs", "2000", "--levels", "4", "--reads", "random"],

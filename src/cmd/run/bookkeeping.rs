@@ -120,6 +120,11 @@ pub(super) struct Driver<'a> {
     pub(super) digests: Digests,
     pub(super) first_mismatch: Option<u64>,
     pub(super) total: Duration,
+    /// The scan time of each full window of `window_scans` scans, in run order (the spread of
+    /// the measurement; a last partial window is left out).
+    pub(super) windows: Vec<Duration>,
+    pub(super) window_scans: u64,
+    window_at: (u64, Duration),
     pub(super) faults: Vec<(u64, u32, FaultKind)>,
     pub(super) fault_count: u64,
     pub(super) tally: FaultTally,
@@ -134,6 +139,7 @@ impl<'a> Driver<'a> {
         digests: Digests,
         trace: Option<Trace<'a>>,
         bar: Bar,
+        window_scans: u64,
     ) -> Driver<'a> {
         Driver {
             inputs,
@@ -146,6 +152,9 @@ impl<'a> Driver<'a> {
             digests,
             first_mismatch: None,
             total: Duration::ZERO,
+            windows: Vec::new(),
+            window_scans: window_scans.max(1),
+            window_at: (0, Duration::ZERO),
             faults: Vec::new(),
             fault_count: 0,
             tally: FaultTally::default(),
@@ -169,6 +178,12 @@ impl ScanDriver for Driver<'_> {
         elapsed: Duration,
     ) {
         self.total += elapsed;
+        self.window_at.0 += 1;
+        self.window_at.1 += elapsed;
+        if self.window_at.0 == self.window_scans {
+            self.windows.push(self.window_at.1);
+            self.window_at = (0, Duration::ZERO);
+        }
         let of = std::ptr::from_ref(m) as usize;
         if of != self.canon_of && !matches!(self.digests, Digests::Skip) {
             let other = match self.canon_other.take() {

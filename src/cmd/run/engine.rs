@@ -46,6 +46,9 @@ pub struct RunReport {
     pub fault_summary: Vec<FaultSummary>,
     /// Per mode: (name, total scan time).
     pub modes: Vec<(&'static str, Duration)>,
+    /// Per mode, as `modes`: the ns per scan of each of its timing windows (a pass's scans in
+    /// up to 8 equal windows; none when it ran fewer than 8 scans).
+    pub windows: Vec<Vec<f64>>,
     /// Which plans the parallel executor could use.
     pub plan_kind: PlanKind,
     /// What the parallel pass ran (when it ran).
@@ -304,9 +307,14 @@ pub(super) fn prepare(c: &RunConfig, progress: &Progress) -> Result<Prepared, Cl
     })
 }
 
+/// How many windows a pass's scans are timed in, for the spread of the measurement.
+const TIMING_WINDOWS: u64 = 8;
+
 /// What one pass (one mode) leaves for the report.
 struct Pass {
     total: Duration,
+    /// ns per scan of each timing window.
+    window_ns: Vec<f64>,
     first_mismatch: Option<u64>,
     faults: Vec<(u64, u32, FaultKind)>,
     fault_count: u64,
@@ -321,6 +329,11 @@ impl Pass {
     fn of(d: Driver<'_>, state: State, log: Option<RunLog>) -> Pass {
         Pass {
             total: d.total,
+            window_ns: d
+                .windows
+                .iter()
+                .map(|w| w.as_nanos() as f64 / d.window_scans as f64)
+                .collect(),
             first_mismatch: d.first_mismatch,
             faults: d.faults,
             fault_count: d.fault_count,
@@ -372,7 +385,7 @@ pub(super) fn execute(
         };
         (
             m,
-            Driver::new(inputs, m, digests, t, bar),
+            Driver::new(inputs, m, digests, t, bar, scans / TIMING_WINDOWS),
             m.initial_state(),
         )
     });
@@ -392,7 +405,7 @@ pub(super) fn execute(
             None => Digests::Skip,
         };
         let bar = progress.bar("par", scans, "scans");
-        let d = Driver::new(inputs, m, digests, t, bar);
+        let d = Driver::new(inputs, m, digests, t, bar, scans / TIMING_WINDOWS);
         (pm, d, pm.initial_state(), pm.start_run(0))
     });
     // The two passes take turns, block by block, so that a change of the machine's speed
@@ -462,6 +475,11 @@ pub(super) fn execute(
     let mut modes = Vec::new();
     modes.extend(seq.as_ref().map(|s| ("seq", s.total)));
     modes.extend(par.as_ref().map(|p| ("par", p.total)));
+    let windows: Vec<Vec<f64>> = seq
+        .iter()
+        .chain(par.iter())
+        .map(|p| p.window_ns.clone())
+        .collect();
     // The report (faults, trace, state) comes from the sequential run when it ran.
     let (pass, m) = match (seq, par) {
         (Some(s), _) => (s, pr.seq.as_ref().expect("seq")),
@@ -488,6 +506,7 @@ pub(super) fn execute(
     let both = modes.len() == 2;
     let extra = Extra {
         modes,
+        windows,
         block_scans: both.then_some(block),
         identical,
         first_difference,
@@ -503,6 +522,7 @@ pub(super) fn execute(
 /// What the report adds to the pass it shows.
 struct Extra {
     modes: Vec<(&'static str, Duration)>,
+    windows: Vec<Vec<f64>>,
     block_scans: Option<u64>,
     identical: Option<bool>,
     first_difference: Option<Json>,
@@ -542,6 +562,7 @@ fn report(pr: &Prepared, c: &RunConfig, m: &Machine, pass: Pass, extra: Extra) -
     let p = &pr.p;
     let Extra {
         modes,
+        windows,
         block_scans,
         identical,
         first_difference,
@@ -598,6 +619,7 @@ fn report(pr: &Prepared, c: &RunConfig, m: &Machine, pass: Pass, extra: Extra) -
             })
             .collect(),
         modes,
+        windows,
         plan_kind: c.plan,
         plan_run,
         sequential_fallback,

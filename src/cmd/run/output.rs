@@ -94,7 +94,18 @@ pub fn render_json(r: &RunReport, deterministic: bool) -> String {
             .collect::<Vec<_>>()),
     );
     let mut modes = Map::new();
-    for &(name, total) in &r.modes {
+    for (k, &(name, total)) in r.modes.iter().enumerate() {
+        let windows = r.windows.get(k).map_or(&[][..], Vec::as_slice);
+        let (lo, hi) = spread(windows).unwrap_or((0.0, 0.0));
+        let (lo, hi, n) = if deterministic {
+            (json!(0), json!(0), json!(0))
+        } else {
+            (
+                json!((lo * 10.0).round() / 10.0),
+                json!((hi * 10.0).round() / 10.0),
+                json!(windows.len()),
+            )
+        };
         let (ns, per_s, rungs_per_s) = if deterministic || total.is_zero() {
             (json!(0), json!(0), json!(0))
         } else {
@@ -108,7 +119,8 @@ pub fn render_json(r: &RunReport, deterministic: bool) -> String {
         };
         modes.insert(
             name.into(),
-            json!({"scans_per_s": per_s, "ns_per_scan": ns, "rungs_per_s": rungs_per_s}),
+            json!({"scans_per_s": per_s, "ns_per_scan": ns, "rungs_per_s": rungs_per_s,
+                   "ns_per_scan_min": lo, "ns_per_scan_max": hi, "timing_windows": n}),
         );
     }
     doc.insert("modes".into(), Json::Object(modes));
@@ -307,7 +319,10 @@ pub fn render_text(r: &RunReport) -> String {
     write_faults(&mut s, r);
     let _ = writeln!(s, "speed:");
     let seq_total = r.modes.iter().find(|m| m.0 == "seq").map(|m| m.1);
-    for &(name, total) in &r.modes {
+    let spreads: Vec<Option<(f64, f64)>> = (0..r.modes.len())
+        .map(|k| spread(r.windows.get(k).map_or(&[][..], Vec::as_slice)))
+        .collect();
+    for (k, &(name, total)) in r.modes.iter().enumerate() {
         let ns = total.as_nanos() as f64 / r.scans as f64;
         let per_s = if ns > 0.0 { 1e9 / ns } else { 0.0 };
         let _ = write!(
@@ -317,19 +332,37 @@ pub fn render_text(r: &RunReport) -> String {
             time_text(ns),
             per_s * r.rungs as f64 / 1e6
         );
+        // A figure whose windows spread by more than a tenth of it is shown with its spread.
+        let wide = |(lo, hi): (f64, f64)| hi - lo > 0.1 * ns;
+        if let Some((lo, hi)) = spreads[k].filter(|&sp| wide(sp)) {
+            let _ = write!(s, "  (windows {}–{}/scan)", time_text(lo), time_text(hi));
+        }
         if let (Some(st), "par") = (seq_total, name) {
             match &r.sequential_fallback {
                 Some(why) => {
-                    let _ = write!(s, "  sequential fallback ({why})");
-                }
-                None if !total.is_zero() => {
                     let _ = write!(
                         s,
-                        "  ({:.2}x seq over {}{}{})",
+                        "  the same sequential walk as seq, so no ratio: sequential fallback ({why})"
+                    );
+                }
+                None if !total.is_zero() => {
+                    // Overlapping windows: the two figures are not told apart by this run.
+                    let overlap = match (spreads.first().copied().flatten(), spreads[k]) {
+                        (Some((slo, shi)), Some((plo, phi))) => slo <= phi && plo <= shi,
+                        _ => false,
+                    };
+                    let _ = write!(
+                        s,
+                        "  ({:.2}x seq over {}{}{}){}",
                         st.as_secs_f64() / total.as_secs_f64(),
                         count(r.scans, "scan", "scans"),
                         mix_text(r),
-                        turns_text(r)
+                        turns_text(r),
+                        if overlap {
+                            ", within the windows' spread"
+                        } else {
+                            ""
+                        }
                     );
                 }
                 None => {}
@@ -430,4 +463,15 @@ pub fn write_html(
         &mut out,
     )?;
     std::io::Write::flush(&mut out)
+}
+
+/// The smallest and largest of a pass's window times (ns per scan), when it has at least three.
+fn spread(windows: &[f64]) -> Option<(f64, f64)> {
+    (windows.len() >= 3).then(|| {
+        windows
+            .iter()
+            .fold((f64::INFINITY, 0.0_f64), |(lo, hi), &w| {
+                (lo.min(w), hi.max(w))
+            })
+    })
 }
