@@ -14,7 +14,7 @@
 //!
 //! Deliberately not here: the ladder drawing itself, and the interaction (the page's script).
 
-use super::ladder::{block_size, draw_block, draw_rung, rung_size, Size};
+use super::ladder::{block_size, draw_block, draw_rung, rung_size, Size, CHAR};
 use super::{esc, thousands, HtmlInput};
 use crate::document::{DependenceEntry, Report, TaskName};
 use plc_fbd::{BlockId, Network};
@@ -28,7 +28,7 @@ pub const MAX_DETAILED_RUNGS: usize = 2000;
 pub const MAX_EDGES: usize = 10_000;
 /// Edges labels are shown (without hovering) up to this many edges.
 const LABELLED_EDGES: usize = 150;
-const CARD_W: f64 = 230.0;
+pub(super) const CARD_W: f64 = 230.0;
 const COL_GAP: f64 = 90.0;
 const HEADER: f64 = 18.0;
 const TOP: f64 = 34.0;
@@ -305,17 +305,31 @@ fn write_card(out: &mut impl Write, input: &HtmlInput, c: &Card) -> io::Result<(
     )?;
     let mut meta = Vec::new();
     if let Some(l) = &rung.label {
-        meta.push(format!("label {}", esc(l)));
+        meta.push(format!("label {l}"));
     }
     if rung.pou.0 != 0 {
-        meta.push(esc(&p.pou(rung.pou).name).into_owned());
+        meta.push(p.pou(rung.pou).name.clone());
     }
     meta.push(format!("cost {}", a.rung_costs[c.rung.index()]));
+    let meta = meta.join(" · ");
+    // The meta line must not run into the title: it gets the card's width less the title's
+    // (11 px bold, about 6.7 px a character) and a gap, and is cut with "…" past that (the
+    // whole line is in the card's tooltip).
+    let room = CARD_W - 12.0 - rung.id.chars().count() as f64 * 6.7 - 10.0;
+    let fits = (room / CHAR).floor().max(1.0) as usize;
+    let shown = if meta.chars().count() > fits {
+        let mut cut: String = meta.chars().take(fits.saturating_sub(1)).collect();
+        cut.push('…');
+        cut
+    } else {
+        meta.clone()
+    };
     writeln!(
         out,
-        r#"<text class="meta" x="{:.1}" y="13" text-anchor="end">{}</text>"#,
+        r#"<text class="meta" x="{:.1}" y="13" text-anchor="end"><title>{}</title>{}</text>"#,
         CARD_W - 6.0,
-        meta.join(" · ")
+        esc(&meta),
+        esc(&shown)
     )?;
     writeln!(
         out,

@@ -491,3 +491,50 @@ fn counts_of_one_are_singular_and_savings_round_as_in_the_text_report() {
     assert!(html.contains("<td>67 %</td>"), "{html}");
     assert!(html.contains("level 1 · 3 tasks<"), "{html}");
 }
+
+/// A landing rung (a jump's label) in a subroutine with a long name: the card's meta line
+/// ("label … · POU · cost N") is cut with "…" where it would run into the title, and keeps the
+/// whole line in its tooltip.
+#[test]
+fn a_cards_meta_line_never_runs_into_its_title() {
+    let html = page_of_text(
+        r#"{"program": "P", "vars": [{"name": "a", "type": "BOOL", "class": "input"},
+            {"name": "q", "type": "BOOL", "class": "output"}],
+          "rungs": [{"id": "R1", "ld": [{"call": "A_SUBROUTINE_WITH_A_VERY_LONG_NAME"}]}],
+          "subroutines": {"A_SUBROUTINE_WITH_A_VERY_LONG_NAME": {"rungs": [
+            {"id": "SUB_R1", "ld": [{"contact": "a"}, {"jmp": "THE_LANDING_LABEL"}]},
+            {"id": "SUB_R2", "label": "THE_LANDING_LABEL", "ld": [{"contact": "a"}, {"coil": "q"}]}]}}}"#,
+    );
+    let doc = parse(&html);
+    let card = doc
+        .descendants()
+        .find(|n| has_class(n, "card") && n.attribute("id") == Some("rung-SUB_R2"))
+        .expect("the landing rung's card");
+    let meta = card
+        .descendants()
+        .find(|n| has_class(n, "meta"))
+        .expect("its meta line");
+    let full = meta
+        .children()
+        .find(|n| n.has_tag_name("title"))
+        .and_then(|t| t.text())
+        .expect("the whole line as a tooltip");
+    assert_eq!(
+        full,
+        "label THE_LANDING_LABEL · A_SUBROUTINE_WITH_A_VERY_LONG_NAME · cost 2"
+    );
+    let shown: String = meta
+        .children()
+        .filter(|n| n.is_text())
+        .filter_map(|n| n.text())
+        .collect();
+    assert!(shown.ends_with('…'), "{shown}");
+    assert!(full.starts_with(shown.trim_end_matches('…')), "{shown}");
+    // Title (11 px bold) from x = 6, meta right-aligned at the card's width less 6: they must
+    // not meet.
+    use super::ladder::CHAR;
+    use super::levels::CARD_W;
+    let title_end = 6.0 + "SUB_R2".chars().count() as f64 * 6.7;
+    let meta_start = CARD_W - 6.0 - shown.chars().count() as f64 * CHAR;
+    assert!(title_end + 4.0 <= meta_start, "{title_end} {meta_start}");
+}
