@@ -28,7 +28,13 @@ pub const MAX_DETAILED_RUNGS: usize = 2000;
 pub const MAX_EDGES: usize = 10_000;
 /// Edges labels are shown (without hovering) up to this many edges.
 const LABELLED_EDGES: usize = 150;
+/// A card's width, unless its column holds a rung that would shrink below [`MIN_SCALE`] in it.
 pub(super) const CARD_W: f64 = 230.0;
+/// The smallest scale a drawing is shown at before its column widens (to [`MAX_CARD_W`] at
+/// most): below it the drawing's 10 px text is under 8 px, unreadable.
+const MIN_SCALE: f64 = 0.8;
+/// The widest a column of cards gets for a long rung (past it, the drawing shrinks).
+const MAX_CARD_W: f64 = 2.0 * CARD_W;
 const COL_GAP: f64 = 90.0;
 const HEADER: f64 = 18.0;
 const TOP: f64 = 34.0;
@@ -40,9 +46,10 @@ enum Drawing<'a> {
     Block(&'a Network, BlockId),
 }
 
-/// The frame drawn around a loop task's cards: its left edge, top and height.
+/// The frame drawn around a loop task's cards: its left edge, width, top and height.
 struct Frame {
     x: f64,
+    w: f64,
     y: f64,
     h: f64,
 }
@@ -51,6 +58,8 @@ struct Card<'a> {
     rung: RungId,
     col: usize,
     x: f64,
+    /// The card's width: its column's.
+    w: f64,
     y: f64,
     h: f64,
     scale: f64,
@@ -131,19 +140,47 @@ fn blocks<'a>(input: &HtmlInput<'_, 'a>) -> HashMap<RungId, (&'a Network, BlockI
     m
 }
 
-/// Places every card; returns the cards by rung, the loop frames and the canvas size.
-fn place<'a>(
-    input: &HtmlInput<'_, 'a>,
-    cols: &[Column],
-) -> (Vec<Option<Card<'a>>>, Vec<Frame>, Size) {
+/// Where the cards go: the cards by rung, the loop frames, each column's left edge and width,
+/// and the canvas size.
+struct Placed<'a> {
+    cards: Vec<Option<Card<'a>>>,
+    frames: Vec<Frame>,
+    columns: Vec<(f64, f64)>,
+    size: Size,
+}
+
+/// Places every card.
+fn place<'a>(input: &HtmlInput<'_, 'a>, cols: &[Column]) -> Placed<'a> {
     let p = input.program;
     let ids: HashMap<&str, RungId> = p.rung_ids().map(|r| (p.rung(r).id.as_str(), r)).collect();
     let blocks = blocks(input);
     let mut cards: Vec<Option<Card<'a>>> = (0..p.rungs.len()).map(|_| None).collect();
     let mut frames = Vec::new();
     let mut height: f64 = 0.0;
+    let drawing_of = |r: RungId| match blocks.get(&r) {
+        Some(&(net, b)) => Drawing::Block(net, b),
+        None => Drawing::Ladder,
+    };
+    let size_of = |d: Drawing<'a>, r: RungId| match d {
+        Drawing::Ladder => rung_size(p, p.rung(r)),
+        Drawing::Block(net, b) => block_size(net, net.block(b)),
+    };
+    let mut x = 0.0;
+    let mut xs = Vec::with_capacity(cols.len());
     for (ci, col) in cols.iter().enumerate() {
-        let x = ci as f64 * (CARD_W + COL_GAP);
+        // The column is as wide as its longest drawing needs at MIN_SCALE, within bounds.
+        let w = col
+            .items
+            .iter()
+            .flatten()
+            .filter_map(|id| ids.get(id))
+            .map(|&r| size_of(drawing_of(r), r).w * MIN_SCALE + 12.0)
+            .fold(CARD_W, f64::max)
+            .min(MAX_CARD_W);
+        if ci > 0 {
+            x += COL_GAP;
+        }
+        xs.push((x, w));
         let mut y = TOP;
         for item in &col.items {
             let framed = item.len() > 1;
@@ -152,21 +189,18 @@ fn place<'a>(
                 y += 16.0;
             }
             for id in item {
-                let Some(&r) = ids.get(id) else { continue };
-                let drawing = match blocks.get(&r) {
-                    Some(&(net, b)) => Drawing::Block(net, b),
-                    None => Drawing::Ladder,
+                let Some(&r) = ids.get(id) else {
+                    continue;
                 };
-                let size = match drawing {
-                    Drawing::Ladder => rung_size(p, p.rung(r)),
-                    Drawing::Block(net, b) => block_size(net, net.block(b)),
-                };
-                let scale = f64::min(1.0, (CARD_W - 12.0) / size.w);
+                let drawing = drawing_of(r);
+                let size = size_of(drawing, r);
+                let scale = f64::min(1.0, (w - 12.0) / size.w);
                 let h = HEADER + size.h * scale + 6.0;
                 cards[r.index()] = Some(Card {
                     rung: r,
                     col: ci,
                     x,
+                    w,
                     y,
                     h,
                     scale,
@@ -177,6 +211,7 @@ fn place<'a>(
             if framed {
                 frames.push(Frame {
                     x: x - 4.0,
+                    w: w + 8.0,
                     y: top,
                     h: y - top,
                 });
@@ -184,16 +219,17 @@ fn place<'a>(
             }
         }
         height = height.max(y);
+        x += w;
     }
-    let width = cols.len() as f64 * (CARD_W + COL_GAP) - COL_GAP;
-    (
+    Placed {
         cards,
         frames,
-        Size {
-            w: width.max(CARD_W),
+        columns: xs,
+        size: Size {
+            w: x.max(CARD_W),
             h: height + 10.0,
         },
-    )
+    }
 }
 
 /// Whether the level view draws the rungs as cards (else it summarises each level).
@@ -208,7 +244,12 @@ pub(super) fn write_levels(out: &mut impl Write, input: &HtmlInput) -> io::Resul
         return write_summaries(out, r);
     }
     let cols = columns(r);
-    let (cards, frames, size) = place(input, &cols);
+    let Placed {
+        cards,
+        frames,
+        columns,
+        size,
+    } = place(input, &cols);
     let p = input.program;
     let n_edges = r.dependences.len();
     let many = if n_edges > LABELLED_EDGES {
@@ -229,15 +270,14 @@ pub(super) fn write_levels(out: &mut impl Write, input: &HtmlInput) -> io::Resul
         writeln!(
             out,
             r#"<text class="colhdr"{level} x="{:.1}" y="18">{}</text>"#,
-            ci as f64 * (CARD_W + COL_GAP),
+            columns[ci].0,
             esc(&col.title)
         )?;
     }
-    for Frame { x, y, h } in frames {
+    for Frame { x, w, y, h } in frames {
         writeln!(
             out,
-            r#"<rect class="loop" x="{x:.1}" y="{y:.1}" width="{:.1}" height="{h:.1}" rx="6"/><text class="looplbl" x="{:.1}" y="{:.1}">loop task (one sequential task)</text>"#,
-            CARD_W + 8.0,
+            r#"<rect class="loop" x="{x:.1}" y="{y:.1}" width="{w:.1}" height="{h:.1}" rx="6"/><text class="looplbl" x="{:.1}" y="{:.1}">loop task (one sequential task)</text>"#,
             x + 6.0,
             y + 12.0
         )?;
@@ -300,8 +340,8 @@ fn write_card(out: &mut impl Write, input: &HtmlInput, c: &Card) -> io::Result<(
     )?;
     writeln!(
         out,
-        r#"<rect class="frame" width="{CARD_W}" height="{:.1}" rx="4"/><text class="hdr" x="6" y="13">{id}</text>"#,
-        c.h
+        r#"<rect class="frame" width="{:.1}" height="{:.1}" rx="4"/><text class="hdr" x="6" y="13">{id}</text>"#,
+        c.w, c.h
     )?;
     let mut meta = Vec::new();
     if let Some(l) = &rung.label {
@@ -315,7 +355,7 @@ fn write_card(out: &mut impl Write, input: &HtmlInput, c: &Card) -> io::Result<(
     // The meta line must not run into the title: it gets the card's width less the title's
     // (11 px bold, about 6.7 px a character) and a gap, and is cut with "…" past that (the
     // whole line is in the card's tooltip).
-    let room = CARD_W - 12.0 - rung.id.chars().count() as f64 * 6.7 - 10.0;
+    let room = c.w - 12.0 - rung.id.chars().count() as f64 * 6.7 - 10.0;
     let fits = (room / CHAR).floor().max(1.0) as usize;
     let shown = if meta.chars().count() > fits {
         let mut cut: String = meta.chars().take(fits.saturating_sub(1)).collect();
@@ -327,7 +367,7 @@ fn write_card(out: &mut impl Write, input: &HtmlInput, c: &Card) -> io::Result<(
     writeln!(
         out,
         r#"<text class="meta" x="{:.1}" y="13" text-anchor="end"><title>{}</title>{}</text>"#,
-        CARD_W - 6.0,
+        c.w - 6.0,
         esc(&meta),
         esc(&shown)
     )?;
@@ -337,7 +377,7 @@ fn write_card(out: &mut impl Write, input: &HtmlInput, c: &Card) -> io::Result<(
         c.scale
     )?;
     match c.drawing {
-        Drawing::Ladder => draw_rung(out, p, rung, (CARD_W - 12.0) / c.scale)?,
+        Drawing::Ladder => draw_rung(out, p, rung, (c.w - 12.0) / c.scale)?,
         Drawing::Block(net, b) => draw_block(out, net, net.block(b))?,
     }
     out.write_all(b"</g>\n</g>\n")
@@ -347,11 +387,11 @@ fn write_card(out: &mut impl Write, input: &HtmlInput, c: &Card) -> io::Result<(
 fn endpoints(a: &Card, b: &Card, k: f64) -> ((f64, f64), (f64, f64), f64, f64) {
     let (ya, yb) = (a.y + a.h / 2.0 + k, b.y + b.h / 2.0 + k);
     if a.col < b.col {
-        ((a.x + CARD_W, ya), (b.x, yb), 1.0, -1.0)
+        ((a.x + a.w, ya), (b.x, yb), 1.0, -1.0)
     } else if a.col > b.col {
-        ((a.x, ya), (b.x + CARD_W, yb), -1.0, 1.0)
+        ((a.x, ya), (b.x + b.w, yb), -1.0, 1.0)
     } else {
-        ((a.x + CARD_W, ya), (b.x + CARD_W, yb), 1.0, 1.0)
+        ((a.x + a.w, ya), (b.x + b.w, yb), 1.0, 1.0)
     }
 }
 

@@ -538,3 +538,62 @@ fn a_cards_meta_line_never_runs_into_its_title() {
     let meta_start = CARD_W - 6.0 - shown.chars().count() as f64 * CHAR;
     assert!(title_end + 4.0 <= meta_start, "{title_end} {meta_start}");
 }
+
+/// A long rung widens its column (up to twice a card's width) instead of shrinking its text
+/// below 0.8 of its size; a short rung's column keeps the card's width.
+#[test]
+fn a_long_rung_widens_its_column_rather_than_shrink_unreadably() {
+    let contacts = |n: usize| {
+        (0..n)
+            .map(|k| format!(r#"{{"contact": "input_number_{k}"}}"#))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let vars = (0..30)
+        .map(|k| format!(r#"{{"name": "input_number_{k}", "type": "BOOL", "class": "input"}}"#))
+        .collect::<Vec<_>>()
+        .join(", ");
+    let html = page_of_text(&format!(
+        r#"{{"program": "P", "vars": [{vars}, {{"name": "q", "type": "BOOL", "class": "output"}},
+            {{"name": "r", "type": "BOOL", "class": "output"}}, {{"name": "s", "type": "BOOL", "class": "output"}}],
+          "rungs": [{{"id": "SHORT", "ld": [{{"contact": "input_number_0"}}, {{"coil": "q"}}]}},
+                    {{"id": "LONG", "ld": [{}, {{"coil": "r"}}]}},
+                    {{"id": "HUGE", "ld": [{}, {{"coil": "s"}}]}}]}}"#,
+        contacts(3),
+        contacts(30)
+    ));
+    let doc = parse(&html);
+    let card = |id: &str| {
+        let card = doc
+            .descendants()
+            .find(|n| has_class(n, "card") && n.attribute("id") == Some(&format!("rung-{id}")))
+            .unwrap_or_else(|| panic!("card {id}"));
+        let w: f64 = card
+            .descendants()
+            .find(|n| has_class(n, "frame"))
+            .and_then(|f| f.attribute("width"))
+            .and_then(|w| w.parse().ok())
+            .expect("a frame width");
+        let scale: f64 = card
+            .descendants()
+            .filter_map(|n| n.attribute("transform"))
+            .find_map(|t| t.split("scale(").nth(1))
+            .and_then(|s| s.trim_end_matches(')').parse().ok())
+            .expect("a scale");
+        (w, scale)
+    };
+    // All three rungs are independent: one level, one column, as wide as the longest needs.
+    let (w_short, s_short) = card("SHORT");
+    let (w_long, s_long) = card("LONG");
+    let (w_huge, s_huge) = card("HUGE");
+    assert_eq!(w_short, w_long);
+    assert_eq!(w_long, w_huge);
+    assert_eq!(
+        w_huge,
+        2.0 * super::levels::CARD_W,
+        "capped at twice a card"
+    );
+    assert_eq!(s_short, 1.0);
+    assert!(s_long >= 0.8, "{s_long}");
+    assert!(s_huge < 0.8, "past the cap the drawing shrinks: {s_huge}");
+}
