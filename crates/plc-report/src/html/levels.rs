@@ -409,6 +409,7 @@ fn write_edges(
         .collect();
     let card = |x: &str| ids.get(x).and_then(|&i| cards[i].as_ref());
     let mut seen: HashMap<(&str, &str), u32> = HashMap::new();
+    let mut labels = LabelSpots::default();
     out.write_all(b"<g class=\"edges\">\n")?;
     for d in r.dependences.iter().take(MAX_EDGES) {
         let (kind, from, to, label) = match &d {
@@ -450,9 +451,15 @@ fn write_edges(
         let (c1, c2) = ((x1 + s1 * dx, y1), (x2 + s2 * dx, y2));
         let mx = 0.125 * x1 + 0.375 * c1.0 + 0.375 * c2.0 + 0.125 * x2;
         let my = 0.125 * y1 + 0.375 * c1.1 + 0.375 * c2.1 + 0.125 * y2;
+        // A label that would cover another is moved along the edge's middle, or, with no free
+        // spot near it, shown only while its edge is highlighted.
+        let (my, crowded) = match labels.place(mx, my - 2.0, label.chars().count()) {
+            Some(y) => (y + 2.0, ""),
+            None => (my, " crowded"),
+        };
         writeln!(
             out,
-            r#"<g class="e {kind}" data-from="{}" data-to="{}" data-var="{}"><title>{} → {}: {kind} {}</title><path d="M{x1:.1} {y1:.1}C{:.1} {:.1} {:.1} {:.1} {x2:.1} {y2:.1}"/><text class="elabel" x="{mx:.1}" y="{:.1}" text-anchor="middle">{}</text></g>"#,
+            r#"<g class="e {kind}" data-from="{}" data-to="{}" data-var="{}"><title>{} → {}: {kind} {}</title><path d="M{x1:.1} {y1:.1}C{:.1} {:.1} {:.1} {:.1} {x2:.1} {y2:.1}"/><text class="elabel{crowded}" x="{mx:.1}" y="{:.1}" text-anchor="middle">{}</text></g>"#,
             esc(from),
             esc(to),
             esc(label),
@@ -468,6 +475,45 @@ fn write_edges(
         )?;
     }
     out.write_all(b"</g>\n")
+}
+
+/// The boxes of the edge labels placed so far, so that no two overlap.
+#[derive(Default)]
+struct LabelSpots {
+    /// (left, right, baseline) of each placed label.
+    placed: Vec<(f64, f64, f64)>,
+}
+
+impl LabelSpots {
+    /// Width of a character of a label (9 px text).
+    const CHAR: f64 = 5.5;
+    /// Height of a label's line.
+    const LINE: f64 = 10.0;
+
+    /// The baseline nearest `y` (tried as `y`, then a line below, above, two below, …) at
+    /// which a label of `chars` characters centred on `x` overlaps no placed one, and records
+    /// it; `None` when the four nearest lines on either side are taken.
+    fn place(&mut self, x: f64, y: f64, chars: usize) -> Option<f64> {
+        let half = chars as f64 * Self::CHAR / 2.0;
+        let (left, right) = (x - half, x + half);
+        let free = |b: f64| {
+            self.placed
+                .iter()
+                .all(|&(l, r, pb)| r <= left || right <= l || (pb - b).abs() >= Self::LINE)
+        };
+        let spot = (0..9)
+            .map(|k| {
+                let step = f64::from((k + 1) / 2) * Self::LINE;
+                if k % 2 == 1 {
+                    y + step
+                } else {
+                    y - step
+                }
+            })
+            .find(|&b| free(b))?;
+        self.placed.push((left, right, spot));
+        Some(spot)
+    }
 }
 
 /// First `n` items of a list, then `(+K more)`.

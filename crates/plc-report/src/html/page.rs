@@ -37,7 +37,7 @@ svg text{font-family:ui-monospace,"DejaVu Sans Mono",Menlo,monospace;font-size:1
 .e.output path{stroke:#c0392b;stroke-dasharray:2 2}.e.control path{stroke:#1e8449;stroke-width:2}
 .e.flow text{fill:#222}.e.anti text{fill:#1f6fd1}.e.output text{fill:#c0392b}.e.control text{fill:#1e8449}
 .e.hl path{opacity:1;stroke-width:3.2}.e.hl text{font-weight:bold;font-size:11px}
-.many .e text{display:none}.many .e.hl text{display:inline}
+.many .e text{display:none}.many .e.hl text{display:inline}.e text.crowded{display:none}.e.hl text.crowded{display:inline}
 .active .e:not(.hl){opacity:.25}
 .chip{display:inline-block;padding:0 5px;margin:1px;border:1px solid #bbb;border-radius:9px;background:#fff;cursor:pointer;font-family:ui-monospace,monospace;font-size:12px}
 .chip.diff{border-color:#c0392b;background:#fdecea;color:#a02a1d;font-weight:bold}

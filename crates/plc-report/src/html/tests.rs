@@ -597,3 +597,52 @@ fn a_long_rung_widens_its_column_rather_than_shrink_unreadably() {
     assert!(s_long >= 0.8, "{s_long}");
     assert!(s_huge < 0.8, "past the cap the drawing shrinks: {s_huge}");
 }
+
+/// Six flow edges between the same two rungs (one per variable) used to stack their labels
+/// 5 px apart, unreadable: no two shown labels overlap now, and one without a free spot is
+/// shown only while its edge is highlighted.
+#[test]
+fn edge_labels_do_not_pile_up() {
+    let names = ["alpha", "bravo", "charlie", "delta", "echo", "foxtrot"];
+    let vars: Vec<String> = names
+        .iter()
+        .map(|n| format!(r#"{{"name": "{n}", "type": "BOOL"}}"#))
+        .collect();
+    let coils: Vec<String> = names
+        .iter()
+        .map(|n| format!(r#"[{{"coil": "{n}"}}]"#))
+        .collect();
+    let contacts: Vec<String> = names
+        .iter()
+        .map(|n| format!(r#"{{"contact": "{n}"}}"#))
+        .collect();
+    let html = page_of_text(&format!(
+        r#"{{"program": "P", "vars": [{{"name": "a", "type": "BOOL", "class": "input"}},
+            {{"name": "q", "type": "BOOL", "class": "output"}}, {}],
+          "rungs": [{{"id": "W", "ld": [{{"contact": "a"}}, {{"branch": [{}]}}]}},
+                    {{"id": "R", "ld": [{}, {{"coil": "q"}}]}}]}}"#,
+        vars.join(", "),
+        coils.join(", "),
+        contacts.join(", ")
+    ));
+    let doc = parse(&html);
+    let shown: Vec<(f64, f64, f64)> = doc
+        .descendants()
+        .filter(|n| has_class(n, "elabel") && !has_class(n, "crowded"))
+        .map(|n| {
+            let x: f64 = n.attribute("x").unwrap().parse().unwrap();
+            let y: f64 = n.attribute("y").unwrap().parse().unwrap();
+            let half = n.text().unwrap_or("").chars().count() as f64 * 5.5 / 2.0;
+            (x - half, x + half, y)
+        })
+        .collect();
+    let all = doc.descendants().filter(|n| has_class(n, "elabel")).count();
+    assert_eq!(all, 6, "one label per flow edge W -> R");
+    assert!(shown.len() >= 2, "{shown:?}");
+    for (i, a) in shown.iter().enumerate() {
+        for b in &shown[i + 1..] {
+            let apart = a.1 <= b.0 || b.1 <= a.0 || (a.2 - b.2).abs() >= 9.9;
+            assert!(apart, "labels overlap: {a:?} {b:?}");
+        }
+    }
+}
