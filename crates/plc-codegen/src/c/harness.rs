@@ -124,6 +124,7 @@ fn slot_kind(ty: Type) -> &'static str {
         Type::Udint | Type::Dword => "_PLC_K_UDINT",
         Type::Ulint | Type::Lword => "_PLC_K_ULINT",
         Type::Lreal => "_PLC_K_LREAL",
+        Type::String => "_PLC_K_STRING",
         Type::Fb(FbKind::Ton | FbKind::Tof | FbKind::Tp) => "_PLC_K_TIMER",
         Type::Fb(FbKind::Ctu | FbKind::Ctd) => "_PLC_K_COUNTER",
         Type::Fb(FbKind::Sr | FbKind::Rs) => "_PLC_K_BISTABLE",
@@ -214,7 +215,7 @@ fn inputs(p: &Program, sh: &Shared, s: &mut String) {
 /// or bit string what its cells must be (`an INT (-32768..32767)`), as `plc-deps run` says it.
 fn cell_type(ty: Type) -> String {
     match ty {
-        Type::Bool | Type::Real | Type::Lreal | Type::Time => ty.to_string(),
+        Type::Bool | Type::Real | Type::Lreal | Type::Time | Type::String => ty.to_string(),
         ty => plc_model::integer_cell(ty),
     }
 }

@@ -263,7 +263,8 @@ fn one(
         .as_ref()
         .is_some_and(|d| matches!(d.base, Base::Whole(_)));
     if let Some(&(from, to)) = MAPPED.iter().find(|(f, _)| *f == ty) {
-        text |= from.eq_ignore_ascii_case("string") || from.eq_ignore_ascii_case("wstring");
+        // A WSTRING has no value in the model (a STRING has: `string` reads as STRING).
+        text |= from.eq_ignore_ascii_case("wstring");
         ty = to.to_owned();
         if data.is_none() {
             mapped.push(Mapped {
