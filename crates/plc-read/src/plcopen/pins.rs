@@ -310,7 +310,8 @@ pub(super) fn block_input(node: Node, place: &str, at: Origin) -> R<Input<'stati
         None if text.trim().starts_with('\'') && is_string_literal(text) => {
             Connection::Constant(Scalar::Str(Cow::Owned(text.trim().to_owned())))
         }
-        None if is_string_literal(text) => Connection::Constant(Scalar::Number(0.into())),
+        // A WSTRING literal: no value; the empty STRING stands in (`run` refuses the body).
+        None if is_string_literal(text) => Connection::Constant(Scalar::Str(Cow::Borrowed("''"))),
         None => Connection::Variable(Cow::Owned(variable_ref(text, node, place)?)),
     };
     Ok(Input { origin: at, from })
