@@ -8,7 +8,8 @@
 //!
 //! Not here: the POUs' code (`ladder`, `fbd`).
 
-use super::ladder::{c_const, Shared};
+use super::ladder::Shared;
+use super::spelling::c_init;
 use super::names::{c_string, json_string};
 use super::text::push;
 use super::CConfig;
@@ -32,7 +33,7 @@ pub(crate) fn program_source(p: &Program, sh: &Shared, extra: &[String], cfg: &C
         .iter()
         .enumerate()
         .filter(|(i, v)| !matches!(v.ty, Type::Fb(_)) && !is_zero(v.init) && !sh.local_only[*i])
-        .map(|(i, v)| format!("    .{} = {},\n", field(sh, i), c_const(v.init)))
+        .map(|(i, v)| format!("    .{} = {},\n", field(sh, i), c_init(v.init)))
         .chain(extra.iter().cloned())
         .collect();
     if inits.is_empty() {

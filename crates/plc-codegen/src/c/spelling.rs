@@ -60,6 +60,18 @@ pub(crate) fn c_type(ty: Type) -> &'static str {
 /// `INT64_C`/`UINT64_C` for the 64-bit types; a minimum as `(-MAX - 1)`, since `-N` negates a
 /// literal that may not fit), a real with its suffix or, when negative or not finite, by its
 /// bits.
+/// A constant as a static initializer: a STRING as `{len, "bytes"}` (a function call is no
+/// constant expression), anything else as [`c_const`].
+pub(crate) fn c_init(v: Value) -> String {
+    match v {
+        Value::Str(id) => {
+            let b = plc_model::str_bytes(id);
+            format!("{{{}, {}}}", b.len(), super::names::c_bytes(b))
+        }
+        v => c_const(v),
+    }
+}
+
 pub(crate) fn c_const(v: Value) -> String {
     let ty = v.ty();
     match v {
