@@ -149,5 +149,13 @@ fn beremiz_exports_with_strings_run() {
         );
         let j: Json = serde_json::from_slice(&out.stdout).unwrap();
         assert_eq!(j["identical"], true, "{file}: seq == par");
+        if file.contains("svghmi") {
+            // PumpControl: strout := CONCAT(INT_TO_STRING(Pressure), strin), Pressure 0 and
+            // strin's initial value `blup` (saved unquoted by Beremiz's editor).
+            assert_eq!(j["state"]["Pump0.strout"], "0blup");
+            // MainStuff: CURRENT_PAGE_0 := SEL(R_TRIG0.Q, CURRENT_PAGE_0, '!RelativePageTest@/PUMP2'):
+            // no rising edge of PAGESWITCH, so it keeps its (empty) value.
+            assert_eq!(j["state"]["CURRENT_PAGE_0"], "");
+        }
     }
 }

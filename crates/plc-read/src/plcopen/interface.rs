@@ -360,7 +360,8 @@ fn data_base(d: &DataType) -> String {
     match &d.base {
         Base::Elementary(t) => t.clone(),
         Base::Enum(_) => "INT".to_owned(),
-        Base::Whole(_) | Base::Struct(_) => "string".to_owned(),
+        // An array (or a structure not flattened) has no value: the DINT stand-in.
+        Base::Whole(_) | Base::Struct(_) => "DINT".to_owned(),
     }
 }
 
