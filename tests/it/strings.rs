@@ -33,7 +33,11 @@ fn string_functions_run_with_matiecs_texts_seq_equal_par() {
         "--format",
         "json",
     ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let j: Json = serde_json::from_slice(&out.stdout).unwrap();
     let s = &j["state"];
     // __sint_to_string: snprintf "%lld".
@@ -139,7 +143,14 @@ fn beremiz_exports_with_strings_run() {
         ),
     ] {
         let path = root().join("tests/plcopen").join(file);
-        let mut args = vec!["run", path.to_str().unwrap(), "--scans", "3", "--format", "json"];
+        let mut args = vec![
+            "run",
+            path.to_str().unwrap(),
+            "--scans",
+            "3",
+            "--format",
+            "json",
+        ];
         args.extend(extra);
         let out = run(&args);
         assert!(
@@ -157,5 +168,41 @@ fn beremiz_exports_with_strings_run() {
             // no rising edge of PAGESWITCH, so it keeps its (empty) value.
             assert_eq!(j["state"]["CURRENT_PAGE_0"], "");
         }
+    }
+}
+
+/// The generated C of the two Beremiz exports that run whole (FBD bodies with STRING locals,
+/// SEL of STRINGs, CONCAT, INT_TO_STRING, a python_poll black box fed a STRING) builds with
+/// its Makefile and ends in the state `run` ends in.
+#[test]
+fn beremiz_exports_with_strings_in_c_end_as_run() {
+    for file in [
+        "beremiz__tests_projects_svghmi_plc.xml",
+        "beremiz__tests_projects_wxHMI_plc.xml",
+    ] {
+        let path = root().join("tests/plcopen").join(file);
+        let path = path.to_str().unwrap();
+        let dir = common::c::fresh_dir("strings-beremiz");
+        let out = run(&["c", path, "-o", dir.to_str().unwrap(), "--force"]);
+        common::c::assert_ok(&out, &format!("plc-deps c {file}"));
+        let make = std::process::Command::new("make")
+            .current_dir(&dir)
+            .output()
+            .expect("make runs");
+        common::c::assert_ok(&make, &format!("make {file}"));
+        let c = common::c::run_with_input(&dir.join("plc_program"), &["3".into()], b"");
+        common::c::assert_ok(&c, &format!("plc_program {file}"));
+        let last = String::from_utf8_lossy(&c.stdout)
+            .lines()
+            .last()
+            .unwrap()
+            .to_owned();
+        let c_state: Json = serde_json::from_str(&last).unwrap();
+        let i = run(&["run", path, "--scans", "3", "--format", "json"]);
+        let i: Json = serde_json::from_slice(&i.stdout).unwrap();
+        assert_eq!(
+            c_state, i["state"],
+            "{file}: C == interpreter after 3 scans"
+        );
     }
 }

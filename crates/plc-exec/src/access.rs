@@ -13,8 +13,8 @@
 
 use super::layout::{Repr, COUNTER_BYTES, CTUD_BYTES, TIMER_BYTES, TRIGGER_BYTES};
 use super::lower::{Op, Pc};
-use super::strings::STR_SLOT;
 use super::store::Addr;
+use super::strings::STR_SLOT;
 use super::Machine;
 use plc_model::{RungId, VarClass, VarId};
 

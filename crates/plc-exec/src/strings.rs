@@ -103,9 +103,7 @@ pub fn of_value(v: Value) -> StrBuf {
 /// matiec's `__str_cmp`: `memcmp` of the common length, else the longer is greater.
 pub fn compare(a: &StrBuf, b: &StrBuf) -> Ordering {
     let n = a.len.min(b.len) as usize;
-    a.body[..n]
-        .cmp(&b.body[..n])
-        .then(a.len.cmp(&b.len))
+    a.body[..n].cmp(&b.body[..n]).then(a.len.cmp(&b.len))
 }
 
 /// An argument or result of a string function: a STRING or another value.
@@ -197,7 +195,11 @@ pub fn apply(func: Function, args: &[Arg], out: Type) -> Arg {
                 return string(StrBuf::EMPTY);
             }
             let (l, p) = (l as u8 as usize, p as u8 as usize);
-            let keep = if p > a.len as usize { a.len as usize } else { p.max(1) - 1 };
+            let keep = if p > a.len as usize {
+                a.len as usize
+            } else {
+                p.max(1) - 1
+            };
             let mut r = StrBuf::new(&a.bytes()[..keep]);
             if a.len as usize > keep + l {
                 r.push(&a.bytes()[keep + l..]);
@@ -212,7 +214,11 @@ pub fn apply(func: Function, args: &[Arg], out: Type) -> Arg {
                 return string(StrBuf::EMPTY);
             }
             let (l, p) = (l as u8 as usize, p as u8 as usize);
-            let keep = if p > a.len as usize { a.len as usize } else { p.max(1) - 1 };
+            let keep = if p > a.len as usize {
+                a.len as usize
+            } else {
+                p.max(1) - 1
+            };
             let mut r = StrBuf::new(&a.bytes()[..keep]);
             r.push(&b.bytes()[..l.min(b.len as usize)]);
             let after = (keep + l) as u8 as usize;
@@ -313,10 +319,14 @@ pub fn string_to_int(b: &[u8]) -> i64 {
     if n > 1 && b[0] == b'2' && b[1] == b'#' {
         // matiec shifts an `int` here (`(c - '0') << shift`): past bit 31 that is undefined C;
         // this reads it as the 64-bit shift the other bases use.
-        return based(2, 1, |c| matches!(c, b'0'..=b'1').then(|| (c - b'0') as u64));
+        return based(2, 1, |c| {
+            matches!(c, b'0'..=b'1').then(|| (c - b'0') as u64)
+        });
     }
     if n > 1 && b[0] == b'8' && b[1] == b'#' {
-        return based(2, 3, |c| matches!(c, b'0'..=b'7').then(|| (c - b'0') as u64));
+        return based(2, 3, |c| {
+            matches!(c, b'0'..=b'7').then(|| (c - b'0') as u64)
+        });
     }
     if n > 2 && b[0] == b'1' && b[1] == b'6' && b[2] == b'#' {
         return based(3, 4, |c| (c as char).to_digit(16).map(u64::from));
@@ -359,7 +369,8 @@ mod tests {
 
     #[test]
     fn functions_as_matiec() {
-        let f = |name: &str, args: &[Arg], out| text(apply(Function::parse(name).unwrap(), args, out));
+        let f =
+            |name: &str, args: &[Arg], out| text(apply(Function::parse(name).unwrap(), args, out));
         let s = Type::String;
         assert_eq!(f("CONCAT", &[st("ab"), st("cd"), st("e")], s), "abcde");
         let long = "x".repeat(100);
@@ -374,18 +385,37 @@ mod tests {
         assert_eq!(f("MID", &[st("hello"), int(2), int(6)], s), "");
         assert_eq!(f("INSERT", &[st("hello"), st("XY"), int(2)], s), "heXYllo");
         assert_eq!(f("DELETE", &[st("hello"), int(2), int(2)], s), "hlo");
-        assert_eq!(f("REPLACE", &[st("hello"), st("XYZ"), int(2), int(2)], s), "hXYZlo");
+        assert_eq!(
+            f("REPLACE", &[st("hello"), st("XYZ"), int(2), int(2)], s),
+            "hXYZlo"
+        );
         assert_eq!(f("FIND", &[st("hello"), st("ll")], Type::Int), "3");
         assert_eq!(f("FIND", &[st("hello"), st("z")], Type::Int), "0");
-        assert_eq!(f("FIND", &[st("aab"), st("ab")], Type::Int), "0", "matiec's __pfind");
+        assert_eq!(
+            f("FIND", &[st("aab"), st("ab")], Type::Int),
+            "0",
+            "matiec's __pfind"
+        );
         assert_eq!(f("INT_TO_STRING", &[int(-42)], s), "-42");
-        assert_eq!(f("BOOL_TO_STRING", &[Arg::Val(Value::Bool(true))], s), "TRUE");
-        assert_eq!(f("WORD_TO_STRING", &[Arg::Val(Value::Word(255))], s), "16#ff");
+        assert_eq!(
+            f("BOOL_TO_STRING", &[Arg::Val(Value::Bool(true))], s),
+            "TRUE"
+        );
+        assert_eq!(
+            f("WORD_TO_STRING", &[Arg::Val(Value::Word(255))], s),
+            "16#ff"
+        );
         assert_eq!(f("STRING_TO_INT", &[st("-123")], Type::Int), "-123");
         assert_eq!(f("STRING_TO_INT", &[st("16#1F")], Type::Int), "31");
         assert_eq!(f("STRING_TO_INT", &[st("12.5")], Type::Int), "5");
         assert_eq!(f("STRING_TO_BOOL", &[st("true")], Type::Bool), "TRUE");
-        assert_eq!(compare(&StrBuf::new(b"ab"), &StrBuf::new(b"abc")), Ordering::Less);
-        assert_eq!(compare(&StrBuf::new(b"b"), &StrBuf::new(b"abc")), Ordering::Greater);
+        assert_eq!(
+            compare(&StrBuf::new(b"ab"), &StrBuf::new(b"abc")),
+            Ordering::Less
+        );
+        assert_eq!(
+            compare(&StrBuf::new(b"b"), &StrBuf::new(b"abc")),
+            Ordering::Greater
+        );
     }
 }

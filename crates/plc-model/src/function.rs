@@ -477,7 +477,10 @@ mod tests {
         }
         assert_eq!(Function::parse("TON_TO_INT"), None);
         assert_eq!(Function::parse("STRING_TO_REAL"), None);
-        assert_eq!(Function::parse("STRING_TO_INT").unwrap().name(), "STRING_TO_INT");
+        assert_eq!(
+            Function::parse("STRING_TO_INT").unwrap().name(),
+            "STRING_TO_INT"
+        );
         assert_eq!(Function::parse("CONCAT").unwrap().name(), "CONCAT");
         // Every elementary type converts to every other, by its IEC name.
         let sint = Function::parse("SINT_TO_ULINT").unwrap();

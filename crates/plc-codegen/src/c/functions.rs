@@ -79,7 +79,9 @@ pub(crate) fn expr(func: Function, args: &[(String, Type)], out: Type) -> String
         Not => wrap(&format!("(int64_t)~{}", bits_of(a(0), out)), out),
         Convert { .. } => convert(a(0), args[0].1, out),
         Trunc => wrap(&format!("{}(trunc((double){}))", TO_I64, a(0)), out),
-        Concat | Len | Left | Right | Mid | Insert | Delete | Replace | Find => string_expr(func, args, out),
+        Concat | Len | Left | Right | Mid | Insert | Delete | Replace | Find => {
+            string_expr(func, args, out)
+        }
     }
 }
 

@@ -9,8 +9,8 @@
 //! Not here: the POUs' code (`ladder`, `fbd`).
 
 use super::ladder::Shared;
-use super::spelling::c_init;
 use super::names::{c_string, json_string};
+use super::spelling::c_init;
 use super::text::push;
 use super::CConfig;
 use plc_model::{FbKind, Program, Type, Value, VarClass};

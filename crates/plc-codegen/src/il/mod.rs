@@ -104,7 +104,9 @@ pub fn generate(p: &Program, fbd: &Fbd) -> Result<String, IlError> {
     if let Some((rung, f)) = textual {
         return Err(IlError {
             place: format!("rung {rung}"),
-            message: format!("{f} works on STRINGs, which have no S7-200 STL form in plc-deps il (not yet)"),
+            message: format!(
+                "{f} works on STRINGs, which have no S7-200 STL form in plc-deps il (not yet)"
+            ),
         });
     }
     let names = Names::new(p);
