@@ -75,7 +75,7 @@ fn a_wstring_is_analysed_everywhere_and_run_refuses_it_where_it_would_execute_th
     let vars = [
         ("inputVars", "go", "<BOOL/>", ""),
         ("outputVars", "lamp", "<BOOL/>", ""),
-        ("localVars", "msg", "<wstring/>", "\"hello\""),
+        ("localVars", "msg", "<wstring/>", "&quot;hello&quot;"),
     ];
     let xml = with_types("LD", &vars, &ld());
     // The report reads it (a whole variable, with a warning naming why `run` would refuse).
@@ -94,7 +94,7 @@ fn a_wstring_is_analysed_everywhere_and_run_refuses_it_where_it_would_execute_th
     let st = with_types(
         "ST",
         &vars,
-        "<xhtml xmlns=\"http://www.w3.org/1999/xhtml\">IF go THEN msg := \"on\"; END_IF;</xhtml>",
+        "<xhtml xmlns=\"http://www.w3.org/1999/xhtml\">IF go THEN msg := &quot;on&quot;; END_IF;</xhtml>",
     );
     let (r, err) = report_and_warnings(&st);
     assert_eq!(r["rungs"][0]["in"], json!(["go", "msg"]));
