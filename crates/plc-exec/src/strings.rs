@@ -253,7 +253,10 @@ pub fn apply(func: Function, args: &[Arg], out: Type) -> Arg {
             };
             int_value(at as i128, out)
         }
-        Convert { from, to } if to == Type::String => string(to_string(args[0], from)),
+        Convert {
+            from,
+            to: Type::String,
+        } => string(to_string(args[0], from)),
         Convert { to, .. } => Arg::Val(from_string(&s(0), to)),
         _ => Arg::Val(out.zero()),
     }
