@@ -397,11 +397,11 @@ fn every_malformed_part_is_one_located_error_with_its_exact_text() {
 
 #[test]
 fn an_fbd_error_carries_the_line_and_column_of_the_field_it_names() {
-    let text = "{\"program\": \"p\", \"vars\": [{\"name\": \"A\", \"type\": \"INT\"}],\n\"fbd\": {\"networks\": [{\"id\": \"N1\", \"blocks\": [\n  {\"id\": 1, \"op\": \"MOVE\", \"in\": [\"A\"], \"out\": \"A\"},\n  {\"id\": 2, \"op\": \"CONCAT\"}]}]}}";
-    let e = plc_deps::load::program_from_json(text).expect_err("CONCAT is no op");
+    let text = "{\"program\": \"p\", \"vars\": [{\"name\": \"A\", \"type\": \"INT\"}],\n\"fbd\": {\"networks\": [{\"id\": \"N1\", \"blocks\": [\n  {\"id\": 1, \"op\": \"MOVE\", \"in\": [\"A\"], \"out\": \"A\"},\n  {\"id\": 2, \"op\": \"CONCATX\"}]}]}}";
+    let e = plc_deps::load::program_from_json(text).expect_err("CONCATX is no op");
     let d = &e.diagnostics()[0];
     assert_eq!(d.location.position, Some((4, 13)));
-    let text = text.replace("\"CONCAT\"", "\"MOVE\", \"in\": [{\"from\": 7}]");
+    let text = text.replace("\"CONCATX\"", "\"MOVE\", \"in\": [{\"from\": 7}]");
     let e = plc_deps::load::program_from_json(&text).expect_err("no block 7");
     assert_eq!(e.diagnostics()[0].location.position, Some((4, 35)));
 }

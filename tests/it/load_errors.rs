@@ -46,8 +46,8 @@ fn every_error_points_at_its_most_precise_node() {
     let cases: &[(&str, &str)] = &[
         (
             r#"{"program": "p", "vars": [
-  {"name": "A", "type": "STRING"}], "rungs": [{"id": "R1", "ld": [{"ret": true}]}]}"#,
-            "p.json:2:25: at vars[0].type: unknown type `STRING`",
+  {"name": "A", "type": "WSTRING"}], "rungs": [{"id": "R1", "ld": [{"ret": true}]}]}"#,
+            "p.json:2:25: at vars[0].type: unknown type `WSTRING`",
         ),
         (
             r#"{"program": "p", "vars": [{"name": "A", "type": "BOOL", "init": 7}],

@@ -74,3 +74,4 @@ mod run_cli;
 mod scan_budget;
 mod schema;
 mod standard_fbs;
+mod strings;

@@ -222,7 +222,7 @@ fn a_function_the_model_lacks_is_a_black_box_with_its_pins() {
 #[test]
 fn a_string_literal_is_analysed_and_run_refuses_it() {
     let fbd = [
-        in_var(1, "'hello'"),
+        in_var(1, "\"hello\""),
         in_var(2, "go"),
         block(
             3,
@@ -244,7 +244,7 @@ fn a_string_literal_is_analysed_and_run_refuses_it() {
     assert!(warnings.contains("python_eval"), "{warnings}");
     let e = error_line(
         &run_stdin(&["run", "-", "--scans", "1"], xml.as_bytes()),
-        "string literal",
+        "wstring literal",
     );
     let at = line_col(&xml, "<inVariable localId=\"1\"");
     assert_eq!(e, format!("error: <stdin>:{at}: at run: pou P: the inVariable localId 1 is a string literal, for which plc-deps has no values: the analysis reads it as a constant, but `run` cannot execute the FBD body of `P`"));

@@ -70,11 +70,12 @@ fn elementary_types_are_read_as_themselves_and_the_others_named_in_one_note() {
 }
 
 #[test]
-fn a_string_is_analysed_everywhere_and_run_refuses_it_where_it_would_execute_the_body() {
+fn a_wstring_is_analysed_everywhere_and_run_refuses_it_where_it_would_execute_the_body() {
+    // A STRING has values (tests/it/strings.rs); a WSTRING has none.
     let vars = [
         ("inputVars", "go", "<BOOL/>", ""),
         ("outputVars", "lamp", "<BOOL/>", ""),
-        ("localVars", "msg", "<string/>", "'hello'"),
+        ("localVars", "msg", "<wstring/>", "&quot;hello&quot;"),
     ];
     let xml = with_types("LD", &vars, &ld());
     // The report reads it (a whole variable, with a warning naming why `run` would refuse).
@@ -82,21 +83,21 @@ fn a_string_is_analysed_everywhere_and_run_refuses_it_where_it_would_execute_the
     assert_eq!(r["rungs"][0]["out"], json!(["lamp"]));
     let at = line_col(&xml, "<variable name=\"msg\"");
     assert!(
-        err.contains(&format!("<stdin>:{at}: pou P: variable `msg` is a STRING")),
+        err.contains(&format!("<stdin>:{at}: pou P: variable `msg` is a WSTRING")),
         "{err}"
     );
     let e = error_line(
         &run_stdin(&["run", "-", "--scans", "1"], xml.as_bytes()),
         "string in LD",
     );
-    assert_eq!(e, format!("error: <stdin>:{at}: at run: pou P: variable `msg` is a STRING, for which plc-deps has no values: the analysis reads it as a whole variable, but `run` cannot execute the LD body of `P`"));
+    assert_eq!(e, format!("error: <stdin>:{at}: at run: pou P: variable `msg` is a WSTRING, for which plc-deps has no values: the analysis reads it as a whole variable, but `run` cannot execute the LD body of `P`"));
     let st = with_types(
         "ST",
         &vars,
-        "<xhtml xmlns=\"http://www.w3.org/1999/xhtml\">IF go THEN msg := 'on'; END_IF;</xhtml>",
+        "<xhtml xmlns=\"http://www.w3.org/1999/xhtml\">IF go THEN msg := &quot;on&quot;; END_IF;</xhtml>",
     );
     let (r, err) = report_and_warnings(&st);
     assert_eq!(r["rungs"][0]["in"], json!(["go", "msg"]));
     assert_eq!(r["rungs"][0]["out"], json!(["msg"]));
-    assert!(err.contains("P.msg STRING → DINT"), "{err}");
+    assert!(err.contains("P.msg WSTRING → DINT"), "{err}");
 }

@@ -116,7 +116,7 @@ pub enum Invalid {
     #[error("`{name}` is not a valid name (letters, digits and _, not starting with a digit)")]
     BadName { name: String },
     #[error(
-        "unknown type `{name}` (expected BOOL, SINT, INT, DINT, LINT, USINT, UINT, UDINT, ULINT, REAL, LREAL, BYTE, WORD, DWORD, LWORD, TIME, TON, TOF, TP, CTU, CTD, SR, RS, R_TRIG, F_TRIG or CTUD)"
+        "unknown type `{name}` (expected BOOL, SINT, INT, DINT, LINT, USINT, UINT, UDINT, ULINT, REAL, LREAL, BYTE, WORD, DWORD, LWORD, TIME, STRING, TON, TOF, TP, CTU, CTD, SR, RS, R_TRIG, F_TRIG or CTUD)"
     )]
     UnknownType { name: String },
     #[error("variable `{name}` is declared twice")]

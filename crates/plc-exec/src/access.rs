@@ -14,6 +14,7 @@
 use super::layout::{Repr, COUNTER_BYTES, CTUD_BYTES, TIMER_BYTES, TRIGGER_BYTES};
 use super::lower::{Op, Pc};
 use super::store::Addr;
+use super::strings::STR_SLOT;
 use super::Machine;
 use plc_model::{RungId, VarClass, VarId};
 
@@ -140,9 +141,17 @@ impl Machine {
                     reads.push((from, w));
                     writes.push((to, w));
                 }
+                Op::StrMove { from, to } => {
+                    reads.push((from, STR_SLOT));
+                    writes.push((to, STR_SLOT));
+                }
+                Op::StrCmp { a, b, .. } => reads.extend([(a, STR_SLOT), (b, STR_SLOT)]),
                 Op::Func { call } => {
                     let c = &self.funcs[call.index()];
-                    let width = |t| Repr::of(t).map_or(1, Repr::width);
+                    let width = |t| match t {
+                        plc_model::Type::String => STR_SLOT,
+                        t => Repr::of(t).map_or(1, Repr::width),
+                    };
                     reads.extend(c.args.iter().map(|&(a, t)| (a, width(t))));
                     writes.push((c.out, width(c.ty)));
                 }

@@ -56,6 +56,8 @@ pub fn apply(func: Function, args: &[Value], out: Type) -> Value {
         Not => Value::from_bits(out, !args[0].to_bits()),
         Convert { .. } => convert(args[0], out),
         Trunc => from_integer(real_to_i64(real64(args[0]).trunc()) as i128, out),
+        // The string functions run on STRING slots (`strings::apply`), never here.
+        Concat | Len | Left | Right | Mid | Insert | Delete | Replace | Find => out.zero(),
     }
 }
 

@@ -64,7 +64,8 @@ impl Repr {
             Type::Ulint | Type::Lword => Some(Repr::U64),
             Type::Real => Some(Repr::F32),
             Type::Lreal => Some(Repr::F64),
-            Type::Fb(_) => None,
+            // A STRING is a slot of bytes, not a scalar word (`strings`).
+            Type::String | Type::Fb(_) => None,
         }
     }
 
@@ -108,6 +109,16 @@ const COUNTER_PARTS: [(u32, u32); 4] = [(Q, 1), (PREV, 1), (CV, 2), (PV, 2)];
 const TRIGGER_PARTS: [(u32, u32); 2] = [(Q, 1), (MEM, 1)];
 const CTUD_PARTS: [(u32, u32); 5] = [(Q, 1), (PREV, 1), (CV, 2), (PV, 2), (QD, 1)];
 const SCALAR_PARTS: [[(u32, u32); 1]; 4] = [[(0, 1)], [(0, 2)], [(0, 4)], [(0, 8)]];
+/// A STRING slot as 16 words of 8 bytes (length byte, body, pad: `strings::STR_SLOT`).
+const STRING_PARTS: [(u32, u32); 16] = {
+    let mut p = [(0, 8); 16];
+    let mut i = 0;
+    while i < 16 {
+        p[i] = (8 * i as u32, 8);
+        i += 1;
+    }
+    p
+};
 
 // Every part aligned to its width, inside its instance.
 const _: () = {
@@ -141,6 +152,7 @@ pub fn parts(ty: Type) -> &'static [(u32, u32)] {
         Type::Fb(FbKind::Sr | FbKind::Rs) => &SCALAR_PARTS[0],
         Type::Fb(FbKind::RTrig | FbKind::FTrig) => &TRIGGER_PARTS,
         Type::Fb(FbKind::Ctud) => &CTUD_PARTS,
+        Type::String => &STRING_PARTS,
         scalar => match Repr::of(scalar).map_or(1, Repr::width) {
             1 => &SCALAR_PARTS[0],
             2 => &SCALAR_PARTS[1],
@@ -158,6 +170,7 @@ pub fn type_size(ty: Type) -> u32 {
         Type::Fb(FbKind::Sr | FbKind::Rs) => BISTABLE_BYTES,
         Type::Fb(FbKind::RTrig | FbKind::FTrig) => TRIGGER_BYTES,
         Type::Fb(FbKind::Ctud) => CTUD_BYTES,
+        Type::String => super::strings::STR_SLOT,
         scalar => Repr::of(scalar).map_or(1, Repr::width),
     }
 }

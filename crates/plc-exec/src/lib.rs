@@ -147,6 +147,7 @@ pub mod parallel;
 mod run;
 #[allow(unsafe_code)]
 mod store;
+pub mod strings;
 mod value;
 
 pub use access::Span;

@@ -9,6 +9,7 @@ use super::fuse::{lookup, FusedId, FusedRung};
 use super::layout::{CV, ET, FLAGS, PREV, PT, PV, Q, START};
 use super::lower::{Num, Op, Width};
 use super::store::{Addr, Word};
+use super::strings;
 use super::value::{load_value, store_value};
 use super::{BudgetSpent, Fault, FaultKind, Machine, ScanCtx, Store};
 use plc_model::{ArithOp, CmpOp, RungId, TimerKind, Type, Value};
@@ -200,6 +201,9 @@ impl Machine {
     /// `out := func(args)` of one standard function box (`super::functions`).
     #[inline(never)]
     fn call_function<S: Store + ?Sized>(&self, st: &mut S, c: &super::lower::FuncCall) {
+        if c.func.is_textual() {
+            return string_function(st, c);
+        }
         let mut buf = [Value::Bool(false); 8];
         let load = |&(at, ty): &(Addr, Type)| load_value(st, at, ty);
         let r = if c.args.len() <= buf.len() {
@@ -212,6 +216,24 @@ impl Machine {
             super::functions::apply(c.func, &vals, c.ty)
         };
         store_value(st, c.out, r);
+    }
+}
+
+/// A string function or a conversion to or from STRING (`strings::apply`): STRING arguments
+/// read from their slots, the result stored in the output's.
+#[cold]
+fn string_function<S: Store + ?Sized>(st: &mut S, c: &super::lower::FuncCall) {
+    let args: Vec<strings::Arg> = c
+        .args
+        .iter()
+        .map(|&(at, ty)| match ty {
+            Type::String => strings::Arg::Str(strings::load_str(st, at)),
+            ty => strings::Arg::Val(load_value(st, at, ty)),
+        })
+        .collect();
+    match strings::apply(c.func, &args, c.ty) {
+        strings::Arg::Str(s) => strings::store_str(st, c.out, &s),
+        strings::Arg::Val(v) => store_value(st, c.out, v),
     }
 }
 
@@ -396,6 +418,16 @@ impl Machine {
                             Width::W8 => copy::<u64, S>(st, from, to),
                         }
                     }
+                }
+                Op::StrMove { from, to } => {
+                    if p != 0 {
+                        let s = strings::load_str(st, from);
+                        strings::store_str(st, to, &s);
+                    }
+                }
+                Op::StrCmp { op, a, b } => {
+                    let o = strings::compare(&strings::load_str(st, a), &strings::load_str(st, b));
+                    p &= compare(op, o, std::cmp::Ordering::Equal) as u64;
                 }
                 Op::Func { call } => {
                     if p != 0 {

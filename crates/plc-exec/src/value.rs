@@ -7,6 +7,7 @@
 
 use super::layout::{Repr, CV, ET, PT, PV, Q, QD};
 use super::store::{Addr, Store};
+use super::strings::{load_str, of_value, store_str, StrBuf};
 use plc_model::{FbKind, Type, Value};
 use serde::{Serialize, Serializer};
 use serde_json::{json, Value as Json};
@@ -14,6 +15,9 @@ use serde_json::{json, Value as Json};
 /// Writes the scalar `v` at `at` in its type's representation.
 #[inline]
 pub fn store_value<S: Store + ?Sized>(st: &mut S, at: Addr, v: Value) {
+    if let Value::Str(_) = v {
+        return store_str(st, at, &of_value(v));
+    }
     // Every representation is its value's bits in native order: store the low bytes.
     let bits = v.to_bits();
     match Repr::of(v.ty()).map_or(1, Repr::width) {
@@ -25,7 +29,8 @@ pub fn store_value<S: Store + ?Sized>(st: &mut S, at: Addr, v: Value) {
 }
 
 /// The scalar of type `ty` stored at `at`. Instance types have no scalar value: for them this
-/// reads the instance's Q (use [`Machine::value`](super::Machine::value)).
+/// reads the instance's Q (use [`Machine::value`](super::Machine::value)); nor has a STRING
+/// (its value is no constant): for it this gives the empty string (use [`VarValue::load`]).
 #[inline]
 pub fn load_value<S: Store + ?Sized>(st: &S, at: Addr, ty: Type) -> Value {
     let Some(repr) = Repr::of(ty) else {
@@ -45,6 +50,8 @@ pub fn load_value<S: Store + ?Sized>(st: &S, at: Addr, ty: Type) -> Value {
 pub enum VarValue {
     /// A variable of an elementary type.
     Scalar(Value),
+    /// A STRING variable.
+    Text(StrBuf),
     /// A TON, TOF or TP instance.
     Timer {
         /// Output.
@@ -109,6 +116,7 @@ impl VarValue {
                 cv: mem.load(at.offset(CV)),
                 pv: mem.load(at.offset(PV)),
             },
+            Type::String => VarValue::Text(load_str(mem, at)),
             scalar => VarValue::Scalar(load_value(mem, at, scalar)),
         }
     }
@@ -139,10 +147,12 @@ impl VarValue {
     /// LREAL a number (the shortest decimal that reads back as the value; `null` for NaN and
     /// infinities, which JSON cannot hold); TIME milliseconds; a timer
     /// `{"Q", "ET", "PT"}`, a counter `{"Q", "CV", "PV"}`, a bistable `{"Q1"}`, an edge detector
-    /// `{"Q"}` and an up-down counter `{"QU", "QD", "CV", "PV"}`.
+    /// `{"Q"}` and an up-down counter `{"QU", "QD", "CV", "PV"}`; a STRING a JSON string, each
+    /// byte one character (Latin-1: ASCII as itself).
     pub fn to_json(&self) -> Json {
         match *self {
             VarValue::Scalar(v) => scalar_json(v),
+            VarValue::Text(s) => Json::String(s.text()),
             VarValue::Timer { q, et, pt } => json!({"Q": q, "ET": et, "PT": pt}),
             VarValue::Counter { q, cv, pv } => json!({"Q": q, "CV": cv, "PV": pv}),
             VarValue::Bistable { q1 } => json!({ "Q1": q1 }),

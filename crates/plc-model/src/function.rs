@@ -51,6 +51,24 @@ pub enum Function {
     },
     /// TRUNC: a REAL to an integer, toward zero.
     Trunc,
+    /// CONCAT(IN1, …, INn) of STRINGs (extensible; IEC 61131-3 2.5.1.5.6 Table 29).
+    Concat,
+    /// LEN(IN): the length of a STRING, as an integer.
+    Len,
+    /// LEFT(IN, L): the first L characters.
+    Left,
+    /// RIGHT(IN, L): the last L characters.
+    Right,
+    /// MID(IN, L, P): L characters from position P (1-based).
+    Mid,
+    /// INSERT(IN1, IN2, P): IN2 inserted after position P of IN1.
+    Insert,
+    /// DELETE(IN, L, P): L characters deleted from position P.
+    Delete,
+    /// REPLACE(IN1, IN2, L, P): L characters of IN1 from position P replaced by IN2.
+    Replace,
+    /// FIND(IN1, IN2): the position of the first IN2 in IN1 (0: none).
+    Find,
 }
 
 /// A set of types a pin accepts (the generic types of IEC 61131-3 2.3.2 the model has).
@@ -77,7 +95,7 @@ impl Class {
             Class::Real => t.is_real(),
             Class::Int => t.is_int(),
             Class::Bit => bit_width(t).is_some(),
-            Class::Elementary => !matches!(t, Type::Fb(_)),
+            Class::Elementary => !matches!(t, Type::Fb(_) | Type::String),
             Class::Exact(x) => t == x,
         }
     }
@@ -160,10 +178,27 @@ impl Function {
             "XOR" => Xor,
             "NOT" => Not,
             "TRUNC" => Trunc,
+            "CONCAT" => Concat,
+            "LEN" => Len,
+            "LEFT" => Left,
+            "RIGHT" => Right,
+            "MID" => Mid,
+            "INSERT" => Insert,
+            "DELETE" => Delete,
+            "REPLACE" => Replace,
+            "FIND" => Find,
             _ => {
                 let (a, b) = name.split_once("_TO_")?;
                 let (from, to) = (Type::parse(a)?, Type::parse(b)?);
                 if matches!(from, Type::Fb(_)) || matches!(to, Type::Fb(_)) {
+                    return None;
+                }
+                // A STRING converts to and from BOOL, the integers and the bit strings (matiec's
+                // `__bool_to_string`, `__sint_to_string`, `__bit_to_string`, `__string_to_sint`
+                // …); REAL and TIME texts are not modelled.
+                let textual = |t: Type| t == Type::Bool || t.is_int() || t.is_bits();
+                if (from == Type::String && !textual(to)) || (to == Type::String && !textual(from))
+                {
                     return None;
                 }
                 Convert { from, to }
@@ -202,6 +237,15 @@ impl Function {
             Xor => "XOR",
             Not => "NOT",
             Trunc => "TRUNC",
+            Concat => "CONCAT",
+            Len => "LEN",
+            Left => "LEFT",
+            Right => "RIGHT",
+            Mid => "MID",
+            Insert => "INSERT",
+            Delete => "DELETE",
+            Replace => "REPLACE",
+            Find => "FIND",
             Convert { from, to } => conversion_name(from, to),
         }
     }
@@ -211,8 +255,19 @@ impl Function {
     pub fn extensible(self) -> bool {
         matches!(
             self,
-            Function::Mux | Function::And | Function::Or | Function::Xor
+            Function::Mux | Function::And | Function::Or | Function::Xor | Function::Concat
         )
+    }
+
+    /// True when the function reads or writes a STRING (the string functions and the
+    /// conversions to and from STRING).
+    pub fn is_textual(self) -> bool {
+        use Function::*;
+        match self {
+            Concat | Len | Left | Right | Mid | Insert | Delete | Replace | Find => true,
+            Convert { from, to } => from == Type::String || to == Type::String,
+            _ => false,
+        }
     }
 
     /// The fixed input pins: names and typing (MUX: K and the first of its repeated inputs).
@@ -220,6 +275,8 @@ impl Function {
         use Function::*;
         const NUM: &[(&str, Pin)] = &[("IN", Pin::Generic(Class::Num))];
         const REAL: &[(&str, Pin)] = &[("IN", Pin::Generic(Class::Real))];
+        const STR: Pin = Pin::Own(Class::Exact(Type::String));
+        const INT: Pin = Pin::Own(Class::Int);
         match self {
             Abs => NUM,
             Sqrt | Ln | Log | Exp | Sin | Cos | Tan | Asin | Acos | Atan => REAL,
@@ -243,6 +300,14 @@ impl Function {
             Trunc => &[("IN", Pin::Own(Class::Real))],
             // Its `from` is checked by `types` (a pin table is static).
             Convert { .. } => &[("IN", Pin::Own(Class::Elementary))],
+            Concat => &[("IN1", STR), ("IN2", STR)],
+            Len => &[("IN", STR)],
+            Left | Right => &[("IN", STR), ("L", INT)],
+            Mid => &[("IN", STR), ("L", INT), ("P", INT)],
+            Insert => &[("IN1", STR), ("IN2", STR), ("P", INT)],
+            Delete => &[("IN", STR), ("L", INT), ("P", INT)],
+            Replace => &[("IN1", STR), ("IN2", STR), ("L", INT), ("P", INT)],
+            Find => &[("IN1", STR), ("IN2", STR)],
         }
     }
 
@@ -275,6 +340,8 @@ impl Function {
         match self {
             Function::Trunc => Pin::Own(Class::Int),
             Function::Convert { to, .. } => Pin::Own(Class::Exact(to)),
+            Function::Len | Function::Find => Pin::Own(Class::Int),
+            f if f.is_textual() => Pin::Own(Class::Exact(Type::String)),
             other => other
                 .pins()
                 .iter()
@@ -376,7 +443,7 @@ fn conversion_name(from: Type, to: Type) -> &'static str {
             super::ELEMENTARY
                 .iter()
                 .map(|&(_, t)| t)
-                .chain([Type::Time])
+                .chain([Type::Time, Type::String])
         };
         types()
             .flat_map(|a| types().map(move |b| (a, b)))
@@ -409,7 +476,12 @@ mod tests {
             assert_eq!(Function::parse(name).unwrap().name(), name);
         }
         assert_eq!(Function::parse("TON_TO_INT"), None);
-        assert_eq!(Function::parse("STRING_TO_INT"), None);
+        assert_eq!(Function::parse("STRING_TO_REAL"), None);
+        assert_eq!(
+            Function::parse("STRING_TO_INT").unwrap().name(),
+            "STRING_TO_INT"
+        );
+        assert_eq!(Function::parse("CONCAT").unwrap().name(), "CONCAT");
         // Every elementary type converts to every other, by its IEC name.
         let sint = Function::parse("SINT_TO_ULINT").unwrap();
         assert_eq!(

@@ -19,9 +19,11 @@
 #![forbid(unsafe_code)]
 
 mod function;
+mod strings;
 mod tasks;
 mod types;
 pub use function::*;
+pub use strings::*;
 pub use tasks::*;
 pub use types::*;
 

@@ -50,6 +50,9 @@ pub enum Type {
     Lword,
     /// Milliseconds, 32-bit signed.
     Time,
+    /// A character string of at most [`STR_MAX_LEN`](super::STR_MAX_LEN) bytes (IEC 61131-3
+    /// 2.3.1 STRING; matiec's length byte and 126-byte body).
+    String,
     /// A function block instance.
     Fb(FbKind),
 }
@@ -143,6 +146,7 @@ impl Type {
         }
         Some(match s {
             "TIME" => Type::Time,
+            "STRING" => Type::String,
             "TON" => Type::Fb(FbKind::Ton),
             "TOF" => Type::Fb(FbKind::Tof),
             "TP" => Type::Fb(FbKind::Tp),
@@ -191,7 +195,7 @@ impl Type {
     /// The types a comparison accepts: every elementary type but BOOL (numbers, TIME and the
     /// bit strings, IEC 61131-3 2.5.1.5.4 `ANY_ELEMENTARY`).
     pub fn is_comparable(self) -> bool {
-        self.is_numeric() || self.is_bits()
+        self.is_numeric() || self.is_bits() || self == Type::String
     }
     /// The width in bits of an integer, real or bit-string type (TIME 32; BOOL 1).
     pub fn bits(self) -> u32 {
@@ -201,7 +205,7 @@ impl Type {
             Type::Int | Type::Uint | Type::Word => 16,
             Type::Dint | Type::Udint | Type::Dword | Type::Real | Type::Time => 32,
             Type::Lint | Type::Ulint | Type::Lword | Type::Lreal => 64,
-            Type::Fb(_) => 0,
+            Type::String | Type::Fb(_) => 0,
         }
     }
     /// The zero value (FALSE, 0, 0.0, T#0ms); instances have no scalar value.
@@ -211,7 +215,7 @@ impl Type {
 }
 
 /// The types [`Type::is_comparable`] accepts, for messages.
-pub const COMPARABLE: &str = "a number, TIME or bit string (not BOOL)";
+pub const COMPARABLE: &str = "a number, TIME, bit string or STRING (not BOOL)";
 
 /// The elementary types but TIME, with their IEC names.
 pub const ELEMENTARY: [(&str, Type); 15] = [
@@ -239,6 +243,7 @@ impl fmt::Display for Type {
         }
         f.write_str(match self {
             Type::Time => "TIME",
+            Type::String => "STRING",
             Type::Fb(FbKind::Ton) => "TON",
             Type::Fb(FbKind::Tof) => "TOF",
             Type::Fb(FbKind::Tp) => "TP",
@@ -368,6 +373,8 @@ pub enum Value {
     Lword(Wide),
     /// Milliseconds.
     Time(i32),
+    /// A STRING constant, interned ([`intern`](super::intern)).
+    Str(super::StrId),
 }
 
 impl Value {
@@ -389,6 +396,7 @@ impl Value {
             Value::Dword(_) => Type::Dword,
             Value::Lword(_) => Type::Lword,
             Value::Time(_) => Type::Time,
+            Value::Str(_) => Type::String,
         }
     }
 
@@ -405,6 +413,8 @@ impl Value {
             Value::Udint(v) | Value::Dword(v) => v as u64,
             Value::Real(v) => v.to_bits() as u64,
             Value::Lint(w) | Value::Ulint(w) | Value::Lreal(w) | Value::Lword(w) => w.bits(),
+            // The interned id: equal strings have equal ids, the empty string 0.
+            Value::Str(id) => id.0 as u64,
         }
     }
 
@@ -428,6 +438,7 @@ impl Value {
             Type::Dword => Value::Dword(bits as u32),
             Type::Lword => Value::Lword(Wide::new(bits)),
             Type::Time => Value::Time(bits as i32),
+            Type::String => Value::Str(super::StrId(bits as u32)),
             Type::Fb(_) => Value::Time(0),
         }
     }
@@ -438,7 +449,7 @@ impl Value {
         let bits = self.to_bits();
         let ty = self.ty();
         match ty {
-            Type::Bool | Type::Real | Type::Lreal | Type::Fb(_) => None,
+            Type::Bool | Type::Real | Type::Lreal | Type::String | Type::Fb(_) => None,
             t if t.is_signed() || t == Type::Time => {
                 let shift = 64 - t.bits();
                 Some((((bits << shift) as i64) >> shift) as i128)
@@ -472,6 +483,7 @@ impl fmt::Display for Value {
             Value::Real(v) => write!(f, "{v:?}"),
             Value::Lreal(w) => write!(f, "{:?}", f64::from_bits(w.bits())),
             Value::Time(ms) => write!(f, "T#{ms}ms"),
+            Value::Str(id) => f.write_str(&super::string_literal(super::str_bytes(*id))),
             v => write!(f, "{}", v.as_i128().unwrap_or(0)),
         }
     }

@@ -5,7 +5,8 @@
 //! `"8#17"`) or typed (`"UINT#5"`, `"WORD#16#FF"`, `"LREAL#1.5"`, `"BOOL#1"`). Numbers and
 //! based literals have no type of their own: they take the type the context needs (the other
 //! compare operand, the box's output), and must fit it. A JSON integer is taken exactly (a ULINT
-//! constant of 2^64 - 1 is not rounded through a double); a typed literal has its type.
+//! constant of 2^64 - 1 is not rounded through a double); a typed literal has its type, and so
+//! has a STRING literal (`"'abc'"`, `$` escapes read: [`plc_model::parse_string_literal`]).
 
 use plc_diag::Invalid;
 use plc_model::{
@@ -54,7 +55,15 @@ pub(crate) fn parse(s: &Scalar, lookup: &Lookup<'_>) -> Result<Untyped, Invalid>
             _ => Untyped::Real(n.as_f64().unwrap_or(f64::NAN)),
         }),
         Scalar::Str(s) => {
-            if plc_syntax::is_time_literal(s) {
+            if s.starts_with('\'') {
+                // A STRING literal (IEC 61131-3 6.3.3), its `$` escapes read.
+                match plc_model::parse_string_literal(s.trim_end()) {
+                    Some(b) => Ok(Untyped::Typed(Value::Str(plc_model::intern(&b)))),
+                    None => Err(Invalid::BadLiteral {
+                        text: s.to_string(),
+                    }),
+                }
+            } else if plc_syntax::is_time_literal(s) {
                 match parse_time_literal(s) {
                     Some(ms) => Ok(Untyped::Time(ms)),
                     None => Err(Invalid::BadTime {

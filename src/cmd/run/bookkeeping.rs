@@ -226,7 +226,12 @@ impl ScanDriver for Driver<'_> {
                 );
                 for &(at, ty) in &t.cols {
                     t.line.push(',');
-                    t.line.push_str(&cell(load_value(slots, at, ty)));
+                    if ty == plc_model::Type::String {
+                        let s = plc_exec::strings::load_str(slots, at);
+                        t.line.push_str(&super::trace::text_cell(&s.text()));
+                    } else {
+                        t.line.push_str(&cell(load_value(slots, at, ty)));
+                    }
                 }
                 t.line.push('\n');
                 if let Err(e) = t.out.write_all(t.line.as_bytes()) {

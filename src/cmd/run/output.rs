@@ -22,6 +22,8 @@ fn value_text(v: VarValue) -> String {
     match v {
         VarValue::Scalar(Value::Real(f)) => format!("{f}"),
         VarValue::Scalar(x) => x.to_string(),
+        // A STRING as its IEC literal (`'a$'b'`, `$hh` for a byte not printable ASCII).
+        VarValue::Text(s) => plc_model::string_literal(s.bytes()),
         VarValue::Timer { q, et, pt } => format!(
             "Q={} ET=T#{et}ms PT=T#{pt}ms",
             if q { "TRUE" } else { "FALSE" }

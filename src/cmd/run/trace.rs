@@ -18,6 +18,11 @@ pub(super) fn cell(v: Value) -> String {
     }
 }
 
+/// A STRING's trace cell: its text quoted as CSV quotes a field (RFC 4180: `"` doubled).
+pub(super) fn text_cell(text: &str) -> String {
+    format!("\"{}\"", text.replace('"', "\"\""))
+}
+
 pub(super) struct Trace<'a> {
     pub(super) out: &'a mut dyn Write,
     pub(super) cols: Vec<(Addr, Type)>,

@@ -49,8 +49,15 @@ pub(crate) fn locals(
 /// Declares the locals at the top of the function.
 pub(crate) fn declare(b: &mut Body, p: &Program, locals: &[(VarId, String)]) {
     for (v, name) in locals {
-        let ty = c_type(p.var(*v).ty);
-        b.line(&format!("{ty} {name} = 0; (void){name};"));
+        let t = p.var(*v).ty;
+        // A STRING local is a struct: zeroed (the empty string) by `{0}`.
+        let zero = if t == plc_model::Type::String {
+            "{0}"
+        } else {
+            "0"
+        };
+        let ty = c_type(t);
+        b.line(&format!("{ty} {name} = {zero}; (void){name};"));
         b.locals.insert(*v, name.clone());
     }
 }

@@ -16,6 +16,9 @@ pub(crate) fn expr(func: Function, args: &[(String, Type)], out: Type) -> String
     use Function::*;
     let a = |i: usize| args[i].0.as_str();
     let wide = out == Type::Lreal;
+    if func.is_textual() {
+        return string_expr(func, args, out);
+    }
     match func {
         Abs => match out {
             Type::Real => format!("fabsf({})", a(0)),
@@ -76,6 +79,9 @@ pub(crate) fn expr(func: Function, args: &[(String, Type)], out: Type) -> String
         Not => wrap(&format!("(int64_t)~{}", bits_of(a(0), out)), out),
         Convert { .. } => convert(a(0), args[0].1, out),
         Trunc => wrap(&format!("{}(trunc((double){}))", TO_I64, a(0)), out),
+        Concat | Len | Left | Right | Mid | Insert | Delete | Replace | Find => {
+            string_expr(func, args, out)
+        }
     }
 }
 
@@ -99,6 +105,36 @@ fn convert(x: &str, from: Type, to: Type) -> String {
         (Type::Real, _) => wrap(&format!("{TO_I64}((double)roundf({x}))"), to),
         (Type::Lreal, _) => wrap(&format!("{TO_I64}(round({x}))"), to),
         _ => wrap(&format!("(int64_t){x}"), to),
+    }
+}
+
+/// A string function or a conversion to or from STRING (`_plc_str_*` of the runtime, each the
+/// C form of one rule of `plc_exec::strings`); integer arguments as `int64_t`, integer results
+/// wrapped to the output's type.
+fn string_expr(func: Function, args: &[(String, Type)], out: Type) -> String {
+    use Function::*;
+    let a = |i: usize| args[i].0.as_str();
+    let n = |i: usize| format!("(int64_t)({})", a(i));
+    match func {
+        Concat => args[1..].iter().fold(a(0).to_owned(), |acc, (x, _)| {
+            format!("_plc_str_concat({acc}, {x})")
+        }),
+        Len => wrap(&format!("{}.len", a(0)), out),
+        Left => format!("_plc_str_left({}, {})", a(0), n(1)),
+        Right => format!("_plc_str_right({}, {})", a(0), n(1)),
+        Mid => format!("_plc_str_mid({}, {}, {})", a(0), n(1), n(2)),
+        Insert => format!("_plc_str_insert({}, {}, {})", a(0), a(1), n(2)),
+        Delete => format!("_plc_str_delete({}, {}, {})", a(0), n(1), n(2)),
+        Replace => format!("_plc_str_replace({}, {}, {}, {})", a(0), a(1), n(2), n(3)),
+        Find => wrap(&format!("_plc_str_find({}, {})", a(0), a(1)), out),
+        Convert { from, .. } if out == Type::String => match from {
+            Type::Bool => format!("_plc_str_of_bool({})", a(0)),
+            t if t.is_bits() => format!("_plc_str_of_bits((uint64_t)({}))", a(0)),
+            t if t.is_unsigned() => format!("_plc_str_of_uint((uint64_t)({}))", a(0)),
+            _ => format!("_plc_str_of_int((int64_t)({}))", a(0)),
+        },
+        _ if out == Type::Bool => format!("_plc_str_to_bool({})", a(0)),
+        _ => wrap(&format!("_plc_str_to_int({})", a(0)), out),
     }
 }
 

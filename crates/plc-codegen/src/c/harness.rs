@@ -8,8 +8,9 @@
 //!
 //! Not here: the POUs' code (`ladder`, `fbd`).
 
-use super::ladder::{c_const, Shared};
+use super::ladder::Shared;
 use super::names::{c_string, json_string};
+use super::spelling::c_init;
 use super::text::push;
 use super::CConfig;
 use plc_model::{FbKind, Program, Type, Value, VarClass};
@@ -32,7 +33,7 @@ pub(crate) fn program_source(p: &Program, sh: &Shared, extra: &[String], cfg: &C
         .iter()
         .enumerate()
         .filter(|(i, v)| !matches!(v.ty, Type::Fb(_)) && !is_zero(v.init) && !sh.local_only[*i])
-        .map(|(i, v)| format!("    .{} = {},\n", field(sh, i), c_const(v.init)))
+        .map(|(i, v)| format!("    .{} = {},\n", field(sh, i), c_init(v.init)))
         .chain(extra.iter().cloned())
         .collect();
     if inits.is_empty() {
@@ -124,6 +125,7 @@ fn slot_kind(ty: Type) -> &'static str {
         Type::Udint | Type::Dword => "_PLC_K_UDINT",
         Type::Ulint | Type::Lword => "_PLC_K_ULINT",
         Type::Lreal => "_PLC_K_LREAL",
+        Type::String => "_PLC_K_STRING",
         Type::Fb(FbKind::Ton | FbKind::Tof | FbKind::Tp) => "_PLC_K_TIMER",
         Type::Fb(FbKind::Ctu | FbKind::Ctd) => "_PLC_K_COUNTER",
         Type::Fb(FbKind::Sr | FbKind::Rs) => "_PLC_K_BISTABLE",
@@ -214,7 +216,7 @@ fn inputs(p: &Program, sh: &Shared, s: &mut String) {
 /// or bit string what its cells must be (`an INT (-32768..32767)`), as `plc-deps run` says it.
 fn cell_type(ty: Type) -> String {
     match ty {
-        Type::Bool | Type::Real | Type::Lreal | Type::Time => ty.to_string(),
+        Type::Bool | Type::Real | Type::Lreal | Type::Time | Type::String => ty.to_string(),
         ty => plc_model::integer_cell(ty),
     }
 }

@@ -385,7 +385,8 @@ impl<'a> Body<'a> {
                 pw
             }
             Element::Branch(branches) => {
-                if let Some(x) = fold::extreme(branches) {
+                let text = |x: &fold::Extreme| self.sh.p.var(x.out).ty == Type::String;
+                if let Some(x) = fold::extreme(branches).filter(|x| !text(x)) {
                     return self.extreme(&x, pw);
                 }
                 let pw = self.materialize(pw);
@@ -614,6 +615,11 @@ impl<'a> Body<'a> {
     /// `(a OP b)`; through `_plc_cmp` when a constant sits at its type's limit (where GCC's
     /// `-Wtype-limits` would call the test always true or false).
     fn compare(&self, sym: &str, a: &Operand, b: &Operand) -> String {
+        if self.operand_type(a) == Some(Type::String) {
+            // matiec's `__str_cmp`, as `plc_exec::strings::compare`.
+            let (x, y) = (self.operand(a), self.operand(b));
+            return format!("(_plc_str_cmp({x}, {y}) {sym} 0)");
+        }
         let at_limit = |o: &Operand| match o {
             Operand::Const(v) => {
                 let (lo, hi) = int_range(v.ty());

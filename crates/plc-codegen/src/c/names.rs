@@ -74,9 +74,15 @@ pub fn encode_file(s: &str, index: usize) -> String {
 /// A C string literal holding `text` exactly: printable ASCII but `"`, `\` and `?` (trigraphs)
 /// as it is, every other byte as a three-digit octal escape.
 pub fn c_string(text: &str) -> String {
-    let mut out = String::with_capacity(text.len() + 2);
+    c_bytes(text.as_bytes())
+}
+
+/// A C string literal holding the bytes `bytes` exactly (as [`c_string`]; any byte but printable
+/// ASCII as an octal escape, so a NUL is `\000`).
+pub fn c_bytes(bytes: &[u8]) -> String {
+    let mut out = String::with_capacity(bytes.len() + 2);
     out.push('"');
-    for b in text.bytes() {
+    for &b in bytes {
         if (0x20..0x7f).contains(&b) && b != b'"' && b != b'\\' && b != b'?' {
             out.push(b as char);
         } else {

@@ -47,6 +47,7 @@ pub(crate) fn c_type(ty: Type) -> &'static str {
         Type::Ulint | Type::Lword => "uint64_t",
         Type::Real => "float",
         Type::Lreal => "double",
+        Type::String => "_plc_string",
         Type::Fb(FbKind::Ton | FbKind::Tof | FbKind::Tp) => "_plc_timer",
         Type::Fb(FbKind::Ctu | FbKind::Ctd) => "_plc_counter",
         Type::Fb(FbKind::Sr | FbKind::Rs) => "_plc_bistable",
@@ -59,10 +60,26 @@ pub(crate) fn c_type(ty: Type) -> &'static str {
 /// `INT64_C`/`UINT64_C` for the 64-bit types; a minimum as `(-MAX - 1)`, since `-N` negates a
 /// literal that may not fit), a real with its suffix or, when negative or not finite, by its
 /// bits.
+/// A constant as a static initializer: a STRING as `{len, "bytes"}` (a function call is no
+/// constant expression), anything else as [`c_const`].
+pub(crate) fn c_init(v: Value) -> String {
+    match v {
+        Value::Str(id) => {
+            let b = plc_model::str_bytes(id);
+            format!("{{{}, {}}}", b.len(), super::names::c_bytes(b))
+        }
+        v => c_const(v),
+    }
+}
+
 pub(crate) fn c_const(v: Value) -> String {
     let ty = v.ty();
     match v {
         Value::Bool(b) => (if b { "1" } else { "0" }).to_string(),
+        Value::Str(id) => {
+            let b = plc_model::str_bytes(id);
+            format!("_plc_str_lit({}, {})", b.len(), super::names::c_bytes(b))
+        }
         Value::Real(f) if f.is_finite() && f.is_sign_positive() => format!("{f:?}f"),
         Value::Real(f) => format!("_plc_f32(0x{:08x}u)", f.to_bits()),
         Value::Lreal(_) => match v.as_f64() {

@@ -84,6 +84,31 @@ impl Net {
 
 /// The STL of `p` (with its FBD bodies `fbd`), or the first construct that has none.
 pub fn generate(p: &Program, fbd: &Fbd) -> Result<String, IlError> {
+    // STRINGs have no S7-200 STL form here: refused by name, never written as numbers.
+    if let Some(v) = p.vars.iter().find(|v| v.ty == Type::String) {
+        return Err(IlError {
+            place: format!("variable {}", v.name),
+            message: "STRING has no S7-200 STL form in plc-deps il (not yet)".into(),
+        });
+    }
+    let mut textual = None;
+    for r in &p.rungs {
+        plc_model::walk_elements(&r.series, &mut |e| {
+            if let Element::Function { func, .. } = e {
+                if func.is_textual() && textual.is_none() {
+                    textual = Some((r.id.clone(), func.static_name()));
+                }
+            }
+        });
+    }
+    if let Some((rung, f)) = textual {
+        return Err(IlError {
+            place: format!("rung {rung}"),
+            message: format!(
+                "{f} works on STRINGs, which have no S7-200 STL form in plc-deps il (not yet)"
+            ),
+        });
+    }
     let names = Names::new(p);
     let mut out = String::new();
     let mut headers = Vec::new();

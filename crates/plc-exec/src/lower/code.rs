@@ -165,6 +165,10 @@ pub(crate) enum Op {
     Ctud { inst: Addr, pins: CtudId },
     /// MOVE box.
     Move { width: Width, from: Addr, to: Addr },
+    /// A STRING copied (its whole slot, `strings::STR_SLOT` bytes) when powered.
+    StrMove { from: Addr, to: Addr },
+    /// A comparison of two STRINGs (`strings::compare`, matiec's `__str_cmp`).
+    StrCmp { op: CmpOp, a: Addr, b: Addr },
     /// Standard function box: operands and output in `funcs`.
     Func { call: FuncId },
     /// Arithmetic box.

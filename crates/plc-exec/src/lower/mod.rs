@@ -242,7 +242,8 @@ impl Lowerer<'_> {
                 }
                 let align = type_align(v.ty()) as u64;
                 let at = self.next_const.next_multiple_of(align);
-                self.next_const = at + align;
+                // A scalar's size is its alignment; a STRING's is its slot.
+                self.next_const = at + align.max(super::layout::type_size(v.ty()) as u64);
                 let at = Addr(at.min(u32::MAX as u64) as u32);
                 self.code.consts.push((at, *v));
                 at
@@ -380,6 +381,10 @@ impl Lowerer<'_> {
                 };
                 self.push(op);
             }
+            Element::Compare { op, a, b } if self.operand_type(a) == Type::String => {
+                let (a, b) = (self.operand(a), self.operand(b));
+                self.push(Op::StrCmp { op: *op, a, b });
+            }
             Element::Compare { op, a, b } => {
                 let num = num_of(self.operand_type(a));
                 let (a, b) = (self.operand(a), self.operand(b));
@@ -445,6 +450,11 @@ impl Lowerer<'_> {
                 let id = CtudId(self.code.ctuds.len() as u32);
                 self.code.ctuds.push(pins);
                 self.push(Op::Ctud { inst, pins: id });
+            }
+            Element::Move { from, to } if self.p.var(*to).ty == Type::String => {
+                let from = self.operand(from);
+                let to = self.layout.start(*to);
+                self.push(Op::StrMove { from, to });
             }
             Element::Move { from, to } => {
                 let width = Width::of(self.p.var(*to).ty);

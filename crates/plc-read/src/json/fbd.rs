@@ -359,6 +359,10 @@ impl<'a> FbdReader<'a> {
             Container::Other(Scalar::Str(s)) if is_time_literal(&s) => {
                 Connection::Constant(Scalar::Str(s))
             }
+            // A STRING literal (`"'text'"`) is a constant, typed where it is used.
+            Container::Other(Scalar::Str(s)) if s.starts_with('\'') => {
+                Connection::Constant(Scalar::Str(s))
+            }
             Container::Other(Scalar::Str(s)) => Connection::Variable(s),
             Container::Other(s @ (Scalar::Number(_) | Scalar::Bool(_))) => Connection::Constant(s),
             other => Connection::Invalid(problem(

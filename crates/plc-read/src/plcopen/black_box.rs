@@ -251,7 +251,7 @@ impl Typer<'_, '_, '_, '_> {
             }
             Some(_) => first_in(),
             None if matches!(ty, "SHL" | "SHR" | "ROL" | "ROR" | "MUX") => first_in(),
-            None if ty.ends_with("_TO_STRING") || ty == "CONCAT" => Some("DINT".to_owned()),
+            None if ty.ends_with("_TO_STRING") || ty == "CONCAT" => Some("STRING".to_owned()),
             None => None,
         }
     }

@@ -15,16 +15,15 @@ pub(super) const MAPPED: &[(&str, &str)] = &[
     ("TIME_OF_DAY", "DINT"),
     ("DT", "DINT"),
     ("DATE_AND_TIME", "DINT"),
-    ("string", "DINT"),
+    ("string", "STRING"),
     ("wstring", "DINT"),
-    ("STRING", "DINT"),
     ("WSTRING", "DINT"),
 ];
 
 /// The elementary types the model has.
 pub(super) const MODEL_ELEMENTARY: &[&str] = &[
     "BOOL", "SINT", "INT", "DINT", "LINT", "USINT", "UINT", "UDINT", "ULINT", "REAL", "LREAL",
-    "BYTE", "WORD", "DWORD", "LWORD", "TIME",
+    "BYTE", "WORD", "DWORD", "LWORD", "TIME", "STRING",
 ];
 
 /// True when a TC6 type element's tag is an elementary type (the model's or a mapped one).

@@ -263,9 +263,10 @@ fn one(
         .as_ref()
         .is_some_and(|d| matches!(d.base, Base::Whole(_)));
     if let Some(&(from, to)) = MAPPED.iter().find(|(f, _)| *f == ty) {
-        text |= from.eq_ignore_ascii_case("string") || from.eq_ignore_ascii_case("wstring");
+        // A WSTRING has no value in the model (a STRING has: `string` reads as STRING).
+        text |= from.eq_ignore_ascii_case("wstring");
         ty = to.to_owned();
-        if data.is_none() {
+        if data.is_none() && to != "STRING" {
             mapped.push(Mapped {
                 var: name.clone(),
                 origin: origin(v),
@@ -300,6 +301,7 @@ fn one(
         (Some(iv), Some(d)) if matches!(d.base, Base::Enum(_)) => {
             Some(Box::new(enum_initial(tc6, iv, d, &name, place)?))
         }
+        (Some(iv), _) if ty == "STRING" => Some(Box::new(string_initial(tc6, iv, &name, place)?)),
         (Some(iv), _) => Some(Box::new(initial_value(tc6, iv, &name, place)?)),
         (None, Some(d)) if !text => type_initial(d, &name, place)?.map(Box::new),
         (None, None) if !text => match field_init {
@@ -358,7 +360,8 @@ fn data_base(d: &DataType) -> String {
     match &d.base {
         Base::Elementary(t) => t.clone(),
         Base::Enum(_) => "INT".to_owned(),
-        Base::Whole(_) | Base::Struct(_) => "string".to_owned(),
+        // An array (or a structure not flattened) has no value: the DINT stand-in.
+        Base::Whole(_) | Base::Struct(_) => "DINT".to_owned(),
     }
 }
 
@@ -509,6 +512,29 @@ fn literal_operand(
 }
 
 /// `initialValue/simpleValue@value` as an operand ([`literal_operand`]).
+/// The initial value of STRING variable `var`: a literal `'…'`, or (as Beremiz's editor saves
+/// what was typed without quotes, `blup`) the text itself.
+fn string_initial(tc6: Tc6, iv: Node, var: &str, place: &str) -> R<Operand<'static>> {
+    let simple = tc6.child(iv, "simpleValue").ok_or_else(|| {
+        error(
+            origin(iv),
+            place,
+            format!("the initial value of `{var}` is not a simple value"),
+        )
+    })?;
+    let text = super::xml::attr(simple, "value", place)?.trim();
+    let lit = if text.starts_with('\'') {
+        text.to_owned()
+    } else {
+        plc_model::string_literal(text.as_bytes())
+    };
+    let at = origin(simple);
+    Ok(Located {
+        value: Scalar::Str(Cow::Owned(lit)),
+        origin: at,
+    })
+}
+
 fn initial_value(tc6: Tc6, iv: Node, var: &str, place: &str) -> R<Operand<'static>> {
     let simple = tc6.child(iv, "simpleValue").ok_or_else(|| {
         error(

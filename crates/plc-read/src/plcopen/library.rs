@@ -8,10 +8,10 @@
 //! The blocks: RTC of IEC 61131-3 (2.5.2.3.5: IN, PDT → Q, CDT; the real-time clock, which
 //! Beremiz's standard library implements), its DT values read as DINT like every date and time;
 //! Beremiz's LOGGER (TRIG, MSG, LEVEL) and its Python blocks python_eval, python_poll,
-//! python_gear (TRIG, CODE [, N] → ACK, RESULT), their strings read as the DINT stand-in.
+//! python_gear (TRIG, CODE [, N] → ACK, RESULT), their strings STRINGs.
 //!
 //! Deliberately not here: what the blocks compute (a clock has no value a scan could compute
-//! without the PLC's time), and blocks with string pins (the model has no strings).
+//! without the PLC's time), nor what Python code returns.
 
 use super::interface::name;
 use super::textual::{stand_in, Read};
@@ -28,8 +28,8 @@ struct Block {
     source: &'static str,
 }
 
-const PY_IN: &[(&str, &str)] = &[("TRIG", "BOOL"), ("CODE", "DINT")];
-const PY_OUT: &[(&str, &str)] = &[("ACK", "BOOL"), ("RESULT", "DINT")];
+const PY_IN: &[(&str, &str)] = &[("TRIG", "BOOL"), ("CODE", "STRING")];
+const PY_OUT: &[(&str, &str)] = &[("ACK", "BOOL"), ("RESULT", "STRING")];
 const PY_SRC: &str = "Beremiz's py_ext library";
 
 const BLOCKS: &[Block] = &[
@@ -53,13 +53,13 @@ const BLOCKS: &[Block] = &[
     },
     Block {
         name: "python_gear",
-        inputs: &[("N", "DINT"), ("TRIG", "BOOL"), ("CODE", "DINT")],
+        inputs: &[("N", "DINT"), ("TRIG", "BOOL"), ("CODE", "STRING")],
         outputs: PY_OUT,
         source: PY_SRC,
     },
     Block {
         name: "LOGGER",
-        inputs: &[("TRIG", "BOOL"), ("MSG", "DINT"), ("LEVEL", "INT")],
+        inputs: &[("TRIG", "BOOL"), ("MSG", "STRING"), ("LEVEL", "INT")],
         outputs: &[],
         source: "Beremiz's standard library (LEVEL: LOGLEVEL, read as INT)",
     },

@@ -306,7 +306,12 @@ pub(super) fn block_input(node: Node, place: &str, at: Origin) -> R<Input<'stati
     let from = match literal(text) {
         Some(v) => Connection::Constant(v),
         // A string has no value in the model: a stand-in 0 (`run` refuses such a body).
-        None if is_string_literal(text) => Connection::Constant(Scalar::Number(0.into())),
+        // A STRING literal, its `$` escapes read when it is typed (`"…"` is a WSTRING: no value).
+        None if text.trim().starts_with('\'') && is_string_literal(text) => {
+            Connection::Constant(Scalar::Str(Cow::Owned(text.trim().to_owned())))
+        }
+        // A WSTRING literal: no value; the empty STRING stands in (`run` refuses the body).
+        None if is_string_literal(text) => Connection::Constant(Scalar::Str(Cow::Borrowed("''"))),
         None => Connection::Variable(Cow::Owned(variable_ref(text, node, place)?)),
     };
     Ok(Input { origin: at, from })

@@ -717,7 +717,8 @@ fn is_external(global: &str, e: &str) -> bool {
             && global[..e.len()].eq_ignore_ascii_case(e))
 }
 
-/// The first `inVariable` of a graphical body whose expression is a string literal (`'…'`).
+/// The first `inVariable` of a graphical body whose expression is a WSTRING literal (`"…"`; a
+/// STRING literal `'…'` has a value).
 fn string_literal<'a, 'i>(lang: Node<'a, 'i>) -> Option<Node<'a, 'i>> {
     lang.children()
         .filter(|n| n.tag_name().name() == "inVariable")
@@ -725,7 +726,7 @@ fn string_literal<'a, 'i>(lang: Node<'a, 'i>) -> Option<Node<'a, 'i>> {
             n.children()
                 .find(|c| c.tag_name().name() == "expression")
                 .and_then(|c| c.text())
-                .is_some_and(super::pins::is_string_literal)
+                .is_some_and(|t| super::pins::is_string_literal(t) && t.trim().starts_with('"'))
         })
 }
 
