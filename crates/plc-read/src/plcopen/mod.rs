@@ -34,6 +34,7 @@ mod library;
 mod pins;
 mod project;
 mod st_body;
+mod st_lower;
 mod textual;
 mod wiring;
 mod xml;
@@ -63,9 +64,22 @@ pub fn parse_selected(
     text: &str,
     select: Option<&str>,
 ) -> Result<(syntax::Program<'static>, Notes), LoadError> {
+    parse_for(text, select, false)
+}
+
+/// [`parse_selected`]; with `exec` (for `run` and `c`), each ST body that lowers to rungs is
+/// read as those rungs ([`st_lower`]), not as a stand-in rung per statement.
+pub fn parse_for(
+    text: &str,
+    select: Option<&str>,
+    exec: bool,
+) -> Result<(syntax::Program<'static>, Notes), LoadError> {
     let doc = xml::parse(text)?;
     let ns = xml::project_namespace(&doc).map_err(|e| e.locate(text))?;
-    let mut notes = Notes::default();
+    let mut notes = Notes {
+        exec,
+        ..Notes::default()
+    };
     let mut program =
         project::program(xml::Tc6 { ns }, &doc, select, &mut notes).map_err(|e| e.locate(text))?;
     program.skipped = std::mem::take(&mut notes.skipped);

@@ -21,6 +21,7 @@
 //! Deliberately not here: executing ST (`run` leaves the values unchanged, and the note says
 //! the body is not executed), IL and SFC (through their interface, [`super::textual`]).
 
+use super::st_lower::{self, Lower};
 use super::textual::{stand_in, Read};
 use super::xml::{error, origin, Note, Notes, R};
 use crate::st;
@@ -39,6 +40,8 @@ pub(super) enum Decl {
     },
     Instance {
         name: String,
+        /// The function block type's name.
+        ty: String,
         read: Option<Read>,
     },
     /// A value of an enumeration data type (a constant: reading it reads no variable).
@@ -67,6 +70,7 @@ impl Scope {
         } else {
             Decl::Instance {
                 name: name.to_owned(),
+                ty: ty.to_owned(),
                 read: first_output(ty).map(|(f, b)| Read {
                     name: format!("{name}.{f}"),
                     bool: b,
@@ -111,7 +115,7 @@ impl Scope {
     /// What access path `path` (`s`, `s.f`, `T1.Q`) names: the declaration of the path, else
     /// of its longest declared prefix, with `true` when that is the whole path. A field of a
     /// structure that has no such field is `Err` with the message.
-    fn find(&self, path: &str) -> Result<Option<(&Decl, bool)>, String> {
+    pub(super) fn find(&self, path: &str) -> Result<Option<(&Decl, bool)>, String> {
         let mut at = path.len();
         loop {
             if let Some(d) = self.get(&path[..at]) {
@@ -172,6 +176,8 @@ pub(super) fn rungs(
     let mut out = Vec::new();
     let mut unseen = Unseen::default();
     let mut k = 0;
+    let mut lower = Lower::new(scope, pou);
+    let mut refused: Option<(Origin, String)> = None;
     for t in node.descendants().filter(|d| d.is_text()) {
         let text = t.text().unwrap_or("");
         if text.trim().is_empty() {
@@ -184,8 +190,17 @@ pub(super) fn rungs(
         };
         let statements = st::statements(text)
             .map_err(|e| error(at(e.at), &place, format!("ST syntax error: {}", e.message)))?;
+        if let (None, Some(p)) = (&refused, st_lower::first_pragma(text)) {
+            refused = Some((at(p), "a pragma `{…}` (matiec copies its text, C code, into what it generates)".to_owned()));
+        }
+        lower.text(map.clone(), origin(t));
         for s in &statements {
             k += 1;
+            if refused.is_none() {
+                if let Err(r) = lower.top(k, s) {
+                    refused = Some((lower.origin(r.at), r.what));
+                }
+            }
             if s.kind == st::ast::Stmt::Empty {
                 continue;
             }
@@ -195,21 +210,40 @@ pub(super) fn rungs(
             out.extend(stand_in(format!("{pou}.st{k}"), here, &reads, &writes));
         }
     }
+    lower.finish();
+    let executed = match &refused {
+        None => "executed by `run` and `c` as the rungs it is lowered to (docs/plcopen.md, ST bodies)".to_owned(),
+        Some((at, what)) => {
+            let (l, c) = at.line_column(source).unwrap_or((0, 0));
+            format!("not executed by `run` or `c`: {what} at {l}:{c} is not executed yet")
+        }
+    };
     notes.push(Note {
         origin: origin(node),
-        message: message(pou, k, &unseen),
+        message: message(pou, k, &unseen, &executed),
     });
-    notes.skipped.push(plc_syntax::SkippedBody {
-        pou: pou.to_owned(),
-        language: "ST".into(),
-        origin: origin(node),
-    });
+    match refused {
+        Some(why) => notes.skipped.push(plc_syntax::SkippedBody {
+            pou: pou.to_owned(),
+            language: "ST".into(),
+            origin: origin(node),
+            why: Some(why),
+        }),
+        // `run` and `c` execute the lowered rungs; the analyses keep a rung per statement.
+        None if notes.exec => {
+            notes
+                .ld_vars
+                .extend(lower.vars.into_iter().map(|v| (pou.to_owned(), v)));
+            return Ok(lower.rungs);
+        }
+        None => {}
+    }
     Ok(out)
 }
 
-fn message(pou: &str, statements: usize, unseen: &Unseen) -> String {
+fn message(pou: &str, statements: usize, unseen: &Unseen, executed: &str) -> String {
     let plural = if statements == 1 { "" } else { "s" };
-    let mut m = format!("pou {pou}: its ST body is analysed per statement ({statements} top-level statement{plural}, rungs {pou}.st1 …, each reading and writing whole variables) and not executed by `run`");
+    let mut m = format!("pou {pou}: its ST body is analysed per statement ({statements} top-level statement{plural}, rungs {pou}.st1 …, each reading and writing whole variables) and {executed}");
     let mut add = |what: &str, v: &[String]| {
         if !v.is_empty() {
             m.push_str(&format!("; {what}: {}", v.join(", ")));
@@ -273,7 +307,9 @@ fn resolve(
                 name: r.name.clone(),
                 bool: r.bool,
             }),
-            Some((Decl::Instance { name, read: None }, _)) => {
+            Some((Decl::Instance {
+                name, read: None, ..
+            }, _)) => {
                 push_once(&mut unseen.instances_read, name)
             }
             Some((Decl::Structure { leaves }, _)) => {
