@@ -178,11 +178,7 @@ pub fn plcopen_for_run_selected(
 /// The program, its FBD bodies, the reader's notes, and the note of what `run` cannot execute.
 type PlcOpenLoaded = (Program, Fbd, Vec<Note>, Option<Note>);
 
-fn plcopen_all(
-    text: &str,
-    select: Option<&str>,
-    exec: bool,
-) -> Result<PlcOpenLoaded, LoadError> {
+fn plcopen_all(text: &str, select: Option<&str>, exec: bool) -> Result<PlcOpenLoaded, LoadError> {
     let (syntax, mut notes) = read::plcopen::parse_for(text, select, exec)?;
     let (p, f) = resolve::resolve(text, &syntax)?;
     for x in &notes.exec_orders {
@@ -247,7 +243,11 @@ pub fn stl_selected(text: &str, select: &str) -> Result<(Program, Fbd), LoadErro
         // An STL program has no configuration.
         Err(NotSelectable::NoConfiguration { subroutines: names })
         | Err(NotSelectable::Unknown { programs: names }) => {
-            return Err(LoadError::invalid(None, "", no_such_routine(select, &names)))
+            return Err(LoadError::invalid(
+                None,
+                "",
+                no_such_routine(select, &names),
+            ))
         }
     };
     resolve::resolve(text, &syntax)

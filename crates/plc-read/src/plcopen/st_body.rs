@@ -18,8 +18,13 @@
 //! the call assigns them. A name that is neither declared nor called (a
 //! function) is an error at its statement; so is an ST syntax error, at its line and column.
 //!
-//! Deliberately not here: executing ST (`run` leaves the values unchanged, and the note says
-//! the body is not executed), IL and SFC (through their interface, [`super::textual`]).
+//! For `run` and `c` ([`super::xml::Notes::exec`]) the same body is also lowered to executable
+//! rungs ([`super::st_lower`]); when every statement lowers, those rungs (and their
+//! temporaries) replace the stand-ins, otherwise the body is marked skipped with the construct
+//! that does not lower and where it is, and `run`/`c` refuse it. The note says which.
+//!
+//! Deliberately not here: the lowering itself ([`super::st_lower`]), IL and SFC (through their
+//! interface, [`super::textual`]).
 
 use super::st_lower::{self, Lower};
 use super::textual::{stand_in, Read};
@@ -191,7 +196,11 @@ pub(super) fn rungs(
         let statements = st::statements(text)
             .map_err(|e| error(at(e.at), &place, format!("ST syntax error: {}", e.message)))?;
         if let (None, Some(p)) = (&refused, st_lower::first_pragma(text)) {
-            refused = Some((at(p), "a pragma `{…}` (matiec copies its text, C code, into what it generates)".to_owned()));
+            refused = Some((
+                at(p),
+                "a pragma `{…}` (matiec copies its text, C code, into what it generates)"
+                    .to_owned(),
+            ));
         }
         lower.text(map.clone(), origin(t));
         for s in &statements {
@@ -212,7 +221,10 @@ pub(super) fn rungs(
     }
     lower.finish();
     let executed = match &refused {
-        None => "executed by `run` and `c` as the rungs it is lowered to (docs/plcopen.md, ST bodies)".to_owned(),
+        None => {
+            "executed by `run` and `c` as the rungs it is lowered to (docs/plcopen.md, ST bodies)"
+                .to_owned()
+        }
         Some((at, what)) => {
             let (l, c) = at.line_column(source).unwrap_or((0, 0));
             format!("not executed by `run` or `c`: {what} at {l}:{c} is not executed yet")
@@ -307,11 +319,12 @@ fn resolve(
                 name: r.name.clone(),
                 bool: r.bool,
             }),
-            Some((Decl::Instance {
-                name, read: None, ..
-            }, _)) => {
-                push_once(&mut unseen.instances_read, name)
-            }
+            Some((
+                Decl::Instance {
+                    name, read: None, ..
+                },
+                _,
+            )) => push_once(&mut unseen.instances_read, name),
             Some((Decl::Structure { leaves }, _)) => {
                 reads.extend(leaves.iter().map(|(name, ty)| Read {
                     name: name.clone(),

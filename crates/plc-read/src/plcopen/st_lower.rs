@@ -469,7 +469,10 @@ impl<'s> Lower<'s> {
     ) -> L<()> {
         let (v, ty) = self.written(var)?;
         if !ty.is_int() {
-            return refuse(var.base_at, format!("FOR on `{v}` of type {ty} (not an integer)"));
+            return refuse(
+                var.base_at,
+                format!("FOR on `{v}` of type {ty} (not an integer)"),
+            );
         }
         let vv = Val::Var(v.clone(), ty);
         // v := from; the final value and the increment once, before the loop.
@@ -584,7 +587,13 @@ impl<'s> Lower<'s> {
         };
         for (n, _) in &inputs {
             if !pins.contains(&n.as_str()) {
-                return refuse(at, format!("input `{n}` in the call of `{inst}` ({ty} has inputs {})", pins.join(", ")));
+                return refuse(
+                    at,
+                    format!(
+                        "input `{n}` in the call of `{inst}` ({ty} has inputs {})",
+                        pins.join(", ")
+                    ),
+                );
             }
         }
         let get = |pin: &str| -> L<&Expr> {
@@ -659,12 +668,18 @@ impl<'s> Lower<'s> {
         self.emit(ld);
         for (pin, target) in outputs {
             let Some(fty) = field_type(&ty, &pin) else {
-                return refuse(at, format!("output `{pin}` in the call of `{inst}` ({ty} has no such output)"));
+                return refuse(
+                    at,
+                    format!("output `{pin}` in the call of `{inst}` ({ty} has no such output)"),
+                );
             };
             let (name, tty) = self.written(target)?;
             let field = format!("{inst}.{pin}");
             if tty != fty {
-                return refuse(target.base_at, format!("`{pin} => {name}`: {name} is {tty}, the output {fty}"));
+                return refuse(
+                    target.base_at,
+                    format!("`{pin} => {name}`: {name} is {tty}, the output {fty}"),
+                );
             }
             if fty == Type::Bool {
                 let c = self.contact(&field, false);
@@ -744,7 +759,10 @@ impl<'s> Lower<'s> {
         match self.scope.find(&path) {
             Ok(Some((Decl::Elementary { name, ty }, true))) => match Type::parse(ty) {
                 Some(t) if !matches!(t, Type::Fb(_)) => Ok((name.clone(), t)),
-                _ => refuse(at, format!("`{path}` of type {ty}, which the model does not execute")),
+                _ => refuse(
+                    at,
+                    format!("`{path}` of type {ty}, which the model does not execute"),
+                ),
             },
             Ok(Some((Decl::Instance { name, ty, .. }, false))) if !write => {
                 let field = path[name.len() + 1..].to_ascii_uppercase();
@@ -757,9 +775,7 @@ impl<'s> Lower<'s> {
                 at,
                 format!("`{path}`: an instance (or its input) as a value"),
             ),
-            Ok(Some((Decl::Constant, _))) => {
-                refuse(at, format!("the enumeration value `{path}`"))
-            }
+            Ok(Some((Decl::Constant, _))) => refuse(at, format!("the enumeration value `{path}`")),
             Ok(Some((Decl::Structure { .. }, _))) => {
                 refuse(at, format!("the structure `{path}` as a whole"))
             }
@@ -824,7 +840,13 @@ impl<'s> Lower<'s> {
                 let v = self.value(e, Some(Type::Bool))?;
                 match v {
                     Val::Var(n, Type::Bool) => Ok(vec![self.contact(&n, false)]),
-                    other => refuse(self.at, format!("a condition of type {}", other.ty().map_or("?".into(), |t| t.to_string()))),
+                    other => refuse(
+                        self.at,
+                        format!(
+                            "a condition of type {}",
+                            other.ty().map_or("?".into(), |t| t.to_string())
+                        ),
+                    ),
                 }
             }
         }
@@ -1028,7 +1050,13 @@ impl<'s> Lower<'s> {
             match a {
                 Arg::Input { value, .. } => values.push(value),
                 Arg::Output { .. } => {
-                    return refuse(at, format!("an output argument in the call of function `{}`", callee.base))
+                    return refuse(
+                        at,
+                        format!(
+                            "an output argument in the call of function `{}`",
+                            callee.base
+                        ),
+                    )
                 }
             }
         }
@@ -1092,7 +1120,10 @@ impl<'s> Lower<'s> {
                 Some(f) => self.function(f, &values, want, out),
                 None => refuse(
                     at,
-                    format!("the call of function `{}` (only the standard functions are executed)", callee.base),
+                    format!(
+                        "the call of function `{}` (only the standard functions are executed)",
+                        callee.base
+                    ),
                 ),
             },
         }
@@ -1151,7 +1182,15 @@ impl<'s> Lower<'s> {
             Err(_) => match f.types(&own, None) {
                 Ok(t) => t.out,
                 Err(m) => {
-                    return refuse(self.at, format!("{}: an operand of type {} where {} is needed", f.name(), m.found, m.expected))
+                    return refuse(
+                        self.at,
+                        format!(
+                            "{}: an operand of type {} where {} is needed",
+                            f.name(),
+                            m.found,
+                            m.expected
+                        ),
+                    )
                 }
             },
         };
@@ -1189,8 +1228,20 @@ fn to_series(me: &Lower, v: Vec<Series>) -> Vec<Vec<Element<'static>>> {
 
 fn bool_literal(e: &Expr) -> Option<bool> {
     match e {
-        Expr::Literal(s) if s.eq_ignore_ascii_case("TRUE") || s.eq_ignore_ascii_case("BOOL#TRUE") || s == "BOOL#1" => Some(true),
-        Expr::Literal(s) if s.eq_ignore_ascii_case("FALSE") || s.eq_ignore_ascii_case("BOOL#FALSE") || s == "BOOL#0" => Some(false),
+        Expr::Literal(s)
+            if s.eq_ignore_ascii_case("TRUE")
+                || s.eq_ignore_ascii_case("BOOL#TRUE")
+                || s == "BOOL#1" =>
+        {
+            Some(true)
+        }
+        Expr::Literal(s)
+            if s.eq_ignore_ascii_case("FALSE")
+                || s.eq_ignore_ascii_case("BOOL#FALSE")
+                || s == "BOOL#0" =>
+        {
+            Some(false)
+        }
         _ => None,
     }
 }
