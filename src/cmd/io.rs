@@ -338,7 +338,13 @@ pub fn load_text_selecting(
 /// those rungs, as `run` executes them.
 pub fn load_program_for_c(path: &Path) -> Result<(Program, Fbd), CliError> {
     let (file, text) = read_program_text(path)?;
-    load_text_for(file, &text, Purpose::Generate, None)
+    load_text_lowered(file, &text)
+}
+
+/// [`load_text`] for what writes a program out (`c`, `il`, `convert`): a PLCopen ST body that
+/// lowers to rungs is those rungs, as `run` executes them, not the analysis's stand-ins.
+pub fn load_text_lowered(file: String, text: &str) -> Result<(Program, Fbd), CliError> {
+    load_text_for(file, text, Purpose::Generate, None)
 }
 
 /// Reads and checks a program file (`-`: standard input), with its FBD bodies as written.

@@ -35,6 +35,7 @@ mod pins;
 mod project;
 mod st_body;
 mod st_lower;
+mod st_scope;
 mod textual;
 mod wiring;
 mod xml;

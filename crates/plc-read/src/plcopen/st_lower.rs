@@ -45,7 +45,7 @@
 //! of enumerations, whole structures.
 
 use super::interface::literal;
-use super::st_body::{Decl, Scope};
+use super::st_scope::{Decl, Scope};
 use crate::st::ast::*;
 use plc_diag::Origin;
 use plc_model::{ArithOp, BistableKind, CmpOp, Function, TimerKind, TriggerKind, Type};
@@ -936,9 +936,11 @@ impl<'s> Lower<'s> {
     // ---- values ----
 
     fn value(&mut self, e: &Expr, want: Option<Type>) -> L<Val> {
-        Ok(self
-            .value_into(e, want, None)?
-            .expect("a value without a target is returned"))
+        match self.value_into(e, want, None)? {
+            Some(v) => Ok(v),
+            // Every path returns its value when it has no target to write.
+            None => refuse(self.at, "an expression without a value"),
+        }
     }
 
     /// `e` as an operand (`want`: the type its use gives a literal). With `out`, a box that
