@@ -1326,3 +1326,18 @@ pub(super) fn first_pragma(text: &str) -> Option<usize> {
     }
     None
 }
+
+#[cfg(test)]
+mod tests {
+    use super::first_pragma;
+
+    #[test]
+    fn a_pragma_is_found_outside_comments_and_strings_only() {
+        assert_eq!(first_pragma("x := 1; (* {not} *) // {no}\ny := '{';"), None);
+        assert_eq!(
+            first_pragma("(* (* {nested} *) *) x := 1;\n{SetFbVar(OUT,1)}"),
+            Some(29)
+        );
+        assert_eq!(first_pragma("s := 'it$'s'; {p}"), Some(14));
+    }
+}
