@@ -12,7 +12,7 @@
 //! DIR that is a symbolic link is refused, as for every `-o`.
 
 use super::io::{
-    create_in_temp_folder, create_temp_folder, discard_temp, load_program_and_fbd,
+    create_in_temp_folder, create_temp_folder, discard_temp, load_program_for_c,
     put_folder_in_place, CliError, FileRole, SYMLINK_REFUSED,
 };
 use plc_codegen::c::{generate, CConfig};
@@ -34,7 +34,7 @@ pub struct CCommand {
 
 /// `plc-deps c`: generates and writes the files.
 pub fn c(cmd: &CCommand) -> Result<(), CliError> {
-    let (p, fbd) = load_program_and_fbd(&cmd.input)?;
+    let (p, fbd) = load_program_for_c(&cmd.input)?;
     super::skipped::refuse_skipped(&p, &cmd.input, cmd.allow_skipped, Some("write the C"))?;
     let dir = &cmd.output;
     let io = |e| CliError::io(FileRole::Output, dir, e);

@@ -8,7 +8,7 @@
 //! IL or SFC body read as stand-in rungs) is refused unless `--allow-skipped`: the JSON format
 //! has no mark for a stand-in, so a run of the converted file could not know it skips code.
 
-use super::io::{format_of, load_text, read_program_text, write_output_with, Format};
+use super::io::{format_of, load_text_lowered, read_program_text, write_output_with, Format};
 use super::CliError;
 use plc_read::{json, plcopen, stl};
 use std::path::PathBuf;
@@ -26,11 +26,11 @@ pub struct ConvertConfig {
 /// as every command recognises it ([`format_of`]: STL, PLCopen TC6 XML or JSON).
 pub fn convert(c: &ConvertConfig) -> Result<(), CliError> {
     let (file, text) = read_program_text(&c.input)?;
-    let (p, _) = load_text(file.clone(), &text)?;
+    let (p, _) = load_text_lowered(file.clone(), &text)?;
     super::skipped::refuse_skipped(&p, &c.input, c.allow_skipped, Some("write the JSON"))?;
     let syntax = match format_of(&file, &text) {
         Format::Stl => stl::parse(&text),
-        Format::PlcOpen => plcopen::parse(&text).map(|(syntax, _)| syntax),
+        Format::PlcOpen => plcopen::parse_for(&text, None, true).map(|(syntax, _)| syntax),
         Format::Json => json::parse(&text),
     }
     .map_err(|error| CliError::load(file.clone(), &text, error))?;

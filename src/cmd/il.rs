@@ -2,7 +2,7 @@
 //! output or written atomically to OUT. A construct with no S7-200 instruction is one error
 //! naming the file and the rung or block (exit code 2); nothing is written then.
 
-use super::io::{check_output_path, load_program_and_fbd, write_output, CliError, FileRole};
+use super::io::{check_output_path, load_program_for_c, write_output, CliError, FileRole};
 use plc_codegen::il::generate;
 use std::path::PathBuf;
 
@@ -18,7 +18,7 @@ pub fn il(cmd: &IlCommand) -> Result<(), CliError> {
     if let Some(out) = &cmd.output {
         check_output_path(out, FileRole::Output)?;
     }
-    let (p, fbd) = load_program_and_fbd(&cmd.input)?;
+    let (p, fbd) = load_program_for_c(&cmd.input)?;
     super::skipped::refuse_skipped(&p, &cmd.input, false, None)?;
     let text = generate(&p, &fbd).map_err(|e| {
         let file = if cmd.input.as_os_str() == "-" {

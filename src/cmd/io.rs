@@ -334,6 +334,19 @@ pub fn load_text_selecting(
     load_text_for(file, text, Purpose::Analyse, select)
 }
 
+/// [`load_program_and_fbd`] for code generation: a PLCopen ST body that lowers to rungs is
+/// those rungs, as `run` executes them.
+pub fn load_program_for_c(path: &Path) -> Result<(Program, Fbd), CliError> {
+    let (file, text) = read_program_text(path)?;
+    load_text_lowered(file, &text)
+}
+
+/// [`load_text`] for what writes a program out (`c`, `il`, `convert`): a PLCopen ST body that
+/// lowers to rungs is those rungs, as `run` executes them, not the analysis's stand-ins.
+pub fn load_text_lowered(file: String, text: &str) -> Result<(Program, Fbd), CliError> {
+    load_text_for(file, text, Purpose::Generate, None)
+}
+
 /// Reads and checks a program file (`-`: standard input), with its FBD bodies as written.
 pub fn load_program_and_fbd(path: &Path) -> Result<(Program, Fbd), CliError> {
     let (file, text) = read_program_text(path)?;
@@ -352,6 +365,8 @@ pub fn load_text(file: String, text: &str) -> Result<(Program, Fbd), CliError> {
 enum Purpose {
     Analyse,
     Run,
+    /// `c`: ST bodies lowered as for `run`, nothing refused here (`c` refuses skipped bodies).
+    Generate,
 }
 
 /// The formats a program file is read in.
@@ -393,6 +408,7 @@ fn load_text_for(
         let load = match purpose {
             Purpose::Analyse => plc_load::plcopen_selected,
             Purpose::Run => plc_load::plcopen_for_run_selected,
+            Purpose::Generate => plc_load::plcopen_lowered_selected,
         };
         let (p, f, notes) =
             load(text, select).map_err(|error| CliError::load(file.clone(), text, error))?;

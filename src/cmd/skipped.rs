@@ -17,6 +17,8 @@ pub struct SkippedPou {
     pub language: String,
     /// 1-based line and column of the body in the program file.
     pub position: Option<(u32, u32)>,
+    /// What in the body is not executed, and where (an ST construct the lowering refuses).
+    pub why: Option<String>,
 }
 
 impl SkippedPou {
@@ -50,6 +52,7 @@ fn skipped_pou(pou: &Pou) -> Option<SkippedPou> {
         pou: pou.name.clone(),
         language: s.language.clone(),
         position: s.position,
+        why: s.why.clone(),
     })
 }
 
@@ -84,8 +87,12 @@ pub fn refuse_skipped(
         Some(what) => format!("give --allow-skipped to {what} without it"),
         None => "its STL cannot be written".to_string(),
     };
+    let why = match &first.why {
+        Some(w) => format!(": {w} is not executed yet"),
+        None => String::new(),
+    };
     Err(CliError::Usage(format!(
-        "{place}: pou {}: its {} body is not executed (it is read only as stand-in rungs that keep every value){more}; {help}",
+        "{place}: pou {}: its {} body is not executed{why} (it is read only as stand-in rungs that keep every value){more}; {help}",
         first.pou, first.language
     )))
 }

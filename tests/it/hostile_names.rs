@@ -309,7 +309,8 @@ fn gen_refuses_sizes_it_could_not_read_back_naming_the_flag() {
     }
 }
 
-/// A PLCopen project whose program `P` has an ST body (two statements), and where it starts.
+/// A PLCopen project whose program `P` has an ST body (three statements, the last calling a
+/// function the project does not define, which `run` cannot execute), and where it starts.
 fn st_project() -> (String, String) {
     let xml = px::project_in(
         "ST",
@@ -318,7 +319,7 @@ fn st_project() -> (String, String) {
             ("outputVars", "run", "BOOL"),
             ("localVars", "count", "INT"),
         ],
-        "<xhtml:p xmlns:xhtml=\"http://www.w3.org/1999/xhtml\"><![CDATA[count := count + 1;\nrun := start;]]></xhtml:p>",
+        "<xhtml:p xmlns:xhtml=\"http://www.w3.org/1999/xhtml\"><![CDATA[count := count + 1;\nrun := start;\ncount := MYFUNC(count);]]></xhtml:p>",
     );
     let at = px::line_col(&xml, "<ST>");
     (xml, at)
@@ -327,8 +328,9 @@ fn st_project() -> (String, String) {
 #[test]
 fn run_c_and_il_refuse_an_st_body_they_do_not_execute_unless_allowed() {
     let (xml, at) = st_project();
+    let call = px::line_col(&xml, "MYFUNC");
     let refused = |what: &str| {
-        format!("error: <stdin>:{at}: pou P: its ST body is not executed (it is read only as stand-in rungs that keep every value); {what}")
+        format!("error: <stdin>:{at}: pou P: its ST body is not executed: the call of function `MYFUNC` (only the standard functions are executed) at {call} is not executed yet (it is read only as stand-in rungs that keep every value); {what}")
     };
     // The reader's warning W0501 comes first: the error is the last line.
     let error_line = |out: &std::process::Output, what: &str| {

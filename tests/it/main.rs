@@ -73,5 +73,6 @@ mod report_warnings;
 mod run_cli;
 mod scan_budget;
 mod schema;
+mod st_exec;
 mod standard_fbs;
 mod strings;

@@ -68,7 +68,7 @@ fn a_codesys_st_body_is_analysed_per_statement_with_a_warning() {
     assert_eq!(rung["id"], "PLC_PRG.st1");
     assert_eq!(rung["in"], serde_json::json!(["i"]));
     assert_eq!(rung["out"], serde_json::json!(["i"]));
-    assert!(err.contains("warning: tests/plcopen/e-cockpit-python-scripting__plc.xml:36:11: pou PLC_PRG: its ST body is analysed per statement (1 top-level statement, rungs PLC_PRG.st1 …, each reading and writing whole variables) and not executed by `run`"), "{err}");
+    assert!(err.contains("warning: tests/plcopen/e-cockpit-python-scripting__plc.xml:36:11: pou PLC_PRG: its ST body is analysed per statement (1 top-level statement, rungs PLC_PRG.st1 …, each reading and writing whole variables) and executed by `run` and `c` as the rungs it is lowered to (docs/plcopen.md, ST bodies)"), "{err}");
     assert!(err.contains("warning: tests/plcopen/e-cockpit-python-scripting__plc.xml:16:5: vendor data (addData) ignored: http://www.3s-software.com/plcopenxml/projectinformation"), "{err}");
 }
 

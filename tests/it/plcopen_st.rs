@@ -1,7 +1,7 @@
 //! PLCopen TC6 XML ST bodies, hand-written: each top-level statement is one stand-in rung
 //! `<pou>.stK` with exactly the variables it reads and writes (a compound statement with all of
 //! its parts; a written variable is also read, by the `move x → x` that stands for the write), located at the statement's line and column in the XML file through CDATA and
-//! entity references; a run leaves the values unchanged; an ST syntax error or an undeclared
+//! entity references; `run` executes the lowered body (tests/it/st_exec.rs has the rest); an ST syntax error or an undeclared
 //! name is one located error.
 
 use crate::common;
@@ -81,17 +81,20 @@ fn each_statement_is_a_rung_with_exactly_its_reads_and_writes() {
     let body = line_col(&xml, "<ST>");
     assert_eq!(
         err.lines().collect::<Vec<_>>(),
-        [format!("warning: <stdin>:{body}: pou P: its ST body is analysed per statement (5 top-level statements, rungs P.st1 …, each reading and writing whole variables) and not executed by `run`; the function block instances it calls are not seen as written: T1"),
+        [format!("warning: <stdin>:{body}: pou P: its ST body is analysed per statement (5 top-level statements, rungs P.st1 …, each reading and writing whole variables) and executed by `run` and `c` as the rungs it is lowered to (docs/plcopen.md, ST bodies); the function block instances it calls are not seen as written: T1"),
         "warning: <stdin>:17:1: rung P.st3 has no effect: nothing is written and control is not transferred".to_owned()]
     );
 }
 
 #[test]
-fn a_run_leaves_the_values_unchanged() {
+fn a_run_executes_the_body() {
+    // start and stop stay FALSE: `count := count + 1` runs every scan (3 after 3 scans, never
+    // past 10), `run` is never set, so T1 never starts and `done` stays FALSE. (Before ST was
+    // executed, the stand-ins left count at 0.)
     let xml = st(BODY);
     let v = run_scans(&xml, 3);
     assert_eq!(v["outputs"], json!({"run": false, "done": false}));
-    assert_eq!(v["state"]["count"], json!(0));
+    assert_eq!(v["state"]["count"], json!(3));
 }
 
 #[test]

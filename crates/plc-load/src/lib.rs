@@ -143,7 +143,17 @@ pub fn plcopen_selected(
     text: &str,
     select: Option<&str>,
 ) -> Result<(Program, Fbd, Vec<Note>), LoadError> {
-    let (p, f, notes, no_run) = plcopen_all(text, select)?;
+    let (p, f, notes, no_run) = plcopen_all(text, select, false)?;
+    Ok((p, f, notes.into_iter().chain(no_run).collect()))
+}
+
+/// [`plcopen_selected`] for code generation (`c`): each ST body that lowers to rungs is those
+/// rungs, as `run` executes them ([`plcopen_for_run`]), instead of a stand-in per statement.
+pub fn plcopen_lowered_selected(
+    text: &str,
+    select: Option<&str>,
+) -> Result<(Program, Fbd, Vec<Note>), LoadError> {
+    let (p, f, notes, no_run) = plcopen_all(text, select, true)?;
     Ok((p, f, notes.into_iter().chain(no_run).collect()))
 }
 
@@ -158,7 +168,7 @@ pub fn plcopen_for_run_selected(
     text: &str,
     select: Option<&str>,
 ) -> Result<(Program, Fbd, Vec<Note>), LoadError> {
-    let (p, f, notes, no_run) = plcopen_all(text, select)?;
+    let (p, f, notes, no_run) = plcopen_all(text, select, true)?;
     match no_run {
         Some(n) => Err(read::plcopen::run_refusal(n, text)),
         None => Ok((p, f, notes)),
@@ -168,8 +178,8 @@ pub fn plcopen_for_run_selected(
 /// The program, its FBD bodies, the reader's notes, and the note of what `run` cannot execute.
 type PlcOpenLoaded = (Program, Fbd, Vec<Note>, Option<Note>);
 
-fn plcopen_all(text: &str, select: Option<&str>) -> Result<PlcOpenLoaded, LoadError> {
-    let (syntax, mut notes) = read::plcopen::parse_selected(text, select)?;
+fn plcopen_all(text: &str, select: Option<&str>, exec: bool) -> Result<PlcOpenLoaded, LoadError> {
+    let (syntax, mut notes) = read::plcopen::parse_for(text, select, exec)?;
     let (p, f) = resolve::resolve(text, &syntax)?;
     for x in &notes.exec_orders {
         if let Some(n) = exec_order_note(&f, x) {

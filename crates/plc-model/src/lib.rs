@@ -92,6 +92,9 @@ pub struct SkippedBody {
     pub language: String,
     /// Line and column (1-based) of the body in the program file.
     pub position: Option<(u32, u32)>,
+    /// What in the body is not executed, with its line and column (`the call of function
+    /// \`F\` at 12:3`), when the reader names one (an ST body it could not lower).
+    pub why: Option<String>,
 }
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]

@@ -78,6 +78,10 @@ fn mark_skipped(program: &mut Program, fbd: &Fbd, skipped: &[syntax::SkippedBody
                 pou.skipped = Some(Box::new(SkippedBody {
                     language: s.language.clone(),
                     position: s.origin.line_column(text),
+                    why: s.why.as_ref().map(|(at, what)| match at.line_column(text) {
+                        Some((l, c)) => format!("{what} at {l}:{c}"),
+                        None => what.clone(),
+                    }),
                 }));
             }
         }

@@ -180,6 +180,9 @@ pub struct SkippedBody {
     pub language: String,
     /// Where the body starts.
     pub origin: Origin,
+    /// What in the body is not executed and where, when the reader names it (an ST body it
+    /// could not lower to rungs).
+    pub why: Option<(Origin, String)>,
 }
 
 /// A POU's body: ladder rungs or an FBD body.

@@ -9,7 +9,7 @@
 //! variable lists ([`data_types`] the data types and structures, a structure flattened into its fields), [`ld`] (with [`ld_power`], [`ld_block`], [`ld_logic`] and the shared [`wiring`] graph) the
 //! LD bodies ([`ld_flow`]: those that are not series-parallel rungs, as Beremiz's data-flow
 //! network), [`fbd`] the FBD bodies ([`black_box`]: conversions and blocks the model lacks; [`expression`]: in variables' expressions), [`st_body`] the ST bodies (a stand-in rung per statement,
-//! from the ST parser), [`textual`] stands IL and SFC bodies in by their interface. What the reader did that changes meaning or skips vendor data is a [`Note`]
+//! from the ST parser, for the analyses; [`st_lower`]: the rungs `run` and `c` execute), [`textual`] stands IL and SFC bodies in by their interface. What the reader did that changes meaning or skips vendor data is a [`Note`]
 //! (a warning with its place). The mapping, the order rules and their sources:
 //! docs/plcopen.md; the research behind them: docs/design/plcopen-semantics.md.
 //!
@@ -34,6 +34,8 @@ mod library;
 mod pins;
 mod project;
 mod st_body;
+mod st_lower;
+mod st_scope;
 mod textual;
 mod wiring;
 mod xml;
@@ -63,9 +65,22 @@ pub fn parse_selected(
     text: &str,
     select: Option<&str>,
 ) -> Result<(syntax::Program<'static>, Notes), LoadError> {
+    parse_for(text, select, false)
+}
+
+/// [`parse_selected`]; with `exec` (for `run` and `c`), each ST body that lowers to rungs is
+/// read as those rungs ([`st_lower`]), not as a stand-in rung per statement.
+pub fn parse_for(
+    text: &str,
+    select: Option<&str>,
+    exec: bool,
+) -> Result<(syntax::Program<'static>, Notes), LoadError> {
     let doc = xml::parse(text)?;
     let ns = xml::project_namespace(&doc).map_err(|e| e.locate(text))?;
-    let mut notes = Notes::default();
+    let mut notes = Notes {
+        exec,
+        ..Notes::default()
+    };
     let mut program =
         project::program(xml::Tc6 { ns }, &doc, select, &mut notes).map_err(|e| e.locate(text))?;
     program.skipped = std::mem::take(&mut notes.skipped);

@@ -21,7 +21,7 @@ use super::block_types::{Ctx, Sig};
 use super::data_types::DataTypes;
 use super::interface::{self, name, Interface, Known};
 use super::xml::{add_data_note, attr, error, identifier, origin, Note, Notes, Tc6, R};
-use super::{fbd, ld, ld_flow, library, st_body, textual};
+use super::{fbd, ld, ld_flow, library, st_body, st_scope, textual};
 use plc_diag::LoadError;
 use plc_model::{Configuration, ProgramInstance, Resource, Task};
 use plc_syntax::{
@@ -274,8 +274,8 @@ fn function_note(pou: Node, pname: &str) -> Note {
 
 /// The names an ST body of a POU with interface `iface` sees: its own variables and the globals
 /// it declares external (`globals`: the name and type of every global of the project).
-fn scope(iface: &Interface, globals: &[(&str, &str)], known: &Known) -> st_body::Scope {
-    let mut s = st_body::Scope::default();
+fn scope(iface: &Interface, globals: &[(&str, &str)], known: &Known) -> st_scope::Scope {
+    let mut s = st_scope::Scope::default();
     for v in iface
         .inputs
         .iter()
@@ -389,7 +389,7 @@ fn body(
     pou: Node,
     name: &str,
     iface: &Interface,
-    scope: &st_body::Scope,
+    scope: &st_scope::Scope,
     ctx: &Ctx,
     notes: &mut Notes,
 ) -> R<Body<'static>> {

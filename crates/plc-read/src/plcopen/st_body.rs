@@ -18,131 +18,22 @@
 //! the call assigns them. A name that is neither declared nor called (a
 //! function) is an error at its statement; so is an ST syntax error, at its line and column.
 //!
-//! Deliberately not here: executing ST (`run` leaves the values unchanged, and the note says
-//! the body is not executed), IL and SFC (through their interface, [`super::textual`]).
+//! For `run` and `c` ([`super::xml::Notes::exec`]) the same body is also lowered to executable
+//! rungs ([`super::st_lower`]); when every statement lowers, those rungs (and their
+//! temporaries) replace the stand-ins, otherwise the body is marked skipped with the construct
+//! that does not lower and where it is, and `run`/`c` refuse it. The note says which.
+//!
+//! Deliberately not here: the lowering itself ([`super::st_lower`]), IL and SFC (through their
+//! interface, [`super::textual`]).
 
+use super::st_lower::{self, Lower};
+use super::st_scope::{Decl, Scope};
 use super::textual::{stand_in, Read};
 use super::xml::{error, origin, Note, Notes, R};
 use crate::st;
 use plc_diag::Origin;
 use plc_syntax::Rung;
 use roxmltree::Node;
-use std::collections::HashMap;
-
-/// What a name of an ST body is: an elementary variable (with its type) or an instance (with
-/// the BOOL-or-not field a read of it stands for, when it has one).
-#[derive(Clone, Debug)]
-pub(super) enum Decl {
-    Elementary {
-        name: String,
-        ty: String,
-    },
-    Instance {
-        name: String,
-        read: Option<Read>,
-    },
-    /// A value of an enumeration data type (a constant: reading it reads no variable).
-    Constant,
-    /// A structure (or a structure inside one) flattened into its fields: its leaf fields'
-    /// names and types. Reading or writing it whole reads or writes every one.
-    Structure {
-        leaves: Vec<(String, String)>,
-    },
-}
-
-/// The declarations an ST body sees, by lower-case name.
-#[derive(Default)]
-pub(super) struct Scope {
-    pub names: HashMap<String, Decl>,
-}
-
-impl Scope {
-    /// Declares `name` of type `ty` (elementary or a function block type).
-    pub(super) fn declare(&mut self, name: &str, ty: &str) {
-        let decl = if super::elementary::is_elementary(ty) {
-            Decl::Elementary {
-                name: name.to_owned(),
-                ty: ty.to_owned(),
-            }
-        } else {
-            Decl::Instance {
-                name: name.to_owned(),
-                read: first_output(ty).map(|(f, b)| Read {
-                    name: format!("{name}.{f}"),
-                    bool: b,
-                }),
-            }
-        };
-        self.names.insert(name.to_ascii_lowercase(), decl);
-        // A structure's field (`Plant.Motor.Speed`) makes its structures (`Plant`,
-        // `Plant.Motor`) known as the sets of their fields.
-        let mut at = name.len();
-        while let Some(dot) = name[..at].rfind('.') {
-            at = dot;
-            let entry = self
-                .names
-                .entry(name[..at].to_ascii_lowercase())
-                .or_insert(Decl::Structure { leaves: Vec::new() });
-            if let Decl::Structure { leaves } = entry {
-                leaves.push((name.to_owned(), ty.to_owned()));
-            }
-        }
-    }
-
-    /// Declares an enumeration value (a constant), unless a variable has its name.
-    pub(super) fn constant(&mut self, name: &str) {
-        self.names
-            .entry(name.to_ascii_lowercase())
-            .or_insert(Decl::Constant);
-    }
-
-    /// `name` as it is, or, when it is a structure, the names of its fields.
-    pub(super) fn fields_of(&self, name: &str) -> Vec<String> {
-        match self.get(name) {
-            Some(Decl::Structure { leaves }) => leaves.iter().map(|(n, _)| n.clone()).collect(),
-            _ => vec![name.to_owned()],
-        }
-    }
-
-    fn get(&self, name: &str) -> Option<&Decl> {
-        self.names.get(&name.to_ascii_lowercase())
-    }
-
-    /// What access path `path` (`s`, `s.f`, `T1.Q`) names: the declaration of the path, else
-    /// of its longest declared prefix, with `true` when that is the whole path. A field of a
-    /// structure that has no such field is `Err` with the message.
-    fn find(&self, path: &str) -> Result<Option<(&Decl, bool)>, String> {
-        let mut at = path.len();
-        loop {
-            if let Some(d) = self.get(&path[..at]) {
-                if let (Decl::Structure { leaves }, false) = (d, at == path.len()) {
-                    let fields: Vec<&str> = leaves.iter().map(|(n, _)| &n[at + 1..]).collect();
-                    return Err(format!(
-                        "`{path}`: structure `{}` has no field `{}` (its fields: {})",
-                        &path[..at],
-                        &path[at + 1..],
-                        fields.join(", ")
-                    ));
-                }
-                return Ok(Some((d, at == path.len())));
-            }
-            match path[..at].rfind('.') {
-                Some(dot) => at = dot,
-                None => return Ok(None),
-            }
-        }
-    }
-}
-
-/// The first output of a standard function block (IEC 61131-3 2.5.2.3), and whether it is BOOL.
-fn first_output(ty: &str) -> Option<(&'static str, bool)> {
-    Some(match ty {
-        "TON" | "TOF" | "TP" | "CTU" | "CTD" | "R_TRIG" | "F_TRIG" => ("Q", true),
-        "SR" | "RS" => ("Q1", true),
-        "CTUD" => ("QU", true),
-        _ => return None,
-    })
-}
 
 /// What the statements of a body leave out of the analysis, for the note.
 #[derive(Default)]
@@ -172,6 +63,8 @@ pub(super) fn rungs(
     let mut out = Vec::new();
     let mut unseen = Unseen::default();
     let mut k = 0;
+    let mut lower = Lower::new(scope, pou);
+    let mut refused: Option<(Origin, String)> = None;
     for t in node.descendants().filter(|d| d.is_text()) {
         let text = t.text().unwrap_or("");
         if text.trim().is_empty() {
@@ -184,8 +77,21 @@ pub(super) fn rungs(
         };
         let statements = st::statements(text)
             .map_err(|e| error(at(e.at), &place, format!("ST syntax error: {}", e.message)))?;
+        if let (None, Some(p)) = (&refused, st_lower::first_pragma(text)) {
+            refused = Some((
+                at(p),
+                "a pragma `{…}` (matiec copies its text, C code, into what it generates)"
+                    .to_owned(),
+            ));
+        }
+        lower.text(map.clone(), origin(t));
         for s in &statements {
             k += 1;
+            if refused.is_none() {
+                if let Err(r) = lower.top(k, s) {
+                    refused = Some((lower.origin(r.at), r.what));
+                }
+            }
             if s.kind == st::ast::Stmt::Empty {
                 continue;
             }
@@ -195,21 +101,43 @@ pub(super) fn rungs(
             out.extend(stand_in(format!("{pou}.st{k}"), here, &reads, &writes));
         }
     }
+    lower.finish();
+    let executed = match &refused {
+        None => {
+            "executed by `run` and `c` as the rungs it is lowered to (docs/plcopen.md, ST bodies)"
+                .to_owned()
+        }
+        Some((at, what)) => {
+            let (l, c) = at.line_column(source).unwrap_or((0, 0));
+            format!("not executed by `run` or `c`: {what} at {l}:{c} is not executed yet")
+        }
+    };
     notes.push(Note {
         origin: origin(node),
-        message: message(pou, k, &unseen),
+        message: message(pou, k, &unseen, &executed),
     });
-    notes.skipped.push(plc_syntax::SkippedBody {
-        pou: pou.to_owned(),
-        language: "ST".into(),
-        origin: origin(node),
-    });
+    match refused {
+        Some(why) => notes.skipped.push(plc_syntax::SkippedBody {
+            pou: pou.to_owned(),
+            language: "ST".into(),
+            origin: origin(node),
+            why: Some(why),
+        }),
+        // `run` and `c` execute the lowered rungs; the analyses keep a rung per statement.
+        None if notes.exec => {
+            notes
+                .ld_vars
+                .extend(lower.vars.into_iter().map(|v| (pou.to_owned(), v)));
+            return Ok(lower.rungs);
+        }
+        None => {}
+    }
     Ok(out)
 }
 
-fn message(pou: &str, statements: usize, unseen: &Unseen) -> String {
+fn message(pou: &str, statements: usize, unseen: &Unseen, executed: &str) -> String {
     let plural = if statements == 1 { "" } else { "s" };
-    let mut m = format!("pou {pou}: its ST body is analysed per statement ({statements} top-level statement{plural}, rungs {pou}.st1 …, each reading and writing whole variables) and not executed by `run`");
+    let mut m = format!("pou {pou}: its ST body is analysed per statement ({statements} top-level statement{plural}, rungs {pou}.st1 …, each reading and writing whole variables) and {executed}");
     let mut add = |what: &str, v: &[String]| {
         if !v.is_empty() {
             m.push_str(&format!("; {what}: {}", v.join(", ")));
@@ -273,9 +201,12 @@ fn resolve(
                 name: r.name.clone(),
                 bool: r.bool,
             }),
-            Some((Decl::Instance { name, read: None }, _)) => {
-                push_once(&mut unseen.instances_read, name)
-            }
+            Some((
+                Decl::Instance {
+                    name, read: None, ..
+                },
+                _,
+            )) => push_once(&mut unseen.instances_read, name),
             Some((Decl::Structure { leaves }, _)) => {
                 reads.extend(leaves.iter().map(|(name, ty)| Read {
                     name: name.clone(),

@@ -134,6 +134,7 @@ pub(super) fn through_interface(
         pou: pou.to_owned(),
         language: lang.to_owned(),
         origin: at,
+        why: None,
     });
     rung.into_iter().collect()
 }

@@ -80,6 +80,9 @@ pub struct Notes {
     pub no_run: Vec<(String, Note)>,
     /// The bodies read only as stand-in rungs (ST, IL, SFC), moved into the syntax tree.
     pub skipped: Vec<plc_syntax::SkippedBody>,
+    /// Read for execution (`run`, `c`): an ST body that lowers to rungs is those rungs
+    /// ([`super::st_lower`]); otherwise (the analyses) a stand-in rung per statement.
+    pub exec: bool,
 }
 
 impl Notes {

@@ -14,7 +14,8 @@
 //! a function call reads its arguments. Names are reported as written (the caller resolves
 //! them against the POU's declarations, case-insensitively as IEC names are).
 //!
-//! Deliberately not here: executing ST (a later step: `run` says which POU it cannot execute),
+//! Deliberately not here: executing ST (the PLCopen reader lowers a body to rungs,
+//! `crate::plcopen::st_lower`),
 //! declarations (a PLCopen file declares variables in the POU's interface), and IL.
 
 pub mod ast;

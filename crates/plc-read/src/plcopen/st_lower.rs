@@ -1,0 +1,1343 @@
+//! ST bodies made executable: each statement of an ST body (IEC 61131-3, 3rd edition, 7.3.3,
+//! as matiec compiles it) LOWERED to ladder rungs of the syntax's vocabulary
+//! ([`plc_syntax::ElementKind`]), so that `run` (sequential and parallel) and `c` execute it
+//! with the executor's own semantics (integer overflow wraps, an integer DIV or MOD by zero
+//! gives 0 and a `div-by-zero` fault, loops are bounded by the loop cap: docs/scan.md).
+//!
+//! Statement `k` (1-based, top level, text order) of POU `P` becomes the rungs `P.stk.1`,
+//! `P.stk.2`, … (a nested statement's rungs belong to its top-level statement), each located
+//! at the statement. Compiler temporaries are POU-local variables named `st__N` (`N` from 1)
+//! and one never-written BOOL `st__false`: IEC 61131-3 identifiers have no double `_`, so they
+//! cannot clash with a user's name. Labels are `st__LN`.
+//!
+//! The lowering, clause by clause:
+//! - expressions (7.3.2): a BOOL expression is a series of conditions — a BOOL variable a
+//!   contact, `NOT` a negated contact (or the condition computed into a temporary and negated),
+//!   `AND` a series, `OR` an `or`, `XOR` and `=`/`<>` of BOOLs two branches, a comparison of
+//!   other types a `compare`; any other expression is computed into temporaries by `op` boxes
+//!   (ADD SUB MUL DIV MOD, EXPT for `**`, SUB from 0 for unary `-`; AND OR XOR NOT of bit
+//!   strings as the standard functions) and standard functions (ABS … ATAN, EXPT, SHL … ROR,
+//!   MUX, `*_TO_*`, TRUNC; MAX, MIN, LIMIT, SEL and MOVE as compares and moves). A literal takes
+//!   the type of the other operand (or of the assignment's target), as IEC and matiec type it.
+//! - `:=`: a BOOL target a coil (TRUE a set, FALSE a reset), another a move, or the last box
+//!   of its expression writing the target directly.
+//! - IF/ELSIF/ELSE and CASE (values, ranges `a..b`, lists, ELSE; the selector evaluated once
+//!   into a temporary, as matiec's `__case_expression`): conditional jumps over labelled rungs.
+//! - WHILE, REPEAT: a backward jump; FOR with or without BY: the control variable set, the
+//!   final value and the increment evaluated once before the loop into temporaries (IEC
+//!   61131-3 7.3.3.4.2), the loop left when `v > end` (BY > 0) or `v < end` (BY <= 0) before
+//!   each iteration, `v := v + BY` after it (the rule of matiec's generated C before its 2024
+//!   change, which skips a one-trip loop; docs/plcopen.md says so). EXIT jumps past the
+//!   innermost loop, CONTINUE to its next test, RETURN is `ret`.
+//! - calls of standard function block instances (TON TOF TP, CTU CTD CTUD, R_TRIG F_TRIG,
+//!   SR RS) with formal arguments: the instance's box, its first BOOL input as the power, its
+//!   other inputs as operands, its outputs `Q => y` moved or coiled after it; `T1.Q`, `T1.ET`,
+//!   `C1.CV` … read the instance's fields.
+//!
+//! Invariants: a body is lowered whole or not at all; what the lowering does not handle is a
+//! [`Refusal`] naming the construct and where it is, and then the body keeps its stand-in
+//! rungs and `run`/`c` refuse it with that reason (never a silently skipped statement).
+//!
+//! Deliberately not here (refused): pragmas `{…}` (matiec pastes their text, often C, into its
+//! output), calls of user function blocks and user functions, a standard function block call
+//! that leaves one of its inputs out (the model keeps no input values between calls), reads
+//! or writes of an instance's inputs, arrays, dereferences, direct addresses, strings, values
+//! of enumerations, whole structures.
+
+use super::interface::literal;
+use super::st_scope::{Decl, Scope};
+use crate::st::ast::*;
+use plc_diag::Origin;
+use plc_model::{ArithOp, BistableKind, CmpOp, Function, TimerKind, TriggerKind, Type};
+use plc_syntax::{
+    Arith, Bistable, Compare, Counter, Ctud, Element, ElementKind, FunctionCall, Located, Move,
+    Name, Operand, Rung, Scalar, Timer, Var, VarClass,
+};
+use std::borrow::Cow;
+
+/// Why a body cannot be lowered: the construct and the ST offset where it is.
+#[derive(Debug)]
+pub(super) struct Refusal {
+    pub at: usize,
+    pub what: String,
+}
+
+type L<T> = Result<T, Refusal>;
+
+fn refuse<T>(at: usize, what: impl Into<String>) -> L<T> {
+    Err(Refusal {
+        at,
+        what: what.into(),
+    })
+}
+
+/// A value an operand carries: a literal (typed by its use) or a variable with its type.
+#[derive(Clone, Debug)]
+enum Val {
+    Lit(Scalar<'static>),
+    Var(String, Type),
+}
+
+impl Val {
+    fn ty(&self) -> Option<Type> {
+        match self {
+            Val::Var(_, t) => Some(*t),
+            Val::Lit(Scalar::Bool(_)) => Some(Type::Bool),
+            Val::Lit(Scalar::Str(s)) if plc_syntax::is_time_literal(s) => Some(Type::Time),
+            Val::Lit(_) => None,
+        }
+    }
+    fn is_real_literal(&self) -> bool {
+        matches!(self, Val::Lit(Scalar::Number(n)) if !n.is_i64() && !n.is_u64())
+    }
+}
+
+/// The lowering of one ST body.
+pub(super) struct Lower<'s> {
+    scope: &'s Scope,
+    pou: String,
+    /// The rungs so far.
+    pub rungs: Vec<Rung<'static>>,
+    /// The temporaries declared so far.
+    pub vars: Vec<Var<'static>>,
+    temps: usize,
+    labels: usize,
+    /// The id of the current top-level statement's rungs (`P.st3`) and how many it has.
+    stmt: String,
+    in_stmt: usize,
+    /// Where the current statement is in the file, and its offset in the ST text.
+    here: Origin,
+    at: usize,
+    /// The file offset of each offset of the current ST text (none: all at `base`).
+    map: Option<Vec<usize>>,
+    base: Origin,
+    /// The label the next rung carries.
+    pending: Option<String>,
+    /// The innermost loops: (label CONTINUE jumps to, label EXIT jumps to).
+    loops: Vec<(String, String)>,
+    false_var: bool,
+}
+
+type Series = Vec<ElementKind<'static>>;
+
+impl<'s> Lower<'s> {
+    pub(super) fn new(scope: &'s Scope, pou: &str) -> Lower<'s> {
+        Lower {
+            scope,
+            pou: pou.to_owned(),
+            rungs: Vec::new(),
+            vars: Vec::new(),
+            temps: 0,
+            labels: 0,
+            stmt: String::new(),
+            in_stmt: 0,
+            here: Origin::NONE,
+            at: 0,
+            map: None,
+            base: Origin::NONE,
+            pending: None,
+            loops: Vec::new(),
+            false_var: false,
+        }
+    }
+
+    /// The ST text the next statements come from: the file offset of each of its offsets
+    /// (`None`: every statement at `base`).
+    pub(super) fn text(&mut self, map: Option<Vec<usize>>, base: Origin) {
+        self.map = map;
+        self.base = base;
+    }
+
+    /// Where ST offset `off` of the current text is in the file.
+    pub(super) fn origin(&self, off: usize) -> Origin {
+        match &self.map {
+            Some(m) => m.get(off).map_or(self.base, |&o| Origin::at(o)),
+            None => self.base,
+        }
+    }
+
+    /// Lowers top-level statement `k` (1-based).
+    pub(super) fn top(&mut self, k: usize, s: &Statement) -> L<()> {
+        self.stmt = format!("{}.st{k}", self.pou);
+        self.in_stmt = 0;
+        self.statement(s)
+    }
+
+    /// Ends the body: a label still pending gets an empty landing rung.
+    pub(super) fn finish(&mut self) {
+        if self.pending.is_some() {
+            self.emit(Vec::new());
+        }
+    }
+
+    fn name(&self, s: &str) -> Name<'static> {
+        Located {
+            value: Cow::Owned(s.to_owned()),
+            origin: self.here,
+        }
+    }
+
+    fn operand(&self, v: &Val) -> Operand<'static> {
+        Located {
+            value: match v {
+                Val::Lit(s) => s.clone(),
+                Val::Var(n, _) => Scalar::Str(Cow::Owned(n.clone())),
+            },
+            origin: self.here,
+        }
+    }
+
+    fn emit(&mut self, ld: Series) {
+        self.in_stmt += 1;
+        let here = self.here;
+        let label = self.pending.take().map(|l| Box::new(self.name(&l)));
+        self.rungs.push(Rung {
+            origin: here,
+            id: self.name(&format!("{}.{}", self.stmt, self.in_stmt)),
+            label,
+            comment: None,
+            ld: ld
+                .into_iter()
+                .map(|kind| Element { origin: here, kind })
+                .collect(),
+            ld_origin: here,
+            problem: None,
+            problem_in_rung: false,
+        });
+    }
+
+    fn label(&mut self) -> String {
+        self.labels += 1;
+        format!("st__L{}", self.labels)
+    }
+
+    /// Puts `l` on the next rung.
+    fn place(&mut self, l: String) {
+        if self.pending.is_some() {
+            self.emit(Vec::new());
+        }
+        self.pending = Some(l);
+    }
+
+    fn jmp(&self, l: &str) -> ElementKind<'static> {
+        ElementKind::Jmp(self.name(l))
+    }
+
+    fn declare(&mut self, name: &str, ty: Type) {
+        let here = self.here;
+        self.vars.push(Var {
+            origin: here,
+            name: self.name(name),
+            ty: self.name(&ty.to_string()),
+            class: Located {
+                value: VarClass::Memory,
+                origin: here,
+            },
+            init: None,
+            problem: None,
+        });
+    }
+
+    fn temp(&mut self, ty: Type) -> String {
+        self.temps += 1;
+        let n = format!("st__{}", self.temps);
+        self.declare(&n, ty);
+        n
+    }
+
+    /// A contact that never passes power (`negated`: always passes).
+    fn constant(&mut self, value: bool) -> ElementKind<'static> {
+        if !self.false_var {
+            self.false_var = true;
+            self.declare("st__false", Type::Bool);
+        }
+        ElementKind::Contact {
+            var: self.name("st__false"),
+            negated: value,
+            edge: None,
+        }
+    }
+
+    fn contact(&self, var: &str, negated: bool) -> ElementKind<'static> {
+        ElementKind::Contact {
+            var: self.name(var),
+            negated,
+            edge: None,
+        }
+    }
+
+    // ---- statements ----
+
+    fn statements(&mut self, body: &[Statement]) -> L<()> {
+        body.iter().try_for_each(|s| self.statement(s))
+    }
+
+    fn statement(&mut self, s: &Statement) -> L<()> {
+        self.at = s.at;
+        self.here = self.origin(s.at);
+        match &s.kind {
+            Stmt::Empty => Ok(()),
+            Stmt::Assign { target, value } => self.assign(target, value),
+            Stmt::Call { callee, args } => self.fb_call(callee, args),
+            Stmt::If { arms, otherwise } => {
+                let end = self.label();
+                for (cond, body) in arms {
+                    let next = self.label();
+                    let c = self.cond(cond)?;
+                    let mut ld = self.negate(c);
+                    ld.push(self.jmp(&next));
+                    self.emit(ld);
+                    self.statements(body)?;
+                    let j = self.jmp(&end);
+                    self.emit(vec![j]);
+                    self.place(next);
+                }
+                self.statements(otherwise)?;
+                self.place(end);
+                Ok(())
+            }
+            Stmt::Case {
+                selector,
+                arms,
+                otherwise,
+            } => self.case(s.at, selector, arms, otherwise),
+            Stmt::While { cond, body } => {
+                let (top, end) = (self.label(), self.label());
+                self.place(top.clone());
+                let c = self.cond(cond)?;
+                let mut ld = self.negate(c);
+                ld.push(self.jmp(&end));
+                self.emit(ld);
+                self.loops.push((top.clone(), end.clone()));
+                self.statements(body)?;
+                self.loops.pop();
+                let j = self.jmp(&top);
+                self.emit(vec![j]);
+                self.place(end);
+                Ok(())
+            }
+            Stmt::Repeat { body, until } => {
+                let (top, test, end) = (self.label(), self.label(), self.label());
+                self.place(top.clone());
+                self.loops.push((test.clone(), end.clone()));
+                self.statements(body)?;
+                self.loops.pop();
+                self.place(test);
+                let c = self.cond(until)?;
+                let mut ld = self.negate(c);
+                ld.push(self.jmp(&top));
+                self.emit(ld);
+                self.place(end);
+                Ok(())
+            }
+            Stmt::For {
+                var,
+                from,
+                to,
+                by,
+                body,
+            } => self.for_loop(var, from, to, by.as_ref(), body),
+            Stmt::Exit | Stmt::Continue => {
+                let exit = matches!(s.kind, Stmt::Exit);
+                let Some((cont, end)) = self.loops.last().cloned() else {
+                    let what = if exit { "EXIT" } else { "CONTINUE" };
+                    return refuse(s.at, format!("{what} outside a loop"));
+                };
+                let j = self.jmp(if exit { &end } else { &cont });
+                self.emit(vec![j]);
+                Ok(())
+            }
+            Stmt::Return => {
+                self.emit(vec![ElementKind::Ret]);
+                Ok(())
+            }
+        }
+    }
+
+    fn assign(&mut self, target: &Place, value: &Expr) -> L<()> {
+        let (name, ty) = self.written(target)?;
+        if ty == Type::Bool {
+            match bool_literal(value) {
+                Some(true) => self.emit(vec![ElementKind::Set(self.name(&name))]),
+                Some(false) => self.emit(vec![ElementKind::Reset(self.name(&name))]),
+                None => {
+                    let mut ld = self.cond(value)?;
+                    ld.push(ElementKind::Coil {
+                        var: self.name(&name),
+                        negated: false,
+                    });
+                    self.emit(ld);
+                }
+            }
+            return Ok(());
+        }
+        let v = self.value_into(value, Some(ty), Some(&name))?;
+        if let Some(v) = v {
+            let m = ElementKind::Move(Box::new(Move {
+                from: self.operand(&v),
+                to: self.name(&name),
+            }));
+            self.emit(vec![m]);
+        }
+        Ok(())
+    }
+
+    fn case(
+        &mut self,
+        at: usize,
+        selector: &Expr,
+        arms: &[(Vec<CaseLabel>, Vec<Statement>)],
+        otherwise: &[Statement],
+    ) -> L<()> {
+        let v = self.value(selector, None)?;
+        let Some(ty) = v.ty() else {
+            return refuse(at, "a CASE on a literal");
+        };
+        if ty == Type::Bool {
+            return refuse(at, "a CASE on a BOOL");
+        }
+        // The selector once, as matiec's `__case_expression`.
+        let sel = match v {
+            Val::Var(ref n, _) if n.starts_with("st__") => v,
+            _ => {
+                let t = self.temp(ty);
+                let m = ElementKind::Move(Box::new(Move {
+                    from: self.operand(&v),
+                    to: self.name(&t),
+                }));
+                self.emit(vec![m]);
+                Val::Var(t, ty)
+            }
+        };
+        let end = self.label();
+        let mut targets = Vec::new();
+        for (labels, _) in arms {
+            let l = self.label();
+            let mut branches = Vec::new();
+            for c in labels {
+                branches.push(match c {
+                    CaseLabel::One(e) => {
+                        let x = self.case_value(e, ty)?;
+                        vec![self.compare(CmpOp::Eq, &sel, &x)]
+                    }
+                    CaseLabel::Range(a, b) => {
+                        let (a, b) = (self.case_value(a, ty)?, self.case_value(b, ty)?);
+                        vec![
+                            self.compare(CmpOp::Ge, &sel, &a),
+                            self.compare(CmpOp::Le, &sel, &b),
+                        ]
+                    }
+                });
+            }
+            let mut ld = if branches.len() == 1 {
+                branches.pop().unwrap_or_default()
+            } else {
+                vec![ElementKind::Or(to_series(self, branches))]
+            };
+            ld.push(self.jmp(&l));
+            self.emit(ld);
+            targets.push(l);
+        }
+        self.statements(otherwise)?;
+        let j = self.jmp(&end);
+        self.emit(vec![j]);
+        for ((_, body), l) in arms.iter().zip(targets) {
+            self.place(l);
+            self.statements(body)?;
+            let j = self.jmp(&end);
+            self.emit(vec![j]);
+        }
+        self.place(end);
+        Ok(())
+    }
+
+    /// A CASE label: a literal (or a constant expression of literals) of the selector's type.
+    fn case_value(&mut self, e: &Expr, ty: Type) -> L<Val> {
+        match self.value(e, Some(ty))? {
+            v @ Val::Lit(_) => Ok(v),
+            _ => refuse(self.at, "a CASE label that is not a literal"),
+        }
+    }
+
+    fn for_loop(
+        &mut self,
+        var: &Place,
+        from: &Expr,
+        to: &Expr,
+        by: Option<&Expr>,
+        body: &[Statement],
+    ) -> L<()> {
+        let (v, ty) = self.written(var)?;
+        if !ty.is_int() {
+            return refuse(
+                var.base_at,
+                format!("FOR on `{v}` of type {ty} (not an integer)"),
+            );
+        }
+        let vv = Val::Var(v.clone(), ty);
+        // v := from; the final value and the increment once, before the loop.
+        self.assign(var, from)?;
+        let end = self.once(to, ty)?;
+        let step = match by {
+            None => Val::Lit(Scalar::Number(1.into())),
+            Some(b) => self.once(b, ty)?,
+        };
+        let (test, cont, out) = (self.label(), self.label(), self.label());
+        self.place(test.clone());
+        let positive = match &step {
+            Val::Lit(Scalar::Number(n)) => Some(n.as_f64().unwrap_or(0.0) > 0.0),
+            _ => None,
+        };
+        let zero = Val::Lit(Scalar::Number(0.into()));
+        let mut ld = match positive {
+            Some(true) => vec![self.compare(CmpOp::Gt, &vv, &end)],
+            Some(false) => vec![self.compare(CmpOp::Lt, &vv, &end)],
+            None => vec![ElementKind::Or(to_series(
+                self,
+                vec![
+                    vec![
+                        self.compare(CmpOp::Gt, &step, &zero),
+                        self.compare(CmpOp::Gt, &vv, &end),
+                    ],
+                    vec![
+                        self.compare(CmpOp::Le, &step, &zero),
+                        self.compare(CmpOp::Lt, &vv, &end),
+                    ],
+                ],
+            ))],
+        };
+        ld.push(self.jmp(&out));
+        self.emit(ld);
+        self.loops.push((cont.clone(), out.clone()));
+        self.statements(body)?;
+        self.loops.pop();
+        self.place(cont);
+        let add = ElementKind::Arith(Box::new(Arith {
+            op: ArithOp::Add,
+            a: self.operand(&vv),
+            b: self.operand(&step),
+            out: self.name(&v),
+        }));
+        let back = self.jmp(&test);
+        self.emit(vec![add, back]);
+        self.place(out);
+        Ok(())
+    }
+
+    /// `e` evaluated now, kept in a temporary unless it is a literal.
+    fn once(&mut self, e: &Expr, ty: Type) -> L<Val> {
+        let v = self.value(e, Some(ty))?;
+        if matches!(v, Val::Lit(_)) {
+            return Ok(v);
+        }
+        let t = self.temp(ty);
+        let m = ElementKind::Move(Box::new(Move {
+            from: self.operand(&v),
+            to: self.name(&t),
+        }));
+        self.emit(vec![m]);
+        Ok(Val::Var(t, ty))
+    }
+
+    /// A call of a standard function block instance (its inputs formal, all given).
+    fn fb_call(&mut self, callee: &Place, args: &[Arg]) -> L<()> {
+        let at = callee.base_at;
+        let (inst, ty) = match self.scope.find(&place_path(callee)) {
+            Ok(Some((Decl::Instance { name, ty, .. }, true))) if callee.selectors.is_empty() => {
+                (name.clone(), ty.clone())
+            }
+            _ => {
+                return refuse(
+                    at,
+                    format!(
+                        "the call of `{}` (only instances of the standard function blocks are executed)",
+                        callee.base
+                    ),
+                )
+            }
+        };
+        let mut inputs: Vec<(String, &Expr)> = Vec::new();
+        let mut outputs: Vec<(String, &Place)> = Vec::new();
+        for a in args {
+            match a {
+                Arg::Input {
+                    name: Some(n),
+                    value,
+                } => inputs.push((n.to_ascii_uppercase(), value)),
+                Arg::Input { name: None, .. } => {
+                    return refuse(at, format!("an informal argument in the call of `{inst}`"))
+                }
+                Arg::Output { name, target } => outputs.push((name.to_ascii_uppercase(), target)),
+            }
+        }
+        let pins: &[&str] = match ty.as_str() {
+            "TON" | "TOF" | "TP" => &["IN", "PT"],
+            "CTU" => &["CU", "R", "PV"],
+            "CTD" => &["CD", "LD", "PV"],
+            "CTUD" => &["CU", "CD", "R", "LD", "PV"],
+            "R_TRIG" | "F_TRIG" => &["CLK"],
+            "SR" => &["S1", "R"],
+            "RS" => &["S", "R1"],
+            _ => {
+                return refuse(
+                    at,
+                    format!("the call of `{inst}`, an instance of the user function block {ty}"),
+                )
+            }
+        };
+        for (n, _) in &inputs {
+            if !pins.contains(&n.as_str()) {
+                return refuse(
+                    at,
+                    format!(
+                        "input `{n}` in the call of `{inst}` ({ty} has inputs {})",
+                        pins.join(", ")
+                    ),
+                );
+            }
+        }
+        let get = |pin: &str| -> L<&Expr> {
+            match inputs.iter().find(|(n, _)| n == pin) {
+                Some((_, e)) => Ok(*e),
+                None => refuse(at, format!("the call of `{inst}` without its input {pin} (plc-deps keeps no input values of a standard function block between calls)")),
+            }
+        };
+        let first = get(pins[0])?;
+        let rest: Vec<&Expr> = pins[1..].iter().map(|p| get(p)).collect::<L<_>>()?;
+        let mut ld = self.cond(first)?;
+        let inst_name = self.name(&inst);
+        let el = match ty.as_str() {
+            "TON" | "TOF" | "TP" => {
+                let pt = self.value(rest[0], Some(Type::Time))?;
+                let kind = match ty.as_str() {
+                    "TON" => TimerKind::Ton,
+                    "TOF" => TimerKind::Tof,
+                    _ => TimerKind::Tp,
+                };
+                ElementKind::Timer(Box::new(Timer {
+                    kind,
+                    instance: inst_name,
+                    pt: self.operand(&pt),
+                }))
+            }
+            "CTU" | "CTD" => {
+                let aux = self.bool_operand(rest[0])?;
+                let pv = self.value(rest[1], Some(Type::Int))?;
+                ElementKind::Counter(Box::new(Counter {
+                    down: ty == "CTD",
+                    instance: inst_name,
+                    pv: self.operand(&pv),
+                    aux: self.operand(&aux),
+                }))
+            }
+            "CTUD" => {
+                let cd = self.bool_operand(rest[0])?;
+                let reset = self.bool_operand(rest[1])?;
+                let load = self.bool_operand(rest[2])?;
+                let pv = self.value(rest[3], Some(Type::Int))?;
+                ElementKind::Ctud(Box::new(Ctud {
+                    instance: inst_name,
+                    cd: self.operand(&cd),
+                    reset: self.operand(&reset),
+                    load: self.operand(&load),
+                    pv: self.operand(&pv),
+                }))
+            }
+            "R_TRIG" | "F_TRIG" => ElementKind::Trigger {
+                kind: if ty == "R_TRIG" {
+                    TriggerKind::Rising
+                } else {
+                    TriggerKind::Falling
+                },
+                instance: inst_name,
+            },
+            _ => {
+                let reset = self.bool_operand(rest[0])?;
+                ElementKind::Bistable(Box::new(Bistable {
+                    kind: if ty == "SR" {
+                        BistableKind::SetDominant
+                    } else {
+                        BistableKind::ResetDominant
+                    },
+                    instance: inst_name,
+                    reset: self.operand(&reset),
+                }))
+            }
+        };
+        ld.push(el);
+        self.emit(ld);
+        for (pin, target) in outputs {
+            let Some(fty) = field_type(&ty, &pin) else {
+                return refuse(
+                    at,
+                    format!("output `{pin}` in the call of `{inst}` ({ty} has no such output)"),
+                );
+            };
+            let (name, tty) = self.written(target)?;
+            let field = format!("{inst}.{pin}");
+            if tty != fty {
+                return refuse(
+                    target.base_at,
+                    format!("`{pin} => {name}`: {name} is {tty}, the output {fty}"),
+                );
+            }
+            if fty == Type::Bool {
+                let c = self.contact(&field, false);
+                self.emit(vec![
+                    c,
+                    ElementKind::Coil {
+                        var: self.name(&name),
+                        negated: false,
+                    },
+                ]);
+            } else {
+                let m = ElementKind::Move(Box::new(Move {
+                    from: self.operand(&Val::Var(field, fty)),
+                    to: self.name(&name),
+                }));
+                self.emit(vec![m]);
+            }
+        }
+        Ok(())
+    }
+
+    /// A BOOL operand of a box: a literal, a variable, or the expression in a temporary.
+    fn bool_operand(&mut self, e: &Expr) -> L<Val> {
+        if let Some(b) = bool_literal(e) {
+            return Ok(Val::Lit(Scalar::Bool(b)));
+        }
+        if let Expr::Var(p) = e {
+            let (n, t) = self.read(p)?;
+            if t == Type::Bool {
+                return Ok(Val::Var(n, t));
+            }
+        }
+        self.bool_temp(e)
+    }
+
+    /// The condition `e` computed into a new BOOL temporary.
+    fn bool_temp(&mut self, e: &Expr) -> L<Val> {
+        let mut ld = self.cond(e)?;
+        let t = self.temp(Type::Bool);
+        ld.push(ElementKind::Coil {
+            var: self.name(&t),
+            negated: false,
+        });
+        self.emit(ld);
+        Ok(Val::Var(t, Type::Bool))
+    }
+
+    // ---- places ----
+
+    /// What `p` reads: an elementary variable, a structure's field, or an instance's output.
+    fn read(&self, p: &Place) -> L<(String, Type)> {
+        self.resolve(p, false)
+    }
+
+    /// What `p` writes: an elementary variable or a structure's field.
+    fn written(&self, p: &Place) -> L<(String, Type)> {
+        self.resolve(p, true)
+    }
+
+    fn resolve(&self, p: &Place, write: bool) -> L<(String, Type)> {
+        let at = p.base_at;
+        if p.base.starts_with('%') {
+            return refuse(at, format!("the direct address `{}`", p.base));
+        }
+        for s in &p.selectors {
+            match s {
+                Selector::Index(_) => {
+                    return refuse(at, format!("the array element `{}[…]`", place_path(p)))
+                }
+                Selector::Deref => {
+                    return refuse(at, format!("the dereference `{}^`", place_path(p)))
+                }
+                Selector::Field(_) => {}
+            }
+        }
+        let path = place_path(p);
+        match self.scope.find(&path) {
+            Ok(Some((Decl::Elementary { name, ty }, true))) => match Type::parse(ty) {
+                Some(t) if !matches!(t, Type::Fb(_)) => Ok((name.clone(), t)),
+                _ => refuse(
+                    at,
+                    format!("`{path}` of type {ty}, which the model does not execute"),
+                ),
+            },
+            Ok(Some((Decl::Instance { name, ty, .. }, false))) if !write => {
+                let field = path[name.len() + 1..].to_ascii_uppercase();
+                match field_type(ty, &field) {
+                    Some(t) if !field.contains('.') => Ok((format!("{name}.{field}"), t)),
+                    _ => refuse(at, format!("`{path}`: only the outputs of a standard function block instance are read")),
+                }
+            }
+            Ok(Some((Decl::Instance { .. }, _))) => refuse(
+                at,
+                format!("`{path}`: an instance (or its input) as a value"),
+            ),
+            Ok(Some((Decl::Constant, _))) => refuse(at, format!("the enumeration value `{path}`")),
+            Ok(Some((Decl::Structure { .. }, _))) => {
+                refuse(at, format!("the structure `{path}` as a whole"))
+            }
+            _ => refuse(at, format!("`{path}`, which is not a variable of the POU")),
+        }
+    }
+
+    // ---- conditions ----
+
+    /// `e` as a series of conditions that passes power when `e` is TRUE.
+    fn cond(&mut self, e: &Expr) -> L<Series> {
+        if let Some(b) = bool_literal(e) {
+            return Ok(vec![self.constant(b)]);
+        }
+        match e {
+            Expr::Var(p) => {
+                let (n, t) = self.read(p)?;
+                if t != Type::Bool {
+                    return refuse(p.base_at, format!("`{n}` of type {t} as a condition"));
+                }
+                Ok(vec![self.contact(&n, false)])
+            }
+            Expr::Unary(UnaryOp::Not, x) => {
+                let c = self.cond(x)?;
+                Ok(self.negate(c))
+            }
+            Expr::Binary(BinaryOp::And, a, b) if self.is_bool(a) => {
+                let mut c = self.cond(a)?;
+                c.extend(self.cond(b)?);
+                Ok(c)
+            }
+            Expr::Binary(BinaryOp::Or, a, b) if self.is_bool(a) => {
+                let (x, y) = (self.cond(a)?, self.cond(b)?);
+                Ok(vec![ElementKind::Or(to_series(self, vec![x, y]))])
+            }
+            Expr::Binary(op @ (BinaryOp::Xor | BinaryOp::Eq | BinaryOp::Ne), a, b)
+                if self.is_bool(a) || self.is_bool(b) =>
+            {
+                let x = self.bool_contact(a)?;
+                let y = self.bool_contact(b)?;
+                let same = *op == BinaryOp::Eq;
+                let (x1, y1) = (self.contact(&x, false), self.contact(&y, !same));
+                let (x2, y2) = (self.contact(&x, true), self.contact(&y, same));
+                Ok(vec![ElementKind::Or(to_series(
+                    self,
+                    vec![vec![x1, y1], vec![x2, y2]],
+                ))])
+            }
+            Expr::Binary(op, a, b) if cmp_op(*op).is_some() => {
+                let op = cmp_op(*op).unwrap_or(CmpOp::Eq);
+                let mut l = self.value(a, None)?;
+                let r = self.value(b, l.ty())?;
+                if l.ty().is_none() {
+                    l = self.value(a, r.ty())?;
+                }
+                if l.ty().is_none() && r.ty().is_none() {
+                    return refuse(self.at, "a comparison of two literals");
+                }
+                Ok(vec![self.compare(op, &l, &r)])
+            }
+            _ => {
+                let v = self.value(e, Some(Type::Bool))?;
+                match v {
+                    Val::Var(n, Type::Bool) => Ok(vec![self.contact(&n, false)]),
+                    other => refuse(
+                        self.at,
+                        format!(
+                            "a condition of type {}",
+                            other.ty().map_or("?".into(), |t| t.to_string())
+                        ),
+                    ),
+                }
+            }
+        }
+    }
+
+    /// A BOOL operand as the name of a variable a contact reads (a literal 0/1 or TRUE/FALSE as
+    /// the never-written `st__false`'s value, `e` otherwise computed into a temporary).
+    fn bool_contact(&mut self, e: &Expr) -> L<String> {
+        if let Some(b) = bool_literal(e).or(match e {
+            Expr::Literal(s) if s == "0" => Some(false),
+            Expr::Literal(s) if s == "1" => Some(true),
+            _ => None,
+        }) {
+            let t = self.temp(Type::Bool);
+            let el = if b {
+                ElementKind::Set(self.name(&t))
+            } else {
+                ElementKind::Reset(self.name(&t))
+            };
+            self.emit(vec![el]);
+            return Ok(t);
+        }
+        match self.bool_operand(e)? {
+            Val::Var(n, _) => Ok(n),
+            Val::Lit(_) => refuse(self.at, "a BOOL literal where a variable is needed"),
+        }
+    }
+
+    fn compare(&self, op: CmpOp, a: &Val, b: &Val) -> ElementKind<'static> {
+        ElementKind::Compare(Box::new(Compare {
+            op,
+            a: self.operand(a),
+            b: self.operand(b),
+        }))
+    }
+
+    /// The series that passes power when `c` does not.
+    fn negate(&mut self, mut c: Series) -> Series {
+        if c.len() == 1 {
+            match &mut c[0] {
+                ElementKind::Contact {
+                    negated,
+                    edge: None,
+                    ..
+                } => {
+                    *negated = !*negated;
+                    return c;
+                }
+                ElementKind::Compare(cmp) => {
+                    cmp.op = match cmp.op {
+                        CmpOp::Eq => CmpOp::Ne,
+                        CmpOp::Ne => CmpOp::Eq,
+                        CmpOp::Lt => CmpOp::Ge,
+                        CmpOp::Ge => CmpOp::Lt,
+                        CmpOp::Gt => CmpOp::Le,
+                        CmpOp::Le => CmpOp::Gt,
+                    };
+                    return c;
+                }
+                _ => {}
+            }
+        }
+        let t = self.temp(Type::Bool);
+        c.push(ElementKind::Coil {
+            var: self.name(&t),
+            negated: false,
+        });
+        self.emit(c);
+        vec![self.contact(&t, true)]
+    }
+
+    /// Whether `e` is a BOOL expression (statically, from its variables and operators).
+    fn is_bool(&self, e: &Expr) -> bool {
+        match e {
+            Expr::Literal(_) => bool_literal(e).is_some(),
+            Expr::Var(p) => matches!(self.read(p), Ok((_, Type::Bool))),
+            Expr::Unary(UnaryOp::Not, x) => self.is_bool(x),
+            Expr::Unary(..) => false,
+            Expr::Binary(op, a, b) => match op {
+                BinaryOp::And | BinaryOp::Or | BinaryOp::Xor => self.is_bool(a) || self.is_bool(b),
+                _ => cmp_op(*op).is_some(),
+            },
+            Expr::Call { callee, .. } => callee.base.to_ascii_uppercase().ends_with("_TO_BOOL"),
+        }
+    }
+
+    // ---- values ----
+
+    fn value(&mut self, e: &Expr, want: Option<Type>) -> L<Val> {
+        match self.value_into(e, want, None)? {
+            Some(v) => Ok(v),
+            // Every path returns its value when it has no target to write.
+            None => refuse(self.at, "an expression without a value"),
+        }
+    }
+
+    /// `e` as an operand (`want`: the type its use gives a literal). With `out`, a box that
+    /// computes `e` writes `out` directly and `None` is returned.
+    fn value_into(&mut self, e: &Expr, want: Option<Type>, out: Option<&str>) -> L<Option<Val>> {
+        let dest = |me: &mut Self, ty: Type| -> String {
+            match out {
+                Some(o) => o.to_owned(),
+                None => me.temp(ty),
+            }
+        };
+        let done = |name: String, ty: Type| match out {
+            Some(_) => None,
+            None => Some(Val::Var(name, ty)),
+        };
+        if let (Some(Type::Bool), Expr::Literal(s)) = (want, e) {
+            if s == "0" || s == "1" {
+                return Ok(Some(Val::Lit(Scalar::Bool(s == "1"))));
+            }
+        }
+        if self.is_bool(e) {
+            if let Some(b) = bool_literal(e) {
+                return Ok(Some(Val::Lit(Scalar::Bool(b))));
+            }
+            if let Expr::Var(p) = e {
+                return Ok(Some(Val::Var(self.read(p)?.0, Type::Bool)));
+            }
+            return Ok(Some(self.bool_temp(e)?));
+        }
+        match e {
+            Expr::Literal(s) => match literal(s) {
+                Some(v) => Ok(Some(Val::Lit(v))),
+                None => refuse(self.at, format!("the literal `{s}`")),
+            },
+            Expr::Var(p) => {
+                let (n, t) = self.read(p)?;
+                Ok(Some(Val::Var(n, t)))
+            }
+            Expr::Unary(UnaryOp::Plus, x) => self.value_into(x, want, out),
+            Expr::Unary(UnaryOp::Neg, x) => {
+                if let Expr::Literal(l) = &**x {
+                    if let Some(v) = literal(&format!("-{l}")) {
+                        return Ok(Some(Val::Lit(v)));
+                    }
+                }
+                let v = self.value(x, want)?;
+                let Some(ty) = v.ty().or(want) else {
+                    return refuse(self.at, "a negation without a type");
+                };
+                let d = dest(self, ty);
+                let el = ElementKind::Arith(Box::new(Arith {
+                    op: ArithOp::Sub,
+                    a: self.operand(&Val::Lit(Scalar::Number(0.into()))),
+                    b: self.operand(&v),
+                    out: self.name(&d),
+                }));
+                self.emit(vec![el]);
+                Ok(done(d, ty))
+            }
+            Expr::Unary(UnaryOp::Not, x) => self.function(Function::Not, &[x], want, out),
+            Expr::Binary(op, a, b) => {
+                let arith = match op {
+                    BinaryOp::Add => ArithOp::Add,
+                    BinaryOp::Sub => ArithOp::Sub,
+                    BinaryOp::Mul => ArithOp::Mul,
+                    BinaryOp::Div => ArithOp::Div,
+                    BinaryOp::Mod => ArithOp::Mod,
+                    BinaryOp::Power => return self.function(Function::Expt, &[a, b], want, out),
+                    BinaryOp::And => return self.function(Function::And, &[a, b], want, out),
+                    BinaryOp::Or => return self.function(Function::Or, &[a, b], want, out),
+                    BinaryOp::Xor => return self.function(Function::Xor, &[a, b], want, out),
+                    _ => return refuse(self.at, "a comparison as a non-BOOL value"),
+                };
+                let mut l = self.value(a, want)?;
+                let r = self.value(b, l.ty().or(want))?;
+                if l.ty().is_none() && r.ty().is_some() {
+                    l = self.value(a, r.ty())?;
+                }
+                let ty = match l.ty().or(r.ty()).or(want) {
+                    Some(t) => t,
+                    None if l.is_real_literal() || r.is_real_literal() => Type::Real,
+                    None => Type::Dint,
+                };
+                let d = dest(self, ty);
+                let el = ElementKind::Arith(Box::new(Arith {
+                    op: arith,
+                    a: self.operand(&l),
+                    b: self.operand(&r),
+                    out: self.name(&d),
+                }));
+                self.emit(vec![el]);
+                Ok(done(d, ty))
+            }
+            Expr::Call { callee, args } => self.call(callee, args, want, out),
+        }
+    }
+
+    fn call(
+        &mut self,
+        callee: &Place,
+        args: &[Arg],
+        want: Option<Type>,
+        out: Option<&str>,
+    ) -> L<Option<Val>> {
+        let at = callee.base_at;
+        let fname = callee.base.to_ascii_uppercase();
+        let mut values: Vec<&Expr> = Vec::new();
+        for a in args {
+            match a {
+                Arg::Input { value, .. } => values.push(value),
+                Arg::Output { .. } => {
+                    return refuse(
+                        at,
+                        format!(
+                            "an output argument in the call of function `{}`",
+                            callee.base
+                        ),
+                    )
+                }
+            }
+        }
+        if !callee.selectors.is_empty() {
+            return refuse(at, format!("the call of `{}`", place_path(callee)));
+        }
+        let n = values.len();
+        match fname.as_str() {
+            "MOVE" if n == 1 => self.value_into(values[0], want, out),
+            "MAX" | "MIN" if n >= 2 => {
+                let mut acc = self.value(values[0], want)?;
+                for (i, e) in values[1..].iter().enumerate() {
+                    let v = self.value(e, acc.ty().or(want))?;
+                    let last = i + 2 == n;
+                    acc = self.pick(&fname, acc, v, want, if last { out } else { None })?;
+                }
+                Ok(match out {
+                    Some(_) => None,
+                    None => Some(acc),
+                })
+            }
+            "LIMIT" if n == 3 => {
+                let mn = self.value(values[0], want)?;
+                let x = self.value(values[1], mn.ty().or(want))?;
+                let mx = self.value(values[2], x.ty().or(mn.ty()).or(want))?;
+                let lo = self.pick("MAX", mn, x, want, None)?;
+                let r = self.pick("MIN", lo, mx, want, out)?;
+                Ok(match out {
+                    Some(_) => None,
+                    None => Some(r),
+                })
+            }
+            "SEL" if n == 3 => {
+                let g = self.bool_contact(values[0])?;
+                let a = self.value(values[1], want)?;
+                let b = self.value(values[2], a.ty().or(want))?;
+                let Some(ty) = a.ty().or(b.ty()).or(want) else {
+                    return refuse(at, "SEL of two literals without a type");
+                };
+                let d = match out {
+                    Some(o) => o.to_owned(),
+                    None => self.temp(ty),
+                };
+                let (c0, c1) = (self.contact(&g, true), self.contact(&g, false));
+                let m0 = ElementKind::Move(Box::new(Move {
+                    from: self.operand(&a),
+                    to: self.name(&d),
+                }));
+                let m1 = ElementKind::Move(Box::new(Move {
+                    from: self.operand(&b),
+                    to: self.name(&d),
+                }));
+                let el = ElementKind::Branch(to_series(self, vec![vec![c0, m0], vec![c1, m1]]));
+                self.emit(vec![el]);
+                Ok(match out {
+                    Some(_) => None,
+                    None => Some(Val::Var(d, ty)),
+                })
+            }
+            _ => match Function::parse(&fname) {
+                Some(f) => self.function(f, &values, want, out),
+                None => refuse(
+                    at,
+                    format!(
+                        "the call of function `{}` (only the standard functions are executed)",
+                        callee.base
+                    ),
+                ),
+            },
+        }
+    }
+
+    /// MAX or MIN of two values: `[branch [[a >= b, move a], [a < b, move b]]]` (MIN: `<=`).
+    fn pick(&mut self, f: &str, a: Val, b: Val, want: Option<Type>, out: Option<&str>) -> L<Val> {
+        let Some(ty) = a.ty().or(b.ty()).or(want) else {
+            return refuse(self.at, format!("{f} of literals without a type"));
+        };
+        let d = match out {
+            Some(o) => o.to_owned(),
+            None => self.temp(ty),
+        };
+        let first = if f == "MAX" { CmpOp::Ge } else { CmpOp::Le };
+        // The comparison into a flag first: a move may write an operand (`x := MAX(x, 5)`).
+        let c1 = self.compare(first, &a, &b);
+        let keep = self.temp(Type::Bool);
+        let flag = ElementKind::Coil {
+            var: self.name(&keep),
+            negated: false,
+        };
+        self.emit(vec![c1, flag]);
+        let m0 = ElementKind::Move(Box::new(Move {
+            from: self.operand(&a),
+            to: self.name(&d),
+        }));
+        let m1 = ElementKind::Move(Box::new(Move {
+            from: self.operand(&b),
+            to: self.name(&d),
+        }));
+        let (k0, k1) = (self.contact(&keep, false), self.contact(&keep, true));
+        let el = ElementKind::Branch(to_series(self, vec![vec![k0, m0], vec![k1, m1]]));
+        self.emit(vec![el]);
+        Ok(Val::Var(d, ty))
+    }
+
+    /// A standard function of `args`, its output typed by the function's rule.
+    fn function(
+        &mut self,
+        f: Function,
+        args: &[&Expr],
+        want: Option<Type>,
+        out: Option<&str>,
+    ) -> L<Option<Val>> {
+        let mut vals = Vec::with_capacity(args.len());
+        for a in args {
+            let hint = vals.iter().find_map(|v: &Val| v.ty());
+            vals.push(self.value(a, hint)?);
+        }
+        // Untyped literals of a generic pin take the first typed argument's type.
+        let own: Vec<(Option<Type>, bool)> =
+            vals.iter().map(|v| (v.ty(), v.is_real_literal())).collect();
+        let out_ty = match f.types(&own, want) {
+            Ok(t) => t.out,
+            Err(_) => match f.types(&own, None) {
+                Ok(t) => t.out,
+                Err(m) => {
+                    return refuse(
+                        self.at,
+                        format!(
+                            "{}: an operand of type {} where {} is needed",
+                            f.name(),
+                            m.found,
+                            m.expected
+                        ),
+                    )
+                }
+            },
+        };
+        let d = match out {
+            Some(o) if want == Some(out_ty) => o.to_owned(),
+            _ => self.temp(out_ty),
+        };
+        let args = vals.iter().map(|v| self.operand(v)).collect();
+        let el = ElementKind::Function(Box::new(FunctionCall {
+            func: f,
+            args,
+            out: self.name(&d),
+        }));
+        self.emit(vec![el]);
+        Ok(match out {
+            Some(o) if o == d => None,
+            _ => Some(Val::Var(d, out_ty)),
+        })
+    }
+}
+
+/// Series of kinds as the branches of an `or` or a `branch`, located at the statement.
+fn to_series(me: &Lower, v: Vec<Series>) -> Vec<Vec<Element<'static>>> {
+    v.into_iter()
+        .map(|s| {
+            s.into_iter()
+                .map(|kind| Element {
+                    origin: me.here,
+                    kind,
+                })
+                .collect()
+        })
+        .collect()
+}
+
+fn bool_literal(e: &Expr) -> Option<bool> {
+    match e {
+        Expr::Literal(s)
+            if s.eq_ignore_ascii_case("TRUE")
+                || s.eq_ignore_ascii_case("BOOL#TRUE")
+                || s == "BOOL#1" =>
+        {
+            Some(true)
+        }
+        Expr::Literal(s)
+            if s.eq_ignore_ascii_case("FALSE")
+                || s.eq_ignore_ascii_case("BOOL#FALSE")
+                || s == "BOOL#0" =>
+        {
+            Some(false)
+        }
+        _ => None,
+    }
+}
+
+fn cmp_op(op: BinaryOp) -> Option<CmpOp> {
+    Some(match op {
+        BinaryOp::Eq => CmpOp::Eq,
+        BinaryOp::Ne => CmpOp::Ne,
+        BinaryOp::Lt => CmpOp::Lt,
+        BinaryOp::Le => CmpOp::Le,
+        BinaryOp::Gt => CmpOp::Gt,
+        BinaryOp::Ge => CmpOp::Ge,
+        _ => return None,
+    })
+}
+
+/// `a.b.c` of a place of fields only.
+fn place_path(p: &Place) -> String {
+    let mut s = p.base.clone();
+    for sel in &p.selectors {
+        if let Selector::Field(f) = sel {
+            s.push('.');
+            s.push_str(f);
+        }
+    }
+    s
+}
+
+/// The type of output `field` of a standard function block of type `fb` (IEC 61131-3 2nd ed.,
+/// 2.5.2.3: CV is INT).
+fn field_type(fb: &str, field: &str) -> Option<Type> {
+    Some(match (fb, field) {
+        ("TON" | "TOF" | "TP", "Q") => Type::Bool,
+        ("TON" | "TOF" | "TP", "ET") => Type::Time,
+        ("CTU" | "CTD", "Q") => Type::Bool,
+        ("CTU" | "CTD" | "CTUD", "CV") => Type::Int,
+        ("CTUD", "QU" | "QD") => Type::Bool,
+        ("R_TRIG" | "F_TRIG", "Q") => Type::Bool,
+        ("SR" | "RS", "Q1") => Type::Bool,
+        _ => return None,
+    })
+}
+
+/// The offset of the first pragma `{…}` of ST text `text` (outside comments and strings).
+pub(super) fn first_pragma(text: &str) -> Option<usize> {
+    let b = text.as_bytes();
+    let mut i = 0;
+    let mut depth = 0usize;
+    while i < b.len() {
+        if depth > 0 {
+            if text[i..].starts_with("*)") {
+                depth -= 1;
+                i += 2;
+            } else if text[i..].starts_with("(*") {
+                depth += 1;
+                i += 2;
+            } else {
+                i += 1;
+            }
+            continue;
+        }
+        match b[i] {
+            b'(' if text[i..].starts_with("(*") => {
+                depth = 1;
+                i += 2;
+            }
+            b'/' if text[i..].starts_with("//") => {
+                i = text[i..].find('\n').map_or(b.len(), |n| i + n);
+            }
+            q @ (b'\'' | b'"') => {
+                i += 1;
+                while i < b.len() && b[i] != q {
+                    i += if b[i] == b'$' { 2 } else { 1 };
+                }
+                i += 1;
+            }
+            b'{' => return Some(i),
+            _ => i += 1,
+        }
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::first_pragma;
+
+    #[test]
+    fn a_pragma_is_found_outside_comments_and_strings_only() {
+        assert_eq!(first_pragma("x := 1; (* {not} *) // {no}\ny := '{';"), None);
+        assert_eq!(
+            first_pragma("(* (* {nested} *) *) x := 1;\n{SetFbVar(OUT,1)}"),
+            Some(29)
+        );
+        assert_eq!(first_pragma("s := 'it$'s'; {p}"), Some(14));
+    }
+}

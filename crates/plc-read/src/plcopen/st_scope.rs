@@ -1,0 +1,127 @@
+//! The names an ST body sees ([`Scope`]): its POU's variables and the globals it declares
+//! external, by lower-case name, each an elementary variable, an instance of a function block
+//! type, an enumeration value or a structure flattened into its fields ([`Decl`]). Shared by
+//! the analysis's stand-ins ([`super::st_body`]) and the lowering ([`super::st_lower`]).
+//!
+//! Invariant: IEC names are case-insensitive; a name found here carries its declared spelling.
+//! Deliberately not here: what a statement reads or writes (the callers').
+
+use super::textual::Read;
+use std::collections::HashMap;
+/// What a name of an ST body is: an elementary variable (with its type) or an instance (with
+/// the BOOL-or-not field a read of it stands for, when it has one).
+#[derive(Clone, Debug)]
+pub(super) enum Decl {
+    Elementary {
+        name: String,
+        ty: String,
+    },
+    Instance {
+        name: String,
+        /// The function block type's name.
+        ty: String,
+        read: Option<Read>,
+    },
+    /// A value of an enumeration data type (a constant: reading it reads no variable).
+    Constant,
+    /// A structure (or a structure inside one) flattened into its fields: its leaf fields'
+    /// names and types. Reading or writing it whole reads or writes every one.
+    Structure {
+        leaves: Vec<(String, String)>,
+    },
+}
+
+/// The declarations an ST body sees, by lower-case name.
+#[derive(Default)]
+pub(super) struct Scope {
+    pub names: HashMap<String, Decl>,
+}
+
+impl Scope {
+    /// Declares `name` of type `ty` (elementary or a function block type).
+    pub(super) fn declare(&mut self, name: &str, ty: &str) {
+        let decl = if super::elementary::is_elementary(ty) {
+            Decl::Elementary {
+                name: name.to_owned(),
+                ty: ty.to_owned(),
+            }
+        } else {
+            Decl::Instance {
+                name: name.to_owned(),
+                ty: ty.to_owned(),
+                read: first_output(ty).map(|(f, b)| Read {
+                    name: format!("{name}.{f}"),
+                    bool: b,
+                }),
+            }
+        };
+        self.names.insert(name.to_ascii_lowercase(), decl);
+        // A structure's field (`Plant.Motor.Speed`) makes its structures (`Plant`,
+        // `Plant.Motor`) known as the sets of their fields.
+        let mut at = name.len();
+        while let Some(dot) = name[..at].rfind('.') {
+            at = dot;
+            let entry = self
+                .names
+                .entry(name[..at].to_ascii_lowercase())
+                .or_insert(Decl::Structure { leaves: Vec::new() });
+            if let Decl::Structure { leaves } = entry {
+                leaves.push((name.to_owned(), ty.to_owned()));
+            }
+        }
+    }
+
+    /// Declares an enumeration value (a constant), unless a variable has its name.
+    pub(super) fn constant(&mut self, name: &str) {
+        self.names
+            .entry(name.to_ascii_lowercase())
+            .or_insert(Decl::Constant);
+    }
+
+    /// `name` as it is, or, when it is a structure, the names of its fields.
+    pub(super) fn fields_of(&self, name: &str) -> Vec<String> {
+        match self.get(name) {
+            Some(Decl::Structure { leaves }) => leaves.iter().map(|(n, _)| n.clone()).collect(),
+            _ => vec![name.to_owned()],
+        }
+    }
+
+    pub(super) fn get(&self, name: &str) -> Option<&Decl> {
+        self.names.get(&name.to_ascii_lowercase())
+    }
+
+    /// What access path `path` (`s`, `s.f`, `T1.Q`) names: the declaration of the path, else
+    /// of its longest declared prefix, with `true` when that is the whole path. A field of a
+    /// structure that has no such field is `Err` with the message.
+    pub(super) fn find(&self, path: &str) -> Result<Option<(&Decl, bool)>, String> {
+        let mut at = path.len();
+        loop {
+            if let Some(d) = self.get(&path[..at]) {
+                if let (Decl::Structure { leaves }, false) = (d, at == path.len()) {
+                    let fields: Vec<&str> = leaves.iter().map(|(n, _)| &n[at + 1..]).collect();
+                    return Err(format!(
+                        "`{path}`: structure `{}` has no field `{}` (its fields: {})",
+                        &path[..at],
+                        &path[at + 1..],
+                        fields.join(", ")
+                    ));
+                }
+                return Ok(Some((d, at == path.len())));
+            }
+            match path[..at].rfind('.') {
+                Some(dot) => at = dot,
+                None => return Ok(None),
+            }
+        }
+    }
+}
+
+/// The first output of a standard function block (IEC 61131-3 2.5.2.3), and whether it is BOOL.
+fn first_output(ty: &str) -> Option<(&'static str, bool)> {
+    Some(match ty {
+        "TON" | "TOF" | "TP" | "CTU" | "CTD" | "R_TRIG" | "F_TRIG" => ("Q", true),
+        "SR" | "RS" => ("Q1", true),
+        "CTUD" => ("QU", true),
+        _ => return None,
+    })
+}
