@@ -240,7 +240,20 @@ impl Fbd<'_, '_, '_> {
         for pin in &el.inputs {
             let name = pin.name.unwrap_or("");
             let (negated, edge) = pin_modifiers(pin.node, ty, name, el.local_id, &here)?;
+            let init = el
+                .node
+                .attribute("instanceName")
+                .and_then(|i| self.ctx.init_of(i, name));
             let mut input = match pin.sources.as_slice() {
+                // An unconnected input keeps the value the instance's declaration gives it
+                // (IEC 61131-3 6.5.1.4: `T0 : TON := (PT := T#1s)`).
+                [] if init.is_some() => {
+                    let (v, at) = init.unwrap_or((Scalar::Bool(false), origin(pin.node)));
+                    Input {
+                        origin: at,
+                        from: Connection::Constant(v),
+                    }
+                }
                 // An unconnected BOOL input of a standard function block keeps its initial
                 // value FALSE (nothing in the body sets it, IEC 61131-3 2.5.2.1).
                 [] if black_box::is_standard_fb(ty)
@@ -281,6 +294,19 @@ impl Fbd<'_, '_, '_> {
                 b.cond = Some(input);
             } else {
                 inputs.push((Cow::Owned(name.to_owned()), input));
+            }
+        }
+        // The inputs the instance's declaration gives a value and the block does not list.
+        if let Some(inst) = el.node.attribute("instanceName") {
+            for (pin, v, at) in self.ctx.init_inputs(inst, ty) {
+                if !el.inputs.iter().any(|p| p.name == Some(pin.as_str())) {
+                    let input = Input {
+                        origin: at,
+                        from: Connection::Constant(v),
+                    };
+                    let input = bool_literal(self.ctx, ty, &pin, input);
+                    inputs.push((Cow::Owned(pin), input));
+                }
             }
         }
         b.inputs = Some(Ok(Inputs::Named(inputs)));

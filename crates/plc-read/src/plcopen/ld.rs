@@ -54,7 +54,13 @@ const LD_TAGS: &[&str] = &[
 ];
 
 /// Reads LD body `node` of POU `pou` into rungs `<pou>.R1`, `<pou>.R2` … in execution order.
-pub(super) fn rungs(tc6: Tc6, node: Node, pou: &str, notes: &mut Notes) -> R<Vec<Rung<'static>>> {
+pub(super) fn rungs(
+    tc6: Tc6,
+    node: Node,
+    pou: &str,
+    inits: &super::block_types::Inits,
+    notes: &mut Notes,
+) -> R<Vec<Rung<'static>>> {
     let place = format!("pou {pou}, LD");
     let g = graph(tc6, node, &place, notes)?;
     g.only(LD_TAGS, "LD", &place)?;
@@ -69,6 +75,7 @@ pub(super) fn rungs(tc6: Tc6, node: Node, pou: &str, notes: &mut Notes) -> R<Vec
         }
     }
     let mut power = Power::new(&g, place.clone(), ld_block::BLOCKS);
+    power.inits = inits.clone();
     let outputs = outputs(&power)?;
     let component = components(&g);
     // Outputs grouped by rung, rungs in the order of their first output.
