@@ -541,6 +541,16 @@ fn enum_operand(
 /// The initial value a variable of data type `d` gets from its type (IEC 61131-3 6.4.4), if any.
 fn type_initial(d: &DataType, var: &str, place: &str) -> R<Option<Operand<'static>>> {
     let Some((text, at)) = &d.init else {
+        // An enumeration without an initial value starts at its first value (IEC 61131-3
+        // 6.4.4.2), which named values may make other than 0.
+        if let Base::Enum(v) = &d.base {
+            if let Some(&(_, first)) = v.first().filter(|f| f.1 != 0) {
+                return Ok(Some(Located {
+                    value: Scalar::Number(first.into()),
+                    origin: plc_diag::Origin::default(),
+                }));
+            }
+        }
         return Ok(None);
     };
     if matches!(d.base, Base::Enum(_)) {
@@ -550,7 +560,7 @@ fn type_initial(d: &DataType, var: &str, place: &str) -> R<Option<Operand<'stati
         error(
             *at,
             place,
-            format!("initial value `{text}` of data type `{}` is not a boolean, a number or a TIME literal", d.name),
+            format!("initial value `{text}` of data type `{}` is not a boolean, a number, a TIME or a date and time literal", d.name),
         )
     })?;
     Ok(Some(Located { value, origin: *at }))
@@ -569,7 +579,7 @@ fn literal_operand(
             at,
             place,
             format!(
-                "initial value `{text}` of `{var}` is not a boolean, a number or a TIME literal"
+                "initial value `{text}` of `{var}` is not a boolean, a number, a TIME or a date and time literal"
             ),
         )
     })?;

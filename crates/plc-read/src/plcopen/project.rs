@@ -534,7 +534,7 @@ fn body(
             };
             notes.no_run.push((name.to_owned(), Note {
                 origin: v.origin,
-                message: format!("{place}: the initial value of instance input `{}.{m}`: {why}; so `run` cannot execute the {tag} body of `{name}`", i.instance),
+                message: format!("{place}: the initial value of `{}.{m}`: {why}; so `run` cannot execute the {tag} body of `{name}`", i.instance),
             }));
         }
     }
