@@ -786,7 +786,20 @@ pub enum DateKind {
 /// `days_from_civil`); `None` when the month or day does not exist.
 fn days_from_civil(y: i64, m: i64, d: i64) -> Option<i64> {
     let leap = (y % 4 == 0 && y % 100 != 0) || y % 400 == 0;
-    let len = [31, if leap { 29 } else { 28 }, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31];
+    let len = [
+        31,
+        if leap { 29 } else { 28 },
+        31,
+        30,
+        31,
+        30,
+        31,
+        31,
+        30,
+        31,
+        30,
+        31,
+    ];
     if !(1..=12).contains(&m) || d < 1 || d > len[(m - 1) as usize] {
         return None;
     }
@@ -920,13 +933,28 @@ mod tests {
     fn date_literals() {
         use DateKind::*;
         // 2024-01-31 is 19753 days after 1970-01-01.
-        assert_eq!(parse_date_literal("D#2024-01-31"), Some((Date, 19_753 * 86_400)));
+        assert_eq!(
+            parse_date_literal("D#2024-01-31"),
+            Some((Date, 19_753 * 86_400))
+        );
         assert_eq!(parse_date_literal("DATE#1970-01-02"), Some((Date, 86_400)));
-        assert_eq!(parse_date_literal("date#2000-03-01"), Some((Date, 11_017 * 86_400)));
+        assert_eq!(
+            parse_date_literal("date#2000-03-01"),
+            Some((Date, 11_017 * 86_400))
+        );
         assert_eq!(parse_date_literal("D#2023-02-29"), None);
-        assert_eq!(parse_date_literal("D#2024-02-29"), Some((Date, 19_782 * 86_400)));
-        assert_eq!(parse_date_literal("TOD#12:30:15.5"), Some((TimeOfDay, 45_015_500)));
-        assert_eq!(parse_date_literal("TIME_OF_DAY#00:00:00"), Some((TimeOfDay, 0)));
+        assert_eq!(
+            parse_date_literal("D#2024-02-29"),
+            Some((Date, 19_782 * 86_400))
+        );
+        assert_eq!(
+            parse_date_literal("TOD#12:30:15.5"),
+            Some((TimeOfDay, 45_015_500))
+        );
+        assert_eq!(
+            parse_date_literal("TIME_OF_DAY#00:00:00"),
+            Some((TimeOfDay, 0))
+        );
         assert_eq!(parse_date_literal("TOD#24:00:00"), None);
         assert_eq!(parse_date_literal("TOD#1:2:3.0001"), None);
         assert_eq!(

@@ -117,10 +117,7 @@ impl DataType {
         let mut d = match &self.base {
             Base::Elementary(t) => format!("an alias of {}", t.to_ascii_uppercase()),
             Base::Enum(v) => {
-                let vals: Vec<String> = v
-                    .iter()
-                    .map(|(n, i)| format!("{n} = {i}"))
-                    .collect();
+                let vals: Vec<String> = v.iter().map(|(n, i)| format!("{n} = {i}")).collect();
                 format!("an enumeration, read as INT with {}", vals.join(", "))
             }
             Base::Whole(a) => format!("{}, read as one whole variable without a value", a.word()),

@@ -137,7 +137,8 @@ pub(super) fn interface(tc6: Tc6, node: Option<Node>, pou: &str, known: &Known) 
                 let mut mapped = Vec::new();
                 let mut inits = Vec::new();
                 let class = VarClass::Default;
-                if let Ok(vars) = var_list(tc6, list, class, &place, known, &mut mapped, &mut inits) {
+                if let Ok(vars) = var_list(tc6, list, class, &place, known, &mut mapped, &mut inits)
+                {
                     out.external_decls.extend(vars);
                     out.external_mapped.extend(mapped);
                 }
@@ -492,7 +493,10 @@ fn fb_init(tc6: Tc6, iv: Node, var: &str, fb: &str, place: &str) -> R<FbInit> {
         })?;
         let text = super::xml::attr(simple, "value", place)?;
         let shown = format!("{var}.{member}");
-        members.push((member, literal_operand(text, origin(simple), &shown, place)?));
+        members.push((
+            member,
+            literal_operand(text, origin(simple), &shown, place)?,
+        ));
     }
     Ok(FbInit {
         instance: var.to_owned(),
@@ -749,7 +753,10 @@ mod tests {
         // Dates as seconds since 1970, times of day as ms since midnight (IEC 61131-3 6.3.4).
         assert_eq!(literal("D#1970-01-02"), Some(Scalar::Number(86_400.into())));
         assert_eq!(literal("TOD#00:00:01.5"), Some(Scalar::Number(1500.into())));
-        assert_eq!(literal("DT#1970-01-01-01:00:00"), Some(Scalar::Number(3600.into())));
+        assert_eq!(
+            literal("DT#1970-01-01-01:00:00"),
+            Some(Scalar::Number(3600.into()))
+        );
         assert_eq!(
             literal("LTIME#2s"),
             Some(Scalar::Str(Cow::Borrowed("LTIME#2s")))

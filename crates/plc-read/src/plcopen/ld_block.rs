@@ -450,11 +450,13 @@ fn operand(p: &mut Power, e: ElemId, pin: &str, ty: &str) -> R<Operand<'static>>
     // reads that value (IEC 61131-3 6.5.1.4, `T0 : TON := (PT := T#1s)`).
     let listed = el.inputs.iter().find(|x| x.name == Some(pin));
     if listed.is_none_or(|x| x.sources.is_empty()) {
-        let inst = el.node.attribute("instanceName").map(str::to_ascii_lowercase);
-        let init = inst.and_then(|i| p.inits.get(&i)).and_then(|m| {
-            m.iter()
-                .find(|(name, _, _)| name.eq_ignore_ascii_case(pin))
-        });
+        let inst = el
+            .node
+            .attribute("instanceName")
+            .map(str::to_ascii_lowercase);
+        let init = inst
+            .and_then(|i| p.inits.get(&i))
+            .and_then(|m| m.iter().find(|(name, _, _)| name.eq_ignore_ascii_case(pin)));
         if let Some((_, value, at)) = init {
             return Ok(Located {
                 value: value.clone(),
