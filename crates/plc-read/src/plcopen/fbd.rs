@@ -215,6 +215,38 @@ impl Fbd<'_, '_, '_> {
         }
     }
 
+    /// The field inputs `pin.f` ← `var.f` when input `pin` of function block type `ty` is a
+    /// structure (the type declares its fields `pin.f`, not `pin`) and `input` reads variable
+    /// `var` whole; `None` otherwise.
+    fn whole_structure(
+        &self,
+        ty: &str,
+        pin: &str,
+        input: &Input<'static>,
+    ) -> Option<Vec<(Cow<'static, str>, Input<'static>)>> {
+        let Connection::Variable(v) = &input.from else {
+            return None;
+        };
+        let declared = self.ctx.fb_inputs.get(ty)?;
+        if declared.iter().any(|(n, _)| n == pin) {
+            return None;
+        }
+        let prefix = format!("{pin}.");
+        let fields: Vec<(Cow<'static, str>, Input<'static>)> = declared
+            .iter()
+            .filter_map(|(n, _)| n.strip_prefix(&prefix).map(|f| (n, f)))
+            .map(|(n, f)| {
+                let from = Connection::Variable(Cow::Owned(format!("{v}.{f}")));
+                let field = Input {
+                    origin: input.origin,
+                    from,
+                };
+                (Cow::Owned(n.clone()), field)
+            })
+            .collect();
+        (!fields.is_empty()).then_some(fields)
+    }
+
     fn block(&self, e: ElemId) -> R<Block<'static>> {
         let el = self.g.get(e);
         let here = self.at(e);
@@ -292,6 +324,10 @@ impl Fbd<'_, '_, '_> {
             input = bool_literal(self.ctx, ty, name, input);
             if name == "EN" {
                 b.cond = Some(input);
+            } else if let Some(fields) = self.whole_structure(ty, name, &input) {
+                // A structure passed whole into a function block's structure input: each field
+                // into its field (the model holds a structure as one variable per field).
+                inputs.extend(fields);
             } else {
                 inputs.push((Cow::Owned(name.to_owned()), input));
             }
