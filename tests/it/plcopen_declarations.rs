@@ -201,3 +201,36 @@ fn malformed_literals_are_one_located_error() {
         assert!(err.contains(&format!("`{init}`")), "{init}: {err}");
     }
 }
+
+#[test]
+fn a_ctu_cv_feeding_an_ld_out_variable_is_assigned_not_a_contact() {
+    // CU rising on scans 0, 2, 4, 6 (go 1, 0, 1, 0 …): CV counts 1, 1, 2, 2, 3, 3, 4 and Q
+    // rises when CV reaches PV = 3 (IEC 61131-3 Table 45, CTU); `count` is CV after the box.
+    let inputs = "go\n1\n0\n1\n0\n1\n0\n1\n";
+    let f = std::fs::read_to_string(file("ld_ctu_cv.xml")).unwrap();
+    let t = trace("decl-ctu-cv", &f, inputs, &["count", "lamp"]);
+    assert_eq!(t[0], ["1", "1", "2", "2", "3", "3", "4"]);
+    assert_eq!(t[1], ["0", "0", "0", "0", "1", "1", "1"]);
+}
+
+#[test]
+fn a_structure_passed_whole_into_a_function_block_input_feeds_its_fields() {
+    // q := (x := 3, y := 4) into F's input p : PT2, whose body adds p.x and p.y.
+    assert_eq!(
+        outputs("struct_whole_input.xml"),
+        json!({"total": 7, "f0.s": 7})
+    );
+}
+
+#[test]
+fn pin_names_in_any_case_and_codesys_positional_operator_pins() {
+    // ADD(In1 := a, In2 := b) with a = INT#5, b = 16#10: 21. MUX(K := k, In0 := a, in1 := b):
+    // a when k = 0, b when k = 1 (IEC 61131-3 Table 31). TON(in := go, Pt := T#20ms): Q at
+    // 20 ms.
+    let inputs = "go,k\n1,0\n1,1\n1,1\n";
+    let f = std::fs::read_to_string(file("codesys_pins.xml")).unwrap();
+    let t = trace("decl-pins", &f, inputs, &["sum", "sel", "lamp"]);
+    assert_eq!(t[0], ["21", "21", "21"]);
+    assert_eq!(t[1], ["5", "16", "16"]);
+    assert_eq!(t[2], ["0", "0", "1"]);
+}

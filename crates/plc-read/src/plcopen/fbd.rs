@@ -247,6 +247,28 @@ impl Fbd<'_, '_, '_> {
         (!fields.is_empty()).then_some(fields)
     }
 
+    /// Input `pin` of block `ty` under the name the model knows it by: IEC names are
+    /// case-insensitive, and CODESYS writes an operator's pins `In1`, `In2` (MUX `K`, `In0`):
+    /// a declared input of a function block or function of the project as declared, a pin of
+    /// a standard function or function block in upper case; others (black boxes) as written.
+    fn pin_name(&self, ty: &str, pin: &str) -> String {
+        let declared = self
+            .ctx
+            .fb_inputs
+            .get(ty)
+            .or_else(|| self.ctx.functions.get(ty).map(|s| &s.inputs));
+        if let Some(d) = declared {
+            return d
+                .iter()
+                .find(|(n, _)| n.eq_ignore_ascii_case(pin))
+                .map_or_else(|| pin.to_owned(), |(n, _)| n.clone());
+        }
+        if plc_fbd::OpKind::parse(ty).is_some() || black_box::is_standard_fb(ty) {
+            return pin.to_ascii_uppercase();
+        }
+        pin.to_owned()
+    }
+
     fn block(&self, e: ElemId) -> R<Block<'static>> {
         let el = self.g.get(e);
         let here = self.at(e);
@@ -270,7 +292,8 @@ impl Fbd<'_, '_, '_> {
         }
         let mut inputs = Vec::new();
         for pin in &el.inputs {
-            let name = pin.name.unwrap_or("");
+            let canon = self.pin_name(ty, pin.name.unwrap_or(""));
+            let name = canon.as_str();
             let (negated, edge) = pin_modifiers(pin.node, ty, name, el.local_id, &here)?;
             let init = el
                 .node
@@ -335,7 +358,11 @@ impl Fbd<'_, '_, '_> {
         // The inputs the instance's declaration gives a value and the block does not list.
         if let Some(inst) = el.node.attribute("instanceName") {
             for (pin, v, at) in self.ctx.init_inputs(inst, ty) {
-                if !el.inputs.iter().any(|p| p.name == Some(pin.as_str())) {
+                if !el
+                    .inputs
+                    .iter()
+                    .any(|p| p.name.is_some_and(|n| n.eq_ignore_ascii_case(&pin)))
+                {
                     let input = Input {
                         origin: at,
                         from: Connection::Constant(v),
