@@ -234,3 +234,18 @@ fn pin_names_in_any_case_and_codesys_positional_operator_pins() {
     assert_eq!(t[1], ["5", "16", "16"]);
     assert_eq!(t[2], ["0", "0", "1"]);
 }
+
+#[test]
+fn codesys_local_ids_up_to_2_to_the_64_and_not_s_in1() {
+    // localIds 2^64 - 1, 2^32 - 1 and 2^63 (TC6 `xsd:unsignedLong`); NOT's pin written In1.
+    let f = file("codesys_local_ids.xml");
+    let text = std::fs::read_to_string(&f).unwrap();
+    let inputs = "go\n1\n0\n";
+    let t = trace("decl-ids", &text, inputs, &["lamp"]);
+    assert_eq!(t[0], ["0", "1"]);
+    let (_, warnings) = json_output(&["report", &f, "--format", "json"], "");
+    assert!(
+        warnings.contains("localIds beyond 4294967295 are renumbered (the model numbers blocks in 32 bits), and messages name them so: 18446744073709551615 → 4294967294, 9223372036854775808 → 4294967293"),
+        "{warnings}"
+    );
+}

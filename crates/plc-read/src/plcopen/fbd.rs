@@ -263,7 +263,17 @@ impl Fbd<'_, '_, '_> {
                 .find(|(n, _)| n.eq_ignore_ascii_case(pin))
                 .map_or_else(|| pin.to_owned(), |(n, _)| n.clone());
         }
-        if plc_fbd::OpKind::parse(ty).is_some() || black_box::is_standard_fb(ty) {
+        if let Some(op) = plc_fbd::OpKind::parse(ty) {
+            let upper = pin.to_ascii_uppercase();
+            // A one-input operator's `In1` is its IN (NOT, ABS, the conversions).
+            let pins = op.input_pins(0);
+            if upper == "IN1" && pins.iter().any(|p| p == "IN") && !pins.iter().any(|p| p == "IN1")
+            {
+                return "IN".to_owned();
+            }
+            return upper;
+        }
+        if black_box::is_standard_fb(ty) {
             return pin.to_ascii_uppercase();
         }
         pin.to_owned()
