@@ -46,7 +46,7 @@ pub(super) struct Ctx {
 pub(super) type Inits = HashMap<String, Vec<(String, plc_syntax::Scalar<'static>, Origin)>>;
 
 impl Ctx {
-    /// The initial value instance `inst` (of type `ty`) declares for its input `pin` (matched
+    /// The initial value instance `inst` declares for its input `pin` (matched
     /// in any case, as IEC names are), if it declares one.
     pub(super) fn init_of(
         &self,
@@ -58,34 +58,5 @@ impl Ctx {
             .iter()
             .find(|(m, _, _)| m.eq_ignore_ascii_case(pin))
             .map(|(_, v, at)| (v.clone(), *at))
-    }
-
-    /// The members of instance `inst`'s initial value that are inputs of its type `ty`, under
-    /// the inputs' own names (`pt` → `PT`), with their values; the others are not inputs.
-    pub(super) fn init_inputs(
-        &self,
-        inst: &str,
-        ty: &str,
-    ) -> Vec<(String, plc_syntax::Scalar<'static>, Origin)> {
-        let Some(members) = self.inits.get(&inst.to_ascii_lowercase()) else {
-            return Vec::new();
-        };
-        members
-            .iter()
-            .filter_map(|(m, v, at)| Some((self.input_pin(ty, m)?, v.clone(), *at)))
-            .collect()
-    }
-
-    /// The input of function block type `ty` named `member` in any case, under its own name.
-    pub(super) fn input_pin(&self, ty: &str, member: &str) -> Option<String> {
-        if super::black_box::is_standard_fb(ty) {
-            let upper = member.to_ascii_uppercase();
-            return self.input_type(ty, &upper).map(|_| upper);
-        }
-        self.fb_inputs
-            .get(ty)?
-            .iter()
-            .find(|(n, _)| n.eq_ignore_ascii_case(member))
-            .map(|(n, _)| n.clone())
     }
 }

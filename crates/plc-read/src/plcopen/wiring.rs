@@ -289,25 +289,26 @@ fn connections<'a>(tc6: Tc6, cp: Node<'a, '_>, place: &str, ids: &LocalIds) -> R
     let mut out = Vec::new();
     for c in tc6.children(cp, "connection") {
         let raw = attr(c, "refLocalId", place)?;
-        let id: u32 =
-            match ids.id(raw) {
-                Some(id) => id,
-                None if raw.trim().parse::<u64>().is_ok() => return Err(error(
+        let id: u32 = match ids.id(raw) {
+            Some(id) => id,
+            None if raw.trim().parse::<u64>().is_ok() => {
+                return Err(error(
                     origin(c),
                     place,
                     format!(
                         "the connection refers to localId {}, which is not an element of this body",
                         raw.trim()
                     ),
-                )),
-                None => {
-                    return Err(error(
-                        origin(c),
-                        place,
-                        format!("refLocalId `{raw}` is not a whole number"),
-                    ))
-                }
-            };
+                ))
+            }
+            None => {
+                return Err(error(
+                    origin(c),
+                    place,
+                    format!("refLocalId `{raw}` is not a whole number"),
+                ))
+            }
+        };
         out.push(Source {
             elem: ElemId(id),
             pin: c.attribute("formalParameter").filter(|p| !p.is_empty()),
