@@ -49,6 +49,7 @@ mod par_layers;
 mod parallel_house;
 mod petgraph_views;
 mod plcopen_data_types;
+mod plcopen_declarations;
 mod plcopen_errors;
 mod plcopen_fbd;
 mod plcopen_fixtures;

@@ -685,27 +685,40 @@ pub fn split_typed_literal(s: &str) -> Option<(Type, &str)> {
     Some((ty, rest))
 }
 
-/// Parses an IEC TIME literal (`T#1s`, `T#250ms`, `TIME#1m30s`, `T#1.5s`) into milliseconds.
+/// Strips the first of `prefixes` (each ending in `#`) that `s` starts with, in any case
+/// (IEC 61131-3 keywords are case-insensitive: `T#`, `t#`, `Time#`).
+fn strip_prefix_ci<'s>(s: &'s str, prefixes: &[&str]) -> Option<&'s str> {
+    prefixes.iter().find_map(|p| {
+        let head = s.get(..p.len())?;
+        head.eq_ignore_ascii_case(p).then(|| &s[p.len()..])
+    })
+}
+
+/// Parses an IEC TIME literal (`T#1s`, `T#250ms`, `TIME#1m30s`, `T#1.5s`, `T#1h_30m`,
+/// `LTIME#5s`) into milliseconds.
+///
+/// The grammar is IEC 61131-3 6.3.3 Table 8 (as matiec's `iec_flex.ll` reads it): a prefix
+/// `T#`, `TIME#`, `LT#` or `LTIME#` in any case, an optional sign, then one or more
+/// `number unit` parts, each unit `d`, `h`, `m`, `s`, `ms`, `us` or `ns` (any case), the number
+/// decimal with `_` between digits and an optional fraction; one `_` may separate a unit from
+/// the next part (`T#0D_0H_0M_0S_1MS`). LTIME is read as TIME (docs/plcopen.md).
 ///
 /// `None` for exactly two reasons: the text is not a TIME literal, or its value is not a whole
-/// number of milliseconds (`T#0.5ms`, `T#1.0005s`): TIME counts milliseconds, and a fraction
-/// would be lost silently. (IEC 61131-3 allows finer literals; this executor does not.) The
-/// arithmetic is exact (decimal digits, not floating point); a value beyond the `i64` range
-/// saturates, so callers check the range they need.
+/// number of milliseconds (`T#0.5ms`, `T#1.0005s`, `T#1us`): TIME counts milliseconds, and a
+/// fraction would be lost silently. (IEC 61131-3 allows finer literals; this executor does
+/// not.) The arithmetic is exact (decimal digits, not floating point); a value beyond the `i64`
+/// range saturates, so callers check the range they need.
 pub fn parse_time_literal(s: &str) -> Option<i64> {
-    let rest = s
-        .strip_prefix("T#")
-        .or_else(|| s.strip_prefix("t#"))
-        .or_else(|| s.strip_prefix("TIME#"))
-        .or_else(|| s.strip_prefix("time#"))?;
-    let (neg, mut rest) = match rest.strip_prefix('-') {
-        Some(r) => (true, r),
-        None => (false, rest),
+    let rest = strip_prefix_ci(s, &["T#", "TIME#", "LT#", "LTIME#"])?;
+    let (neg, mut rest) = match rest.as_bytes().first() {
+        Some(b'-') => (true, &rest[1..]),
+        Some(b'+') => (false, &rest[1..]),
+        _ => (false, rest),
     };
     if rest.is_empty() {
         return None;
     }
-    // The value in units of 10^-FRAC ms; more fractional digits than FRAC can never add up to
+    // The value in units of 10^-FRAC ns; more fractional digits than FRAC can never add up to
     // whole milliseconds (a unit is at most 2^10 · 3^3 · 5^5 ms), so they are refused.
     const FRAC: u32 = 12;
     let mut total: i128 = 0;
@@ -714,7 +727,11 @@ pub fn parse_time_literal(s: &str) -> Option<i64> {
         let num_len = rest
             .find(|c: char| !(c.is_ascii_digit() || c == '.' || c == '_'))
             .unwrap_or(rest.len());
-        let number = rest[..num_len].replace('_', "");
+        let raw = &rest[..num_len];
+        if raw.starts_with('_') || raw.ends_with('_') || raw.contains("__") {
+            return None;
+        }
+        let number = raw.replace('_', "");
         rest = &rest[num_len..];
         if number.matches('.').count() > 1 || !number.bytes().any(|b| b.is_ascii_digit()) {
             return None;
@@ -722,17 +739,26 @@ pub fn parse_time_literal(s: &str) -> Option<i64> {
         let (int, frac) = number.split_once('.').unwrap_or((&number, ""));
         let frac = frac.trim_end_matches('0');
         let unit_len = rest
-            .find(|c: char| c.is_ascii_digit() || c == '.')
+            .find(|c: char| !c.is_ascii_alphabetic())
             .unwrap_or(rest.len());
         let factor: i128 = match rest[..unit_len].to_ascii_lowercase().as_str() {
-            "d" => 86_400_000,
-            "h" => 3_600_000,
-            "m" => 60_000,
-            "s" => 1000,
-            "ms" => 1,
+            "d" => 86_400_000_000_000,
+            "h" => 3_600_000_000_000,
+            "m" => 60_000_000_000,
+            "s" => 1_000_000_000,
+            "ms" => 1_000_000,
+            "us" => 1000,
+            "ns" => 1,
             _ => return None,
         };
         rest = &rest[unit_len..];
+        // One `_` between a unit and the next part (IEC 61131-3 Table 8, `T#25h_15m`).
+        if let Some(r) = rest.strip_prefix('_') {
+            if r.is_empty() {
+                return None;
+            }
+            rest = r;
+        }
         if frac.len() > FRAC as usize {
             return None;
         }
@@ -746,7 +772,7 @@ pub fn parse_time_literal(s: &str) -> Option<i64> {
             None => saturated = true,
         }
     }
-    let unit = 10i128.pow(FRAC);
+    let unit = 10i128.pow(FRAC) * 1_000_000;
     if saturated {
         return Some(if neg { i64::MIN } else { i64::MAX });
     }
@@ -755,6 +781,117 @@ pub fn parse_time_literal(s: &str) -> Option<i64> {
     }
     let ms = i64::try_from(total / unit).unwrap_or(i64::MAX);
     Some(if neg { -ms } else { ms })
+}
+
+/// The kinds of the IEC 61131-3 date and time-of-day literals (6.3.4, Table 9).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum DateKind {
+    /// `D#`, `DATE#` (and `LD#`, `LDATE#`): seconds since 1970-01-01.
+    Date,
+    /// `TOD#`, `TIME_OF_DAY#` (and `LTOD#`, `LTIME_OF_DAY#`): milliseconds since midnight.
+    TimeOfDay,
+    /// `DT#`, `DATE_AND_TIME#` (and `LDT#`, `LDATE_AND_TIME#`): seconds since 1970-01-01.
+    DateAndTime,
+}
+
+/// Days from 1970-01-01 to the proleptic Gregorian date `y-m-d` (H. Hinnant's
+/// `days_from_civil`); `None` when the month or day does not exist.
+fn days_from_civil(y: i64, m: i64, d: i64) -> Option<i64> {
+    let leap = (y % 4 == 0 && y % 100 != 0) || y % 400 == 0;
+    let len = [
+        31,
+        if leap { 29 } else { 28 },
+        31,
+        30,
+        31,
+        30,
+        31,
+        31,
+        30,
+        31,
+        30,
+        31,
+    ];
+    if !(1..=12).contains(&m) || d < 1 || d > len[(m - 1) as usize] {
+        return None;
+    }
+    let y = if m <= 2 { y - 1 } else { y };
+    let era = y.div_euclid(400);
+    let yoe = y - era * 400;
+    let mp = (m + 9) % 12;
+    let doy = (153 * mp + 2) / 5 + d - 1;
+    let doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
+    Some(era * 146_097 + doe - 719_468)
+}
+
+/// `yyyy-mm-dd` as days since 1970-01-01.
+fn date_days(s: &str) -> Option<i64> {
+    let mut it = s.split('-');
+    let num = |p: Option<&str>| -> Option<i64> {
+        let p = p?.replace('_', "");
+        (!p.is_empty() && p.bytes().all(|b| b.is_ascii_digit())).then_some(())?;
+        p.parse().ok()
+    };
+    let (y, m, d) = (num(it.next())?, num(it.next())?, num(it.next())?);
+    if it.next().is_some() {
+        return None;
+    }
+    days_from_civil(y, m, d)
+}
+
+/// `hh:mm:ss[.fff]` as milliseconds since midnight; `None` unless a whole number of ms.
+fn daytime_ms(s: &str) -> Option<i64> {
+    let mut it = s.split(':');
+    let (h, m, sec) = (it.next()?, it.next()?, it.next()?);
+    if it.next().is_some() {
+        return None;
+    }
+    let int = |p: &str| -> Option<i64> {
+        (!p.is_empty() && p.bytes().all(|b| b.is_ascii_digit())).then_some(())?;
+        p.parse().ok()
+    };
+    let (h, m) = (int(h)?, int(m)?);
+    let (si, sf) = sec.split_once('.').unwrap_or((sec, ""));
+    let si = int(si)?;
+    let sf = sf.trim_end_matches('0');
+    if sf.len() > 3 || !sf.bytes().all(|b| b.is_ascii_digit()) {
+        return None;
+    }
+    let frac_ms: i64 = format!("{sf:0<3}").parse().ok()?;
+    if h > 23 || m > 59 || si > 59 {
+        return None;
+    }
+    Some(((h * 60 + m) * 60 + si) * 1000 + frac_ms)
+}
+
+/// Parses an IEC date, time-of-day or date-and-time literal (IEC 61131-3 6.3.4, Table 9:
+/// `D#2024-01-31`, `TOD#12:30:15.5`, `DT#2024-01-31-12:30:00`, any prefix in any case) into
+/// the integer the model holds for it: seconds since 1970-01-01 for a DATE (matiec's
+/// `__date_to_timespec` `tv_sec`) and a DATE_AND_TIME (its `__dt_to_timespec` `tv_sec`),
+/// milliseconds since midnight for a TIME_OF_DAY (CODESYS's TOD). `None` when the text is not
+/// one, names a day or time that does not exist, or (DT, TOD) has a fraction finer than its
+/// unit: it would be lost silently.
+pub fn parse_date_literal(s: &str) -> Option<(DateKind, i64)> {
+    if let Some(r) = strip_prefix_ci(s, &["DATE_AND_TIME#", "DT#", "LDATE_AND_TIME#", "LDT#"]) {
+        // The date's three parts, then the daytime.
+        let mut cut = 0;
+        for _ in 0..3 {
+            cut += r[cut..].find('-')? + 1;
+        }
+        let (date, time) = (&r[..cut - 1], &r[cut..]);
+        let ms = daytime_ms(time)?;
+        if ms % 1000 != 0 {
+            return None;
+        }
+        return Some((DateKind::DateAndTime, date_days(date)? * 86_400 + ms / 1000));
+    }
+    if let Some(r) = strip_prefix_ci(s, &["TIME_OF_DAY#", "TOD#", "LTIME_OF_DAY#", "LTOD#"]) {
+        return Some((DateKind::TimeOfDay, daytime_ms(r)?));
+    }
+    if let Some(r) = strip_prefix_ci(s, &["DATE#", "D#", "LDATE#", "LD#"]) {
+        return Some((DateKind::Date, date_days(r)? * 86_400));
+    }
+    None
 }
 
 #[cfg(test)]
@@ -791,5 +928,58 @@ mod tests {
             parse_time_literal("T#99999999999999999999999999999999999999999d"),
             Some(i64::MAX)
         );
+        // `_` between units, any case, LTIME, finer units (IEC 61131-3 Table 8, matiec's lexer).
+        assert_eq!(parse_time_literal("T#1h_30m"), Some(5_400_000));
+        assert_eq!(parse_time_literal("T#0D_0H_0M_0S_1MS"), Some(1));
+        assert_eq!(parse_time_literal("Time#1s"), Some(1000));
+        assert_eq!(parse_time_literal("LTIME#1d_2h"), Some(93_600_000));
+        assert_eq!(parse_time_literal("lt#+3s"), Some(3000));
+        assert_eq!(parse_time_literal("T#1500us"), None, "1.5 ms");
+        assert_eq!(parse_time_literal("T#2000us_3000000ns"), Some(5));
+        assert_eq!(parse_time_literal("T#100ms_"), None);
+        assert_eq!(parse_time_literal("T#1h__30m"), None);
+        assert_eq!(parse_time_literal("T#1h_"), None);
+    }
+
+    #[test]
+    fn date_literals() {
+        use DateKind::*;
+        // 2024-01-31 is 19753 days after 1970-01-01.
+        assert_eq!(
+            parse_date_literal("D#2024-01-31"),
+            Some((Date, 19_753 * 86_400))
+        );
+        assert_eq!(parse_date_literal("DATE#1970-01-02"), Some((Date, 86_400)));
+        assert_eq!(
+            parse_date_literal("date#2000-03-01"),
+            Some((Date, 11_017 * 86_400))
+        );
+        assert_eq!(parse_date_literal("D#2023-02-29"), None);
+        assert_eq!(
+            parse_date_literal("D#2024-02-29"),
+            Some((Date, 19_782 * 86_400))
+        );
+        assert_eq!(
+            parse_date_literal("TOD#12:30:15.5"),
+            Some((TimeOfDay, 45_015_500))
+        );
+        assert_eq!(
+            parse_date_literal("TIME_OF_DAY#00:00:00"),
+            Some((TimeOfDay, 0))
+        );
+        assert_eq!(parse_date_literal("TOD#24:00:00"), None);
+        assert_eq!(parse_date_literal("TOD#1:2:3.0001"), None);
+        assert_eq!(
+            parse_date_literal("DT#1970-01-01-00:01:00"),
+            Some((DateAndTime, 60))
+        );
+        assert_eq!(
+            parse_date_literal("DATE_AND_TIME#2024-01-31-12:00:00"),
+            Some((DateAndTime, 19_753 * 86_400 + 43_200))
+        );
+        assert_eq!(parse_date_literal("DT#1970-01-01-00:00:00.5"), None);
+        assert_eq!(parse_date_literal("DT#1970-01-01"), None);
+        assert_eq!(parse_date_literal("D#1970-13-01"), None);
+        assert_eq!(parse_date_literal("T#1s"), None);
     }
 }

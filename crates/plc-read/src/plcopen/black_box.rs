@@ -68,6 +68,35 @@ pub(super) fn is_standard_fb(ty: &str) -> bool {
 }
 
 impl Ctx {
+    /// The members of instance `inst`'s initial value that are inputs of its type `ty`, under
+    /// the inputs' own names (`pt` → `PT`), with their values; the others are not inputs.
+    pub(super) fn init_inputs(
+        &self,
+        inst: &str,
+        ty: &str,
+    ) -> Vec<(String, Scalar<'static>, Origin)> {
+        let Some(members) = self.inits.get(&inst.to_ascii_lowercase()) else {
+            return Vec::new();
+        };
+        members
+            .iter()
+            .filter_map(|(m, v, at)| Some((self.input_pin(ty, m)?, v.clone(), *at)))
+            .collect()
+    }
+
+    /// The input of function block type `ty` named `member` in any case, under its own name.
+    pub(super) fn input_pin(&self, ty: &str, member: &str) -> Option<String> {
+        if is_standard_fb(ty) {
+            let upper = member.to_ascii_uppercase();
+            return self.input_type(ty, &upper).map(|_| upper);
+        }
+        self.fb_inputs
+            .get(ty)?
+            .iter()
+            .find(|(n, _)| n.eq_ignore_ascii_case(member))
+            .map(|(n, _)| n.clone())
+    }
+
     /// The function block type instance `inst` is declared with, if it is one.
     pub(super) fn fb_type_of(&self, inst: &str) -> Option<String> {
         let t = self.vars.get(&inst.to_ascii_lowercase())?;

@@ -36,4 +36,27 @@ pub(super) struct Ctx {
     pub fb_inputs: HashMap<String, Vec<(String, String)>>,
     /// The POU's variables and the globals it sees: lower-case name → model type.
     pub vars: HashMap<String, String>,
+    /// The initial values of the POU's function block instances: lower-case instance name →
+    /// (member as written, its literal) (`super::interface::FbInit`).
+    pub inits: Inits,
+}
+
+/// The initial values of a POU's function block instances: lower-case instance name →
+/// (member as written, its literal, where).
+pub(super) type Inits = HashMap<String, Vec<(String, plc_syntax::Scalar<'static>, Origin)>>;
+
+impl Ctx {
+    /// The initial value instance `inst` declares for its input `pin` (matched
+    /// in any case, as IEC names are), if it declares one.
+    pub(super) fn init_of(
+        &self,
+        inst: &str,
+        pin: &str,
+    ) -> Option<(plc_syntax::Scalar<'static>, Origin)> {
+        let members = self.inits.get(&inst.to_ascii_lowercase())?;
+        members
+            .iter()
+            .find(|(m, _, _)| m.eq_ignore_ascii_case(pin))
+            .map(|(_, v, at)| (v.clone(), *at))
+    }
 }

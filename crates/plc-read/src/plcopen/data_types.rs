@@ -63,8 +63,10 @@ use std::collections::HashMap;
 pub(super) enum Base {
     /// An elementary type as TC6 writes it (`INT`, `UINT`, `string`).
     Elementary(String),
-    /// An enumeration: its value names; value `k` (0-based) is the integer `k`.
-    Enum(Vec<String>),
+    /// An enumeration: its value names and integers, in declaration order: a value's own
+    /// (`value` attribute, IEC 61131-3 6.4.4.2 named values), else one more than the previous
+    /// one's (the first 0), as CODESYS and matiec number them.
+    Enum(Vec<(String, i64)>),
     /// An array, analysed as one whole variable (a structure is always [`Base::Struct`]).
     Whole(Aggregate),
     /// A structure: its members in declaration order.
@@ -115,11 +117,7 @@ impl DataType {
         let mut d = match &self.base {
             Base::Elementary(t) => format!("an alias of {}", t.to_ascii_uppercase()),
             Base::Enum(v) => {
-                let vals: Vec<String> = v
-                    .iter()
-                    .enumerate()
-                    .map(|(i, n)| format!("{n} = {i}"))
-                    .collect();
+                let vals: Vec<String> = v.iter().map(|(n, i)| format!("{n} = {i}")).collect();
                 format!("an enumeration, read as INT with {}", vals.join(", "))
             }
             Base::Whole(a) => format!("{}, read as one whole variable without a value", a.word()),
@@ -193,6 +191,18 @@ impl DataTypes {
         if let Some(t) = self.types.get(name) {
             return Some(t.clone());
         }
+        if name == "LOGLEVEL" {
+            // Beremiz's NativeLib.xml: `TYPE LOGLEVEL : (CRITICAL, WARNING, INFO, DEBUG) :=
+            // INFO; END_TYPE`, the type of its LOGGER's LEVEL ([`super::library`]).
+            let vals = ["CRITICAL", "WARNING", "INFO", "DEBUG"];
+            return Some(DataType {
+                name: name.to_owned(),
+                base: Base::Enum(vals.iter().map(|v| v.to_string()).zip(0..).collect()),
+                range: None,
+                init: Some(("INFO".to_owned(), Origin::default())),
+                library: Some("Beremiz NativeLib"),
+            });
+        }
         let &(n, b) = SVGHMI.iter().find(|(n, _)| *n == name)?;
         Some(DataType {
             name: n.to_owned(),
@@ -208,7 +218,7 @@ impl DataTypes {
         let mut out = Vec::new();
         for t in self.types.values() {
             if let Base::Enum(v) = &t.base {
-                out.extend(v.iter().cloned().zip(0..));
+                out.extend(v.iter().cloned());
             }
         }
         out
@@ -224,8 +234,8 @@ impl DataTypes {
             None => text,
         };
         v.iter()
-            .position(|x| x.eq_ignore_ascii_case(name))
-            .map(|i| i as i64)
+            .find(|(x, _)| x.eq_ignore_ascii_case(name))
+            .map(|&(_, i)| i)
     }
 }
 
@@ -345,18 +355,31 @@ pub(super) fn base(
             Ok(t)
         }
         "enum" => {
-            let mut vals = Vec::new();
+            let mut vals: Vec<(String, i64)> = Vec::new();
             for v in tc6
                 .child(bt, "values")
                 .into_iter()
                 .flat_map(|vs| tc6.children(vs, "value"))
             {
-                vals.push(identifier(
-                    attr(v, "name", place)?,
-                    "enumeration value",
-                    v,
-                    place,
-                )?);
+                let n = identifier(attr(v, "name", place)?, "enumeration value", v, place)?;
+                let i = match v.attribute("value") {
+                    // `5`, `-1`, `16#1F`, `INT#5`: an integer literal (IEC 61131-3 6.3.2).
+                    Some(text) => {
+                        let t = text.trim();
+                        let t = plc_model::split_typed_literal(t).map_or(t, |(_, r)| r);
+                        plc_model::parse_int_literal(t)
+                            .and_then(|i| i64::try_from(i).ok())
+                            .ok_or_else(|| {
+                                error(
+                                    origin(v),
+                                    place,
+                                    format!("value `{text}` of enumeration value `{n}` of `{name}` is not an integer literal"),
+                                )
+                            })?
+                    }
+                    None => vals.last().map_or(0, |&(_, p)| p.saturating_add(1)),
+                };
+                vals.push((n, i));
             }
             if vals.is_empty() {
                 return Err(error(

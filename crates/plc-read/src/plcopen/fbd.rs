@@ -215,6 +215,70 @@ impl Fbd<'_, '_, '_> {
         }
     }
 
+    /// The field inputs `pin.f` ← `var.f` when input `pin` of function block type `ty` is a
+    /// structure (the type declares its fields `pin.f`, not `pin`) and `input` reads variable
+    /// `var` whole; `None` otherwise.
+    fn whole_structure(
+        &self,
+        ty: &str,
+        pin: &str,
+        input: &Input<'static>,
+    ) -> Option<Vec<(Cow<'static, str>, Input<'static>)>> {
+        let Connection::Variable(v) = &input.from else {
+            return None;
+        };
+        let declared = self.ctx.fb_inputs.get(ty)?;
+        if declared.iter().any(|(n, _)| n == pin) {
+            return None;
+        }
+        let prefix = format!("{pin}.");
+        let fields: Vec<(Cow<'static, str>, Input<'static>)> = declared
+            .iter()
+            .filter_map(|(n, _)| n.strip_prefix(&prefix).map(|f| (n, f)))
+            .map(|(n, f)| {
+                let from = Connection::Variable(Cow::Owned(format!("{v}.{f}")));
+                let field = Input {
+                    origin: input.origin,
+                    from,
+                };
+                (Cow::Owned(n.clone()), field)
+            })
+            .collect();
+        (!fields.is_empty()).then_some(fields)
+    }
+
+    /// Input `pin` of block `ty` under the name the model knows it by: IEC names are
+    /// case-insensitive, and CODESYS writes an operator's pins `In1`, `In2` (MUX `K`, `In0`):
+    /// a declared input of a function block or function of the project as declared, a pin of
+    /// a standard function or function block in upper case; others (black boxes) as written.
+    fn pin_name(&self, ty: &str, pin: &str) -> String {
+        let declared = self
+            .ctx
+            .fb_inputs
+            .get(ty)
+            .or_else(|| self.ctx.functions.get(ty).map(|s| &s.inputs));
+        if let Some(d) = declared {
+            return d
+                .iter()
+                .find(|(n, _)| n.eq_ignore_ascii_case(pin))
+                .map_or_else(|| pin.to_owned(), |(n, _)| n.clone());
+        }
+        if let Some(op) = plc_fbd::OpKind::parse(ty) {
+            let upper = pin.to_ascii_uppercase();
+            // A one-input operator's `In1` is its IN (NOT, ABS, the conversions).
+            let pins = op.input_pins(0);
+            if upper == "IN1" && pins.iter().any(|p| p == "IN") && !pins.iter().any(|p| p == "IN1")
+            {
+                return "IN".to_owned();
+            }
+            return upper;
+        }
+        if black_box::is_standard_fb(ty) {
+            return pin.to_ascii_uppercase();
+        }
+        pin.to_owned()
+    }
+
     fn block(&self, e: ElemId) -> R<Block<'static>> {
         let el = self.g.get(e);
         let here = self.at(e);
@@ -238,9 +302,23 @@ impl Fbd<'_, '_, '_> {
         }
         let mut inputs = Vec::new();
         for pin in &el.inputs {
-            let name = pin.name.unwrap_or("");
+            let canon = self.pin_name(ty, pin.name.unwrap_or(""));
+            let name = canon.as_str();
             let (negated, edge) = pin_modifiers(pin.node, ty, name, el.local_id, &here)?;
+            let init = el
+                .node
+                .attribute("instanceName")
+                .and_then(|i| self.ctx.init_of(i, name));
             let mut input = match pin.sources.as_slice() {
+                // An unconnected input keeps the value the instance's declaration gives it
+                // (IEC 61131-3 6.5.1.4: `T0 : TON := (PT := T#1s)`).
+                [] if init.is_some() => {
+                    let (v, at) = init.unwrap_or((Scalar::Bool(false), origin(pin.node)));
+                    Input {
+                        origin: at,
+                        from: Connection::Constant(v),
+                    }
+                }
                 // An unconnected BOOL input of a standard function block keeps its initial
                 // value FALSE (nothing in the body sets it, IEC 61131-3 2.5.2.1).
                 [] if black_box::is_standard_fb(ty)
@@ -279,8 +357,29 @@ impl Fbd<'_, '_, '_> {
             input = bool_literal(self.ctx, ty, name, input);
             if name == "EN" {
                 b.cond = Some(input);
+            } else if let Some(fields) = self.whole_structure(ty, name, &input) {
+                // A structure passed whole into a function block's structure input: each field
+                // into its field (the model holds a structure as one variable per field).
+                inputs.extend(fields);
             } else {
                 inputs.push((Cow::Owned(name.to_owned()), input));
+            }
+        }
+        // The inputs the instance's declaration gives a value and the block does not list.
+        if let Some(inst) = el.node.attribute("instanceName") {
+            for (pin, v, at) in self.ctx.init_inputs(inst, ty) {
+                if !el
+                    .inputs
+                    .iter()
+                    .any(|p| p.name.is_some_and(|n| n.eq_ignore_ascii_case(&pin)))
+                {
+                    let input = Input {
+                        origin: at,
+                        from: Connection::Constant(v),
+                    };
+                    let input = bool_literal(self.ctx, ty, &pin, input);
+                    inputs.push((Cow::Owned(pin), input));
+                }
             }
         }
         b.inputs = Some(Ok(Inputs::Named(inputs)));

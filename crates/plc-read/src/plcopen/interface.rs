@@ -51,6 +51,21 @@ pub(super) struct Interface {
     /// The declarations of the `externalVars`, and those of them whose type was mapped.
     pub external_decls: Vec<Var<'static>>,
     pub external_mapped: Vec<Mapped>,
+    /// The initial values of function block instances (`T0 : TON := (PT := T#1s)`).
+    pub fb_inits: Vec<FbInit>,
+}
+
+/// The initial value of a function block instance (IEC 61131-3 6.5.1.4 Table 14, TC6
+/// `initialValue/structValue`): a value for each member it names, in file order. A graphical
+/// call of the instance that leaves an input unconnected reads it (`super::fbd`,
+/// `super::ld_block`); [`super::project`] makes `run` refuse a POU where one cannot apply.
+#[derive(Clone, Debug)]
+pub(super) struct FbInit {
+    pub instance: String,
+    /// The instance's function block type.
+    pub fb: String,
+    pub origin: plc_diag::Origin,
+    pub members: Vec<(String, Operand<'static>)>,
 }
 
 /// A variable whose IEC 61131-3 elementary type the model lacks, read as one it has.
@@ -103,7 +118,8 @@ pub(super) fn interface(tc6: Tc6, node: Option<Node>, pou: &str, known: &Known) 
                     "outputVars" => VarClass::Output,
                     _ => VarClass::Default,
                 };
-                let vars = var_list(tc6, list, class, &place, known, &mut out.mapped)?;
+                let (m, f) = (&mut out.mapped, &mut out.fb_inits);
+                let vars = var_list(tc6, list, class, &place, known, m, f)?;
                 match kind {
                     "inputVars" => out.inputs.extend(vars),
                     "outputVars" => out.outputs.extend(vars),
@@ -119,7 +135,9 @@ pub(super) fn interface(tc6: Tc6, node: Option<Node>, pou: &str, known: &Known) 
                 // Their declarations, for a global the file does not declare (an editor
                 // extension's); one that cannot be read is left to the global's.
                 let mut mapped = Vec::new();
-                if let Ok(vars) = var_list(tc6, list, VarClass::Default, &place, known, &mut mapped)
+                let mut inits = Vec::new();
+                let class = VarClass::Default;
+                if let Ok(vars) = var_list(tc6, list, class, &place, known, &mut mapped, &mut inits)
                 {
                     out.external_decls.extend(vars);
                     out.external_mapped.extend(mapped);
@@ -153,10 +171,11 @@ pub(super) fn var_list(
     place: &str,
     known: &Known,
     mapped: &mut Vec<Mapped>,
+    fb_inits: &mut Vec<FbInit>,
 ) -> R<Vec<Var<'static>>> {
     let mut out = Vec::new();
     for v in tc6.children(list, "variable") {
-        out.extend(variable(tc6, v, class, place, known, mapped)?);
+        out.extend(variable(tc6, v, class, place, known, mapped, fb_inits)?);
     }
     Ok(out)
 }
@@ -170,6 +189,7 @@ fn variable(
     place: &str,
     known: &Known,
     mapped: &mut Vec<Mapped>,
+    fb_inits: &mut Vec<FbInit>,
 ) -> R<Vec<Var<'static>>> {
     let raw = super::xml::attr(v, "name", place)?;
     let name = identifier(raw, "variable", v, place)?;
@@ -191,6 +211,10 @@ fn variable(
     };
     let Ty::Data(d) = &ty else {
         let iv = tc6.child(v, "initialValue");
+        if let (Ty::Fb(fb), Some(iv)) = (&ty, iv) {
+            fb_inits.push(fb_init(tc6, iv, &name, fb, &place)?);
+            return Ok(vec![one(tc6, &decl, name, ty, None, None, mapped)?]);
+        }
         return Ok(vec![one(tc6, &decl, name, ty, iv, None, mapped)?]);
     };
     let Base::Struct(members) = &d.base else {
@@ -397,6 +421,19 @@ fn type_name(tc6: Tc6, ty: Node, var: &str, place: &str, known: &Known) -> R<Ty>
     };
     match tag {
         "array" => return whole(Aggregate::Array, "ARRAY"),
+        // A subrange or enumeration declared in place (`x : INT (0..10)`, `c : (RED, GREEN)`).
+        "subrangeSigned" | "subrangeUnsigned" | "enum" => {
+            let shown = if tag == "enum" { "ENUM" } else { "SUBRANGE" };
+            let d = super::data_types::base(
+                tc6,
+                &std::collections::HashMap::new(),
+                shown,
+                t,
+                0,
+                place,
+            )?;
+            return Ok(Ty::Data(d));
+        }
         "struct" => {
             let members = super::data_types::members(
                 tc6,
@@ -435,6 +472,41 @@ fn type_name(tc6: Tc6, ty: Node, var: &str, place: &str, known: &Known) -> R<Ty>
         ));
     }
     Ok(Ty::Fb(name))
+}
+
+/// The initial value `iv` of function block instance `var` of type `fb`: a structured value
+/// whose members are simple values (`(PT := T#1s, PV := 3)`).
+fn fb_init(tc6: Tc6, iv: Node, var: &str, fb: &str, place: &str) -> R<FbInit> {
+    let sv = tc6.child(iv, "structValue").ok_or_else(|| {
+        error(
+            origin(iv),
+            place,
+            format!("the initial value of function block instance `{var}` is not a structured value (`(PT := T#1s)`)"),
+        )
+    })?;
+    let mut members = Vec::new();
+    for m in tc6.children(sv, "value") {
+        let member = super::xml::attr(m, "member", place)?.trim().to_owned();
+        let simple = tc6.child(m, "simpleValue").ok_or_else(|| {
+            error(
+                origin(m),
+                place,
+                format!("the initial value of `{var}.{member}` is not a simple value (nested structured and array values of an instance are not supported yet)"),
+            )
+        })?;
+        let text = super::xml::attr(simple, "value", place)?;
+        let shown = format!("{var}.{member}");
+        members.push((
+            member,
+            literal_operand(text, origin(simple), &shown, place)?,
+        ));
+    }
+    Ok(FbInit {
+        instance: var.to_owned(),
+        fb: fb.to_owned(),
+        origin: origin(iv),
+        members,
+    })
 }
 
 /// The initial value of enumeration variable `var`: one of its type's values.
@@ -476,6 +548,16 @@ fn enum_operand(
 /// The initial value a variable of data type `d` gets from its type (IEC 61131-3 6.4.4), if any.
 fn type_initial(d: &DataType, var: &str, place: &str) -> R<Option<Operand<'static>>> {
     let Some((text, at)) = &d.init else {
+        // An enumeration without an initial value starts at its first value (IEC 61131-3
+        // 6.4.4.2), which named values may make other than 0.
+        if let Base::Enum(v) = &d.base {
+            if let Some(&(_, first)) = v.first().filter(|f| f.1 != 0) {
+                return Ok(Some(Located {
+                    value: Scalar::Number(first.into()),
+                    origin: plc_diag::Origin::default(),
+                }));
+            }
+        }
         return Ok(None);
     };
     if matches!(d.base, Base::Enum(_)) {
@@ -485,7 +567,7 @@ fn type_initial(d: &DataType, var: &str, place: &str) -> R<Option<Operand<'stati
         error(
             *at,
             place,
-            format!("initial value `{text}` of data type `{}` is not a boolean, a number or a TIME literal", d.name),
+            format!("initial value `{text}` of data type `{}` is not a boolean, a number, a TIME or a date and time literal", d.name),
         )
     })?;
     Ok(Some(Located { value, origin: *at }))
@@ -504,7 +586,7 @@ fn literal_operand(
             at,
             place,
             format!(
-                "initial value `{text}` of `{var}` is not a boolean, a number or a TIME literal"
+                "initial value `{text}` of `{var}` is not a boolean, a number, a TIME or a date and time literal"
             ),
         )
     })?;
@@ -559,6 +641,11 @@ pub(super) fn literal(text: &str) -> Option<Scalar<'static>> {
     }
     if plc_syntax::is_time_literal(t) {
         return Some(Scalar::Str(Cow::Owned(t.to_owned())));
+    }
+    // A date, time of day or date and time: the integer the model holds for it (seconds since
+    // 1970 for DATE and DT, ms since midnight for TOD; [`plc_model::parse_date_literal`]).
+    if let Some((_, v)) = plc_model::parse_date_literal(t) {
+        return Some(Scalar::Number(v.into()));
     }
     if let Some((prefix, rest)) = t.split_once('#') {
         let p = prefix.to_ascii_uppercase();
@@ -689,5 +776,16 @@ mod tests {
             Some(Scalar::Str(Cow::Borrowed("TIME#2s")))
         );
         assert_eq!(literal("FOO#5"), None);
+        // Dates as seconds since 1970, times of day as ms since midnight (IEC 61131-3 6.3.4).
+        assert_eq!(literal("D#1970-01-02"), Some(Scalar::Number(86_400.into())));
+        assert_eq!(literal("TOD#00:00:01.5"), Some(Scalar::Number(1500.into())));
+        assert_eq!(
+            literal("DT#1970-01-01-01:00:00"),
+            Some(Scalar::Number(3600.into()))
+        );
+        assert_eq!(
+            literal("LTIME#2s"),
+            Some(Scalar::Str(Cow::Borrowed("LTIME#2s")))
+        );
     }
 }

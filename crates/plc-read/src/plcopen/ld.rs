@@ -54,7 +54,13 @@ const LD_TAGS: &[&str] = &[
 ];
 
 /// Reads LD body `node` of POU `pou` into rungs `<pou>.R1`, `<pou>.R2` … in execution order.
-pub(super) fn rungs(tc6: Tc6, node: Node, pou: &str, notes: &mut Notes) -> R<Vec<Rung<'static>>> {
+pub(super) fn rungs(
+    tc6: Tc6,
+    node: Node,
+    pou: &str,
+    inits: &super::block_types::Inits,
+    notes: &mut Notes,
+) -> R<Vec<Rung<'static>>> {
     let place = format!("pou {pou}, LD");
     let g = graph(tc6, node, &place, notes)?;
     g.only(LD_TAGS, "LD", &place)?;
@@ -69,6 +75,7 @@ pub(super) fn rungs(tc6: Tc6, node: Node, pou: &str, notes: &mut Notes) -> R<Vec
         }
     }
     let mut power = Power::new(&g, place.clone(), ld_block::BLOCKS);
+    power.inits = inits.clone();
     let outputs = outputs(&power)?;
     let component = components(&g);
     // Outputs grouped by rung, rungs in the order of their first output.
@@ -298,6 +305,22 @@ fn output_path(p: &mut Power, o: ElemId) -> R<Path> {
             ElementKind::Jmp(name(identifier(raw, "label", node, &p.at(o))?, node))
         }
         "return" => ElementKind::Ret,
+        // An out variable fed by a function block's data output (a CTU's CV, a timer's ET) is
+        // assigned that output after the box (as Beremiz generates it), not a coil powered
+        // through a contact on it: the output is not BOOL.
+        "outVariable" => match data_side_output(p, o)? {
+            Some(from) => {
+                let to = p.variable(o)?;
+                return Ok(vec![Item {
+                    key: Key::Elem(o),
+                    element: Element {
+                        origin: origin(node),
+                        kind: ElementKind::Move(Box::new(plc_syntax::Move { from, to })),
+                    },
+                }]);
+            }
+            None => return p.out(o, None),
+        },
         _ => return p.out(o, None),
     };
     let mut path = p.input(o, 0)?;
@@ -309,6 +332,32 @@ fn output_path(p: &mut Power, o: ElemId) -> R<Path> {
         },
     });
     Ok(path)
+}
+
+/// The field `instance.CV` / `instance.ET` when out variable `o` is fed by one alone: the data
+/// outputs of the standard function blocks (IEC 61131-3 2.5.2.3), the others being BOOL.
+fn data_side_output(p: &Power, o: ElemId) -> R<Option<plc_syntax::Operand<'static>>> {
+    let el = p.g.get(o);
+    let [pin] = el.inputs.as_slice() else {
+        return Ok(None);
+    };
+    let [s] = pin.sources.as_slice() else {
+        return Ok(None);
+    };
+    let Some(out) = s.pin.filter(|x| matches!(*x, "CV" | "ET")) else {
+        return Ok(None);
+    };
+    if !ld_block::reads_side(p, s.elem, Some(out)) {
+        return Ok(None);
+    }
+    let src = p.g.get(s.elem).node;
+    let here = p.at(s.elem);
+    let raw = attr(src, "instanceName", &here)?;
+    let instance = identifier(raw, "instance", src, &here)?;
+    Ok(Some(Located {
+        value: plc_syntax::Scalar::Str(format!("{instance}.{out}").into()),
+        origin: origin(el.node),
+    }))
 }
 
 fn name(s: String, node: Node) -> Name<'static> {

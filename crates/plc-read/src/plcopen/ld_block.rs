@@ -446,6 +446,24 @@ fn box_kind(p: &mut Power, e: ElemId, spec: &Spec, ty: &str) -> R<ElementKind<'s
 fn operand(p: &mut Power, e: ElemId, pin: &str, ty: &str) -> R<Operand<'static>> {
     let el = p.g.get(e);
     let here = p.at(e);
+    // An unconnected (or unlisted) input of an instance whose declaration gives it a value
+    // reads that value (IEC 61131-3 6.5.1.4, `T0 : TON := (PT := T#1s)`).
+    let listed = el.inputs.iter().find(|x| x.name == Some(pin));
+    if listed.is_none_or(|x| x.sources.is_empty()) {
+        let inst = el
+            .node
+            .attribute("instanceName")
+            .map(str::to_ascii_lowercase);
+        let init = inst
+            .and_then(|i| p.inits.get(&i))
+            .and_then(|m| m.iter().find(|(name, _, _)| name.eq_ignore_ascii_case(pin)));
+        if let Some((_, value, at)) = init {
+            return Ok(Located {
+                value: value.clone(),
+                origin: *at,
+            });
+        }
+    }
     let Some(input) = el.inputs.iter().find(|x| x.name == Some(pin)) else {
         return Err(error(
             origin(el.node),

@@ -100,6 +100,9 @@ pub(super) struct Power<'g, 'a, 'i> {
     pub feeds: Vec<(ElemId, Path)>,
     /// The variables those series write.
     pub vars: Vec<plc_syntax::Var<'static>>,
+    /// The initial values of the POU's function block instances (an unconnected input reads
+    /// its instance's, `super::interface::FbInit`).
+    pub inits: super::block_types::Inits,
     blocks: Blocks,
 }
 
@@ -113,6 +116,7 @@ impl<'g, 'a, 'i> Power<'g, 'a, 'i> {
             depth: 0,
             feeds: Vec::new(),
             vars: Vec::new(),
+            inits: Default::default(),
             blocks,
         }
     }

@@ -155,6 +155,7 @@ pub(super) fn program(
         notes.push(note);
     }
     library_fbs(&mut fbs, &programs, &globals, notes);
+    opaque_types(&mut programs, &mut fbs, &mut globals, notes);
     if let Some(s) = select {
         // `run` runs the selected program alone: the others' bodies do not matter to it.
         let others: Vec<&str> = programs
@@ -218,6 +219,76 @@ fn library_fbs(
             fbs.push(fb);
             notes.push(note);
         }
+    }
+}
+
+/// Variables of a type that nothing defines (not elementary, not a data type of the file or a
+/// library, not a function block the model, the file or a black box has: a CODESYS library
+/// type such as `JSONVAR`): each becomes a black box, a whole variable standing in as a DINT
+/// without a value, so that the analysis sees its reads and writes; one note names the types
+/// and their variables, and `run` refuses each POU that declares one (by name).
+fn opaque_types(
+    programs: &mut [ProgramPou],
+    fbs: &mut [FunctionBlock<'static>],
+    globals: &mut [Var<'static>],
+    notes: &mut Notes,
+) {
+    let known: HashSet<String> = fbs.iter().map(|f| f.name.to_string()).collect();
+    let mut found: Vec<(String, plc_diag::Origin, Vec<String>)> = Vec::new();
+    let mut refuse: Vec<(String, plc_diag::Origin, String, String)> = Vec::new();
+    let mut visit = |pou: &str, v: &mut Var<'static>| {
+        let ty = v.ty.as_str();
+        if plc_model::Type::parse(ty).is_some() || known.contains(ty) {
+            return;
+        }
+        let ty = ty.to_owned();
+        let who = if pou.is_empty() {
+            v.name.as_str().to_owned()
+        } else {
+            format!("{pou}.{}", v.name.as_str())
+        };
+        match found.iter_mut().find(|f| f.0 == ty) {
+            Some(f) => f.2.push(who),
+            None => found.push((ty.clone(), v.ty.origin, vec![who])),
+        }
+        let owner = if pou.is_empty() { "(global)" } else { pou };
+        refuse.push((owner.to_owned(), v.origin, v.name.as_str().to_owned(), ty));
+        v.ty.value = std::borrow::Cow::Borrowed("DINT");
+        v.init = None;
+    };
+    for p in programs.iter_mut() {
+        for v in &mut p.vars {
+            visit(&p.name, v);
+        }
+    }
+    for f in fbs.iter_mut() {
+        let name = f.name.to_string();
+        for v in f.inputs.iter_mut().chain(&mut f.outputs).chain(&mut f.vars) {
+            visit(&name, v);
+        }
+    }
+    for v in globals.iter_mut() {
+        visit("", v);
+    }
+    let Some(first) = found.first() else { return };
+    let list: Vec<String> = found
+        .iter()
+        .map(|(t, _, who)| format!("{t}: {}", who.join(", ")))
+        .collect();
+    notes.push(Note {
+        origin: first.1,
+        message: format!("types that the file names and nobody defines (an editor's library types?) are read as black boxes: {}; each such variable is one whole variable without a value (a DINT stand-in), so the analysis sees its reads and writes, and `run` cannot execute the POUs that declare one", list.join("; ")),
+    });
+    for (pou, at, var, ty) in refuse {
+        let pou = if pou == "(global)" {
+            programs.first().map_or(pou, |p| p.name.clone())
+        } else {
+            pou
+        };
+        notes.no_run.push((pou.clone(), Note {
+            origin: at,
+            message: format!("pou {pou}: variable `{var}` is of type `{ty}`, which the file does not define (a black box without a value), so `run` cannot execute `{pou}`"),
+        }));
     }
 }
 
@@ -452,6 +523,21 @@ fn body(
             message: format!("{place}: the {} localId {} reads an array element, `{}`; the model holds an array as one value, so the analysis reads the whole array (and the subscripts), but `run` cannot execute the {tag} body of `{name}`", n.tag_name().name(), n.attribute("localId").unwrap_or("?"), super::pins::expression_text(n).trim()),
         }));
     }
+    for i in &iface.fb_inits {
+        for (m, v) in &i.members {
+            let why = if ctx.input_pin(&i.fb, m).is_none() {
+                format!("`{m}` is not an input of {} (the model gives an instance's inputs their declared values, nothing else)", i.fb)
+            } else if !matches!(tag, "LD" | "FBD") {
+                format!("the value is applied to the unconnected inputs of LD and FBD calls only, and the body is {tag}")
+            } else {
+                continue;
+            };
+            notes.no_run.push((name.to_owned(), Note {
+                origin: v.origin,
+                message: format!("{place}: the initial value of `{}.{m}`: {why}; so `run` cannot execute the {tag} body of `{name}`", i.instance),
+            }));
+        }
+    }
     Ok(match tag {
         "LD" => ld_body(tc6, lang, name, ctx, notes)?,
         "FBD" => Body::Fbd(fbd::body(tc6, lang, name, ctx, notes)?),
@@ -526,7 +612,17 @@ fn instances<'a, 'i>(
     let mut globals_of = |node: Node, globals: &mut Vec<Var<'static>>| -> R<()> {
         for gv in tc6.children(node, "globalVars") {
             let class = plc_syntax::VarClass::Default;
-            globals.extend(interface::var_list(tc6, gv, class, place, known, mapped)?);
+            let mut inits = Vec::new();
+            globals.extend(interface::var_list(
+                tc6, gv, class, place, known, mapped, &mut inits,
+            )?);
+            if let Some(i) = inits.first() {
+                return Err(error(
+                    i.origin,
+                    place,
+                    format!("global function block instance `{}` has an initial value; initial values of global instances are not supported yet (those of a POU's instances are)", i.instance),
+                ));
+            }
         }
         Ok(())
     };
@@ -617,7 +713,7 @@ fn instance_type(pi: Node, place: &str) -> R<String> {
 /// both fail, the rung reader's error.
 fn ld_body(tc6: Tc6, lang: Node, name: &str, ctx: &Ctx, notes: &mut Notes) -> R<Body<'static>> {
     let (list, vars) = (notes.list.len(), notes.ld_vars.len());
-    let why = match ld::rungs(tc6, lang, name, notes) {
+    let why = match ld::rungs(tc6, lang, name, &ctx.inits, notes) {
         Ok(r) => return Ok(Body::Rungs(r)),
         Err(e) => e,
     };
@@ -700,11 +796,21 @@ fn pou_ctx(base: &Ctx, iface: &Interface, globals: &[(&str, &str)]) -> Ctx {
             vars.insert(n.to_ascii_lowercase(), t.to_string());
         }
     }
+    let mut inits = std::collections::HashMap::new();
+    for i in &iface.fb_inits {
+        let members = i
+            .members
+            .iter()
+            .map(|(m, v)| (m.clone(), v.value.clone(), v.origin))
+            .collect();
+        inits.insert(i.instance.to_ascii_lowercase(), members);
+    }
     Ctx {
         functions: base.functions.clone(),
         fbs: base.fbs.clone(),
         fb_inputs: base.fb_inputs.clone(),
         vars,
+        inits,
     }
 }
 

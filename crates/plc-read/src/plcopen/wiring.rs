@@ -126,6 +126,7 @@ pub(super) fn graph<'a, 'i>(
     notes: &mut Notes,
 ) -> R<Graph<'a, 'i>> {
     let doc = body.document();
+    let ids = LocalIds::of(tc6, body, place, notes);
     let mut elems: Vec<Elem> = Vec::new();
     let mut by_id: HashMap<u32, ElemId> = HashMap::new();
     for n in tc6.elements(body) {
@@ -135,7 +136,7 @@ pub(super) fn graph<'a, 'i>(
         }
         let here = format!("{place}, {tag}");
         let raw = attr(n, "localId", &here)?;
-        let local_id: u32 = raw.trim().parse().map_err(|_| {
+        let local_id: u32 = ids.id(raw).ok_or_else(|| {
             error(
                 origin(n),
                 &here,
@@ -162,13 +163,13 @@ pub(super) fn graph<'a, 'i>(
             outputs: Vec::new(),
         };
         if tag == "block" {
-            block_pins(tc6, &mut el, &here)?;
+            block_pins(tc6, &mut el, &here, &ids)?;
         } else if !UNWIRED.contains(&tag) {
             for cp in tc6.children(n, "connectionPointIn") {
                 el.inputs.push(Pin {
                     name: None,
                     node: n,
-                    sources: connections(tc6, cp, &here)?,
+                    sources: connections(tc6, cp, &here, &ids)?,
                 });
             }
         }
@@ -193,14 +194,70 @@ pub(super) fn graph<'a, 'i>(
     Ok(g)
 }
 
-fn block_pins<'a, 'i>(tc6: Tc6, el: &mut Elem<'a, 'i>, place: &str) -> R<()> {
+/// The localIds of a body as the reader numbers them: TC6 allows any `xsd:unsignedLong` and
+/// CODESYS writes ids up to 2^64 - 1, the model's blocks are numbered in 32 bits. An id that
+/// fits is itself; the others are renumbered down from 2^32 - 1 (skipping the ids in use), in
+/// file order, and one note gives the mapping.
+struct LocalIds {
+    big: HashMap<u64, u32>,
+}
+
+impl LocalIds {
+    fn of(tc6: Tc6, body: Node, place: &str, notes: &mut Notes) -> LocalIds {
+        let raw: Vec<u64> = tc6
+            .elements(body)
+            .filter_map(|n| n.attribute("localId"))
+            .filter_map(|r| r.trim().parse::<u64>().ok())
+            .collect();
+        let mut big = HashMap::new();
+        if raw.iter().all(|&x| x <= u32::MAX as u64) {
+            return LocalIds { big };
+        }
+        let used: std::collections::HashSet<u64> = raw.iter().copied().collect();
+        let mut next = u32::MAX;
+        let mut shown = Vec::new();
+        for &x in raw.iter().filter(|&&x| x > u32::MAX as u64) {
+            if big.contains_key(&x) {
+                continue;
+            }
+            while used.contains(&(next as u64)) {
+                next -= 1;
+            }
+            big.insert(x, next);
+            shown.push(format!("{x} → {next}"));
+            next -= 1;
+        }
+        let at = tc6
+            .elements(body)
+            .find(|n| {
+                n.attribute("localId")
+                    .and_then(|r| r.trim().parse::<u64>().ok())
+                    .is_some_and(|x| x > u32::MAX as u64)
+            })
+            .map_or_else(|| origin(body), origin);
+        notes.push(super::xml::Note {
+            origin: at,
+            message: format!("{place}: localIds beyond 4294967295 are renumbered (the model numbers blocks in 32 bits), and messages name them so: {}", shown.join(", ")),
+        });
+        LocalIds { big }
+    }
+
+    /// The reader's number of localId `raw`; `None` when it is not a whole number (or a big
+    /// one no element has).
+    fn id(&self, raw: &str) -> Option<u32> {
+        let x: u64 = raw.trim().parse().ok()?;
+        u32::try_from(x).ok().or_else(|| self.big.get(&x).copied())
+    }
+}
+
+fn block_pins<'a, 'i>(tc6: Tc6, el: &mut Elem<'a, 'i>, place: &str, ids: &LocalIds) -> R<()> {
     let n = el.node;
     for list in ["inputVariables", "inOutVariables"] {
         for l in tc6.children(n, list) {
             for v in tc6.children(l, "variable") {
                 let name = attr(v, "formalParameter", place)?;
                 let sources = match tc6.child(v, "connectionPointIn") {
-                    Some(cp) => connections(tc6, cp, place)?,
+                    Some(cp) => connections(tc6, cp, place, ids)?,
                     None => Vec::new(),
                 };
                 el.inputs.push(Pin {
@@ -221,7 +278,7 @@ fn block_pins<'a, 'i>(tc6: Tc6, el: &mut Elem<'a, 'i>, place: &str) -> R<()> {
 
 /// The connections of one `connectionPointIn` (its `refLocalId`s still raw: `elem` is the
 /// localId until [`resolve_refs`]).
-fn connections<'a>(tc6: Tc6, cp: Node<'a, '_>, place: &str) -> R<Vec<Source<'a>>> {
+fn connections<'a>(tc6: Tc6, cp: Node<'a, '_>, place: &str, ids: &LocalIds) -> R<Vec<Source<'a>>> {
     if let Some(e) = tc6.child(cp, "expression") {
         return Err(error(
             origin(e),
@@ -232,13 +289,26 @@ fn connections<'a>(tc6: Tc6, cp: Node<'a, '_>, place: &str) -> R<Vec<Source<'a>>
     let mut out = Vec::new();
     for c in tc6.children(cp, "connection") {
         let raw = attr(c, "refLocalId", place)?;
-        let id: u32 = raw.trim().parse().map_err(|_| {
-            error(
-                origin(c),
-                place,
-                format!("refLocalId `{raw}` is not a whole number"),
-            )
-        })?;
+        let id: u32 = match ids.id(raw) {
+            Some(id) => id,
+            None if raw.trim().parse::<u64>().is_ok() => {
+                return Err(error(
+                    origin(c),
+                    place,
+                    format!(
+                        "the connection refers to localId {}, which is not an element of this body",
+                        raw.trim()
+                    ),
+                ))
+            }
+            None => {
+                return Err(error(
+                    origin(c),
+                    place,
+                    format!("refLocalId `{raw}` is not a whole number"),
+                ))
+            }
+        };
         out.push(Source {
             elem: ElemId(id),
             pin: c.attribute("formalParameter").filter(|p| !p.is_empty()),
