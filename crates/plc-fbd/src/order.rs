@@ -111,6 +111,7 @@ mod tests {
                     vars: vec![],
                 }],
                 cond: None,
+                en: false,
                 after: vec![],
                 comment: None,
             })

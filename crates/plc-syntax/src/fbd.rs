@@ -67,6 +67,10 @@ pub struct Block<'a> {
     pub label: Option<Read<Text<'a>>>,
     /// The conditional arc into the control input (a JMP's or RET's own condition).
     pub cond: Option<Input<'a>>,
+    /// `cond` is the block's IEC 61131-3 EN input (2.5.1.2, PLCopen and the JSON key `en`): it
+    /// decides whether this block alone runs, and blocks fed by it run in every scan. Without
+    /// it, `cond` is a conditional arc that opens a fragment (the FBD text-generation paper).
+    pub en: bool,
     /// Control arcs: the ids of the blocks whose control outputs feed the control input.
     pub after: Option<Read<Vec<Read<u32>>>>,
     pub comment: Option<Read<Text<'a>>>,

@@ -370,7 +370,8 @@ fn block(b: &Block) -> io::Result<Value> {
         o.insert("out".into(), outputs(read(outs)?)?);
     }
     if let Some(c) = &b.cond {
-        o.insert("cond".into(), input(c)?);
+        let key = if b.en { "en" } else { "cond" };
+        o.insert(key.into(), input(c)?);
     }
     if let Some(after) = &b.after {
         let ids = read(after)?

@@ -21,7 +21,7 @@ type Result<T> = P<T>;
 const BODY_KEYS: &[&str] = &["networks", "comment"];
 const NETWORK_KEYS: &[&str] = &["id", "label", "comment", "blocks"];
 const BLOCK_KEYS: &[&str] = &[
-    "id", "op", "in", "out", "instance", "cond", "after", "label", "comment",
+    "id", "op", "in", "out", "instance", "cond", "en", "after", "label", "comment",
 ];
 const ARC_KEYS: &[&str] = &["from", "pin"];
 
@@ -275,6 +275,7 @@ impl<'a> FbdReader<'a> {
             instance: None,
             label: None,
             cond: None,
+            en: false,
             after: None,
             comment: None,
             problem: None,
@@ -318,6 +319,20 @@ impl<'a> FbdReader<'a> {
         b.label = self.text(&e, "label")?;
         if let Some(c) = get(&e, "cond") {
             b.cond = Some(self.input(c)?);
+        }
+        if let Some(c) = get(&e, "en") {
+            if b.cond.is_some() {
+                b.problem = Some(problem(
+                    ".en",
+                    c.origin(),
+                    Invalid::Misplaced {
+                        what: "`en`",
+                        place: "together with `cond` (a block has one control input)",
+                    },
+                ));
+            }
+            b.cond = Some(self.input(c)?);
+            b.en = true;
         }
         if let Some(a) = get(&e, "after") {
             b.after = Some(self.after(a)?);

@@ -209,6 +209,7 @@ impl Fbd<'_, '_, '_> {
             instance: None,
             label: None,
             cond: None,
+            en: false,
             after: None,
             comment: None,
             problem: None,
@@ -279,6 +280,7 @@ impl Fbd<'_, '_, '_> {
             input = bool_literal(self.ctx, ty, name, input);
             if name == "EN" {
                 b.cond = Some(input);
+                b.en = true;
             } else {
                 inputs.push((Cow::Owned(name.to_owned()), input));
             }

@@ -354,6 +354,7 @@ impl Flow<'_, '_, '_> {
             instance: None,
             label: None,
             cond: None,
+            en: false,
             after: None,
             comment: None,
             problem: None,
@@ -396,6 +397,7 @@ impl Flow<'_, '_, '_> {
         }
         let net = &mut self.a.blocks;
         net[idx].inputs = Some(Ok(Inputs::Named(inputs)));
+        net[idx].en = cond.is_some();
         net[idx].cond = cond;
         let mut b = std::mem::replace(&mut self.a.blocks[idx], placeholder());
         let t = black_box::Typer {
@@ -523,6 +525,7 @@ impl Flow<'_, '_, '_> {
             instance: None,
             label: label.map(|l| Ok(Cow::Owned(l))),
             cond: (!is_const(&p, true)).then_some(p),
+            en: false,
             after: None,
             comment: None,
             problem: None,
@@ -559,6 +562,7 @@ fn placeholder() -> Block<'static> {
         instance: None,
         label: None,
         cond: None,
+        en: false,
         after: None,
         comment: None,
         problem: None,

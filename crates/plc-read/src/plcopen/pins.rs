@@ -92,6 +92,7 @@ impl Added {
             instance: instance.map(|i| Ok(Cow::Owned(i))),
             label: None,
             cond: None,
+            en: false,
             after: None,
             comment: None,
             problem: None,
