@@ -104,6 +104,9 @@ pub struct Network {
     pub origin: plc_diag::Origin,
     /// Sorted by [`Block::id`].
     pub blocks: Vec<Block>,
+    /// The blocks the depth-first order starts from first, in this order (Beremiz's statement
+    /// order of a PLCopen body); empty: by id.
+    pub roots: Vec<BlockId>,
 }
 
 impl Network {

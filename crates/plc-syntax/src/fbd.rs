@@ -46,6 +46,10 @@ pub struct Network<'a> {
     pub comment: Option<Read<Text<'a>>>,
     /// `Err`: missing, not an array, or empty.
     pub blocks: Read<Vec<Block<'a>>>,
+    /// The blocks (by id) that the depth-first execution order starts from, in this order: each
+    /// runs after the blocks it depends on and before later ones (Beremiz's statement order of
+    /// a PLCopen body; the JSON key `order`). The other blocks follow by id.
+    pub order: Option<Read<Vec<Read<u32>>>>,
     /// An unknown field.
     pub problem: Option<Box<Problem>>,
 }

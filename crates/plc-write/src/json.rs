@@ -335,6 +335,13 @@ fn network(n: &Network, w: &mut impl Write, indent: &str) -> io::Result<()> {
     if let Some(c) = &n.comment {
         write!(w, ", \"comment\": {}", string(read(c)?))?;
     }
+    if let Some(o) = &n.order {
+        let ids = read(o)?
+            .iter()
+            .map(|id| read(id).map(|&id| Value::from(id)))
+            .collect::<io::Result<_>>()?;
+        write!(w, ", \"order\": {}", Value::Array(ids))?;
+    }
     write!(w, ", \"blocks\": ")?;
     let items: Vec<Value> = read(&n.blocks)?
         .iter()

@@ -175,6 +175,7 @@ fn network(
         label: label.map(|(l, _)| Ok(Cow::Owned(l))),
         comment: (!comments.is_empty()).then(|| Ok(Cow::Owned(comments.join("\n")))),
         blocks: Ok(blocks),
+        order: None,
         problem: None,
     }
 }
@@ -327,9 +328,13 @@ impl Fbd<'_, '_, '_> {
             if *pin == "ENO" && !targets.is_empty() {
                 // ENO is EN (IEC 61131-3 2.5.1.2: TRUE when the block ran without error).
                 let en = self.eno(e, origin(*pnode))?;
+                // Beremiz writes an out variable fed by a block with EN only under
+                // `IF <ENO> THEN` (PLCGenerator.GetUsedEno): a MOVE gated by the same EN.
                 let mut a = self.a.borrow_mut();
-                a.add_on("MOVE", None, Inputs::List(vec![en]), origin(*pnode));
+                a.add_on("MOVE", None, Inputs::List(vec![en.clone()]), origin(*pnode));
                 if let Some(m) = a.blocks.last_mut() {
+                    m.cond = Some(en);
+                    m.en = true;
                     for t in targets {
                         add_target(m, "OUT".to_owned(), t);
                     }

@@ -91,40 +91,64 @@ pub(super) fn body(
         tracing: HashSet::new(),
         depth: 0,
     };
-    // Networks in the order of their first statement; rungs of blocks only after the others.
-    let mut order: Vec<usize> = Vec::new();
+    // Beremiz's statement order (PLCGenerator.ComputeProgram): coils, out and in-out variables
+    // in file order, then the blocks; each block is computed when a statement first reads it.
+    // Rungs whose statements interleave in the file are one network, so that this order holds
+    // across them; networks in the order of their first statement, rungs of blocks only last.
     let statement = |t: &str| {
         matches!(
             t,
             "coil" | "outVariable" | "inOutVariable" | "jump" | "return"
         )
     };
-    for pass in [true, false] {
-        for (i, el) in g.elems.iter().enumerate() {
-            let wanted = if pass {
-                statement(el.tag)
-            } else {
-                el.tag == "block"
-            };
-            if wanted && !order.contains(&component[i]) {
-                order.push(component[i]);
-            }
+    let mut span: HashMap<usize, (usize, usize)> = HashMap::new();
+    let mut firsts: Vec<usize> = Vec::new();
+    for (i, el) in g.elems.iter().enumerate() {
+        if statement(el.tag) {
+            let s = span.entry(component[i]).or_insert_with(|| {
+                firsts.push(component[i]);
+                (i, i)
+            });
+            s.1 = i;
+        }
+    }
+    // The network of each component: components whose spans overlap share one.
+    let mut net_of: HashMap<usize, usize> = HashMap::new();
+    let mut nets = 0;
+    let mut reach = 0;
+    for &c in &firsts {
+        let (first, last) = span[&c];
+        if nets == 0 || first > reach {
+            nets += 1;
+            reach = last;
+        } else {
+            reach = reach.max(last);
+        }
+        net_of.insert(c, nets - 1);
+    }
+    for (i, el) in g.elems.iter().enumerate() {
+        if el.tag == "block" && !net_of.contains_key(&component[i]) {
+            nets += 1;
+            net_of.insert(component[i], nets - 1);
         }
     }
     let mut networks = Vec::new();
-    for c in order {
+    for n in 0..nets {
+        let mut roots: Vec<u32> = Vec::new();
         for (i, el) in g.elems.iter().enumerate() {
-            if component[i] != c {
+            if net_of.get(&component[i]) != Some(&n) {
                 continue;
             }
             let e = ElemId(i as u32);
             match el.tag {
-                "coil" | "outVariable" | "inOutVariable" => f.write_out(e)?,
-                "jump" | "return" => f.control(e)?,
-                "block" => {
-                    f.block(e)?;
-                }
+                "coil" | "outVariable" | "inOutVariable" => roots.extend(f.write_out(e)?),
+                "jump" | "return" => roots.push(f.control(e)?),
                 _ => {}
+            }
+        }
+        for (i, el) in g.elems.iter().enumerate() {
+            if el.tag == "block" && net_of.get(&component[i]) == Some(&n) {
+                roots.push(f.block(ElemId(i as u32))?);
             }
         }
         let mut blocks = std::mem::take(&mut f.a.blocks);
@@ -139,12 +163,18 @@ pub(super) fn body(
             continue;
         }
         let k = networks.len() + 1;
+        let blocks_ids: HashSet<u32> = blocks.iter().filter_map(|b| b.id.clone().ok()).collect();
         networks.push(Network {
             origin: blocks[0].origin,
             id: Ok(Cow::Owned(format!("{pou}.N{k}"))),
             label: None,
             comment: None,
             blocks: Ok(blocks),
+            order: Some(Ok(roots
+                .into_iter()
+                .filter(|r| blocks_ids.contains(r))
+                .map(Ok)
+                .collect())),
             problem: None,
         });
     }
@@ -425,7 +455,7 @@ impl Flow<'_, '_, '_> {
 
     /// Writes `v` into variable `var` (at `at`): as a target of the block whose output `v` is,
     /// else by a MOVE.
-    fn write(&mut self, var: String, v: Input<'static>, at: Origin) {
+    fn write(&mut self, var: String, v: Input<'static>, at: Origin) -> u32 {
         let target = OutVar {
             origin: at,
             name: Cow::Owned(var),
@@ -442,13 +472,15 @@ impl Flow<'_, '_, '_> {
                 .find(|b| b.id.as_ref().ok() == Some(&block))
             {
                 add_target(b, pin.unwrap_or_else(|| "OUT".to_owned()), target);
-                return;
+                return block;
             }
         }
+        let id = self.a.next_id;
         let _ = self.a.add_on("MOVE", None, Inputs::List(vec![v]), at);
         if let Some(b) = self.a.blocks.last_mut() {
             b.outputs = Some(Ok(Outputs::First(target)));
         }
+        id
     }
 
     /// The first output pin of the block with id `id`, when it is an element of the body.
@@ -465,19 +497,19 @@ impl Flow<'_, '_, '_> {
             .map(str::to_owned)
     }
 
-    /// A coil, an out variable or the input side of an in-out variable.
-    fn write_out(&mut self, e: ElemId) -> R<()> {
+    /// A coil, an out variable or the input side of an in-out variable: the id of the block
+    /// that writes its variable.
+    fn write_out(&mut self, e: ElemId) -> R<Option<u32>> {
         let el = self.g.get(e);
         if el.inputs.first().is_none_or(|p| p.sources.is_empty()) {
-            return Ok(()); // Beremiz skips an unconnected coil or variable.
+            return Ok(None); // Beremiz skips an unconnected coil or variable.
         }
         let at = origin(el.node);
         let here = self.at(e);
         let var = variable_ref(&self.expression(e)?, el.node, &here)?;
         let p = self.power(e)?;
         if el.tag != "coil" {
-            self.write(var, p, at);
-            return Ok(());
+            return Ok(Some(self.write(var, p, at)));
         }
         let flag = |a: &str| el.node.attribute(a);
         let v = match (flag("negated"), flag("storage"), flag("edge")) {
@@ -494,12 +526,11 @@ impl Flow<'_, '_, '_> {
             (_, _, Some(edge @ ("rising" | "falling"))) => self.a.trigger(edge, p, el.local_id, at),
             _ => p,
         };
-        self.write(var, v, at);
-        Ok(())
+        Ok(Some(self.write(var, v, at)))
     }
 
-    /// A jump or a return: JMP/RET with the power as its condition.
-    fn control(&mut self, e: ElemId) -> R<()> {
+    /// A jump or a return: JMP/RET with the power as its condition; its block id.
+    fn control(&mut self, e: ElemId) -> R<u32> {
         let el = self.g.get(e);
         let at = origin(el.node);
         let here = self.at(e);
@@ -530,7 +561,7 @@ impl Flow<'_, '_, '_> {
             comment: None,
             problem: None,
         });
-        Ok(())
+        Ok(id)
     }
 }
 
