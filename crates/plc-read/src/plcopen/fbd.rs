@@ -130,6 +130,15 @@ pub(super) fn body(
     let k = networks.len();
     f.close_loops(&mut current);
     networks.push(network(pou, k, label, current, comments));
+    let roots = statement_order(&g);
+    for n in &mut networks {
+        if let Ok(blocks) = &n.blocks {
+            let ids: std::collections::HashSet<u32> =
+                blocks.iter().filter_map(|b| b.id.clone().ok()).collect();
+            let mine = roots.iter().copied().filter(|r| ids.contains(r)).map(Ok);
+            n.order = Some(Ok(mine.collect()));
+        }
+    }
     if labels == 0 {
         if let Some(n) = networks.first_mut() {
             n.id = Ok(Cow::Owned(pou.to_owned()));
@@ -157,6 +166,47 @@ pub(super) fn body(
         networks,
         problem: None,
     })
+}
+
+/// Beremiz's statement order of an FBD body (PLCGenerator.ComputeProgram): the blocks, out and
+/// in-out variables with an `executionOrderId` above 0 in that order, then the out and in-out
+/// variables in file order, then the blocks in file order; each as the id of the block that
+/// runs it (an out variable fed by a block: that block; fed by a variable: its own MOVE).
+/// Beremiz computes a block when a statement first reads it, which the depth-first order from
+/// these roots does.
+fn statement_order(g: &Graph) -> Vec<u32> {
+    let runner = |i: usize| -> Option<u32> {
+        let el = &g.elems[i];
+        match el.tag {
+            "block" => Some(el.local_id),
+            "outVariable" | "inOutVariable" => match el.inputs.first().map(|p| p.sources.as_slice()) {
+                Some([s]) if g.get(s.elem).tag == "block" => Some(g.get(s.elem).local_id),
+                Some([_]) => Some(el.local_id),
+                _ => None,
+            },
+            _ => None,
+        }
+    };
+    let exec_id = |i: usize| {
+        g.elems[i]
+            .node
+            .attribute("executionOrderId")
+            .and_then(|x| x.trim().parse::<u32>().ok())
+            .filter(|&x| x > 0)
+    };
+    let mut ordered: Vec<(u32, usize)> = (0..g.elems.len())
+        .filter_map(|i| exec_id(i).map(|x| (x, i)))
+        .collect();
+    ordered.sort_unstable();
+    let mut roots: Vec<u32> = ordered.iter().filter_map(|&(_, i)| runner(i)).collect();
+    for tags in [&["outVariable", "inOutVariable"][..], &["block"][..]] {
+        for i in 0..g.elems.len() {
+            if tags.contains(&g.elems[i].tag) && exec_id(i).is_none() {
+                roots.extend(runner(i));
+            }
+        }
+    }
+    roots
 }
 
 fn network(
