@@ -546,7 +546,13 @@ fn pou_on_a_program_without_configuration_reports_that_subroutine() {
             .as_array()
             .unwrap()
             .iter()
-            .map(|r| format!("{} {}", r["id"].as_str().unwrap(), r["pou"].as_str().unwrap()))
+            .map(|r| {
+                format!(
+                    "{} {}",
+                    r["id"].as_str().unwrap(),
+                    r["pou"].as_str().unwrap()
+                )
+            })
             .collect();
         assert_eq!(rungs, ["R11 SBR_A"], "{file}");
     }
@@ -555,7 +561,16 @@ fn pou_on_a_program_without_configuration_reports_that_subroutine() {
     let out = run(&["report", "analyses/conveyor/program.json", "--pou", "ALARM"]);
     let text = String::from_utf8(out.stdout).unwrap();
     assert!(text.starts_with("ALARM: 2 rungs\n"), "{text}");
-    let out = run(&["run", "analyses/conveyor/program.json", "--pou", "ALARM", "--scans", "1"]);
+    let out = run(&[
+        "run",
+        "analyses/conveyor/program.json",
+        "--pou",
+        "ALARM",
+        "--scans",
+        "1",
+    ]);
     assert_eq!(out.status.code(), Some(0));
-    assert!(String::from_utf8(out.stdout).unwrap().starts_with("program ALARM: 1 scan"));
+    assert!(String::from_utf8(out.stdout)
+        .unwrap()
+        .starts_with("program ALARM: 1 scan"));
 }

@@ -238,7 +238,10 @@ fn int_to_real_goes_through_a_dint_and_a_refused_conversion_names_its_types() {
     ]});
     let (p, fbd) = load(&doc);
     let stl = plc_deps::codegen::il::generate(&p, &fbd).unwrap();
-    assert!(stl.contains("LD     go\nI_DI   a, IL_TMP_DINT\nDI_R   IL_TMP_DINT, x\n"), "{stl}");
+    assert!(
+        stl.contains("LD     go\nI_DI   a, IL_TMP_DINT\nDI_R   IL_TMP_DINT, x\n"),
+        "{stl}"
+    );
     let (back, _) = plc_deps::load::stl(&stl).unwrap_or_else(|e| panic!("{e:?}\n{stl}"));
     let scans = [(true, -32768, 32767), (false, 5, -3), (true, 12345, 1)];
     let want = run_named(&p, &["x", "y"], &scans);

@@ -233,7 +233,11 @@ pub fn stl_selected(text: &str, select: &str) -> Result<(Program, Fbd), LoadErro
         // An STL program has no configuration.
         Err(NotSelectable::NoConfiguration { subroutines: names })
         | Err(NotSelectable::Unknown { programs: names }) => {
-            return Err(LoadError::invalid(None, "", no_such_routine(select, &names)))
+            return Err(LoadError::invalid(
+                None,
+                "",
+                no_such_routine(select, &names),
+            ))
         }
     };
     resolve::resolve(text, &syntax)

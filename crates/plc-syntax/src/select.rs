@@ -113,7 +113,11 @@ fn select_routine<'a>(mut p: Program<'a>, select: &str) -> Result<Program<'a>, N
             if called.iter().any(|c| c.eq_ignore_ascii_case(&n)) {
                 continue;
             }
-            if let Some(s) = p.subroutines.iter().find(|s| s.name.eq_ignore_ascii_case(&n)) {
+            if let Some(s) = p
+                .subroutines
+                .iter()
+                .find(|s| s.name.eq_ignore_ascii_case(&n))
+            {
                 todo.push(s.body.as_ref());
             }
             called.push(n);

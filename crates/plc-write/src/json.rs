@@ -490,10 +490,11 @@ mod tests {
           "vars": [{"name": "V1", "type": "INT", "class": "input"}, {"name": "L", "type": "INT"},
                    {"name": "R", "type": "INT"}, {"name": "G1", "type": "GEN"}],
           "fbd": {"comment": "body", "networks": [
-            {"id": "N1", "label": "L2", "comment": "n", "blocks": [
+            {"id": "N1", "label": "L2", "comment": "n", "order": [9, 3], "blocks": [
               {"id": 3, "op": "EQ", "in": ["V1", 1]},
               {"id": 8, "op": "ADD", "in": ["L", 10], "out": "L", "cond": {"from": 3}},
               {"id": 9, "op": "NOT", "in": [{"from": 3}]},
+              {"id": 10, "op": "MOVE", "in": ["V1"], "out": "R", "en": {"from": 9}},
               {"id": 15, "op": "SUB", "in": ["L", 1], "after": [8], "comment": "b"},
               {"id": 17, "op": "GEN", "instance": "G1", "in": {"PERIOD": "T#1s"},
                "out": {"RESULT": "R"}},

@@ -179,11 +179,13 @@ fn statement_order(g: &Graph) -> Vec<u32> {
         let el = &g.elems[i];
         match el.tag {
             "block" => Some(el.local_id),
-            "outVariable" | "inOutVariable" => match el.inputs.first().map(|p| p.sources.as_slice()) {
-                Some([s]) if g.get(s.elem).tag == "block" => Some(g.get(s.elem).local_id),
-                Some([_]) => Some(el.local_id),
-                _ => None,
-            },
+            "outVariable" | "inOutVariable" => {
+                match el.inputs.first().map(|p| p.sources.as_slice()) {
+                    Some([s]) if g.get(s.elem).tag == "block" => Some(g.get(s.elem).local_id),
+                    Some([_]) => Some(el.local_id),
+                    _ => None,
+                }
+            }
             _ => None,
         }
     };

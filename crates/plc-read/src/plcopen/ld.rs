@@ -423,12 +423,7 @@ fn labels(g: &Graph, groups: &[Vec<ElemId>], place: &str) -> R<Vec<Option<Name<'
 /// join the last rung of their component (Beremiz computes them after every statement). A box
 /// cannot run once per rung, so a component with a block whose outputs are split is an error,
 /// after which the body is read as data flow ([`super::ld_flow`]), which keeps that order.
-fn groups(
-    g: &Graph,
-    outputs: &[ElemId],
-    component: &[usize],
-    place: &str,
-) -> R<Vec<Vec<ElemId>>> {
+fn groups(g: &Graph, outputs: &[ElemId], component: &[usize], place: &str) -> R<Vec<Vec<ElemId>>> {
     let mut groups: Vec<Vec<ElemId>> = Vec::new();
     let mut of: Vec<usize> = Vec::new(); // the component of each group
     let mut last_group: std::collections::HashMap<usize, usize> = Default::default();
@@ -459,7 +454,9 @@ fn groups(
     }
     if let Some((o, prev)) = split {
         let c = component[o.0 as usize];
-        if let Some(b) = (0..g.elems.len()).find(|&i| component[i] == c && g.elems[i].tag == "block") {
+        if let Some(b) =
+            (0..g.elems.len()).find(|&i| component[i] == c && g.elems[i].tag == "block")
+        {
             let el = g.get(o);
             return Err(error(
                 origin(el.node),
@@ -476,4 +473,3 @@ fn groups(
     }
     Ok(groups)
 }
-

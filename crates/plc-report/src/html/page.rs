@@ -11,8 +11,8 @@
 //! between visits.
 
 use super::{esc, thousands};
-use crate::words::plural;
 use crate::document::Report;
+use crate::words::plural;
 use std::io::{self, Write};
 
 const STYLE: &str = r#"

@@ -17,9 +17,9 @@
 //! Deliberately not here: running anything, and the cost model itself (the figures come from the
 //! report document, `cost`).
 
-use crate::words::plural;
 use super::{esc, thousands};
 use crate::document::Report;
+use crate::words::plural;
 use std::io::{self, Write};
 
 /// One mode's measured time.
@@ -203,7 +203,13 @@ pub(super) fn write_rates(out: &mut impl Write, run: &RunFigures) -> io::Result<
             .scans_on
             .iter()
             .filter(|(_, n)| *n > 0)
-            .map(|(c, n)| format!("<code>{}</code> {}", esc(c), plural(*n as usize, "scan", "scans")))
+            .map(|(c, n)| {
+                format!(
+                    "<code>{}</code> {}",
+                    esc(c),
+                    plural(*n as usize, "scan", "scans")
+                )
+            })
             .collect();
         writeln!(
             out,

@@ -473,9 +473,15 @@ fn counts_of_one_are_singular_and_savings_round_as_in_the_text_report() {
         {"name": "y", "type": "BOOL", "class": "output"}],
         "rungs": [{"id": "R1", "ld": [{"contact": "a"}, {"coil": "y"}]}]}"#;
     let html = page_of_text(one);
-    assert!(html.contains("<p>1 rung (1 in the main program, 0 in subroutines).</p>"), "{html}");
+    assert!(
+        html.contains("<p>1 rung (1 in the main program, 0 in subroutines).</p>"),
+        "{html}"
+    );
     assert!(html.contains("level 1 · 1 task<"), "{html}");
-    assert!(!html.contains(" 1 tasks") && !html.contains(" 1 rungs"), "{html}");
+    assert!(
+        !html.contains(" 1 tasks") && !html.contains(" 1 rungs"),
+        "{html}"
+    );
     let three = r#"{"program": "three", "vars": [{"name": "a", "type": "BOOL", "class": "input"},
         {"name": "x", "type": "BOOL"}, {"name": "y", "type": "BOOL"}, {"name": "z", "type": "BOOL"}],
         "rungs": [{"id": "R1", "ld": [{"contact": "a"}, {"coil": "x"}]},
