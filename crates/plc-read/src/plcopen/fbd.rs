@@ -23,7 +23,10 @@
 
 use super::black_box;
 use super::block_types::{BlackBox, Ctx};
-use super::pins::{add_target, bool_literal, konst, output_negated, pin_modifiers, pin_of, Added};
+use super::pins::{
+    add_target, bool_literal, konst, output_negated, pin_modifiers, pin_of, unconnected_default,
+    Added,
+};
 use super::wiring::{graph, ElemId, Graph, Source};
 use super::xml::{attr, error, identifier, origin, variable_ref, ExecOrder, Note, Notes, Tc6, R};
 use plc_diag::{Invalid, LoadError, Origin};
@@ -302,7 +305,16 @@ impl Fbd<'_, '_, '_> {
                 {
                     konst(false, origin(pin.node))
                 }
-                [] => continue,
+                [] => match unconnected_default(ty, name, origin(pin.node)) {
+                    Some((c, text)) => {
+                        self.notes.borrow_mut().push(Note {
+                            origin: origin(pin.node),
+                            message: format!("{here}: input {name} of {ty} (localId {}) is not connected: it takes its type's initial value {text} (IEC 61131-3 2.5.2.1)", el.local_id),
+                        });
+                        c
+                    }
+                    None => continue,
+                },
                 [s] => self.input(e, s)?,
                 _ => {
                     return Err(error(

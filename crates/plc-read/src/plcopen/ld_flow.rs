@@ -31,10 +31,11 @@ use super::black_box;
 use super::block_types::{BlackBox, Ctx};
 use super::ld::components;
 use super::pins::{
-    add_target, bool_literal, is_const, konst, output_negated, pin_modifiers, pin_of, Added,
+    add_target, bool_literal, is_const, konst, output_negated, pin_modifiers, pin_of,
+    unconnected_default, Added,
 };
 use super::wiring::{graph, ElemId, Graph, Source};
-use super::xml::{attr, error, identifier, origin, variable_ref, Notes, Tc6, R};
+use super::xml::{attr, error, identifier, origin, variable_ref, Note, Notes, Tc6, R};
 use plc_diag::Origin;
 use plc_syntax::fbd::{Block, Connection, Input, Inputs, Network, OutVar, Outputs};
 use plc_syntax::{FbdBody, Scalar};
@@ -89,6 +90,7 @@ pub(super) fn body(
         ctx,
         boxes: std::mem::take(&mut notes.black_boxes),
         tracing: HashSet::new(),
+        notes: Vec::new(),
         depth: 0,
     };
     // Beremiz's statement order (PLCGenerator.ComputeProgram): coils, out and in-out variables
@@ -179,6 +181,7 @@ pub(super) fn body(
         });
     }
     notes.black_boxes = std::mem::take(&mut f.boxes);
+    notes.list.append(&mut f.notes);
     notes
         .ld_vars
         .extend(f.a.vars.drain(..).map(|v| (pou.to_owned(), v)));
@@ -203,6 +206,8 @@ struct Flow<'g, 'a, 'i> {
     boxes: Vec<BlackBox>,
     /// Contacts, coils and ENOs whose power is being followed (`through`).
     tracing: HashSet<ElemId>,
+    /// Warnings for the body (unconnected inputs that take their initial value).
+    notes: Vec<Note>,
     /// Calls of [`Flow::value`] open: at most [`super::ld_power::MAX_POWER_DEPTH`], so that a
     /// long wiring is an error, not a stack overflow.
     depth: usize,
@@ -403,8 +408,18 @@ impl Flow<'_, '_, '_> {
             let pin = &el.inputs[k];
             let pname = pin.name.unwrap_or("");
             let pnode = pin.node;
-            let Some(mut v) = self.pin(e, k)? else {
-                continue;
+            let mut v = match self.pin(e, k)? {
+                Some(v) => v,
+                None => match unconnected_default(ty, pname, origin(pnode)) {
+                    Some((c, text)) => {
+                        self.notes.push(Note {
+                            origin: origin(pnode),
+                            message: format!("{here}: input {pname} of {ty} (localId {}) is not connected: it takes its type's initial value {text} (IEC 61131-3 2.5.2.1)", el.local_id),
+                        });
+                        c
+                    }
+                    None => continue,
+                },
             };
             let at = origin(pnode);
             let (negated, edge) = pin_modifiers(pnode, ty, pname, el.local_id, &here)?;
