@@ -162,3 +162,25 @@ fn fbd_blocks_with_execution_order_ids_run_first_in_id_order() {
     assert_eq!(t[0], col(&["1", "2", "3"]), "A");
     assert_eq!(t[1], col(&["0", "2", "4"]), "B");
 }
+
+#[test]
+fn an_unconnected_timer_pt_takes_its_initial_value_with_a_warning() {
+    // IEC 61131-3 2.5.2.1: an input nothing sets keeps its initial value, TIME's T#0ms (Beremiz
+    // leaves PT out of the call `T1(IN := Start)`, matiec keeps the instance's initial PT). A
+    // TON with PT 0 has Q = IN in every scan.
+    let t = scans(
+        "unconnected_pt_fbd.xml",
+        "Start\n1\n0\n1\n",
+        &["Q", "T1.PT"],
+    );
+    assert_eq!(t[0], col(&["1", "0", "1"]), "Q");
+    assert_eq!(t[1], col(&["0", "0", "0"]), "T1.PT");
+    let (_, xml) = file("unconnected_pt_fbd.xml");
+    let (_, warnings) = px::report_and_warnings(&xml);
+    assert!(
+        warnings.contains(
+            "input PT of TON (localId 4) is not connected: it takes its type's initial value T#0ms"
+        ),
+        "{warnings}"
+    );
+}
