@@ -56,7 +56,7 @@ const CASES: &[(&str, &str, &str)] = &[
     (
         r###"{"networks": [{"id": "N1", "blocks": [{"id": 1, "op": "ADD", "in": ["A", 1], "out": "B"}], "x": 1}]}"###,
         r###"{}"###,
-        r###"network N1 at fbd.networks[0].x: unknown field `x` in a network (allowed: id, label, comment, blocks)"###,
+        r###"network N1 at fbd.networks[0].x: unknown field `x` in a network (allowed: id, label, comment, blocks, order)"###,
     ),
     (
         r###"{"networks": [{"id": "N1", "blocks": [{"id": 1, "op": "ADD", "in": ["A", 1], "out": "B"}], "label": 5}]}"###,
@@ -121,7 +121,7 @@ const CASES: &[(&str, &str, &str)] = &[
     (
         r###"{"networks": [{"id": "N1", "blocks": [{"id": 1, "op": "ADD", "in": ["A", 1], "out": "B", "x": 1}]}]}"###,
         r###"{}"###,
-        r###"network N1 block 1 at fbd.networks[0].blocks[0].x: unknown field `x` in a block (allowed: id, op, in, out, instance, cond, after, label, comment)"###,
+        r###"network N1 block 1 at fbd.networks[0].blocks[0].x: unknown field `x` in a block (allowed: id, op, in, out, instance, cond, en, after, label, comment)"###,
     ),
     (
         r###"{"networks": [{"id": "N1", "blocks": [{"id": 1}]}]}"###,
@@ -326,7 +326,7 @@ const CASES: &[(&str, &str, &str)] = &[
     (
         r###"{"networks": [{"id": "N1", "blocks": [{"id": 1, "op": "ADD", "in": 5, "x": 1}]}]}"###,
         r###"{}"###,
-        r###"network N1 block 1 at fbd.networks[0].blocks[0].x: unknown field `x` in a block (allowed: id, op, in, out, instance, cond, after, label, comment)"###,
+        r###"network N1 block 1 at fbd.networks[0].blocks[0].x: unknown field `x` in a block (allowed: id, op, in, out, instance, cond, en, after, label, comment)"###,
     ),
     (
         r###"{"networks": [{"id": "N1", "blocks": [{"id": 1, "op": "ADD", "in": ["A", 1], "out": "B"}], "label": "1a", "comment": 5}]}"###,

@@ -61,6 +61,7 @@ mod plcopen_ld_pins;
 mod plcopen_library_fbs;
 mod plcopen_mutation;
 mod plcopen_project;
+mod plcopen_semantics;
 mod plcopen_speed;
 mod plcopen_st;
 mod plcopen_standard_fbs;

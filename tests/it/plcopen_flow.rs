@@ -170,9 +170,11 @@ fn negated_pins_and_a_wired_eno_in_fbd() {
         "A,B,C\n0,1,1\n1,1,1\n0,0,1\n0,1,0\n",
         &["Y", "Z"],
     );
-    // Scan 3: EN is FALSE, so the AND does not run and Y keeps its value from scan 2.
+    // Scan 4: EN is FALSE, so the AND does not run and Y keeps its value from scan 3. Beremiz
+    // writes an out variable fed by a block with EN only `IF _TMP_AND4_ENO THEN`
+    // (PLCGenerator.GetUsedEno), Z := ENO included, so Z keeps TRUE.
     assert_eq!(t[0], ["1", "0", "0", "0"]);
-    assert_eq!(t[1], ["1", "1", "1", "0"]);
+    assert_eq!(t[1], ["1", "1", "1", "1"]);
 }
 
 #[test]

@@ -111,9 +111,12 @@ fn a_structure_in_a_function_block_interface_is_a_field_of_each_instance() {
         rungs.contains(&rung("P.4", &["d.st.On"], &["lamp"])),
         "{rungs:?}"
     );
-    // start → d.go → d.st.On → lamp in the same scan; d.st.Speed copies the input structure's
-    // field, which nothing wires: its declared 5. The instance's outputs are outputs too.
-    let v = run_inputs("struct-fb", &xml, "start\n1\n", &[]);
+    // start → d.go → d.st.On → lamp: Beremiz (PLCGenerator.ComputeProgram) writes the out
+    // variables lamp and speed before it calls d (blocks after out variables), so lamp sees
+    // d.st.On of the previous scan: TRUE after the second scan. d.st.Speed copies the input
+    // structure's field, which nothing wires: its declared 5. The instance's outputs are
+    // outputs too.
+    let v = run_inputs("struct-fb", &xml, "start\n1\n1\n", &[]);
     assert_eq!(
         v["outputs"],
         json!({"lamp": true, "speed": 5, "d.st.On": true, "d.st.Speed": 5})

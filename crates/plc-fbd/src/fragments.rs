@@ -85,7 +85,7 @@ pub fn fragments(net: &Network, topological: Vec<BlockId>) -> Result<Plan, LoadE
                 fd = f;
             }
         }
-        let own_cond = b.cond.as_ref().filter(|_| !b.cond_is_own());
+        let own_cond = b.cond.as_ref().filter(|_| b.cond_opens_fragment());
         let frag = if let Some(cond) = own_cond {
             if mc.len() >= 2 {
                 return Err(LoadError::fbd(

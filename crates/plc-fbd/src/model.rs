@@ -104,6 +104,9 @@ pub struct Network {
     pub origin: plc_diag::Origin,
     /// Sorted by [`Block::id`].
     pub blocks: Vec<Block>,
+    /// The blocks the depth-first order starts from first, in this order (Beremiz's statement
+    /// order of a PLCopen body); empty: by id.
+    pub roots: Vec<BlockId>,
 }
 
 impl Network {
@@ -144,6 +147,11 @@ pub struct Block {
     pub outputs: Vec<OutputPin>,
     /// The conditional arc into the control input (for JMP and RET: their condition).
     pub cond: Option<Input>,
+    /// `cond` is the IEC 61131-3 EN input (2.5.1.2): when it is FALSE this block alone does not
+    /// run (a function's arc outputs read its type's initial value, as matiec's `TEST_EN`
+    /// returns it; a function block keeps its outputs), and the blocks it feeds still run. It
+    /// opens no fragment.
+    pub en: bool,
     /// Control arcs from these blocks' control outputs (sorted, no duplicates).
     pub after: Vec<BlockId>,
     pub comment: Option<String>,
@@ -162,6 +170,11 @@ impl Block {
     /// that opens a fragment.
     pub fn cond_is_own(&self) -> bool {
         matches!(self.op, Op::Jmp { .. } | Op::Ret)
+    }
+    /// True when `cond` is a conditional arc that opens a fragment: neither the block's own
+    /// condition (JMP, RET) nor its EN.
+    pub fn cond_opens_fragment(&self) -> bool {
+        self.cond.is_some() && !self.en && !self.cond_is_own()
     }
     /// The index of output pin `name`.
     pub fn output_pin(&self, name: &str) -> Option<u32> {

@@ -8,6 +8,11 @@
 //! numbers of an FBD editor), and a block's inputs are placed just before it when nothing
 //! placed them earlier. Every arc counts: data arcs, conditional arcs and control arcs (`after`).
 //!
+//! A network may name its *roots* (PLCopen: Beremiz's statement order): the search starts from
+//! them in that order, then from the other blocks by id; so a root runs after what it depends on
+//! and before the roots after it, each block just before its first consumer (Beremiz pulls a
+//! block when a statement first reads it).
+//!
 //! A grey block met again closes a cycle (a back edge of the search); the blocks on it are
 //! returned in data-flow order, starting from the smallest id.
 
@@ -34,7 +39,8 @@ pub fn topological_order(net: &Network) -> Result<Vec<BlockId>, Vec<BlockId>> {
     let mut order = Vec::with_capacity(n);
     // (block, next predecessor index)
     let mut stack: Vec<(u32, u32)> = Vec::new();
-    for root in 0..n as u32 {
+    let roots = net.roots.iter().map(|b| b.0).chain(0..n as u32);
+    for root in roots {
         if colour[root as usize] != Colour::White {
             continue;
         }
@@ -111,6 +117,7 @@ mod tests {
                     vars: vec![],
                 }],
                 cond: None,
+                en: false,
                 after: vec![],
                 comment: None,
             })
@@ -122,6 +129,7 @@ mod tests {
             path: String::new(),
             origin: plc_diag::Origin::NONE,
             blocks,
+            roots: vec![],
         }
     }
 

@@ -46,6 +46,10 @@ pub struct Network<'a> {
     pub comment: Option<Read<Text<'a>>>,
     /// `Err`: missing, not an array, or empty.
     pub blocks: Read<Vec<Block<'a>>>,
+    /// The blocks (by id) that the depth-first execution order starts from, in this order: each
+    /// runs after the blocks it depends on and before later ones (Beremiz's statement order of
+    /// a PLCopen body; the JSON key `order`). The other blocks follow by id.
+    pub order: Option<Read<Vec<Read<u32>>>>,
     /// An unknown field.
     pub problem: Option<Box<Problem>>,
 }
@@ -67,6 +71,10 @@ pub struct Block<'a> {
     pub label: Option<Read<Text<'a>>>,
     /// The conditional arc into the control input (a JMP's or RET's own condition).
     pub cond: Option<Input<'a>>,
+    /// `cond` is the block's IEC 61131-3 EN input (2.5.1.2, PLCopen and the JSON key `en`): it
+    /// decides whether this block alone runs, and blocks fed by it run in every scan. Without
+    /// it, `cond` is a conditional arc that opens a fragment (the FBD text-generation paper).
+    pub en: bool,
     /// Control arcs: the ids of the blocks whose control outputs feed the control input.
     pub after: Option<Read<Vec<Read<u32>>>>,
     pub comment: Option<Read<Text<'a>>>,

@@ -335,6 +335,13 @@ fn network(n: &Network, w: &mut impl Write, indent: &str) -> io::Result<()> {
     if let Some(c) = &n.comment {
         write!(w, ", \"comment\": {}", string(read(c)?))?;
     }
+    if let Some(o) = &n.order {
+        let ids = read(o)?
+            .iter()
+            .map(|id| read(id).map(|&id| Value::from(id)))
+            .collect::<io::Result<_>>()?;
+        write!(w, ", \"order\": {}", Value::Array(ids))?;
+    }
     write!(w, ", \"blocks\": ")?;
     let items: Vec<Value> = read(&n.blocks)?
         .iter()
@@ -370,7 +377,8 @@ fn block(b: &Block) -> io::Result<Value> {
         o.insert("out".into(), outputs(read(outs)?)?);
     }
     if let Some(c) = &b.cond {
-        o.insert("cond".into(), input(c)?);
+        let key = if b.en { "en" } else { "cond" };
+        o.insert(key.into(), input(c)?);
     }
     if let Some(after) = &b.after {
         let ids = read(after)?
@@ -482,10 +490,11 @@ mod tests {
           "vars": [{"name": "V1", "type": "INT", "class": "input"}, {"name": "L", "type": "INT"},
                    {"name": "R", "type": "INT"}, {"name": "G1", "type": "GEN"}],
           "fbd": {"comment": "body", "networks": [
-            {"id": "N1", "label": "L2", "comment": "n", "blocks": [
+            {"id": "N1", "label": "L2", "comment": "n", "order": [9, 3], "blocks": [
               {"id": 3, "op": "EQ", "in": ["V1", 1]},
               {"id": 8, "op": "ADD", "in": ["L", 10], "out": "L", "cond": {"from": 3}},
               {"id": 9, "op": "NOT", "in": [{"from": 3}]},
+              {"id": 10, "op": "MOVE", "in": ["V1"], "out": "R", "en": {"from": 9}},
               {"id": 15, "op": "SUB", "in": ["L", 1], "after": [8], "comment": "b"},
               {"id": 17, "op": "GEN", "instance": "G1", "in": {"PERIOD": "T#1s"},
                "out": {"RESULT": "R"}},

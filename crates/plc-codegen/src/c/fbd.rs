@@ -8,7 +8,9 @@
 //! landing rungs of the lowering become the `if (…) {` and `}` of their fragment, never jumps.
 //!
 //! Invariant relied on: the rungs of one lowered network are, in order, one per step of its
-//! plan (guard for `Enter`, the block's rung for `Block`, landing for `Leave`).
+//! plan (guard for `Enter`, the block's rung for `Block`, landing for `Leave`), except that a
+//! block gated by its EN has its guard rung before its rung and its landing rung after it;
+//! those two are written as ladder rungs (a `goto` over the block).
 
 use super::ladder::{c_type, negate, Body};
 use plc_fbd::{FbdPou, FragmentKind, LoweredCopy, Plan, Step};
@@ -86,8 +88,10 @@ pub(crate) fn pou(b: &mut Body, p: &Program, pou: &FbdPou, copy: &LoweredCopy) {
 }
 
 fn network(b: &mut Body, p: &Program, plan: &Plan, start: u32, blocks: &[RungId]) {
-    for (cursor, step) in (start..).zip(&plan.steps) {
+    let mut cursor = start;
+    for step in &plan.steps {
         let r = RungId(cursor);
+        cursor += 1;
         match *step {
             Step::Enter(f) => {
                 b.label(r);
@@ -100,8 +104,18 @@ fn network(b: &mut Body, p: &Program, plan: &Plan, start: u32, blocks: &[RungId]
                 b.indent += 1;
             }
             Step::Block(blk) => {
-                debug_assert_eq!(blocks[blk.index()], r);
-                b.rung(r);
+                let target = blocks[blk.index()];
+                // An EN guard before the block's rung, its landing after it.
+                let gated = r != target;
+                for g in r.0..target.0 {
+                    b.rung(RungId(g));
+                }
+                b.rung(target);
+                cursor = target.0 + 1;
+                if gated {
+                    b.rung(RungId(cursor));
+                    cursor += 1;
+                }
             }
             Step::Leave(_) => {
                 b.indent -= 1;

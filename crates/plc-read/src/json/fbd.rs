@@ -19,9 +19,9 @@ use plc_syntax::{Origin, Problem, Scalar, Text};
 type Result<T> = P<T>;
 
 const BODY_KEYS: &[&str] = &["networks", "comment"];
-const NETWORK_KEYS: &[&str] = &["id", "label", "comment", "blocks"];
+const NETWORK_KEYS: &[&str] = &["id", "label", "comment", "blocks", "order"];
 const BLOCK_KEYS: &[&str] = &[
-    "id", "op", "in", "out", "instance", "cond", "after", "label", "comment",
+    "id", "op", "in", "out", "instance", "cond", "en", "after", "label", "comment",
 ];
 const ARC_KEYS: &[&str] = &["from", "pin"];
 
@@ -205,6 +205,7 @@ impl<'a> FbdReader<'a> {
             label: None,
             comment: None,
             blocks: Ok(Vec::new()),
+            order: None,
             problem: None,
         };
         let e = match self.container(v)? {
@@ -240,6 +241,9 @@ impl<'a> FbdReader<'a> {
         net.problem = unknown_key(&e, NETWORK_KEYS, "a network");
         net.label = self.text(&e, "label")?;
         net.comment = self.text(&e, "comment")?;
+        if let Some(o) = get(&e, "order") {
+            net.order = Some(self.ids(o, "order")?);
+        }
         net.blocks = match get(&e, "blocks") {
             None => Err(missing(v.origin(), "blocks", "a network")),
             Some(b) => match self.container(b)? {
@@ -275,6 +279,7 @@ impl<'a> FbdReader<'a> {
             instance: None,
             label: None,
             cond: None,
+            en: false,
             after: None,
             comment: None,
             problem: None,
@@ -319,8 +324,22 @@ impl<'a> FbdReader<'a> {
         if let Some(c) = get(&e, "cond") {
             b.cond = Some(self.input(c)?);
         }
+        if let Some(c) = get(&e, "en") {
+            if b.cond.is_some() {
+                b.problem = Some(problem(
+                    ".en",
+                    c.origin(),
+                    Invalid::Misplaced {
+                        what: "`en`",
+                        place: "together with `cond` (a block has one control input)",
+                    },
+                ));
+            }
+            b.cond = Some(self.input(c)?);
+            b.en = true;
+        }
         if let Some(a) = get(&e, "after") {
-            b.after = Some(self.after(a)?);
+            b.after = Some(self.ids(a, "after")?);
         }
         b.comment = self.text(&e, "comment")?;
         Ok(b)
@@ -473,7 +492,8 @@ impl<'a> FbdReader<'a> {
         })
     }
 
-    fn after(&self, v: Raw) -> Result<Read<Vec<Read<u32>>>> {
+    /// An array of block ids (the value of `key`).
+    fn ids(&self, v: Raw, key: &str) -> Result<Read<Vec<Read<u32>>>> {
         Ok(match self.container(v)? {
             Container::Array(items) => {
                 let mut ids = Vec::with_capacity(items.len());
@@ -481,7 +501,7 @@ impl<'a> FbdReader<'a> {
                     let s = self.scalar(item)?;
                     ids.push(block_id(&s).ok_or_else(|| {
                         problem(
-                            format!(".after[{i}]"),
+                            format!(".{key}[{i}]"),
                             item.origin(),
                             shape("a block id", &s),
                         )
@@ -490,7 +510,7 @@ impl<'a> FbdReader<'a> {
                 Ok(ids)
             }
             other => Err(problem(
-                ".after",
+                format!(".{key}"),
                 v.origin(),
                 shape("an array of block ids", &found(other)),
             )),

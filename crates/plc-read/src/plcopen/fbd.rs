@@ -23,7 +23,10 @@
 
 use super::black_box;
 use super::block_types::{BlackBox, Ctx};
-use super::pins::{add_target, bool_literal, konst, output_negated, pin_modifiers, pin_of, Added};
+use super::pins::{
+    add_target, bool_literal, konst, output_negated, pin_modifiers, pin_of, unconnected_default,
+    Added,
+};
 use super::wiring::{graph, ElemId, Graph, Source};
 use super::xml::{attr, error, identifier, origin, variable_ref, ExecOrder, Note, Notes, Tc6, R};
 use plc_diag::{Invalid, LoadError, Origin};
@@ -130,6 +133,15 @@ pub(super) fn body(
     let k = networks.len();
     f.close_loops(&mut current);
     networks.push(network(pou, k, label, current, comments));
+    let roots = statement_order(&g);
+    for n in &mut networks {
+        if let Ok(blocks) = &n.blocks {
+            let ids: std::collections::HashSet<u32> =
+                blocks.iter().filter_map(|b| b.id.clone().ok()).collect();
+            let mine = roots.iter().copied().filter(|r| ids.contains(r)).map(Ok);
+            n.order = Some(Ok(mine.collect()));
+        }
+    }
     if labels == 0 {
         if let Some(n) = networks.first_mut() {
             n.id = Ok(Cow::Owned(pou.to_owned()));
@@ -159,6 +171,49 @@ pub(super) fn body(
     })
 }
 
+/// Beremiz's statement order of an FBD body (PLCGenerator.ComputeProgram): the blocks, out and
+/// in-out variables with an `executionOrderId` above 0 in that order, then the out and in-out
+/// variables in file order, then the blocks in file order; each as the id of the block that
+/// runs it (an out variable fed by a block: that block; fed by a variable: its own MOVE).
+/// Beremiz computes a block when a statement first reads it, which the depth-first order from
+/// these roots does.
+fn statement_order(g: &Graph) -> Vec<u32> {
+    let runner = |i: usize| -> Option<u32> {
+        let el = &g.elems[i];
+        match el.tag {
+            "block" => Some(el.local_id),
+            "outVariable" | "inOutVariable" => {
+                match el.inputs.first().map(|p| p.sources.as_slice()) {
+                    Some([s]) if g.get(s.elem).tag == "block" => Some(g.get(s.elem).local_id),
+                    Some([_]) => Some(el.local_id),
+                    _ => None,
+                }
+            }
+            _ => None,
+        }
+    };
+    let exec_id = |i: usize| {
+        g.elems[i]
+            .node
+            .attribute("executionOrderId")
+            .and_then(|x| x.trim().parse::<u32>().ok())
+            .filter(|&x| x > 0)
+    };
+    let mut ordered: Vec<(u32, usize)> = (0..g.elems.len())
+        .filter_map(|i| exec_id(i).map(|x| (x, i)))
+        .collect();
+    ordered.sort_unstable();
+    let mut roots: Vec<u32> = ordered.iter().filter_map(|&(_, i)| runner(i)).collect();
+    for tags in [&["outVariable", "inOutVariable"][..], &["block"][..]] {
+        for i in 0..g.elems.len() {
+            if tags.contains(&g.elems[i].tag) && exec_id(i).is_none() {
+                roots.extend(runner(i));
+            }
+        }
+    }
+    roots
+}
+
 fn network(
     pou: &str,
     k: usize,
@@ -175,6 +230,7 @@ fn network(
         label: label.map(|(l, _)| Ok(Cow::Owned(l))),
         comment: (!comments.is_empty()).then(|| Ok(Cow::Owned(comments.join("\n")))),
         blocks: Ok(blocks),
+        order: None,
         problem: None,
     }
 }
@@ -209,6 +265,7 @@ impl Fbd<'_, '_, '_> {
             instance: None,
             label: None,
             cond: None,
+            en: false,
             after: None,
             comment: None,
             problem: None,
@@ -326,7 +383,16 @@ impl Fbd<'_, '_, '_> {
                 {
                     konst(false, origin(pin.node))
                 }
-                [] => continue,
+                [] => match unconnected_default(ty, name, origin(pin.node)) {
+                    Some((c, text)) => {
+                        self.notes.borrow_mut().push(Note {
+                            origin: origin(pin.node),
+                            message: format!("{here}: input {name} of {ty} (localId {}) is not connected: it takes its type's initial value {text} (IEC 61131-3 2.5.2.1)", el.local_id),
+                        });
+                        c
+                    }
+                    None => continue,
+                },
                 [s] => self.input(e, s)?,
                 _ => {
                     return Err(error(
@@ -357,6 +423,7 @@ impl Fbd<'_, '_, '_> {
             input = bool_literal(self.ctx, ty, name, input);
             if name == "EN" {
                 b.cond = Some(input);
+                b.en = true;
             } else if let Some(fields) = self.whole_structure(ty, name, &input) {
                 // A structure passed whole into a function block's structure input: each field
                 // into its field (the model holds a structure as one variable per field).
@@ -424,9 +491,13 @@ impl Fbd<'_, '_, '_> {
             if *pin == "ENO" && !targets.is_empty() {
                 // ENO is EN (IEC 61131-3 2.5.1.2: TRUE when the block ran without error).
                 let en = self.eno(e, origin(*pnode))?;
+                // Beremiz writes an out variable fed by a block with EN only under
+                // `IF <ENO> THEN` (PLCGenerator.GetUsedEno): a MOVE gated by the same EN.
                 let mut a = self.a.borrow_mut();
-                a.add_on("MOVE", None, Inputs::List(vec![en]), origin(*pnode));
+                a.add_on("MOVE", None, Inputs::List(vec![en.clone()]), origin(*pnode));
                 if let Some(m) = a.blocks.last_mut() {
+                    m.cond = Some(en);
+                    m.en = true;
                     for t in targets {
                         add_target(m, "OUT".to_owned(), t);
                     }

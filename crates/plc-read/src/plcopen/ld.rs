@@ -78,19 +78,8 @@ pub(super) fn rungs(
     power.inits = inits.clone();
     let outputs = outputs(&power)?;
     let component = components(&g);
-    // Outputs grouped by rung, rungs in the order of their first output.
-    let mut rung_of: Vec<Option<usize>> = vec![None; g.elems.len()];
-    let mut groups: Vec<Vec<ElemId>> = Vec::new();
-    for &o in &outputs {
-        let c = component[o.0 as usize];
-        let r = *rung_of[c].get_or_insert_with(|| {
-            groups.push(Vec::new());
-            groups.len() - 1
-        });
-        groups[r].push(o);
-    }
-    interleave_note(&g, &outputs, &component, &rung_of, &place, pou, notes);
-    let labels = labels(&g, &outputs, &rung_of, &component, &place)?;
+    let groups = groups(&g, &outputs, &component, &place)?;
+    let labels = labels(&g, &groups, &place)?;
     let mut out = Vec::with_capacity(groups.len());
     for (r, group) in groups.iter().enumerate() {
         let mut paths = Vec::with_capacity(group.len());
@@ -436,22 +425,14 @@ pub(super) fn components(g: &Graph) -> Vec<usize> {
 }
 
 /// Labels: each starts the first rung whose first output follows it in the file.
-fn labels(
-    g: &Graph,
-    outputs: &[ElemId],
-    rung_of: &[Option<usize>],
-    component: &[usize],
-    place: &str,
-) -> R<Vec<Option<Name<'static>>>> {
-    let rungs = rung_of.iter().flatten().max().map_or(0, |m| m + 1);
+fn labels(g: &Graph, groups: &[Vec<ElemId>], place: &str) -> R<Vec<Option<Name<'static>>>> {
+    let rungs = groups.len();
     let mut labels: Vec<Option<Name>> = vec![None; rungs];
     // The first output of each rung, by file position.
-    let mut first_at: Vec<usize> = vec![usize::MAX; rungs];
-    for &o in outputs {
-        if let Some(r) = rung_of[component[o.0 as usize]] {
-            first_at[r] = first_at[r].min(o.0 as usize);
-        }
-    }
+    let first_at: Vec<usize> = groups
+        .iter()
+        .map(|gr| gr.iter().map(|o| o.0 as usize).min().unwrap_or(usize::MAX))
+        .collect();
     for (i, el) in g.elems.iter().enumerate() {
         if el.tag != "label" {
             continue;
@@ -483,37 +464,61 @@ fn labels(
     Ok(labels)
 }
 
-/// A note when the outputs of rungs interleave in the file (Beremiz would run them
-/// interleaved, plc-deps runs each rung whole).
-fn interleave_note(
-    g: &Graph,
-    outputs: &[ElemId],
-    component: &[usize],
-    rung_of: &[Option<usize>],
-    place: &str,
-    pou: &str,
-    notes: &mut Notes,
-) {
-    let mut seen_last = None;
+/// The outputs grouped into rungs, in execution order. A rung is a component's outputs, in the
+/// order of its first. Beremiz runs one statement per coil, out variable, jump and return in
+/// file order (PLCGenerator.ComputeProgram), so where the outputs of components interleave in
+/// the file, each run of consecutive outputs of one component is a rung of its own (its
+/// contacts read again, as Beremiz reads them for each coil). Blocks whose power goes nowhere
+/// join the last rung of their component (Beremiz computes them after every statement). A box
+/// cannot run once per rung, so a component with a block whose outputs are split is an error,
+/// after which the body is read as data flow ([`super::ld_flow`]), which keeps that order.
+fn groups(g: &Graph, outputs: &[ElemId], component: &[usize], place: &str) -> R<Vec<Vec<ElemId>>> {
+    let mut groups: Vec<Vec<ElemId>> = Vec::new();
+    let mut of: Vec<usize> = Vec::new(); // the component of each group
+    let mut last_group: std::collections::HashMap<usize, usize> = Default::default();
+    let mut split: Option<(ElemId, usize)> = None;
     for &o in outputs.iter().filter(|o| g.get(**o).tag != "block") {
-        let Some(r) = rung_of[component[o.0 as usize]] else {
+        let c = component[o.0 as usize];
+        if of.last() == Some(&c) {
+            groups.last_mut().expect("of and groups agree").push(o);
             continue;
-        };
-        if let Some(prev) = seen_last {
-            if r < prev {
-                notes.push(Note {
-                    origin: origin(g.get(o).node),
-                    message: format!(
-                        "{place}: {} localId {} of rung {pou}.R{} comes in the file after outputs of rung {pou}.R{}; Beremiz runs the outputs in file order, plc-deps runs each rung whole, in the order of its first output",
-                        g.get(o).tag,
-                        g.get(o).local_id,
-                        r + 1,
-                        prev + 1
-                    ),
-                });
-                return;
+        }
+        if let Some(&prev) = last_group.get(&c) {
+            split.get_or_insert((o, prev));
+        }
+        groups.push(vec![o]);
+        of.push(c);
+        last_group.insert(c, groups.len() - 1);
+    }
+    for &o in outputs.iter().filter(|o| g.get(**o).tag == "block") {
+        let c = component[o.0 as usize];
+        match last_group.get(&c) {
+            Some(&k) => groups[k].push(o),
+            None => {
+                groups.push(vec![o]);
+                of.push(c);
+                last_group.insert(c, groups.len() - 1);
             }
         }
-        seen_last = Some(seen_last.map_or(r, |p: usize| p.max(r)));
     }
+    if let Some((o, prev)) = split {
+        let c = component[o.0 as usize];
+        if let Some(b) =
+            (0..g.elems.len()).find(|&i| component[i] == c && g.elems[i].tag == "block")
+        {
+            let el = g.get(o);
+            return Err(error(
+                origin(el.node),
+                &g.place(place, o),
+                format!(
+                    "{} localId {} comes in the file after outputs of another rung, and its rung (with rung {} before them) holds block localId {}: Beremiz runs the outputs in file order, which splits the rung, and a box cannot run once per part",
+                    el.tag,
+                    el.local_id,
+                    prev + 1,
+                    g.elems[b].local_id
+                ),
+            ));
+        }
+    }
+    Ok(groups)
 }

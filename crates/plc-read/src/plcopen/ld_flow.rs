@@ -31,10 +31,11 @@ use super::black_box;
 use super::block_types::{BlackBox, Ctx};
 use super::ld::components;
 use super::pins::{
-    add_target, bool_literal, is_const, konst, output_negated, pin_modifiers, pin_of, Added,
+    add_target, bool_literal, is_const, konst, output_negated, pin_modifiers, pin_of,
+    unconnected_default, Added,
 };
 use super::wiring::{graph, ElemId, Graph, Source};
-use super::xml::{attr, error, identifier, origin, variable_ref, Notes, Tc6, R};
+use super::xml::{attr, error, identifier, origin, variable_ref, Note, Notes, Tc6, R};
 use plc_diag::Origin;
 use plc_syntax::fbd::{Block, Connection, Input, Inputs, Network, OutVar, Outputs};
 use plc_syntax::{FbdBody, Scalar};
@@ -89,42 +90,67 @@ pub(super) fn body(
         ctx,
         boxes: std::mem::take(&mut notes.black_boxes),
         tracing: HashSet::new(),
+        notes: Vec::new(),
         depth: 0,
     };
-    // Networks in the order of their first statement; rungs of blocks only after the others.
-    let mut order: Vec<usize> = Vec::new();
+    // Beremiz's statement order (PLCGenerator.ComputeProgram): coils, out and in-out variables
+    // in file order, then the blocks; each block is computed when a statement first reads it.
+    // Rungs whose statements interleave in the file are one network, so that this order holds
+    // across them; networks in the order of their first statement, rungs of blocks only last.
     let statement = |t: &str| {
         matches!(
             t,
             "coil" | "outVariable" | "inOutVariable" | "jump" | "return"
         )
     };
-    for pass in [true, false] {
-        for (i, el) in g.elems.iter().enumerate() {
-            let wanted = if pass {
-                statement(el.tag)
-            } else {
-                el.tag == "block"
-            };
-            if wanted && !order.contains(&component[i]) {
-                order.push(component[i]);
-            }
+    let mut span: HashMap<usize, (usize, usize)> = HashMap::new();
+    let mut firsts: Vec<usize> = Vec::new();
+    for (i, el) in g.elems.iter().enumerate() {
+        if statement(el.tag) {
+            let s = span.entry(component[i]).or_insert_with(|| {
+                firsts.push(component[i]);
+                (i, i)
+            });
+            s.1 = i;
+        }
+    }
+    // The network of each component: components whose spans overlap share one.
+    let mut net_of: HashMap<usize, usize> = HashMap::new();
+    let mut nets = 0;
+    let mut reach = 0;
+    for &c in &firsts {
+        let (first, last) = span[&c];
+        if nets == 0 || first > reach {
+            nets += 1;
+            reach = last;
+        } else {
+            reach = reach.max(last);
+        }
+        net_of.insert(c, nets - 1);
+    }
+    for (i, el) in g.elems.iter().enumerate() {
+        if el.tag == "block" && !net_of.contains_key(&component[i]) {
+            nets += 1;
+            net_of.insert(component[i], nets - 1);
         }
     }
     let mut networks = Vec::new();
-    for c in order {
+    for n in 0..nets {
+        let mut roots: Vec<u32> = Vec::new();
         for (i, el) in g.elems.iter().enumerate() {
-            if component[i] != c {
+            if net_of.get(&component[i]) != Some(&n) {
                 continue;
             }
             let e = ElemId(i as u32);
             match el.tag {
-                "coil" | "outVariable" | "inOutVariable" => f.write_out(e)?,
-                "jump" | "return" => f.control(e)?,
-                "block" => {
-                    f.block(e)?;
-                }
+                "coil" | "outVariable" | "inOutVariable" => roots.extend(f.write_out(e)?),
+                "jump" | "return" => roots.push(f.control(e)?),
                 _ => {}
+            }
+        }
+        for (i, el) in g.elems.iter().enumerate() {
+            if el.tag == "block" && net_of.get(&component[i]) == Some(&n) {
+                roots.push(f.block(ElemId(i as u32))?);
             }
         }
         let mut blocks = std::mem::take(&mut f.a.blocks);
@@ -139,16 +165,23 @@ pub(super) fn body(
             continue;
         }
         let k = networks.len() + 1;
+        let blocks_ids: HashSet<u32> = blocks.iter().filter_map(|b| b.id.clone().ok()).collect();
         networks.push(Network {
             origin: blocks[0].origin,
             id: Ok(Cow::Owned(format!("{pou}.N{k}"))),
             label: None,
             comment: None,
             blocks: Ok(blocks),
+            order: Some(Ok(roots
+                .into_iter()
+                .filter(|r| blocks_ids.contains(r))
+                .map(Ok)
+                .collect())),
             problem: None,
         });
     }
     notes.black_boxes = std::mem::take(&mut f.boxes);
+    notes.list.append(&mut f.notes);
     notes
         .ld_vars
         .extend(f.a.vars.drain(..).map(|v| (pou.to_owned(), v)));
@@ -173,6 +206,8 @@ struct Flow<'g, 'a, 'i> {
     boxes: Vec<BlackBox>,
     /// Contacts, coils and ENOs whose power is being followed (`through`).
     tracing: HashSet<ElemId>,
+    /// Warnings for the body (unconnected inputs that take their initial value).
+    notes: Vec<Note>,
     /// Calls of [`Flow::value`] open: at most [`super::ld_power::MAX_POWER_DEPTH`], so that a
     /// long wiring is an error, not a stack overflow.
     depth: usize,
@@ -354,6 +389,7 @@ impl Flow<'_, '_, '_> {
             instance: None,
             label: None,
             cond: None,
+            en: false,
             after: None,
             comment: None,
             problem: None,
@@ -372,8 +408,18 @@ impl Flow<'_, '_, '_> {
             let pin = &el.inputs[k];
             let pname = pin.name.unwrap_or("");
             let pnode = pin.node;
-            let Some(mut v) = self.pin(e, k)? else {
-                continue;
+            let mut v = match self.pin(e, k)? {
+                Some(v) => v,
+                None => match unconnected_default(ty, pname, origin(pnode)) {
+                    Some((c, text)) => {
+                        self.notes.push(Note {
+                            origin: origin(pnode),
+                            message: format!("{here}: input {pname} of {ty} (localId {}) is not connected: it takes its type's initial value {text} (IEC 61131-3 2.5.2.1)", el.local_id),
+                        });
+                        c
+                    }
+                    None => continue,
+                },
             };
             let at = origin(pnode);
             let (negated, edge) = pin_modifiers(pnode, ty, pname, el.local_id, &here)?;
@@ -396,6 +442,7 @@ impl Flow<'_, '_, '_> {
         }
         let net = &mut self.a.blocks;
         net[idx].inputs = Some(Ok(Inputs::Named(inputs)));
+        net[idx].en = cond.is_some();
         net[idx].cond = cond;
         let mut b = std::mem::replace(&mut self.a.blocks[idx], placeholder());
         let t = black_box::Typer {
@@ -423,7 +470,7 @@ impl Flow<'_, '_, '_> {
 
     /// Writes `v` into variable `var` (at `at`): as a target of the block whose output `v` is,
     /// else by a MOVE.
-    fn write(&mut self, var: String, v: Input<'static>, at: Origin) {
+    fn write(&mut self, var: String, v: Input<'static>, at: Origin) -> u32 {
         let target = OutVar {
             origin: at,
             name: Cow::Owned(var),
@@ -440,13 +487,15 @@ impl Flow<'_, '_, '_> {
                 .find(|b| b.id.as_ref().ok() == Some(&block))
             {
                 add_target(b, pin.unwrap_or_else(|| "OUT".to_owned()), target);
-                return;
+                return block;
             }
         }
+        let id = self.a.next_id;
         let _ = self.a.add_on("MOVE", None, Inputs::List(vec![v]), at);
         if let Some(b) = self.a.blocks.last_mut() {
             b.outputs = Some(Ok(Outputs::First(target)));
         }
+        id
     }
 
     /// The first output pin of the block with id `id`, when it is an element of the body.
@@ -463,19 +512,19 @@ impl Flow<'_, '_, '_> {
             .map(str::to_owned)
     }
 
-    /// A coil, an out variable or the input side of an in-out variable.
-    fn write_out(&mut self, e: ElemId) -> R<()> {
+    /// A coil, an out variable or the input side of an in-out variable: the id of the block
+    /// that writes its variable.
+    fn write_out(&mut self, e: ElemId) -> R<Option<u32>> {
         let el = self.g.get(e);
         if el.inputs.first().is_none_or(|p| p.sources.is_empty()) {
-            return Ok(()); // Beremiz skips an unconnected coil or variable.
+            return Ok(None); // Beremiz skips an unconnected coil or variable.
         }
         let at = origin(el.node);
         let here = self.at(e);
         let var = variable_ref(&self.expression(e)?, el.node, &here)?;
         let p = self.power(e)?;
         if el.tag != "coil" {
-            self.write(var, p, at);
-            return Ok(());
+            return Ok(Some(self.write(var, p, at)));
         }
         let flag = |a: &str| el.node.attribute(a);
         let v = match (flag("negated"), flag("storage"), flag("edge")) {
@@ -492,12 +541,11 @@ impl Flow<'_, '_, '_> {
             (_, _, Some(edge @ ("rising" | "falling"))) => self.a.trigger(edge, p, el.local_id, at),
             _ => p,
         };
-        self.write(var, v, at);
-        Ok(())
+        Ok(Some(self.write(var, v, at)))
     }
 
-    /// A jump or a return: JMP/RET with the power as its condition.
-    fn control(&mut self, e: ElemId) -> R<()> {
+    /// A jump or a return: JMP/RET with the power as its condition; its block id.
+    fn control(&mut self, e: ElemId) -> R<u32> {
         let el = self.g.get(e);
         let at = origin(el.node);
         let here = self.at(e);
@@ -523,11 +571,12 @@ impl Flow<'_, '_, '_> {
             instance: None,
             label: label.map(|l| Ok(Cow::Owned(l))),
             cond: (!is_const(&p, true)).then_some(p),
+            en: false,
             after: None,
             comment: None,
             problem: None,
         });
-        Ok(())
+        Ok(id)
     }
 }
 
@@ -559,6 +608,7 @@ fn placeholder() -> Block<'static> {
         instance: None,
         label: None,
         cond: None,
+        en: false,
         after: None,
         comment: None,
         problem: None,

@@ -46,6 +46,29 @@ pub(super) fn konst(b: bool, at: Origin) -> Input<'static> {
     }
 }
 
+/// The value an unconnected data input `pin` of standard function block `ty` takes: its type's
+/// initial value (IEC 61131-3 2.5.2.1: an input nothing sets keeps its initial value; 2.4.2: the
+/// type's default), T#0ms for a timer's PT and 0 for a counter's PV, with the text the warning
+/// shows. BOOL inputs are read as FALSE by the callers already; other blocks: `None`.
+pub(super) fn unconnected_default(
+    ty: &str,
+    pin: &str,
+    at: Origin,
+) -> Option<(Input<'static>, &'static str)> {
+    let (c, text) = match (ty, pin) {
+        ("TON" | "TOF" | "TP", "PT") => (Scalar::Str(Cow::Borrowed("T#0ms")), "T#0ms"),
+        ("CTU" | "CTD" | "CTUD", "PV") => (Scalar::Number(0.into()), "0"),
+        _ => return None,
+    };
+    Some((
+        Input {
+            origin: at,
+            from: Connection::Constant(c),
+        },
+        text,
+    ))
+}
+
 pub(super) fn is_const(i: &Input, b: bool) -> bool {
     matches!(i.from, Connection::Constant(Scalar::Bool(x)) if x == b)
 }
@@ -92,6 +115,7 @@ impl Added {
             instance: instance.map(|i| Ok(Cow::Owned(i))),
             label: None,
             cond: None,
+            en: false,
             after: None,
             comment: None,
             problem: None,

@@ -84,6 +84,7 @@ impl Net<'_, '_, '_> {
             inputs,
             outputs,
             cond,
+            en: d.syn.en && d.syn.cond.is_some(),
             after,
             comment,
         })

@@ -209,6 +209,26 @@ fn network(
                 .map_err(|e| e.at(d.syn.origin))
         })
         .collect::<Result<Vec<_>>>()?;
+    let mut roots = Vec::new();
+    if let Some(order) = &n.order {
+        let ids = order.as_ref().map_err(|p| reported(p, path, e))?;
+        for (k, r) in ids.iter().enumerate() {
+            let q = format!("{path}.order[{k}]");
+            let id = *r.as_ref().map_err(|p| reported(p, &q, e))?;
+            let b = index.get(&id).copied().ok_or_else(|| {
+                e(
+                    &q,
+                    Invalid::Misplaced {
+                        what: "a block id in `order`",
+                        place: "that no block of the network has",
+                    },
+                )
+            })?;
+            if !roots.contains(&b) {
+                roots.push(b);
+            }
+        }
+    }
     Ok(Network {
         id,
         label,
@@ -216,6 +236,7 @@ fn network(
         path: path.to_owned(),
         origin: n.origin,
         blocks,
+        roots,
     })
 }
 

@@ -109,6 +109,27 @@ impl Cx<'_> {
                 Step::Block(b) => {
                     let blk = net.block(b);
                     let mut series = self.block(&mut nx, b, labels)?;
+                    // EN (IEC 61131-3 2.5.1.2): an `if` around this block alone.
+                    let gate = match (&blk.cond, blk.en) {
+                        (Some(c), true) => self.en_guard(&mut nx, b, c)?,
+                        _ => None,
+                    };
+                    let landing = format!("{rp}{}.{}.en.end", net.id, blk.id);
+                    let gated = gate.is_some();
+                    if let Some(mut guard) = gate {
+                        guard.push(Element::Jmp {
+                            label: landing.clone(),
+                            target: RungId(u32::MAX),
+                        });
+                        guard.splice(0..0, pending.drain(..));
+                        guards.push(self.push(
+                            format!("{rp}{}.{}.en", net.id, blk.id),
+                            None,
+                            Some(format!("if EN of {}", blk.id)),
+                            guard,
+                            (&blk.path, blk.origin),
+                        ));
+                    }
                     series.splice(0..0, pending.drain(..));
                     let r = self.push(
                         format!("{rp}{}.{}", net.id, blk.id),
@@ -124,6 +145,17 @@ impl Cx<'_> {
                         }
                     }
                     block_rung[b.index()] = Some(r as u32);
+                    if gated {
+                        let end = self.push(
+                            landing.clone(),
+                            Some(landing),
+                            None,
+                            Vec::new(),
+                            (&blk.path, blk.origin),
+                        );
+                        let g = guards.pop().expect("pushed above");
+                        set_jump_target(&mut self.rungs[g], RungId(end as u32));
+                    }
                 }
                 Step::Leave(f) => {
                     let frag = &plan.fragments[f.index()];
@@ -151,5 +183,50 @@ impl Cx<'_> {
             .map(|r| r.expect("a plan's steps hold every block of its network once"))
             .collect();
         Ok((block_rung, self.typed_network(&nx)))
+    }
+
+    /// The guard of block `b` whose EN is `en`: the series that is powered when EN is FALSE
+    /// (the caller adds the jump over the block). A disabled function's outputs that arcs read
+    /// take their type's initial value there, as matiec's `TEST_EN` returns `__INIT_<type>`
+    /// (lib/C/iec_std_functions.h) into the temporary Beremiz assigns; a function block keeps
+    /// its outputs (its body returns at once). `None` when EN is the constant TRUE.
+    fn en_guard(&mut self, nx: &mut Net, b: BlockId, en: &Input) -> Result<Option<Series>> {
+        let blk = nx.net.block(b);
+        let path = format!("{}.en", blk.path);
+        let o = self.bool_input(nx, Some(blk.id), en, &path, "EN")?;
+        if o == Operand::Const(Value::Bool(true)) {
+            return Ok(None);
+        }
+        let mut guard = condition(o, true);
+        let function = !matches!(
+            blk.op,
+            Op::Timer { .. }
+                | Op::Ctu { .. }
+                | Op::Ctd { .. }
+                | Op::Ctud { .. }
+                | Op::Bistable { .. }
+                | Op::Trigger { .. }
+                | Op::Call { .. }
+                | Op::Jmp { .. }
+                | Op::Ret
+                | Op::TStart
+                | Op::TStop
+        );
+        if function {
+            for (pin, v) in nx.values[b.index()].iter().enumerate() {
+                if let (true, Some((Operand::Var(r), ty))) = (nx.used[b.index()][pin], v) {
+                    if r.field.is_none() {
+                        guard.push(match ty {
+                            Type::Bool => Element::Reset(r.var),
+                            _ => Element::Move {
+                                from: Operand::Const(ty.zero()),
+                                to: r.var,
+                            },
+                        });
+                    }
+                }
+            }
+        }
+        Ok(Some(guard))
     }
 }
