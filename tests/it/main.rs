@@ -12,6 +12,7 @@ mod c_codegen;
 mod c_codegen_cli;
 mod cli;
 mod convert;
+mod corpus;
 mod csv_inputs;
 mod diagnostics;
 mod differential;
