@@ -423,7 +423,7 @@ impl OpKind {
                 | OpKind::Xor
                 | OpKind::Max
                 | OpKind::Min
-        )
+        ) || matches!(self, OpKind::Function(f) if f.extensible() && f != Function::Mux)
     }
 
     /// Whether the op needs an `instance`.

@@ -171,7 +171,9 @@ pub(crate) fn random_csv(p: &Program, rng: &mut Rng, rows: usize) -> String {
     let ins: Vec<_> = p
         .vars
         .iter()
-        .filter(|v| v.class == VarClass::Input && !v.hidden)
+        // A STRING input is not set from an inputs file (neither `run` nor the harness reads
+        // one): it keeps its initial value.
+        .filter(|v| v.class == VarClass::Input && !v.hidden && v.ty != Type::String)
         .collect();
     if ins.is_empty() {
         return String::new();

@@ -1294,10 +1294,10 @@ pub(super) fn first_pragma(text: &str) -> Option<usize> {
     let mut depth = 0usize;
     while i < b.len() {
         if depth > 0 {
-            if text[i..].starts_with("*)") {
+            if b[i..].starts_with(b"*)") {
                 depth -= 1;
                 i += 2;
-            } else if text[i..].starts_with("(*") {
+            } else if b[i..].starts_with(b"(*") {
                 depth += 1;
                 i += 2;
             } else {
@@ -1306,12 +1306,15 @@ pub(super) fn first_pragma(text: &str) -> Option<usize> {
             continue;
         }
         match b[i] {
-            b'(' if text[i..].starts_with("(*") => {
+            b'(' if b[i..].starts_with(b"(*") => {
                 depth = 1;
                 i += 2;
             }
-            b'/' if text[i..].starts_with("//") => {
-                i = text[i..].find('\n').map_or(b.len(), |n| i + n);
+            b'/' if b[i..].starts_with(b"//") => {
+                i = b[i..]
+                    .iter()
+                    .position(|&c| c == b'\n')
+                    .map_or(b.len(), |n| i + n);
             }
             q @ (b'\'' | b'"') => {
                 i += 1;
@@ -1339,5 +1342,9 @@ mod tests {
             Some(29)
         );
         assert_eq!(first_pragma("s := 'it$'s'; {p}"), Some(14));
+        // Bytes, not characters: a comment or string with non-ASCII text (a panic once, on
+        // a real export's `ó`).
+        assert_eq!(first_pragma("(* válvula ó *) x := 'ñ'; {p}"), Some(29));
+        assert_eq!(first_pragma("// ó\n(*ó*)"), None);
     }
 }
