@@ -390,7 +390,8 @@ mod tests {
         assert_eq!(f("DELETE", &[st("hello"), int(2), int(2)], s), "hlo");
         assert_eq!(
             f("REPLACE", &[st("hello"), st("XYZ"), int(2), int(2)], s),
-            "hXYZlo"
+            "hXYlo",
+            "matiec's __replace copies at most L bytes of IN2"
         );
         assert_eq!(f("FIND", &[st("hello"), st("ll")], Type::Int), "3");
         assert_eq!(f("FIND", &[st("hello"), st("z")], Type::Int), "0");
@@ -410,7 +411,9 @@ mod tests {
         );
         assert_eq!(f("STRING_TO_INT", &[st("-123")], Type::Int), "-123");
         assert_eq!(f("STRING_TO_INT", &[st("16#1F")], Type::Int), "31");
-        assert_eq!(f("STRING_TO_INT", &[st("12.5")], Type::Int), "5");
+        // matiec's __pstring_to_sint reads from the right and restarts at any byte >= '.':
+        // "5", then '.' restarts, then "12".
+        assert_eq!(f("STRING_TO_INT", &[st("12.5")], Type::Int), "12");
         assert_eq!(f("STRING_TO_BOOL", &[st("true")], Type::Bool), "TRUE");
         assert_eq!(
             compare(&StrBuf::new(b"ab"), &StrBuf::new(b"abc")),
