@@ -44,6 +44,7 @@ mod il_fbd_roundtrip;
 mod il_roundtrip;
 mod interrupts;
 mod load_errors;
+mod matiec_traces;
 mod module_cycles;
 mod paper_examples;
 mod par_layers;
