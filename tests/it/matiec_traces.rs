@@ -147,7 +147,9 @@ fn every_program_compares_with_matiec_as_recorded() {
         traced += 1;
         let now = outcome(source);
         if now != recorded {
-            wrong.push(format!("{source}\n  recorded: {recorded}\n  now:      {now}"));
+            wrong.push(format!(
+                "{source}\n  recorded: {recorded}\n  now:      {now}"
+            ));
         }
         written.push_str(&format!("{source} | {now}\n"));
     }
