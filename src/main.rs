@@ -225,6 +225,11 @@ struct RunArgs {
     /// a POU is an error.
     #[arg(long)]
     allow_skipped: bool,
+    /// Whose rules to follow where toolchains differ (counters, timers, TIME conversions;
+    /// docs/dialects.md): iec, matiec or codesys [default: a PLCopen file's editor's (CODESYS
+    /// and TwinCAT: codesys, any other: matiec); iec for JSON and STL].
+    #[arg(long, value_parser = parse_dialect)]
+    dialect: Option<plc_deps::model::Dialect>,
     /// Write the report to this file instead of standard output.
     #[arg(short, long)]
     output: Option<PathBuf>,
@@ -260,9 +265,23 @@ struct CArgs {
     /// a POU is an error.
     #[arg(long)]
     allow_skipped: bool,
+    /// Whose rules to follow where toolchains differ, as `run --dialect` (docs/dialects.md).
+    #[arg(long, value_parser = parse_dialect)]
+    dialect: Option<plc_deps::model::Dialect>,
     /// Accepted for compatibility: rows are the default.
     #[arg(long, hide = true)]
     rows: bool,
+}
+
+/// `--dialect NAME`.
+fn parse_dialect(name: &str) -> Result<plc_deps::model::Dialect, String> {
+    plc_deps::model::Dialect::from_name(name).ok_or_else(|| {
+        let names: Vec<&str> = plc_deps::model::Dialect::ALL
+            .iter()
+            .map(|d| d.name())
+            .collect();
+        format!("`{name}` is not a dialect ({})", names.join(", "))
+    })
 }
 
 fn run(cli: Cli) -> Result<(), CliError> {
@@ -366,6 +385,7 @@ impl CArgs {
             output: self.output,
             force: self.force,
             allow_skipped: self.allow_skipped,
+            dialect: self.dialect,
             config: plc_deps::codegen::c::CConfig {
                 cycle_ms: cmd::run::parse_cycle(&self.cycle)?,
                 loop_cap: self.loop_cap,
@@ -422,6 +442,7 @@ impl RunArgs {
         config.output = self.output;
         config.program = self.pou;
         config.allow_skipped = self.allow_skipped;
+        config.dialect = self.dialect;
         Ok(config)
     }
 }

@@ -29,12 +29,17 @@ pub struct CCommand {
     /// `--allow-skipped`: write C for a program some of whose POU bodies are not executed
     /// (each such function says so in a comment); false: such a program is refused.
     pub allow_skipped: bool,
+    /// `--dialect` (docs/dialects.md); `None`: the file's.
+    pub dialect: Option<plc_model::Dialect>,
     pub config: CConfig,
 }
 
 /// `plc-deps c`: generates and writes the files.
 pub fn c(cmd: &CCommand) -> Result<(), CliError> {
-    let (p, fbd) = load_program_for_c(&cmd.input)?;
+    let (mut p, fbd) = load_program_for_c(&cmd.input)?;
+    if let Some(d) = cmd.dialect {
+        p.dialect = d;
+    }
     super::skipped::refuse_skipped(&p, &cmd.input, cmd.allow_skipped, Some("write the C"))?;
     let dir = &cmd.output;
     let io = |e| CliError::io(FileRole::Output, dir, e);

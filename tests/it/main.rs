@@ -15,6 +15,7 @@ mod convert;
 mod corpus;
 mod csv_inputs;
 mod diagnostics;
+mod dialects;
 mod differential;
 mod docs_examples;
 mod elementary_types;

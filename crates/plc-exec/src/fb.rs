@@ -75,7 +75,16 @@ pub(crate) fn trigger<S: Store + ?Sized>(
 /// without a CD edge counts up below PVmax and a CD edge without a CU edge down above PVmin;
 /// QU := CV >= PV, QD := CV <= 0.
 #[inline]
-pub(crate) fn ctud<S: Store + ?Sized>(st: &mut S, i: Addr, pins: CtudPins, cu: bool) -> bool {
+///
+/// `stop_at_preset`: count up only while `CV < PV` and down only while `CV > 0` (matiec's and
+/// CODESYS's CTUD, [`plc_model::Dialect::counters_stop_at_preset`]); else to the INT limits.
+pub(crate) fn ctud<S: Store + ?Sized>(
+    st: &mut S,
+    i: Addr,
+    pins: CtudPins,
+    cu: bool,
+    stop_at_preset: bool,
+) -> bool {
     let pv = st.load::<i16>(pins.pv);
     let cd = st.load::<u8>(pins.cd) != 0;
     let reset = st.load::<u8>(pins.reset) != 0;
@@ -90,9 +99,14 @@ pub(crate) fn ctud<S: Store + ?Sized>(st: &mut S, i: Addr, pins: CtudPins, cu: b
     } else if load {
         cv = pv;
     } else if !(up && down) {
-        if up && cv < i16::MAX {
+        let (top, bottom) = if stop_at_preset {
+            (pv, 0)
+        } else {
+            (i16::MAX, i16::MIN)
+        };
+        if up && cv < top {
             cv += 1;
-        } else if down && cv > i16::MIN {
+        } else if down && cv > bottom {
             cv -= 1;
         }
     }

@@ -186,6 +186,30 @@ pub fn convert(v: Value, to: Type) -> Value {
     }
 }
 
+/// `convert(v, to)` where a TIME is counted in units of `unit` milliseconds rather than in
+/// milliseconds ([`plc_model::Dialect::time_unit_ms`]: matiec's seconds): TIME to an integer
+/// is the whole units, toward zero (`tv_sec`); TIME to a real the units with their fraction;
+/// an integer to TIME that many units, a real to TIME its units cut toward zero to the
+/// millisecond (matiec's `__real_to_time` keeps the fraction in nanoseconds); anything else as
+/// [`convert`].
+pub fn convert_time_in(v: Value, from: Type, to: Type, unit: i64) -> Value {
+    let unit = unit as i128;
+    match (from, to) {
+        (Type::Time, Type::Time) | (Type::Time, Type::Bool) => convert(v, to),
+        (Type::Time, Type::Real | Type::Lreal) => {
+            let units = integer(v) as f64 / unit as f64;
+            convert(lreal(units), to)
+        }
+        (Type::Time, _) => from_integer(integer(v) / unit, to),
+        (Type::Real | Type::Lreal, Type::Time) => {
+            let ms = (real64(v) * unit as f64).trunc();
+            from_integer(real_to_i64(ms) as i128, to)
+        }
+        (_, Type::Time) => from_integer(integer(v) * unit, to),
+        _ => convert(v, to),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

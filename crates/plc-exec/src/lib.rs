@@ -306,6 +306,8 @@ pub struct Machine {
     inits: Vec<Value>,
     layout: Layout,
     config: ExecConfig,
+    /// The rules where toolchains differ (counters, timers, TIME conversions).
+    dialect: plc_model::Dialect,
 }
 
 impl Machine {
@@ -351,6 +353,7 @@ impl Machine {
             for_of_head: code.for_of_head,
             pou_entry: code.pou_entry,
             counters: code.counters,
+            dialect: code.dialect,
             budget_task: budget::tasks(program),
             size: code.size,
             vars: program

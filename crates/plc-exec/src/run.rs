@@ -206,7 +206,10 @@ impl Machine {
         }
         let mut buf = [Value::Bool(false); 8];
         let load = |&(at, ty): &(Addr, Type)| load_value(st, at, ty);
-        let r = if c.args.len() <= buf.len() {
+        let unit = self.dialect.time_unit_ms();
+        let r = if let (plc_model::Function::Convert { from, to }, true) = (c.func, unit != 1) {
+            super::functions::convert_time_in(load(&c.args[0]), from, to, unit)
+        } else if c.args.len() <= buf.len() {
             for (slot, a) in buf.iter_mut().zip(c.args.iter()) {
                 *slot = load(a);
             }
@@ -381,22 +384,25 @@ impl Machine {
                 }
                 Op::Timer { kind, inst, pt } => {
                     let pt = st.load::<i32>(pt) as i64;
+                    let late = self.dialect.timer_compares_after_edge();
                     let q = match kind {
-                        TimerKind::Ton => ton(st, ctx.now, inst, pt, p != 0),
-                        TimerKind::Tof => tof(st, ctx.now, inst, pt, p != 0),
-                        TimerKind::Tp => tp(st, ctx.now, inst, pt, p != 0),
+                        TimerKind::Ton => ton(st, ctx.now, inst, pt, p != 0, late),
+                        TimerKind::Tof => tof(st, ctx.now, inst, pt, p != 0, late),
+                        TimerKind::Tp => tp(st, ctx.now, inst, pt, p != 0, late),
                     };
                     p = q as u64;
                 }
                 Op::Ctu { inst, pv, reset } => {
                     let pv = st.load::<i16>(pv);
                     let reset = st.load::<u8>(reset) != 0;
-                    p = counter(st, inst, pv, p as u8, reset, true) as u64;
+                    let stop = self.dialect.counters_stop_at_preset();
+                    p = counter(st, inst, pv, p as u8, reset, true, stop) as u64;
                 }
                 Op::Ctd { inst, pv, load } => {
                     let pv = st.load::<i16>(pv);
                     let load = st.load::<u8>(load) != 0;
-                    p = counter(st, inst, pv, p as u8, load, false) as u64;
+                    let stop = self.dialect.counters_stop_at_preset();
+                    p = counter(st, inst, pv, p as u8, load, false, stop) as u64;
                 }
                 Op::Bistable { kind, inst, reset } => {
                     let reset = st.load::<u8>(reset) != 0;
@@ -407,7 +413,8 @@ impl Machine {
                 }
                 Op::Ctud { inst, pins } => {
                     let pins = self.ctuds[pins.index()];
-                    p = super::fb::ctud(st, inst, pins, p != 0) as u64;
+                    let stop = self.dialect.counters_stop_at_preset();
+                    p = super::fb::ctud(st, inst, pins, p != 0, stop) as u64;
                 }
                 Op::Move { width, from, to } => {
                     if p != 0 {
@@ -622,9 +629,10 @@ fn contact_bits<S: Store + ?Sized>(st: &S, r: &FusedRung) -> usize {
     bits
 }
 
-/// TON on the instance at `i`; returns Q.
+/// TON on the instance at `i`; returns Q. `late`: the call that sees IN rise only starts the
+/// time, with Q FALSE, and later calls compare ([`plc_model::Dialect::timer_compares_after_edge`]).
 #[inline]
-fn ton<S: Store + ?Sized>(st: &mut S, now: i64, i: Addr, pt: i64, input: bool) -> bool {
+fn ton<S: Store + ?Sized>(st: &mut S, now: i64, i: Addr, pt: i64, input: bool, late: bool) -> bool {
     st.store(i.offset(PT), pt as i32);
     if !input {
         st.store(i.offset(Q), 0u8);
@@ -635,6 +643,10 @@ fn ton<S: Store + ?Sized>(st: &mut S, now: i64, i: Addr, pt: i64, input: bool) -
     let start = if st.load::<u8>(i.offset(FLAGS)) & ACTIVE == 0 {
         st.store(i.offset(FLAGS), ACTIVE | PREV_IN);
         st.store(i.offset(START), now);
+        if late {
+            st.store(i.offset(Q), 0u8);
+            return false;
+        }
         now
     } else {
         st.load::<i64>(i.offset(START))
@@ -646,9 +658,10 @@ fn ton<S: Store + ?Sized>(st: &mut S, now: i64, i: Addr, pt: i64, input: bool) -
     q
 }
 
-/// TOF on the instance at `i`; returns Q.
+/// TOF on the instance at `i`; returns Q. `late`: the call that sees IN fall only starts the
+/// time, with Q TRUE.
 #[inline]
-fn tof<S: Store + ?Sized>(st: &mut S, now: i64, i: Addr, pt: i64, input: bool) -> bool {
+fn tof<S: Store + ?Sized>(st: &mut S, now: i64, i: Addr, pt: i64, input: bool, late: bool) -> bool {
     st.store(i.offset(PT), pt as i32);
     if input {
         st.store(i.offset(Q), 1u8);
@@ -661,6 +674,10 @@ fn tof<S: Store + ?Sized>(st: &mut S, now: i64, i: Addr, pt: i64, input: bool) -
     let start = if flags & PREV_IN != 0 {
         active = true;
         st.store(i.offset(START), now);
+        if late {
+            st.store(i.offset(FLAGS), ACTIVE);
+            return st.load::<u8>(i.offset(Q)) != 0;
+        }
         now
     } else {
         st.load::<i64>(i.offset(START))
@@ -677,9 +694,10 @@ fn tof<S: Store + ?Sized>(st: &mut S, now: i64, i: Addr, pt: i64, input: bool) -
     st.load::<u8>(i.offset(Q)) != 0
 }
 
-/// TP on the instance at `i`; returns Q.
+/// TP on the instance at `i`; returns Q. `late`: the call that sees IN rise only starts the
+/// pulse, with Q TRUE, and later calls compare.
 #[inline]
-fn tp<S: Store + ?Sized>(st: &mut S, now: i64, i: Addr, pt: i64, input: bool) -> bool {
+fn tp<S: Store + ?Sized>(st: &mut S, now: i64, i: Addr, pt: i64, input: bool, late: bool) -> bool {
     st.store(i.offset(PT), pt as i32);
     let flags = st.load::<u8>(i.offset(FLAGS));
     let mut pulsing = flags & ACTIVE != 0;
@@ -687,6 +705,11 @@ fn tp<S: Store + ?Sized>(st: &mut S, now: i64, i: Addr, pt: i64, input: bool) ->
     let start = if !pulsing && input && flags & PREV_IN == 0 {
         pulsing = true;
         st.store(i.offset(START), now);
+        if late {
+            st.store(i.offset(Q), 1u8);
+            st.store(i.offset(FLAGS), ACTIVE | PREV_IN);
+            return true;
+        }
         now
     } else {
         st.load::<i64>(i.offset(START))
@@ -713,7 +736,8 @@ fn tp<S: Store + ?Sized>(st: &mut S, now: i64, i: Addr, pt: i64, input: bool) ->
 }
 
 /// CTU (`up`) or CTD on the instance at `i`: `clock` is CU/CD (0 or 1), `preset` R (CTU) or LD
-/// (CTD); returns Q.
+/// (CTD); returns Q. `stop_at_preset`: CTU counts only while `CV < PV`, CTD while `CV > 0`
+/// ([`plc_model::Dialect::counters_stop_at_preset`]); else to the INT limits.
 #[inline]
 fn counter<S: Store + ?Sized>(
     st: &mut S,
@@ -722,6 +746,7 @@ fn counter<S: Store + ?Sized>(
     clock: u8,
     preset: bool,
     up: bool,
+    stop_at_preset: bool,
 ) -> bool {
     st.store(i.offset(PV), pv);
     let rising = clock & !st.load::<u8>(i.offset(PREV)) & 1 != 0;
@@ -730,12 +755,12 @@ fn counter<S: Store + ?Sized>(
     if up {
         if preset {
             cv = 0;
-        } else if rising && cv < i16::MAX {
+        } else if rising && cv < if stop_at_preset { pv } else { i16::MAX } {
             cv += 1;
         }
     } else if preset {
         cv = pv;
-    } else if rising && cv > i16::MIN {
+    } else if rising && cv > if stop_at_preset { 0 } else { i16::MIN } {
         cv -= 1;
     }
     st.store(i.offset(CV), cv);

@@ -90,6 +90,7 @@ pub fn program_and_fbd_from_json_selected(
     };
     let (mut p, f) = resolve::resolve(text, &syntax).map_err(|e| placed(text, e))?;
     p.configuration = whole.configuration;
+    p.dialect = whole.dialect;
     Ok((p, f))
 }
 

@@ -18,10 +18,12 @@
 //! Element semantics follow IEC 61131-3 (LD, §4.2) and the S7-200 shapes of Zhao & Yan (2012).
 #![forbid(unsafe_code)]
 
+mod dialect;
 mod function;
 mod strings;
 mod tasks;
 mod types;
+pub use dialect::Dialect;
 pub use function::*;
 pub use strings::*;
 pub use tasks::*;
@@ -70,6 +72,9 @@ pub struct Program {
     /// The PLCopen configuration that runs the program's POUs (tasks and program instances);
     /// `None` for programs without one (JSON, STL, a project without instances).
     pub configuration: Option<Configuration>,
+    /// Whose rules `run` and `c` follow where toolchains differ (docs/dialects.md): the
+    /// reader's choice by the file's editor, or the command line's `--dialect`.
+    pub dialect: Dialect,
 }
 
 /// The main program or one subroutine.

@@ -136,6 +136,7 @@ impl<'a> Builder<'a> {
         let types = b.fb_type_models(&bodies);
         let mut program = b.build(syn.name.to_string(), syn.origin)?;
         program.configuration = syn.configuration.clone();
+        program.dialect = syn.dialect;
         for body in &mut bodies {
             for copy in &mut body.copies {
                 let start = program.pou(copy.pou).rungs.start;
@@ -505,6 +506,7 @@ impl<'a> Builder<'a> {
             pous,
             rungs,
             configuration: None,
+            dialect: plc_model::Dialect::default(),
         };
         structure::check(&program, &places, loops)?;
         Ok(program)

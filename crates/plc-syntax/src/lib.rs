@@ -162,6 +162,8 @@ pub struct Program<'a> {
     pub function_blocks: Vec<FunctionBlock<'a>>,
     /// The PLCopen configuration (tasks and program instances), carried to the model unchanged.
     pub configuration: Option<plc_model::Configuration>,
+    /// The dialect of the file's toolchain (PLCopen: by its editor; JSON and STL: IEC).
+    pub dialect: plc_model::Dialect,
     /// Problems of the program object itself and of its non-rung parts, with absolute paths.
     pub problems: Vec<Problem>,
     /// The bodies the reader did not read as logic (it wrote stand-in rungs for them), by the

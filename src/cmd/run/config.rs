@@ -75,6 +75,9 @@ pub struct RunConfig {
     /// `--allow-skipped`: run a project whose ST, IL or SFC bodies are not executed (the
     /// report lists them); false: such a project is refused.
     pub allow_skipped: bool,
+    /// `--dialect`: whose rules to follow where toolchains differ (docs/dialects.md);
+    /// `None`: the file's (its editor's for PLCopen, IEC for JSON and STL).
+    pub dialect: Option<plc_model::Dialect>,
     /// Measure the cost of a moved cache line before planning (a few ms; default on), instead
     /// of the built-in default.
     pub calibrate: bool,
@@ -104,6 +107,7 @@ impl RunConfig {
             calibrate: true,
             program: None,
             allow_skipped: false,
+            dialect: None,
         }
     }
 }

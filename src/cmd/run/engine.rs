@@ -191,10 +191,13 @@ pub(super) fn prepare(c: &RunConfig, progress: &Progress) -> Result<Prepared, Cl
     if let Some(t) = &c.trace {
         check_output_path(t, FileRole::Trace)?;
     }
-    let (p, fbd) = {
+    let (mut p, fbd) = {
         let _phase = progress.phase(&format!("reading {}", c.input.display()));
         load_program_for_run_selecting(&c.input, c.program.as_deref())?
     };
+    if let Some(d) = c.dialect {
+        p.dialect = d;
+    }
     let what = Some("run the rest of the project");
     crate::cmd::skipped::refuse_skipped(&p, &c.input, c.allow_skipped, what)?;
     let mut warnings: Vec<RunWarning> = p

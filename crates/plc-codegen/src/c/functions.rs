@@ -12,7 +12,10 @@ use plc_model::{bit_width, Function, Type};
 
 /// `func(args)` as a C expression of the output type `out`; each argument is its C text and
 /// its type.
-pub(crate) fn expr(func: Function, args: &[(String, Type)], out: Type) -> String {
+///
+/// `time_unit`: milliseconds per unit of a number converted from or to TIME
+/// ([`plc_model::Dialect::time_unit_ms`]), as `plc_exec::functions::convert_time_in`.
+pub(crate) fn expr(func: Function, args: &[(String, Type)], out: Type, time_unit: i64) -> String {
     use Function::*;
     let a = |i: usize| args[i].0.as_str();
     let wide = out == Type::Lreal;
@@ -77,6 +80,9 @@ pub(crate) fn expr(func: Function, args: &[(String, Type)], out: Type) -> String
             wrap(&format!("(int64_t)({})", bits.join(op)), out)
         }
         Not => wrap(&format!("(int64_t)~{}", bits_of(a(0), out)), out),
+        Convert { from, to } if time_unit != 1 && (from == Type::Time) != (to == Type::Time) => {
+            convert_time_in(a(0), from, to, time_unit)
+        }
         Convert { .. } => convert(a(0), args[0].1, out),
         Trunc => wrap(&format!("{}(trunc((double){}))", TO_I64, a(0)), out),
         Concat | Len | Left | Right | Mid | Insert | Delete | Replace | Find => {
@@ -105,6 +111,25 @@ fn convert(x: &str, from: Type, to: Type) -> String {
         (Type::Real, _) => wrap(&format!("{TO_I64}((double)roundf({x}))"), to),
         (Type::Lreal, _) => wrap(&format!("{TO_I64}(round({x}))"), to),
         _ => wrap(&format!("(int64_t){x}"), to),
+    }
+}
+
+/// `x` (of type `from`) converted to `to` with TIME counted in units of `unit` ms, as
+/// `plc_exec::functions::convert_time_in`: TIME to an integer whole units toward zero (C's
+/// division), to a real the units with their fraction; an integer to TIME that many units, a
+/// real its units cut toward zero to the millisecond.
+fn convert_time_in(x: &str, from: Type, to: Type, unit: i64) -> String {
+    match (from, to) {
+        (Type::Time, Type::Bool) => convert(x, from, to),
+        (Type::Time, Type::Real | Type::Lreal) => {
+            format!("({})((double){x} / {unit}.0)", c_type(to))
+        }
+        (Type::Time, _) => wrap(&format!("((int64_t){x} / {unit})"), to),
+        (Type::Real | Type::Lreal, Type::Time) => {
+            wrap(&format!("{TO_I64}(trunc((double){x} * {unit}.0))"), to)
+        }
+        (_, Type::Time) => wrap(&format!("((int64_t){x} * {unit})"), to),
+        _ => convert(x, from, to),
     }
 }
 

@@ -402,10 +402,11 @@ impl<'a> Body<'a> {
                     TimerKind::Tp => "_plc_tp",
                 };
                 let call = format!(
-                    "{f}(&{}, ctx->now, {}, {})",
+                    "{f}(&{}, ctx->now, {}, {}, {})",
                     self.var(*instance),
                     self.operand(pt),
-                    Self::text(&pw)
+                    Self::text(&pw),
+                    u8::from(self.sh.p.dialect.timer_compares_after_edge())
                 );
                 self.boxed(call, last)
             }
@@ -425,11 +426,12 @@ impl<'a> Body<'a> {
                     "_plc_ctd"
                 };
                 let call = format!(
-                    "{f}(&{}, {}, {}, {})",
+                    "{f}(&{}, {}, {}, {}, {})",
                     self.var(*instance),
                     self.operand(pv),
                     Self::text(&pw),
-                    self.operand(reset)
+                    self.operand(reset),
+                    u8::from(self.sh.p.dialect.counters_stop_at_preset())
                 );
                 self.boxed(call, last)
             }
@@ -460,13 +462,14 @@ impl<'a> Body<'a> {
             }
             Element::Ctud { instance, inputs } => {
                 let call = format!(
-                    "_plc_ctud(&{}, {}, {}, {}, {}, {})",
+                    "_plc_ctud(&{}, {}, {}, {}, {}, {}, {})",
                     self.var(*instance),
                     self.operand(&inputs.pv),
                     Self::text(&pw),
                     self.operand(&inputs.cd),
                     self.operand(&inputs.reset),
-                    self.operand(&inputs.load)
+                    self.operand(&inputs.load),
+                    u8::from(self.sh.p.dialect.counters_stop_at_preset())
                 );
                 self.boxed(call, last)
             }
@@ -497,7 +500,8 @@ impl<'a> Body<'a> {
                     .map(|a| (self.operand(a), self.operand_type(a).unwrap_or(Type::Bool)))
                     .collect();
                 let ty = self.sh.p.var(*out).ty;
-                let value = super::functions::expr(*func, &args, ty);
+                let unit = self.sh.p.dialect.time_unit_ms();
+                let value = super::functions::expr(*func, &args, ty, unit);
                 let stmt = format!("{} = {value};", self.var(*out));
                 self.when(&pw, &stmt);
                 pw

@@ -82,11 +82,16 @@ typedef struct { bool QU; bool QD; int16_t CV; int16_t PV; uint8_t prev; } _plc_
 #define _PLC_PREV_IN 1u
 #define _PLC_ACTIVE 2u
 
-static inline bool _plc_ton(_plc_timer *t, int64_t now, int32_t pt, bool in) {
+/* `late` (matiec's timers): the call that sees the edge only starts the time (TON: Q FALSE,
+   TOF: Q TRUE, TP: Q TRUE) and later calls compare the elapsed time with PT. */
+static inline bool _plc_ton(_plc_timer *t, int64_t now, int32_t pt, bool in, bool late) {
     t->PT = pt;
     if (!in) { t->Q = 0; t->ET = 0; t->flags = 0; return 0; }
     int64_t start;
-    if (!(t->flags & _PLC_ACTIVE)) { t->flags = _PLC_ACTIVE | _PLC_PREV_IN; t->start = now; start = now; }
+    if (!(t->flags & _PLC_ACTIVE)) {
+        t->flags = _PLC_ACTIVE | _PLC_PREV_IN; t->start = now; start = now;
+        if (late) { t->Q = 0; return 0; }
+    }
     else start = t->start;
     int64_t et = now - start;
     if (et > pt) et = pt;
@@ -96,12 +101,15 @@ static inline bool _plc_ton(_plc_timer *t, int64_t now, int32_t pt, bool in) {
     return q;
 }
 
-static inline bool _plc_tof(_plc_timer *t, int64_t now, int32_t pt, bool in) {
+static inline bool _plc_tof(_plc_timer *t, int64_t now, int32_t pt, bool in, bool late) {
     t->PT = pt;
     if (in) { t->Q = 1; t->ET = 0; t->flags = _PLC_PREV_IN; return 1; }
     bool active = (t->flags & _PLC_ACTIVE) != 0;
     int64_t start;
-    if (t->flags & _PLC_PREV_IN) { active = 1; t->start = now; start = now; }
+    if (t->flags & _PLC_PREV_IN) {
+        active = 1; t->start = now; start = now;
+        if (late) { t->flags = _PLC_ACTIVE; return t->Q; }
+    }
     else start = t->start;
     if (active) {
         int64_t et = now - start;
@@ -113,12 +121,15 @@ static inline bool _plc_tof(_plc_timer *t, int64_t now, int32_t pt, bool in) {
     return t->Q;
 }
 
-static inline bool _plc_tp(_plc_timer *t, int64_t now, int32_t pt, bool in) {
+static inline bool _plc_tp(_plc_timer *t, int64_t now, int32_t pt, bool in, bool late) {
     t->PT = pt;
     uint8_t flags = t->flags;
     bool pulsing = (flags & _PLC_ACTIVE) != 0, q = 0;
     int64_t start;
-    if (!pulsing && in && !(flags & _PLC_PREV_IN)) { pulsing = 1; t->start = now; start = now; }
+    if (!pulsing && in && !(flags & _PLC_PREV_IN)) {
+        pulsing = 1; t->start = now; start = now;
+        if (late) { t->Q = 1; t->flags = _PLC_ACTIVE | _PLC_PREV_IN; return 1; }
+    }
     else start = t->start;
     if (pulsing) {
         int64_t et = now - start;
@@ -131,25 +142,27 @@ static inline bool _plc_tp(_plc_timer *t, int64_t now, int32_t pt, bool in) {
     return q;
 }
 
-static inline bool _plc_ctu(_plc_counter *c, int16_t pv, bool cu, bool r) {
+/* `stop` (matiec's and CODESYS's counters): CTU counts only while CV < PV, CTD while CV > 0,
+   CTUD both; else to the INT limits. */
+static inline bool _plc_ctu(_plc_counter *c, int16_t pv, bool cu, bool r, bool stop) {
     c->PV = pv;
     bool rising = cu && !c->prev;
     c->prev = cu;
     int16_t cv = c->CV;
     if (r) cv = 0;
-    else if (rising && cv < INT16_MAX) cv++;
+    else if (rising && cv < (stop ? pv : INT16_MAX)) cv++;
     c->CV = cv;
     c->Q = cv >= pv;
     return c->Q;
 }
 
-static inline bool _plc_ctd(_plc_counter *c, int16_t pv, bool cd, bool ld) {
+static inline bool _plc_ctd(_plc_counter *c, int16_t pv, bool cd, bool ld, bool stop) {
     c->PV = pv;
     bool rising = cd && !c->prev;
     c->prev = cd;
     int16_t cv = c->CV;
     if (ld) cv = pv;
-    else if (rising && cv > INT16_MIN) cv--;
+    else if (rising && cv > (stop ? 0 : INT16_MIN)) cv--;
     c->CV = cv;
     c->Q = cv <= 0;
     return c->Q;
@@ -177,16 +190,17 @@ static inline bool _plc_f_trig(_plc_trigger *t, bool clk) {
     return t->Q;
 }
 
-/* CTUD: both edges first, then R, LD, or one edge alone counts (stopping at the INT limits). */
-static inline bool _plc_ctud(_plc_updown *c, int16_t pv, bool cu, bool cd, bool r, bool ld) {
+/* CTUD: both edges first, then R, LD, or one edge alone counts (stopping at the INT limits, or
+   with `stop` at PV and 0). */
+static inline bool _plc_ctud(_plc_updown *c, int16_t pv, bool cu, bool cd, bool r, bool ld, bool stop) {
     bool up = cu && !(c->prev & 1u), down = cd && !(c->prev & 2u);
     c->prev = (uint8_t)((cu ? 1u : 0u) | (cd ? 2u : 0u));
     int16_t cv = c->CV;
     if (r) cv = 0;
     else if (ld) cv = pv;
     else if (!(up && down)) {
-        if (up && cv < INT16_MAX) cv++;
-        else if (down && cv > INT16_MIN) cv--;
+        if (up && cv < (stop ? pv : INT16_MAX)) cv++;
+        else if (down && cv > (stop ? 0 : INT16_MIN)) cv--;
     }
     c->CV = cv;
     c->PV = pv;
@@ -227,18 +241,20 @@ static inline T _plc_mod_##s(T a, T b, _plc_ctx *ctx, uint32_t rung) { \
 _PLC_SDIV(i8, int8_t, uint8_t) _PLC_SDIV(i16, int16_t, uint16_t)
 _PLC_SDIV(i32, int32_t, uint32_t) _PLC_SDIV(i64, int64_t, uint64_t)
 _PLC_UDIV(u8, uint8_t) _PLC_UDIV(u16, uint16_t) _PLC_UDIV(u32, uint32_t) _PLC_UDIV(u64, uint64_t)
-/* The rows' boxes whose kind is data (docs/c.md, Rows): a timer (0 TON, 1 TOF, 2 TP), a counter
-   (0 CTU, 1 CTD), INT ADD/SUB/MUL (0, 1, 2) and INT DIV/MOD (0, 1), each the statements' function
+/* The rows' boxes whose kind is data (docs/c.md, Rows): a timer (0 TON, 1 TOF, 2 TP; bit 2 `late`), a counter
+   (0 CTU, 1 CTD; bit 1 `stop`), INT ADD/SUB/MUL (0, 1, 2) and INT DIV/MOD (0, 1), each the statements' function
    of that kind; a compare's operator as a mask over (a < b) | (a == b) << 1. */
 static inline bool _plc_timer_row(_plc_timer *t, int64_t now, unsigned kind, int32_t pt, bool in) {
-    switch (kind) {
-    case 0: return _plc_ton(t, now, pt, in);
-    case 1: return _plc_tof(t, now, pt, in);
-    default: return _plc_tp(t, now, pt, in);
+    bool late = (kind >> 2) & 1u;
+    switch (kind & 3u) {
+    case 0: return _plc_ton(t, now, pt, in, late);
+    case 1: return _plc_tof(t, now, pt, in, late);
+    default: return _plc_tp(t, now, pt, in, late);
     }
 }
 static inline bool _plc_counter_row(_plc_counter *c, unsigned kind, int16_t pv, bool in, bool r) {
-    return kind ? _plc_ctd(c, pv, in, r) : _plc_ctu(c, pv, in, r);
+    bool stop = (kind >> 1) & 1u;
+    return (kind & 1u) ? _plc_ctd(c, pv, in, r, stop) : _plc_ctu(c, pv, in, r, stop);
 }
 static inline int16_t _plc_ring_row_i16(unsigned op, int16_t a, int16_t b) {
     uint64_t x = (uint64_t)a, y = (uint64_t)b;

@@ -260,6 +260,8 @@ pub(crate) struct Code {
     pub counters: Vec<(RungId, Addr)>,
     /// Bytes of the whole state: variables, loop counters, constants.
     pub size: u32,
+    /// The rules where toolchains differ (counters, timers, TIME conversions).
+    pub dialect: plc_model::Dialect,
 }
 
 /// Why a program could not be lowered.

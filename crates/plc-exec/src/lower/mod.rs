@@ -107,6 +107,7 @@ pub(crate) fn lower(p: &Program, layout: &Layout, fuse: bool) -> Result<Code, Lo
             pou_entry: Vec::with_capacity(p.pous.len()),
             counters,
             size: 0,
+            dialect: p.dialect,
         },
         jumps: Vec::new(),
         calls: Vec::new(),

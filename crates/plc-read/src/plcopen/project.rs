@@ -173,6 +173,12 @@ pub(super) fn program(
     };
     let mut program = assemble(root, programs, fbs, globals, order)?;
     program.configuration = configuration;
+    // The toolchain's dialect, by the editor the header names (docs/dialects.md).
+    let product = tc6
+        .child(root, "fileHeader")
+        .and_then(|h| h.attribute("productName"))
+        .unwrap_or("");
+    program.dialect = plc_model::Dialect::of_editor(product);
     Ok(program)
 }
 
