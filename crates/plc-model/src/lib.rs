@@ -70,6 +70,12 @@ pub struct Program {
     /// The PLCopen configuration that runs the program's POUs (tasks and program instances);
     /// `None` for programs without one (JSON, STL, a project without instances).
     pub configuration: Option<Configuration>,
+    /// The input variables the program itself writes (a coil, set/reset, move or block output
+    /// on an input, which matiec accepts), ascending: the scan copies the input image into them
+    /// before every scan, as the Beremiz/OpenPLC runtime copies its input image into the
+    /// located `%I` variables (docs/scan.md; warning W0208). An instance's inputs, which its
+    /// calls set, are not among them.
+    pub written_inputs: Vec<VarId>,
 }
 
 /// The main program or one subroutine.
