@@ -28,7 +28,11 @@ fn scans(name: &str, csv: &str, columns: &[&str]) -> Vec<Vec<String>> {
     let tr = common::cli::tmp(&format!("{tag}-trace.csv"));
     let extra = ["--mode", "both", "--trace", tr.to_str().unwrap()];
     let v = px::run_inputs(&tag, &xml, csv, &extra);
-    assert_eq!(v["identical"], serde_json::json!(true), "{name}: seq != par");
+    assert_eq!(
+        v["identical"],
+        serde_json::json!(true),
+        "{name}: seq != par"
+    );
     let rows = csv.lines().count() as u64 - 1;
     c_matches_interpreter(&xml, csv, rows, &tag);
     px::trace_columns(&tr, columns)
@@ -95,7 +99,11 @@ fn a_coil_on_a_located_input_lasts_until_the_next_scans_input_copy() {
         warnings.contains("rung P.R2 writes the input `Btn`: the value lasts until the next scan copies the input image into it"),
         "{warnings}"
     );
-    assert_eq!(warnings.matches("writes the input").count(), 1, "{warnings}");
+    assert_eq!(
+        warnings.matches("writes the input").count(),
+        1,
+        "{warnings}"
+    );
 }
 
 #[test]
@@ -107,11 +115,23 @@ fn unconnected_counter_inputs_take_their_initial_values_in_an_ld_body_read_as_da
     // memory keeps TRUE from scan 2 and the TRUE CU of scan 5 is no edge. C0 has PV not
     // connected (0): Q0 = CV >= 0 is TRUE from the first call.
     let csv = "En,Up\n1,1\n1,0\n1,1\n0,0\n0,1\n1,1\n1,0\n1,1\n";
-    let t = scans("unconnected_ctu_ld.xml", csv, &["C1.CV", "Q", "Q0", "C0.CV"]);
-    assert_eq!(t[0], col(&["1", "1", "2", "2", "2", "2", "2", "3"]), "C1.CV");
+    let t = scans(
+        "unconnected_ctu_ld.xml",
+        csv,
+        &["C1.CV", "Q", "Q0", "C0.CV"],
+    );
+    assert_eq!(
+        t[0],
+        col(&["1", "1", "2", "2", "2", "2", "2", "3"]),
+        "C1.CV"
+    );
     assert_eq!(t[1], col(&["0", "0", "1", "1", "1", "1", "1", "1"]), "Q");
     assert_eq!(t[2], col(&["1", "1", "1", "1", "1", "1", "1", "1"]), "Q0");
-    assert_eq!(t[3], col(&["1", "1", "2", "2", "3", "3", "3", "4"]), "C0.CV");
+    assert_eq!(
+        t[3],
+        col(&["1", "1", "2", "2", "3", "3", "3", "4"]),
+        "C0.CV"
+    );
     let (_, warnings) = px::report_and_warnings(&file("unconnected_ctu_ld.xml"));
     for pin in ["input R of CTU (localId 5)", "input PV of CTU (localId 8)"] {
         assert!(warnings.contains(pin), "{pin}: {warnings}");

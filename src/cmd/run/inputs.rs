@@ -36,8 +36,7 @@ impl InputTable {
         if written.is_empty() {
             return self;
         }
-        let mut image: Vec<(VarId, Value)> =
-            written.iter().map(|&v| (v, p.var(v).init)).collect();
+        let mut image: Vec<(VarId, Value)> = written.iter().map(|&v| (v, p.var(v).init)).collect();
         for row in &mut self.rows {
             for (v, x) in row.iter() {
                 if let Ok(k) = written.binary_search(v) {

@@ -220,9 +220,7 @@ fn inputs(p: &Program, sh: &Shared, s: &mut String) {
 /// Beremiz/OpenPLC runtime copies its input image into the located `%I` variables.
 fn restore_inputs(p: &Program, sh: &Shared, s: &mut String) {
     let written = &p.written_inputs;
-    s.push_str(
-        "static void _plc_restore_inputs(_plc_state *self, const _plc_state *image) {\n",
-    );
+    s.push_str("static void _plc_restore_inputs(_plc_state *self, const _plc_state *image) {\n");
     if written.is_empty() {
         s.push_str("    (void)self; (void)image;\n");
     }

@@ -118,8 +118,7 @@ pub(super) fn interface(tc6: Tc6, node: Option<Node>, pou: &str, known: &Known) 
                     Ty::Fb(_) => None,
                 };
             }
-            "inputVars" | "inOutVars" | "outputVars" | "localVars" | "tempVars"
-            | "globalVars" => {
+            "inputVars" | "inOutVars" | "outputVars" | "localVars" | "tempVars" | "globalVars" => {
                 let class = match kind {
                     "inputVars" | "inOutVars" => VarClass::Input,
                     "outputVars" => VarClass::Output,
