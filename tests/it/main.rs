@@ -62,6 +62,7 @@ mod plcopen_ld;
 mod plcopen_ld_logic;
 mod plcopen_ld_pins;
 mod plcopen_library_fbs;
+mod plcopen_loaders;
 mod plcopen_mutation;
 mod plcopen_project;
 mod plcopen_semantics;

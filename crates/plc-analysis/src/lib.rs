@@ -68,6 +68,29 @@ pub enum Warning {
     Empty(Vec<RungId>),
     /// Rungs that write nothing and transfer no control: they have no effect on the scan.
     NoEffect(Vec<RungId>),
+    /// Rungs that write an input variable (matiec accepts a coil on `%IX0.0`): the value lasts
+    /// until the next scan copies the input image in ([`Program::written_inputs`]).
+    WritesInput(VarId, Vec<RungId>),
+}
+
+/// Per input variable the program writes ([`Program::written_inputs`]), the rungs that write
+/// it (listing order).
+fn input_writes(p: &Program, acc: &Accesses) -> Vec<(VarId, Vec<RungId>)> {
+    let written = &p.written_inputs;
+    let mut by: Vec<(VarId, Vec<RungId>)> = written.iter().map(|&v| (v, Vec::new())).collect();
+    if by.is_empty() {
+        return by;
+    }
+    for r in p.rung_ids() {
+        for v in acc.outs(r) {
+            if let Ok(k) = written.binary_search(v) {
+                if by[k].1.last() != Some(&r) {
+                    by[k].1.push(r);
+                }
+            }
+        }
+    }
+    by
 }
 
 /// Rungs of the user's ladder program that are empty or have no effect. Rungs lowered from FBD
@@ -282,6 +305,9 @@ pub fn analyse_with(p: &Program, config: &AnalysisConfig) -> Analysis {
     }
     if !no_effect.is_empty() {
         warnings.push(Warning::NoEffect(no_effect));
+    }
+    for (v, rungs) in input_writes(p, &acc) {
+        warnings.push(Warning::WritesInput(v, rungs));
     }
     let interrupts = interrupts::interrupt_sharing(p, &acc);
     let task_sharing = task_sharing::task_sharing(p, &acc);

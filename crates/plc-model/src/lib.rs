@@ -75,6 +75,12 @@ pub struct Program {
     /// Whose rules `run` and `c` follow where toolchains differ (docs/dialects.md): the
     /// reader's choice by the file's editor, or the command line's `--dialect`.
     pub dialect: Dialect,
+    /// The input variables the program itself writes (a coil, set/reset, move or block output
+    /// on an input, which matiec accepts), ascending: the scan copies the input image into them
+    /// before every scan, as the Beremiz/OpenPLC runtime copies its input image into the
+    /// located `%I` variables (docs/scan.md; warning W0208). An instance's inputs, which its
+    /// calls set, are not among them.
+    pub written_inputs: Vec<VarId>,
 }
 
 /// The main program or one subroutine.

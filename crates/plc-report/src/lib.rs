@@ -190,6 +190,12 @@ pub fn warning_text(p: &Program, w: &Warning) -> String {
             ids(rs),
             if rs.len() == 1 { "has" } else { "have" }
         ),
+        Warning::WritesInput(v, rs) => format!(
+            "{} {} the input `{}`: the value lasts until the next scan copies the input image into it (as the Beremiz/OpenPLC runtime does with located %I variables)",
+            ids(rs),
+            if rs.len() == 1 { "writes" } else { "write" },
+            p.var(*v).name
+        ),
     }
 }
 
@@ -202,7 +208,8 @@ pub fn warning_origin(p: &Program, w: &Warning) -> plc_diag::Origin {
         Warning::Unreachable(rs)
         | Warning::Endless(rs)
         | Warning::Empty(rs)
-        | Warning::NoEffect(rs) => rs.first().copied(),
+        | Warning::NoEffect(rs)
+        | Warning::WritesInput(_, rs) => rs.first().copied(),
         Warning::Uncalled(pou) | Warning::Interrupt(pou) => p.pou_rungs(*pou).next(),
     };
     first.map_or(plc_diag::Origin::NONE, |r| p.rung(r).origin)
@@ -216,6 +223,7 @@ pub fn warning_code(w: &Warning) -> &'static str {
         Warning::Interrupt(_) => "W0204",
         Warning::Empty(_) => "W0205",
         Warning::NoEffect(_) => "W0206",
+        Warning::WritesInput(..) => "W0208",
     }
 }
 

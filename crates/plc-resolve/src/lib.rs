@@ -276,6 +276,9 @@ struct Builder<'a> {
     /// `Motor` of `Motor.Speed`) by scope (a POU's index, `u32::MAX` for the program's), so
     /// that an unknown field of a structure is named as such.
     structure_roots: FastSet<(u32, String)>,
+    /// The input variables that coils, set/reset, moves and block outputs write
+    /// ([`Program::written_inputs`]).
+    written_inputs: std::cell::RefCell<Vec<VarId>>,
 }
 
 /// A ladder rung after pass 1: its id, its syntax and its (prefixed) id text.
@@ -500,6 +503,9 @@ impl<'a> Builder<'a> {
             }
         }
         self.phase_end()?;
+        let mut written_inputs = self.written_inputs.into_inner();
+        written_inputs.sort_unstable();
+        written_inputs.dedup();
         let program = Program {
             name,
             vars: self.vars,
@@ -507,6 +513,7 @@ impl<'a> Builder<'a> {
             rungs,
             configuration: None,
             dialect: plc_model::Dialect::default(),
+            written_inputs,
         };
         structure::check(&program, &places, loops)?;
         Ok(program)

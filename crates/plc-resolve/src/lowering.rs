@@ -3,7 +3,7 @@
 
 use super::lower::{Env, InstanceRef, Names};
 use super::{Builder, Result};
-use plc_diag::Invalid;
+use plc_diag::{Diagnostic, Invalid, LoadError};
 use plc_fbd::{FbdPouKind, LoweredCopy};
 use plc_model::*;
 
@@ -26,7 +26,7 @@ impl<'a> Builder<'a> {
             let origin = self.fbd_origins[i];
             let lowered =
                 super::lower::lower(&bodies[i], &mut PouEnv { b: self, pou: pid }, &names, pid)
-                    .map_err(|e| e.at(origin))?;
+                    .map_err(|e| at_blocks(e, &bodies[i]).at(origin))?;
             if bodies[i].kind == FbdPouKind::FunctionBlock {
                 self.keep_typed_body(i, pid, &lowered.typed);
             }
@@ -44,6 +44,29 @@ impl<'a> Builder<'a> {
         self.fbd_bodies = bodies;
         Ok(())
     }
+}
+
+/// `e` with each problem that names a block and has no place yet placed at that block (where
+/// the reader read it: a PLCopen element's line, the element a block the reader added stands
+/// for), rather than at the start of its body.
+fn at_blocks(mut e: LoadError, body: &plc_fbd::FbdPou) -> LoadError {
+    let ds: &mut [Diagnostic] = match &mut e {
+        LoadError::Invalid(d) => std::slice::from_mut(&mut **d),
+        LoadError::Several(ds) => ds,
+        _ => return e,
+    };
+    for d in ds {
+        let Some((net, Some(id))) = &d.location.network else {
+            continue;
+        };
+        let Some(n) = body.networks.iter().find(|n| &n.id == net) else {
+            continue;
+        };
+        if let Some(b) = n.find(*id) {
+            d.location.origin = d.location.origin.or(n.block(b).origin);
+        }
+    }
+    e
 }
 
 /// The lowering's view of one POU's scope.

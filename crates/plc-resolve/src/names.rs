@@ -45,8 +45,9 @@ impl<'a> Builder<'a> {
         d.with_hint(hint)
     }
 
-    /// A name a block or element writes, in the scope of `pou`: not an input, not a field, not
-    /// a member or an instance.
+    /// A name a block or element writes, in the scope of `pou`: not a field, not a member or an
+    /// instance. An input may be written (matiec accepts a coil on `%IX0.0`): the write lasts
+    /// until the next scan copies the input image in (the analysis warns, W0208).
     pub(super) fn writable_name(
         &self,
         text: &str,
@@ -54,7 +55,6 @@ impl<'a> Builder<'a> {
         what: &'static str,
     ) -> std::result::Result<VarId, Invalid> {
         let (r, t) = self.lookup(text, pou)?;
-        let var = &self.vars[r.var.index()];
         let fail = |why| {
             Err(Invalid::NotWritable {
                 what,
@@ -68,11 +68,14 @@ impl<'a> Builder<'a> {
         if text.contains('.') && !self.is_own_variable(text, pou) {
             return fail("it belongs to a function block instance (only the instance writes it)");
         }
-        if var.class == VarClass::Input {
-            return fail("it is an input (inputs are written by the scan, not the program)");
-        }
         if matches!(t, Type::Fb(_)) {
             return fail("it is a function block instance");
+        }
+        // An instance's own input (`G1.X`, written in its body) is set by its calls, not by the
+        // input image.
+        let v = &self.vars[r.var.index()];
+        if v.class == VarClass::Input && !v.hidden && !v.name.contains('.') {
+            self.written_inputs.borrow_mut().push(r.var);
         }
         Ok(r.var)
     }

@@ -123,21 +123,15 @@ impl<'a> Builder<'a> {
             .at(v.ty.origin));
         }
         let class = match v.class.value {
+            // A function block instance declared in a program's VAR_INPUT or VAR_OUTPUT (an
+            // OpenPLC project's `CTU1` in `inputVars`): nothing passes a program an instance
+            // (the configuration calls it without arguments), so, as in matiec, it is the
+            // program's own instance, called where the body calls it.
+            _ if matches!(ty, Type::Fb(_)) => VarClass::Memory,
             syntax::VarClass::Input => VarClass::Input,
             syntax::VarClass::Output => VarClass::Output,
             syntax::VarClass::Memory | syntax::VarClass::Default => VarClass::Memory,
         };
-        if matches!(ty, Type::Fb(_)) && class != VarClass::Memory {
-            return Err(LoadError::invalid(
-                None,
-                &format!("{}.class", p()),
-                Invalid::Misplaced {
-                    what: "an input or output class",
-                    place: "on a function block instance",
-                },
-            )
-            .at(v.class.origin));
-        }
         let init = match &v.init {
             None => ty.zero(),
             Some(j) if matches!(ty, Type::Fb(_)) => {

@@ -254,6 +254,8 @@ pub(super) fn prepare(c: &RunConfig, progress: &Progress) -> Result<Prepared, Cl
     let html = c.format == RunFormat::Html;
     let needs_par = c.mode != RunMode::Seq || c.explain;
     let analysis = (needs_par || html).then(|| analyse(&p));
+    // The inputs the program writes get their image copied in before every scan (W0208).
+    let inputs = inputs.with_image(&p, &p.written_inputs);
     let par = if let (true, Some(a)) = (needs_par, &analysis) {
         Some(
             ParallelMachine::new(

@@ -9,15 +9,48 @@ use std::path::Path;
 
 /// Input values per scan: `rows[k]` holds the values that change at scan `k`; an input not in a
 /// row (and every input after the last row) keeps its value.
+///
+/// An input the program writes (W0208) is the exception: the scan copies its *image* in before
+/// every scan (the value the rows last gave it, else its initial value), as the Beremiz/OpenPLC
+/// runtime copies the input image into located `%I` variables; [`InputTable::with_image`] puts
+/// that copy into every row and into `tail`, the values of the scans after the last row.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct InputTable {
     pub rows: Vec<Vec<(VarId, Value)>>,
+    /// What is written before each scan after the last row: the images of the written inputs.
+    pub tail: Vec<(VarId, Value)>,
 }
 
 impl InputTable {
     /// The values written before scan `scan`.
     pub fn at(&self, scan: u64) -> &[(VarId, Value)] {
-        self.rows.get(scan as usize).map_or(&[], |r| r.as_slice())
+        self.rows
+            .get(scan as usize)
+            .map_or(self.tail.as_slice(), |r| r.as_slice())
+    }
+
+    /// The table with the input image of each of `written` (the inputs the program writes,
+    /// `Program::written_inputs`) copied in before every scan: each row gets the image
+    /// of every written input it does not set, and `tail` the images after the last row.
+    pub fn with_image(mut self, p: &Program, written: &[VarId]) -> InputTable {
+        if written.is_empty() {
+            return self;
+        }
+        let mut image: Vec<(VarId, Value)> = written.iter().map(|&v| (v, p.var(v).init)).collect();
+        for row in &mut self.rows {
+            for (v, x) in row.iter() {
+                if let Ok(k) = written.binary_search(v) {
+                    image[k].1 = *x;
+                }
+            }
+            for &(v, x) in &image {
+                if !row.iter().any(|(w, _)| *w == v) {
+                    row.push((v, x));
+                }
+            }
+        }
+        self.tail = image;
+        self
     }
 }
 
@@ -430,7 +463,11 @@ pub fn parse_inputs_csv(p: &Program, text: &str, file: &str) -> Result<InputTabl
         }
         rows.push(row);
     }
-    Ok(InputTable { rows })
+    Ok(InputTable {
+        rows,
+        tail: Vec::new(),
+    }
+    .with_image(p, &p.written_inputs))
 }
 
 /// Parses inputs in JSON: an array with one object per scan (element k is scan k) mapping input
@@ -537,7 +574,11 @@ pub fn parse_inputs_json(p: &Program, text: &str, file: &str) -> Result<InputTab
             let (line, col) = json_place(text, e.line(), e.column());
             CliError::Usage(format!("{file}:{line}:{col}: {msg}"))
         })?;
-    Ok(InputTable { rows })
+    Ok(InputTable {
+        rows,
+        tail: Vec::new(),
+    }
+    .with_image(p, &p.written_inputs))
 }
 
 /// The line and column to report for a `serde_json` error at `line`:`column`. serde_json

@@ -70,6 +70,7 @@ pub(crate) fn program_source(p: &Program, sh: &Shared, extra: &[String], cfg: &C
         format_args!("    {}(self, ctx);\n}}\n\n", sh.pou_fns[0]),
     );
     inputs(p, sh, &mut s);
+    restore_inputs(p, sh, &mut s);
     print_state(p, sh, &mut s);
     s.push_str("const char *const _plc_rung_ids[] = {\n");
     for r in &p.rungs {
@@ -94,11 +95,12 @@ static int _plc_desc_set_input(void *self, unsigned input, const char *text) {
     return _plc_set_input(self, input, text);
 }
 static void _plc_desc_print(const void *self, FILE *out) { _plc_print_state(self, out); }
+static void _plc_desc_restore(void *self, const void *image) { _plc_restore_inputs(self, image); }
 
 const _plc_program _plc_program_desc = {
     sizeof(_plc_state), &_plc_initial, _plc_desc_scan, _plc_desc_set_input, _plc_desc_print,
     _plc_input_names, _plc_input_types, _plc_output_names, _plc_memory_names, _plc_rung_ids,
-    @CYCLE@, @LOOP_CAP@
+    @CYCLE@, @LOOP_CAP@, _plc_desc_restore
 };
 ";
 
@@ -210,6 +212,27 @@ fn inputs(p: &Program, sh: &Shared, s: &mut String) {
             ),
         );
     }
+}
+
+/// `_plc_restore_inputs`: copies the input image (`image`, a state the driver sets every cell of
+/// the inputs into) into each input the program writes (`Program::written_inputs`, warning
+/// W0208) before every scan, as `plc-deps run` does (`InputTable::with_image`) and as the
+/// Beremiz/OpenPLC runtime copies its input image into the located `%I` variables.
+fn restore_inputs(p: &Program, sh: &Shared, s: &mut String) {
+    let written = &p.written_inputs;
+    s.push_str("static void _plc_restore_inputs(_plc_state *self, const _plc_state *image) {\n");
+    if written.is_empty() {
+        s.push_str("    (void)self; (void)image;\n");
+    }
+    for &v in written {
+        let lhs = &sh.vars[v.index()];
+        let rhs = lhs.replacen("self->", "image->", 1);
+        push(
+            s,
+            format_args!("    memcpy(&{lhs}, &{rhs}, sizeof {lhs});\n"),
+        );
+    }
+    s.push_str("}\n\n");
 }
 
 /// An input's entry of `_plc_input_types`: `BOOL`, `REAL`, `LREAL`, `TIME`, or for an integer
@@ -601,10 +624,13 @@ static int _plc_main(const _plc_program *prog, int argc, char **argv) {
     }
     size_t skip = len >= 3 && !memcmp(text, "\xEF\xBB\xBF", 3) ? 3 : 0;
     _plc_csv f = {bytes + skip, len - skip, malloc(len - skip + 1)};
-    void *state = malloc(prog->size), *scratch = malloc(prog->size);
-    if (!f.out || !state || !scratch) return 2;
+    void *state = malloc(prog->size), *scratch = malloc(prog->size), *image = malloc(prog->size);
+    if (!f.out || !state || !scratch || !image) return 2;
     memcpy(state, prog->initial, prog->size);
     memcpy(scratch, prog->initial, prog->size);
+    /* The input image: every cell is set into it too, and the inputs the program writes are
+       copied from it before each scan (docs/scan.md, Inputs). */
+    memcpy(image, prog->initial, prog->size);
     _plc_cell *cells = NULL;
     size_t cells_cap = 0, ncells = 0, pos = 0, ncols = 0;
     int *column_input = NULL;
@@ -660,8 +686,11 @@ static int _plc_main(const _plc_program *prog, int argc, char **argv) {
     _plc_ctx ctx = {0, 0, prog->loop_cap, on_fault, (void *)prog, 0, 0};
     for (unsigned long long k = 0; k < scans; k++) {
         if (k < nrows)
-            for (size_t v = rows[k].first; v < rows[k].first + rows[k].count; v++)
+            for (size_t v = rows[k].first; v < rows[k].first + rows[k].count; v++) {
                 _plc_set_cell(prog, &f, state, value_input[v], &values[v], (size_t)k);
+                _plc_set_cell(prog, &f, image, value_input[v], &values[v], (size_t)k);
+            }
+        prog->restore_inputs(state, image);
         ctx.scan = k;
         ctx.now = (int64_t)k * prog->cycle_ms;
         double t0 = timing ? seconds() : 0;
@@ -675,6 +704,7 @@ static int _plc_main(const _plc_program *prog, int argc, char **argv) {
     }
     free(state);
     free(scratch);
+    free(image);
     free(rows);
     free(values);
     free(value_input);

@@ -59,6 +59,8 @@ typedef struct _plc_program {
     const char *const *rung_ids;
     int64_t cycle_ms;
     uint64_t loop_cap;
+    /* Before each scan: copies the input image into the inputs the program writes. */
+    void (*restore_inputs)(void *self, const void *image);
 } _plc_program;
 
 static inline void _plc_fault(_plc_ctx *ctx, uint32_t rung, int kind) {

@@ -350,6 +350,16 @@ pub(super) fn mixed_arithmetic(t: &Typer, ty: &str, b: &Block) -> bool {
     types.windows(2).any(|w| w[0] != w[1])
 }
 
+/// The model's op for the typed TIME arithmetic `ty` of IEC 61131-3 Table 30 that is one TIME
+/// operation: ADD_TIME and SUB_TIME (TIME, TIME → TIME).
+fn time_arithmetic(ty: &str) -> Option<&'static str> {
+    match ty {
+        "ADD_TIME" => Some("ADD"),
+        "SUB_TIME" => Some("SUB"),
+        _ => None,
+    }
+}
+
 /// True when the model or the project has op `ty` (nothing to do here).
 pub(super) fn is_known(ctx: &Ctx, ty: &str) -> bool {
     OpKind::parse(ty).is_some() || ctx.fbs.contains_key(ty)
@@ -372,6 +382,13 @@ pub(super) fn rewrite(
         _ => Vec::new(),
     };
     let at = b.origin;
+    if let Some(op) = time_arithmetic(ty) {
+        // ADD_TIME, SUB_TIME (IEC 61131-3 Table 30: TIME + TIME, TIME - TIME → TIME; matiec's
+        // standard library): the model's ADD and SUB of TIME.
+        b.op = Ok(Cow::Borrowed(op));
+        b.inputs = Some(Ok(Inputs::Named(inputs)));
+        return Ok(None);
+    }
     if let Some(f) = standard_function(ty) {
         // A conversion between types the reader maps onto the model's: the model's own.
         b.op = Ok(Cow::Owned(f.name()));

@@ -18,7 +18,13 @@
 //! type's description. A structure (named or declared in place) is flattened into one variable
 //! per elementary field, `Motor.Speed` ([`super::data_types`]), each read as above.
 //!
-//! Deliberately not here: structured initial values of elementary variables and `VAR_IN_OUT`
+//! `VAR_IN_OUT` (`inOutVars`) is read as an input of the POU: a POU no call passes an argument
+//! to (a program, which the configuration calls without arguments; a function block whose calls
+//! leave the in-out unconnected) uses its own variable, as matiec's reference then points at
+//! nothing else; a call that wires an in-out is refused by name ([`super::wiring`]), since
+//! passing by reference is not modelled.
+//!
+//! Deliberately not here: structured initial values of elementary variables and `VAR_ACCESS`
 //! — each an error naming the variable, until the model has them.
 
 use super::data_types::{Aggregate, Base, DataType, DataTypes};
@@ -112,16 +118,16 @@ pub(super) fn interface(tc6: Tc6, node: Option<Node>, pou: &str, known: &Known) 
                     Ty::Fb(_) => None,
                 };
             }
-            "inputVars" | "outputVars" | "localVars" | "tempVars" | "globalVars" => {
+            "inputVars" | "inOutVars" | "outputVars" | "localVars" | "tempVars" | "globalVars" => {
                 let class = match kind {
-                    "inputVars" => VarClass::Input,
+                    "inputVars" | "inOutVars" => VarClass::Input,
                     "outputVars" => VarClass::Output,
                     _ => VarClass::Default,
                 };
                 let (m, f) = (&mut out.mapped, &mut out.fb_inits);
                 let vars = var_list(tc6, list, class, &place, known, m, f)?;
                 match kind {
-                    "inputVars" => out.inputs.extend(vars),
+                    "inputVars" | "inOutVars" => out.inputs.extend(vars),
                     "outputVars" => out.outputs.extend(vars),
                     "globalVars" => out.globals.extend(vars),
                     _ => out.locals.extend(vars),
@@ -143,11 +149,11 @@ pub(super) fn interface(tc6: Tc6, node: Option<Node>, pou: &str, known: &Known) 
                     out.external_mapped.extend(mapped);
                 }
             }
-            "inOutVars" | "accessVars" => {
+            "accessVars" => {
                 return Err(error(
                     origin(list),
                     &place,
-                    format!("{kind} (VAR_IN_OUT, VAR_ACCESS) of POU `{pou}` are not supported yet"),
+                    format!("{kind} (VAR_ACCESS) of POU `{pou}` are not supported yet"),
                 ))
             }
             "documentation" | "addData" => {}

@@ -49,15 +49,27 @@ pub(super) fn konst(b: bool, at: Origin) -> Input<'static> {
 /// The value an unconnected data input `pin` of standard function block `ty` takes: its type's
 /// initial value (IEC 61131-3 2.5.2.1: an input nothing sets keeps its initial value; 2.4.2: the
 /// type's default), T#0ms for a timer's PT and 0 for a counter's PV, with the text the warning
-/// shows. BOOL inputs are read as FALSE by the callers already; other blocks: `None`.
+/// shows; a BOOL input (a timer's IN, a counter's CU, CD, R or LD, a bistable's or a trigger's
+/// input) FALSE, as matiec leaves an input no call sets at its initial value. Other blocks and
+/// pins: `None`.
 pub(super) fn unconnected_default(
     ty: &str,
     pin: &str,
     at: Origin,
 ) -> Option<(Input<'static>, &'static str)> {
+    let counter = |t: &str| {
+        ["CTU", "CTD", "CTUD"]
+            .iter()
+            .any(|c| t == *c || t.strip_prefix(c).is_some_and(|r| r.starts_with('_')))
+    };
     let (c, text) = match (ty, pin) {
         ("TON" | "TOF" | "TP", "PT") => (Scalar::Str(Cow::Borrowed("T#0ms")), "T#0ms"),
-        ("CTU" | "CTD" | "CTUD", "PV") => (Scalar::Number(0.into()), "0"),
+        (t, "PV") if counter(t) => (Scalar::Number(0.into()), "0"),
+        ("TON" | "TOF" | "TP", "IN")
+        | ("SR", "S1" | "R")
+        | ("RS", "S" | "R1")
+        | ("R_TRIG" | "F_TRIG", "CLK") => (Scalar::Bool(false), "FALSE"),
+        (t, "CU" | "CD" | "R" | "LD") if counter(t) => (Scalar::Bool(false), "FALSE"),
         _ => return None,
     };
     Some((

@@ -256,6 +256,15 @@ fn block_pins<'a, 'i>(tc6: Tc6, el: &mut Elem<'a, 'i>, place: &str, ids: &LocalI
         for l in tc6.children(n, list) {
             for v in tc6.children(l, "variable") {
                 let name = attr(v, "formalParameter", place)?;
+                if list == "inOutVariables" {
+                    // matiec passes a VAR_IN_OUT by reference: what the block writes into it
+                    // goes back to the wired variable, which the model has no arc for.
+                    return Err(error(
+                        origin(v),
+                        place,
+                        format!("block localId {} passes `{name}` to a VAR_IN_OUT, which is not supported yet (a POU's own in-out variables are: they are read as inputs when no call wires them)", el.local_id),
+                    ));
+                }
                 let sources = match tc6.child(v, "connectionPointIn") {
                     Some(cp) => connections(tc6, cp, place, ids)?,
                     None => Vec::new(),
