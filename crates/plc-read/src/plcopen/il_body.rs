@@ -422,7 +422,8 @@ impl Tr {
                 )
             }
         };
-        let Some(ty) = self.type_of(&e) else {
+        // An untyped literal takes the type another path gave the label.
+        let Some(ty) = self.type_of(&e).or(self.labels.get(l).map(|x| x.1)) else {
             return refuse(
                 at,
                 format!("the current result at label `{l}`: its type cannot be told (an untyped literal?)"),
