@@ -260,7 +260,10 @@ fn what_il_cannot_execute_is_refused_by_run_and_c_with_its_place() {
         let place = px::line_col(&xml, at);
         for (args, help) in [
             (vec!["run", "-"], "run the rest of the project"),
-            (vec!["c", "-", "-o", "/nonexistent/il-refused"], "write the C"),
+            (
+                vec!["c", "-", "-o", "/nonexistent/il-refused"],
+                "write the C",
+            ),
         ] {
             let e = refusal(&run_stdin(&args, xml.as_bytes()), body);
             assert_eq!(

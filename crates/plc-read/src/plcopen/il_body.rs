@@ -392,7 +392,10 @@ impl Tr {
         }
         let e = e.clone();
         let Some(ty) = self.type_of(&e) else {
-            return refuse(at, "a current result whose type the translation cannot tell");
+            return refuse(
+                at,
+                "a current result whose type the translation cannot tell",
+            );
         };
         let t = self.temp(ty, at);
         let Expr::Var(p) = &t else { unreachable!() };
@@ -533,9 +536,17 @@ impl Tr {
                 self.cr(i)?;
                 self.settle(at, Some(&target.base))?;
                 let cr = self.cr(i)?;
-                if let (Some(a), Some(b)) = (self.type_of(&cr), self.type_of(&Expr::Var(target.clone()))) {
+                if let (Some(a), Some(b)) =
+                    (self.type_of(&cr), self.type_of(&Expr::Var(target.clone())))
+                {
                     if a != b {
-                        return refuse(at, format!("`{}` of a {a} current result into {b} `{}`", i.name, target.base));
+                        return refuse(
+                            at,
+                            format!(
+                                "`{}` of a {a} current result into {b} `{}`",
+                                i.name, target.base
+                            ),
+                        );
                     }
                 }
                 let value = if *neg { not(cr.clone()) } else { cr.clone() };
@@ -547,8 +558,15 @@ impl Tr {
                     },
                 );
                 // The stored variable holds the CR now: later uses read it, not the expression.
-                let elementary = matches!(self.scope.find(&path(&target)), Ok(Some((Decl::Elementary { .. }, true))));
-                if !*neg && elementary && !is_temp(&cr) && !matches!(cr, Expr::Literal(_) | Expr::Var(_)) {
+                let elementary = matches!(
+                    self.scope.find(&path(&target)),
+                    Ok(Some((Decl::Elementary { .. }, true)))
+                );
+                if !*neg
+                    && elementary
+                    && !is_temp(&cr)
+                    && !matches!(cr, Expr::Literal(_) | Expr::Var(_))
+                {
                     self.cr = Cr::Val(Expr::Var(target));
                 }
             }
@@ -568,7 +586,14 @@ impl Tr {
                 } else {
                     let _ = cr;
                     self.settle(at, Some(&target.base))?;
-                    let value = Expr::Literal(if matches!(i.op, Op::Set) { "TRUE" } else { "FALSE" }.into());
+                    let value = Expr::Literal(
+                        if matches!(i.op, Op::Set) {
+                            "TRUE"
+                        } else {
+                            "FALSE"
+                        }
+                        .into(),
+                    );
                     self.guarded(i, Cond::IfTrue, Stmt::Assign { target, value })?;
                 }
             }
@@ -600,14 +625,24 @@ impl Tr {
                         let inner = match &self.cr {
                             Cr::Val(e) => e.clone(),
                             Cr::None(why) => {
-                                return refuse(at, format!("`{}( … )` whose list leaves no current result ({why})", i.name))
+                                return refuse(
+                                    at,
+                                    format!(
+                                        "`{}( … )` whose list leaves no current result ({why})",
+                                        i.name
+                                    ),
+                                )
                             }
                         };
                         self.cr = outer;
                         inner
                     }
                 };
-                let left = if i.nested.is_some() { self.cr(i)? } else { left };
+                let left = if i.nested.is_some() {
+                    self.cr(i)?
+                } else {
+                    left
+                };
                 if *neg {
                     right = not(right);
                 }
@@ -634,7 +669,10 @@ impl Tr {
             }
             Op::Jmp(c, l) => {
                 if !top {
-                    return refuse(at, format!("`{}` inside a deferred operand's parentheses", i.name));
+                    return refuse(
+                        at,
+                        format!("`{}` inside a deferred operand's parentheses", i.name),
+                    );
                 }
                 if !self.live.contains_key(l) {
                     return refuse(at, format!("`{} {l}`: the body has no label `{l}`", i.name));
@@ -644,7 +682,8 @@ impl Tr {
                 }
                 self.into_label(at, l)?;
                 let cond = self.cond_expr(i, *c)?;
-                self.out.push(Piece::Jump(self.k, at, cond, format!("il__{l}")));
+                self.out
+                    .push(Piece::Jump(self.k, at, cond, format!("il__{l}")));
                 if *c == Cond::Always {
                     self.reach = false;
                     self.cr = Cr::None("after an unconditional JMP");
@@ -696,7 +735,12 @@ impl Tr {
             },
             Expr::Unary(_, x) => self.type_of(x),
             Expr::Binary(op, a, b) => match op {
-                BinaryOp::Lt | BinaryOp::Gt | BinaryOp::Le | BinaryOp::Ge | BinaryOp::Eq | BinaryOp::Ne => Some(Type::Bool),
+                BinaryOp::Lt
+                | BinaryOp::Gt
+                | BinaryOp::Le
+                | BinaryOp::Ge
+                | BinaryOp::Eq
+                | BinaryOp::Ne => Some(Type::Bool),
                 _ => self.type_of(a).or_else(|| self.type_of(b)),
             },
             Expr::Call { callee, args } => {
@@ -716,7 +760,12 @@ impl Tr {
                         let f = Function::parse(&name)?;
                         let own: Vec<(Option<Type>, bool)> = vals
                             .iter()
-                            .map(|v| (self.type_of(v), matches!(v, Expr::Literal(l) if l.contains('.'))))
+                            .map(|v| {
+                                (
+                                    self.type_of(v),
+                                    matches!(v, Expr::Literal(l) if l.contains('.')),
+                                )
+                            })
                             .collect();
                         f.types(&own, None).ok().map(|t| t.out)
                     }

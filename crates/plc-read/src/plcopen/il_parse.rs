@@ -38,16 +38,23 @@ pub(super) enum Cond {
 #[derive(Clone, Debug, PartialEq)]
 pub(super) enum Op {
     /// `LD` (`neg`: `LDN`).
-    Ld { neg: bool },
+    Ld {
+        neg: bool,
+    },
     /// `ST` (`neg`: `STN`).
-    St { neg: bool },
+    St {
+        neg: bool,
+    },
     /// `S` and `R`: set or reset a BOOL when the current result is TRUE, or an implicit call
     /// of an instance's input `S` or `R`.
     Set,
     Reset,
     Not,
     /// An expression operator (`AND`, `ADD`, `GT`, …; `neg`: the operand negated, `ANDN`).
-    Binary { op: BinaryOp, neg: bool },
+    Binary {
+        op: BinaryOp,
+        neg: bool,
+    },
     /// A function block input operator (`CLK R1`): the instance called with that input set to
     /// the current result (matiec's `XXX_CAL_operator`).
     FbInput(String),
@@ -59,7 +66,10 @@ pub(super) enum Op {
         args: Vec<Arg>,
     },
     /// A function called with the current result first, then `args`.
-    Function { name: String, args: Vec<Expr> },
+    Function {
+        name: String,
+        args: Vec<Expr>,
+    },
     /// A construct parsed only to be refused by name.
     Unsupported(String),
 }
@@ -187,7 +197,10 @@ impl<'a> P<'a> {
                 t.at,
                 format!("`{}` where {wanted} was expected", tok_text(&t.kind)),
             ),
-            None => self.err(self.end, format!("the end of the text where {wanted} was expected")),
+            None => self.err(
+                self.end,
+                format!("the end of the text where {wanted} was expected"),
+            ),
         }
     }
     fn end_of_instruction(&self, in_parens: bool) -> R<()> {
@@ -214,9 +227,18 @@ impl<'a> P<'a> {
             }
             // A label: `name:` (not `name :=`).
             if let Tok::Ident(n) = t.kind {
-                if matches!(self.toks.get(self.i + 1), Some(Token { kind: Tok::Sym(":"), .. })) {
+                if matches!(
+                    self.toks.get(self.i + 1),
+                    Some(Token {
+                        kind: Tok::Sym(":"),
+                        ..
+                    })
+                ) {
                     if nested {
-                        return self.err(t.at, format!("the label `{n}` inside a deferred operand's parentheses"));
+                        return self.err(
+                            t.at,
+                            format!("the label `{n}` inside a deferred operand's parentheses"),
+                        );
                     }
                     self.i += 2;
                     out.push(Item::Label(n.to_ascii_uppercase(), t.at));
@@ -355,7 +377,10 @@ impl<'a> P<'a> {
                 }
             }
             Op::Not if !self.at_eol() && !(nested && self.is_sym(")")) => {
-                return self.err(self.at(), "an operand after NOT (IEC gives it no meaning; matiec refuses it)")
+                return self.err(
+                    self.at(),
+                    "an operand after NOT (IEC gives it no meaning; matiec refuses it)",
+                )
             }
             _ => {}
         }
@@ -372,7 +397,16 @@ impl<'a> P<'a> {
         loop {
             let formal = matches!(
                 (self.peek(), self.toks.get(self.i + 1)),
-                (Some(Token { kind: Tok::Ident(_), .. }), Some(Token { kind: Tok::Sym(":=" | "=>"), .. }))
+                (
+                    Some(Token {
+                        kind: Tok::Ident(_),
+                        ..
+                    }),
+                    Some(Token {
+                        kind: Tok::Sym(":=" | "=>"),
+                        ..
+                    })
+                )
             );
             let negated_out = matches!(
                 (self.peek(), self.toks.get(self.i + 2)),
@@ -524,17 +558,41 @@ mod tests {
         );
         let items = parse("AND( b\n OR c\n)\nST d").unwrap();
         let Item::Instr(i) = &items[0] else { panic!() };
-        assert_eq!(i.op, Op::Binary { op: BinaryOp::And, neg: false });
-        assert_eq!(i.operand, Some(Expr::Var(Place { base: "b".into(), base_at: 5, selectors: vec![] })));
+        assert_eq!(
+            i.op,
+            Op::Binary {
+                op: BinaryOp::And,
+                neg: false
+            }
+        );
+        assert_eq!(
+            i.operand,
+            Some(Expr::Var(Place {
+                base: "b".into(),
+                base_at: 5,
+                selectors: vec![]
+            }))
+        );
         assert_eq!(i.nested.as_ref().map(|n| n.len()), Some(1));
-        let Item::Instr(f) = &parse("LIMIT 0, -5").unwrap()[0] else { panic!() };
-        assert_eq!(f.op, Op::Function { name: "LIMIT".into(), args: vec![Expr::Literal("0".into()), Expr::Literal("-5".into())] });
+        let Item::Instr(f) = &parse("LIMIT 0, -5").unwrap()[0] else {
+            panic!()
+        };
+        assert_eq!(
+            f.op,
+            Op::Function {
+                name: "LIMIT".into(),
+                args: vec![Expr::Literal("0".into()), Expr::Literal("-5".into())]
+            }
+        );
     }
 
     #[test]
     fn errors_are_at_the_token() {
         let e = parse("LD a b").unwrap_err();
-        assert_eq!((e.at, e.message.as_str()), (5, "`b` where the end of the line was expected"));
+        assert_eq!(
+            (e.at, e.message.as_str()),
+            (5, "`b` where the end of the line was expected")
+        );
         let e = parse("LD\nST x").unwrap_err();
         assert_eq!(e.at, 3);
         assert!(parse("AND( a\nOR b").unwrap_err().message.contains("`)`"));
