@@ -250,7 +250,7 @@ enum Cr {
 /// What the translation produces, in order: statements of instruction `k`, jumps (`k`, the
 /// offset, the condition, the label) and labels.
 enum Piece {
-    Stmt(usize, Statement),
+    Stmt(usize, Box<Statement>),
     Jump(usize, usize, Option<Expr>, String),
     Label(String),
 }
@@ -330,7 +330,8 @@ fn stores(items: &[Item]) -> bool {
 
 impl Tr {
     fn stmt(&mut self, at: usize, kind: Stmt) {
-        self.out.push(Piece::Stmt(self.k, Statement { at, kind }));
+        self.out
+            .push(Piece::Stmt(self.k, Box::new(Statement { at, kind })));
     }
 
     fn temp(&mut self, ty: Type, at: usize) -> Expr {
@@ -412,7 +413,7 @@ impl Tr {
 
     /// Before a jump to, or the fall-through into, label `l` whose CR is used: the CR into
     /// the label's temporary.
-    fn into_label(&mut self, at: usize, l: &str) -> L<()> {
+    fn enter_label(&mut self, at: usize, l: &str) -> L<()> {
         if !self.live.get(l).copied().unwrap_or(false) {
             return Ok(());
         }
@@ -470,7 +471,7 @@ impl Tr {
             match it {
                 Item::Label(l, at) => {
                     if self.reach {
-                        self.into_label(*at, l)?;
+                        self.enter_label(*at, l)?;
                     }
                     self.out.push(Piece::Label(format!("il__{l}")));
                     self.reach = true;
@@ -680,7 +681,7 @@ impl Tr {
                 if *c != Cond::Always {
                     self.cr(i)?;
                 }
-                self.into_label(at, l)?;
+                self.enter_label(at, l)?;
                 let cond = self.cond_expr(i, *c)?;
                 self.out
                     .push(Piece::Jump(self.k, at, cond, format!("il__{l}")));

@@ -203,6 +203,10 @@ impl<'a> P<'a> {
             ),
         }
     }
+    /// Whether the instruction's line ends here (`nested`: or its list's `)` comes).
+    fn line_ends(&self, nested: bool) -> bool {
+        self.at_eol() || (nested && self.is_sym(")"))
+    }
     fn end_of_instruction(&self, in_parens: bool) -> R<()> {
         if self.at_eol() || (in_parens && self.is_sym(")")) {
             Ok(())
@@ -331,7 +335,7 @@ impl<'a> P<'a> {
                     Op::Unsupported(format!("the formal call of function `{name}` in IL"))
                 } else if let Tok::Ident(orig) = t.kind {
                     let mut args = Vec::new();
-                    if !self.at_eol() && !(nested && self.is_sym(")")) {
+                    if !self.line_ends(nested) {
                         args.push(self.operand()?);
                         while self.eat_sym(",") {
                             args.push(self.operand()?);
@@ -376,7 +380,7 @@ impl<'a> P<'a> {
                     instr.operand = Some(self.operand()?);
                 }
             }
-            Op::Not if !self.at_eol() && !(nested && self.is_sym(")")) => {
+            Op::Not if !self.line_ends(nested) => {
                 return self.err(
                     self.at(),
                     "an operand after NOT (IEC gives it no meaning; matiec refuses it)",
