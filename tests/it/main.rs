@@ -41,6 +41,7 @@ mod il_arith;
 mod il_errors;
 mod il_example_d;
 mod il_examples;
+mod il_exec;
 mod il_fbd_roundtrip;
 mod il_roundtrip;
 mod interrupts;

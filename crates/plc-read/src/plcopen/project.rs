@@ -21,7 +21,7 @@ use super::block_types::{Ctx, Sig};
 use super::data_types::DataTypes;
 use super::interface::{self, name, Interface, Known};
 use super::xml::{add_data_note, attr, error, identifier, origin, Note, Notes, Tc6, R};
-use super::{fbd, ld, ld_flow, library, st_body, st_scope, textual};
+use super::{fbd, il_body, ld, ld_flow, library, st_body, st_scope, textual};
 use plc_diag::LoadError;
 use plc_model::{Configuration, ProgramInstance, Resource, Task};
 use plc_syntax::{
@@ -561,6 +561,11 @@ fn body(
                 .iter()
                 .flat_map(|e| scope.fields_of(e))
                 .collect();
+            if tag == "IL" {
+                return Ok(Body::Rungs(il_body::rungs(
+                    lang, name, scope, &reads, &writes, &externals, notes,
+                )?));
+            }
             Body::Rungs(textual::through_interface(
                 tag, lang, name, &reads, &writes, &externals, notes,
             ))

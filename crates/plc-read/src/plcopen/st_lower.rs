@@ -158,9 +158,39 @@ impl<'s> Lower<'s> {
 
     /// Lowers top-level statement `k` (1-based).
     pub(super) fn top(&mut self, k: usize, s: &Statement) -> L<()> {
-        self.stmt = format!("{}.st{k}", self.pou);
-        self.in_stmt = 0;
+        self.unit("st", k);
         self.statement(s)
+    }
+
+    /// Starts unit `k` (1-based) of kind `tag`: the rungs that follow are `P.<tag>k.1`,
+    /// `P.<tag>k.2`, … (an IL instruction is the unit `P.ilk`, [`super::il_body`]).
+    pub(super) fn unit(&mut self, tag: &str, k: usize) {
+        self.stmt = format!("{}.{tag}{k}", self.pou);
+        self.in_stmt = 0;
+    }
+
+    /// Lowers one more statement into the current unit.
+    pub(super) fn more(&mut self, s: &Statement) -> L<()> {
+        self.statement(s)
+    }
+
+    /// Puts label `l` (a name no other label of the body has) on the next rung.
+    pub(super) fn label_next(&mut self, l: &str) {
+        self.place(l.to_owned());
+    }
+
+    /// A jump to label `l` at ST offset `at`, when `cond` holds (`None`: always), in the
+    /// current unit.
+    pub(super) fn jump(&mut self, at: usize, cond: Option<&Expr>, l: &str) -> L<()> {
+        self.at = at;
+        self.here = self.origin(at);
+        let mut ld = match cond {
+            Some(c) => self.cond(c)?,
+            None => Vec::new(),
+        };
+        ld.push(self.jmp(l));
+        self.emit(ld);
+        Ok(())
     }
 
     /// Ends the body: a label still pending gets an empty landing rung.
@@ -1274,7 +1304,7 @@ fn place_path(p: &Place) -> String {
 
 /// The type of output `field` of a standard function block of type `fb` (IEC 61131-3 2nd ed.,
 /// 2.5.2.3: CV is INT).
-fn field_type(fb: &str, field: &str) -> Option<Type> {
+pub(super) fn field_type(fb: &str, field: &str) -> Option<Type> {
     Some(match (fb, field) {
         ("TON" | "TOF" | "TP", "Q") => Type::Bool,
         ("TON" | "TOF" | "TP", "ET") => Type::Time,

@@ -1,0 +1,276 @@
+//! PLCopen IL bodies executed (crates/plc-read/src/plcopen/il_parse.rs, il_body.rs): the
+//! programs of tests/il_iec/ — the load and store operators, every expression operator with its
+//! `N` modifier and deferred operand `OP( … )`, functions with the current result as first
+//! input, jumps and labels (a label whose current result comes from two paths), RETC, CAL and
+//! CALC with formal arguments, an input operator (`CLK`) — run to the values worked out by hand
+//! below from IEC 61131-3 (3rd ed., 7.2: the current result, Tables 67 and 68) as matiec's
+//! generate_c_il.cc executes them (CR := CR OP operand, left to right with no precedence; a
+//! function's first input is the CR; ST, JMP, CAL and RET leave the CR as it is) and the
+//! executor's number rules (docs/scan.md), sequential and parallel equal after every scan
+//! (`--mode both`); the C that `plc-deps c` writes for each builds and prints the interpreter's
+//! state after every scan. What is not executed is refused by `run` and `c`, naming the
+//! instruction and its line and column.
+
+use crate::common;
+use crate::plcopen_common as px;
+
+use common::c::{assert_ok, run_with_input};
+use common::cli::{run, run_stdin, tmp};
+use serde_json::{json, Value};
+use std::process::Command;
+use std::process::Output;
+
+/// `plc-deps run FILE --scans N --mode both --format json [--inputs CSV]`: the report, with
+/// seq == par checked (as tests/it/st_exec.rs does).
+fn run_json(file: &str, scans: u32, inputs: Option<&str>) -> Value {
+    let n = scans.to_string();
+    let mut args = vec![
+        "run", file, "--scans", &n, "--mode", "both", "--format", "json",
+    ];
+    if let Some(i) = inputs {
+        args.extend(["--inputs", i]);
+    }
+    let out = run(&args);
+    let v: Value = serde_json::from_slice(&out.stdout)
+        .unwrap_or_else(|e| panic!("{file}: {e}: {}", String::from_utf8_lossy(&out.stderr)));
+    assert_eq!(v["identical"], json!(true), "{file}: seq != par");
+    v
+}
+
+fn values(v: &Value, names: &[&str]) -> Vec<(String, Value)> {
+    names
+        .iter()
+        .map(|n| (n.to_string(), v["state"][*n].clone()))
+        .collect()
+}
+
+fn pairs(expected: &[(&str, Value)]) -> Vec<(String, Value)> {
+    expected
+        .iter()
+        .map(|(n, v)| (n.to_string(), v.clone()))
+        .collect()
+}
+
+/// `plc-deps c FILE`, built with its Makefile and run for `scans` scans on `csv`: the state line
+/// after every scan equals the state of `plc-deps run --scans k` for every k.
+fn c_equals_run(file: &str, scans: u32, csv: Option<&str>) {
+    let dir = tmp(&format!("il-c-{}", file.replace(['/', '.'], "_")));
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = run(&["c", file, "-o", dir.to_str().unwrap()]);
+    assert_ok(&out, "plc-deps c");
+    let make = Command::new("make")
+        .arg("-s")
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert_ok(&make, "make");
+    let input = match csv {
+        Some(c) => std::fs::read(common::cli::root().join(c)).unwrap(),
+        None => Vec::new(),
+    };
+    let out = run_with_input(&dir.join("plc_program"), &[scans.to_string()], &input);
+    let lines: Vec<Value> = String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(lines.len(), scans as usize, "{file}");
+    for k in 1..=scans {
+        let r = run_json(file, k, csv);
+        assert_eq!(
+            lines[k as usize - 1],
+            r["state"],
+            "{file}: C and run differ after scan {k}"
+        );
+    }
+}
+
+/// The `error:` line of a command that failed with exit code 2.
+fn refusal(out: &Output, what: &str) -> String {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{what}: {stderr}");
+    let errors: Vec<&str> = stderr.lines().filter(|l| l.starts_with("error")).collect();
+    assert_eq!(errors.len(), 1, "{what}: {stderr}");
+    errors[0].to_owned()
+}
+
+#[test]
+fn il_operators_apply_to_the_current_result_left_to_right() {
+    let f = "tests/il_iec/basic.xml";
+    // a = 7, b = 3; n counts the scans. r1 = (7 + 3) * 2 (no precedence in IL); r2 = 7 - (3 * 2)
+    // (the deferred operand); r3 = 7 / 3, r4 = 7 MOD 3; r5 = MAX(a, n); r6 = LIMIT(MN := 2,
+    // IN := n, MX := 4) (the CR 2 is the first input); r7 = NOT 7 on an INT, bitwise: -8;
+    // f = INT_TO_REAL(7) / 2.0. big = n > 2; x2 = NOT big AND (n = 2); x3 = big XOR NOT x2;
+    // x4 = NOT (big OR NOT x2); latched set by x2 (n = 2), reset by big AND (n >= 4);
+    // x5 = ((a > b) AND (b < 5)) OR (n = 1).
+    let rows = [
+        // n, r6, big, x2, x3, x4, latched
+        (1, 2, false, false, true, false, false),
+        (2, 2, false, true, false, true, true),
+        (3, 3, true, false, false, false, true),
+        (4, 4, true, false, false, false, false),
+        (5, 4, true, false, false, false, false),
+    ];
+    for (n, r6, big, x2, x3, x4, latched) in rows {
+        let v = run_json(f, n, None);
+        let expected = [
+            ("n", json!(n)),
+            ("r1", json!(20)),
+            ("r2", json!(1)),
+            ("r3", json!(2)),
+            ("r4", json!(1)),
+            ("r5", json!(7)),
+            ("r6", json!(r6)),
+            ("r7", json!(-8)),
+            ("f", json!(3.5)),
+            ("big", json!(big)),
+            ("x2", json!(x2)),
+            ("x3", json!(x3)),
+            ("x4", json!(x4)),
+            ("x5", json!(true)),
+            ("latched", json!(latched)),
+        ];
+        let names: Vec<&str> = expected.iter().map(|e| e.0).collect();
+        assert_eq!(values(&v, &names), pairs(&expected), "after {n} scans");
+    }
+    c_equals_run(f, 5, None);
+}
+
+#[test]
+fn il_jumps_labels_and_retc_follow_the_current_result() {
+    let f = "tests/il_iec/jumps.xml";
+    // cnt counts 1, 2, 3 and is reset to 0 by the scan that finds it >= 3 (the value stored
+    // at QuitFb comes from `ADD 1` on one path, `LD 0` on the other); sum = 1 + … + cnt by a
+    // backward jump; `after` counts the scans that do not end at RETC (cnt = 2).
+    let rows = [
+        (1, 1, 1, 1),
+        (2, 2, 3, 1),
+        (3, 3, 6, 2),
+        (4, 0, 0, 3),
+        (5, 1, 1, 4),
+    ];
+    for (n, cnt, sum, after) in rows {
+        let v = run_json(f, n, None);
+        assert_eq!(
+            values(&v, &["cnt", "out", "sum", "after"]),
+            pairs(&[
+                ("cnt", json!(cnt)),
+                ("out", json!(cnt)),
+                ("sum", json!(sum)),
+                ("after", json!(after))
+            ]),
+            "after {n} scans"
+        );
+    }
+    c_equals_run(f, 5, None);
+}
+
+#[test]
+fn il_cal_calc_and_input_operators_call_the_standard_function_blocks() {
+    let (f, csv) = ("tests/il_iec/fbs.xml", "tests/il_iec/fbs.csv");
+    // start = 1, 1, 1, 1, 1, 0, 1, 1 at t = 0, 10, … 70 ms (the values tests/it/st_exec.rs
+    // uses for the same blocks in ST). TON PT 30 ms: Q from t = 30 (ET 30), reset at scan 6,
+    // restarted at t = 60 (ET 10 at t = 70). `CLK trig` calls the R_TRIG with CLK := start:
+    // rises at scans 1 and 7, counted past JMPCN. CALC calls the CTU only when start is TRUE:
+    // CU := trig.Q counts the same rises, Q at CV 2 from scan 7.
+    let rows = [
+        (1, false, 0, 1, 1, false),
+        (5, true, 30, 1, 1, false),
+        (6, false, 0, 1, 1, false),
+        (7, false, 0, 2, 2, true),
+        (8, false, 10, 2, 2, true),
+    ];
+    for (n, done, et, edges, cv, q) in rows {
+        let v = run_json(f, n, Some(csv));
+        assert_eq!(
+            values(&v, &["done", "et", "edges", "cv", "q"]),
+            pairs(&[
+                ("done", json!(done)),
+                ("et", json!(et)),
+                ("edges", json!(edges)),
+                ("cv", json!(cv)),
+                ("q", json!(q))
+            ]),
+            "after {n} scans"
+        );
+    }
+    c_equals_run(f, 8, Some(csv));
+}
+
+#[test]
+fn beremiz_first_steps_counter_il_counts_like_its_st_twin() {
+    // CounterIL (LD Reset, JMPC ResetCnt, LD Cnt, ADD 1, JMP QuitFb, ResetCnt: LD
+    // ResetCounterValue, QuitFb: ST Cnt, ST Out) counts the scans with Reset FALSE, as
+    // CounterST does; the project's SFC block still needs --allow-skipped.
+    let f = "tests/plcopen/beremiz__exemples_first_steps_plc.xml";
+    let out = run(&[
+        "run",
+        f,
+        "--scans",
+        "4",
+        "--allow-skipped",
+        "--format",
+        "json",
+    ]);
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["state"]["CounterIL0.Cnt"], json!(4));
+    assert_eq!(v["state"]["CounterIL0.OUT"], json!(4));
+    assert_eq!(v["state"]["CounterST0.OUT"], json!(4));
+    let skipped: Vec<&str> = v["skipped_pous"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["pou"].as_str().unwrap())
+        .collect();
+    assert!(!skipped.contains(&"CounterIL0"), "{skipped:?}");
+}
+
+/// An IL program P with an INT x, an INT y, a BOOL b, a TON T1 and the body `body`.
+fn il_program(body: &str) -> String {
+    px::project_in(
+        "IL",
+        &[
+            ("localVars", "x", "INT"),
+            ("localVars", "y", "INT"),
+            ("localVars", "b", "BOOL"),
+            ("localVars", "T1", "TON"),
+        ],
+        &format!(
+            "<xhtml:p xmlns:xhtml=\"http://www.w3.org/1999/xhtml\"><![CDATA[{body}]]></xhtml:p>"
+        ),
+    )
+}
+
+#[test]
+fn what_il_cannot_execute_is_refused_by_run_and_c_with_its_place() {
+    let cases = [
+        ("LD x\nST y\nJMP Nowhere", "JMP Nowhere", "`JMP NOWHERE`: the body has no label `NOWHERE`"),
+        ("ST y\nLD x", "ST y", "`ST` without a current result (no instruction before it sets it)"),
+        ("LD x\nMYFUNC 3\nST y", "MYFUNC", "the call of function `MYFUNC` (only the standard functions are executed)"),
+        ("LD b\nCAL T1(IN := TRUE)", "T1(IN", "the call of `T1` without its input PT (plc-deps keeps no input values of a standard function block between calls)"),
+        ("LD x\nLIMIT(MN := 0, IN := x, MX := 5)\nST y", "LIMIT(", "the formal call of function `LIMIT` in IL"),
+        ("LD x y\nST y", "y\nST", "IL syntax error (`y` where the end of the line was expected)"),
+        ("LD T1.PT\nST y", "T1.PT", "`T1.PT`: only the outputs of a standard function block instance are read"),
+        ("LD b\nST x", "ST x", "`ST` of a BOOL current result into INT `x`"),
+        ("LD 1\nL: ST y", "L: ST", "the current result at label `L`: its type cannot be told (an untyped literal?)"),
+    ];
+    for (body, at, what) in cases {
+        let xml = il_program(body);
+        let body_at = px::line_col(&xml, "<IL>");
+        let place = px::line_col(&xml, at);
+        for (args, help) in [
+            (vec!["run", "-"], "run the rest of the project"),
+            (
+                vec!["c", "-", "-o", "/nonexistent/il-refused"],
+                "write the C",
+            ),
+        ] {
+            let e = refusal(&run_stdin(&args, xml.as_bytes()), body);
+            assert_eq!(
+                e,
+                format!("error: <stdin>:{body_at}: pou P: its IL body is not executed: {what} at {place} is not executed yet (it is read only as stand-in rungs that keep every value); give --allow-skipped to {help} without it"),
+                "{body}"
+            );
+        }
+    }
+}
