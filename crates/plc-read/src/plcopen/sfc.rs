@@ -35,6 +35,8 @@ pub(super) enum Code<'a, 'i> {
     Statements { node: Node<'a, 'i> },
     /// An LD body (an action's).
     Ld { node: Node<'a, 'i> },
+    /// ST statements made here (Beremiz's COMPUTE_FUNCTION_BLOCKS action), located at `node`.
+    Text { text: String, node: Node<'a, 'i> },
 }
 
 /// One action association of a step (`A(N)`, `A(L, T#2s)`).
@@ -53,7 +55,7 @@ pub(super) struct Step {
 }
 
 pub(super) struct Transition<'a, 'i> {
-    /// The transition's name in rung ids: its reference's name, else `T<localId>`.
+    /// The transition in rung ids: `T<localId>`, `T<localId>.NAME` for a named transition.
     pub unit: String,
     pub origin: Origin,
     pub priority: Option<i64>,
@@ -76,6 +78,8 @@ pub(super) struct Chart<'a, 'i> {
     pub actions: Vec<Action<'a, 'i>>,
     /// The first thing that cannot be executed, and where it is.
     pub refused: Option<(Origin, String)>,
+    /// The BOOL temporaries of COMPUTE_FUNCTION_BLOCKS (Beremiz's `_TMP_…_OUT`).
+    pub temps: Vec<String>,
 }
 
 struct StepInfo {
@@ -108,6 +112,11 @@ struct Gen<'a, 'i> {
     initial: Vec<String>,
     inline_count: usize,
     refused: Option<(Origin, String)>,
+    /// Beremiz's `SFCComputedBlocks`: the statements of the blocks transition conditions go
+    /// through, the blocks done (by file offset), and their temporaries.
+    compute: Vec<String>,
+    computed: std::collections::HashSet<usize>,
+    temps: Vec<String>,
 }
 
 /// Reads SFC body `sfc` of POU `pou` into its chart.
@@ -124,6 +133,9 @@ pub(super) fn chart<'a, 'i>(tc6: Tc6, pou: Node<'a, 'i>, sfc: Node<'a, 'i>) -> C
         initial: Vec::new(),
         inline_count: 0,
         refused: None,
+        compute: Vec::new(),
+        computed: std::collections::HashSet::new(),
+        temps: Vec::new(),
     };
     for n in tc6.elements(sfc) {
         if let Some(id) = n.attribute("localId") {
@@ -145,6 +157,21 @@ pub(super) fn chart<'a, 'i>(tc6: Tc6, pou: Node<'a, 'i>, sfc: Node<'a, 'i>) -> C
     if g.initial.is_empty() && g.refused.is_none() {
         g.refused = Some((origin(sfc), "an SFC body without an initial step".into()));
     }
+    // GenerateSFCBody: the blocks the conditions need, an action set by the first initial step.
+    if let (Some(first), false) = (g.initial.first().cloned(), g.compute.is_empty()) {
+        let name = "COMPUTE_FUNCTION_BLOCKS".to_owned();
+        let text = g.compute.join("\n");
+        g.actions
+            .insert(name.clone(), (origin(sfc), Code::Text { text, node: sfc }));
+        if let Some(s) = g.steps.get_mut(&first) {
+            s.assocs.push(Assoc {
+                action: name,
+                qualifier: "S".into(),
+                duration: None,
+                origin: origin(sfc),
+            });
+        }
+    }
     let mut c = Chart::default();
     let mut done_steps = std::collections::HashSet::new();
     let mut done_trs = std::collections::HashSet::new();
@@ -152,6 +179,7 @@ pub(super) fn chart<'a, 'i>(tc6: Tc6, pou: Node<'a, 'i>, sfc: Node<'a, 'i>) -> C
         g.compute_step(&s, &mut c, &mut done_steps, &mut done_trs);
     }
     c.refused = g.refused;
+    c.temps = g.temps;
     c
 }
 
@@ -394,7 +422,14 @@ impl<'a, 'i> Gen<'a, 'i> {
     fn condition(&mut self, n: Node<'a, 'i>, k: usize) -> Option<Code<'a, 'i>> {
         let tc6 = self.tc6;
         let Some(c) = tc6.child(n, "condition") else {
-            self.refuse(n, "a transition without a condition");
+            self.refuse(
+                n,
+                format!(
+                    "a transition without a condition ({} {:?})",
+                    n.tag_name().name(),
+                    n.attribute("localId")
+                ),
+            );
             return None;
         };
         if let Some(i) = tc6.child(c, "inline") {
@@ -411,7 +446,7 @@ impl<'a, 'i> Gen<'a, 'i> {
         }
         if let Some(r) = tc6.child(c, "reference") {
             let name = r.attribute("name").unwrap_or("").to_owned();
-            self.trs[k].unit = name.clone();
+            self.trs[k].unit = format!("{}.{name}", self.trs[k].unit);
             return self.named_transition(r, &name);
         }
         if let Some(cpi) = tc6.child(c, "connectionPointIn") {
@@ -520,7 +555,7 @@ impl<'a, 'i> Gen<'a, 'i> {
     /// The ST expression for what feeds `cpi` (Beremiz's `ComputeExpression`, for the elements
     /// that make an expression without a function block instance): OR of its connections.
     fn expression(
-        &self,
+        &mut self,
         by_id: &HashMap<&'a str, Node<'a, 'i>>,
         cpi: Node<'a, 'i>,
     ) -> Result<String, (Node<'a, 'i>, String)> {
@@ -535,7 +570,7 @@ impl<'a, 'i> Gen<'a, 'i> {
             else {
                 return Err((c, "a connection to an element that does not exist".into()));
             };
-            terms.push(self.element_expr(by_id, n, 0)?);
+            terms.push(self.element_expr(by_id, n, c.attribute("formalParameter"), 0)?);
         }
         match terms.len() {
             0 => Err((cpi, "an unconnected transition condition".into())),
@@ -545,9 +580,10 @@ impl<'a, 'i> Gen<'a, 'i> {
     }
 
     fn element_expr(
-        &self,
+        &mut self,
         by_id: &HashMap<&'a str, Node<'a, 'i>>,
         n: Node<'a, 'i>,
+        link: Option<&str>,
         depth: usize,
     ) -> Result<String, (Node<'a, 'i>, String)> {
         if depth > 200 {
@@ -559,15 +595,6 @@ impl<'a, 'i> Gen<'a, 'i> {
                 format!("NOT {s}")
             } else {
                 s
-            }
-        };
-        let inner = |node: Node<'a, 'i>| -> Result<String, (Node<'a, 'i>, String)> {
-            match tc6.child(node, "connectionPointIn") {
-                Some(cpi) => self.expression(by_id, cpi),
-                None => Err((
-                    node,
-                    "an unconnected element in a transition condition".into(),
-                )),
             }
         };
         match n.tag_name().name() {
@@ -590,43 +617,120 @@ impl<'a, 'i> Gen<'a, 'i> {
                     return Err((n, "an edge contact in a transition condition (Beremiz computes it with an R_TRIG/F_TRIG instance)".into()));
                 }
                 let me = neg(format!("({v})"), n);
-                let before = inner(n)?;
+                let before = match tc6.child(n, "connectionPointIn") {
+                    Some(cpi) => self.expression(by_id, cpi)?,
+                    None => {
+                        return Err((n, "an unconnected element in a transition condition".into()))
+                    }
+                };
                 Ok(if before == "TRUE" {
                     me
                 } else {
                     format!("({before} AND {me})")
                 })
             }
-            "block" if n.attribute("instanceName").is_none() => {
-                let ty = n.attribute("typeName").unwrap_or("").to_ascii_uppercase();
-                let op = match ty.as_str() {
-                    "NOT" => "NOT",
-                    "AND" => "AND",
-                    "OR" => "OR",
-                    "XOR" => "XOR",
-                    _ => {
-                        return Err((n, format!("the function `{ty}` in a transition condition (not executed yet)")))
-                    }
-                };
-                let mut args = Vec::new();
-                if let Some(iv) = tc6.child(n, "inputVariables") {
-                    for v in tc6.children(iv, "variable") {
-                        let Some(cpi) = tc6.child(v, "connectionPointIn") else {
-                            return Err((v, "an unconnected input in a transition condition".into()));
-                        };
-                        args.push(neg(self.expression(by_id, cpi)?, v));
-                    }
-                }
-                let e = match (op, args.as_slice()) {
-                    ("NOT", [a]) => format!("(NOT {a})"),
-                    (_, [_, _, ..]) if op != "NOT" => format!("({})", args.join(&format!(" {op} "))),
-                    _ => return Err((n, format!("the function `{ty}` with {} inputs", args.len()))),
-                };
-                Ok(e)
-            }
-            "block" => Err((n, format!("the function block instance `{}` in a transition condition (Beremiz computes it in an extra action, COMPUTE_FUNCTION_BLOCKS; not executed yet)", n.attribute("instanceName").unwrap_or("")))),
+            "block" => self.block_expr(by_id, n, link),
             other => Err((n, format!("a `{other}` in a transition condition"))),
         }
+    }
+
+    /// A block in a condition (Beremiz's `GenerateBlock`): a function block instance called
+    /// as `Inst(IN := …);`, read as `Inst.Q`; a BOOL function computed into a temporary
+    /// `sfc__NOT42_OUT` (Beremiz's `_TMP_NOT42_OUT`); each once, in COMPUTE_FUNCTION_BLOCKS.
+    fn block_expr(
+        &mut self,
+        by_id: &HashMap<&'a str, Node<'a, 'i>>,
+        n: Node<'a, 'i>,
+        link: Option<&str>,
+    ) -> Result<String, (Node<'a, 'i>, String)> {
+        let tc6 = self.tc6;
+        let ty = n.attribute("typeName").unwrap_or("").to_owned();
+        let id = n.attribute("localId").unwrap_or("");
+        let mut args = Vec::new();
+        let first = !self.computed.contains(&n.range().start);
+        if first {
+            self.computed.insert(n.range().start);
+            if let Some(iv) = tc6.child(n, "inputVariables") {
+                for v in tc6.children(iv, "variable") {
+                    if matches!(v.attribute("edge"), Some("rising" | "falling")) {
+                        return Err((v, "an edge input in a transition condition".into()));
+                    }
+                    let p = v.attribute("formalParameter").unwrap_or("").to_owned();
+                    if let Some(cpi) = tc6.child(v, "connectionPointIn") {
+                        if cpi
+                            .children()
+                            .any(|c| c.is_element() && c.tag_name().name() == "connection")
+                        {
+                            let e = self.expression(by_id, cpi)?;
+                            let e = if v.attribute("negated") == Some("true") {
+                                format!("NOT {e}")
+                            } else {
+                                e
+                            };
+                            args.push((p, e));
+                        }
+                    }
+                }
+            }
+        }
+        let outputs: Vec<Node> = tc6
+            .child(n, "outputVariables")
+            .map(|o| tc6.children(o, "variable").collect())
+            .unwrap_or_default();
+        let out = match link.filter(|l| !l.is_empty()) {
+            Some(l) => outputs
+                .iter()
+                .find(|o| o.attribute("formalParameter") == Some(l))
+                .copied(),
+            None => outputs.first().copied(),
+        };
+        let Some(out) = out else {
+            return Err((
+                n,
+                format!("block `{ty}` without the output the condition reads"),
+            ));
+        };
+        let param = out.attribute("formalParameter").unwrap_or("").to_owned();
+        let negate = |s: String| {
+            if out.attribute("negated") == Some("true") {
+                format!("(NOT {s})")
+            } else {
+                s
+            }
+        };
+        if let Some(inst) = n.attribute("instanceName") {
+            if first {
+                let list: Vec<String> = args.iter().map(|(p, e)| format!("{p} := {e}")).collect();
+                self.compute.push(format!("{inst}({});", list.join(", ")));
+            }
+            return Ok(negate(format!("{inst}.{param}")));
+        }
+        let up = ty.to_ascii_uppercase();
+        let temp = format!("sfc__{ty}{id}_{param}");
+        if first {
+            let vals: Vec<&str> = args.iter().map(|(_, e)| e.as_str()).collect();
+            let e = match (up.as_str(), vals.as_slice()) {
+                ("NOT", [a]) => format!("NOT {a}"),
+                ("AND" | "OR" | "XOR", [_, _, ..]) => vals.join(&format!(" {up} ")),
+                ("GT" | "GE" | "EQ" | "NE" | "LE" | "LT", [a, b]) => {
+                    let op = match up.as_str() {
+                        "GT" => ">",
+                        "GE" => ">=",
+                        "EQ" => "=",
+                        "NE" => "<>",
+                        "LE" => "<=",
+                        _ => "<",
+                    };
+                    format!("{a} {op} {b}")
+                }
+                _ => {
+                    return Err((n, format!("the function `{ty}` with {} connected inputs in a transition condition (only NOT, AND, OR, XOR and comparisons are executed there)", vals.len())))
+                }
+            };
+            self.compute.push(format!("{temp} := {e};"));
+            self.temps.push(temp.clone());
+        }
+        Ok(negate(temp))
     }
 
     /// `ComputeSFCStep`, with `ComputeSFCAction` and `ComputeSFCTransition`.

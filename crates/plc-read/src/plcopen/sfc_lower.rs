@@ -194,6 +194,10 @@ pub(super) fn lower(
         }
         declare(&mut vars, &prev(&s.name), "BOOL", None, s.origin);
     }
+    for t in &c.temps {
+        sc.declare(t, "BOOL");
+        declare(&mut vars, t, "BOOL", None, at);
+    }
     // matiec's action list: the actions (text order), then the variables named as actions.
     let mut entries: Vec<Entry> = c
         .actions
@@ -209,13 +213,15 @@ pub(super) fn lower(
         for a in &s.assocs {
             let var = match sc.get(&a.action) {
                 Some(Decl::Elementary { name, ty }) if ty == "BOOL" => Some(name.clone()),
-                Some(_) => return Err((
-                    a.origin,
-                    format!(
+                Some(_) => {
+                    return Err((
+                        a.origin,
+                        format!(
                         "action `{}` is a variable that is not BOOL (matiec writes 0 or 1 to it)",
                         a.action
                     ),
-                )),
+                    ))
+                }
                 None => None,
             };
             let known = entries
@@ -628,6 +634,24 @@ pub(super) fn lower(
                 for r in rungs {
                     l.rung(r.ld.into_iter().map(|e| e.kind).collect());
                 }
+            }
+            Code::Text { text, node } => {
+                l.text(None, origin(*node));
+                let body = st::statements(text).map_err(|e| {
+                    (
+                        origin(*node),
+                        format!(
+                            "ST syntax error in COMPUTE_FUNCTION_BLOCKS `{text}`: {}",
+                            e.message
+                        ),
+                    )
+                })?;
+                l.lower_statements(&body).map_err(|e| {
+                    (
+                        origin(*node),
+                        format!("{} (in the blocks of the transition conditions)", e.what),
+                    )
+                })?;
             }
             Code::Expr { .. } => {}
         }

@@ -886,6 +886,8 @@ impl<'s> Lower<'s> {
                 let v = self.value(e, Some(Type::Bool))?;
                 match v {
                     Val::Var(n, Type::Bool) => Ok(vec![self.contact(&n, false)]),
+                    // `1` or `0` where a BOOL is expected (matiec types them BOOL).
+                    Val::Lit(Scalar::Bool(b)) => Ok(vec![self.constant(b)]),
                     other => refuse(
                         self.at,
                         format!(
