@@ -372,6 +372,10 @@ impl<'a, 'i> Gen<'a, 'i> {
 
     /// `GenerateSFCTransition`: its index.
     fn transition(&mut self, n: Node<'a, 'i>) -> Option<usize> {
+        if n.tag_name().name() != "transition" {
+            self.refuse(n, format!("a `{}` where a transition is expected (Beremiz's generator reads only transitions into a step, a jump or a selectionConvergence)", n.tag_name().name()));
+            return None;
+        }
         let id = n.attribute("localId").unwrap_or("").to_owned();
         if let Some(&k) = self.tr_index.get(&id) {
             return Some(k);
