@@ -453,7 +453,9 @@ impl<'a, 'i> Gen<'a, 'i> {
             self.trs[k].unit = format!("{}.{name}", self.trs[k].unit);
             return self.named_transition(r, &name);
         }
-        if let Some(cpi) = tc6.child(c, "connectionPointIn") {
+        // The old schema (tc6.xsd) puts the connection right in the condition.
+        let direct = tc6.child(c, "connection").map(|_| c);
+        if let Some(cpi) = tc6.child(c, "connectionPointIn").or(direct) {
             let by_id = self.by_id.clone();
             return match self.expression(&by_id, cpi) {
                 Ok(text) => Some(Code::Expr { text, node: n }),
