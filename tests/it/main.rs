@@ -80,6 +80,7 @@ mod report_warnings;
 mod run_cli;
 mod scan_budget;
 mod schema;
+mod sfc_exec;
 mod st_exec;
 mod standard_fbs;
 mod strings;

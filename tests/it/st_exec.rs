@@ -20,7 +20,7 @@ use std::process::Output;
 
 /// `plc-deps run FILE --scans N --mode both --format json [--inputs CSV]`: the report, with
 /// seq == par checked.
-fn run_json(file: &str, scans: u32, inputs: Option<&str>) -> Value {
+pub(crate) fn run_json(file: &str, scans: u32, inputs: Option<&str>) -> Value {
     let n = scans.to_string();
     let mut args = vec![
         "run", file, "--scans", &n, "--mode", "both", "--format", "json",
@@ -53,7 +53,7 @@ fn pairs(expected: &[(&str, Value)]) -> Vec<(String, Value)> {
 
 /// `plc-deps c FILE`, built with its Makefile and run for `scans` scans on `csv`: the state line
 /// after every scan equals the state of `plc-deps run --scans k` for every k.
-fn c_equals_run(file: &str, scans: u32, csv: Option<&str>) {
+pub(crate) fn c_equals_run(file: &str, scans: u32, csv: Option<&str>) {
     let dir = tmp(&format!("st-c-{}", file.replace(['/', '.'], "_")));
     let _ = std::fs::remove_dir_all(&dir);
     let out = run(&["c", file, "-o", dir.to_str().unwrap()]);

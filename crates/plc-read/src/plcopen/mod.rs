@@ -35,6 +35,8 @@ mod ld_power;
 mod library;
 mod pins;
 mod project;
+mod sfc;
+mod sfc_lower;
 mod st_body;
 mod st_lower;
 mod st_scope;

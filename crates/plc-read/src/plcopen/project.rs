@@ -21,7 +21,7 @@ use super::block_types::{Ctx, Sig};
 use super::data_types::DataTypes;
 use super::interface::{self, name, Interface, Known};
 use super::xml::{add_data_note, attr, error, identifier, origin, Note, Notes, Tc6, R};
-use super::{fbd, il_body, ld, ld_flow, library, st_body, st_scope, textual};
+use super::{fbd, il_body, ld, ld_flow, library, sfc, sfc_lower, st_body, st_scope, textual};
 use plc_diag::LoadError;
 use plc_model::{Configuration, ProgramInstance, Resource, Task};
 use plc_syntax::{
@@ -548,7 +548,8 @@ fn body(
         "LD" => ld_body(tc6, lang, name, ctx, notes)?,
         "FBD" => Body::Fbd(fbd::body(tc6, lang, name, ctx, notes)?),
         "ST" => Body::Rungs(st_body::rungs(lang, name, scope, notes)?),
-        "IL" | "SFC" => {
+        "SFC" => Body::Rungs(sfc_body(tc6, pou, lang, name, iface, scope, ctx, notes)),
+        "IL" => {
             let reads: Vec<&Var> = iface.inputs.iter().collect();
             let writes: Vec<&Var> = iface
                 .outputs
@@ -578,6 +579,64 @@ fn body(
             ))
         }
     })
+}
+
+/// The rungs of SFC body `lang` of POU `pou` ([`sfc`], lowered by [`sfc_lower`]); when it
+/// cannot be executed, the stand-in through its interface, marked skipped with the reason.
+#[allow(clippy::too_many_arguments)]
+fn sfc_body(
+    tc6: Tc6,
+    pou: Node,
+    lang: Node,
+    name: &str,
+    iface: &Interface,
+    scope: &st_scope::Scope,
+    ctx: &Ctx,
+    notes: &mut Notes,
+) -> Vec<Rung<'static>> {
+    let chart = sfc::chart(tc6, pou, lang);
+    let (list, vars) = (notes.list.len(), notes.ld_vars.len());
+    match sfc_lower::lower(tc6, &chart, name, scope, &ctx.inits, notes, origin(lang)) {
+        Ok(l) => {
+            notes.list.truncate(list);
+            notes.ld_vars.truncate(vars);
+            notes.push(Note {
+                origin: origin(lang),
+                message: format!(
+                    "pou {name}: its SFC body ({} steps, {} transitions, {} actions) is executed by `run` and `c` as the rungs it is lowered to ({name}.step.S…, {name}.tr.T…, {name}.act.A…; docs/plcopen.md, SFC bodies)",
+                    chart.steps.len(),
+                    chart.transitions.len(),
+                    chart.actions.len()
+                ),
+            });
+            notes
+                .ld_vars
+                .extend(l.vars.into_iter().map(|v| (name.to_owned(), v)));
+            l.rungs
+        }
+        Err((at, what)) => {
+            notes.list.truncate(list);
+            notes.ld_vars.truncate(vars);
+            let reads: Vec<&Var> = iface.inputs.iter().collect();
+            let writes: Vec<&Var> = iface
+                .outputs
+                .iter()
+                .chain(&iface.locals)
+                .chain(&iface.globals)
+                .collect();
+            let externals: Vec<String> = iface
+                .externals
+                .iter()
+                .flat_map(|e| scope.fields_of(e))
+                .collect();
+            let rungs =
+                textual::through_interface("SFC", lang, name, &reads, &writes, &externals, notes);
+            if let Some(s) = notes.skipped.last_mut() {
+                s.why = Some((at, what));
+            }
+            rungs
+        }
+    }
 }
 
 /// Task order of program instances: the instance's task and type.

@@ -193,6 +193,52 @@ impl<'s> Lower<'s> {
         Ok(())
     }
 
+    // ---- for bodies lowered piece by piece (SFC: super::sfc_lower) ----
+
+    /// Starts unit `id` (its rungs `id.1`, `id.2`, …), located at `here`, its ST text (if
+    /// any) given next by [`Lower::text`].
+    pub(super) fn unit_at(&mut self, id: String, here: Origin) {
+        self.stmt = id;
+        self.in_stmt = 0;
+        self.here = here;
+        self.map = None;
+        self.base = here;
+    }
+
+    /// Lowers the statements of the current unit (nested, as if one compound statement).
+    pub(super) fn lower_statements(&mut self, body: &[Statement]) -> L<()> {
+        self.statements(body)
+    }
+
+    /// BOOL expression `e` as a series of conditions (rungs for its temporaries emitted first).
+    pub(super) fn condition(&mut self, e: &Expr) -> L<Vec<ElementKind<'static>>> {
+        self.cond(e)
+    }
+
+    /// `e` as an operand of type `ty` (a literal typed by it, a variable, or a temporary).
+    pub(super) fn operand_of(&mut self, e: &Expr, ty: Type) -> L<Operand<'static>> {
+        let v = self.value(e, Some(ty))?;
+        Ok(self.operand(&v))
+    }
+
+    /// Emits a rung of the current unit.
+    pub(super) fn rung(&mut self, ld: Vec<ElementKind<'static>>) {
+        self.emit(ld)
+    }
+
+    /// A new label, and placing one on the next rung.
+    pub(super) fn new_label(&mut self) -> String {
+        self.label()
+    }
+    pub(super) fn put_label(&mut self, l: String) {
+        self.place(l)
+    }
+
+    /// A new BOOL temporary.
+    pub(super) fn bool_temp_var(&mut self) -> String {
+        self.temp(Type::Bool)
+    }
+
     /// Ends the body: a label still pending gets an empty landing rung.
     pub(super) fn finish(&mut self) {
         if self.pending.is_some() {
@@ -870,6 +916,8 @@ impl<'s> Lower<'s> {
                 let v = self.value(e, Some(Type::Bool))?;
                 match v {
                     Val::Var(n, Type::Bool) => Ok(vec![self.contact(&n, false)]),
+                    // `1` or `0` where a BOOL is expected (matiec types them BOOL).
+                    Val::Lit(Scalar::Bool(b)) => Ok(vec![self.constant(b)]),
                     other => refuse(
                         self.at,
                         format!(
