@@ -193,3 +193,22 @@ fn a_c_pragma_is_a_statement_that_reads_and_writes_everything_and_run_refuses_it
         );
     }
 }
+
+#[test]
+fn a_variable_of_an_undefined_enumeration_with_an_initial_value_is_no_instance() {
+    // `LEVEL : LOGLEVEL := DEBUG`: LOGLEVEL is Beremiz's, not in the file. A simple initial
+    // value makes it no function block instance (IEC 61131-3 6.5.1.4: an instance's is
+    // structured): a black box variable, its value not read; P declares it, so `run` refuses P
+    // by name (the black box has no value).
+    let w = warnings("library_enum_init.xml");
+    assert!(
+        w.contains("LOGLEVEL → DINT (a type the file does not define, given the simple initial value `DEBUG`")
+            && w.contains("read as black boxes: LOGLEVEL: P.LEVEL"),
+        "{w}"
+    );
+    let e = refused("run", "library_enum_init.xml");
+    assert!(
+        e.contains("variable `LEVEL` is of type `LOGLEVEL`, which the file does not define"),
+        "{e}"
+    );
+}
