@@ -114,7 +114,11 @@ fn a_cycle_of_data_types_is_one_located_error() {
     // a black box, no longer an error (issue 39): the variable of it is one whole variable.
     let unknown = project_in(
         "LD",
-        &[("inputVars", "go", "BOOL"), ("localVars", "x", "A")],
+        &[
+            ("inputVars", "go", "BOOL"),
+            ("outputVars", "lamp", "BOOL"),
+            ("localVars", "x", "A"),
+        ],
         &ld(),
     )
     .replace(

@@ -50,7 +50,11 @@ fn scans(name: &str, csv: &str, columns: &[&str]) -> Vec<Vec<String>> {
     let err = common::cli::one_line(&String::from_utf8_lossy(&out.stderr));
     assert_eq!(out.status.code(), Some(0), "{name}: {err}");
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert_eq!(v["identical"], serde_json::json!(true), "{name}: seq != par");
+    assert_eq!(
+        v["identical"],
+        serde_json::json!(true),
+        "{name}: seq != par"
+    );
     let xml = std::fs::read_to_string(&p).unwrap();
     let rows = csv.lines().count() as u64 - 1;
     c_matches_interpreter(&xml, csv, rows, &tag);
@@ -106,7 +110,9 @@ fn a_codesys_vendor_element_is_skipped_with_a_note_and_positional_pins_are_read(
     // Z = (K = 0 ? A - B : B).
     let w = warnings("vendor_element_fbd.xml");
     assert!(
-        w.contains("vendorElement localId 10000000000 (`FBD Implementation Attributes`) is skipped"),
+        w.contains(
+            "vendorElement localId 10000000000 (`FBD Implementation Attributes`) is skipped"
+        ),
         "{w}"
     );
     let t = scans(
@@ -155,7 +161,11 @@ fn a_member_of_an_undefined_library_type_is_a_black_box_and_the_rest_runs() {
             && w.contains("P1.m.topic"),
         "{w}"
     );
-    let t = scans("library_type_member.xml", "P2:A\n4\n-1\n", &["P1:Q", "P2:Y"]);
+    let t = scans(
+        "library_type_member.xml",
+        "P2:A\n4\n-1\n",
+        &["P1:Q", "P2:Y"],
+    );
     assert_eq!(t[0], col(&["0", "0"]), "P1:Q");
     assert_eq!(t[1], col(&["5", "0"]), "P2:Y");
 }
@@ -182,13 +192,15 @@ fn a_c_pragma_is_a_statement_that_reads_and_writes_everything_and_run_refuses_it
     );
     let w = common::cli::one_line(&String::from_utf8_lossy(&out.stderr));
     assert!(
-        w.contains("statement 2 (at 17:1) holds a pragma") && w.contains("statement 3 (at 23:1) holds a pragma"),
+        w.contains("statement 2 (at 17:1) holds a pragma")
+            && w.contains("statement 3 (at 23:1) holds a pragma"),
         "{w}"
     );
     for cmd in ["run", "c"] {
         let e = refused(cmd, "c_pragma_st.xml");
         assert!(
-            e.contains("pou P: its ST body is not executed: a pragma `{…}`") && e.contains("at 18:1"),
+            e.contains("pou P: its ST body is not executed: a pragma `{…}`")
+                && e.contains("at 18:1"),
             "{cmd}: {e}"
         );
     }
@@ -196,19 +208,20 @@ fn a_c_pragma_is_a_statement_that_reads_and_writes_everything_and_run_refuses_it
 
 #[test]
 fn a_variable_of_an_undefined_enumeration_with_an_initial_value_is_no_instance() {
-    // `LEVEL : LOGLEVEL := DEBUG`: LOGLEVEL is Beremiz's, not in the file. A simple initial
+    // `MODE : OPMODE := AUTO`: OPMODE is not in the file. A simple initial
     // value makes it no function block instance (IEC 61131-3 6.5.1.4: an instance's is
     // structured): a black box variable, its value not read; P declares it, so `run` refuses P
     // by name (the black box has no value).
     let w = warnings("library_enum_init.xml");
     assert!(
-        w.contains("LOGLEVEL → DINT (a type the file does not define, given the simple initial value `DEBUG`")
-            && w.contains("read as black boxes: LOGLEVEL: P.LEVEL"),
+        w.contains(
+            "OPMODE → DINT (a type the file does not define, given the simple initial value `AUTO`"
+        ) && w.contains("read as black boxes: OPMODE: P.MODE"),
         "{w}"
     );
     let e = refused("run", "library_enum_init.xml");
     assert!(
-        e.contains("variable `LEVEL` is of type `LOGLEVEL`, which the file does not define"),
+        e.contains("variable `MODE` is of type `OPMODE`, which the file does not define"),
         "{e}"
     );
 }

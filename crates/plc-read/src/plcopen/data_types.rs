@@ -100,7 +100,9 @@ impl Aggregate {
     pub(super) fn word(self) -> &'static str {
         match self {
             Aggregate::Array => "an array",
-            Aggregate::Undefined => "a type that neither the file nor plc-deps defines (a library type: a black box)",
+            Aggregate::Undefined => {
+                "a type that neither the file nor plc-deps defines (a library type: a black box)"
+            }
         }
     }
 }

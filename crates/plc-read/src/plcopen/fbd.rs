@@ -741,7 +741,10 @@ impl Fbd<'_, '_, '_> {
 fn positional_pins(op: &str, inputs: &mut [(Cow<'static, str>, Input<'static>)]) {
     let index = |n: &str| -> Option<usize> {
         let u = n.to_ascii_uppercase();
-        u.strip_prefix("IN")?.parse::<usize>().ok().filter(|&k| k >= 1)
+        u.strip_prefix("IN")?
+            .parse::<usize>()
+            .ok()
+            .filter(|&k| k >= 1)
     };
     if inputs.is_empty() || !inputs.iter().all(|(n, _)| index(n).is_some()) {
         return;

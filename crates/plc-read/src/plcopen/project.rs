@@ -204,7 +204,10 @@ fn vendor_pous<'a, 'i>(
     standard: &[Node<'a, 'i>],
     notes: &mut Notes,
 ) -> Vec<Node<'a, 'i>> {
-    let named = |p: &Node, n: &str| p.attribute("name").is_some_and(|m| m.eq_ignore_ascii_case(n));
+    let named = |p: &Node, n: &str| {
+        p.attribute("name")
+            .is_some_and(|m| m.eq_ignore_ascii_case(n))
+    };
     let mut found: Vec<Node> = Vec::new();
     for pou in root.descendants().filter(|n| tc6.is(*n, "pou")) {
         let in_data = pou.parent_element().is_some_and(|d| {

@@ -139,7 +139,9 @@ impl<'a> Parser<'a> {
             Some(Tok::Ident(s) | Tok::Literal(s) | Tok::Direct(s) | Tok::Sym(s)) => {
                 format!("`{s}`")
             }
-            Some(Tok::Pragma(_)) => "a pragma `{…}` (one may stand only where a statement may)".to_owned(),
+            Some(Tok::Pragma(_)) => {
+                "a pragma `{…}` (one may stand only where a statement may)".to_owned()
+            }
             None => "the end of the body".to_owned(),
         };
         LexError {

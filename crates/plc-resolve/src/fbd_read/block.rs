@@ -343,10 +343,12 @@ impl Net<'_, '_, '_> {
             Ok(syn::Outputs::Named(map)) => {
                 for (k, targets) in map {
                     let q = format!("{p}.out.{k}");
-                    let Some(i) = pins.iter().position(|x| x.eq_ignore_ascii_case(k)).or(
-                        (pins.len() == 1 && pins[0] == "OUT" && k.eq_ignore_ascii_case("OUT1"))
-                            .then_some(0),
-                    ) else {
+                    let Some(i) = pins.iter().position(|x| x.eq_ignore_ascii_case(k)).or((pins
+                        .len()
+                        == 1
+                        && pins[0] == "OUT"
+                        && k.eq_ignore_ascii_case("OUT1"))
+                    .then_some(0)) else {
                         return Err(self.err(
                             d,
                             &q,
