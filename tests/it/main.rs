@@ -72,6 +72,7 @@ mod plcopen_st;
 mod plcopen_standard_fbs;
 mod plcopen_structs;
 mod plcopen_types;
+mod plcopen_vendor;
 mod readme;
 mod report_networks;
 mod report_schema;

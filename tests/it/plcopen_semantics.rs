@@ -43,7 +43,7 @@ fn scans(name: &str, csv: &str, columns: &[&str]) -> Vec<Vec<String>> {
 
 /// Builds the generated C of `xml`, runs it on `csv` and compares its state line after every
 /// scan (and its faults) with the sequential interpreter's.
-fn c_matches_interpreter(xml: &str, csv: &str, scans: u64, tag: &str) {
+pub(crate) fn c_matches_interpreter(xml: &str, csv: &str, scans: u64, tag: &str) {
     let (p, fbd, _) = plc_deps::load::plcopen_for_run(xml).expect("the file loads for run");
     let cfg = CConfig::default();
     let dir = common::c::fresh_dir(tag);

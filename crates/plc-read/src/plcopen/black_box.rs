@@ -14,8 +14,9 @@
 //! such block). Its pins' types come from the function's declaration (a user function), from
 //! the conversion's name, or else from what is wired to each pin (the variable, constant or
 //! block output feeding an input; the variables an output writes, or the type of its first
-//! input for SHL, SHR, ROL, ROR, MUX and MOVE-like ops); a pin whose type cannot be told is an
-//! error naming it.
+//! input for SHL, SHR, ROL, ROR, MUX and MOVE-like ops); an input whose type cannot be told is
+//! an error naming it; so is an output that feeds something whose type cannot be told; an
+//! output that feeds nothing is read as BOOL, and the black box's note names it.
 //!
 //! Invariants: a stand-in type is named after the op, with `__2`, `__3` … for a second
 //! signature of the same op (`__1`, `__2` … for a built-in op such as `SUB` of a DT and a TIME); every black box of a body is in [`Notes::black_boxes`].
@@ -24,7 +25,7 @@
 
 use super::block_types::{BlackBox, Ctx, Sig};
 use super::wiring::{ElemId, Graph};
-use super::xml::{error, origin, R};
+use super::xml::{error, R};
 use plc_diag::Origin;
 use plc_fbd::OpKind;
 use plc_model::Function;
@@ -403,6 +404,7 @@ pub(super) fn rewrite(
         inputs: Vec::new(),
         outputs: Vec::new(),
     };
+    let mut guessed = Vec::new();
     for (pin, input) in &inputs {
         let from_decl = declared.as_ref().and_then(|d| {
             d.inputs
@@ -435,16 +437,37 @@ pub(super) fn rewrite(
             t.output(e, Some(pin), 0)
                 .or_else(|| t.consumer_type(e, pin, k == 0))
         };
-        let Some(pty) = pty else {
-            return Err(error(
-                origin(*pnode),
-                place,
-                format!("the type of output {pname} of {ty} (localId {}) cannot be told from what it feeds; plc-deps reads {ty} as a black box, whose pins need a type", el.local_id),
-            ));
+        // Nothing tells the type because the output feeds nothing (Beremiz's `csv_reload` ACK
+        // left unwired): BOOL, which the black box's note says; nothing reads it, and what it
+        // would hold is not computed anyway. An output that feeds something untyped stays an
+        // error.
+        let feeds_nothing = !t.g.consumers[e.0 as usize]
+            .iter()
+            .any(|(_, _, p)| p.map_or(k == 0, |p| p == *pin));
+        let pty = match pty {
+            Some(p) => p,
+            None if feeds_nothing => {
+                guessed.push(format!("{pname} (localId {})", el.local_id));
+                "BOOL".to_owned()
+            }
+            None => {
+                return Err(error(
+                    super::xml::origin(*pnode),
+                    place,
+                    format!("the type of output {pname} of {ty} (localId {}) cannot be told from what it feeds; plc-deps reads {ty} as a black box, whose pins need a type", el.local_id),
+                ))
+            }
         };
         sig.outputs.push((pname.to_owned(), pty));
     }
     let name = stand_in_name(boxes, ty, &sig, at);
+    if let Some(bb) = boxes.iter_mut().find(|x| x.name == name) {
+        for g in guessed {
+            if !bb.guessed.contains(&g) {
+                bb.guessed.push(g);
+            }
+        }
+    }
     let inst = match el.node.attribute("instanceName") {
         Some(i) => i.to_owned(),
         None => format!("{}__{}", ty, el.local_id),
@@ -480,6 +503,7 @@ fn stand_in_name(boxes: &mut Vec<BlackBox>, op: &str, sig: &Sig, at: Origin) -> 
         sig: sig.clone(),
         origin: at,
         sites: Vec::new(),
+        guessed: Vec::new(),
     });
     name
 }

@@ -23,6 +23,9 @@ pub struct BlackBox {
     pub sig: Sig,
     pub origin: Origin,
     pub sites: Vec<String>,
+    /// Outputs whose type nothing tells (nothing reads them, or what reads them has no type),
+    /// read as BOOL ([`super::black_box`]).
+    pub guessed: Vec<String>,
 }
 
 /// What a body's blocks may call, and the types of the names it sees.

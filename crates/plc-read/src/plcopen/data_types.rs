@@ -21,9 +21,12 @@
 //! which an exported project does not contain: they are aliases of BOOL, INT, REAL, STRING and
 //! BOOL, and read as such unless the project declares a type of the same name.
 //!
+//! A type derived from a type that nobody defines (a CODESYS library type such as `JSONVAR`)
+//! is a black box: one whole variable without a value, like an array.
+//!
 //! Invariants: every type of the file resolves to a [`Base`] or is an error at its
-//! `dataType` (an unknown base, a cycle of aliases, a malformed range or enumeration); names are
-//! IEC identifiers.
+//! `dataType` (a cycle of aliases, a malformed range or enumeration); names are IEC
+//! identifiers.
 //!
 //! Deliberately not here: range checks, element-wise arrays, pointers and references (errors).
 //!
@@ -88,12 +91,18 @@ pub(super) struct Member {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) enum Aggregate {
     Array,
+    /// A type the file names and nobody defines (a CODESYS library type such as `JSONVAR`):
+    /// a black box, read as one whole variable.
+    Undefined,
 }
 
 impl Aggregate {
     pub(super) fn word(self) -> &'static str {
         match self {
             Aggregate::Array => "an array",
+            Aggregate::Undefined => {
+                "a type that neither the file nor plc-deps defines (a library type: a black box)"
+            }
         }
     }
 }
@@ -319,11 +328,13 @@ pub(super) fn base(
             if let Some(&(_, b)) = SVGHMI.iter().find(|(n, _)| *n == of) {
                 return Ok(plain(Base::Elementary(b.to_owned())));
             }
-            Err(error(
-                origin(bt),
-                place,
-                format!("data type `{name}` derives from `{of}`, which is neither an elementary type nor a data type of the project"),
-            ))
+            // A library type the file does not define (CODESYS's `JSONVAR`): a black box, one
+            // whole variable without a value, named after the type (the data type's note says
+            // so, and `run` refuses the bodies that use it, [`super::interface::Mapped`]).
+            Ok(DataType {
+                name: of,
+                ..plain(Base::Whole(Aggregate::Undefined))
+            })
         }
         "subrangeSigned" | "subrangeUnsigned" => {
             let r = tc6.child(bt, "range").ok_or_else(|| {

@@ -284,7 +284,13 @@ impl Fbd<'_, '_, '_> {
         let Connection::Variable(v) = &input.from else {
             return None;
         };
-        let declared = self.ctx.fb_inputs.get(ty)?;
+        // A function block's inputs, or a function's (a user function is a black box whose
+        // pins are its declared inputs, a structure one per field).
+        let declared = self
+            .ctx
+            .fb_inputs
+            .get(ty)
+            .or_else(|| self.ctx.functions.get(ty).map(|s| &s.inputs))?;
         if declared.iter().any(|(n, _)| n == pin) {
             return None;
         }
@@ -449,6 +455,7 @@ impl Fbd<'_, '_, '_> {
                 }
             }
         }
+        positional_pins(ty, &mut inputs);
         b.inputs = Some(Ok(Inputs::Named(inputs)));
         let t = black_box::Typer {
             ctx: self.ctx,
@@ -723,5 +730,52 @@ impl Fbd<'_, '_, '_> {
                 ),
             )),
         }
+    }
+}
+
+/// CODESYS names the inputs of the standard operators by position, `In1`, `In2`, … (its own
+/// operator boxes): the standard names in the standard's order (IEC 61131-3 2.5.1.5: MUX is
+/// `K, IN0, IN1, …`, SEL `G, IN0, IN1`, LIMIT `MN, IN, MX`, the shifts `IN, N`, one-input
+/// functions `IN`). Applied only when every data input is so named; `IN1`, `IN2` of the
+/// extensible ops (ADD, AND, …) are their own names already.
+fn positional_pins(op: &str, inputs: &mut [(Cow<'static, str>, Input<'static>)]) {
+    let index = |n: &str| -> Option<usize> {
+        let u = n.to_ascii_uppercase();
+        u.strip_prefix("IN")?
+            .parse::<usize>()
+            .ok()
+            .filter(|&k| k >= 1)
+    };
+    if inputs.is_empty() || !inputs.iter().all(|(n, _)| index(n).is_some()) {
+        return;
+    }
+    let fixed: &[&str] = match op.to_ascii_uppercase().as_str() {
+        "SEL" => &["G", "IN0", "IN1"],
+        "LIMIT" => &["MN", "IN", "MX"],
+        "SHL" | "SHR" | "ROL" | "ROR" => &["IN", "N"],
+        "MUX" => &[],
+        "NOT" | "MOVE" | "ABS" | "SQRT" | "LN" | "LOG" | "EXP" | "SIN" | "COS" | "TAN" | "ASIN"
+        | "ACOS" | "ATAN" | "TRUNC" => &["IN"],
+        u if u.contains("_TO_") => &["IN"],
+        _ => return,
+    };
+    let mut names = Vec::with_capacity(inputs.len());
+    for (n, _) in inputs.iter() {
+        let k = index(n).expect("checked above");
+        names.push(if op.eq_ignore_ascii_case("MUX") {
+            if k == 1 {
+                "K".to_owned()
+            } else {
+                format!("IN{}", k - 2)
+            }
+        } else {
+            match fixed.get(k - 1) {
+                Some(s) => (*s).to_owned(),
+                None => return,
+            }
+        });
+    }
+    for ((n, _), name) in inputs.iter_mut().zip(names) {
+        *n = Cow::Owned(name);
     }
 }

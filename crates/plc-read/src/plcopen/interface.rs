@@ -217,6 +217,24 @@ fn variable(
     };
     let Ty::Data(d) = &ty else {
         let iv = tc6.child(v, "initialValue");
+        let simple = iv
+            .and_then(|iv| tc6.child(iv, "simpleValue"))
+            .and_then(|s| s.attribute("value"));
+        if let (Ty::Fb(fb), Some(value)) = (&ty, simple) {
+            // A function block instance has no simple initial value (IEC 61131-3 6.5.1.4): the
+            // type is one the file names and does not define, a library's enumeration most
+            // often (`LEVEL : LOGLEVEL := DEBUG`, Beremiz's LOGLEVEL). It is read as the type
+            // nobody defines (a black box, [`super::project`]), its initial value not read.
+            mapped.push(Mapped {
+                var: name.clone(),
+                origin: origin(v),
+                from: fb.clone(),
+                to: "DINT",
+                text: true,
+                via: Some(format!("a type the file does not define, given the simple initial value `{}`, which is not read: not a function block instance, whose initial value would be structured", value.trim())),
+            });
+            return Ok(vec![one(tc6, &decl, name, ty, None, None, mapped)?]);
+        }
         if let (Ty::Fb(fb), Some(iv)) = (&ty, iv) {
             fb_inits.push(fb_init(tc6, iv, &name, fb, &place)?);
             return Ok(vec![one(tc6, &decl, name, ty, None, None, mapped)?]);

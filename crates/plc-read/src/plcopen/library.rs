@@ -202,5 +202,12 @@ pub(super) fn black_box_type(b: &super::block_types::BlackBox) -> (FunctionBlock
             b.sites.join("; ")
         ),
     };
+    let mut note = note;
+    if !b.guessed.is_empty() {
+        note.message.push_str(&format!(
+            ". Outputs that feed nothing, whose type nothing in the file tells, are read as BOOL: {}",
+            b.guessed.join(", ")
+        ));
+    }
     (fb, note)
 }

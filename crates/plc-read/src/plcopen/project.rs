@@ -59,7 +59,12 @@ pub(super) fn program(
     // against them all.
     let mut read = Vec::new();
     let pous = types.and_then(|t| tc6.child(t, "pous"));
-    for pou in pous.into_iter().flat_map(|p| tc6.children(p, "pou")) {
+    let standard: Vec<Node> = pous
+        .into_iter()
+        .flat_map(|p| tc6.children(p, "pou"))
+        .collect();
+    let vendor = vendor_pous(tc6, root, &standard, notes);
+    for pou in standard.into_iter().chain(vendor) {
         let raw = attr(pou, "name", "types/pous")?;
         let pname = identifier(raw, "POU", pou, "types/pous")?;
         let place = format!("pou {pname}");
@@ -90,6 +95,12 @@ pub(super) fn program(
         .chain(read.iter().flat_map(|r| &r.3.globals))
         .map(|v| (v.name.as_str(), v.ty.as_str()))
         .collect();
+    let input_globals: HashSet<String> = globals
+        .iter()
+        .chain(read.iter().flat_map(|r| &r.3.globals))
+        .filter(|v| v.class.value == plc_syntax::VarClass::Input)
+        .map(|v| v.name.as_str().to_ascii_lowercase())
+        .collect();
     let base = base_ctx(&read);
     let mut bodies = Vec::new();
     for (pou, pname, kind, iface) in &read {
@@ -100,7 +111,13 @@ pub(super) fn program(
             bodies.push(None);
             continue;
         }
-        let scope = scope(iface, &global_types, &known);
+        let mut scope = scope(iface, &global_types, &known);
+        scope.inputs.extend(
+            input_globals
+                .iter()
+                .filter(|g| iface.externals.iter().any(|e| e.eq_ignore_ascii_case(g)))
+                .cloned(),
+        );
         let ctx = pou_ctx(&base, iface, &global_types);
         bodies.push(Some(body(tc6, *pou, pname, iface, &scope, &ctx, notes)?));
     }
@@ -180,6 +197,51 @@ pub(super) fn program(
         .unwrap_or("");
     program.dialect = plc_model::Dialect::of_editor(product);
     Ok(program)
+}
+
+/// The POUs CODESYS and TwinCAT keep in vendor data rather than in `types/pous`: a TC6 `pou`
+/// element as the child of an `addData/data` whose name ends in `/pou` (CODESYS puts its
+/// programs in `resource/addData`, TwinCAT all its POUs in the project's application data,
+/// leaving `types/pous` empty). They are read as the standard POUs are; one whose name a POU of
+/// `types/pous` already has is left out. A note names those read.
+fn vendor_pous<'a, 'i>(
+    tc6: Tc6,
+    root: Node<'a, 'i>,
+    standard: &[Node<'a, 'i>],
+    notes: &mut Notes,
+) -> Vec<Node<'a, 'i>> {
+    let named = |p: &Node, n: &str| {
+        p.attribute("name")
+            .is_some_and(|m| m.eq_ignore_ascii_case(n))
+    };
+    let mut found: Vec<Node> = Vec::new();
+    for pou in root.descendants().filter(|n| tc6.is(*n, "pou")) {
+        let in_data = pou.parent_element().is_some_and(|d| {
+            tc6.is(d, "data")
+                && d.attribute("name").is_some_and(|n| n.ends_with("/pou"))
+                && d.parent_element().is_some_and(|a| tc6.is(a, "addData"))
+        });
+        let Some(name) = pou.attribute("name") else {
+            continue;
+        };
+        if in_data
+            && !standard.iter().any(|p| named(p, name))
+            && !found.iter().any(|p| named(p, name))
+        {
+            found.push(pou);
+        }
+    }
+    if let Some(first) = found.first() {
+        let names: Vec<&str> = found.iter().filter_map(|p| p.attribute("name")).collect();
+        notes.push(Note {
+            origin: origin(*first),
+            message: format!(
+                "POUs read from vendor data (addData, as CODESYS and TwinCAT export them) rather than types/pous: {}",
+                names.join(", ")
+            ),
+        });
+    }
+    found
 }
 
 /// Adds the stand-in type of each library block ([`super::library`]) that a variable is an
@@ -361,6 +423,9 @@ fn scope(iface: &Interface, globals: &[(&str, &str)], known: &Known) -> st_scope
         .chain(&iface.globals)
     {
         s.declare(v.name.as_str(), v.ty.as_str());
+        if v.class.value == plc_syntax::VarClass::Input {
+            s.inputs.insert(v.name.as_str().to_ascii_lowercase());
+        }
     }
     for e in &iface.externals {
         for (n, t) in globals.iter().filter(|(n, _)| is_external(n, e)) {
@@ -654,14 +719,13 @@ fn instances<'a, 'i>(
     mapped: &mut Vec<interface::Mapped>,
 ) -> R<Instances<'a, 'i>> {
     let mut globals = Vec::new();
-    let mut order = Vec::new();
-    let Some(confs) = tc6
+    let order = Vec::new();
+    let configurations: Vec<Node> = tc6
         .child(root, "instances")
         .and_then(|i| tc6.child(i, "configurations"))
-    else {
-        return Ok((globals, order, None));
-    };
-    let configurations: Vec<Node> = tc6.children(confs, "configuration").collect();
+        .into_iter()
+        .flat_map(|c| tc6.children(c, "configuration"))
+        .collect();
     if configurations.len() > 1 {
         return Err(error(
             origin(configurations[1]),
@@ -669,34 +733,34 @@ fn instances<'a, 'i>(
             "several configurations are not supported yet",
         ));
     }
+    let place = "instances/configuration";
     let Some(conf) = configurations.first().copied() else {
-        return Ok((globals, order, None));
+        // TwinCAT leaves `instances` empty and keeps its resource (tasks, global variable
+        // lists) in the project's application data: read it as the resource of a configuration
+        // of the same name.
+        let Some(res) = tc6
+            .children(root, "addData")
+            .flat_map(|a| tc6.children(a, "data"))
+            .find_map(|d| tc6.child(d, "resource"))
+        else {
+            return Ok((globals, order, None));
+        };
+        notes.push(Note {
+            origin: origin(res),
+            message: "the resource is read from vendor data (addData, as TwinCAT exports it): the project's instances/configurations is empty".into(),
+        });
+        let configuration = Configuration {
+            name: identifier(attr(res, "name", place)?, "resource", res, place)?,
+            resources: Vec::new(),
+        };
+        return resource(tc6, res, configuration, known, notes, mapped, globals);
     };
     add_data_note(tc6, conf, notes);
-    let place = "instances/configuration";
-    let mut configuration = Configuration {
+    let configuration = Configuration {
         name: identifier(attr(conf, "name", place)?, "configuration", conf, place)?,
         resources: Vec::new(),
     };
-    // The globals of the configuration, then of its resource.
-    let mut globals_of = |node: Node, globals: &mut Vec<Var<'static>>| -> R<()> {
-        for gv in tc6.children(node, "globalVars") {
-            let class = plc_syntax::VarClass::Default;
-            let mut inits = Vec::new();
-            globals.extend(interface::var_list(
-                tc6, gv, class, place, known, mapped, &mut inits,
-            )?);
-            if let Some(i) = inits.first() {
-                return Err(error(
-                    i.origin,
-                    place,
-                    format!("global function block instance `{}` has an initial value; initial values of global instances are not supported yet (those of a POU's instances are)", i.instance),
-                ));
-            }
-        }
-        Ok(())
-    };
-    globals_of(conf, &mut globals)?;
+    globals_of(tc6, conf, known, mapped, &mut globals)?;
     let resources: Vec<Node> = tc6.children(conf, "resource").collect();
     if resources.len() > 1 {
         return Err(error(
@@ -708,7 +772,49 @@ fn instances<'a, 'i>(
     let Some(res) = resources.first().copied() else {
         return Ok((globals, order, Some(configuration)));
     };
-    globals_of(res, &mut globals)?;
+    resource(tc6, res, configuration, known, notes, mapped, globals)
+}
+
+/// The global variables of a configuration or resource, appended to `globals`.
+fn globals_of(
+    tc6: Tc6,
+    node: Node,
+    known: &Known,
+    mapped: &mut Vec<interface::Mapped>,
+    globals: &mut Vec<Var<'static>>,
+) -> R<()> {
+    let place = "instances/configuration";
+    for gv in tc6.children(node, "globalVars") {
+        let class = plc_syntax::VarClass::Default;
+        let mut inits = Vec::new();
+        globals.extend(interface::var_list(
+            tc6, gv, class, place, known, mapped, &mut inits,
+        )?);
+        if let Some(i) = inits.first() {
+            return Err(error(
+                i.origin,
+                place,
+                format!("global function block instance `{}` has an initial value; initial values of global instances are not supported yet (those of a POU's instances are)", i.instance),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The resource `res` of `configuration`: its globals (after those in `globals`), its tasks
+/// and program instances in run order.
+fn resource<'a, 'i>(
+    tc6: Tc6,
+    res: Node<'a, 'i>,
+    mut configuration: Configuration,
+    known: &Known,
+    notes: &mut Notes,
+    mapped: &mut Vec<interface::Mapped>,
+    mut globals: Vec<Var<'static>>,
+) -> R<Instances<'a, 'i>> {
+    let place = "instances/configuration";
+    let mut order = Vec::new();
+    globals_of(tc6, res, known, mapped, &mut globals)?;
     let mut resource = Resource {
         name: identifier(attr(res, "name", place)?, "resource", res, place)?,
         ..Resource::default()
@@ -775,6 +881,11 @@ fn instance_type(pi: Node, place: &str) -> R<String> {
         .attribute("typeName")
         .or(pi.attribute("type"))
         .ok_or_else(|| error(origin(pi), place, "pouInstance has no typeName"))?;
+    // TwinCAT writes `<pouInstance name="MAIN" typeName="">`: the instance of program MAIN.
+    let ty = match (ty.trim(), pi.attribute("name")) {
+        ("", Some(n)) => n,
+        _ => ty,
+    };
     identifier(ty, "program", pi, place)
 }
 

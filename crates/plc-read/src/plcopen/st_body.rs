@@ -18,6 +18,10 @@
 //! the call assigns them. A name that is neither declared nor called (a
 //! function) is an error at its statement; so is an ST syntax error, at its line and column.
 //!
+//! A pragma where a statement stands (`{…}`, Beremiz's C code `{{…}}`) is a statement plc-deps
+//! cannot see into: its rung reads and writes every elementary variable the body sees, a
+//! warning names its line, and `run`/`c` refuse the POU.
+//!
 //! For `run` and `c` ([`super::xml::Notes::exec`]) the same body is also lowered to executable
 //! rungs ([`super::st_lower`]); when every statement lowers, those rungs (and their
 //! temporaries) replace the stand-ins, otherwise the body is marked skipped with the construct
@@ -96,8 +100,17 @@ pub(super) fn rungs(
                 continue;
             }
             let here = at(s.at);
-            let (reads, writes) = resolve(&st::accesses(s), scope, &mut unseen, pou)
-                .map_err(|m| error(here, &place, m))?;
+            let acc = st::accesses(s);
+            let (mut reads, mut writes) =
+                resolve(&acc, scope, &mut unseen, pou).map_err(|m| error(here, &place, m))?;
+            if acc.pragma {
+                everything(scope, &mut reads, &mut writes);
+                let (l, c) = here.line_column(source).unwrap_or((0, 0));
+                notes.push(Note {
+                    origin: here,
+                    message: format!("{place}: statement {k} (at {l}:{c}) holds a pragma `{{…}}`, C code that matiec copies into what it generates and plc-deps cannot see into: the analysis takes it as reading and writing every variable of `{pou}`, and `run` and `c` refuse `{pou}`"),
+                });
+            }
             out.extend(stand_in(format!("{pou}.st{k}"), here, &reads, &writes));
         }
     }
@@ -133,6 +146,32 @@ pub(super) fn rungs(
         None => {}
     }
     Ok(out)
+}
+
+/// Adds to a statement holding a pragma every elementary variable the body sees (the POU's and
+/// the globals it declares external), read, and written but for inputs (the scan writes those),
+/// in name order: C code may touch any.
+fn everything(scope: &Scope, reads: &mut Vec<Read>, writes: &mut Vec<String>) {
+    let mut all: Vec<(&String, &String)> = scope
+        .names
+        .values()
+        .filter_map(|d| match d {
+            Decl::Elementary { name, ty } => Some((name, ty)),
+            _ => None,
+        })
+        .collect();
+    all.sort();
+    for (name, ty) in all {
+        if !reads.iter().any(|r| &r.name == name) {
+            reads.push(Read {
+                name: name.clone(),
+                bool: ty == "BOOL",
+            });
+        }
+        if !writes.contains(name) && !scope.inputs.contains(&name.to_ascii_lowercase()) {
+            writes.push(name.clone());
+        }
+    }
 }
 
 fn message(pou: &str, statements: usize, unseen: &Unseen, executed: &str) -> String {

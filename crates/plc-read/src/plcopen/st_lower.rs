@@ -353,6 +353,10 @@ impl<'s> Lower<'s> {
         self.here = self.origin(s.at);
         match &s.kind {
             Stmt::Empty => Ok(()),
+            Stmt::Pragma { .. } => refuse(
+                s.at,
+                "a pragma `{…}` (matiec copies its text, C code, into what it generates)",
+            ),
             Stmt::Assign { target, value } => self.assign(target, value),
             Stmt::Call { callee, args } => self.fb_call(callee, args),
             Stmt::If { arms, otherwise } => {

@@ -35,6 +35,9 @@ pub(super) enum Decl {
 #[derive(Default)]
 pub(super) struct Scope {
     pub names: HashMap<String, Decl>,
+    /// The lower-case names of the variables of class input (declared inputs, `%I` locations):
+    /// the scan writes them, the program only reads them.
+    pub inputs: std::collections::HashSet<String>,
 }
 
 impl Scope {

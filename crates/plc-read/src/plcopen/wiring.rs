@@ -126,14 +126,12 @@ pub(super) fn graph<'a, 'i>(
     notes: &mut Notes,
 ) -> R<Graph<'a, 'i>> {
     let doc = body.document();
-    let ids = LocalIds::of(tc6, body, place, notes);
+    let nodes = body_elements(tc6, body, place, notes)?;
+    let ids = LocalIds::of(&nodes, body, place, notes);
     let mut elems: Vec<Elem> = Vec::new();
     let mut by_id: HashMap<u32, ElemId> = HashMap::new();
-    for n in tc6.elements(body) {
+    for n in nodes {
         let tag = n.tag_name().name();
-        if tag == "addData" || tag == "documentation" {
-            continue;
-        }
         let here = format!("{place}, {tag}");
         let raw = attr(n, "localId", &here)?;
         let local_id: u32 = ids.id(raw).ok_or_else(|| {
@@ -203,9 +201,9 @@ struct LocalIds {
 }
 
 impl LocalIds {
-    fn of(tc6: Tc6, body: Node, place: &str, notes: &mut Notes) -> LocalIds {
-        let raw: Vec<u64> = tc6
-            .elements(body)
+    fn of(nodes: &[Node], body: Node, place: &str, notes: &mut Notes) -> LocalIds {
+        let raw: Vec<u64> = nodes
+            .iter()
             .filter_map(|n| n.attribute("localId"))
             .filter_map(|r| r.trim().parse::<u64>().ok())
             .collect();
@@ -227,8 +225,9 @@ impl LocalIds {
             shown.push(format!("{x} → {next}"));
             next -= 1;
         }
-        let at = tc6
-            .elements(body)
+        let at = nodes
+            .iter()
+            .copied()
             .find(|n| {
                 n.attribute("localId")
                     .and_then(|r| r.trim().parse::<u64>().ok())
@@ -248,6 +247,88 @@ impl LocalIds {
         let x: u64 = raw.trim().parse().ok()?;
         u32::try_from(x).ok().or_else(|| self.big.get(&x).copied())
     }
+}
+
+/// The elements of a graphical body that take part in it, in file order: its TC6 children but
+/// `addData` and `documentation`; a `vendorElement` (TC6's element for what an editor adds,
+/// CODESYS writes one holding its FBD implementation attributes) stands for the standard
+/// elements it holds, if any, with a note; else, when nothing connects to it and it has no
+/// connection points (it cannot take part in the data flow), it is skipped with a note naming
+/// its localId. One that is wired is an error: what it computes cannot be told.
+fn body_elements<'a, 'i>(
+    tc6: Tc6,
+    body: Node<'a, 'i>,
+    place: &str,
+    notes: &mut Notes,
+) -> R<Vec<Node<'a, 'i>>> {
+    const STANDARD: &[&str] = &[
+        "block",
+        "inVariable",
+        "outVariable",
+        "inOutVariable",
+        "label",
+        "jump",
+        "return",
+        "comment",
+        "error",
+        "connector",
+        "continuation",
+        "actionBlock",
+        "leftPowerRail",
+        "rightPowerRail",
+        "contact",
+        "coil",
+    ];
+    let mut out = Vec::new();
+    for n in tc6.elements(body) {
+        let tag = n.tag_name().name();
+        if tag == "addData" || tag == "documentation" {
+            continue;
+        }
+        if tag != "vendorElement" {
+            out.push(n);
+            continue;
+        }
+        let id = n.attribute("localId").unwrap_or("?");
+        let what = n
+            .descendants()
+            .find(|d| d.tag_name().name() == "alternativeText")
+            .and_then(|a| a.descendants().find_map(|t| t.text()))
+            .map(|t| format!(" (`{}`)", t.trim()))
+            .unwrap_or_default();
+        let inner: Vec<Node> = tc6
+            .elements(n)
+            .filter(|c| STANDARD.contains(&c.tag_name().name()))
+            .collect();
+        if !inner.is_empty() {
+            notes.push(Note {
+                origin: origin(n),
+                message: format!("{place}: vendorElement localId {id}{what} is read as the standard elements it holds ({})", inner.iter().map(|c| c.tag_name().name()).collect::<Vec<_>>().join(", ")),
+            });
+            out.extend(inner);
+            continue;
+        }
+        let wired = n.descendants().any(|d| {
+            matches!(
+                d.tag_name().name(),
+                "connectionPointIn" | "connectionPointOut" | "connectionPointOutAction"
+            )
+        }) || body.descendants().any(|d| {
+            tc6.is(d, "connection") && d.attribute("refLocalId").map(str::trim) == Some(id.trim())
+        });
+        if wired {
+            return Err(error(
+                origin(n),
+                &format!("{place}, vendorElement localId {id}"),
+                format!("vendorElement localId {id}{what} is wired into the body, and what an editor's own element computes cannot be told: redraw it with standard blocks"),
+            ));
+        }
+        notes.push(Note {
+            origin: origin(n),
+            message: format!("{place}: vendorElement localId {id}{what} is skipped: it holds no standard element and nothing is wired to it, so it takes no part in what the body computes"),
+        });
+    }
+    Ok(out)
 }
 
 fn block_pins<'a, 'i>(tc6: Tc6, el: &mut Elem<'a, 'i>, place: &str, ids: &LocalIds) -> R<()> {

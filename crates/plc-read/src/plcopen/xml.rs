@@ -311,11 +311,13 @@ pub(super) fn variable_ref(s: &str, n: Node, place: &str) -> R<String> {
     }
 }
 
-/// The `addData` children of `n` as one note (their `data@name`s), if any.
+/// The `addData` children of `n` as one note (their `data@name`s), if any. A `data` holding a
+/// TC6 `pou` or `resource` is not ignored (the project reader reads them) and is left out.
 pub(super) fn add_data_note(tc6: Tc6, n: Node, notes: &mut Notes) {
     for a in tc6.children(n, "addData") {
         let names: Vec<&str> = tc6
             .children(a, "data")
+            .filter(|d| tc6.child(*d, "pou").is_none() && tc6.child(*d, "resource").is_none())
             .filter_map(|d| d.attribute("name"))
             .collect();
         if !names.is_empty() {

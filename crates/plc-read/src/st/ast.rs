@@ -51,6 +51,11 @@ pub enum Stmt {
     Return,
     /// `;` alone.
     Empty,
+    /// A pragma where a statement may stand (`{ … }`, Beremiz's C code `{{ … }}`), as written:
+    /// matiec copies its text into the C it generates, so it may read and write anything.
+    Pragma {
+        text: String,
+    },
 }
 
 /// A variable as written: `a`, `a.b[i, j].c`, `%IX0.1`, `p^`.

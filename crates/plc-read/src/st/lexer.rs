@@ -1,7 +1,13 @@
 //! The tokens of Structured Text (IEC 61131-3, 3rd edition, 7.3 and the common elements of
 //! 6.1–6.3): identifiers and keywords (case-insensitive), numeric, typed, time and string
 //! literals, direct addresses (`%IX0.1`), operators and punctuation; comments `(* … *)` (which
-//! may nest, as CODESYS and Beremiz allow), `// …` and pragmas `{ … }` are skipped.
+//! may nest, as CODESYS allows), `// …`; pragmas `{ … }` and `{{ … }}` (Beremiz's C code) are
+//! tokens of their own ([`Tok::Pragma`]), delimited as matiec delimits them
+//! (`stage1_2/iec_flex.ll`: `"{"[^}]*"}"`, or `"{{"` up to the first `"}}"`).
+//!
+//! Comments: nested first; when a `(*` is then left unclosed, the text is read again with flat
+//! comments (each `(*` closed by the first `*)`), which is how matiec reads them unless given
+//! `-n` (and Beremiz does not give it): `(* a (* b *)` is one whole comment there.
 //!
 //! Every token has its byte offset in the text. A character that starts no token, an
 //! unterminated comment or string: one error at its offset.
@@ -27,6 +33,8 @@ pub enum Tok<'a> {
     Direct(&'a str),
     /// An operator or punctuation: `:=`, `=>`, `<=`, `>=`, `<>`, `**`, `..`, or one character.
     Sym(&'a str),
+    /// A pragma as written, braces included: `{attribute 'x'}`, `{{ C code }}`.
+    Pragma(&'a str),
 }
 
 /// A lexical error: where and what.
@@ -39,8 +47,27 @@ pub struct LexError {
 const TWO: &[&str] = &[":=", "=>", "<=", ">=", "<>", "**", ".."];
 const ONE: &str = "+-*/=<>()[],;:.&^#";
 
-/// The tokens of `text`.
+/// The tokens of `text`: comments nested, else (a `(*` left unclosed) flat as matiec reads
+/// them.
 pub fn tokens(text: &str) -> Result<Vec<Token<'_>>, LexError> {
+    match tokens_with(text, true) {
+        Err(e) if e.message.starts_with("a comment") => tokens_with(text, false).map_err(|_| e),
+        r => r,
+    }
+}
+
+/// The end of the pragma opened at `i`: `{{ … }}` up to the first `}}`, `{ … }` up to the
+/// first `}` (matiec's two rules, the longer match first).
+fn pragma_end(text: &str, i: usize) -> Option<usize> {
+    if text[i..].starts_with("{{") {
+        if let Some(n) = text[i + 2..].find("}}") {
+            return Some(i + 2 + n + 2);
+        }
+    }
+    text[i..].find('}').map(|n| i + n + 1)
+}
+
+fn tokens_with(text: &str, nested: bool) -> Result<Vec<Token<'_>>, LexError> {
     let b = text.as_bytes();
     let mut out = Vec::new();
     let mut i = 0;
@@ -53,14 +80,21 @@ pub fn tokens(text: &str) -> Result<Vec<Token<'_>>, LexError> {
         if c.is_ascii_whitespace() {
             i += 1;
         } else if text[i..].starts_with("(*") {
-            i = comment_end(text, i).ok_or_else(|| err(i, "a comment `(*` is not closed"))?;
+            let end = if nested {
+                comment_end(text, i)
+            } else {
+                text[i + 2..].find("*)").map(|n| i + 2 + n + 2)
+            };
+            i = end.ok_or_else(|| err(i, "a comment `(*` is not closed"))?;
         } else if text[i..].starts_with("//") {
             i = text[i..].find('\n').map_or(b.len(), |n| i + n);
         } else if c == b'{' {
-            i = text[i..]
-                .find('}')
-                .map(|n| i + n + 1)
-                .ok_or_else(|| err(i, "a pragma `{` is not closed"))?;
+            let end = pragma_end(text, i).ok_or_else(|| err(i, "a pragma `{` is not closed"))?;
+            out.push(Token {
+                at: i,
+                kind: Tok::Pragma(&text[i..end]),
+            });
+            i = end;
         } else if c == b'\'' || c == b'"' {
             let end = string_end(b, i).ok_or_else(|| err(i, "a string is not closed"))?;
             out.push(Token {

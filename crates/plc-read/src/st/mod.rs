@@ -38,6 +38,8 @@ pub struct Accesses {
     /// (`s.f := 1` reads `s.f` as a part of `s`): where `s.f` is a variable of its own (a
     /// flattened structure's field), the write is whole and this read is not one.
     pub kept: Vec<String>,
+    /// The statement holds a pragma (C code that may read and write anything of the POU).
+    pub pragma: bool,
 }
 
 impl Accesses {
@@ -129,6 +131,7 @@ fn statement(s: &Statement, a: &mut Accesses) {
             expr(until, a);
         }
         Stmt::Exit | Stmt::Continue | Stmt::Return | Stmt::Empty => {}
+        Stmt::Pragma { .. } => a.pragma = true,
     }
 }
 

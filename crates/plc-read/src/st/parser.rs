@@ -139,6 +139,9 @@ impl<'a> Parser<'a> {
             Some(Tok::Ident(s) | Tok::Literal(s) | Tok::Direct(s) | Tok::Sym(s)) => {
                 format!("`{s}`")
             }
+            Some(Tok::Pragma(_)) => {
+                "a pragma `{…}` (one may stand only where a statement may)".to_owned()
+            }
             None => "the end of the body".to_owned(),
         };
         LexError {
@@ -232,6 +235,15 @@ impl<'a> Parser<'a> {
 
     fn statement(&mut self) -> P<Statement> {
         let at = self.at();
+        if let Some(Tok::Pragma(p)) = self.peek_at(0) {
+            // matiec takes a pragma as a statement of the list, without a `;`.
+            let text = p.to_string();
+            self.i += 1;
+            return Ok(Statement {
+                at,
+                kind: Stmt::Pragma { text },
+            });
+        }
         let kind = if self.eat_sym(";") {
             return Ok(Statement {
                 at,

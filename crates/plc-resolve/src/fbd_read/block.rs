@@ -229,13 +229,14 @@ impl Net<'_, '_, '_> {
             None if d.kind.extensible() => {
                 let mut n = 0;
                 for (k, _) in map {
+                    let k = k.to_ascii_uppercase();
                     match k
                         .strip_prefix("IN")
                         .and_then(|x| x.parse::<usize>().ok())
-                        .filter(|&x| x >= 1 && format!("IN{x}") == *k)
+                        .filter(|&x| x >= 1 && format!("IN{x}") == k)
                     {
                         Some(x) => n = n.max(x),
-                        None => return Err(unknown(k, "IN1, IN2, …".into())),
+                        None => return Err(unknown(&k, "IN1, IN2, …".into())),
                     }
                 }
                 if n > map.len() {
@@ -247,10 +248,17 @@ impl Net<'_, '_, '_> {
             None if d.kind == OpKind::Function(plc_model::Function::Mux) => {
                 let n = map
                     .iter()
-                    .filter_map(|(k, _)| k.strip_prefix("IN").and_then(|x| x.parse::<usize>().ok()))
+                    .filter_map(|(k, _)| {
+                        k.to_ascii_uppercase()
+                            .strip_prefix("IN")
+                            .and_then(|x| x.parse::<usize>().ok())
+                    })
                     .max()
                     .unwrap_or(1);
-                let given = map.iter().filter(|(k, _)| k.starts_with("IN")).count();
+                let given = map
+                    .iter()
+                    .filter(|(k, _)| k.to_ascii_uppercase().starts_with("IN"))
+                    .count();
                 if n >= given {
                     return Err(self.gap(d, map, (0..=n).map(|i| format!("IN{i}"))));
                 }
@@ -258,13 +266,16 @@ impl Net<'_, '_, '_> {
             }
             None => d.kind.input_pins(0),
         };
-        if let Some((k, _)) = map.iter().find(|(k, _)| !pins.iter().any(|x| x == k)) {
+        if let Some((k, _)) = map
+            .iter()
+            .find(|(k, _)| !pins.iter().any(|x| x.eq_ignore_ascii_case(k)))
+        {
             return Err(unknown(k, list_or_none(&pins)));
         }
         let mut inputs = Vec::with_capacity(pins.len());
         for name in pins {
             let q = format!("{p}.in.{name}");
-            let (input, path) = match map.iter().find(|(k, _)| *k == name) {
+            let (input, path) = match map.iter().find(|(k, _)| k.eq_ignore_ascii_case(&name)) {
                 Some((_, j)) => (Some(self.input(d, j, &q)?), q),
                 None => (None, format!("{p}.in")),
             };
@@ -332,7 +343,12 @@ impl Net<'_, '_, '_> {
             Ok(syn::Outputs::Named(map)) => {
                 for (k, targets) in map {
                     let q = format!("{p}.out.{k}");
-                    let Some(i) = pins.iter().position(|x| x == k) else {
+                    let Some(i) = pins.iter().position(|x| x.eq_ignore_ascii_case(k)).or((pins
+                        .len()
+                        == 1
+                        && pins[0] == "OUT"
+                        && k.eq_ignore_ascii_case("OUT1"))
+                    .then_some(0)) else {
                         return Err(self.err(
                             d,
                             &q,

@@ -69,7 +69,15 @@ impl Net<'_, '_, '_> {
             }
             None => 0,
             Some(Err(e)) => return Err(self.problem(d, e, path)),
-            Some(Ok(name)) => match pins.iter().position(|x| x == name) {
+            // IEC 61131-3 names are case-insensitive (CODESYS writes `Out`); CODESYS names an
+            // operator's single result `Out1`.
+            Some(Ok(name)) => match pins
+                .iter()
+                .position(|x| x.eq_ignore_ascii_case(name))
+                .or(
+                    (pins.len() == 1 && pins[0] == "OUT" && name.eq_ignore_ascii_case("OUT1"))
+                        .then_some(0),
+                ) {
                 Some(i) => i as u32,
                 None => {
                     return Err(self.err(

@@ -1,0 +1,227 @@
+//! What editors write beyond the TC6 standard elements, read as the toolchain the file was
+//! made for reads it (issue 39): POUs that CODESYS and TwinCAT keep in vendor data (`addData`),
+//! CODESYS `vendorElement`s in FBD bodies, types and blocks a file names and nobody defines
+//! (black boxes), Beremiz C pragmas in ST, and misreadings that ended in false errors.
+//!
+//! Each case is a small hand-written file of `tests/plcopen_vendor/` (not a corpus file).
+//! Where the file runs, it runs without `--allow-skipped`, with `--mode both` (seq == par after
+//! every scan), and its generated C gives the interpreter's state after every scan; where it
+//! cannot run, `run` and `c` refuse it naming the POU and the construct.
+
+use crate::common;
+use crate::plcopen_semantics::c_matches_interpreter;
+
+use std::path::PathBuf;
+use std::process::Output;
+
+fn path(name: &str) -> PathBuf {
+    common::cli::root().join("tests/plcopen_vendor").join(name)
+}
+
+/// `plc-deps report FILE`: must succeed; its standard error (the warnings) on one line.
+fn warnings(name: &str) -> String {
+    let p = path(name);
+    let out = common::cli::run(&["report", p.to_str().unwrap()]);
+    let err = common::cli::one_line(&String::from_utf8_lossy(&out.stderr));
+    assert_eq!(out.status.code(), Some(0), "{name}: {err}");
+    err
+}
+
+/// Runs `name` one scan per row of `csv` (no `--allow-skipped`), `--mode both`, which must find
+/// seq == par; checks the C against the interpreter; returns each of `columns` after each scan.
+fn scans(name: &str, csv: &str, columns: &[&str]) -> Vec<Vec<String>> {
+    let p = path(name);
+    let tag = format!("vendor-{}", name.trim_end_matches(".xml"));
+    let inputs = common::cli::tmp(&format!("{tag}.csv"));
+    std::fs::write(&inputs, csv).unwrap();
+    let tr = common::cli::tmp(&format!("{tag}-trace.csv"));
+    let out = common::cli::run(&[
+        "run",
+        p.to_str().unwrap(),
+        "--inputs",
+        inputs.to_str().unwrap(),
+        "--format",
+        "json",
+        "--mode",
+        "both",
+        "--trace",
+        tr.to_str().unwrap(),
+    ]);
+    let err = common::cli::one_line(&String::from_utf8_lossy(&out.stderr));
+    assert_eq!(out.status.code(), Some(0), "{name}: {err}");
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(
+        v["identical"],
+        serde_json::json!(true),
+        "{name}: seq != par"
+    );
+    let xml = std::fs::read_to_string(&p).unwrap();
+    let rows = csv.lines().count() as u64 - 1;
+    c_matches_interpreter(&xml, csv, rows, &tag);
+    crate::plcopen_common::trace_columns(&tr, columns)
+}
+
+/// `plc-deps CMD FILE` must fail with exit 2; its standard error on one line.
+fn refused(cmd: &str, name: &str) -> String {
+    let p = path(name);
+    let dir = common::cli::tmp(&format!("vendor-{cmd}-{name}.out"));
+    let mut args = vec![cmd, p.to_str().unwrap()];
+    if cmd == "c" {
+        args.extend(["--output", dir.to_str().unwrap()]);
+    }
+    let out: Output = common::cli::run(&args);
+    let err = common::cli::one_line(&String::from_utf8_lossy(&out.stderr));
+    assert_eq!(out.status.code(), Some(2), "{cmd} {name}: {err}");
+    err
+}
+
+fn col(v: &[&str]) -> Vec<String> {
+    v.iter().map(|s| s.to_string()).collect()
+}
+
+#[test]
+fn twincat_pous_and_resource_in_application_data_are_read_and_run() {
+    // types/pous and instances are empty; MAIN and the GVL are in addData. Y := A * 2 and
+    // Over := Y > Limit (Limit = 10 from the GVL): A = 3 gives 6, FALSE; A = 7 gives 14, TRUE.
+    let w = warnings("twincat_adddata_pous.xml");
+    assert!(w.contains("POUs read from vendor data"), "{w}");
+    assert!(w.contains("resource is read from vendor data"), "{w}");
+    assert!(!w.contains("vendor data (addData) ignored"), "{w}");
+    let t = scans("twincat_adddata_pous.xml", "A\n3\n7\n", &["Y", "Over"]);
+    assert_eq!(t[0], col(&["6", "14"]), "Y");
+    assert_eq!(t[1], col(&["0", "1"]), "Over");
+}
+
+#[test]
+fn codesys_programs_in_resource_data_are_read_and_run() {
+    // PLC_PRG (in the resource's addData, run by MainTask through `typeName=""`) calls the
+    // function block Twice of types/pous: Y = A + A.
+    let w = warnings("codesys_resource_pous.xml");
+    assert!(w.contains("PLC_PRG"), "{w}");
+    let t = scans("codesys_resource_pous.xml", "A\n3\n-4\n", &["Y"]);
+    assert_eq!(t[0], col(&["6", "-8"]), "Y");
+}
+
+#[test]
+fn a_codesys_vendor_element_is_skipped_with_a_note_and_positional_pins_are_read() {
+    // The vendorElement (FBD implementation attributes) is wired to nothing: skipped, named by
+    // its localId. SUB's In1, In2 and Out1 are IN1, IN2 and OUT; MUX's In1, In2, In3 are K,
+    // IN0, IN1 (IEC 61131-3 2.5.1.5.6: MUX(K, IN0, IN1) selects IN<K>). Y = A - B;
+    // Z = (K = 0 ? A - B : B).
+    let w = warnings("vendor_element_fbd.xml");
+    assert!(
+        w.contains(
+            "vendorElement localId 10000000000 (`FBD Implementation Attributes`) is skipped"
+        ),
+        "{w}"
+    );
+    let t = scans(
+        "vendor_element_fbd.xml",
+        "A,B,K\n5,3,0\n5,3,1\n-2,7,0\n",
+        &["Y", "Z"],
+    );
+    assert_eq!(t[0], col(&["2", "2", "-9"]), "Y");
+    assert_eq!(t[1], col(&["2", "3", "-9"]), "Z");
+}
+
+#[test]
+fn a_wired_vendor_element_is_refused_naming_its_local_id() {
+    let e = refused("report", "vendor_element_wired.xml");
+    assert!(
+        e.contains("vendor_element_wired.xml:22:9")
+            && e.contains("vendorElement localId 10000000000")
+            && e.contains("is wired into the body"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_black_box_output_that_feeds_nothing_is_read_as_bool_with_a_warning() {
+    // csv_reload is defined nowhere in the file: a black box. ACK feeds nothing (BOOL, said by
+    // the warning); RESULT feeds the INT R, so it is INT. `run` does not compute the black box:
+    // R keeps RESULT's initial value 0.
+    let w = warnings("black_box_output.xml");
+    assert!(
+        w.contains("csv_reload is read as a black box")
+            && w.contains("writing its outputs ACK BOOL, RESULT INT")
+            && w.contains("feed nothing, whose type nothing in the file tells, are read as BOOL: ACK (localId 2)"),
+        "{w}"
+    );
+    let t = scans("black_box_output.xml", "Go\n1\n0\n", &["R"]);
+    assert_eq!(t[0], col(&["0", "0"]), "R");
+}
+
+#[test]
+fn a_member_of_an_undefined_library_type_is_a_black_box_and_the_rest_runs() {
+    // MSG_T.topic is of CODESYS's JSONVAR, which the export does not carry: one whole variable
+    // without a value. P1 reads only m.qos (INT, initial 0) and P2 adds 1 to A: both run.
+    let w = warnings("library_type_member.xml");
+    assert!(
+        w.contains("JSONVAR → DINT (a type that neither the file nor plc-deps defines (a library type: a black box)")
+            && w.contains("P1.m.topic"),
+        "{w}"
+    );
+    let t = scans(
+        "library_type_member.xml",
+        "P2:A\n4\n-1\n",
+        &["P1:Q", "P2:Y"],
+    );
+    assert_eq!(t[0], col(&["0", "0"]), "P1:Q");
+    assert_eq!(t[1], col(&["5", "0"]), "P2:Y");
+}
+
+#[test]
+fn a_c_pragma_is_a_statement_that_reads_and_writes_everything_and_run_refuses_it() {
+    // `{{ … }}` (C code with braces of its own, closed by the first `}}` as matiec's lexer
+    // closes it) and `{ … }` are statements; a `(* (* *)` comment closes at its first `*)`
+    // (matiec without -n). The IF holding the pragma reads and writes every variable of P
+    // but the input IN (the scan writes it), and so does the lone pragma.
+    let p = path("c_pragma_st.xml");
+    let out = common::cli::run(&["report", p.to_str().unwrap(), "--format", "json"]);
+    assert_eq!(out.status.code(), Some(0));
+    let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let io = crate::plcopen_common::io(&r);
+    assert_eq!(
+        io,
+        vec![
+            crate::plcopen_common::rung("P.st1", &["IN", "Done"], &["Done"]),
+            crate::plcopen_common::rung("P.st2", &["IN", "OUT", "Done"], &["OUT", "Done"]),
+            crate::plcopen_common::rung("P.st3", &["IN", "OUT", "Done"], &["OUT", "Done"]),
+            crate::plcopen_common::rung("P.st4", &["Done"], &["Done"]),
+        ]
+    );
+    let w = common::cli::one_line(&String::from_utf8_lossy(&out.stderr));
+    assert!(
+        w.contains("statement 2 (at 17:1) holds a pragma")
+            && w.contains("statement 3 (at 23:1) holds a pragma"),
+        "{w}"
+    );
+    for cmd in ["run", "c"] {
+        let e = refused(cmd, "c_pragma_st.xml");
+        assert!(
+            e.contains("pou P: its ST body is not executed: a pragma `{…}`")
+                && e.contains("at 18:1"),
+            "{cmd}: {e}"
+        );
+    }
+}
+
+#[test]
+fn a_variable_of_an_undefined_enumeration_with_an_initial_value_is_no_instance() {
+    // `MODE : OPMODE := AUTO`: OPMODE is not in the file. A simple initial
+    // value makes it no function block instance (IEC 61131-3 6.5.1.4: an instance's is
+    // structured): a black box variable, its value not read; P declares it, so `run` refuses P
+    // by name (the black box has no value).
+    let w = warnings("library_enum_init.xml");
+    assert!(
+        w.contains(
+            "OPMODE → DINT (a type the file does not define, given the simple initial value `AUTO`"
+        ) && w.contains("read as black boxes: OPMODE: P.MODE"),
+        "{w}"
+    );
+    let e = refused("run", "library_enum_init.xml");
+    assert!(
+        e.contains("variable `MODE` is of type `OPMODE`, which the file does not define"),
+        "{e}"
+    );
+}
