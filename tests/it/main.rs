@@ -76,6 +76,7 @@ mod report_warnings;
 mod run_cli;
 mod scan_budget;
 mod schema;
+mod st_calls;
 mod st_exec;
 mod standard_fbs;
 mod strings;
