@@ -94,7 +94,7 @@ impl Lower<'_> {
         }
         for (inst, pin, ty) in want {
             let n = held(&inst, &pin);
-            if !self.held.iter().any(|h| *h == n) {
+            if !self.held.contains(&n) {
                 self.declare(&n, ty);
                 self.held.push(n);
             }
@@ -104,7 +104,7 @@ impl Lower<'_> {
     /// The variable holding input `pin` of standard instance `inst`, if it has one.
     pub(super) fn held_var(&self, inst: &str, pin: &str) -> Option<String> {
         let n = held(inst, pin);
-        self.held.iter().any(|h| *h == n).then_some(n)
+        self.held.contains(&n).then_some(n)
     }
 
     /// What field `field` (upper case) of instance `name` of type `ty` is as a variable: an
