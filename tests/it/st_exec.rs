@@ -37,14 +37,14 @@ pub(crate) fn run_json(file: &str, scans: u32, inputs: Option<&str>) -> Value {
 
 /// The user's variables of a run's state (the compiler temporaries `st__…` left out), as
 /// (name, value) pairs for the names asked.
-fn values(v: &Value, names: &[&str]) -> Vec<(String, Value)> {
+pub(crate) fn values(v: &Value, names: &[&str]) -> Vec<(String, Value)> {
     names
         .iter()
         .map(|n| (n.to_string(), v["state"][*n].clone()))
         .collect()
 }
 
-fn pairs(expected: &[(&str, Value)]) -> Vec<(String, Value)> {
+pub(crate) fn pairs(expected: &[(&str, Value)]) -> Vec<(String, Value)> {
     expected
         .iter()
         .map(|(n, v)| (n.to_string(), v.clone()))
@@ -87,7 +87,7 @@ pub(crate) fn c_equals_run(file: &str, scans: u32, csv: Option<&str>) {
 
 /// The `error:` line of a command that failed with exit code 2 (the reader's warnings before it
 /// left out).
-fn refusal(out: &Output, what: &str) -> String {
+pub(crate) fn refusal(out: &Output, what: &str) -> String {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{what}: {stderr}");
     let errors: Vec<&str> = stderr.lines().filter(|l| l.starts_with("error")).collect();
@@ -235,11 +235,31 @@ fn st_program(body: &str) -> String {
 #[test]
 fn what_is_not_executed_is_refused_by_run_and_c_with_its_place() {
     let cases = [
-        ("x := 1;\ny := MYFUNC(x);", "MYFUNC(", "the call of function `MYFUNC` (only the standard functions are executed)"),
-        ("x := 1;\nT1(IN := TRUE);", "T1(IN", "the call of `T1` without its input PT (plc-deps keeps no input values of a standard function block between calls)"),
-        ("x := 1;\n{ printf(\"hi\"); }\ny := 2;", "{ printf", "a pragma `{…}` (matiec copies its text, C code, into what it generates)"),
-        ("x := T1.PT;", "T1.PT", "`T1.PT`: only the outputs of a standard function block instance are read"),
-        ("IF x > 0 THEN\n  EXIT;\nEND_IF;", "EXIT", "EXIT outside a loop"),
+        (
+            "x := 1;\ny := MYFUNC(x);",
+            "MYFUNC(",
+            "the call of function `MYFUNC` (only the standard functions are executed)",
+        ),
+        (
+            "x := 1;\nT1(TRUE, T#1s);",
+            "T1(TRUE",
+            "an informal argument in the call of `T1`",
+        ),
+        (
+            "x := 1;\n{ printf(\"hi\"); }\ny := 2;",
+            "{ printf",
+            "a pragma `{…}` (matiec copies its text, C code, into what it generates)",
+        ),
+        (
+            "T1.Q := TRUE;",
+            "T1.Q",
+            "a write of `T1.Q`, which is not an input of the instance",
+        ),
+        (
+            "IF x > 0 THEN\n  EXIT;\nEND_IF;",
+            "EXIT",
+            "EXIT outside a loop",
+        ),
     ];
     for (body, at, what) in cases {
         let xml = st_program(body);

@@ -280,12 +280,19 @@ impl<'a> Builder<'a> {
                         },
                     ));
                 }
+                // A user function block instance the POU sees (its own, else a global one) is
+                // called as its POU (IEC 61131-3 6.6.3: an ST `Inst();` with its inputs set).
+                let instance = self.local_instances[s.pou.index()]
+                    .get(name.as_str())
+                    .or_else(|| self.global_instances.get(name.as_str()))
+                    .and_then(|&i| self.instances[i].pou);
                 let pou = self
                     .pous
                     .iter()
                     .position(|p| {
                         p.kind == PouKind::Subroutine && p.callable && p.name == name.as_str()
                     })
+                    .or(instance.map(|p| p.index()))
                     .ok_or_else(|| {
                         err(
                             "call",

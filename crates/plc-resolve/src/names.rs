@@ -65,7 +65,9 @@ impl<'a> Builder<'a> {
         if r.field.is_some() {
             return fail("instance fields are written only by their function block");
         }
-        if text.contains('.') && !self.is_own_variable(text, pou) {
+        // An input of a user instance is set by the instance's caller (IEC 61131-3 6.6.1.2).
+        let member_input = self.is_member_input(text, pou);
+        if text.contains('.') && !self.is_own_variable(text, pou) && !member_input {
             return fail("it belongs to a function block instance (only the instance writes it)");
         }
         if matches!(t, Type::Fb(_)) {
@@ -182,6 +184,18 @@ impl<'a> Builder<'a> {
         Invalid::UndefinedVar {
             name: name.to_owned(),
         }
+    }
+
+    /// True when `text` is an input of a user function block instance `pou` sees (`G1.IN`),
+    /// which IEC 61131-3 (6.6.1.2) lets the instance's caller set before a call.
+    fn is_member_input(&self, text: &str, pou: PouId) -> bool {
+        let Some((base, field)) = text.split_once('.') else {
+            return false;
+        };
+        let i = self.local_instances[pou.index()]
+            .get(base)
+            .or_else(|| self.global_instances.get(base));
+        i.is_some_and(|&i| self.instances[i].inputs.iter().any(|(n, _)| n == field))
     }
 
     /// True when `text` is the name of a variable of `pou`'s scope or the program's as it is

@@ -222,12 +222,12 @@ impl DataTypes {
         })
     }
 
-    /// Every enumeration value of the project and its integer.
-    pub(super) fn enum_values(&self) -> Vec<(String, i64)> {
+    /// Every enumeration value of the project: its type's name, its name and its integer.
+    pub(super) fn enum_values(&self) -> Vec<(String, String, i64)> {
         let mut out = Vec::new();
         for t in self.types.values() {
             if let Base::Enum(v) = &t.base {
-                out.extend(v.iter().cloned());
+                out.extend(v.iter().map(|(n, i)| (t.name.clone(), n.clone(), *i)));
             }
         }
         out

@@ -163,9 +163,7 @@ fn lower(
         what: format!("IL syntax error ({})", e.message),
     })?;
     let mut tr = Tr {
-        scope: Scope {
-            names: scope.names.clone(),
-        },
+        scope: scope.clone(),
         temps: Vec::new(),
         out: Vec::new(),
         cr: Cr::None("no instruction before it sets it"),

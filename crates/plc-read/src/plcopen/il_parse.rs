@@ -115,7 +115,7 @@ pub(super) fn parse(text: &str) -> Result<Vec<Item>, LexError> {
 
 fn tok_text<'a>(t: &Tok<'a>) -> &'a str {
     match t {
-        Tok::Ident(s) | Tok::Literal(s) | Tok::Direct(s) | Tok::Sym(s) => s,
+        Tok::Ident(s) | Tok::Literal(s) | Tok::Direct(s) | Tok::Sym(s) | Tok::Pragma(s) => s,
     }
 }
 

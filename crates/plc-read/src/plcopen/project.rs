@@ -102,6 +102,21 @@ pub(super) fn program(
         .map(|v| v.name.as_str().to_ascii_lowercase())
         .collect();
     let base = base_ctx(&read);
+    // The project's function block types' pins, for ST calls and field accesses.
+    let pins = |v: &[Var]| -> Vec<(String, String)> {
+        v.iter()
+            .map(|v| (v.name.as_str().to_owned(), v.ty.as_str().to_owned()))
+            .collect()
+    };
+    let user_fbs: Vec<st_scope::FbPins> = read
+        .iter()
+        .filter(|r| r.2 == "functionBlock")
+        .map(|(_, n, _, i)| st_scope::FbPins {
+            name: n.clone(),
+            inputs: pins(&i.inputs),
+            outputs: pins(&i.outputs),
+        })
+        .collect();
     let mut bodies = Vec::new();
     for (pou, pname, kind, iface) in &read {
         add_data_note(tc6, *pou, notes);
@@ -111,7 +126,7 @@ pub(super) fn program(
             bodies.push(None);
             continue;
         }
-        let mut scope = scope(iface, &global_types, &known);
+        let mut scope = scope(iface, &global_types, &known, &user_fbs);
         scope.inputs.extend(
             input_globals
                 .iter()
@@ -413,8 +428,16 @@ fn function_note(pou: Node, pname: &str) -> Note {
 
 /// The names an ST body of a POU with interface `iface` sees: its own variables and the globals
 /// it declares external (`globals`: the name and type of every global of the project).
-fn scope(iface: &Interface, globals: &[(&str, &str)], known: &Known) -> st_scope::Scope {
+fn scope(
+    iface: &Interface,
+    globals: &[(&str, &str)],
+    known: &Known,
+    fbs: &[st_scope::FbPins],
+) -> st_scope::Scope {
     let mut s = st_scope::Scope::default();
+    for f in fbs {
+        s.fbs.insert(f.name.to_ascii_lowercase(), f.clone());
+    }
     for v in iface
         .inputs
         .iter()
@@ -432,8 +455,8 @@ fn scope(iface: &Interface, globals: &[(&str, &str)], known: &Known) -> st_scope
             s.declare(n, t);
         }
     }
-    for (v, _) in known.data_types.enum_values() {
-        s.constant(&v);
+    for (t, v, i) in known.data_types.enum_values() {
+        s.constant(&t, &v, i);
     }
     s
 }

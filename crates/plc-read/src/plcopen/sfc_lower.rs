@@ -176,9 +176,7 @@ pub(super) fn lower(
         return Err(r.clone());
     }
     // The names the conditions and actions see: the POU's, and each step's X and T.
-    let mut sc = Scope {
-        names: scope.names.clone(),
-    };
+    let mut sc = scope.clone();
     let mut vars = Vec::new();
     for s in &c.steps {
         for (f, ty) in [("X", "BOOL"), ("T", "TIME")] {

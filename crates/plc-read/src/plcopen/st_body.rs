@@ -89,6 +89,7 @@ pub(super) fn rungs(
             ));
         }
         lower.text(map.clone(), origin(t));
+        lower.prepare(&statements);
         for s in &statements {
             k += 1;
             if refused.is_none() {
@@ -100,10 +101,10 @@ pub(super) fn rungs(
                 continue;
             }
             let here = at(s.at);
-            let acc = st::accesses(s);
+            let a = st::accesses(s);
             let (mut reads, mut writes) =
-                resolve(&acc, scope, &mut unseen, pou).map_err(|m| error(here, &place, m))?;
-            if acc.pragma {
+                resolve(&a, scope, &mut unseen, pou).map_err(|m| error(here, &place, m))?;
+            if a.pragma {
                 everything(scope, &mut reads, &mut writes);
                 let (l, c) = here.line_column(source).unwrap_or((0, 0));
                 notes.push(Note {
@@ -111,7 +112,23 @@ pub(super) fn rungs(
                     message: format!("{place}: statement {k} (at {l}:{c}) holds a pragma `{{…}}`, C code that matiec copies into what it generates and plc-deps cannot see into: the analysis takes it as reading and writing every variable of `{pou}`, and `run` and `c` refuse `{pou}`"),
                 });
             }
-            out.extend(stand_in(format!("{pou}.st{k}"), here, &reads, &writes));
+            let id = format!("{pou}.st{k}");
+            let mut rung = stand_in(id.clone(), here, &reads, &writes);
+            // The analysis sees a call of a user instance as the call of its POU (what its
+            // body reads and writes); a run never executes it from a stand-in.
+            if !notes.exec {
+                for inst in user_calls(&a, scope) {
+                    let r = rung.get_or_insert_with(|| empty_rung(id.clone(), here));
+                    r.ld.push(plc_syntax::Element {
+                        origin: here,
+                        kind: plc_syntax::ElementKind::Call(plc_syntax::Located {
+                            value: inst.into(),
+                            origin: here,
+                        }),
+                    });
+                }
+            }
+            out.extend(rung);
         }
     }
     lower.finish();
@@ -171,6 +188,36 @@ fn everything(scope: &Scope, reads: &mut Vec<Read>, writes: &mut Vec<String>) {
         if !writes.contains(name) && !scope.inputs.contains(&name.to_ascii_lowercase()) {
             writes.push(name.clone());
         }
+    }
+}
+
+/// The user function block instances statement accesses `a` calls, by their declared names.
+fn user_calls(a: &st::Accesses, scope: &Scope) -> Vec<String> {
+    let mut v = Vec::new();
+    for c in &a.calls {
+        if let Some(Decl::Instance { name, ty, .. }) = scope.get(c) {
+            if scope.fb(ty).is_some() {
+                push_once(&mut v, name);
+            }
+        }
+    }
+    v
+}
+
+fn empty_rung(id: String, at: Origin) -> Rung<'static> {
+    let name = |s: String| plc_syntax::Located {
+        value: s.into(),
+        origin: at,
+    };
+    Rung {
+        origin: at,
+        id: name(id),
+        label: None,
+        comment: None,
+        ld: Vec::new(),
+        ld_origin: at,
+        problem: None,
+        problem_in_rung: false,
     }
 }
 
@@ -240,19 +287,35 @@ fn resolve(
                 name: r.name.clone(),
                 bool: r.bool,
             }),
+            Some((Decl::Instance { name, ty, .. }, false))
+                if member(scope, name, ty, n).is_some() =>
+            {
+                if let Some((field, bool)) = member(scope, name, ty, n) {
+                    reads.push(Read { name: field, bool });
+                }
+            }
             Some((
                 Decl::Instance {
-                    name, read: None, ..
+                    name,
+                    ty,
+                    read: None,
                 },
                 _,
-            )) => push_once(&mut unseen.instances_read, name),
+            )) => {
+                // A call of a user instance is seen as its POU's call (the stand-in's `call`).
+                let called_user =
+                    scope.fb(ty).is_some() && a.calls.iter().any(|c| c.eq_ignore_ascii_case(name));
+                if !called_user {
+                    push_once(&mut unseen.instances_read, name)
+                }
+            }
             Some((Decl::Structure { leaves }, _)) => {
                 reads.extend(leaves.iter().map(|(name, ty)| Read {
                     name: name.clone(),
                     bool: ty == "BOOL",
                 }))
             }
-            Some((Decl::Constant, _)) => {}
+            Some((Decl::Constant(_), _)) => {}
             None if n.starts_with('%') => push_once(&mut unseen.addresses, n),
             None if called(n) => {}
             None => return Err(undeclared(n)),
@@ -262,13 +325,23 @@ fn resolve(
     for n in &a.writes {
         match scope.find(n)? {
             Some((Decl::Elementary { name, .. }, _)) => writes.push(name.clone()),
+            Some((Decl::Instance { name, ty, .. }, false))
+                if input(scope, name, ty, n).is_some() =>
+            {
+                if let Some(field) = input(scope, name, ty, n) {
+                    writes.push(field);
+                }
+            }
+            Some((Decl::Instance { ty, .. }, _)) if scope.fb(ty).is_some() => {
+                // Called: the stand-in's `call` writes what the instance writes.
+            }
             Some((Decl::Instance { name, .. }, _)) => {
                 push_once(&mut unseen.instances_written, name)
             }
             Some((Decl::Structure { leaves }, _)) => {
                 writes.extend(leaves.iter().map(|(name, _)| name.clone()))
             }
-            Some((Decl::Constant, _)) => return Err(undeclared(n)),
+            Some((Decl::Constant(_), _)) => return Err(undeclared(n)),
             None if n.starts_with('%') => push_once(&mut unseen.addresses, n),
             None if called(n) => {}
             None => return Err(undeclared(n)),
@@ -280,6 +353,30 @@ fn resolve(
     seen.clear();
     writes.retain(|w| seen.insert(w.clone()));
     Ok((reads, writes))
+}
+
+/// Input or output `path` (`Inst.X`) of instance `name` of the project's function block type
+/// `ty`: the variable (`Inst.X` as declared) and whether it is BOOL.
+fn member(scope: &Scope, name: &str, ty: &str, path: &str) -> Option<(String, bool)> {
+    let fb = scope.fb(ty)?;
+    let field = path.get(name.len() + 1..)?;
+    fb.inputs
+        .iter()
+        .chain(&fb.outputs)
+        .find(|(n, _)| n.eq_ignore_ascii_case(field))
+        .map(|(n, t)| (format!("{name}.{n}"), t == "BOOL"))
+}
+
+/// Input `path` (`Inst.X`) of instance `name` of the project's function block type `ty`
+/// (an output is written only by the instance).
+fn input(scope: &Scope, name: &str, ty: &str, path: &str) -> Option<String> {
+    let field = path.get(name.len() + 1..)?;
+    scope
+        .fb(ty)?
+        .inputs
+        .iter()
+        .find(|(n, _)| n.eq_ignore_ascii_case(field))
+        .map(|(n, _)| format!("{name}.{n}"))
 }
 
 /// For each byte offset of `text` (and its end), the offset in `source` it was read from, when

@@ -32,17 +32,26 @@
 //! - calls of standard function block instances (TON TOF TP, CTU CTD CTUD, R_TRIG F_TRIG,
 //!   SR RS) with formal arguments: the instance's box, its first BOOL input as the power, its
 //!   other inputs as operands, its outputs `Q => y` moved or coiled after it; `T1.Q`, `T1.ET`,
-//!   `C1.CV` … read the instance's fields.
+//!   `C1.CV` … read the instance's fields. Inputs left out keep their last values ([`calls`]:
+//!   the inputs the body leaves out or names get a POU variable `st__T1__IN` holding them).
+//! - calls of instances of the project's function blocks (`Inst(X := e, Q => y)`): the inputs
+//!   moved into the instance's variables, a `call` of its POU, the outputs moved out; its
+//!   inputs and outputs as variables (`Inst.X := e`, `y := Inst.Q`) ([`calls`]).
+//! - enumeration values (`RED`, `COLOR#RED`, CASE labels) as their integers (the enumeration
+//!   is INT, numbered as matiec numbers it: [`super::data_types`]).
+//! - `a := b` of two structures: a move per field ([`calls`]).
 //!
 //! Invariants: a body is lowered whole or not at all; what the lowering does not handle is a
 //! [`Refusal`] naming the construct and where it is, and then the body keeps its stand-in
 //! rungs and `run`/`c` refuse it with that reason (never a silently skipped statement).
 //!
 //! Deliberately not here (refused): pragmas `{…}` (matiec pastes their text, often C, into its
-//! output), calls of user function blocks and user functions, a standard function block call
-//! that leaves one of its inputs out (the model keeps no input values between calls), reads
-//! or writes of an instance's inputs, arrays, dereferences, direct addresses, strings, values
-//! of enumerations, whole structures.
+//! output), calls of user functions, informal arguments of function block calls, an instance
+//! as a value, writes of an instance's outputs, arrays, dereferences, direct addresses,
+//! strings.
+
+#[path = "st_calls.rs"]
+mod calls;
 
 use super::interface::literal;
 use super::st_scope::{Decl, Scope};
@@ -116,6 +125,8 @@ pub(super) struct Lower<'s> {
     /// The innermost loops: (label CONTINUE jumps to, label EXIT jumps to).
     loops: Vec<(String, String)>,
     false_var: bool,
+    /// The variables holding inputs of standard instances ([`calls`]).
+    held: Vec<String>,
 }
 
 type Series = Vec<ElementKind<'static>>;
@@ -138,6 +149,7 @@ impl<'s> Lower<'s> {
             pending: None,
             loops: Vec::new(),
             false_var: false,
+            held: Vec::new(),
         }
     }
 
@@ -435,7 +447,16 @@ impl<'s> Lower<'s> {
     }
 
     fn assign(&mut self, target: &Place, value: &Expr) -> L<()> {
+        if self.structure_assign(target.base_at, target, value)? {
+            return Ok(());
+        }
         let (name, ty) = self.written(target)?;
+        self.assign_to(&name, ty, value)
+    }
+
+    /// `name := value` of a variable `name` of type `ty`.
+    fn assign_to(&mut self, name: &str, ty: Type, value: &Expr) -> L<()> {
+        let name = name.to_owned();
         if ty == Type::Bool {
             match bool_literal(value) {
                 Some(true) => self.emit(vec![ElementKind::Set(self.name(&name))]),
@@ -636,6 +657,9 @@ impl<'s> Lower<'s> {
                 )
             }
         };
+        if let Some(fb) = self.scope.fb(&ty).cloned() {
+            return self.user_fb_call(at, &inst, &fb, args);
+        }
         let mut inputs: Vec<(String, &Expr)> = Vec::new();
         let mut outputs: Vec<(String, &Place)> = Vec::new();
         for a in args {
@@ -650,21 +674,13 @@ impl<'s> Lower<'s> {
                 Arg::Output { name, target } => outputs.push((name.to_ascii_uppercase(), target)),
             }
         }
-        let pins: &[&str] = match ty.as_str() {
-            "TON" | "TOF" | "TP" => &["IN", "PT"],
-            "CTU" => &["CU", "R", "PV"],
-            "CTD" => &["CD", "LD", "PV"],
-            "CTUD" => &["CU", "CD", "R", "LD", "PV"],
-            "R_TRIG" | "F_TRIG" => &["CLK"],
-            "SR" => &["S1", "R"],
-            "RS" => &["S", "R1"],
-            _ => {
-                return refuse(
-                    at,
-                    format!("the call of `{inst}`, an instance of the user function block {ty}"),
-                )
-            }
+        let Some(typed) = calls::std_pins(&ty) else {
+            return refuse(
+                at,
+                format!("the call of `{inst}`, an instance of {ty} (only the standard function blocks and the project's are executed)"),
+            );
         };
+        let pins: Vec<&str> = typed.iter().map(|(p, _)| *p).collect();
         for (n, _) in &inputs {
             if !pins.contains(&n.as_str()) {
                 return refuse(
@@ -676,19 +692,45 @@ impl<'s> Lower<'s> {
                 );
             }
         }
-        let get = |pin: &str| -> L<&Expr> {
-            match inputs.iter().find(|(n, _)| n == pin) {
-                Some((_, e)) => Ok(*e),
-                None => refuse(at, format!("the call of `{inst}` without its input {pin} (plc-deps keeps no input values of a standard function block between calls)")),
-            }
+        // Each input: the expression given, stored into its holding variable when it has one
+        // (then the variable is the operand); left out, the holding variable or, for PT and
+        // PV, the instance's own field.
+        let mut vals: Vec<Val> = Vec::new();
+        let mut first: Option<Series> = None;
+        for (k, &(pin, pty)) in typed.iter().enumerate() {
+            let given = inputs.iter().find(|(n, _)| n == pin).map(|(_, e)| *e);
+            let held = self.held_var(&inst, pin);
+            let v = match (given, held) {
+                (Some(e), None) if k == 0 => {
+                    // The power flow of the box, as the condition itself.
+                    first = Some(self.cond(e)?);
+                    Val::Lit(Scalar::Bool(true))
+                }
+                (Some(e), Some(h)) => {
+                    self.assign_to(&h, pty, e)?;
+                    Val::Var(h, pty)
+                }
+                (Some(e), None) if pty == Type::Bool => self.bool_operand(e)?,
+                (Some(e), None) => self.value(e, Some(pty))?,
+                (None, Some(h)) => Val::Var(h, pty),
+                (None, None) if pty != Type::Bool => Val::Var(format!("{inst}.{pin}"), pty),
+                (None, None) => {
+                    return refuse(at, format!("the call of `{inst}` without its input {pin}"))
+                }
+            };
+            vals.push(v);
+        }
+        let mut ld = match &vals[0] {
+            _ if first.is_some() => first.unwrap_or_default(),
+            Val::Lit(Scalar::Bool(b)) => vec![self.constant(*b)],
+            Val::Var(n, _) => vec![self.contact(n, false)],
+            Val::Lit(_) => return refuse(at, format!("a non-BOOL literal as {}", pins[0])),
         };
-        let first = get(pins[0])?;
-        let rest: Vec<&Expr> = pins[1..].iter().map(|p| get(p)).collect::<L<_>>()?;
-        let mut ld = self.cond(first)?;
+        let rest = &vals[1..];
         let inst_name = self.name(&inst);
         let el = match ty.as_str() {
             "TON" | "TOF" | "TP" => {
-                let pt = self.value(rest[0], Some(Type::Time))?;
+                let pt = rest[0].clone();
                 let kind = match ty.as_str() {
                     "TON" => TimerKind::Ton,
                     "TOF" => TimerKind::Tof,
@@ -701,8 +743,7 @@ impl<'s> Lower<'s> {
                 }))
             }
             "CTU" | "CTD" => {
-                let aux = self.bool_operand(rest[0])?;
-                let pv = self.value(rest[1], Some(Type::Int))?;
+                let (aux, pv) = (rest[0].clone(), rest[1].clone());
                 ElementKind::Counter(Box::new(Counter {
                     down: ty == "CTD",
                     instance: inst_name,
@@ -711,10 +752,12 @@ impl<'s> Lower<'s> {
                 }))
             }
             "CTUD" => {
-                let cd = self.bool_operand(rest[0])?;
-                let reset = self.bool_operand(rest[1])?;
-                let load = self.bool_operand(rest[2])?;
-                let pv = self.value(rest[3], Some(Type::Int))?;
+                let (cd, reset, load, pv) = (
+                    rest[0].clone(),
+                    rest[1].clone(),
+                    rest[2].clone(),
+                    rest[3].clone(),
+                );
                 ElementKind::Ctud(Box::new(Ctud {
                     instance: inst_name,
                     cd: self.operand(&cd),
@@ -732,7 +775,7 @@ impl<'s> Lower<'s> {
                 instance: inst_name,
             },
             _ => {
-                let reset = self.bool_operand(rest[0])?;
+                let reset = rest[0].clone();
                 ElementKind::Bistable(Box::new(Bistable {
                     kind: if ty == "SR" {
                         BistableKind::SetDominant
@@ -844,22 +887,44 @@ impl<'s> Lower<'s> {
                     format!("`{path}` of type {ty}, which the model does not execute"),
                 ),
             },
-            Ok(Some((Decl::Instance { name, ty, .. }, false))) if !write => {
+            Ok(Some((Decl::Instance { name, ty, .. }, false))) => {
                 let field = path[name.len() + 1..].to_ascii_uppercase();
-                match field_type(ty, &field) {
-                    Some(t) if !field.contains('.') => Ok((format!("{name}.{field}"), t)),
-                    _ => refuse(at, format!("`{path}`: only the outputs of a standard function block instance are read")),
+                if field.contains('.') {
+                    return refuse(at, format!("`{path}`: a field of a field of an instance"));
                 }
+                self.instance_field(at, name, ty, &field, write)
             }
             Ok(Some((Decl::Instance { .. }, _))) => refuse(
                 at,
                 format!("`{path}`: an instance (or its input) as a value"),
             ),
-            Ok(Some((Decl::Constant, _))) => refuse(at, format!("the enumeration value `{path}`")),
+            Ok(Some((Decl::Constant(_), _))) => refuse(
+                at,
+                format!("the enumeration value `{path}` where a variable is needed"),
+            ),
             Ok(Some((Decl::Structure { .. }, _))) => {
                 refuse(at, format!("the structure `{path}` as a whole"))
             }
             _ => refuse(at, format!("`{path}`, which is not a variable of the POU")),
+        }
+    }
+
+    /// The integer of enumeration value `p` (IEC 61131-3 6.4.4.2; numbered as matiec and
+    /// [`super::data_types`] do), `None` when `p` is not one.
+    fn enum_value(&self, p: &Place) -> L<Option<i64>> {
+        if !p.selectors.is_empty() {
+            return Ok(None);
+        }
+        match self.scope.get(&p.base) {
+            Some(Decl::Constant(Some(i))) => Ok(Some(*i)),
+            Some(Decl::Constant(None)) => refuse(
+                p.base_at,
+                format!(
+                    "the enumeration value `{}`, which several enumerations have with different values (write TYPE#{})",
+                    p.base, p.base
+                ),
+            ),
+            _ => Ok(None),
         }
     }
 
@@ -1053,11 +1118,15 @@ impl<'s> Lower<'s> {
             return Ok(Some(self.bool_temp(e)?));
         }
         match e {
-            Expr::Literal(s) => match literal(s) {
-                Some(v) => Ok(Some(Val::Lit(v))),
-                None => refuse(self.at, format!("the literal `{s}`")),
+            Expr::Literal(s) => match (literal(s), self.scope.enum_literal(s)) {
+                (_, Some(i)) => Ok(Some(Val::Lit(Scalar::Number(i.into())))),
+                (Some(v), _) => Ok(Some(Val::Lit(v))),
+                (None, None) => refuse(self.at, format!("the literal `{s}`")),
             },
             Expr::Var(p) => {
+                if let Some(i) = self.enum_value(p)? {
+                    return Ok(Some(Val::Lit(Scalar::Number(i.into()))));
+                }
                 let (n, t) = self.read(p)?;
                 Ok(Some(Val::Var(n, t)))
             }

@@ -22,8 +22,10 @@ pub(super) enum Decl {
         ty: String,
         read: Option<Read>,
     },
-    /// A value of an enumeration data type (a constant: reading it reads no variable).
-    Constant,
+    /// A value of an enumeration data type (a constant: reading it reads no variable), with
+    /// its integer (`None` when values of two enumerations have its name and different
+    /// integers: then only `TYPE#VALUE` says which).
+    Constant(Option<i64>),
     /// A structure (or a structure inside one) flattened into its fields: its leaf fields'
     /// names and types. Reading or writing it whole reads or writes every one.
     Structure {
@@ -32,12 +34,25 @@ pub(super) enum Decl {
 }
 
 /// The declarations an ST body sees, by lower-case name.
-#[derive(Default)]
+#[derive(Clone, Default)]
 pub(super) struct Scope {
     pub names: HashMap<String, Decl>,
     /// The lower-case names of the variables of class input (declared inputs, `%I` locations):
     /// the scan writes them, the program only reads them.
     pub inputs: std::collections::HashSet<String>,
+    /// The enumeration values as `type#value` (lower case), with their integers.
+    pub typed: HashMap<String, i64>,
+    /// The project's function block types by lower-case name.
+    pub fbs: HashMap<String, FbPins>,
+}
+
+/// A function block type of the project: its inputs and outputs (name as declared, model
+/// type as the reader maps it; a structure's fields flattened, `st.On`).
+#[derive(Clone, Debug)]
+pub(super) struct FbPins {
+    pub name: String,
+    pub inputs: Vec<(String, String)>,
+    pub outputs: Vec<(String, String)>,
 }
 
 impl Scope {
@@ -74,11 +89,25 @@ impl Scope {
         }
     }
 
-    /// Declares an enumeration value (a constant), unless a variable has its name.
-    pub(super) fn constant(&mut self, name: &str) {
-        self.names
+    /// Declares value `name` (integer `value`) of enumeration `ty` (a constant), unless a
+    /// variable has its name.
+    pub(super) fn constant(&mut self, ty: &str, name: &str, value: i64) {
+        self.typed
+            .insert(format!("{ty}#{name}").to_ascii_lowercase(), value);
+        let e = self
+            .names
             .entry(name.to_ascii_lowercase())
-            .or_insert(Decl::Constant);
+            .or_insert(Decl::Constant(Some(value)));
+        if let Decl::Constant(Some(v)) = e {
+            if *v != value {
+                *e = Decl::Constant(None);
+            }
+        }
+    }
+
+    /// The integer of enumeration literal `text` (`COLOR#RED`), if it is one.
+    pub(super) fn enum_literal(&self, text: &str) -> Option<i64> {
+        self.typed.get(&text.to_ascii_lowercase()).copied()
     }
 
     /// `name` as it is, or, when it is a structure, the names of its fields.
@@ -87,6 +116,11 @@ impl Scope {
             Some(Decl::Structure { leaves }) => leaves.iter().map(|(n, _)| n.clone()).collect(),
             _ => vec![name.to_owned()],
         }
+    }
+
+    /// The pins of the project's function block type `ty`, if it is one.
+    pub(super) fn fb(&self, ty: &str) -> Option<&FbPins> {
+        self.fbs.get(&ty.to_ascii_lowercase())
     }
 
     pub(super) fn get(&self, name: &str) -> Option<&Decl> {
