@@ -260,6 +260,10 @@ struct CArgs {
     /// docs/c.md), the interpreter's parallel plan written as C on N pthreads.
     #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u16).range(1..))]
     threads: u16,
+    /// With --threads: every level of the schedule a parallel phase, whatever the cost model
+    /// says (for tests and measurements).
+    #[arg(long, hide = true)]
+    parallel_all: bool,
     /// Go on when a POU's body is not executed (a PLCopen ST, IL or SFC body, read only as
     /// stand-in rungs that keep every value): the output lists those POUs. Without it, such
     /// a POU is an error.
@@ -377,6 +381,7 @@ impl CArgs {
                 scan_budget: self.scan_budget,
                 rows: !self.statements,
                 threads: usize::from(self.threads),
+                parallel_all: self.parallel_all,
                 ..Default::default()
             },
         })

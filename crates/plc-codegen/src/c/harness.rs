@@ -262,8 +262,11 @@ int main(int argc, char **argv) {
 pub(crate) fn par_makefile(seq: &str) -> String {
     let old = "CSTD = -std=c11\n";
     assert!(seq.contains(old), "the Makefile sets CSTD");
-    seq.replacen(old, "CSTD = -std=c11 -pthread\n", 1)
-        .replacen("plc_main.h\n", "plc_main.h plc_api.h plc_parallel.h\n", 1)
+    seq.replacen(old, "CSTD = -std=c11 -pthread\n", 1).replacen(
+        "plc_main.h\n",
+        "plc_main.h plc_api.h plc_parallel.h\n",
+        1,
+    )
 }
 
 /// The scan loop of the driver, which a `--threads` build replaces (`par_main_h`).

@@ -72,6 +72,9 @@ pub struct CConfig {
     /// sequential program only; N ≥ 2 adds `plc_scan_parallel` and the runtime API
     /// (`parallel`, docs/c.md).
     pub threads: usize,
+    /// With `threads` ≥ 2: every level of the schedule a parallel phase (the planner's
+    /// `Strategy::AllParallel`), whatever the cost model says; for tests and measurements.
+    pub parallel_all: bool,
 }
 
 impl Default for CConfig {
@@ -83,6 +86,7 @@ impl Default for CConfig {
             chunk_rungs: 64,
             rows: true,
             threads: 1,
+            parallel_all: false,
         }
     }
 }
@@ -220,9 +224,8 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
             });
         }
     }
-    let par_files = (cfg.threads >= 2).then(|| {
-        parallel::files(&sh, ladder[0], cfg, &mut data, &mut objects, &mut parts)
-    });
+    let par_files = (cfg.threads >= 2)
+        .then(|| parallel::files(&sh, ladder[0], cfg, &mut data, &mut objects, &mut parts));
     data.files.extend(kernels.sources());
     for (stem, text) in data.files.into_iter().chain(type_files) {
         files.push(CFile {

@@ -39,7 +39,7 @@ use super::parts::DataFiles;
 use super::table::Tables;
 use super::text::push;
 use super::{CConfig, CFile};
-use plc_exec::parallel::{plan, PlanConfig, ScanPlan, ScanPlanKind};
+use plc_exec::parallel::{plan, PlanConfig, ScanPlan, ScanPlanKind, Strategy};
 use plc_model::{walk_elements, Element, PouId, Program, RungId, VarClass};
 
 /// The plan as the C writes it: per phase, its barrier and each worker's tasks in order.
@@ -72,11 +72,13 @@ pub(crate) fn files(
     let p = sh.p;
     let threads = cfg.threads.max(2);
     let split = if main_is_ladder {
-        split(sh, threads)
+        split(sh, threads, cfg.parallel_all)
     } else {
-        Err("the main program is written in FBD: its C is one function of fragment trees, \
+        Err(
+            "the main program is written in FBD: its C is one function of fragment trees, \
              not of tasks"
-            .to_string())
+                .to_string(),
+        )
     };
     let mut out = Vec::new();
     let mut chunk_decls = String::new();
@@ -110,7 +112,14 @@ pub(crate) fn files(
     });
     out.push(CFile {
         name: "plc_parallel.c".into(),
-        text: parallel_source(sh, split.as_ref().ok(), &header, &worker_code, &task_table, threads),
+        text: parallel_source(
+            sh,
+            split.as_ref().ok(),
+            &header,
+            &worker_code,
+            &task_table,
+            threads,
+        ),
     });
     objects.push("plc_parallel".into());
     out.push(CFile {
@@ -126,10 +135,14 @@ pub(crate) fn files(
 
 /// The plan for `threads` workers, mapped to tasks and checked; the reason it runs sequentially
 /// otherwise.
-fn split(sh: &Shared, threads: usize) -> Result<Split, String> {
+fn split(sh: &Shared, threads: usize, all: bool) -> Result<Split, String> {
     let p = sh.p;
     let a = plc_analysis::analyse(p);
-    let sp = plan(p, &a, &PlanConfig::new(threads)).map_err(|e| e.to_string())?;
+    let mut config = PlanConfig::new(threads);
+    if all {
+        config.strategy = Strategy::AllParallel;
+    }
+    let sp = plan(p, &a, &config).map_err(|e| e.to_string())?;
     match &sp.kind {
         ScanPlanKind::Sequential(why) => return Err(format!("the planner: {why}")),
         ScanPlanKind::DependenceDriven => {
@@ -149,10 +162,12 @@ fn split(sh: &Shared, threads: usize) -> Result<Split, String> {
                     || it.decision.is_some()
                     || !it.waits.is_empty()
                 {
-                    return Err("the plan has control decisions of the main program (a jump, \
+                    return Err(
+                        "the plan has control decisions of the main program (a jump, \
                                 RET or END that leaves a task), which this generator does not \
                                 write"
-                        .into());
+                            .into(),
+                    );
                 }
                 tasks.extend(it.first.0..=it.last.0);
             }
@@ -308,7 +323,9 @@ fn counter_callees(p: &Program, sh: &Shared) -> Vec<Vec<PouId>> {
 /// Whether rung `r` calls a POU (its faults may name rungs outside the main program).
 fn calls(p: &Program, r: RungId) -> bool {
     let mut any = false;
-    walk_elements(&p.rung(r).series, &mut |e| any |= matches!(e, Element::Call { .. }));
+    walk_elements(&p.rung(r).series, &mut |e| {
+        any |= matches!(e, Element::Call { .. })
+    });
     any
 }
 
@@ -472,7 +489,8 @@ fn describe(p: &Program, sh: &Shared, s: &Split) -> String {
             .max()
             .unwrap_or(0)
     });
-    let barriers = s.phases.iter().filter(|ph| ph.barrier).count() + usize::from(s.plan.end_barrier);
+    let barriers =
+        s.phases.iter().filter(|ph| ph.barrier).count() + usize::from(s.plan.end_barrier);
     push(
         &mut h,
         format_args!(
@@ -486,7 +504,10 @@ fn describe(p: &Program, sh: &Shared, s: &Split) -> String {
             .workers
             .iter()
             .map(|ts| {
-                let n: usize = ts.iter().map(|&t| s.plan.task_rungs[t as usize].len()).sum();
+                let n: usize = ts
+                    .iter()
+                    .map(|&t| s.plan.task_rungs[t as usize].len())
+                    .sum();
                 format!("{} tasks/{n} rungs", ts.len())
             })
             .collect();
@@ -496,7 +517,11 @@ fn describe(p: &Program, sh: &Shared, s: &Split) -> String {
                 " *   phase {k} (levels {}..{}, {}): {}\n",
                 lv.start,
                 lv.end,
-                if ph.parallel { "parallel" } else { "worker 0 alone" },
+                if ph.parallel {
+                    "parallel"
+                } else {
+                    "worker 0 alone"
+                },
                 if ph.parallel {
                     rungs.join(", ")
                 } else {
@@ -505,7 +530,10 @@ fn describe(p: &Program, sh: &Shared, s: &Split) -> String {
             ),
         );
         if h.len() > 4000 && k + 1 < s.phases.len() {
-            push(&mut h, format_args!(" *   … {} more phases\n", s.phases.len() - k - 1));
+            push(
+                &mut h,
+                format_args!(" *   … {} more phases\n", s.phases.len() - k - 1),
+            );
             break;
         }
     }
@@ -591,7 +619,8 @@ fn crossing_lines(p: &Program, sh: &Shared, s: &Split) -> (usize, usize) {
 }
 
 /// Declarations of `plc_parallel.h` before the chunk functions'.
-const WORKER_DECLS: &str = "/* A fault a worker raised, with the task it ran (faults are replayed in task order). */
+const WORKER_DECLS: &str =
+    "/* A fault a worker raised, with the task it ran (faults are replayed in task order). */
 typedef struct { uint32_t rung; int kind; uint32_t task; } _plc_par_fault;
 /* A worker's context (its first member: the fault hook finds the rest from it), on lines of
    its own. */
