@@ -188,9 +188,10 @@ fn examples_run_the_same_on_every_thread_count() {
             check(&text, &csv, scans, cfg, &format!("par-{name}")).0
         },
     );
-    // Most examples jump (conditional JMPs, RET) in the main program: their plans have control
-    // decisions, which the C runs sequentially (docs/c.md); example-a/b/c and mixing-station
-    // (four, measured on 7 December 2026) get a parallel plan.
+    // Seven examples have an FBD main program (example-c, example-d, kaskad-1…5) and three
+    // jump in theirs (conveyor, example-b, mixing-station): their C runs sequentially
+    // (docs/c.md); analog-scaling, encoder-interrupt, example-a and packaging-line get a
+    // parallel plan (7 December 2026).
     let parallel = results.iter().filter(|&&p| p).count();
     assert!(
         parallel >= 4,
