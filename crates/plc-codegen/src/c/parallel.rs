@@ -727,13 +727,16 @@ fn parallel_source(
 }
 
 /// The barrier and its wait (spin, then yield, then sleep on a condition variable).
-const RUNTIME_C: &str = "/* Waiting: spin with a pause up to _PLC_SPINS times, yield up to _PLC_YIELDS times, then sleep
-   on a condition variable until woken: never an unbounded busy wait. */
+const RUNTIME_C: &str =
+    "/* Waiting: spin with a pause up to _PLC_SPINS times (about 1-4 ms: a level's work is
+   microseconds, and with 2,000 spins the sleep below was reached often enough to halve the
+   speed of gen 20k), yield up to _PLC_YIELDS times, then sleep on a condition variable until
+   woken: never an unbounded busy wait. */
 #ifndef _PLC_SPINS
-#define _PLC_SPINS 2000
+#define _PLC_SPINS 100000
 #endif
 #ifndef _PLC_YIELDS
-#define _PLC_YIELDS 50
+#define _PLC_YIELDS 100
 #endif
 static inline void _plc_pause(void) {
 #if defined(__x86_64__) || defined(__i386__)
