@@ -260,6 +260,15 @@ struct CArgs {
     /// 1 ms of CPU per rung written as statements, minutes at 100,000 rungs.
     #[arg(long)]
     statements: bool,
+    /// Worker threads of the parallel scan (N ≥ 1): 1 writes the sequential program only;
+    /// N ≥ 2 adds `plc_scan_parallel`, the adaptive scan and the runtime API (plc_api.h;
+    /// docs/c.md), the interpreter's parallel plan written as C on N pthreads.
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u16).range(1..))]
+    threads: u16,
+    /// With --threads: every level of the schedule a parallel phase, whatever the cost model
+    /// says (for tests and measurements).
+    #[arg(long, hide = true)]
+    parallel_all: bool,
     /// Go on when a POU's body is not executed (a PLCopen ST, IL or SFC body, read only as
     /// stand-in rungs that keep every value): the output lists those POUs. Without it, such
     /// a POU is an error.
@@ -391,6 +400,8 @@ impl CArgs {
                 loop_cap: self.loop_cap,
                 scan_budget: self.scan_budget,
                 rows: !self.statements,
+                threads: usize::from(self.threads),
+                parallel_all: self.parallel_all,
                 ..Default::default()
             },
         })

@@ -72,6 +72,7 @@ fn random_programs(
             rows: seed % 2 == 1,
             // Budgets that the random loops and calls reach now and then (scan-budget faults).
             scan_budget: 10 + rng.below(300),
+            ..CConfig::default()
         };
         batch.add(text, csv, 40, cfg, format!("{tag}-{seed}"));
     }

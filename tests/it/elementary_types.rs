@@ -288,6 +288,7 @@ fn generated_c_prints_the_interpreters_state_after_every_scan() {
         chunk_rungs: 4,
         rows: false,
         scan_budget: plc_deps::exec::DEFAULT_SCAN_BUDGET,
+        ..CConfig::default()
     };
     common::c::check(PROGRAM, INPUTS, 3, &cfg, "elementary-types");
 }

@@ -10,6 +10,7 @@ mod architecture;
 mod c_build;
 mod c_codegen;
 mod c_codegen_cli;
+mod c_parallel;
 mod cli;
 mod convert;
 mod corpus;

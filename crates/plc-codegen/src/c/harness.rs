@@ -266,6 +266,104 @@ pub(crate) const MAIN_C: &str =
 int main(int argc, char **argv) { return _plc_main(&_plc_program_desc, argc, argv); }
 ";
 
+/// `main.c` of a `--threads` build: starts the workers, then the driver (`par_main_h`).
+pub(crate) const PAR_MAIN_C: &str =
+    "/* main.c: runs the generated program scan by scan on virtual time, on the parallel scan's
+   worker threads (docs/c.md). */
+#include \"plc_program.h\"
+#include \"plc_api.h\"
+#include \"plc_main.h\"
+
+int main(int argc, char **argv) {
+    _plc_par_start();
+    return _plc_main(&_plc_program_desc, argc, argv);
+}
+";
+
+/// The `Makefile` of a `--threads` build: `-pthread` with the C standard (kept when a user
+/// sets `CFLAGS`).
+pub(crate) fn par_makefile(seq: &str) -> String {
+    let old = "CSTD = -std=c11\n";
+    assert!(seq.contains(old), "the Makefile sets CSTD");
+    seq.replacen(old, "CSTD = -std=c11 -pthread\n", 1).replacen(
+        "plc_main.h\n",
+        "plc_main.h plc_api.h plc_parallel.h\n",
+        1,
+    )
+}
+
+/// The scan loop of the driver, which a `--threads` build replaces (`par_main_h`).
+const SCAN_LOOP: &str = r#"    double spent = 0;
+    _plc_ctx ctx = {0, 0, prog->loop_cap, on_fault, (void *)prog, 0, 0};
+    for (unsigned long long k = 0; k < scans; k++) {
+        if (k < nrows)
+            for (size_t v = rows[k].first; v < rows[k].first + rows[k].count; v++)
+                _plc_set_cell(prog, &f, state, value_input[v], &values[v], (size_t)k);
+        ctx.scan = k;
+        ctx.now = (int64_t)k * prog->cycle_ms;
+        double t0 = timing ? seconds() : 0;
+        prog->scan(state, &ctx);
+        if (timing) spent += seconds() - t0;
+        else prog->print(state, stdout);
+    }
+    if (timing) {
+        prog->print(state, stdout);
+        fprintf(stderr, "{\"ns_per_scan\": %.1f}\n", scans ? spent * 1e9 / (double)scans : 0.0);
+    }
+"#;
+
+/// The driver's scan loop in a `--threads` build: argv[2] `--sequential`, `--parallel` (the
+/// default) or `--adaptive` picks the scan; `--time` runs the three, each from the initial
+/// state, and reports them side by side with the adaptive scan's choice.
+const PAR_SCAN_LOOP: &str = r#"    /* --threads build: argv[2] --sequential, --parallel (the default) or --adaptive picks the
+       scan; --time runs the three from the initial state, one after another, and prints
+       {"ns_per_scan": adaptive, "sequential_ns_per_scan", "parallel_ns_per_scan",
+       "parallel_speedup": sequential / parallel, "threads", "adaptive_choice"} on stderr. */
+    void (*const scan_of[3])(void *, _plc_ctx *) = {prog->scan, _plc_scan_parallel_desc,
+                                                    _plc_scan_adaptive_desc};
+    int mode = argc > 2 && !strcmp(argv[2], "--sequential") ? 0
+               : argc > 2 && !strcmp(argv[2], "--adaptive") ? 2 : 1;
+    double spent_in[3] = {0, 0, 0};
+    for (int m = timing ? 0 : mode; m < (timing ? 3 : mode + 1); m++) {
+        double spent = 0;
+        memcpy(state, prog->initial, prog->size);
+        _plc_ctx ctx = {0, 0, prog->loop_cap, on_fault, (void *)prog, 0, 0};
+        for (unsigned long long k = 0; k < scans; k++) {
+            if (k < nrows)
+                for (size_t v = rows[k].first; v < rows[k].first + rows[k].count; v++)
+                    _plc_set_cell(prog, &f, state, value_input[v], &values[v], (size_t)k);
+            ctx.scan = k;
+            ctx.now = (int64_t)k * prog->cycle_ms;
+            double t0 = timing ? seconds() : 0;
+            scan_of[m](state, &ctx);
+            if (timing) spent += seconds() - t0;
+            else prog->print(state, stdout);
+        }
+        spent_in[m] = spent;
+    }
+    if (timing) {
+        prog->print(state, stdout);
+        double n = scans ? (double)scans : 1.0;
+        fprintf(stderr, "{\"ns_per_scan\": %.1f, \"sequential_ns_per_scan\": %.1f, "
+                "\"parallel_ns_per_scan\": %.1f, \"parallel_speedup\": %.3f, \"threads\": %d, "
+                "\"adaptive_choice\": \"%s\"}\n",
+                spent_in[2] * 1e9 / n, spent_in[0] * 1e9 / n, spent_in[1] * 1e9 / n,
+                spent_in[1] > 0 ? spent_in[0] / spent_in[1] : 0.0, PLC_THREADS,
+                _plc_adaptive_choice());
+    }
+"#;
+
+/// `plc_main.h` of a `--threads` build: the driver with [`PAR_SCAN_LOOP`].
+pub(crate) fn par_main_h() -> String {
+    assert!(PLC_MAIN_H.contains(SCAN_LOOP), "the driver's scan loop");
+    PLC_MAIN_H.replacen(SCAN_LOOP, PAR_SCAN_LOOP, 1).replacen(
+        "   argv[2] = --time: only the last state,",
+        "   argv[2] = --sequential, --parallel (the default) or --adaptive: the scan run (a
+            plc-deps c --threads build); = --time: only the last state,",
+        1,
+    )
+}
+
 /// The `Makefile`: every object `stems` with `CSTD` (the C standard, not replaced by a user's
 /// `CFLAGS`) and `CFLAGS`, the part files `parts` with `PARTFLAGS` too.
 pub(crate) fn makefile(stems: &[String], parts: &[String]) -> String {

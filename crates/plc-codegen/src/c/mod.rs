@@ -34,6 +34,7 @@ mod kernel;
 mod ladder;
 pub mod names;
 mod order;
+mod parallel;
 mod parts;
 mod rows;
 mod runtime;
@@ -67,6 +68,13 @@ pub struct CConfig {
     /// (`rows`; `plc-deps c --statements` turns it off): `cc` takes seconds instead of minutes
     /// at 100,000 rungs, and the rows run as fast as the statements or faster (docs/c.md).
     pub rows: bool,
+    /// Worker threads of the parallel scan (`--threads`): 1 (the default) writes the
+    /// sequential program only; N ≥ 2 adds `plc_scan_parallel` and the runtime API
+    /// (`parallel`, docs/c.md).
+    pub threads: usize,
+    /// With `threads` ≥ 2: every level of the schedule a parallel phase (the planner's
+    /// `Strategy::AllParallel`), whatever the cost model says; for tests and measurements.
+    pub parallel_all: bool,
 }
 
 impl Default for CConfig {
@@ -77,6 +85,8 @@ impl Default for CConfig {
             scan_budget: plc_exec::DEFAULT_SCAN_BUDGET,
             chunk_rungs: 64,
             rows: true,
+            threads: 1,
+            parallel_all: false,
         }
     }
 }
@@ -214,6 +224,8 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
             });
         }
     }
+    let par_files = (cfg.threads >= 2)
+        .then(|| parallel::files(&sh, ladder[0], cfg, &mut data, &mut objects, &mut parts));
     data.files.extend(kernels.sources());
     for (stem, text) in data.files.into_iter().chain(type_files) {
         files.push(CFile {
@@ -222,13 +234,25 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
         });
         objects.push(stem);
     }
+    let mut makefile = harness::makefile(&objects, &parts);
+    let mut main_c = harness::MAIN_C.to_string();
+    if let Some(par) = par_files {
+        files.extend(par);
+        main_c = harness::PAR_MAIN_C.to_string();
+        makefile = harness::par_makefile(&makefile);
+        let driver = files
+            .iter_mut()
+            .find(|f| f.name == "plc_main.h")
+            .expect("the driver");
+        driver.text = harness::par_main_h();
+    }
     files.push(CFile {
         name: "main.c".into(),
-        text: harness::MAIN_C.into(),
+        text: main_c,
     });
     files.push(CFile {
         name: "Makefile".into(),
-        text: harness::makefile(&objects, &parts),
+        text: makefile,
     });
     files
 }
