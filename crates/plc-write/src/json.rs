@@ -63,6 +63,9 @@ pub fn program(p: &Program, w: &mut impl Write) -> io::Result<()> {
         write!(w, ",\n\"configuration\": ")?;
         configuration(c, w)?;
     }
+    if p.dialect != plc_model::Dialect::default() {
+        write!(w, ",\n\"dialect\": {}", string(p.dialect.name()))?;
+    }
     writeln!(w, "\n}}")
 }
 

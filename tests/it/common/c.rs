@@ -247,6 +247,8 @@ const HARNESS_SYMBOLS: &[&str] = &[
     "_plc_desc_scan",
     "_plc_desc_set_input",
     "_plc_desc_print",
+    "_plc_restore_inputs",
+    "_plc_desc_restore",
 ];
 
 /// Macros a program's files define (undefined before the next program's).

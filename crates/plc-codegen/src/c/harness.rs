@@ -297,8 +297,11 @@ const SCAN_LOOP: &str = r#"    double spent = 0;
     _plc_ctx ctx = {0, 0, prog->loop_cap, on_fault, (void *)prog, 0, 0};
     for (unsigned long long k = 0; k < scans; k++) {
         if (k < nrows)
-            for (size_t v = rows[k].first; v < rows[k].first + rows[k].count; v++)
+            for (size_t v = rows[k].first; v < rows[k].first + rows[k].count; v++) {
                 _plc_set_cell(prog, &f, state, value_input[v], &values[v], (size_t)k);
+                _plc_set_cell(prog, &f, image, value_input[v], &values[v], (size_t)k);
+            }
+        prog->restore_inputs(state, image);
         ctx.scan = k;
         ctx.now = (int64_t)k * prog->cycle_ms;
         double t0 = timing ? seconds() : 0;
@@ -327,11 +330,15 @@ const PAR_SCAN_LOOP: &str = r#"    /* --threads build: argv[2] --sequential, --p
     for (int m = timing ? 0 : mode; m < (timing ? 3 : mode + 1); m++) {
         double spent = 0;
         memcpy(state, prog->initial, prog->size);
+        memcpy(image, prog->initial, prog->size);
         _plc_ctx ctx = {0, 0, prog->loop_cap, on_fault, (void *)prog, 0, 0};
         for (unsigned long long k = 0; k < scans; k++) {
             if (k < nrows)
-                for (size_t v = rows[k].first; v < rows[k].first + rows[k].count; v++)
+                for (size_t v = rows[k].first; v < rows[k].first + rows[k].count; v++) {
                     _plc_set_cell(prog, &f, state, value_input[v], &values[v], (size_t)k);
+                    _plc_set_cell(prog, &f, image, value_input[v], &values[v], (size_t)k);
+                }
+            prog->restore_inputs(state, image);
             ctx.scan = k;
             ctx.now = (int64_t)k * prog->cycle_ms;
             double t0 = timing ? seconds() : 0;

@@ -185,6 +185,7 @@ struct Parts<'a> {
     interrupts: Option<Part<Vec<syntax::Subroutine<'a>>>>,
     function_blocks: Option<Part<Vec<syntax::FunctionBlock<'a>>>>,
     configuration: Option<Result<plc_model::Configuration, Problem>>,
+    dialect: Option<(Scalar<'a>, Origin)>,
 }
 
 const PROGRAM_KEYS: &[&str] = &[
@@ -196,6 +197,7 @@ const PROGRAM_KEYS: &[&str] = &[
     "interrupts",
     "function_blocks",
     "configuration",
+    "dialect",
     "comment",
 ];
 const SUBROUTINE_KEYS: &[&str] = &["vars", "rungs", "fbd", "comment"];
@@ -316,6 +318,7 @@ impl<'a, 'r> Reader<'a, 'r> {
             match key.as_ref() {
                 "program" => parts.name = Some((self.c.scalar()?, origin)),
                 "comment" => parts.comment = Some(self.c.scalar()?),
+                "dialect" => parts.dialect = Some((self.c.scalar()?, origin)),
                 "vars" if path.is_empty() && self.streamed => {
                     self.retract();
                     parts.vars = Some(self.part(|r| r.vars(&at()))?)
@@ -405,6 +408,26 @@ impl<'a, 'r> Reader<'a, 'r> {
             Some(Ok(c)) => p.configuration = Some(c),
             Some(Err(problem)) => problems.push(problem),
             None => {}
+        }
+        // Whose rules `run` and `c` follow (docs/dialects.md); IEC when absent.
+        match parts.dialect {
+            None => {}
+            Some((Scalar::Str(s), o)) => match plc_model::Dialect::from_name(&s) {
+                Some(d) => p.dialect = d,
+                None => problems.push(Problem {
+                    at: "dialect".into(),
+                    origin: o,
+                    kind: Invalid::Shape {
+                        expected: "a dialect (\"iec\", \"matiec\" or \"codesys\")",
+                        found: format!("\"{s}\""),
+                    },
+                }),
+            },
+            Some((other, o)) => problems.push(Problem {
+                at: "dialect".into(),
+                origin: o,
+                kind: shape("a dialect (\"iec\", \"matiec\" or \"codesys\")", &other),
+            }),
         }
         p.problems = problems;
         Ok(p)
