@@ -110,10 +110,12 @@ fn a_coil_on_a_located_input_lasts_until_the_next_scans_input_copy() {
 fn unconnected_counter_inputs_take_their_initial_values_in_an_ld_body_read_as_data_flow() {
     // C1 has EN (from contact En), so the body is read as data flow (Beremiz's form of LD);
     // its R is not connected: FALSE (IEC 61131-3 2.5.2.1, the type's initial value), PV is 2.
-    // matiec's CTU: on a rising CU (its R_TRIG), CV := CV + 1; Q := CV >= PV. With EN FALSE the
+    // matiec's CTU (lib/counter.txt): on a rising CU (its R_TRIG), CV := CV + 1 while CV < PV;
+    // Q := CV >= PV. With EN FALSE the
     // body does not run (generate_c.cc: `if (!EN) { ENO := FALSE; return; }`), so its CU edge
     // memory keeps TRUE from scan 2 and the TRUE CU of scan 5 is no edge. C0 has PV not
-    // connected (0): Q0 = CV >= 0 is TRUE from the first call.
+    // connected (0): it never counts (CV < PV is 0 < 0) and Q0 = CV >= 0 is TRUE from the first
+    // call. C1 stops at its PV, 2.
     let csv = "En,Up\n1,1\n1,0\n1,1\n0,0\n0,1\n1,1\n1,0\n1,1\n";
     let t = scans(
         "unconnected_ctu_ld.xml",
@@ -122,14 +124,14 @@ fn unconnected_counter_inputs_take_their_initial_values_in_an_ld_body_read_as_da
     );
     assert_eq!(
         t[0],
-        col(&["1", "1", "2", "2", "2", "2", "2", "3"]),
+        col(&["1", "1", "2", "2", "2", "2", "2", "2"]),
         "C1.CV"
     );
     assert_eq!(t[1], col(&["0", "0", "1", "1", "1", "1", "1", "1"]), "Q");
     assert_eq!(t[2], col(&["1", "1", "1", "1", "1", "1", "1", "1"]), "Q0");
     assert_eq!(
         t[3],
-        col(&["1", "1", "2", "2", "3", "3", "3", "4"]),
+        col(&["0", "0", "0", "0", "0", "0", "0", "0"]),
         "C0.CV"
     );
     let (_, warnings) = px::report_and_warnings(&file("unconnected_ctu_ld.xml"));

@@ -166,14 +166,16 @@ fn fbd_blocks_with_execution_order_ids_run_first_in_id_order() {
 #[test]
 fn an_unconnected_timer_pt_takes_its_initial_value_with_a_warning() {
     // IEC 61131-3 2.5.2.1: an input nothing sets keeps its initial value, TIME's T#0ms (Beremiz
-    // leaves PT out of the call `T1(IN := Start)`, matiec keeps the instance's initial PT). A
-    // TON with PT 0 has Q = IN in every scan.
+    // leaves PT out of the call `T1(IN := Start)`, matiec keeps the instance's initial PT).
+    // matiec's TON (lib/timer.txt) only starts the time in the call that sees IN rise (Q FALSE)
+    // and compares from the next call, so an IN that is TRUE one scan at a time never shows Q
+    // (docs/dialects.md).
     let t = scans(
         "unconnected_pt_fbd.xml",
         "Start\n1\n0\n1\n",
         &["Q", "T1.PT"],
     );
-    assert_eq!(t[0], col(&["1", "0", "1"]), "Q");
+    assert_eq!(t[0], col(&["0", "0", "0"]), "Q");
     assert_eq!(t[1], col(&["0", "0", "0"]), "T1.PT");
     let (_, xml) = file("unconnected_pt_fbd.xml");
     let (_, warnings) = px::report_and_warnings(&xml);

@@ -71,14 +71,15 @@ fn standard_function_block_calls_that_leave_inputs_out_use_their_last_values() {
     // `T1();` keeps both (IEC 61131-3 6.6.1.2): ET 0, 10, 20 and Q from scan 3 (t = 20). In
     // scan 6, after the call, `T1.IN := FALSE`: scan 7's call resets it (Q FALSE, ET 0), and
     // `in1 := T1.IN` reads TRUE until then. C1: PV := 3, CU := NOT CU toggles, so CU rises in
-    // scans 1, 3, 5, 7: CV 1, 1, 2, 2, 3, 3, 4, Q (CV >= PV) from scan 5; R never given: FALSE.
+    // scans 1, 3, 5, 7: CV 1, 1, 2, 2, 3, 3, 3 (matiec's CTU counts while CV < PV), Q (CV >= PV)
+    // from scan 5; R never given: FALSE.
     let expect = [
         (1, false, 0, true, 1),
         (2, false, 10, true, 1),
         (3, true, 20, true, 2),
         (5, true, 20, true, 3),
         (6, true, 20, true, 3),
-        (7, false, 0, false, 4),
+        (7, false, 0, false, 3),
     ];
     for (scans, q, et, in1, cv) in expect {
         let v = run_json(f, scans, None);
