@@ -245,7 +245,7 @@ mod tests {
             kinds("x := 16#FF + INT#-5 (* a (* nested *) one *) ** 2.5E3; // end\n{pragma} t := T#1h2m;"),
             vec![
                 Ident("x"), Sym(":="), Literal("16#FF"), Sym("+"), Literal("INT#-5"),
-                Sym("**"), Literal("2.5E3"), Sym(";"), Ident("t"), Sym(":="),
+                Sym("**"), Literal("2.5E3"), Sym(";"), Pragma("{pragma}"), Ident("t"), Sym(":="),
                 Literal("T#1h2m"), Sym(";")
             ]
         );
