@@ -14,85 +14,9 @@
 use crate::common;
 use crate::plcopen_common as px;
 
-use common::c::{assert_ok, run_with_input};
-use common::cli::{run, run_stdin, tmp};
+use crate::st_exec::{c_equals_run, pairs, refusal, run_json, values};
+use common::cli::{run, run_stdin};
 use serde_json::{json, Value};
-use std::process::Command;
-use std::process::Output;
-
-/// `plc-deps run FILE --scans N --mode both --format json [--inputs CSV]`: the report, with
-/// seq == par checked (as tests/it/st_exec.rs does).
-fn run_json(file: &str, scans: u32, inputs: Option<&str>) -> Value {
-    let n = scans.to_string();
-    let mut args = vec![
-        "run", file, "--scans", &n, "--mode", "both", "--format", "json",
-    ];
-    if let Some(i) = inputs {
-        args.extend(["--inputs", i]);
-    }
-    let out = run(&args);
-    let v: Value = serde_json::from_slice(&out.stdout)
-        .unwrap_or_else(|e| panic!("{file}: {e}: {}", String::from_utf8_lossy(&out.stderr)));
-    assert_eq!(v["identical"], json!(true), "{file}: seq != par");
-    v
-}
-
-fn values(v: &Value, names: &[&str]) -> Vec<(String, Value)> {
-    names
-        .iter()
-        .map(|n| (n.to_string(), v["state"][*n].clone()))
-        .collect()
-}
-
-fn pairs(expected: &[(&str, Value)]) -> Vec<(String, Value)> {
-    expected
-        .iter()
-        .map(|(n, v)| (n.to_string(), v.clone()))
-        .collect()
-}
-
-/// `plc-deps c FILE`, built with its Makefile and run for `scans` scans on `csv`: the state line
-/// after every scan equals the state of `plc-deps run --scans k` for every k.
-fn c_equals_run(file: &str, scans: u32, csv: Option<&str>) {
-    let dir = tmp(&format!("il-c-{}", file.replace(['/', '.'], "_")));
-    let _ = std::fs::remove_dir_all(&dir);
-    let out = run(&["c", file, "-o", dir.to_str().unwrap()]);
-    assert_ok(&out, "plc-deps c");
-    let make = Command::new("make")
-        .arg("-s")
-        .current_dir(&dir)
-        .output()
-        .unwrap();
-    assert_ok(&make, "make");
-    let input = match csv {
-        Some(c) => std::fs::read(common::cli::root().join(c)).unwrap(),
-        None => Vec::new(),
-    };
-    let out = run_with_input(&dir.join("plc_program"), &[scans.to_string()], &input);
-    let lines: Vec<Value> = String::from_utf8(out.stdout)
-        .unwrap()
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect();
-    assert_eq!(lines.len(), scans as usize, "{file}");
-    for k in 1..=scans {
-        let r = run_json(file, k, csv);
-        assert_eq!(
-            lines[k as usize - 1],
-            r["state"],
-            "{file}: C and run differ after scan {k}"
-        );
-    }
-}
-
-/// The `error:` line of a command that failed with exit code 2.
-fn refusal(out: &Output, what: &str) -> String {
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{what}: {stderr}");
-    let errors: Vec<&str> = stderr.lines().filter(|l| l.starts_with("error")).collect();
-    assert_eq!(errors.len(), 1, "{what}: {stderr}");
-    errors[0].to_owned()
-}
 
 #[test]
 fn il_operators_apply_to_the_current_result_left_to_right() {
