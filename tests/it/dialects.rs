@@ -11,6 +11,14 @@
 //! - TIME_TO_INT(T#2500ms), INT_TO_TIME(3), TIME_TO_REAL(T#1500ms): matiec counts seconds
 //!   (`__time_to_int` is `tv_sec`; `__int_to_time(3)` is 3 s; `__time_to_real` seconds): 2,
 //!   T#3s, 1.5; CODESYS milliseconds: 2500, T#3ms, 1500.0.
+//! - `i * 258` with INT `i = 200`: matiec writes C's `i * 258`, computed in `int` (C11
+//!   6.3.1.1), so `(i * 258) > 30000` compares 51600 (TRUE) and `(i * 258) / 2` is 25800,
+//!   cut to INT only when stored; IEC 61131-3 types the product INT, which wraps to -13936:
+//!   FALSE and -6968 (the CODESYS export keeps IEC's rule). Both cut the product passed to
+//!   INT_TO_DINT's INT input: -13936.
+//! - TON `T2` called twice a scan, with `PT := T#0s` then `T#1h`: matiec's TON, once elapsed
+//!   (STATE 2 in `lib/timer.txt`), keeps Q until IN falls, so `q2` is TRUE from scan 2 (scan 1
+//!   only starts the time); CODESYS and `iec` recompute `ET >= PT` in each call: FALSE.
 
 use crate::common::c::{assert_ok, run_with_input};
 use crate::common::cli::{run, tmp};
@@ -83,7 +91,14 @@ fn a_beremiz_project_runs_as_matiec_runs_it() {
         (&s1["secs"], &s1["t3"], &s1["r"]),
         (&json!(2), &json!(3000), &json!(1.5))
     );
-    assert_eq!(state(BEREMIZ, 2, None)["q0"], json!(true));
+    assert_eq!(
+        (&s1["big"], &s1["half"], &s1["conv"]),
+        (&json!(true), &json!(25800), &json!(-13936)),
+        "INT arithmetic in C's int, cut where stored or passed"
+    );
+    assert_eq!(s1["q2"], json!(false));
+    let s2 = state(BEREMIZ, 2, None);
+    assert_eq!((&s2["q0"], &s2["q2"]), (&json!(true), &json!(true)));
     let s10 = state(BEREMIZ, 10, None);
     assert_eq!((&s10["C1"]["CV"], &s10["D1"]["CV"]), (&json!(3), &json!(0)));
     c_equals_run(BEREMIZ, 4, None);
@@ -97,6 +112,12 @@ fn a_codesys_export_runs_as_codesys_runs_it() {
         (&s1["secs"], &s1["t3"], &s1["r"]),
         (&json!(2500), &json!(3), &json!(1500.0))
     );
+    assert_eq!(
+        (&s1["big"], &s1["half"], &s1["conv"]),
+        (&json!(false), &json!(-6968), &json!(-13936)),
+        "INT arithmetic in INT (IEC's typing)"
+    );
+    assert_eq!(state(CODESYS, 2, None)["q2"], json!(false));
     let s10 = state(CODESYS, 10, None);
     assert_eq!((&s10["C1"]["CV"], &s10["D1"]["CV"]), (&json!(3), &json!(0)));
     c_equals_run(CODESYS, 4, None);
@@ -106,6 +127,11 @@ fn a_codesys_export_runs_as_codesys_runs_it() {
 fn dialect_on_the_command_line_overrides_the_files() {
     let s1 = state(BEREMIZ, 1, Some("iec"));
     assert_eq!((&s1["q0"], &s1["secs"]), (&json!(true), &json!(2500)));
+    assert_eq!(
+        s1["half"],
+        json!(25800),
+        "the width of ST arithmetic is fixed when the body is read, by the file's editor"
+    );
     let s10 = state(BEREMIZ, 10, Some("iec"));
     assert_eq!(
         (&s10["C1"]["CV"], &s10["D1"]["CV"]),

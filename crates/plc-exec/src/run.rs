@@ -630,7 +630,8 @@ fn contact_bits<S: Store + ?Sized>(st: &S, r: &FusedRung) -> usize {
 }
 
 /// TON on the instance at `i`; returns Q. `late`: the call that sees IN rise only starts the
-/// time, with Q FALSE, and later calls compare ([`plc_model::Dialect::timer_compares_after_edge`]).
+/// time, with Q FALSE, later calls compare, and once Q is TRUE it stays (with ET) until IN
+/// falls ([`plc_model::Dialect::timer_compares_after_edge`], matiec's `lib/timer.txt`).
 #[inline]
 fn ton<S: Store + ?Sized>(st: &mut S, now: i64, i: Addr, pt: i64, input: bool, late: bool) -> bool {
     st.store(i.offset(PT), pt as i32);
@@ -649,6 +650,11 @@ fn ton<S: Store + ?Sized>(st: &mut S, now: i64, i: Addr, pt: i64, input: bool, l
         }
         now
     } else {
+        if late && st.load::<u8>(i.offset(Q)) != 0 {
+            // matiec's TON, once elapsed (its STATE 2), keeps Q and ET until IN falls, even if
+            // a later call gives a longer PT.
+            return true;
+        }
         st.load::<i64>(i.offset(START))
     };
     let et = now.wrapping_sub(start).min(pt);

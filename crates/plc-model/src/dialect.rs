@@ -82,8 +82,19 @@ impl Dialect {
     /// A timer's Q changes only in a call after the one that sees its edge (matiec's
     /// `lib/timer.txt`: the rising-edge call of TON sets `Q := FALSE` and starts the time; the
     /// elapsed time is compared from the next call, so with `PT = T#0s` Q rises one call after
-    /// IN; likewise TOF's falling edge and TP's end). The others compare in the edge's call.
+    /// IN; likewise TOF's falling edge and TP's end); and an elapsed TON keeps Q and ET until IN
+    /// falls, even if a later call gives a longer PT (its STATE 2). The others compare in the
+    /// edge's call.
     pub fn timer_compares_after_edge(self) -> bool {
+        self == Dialect::Matiec
+    }
+
+    /// ST arithmetic of types narrower than DINT (SINT, INT, USINT, UINT) is computed in DINT
+    /// and cut to its type only where it is stored or passed: matiec writes `a * b` as C's
+    /// `a * b`, which C computes in `int` (C11 6.3.1.1), so `w <= i * 258` compares the whole
+    /// product. IEC 61131-3 types `i * 258` INT; CODESYS's rule is not documented, so it keeps
+    /// IEC's. Fixed when an ST body is read, by the file's editor (`--dialect` does not change it).
+    pub fn int_arithmetic_in_dint(self) -> bool {
         self == Dialect::Matiec
     }
 }

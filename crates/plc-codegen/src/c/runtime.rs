@@ -94,6 +94,7 @@ static inline bool _plc_ton(_plc_timer *t, int64_t now, int32_t pt, bool in, boo
         t->flags = _PLC_ACTIVE | _PLC_PREV_IN; t->start = now; start = now;
         if (late) { t->Q = 0; return 0; }
     }
+    else if (late && t->Q) return 1; /* matiec: elapsed, Q and ET kept until IN falls */
     else start = t->start;
     int64_t et = now - start;
     if (et > pt) et = pt;

@@ -182,6 +182,9 @@ fn lower(
         }
     }
     tr.items(&items, true)?;
+    // matiec keeps IL's current result in a variable of the operand's type, so each
+    // instruction's arithmetic is cut to that type (no `int` promotion across instructions).
+    tr.scope.int_arithmetic_in_dint = false;
     let mut lw = Lower::new(&tr.scope, pou);
     lw.text(map, base);
     let mut unit = 0;

@@ -52,6 +52,11 @@ pub(super) fn program(
         add_data_note(tc6, ch, notes);
     }
     let types = tc6.child(root, "types");
+    let dialect = plc_model::Dialect::of_editor(
+        tc6.child(root, "fileHeader")
+            .and_then(|h| h.attribute("productName"))
+            .unwrap_or(""),
+    );
     let known = Known {
         data_types: DataTypes::read(tc6, types.and_then(|t| tc6.child(t, "dataTypes")))?,
     };
@@ -127,6 +132,7 @@ pub(super) fn program(
             continue;
         }
         let mut scope = scope(iface, &global_types, &known, &user_fbs);
+        scope.int_arithmetic_in_dint = dialect.int_arithmetic_in_dint();
         scope.inputs.extend(
             input_globals
                 .iter()

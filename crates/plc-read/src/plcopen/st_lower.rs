@@ -19,6 +19,10 @@
 //!   strings as the standard functions) and standard functions (ABS … ATAN, EXPT, SHL … ROR,
 //!   MUX, `*_TO_*`, TRUNC; MAX, MIN, LIMIT, SEL and MOVE as compares and moves). A literal takes
 //!   the type of the other operand (or of the assignment's target), as IEC and matiec type it.
+//! - in a file of matiec's dialect, arithmetic of SINT, INT, USINT and UINT is computed in DINT
+//!   and converted to its type where it is assigned or passed, and a comparison compares the
+//!   DINT values: matiec's C computes it in `int` (C11 6.3.1.1, the integer promotions).
+//!   An argument of a conversion's input takes the input's type (`INT_TO_DINT(297 / 2)` is INT).
 //! - `:=`: a BOOL target a coil (TRUE a set, FALSE a reset), another a move, or the last box
 //!   of its expression writing the target directly.
 //! - IF/ELSIF/ELSE and CASE (values, ranges `a..b`, lists, ELSE; the selector evaluated once
@@ -969,6 +973,17 @@ impl<'s> Lower<'s> {
                     vec![vec![x1, y1], vec![x2, y2]],
                 ))])
             }
+            Expr::Binary(op, a, b)
+                if cmp_op(*op).is_some()
+                    && (self.narrow_arith(a, None) || self.narrow_arith(b, None)) =>
+            {
+                // matiec's C compares the `int` values of its sides: both widened to DINT.
+                let op = cmp_op(*op).unwrap_or(CmpOp::Eq);
+                let nat = self.natural(a, None).or(self.natural(b, None));
+                let l = self.widened(a, nat)?;
+                let r = self.widened(b, nat)?;
+                Ok(vec![self.compare(op, &l, &r)])
+            }
             Expr::Binary(op, a, b) if cmp_op(*op).is_some() => {
                 let op = cmp_op(*op).unwrap_or(CmpOp::Eq);
                 let mut l = self.value(a, None)?;
@@ -996,6 +1011,104 @@ impl<'s> Lower<'s> {
                     ),
                 }
             }
+        }
+    }
+
+    // ---- matiec's integer promotion ----
+
+    /// Whether `e` is arithmetic (`+ - * / MOD`) whose IEC type is narrower than C's `int`
+    /// (SINT, INT, USINT, UINT) in a project whose toolchain computes it in `int`
+    /// ([`Scope::int_arithmetic_in_dint`]): matiec writes `a * b` of two INTs as C's `a * b`,
+    /// which C computes in `int` (C11 6.3.1.1, the integer promotions), and the value is cut to
+    /// INT only where it is stored or passed (`i := a * b`, `INT_TO_DINT(a * b)`), so
+    /// `w <= i * 258` compares the full product.
+    fn narrow_arith(&self, e: &Expr, want: Option<Type>) -> bool {
+        self.scope.int_arithmetic_in_dint
+            && matches!(
+                e,
+                Expr::Binary(
+                    BinaryOp::Add | BinaryOp::Sub | BinaryOp::Mul | BinaryOp::Div | BinaryOp::Mod,
+                    ..
+                )
+            )
+            && self
+                .natural(e, want)
+                .is_some_and(|t| matches!(t, Type::Sint | Type::Int | Type::Usint | Type::Uint))
+    }
+
+    /// The IEC type of `e` where its operands say it without computing anything (`None`: a
+    /// literal, or a call whose type only its lowering knows).
+    fn natural(&self, e: &Expr, want: Option<Type>) -> Option<Type> {
+        match e {
+            Expr::Var(p) => match self.enum_value(p) {
+                Ok(None) => self.read(p).ok().map(|(_, t)| t),
+                _ => None,
+            },
+            Expr::Unary(UnaryOp::Neg | UnaryOp::Plus, x) => self.natural(x, want),
+            Expr::Binary(
+                BinaryOp::Add | BinaryOp::Sub | BinaryOp::Mul | BinaryOp::Div | BinaryOp::Mod,
+                a,
+                b,
+            ) => self.natural(a, None).or(self.natural(b, None)).or(want),
+            Expr::Call { callee, .. } if callee.selectors.is_empty() => {
+                match Function::parse(&callee.base.to_ascii_uppercase()) {
+                    Some(Function::Convert { to, .. }) => Some(to),
+                    _ => None,
+                }
+            }
+            _ => None,
+        }
+    }
+
+    /// `e` (arithmetic of type `nat`, narrower than `int`) computed in DINT: the DINT value and
+    /// `nat`.
+    fn wide(&mut self, e: &Expr, want: Option<Type>) -> L<(Val, Type)> {
+        let nat = self.natural(e, want).unwrap_or(Type::Dint);
+        let Expr::Binary(op, a, b) = e else {
+            return Ok((self.widened(e, Some(nat))?, nat));
+        };
+        let arith = match op {
+            BinaryOp::Add => ArithOp::Add,
+            BinaryOp::Sub => ArithOp::Sub,
+            BinaryOp::Mul => ArithOp::Mul,
+            BinaryOp::Div => ArithOp::Div,
+            _ => ArithOp::Mod,
+        };
+        let l = self.widened(a, Some(nat))?;
+        let r = self.widened(b, Some(nat))?;
+        let d = self.temp(Type::Dint);
+        let el = ElementKind::Arith(Box::new(Arith {
+            op: arith,
+            a: self.operand(&l),
+            b: self.operand(&r),
+            out: self.name(&d),
+        }));
+        self.emit(vec![el]);
+        Ok((Val::Var(d, Type::Dint), nat))
+    }
+
+    /// An operand of `int` arithmetic or comparison as DINT: narrower arithmetic computed wide
+    /// ([`Self::wide`]), a narrower value converted, a literal as it is.
+    fn widened(&mut self, e: &Expr, nat: Option<Type>) -> L<Val> {
+        if self.narrow_arith(e, nat) {
+            return Ok(self.wide(e, nat)?.0);
+        }
+        let v = self.value(e, nat)?;
+        match v {
+            Val::Var(n, t @ (Type::Sint | Type::Int | Type::Usint | Type::Uint)) => {
+                let d = self.temp(Type::Dint);
+                let el = ElementKind::Function(Box::new(FunctionCall {
+                    func: Function::Convert {
+                        from: t,
+                        to: Type::Dint,
+                    },
+                    args: vec![self.operand(&Val::Var(n, t))],
+                    out: self.name(&d),
+                }));
+                self.emit(vec![el]);
+                Ok(Val::Var(d, Type::Dint))
+            }
+            other => Ok(other),
         }
     }
 
@@ -1152,6 +1265,21 @@ impl<'s> Lower<'s> {
                 Ok(done(d, ty))
             }
             Expr::Unary(UnaryOp::Not, x) => self.function(Function::Not, &[x], want, out),
+            Expr::Binary(..) if self.narrow_arith(e, want) => {
+                // matiec's C: computed in `int`, cut to the expression's type where it is used.
+                let (w, nat) = self.wide(e, want)?;
+                let d = dest(self, nat);
+                let el = ElementKind::Function(Box::new(FunctionCall {
+                    func: Function::Convert {
+                        from: Type::Dint,
+                        to: nat,
+                    },
+                    args: vec![self.operand(&w)],
+                    out: self.name(&d),
+                }));
+                self.emit(vec![el]);
+                Ok(done(d, nat))
+            }
             Expr::Binary(op, a, b) => {
                 let arith = match op {
                     BinaryOp::Add => ArithOp::Add,
@@ -1323,8 +1451,14 @@ impl<'s> Lower<'s> {
         out: Option<&str>,
     ) -> L<Option<Val>> {
         let mut vals = Vec::with_capacity(args.len());
-        for a in args {
-            let hint = vals.iter().find_map(|v: &Val| v.ty());
+        for (i, a) in args.iter().enumerate() {
+            // A pin of one exact type (a conversion's input, a string function's) types its
+            // argument, as matiec types `INT_TO_DINT(297 / 2)` INT; a generic pin takes the
+            // first typed argument's type.
+            let hint = match f.pin(i) {
+                plc_model::Pin::Own(plc_model::Class::Exact(t)) => Some(t),
+                _ => vals.iter().find_map(|v: &Val| v.ty()),
+            };
             vals.push(self.value(a, hint)?);
         }
         // Untyped literals of a generic pin take the first typed argument's type.

@@ -44,6 +44,10 @@ pub(super) struct Scope {
     pub typed: HashMap<String, i64>,
     /// The project's function block types by lower-case name.
     pub fbs: HashMap<String, FbPins>,
+    /// Arithmetic of types narrower than DINT is computed in DINT and cut where it is stored
+    /// or passed, as matiec's C computes it in `int` (the file's editor is Beremiz or OpenPLC:
+    /// [`plc_model::Dialect::int_arithmetic_in_dint`]).
+    pub int_arithmetic_in_dint: bool,
 }
 
 /// A function block type of the project: its inputs and outputs (name as declared, model
