@@ -376,16 +376,23 @@ impl<'s> Lower<'s> {
             Stmt::Assign { target, value } => self.assign(target, value),
             Stmt::Call { callee, args } => self.fb_call(callee, args),
             Stmt::If { arms, otherwise } => {
+                if let ([(cond, body)], []) = (arms.as_slice(), otherwise.as_slice()) {
+                    if self.guarded(cond, body)? {
+                        return Ok(());
+                    }
+                }
                 let end = self.label();
-                for (cond, body) in arms {
+                for (i, (cond, body)) in arms.iter().enumerate() {
                     let next = self.label();
                     let c = self.cond(cond)?;
                     let mut ld = self.negate(c);
                     ld.push(self.jmp(&next));
                     self.emit(ld);
                     self.statements(body)?;
-                    let j = self.jmp(&end);
-                    self.emit(vec![j]);
+                    if i + 1 < arms.len() || !otherwise.is_empty() {
+                        let j = self.jmp(&end);
+                        self.emit(vec![j]);
+                    }
                     self.place(next);
                 }
                 self.statements(otherwise)?;
@@ -448,6 +455,116 @@ impl<'s> Lower<'s> {
                 Ok(())
             }
         }
+    }
+
+    /// `IF cond THEN body END_IF` whose body lowers to rungs that do nothing without power
+    /// (moves, arithmetic and function boxes, set and reset after their conditions; no coil,
+    /// no block, no jump or label): the condition put in front of the body's one rung, or
+    /// computed once into a temporary whose contact is put in front of each rung, instead of
+    /// a jump over the body. Returns false, having emitted nothing, when the body is not so.
+    fn guarded(&mut self, cond: &Expr, body: &[Statement]) -> L<bool> {
+        // Only assignments are tried (a nested statement has labels, and trying it would
+        // lower it twice at every depth).
+        if !body
+            .iter()
+            .all(|s| matches!(s.kind, Stmt::Assign { .. } | Stmt::Empty))
+        {
+            return Ok(false);
+        }
+        let (rungs, temps, labels, vars, in_stmt, false_var, held) = (
+            self.rungs.len(),
+            self.temps,
+            self.labels,
+            self.vars.len(),
+            self.in_stmt,
+            self.false_var,
+            self.held.len(),
+        );
+        let pending = self.pending.take();
+        // Everything lowering the condition and the body may have changed, as it was.
+        let undo = |me: &mut Self, pending: Option<String>| {
+            me.rungs.truncate(rungs);
+            me.vars.truncate(vars);
+            me.held.truncate(held);
+            (me.temps, me.labels, me.in_stmt) = (temps, labels, in_stmt);
+            me.false_var = false_var;
+            me.pending = pending;
+        };
+        let c = self.cond(cond)?;
+        let first = self.rungs.len();
+        match self.statements(body) {
+            Ok(()) if self.pending.is_none() => {}
+            other => {
+                undo(self, pending);
+                return other.map(|()| false);
+            }
+        }
+        let inert = first < self.rungs.len()
+            && self.rungs[first..]
+                .iter()
+                .all(|r| r.label.is_none() && r.ld.iter().all(|e| inert(&e.kind)));
+        if !inert {
+            undo(self, pending);
+            return Ok(false);
+        }
+        let guard = if self.rungs.len() - first == 1 {
+            c
+        } else {
+            let flag = self.temp(Type::Bool);
+            let mut ld = c;
+            ld.push(ElementKind::Coil {
+                var: self.name(&flag),
+                negated: false,
+            });
+            let at = self.here;
+            let rung = Rung {
+                origin: at,
+                id: self.name(""),
+                label: None,
+                comment: None,
+                ld: ld
+                    .into_iter()
+                    .map(|kind| Element { origin: at, kind })
+                    .collect(),
+                ld_origin: at,
+                problem: None,
+                problem_in_rung: false,
+            };
+            self.rungs.insert(first, rung);
+            self.in_stmt += 1;
+            vec![self.contact(&flag, false)]
+        };
+        let skip = usize::from(self.rungs.len() - first > 1 && guard.len() == 1);
+        for r in &mut self.rungs[first + skip..] {
+            let here = r.origin;
+            let mut ld: Vec<Element<'static>> = guard
+                .iter()
+                .map(|k| Element {
+                    origin: here,
+                    kind: k.clone(),
+                })
+                .collect();
+            ld.append(&mut r.ld);
+            r.ld = ld;
+        }
+        // The rungs from the first of the condition's on, numbered in order again.
+        let base = in_stmt + (self.rungs.len() - rungs);
+        let mut k = in_stmt;
+        for r in &mut self.rungs[rungs..] {
+            k += 1;
+            r.id.value = Cow::Owned(format!("{}.{k}", self.stmt));
+        }
+        debug_assert_eq!(k, base);
+        self.in_stmt = k;
+        if let Some(l) = pending {
+            // The statement's first rung carries the label that waited for it.
+            let name = Box::new(self.name(&l));
+            match self.rungs.get_mut(rungs) {
+                Some(r) => r.label = Some(name),
+                None => self.pending = Some(l),
+            }
+        }
+        Ok(true)
     }
 
     fn assign(&mut self, target: &Place, value: &Expr) -> L<()> {
@@ -1496,6 +1613,24 @@ impl<'s> Lower<'s> {
             Some(o) if o == d => None,
             _ => Some(Val::Var(d, out_ty)),
         })
+    }
+}
+
+/// Whether element `k` does nothing without power: a condition, or a move, arithmetic or
+/// function box, set or reset (a coil writes FALSE, a block runs its instance).
+fn inert(k: &ElementKind) -> bool {
+    match k {
+        ElementKind::Contact { .. }
+        | ElementKind::Compare(_)
+        | ElementKind::Move(_)
+        | ElementKind::Arith(_)
+        | ElementKind::Function(_)
+        | ElementKind::Set(_)
+        | ElementKind::Reset(_) => true,
+        ElementKind::Or(s) | ElementKind::Branch(s) => {
+            s.iter().all(|series| series.iter().all(|e| inert(&e.kind)))
+        }
+        _ => false,
     }
 }
 
