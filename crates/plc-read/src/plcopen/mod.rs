@@ -33,6 +33,7 @@ mod ld_flow;
 mod ld_logic;
 mod ld_power;
 mod library;
+mod matiec_lib;
 mod pins;
 mod project;
 mod sfc;
