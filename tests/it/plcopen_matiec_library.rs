@@ -282,3 +282,23 @@ fn the_report_analyses_library_blocks_like_user_function_blocks() {
         assert!(text.contains(r), "{r} in {text}");
     }
 }
+
+#[test]
+fn codesys_projects_do_not_get_matiecs_library() {
+    // CODESYS's and TwinCAT's libraries have their own blocks of these names (CODESYS's Util
+    // PID has other pins): in their dialect (docs/dialects.md) an undefined INTEGRAL stays an
+    // undefined type, which `run` refuses by name.
+    let xml = std::fs::read_to_string(
+        crate::common::cli::root().join("tests/matiec_library/own_pid.xml"),
+    )
+    .unwrap()
+    .replace("productName=\"Beremiz\"", "productName=\"CODESYS\"");
+    let (_, err) = crate::plcopen_common::report_and_warnings(&xml);
+    assert!(!err.contains("matiec's library"), "{err}");
+    let out = crate::common::cli::run_stdin(&["run", "-"], xml.as_bytes());
+    let e = crate::st_exec::refusal(&out, "run");
+    assert!(
+        e.contains("variable `i1` is of type `INTEGRAL`, which the file does not define"),
+        "{e}"
+    );
+}

@@ -22,6 +22,9 @@
 //! the notes the reader would make about their bodies are left out, one note naming the blocks
 //! added instead ([`Added::note`]).
 //!
+//! Only for projects of matiec's dialect (the caller asks): CODESYS's and TwinCAT's libraries have
+//! blocks of these names with other pins (CODESYS's Util PID).
+//!
 //! Deliberately not here: RTC (it reads the PLC's wall clock: a black box of
 //! [`super::library`]), and the typed counters' names in other cases than upper case (Beremiz
 //! writes them so).

@@ -71,7 +71,11 @@ pub(super) fn program(
         .chain(&vendor)
         .filter_map(|p| p.attribute("name"))
         .collect();
-    let added = matiec_lib::added(tc6, root, &own, doc.input_text().len());
+    // Only in matiec's dialect: CODESYS's and TwinCAT's libraries have their own blocks of
+    // these names (CODESYS's Util PID has other pins), which stay undefined black boxes.
+    let added = (dialect_of(tc6, root) == plc_model::Dialect::Matiec)
+        .then(|| matiec_lib::added(tc6, root, &own, doc.input_text().len()))
+        .flatten();
     let added_doc = match &added {
         Some(a) => Some(super::xml::parse(&a.text)?),
         None => None,
@@ -229,13 +233,17 @@ pub(super) fn program(
     };
     let mut program = assemble(root, programs, fbs, globals, order)?;
     program.configuration = configuration;
-    // The toolchain's dialect, by the editor the header names (docs/dialects.md).
+    program.dialect = dialect_of(tc6, root);
+    Ok(program)
+}
+
+/// The toolchain's dialect, by the editor the header names (docs/dialects.md).
+fn dialect_of(tc6: Tc6, root: Node) -> plc_model::Dialect {
     let product = tc6
         .child(root, "fileHeader")
         .and_then(|h| h.attribute("productName"))
         .unwrap_or("");
-    program.dialect = plc_model::Dialect::of_editor(product);
-    Ok(program)
+    plc_model::Dialect::of_editor(product)
 }
 
 /// The POUs CODESYS and TwinCAT keep in vendor data rather than in `types/pous`: a TC6 `pou`
