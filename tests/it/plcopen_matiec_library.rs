@@ -41,7 +41,8 @@ fn typed_counters_count_past_int_and_stop_at_their_limits_in_st() {
     // x toggles, TRUE in odd scans: CU/CD rise in scans 1, 3, 5, …
     // c1: PV 100000, R in scan 3: CV 1, 1, 0 (R wins over the edge), 0, 1, 1, 2, …
     // c2: PV 2, LD in scan 1: CV 2, 2, 1, 1, 0 (Q), 0, 0 (an UDINT at 0 is not counted down).
-    // c3: PV 5 000 000 000 (beyond DINT), LD in scan 1: 5e9 (QU); CD rises in scans 3 and 5:
+    // c3 (R left out of the call: FALSE, its initial value, IEC 61131-3 6.6.1.2): PV
+    // 5 000 000 000 (beyond DINT), LD in scan 1: 5e9 (QU); CD rises in scans 3 and 5:
     // 4 999 999 999, 4 999 999 998; CU from scan 6 rises in 7 and 9: back to 5e9, then kept.
     let names = ["cv1", "q1", "cv2", "q2", "cv3", "qu3", "qd3"];
     let expect: [(u32, [Value; 7]); 7] = [
