@@ -65,6 +65,7 @@ mod plcopen_ld_logic;
 mod plcopen_ld_pins;
 mod plcopen_library_fbs;
 mod plcopen_loaders;
+mod plcopen_matiec_library;
 mod plcopen_mutation;
 mod plcopen_project;
 mod plcopen_semantics;

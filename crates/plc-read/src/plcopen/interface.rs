@@ -88,19 +88,6 @@ pub(super) struct Mapped {
     pub via: Option<String>,
 }
 
-/// Standard function blocks the model has.
-const MODEL_FBS: &[&str] = &[
-    "TON", "TOF", "TP", "CTU", "CTD", "SR", "RS", "R_TRIG", "F_TRIG", "CTUD",
-];
-/// Standard function blocks of IEC 61131-3 the model does not have yet.
-const OTHER_STD_FBS: &[&str] = &[
-    "CTU_DINT",
-    "CTD_DINT",
-    "CTUD_DINT",
-    "CTU_LINT",
-    "CTU_UDINT",
-    "CTU_ULINT",
-];
 /// Reads the interface of POU `pou` (its `interface` element; none is an empty interface).
 pub(super) fn interface(tc6: Tc6, node: Option<Node>, pou: &str, known: &Known) -> R<Interface> {
     let mut out = Interface::default();
@@ -487,13 +474,6 @@ fn type_name(tc6: Tc6, ty: Node, var: &str, place: &str, known: &Known) -> R<Ty>
     let name = identifier(name, "type", t, place)?;
     if let Some(d) = known.data_types.get(&name) {
         return Ok(Ty::Data(d));
-    }
-    if OTHER_STD_FBS.contains(&name.as_str()) {
-        return Err(error(
-            origin(t),
-            place,
-            format!("variable `{var}` is an instance of the standard function block {name}, which is not supported yet (supported: {})", MODEL_FBS.join(", ")),
-        ));
     }
     Ok(Ty::Fb(name))
 }

@@ -9,7 +9,7 @@
 //! variable lists ([`data_types`] the data types and structures, a structure flattened into its fields), [`ld`] (with [`ld_power`], [`ld_block`], [`ld_logic`] and the shared [`wiring`] graph) the
 //! LD bodies ([`ld_flow`]: those that are not series-parallel rungs, as Beremiz's data-flow
 //! network), [`fbd`] the FBD bodies ([`black_box`]: conversions and blocks the model lacks; [`expression`]: in variables' expressions), [`st_body`] the ST bodies (a stand-in rung per statement,
-//! from the ST parser, for the analyses; [`st_lower`]: the rungs `run` and `c` execute), [`il_body`] the IL bodies ([`il_parse`]; translated to ST and lowered for `run` and `c`, analysed through their interface), [`textual`] stands SFC bodies in by their interface. What the reader did that changes meaning or skips vendor data is a [`Note`]
+//! from the ST parser, for the analyses; [`st_lower`]: the rungs `run` and `c` execute), [`il_body`] the IL bodies ([`il_parse`]; translated to ST and lowered for `run` and `c`, analysed through their interface), [`textual`] stands SFC bodies in by their interface; [`matiec_lib`] adds matiec's library blocks (typed counters, PID …) a project uses as ST POUs. What the reader did that changes meaning or skips vendor data is a [`Note`]
 //! (a warning with its place). The mapping, the order rules and their sources:
 //! docs/plcopen.md; the research behind them: docs/design/plcopen-semantics.md.
 //!
@@ -33,6 +33,7 @@ mod ld_flow;
 mod ld_logic;
 mod ld_power;
 mod library;
+mod matiec_lib;
 mod pins;
 mod project;
 mod sfc;

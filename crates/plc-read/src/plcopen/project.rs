@@ -21,7 +21,9 @@ use super::block_types::{Ctx, Sig};
 use super::data_types::DataTypes;
 use super::interface::{self, name, Interface, Known};
 use super::xml::{add_data_note, attr, error, identifier, origin, Note, Notes, Tc6, R};
-use super::{fbd, il_body, ld, ld_flow, library, sfc, sfc_lower, st_body, st_scope, textual};
+use super::{
+    fbd, il_body, ld, ld_flow, library, matiec_lib, sfc, sfc_lower, st_body, st_scope, textual,
+};
 use plc_diag::LoadError;
 use plc_model::{Configuration, ProgramInstance, Resource, Task};
 use plc_syntax::{
@@ -62,14 +64,33 @@ pub(super) fn program(
     };
     // The interfaces first, then the globals, then the bodies: an ST body resolves its names
     // against them all.
-    let mut read = Vec::new();
     let pous = types.and_then(|t| tc6.child(t, "pous"));
     let standard: Vec<Node> = pous
         .into_iter()
         .flat_map(|p| tc6.children(p, "pou"))
         .collect();
     let vendor = vendor_pous(tc6, root, &standard, notes);
-    for pou in standard.into_iter().chain(vendor) {
+    // matiec's library blocks the project uses and does not define, read as its own POUs.
+    let own: Vec<&str> = standard
+        .iter()
+        .chain(&vendor)
+        .filter_map(|p| p.attribute("name"))
+        .collect();
+    // Only in matiec's dialect: CODESYS's and TwinCAT's libraries have their own blocks of
+    // these names (CODESYS's Util PID has other pins), which stay undefined black boxes.
+    let added = (dialect_of(tc6, root) == plc_model::Dialect::Matiec)
+        .then(|| matiec_lib::added(tc6, root, &own, doc.input_text().len()))
+        .flatten();
+    let added_doc = match &added {
+        Some(a) => Some(super::xml::parse(&a.text)?),
+        None => None,
+    };
+    let library_pous: Vec<Node> = added_doc
+        .iter()
+        .flat_map(|d| tc6.children(d.root_element(), "pou"))
+        .collect();
+    let mut read = Vec::new();
+    for pou in standard.into_iter().chain(vendor).chain(library_pous) {
         let raw = attr(pou, "name", "types/pous")?;
         let pname = identifier(raw, "POU", pou, "types/pous")?;
         let place = format!("pou {pname}");
@@ -143,6 +164,13 @@ pub(super) fn program(
         bodies.push(Some(body(tc6, *pou, pname, iface, &scope, &ctx, notes)?));
     }
     notes.list.extend(later.list);
+    if let Some(a) = &added {
+        // What the reader says about the library's own bodies: the one note instead.
+        notes
+            .list
+            .retain(|n| !matiec_lib::in_library(n.origin, a.start));
+        notes.push(a.note.clone());
+    }
     let (mut programs, mut fbs) = (Vec::new(), Vec::new());
     for ((pou, pname, kind, iface), body) in read.into_iter().zip(bodies) {
         let place = format!("pou {pname}");
@@ -211,13 +239,17 @@ pub(super) fn program(
     };
     let mut program = assemble(root, programs, fbs, globals, order)?;
     program.configuration = configuration;
-    // The toolchain's dialect, by the editor the header names (docs/dialects.md).
+    program.dialect = dialect_of(tc6, root);
+    Ok(program)
+}
+
+/// The toolchain's dialect, by the editor the header names (docs/dialects.md).
+fn dialect_of(tc6: Tc6, root: Node) -> plc_model::Dialect {
     let product = tc6
         .child(root, "fileHeader")
         .and_then(|h| h.attribute("productName"))
         .unwrap_or("");
-    program.dialect = plc_model::Dialect::of_editor(product);
-    Ok(program)
+    plc_model::Dialect::of_editor(product)
 }
 
 /// The POUs CODESYS and TwinCAT keep in vendor data rather than in `types/pous`: a TC6 `pou`
