@@ -40,15 +40,21 @@
 //! - enumeration values (`RED`, `COLOR#RED`, CASE labels) as their integers (the enumeration
 //!   is INT, numbered as matiec numbers it: [`super::data_types`]).
 //! - `a := b` of two structures: a move per field ([`calls`]).
+//! - calls of the project's functions (`y := F(a, b)`, formal, `=>` outputs, EN/ENO, nested,
+//!   as statements): the inputs moved into the body's instance of the function's type, a
+//!   `call`, the result and outputs moved out ([`functions`], [`super::user_functions`]).
+//! - informal arguments of function block calls, bound in declaration order; formal arguments
+//!   of standard functions put in their pins' order ([`functions`]).
+//! - STRING literals (`'a$'b'`) and variables: moves, comparisons, the string functions and
+//!   conversions the model has ([`functions`]).
 //!
 //! Invariants: a body is lowered whole or not at all; what the lowering does not handle is a
 //! [`Refusal`] naming the construct and where it is, and then the body keeps its stand-in
 //! rungs and `run`/`c` refuse it with that reason (never a silently skipped statement).
 //!
 //! Deliberately not here (refused): pragmas `{…}` (matiec pastes their text, often C, into its
-//! output), calls of user functions, informal arguments of function block calls, an instance
-//! as a value, writes of an instance's outputs, arrays, dereferences, direct addresses,
-//! strings.
+//! output), recursive calls of functions, an instance as a value, writes of an instance's
+//! outputs, arrays, dereferences, direct addresses, WSTRINGs.
 
 #[path = "st_calls.rs"]
 mod calls;
@@ -1450,6 +1456,11 @@ fn cmp_op(op: BinaryOp) -> Option<CmpOp> {
         BinaryOp::Ge => CmpOp::Ge,
         _ => return None,
     })
+}
+
+/// The instance through which a body calls the project's function `f`.
+pub(super) fn function_instance_name(f: &str) -> String {
+    functions::instance_name(f)
 }
 
 /// `a.b.c` of a place of fields only.
