@@ -82,7 +82,7 @@ pub(super) fn sig(
         .collect();
     let mut refused = None;
     if ret.is_none() {
-        refused = Some(format!("its result's type is not one the model executes"));
+        refused = Some("its result's type is not one the model executes".to_owned());
     }
     if let Some(v) = inputs.iter().chain(outputs).chain(locals).find(|v| {
         plc_model::Type::parse(v.ty.as_str()).is_none_or(|t| matches!(t, plc_model::Type::Fb(_)))
@@ -317,7 +317,8 @@ fn start(body: &mut Body<'static>, sig: &FnSig) -> Result<(), String> {
     let rungs = match body {
         Body::Rungs(r) => r,
         Body::Fbd(_) => {
-            let locals = sig.starts.len() - sig.inputs.len() - sig.outputs.len() - 1;
+            let locals =
+                (sig.starts.len()).saturating_sub(sig.inputs.len() + sig.outputs.len() + 1);
             if locals > 0 {
                 return Err(
                     "its FBD body has local variables, which a call cannot start yet".into(),
@@ -325,8 +326,6 @@ fn start(body: &mut Body<'static>, sig: &FnSig) -> Result<(), String> {
             }
             return Ok(());
         }
-        #[allow(unreachable_patterns)]
-        _ => return Err("its body is of a kind a call cannot start".into()),
     };
     let at = rungs.first().map_or(plc_diag::Origin::NONE, |r| r.origin);
     let l = |s: String| Located {
