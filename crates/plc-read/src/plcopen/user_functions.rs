@@ -104,6 +104,10 @@ pub(super) fn sig(
     }
 }
 
+/// Reads the body of the function of a given index, its scope seeing the functions given.
+pub(super) type ReadBody<'a> =
+    dyn FnMut(usize, &HashMap<String, FnSig>, &mut Notes) -> R<Body<'static>> + 'a;
+
 /// A function's body as read, with the notes its reading made.
 pub(super) struct ReadFn {
     pub body: Body<'static>,
@@ -117,7 +121,7 @@ pub(super) fn read_all(
     funcs: &[(usize, String)],
     sigs: &mut HashMap<String, FnSig>,
     exec: bool,
-    read_body: &mut dyn FnMut(usize, &HashMap<String, FnSig>, &mut Notes) -> R<Body<'static>>,
+    read_body: &mut ReadBody,
 ) -> HashMap<usize, ReadFn> {
     loop {
         let mut done: HashMap<usize, ReadFn> = HashMap::new();
