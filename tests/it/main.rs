@@ -86,5 +86,6 @@ mod schema;
 mod sfc_exec;
 mod st_calls;
 mod st_exec;
+mod st_functions;
 mod standard_fbs;
 mod strings;

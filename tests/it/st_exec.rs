@@ -243,9 +243,11 @@ fn what_is_not_executed_is_refused_by_run_and_c_with_its_place() {
             "the call of function `MYFUNC` (only the standard functions are executed)",
         ),
         (
-            "x := 1;\nT1(TRUE, T#1s);",
+            // Informal arguments bind to IN, PT in order (tests/it/st_functions.rs); a third
+            // has no input to go to.
+            "x := 1;\nT1(TRUE, T#1s, 3);",
             "T1(TRUE",
-            "an informal argument in the call of `T1`",
+            "3 informal arguments in the call of `T1`, which has 2 inputs (IN, PT)",
         ),
         (
             "x := 1;\n{ printf(\"hi\"); }\ny := 2;",

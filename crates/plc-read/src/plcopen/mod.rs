@@ -42,6 +42,7 @@ mod st_body;
 mod st_lower;
 mod st_scope;
 mod textual;
+mod user_functions;
 mod wiring;
 mod xml;
 

@@ -23,6 +23,7 @@ use super::interface::{self, name, Interface, Known};
 use super::xml::{add_data_note, attr, error, identifier, origin, Note, Notes, Tc6, R};
 use super::{
     fbd, il_body, ld, ld_flow, library, matiec_lib, sfc, sfc_lower, st_body, st_scope, textual,
+    user_functions,
 };
 use plc_diag::LoadError;
 use plc_model::{Configuration, ProgramInstance, Resource, Task};
@@ -54,11 +55,7 @@ pub(super) fn program(
         add_data_note(tc6, ch, notes);
     }
     let types = tc6.child(root, "types");
-    let dialect = plc_model::Dialect::of_editor(
-        tc6.child(root, "fileHeader")
-            .and_then(|h| h.attribute("productName"))
-            .unwrap_or(""),
-    );
+    let dialect = dialect_of(tc6, root);
     let known = Known {
         data_types: DataTypes::read(tc6, types.and_then(|t| tc6.child(t, "dataTypes")))?,
     };
@@ -78,7 +75,7 @@ pub(super) fn program(
         .collect();
     // Only in matiec's dialect: CODESYS's and TwinCAT's libraries have their own blocks of
     // these names (CODESYS's Util PID has other pins), which stay undefined black boxes.
-    let added = (dialect_of(tc6, root) == plc_model::Dialect::Matiec)
+    let added = (dialect == plc_model::Dialect::Matiec)
         .then(|| matiec_lib::added(tc6, root, &own, doc.input_text().len()))
         .flatten();
     let added_doc = match &added {
@@ -102,7 +99,10 @@ pub(super) fn program(
                 format!("unknown pouType `{kind}` of POU `{pname}`"),
             ));
         }
-        let iface = interface::interface(tc6, tc6.child(pou, "interface"), &pname, &known)?;
+        let mut iface = interface::interface(tc6, tc6.child(pou, "interface"), &pname, &known)?;
+        if kind == "function" {
+            user_functions::add_result(&pname, &mut iface);
+        }
         read.push((pou, pname, kind, iface));
     }
     let mut later = Notes::default();
@@ -143,15 +143,8 @@ pub(super) fn program(
             outputs: pins(&i.outputs),
         })
         .collect();
-    let mut bodies = Vec::new();
-    for (pou, pname, kind, iface) in &read {
-        add_data_note(tc6, *pou, notes);
-        check_return(*pou, pname, kind, iface)?;
-        if *kind == "function" {
-            notes.push(function_note(*pou, pname));
-            bodies.push(None);
-            continue;
-        }
+    // The functions first: which of them an ST body can call (user_functions).
+    let scope_of = |iface: &Interface| {
         let mut scope = scope(iface, &global_types, &known, &user_fbs);
         scope.int_arithmetic_in_dint = dialect.int_arithmetic_in_dint();
         scope.inputs.extend(
@@ -160,8 +153,57 @@ pub(super) fn program(
                 .filter(|g| iface.externals.iter().any(|e| e.eq_ignore_ascii_case(g)))
                 .cloned(),
         );
+        scope
+    };
+    let fn_list: Vec<(usize, String)> = read
+        .iter()
+        .enumerate()
+        .filter(|(_, r)| r.2 == "function")
+        .map(|(k, r)| (k, r.1.clone()))
+        .collect();
+    let mut sigs = user_functions::sigs(&read);
+    let mut fn_bodies =
+        user_functions::read_all(&fn_list, &mut sigs, notes.exec, &mut |k, sigs, scratch| {
+            let (pou, pname, _, iface) = &read[k];
+            check_return(*pou, pname, "function", iface)?;
+            let mut scope = scope_of(iface);
+            scope.funcs = sigs.clone();
+            let ctx = pou_ctx(&base, iface, &global_types);
+            body(tc6, *pou, pname, iface, &scope, &ctx, scratch)
+        });
+    let mut fn_notes_at = Vec::new();
+    let mut bodies = Vec::new();
+    for (k, (pou, pname, kind, iface)) in read.iter().enumerate() {
+        add_data_note(tc6, *pou, notes);
+        check_return(*pou, pname, kind, iface)?;
+        if *kind == "function" {
+            fn_notes_at.push((k, notes.list.len()));
+            bodies.push(None);
+            continue;
+        }
+        let mut scope = scope_of(iface);
+        scope.funcs = sigs.clone();
         let ctx = pou_ctx(&base, iface, &global_types);
         bodies.push(Some(body(tc6, *pou, pname, iface, &scope, &ctx, notes)?));
+    }
+    // The functions some body calls, directly or through others, become types; each keeps
+    // its note where it was.
+    let used = user_functions::used(&notes.ld_vars, &fn_list, &fn_bodies);
+    for &(k, at) in fn_notes_at.iter().rev() {
+        let (pou, pname, _, _) = &read[k];
+        let executed = used.contains(&pname.to_ascii_lowercase());
+        match fn_bodies.remove(&k) {
+            Some(r) if executed => {
+                let mut list = vec![user_functions::executed_note(origin(*pou), pname)];
+                list.extend(r.notes.list);
+                notes.list.splice(at..at, list);
+                notes.ld_vars.extend(r.notes.ld_vars);
+                notes.black_boxes.extend(r.notes.black_boxes);
+                notes.exec_orders.extend(r.notes.exec_orders);
+                bodies[k] = Some(r.body);
+            }
+            _ => notes.list.insert(at, function_note(*pou, pname)),
+        }
     }
     notes.list.extend(later.list);
     if let Some(a) = &added {
@@ -211,8 +253,19 @@ pub(super) fn program(
                     body: Some(body),
                 });
             }
-            // A function (its body is `None`, skipped above).
-            _ => {}
+            // A function some body calls (user_functions).
+            _ => fbs.push(FunctionBlock {
+                origin: origin(pou),
+                name: user_functions::type_name(&pname).into(),
+                inputs: iface.inputs,
+                outputs: iface.outputs,
+                vars: iface
+                    .locals
+                    .into_iter()
+                    .chain(notes.take_ld_vars(&pname))
+                    .collect(),
+                body: Some(body),
+            }),
         }
     }
     for b in std::mem::take(&mut notes.black_boxes) {
@@ -239,7 +292,7 @@ pub(super) fn program(
     };
     let mut program = assemble(root, programs, fbs, globals, order)?;
     program.configuration = configuration;
-    program.dialect = dialect_of(tc6, root);
+    program.dialect = dialect;
     Ok(program)
 }
 
@@ -466,7 +519,7 @@ fn function_note(pou: Node, pname: &str) -> Note {
 
 /// The names an ST body of a POU with interface `iface` sees: its own variables and the globals
 /// it declares external (`globals`: the name and type of every global of the project).
-fn scope(
+pub(super) fn scope(
     iface: &Interface,
     globals: &[(&str, &str)],
     known: &Known,
@@ -995,7 +1048,12 @@ fn base_ctx(read: &[(Node, String, &str, Interface)]) -> Ctx {
                 if let Some(t) = &iface.return_ty {
                     outputs.push(("OUT".to_owned(), t.clone()));
                 }
-                outputs.extend(pins(&iface.outputs));
+                // The result (a variable named like the function) is `OUT`.
+                outputs.extend(
+                    pins(&iface.outputs)
+                        .into_iter()
+                        .filter(|(n, _)| !n.eq_ignore_ascii_case(name)),
+                );
                 let sig = Sig {
                     inputs: pins(&iface.inputs),
                     outputs,

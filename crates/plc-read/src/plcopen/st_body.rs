@@ -46,6 +46,8 @@ struct Unseen {
     instances_read: Vec<String>,
     addresses: Vec<String>,
     functions: Vec<String>,
+    /// The project's functions it calls, executed (seen through their bodies).
+    user_functions: Vec<String>,
 }
 
 fn push_once(v: &mut Vec<String>, s: &str) {
@@ -69,6 +71,8 @@ pub(super) fn rungs(
     let mut k = 0;
     let mut lower = Lower::new(scope, pou);
     let mut refused: Option<(Origin, String)> = None;
+    // The instances the stand-ins call the project's functions through.
+    let mut declared: Vec<String> = Vec::new();
     for t in node.descendants().filter(|d| d.is_text()) {
         let text = t.text().unwrap_or("");
         if text.trim().is_empty() {
@@ -117,7 +121,17 @@ pub(super) fn rungs(
             // The analysis sees a call of a user instance as the call of its POU (what its
             // body reads and writes); a run never executes it from a stand-in.
             if !notes.exec {
-                for inst in user_calls(&a, scope) {
+                let calls = user_calls(&a, scope);
+                for (inst, ty) in function_calls(&a, scope) {
+                    if !declared.contains(&inst) {
+                        notes
+                            .ld_vars
+                            .push((pou.to_owned(), instance_var(&inst, &ty, here)));
+                        declared.push(inst.clone());
+                    }
+                }
+                let fns = function_calls(&a, scope).into_iter().map(|(i, _)| i);
+                for inst in calls.into_iter().chain(fns) {
                     let r = rung.get_or_insert_with(|| empty_rung(id.clone(), here));
                     r.ld.push(plc_syntax::Element {
                         origin: here,
@@ -191,6 +205,42 @@ fn everything(scope: &Scope, reads: &mut Vec<Read>, writes: &mut Vec<String>) {
     }
 }
 
+/// The instances (and their types) through which statement accesses `a` call the project's
+/// functions that execute ([`super::user_functions`]): the analysis sees such a call as the
+/// call of the function's body, what it reads and writes (its arguments and the globals it
+/// touches), as `run` executes it.
+fn function_calls(a: &st::Accesses, scope: &Scope) -> Vec<(String, String)> {
+    let mut v: Vec<(String, String)> = Vec::new();
+    for c in &a.calls {
+        if let Some(f) = scope.func(c).filter(|f| f.refused.is_none()) {
+            let inst = st_lower::function_instance_name(&f.name);
+            if !v.iter().any(|(i, _)| *i == inst) {
+                v.push((inst, f.ty.clone()));
+            }
+        }
+    }
+    v
+}
+
+/// The declaration of instance `name` of function block type `ty`.
+fn instance_var(name: &str, ty: &str, at: Origin) -> plc_syntax::Var<'static> {
+    let l = |s: &str| plc_syntax::Located {
+        value: std::borrow::Cow::Owned(s.to_owned()),
+        origin: at,
+    };
+    plc_syntax::Var {
+        origin: at,
+        name: l(name),
+        ty: l(ty),
+        class: plc_syntax::Located {
+            value: plc_syntax::VarClass::Memory,
+            origin: at,
+        },
+        init: None,
+        problem: None,
+    }
+}
+
 /// The user function block instances statement accesses `a` calls, by their declared names.
 fn user_calls(a: &st::Accesses, scope: &Scope) -> Vec<String> {
     let mut v = Vec::new();
@@ -242,6 +292,10 @@ fn message(pou: &str, statements: usize, unseen: &Unseen, executed: &str) -> Str
         &unseen.addresses,
     );
     add(
+        "the project's functions it calls are seen and executed through their bodies",
+        &unseen.user_functions,
+    );
+    add(
         "the functions it calls are black boxes (the arguments read, the result and outputs written where the call assigns them)",
         &unseen.functions,
     );
@@ -268,8 +322,10 @@ fn resolve(
     };
     let called = |n: &str| called(n.split('.').next().unwrap_or(n));
     for c in &a.calls {
-        if scope.get(c).is_none() {
-            push_once(&mut unseen.functions, c);
+        match scope.func(c) {
+            Some(f) if f.refused.is_none() => push_once(&mut unseen.user_functions, &f.name),
+            _ if scope.get(c).is_none() => push_once(&mut unseen.functions, c),
+            _ => {}
         }
     }
     let mut reads = Vec::new();

@@ -19,8 +19,8 @@
 //!
 //! Invariant: which inputs need their variable is decided for a whole ST text before its first
 //! statement is lowered ([`Lower::prepare`]), so that every call stores what a later one reads.
-//! Deliberately not here: informal (positional) arguments of function block calls, EN/ENO of
-//! function block calls, instances of the library's function blocks other than the standard
+//! Informal (positional) arguments are named before they come here ([`super::functions`]).
+//! Deliberately not here: EN/ENO of function block calls, instances of the library's function blocks other than the standard
 //! ones (refused by name).
 
 use super::super::st_scope::{Decl, FbPins};

@@ -44,18 +44,26 @@
 //! - enumeration values (`RED`, `COLOR#RED`, CASE labels) as their integers (the enumeration
 //!   is INT, numbered as matiec numbers it: [`super::data_types`]).
 //! - `a := b` of two structures: a move per field ([`calls`]).
+//! - calls of the project's functions (`y := F(a, b)`, formal, `=>` outputs, EN/ENO, nested,
+//!   as statements): the inputs moved into the body's instance of the function's type, a
+//!   `call`, the result and outputs moved out ([`functions`], [`super::user_functions`]).
+//! - informal arguments of function block calls, bound in declaration order; formal arguments
+//!   of standard functions put in their pins' order ([`functions`]).
+//! - STRING literals (`'a$'b'`) and variables: moves, comparisons, the string functions and
+//!   conversions the model has ([`functions`]).
 //!
 //! Invariants: a body is lowered whole or not at all; what the lowering does not handle is a
 //! [`Refusal`] naming the construct and where it is, and then the body keeps its stand-in
 //! rungs and `run`/`c` refuse it with that reason (never a silently skipped statement).
 //!
 //! Deliberately not here (refused): pragmas `{…}` (matiec pastes their text, often C, into its
-//! output), calls of user functions, informal arguments of function block calls, an instance
-//! as a value, writes of an instance's outputs, arrays, dereferences, direct addresses,
-//! strings.
+//! output), recursive calls of functions, an instance as a value, writes of an instance's
+//! outputs, arrays, dereferences, direct addresses, WSTRINGs.
 
 #[path = "st_calls.rs"]
 mod calls;
+#[path = "st_functions.rs"]
+mod functions;
 
 use super::interface::literal;
 use super::st_scope::{Decl, Scope};
@@ -97,6 +105,7 @@ impl Val {
             Val::Var(_, t) => Some(*t),
             Val::Lit(Scalar::Bool(_)) => Some(Type::Bool),
             Val::Lit(Scalar::Str(s)) if plc_syntax::is_time_literal(s) => Some(Type::Time),
+            Val::Lit(Scalar::Str(s)) if s.starts_with('\'') => Some(Type::String),
             Val::Lit(_) => None,
         }
     }
@@ -131,6 +140,8 @@ pub(super) struct Lower<'s> {
     false_var: bool,
     /// The variables holding inputs of standard instances ([`calls`]).
     held: Vec<String>,
+    /// The instances the body calls the project's functions through ([`functions`]).
+    pub fn_instances: Vec<String>,
 }
 
 type Series = Vec<ElementKind<'static>>;
@@ -154,6 +165,7 @@ impl<'s> Lower<'s> {
             loops: Vec::new(),
             false_var: false,
             held: Vec::new(),
+            fn_instances: Vec::new(),
         }
     }
 
@@ -328,6 +340,17 @@ impl<'s> Lower<'s> {
             init: None,
             problem: None,
         });
+    }
+
+    /// Declares `name`, an instance of function block type `ty`.
+    fn declare_instance(&mut self, name: &str, ty: &str) {
+        self.declare(name, Type::Bool);
+        if let Some(v) = self.vars.last_mut() {
+            v.ty = Located {
+                value: Cow::Owned(ty.to_owned()),
+                origin: v.ty.origin,
+            };
+        }
     }
 
     fn temp(&mut self, ty: Type) -> String {
@@ -764,6 +787,10 @@ impl<'s> Lower<'s> {
     /// A call of a standard function block instance (its inputs formal, all given).
     fn fb_call(&mut self, callee: &Place, args: &[Arg]) -> L<()> {
         let at = callee.base_at;
+        // A function called as a statement, its result dropped.
+        if self.user_function_call(callee, args, None, None)?.is_some() {
+            return Ok(());
+        }
         let (inst, ty) = match self.scope.find(&place_path(callee)) {
             Ok(Some((Decl::Instance { name, ty, .. }, true))) if callee.selectors.is_empty() => {
                 (name.clone(), ty.clone())
@@ -778,6 +805,12 @@ impl<'s> Lower<'s> {
                 )
             }
         };
+        let pin_names: Vec<String> = match (self.scope.fb(&ty), calls::std_pins(&ty)) {
+            (Some(fb), _) => fb.inputs.iter().map(|(n, _)| n.clone()).collect(),
+            (None, Some(ps)) => ps.iter().map(|(n, _)| n.to_string()).collect(),
+            (None, None) => Vec::new(),
+        };
+        let args = &*functions::name_informal(at, &inst, &pin_names, args)?;
         if let Some(fb) = self.scope.fb(&ty).cloned() {
             return self.user_fb_call(at, &inst, &fb, args);
         }
@@ -1306,7 +1339,13 @@ impl<'s> Lower<'s> {
                 BinaryOp::And | BinaryOp::Or | BinaryOp::Xor => self.is_bool(a) || self.is_bool(b),
                 _ => cmp_op(*op).is_some(),
             },
-            Expr::Call { callee, .. } => callee.base.to_ascii_uppercase().ends_with("_TO_BOOL"),
+            Expr::Call { callee, .. } => {
+                callee.base.to_ascii_uppercase().ends_with("_TO_BOOL")
+                    || self
+                        .scope
+                        .func(&callee.base)
+                        .is_some_and(|f| f.ret.eq_ignore_ascii_case("BOOL"))
+            }
         }
     }
 
@@ -1338,7 +1377,8 @@ impl<'s> Lower<'s> {
                 return Ok(Some(Val::Lit(Scalar::Bool(s == "1"))));
             }
         }
-        if self.is_bool(e) {
+        // A call computes its value itself (`cond` of a BOOL call asks for its value here).
+        if self.is_bool(e) && !matches!(e, Expr::Call { .. }) {
             if let Some(b) = bool_literal(e) {
                 return Ok(Some(Val::Lit(Scalar::Bool(b))));
             }
@@ -1348,6 +1388,9 @@ impl<'s> Lower<'s> {
             return Ok(Some(self.bool_temp(e)?));
         }
         match e {
+            Expr::Literal(s) if s.starts_with('\'') || s.starts_with('"') => {
+                functions::string_literal(self.at, s).map(|v| Some(Val::Lit(v)))
+            }
             Expr::Literal(s) => match (literal(s), self.scope.enum_literal(s)) {
                 (_, Some(i)) => Ok(Some(Val::Lit(Scalar::Number(i.into())))),
                 (Some(v), _) => Ok(Some(Val::Lit(v))),
@@ -1443,8 +1486,12 @@ impl<'s> Lower<'s> {
     ) -> L<Option<Val>> {
         let at = callee.base_at;
         let fname = callee.base.to_ascii_uppercase();
+        if let Some(done) = self.user_function_call(callee, args, want, out)? {
+            return Ok(done);
+        }
+        let args = functions::formal_order(at, &fname, args)?;
         let mut values: Vec<&Expr> = Vec::new();
-        for a in args {
+        for a in args.iter() {
             match a {
                 Arg::Input { value, .. } => values.push(value),
                 Arg::Output { .. } => {
@@ -1678,6 +1725,11 @@ fn cmp_op(op: BinaryOp) -> Option<CmpOp> {
         BinaryOp::Ge => CmpOp::Ge,
         _ => return None,
     })
+}
+
+/// The instance through which a body calls the project's function `f`.
+pub(super) fn function_instance_name(f: &str) -> String {
+    functions::instance_name(f)
 }
 
 /// `a.b.c` of a place of fields only.

@@ -48,6 +48,8 @@ pub(super) struct Scope {
     /// or passed, as matiec's C computes it in `int` (the file's editor is Beremiz or OpenPLC:
     /// [`plc_model::Dialect::int_arithmetic_in_dint`]).
     pub int_arithmetic_in_dint: bool,
+    /// The project's functions by lower-case name ([`super::user_functions`]).
+    pub funcs: HashMap<String, super::user_functions::FnSig>,
 }
 
 /// A function block type of the project: its inputs and outputs (name as declared, model
@@ -125,6 +127,14 @@ impl Scope {
     /// The pins of the project's function block type `ty`, if it is one.
     pub(super) fn fb(&self, ty: &str) -> Option<&FbPins> {
         self.fbs.get(&ty.to_ascii_lowercase())
+    }
+
+    /// The project's function `name`, if it is one (and no variable hides it).
+    pub(super) fn func(&self, name: &str) -> Option<&super::user_functions::FnSig> {
+        if self.get(name).is_some() {
+            return None;
+        }
+        self.funcs.get(&name.to_ascii_lowercase())
     }
 
     pub(super) fn get(&self, name: &str) -> Option<&Decl> {
