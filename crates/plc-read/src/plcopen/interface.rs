@@ -27,7 +27,7 @@
 //! Deliberately not here: structured initial values of elementary variables and `VAR_ACCESS`
 //! — each an error naming the variable, until the model has them.
 
-use super::data_types::{Aggregate, Base, DataType, DataTypes};
+use super::data_types::{Base, DataType, DataTypes};
 use super::elementary::{is_elementary_tag, model_type_of, MAPPED, MODEL_ELEMENTARY};
 use super::xml::{error, identifier, origin, Tc6, R};
 use plc_syntax::{Located, Name, Operand, Scalar, Var, VarClass};
@@ -241,6 +241,37 @@ fn variable(
         }
         return Ok(vec![one(tc6, &decl, name, ty, iv, None, mapped)?]);
     };
+    if let Base::Array(a) = &d.base {
+        let mut a = (**a).clone();
+        if let Some(iv) = tc6.child(v, "initialValue") {
+            let av = tc6.child(iv, "arrayValue").ok_or_else(|| {
+                error(
+                    origin(iv),
+                    &place,
+                    format!("the initial value of array `{name}` is not an array value (`[1, 2, 3]`)"),
+                )
+            })?;
+            a.init = super::data_types::array_value(tc6, av, a.len(), &name, &place)?;
+        }
+        mapped.push(Mapped {
+            var: name.clone(),
+            origin: origin(v),
+            from: d.name.clone(),
+            to: "its elements",
+            text: false,
+            via: Some(d.describe()),
+        });
+        let mut out = Vec::new();
+        for el in super::data_types::elements(&name, &a) {
+            let ty = if el.elementary {
+                Ty::Elementary(data_base(&el.ty))
+            } else {
+                Ty::Data(el.ty)
+            };
+            out.push(one(tc6, &decl, el.path, ty, None, el.init, mapped)?);
+        }
+        return Ok(out);
+    }
     let Base::Struct(members) = &d.base else {
         let iv = tc6.child(v, "initialValue");
         return Ok(vec![one(tc6, &decl, name, ty, iv, None, mapped)?]);
@@ -409,7 +440,7 @@ fn data_base(d: &DataType) -> String {
         Base::Elementary(t) => t.clone(),
         Base::Enum(_) => "INT".to_owned(),
         // An array (or a structure not flattened) has no value: the DINT stand-in.
-        Base::Whole(_) | Base::Struct(_) => "DINT".to_owned(),
+        Base::Whole(_) | Base::Struct(_) | Base::Array(_) => "DINT".to_owned(),
     }
 }
 
@@ -434,17 +465,18 @@ fn type_name(tc6: Tc6, ty: Node, var: &str, place: &str, known: &Known) -> R<Ty>
     if is_elementary_tag(tag) {
         return Ok(Ty::Elementary(tag.to_owned()));
     }
-    let whole = |a: Aggregate, n: &str| {
-        Ok(Ty::Data(DataType {
-            name: n.to_owned(),
-            base: Base::Whole(a),
-            range: None,
-            init: None,
-            library: None,
-        }))
-    };
     match tag {
-        "array" => return whole(Aggregate::Array, "ARRAY"),
+        "array" => {
+            return Ok(Ty::Data(super::data_types::array(
+                tc6,
+                &std::collections::HashMap::new(),
+                Some(&known.data_types),
+                "ARRAY",
+                t,
+                0,
+                place,
+            )?))
+        }
         // A subrange or enumeration declared in place (`x : INT (0..10)`, `c : (RED, GREEN)`).
         "subrangeSigned" | "subrangeUnsigned" | "enum" => {
             let shown = if tag == "enum" { "ENUM" } else { "SUBRANGE" };
