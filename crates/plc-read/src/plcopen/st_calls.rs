@@ -264,20 +264,27 @@ impl Lower<'_> {
             return Ok(false);
         };
         let (tp, sp) = (place_path(target), place_path(source));
-        let (
-            Ok(Some((Decl::Structure { leaves: to }, true))),
-            Ok(Some((Decl::Structure { leaves: from }, true))),
-        ) = (self.scope.find(&tp), self.scope.find(&sp))
+        // Two structures, or two arrays (`a := b`: a move per element, IEC 61131-3 6.4.4.5
+        // assigns an array of the same type whole).
+        let (Ok(Some((to, true))), Ok(Some((from, true)))) =
+            (self.scope.find(&tp), self.scope.find(&sp))
         else {
             return Ok(false);
         };
+        let arrays = matches!((to, from), (Decl::Array { .. }, Decl::Array { .. }));
+        let structures = matches!((to, from), (Decl::Structure { .. }, Decl::Structure { .. }));
+        let (Some(to), Some(from), true) = (to.leaves(), from.leaves(), arrays || structures)
+        else {
+            return Ok(false);
+        };
+        let what = if arrays { "arrays whose elements" } else { "structures whose fields" };
         let rel = |leaves: &[(String, String)], root: usize| -> Vec<(String, String, String)> {
             leaves
                 .iter()
                 .map(|(n, t)| (n[root..].to_ascii_lowercase(), n.clone(), t.clone()))
                 .collect()
         };
-        let (mut to, mut from) = (rel(to, tp.len()), rel(from, sp.len()));
+        let (mut to, mut from) = (rel(&to, tp.len()), rel(&from, sp.len()));
         to.sort();
         from.sort();
         let same =
@@ -285,7 +292,7 @@ impl Lower<'_> {
         if !same {
             return refuse(
                 at,
-                format!("`{tp} := {sp}` of structures whose fields differ"),
+                format!("`{tp} := {sp}` of {what} differ"),
             );
         }
         for ((_, t, ty), (_, f, _)) in to.iter().zip(&from) {
