@@ -83,6 +83,7 @@ mod run_cli;
 mod scan_budget;
 mod schema;
 mod sfc_exec;
+mod st_arrays;
 mod st_calls;
 mod st_exec;
 mod standard_fbs;

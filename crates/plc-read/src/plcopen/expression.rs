@@ -31,10 +31,12 @@ use std::borrow::Cow;
 /// What in variable `node` (in `place`, its pin at `at`) gives: its literal, its variable, or
 /// the output of the blocks its expression is made into.
 pub(super) fn block_input(a: &mut Added, node: Node, place: &str, at: Origin) -> R<Input<'static>> {
-    if let Ok(simple) = super::pins::block_input(node, place, at) {
-        return Ok(simple);
-    }
     let text = expression_text(node);
+    if !text.contains('[') {
+        if let Ok(simple) = super::pins::block_input(node, place, at) {
+            return Ok(simple);
+        }
+    }
     let shown = shortened(text.trim());
     let bad = |why: String| error(origin(node), place, format!("expression `{shown}`: {why}"));
     let e = crate::st::parser::expression(text).map_err(|e| bad(e.message))?;
@@ -50,9 +52,48 @@ fn shortened(text: &str) -> Cow<'_, str> {
     }
 }
 
-/// Whether in variable `node` reads an array element (its expression has a subscript).
-pub(super) fn reads_array_element(node: Node) -> bool {
-    expression_text(node).contains('[')
+/// Whether in variable `node` reads an array element that is not the variable of a scalarised
+/// array's element (`vars`: the POU's variables by lower-case name): a subscript that is not
+/// constant, or an array plc-deps holds as one value.
+pub(super) fn reads_array_element(node: Node, vars: &std::collections::HashMap<String, String>) -> bool {
+    let text = expression_text(node);
+    if !text.contains('[') {
+        return false;
+    }
+    fn known(e: &Expr, vars: &std::collections::HashMap<String, String>) -> bool {
+        match e {
+            Expr::Literal(_) => true,
+            Expr::Var(p) => {
+                !p.selectors.iter().any(|s| matches!(s, Selector::Index(_)))
+                    || element_name(p).is_some_and(|n| vars.contains_key(&n.to_ascii_lowercase()))
+            }
+            Expr::Unary(_, x) => known(x, vars),
+            Expr::Binary(_, a, b) => known(a, vars) && known(b, vars),
+            Expr::Call { .. } => true,
+        }
+    }
+    match crate::st::parser::expression(text) {
+        Ok(e) => !known(&e, vars),
+        Err(_) => true,
+    }
+}
+
+/// The variable of array element `p` when its subscripts are constant and last (`a[3]`,
+/// `s.m[1, -2]` as `s.m[1,-2]`), the name a scalarised array's element has.
+pub(super) fn element_name(p: &Place) -> Option<String> {
+    let (last, fields) = p.selectors.split_last()?;
+    let Selector::Index(ix) = last else { return None };
+    let mut name = p.base.clone();
+    for f in fields {
+        let Selector::Field(f) = f else { return None };
+        name.push('.');
+        name.push_str(f);
+    }
+    let ks: Option<Vec<String>> = ix
+        .iter()
+        .map(|e| crate::st::constant(e).map(|k| k.to_string()))
+        .collect();
+    Some(format!("{name}[{}]", ks?.join(",")))
 }
 
 struct Lower<'l, F> {
@@ -118,6 +159,12 @@ impl<F: Fn(String) -> LoadError> Lower<'_, F> {
     /// A variable, a field of one, or an array element (see the module's comment).
     fn place(&mut self, p: &Place) -> R<Input<'static>> {
         let at = self.at;
+        if let Some(n) = element_name(p).filter(|n| self.a.elements.contains(&n.to_ascii_lowercase())) {
+            return Ok(Input {
+                origin: at,
+                from: Connection::Variable(Cow::Owned(n)),
+            });
+        }
         let mut name = p.base.clone();
         let mut subscripts = Vec::new();
         for s in &p.selectors {

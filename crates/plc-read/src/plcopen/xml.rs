@@ -297,11 +297,22 @@ pub(super) fn identifier(s: &str, what: &str, n: Node, place: &str) -> R<String>
 }
 
 /// A variable reference as an LD/FBD element names it: an identifier or a field of one
-/// (`T1.Q`, `G1.RESULT`), trimmed.
+/// (`T1.Q`, `G1.RESULT`), trimmed; or an element of constant subscripts of a scalarised array,
+/// as its variable's name (`a[ 1 + 2 ]` as `a[3]`, [`super::data_types`]).
 pub(super) fn variable_ref(s: &str, n: Node, place: &str) -> R<String> {
     let t = s.trim();
     if !t.is_empty() && t.split('.').all(is_identifier) {
         Ok(t.to_owned())
+    } else if let Some(e) = t
+        .contains('[')
+        .then(|| crate::st::parser::expression(t).ok())
+        .flatten()
+        .and_then(|e| match e {
+            crate::st::ast::Expr::Var(p) => super::expression::element_name(&p),
+            _ => None,
+        })
+    {
+        Ok(e)
     } else {
         Err(error(
             origin(n),
