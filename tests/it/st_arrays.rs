@@ -96,10 +96,7 @@ fn constant_and_variable_subscripts_read_and_write_their_elements() {
         ("b[1]", json!(false)), // NOT TRUE
         ("bb", json!(false)),   // TRUE AND FALSE
     ];
-    assert_eq!(
-        values(&v, &["s", "b[1]", "bb"]),
-        pairs(&scan2),
-    );
+    assert_eq!(values(&v, &["s", "b[1]", "bb"]), pairs(&scan2),);
     c_equals_run(f, 2, None);
 }
 
@@ -174,4 +171,25 @@ fn report_dependences_are_per_element_for_constant_subscripts_only() {
             json!({"kind": "flow", "from": "P.st1", "to": "P.st5", "var": "a[2]"}),
         ]
     );
+}
+
+/// FBD: `a[3] := ADD(a[1], a[ 1 + 1 ])` = 5 + 6 and `Twice := a[3] * 2` = 22 (a = [5, 6, 0]);
+/// the analysis sees the elements as the variables they are: one flow dependence, on `a[3]`.
+#[test]
+fn fbd_in_and_out_variables_of_constant_subscripts_are_the_elements() {
+    let f = "tests/st_arrays/fbd.xml";
+    let v = run_json(f, 1, None);
+    assert_eq!(
+        values(&v, &["a[1]", "a[2]", "a[3]", "Twice"]),
+        pairs(&[
+            ("a[1]", json!(5)),
+            ("a[2]", json!(6)),
+            ("a[3]", json!(11)),
+            ("Twice", json!(22)),
+        ])
+    );
+    let xml = std::fs::read_to_string(crate::common::cli::root().join(f)).unwrap();
+    let r = px::report(&xml);
+    assert_eq!(px::io(&r)[0], px::rung("P.3", &["a[1]", "a[2]"], &["a[3]"]));
+    c_equals_run(f, 1, None);
 }

@@ -12,9 +12,14 @@
 //!   (an initial value, an ST expression);
 //! - a structure as its members (below, *Structures*): a variable of it is flattened into one
 //!   variable per elementary leaf field (`Motor.Speed`), nested structures recursively;
-//! - an array as one whole variable: a read or write of any element is a read or write of the
-//!   variable. It has no value (it stands in as a DINT 0, like a string), so it may appear only
-//!   in bodies `run` does not execute.
+//! - an array of an elementary type (or of an alias, subrange or enumeration of one) with
+//!   integer bounds, at most [`MAX_ELEMENTS`] elements, SCALARISED ([`ArrayOf`]): one variable
+//!   per element named `a[3]`, `m[1,-2]` (IEC 61131-3 6.4.4.5), in element order (the last
+//!   subscript fastest), its initial values from an `arrayValue` (`[1, 2]`, `[3(0)]`; the rest the
+//!   element type's default); the ST lowering ([`super::st_lower`]) selects among them;
+//! - any other array as one whole variable: a read or write of any element is a read or write
+//!   of the variable. It has no value (it stands in as a DINT 0, like a string), so it may
+//!   appear only in bodies `run` does not execute.
 //!
 //! Beremiz's SVGHMI extension declares HMI_BOOL, HMI_INT, HMI_REAL, HMI_STRING and HMI_NODE
 //! (and, in older versions, HMI_CLASS and HMI_LABEL) in its own library (`svghmi/pous.xml`),
@@ -28,7 +33,8 @@
 //! `dataType` (a cycle of aliases, a malformed range or enumeration); names are IEC
 //! identifiers.
 //!
-//! Deliberately not here: range checks, element-wise arrays, pointers and references (errors).
+//! Deliberately not here: range checks, arrays of structures or instances (whole variables),
+//! pointers and references (errors).
 //!
 //! # Structures
 //!
@@ -42,8 +48,9 @@
 //! `Speed : INT` and `On : BOOL` is read as the variables `Motor.Speed` (INT) and `Motor.On`
 //! (BOOL), named as a function block instance's members are (`G1.IN`); a nested structure
 //! recurses (`Plant.Motor.Speed`). So a field read or written in any body is exactly that
-//! variable, and dependences are per field. A member that is an array stays one whole
-//! variable (the array's stand-in, above); an array of structures is an array.
+//! variable, and dependences are per field. A member that is an array of an elementary type is
+//! one variable per element (`Motor.Hist[0]`); another array stays one whole variable (the
+//! array's stand-in, above); an array of structures is such an array.
 //!
 //! A leaf's initial value is, first found: the variable's own structured initial value for that
 //! field, the member's `initialValue` in the structure's declaration (or a structured initial
@@ -53,7 +60,7 @@
 //! least one member and at most [`MAX_LEAVES`] leaf fields (so a chain of structures nesting
 //! each other several times cannot blow up); a `structValue` names only members that exist.
 //!
-//! Deliberately not here: element-wise arrays; whole-structure assignment in graphical bodies
+//! Deliberately not here: arrays of structures; whole-structure assignment in graphical bodies
 //! (a structure read or written as a whole is its fields in ST, [`super::st_body`]).
 
 use super::xml::{attr, error, identifier, origin, Tc6, R};
@@ -366,8 +373,7 @@ pub(super) fn resolve(
     {
         apply_value(tc6, members, sv, name, &place)?;
     }
-    if let (Some(av), Base::Array(a)) =
-        (iv.and_then(|iv| tc6.child(iv, "arrayValue")), &mut t.base)
+    if let (Some(av), Base::Array(a)) = (iv.and_then(|iv| tc6.child(iv, "arrayValue")), &mut t.base)
     {
         a.init = array_value(tc6, av, a.len(), name, &place)?;
     }

@@ -9,7 +9,8 @@
 //!
 //! A function block instance's output (`t.Q`) is the field reference the model has for it; a
 //! structure's field (`s.f`, `s.inner.f`) is passed on as such: it is the name of the field's
-//! own variable ([`super::data_types`]). An array element
+//! own variable ([`super::data_types`]), and so is an element of constant subscripts of a
+//! scalarised array (`a[3]`, `a[1 + 2]`: [`Added::elements`]). Any other array element
 //! (`a[i]`) reads the whole array and the variables of its subscripts: the model holds an array
 //! as one value of its element type (docs/plcopen.md, "Data types"), so the element stands in as
 //! `SEL(NE(i, i), a, a)` — the value `a`, with `i` read — and `run` refuses the body (the
@@ -55,7 +56,10 @@ fn shortened(text: &str) -> Cow<'_, str> {
 /// Whether in variable `node` reads an array element that is not the variable of a scalarised
 /// array's element (`vars`: the POU's variables by lower-case name): a subscript that is not
 /// constant, or an array plc-deps holds as one value.
-pub(super) fn reads_array_element(node: Node, vars: &std::collections::HashMap<String, String>) -> bool {
+pub(super) fn reads_array_element(
+    node: Node,
+    vars: &std::collections::HashMap<String, String>,
+) -> bool {
     let text = expression_text(node);
     if !text.contains('[') {
         return false;
@@ -82,7 +86,9 @@ pub(super) fn reads_array_element(node: Node, vars: &std::collections::HashMap<S
 /// `s.m[1, -2]` as `s.m[1,-2]`), the name a scalarised array's element has.
 pub(super) fn element_name(p: &Place) -> Option<String> {
     let (last, fields) = p.selectors.split_last()?;
-    let Selector::Index(ix) = last else { return None };
+    let Selector::Index(ix) = last else {
+        return None;
+    };
     let mut name = p.base.clone();
     for f in fields {
         let Selector::Field(f) = f else { return None };
@@ -159,7 +165,9 @@ impl<F: Fn(String) -> LoadError> Lower<'_, F> {
     /// A variable, a field of one, or an array element (see the module's comment).
     fn place(&mut self, p: &Place) -> R<Input<'static>> {
         let at = self.at;
-        if let Some(n) = element_name(p).filter(|n| self.a.elements.contains(&n.to_ascii_lowercase())) {
+        if let Some(n) =
+            element_name(p).filter(|n| self.a.elements.contains(&n.to_ascii_lowercase()))
+        {
             return Ok(Input {
                 origin: at,
                 from: Connection::Variable(Cow::Owned(n)),

@@ -14,8 +14,9 @@
 //!
 //! A user data type (or a library one, [`super::data_types`]) is read as its base: an alias or
 //! subrange as its elementary type, an enumeration as INT, an array (named or declared in
-//! place) as a whole variable without a value; each such variable is recorded too, with the
-//! type's description. A structure (named or declared in place) is flattened into one variable
+//! place) of an elementary type as one variable per element (`a[3]`, its initial values from an
+//! `arrayValue`), any other array as a whole variable without a value; each such variable is
+//! recorded too, with the type's description. A structure (named or declared in place) is flattened into one variable
 //! per elementary field, `Motor.Speed` ([`super::data_types`]), each read as above.
 //!
 //! `VAR_IN_OUT` (`inOutVars`) is read as an input of the POU: a POU no call passes an argument
@@ -248,7 +249,9 @@ fn variable(
                 error(
                     origin(iv),
                     &place,
-                    format!("the initial value of array `{name}` is not an array value (`[1, 2, 3]`)"),
+                    format!(
+                        "the initial value of array `{name}` is not an array value (`[1, 2, 3]`)"
+                    ),
                 )
             })?;
             a.init = super::data_types::array_value(tc6, av, a.len(), &name, &place)?;
@@ -790,7 +793,7 @@ fn derived_note(mapped: &[(Option<String>, Mapped)]) -> Option<super::xml::Note>
         .collect();
     Some(super::xml::Note {
         origin: first.1.origin,
-        message: format!("data types are read as the model's types (IEC 61131-3 6.4.4): {}; `run` does not check subranges, an array is one whole variable (a read or write of any element reads or writes it) with no value, and a structure is one variable per elementary field (`s.f`)", list.join("; ")),
+        message: format!("data types are read as the model's types (IEC 61131-3 6.4.4): {}; `run` does not check subranges, an array of an elementary type is one variable per element (`a[i]`) and any other array one whole variable (a read or write of any element reads or writes it) with no value, and a structure is one variable per elementary field (`s.f`)", list.join("; ")),
     })
 }
 

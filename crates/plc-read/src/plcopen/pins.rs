@@ -99,7 +99,10 @@ impl Added {
     }
 
     /// The same, knowing the element variables among `vars` (lower-case name → type).
-    pub(super) fn with_elements(mut self, vars: &std::collections::HashMap<String, String>) -> Added {
+    pub(super) fn with_elements(
+        mut self,
+        vars: &std::collections::HashMap<String, String>,
+    ) -> Added {
         self.elements = vars.keys().filter(|n| n.contains('[')).cloned().collect();
         self
     }

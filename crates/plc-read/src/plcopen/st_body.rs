@@ -315,12 +315,15 @@ fn resolve(
                     bool: ty == "BOOL",
                 }))
             }
-            Some((d @ Decl::Array { .. }, _)) => {
-                reads.extend(d.leaves().unwrap_or_default().into_iter().map(|(name, ty)| Read {
-                    name,
-                    bool: ty == "BOOL",
-                }))
-            }
+            Some((d @ Decl::Array { .. }, _)) => reads.extend(
+                d.leaves()
+                    .unwrap_or_default()
+                    .into_iter()
+                    .map(|(name, ty)| Read {
+                        name,
+                        bool: ty == "BOOL",
+                    }),
+            ),
             Some((Decl::Constant(_), _)) => {}
             None if n.starts_with('%') => push_once(&mut unseen.addresses, n),
             None if called(n) => {}

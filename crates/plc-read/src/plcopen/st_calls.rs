@@ -277,7 +277,11 @@ impl Lower<'_> {
         else {
             return Ok(false);
         };
-        let what = if arrays { "arrays whose elements" } else { "structures whose fields" };
+        let what = if arrays {
+            "arrays whose elements"
+        } else {
+            "structures whose fields"
+        };
         let rel = |leaves: &[(String, String)], root: usize| -> Vec<(String, String, String)> {
             leaves
                 .iter()
@@ -290,10 +294,7 @@ impl Lower<'_> {
         let same =
             to.len() == from.len() && to.iter().zip(&from).all(|(a, b)| a.0 == b.0 && a.2 == b.2);
         if !same {
-            return refuse(
-                at,
-                format!("`{tp} := {sp}` of {what} differ"),
-            );
+            return refuse(at, format!("`{tp} := {sp}` of {what} differ"));
         }
         for ((_, t, ty), (_, f, _)) in to.iter().zip(&from) {
             match Type::parse(ty) {

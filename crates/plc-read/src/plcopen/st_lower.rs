@@ -39,7 +39,17 @@
 //!   inputs and outputs as variables (`Inst.X := e`, `y := Inst.Q`) ([`calls`]).
 //! - enumeration values (`RED`, `COLOR#RED`, CASE labels) as their integers (the enumeration
 //!   is INT, numbered as matiec numbers it: [`super::data_types`]).
-//! - `a := b` of two structures: a move per field ([`calls`]).
+//! - `a := b` of two structures: a move per field; of two arrays: a move per element
+//!   ([`calls`]).
+//! - array elements (IEC 61131-3 6.4.4.5; the reader scalarises an array of an elementary type
+//!   into one variable per element, `a[3]`, [`super::data_types`]): constant subscripts (integer
+//!   literals, `+ - *` of them, enumeration values) name the element's variable, and one out of
+//!   the bounds is refused; other subscripts are evaluated once into temporaries and the access
+//!   is a SELECTION, one rung per element it may choose (a compare per variable subscript): a
+//!   read moves the chosen element into a temporary that first gets the type's default, a write
+//!   moves the value (evaluated once, first) into it. A subscript outside its bounds reads the
+//!   default, writes nothing, and records a fault on the statement's bounds rung (a DIV of 1 by
+//!   the never-written `st__zero`: the executor's `div-by-zero`, docs/plcopen.md, Arrays).
 //!
 //! Invariants: a body is lowered whole or not at all; what the lowering does not handle is a
 //! [`Refusal`] naming the construct and where it is, and then the body keeps its stand-in
@@ -47,8 +57,9 @@
 //!
 //! Deliberately not here (refused): pragmas `{…}` (matiec pastes their text, often C, into its
 //! output), calls of user functions, informal arguments of function block calls, an instance
-//! as a value, writes of an instance's outputs, arrays, dereferences, direct addresses,
-//! strings.
+//! as a value, writes of an instance's outputs, arrays held as one whole variable (of
+//! structures, strings, …), a variable subscript as a call's output or a FOR variable, an
+//! array as a whole but in `a := b`, dereferences, direct addresses, strings.
 
 #[path = "st_calls.rs"]
 mod calls;
@@ -931,7 +942,13 @@ impl<'s> Lower<'s> {
             selectors: p.selectors[..ix].to_vec(),
         };
         let path = place_path(&array_place);
-        if p.base.starts_with('%') || ix > 0 && !array_place.selectors.iter().all(|s| matches!(s, Selector::Field(_))) {
+        if p.base.starts_with('%')
+            || ix > 0
+                && !array_place
+                    .selectors
+                    .iter()
+                    .all(|s| matches!(s, Selector::Field(_)))
+        {
             return refuse(at, format!("the array element `{path}[…]`"));
         }
         let (name, elements) = match self.scope.find(&path) {
@@ -944,18 +961,29 @@ impl<'s> Lower<'s> {
             }
         };
         if ix + 1 != p.selectors.len() {
-            return refuse(at, format!("a selector after the array element `{path}[…]`"));
+            return refuse(
+                at,
+                format!("a selector after the array element `{path}[…]`"),
+            );
         }
         let rank = elements.first().map_or(0, |e| e.index.len());
         if subs.len() != rank {
             return refuse(
                 at,
-                format!("`{path}` with {} subscripts (it has {rank} dimensions)", subs.len()),
+                format!(
+                    "`{path}` with {} subscripts (it has {rank} dimensions)",
+                    subs.len()
+                ),
             );
         }
         let ty = match elements.first().and_then(|e| Type::parse(&e.ty)) {
             Some(t) if !matches!(t, Type::Fb(_)) => t,
-            _ => return refuse(at, format!("the elements of `{path}`, whose type the model does not execute")),
+            _ => {
+                return refuse(
+                    at,
+                    format!("the elements of `{path}`, whose type the model does not execute"),
+                )
+            }
         };
         let dims: Vec<(i64, i64)> = (0..rank)
             .map(|d| {
@@ -1082,7 +1110,9 @@ impl<'s> Lower<'s> {
                     Ok(_) => continue 'el,
                     Err(v) => {
                         let k = e.index[d];
-                        if v.ty().is_some_and(|t| plc_model::Value::int_of(t, k.into()).is_none()) {
+                        if v.ty()
+                            .is_some_and(|t| plc_model::Value::int_of(t, k.into()).is_none())
+                        {
                             continue 'el;
                         }
                         c.push(self.compare(CmpOp::Eq, v, &Val::Lit(Scalar::Number(k.into()))));
@@ -1138,7 +1168,9 @@ impl<'s> Lower<'s> {
             let zero = match sel.ty {
                 Type::Time => Val::Lit(Scalar::Str(Cow::Borrowed("T#0s"))),
                 t if t.is_int() || t.is_bits() => Val::Lit(Scalar::Number(0.into())),
-                _ => Val::Lit(Scalar::Number(serde_json::Number::from_f64(0.0).unwrap_or(0.into()))),
+                _ => Val::Lit(Scalar::Number(
+                    serde_json::Number::from_f64(0.0).unwrap_or(0.into()),
+                )),
             };
             let m = ElementKind::Move(Box::new(Move {
                 from: self.operand(&zero),
@@ -1408,11 +1440,7 @@ impl<'s> Lower<'s> {
             Expr::Literal(_) => bool_literal(e).is_some(),
             Expr::Var(p) => matches!(
                 self.locate(p),
-                Ok(Access::One(_, Type::Bool))
-                    | Ok(Access::Select(Select {
-                        ty: Type::Bool,
-                        ..
-                    }))
+                Ok(Access::One(_, Type::Bool)) | Ok(Access::Select(Select { ty: Type::Bool, .. }))
             ),
             Expr::Unary(UnaryOp::Not, x) => self.is_bool(x),
             Expr::Unary(..) => false,

@@ -1,6 +1,7 @@
 //! The names an ST body sees ([`Scope`]): its POU's variables and the globals it declares
 //! external, by lower-case name, each an elementary variable, an instance of a function block
-//! type, an enumeration value or a structure flattened into its fields ([`Decl`]). Shared by
+//! type, an enumeration value, a structure flattened into its fields or an array scalarised
+//! into its elements ([`Decl`]; an element `a[3]` is an elementary variable too). Shared by
 //! the analysis's stand-ins ([`super::st_body`]) and the lowering ([`super::st_lower`]).
 //!
 //! Invariant: IEC names are case-insensitive; a name found here carries its declared spelling.

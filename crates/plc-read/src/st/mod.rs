@@ -191,7 +191,9 @@ fn path(p: &Place) -> String {
 fn exact(p: &Place) -> bool {
     p.selectors.iter().enumerate().all(|(i, s)| match s {
         Selector::Field(_) => true,
-        Selector::Index(es) => i + 1 == p.selectors.len() && es.iter().all(|e| constant(e).is_some()),
+        Selector::Index(es) => {
+            i + 1 == p.selectors.len() && es.iter().all(|e| constant(e).is_some())
+        }
         Selector::Deref => false,
     })
 }
@@ -202,14 +204,16 @@ pub fn constant(e: &Expr) -> Option<i64> {
     match e {
         Expr::Literal(s) => {
             let t = s.replace('_', "");
-            let t = ["INT#", "DINT#", "SINT#", "LINT#", "UINT#", "UDINT#", "USINT#", "ULINT#"]
-                .iter()
-                .find_map(|p| {
-                    t.get(..p.len())
-                        .filter(|h| h.eq_ignore_ascii_case(p))
-                        .map(|_| t[p.len()..].to_owned())
-                })
-                .unwrap_or(t);
+            let t = [
+                "INT#", "DINT#", "SINT#", "LINT#", "UINT#", "UDINT#", "USINT#", "ULINT#",
+            ]
+            .iter()
+            .find_map(|p| {
+                t.get(..p.len())
+                    .filter(|h| h.eq_ignore_ascii_case(p))
+                    .map(|_| t[p.len()..].to_owned())
+            })
+            .unwrap_or(t);
             if let Some((radix, digits)) = t.split_once('#') {
                 let r = match radix {
                     "2" => 2,
