@@ -165,6 +165,9 @@ struct Select {
     subs: Vec<(Expr, Option<i64>)>,
 }
 
+/// A subscript evaluated: its constant, or the variable holding its value.
+type Sub = Result<i64, Val>;
+
 /// The most elements a variable subscript may choose among.
 const MAX_SELECTED: usize = 4096;
 
@@ -1032,7 +1035,7 @@ impl<'s> Lower<'s> {
     /// The subscripts of `sel` evaluated (constants as they are, the others into integer
     /// temporaries unless already one), with the series of compares that passes power when
     /// any is outside its dimension's bounds (`None`: none can be).
-    fn subscripts(&mut self, sel: &Select) -> L<(Vec<Result<i64, Val>>, Option<Series>)> {
+    fn subscripts(&mut self, sel: &Select) -> L<(Vec<Sub>, Option<Series>)> {
         let mut out = Vec::new();
         let mut outside: Vec<Series> = Vec::new();
         for (d, (e, k)) in sel.subs.iter().enumerate() {
@@ -1100,7 +1103,7 @@ impl<'s> Lower<'s> {
     /// For each element `sel` may choose: its variable and the compares that pass power when the
     /// subscripts `subs` choose it (elements a constant subscript rules out, or whose
     /// subscripts a variable's type cannot hold, left out).
-    fn choices(&self, sel: &Select, subs: &[Result<i64, Val>]) -> L<Vec<(String, Series)>> {
+    fn choices(&self, sel: &Select, subs: &[Sub]) -> L<Vec<(String, Series)>> {
         let mut out = Vec::new();
         'el: for e in &sel.elements {
             let mut c = Vec::new();
