@@ -21,7 +21,7 @@
 
 use super::interface::literal;
 use super::pins::{expression_text, Added};
-use super::xml::{error, is_identifier, origin, R};
+use super::xml::{element_name, error, is_identifier, origin, R};
 use crate::st::ast::{BinaryOp, Expr, Place, Selector, UnaryOp};
 use plc_diag::{LoadError, Origin};
 use plc_syntax::fbd::{Connection, Input};
@@ -80,26 +80,6 @@ pub(super) fn reads_array_element(
         Ok(e) => !known(&e, vars),
         Err(_) => true,
     }
-}
-
-/// The variable of array element `p` when its subscripts are constant and last (`a[3]`,
-/// `s.m[1, -2]` as `s.m[1,-2]`), the name a scalarised array's element has.
-pub(super) fn element_name(p: &Place) -> Option<String> {
-    let (last, fields) = p.selectors.split_last()?;
-    let Selector::Index(ix) = last else {
-        return None;
-    };
-    let mut name = p.base.clone();
-    for f in fields {
-        let Selector::Field(f) = f else { return None };
-        name.push('.');
-        name.push_str(f);
-    }
-    let ks: Option<Vec<String>> = ix
-        .iter()
-        .map(|e| crate::st::constant(e).map(|k| k.to_string()))
-        .collect();
-    Some(format!("{name}[{}]", ks?.join(",")))
 }
 
 struct Lower<'l, F> {
