@@ -84,6 +84,7 @@ mod run_cli;
 mod scan_budget;
 mod schema;
 mod sfc_exec;
+mod st_arrays;
 mod st_calls;
 mod st_exec;
 mod st_functions;

@@ -88,15 +88,29 @@ pub(super) fn check_label(
 }
 
 /// A valid variable name: an identifier, or identifiers joined by `.` (a structure's field
-/// flattened into its own variable, `Motor.Speed`); else the error at the path `path` renders.
+/// flattened into its own variable, `Motor.Speed`), each optionally followed by one subscript
+/// of integers (an array's element scalarised into its own variable by the PLCopen reader,
+/// `a[3]`, `m[1,-2]`, `s.a[0]`); else the error at the path `path` renders.
 pub(super) fn check_var_name(name: &str, path: impl FnOnce() -> String) -> Result<()> {
-    if !name.contains('.') {
+    if !name.contains(['.', '[']) {
         return check_name(name, path, None);
     }
-    if name
-        .split('.')
-        .all(|part| check_name(part, String::new, None).is_ok())
-    {
+    let part_ok = |part: &str| {
+        let (id, sub) = match part.split_once('[') {
+            Some((id, rest)) => (id, Some(rest)),
+            None => (part, None),
+        };
+        check_name(id, String::new, None).is_ok()
+            && sub.is_none_or(|s| {
+                s.strip_suffix(']').is_some_and(|inner| {
+                    inner.split(',').all(|k| {
+                        let k = k.strip_prefix('-').unwrap_or(k);
+                        !k.is_empty() && k.bytes().all(|b| b.is_ascii_digit())
+                    })
+                })
+            })
+    };
+    if name.split('.').all(part_ok) {
         Ok(())
     } else {
         Err(LoadError::invalid(

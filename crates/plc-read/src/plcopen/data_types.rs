@@ -12,9 +12,14 @@
 //!   (an initial value, an ST expression);
 //! - a structure as its members (below, *Structures*): a variable of it is flattened into one
 //!   variable per elementary leaf field (`Motor.Speed`), nested structures recursively;
-//! - an array as one whole variable: a read or write of any element is a read or write of the
-//!   variable. It has no value (it stands in as a DINT 0, like a string), so it may appear only
-//!   in bodies `run` does not execute.
+//! - an array of an elementary type (or of an alias, subrange or enumeration of one) with
+//!   integer bounds, at most [`MAX_ELEMENTS`] elements, SCALARISED ([`ArrayOf`]): one variable
+//!   per element named `a[3]`, `m[1,-2]` (IEC 61131-3 6.4.4.5), in element order (the last
+//!   subscript fastest), its initial values from an `arrayValue` (`[1, 2]`, `[3(0)]`; the rest the
+//!   element type's default); the ST lowering ([`super::st_lower`]) selects among them;
+//! - any other array as one whole variable: a read or write of any element is a read or write
+//!   of the variable. It has no value (it stands in as a DINT 0, like a string), so it may
+//!   appear only in bodies `run` does not execute.
 //!
 //! Beremiz's SVGHMI extension declares HMI_BOOL, HMI_INT, HMI_REAL, HMI_STRING and HMI_NODE
 //! (and, in older versions, HMI_CLASS and HMI_LABEL) in its own library (`svghmi/pous.xml`),
@@ -28,7 +33,8 @@
 //! `dataType` (a cycle of aliases, a malformed range or enumeration); names are IEC
 //! identifiers.
 //!
-//! Deliberately not here: range checks, element-wise arrays, pointers and references (errors).
+//! Deliberately not here: range checks, arrays of structures or instances (whole variables),
+//! pointers and references (errors).
 //!
 //! # Structures
 //!
@@ -42,8 +48,9 @@
 //! `Speed : INT` and `On : BOOL` is read as the variables `Motor.Speed` (INT) and `Motor.On`
 //! (BOOL), named as a function block instance's members are (`G1.IN`); a nested structure
 //! recurses (`Plant.Motor.Speed`). So a field read or written in any body is exactly that
-//! variable, and dependences are per field. A member that is an array stays one whole
-//! variable (the array's stand-in, above); an array of structures is an array.
+//! variable, and dependences are per field. A member that is an array of an elementary type is
+//! one variable per element (`Motor.Hist[0]`); another array stays one whole variable (the
+//! array's stand-in, above); an array of structures is such an array.
 //!
 //! A leaf's initial value is, first found: the variable's own structured initial value for that
 //! field, the member's `initialValue` in the structure's declaration (or a structured initial
@@ -53,7 +60,7 @@
 //! least one member and at most [`MAX_LEAVES`] leaf fields (so a chain of structures nesting
 //! each other several times cannot blow up); a `structValue` names only members that exist.
 //!
-//! Deliberately not here: element-wise arrays; whole-structure assignment in graphical bodies
+//! Deliberately not here: arrays of structures; whole-structure assignment in graphical bodies
 //! (a structure read or written as a whole is its fields in ST, [`super::st_body`]).
 
 use super::xml::{attr, error, identifier, origin, Tc6, R};
@@ -70,8 +77,12 @@ pub(super) enum Base {
     /// (`value` attribute, IEC 61131-3 6.4.4.2 named values), else one more than the previous
     /// one's (the first 0), as CODESYS and matiec number them.
     Enum(Vec<(String, i64)>),
-    /// An array, analysed as one whole variable (a structure is always [`Base::Struct`]).
+    /// An array whose elements are not scalarised (of structures, instances, strings, arrays,
+    /// or with bounds that are not integers), or a type nobody defines: one whole variable.
     Whole(Aggregate),
+    /// An array of an elementary type (or an alias, subrange or enumeration of one),
+    /// scalarised into one variable per element ([`ArrayOf`]).
+    Array(Box<ArrayOf>),
     /// A structure: its members in declaration order.
     Struct(Vec<Member>),
 }
@@ -86,6 +97,70 @@ pub(super) struct Member {
     /// The member's type is an elementary type as written (not a data type).
     pub elementary: bool,
 }
+
+/// An array type scalarised (IEC 61131-3 6.4.4.5; TC6 `array`: `dimension@lower/@upper` and a
+/// `baseType`): its dimensions, its element type and its elements' initial values.
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct ArrayOf {
+    /// The bounds of each dimension, `lower..=upper`.
+    pub dims: Vec<(i64, i64)>,
+    /// The element type: an elementary type as written (`elementary`), else a data type.
+    pub elem: DataType,
+    pub elementary: bool,
+    /// The elements' initial values in element order (the last index varying fastest), from an
+    /// `arrayValue`; `None` where it gives none (the element type's default applies).
+    pub init: Vec<Option<(String, Origin)>>,
+}
+
+impl ArrayOf {
+    /// How many elements the array has.
+    pub(super) fn len(&self) -> usize {
+        self.dims
+            .iter()
+            .map(|&(lo, hi)| (hi - lo + 1) as usize)
+            .product()
+    }
+
+    /// The subscripts of every element, in element order (the last index varying fastest, as
+    /// IEC 61131-3 6.4.4.5 orders an array's initial values).
+    pub(super) fn subscripts(&self) -> Vec<Vec<i64>> {
+        let mut out: Vec<Vec<i64>> = vec![Vec::new()];
+        for &(lo, hi) in &self.dims {
+            out = out
+                .into_iter()
+                .flat_map(|p| {
+                    (lo..=hi).map(move |k| {
+                        let mut q = p.clone();
+                        q.push(k);
+                        q
+                    })
+                })
+                .collect();
+        }
+        out
+    }
+
+    /// The variable of the element with subscripts `k` of array variable `name`: `a[3]`,
+    /// `m[1,2]`.
+    pub(super) fn element_name(name: &str, k: &[i64]) -> String {
+        let ks: Vec<String> = k.iter().map(|i| i.to_string()).collect();
+        format!("{name}[{}]", ks.join(","))
+    }
+
+    /// `ARRAY[1..10, 0..3] OF INT`, for the notes.
+    fn describe(&self) -> String {
+        let dims: Vec<String> = self.dims.iter().map(|(l, h)| format!("{l}..{h}")).collect();
+        let of = if self.elementary {
+            self.elem.name.to_ascii_uppercase()
+        } else {
+            self.elem.name.clone()
+        };
+        format!("ARRAY[{}] OF {of}", dims.join(", "))
+    }
+}
+
+/// The most elements an array may have to be scalarised (a larger one is one whole variable).
+pub(super) const MAX_ELEMENTS: usize = 65_536;
 
 /// The aggregate kinds of IEC 61131-3 6.4.4 read as one whole variable.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -130,6 +205,10 @@ impl DataType {
                 format!("an enumeration, read as INT with {}", vals.join(", "))
             }
             Base::Whole(a) => format!("{}, read as one whole variable without a value", a.word()),
+            Base::Array(a) => format!(
+                "{}, read as one variable per element (`a[i]`)",
+                a.describe()
+            ),
             Base::Struct(m) => format!(
                 "a structure, read as one variable per field: {}",
                 leaves(m)
@@ -294,6 +373,10 @@ pub(super) fn resolve(
     {
         apply_value(tc6, members, sv, name, &place)?;
     }
+    if let (Some(av), Base::Array(a)) = (iv.and_then(|iv| tc6.child(iv, "arrayValue")), &mut t.base)
+    {
+        a.init = array_value(tc6, av, a.len(), name, &place)?;
+    }
     Ok(t)
 }
 
@@ -401,7 +484,7 @@ pub(super) fn base(
             }
             Ok(plain(Base::Enum(vals)))
         }
-        "array" => Ok(plain(Base::Whole(Aggregate::Array))),
+        "array" => array(tc6, raw, None, name, bt, depth, place),
         "struct" => Ok(plain(Base::Struct(members(
             tc6, raw, None, name, bt, depth, place,
         )?))),
@@ -467,7 +550,7 @@ pub(super) fn members(
                 library: None,
             },
             // An array declared in place is named as a variable's is (`ARRAY`).
-            "array" => base(tc6, raw, "ARRAY", te, depth + 1, place)?,
+            "array" => array(tc6, raw, resolved, "ARRAY", te, depth + 1, place)?,
             _ => base(tc6, raw, &inner, te, depth + 1, place)?,
         };
         let elementary = super::elementary::is_elementary_tag(te.tag_name().name());
@@ -522,6 +605,7 @@ fn count(members: &[Member]) -> usize {
         .iter()
         .map(|m| match &m.ty.base {
             Base::Struct(inner) => count(inner),
+            Base::Array(a) => a.len(),
             _ => 1,
         })
         .sum()
@@ -571,7 +655,12 @@ pub(super) fn apply_value(
             )
         };
         match (tag, &mut member.ty.base) {
-            ("simpleValue", Base::Struct(_) | Base::Whole(_)) => return Err(mismatch()),
+            ("simpleValue", Base::Struct(_) | Base::Whole(_) | Base::Array(_)) => {
+                return Err(mismatch())
+            }
+            ("arrayValue", Base::Array(a)) => {
+                a.init = array_value(tc6, content, a.len(), &inner, place)?
+            }
             ("simpleValue", _) => member.init = simple(tc6, v, place)?,
             ("structValue", Base::Struct(inner_members)) => {
                 apply_value(tc6, inner_members, content, &inner, place)?
@@ -612,6 +701,7 @@ pub(super) fn flatten(name: &str, members: &[Member]) -> Vec<Leaf> {
         let path = format!("{name}.{}", m.name);
         match &m.ty.base {
             Base::Struct(inner) => out.extend(flatten(&path, inner)),
+            Base::Array(a) => out.extend(elements(&path, a)),
             _ => out.push(Leaf {
                 path,
                 ty: m.ty.clone(),
@@ -623,6 +713,208 @@ pub(super) fn flatten(name: &str, members: &[Member]) -> Vec<Leaf> {
     out
 }
 
+/// The elements of array variable `name` of type `a` as leaves (`a[1]`, `m[0,2]`), in element
+/// order, each with its initial value (the array value's, else the element type's).
+pub(super) fn elements(name: &str, a: &ArrayOf) -> Vec<Leaf> {
+    a.subscripts()
+        .into_iter()
+        .enumerate()
+        .map(|(i, k)| Leaf {
+            path: ArrayOf::element_name(name, &k),
+            ty: a.elem.clone(),
+            elementary: a.elementary,
+            init: a
+                .init
+                .get(i)
+                .cloned()
+                .flatten()
+                .or_else(|| a.elem.init.clone()),
+        })
+        .collect()
+}
+
+/// Array type element `arr` (TC6 `array`) of type `name`: scalarised ([`Base::Array`]) when its
+/// bounds are integers and its elements of an elementary type, an alias, a subrange or an
+/// enumeration, and it has at most [`MAX_ELEMENTS`] elements; else one whole variable
+/// ([`Base::Whole`]), which `run` refuses by name.
+pub(super) fn array(
+    tc6: Tc6,
+    raw: &HashMap<String, Node>,
+    resolved: Option<&DataTypes>,
+    name: &str,
+    arr: Node,
+    depth: usize,
+    place: &str,
+) -> R<DataType> {
+    let whole = DataType {
+        name: name.to_owned(),
+        base: Base::Whole(Aggregate::Array),
+        range: None,
+        init: None,
+        library: None,
+    };
+    let mut dims = Vec::new();
+    for d in tc6.children(arr, "dimension") {
+        let bound = |a: &str| {
+            d.attribute(a)
+                .and_then(|v| plc_model::parse_int_literal(v.trim()))
+                .and_then(|v| i64::try_from(v).ok())
+                .or_else(|| {
+                    let v = d.attribute(a)?.trim();
+                    let v = v.strip_prefix('-')?;
+                    plc_model::parse_int_literal(v)
+                        .and_then(|v| i64::try_from(v).ok())
+                        .map(|v| -v)
+                })
+        };
+        let (Some(lo), Some(hi)) = (bound("lower"), bound("upper")) else {
+            return Ok(whole);
+        };
+        if hi < lo {
+            return Err(error(
+                origin(d),
+                place,
+                format!("array `{name}` has a dimension {lo}..{hi} whose upper bound is below its lower bound"),
+            ));
+        }
+        dims.push((lo, hi));
+    }
+    let Some(bt) = tc6
+        .child(arr, "baseType")
+        .and_then(|b| tc6.elements(b).next())
+    else {
+        return Err(error(
+            origin(arr),
+            place,
+            format!("array `{name}` has no element type"),
+        ));
+    };
+    let total = dims.iter().try_fold(1usize, |n, &(lo, hi)| {
+        usize::try_from(hi - lo + 1)
+            .ok()
+            .and_then(|k| n.checked_mul(k))
+    });
+    if dims.is_empty() || total.is_none_or(|n| n > MAX_ELEMENTS) {
+        return Ok(whole);
+    }
+    let tag = bt.tag_name().name();
+    let elementary = super::elementary::is_elementary_tag(tag);
+    let elem = match tag {
+        _ if elementary => DataType {
+            name: tag.to_owned(),
+            base: Base::Elementary(tag.to_owned()),
+            range: None,
+            init: None,
+            library: None,
+        },
+        "derived" => {
+            let of = identifier(attr(bt, "name", place)?, "type", bt, place)?;
+            match (raw.get(&of), resolved.and_then(|r| r.get(&of))) {
+                (Some(dt), _) => resolve(tc6, raw, &of, *dt, depth + 1)?,
+                (None, Some(d)) => d,
+                (None, None) => base(tc6, raw, &of, bt, depth + 1, place)?,
+            }
+        }
+        "subrangeSigned" | "subrangeUnsigned" | "enum" => {
+            base(tc6, raw, name, bt, depth + 1, place)?
+        }
+        _ => return Ok(whole),
+    };
+    let scalar = match &elem.base {
+        Base::Elementary(t) => !matches!(t.to_ascii_lowercase().as_str(), "string" | "wstring"),
+        Base::Enum(_) => true,
+        _ => false,
+    };
+    if !scalar {
+        return Ok(whole);
+    }
+    Ok(DataType {
+        name: name.to_owned(),
+        base: Base::Array(Box::new(ArrayOf {
+            dims,
+            elem,
+            elementary,
+            init: Vec::new(),
+        })),
+        range: None,
+        init: None,
+        library: None,
+    })
+}
+
+/// The initial values of the `len` elements of array `what` from array value `av` (TC6
+/// `arrayValue`: `value` elements, each a `simpleValue` (or a nested `arrayValue`, read in
+/// order) and an optional `repetitionValue`, IEC 61131-3 6.4.4.5's `[3(0), 2(1)]`): in element
+/// order, `None` for the elements after the last value given. More values than elements is an
+/// error, as in matiec.
+pub(super) fn array_value(
+    tc6: Tc6,
+    av: Node,
+    len: usize,
+    what: &str,
+    place: &str,
+) -> R<Vec<Option<(String, Origin)>>> {
+    let mut out = Vec::new();
+    fn walk(
+        tc6: Tc6,
+        av: Node,
+        len: usize,
+        what: &str,
+        place: &str,
+        out: &mut Vec<Option<(String, Origin)>>,
+    ) -> R<()> {
+        for v in tc6.children(av, "value") {
+            let times = match v.attribute("repetitionValue") {
+                None => 1,
+                Some(r) => r.trim().parse::<usize>().map_err(|_| {
+                    error(
+                        origin(v),
+                        place,
+                        format!("repetition `{r}` in the initial value of `{what}` is not a whole number"),
+                    )
+                })?,
+            };
+            let Some(content) = tc6.elements(v).next() else {
+                return Err(error(
+                    origin(v),
+                    place,
+                    format!("a value in the initial value of `{what}` is empty"),
+                ));
+            };
+            match content.tag_name().name() {
+                "simpleValue" => {
+                    let text = attr(content, "value", place)?.to_owned();
+                    if out.len().saturating_add(times) > len {
+                        return Err(error(
+                            origin(v),
+                            place,
+                            format!("the initial value of `{what}` gives more values than its {len} elements"),
+                        ));
+                    }
+                    for _ in 0..times {
+                        out.push(Some((text.clone(), origin(content))));
+                    }
+                }
+                "arrayValue" => {
+                    for _ in 0..times {
+                        walk(tc6, content, len, what, place, out)?;
+                    }
+                }
+                other => {
+                    return Err(error(
+                        origin(content),
+                        place,
+                        format!("the initial value of `{what}` holds a `{other}`, which an array of an elementary type cannot take"),
+                    ))
+                }
+            }
+        }
+        Ok(())
+    }
+    walk(tc6, av, len, what, place, &mut out)?;
+    Ok(out)
+}
+
 /// The leaf fields of a structure relative to it (`Speed`, `Motor.Speed`) with their types as
 /// the notes show them (`INT`, `MYTYPE`, an array as `ARRAY`).
 pub(super) fn leaves(members: &[Member]) -> Vec<(String, String)> {
@@ -630,7 +922,7 @@ pub(super) fn leaves(members: &[Member]) -> Vec<(String, String)> {
         .into_iter()
         .map(|l| {
             let t = match &l.ty.base {
-                Base::Whole(_) => "ARRAY".to_owned(),
+                Base::Whole(_) | Base::Array(_) => "ARRAY".to_owned(),
                 Base::Elementary(t) if l.elementary => t.to_ascii_uppercase(),
                 _ => l.ty.name.clone(),
             };

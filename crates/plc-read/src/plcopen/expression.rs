@@ -9,7 +9,8 @@
 //!
 //! A function block instance's output (`t.Q`) is the field reference the model has for it; a
 //! structure's field (`s.f`, `s.inner.f`) is passed on as such: it is the name of the field's
-//! own variable ([`super::data_types`]). An array element
+//! own variable ([`super::data_types`]), and so is an element of constant subscripts of a
+//! scalarised array (`a[3]`, `a[1 + 2]`: [`Added::elements`]). Any other array element
 //! (`a[i]`) reads the whole array and the variables of its subscripts: the model holds an array
 //! as one value of its element type (docs/plcopen.md, "Data types"), so the element stands in as
 //! `SEL(NE(i, i), a, a)` — the value `a`, with `i` read — and `run` refuses the body (the
@@ -20,7 +21,7 @@
 
 use super::interface::literal;
 use super::pins::{expression_text, Added};
-use super::xml::{error, is_identifier, origin, R};
+use super::xml::{element_name, error, is_identifier, origin, R};
 use crate::st::ast::{BinaryOp, Expr, Place, Selector, UnaryOp};
 use plc_diag::{LoadError, Origin};
 use plc_syntax::fbd::{Connection, Input};
@@ -31,10 +32,12 @@ use std::borrow::Cow;
 /// What in variable `node` (in `place`, its pin at `at`) gives: its literal, its variable, or
 /// the output of the blocks its expression is made into.
 pub(super) fn block_input(a: &mut Added, node: Node, place: &str, at: Origin) -> R<Input<'static>> {
-    if let Ok(simple) = super::pins::block_input(node, place, at) {
-        return Ok(simple);
-    }
     let text = expression_text(node);
+    if !text.contains('[') {
+        if let Ok(simple) = super::pins::block_input(node, place, at) {
+            return Ok(simple);
+        }
+    }
     let shown = shortened(text.trim());
     let bad = |why: String| error(origin(node), place, format!("expression `{shown}`: {why}"));
     let e = crate::st::parser::expression(text).map_err(|e| bad(e.message))?;
@@ -50,9 +53,33 @@ fn shortened(text: &str) -> Cow<'_, str> {
     }
 }
 
-/// Whether in variable `node` reads an array element (its expression has a subscript).
-pub(super) fn reads_array_element(node: Node) -> bool {
-    expression_text(node).contains('[')
+/// Whether in variable `node` reads an array element that is not the variable of a scalarised
+/// array's element (`vars`: the POU's variables by lower-case name): a subscript that is not
+/// constant, or an array plc-deps holds as one value.
+pub(super) fn reads_array_element(
+    node: Node,
+    vars: &std::collections::HashMap<String, String>,
+) -> bool {
+    let text = expression_text(node);
+    if !text.contains('[') {
+        return false;
+    }
+    fn known(e: &Expr, vars: &std::collections::HashMap<String, String>) -> bool {
+        match e {
+            Expr::Literal(_) => true,
+            Expr::Var(p) => {
+                !p.selectors.iter().any(|s| matches!(s, Selector::Index(_)))
+                    || element_name(p).is_some_and(|n| vars.contains_key(&n.to_ascii_lowercase()))
+            }
+            Expr::Unary(_, x) => known(x, vars),
+            Expr::Binary(_, a, b) => known(a, vars) && known(b, vars),
+            Expr::Call { .. } => true,
+        }
+    }
+    match crate::st::parser::expression(text) {
+        Ok(e) => !known(&e, vars),
+        Err(_) => true,
+    }
 }
 
 struct Lower<'l, F> {
@@ -118,6 +145,14 @@ impl<F: Fn(String) -> LoadError> Lower<'_, F> {
     /// A variable, a field of one, or an array element (see the module's comment).
     fn place(&mut self, p: &Place) -> R<Input<'static>> {
         let at = self.at;
+        if let Some(n) =
+            element_name(p).filter(|n| self.a.elements.contains(&n.to_ascii_lowercase()))
+        {
+            return Ok(Input {
+                origin: at,
+                from: Connection::Variable(Cow::Owned(n)),
+            });
+        }
         let mut name = p.base.clone();
         let mut subscripts = Vec::new();
         for s in &p.selectors {

@@ -77,7 +77,7 @@ pub(super) fn body(
     let f = Fbd {
         g: &g,
         place,
-        a: RefCell::new(Added::new(&g)),
+        a: RefCell::new(Added::new(&g).with_elements(&ctx.vars)),
         ctx,
         boxes: RefCell::new(std::mem::take(&mut notes.black_boxes)),
         notes: RefCell::new(Vec::new()),

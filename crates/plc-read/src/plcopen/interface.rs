@@ -14,8 +14,9 @@
 //!
 //! A user data type (or a library one, [`super::data_types`]) is read as its base: an alias or
 //! subrange as its elementary type, an enumeration as INT, an array (named or declared in
-//! place) as a whole variable without a value; each such variable is recorded too, with the
-//! type's description. A structure (named or declared in place) is flattened into one variable
+//! place) of an elementary type as one variable per element (`a[3]`, its initial values from an
+//! `arrayValue`), any other array as a whole variable without a value; each such variable is
+//! recorded too, with the type's description. A structure (named or declared in place) is flattened into one variable
 //! per elementary field, `Motor.Speed` ([`super::data_types`]), each read as above.
 //!
 //! `VAR_IN_OUT` (`inOutVars`) is read as an input of the POU: a POU no call passes an argument
@@ -27,7 +28,7 @@
 //! Deliberately not here: structured initial values of elementary variables and `VAR_ACCESS`
 //! — each an error naming the variable, until the model has them.
 
-use super::data_types::{Aggregate, Base, DataType, DataTypes};
+use super::data_types::{Base, DataType, DataTypes};
 use super::elementary::{is_elementary_tag, model_type_of, MAPPED, MODEL_ELEMENTARY};
 use super::xml::{error, identifier, origin, Tc6, R};
 use plc_syntax::{Located, Name, Operand, Scalar, Var, VarClass};
@@ -228,6 +229,39 @@ fn variable(
         }
         return Ok(vec![one(tc6, &decl, name, ty, iv, None, mapped)?]);
     };
+    if let Base::Array(a) = &d.base {
+        let mut a = (**a).clone();
+        if let Some(iv) = tc6.child(v, "initialValue") {
+            let av = tc6.child(iv, "arrayValue").ok_or_else(|| {
+                error(
+                    origin(iv),
+                    &place,
+                    format!(
+                        "the initial value of array `{name}` is not an array value (`[1, 2, 3]`)"
+                    ),
+                )
+            })?;
+            a.init = super::data_types::array_value(tc6, av, a.len(), &name, &place)?;
+        }
+        mapped.push(Mapped {
+            var: name.clone(),
+            origin: origin(v),
+            from: d.name.clone(),
+            to: "its elements",
+            text: false,
+            via: Some(d.describe()),
+        });
+        let mut out = Vec::new();
+        for el in super::data_types::elements(&name, &a) {
+            let ty = if el.elementary {
+                Ty::Elementary(data_base(&el.ty))
+            } else {
+                Ty::Data(el.ty)
+            };
+            out.push(one(tc6, &decl, el.path, ty, None, el.init, mapped)?);
+        }
+        return Ok(out);
+    }
     let Base::Struct(members) = &d.base else {
         let iv = tc6.child(v, "initialValue");
         return Ok(vec![one(tc6, &decl, name, ty, iv, None, mapped)?]);
@@ -396,7 +430,7 @@ fn data_base(d: &DataType) -> String {
         Base::Elementary(t) => t.clone(),
         Base::Enum(_) => "INT".to_owned(),
         // An array (or a structure not flattened) has no value: the DINT stand-in.
-        Base::Whole(_) | Base::Struct(_) => "DINT".to_owned(),
+        Base::Whole(_) | Base::Struct(_) | Base::Array(_) => "DINT".to_owned(),
     }
 }
 
@@ -421,17 +455,18 @@ fn type_name(tc6: Tc6, ty: Node, var: &str, place: &str, known: &Known) -> R<Ty>
     if is_elementary_tag(tag) {
         return Ok(Ty::Elementary(tag.to_owned()));
     }
-    let whole = |a: Aggregate, n: &str| {
-        Ok(Ty::Data(DataType {
-            name: n.to_owned(),
-            base: Base::Whole(a),
-            range: None,
-            init: None,
-            library: None,
-        }))
-    };
     match tag {
-        "array" => return whole(Aggregate::Array, "ARRAY"),
+        "array" => {
+            return Ok(Ty::Data(super::data_types::array(
+                tc6,
+                &std::collections::HashMap::new(),
+                Some(&known.data_types),
+                "ARRAY",
+                t,
+                0,
+                place,
+            )?))
+        }
         // A subrange or enumeration declared in place (`x : INT (0..10)`, `c : (RED, GREEN)`).
         "subrangeSigned" | "subrangeUnsigned" | "enum" => {
             let shown = if tag == "enum" { "ENUM" } else { "SUBRANGE" };
@@ -738,7 +773,7 @@ fn derived_note(mapped: &[(Option<String>, Mapped)]) -> Option<super::xml::Note>
         .collect();
     Some(super::xml::Note {
         origin: first.1.origin,
-        message: format!("data types are read as the model's types (IEC 61131-3 6.4.4): {}; `run` does not check subranges, an array is one whole variable (a read or write of any element reads or writes it) with no value, and a structure is one variable per elementary field (`s.f`)", list.join("; ")),
+        message: format!("data types are read as the model's types (IEC 61131-3 6.4.4): {}; `run` does not check subranges, an array of an elementary type is one variable per element (`a[i]`) and any other array one whole variable (a read or write of any element reads or writes it) with no value, and a structure is one variable per elementary field (`s.f`)", list.join("; ")),
     })
 }
 

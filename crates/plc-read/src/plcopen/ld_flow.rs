@@ -85,7 +85,7 @@ pub(super) fn body(
     let mut f = Flow {
         g: &g,
         place,
-        a: Added::new(&g),
+        a: Added::new(&g).with_elements(&ctx.vars),
         done: HashMap::new(),
         ctx,
         boxes: std::mem::take(&mut notes.black_boxes),

@@ -37,6 +37,9 @@ pub(super) struct Added {
     pub blocks: Vec<Block<'static>>,
     /// Edge-detector instances (`R_TRIG__<localId>`), to add to the POU.
     pub vars: Vec<Var<'static>>,
+    /// The lower-case names of the scalarised arrays' element variables the POU sees (`a[3]`,
+    /// [`super::data_types`]): an element of constant subscripts that is one is read as it.
+    pub elements: std::collections::HashSet<String>,
 }
 
 pub(super) fn konst(b: bool, at: Origin) -> Input<'static> {
@@ -91,7 +94,17 @@ impl Added {
             next_id: g.elems.iter().map(|el| el.local_id).max().unwrap_or(0) + 1,
             blocks: Vec::new(),
             vars: Vec::new(),
+            elements: std::collections::HashSet::new(),
         }
+    }
+
+    /// The same, knowing the element variables among `vars` (lower-case name → type).
+    pub(super) fn with_elements(
+        mut self,
+        vars: &std::collections::HashMap<String, String>,
+    ) -> Added {
+        self.elements = vars.keys().filter(|n| n.contains('[')).cloned().collect();
+        self
     }
 
     /// Adds block `op` with `inputs` (by pin name) at `at`: an arc from its first output.

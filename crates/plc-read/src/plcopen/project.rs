@@ -700,7 +700,7 @@ fn body(
     }
     let array_element = lang.children().find(|n| {
         matches!(n.tag_name().name(), "inVariable" | "inOutVariable")
-            && super::expression::reads_array_element(*n)
+            && super::expression::reads_array_element(*n, &ctx.vars)
     });
     if let (Some(n), "LD" | "FBD") = (array_element, tag) {
         notes.no_run.push((name.to_owned(), Note {
@@ -1119,7 +1119,7 @@ fn pou_ctx(base: &Ctx, iface: &Interface, globals: &[(&str, &str)]) -> Ctx {
 fn is_external(global: &str, e: &str) -> bool {
     global.eq_ignore_ascii_case(e)
         || (global.len() > e.len()
-            && global.as_bytes()[e.len()] == b'.'
+            && matches!(global.as_bytes()[e.len()], b'.' | b'[')
             && global[..e.len()].eq_ignore_ascii_case(e))
 }
 

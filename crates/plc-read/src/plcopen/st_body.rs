@@ -330,7 +330,7 @@ fn resolve(
     }
     let mut reads = Vec::new();
     for n in &a.reads {
-        let found = scope.find(n)?;
+        let found = find(scope, n)?;
         // A field written whole keeps nothing of its structure: no read.
         let kept = a.kept.iter().any(|k| k.eq_ignore_ascii_case(n));
         match found {
@@ -371,6 +371,15 @@ fn resolve(
                     bool: ty == "BOOL",
                 }))
             }
+            Some((d @ Decl::Array { .. }, _)) => reads.extend(
+                d.leaves()
+                    .unwrap_or_default()
+                    .into_iter()
+                    .map(|(name, ty)| Read {
+                        name,
+                        bool: ty == "BOOL",
+                    }),
+            ),
             Some((Decl::Constant(_), _)) => {}
             None if n.starts_with('%') => push_once(&mut unseen.addresses, n),
             None if called(n) => {}
@@ -379,8 +388,11 @@ fn resolve(
     }
     let mut writes = Vec::new();
     for n in &a.writes {
-        match scope.find(n)? {
+        match find(scope, n)? {
             Some((Decl::Elementary { name, .. }, _)) => writes.push(name.clone()),
+            Some((d @ Decl::Array { .. }, _)) => {
+                writes.extend(d.leaves().unwrap_or_default().into_iter().map(|(n, _)| n))
+            }
             Some((Decl::Instance { name, ty, .. }, false))
                 if input(scope, name, ty, n).is_some() =>
             {
@@ -409,6 +421,18 @@ fn resolve(
     seen.clear();
     writes.retain(|w| seen.insert(w.clone()));
     Ok((reads, writes))
+}
+
+/// What access path `n` names ([`Scope::find`]); an array element whose constant subscripts
+/// are out of the array's bounds (`a[11]`, which the lowering refuses) is the whole array.
+fn find<'s>(scope: &'s Scope, n: &str) -> Result<Option<(&'s Decl, bool)>, String> {
+    match scope.find(n)? {
+        None => match super::st_scope::split_element(n) {
+            Some((array, _)) => scope.find(array),
+            None => Ok(None),
+        },
+        found => Ok(found),
+    }
 }
 
 /// Input or output `path` (`Inst.X`) of instance `name` of the project's function block type

@@ -264,12 +264,23 @@ impl Lower<'_> {
             return Ok(false);
         };
         let (tp, sp) = (place_path(target), place_path(source));
-        let (
-            Ok(Some((Decl::Structure { leaves: to }, true))),
-            Ok(Some((Decl::Structure { leaves: from }, true))),
-        ) = (self.scope.find(&tp), self.scope.find(&sp))
+        // Two structures, or two arrays (`a := b`: a move per element, IEC 61131-3 6.4.4.5
+        // assigns an array of the same type whole).
+        let (Ok(Some((to, true))), Ok(Some((from, true)))) =
+            (self.scope.find(&tp), self.scope.find(&sp))
         else {
             return Ok(false);
+        };
+        let arrays = matches!((to, from), (Decl::Array { .. }, Decl::Array { .. }));
+        let structures = matches!((to, from), (Decl::Structure { .. }, Decl::Structure { .. }));
+        let (Some(to), Some(from), true) = (to.leaves(), from.leaves(), arrays || structures)
+        else {
+            return Ok(false);
+        };
+        let what = if arrays {
+            "arrays whose elements"
+        } else {
+            "structures whose fields"
         };
         let rel = |leaves: &[(String, String)], root: usize| -> Vec<(String, String, String)> {
             leaves
@@ -277,16 +288,13 @@ impl Lower<'_> {
                 .map(|(n, t)| (n[root..].to_ascii_lowercase(), n.clone(), t.clone()))
                 .collect()
         };
-        let (mut to, mut from) = (rel(to, tp.len()), rel(from, sp.len()));
+        let (mut to, mut from) = (rel(&to, tp.len()), rel(&from, sp.len()));
         to.sort();
         from.sort();
         let same =
             to.len() == from.len() && to.iter().zip(&from).all(|(a, b)| a.0 == b.0 && a.2 == b.2);
         if !same {
-            return refuse(
-                at,
-                format!("`{tp} := {sp}` of structures whose fields differ"),
-            );
+            return refuse(at, format!("`{tp} := {sp}` of {what} differ"));
         }
         for ((_, t, ty), (_, f, _)) in to.iter().zip(&from) {
             match Type::parse(ty) {

@@ -43,7 +43,8 @@
 //!   inputs and outputs as variables (`Inst.X := e`, `y := Inst.Q`) ([`calls`]).
 //! - enumeration values (`RED`, `COLOR#RED`, CASE labels) as their integers (the enumeration
 //!   is INT, numbered as matiec numbers it: [`super::data_types`]).
-//! - `a := b` of two structures: a move per field ([`calls`]).
+//! - `a := b` of two structures: a move per field; of two arrays: a move per element
+//!   ([`calls`]).
 //! - calls of the project's functions (`y := F(a, b)`, formal, `=>` outputs, EN/ENO, nested,
 //!   as statements): the inputs moved into the body's instance of the function's type, a
 //!   `call`, the result and outputs moved out ([`functions`], [`super::user_functions`]).
@@ -51,6 +52,15 @@
 //!   of standard functions put in their pins' order ([`functions`]).
 //! - STRING literals (`'a$'b'`) and variables: moves, comparisons, the string functions and
 //!   conversions the model has ([`functions`]).
+//! - array elements (IEC 61131-3 6.4.4.5; the reader scalarises an array of an elementary type
+//!   into one variable per element, `a[3]`, [`super::data_types`]): constant subscripts (integer
+//!   literals, `+ - *` of them, enumeration values) name the element's variable, and one out of
+//!   the bounds is refused; other subscripts are evaluated once into temporaries and the access
+//!   is a SELECTION, one rung per element it may choose (a compare per variable subscript): a
+//!   read moves the chosen element into a temporary that first gets the type's default, a write
+//!   moves the value (evaluated once, first) into it. A subscript outside its bounds reads the
+//!   default, writes nothing, and records a fault on the statement's bounds rung (a DIV of 1 by
+//!   the never-written `st__zero`: the executor's `div-by-zero`, docs/plcopen.md, Arrays).
 //!
 //! Invariants: a body is lowered whole or not at all; what the lowering does not handle is a
 //! [`Refusal`] naming the construct and where it is, and then the body keeps its stand-in
@@ -58,7 +68,9 @@
 //!
 //! Deliberately not here (refused): pragmas `{…}` (matiec pastes their text, often C, into its
 //! output), recursive calls of functions, an instance as a value, writes of an instance's
-//! outputs, arrays, dereferences, direct addresses, WSTRINGs.
+//! outputs, arrays held as one whole variable (of structures, strings, …), a variable
+//! subscript as a call's output or a FOR variable, an array as a whole but in `a := b`,
+//! dereferences, direct addresses, WSTRINGs.
 
 #[path = "st_calls.rs"]
 mod calls;
@@ -138,6 +150,8 @@ pub(super) struct Lower<'s> {
     /// The innermost loops: (label CONTINUE jumps to, label EXIT jumps to).
     loops: Vec<(String, String)>,
     false_var: bool,
+    /// `st__zero` and `st__range` (an out-of-bounds subscript's fault) are declared.
+    zero_var: bool,
     /// The variables holding inputs of standard instances ([`calls`]).
     held: Vec<String>,
     /// The instances the body calls the project's functions through ([`functions`]).
@@ -145,6 +159,33 @@ pub(super) struct Lower<'s> {
 }
 
 type Series = Vec<ElementKind<'static>>;
+
+/// What a place denotes ([`Lower::locate`]).
+enum Access {
+    /// One variable and its type.
+    One(String, Type),
+    /// An element of an array chosen by subscripts not all constant.
+    Select(Select),
+}
+
+/// An array element chosen by subscripts not all constant.
+struct Select {
+    /// The array's name (for messages).
+    array: String,
+    /// The elements' type.
+    ty: Type,
+    elements: Vec<super::st_scope::Element>,
+    /// Each dimension's bounds.
+    dims: Vec<(i64, i64)>,
+    /// Each subscript, with its value when it is constant.
+    subs: Vec<(Expr, Option<i64>)>,
+}
+
+/// A subscript evaluated: its constant, or the variable holding its value.
+type Sub = Result<i64, Val>;
+
+/// The most elements a variable subscript may choose among.
+const MAX_SELECTED: usize = 4096;
 
 impl<'s> Lower<'s> {
     pub(super) fn new(scope: &'s Scope, pou: &str) -> Lower<'s> {
@@ -164,6 +205,7 @@ impl<'s> Lower<'s> {
             pending: None,
             loops: Vec::new(),
             false_var: false,
+            zero_var: false,
             held: Vec::new(),
             fn_instances: Vec::new(),
         }
@@ -594,6 +636,9 @@ impl<'s> Lower<'s> {
         if self.structure_assign(target.base_at, target, value)? {
             return Ok(());
         }
+        if let Access::Select(sel) = self.locate(target)? {
+            return self.select_write(sel, value);
+        }
         let (name, ty) = self.written(target)?;
         self.assign_to(&name, ty, value)
     }
@@ -1006,14 +1051,339 @@ impl<'s> Lower<'s> {
 
     // ---- places ----
 
-    /// What `p` reads: an elementary variable, a structure's field, or an instance's output.
-    fn read(&self, p: &Place) -> L<(String, Type)> {
-        self.resolve(p, false)
+    /// What `p` reads: an elementary variable, a structure's field, an array's element (a
+    /// variable subscript selects it into a temporary, [`Lower::select_read`]), or an
+    /// instance's output.
+    fn read(&mut self, p: &Place) -> L<(String, Type)> {
+        match self.locate(p)? {
+            Access::One(n, t) => Ok((n, t)),
+            Access::Select(sel) => self.select_read(sel),
+        }
     }
 
-    /// What `p` writes: an elementary variable or a structure's field.
+    /// What `p` writes: an elementary variable, a structure's field or an array's element of
+    /// constant subscripts (a variable subscript is written by [`Lower::assign`] only).
     fn written(&self, p: &Place) -> L<(String, Type)> {
-        self.resolve(p, true)
+        if !p.selectors.iter().any(|s| matches!(s, Selector::Index(_))) {
+            return self.resolve(p, true);
+        }
+        match self.locate(p)? {
+            Access::One(n, t) => Ok((n, t)),
+            Access::Select(sel) => refuse(
+                p.base_at,
+                format!(
+                    "the element of `{}` chosen by a variable subscript as the target of a call's output or a FOR (only an assignment writes one)",
+                    sel.array
+                ),
+            ),
+        }
+    }
+
+    /// What `p` denotes: one variable (with its type), or an array element chosen by
+    /// subscripts that are not all constant.
+    fn locate(&self, p: &Place) -> L<Access> {
+        let Some(ix) = p
+            .selectors
+            .iter()
+            .position(|s| matches!(s, Selector::Index(_)))
+        else {
+            let (n, t) = self.resolve(p, false)?;
+            return Ok(Access::One(n, t));
+        };
+        let at = p.base_at;
+        let Selector::Index(subs) = &p.selectors[ix] else {
+            return refuse(at, "a subscript");
+        };
+        let array_place = Place {
+            base: p.base.clone(),
+            base_at: p.base_at,
+            selectors: p.selectors[..ix].to_vec(),
+        };
+        let path = place_path(&array_place);
+        if p.base.starts_with('%')
+            || ix > 0
+                && !array_place
+                    .selectors
+                    .iter()
+                    .all(|s| matches!(s, Selector::Field(_)))
+        {
+            return refuse(at, format!("the array element `{path}[…]`"));
+        }
+        let (name, elements) = match self.scope.find(&path) {
+            Ok(Some((Decl::Array { name, elements }, true))) => (name.clone(), elements.clone()),
+            _ => {
+                return refuse(
+                    at,
+                    format!("the array element `{path}[…]` (`{path}` is not an array of an elementary type with integer bounds, which plc-deps scalarises)"),
+                )
+            }
+        };
+        if ix + 1 != p.selectors.len() {
+            return refuse(
+                at,
+                format!("a selector after the array element `{path}[…]`"),
+            );
+        }
+        let rank = elements.first().map_or(0, |e| e.index.len());
+        if subs.len() != rank {
+            return refuse(
+                at,
+                format!(
+                    "`{path}` with {} subscripts (it has {rank} dimensions)",
+                    subs.len()
+                ),
+            );
+        }
+        let ty = match elements.first().and_then(|e| Type::parse(&e.ty)) {
+            Some(t) if !matches!(t, Type::Fb(_)) => t,
+            _ => {
+                return refuse(
+                    at,
+                    format!("the elements of `{path}`, whose type the model does not execute"),
+                )
+            }
+        };
+        let dims: Vec<(i64, i64)> = (0..rank)
+            .map(|d| {
+                let ks = elements.iter().map(|e| e.index[d]);
+                (ks.clone().min().unwrap_or(0), ks.max().unwrap_or(0))
+            })
+            .collect();
+        let mut fixed = Vec::new();
+        for e in subs {
+            let k = match crate::st::constant(e) {
+                Some(k) => Some(k),
+                None => match e {
+                    Expr::Var(q) => self.enum_value(q)?,
+                    _ => None,
+                },
+            };
+            fixed.push(k);
+        }
+        for (d, k) in fixed.iter().enumerate() {
+            if let Some(k) = k {
+                let (lo, hi) = dims[d];
+                if *k < lo || *k > hi {
+                    return refuse(
+                        at,
+                        format!("the subscript {k} of `{path}`, outside its bounds {lo}..{hi} (IEC 61131-3 6.4.4.5)"),
+                    );
+                }
+            }
+        }
+        if let Some(k) = fixed.iter().copied().collect::<Option<Vec<i64>>>() {
+            let el = elements.iter().find(|e| e.index == k);
+            return match el {
+                Some(e) => Ok(Access::One(e.name.clone(), ty)),
+                None => refuse(at, format!("the element `{path}{k:?}`")),
+            };
+        }
+        Ok(Access::Select(Select {
+            array: name,
+            ty,
+            elements,
+            dims,
+            subs: subs.iter().cloned().zip(fixed).collect(),
+        }))
+    }
+
+    /// The subscripts of `sel` evaluated (constants as they are, the others into integer
+    /// temporaries unless already one), with the series of compares that passes power when
+    /// any is outside its dimension's bounds (`None`: none can be).
+    fn subscripts(&mut self, sel: &Select) -> L<(Vec<Sub>, Option<Series>)> {
+        let mut out = Vec::new();
+        let mut outside: Vec<Series> = Vec::new();
+        for (d, (e, k)) in sel.subs.iter().enumerate() {
+            if let Some(k) = k {
+                out.push(Ok(*k));
+                continue;
+            }
+            let v = self.value(e, None)?;
+            let ty = match &v {
+                Val::Lit(Scalar::Number(n)) => {
+                    let (lo, hi) = sel.dims[d];
+                    match n.as_i64() {
+                        Some(k) if (lo..=hi).contains(&k) => out.push(Ok(k)),
+                        _ => {
+                            return refuse(
+                                self.at,
+                                format!("the subscript {n} of `{}`, outside its bounds {lo}..{hi} or not an integer", sel.array),
+                            )
+                        }
+                    }
+                    continue;
+                }
+                Val::Var(_, t) if t.is_int() => *t,
+                _ => {
+                    return refuse(
+                        self.at,
+                        format!("a subscript of `{}` that is not an integer", sel.array),
+                    )
+                }
+            };
+            let v = match v {
+                Val::Var(ref n, _) if n.starts_with("st__") => v,
+                _ => {
+                    let t = self.temp(ty);
+                    let m = ElementKind::Move(Box::new(Move {
+                        from: self.operand(&v),
+                        to: self.name(&t),
+                    }));
+                    self.emit(vec![m]);
+                    Val::Var(t, ty)
+                }
+            };
+            let (lo, hi) = sel.dims[d];
+            let fits = |k: i64| plc_model::Value::int_of(ty, k.into()).is_some();
+            if fits(lo) && fits(lo - 1) {
+                let b = Val::Lit(Scalar::Number(lo.into()));
+                outside.push(vec![self.compare(CmpOp::Lt, &v, &b)]);
+            } else if !fits(lo) && lo > 0 {
+                return refuse(self.at, format!("a subscript of type {ty}, which cannot reach the bounds {lo}..{hi} of `{}`", sel.array));
+            }
+            if fits(hi) && fits(hi + 1) {
+                let b = Val::Lit(Scalar::Number(hi.into()));
+                outside.push(vec![self.compare(CmpOp::Gt, &v, &b)]);
+            }
+            out.push(Err(v));
+        }
+        let series = match outside.len() {
+            0 => None,
+            1 => outside.pop(),
+            _ => Some(vec![ElementKind::Or(to_series(self, outside))]),
+        };
+        Ok((out, series))
+    }
+
+    /// For each element `sel` may choose: its variable and the compares that pass power when the
+    /// subscripts `subs` choose it (elements a constant subscript rules out, or whose
+    /// subscripts a variable's type cannot hold, left out).
+    fn choices(&self, sel: &Select, subs: &[Sub]) -> L<Vec<(String, Series)>> {
+        let mut out = Vec::new();
+        'el: for e in &sel.elements {
+            let mut c = Vec::new();
+            for (d, s) in subs.iter().enumerate() {
+                match s {
+                    Ok(k) if *k == e.index[d] => {}
+                    Ok(_) => continue 'el,
+                    Err(v) => {
+                        let k = e.index[d];
+                        if v.ty()
+                            .is_some_and(|t| plc_model::Value::int_of(t, k.into()).is_none())
+                        {
+                            continue 'el;
+                        }
+                        c.push(self.compare(CmpOp::Eq, v, &Val::Lit(Scalar::Number(k.into()))));
+                    }
+                }
+            }
+            out.push((e.name.clone(), c));
+        }
+        if out.len() > MAX_SELECTED {
+            return refuse(
+                self.at,
+                format!("a variable subscript of `{}` choosing among {} elements (more than the {MAX_SELECTED} plc-deps lowers to a selection)", sel.array, out.len()),
+            );
+        }
+        Ok(out)
+    }
+
+    /// The rung that records a fault of the scan when a subscript is outside its bounds:
+    /// an integer DIV by the never-written `st__zero`, which records `div-by-zero` at this
+    /// statement's rung (docs/plcopen.md, Arrays).
+    fn range_fault(&mut self, outside: Option<Series>) {
+        let Some(mut ld) = outside else { return };
+        if !self.zero_var {
+            self.zero_var = true;
+            self.declare("st__zero", Type::Dint);
+            self.declare("st__range", Type::Dint);
+        }
+        ld.push(ElementKind::Arith(Box::new(Arith {
+            op: ArithOp::Div,
+            a: self.operand(&Val::Lit(Scalar::Number(1.into()))),
+            b: self.operand(&Val::Var("st__zero".to_owned(), Type::Dint)),
+            out: self.name("st__range"),
+        })));
+        self.emit(ld);
+    }
+
+    /// A read of the element `sel` chooses, into a new temporary: the type's default first
+    /// (what an out-of-bounds read gives, with the fault), then the chosen element's value.
+    fn select_read(&mut self, sel: Select) -> L<(String, Type)> {
+        let (subs, outside) = self.subscripts(&sel)?;
+        let choices = self.choices(&sel, &subs)?;
+        self.range_fault(outside);
+        let t = self.temp(sel.ty);
+        let tn = self.name(&t);
+        if sel.ty == Type::Bool {
+            self.emit(vec![ElementKind::Reset(tn.clone())]);
+            for (n, mut c) in choices {
+                c.push(self.contact(&n, false));
+                c.push(ElementKind::Set(tn.clone()));
+                self.emit(c);
+            }
+        } else {
+            let zero = match sel.ty {
+                Type::Time => Val::Lit(Scalar::Str(Cow::Borrowed("T#0s"))),
+                t if t.is_int() || t.is_bits() => Val::Lit(Scalar::Number(0.into())),
+                _ => Val::Lit(Scalar::Number(
+                    serde_json::Number::from_f64(0.0).unwrap_or(0.into()),
+                )),
+            };
+            let m = ElementKind::Move(Box::new(Move {
+                from: self.operand(&zero),
+                to: tn.clone(),
+            }));
+            self.emit(vec![m]);
+            for (n, mut c) in choices {
+                c.push(ElementKind::Move(Box::new(Move {
+                    from: self.operand(&Val::Var(n, sel.ty)),
+                    to: tn.clone(),
+                })));
+                self.emit(c);
+            }
+        }
+        Ok((t, sel.ty))
+    }
+
+    /// `a[i] := value` with a subscript that is not constant: the value once, the subscripts
+    /// once, then a conditional write of each element it may choose (none, and a fault, when a
+    /// subscript is outside its bounds).
+    fn select_write(&mut self, sel: Select, value: &Expr) -> L<()> {
+        let v = if sel.ty == Type::Bool {
+            Val::Var(self.bool_contact(value)?, Type::Bool)
+        } else {
+            let v = self.value(value, Some(sel.ty))?;
+            match v {
+                Val::Var(ref n, _) if !n.starts_with("st__") => {
+                    let t = self.temp(sel.ty);
+                    let m = ElementKind::Move(Box::new(Move {
+                        from: self.operand(&v),
+                        to: self.name(&t),
+                    }));
+                    self.emit(vec![m]);
+                    Val::Var(t, sel.ty)
+                }
+                v => v,
+            }
+        };
+        let (subs, outside) = self.subscripts(&sel)?;
+        let choices = self.choices(&sel, &subs)?;
+        self.range_fault(outside);
+        for (n, mut c) in choices {
+            if let Val::Var(b, Type::Bool) = &v {
+                let set = vec![self.contact(b, false), ElementKind::Set(self.name(&n))];
+                let reset = vec![self.contact(b, true), ElementKind::Reset(self.name(&n))];
+                c.push(ElementKind::Branch(to_series(self, vec![set, reset])));
+            } else {
+                c.push(ElementKind::Move(Box::new(Move {
+                    from: self.operand(&v),
+                    to: self.name(&n),
+                })));
+            }
+            self.emit(c);
+        }
+        Ok(())
     }
 
     fn resolve(&self, p: &Place, write: bool) -> L<(String, Type)> {
@@ -1058,6 +1428,9 @@ impl<'s> Lower<'s> {
             ),
             Ok(Some((Decl::Structure { .. }, _))) => {
                 refuse(at, format!("the structure `{path}` as a whole"))
+            }
+            Ok(Some((Decl::Array { .. }, _))) => {
+                refuse(at, format!("the array `{path}` as a whole"))
             }
             _ => refuse(at, format!("`{path}`, which is not a variable of the POU")),
         }
@@ -1191,7 +1564,11 @@ impl<'s> Lower<'s> {
     fn natural(&self, e: &Expr, want: Option<Type>) -> Option<Type> {
         match e {
             Expr::Var(p) => match self.enum_value(p) {
-                Ok(None) => self.read(p).ok().map(|(_, t)| t),
+                Ok(None) => match self.locate(p) {
+                    Ok(Access::One(_, t)) => Some(t),
+                    Ok(Access::Select(sel)) => Some(sel.ty),
+                    Err(_) => None,
+                },
                 _ => None,
             },
             Expr::Unary(UnaryOp::Neg | UnaryOp::Plus, x) => self.natural(x, want),
@@ -1332,7 +1709,10 @@ impl<'s> Lower<'s> {
     fn is_bool(&self, e: &Expr) -> bool {
         match e {
             Expr::Literal(_) => bool_literal(e).is_some(),
-            Expr::Var(p) => matches!(self.read(p), Ok((_, Type::Bool))),
+            Expr::Var(p) => matches!(
+                self.locate(p),
+                Ok(Access::One(_, Type::Bool)) | Ok(Access::Select(Select { ty: Type::Bool, .. }))
+            ),
             Expr::Unary(UnaryOp::Not, x) => self.is_bool(x),
             Expr::Unary(..) => false,
             Expr::Binary(op, a, b) => match op {

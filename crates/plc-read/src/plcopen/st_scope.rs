@@ -1,6 +1,7 @@
 //! The names an ST body sees ([`Scope`]): its POU's variables and the globals it declares
 //! external, by lower-case name, each an elementary variable, an instance of a function block
-//! type, an enumeration value or a structure flattened into its fields ([`Decl`]). Shared by
+//! type, an enumeration value, a structure flattened into its fields or an array scalarised
+//! into its elements ([`Decl`]; an element `a[3]` is an elementary variable too). Shared by
 //! the analysis's stand-ins ([`super::st_body`]) and the lowering ([`super::st_lower`]).
 //!
 //! Invariant: IEC names are case-insensitive; a name found here carries its declared spelling.
@@ -31,6 +32,51 @@ pub(super) enum Decl {
     Structure {
         leaves: Vec<(String, String)>,
     },
+    /// An array scalarised into its elements ([`super::data_types::ArrayOf`]): each element's
+    /// variable (`a[3]`, its own [`Decl::Elementary`] too), subscripts and type, in declaration
+    /// order. Reading or writing it whole (or through a subscript that is not constant) reads
+    /// or writes every one.
+    Array {
+        /// The array's name as declared (`a`, `s.a`).
+        name: String,
+        elements: Vec<Element>,
+    },
+}
+
+/// An element of a scalarised array: its variable, subscripts and type.
+#[derive(Clone, Debug)]
+pub(super) struct Element {
+    pub name: String,
+    pub index: Vec<i64>,
+    pub ty: String,
+}
+
+impl Decl {
+    /// The elementary variables a structure or an array stands for, with their types (`None`
+    /// for any other declaration).
+    pub(super) fn leaves(&self) -> Option<Vec<(String, String)>> {
+        match self {
+            Decl::Structure { leaves } => Some(leaves.clone()),
+            Decl::Array { elements, .. } => Some(
+                elements
+                    .iter()
+                    .map(|e| (e.name.clone(), e.ty.clone()))
+                    .collect(),
+            ),
+            _ => None,
+        }
+    }
+}
+
+/// The array and subscripts of an element variable's name (`m[1,-2]` → `m`, `[1, -2]`).
+pub(super) fn split_element(name: &str) -> Option<(&str, Vec<i64>)> {
+    let inner = name.strip_suffix(']')?;
+    let open = inner.rfind('[')?;
+    let index: Option<Vec<i64>> = inner[open + 1..]
+        .split(',')
+        .map(|k| k.trim().parse().ok())
+        .collect();
+    Some((&name[..open], index?))
 }
 
 /// The declarations an ST body sees, by lower-case name.
@@ -80,6 +126,23 @@ impl Scope {
             }
         };
         self.names.insert(name.to_ascii_lowercase(), decl);
+        // An array's element (`a[3]`) makes its array known as the set of its elements.
+        if let Some((array, index)) = split_element(name) {
+            let entry = self
+                .names
+                .entry(array.to_ascii_lowercase())
+                .or_insert_with(|| Decl::Array {
+                    name: array.to_owned(),
+                    elements: Vec::new(),
+                });
+            if let Decl::Array { elements, .. } = entry {
+                elements.push(Element {
+                    name: name.to_owned(),
+                    index,
+                    ty: ty.to_owned(),
+                });
+            }
+        }
         // A structure's field (`Plant.Motor.Speed`) makes its structures (`Plant`,
         // `Plant.Motor`) known as the sets of their fields.
         let mut at = name.len();
@@ -118,9 +181,9 @@ impl Scope {
 
     /// `name` as it is, or, when it is a structure, the names of its fields.
     pub(super) fn fields_of(&self, name: &str) -> Vec<String> {
-        match self.get(name) {
-            Some(Decl::Structure { leaves }) => leaves.iter().map(|(n, _)| n.clone()).collect(),
-            _ => vec![name.to_owned()],
+        match self.get(name).and_then(Decl::leaves) {
+            Some(leaves) => leaves.into_iter().map(|(n, _)| n).collect(),
+            None => vec![name.to_owned()],
         }
     }
 

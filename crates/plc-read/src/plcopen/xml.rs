@@ -297,11 +297,22 @@ pub(super) fn identifier(s: &str, what: &str, n: Node, place: &str) -> R<String>
 }
 
 /// A variable reference as an LD/FBD element names it: an identifier or a field of one
-/// (`T1.Q`, `G1.RESULT`), trimmed.
+/// (`T1.Q`, `G1.RESULT`), trimmed; or an element of constant subscripts of a scalarised array,
+/// as its variable's name (`a[ 1 + 2 ]` as `a[3]`, [`super::data_types`]).
 pub(super) fn variable_ref(s: &str, n: Node, place: &str) -> R<String> {
     let t = s.trim();
     if !t.is_empty() && t.split('.').all(is_identifier) {
         Ok(t.to_owned())
+    } else if let Some(e) = t
+        .contains('[')
+        .then(|| crate::st::parser::expression(t).ok())
+        .flatten()
+        .and_then(|e| match e {
+            crate::st::ast::Expr::Var(p) => element_name(&p),
+            _ => None,
+        })
+    {
+        Ok(e)
     } else {
         Err(error(
             origin(n),
@@ -309,6 +320,28 @@ pub(super) fn variable_ref(s: &str, n: Node, place: &str) -> R<String> {
             format!("`{t}` is not a variable or a field of one (`X`, `T1.Q`): array elements, direct addresses and expressions are not supported here yet"),
         ))
     }
+}
+
+/// The variable of array element `p` when its subscripts are constant and last (`a[3]`,
+/// `s.m[1, -2]` as `s.m[1,-2]`), the name a scalarised array's element has.
+pub(super) fn element_name(p: &crate::st::ast::Place) -> Option<String> {
+    let (last, fields) = p.selectors.split_last()?;
+    let crate::st::ast::Selector::Index(ix) = last else {
+        return None;
+    };
+    let mut name = p.base.clone();
+    for f in fields {
+        let crate::st::ast::Selector::Field(f) = f else {
+            return None;
+        };
+        name.push('.');
+        name.push_str(f);
+    }
+    let ks: Option<Vec<String>> = ix
+        .iter()
+        .map(|e| crate::st::constant(e).map(|k| k.to_string()))
+        .collect();
+    Some(format!("{name}[{}]", ks?.join(",")))
 }
 
 /// The `addData` children of `n` as one note (their `data@name`s), if any. A `data` holding a

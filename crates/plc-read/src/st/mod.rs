@@ -159,7 +159,10 @@ fn indices(p: &Place, a: &mut Accesses) {
     }
 }
 
-/// `p`'s access path: its base and the fields selected before any subscript or dereference.
+/// `p`'s access path: its base and the fields selected before any dereference or subscript
+/// that is not constant; a constant subscript (integer literals and `+ - *` of them, IEC
+/// 61131-3 6.4.4.5) is kept as the element's name (`a[3]`, `m[1,-2]`, a variable of its own
+/// where the reader scalarises the array), and ends the path.
 fn path(p: &Place) -> String {
     let mut out = p.base.clone();
     for s in &p.selectors {
@@ -168,10 +171,73 @@ fn path(p: &Place) -> String {
                 out.push('.');
                 out.push_str(f);
             }
-            Selector::Index(_) | Selector::Deref => break,
+            Selector::Index(es) => {
+                if let Some(k) = es.iter().map(constant).collect::<Option<Vec<i64>>>() {
+                    let k: Vec<String> = k.iter().map(|i| i.to_string()).collect();
+                    out.push('[');
+                    out.push_str(&k.join(","));
+                    out.push(']');
+                }
+                break;
+            }
+            Selector::Deref => break,
         }
     }
     out
+}
+
+/// Whether `p` is a whole path: fields and constant subscripts only (a write of it writes that
+/// variable whole).
+fn exact(p: &Place) -> bool {
+    p.selectors.iter().enumerate().all(|(i, s)| match s {
+        Selector::Field(_) => true,
+        Selector::Index(es) => {
+            i + 1 == p.selectors.len() && es.iter().all(|e| constant(e).is_some())
+        }
+        Selector::Deref => false,
+    })
+}
+
+/// The value of constant integer expression `e` (integer literals, unary `-` and `+`, `+ - *`
+/// of them), `None` when it is not one.
+pub fn constant(e: &Expr) -> Option<i64> {
+    match e {
+        Expr::Literal(s) => {
+            let t = s.replace('_', "");
+            let t = [
+                "INT#", "DINT#", "SINT#", "LINT#", "UINT#", "UDINT#", "USINT#", "ULINT#",
+            ]
+            .iter()
+            .find_map(|p| {
+                t.get(..p.len())
+                    .filter(|h| h.eq_ignore_ascii_case(p))
+                    .map(|_| t[p.len()..].to_owned())
+            })
+            .unwrap_or(t);
+            if let Some((radix, digits)) = t.split_once('#') {
+                let r = match radix {
+                    "2" => 2,
+                    "8" => 8,
+                    "16" => 16,
+                    _ => return None,
+                };
+                return i64::from_str_radix(digits, r).ok();
+            }
+            t.parse().ok()
+        }
+        Expr::Unary(UnaryOp::Neg, x) => constant(x)?.checked_neg(),
+        Expr::Unary(UnaryOp::Plus, x) => constant(x),
+        Expr::Binary(op, a, b) => {
+            let (a, b) = (constant(a)?, constant(b)?);
+            match op {
+                BinaryOp::Add => a.checked_add(b),
+                BinaryOp::Sub => a.checked_sub(b),
+                BinaryOp::Mul => a.checked_mul(b),
+                _ => None,
+            }
+        }
+        _ => None,
+    }
 }
 
 fn read_place(p: &Place, a: &mut Accesses) {
@@ -184,10 +250,7 @@ fn write_place(p: &Place, a: &mut Accesses) {
     // Writing through a pointer reads the pointer; writing a part of a variable keeps the rest
     // (a field path names the part when the selectors are fields only).
     let whole = path(p);
-    if p.selectors
-        .iter()
-        .any(|s| matches!(s, Selector::Deref | Selector::Index(_)))
-    {
+    if !exact(p) {
         a.read(&whole);
     } else if !p.selectors.is_empty() {
         a.read_kept(&whole);
