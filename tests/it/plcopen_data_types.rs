@@ -47,7 +47,7 @@ fn aliases_subranges_enumerations_and_hmi_types_load_and_run_with_their_defaults
     let (_, err) = report_and_warnings(&xml);
     assert_eq!(
         err.trim_end(),
-        format!("warning: <stdin>:{}: data types are read as the model's types (IEC 61131-3 6.4.4): HMI_BOOL → BOOL (an alias of BOOL, from the Beremiz SVGHMI library): P.go, P.lamp; LEVEL2 → INT (an alias of INT, subrange 0..1000 not enforced): P.lvl; VALVE → INT (an enumeration, read as INT with OPEN = 0, CLOSED = 1): P.v; HMI_INT → INT (an alias of INT, from the Beremiz SVGHMI library): P.n; `run` does not check subranges, an array is one whole variable (a read or write of any element reads or writes it) with no value, and a structure is one variable per elementary field (`s.f`)", line_col(&xml, "<variable name=\"go\""))
+        format!("warning: <stdin>:{}: data types are read as the model's types (IEC 61131-3 6.4.4): HMI_BOOL → BOOL (an alias of BOOL, from the Beremiz SVGHMI library): P.go, P.lamp; LEVEL2 → INT (an alias of INT, subrange 0..1000 not enforced): P.lvl; VALVE → INT (an enumeration, read as INT with OPEN = 0, CLOSED = 1): P.v; HMI_INT → INT (an alias of INT, from the Beremiz SVGHMI library): P.n; `run` does not check subranges, an array of an elementary type is one variable per element (`a[i]`) and any other array one whole variable (a read or write of any element reads or writes it) with no value, and a structure is one variable per elementary field (`s.f`)", line_col(&xml, "<variable name=\"go\""))
     );
     let v = run_scans(&xml, 1);
     assert_eq!(
@@ -57,7 +57,8 @@ fn aliases_subranges_enumerations_and_hmi_types_load_and_run_with_their_defaults
 }
 
 #[test]
-fn st_reads_enumeration_values_as_constants_and_array_elements_as_the_whole_array() {
+fn st_reads_enumeration_values_as_constants_and_an_element_of_a_variable_subscript_as_any_element()
+{
     let body = "<xhtml:p xmlns:xhtml=\"http://www.w3.org/1999/xhtml\"><![CDATA[v := OPEN;\ntab[i] := tab[2] + 1;\nIF v = CLOSED THEN i := 1; END_IF;]]></xhtml:p>";
     let xml = with_types(
         "ST",
@@ -73,14 +74,23 @@ fn st_reads_enumeration_values_as_constants_and_array_elements_as_the_whole_arra
         io(&r),
         vec![
             rung("P.st1", &["v"], &["v"]),
-            rung("P.st2", &["i", "tab"], &["tab"]),
+            // `tab[i] := tab[2] + 1`: the element `i` chooses may be any (docs/plcopen.md,
+            // "Arrays").
+            rung(
+                "P.st2",
+                &[
+                    "i", "tab[1]", "tab[2]", "tab[3]", "tab[4]", "tab[5]", "tab[6]", "tab[7]",
+                    "tab[8]"
+                ],
+                &["tab[1]", "tab[2]", "tab[3]", "tab[4]", "tab[5]", "tab[6]", "tab[7]", "tab[8]"]
+            ),
             rung("P.st3", &["v", "i"], &["i"]),
         ]
     );
 }
 
 #[test]
-fn an_array_is_analysed_and_run_refuses_it_where_it_would_execute_the_body() {
+fn an_array_of_int_is_one_variable_per_element_and_its_pou_runs() {
     let xml = with_types(
         "LD",
         &[
@@ -91,12 +101,10 @@ fn an_array_is_analysed_and_run_refuses_it_where_it_would_execute_the_body() {
         &ld(),
     );
     assert!(run_stdin(&["report", "-"], xml.as_bytes()).status.success());
-    let e = error_line(
-        &run_stdin(&["run", "-", "--scans", "1"], xml.as_bytes()),
-        "array in LD",
-    );
-    let at = line_col(&xml, "<variable name=\"tab\"");
-    assert_eq!(e, format!("error: <stdin>:{at}: at run: pou P: variable `tab` is a TABLE, for which plc-deps has no values: the analysis reads it as a whole variable, but `run` cannot execute the LD body of `P`"));
+    // TABLE is ARRAY[1..8] OF INT: eight INT variables `tab[1]` … `tab[8]` (docs/plcopen.md,
+    // "Arrays"), so the LD body runs.
+    let v = run_scans(&xml, 1);
+    assert_eq!(v["outputs"]["lamp"], json!(false), "{v}");
 }
 
 #[test]

@@ -146,13 +146,13 @@ fn an_unknown_field_is_one_located_error() {
         "unknown ST field",
     );
     let at = line_col(&st, "n := a.Sped");
-    assert_eq!(e, format!("error: <stdin>:{at}: at pou P, ST: `a.Sped`: structure `a` has no field `Sped` (its fields: Speed, On, Hist)"));
+    assert_eq!(e, format!("error: <stdin>:{at}: at pou P, ST: `a.Sped`: structure `a` has no field `Sped` (its fields: Speed, On, Hist[1], Hist[2], Hist[3], Hist[4])"));
 }
 
 /// An array field is one whole variable without a value: the report reads the other fields
 /// one by one, and `run` refuses the LD body, naming the field.
 #[test]
-fn an_array_field_stays_one_whole_variable() {
+fn an_array_field_is_one_variable_per_element_and_runs() {
     let xml = fixture("struct_array_field");
     let r = report(&xml);
     assert_eq!(
@@ -162,17 +162,14 @@ fn an_array_field_stays_one_whole_variable() {
             rung("P.R2", &["m.On"], &["lamp"]),
         ]
     );
-    let e = error_line(
-        &run_stdin(&["run", "-", "--scans", "1"], xml.as_bytes()),
-        "array field in LD",
-    );
-    let at = line_col(&xml, "<variable name=\"m\"");
-    assert_eq!(e, format!("error: <stdin>:{at}: at run: pou P: variable `m.Hist` is a ARRAY, for which plc-deps has no values: the analysis reads it as a whole variable, but `run` cannot execute the LD body of `P`"));
+    // The array field of INT is scalarised (docs/plcopen.md, "Arrays"): the body runs.
+    let v = run_scans(&xml, 1);
+    assert_eq!(v["outputs"]["lamp"], json!(false), "{v}");
 }
 
 /// ST: a field is its variable (written whole, it is not read but for the stand-in's
-/// may-write); `b := a` reads every field of `a` and writes every field of `b`; an element of an
-/// array field reads and writes the whole array field.
+/// may-write); `b := a` reads every field of `a` and writes every field of `b`; an array field
+/// is one variable per element, and an element of a variable subscript may be any of them.
 #[test]
 fn st_reads_fields_and_whole_structures() {
     let r = report(&fixture("struct_st"));
@@ -183,10 +180,35 @@ fn st_reads_fields_and_whole_structures() {
             rung("P.st2", &["a.Speed", "n"], &["n"]),
             rung(
                 "P.st3",
-                &["a.Speed", "a.On", "a.Hist", "b.Speed", "b.On", "b.Hist"],
-                &["b.Speed", "b.On", "b.Hist"]
+                &[
+                    "a.Speed",
+                    "a.On",
+                    "a.Hist[1]",
+                    "a.Hist[2]",
+                    "a.Hist[3]",
+                    "a.Hist[4]",
+                    "b.Speed",
+                    "b.On",
+                    "b.Hist[1]",
+                    "b.Hist[2]",
+                    "b.Hist[3]",
+                    "b.Hist[4]"
+                ],
+                &[
+                    "b.Speed",
+                    "b.On",
+                    "b.Hist[1]",
+                    "b.Hist[2]",
+                    "b.Hist[3]",
+                    "b.Hist[4]"
+                ]
             ),
-            rung("P.st4", &["i", "a.Hist", "n"], &["a.Hist"]),
+            // `a.Hist[i]`: the element `i` chooses may be any (docs/plcopen.md, "Arrays").
+            rung(
+                "P.st4",
+                &["i", "a.Hist[1]", "a.Hist[2]", "a.Hist[3]", "a.Hist[4]", "n"],
+                &["a.Hist[1]", "a.Hist[2]", "a.Hist[3]", "a.Hist[4]"]
+            ),
             rung("P.st5", &["a.Speed"], &["a.Speed"]),
         ]
     );

@@ -14,7 +14,8 @@
 //! (`a[i]`) reads the whole array and the variables of its subscripts: the model holds an array
 //! as one value of its element type (docs/plcopen.md, "Data types"), so the element stands in as
 //! `SEL(NE(i, i), a, a)` — the value `a`, with `i` read — and `run` refuses the body (the
-//! reader's note says why, `super::project`).
+//! reader's note says why, `super::project`); a scalarised array's elements stand in for `a`,
+//! each read through a `SEL(FALSE, …)`.
 //!
 //! Deliberately not here: function calls and `**` (the model has no EXPT) in an expression,
 //! direct addresses and dereferences (one error each, naming the expression).
@@ -174,11 +175,37 @@ impl<F: Fn(String) -> LoadError> Lower<'_, F> {
                 "`{name}` is not a variable or a field of one"
             )));
         }
+        // A scalarised array (`name` has no variable, its elements have): its elements stand
+        // in for it, each read (in name order).
+        let prefix = format!("{}[", name.to_ascii_lowercase());
+        let mut parts: Vec<&String> = self
+            .a
+            .elements
+            .iter()
+            .filter(|e| e.starts_with(&prefix))
+            .collect();
+        parts.sort();
+        let parts: Vec<String> = parts.into_iter().cloned().collect();
         let var = || Input {
             origin: at,
-            from: Connection::Variable(Cow::Owned(name.clone())),
+            from: Connection::Variable(Cow::Owned(
+                parts.first().cloned().unwrap_or_else(|| name.clone()),
+            )),
         };
         let mut value = var();
+        for e in parts.iter().skip(1) {
+            let zero = Input {
+                origin: at,
+                from: Connection::Constant(Scalar::Bool(false)),
+            };
+            let next = Input {
+                origin: at,
+                from: Connection::Variable(Cow::Owned(e.clone())),
+            };
+            value = self
+                .a
+                .add("SEL", vec![("G", zero), ("IN0", value), ("IN1", next)], at);
+        }
         for ix in subscripts {
             let i = self.expr(ix)?;
             let never = self.a.add("NE", vec![("IN1", i.clone()), ("IN2", i)], at);
