@@ -130,7 +130,9 @@ fn an_out_of_bounds_subscript_is_a_fault_of_its_scan_and_statement() {
         json!([
             {"scan": 1, "rung": "P.st1.2", "kind": "div-by-zero"},
             {"scan": 2, "rung": "P.st1.2", "kind": "div-by-zero"},
-            {"scan": 2, "rung": "P.st2.3", "kind": "div-by-zero"},
+            // Statement 2's bounds rung comes after the rungs of `k - 1` and `40 + k`, each
+            // computed in DINT and cut to INT as matiec's C does (docs/dialects.md).
+            {"scan": 2, "rung": "P.st2.7", "kind": "div-by-zero"},
         ])
     );
     c_equals_run(f, 3, Some(csv));

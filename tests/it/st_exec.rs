@@ -123,6 +123,8 @@ fn operators_follow_the_standards_precedence_and_the_executors_number_rules() {
         ("m5", json!(4)),       // ABS(3 - 7)
         ("m6", json!(1)),       // MAX(m6, n) writing an operand: MAX(0, 1)
         ("d1", json!(7000000)), // INT_TO_DINT(7) * 1000000 in DINT
+        ("m7", json!(3)),       // MOD(7, 3) + DIV(7, 3): the standard functions (Table 29)
+        ("m8", json!(11)),      // ADD(7, 3, 1): ADD is extensible
     ];
     let names: Vec<&str> = expected.iter().map(|e| e.0).collect();
     assert_eq!(values(&v, &names), pairs(&expected));

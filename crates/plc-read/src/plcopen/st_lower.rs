@@ -1941,6 +1941,24 @@ impl<'s> Lower<'s> {
                     None => Some(Val::Var(d, ty)),
                 })
             }
+            // The arithmetic standard functions (IEC 61131-3 Table 29): ADD and MUL of two or
+            // more inputs, SUB, DIV, MOD of two, as the operators they are.
+            "ADD" | "MUL" | "SUB" | "DIV" | "MOD"
+                if n == 2 || (n > 2 && matches!(fname.as_str(), "ADD" | "MUL")) =>
+            {
+                let op = match fname.as_str() {
+                    "ADD" => BinaryOp::Add,
+                    "MUL" => BinaryOp::Mul,
+                    "SUB" => BinaryOp::Sub,
+                    "DIV" => BinaryOp::Div,
+                    _ => BinaryOp::Mod,
+                };
+                let mut e = values[0].clone();
+                for v in &values[1..] {
+                    e = Expr::Binary(op, Box::new(e), Box::new((*v).clone()));
+                }
+                self.value_into(&e, want, out)
+            }
             _ => match Function::parse(&fname) {
                 Some(f) => self.function(f, &values, want, out),
                 None => refuse(
