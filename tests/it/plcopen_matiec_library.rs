@@ -189,6 +189,24 @@ fn integral_derivative_pid_ramp_hysteresis_and_sema_follow_matiecs_definitions_i
     c_equals_run(f, 7, None);
 }
 
+/// An informal call binds its arguments in declaration order, the inputs first and then the
+/// outputs (matiec's `generate_c_st.cc`, `fb_invocation_c`: each parameter in turn takes the
+/// next informal value, and an output's is assigned after the call): `pid2(n >= 3, xr, …,
+/// T#500ms, px2)` is `pid1`'s formal call with `XOUT => px2`, so `px2` is `px` after every scan.
+#[test]
+fn an_informal_call_binds_the_inputs_then_the_outputs() {
+    let f = "tests/matiec_library/blocks_st.xml";
+    for scans in 1..=5 {
+        let s = state(f, scans, None, &["px", "px2"]);
+        assert_eq!(s[0], s[1], "after scan {scans}");
+        assert_ne!(
+            s[0],
+            json!(0.0),
+            "after scan {scans}: the PID's output is not 0"
+        );
+    }
+}
+
 #[test]
 fn library_blocks_run_as_fbd_blocks() {
     let (f, csv) = (

@@ -97,14 +97,19 @@ pub(super) fn formal_order<'a>(at: usize, f: &str, args: &'a [Arg]) -> L<Cow<'a,
     Ok(Cow::Owned(out))
 }
 
-/// The arguments of a call of function block instance `inst` whose inputs are `pins` (in
-/// declaration order), informal ones named: `T1(start, T#1s)` is `T1(IN := start, PT := T#1s)`
-/// (IEC 61131-3 3rd ed., 6.6.1.4.2; matiec binds them in declaration order, EN left out).
-/// Informal and formal inputs mixed, or more informal ones than inputs, are refused.
+/// The arguments of a call of function block instance `inst` whose inputs are `pins` and
+/// outputs `outs` (in declaration order), informal ones named: `T1(start, T#1s)` is
+/// `T1(IN := start, PT := T#1s)` (IEC 61131-3 3rd ed., 6.6.1.4.2; matiec binds them in
+/// declaration order, EN left out), and informal arguments past the inputs are the outputs'
+/// targets: `pid1(TRUE, pv, sp, 0.0, kp, tr, td, t, y)` gives `XOUT => y`, as matiec's C for an
+/// informal call assigns each output after the call (`generate_c_st.cc`, `fb_invocation_c`).
+/// Informal and formal inputs mixed, more informal ones than inputs and outputs, or an output's
+/// argument that is not a variable, are refused.
 pub(super) fn name_informal<'a>(
     at: usize,
     inst: &str,
     pins: &[String],
+    outs: &[String],
     args: &'a [Arg],
 ) -> L<Cow<'a, [Arg]>> {
     let informal = |a: &Arg| matches!(a, Arg::Input { name: None, .. });
@@ -117,29 +122,49 @@ pub(super) fn name_informal<'a>(
             format!("the call of `{inst}` with formal and informal arguments mixed"),
         );
     }
-    if args.len() > pins.len() {
+    if args.len() > pins.len() + outs.len() {
         return refuse(
             at,
             format!(
-                "{} informal arguments in the call of `{inst}`, which has {} inputs ({})",
+                "{} informal arguments in the call of `{inst}`, which has {} inputs ({}){}",
                 args.len(),
                 pins.len(),
-                pins.join(", ")
+                pins.join(", "),
+                match outs.len() {
+                    0 => String::new(),
+                    n => format!(" and {n} outputs ({})", outs.join(", ")),
+                }
             ),
         );
     }
-    Ok(Cow::Owned(
-        args.iter()
-            .zip(pins)
-            .map(|(a, p)| match a {
-                Arg::Input { value, .. } => Arg::Input {
-                    name: Some(p.clone()),
-                    value: value.clone(),
-                },
-                other => other.clone(),
-            })
-            .collect(),
-    ))
+    let mut named = Vec::with_capacity(args.len());
+    for (k, a) in args.iter().enumerate() {
+        let Arg::Input { value, .. } = a else {
+            named.push(a.clone());
+            continue;
+        };
+        named.push(match (pins.get(k), value) {
+            (Some(p), _) => Arg::Input {
+                name: Some(p.clone()),
+                value: value.clone(),
+            },
+            (None, Expr::Var(target)) => Arg::Output {
+                name: outs[k - pins.len()].clone(),
+                target: target.clone(),
+            },
+            (None, _) => {
+                return refuse(
+                    at,
+                    format!(
+                        "informal argument {} of the call of `{inst}` is for its output `{}`, and is not a variable",
+                        k + 1,
+                        outs[k - pins.len()]
+                    ),
+                )
+            }
+        });
+    }
+    Ok(Cow::Owned(named))
 }
 
 /// A value moved into a variable: a literal or a variable.

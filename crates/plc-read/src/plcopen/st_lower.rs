@@ -855,7 +855,12 @@ impl<'s> Lower<'s> {
             (None, Some(ps)) => ps.iter().map(|(n, _)| n.to_string()).collect(),
             (None, None) => Vec::new(),
         };
-        let args = &*functions::name_informal(at, &inst, &pin_names, args)?;
+        // A user function block's outputs take the informal arguments past its inputs.
+        let out_names: Vec<String> = match self.scope.fb(&ty) {
+            Some(fb) => fb.outputs.iter().map(|(n, _)| n.clone()).collect(),
+            None => Vec::new(),
+        };
+        let args = &*functions::name_informal(at, &inst, &pin_names, &out_names, args)?;
         if let Some(fb) = self.scope.fb(&ty).cloned() {
             return self.user_fb_call(at, &inst, &fb, args);
         }
