@@ -687,18 +687,7 @@ impl<'s> Lower<'s> {
             return refuse(at, "a CASE on a BOOL");
         }
         // The selector once, as matiec's `__case_expression`.
-        let sel = match v {
-            Val::Var(ref n, _) if n.starts_with("st__") => v,
-            _ => {
-                let t = self.temp(ty);
-                let m = ElementKind::Move(Box::new(Move {
-                    from: self.operand(&v),
-                    to: self.name(&t),
-                }));
-                self.emit(vec![m]);
-                Val::Var(t, ty)
-            }
-        };
+        let sel = self.held(v, ty);
         let end = self.label();
         let mut targets = Vec::new();
         for (labels, _) in arms {
@@ -815,6 +804,21 @@ impl<'s> Lower<'s> {
     }
 
     /// `e` evaluated now, kept in a temporary unless it is a literal.
+    /// `v` held in a temporary of type `ty`, so that later writes of its variables do not
+    /// change it (a compiler temporary already is one).
+    fn held(&mut self, v: Val, ty: Type) -> Val {
+        if matches!(&v, Val::Var(n, _) if n.starts_with("st__")) {
+            return v;
+        }
+        let t = self.temp(ty);
+        let m = ElementKind::Move(Box::new(Move {
+            from: self.operand(&v),
+            to: self.name(&t),
+        }));
+        self.emit(vec![m]);
+        Val::Var(t, ty)
+    }
+
     fn once(&mut self, e: &Expr, ty: Type) -> L<Val> {
         let v = self.value(e, Some(ty))?;
         if matches!(v, Val::Lit(_)) {
@@ -1226,18 +1230,7 @@ impl<'s> Lower<'s> {
                     )
                 }
             };
-            let v = match v {
-                Val::Var(ref n, _) if n.starts_with("st__") => v,
-                _ => {
-                    let t = self.temp(ty);
-                    let m = ElementKind::Move(Box::new(Move {
-                        from: self.operand(&v),
-                        to: self.name(&t),
-                    }));
-                    self.emit(vec![m]);
-                    Val::Var(t, ty)
-                }
-            };
+            let v = self.held(v, ty);
             let (lo, hi) = sel.dims[d];
             let fits = |k: i64| plc_model::Value::int_of(ty, k.into()).is_some();
             if fits(lo) && fits(lo - 1) {
@@ -1554,10 +1547,7 @@ impl<'s> Lower<'s> {
         self.scope.int_arithmetic_in_dint
             && matches!(
                 e,
-                Expr::Binary(
-                    BinaryOp::Add | BinaryOp::Sub | BinaryOp::Mul | BinaryOp::Div | BinaryOp::Mod,
-                    ..
-                )
+                Expr::Binary(op, ..) if arith_op(*op).is_some()
             )
             && self
                 .natural(e, want)
@@ -1599,12 +1589,8 @@ impl<'s> Lower<'s> {
         let Expr::Binary(op, a, b) = e else {
             return Ok((self.widened(e, Some(nat))?, nat));
         };
-        let arith = match op {
-            BinaryOp::Add => ArithOp::Add,
-            BinaryOp::Sub => ArithOp::Sub,
-            BinaryOp::Mul => ArithOp::Mul,
-            BinaryOp::Div => ArithOp::Div,
-            _ => ArithOp::Mod,
+        let Some(arith) = arith_op(*op) else {
+            return Ok((self.widened(e, Some(nat))?, nat));
         };
         let l = self.widened(a, Some(nat))?;
         let r = self.widened(b, Some(nat))?;
@@ -1826,17 +1812,18 @@ impl<'s> Lower<'s> {
                 Ok(done(d, nat))
             }
             Expr::Binary(op, a, b) => {
-                let arith = match op {
-                    BinaryOp::Add => ArithOp::Add,
-                    BinaryOp::Sub => ArithOp::Sub,
-                    BinaryOp::Mul => ArithOp::Mul,
-                    BinaryOp::Div => ArithOp::Div,
-                    BinaryOp::Mod => ArithOp::Mod,
-                    BinaryOp::Power => return self.function(Function::Expt, &[a, b], want, out),
-                    BinaryOp::And => return self.function(Function::And, &[a, b], want, out),
-                    BinaryOp::Or => return self.function(Function::Or, &[a, b], want, out),
-                    BinaryOp::Xor => return self.function(Function::Xor, &[a, b], want, out),
-                    _ => return refuse(self.at, "a comparison as a non-BOOL value"),
+                let arith = match arith_op(*op) {
+                    Some(a) => a,
+                    None => {
+                        let f = match op {
+                            BinaryOp::Power => Function::Expt,
+                            BinaryOp::And => Function::And,
+                            BinaryOp::Or => Function::Or,
+                            BinaryOp::Xor => Function::Xor,
+                            _ => return refuse(self.at, "a comparison as a non-BOOL value"),
+                        };
+                        return self.function(f, &[a, b], want, out);
+                    }
                 };
                 let mut l = self.value(a, want)?;
                 let r = self.value(b, l.ty().or(want))?;
@@ -2064,6 +2051,18 @@ impl<'s> Lower<'s> {
             _ => Some(Val::Var(d, out_ty)),
         })
     }
+}
+
+/// The arithmetic operation of an arithmetic operator (`+ - * / MOD`).
+fn arith_op(op: BinaryOp) -> Option<ArithOp> {
+    Some(match op {
+        BinaryOp::Add => ArithOp::Add,
+        BinaryOp::Sub => ArithOp::Sub,
+        BinaryOp::Mul => ArithOp::Mul,
+        BinaryOp::Div => ArithOp::Div,
+        BinaryOp::Mod => ArithOp::Mod,
+        _ => return None,
+    })
 }
 
 /// Whether element `k` does nothing without power: a condition, or a move, arithmetic or
