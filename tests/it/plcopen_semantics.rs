@@ -155,6 +155,19 @@ fn fbd_out_variables_run_in_file_order_each_pulling_its_block() {
 }
 
 #[test]
+fn an_fbd_out_variable_is_written_at_its_own_statement() {
+    // Beremiz writes Y := GT(ADD(X, 1), 0) first (localId 8): ADD's result goes into the
+    // temporary _TMP_ADD5_OUT; then Z := X (localId 9) reads last scan's X; only then
+    // X := _TMP_ADD5_OUT (localId 10). So Z lags X by one scan: X 1, 2, 3, Z 0, 1, 2
+    // (matiec's trace of this file through Beremiz's generator, corpus/against-matiec, is
+    // the same). Were X written when ADD runs, Z would equal X.
+    let t = scans("write_place_fbd.xml", "Go\n0\n0\n0\n", &["X", "Z", "Y"]);
+    assert_eq!(t[0], col(&["1", "2", "3"]), "X");
+    assert_eq!(t[1], col(&["0", "1", "2"]), "Z");
+    assert_eq!(t[2], col(&["1", "1", "1"]), "Y");
+}
+
+#[test]
 fn fbd_blocks_with_execution_order_ids_run_first_in_id_order() {
     // The same body with executionOrderId 1 on MUL and 2 on ADD: Beremiz computes MUL first,
     // so B := 2 * A reads the A of the previous scan.

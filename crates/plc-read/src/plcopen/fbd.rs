@@ -28,6 +28,7 @@ use super::pins::{
     Added,
 };
 use super::wiring::{graph, ElemId, Graph, Source};
+use super::write_places::{self, Statement};
 use super::xml::{attr, error, identifier, origin, variable_ref, ExecOrder, Note, Notes, Tc6, R};
 use plc_diag::{Invalid, LoadError, Origin};
 use plc_syntax::fbd::{Block, Connection, Input, Inputs, Network, OutVar, Outputs, Targets};
@@ -133,13 +134,11 @@ pub(super) fn body(
     let k = networks.len();
     f.close_loops(&mut current);
     networks.push(network(pou, k, label, current, comments));
-    let roots = statement_order(&g);
+    let statements = statement_order(&g);
     for n in &mut networks {
-        if let Ok(blocks) = &n.blocks {
-            let ids: std::collections::HashSet<u32> =
-                blocks.iter().filter_map(|b| b.id.clone().ok()).collect();
-            let mine = roots.iter().copied().filter(|r| ids.contains(r)).map(Ok);
-            n.order = Some(Ok(mine.collect()));
+        if let Ok(blocks) = &mut n.blocks {
+            let roots = write_places::place_writes(blocks, &statements, &mut f.a.borrow_mut(), ctx);
+            n.order = Some(Ok(roots.into_iter().map(Ok).collect()));
         }
     }
     if labels == 0 {
@@ -173,22 +172,22 @@ pub(super) fn body(
 
 /// Beremiz's statement order of an FBD body (PLCGenerator.ComputeProgram): the blocks, out and
 /// in-out variables with an `executionOrderId` above 0 in that order, then the out and in-out
-/// variables in file order, then the blocks in file order; each as the id of the block that
-/// runs it (an out variable fed by a block: that block; fed by a variable: its own MOVE).
-/// Beremiz computes a block when a statement first reads it, which the depth-first order from
-/// these roots does.
-fn statement_order(g: &Graph) -> Vec<u32> {
-    let runner = |i: usize| -> Option<u32> {
+/// variables in file order, then the blocks in file order. An out variable's statement is its
+/// write ([`write_places`] finds the block that holds it), a block's is its run. Beremiz
+/// computes a block when a statement first reads it, which the depth-first order from these
+/// roots does.
+fn statement_order(g: &Graph) -> Vec<Statement> {
+    let statement = |i: usize| -> Option<Statement> {
         let el = &g.elems[i];
         match el.tag {
-            "block" => Some(el.local_id),
-            "outVariable" | "inOutVariable" => {
-                match el.inputs.first().map(|p| p.sources.as_slice()) {
-                    Some([s]) if g.get(s.elem).tag == "block" => Some(g.get(s.elem).local_id),
-                    Some([_]) => Some(el.local_id),
-                    _ => None,
-                }
-            }
+            "block" => Some(Statement::Run(el.local_id)),
+            "outVariable" | "inOutVariable" => match el.inputs.first().map(|p| p.sources.len()) {
+                Some(1) => Some(Statement::Write {
+                    at: origin(el.node),
+                    local_id: el.local_id,
+                }),
+                _ => None,
+            },
             _ => None,
         }
     };
@@ -203,15 +202,16 @@ fn statement_order(g: &Graph) -> Vec<u32> {
         .filter_map(|i| exec_id(i).map(|x| (x, i)))
         .collect();
     ordered.sort_unstable();
-    let mut roots: Vec<u32> = ordered.iter().filter_map(|&(_, i)| runner(i)).collect();
+    let mut statements: Vec<Statement> =
+        ordered.iter().filter_map(|&(_, i)| statement(i)).collect();
     for tags in [&["outVariable", "inOutVariable"][..], &["block"][..]] {
         for i in 0..g.elems.len() {
             if tags.contains(&g.elems[i].tag) && exec_id(i).is_none() {
-                roots.extend(runner(i));
+                statements.extend(statement(i));
             }
         }
     }
-    roots
+    statements
 }
 
 fn network(

@@ -81,6 +81,7 @@ pub(super) fn rungs(
     let groups = groups(&g, &outputs, &component, &place)?;
     let labels = labels(&g, &groups, &place)?;
     let mut out = Vec::with_capacity(groups.len());
+    let mut placed = vec![false; g.elems.len()];
     for (r, group) in groups.iter().enumerate() {
         let mut paths = Vec::with_capacity(group.len());
         for &o in group {
@@ -89,6 +90,11 @@ pub(super) fn rungs(
         let paths = after_their_boxes(&power, group, paths);
         let paths = with_feeds(&mut power, paths);
         check_order(&power, &paths)?;
+        for item in paths.iter().flatten() {
+            if let Key::Elem(e) = item.key {
+                placed[e.0 as usize] = true;
+            }
+        }
         let refs: Vec<&[Item]> = paths.iter().map(|p| p.as_slice()).collect();
         let ld = merge(&refs);
         let first = origin(g.get(group[0]).node);
@@ -106,10 +112,37 @@ pub(super) fn rungs(
             problem_in_rung: false,
         });
     }
+    unplaced(&power, &placed)?;
     notes
         .ld_vars
         .extend(power.vars.drain(..).map(|v| (pou.to_owned(), v)));
     Ok(out)
+}
+
+/// An error naming the first box or coil that no output's series holds: a loop of blocks that
+/// feed each other with nothing after them (a TP and a TOF blinking each other, a counter
+/// whose Q resets it) has no output, and a rung reader that stopped there would drop it.
+fn unplaced(p: &Power, placed: &[bool]) -> R<()> {
+    let g = p.g;
+    for (i, el) in g.elems.iter().enumerate() {
+        let boxed = el.tag == "block"
+            && !el
+                .node
+                .attribute("typeName")
+                .is_some_and(super::ld_logic::is_logic);
+        if (boxed || el.tag == "coil") && !placed[i] {
+            let what = el.node.attribute("typeName").unwrap_or(el.tag);
+            return Err(error(
+                origin(el.node),
+                &p.at(ElemId(i as u32)),
+                format!(
+                    "{what} (localId {}) is on no rung: it feeds a loop of blocks that ends in no coil, out variable or unread block",
+                    el.local_id
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The outputs of the body in statement order: coils, out variables, jumps, returns and ending

@@ -145,6 +145,8 @@ impl Spec {
 const SUPPORTED: &str = "TON, TOF, TP, CTU, CTD, SR, RS, R_TRIG, F_TRIG, CTUD, ADD, SUB, MUL, DIV, MOD, MOVE, EQ, NE, LT, LE, GT, GE, AND, OR, XOR, NOT, and the standard functions ABS … ATAN, EXPT, SHL … ROR, MUX, *_TO_*, TRUNC";
 
 /// True when out variable `e` is the result of an ADD … MOD or MOVE block (part of its box).
+/// The boolean functions AND, OR, XOR and NOT are not boxes but conditions of the rung
+/// ([`super::ld_logic`]): an out variable after one is the rung's output, a coil.
 pub(super) fn absorbed(p: &Power, e: ElemId) -> bool {
     let el = p.g.get(e);
     let [pin] = el.inputs.as_slice() else {
@@ -155,6 +157,10 @@ pub(super) fn absorbed(p: &Power, e: ElemId) -> bool {
     };
     let src = p.g.get(s.elem);
     src.tag == "block"
+        && !src
+            .node
+            .attribute("typeName")
+            .is_some_and(super::ld_logic::is_logic)
         && matches!(
             src.node.attribute("typeName").and_then(Spec::of),
             Some(Spec::Arith(_) | Spec::Move | Spec::Function(_))

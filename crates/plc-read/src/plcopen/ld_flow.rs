@@ -35,6 +35,7 @@ use super::pins::{
     unconnected_default, Added,
 };
 use super::wiring::{graph, ElemId, Graph, Source};
+use super::write_places::{self, Statement};
 use super::xml::{attr, error, identifier, origin, variable_ref, Note, Notes, Tc6, R};
 use plc_diag::Origin;
 use plc_syntax::fbd::{Block, Connection, Input, Inputs, Network, OutVar, Outputs};
@@ -136,21 +137,28 @@ pub(super) fn body(
     }
     let mut networks = Vec::new();
     for n in 0..nets {
-        let mut roots: Vec<u32> = Vec::new();
+        let mut statements: Vec<Statement> = Vec::new();
         for (i, el) in g.elems.iter().enumerate() {
             if net_of.get(&component[i]) != Some(&n) {
                 continue;
             }
             let e = ElemId(i as u32);
             match el.tag {
-                "coil" | "outVariable" | "inOutVariable" => roots.extend(f.write_out(e)?),
-                "jump" | "return" => roots.push(f.control(e)?),
+                "coil" | "outVariable" | "inOutVariable" => {
+                    if f.write_out(e)?.is_some() {
+                        statements.push(Statement::Write {
+                            at: origin(el.node),
+                            local_id: el.local_id,
+                        });
+                    }
+                }
+                "jump" | "return" => statements.push(Statement::Run(f.control(e)?)),
                 _ => {}
             }
         }
         for (i, el) in g.elems.iter().enumerate() {
             if el.tag == "block" && net_of.get(&component[i]) == Some(&n) {
-                roots.push(f.block(ElemId(i as u32))?);
+                statements.push(Statement::Run(f.block(ElemId(i as u32))?));
             }
         }
         let mut blocks = std::mem::take(&mut f.a.blocks);
@@ -165,18 +173,14 @@ pub(super) fn body(
             continue;
         }
         let k = networks.len() + 1;
-        let blocks_ids: HashSet<u32> = blocks.iter().filter_map(|b| b.id.clone().ok()).collect();
+        let roots = write_places::place_writes(&mut blocks, &statements, &mut f.a, ctx);
         networks.push(Network {
             origin: blocks[0].origin,
             id: Ok(Cow::Owned(format!("{pou}.N{k}"))),
             label: None,
             comment: None,
             blocks: Ok(blocks),
-            order: Some(Ok(roots
-                .into_iter()
-                .filter(|r| blocks_ids.contains(r))
-                .map(Ok)
-                .collect())),
+            order: Some(Ok(roots.into_iter().map(Ok).collect())),
             problem: None,
         });
     }

@@ -44,6 +44,7 @@ mod st_scope;
 mod textual;
 mod user_functions;
 mod wiring;
+mod write_places;
 mod xml;
 
 pub use xml::{ExecOrder, Note, Notes, MAX_XML_BYTES, NAMESPACES};
