@@ -10,7 +10,7 @@
 
 use super::io::{format_of, load_text_lowered, read_program_text, write_output_with, Format};
 use super::CliError;
-use plc_read::{json, plcopen, stl};
+use plc_read::{json, stl};
 use std::path::PathBuf;
 
 /// A validated `plc-deps convert` invocation.
@@ -30,7 +30,7 @@ pub fn convert(c: &ConvertConfig) -> Result<(), CliError> {
     super::skipped::refuse_skipped(&p, &c.input, c.allow_skipped, Some("write the JSON"))?;
     let syntax = match format_of(&file, &text) {
         Format::Stl => stl::parse(&text),
-        Format::PlcOpen => plcopen::parse_for(&text, None, true).map(|(syntax, _)| syntax),
+        Format::PlcOpen => plc_load::plcopen_syntax(&text, None, true),
         Format::Json => json::parse(&text),
     }
     .map_err(|error| CliError::load(file.clone(), &text, error))?;

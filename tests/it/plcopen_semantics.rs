@@ -168,6 +168,19 @@ fn an_fbd_out_variable_is_written_at_its_own_statement() {
 }
 
 #[test]
+fn a_user_function_called_from_fbd_runs_its_body_with_its_locals_started_on_every_call() {
+    // TWICE_SUM's FBD body writes its result MUL(T, 2) first (the first out variable in the
+    // file), with T started from its initial value 7 on every call (matiec's C declares a
+    // function's variables on each call), then T := A + B, which no later call sees: Y and Z
+    // are 14 on every scan, X counts (matiec's trace of this file through Beremiz's generator
+    // is the same). Read as a black box, Y and Z would stay 0.
+    let t = scans("user_function_fbd.xml", "Go\n0\n0\n0\n", &["X", "Y", "Z"]);
+    assert_eq!(t[0], col(&["1", "2", "3"]), "X");
+    assert_eq!(t[1], col(&["14", "14", "14"]), "Y");
+    assert_eq!(t[2], col(&["14", "14", "14"]), "Z");
+}
+
+#[test]
 fn fbd_blocks_with_execution_order_ids_run_first_in_id_order() {
     // The same body with executionOrderId 1 on MUL and 2 on ADD: Beremiz computes MUL first,
     // so B := 2 * A reads the A of the previous scan.

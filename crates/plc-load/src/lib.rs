@@ -180,8 +180,7 @@ pub fn plcopen_for_run_selected(
 type PlcOpenLoaded = (Program, Fbd, Vec<Note>, Option<Note>);
 
 fn plcopen_all(text: &str, select: Option<&str>, exec: bool) -> Result<PlcOpenLoaded, LoadError> {
-    let (syntax, mut notes) = read::plcopen::parse_for(text, select, exec)?;
-    let (p, f) = resolve::resolve(text, &syntax)?;
+    let (_, mut notes, (p, f)) = plcopen_read(text, select, exec)?;
     for x in &notes.exec_orders {
         if let Some(n) = exec_order_note(&f, x) {
             notes.list.push(n);
@@ -189,6 +188,57 @@ fn plcopen_all(text: &str, select: Option<&str>, exec: bool) -> Result<PlcOpenLo
     }
     let no_run = notes.no_run.into_iter().next().map(|(_, n)| n);
     Ok((p, f, notes.list, no_run))
+}
+
+/// The syntax of PLCopen `text` as the loaders read it ([`plcopen_read`]): what `convert`
+/// writes.
+pub fn plcopen_syntax(
+    text: &str,
+    select: Option<&str>,
+    exec: bool,
+) -> Result<plc_syntax::Program<'static>, LoadError> {
+    plcopen_read(text, select, exec).map(|(syntax, _, _)| syntax)
+}
+
+/// PLCopen `text` read and resolved. A function whose body the reader takes but the resolver
+/// refuses (an AND of BYTEs, which the model does not have) is read again as a black box, as
+/// before its calls were executed: once per such function.
+fn plcopen_read(
+    text: &str,
+    select: Option<&str>,
+    exec: bool,
+) -> Result<
+    (
+        plc_syntax::Program<'static>,
+        read::plcopen::Notes,
+        (Program, Fbd),
+    ),
+    LoadError,
+> {
+    let mut refuse: Vec<(String, String)> = Vec::new();
+    loop {
+        let (syntax, notes) = read::plcopen::parse_refusing(text, select, exec, refuse.clone())?;
+        match resolve::resolve(text, &syntax) {
+            Ok(pf) => return Ok((syntax, notes, pf)),
+            Err(e) => match failed_function(&e) {
+                Some(name) if !refuse.iter().any(|(n, _)| *n == name) => {
+                    refuse.push((name, format!("its body does not load: {e}")));
+                }
+                _ => return Err(e),
+            },
+        }
+    }
+}
+
+/// The function (lower case) whose body, executed as a function block type (`st__fn__F`), the
+/// error `e` is in.
+fn failed_function(e: &LoadError) -> Option<String> {
+    let LoadError::Invalid(d) = e else {
+        return None;
+    };
+    let rest = d.location.path.strip_prefix("function_blocks.st__fn__")?;
+    let name = rest.split('.').next()?;
+    Some(name.to_ascii_lowercase())
 }
 
 /// Compares the order of the file's executionOrderIds with the order plc-deps runs the same

@@ -396,6 +396,16 @@ pub(super) fn rewrite(
         b.inputs = Some(Ok(Inputs::Named(inputs)));
         return Ok(None);
     }
+    if let Some(f) = t.ctx.executed_functions.get(&ty.to_ascii_lowercase()) {
+        // A function of the project whose calls are executed: a call of its body on an
+        // instance of this block's own (super::user_functions).
+        let inst = format!("{}__{}", f, el.local_id);
+        let name = super::user_functions::type_name(f);
+        b.op = Ok(Cow::Owned(name.clone()));
+        b.instance = Some(Ok(Cow::Owned(inst.clone())));
+        b.inputs = Some(Ok(Inputs::Named(inputs)));
+        return Ok(Some((inst, name)));
+    }
     // A black box: its name becomes a function block type's, so it must be an identifier.
     super::xml::identifier(ty, "block type", el.node, place)?;
     let declared = t.ctx.functions.get(ty).cloned();

@@ -42,6 +42,9 @@ pub(super) struct Ctx {
     /// The initial values of the POU's function block instances: lower-case instance name →
     /// (member as written, its literal) (`super::interface::FbInit`).
     pub inits: Inits,
+    /// The project's functions whose calls are executed (lower-case name → name as declared):
+    /// a block calling one calls its body ([`super::user_functions`]), not a black box.
+    pub executed_functions: HashMap<String, String>,
 }
 
 /// The initial values of a POU's function block instances: lower-case instance name →

@@ -137,6 +137,7 @@ pub(super) fn body(
     let statements = statement_order(&g);
     for n in &mut networks {
         if let Ok(blocks) = &mut n.blocks {
+            super::user_functions::call_pins(blocks);
             let roots = write_places::place_writes(blocks, &statements, &mut f.a.borrow_mut(), ctx);
             n.order = Some(Ok(roots.into_iter().map(Ok).collect()));
         }

@@ -173,6 +173,7 @@ pub(super) fn body(
             continue;
         }
         let k = networks.len() + 1;
+        super::user_functions::call_pins(&mut blocks);
         let roots = write_places::place_writes(&mut blocks, &statements, &mut f.a, ctx);
         networks.push(Network {
             origin: blocks[0].origin,

@@ -82,10 +82,22 @@ pub fn parse_for(
     select: Option<&str>,
     exec: bool,
 ) -> Result<(syntax::Program<'static>, Notes), LoadError> {
+    parse_refusing(text, select, exec, Vec::new())
+}
+
+/// [`parse_for`], the calls of the functions `refuse` names (lower-case name, why) read as
+/// black boxes.
+pub fn parse_refusing(
+    text: &str,
+    select: Option<&str>,
+    exec: bool,
+    refuse: Vec<(String, String)>,
+) -> Result<(syntax::Program<'static>, Notes), LoadError> {
     let doc = xml::parse(text)?;
     let ns = xml::project_namespace(&doc).map_err(|e| e.locate(text))?;
     let mut notes = Notes {
         exec,
+        refuse_functions: refuse,
         ..Notes::default()
     };
     let mut program =

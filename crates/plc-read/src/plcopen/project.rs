@@ -162,13 +162,19 @@ pub(super) fn program(
         .map(|(k, r)| (k, r.1.clone()))
         .collect();
     let mut sigs = user_functions::sigs(&read);
+    for (f, why) in &notes.refuse_functions {
+        if let Some(s) = sigs.get_mut(f) {
+            s.refused.get_or_insert_with(|| why.clone());
+        }
+    }
     let mut fn_bodies =
         user_functions::read_all(&fn_list, &mut sigs, notes.exec, &mut |k, sigs, scratch| {
             let (pou, pname, _, iface) = &read[k];
             check_return(*pou, pname, "function", iface)?;
             let mut scope = scope_of(iface);
             scope.funcs = sigs.clone();
-            let ctx = pou_ctx(&base, iface, &global_types);
+            let mut ctx = pou_ctx(&base, iface, &global_types);
+            ctx.executed_functions = user_functions::executed(sigs);
             body(tc6, *pou, pname, iface, &scope, &ctx, scratch)
         });
     let mut fn_notes_at = Vec::new();
@@ -183,7 +189,8 @@ pub(super) fn program(
         }
         let mut scope = scope_of(iface);
         scope.funcs = sigs.clone();
-        let ctx = pou_ctx(&base, iface, &global_types);
+        let mut ctx = pou_ctx(&base, iface, &global_types);
+        ctx.executed_functions = user_functions::executed(&sigs);
         bodies.push(Some(body(tc6, *pou, pname, iface, &scope, &ctx, notes)?));
     }
     // The functions some body calls, directly or through others, become types; each keeps
@@ -1111,6 +1118,7 @@ fn pou_ctx(base: &Ctx, iface: &Interface, globals: &[(&str, &str)]) -> Ctx {
         fb_inputs: base.fb_inputs.clone(),
         vars,
         inits,
+        executed_functions: std::collections::HashMap::new(),
     }
 }
 

@@ -20,8 +20,14 @@
 //!
 //! Invariant: only the functions some body calls (directly or through other functions) become
 //! types; the others keep the note they had (their bodies are not part of the model).
-//! Deliberately not here: VAR_IN_OUT of functions (refused), calls of user functions in LD,
-//! FBD and IL bodies (black boxes, [`super::black_box`]).
+//! A block of an LD or FBD body that calls `F` is the same call on an instance of its own,
+//! `F__<localId>` ([`super::black_box::rewrite`]; an FBD arc reads the instance's output when
+//! its reader runs, so two calls must not share one); its `OUT` pin is the result `F`
+//! ([`call_pins`]). A function whose body is read but refused by the resolver is read again as
+//! a black box (`plc_load` names it in `Notes::refuse_functions`).
+//!
+//! Deliberately not here: VAR_IN_OUT of functions (refused), calls of user functions in IL
+//! bodies (black boxes, [`super::black_box`]).
 
 use super::xml::{Note, Notes, R};
 use plc_syntax::{Body, Element, ElementKind, Located, Move, Rung, Scalar, Var};
@@ -31,6 +37,63 @@ use std::collections::HashMap;
 /// The function block type a function `f` is executed as.
 pub(super) fn type_name(f: &str) -> String {
     format!("st__fn__{f}")
+}
+
+/// The functions of `sigs` whose calls are executed: lower-case name → name as declared.
+pub(super) fn executed(sigs: &HashMap<String, FnSig>) -> HashMap<String, String> {
+    sigs.iter()
+        .filter(|(_, s)| s.refused.is_none())
+        .map(|(k, s)| (k.clone(), s.name.clone()))
+        .collect()
+}
+
+/// In `blocks` (one FBD network), the pins of the calls of functions executed as their type
+/// ([`type_name`]): the result, which LD and FBD call `OUT` (or leave unnamed, the first
+/// output), is the type's output named like the function.
+pub(super) fn call_pins(blocks: &mut [plc_syntax::fbd::Block<'static>]) {
+    use plc_syntax::fbd::{Connection, Inputs, Outputs};
+    let result: HashMap<u32, String> = blocks
+        .iter()
+        .filter_map(|b| {
+            let f = b.op.as_ref().ok()?.strip_prefix("st__fn__")?;
+            Some((*b.id.as_ref().ok()?, f.to_owned()))
+        })
+        .collect();
+    if result.is_empty() {
+        return;
+    }
+    let is_out = |p: &Option<plc_syntax::fbd::Read<plc_syntax::Text<'static>>>| match p {
+        None => true,
+        Some(Ok(n)) => n.eq_ignore_ascii_case("OUT"),
+        Some(Err(_)) => false,
+    };
+    for b in blocks.iter_mut() {
+        let mut inputs: Vec<&mut plc_syntax::fbd::Input<'static>> = match &mut b.inputs {
+            Some(Ok(Inputs::List(v))) => v.iter_mut().collect(),
+            Some(Ok(Inputs::Named(v))) => v.iter_mut().map(|(_, i)| i).collect(),
+            _ => Vec::new(),
+        };
+        inputs.extend(b.cond.as_mut());
+        for i in inputs {
+            if let Connection::Arc { block, pin } = &mut i.from {
+                if let Some(f) = result.get(block) {
+                    if is_out(pin) {
+                        *pin = Some(Ok(Cow::Owned(f.clone())));
+                    }
+                }
+            }
+        }
+        let Some(f) = b.id.as_ref().ok().and_then(|id| result.get(id)) else {
+            continue;
+        };
+        if let Some(Ok(Outputs::Named(v))) = &mut b.outputs {
+            for (pin, _) in v.iter_mut() {
+                if pin.eq_ignore_ascii_case("OUT") {
+                    *pin = Cow::Owned(f.clone());
+                }
+            }
+        }
+    }
 }
 
 /// A function of the project as a body may call it.
@@ -228,7 +291,7 @@ pub(super) fn called<'a>(vars: impl Iterator<Item = &'a Var<'static>>) -> Vec<St
 pub(super) fn executed_note(at: plc_diag::Origin, name: &str) -> Note {
     Note {
         origin: at,
-        message: format!("pou {name}: a function; its calls in ST bodies are executed as calls of its body (function block type {}, one instance per calling body, every variable started from its initial value on each call as matiec does); its calls in LD and FBD bodies are black boxes", type_name(name)),
+        message: format!("pou {name}: a function; its calls in ST bodies are executed as calls of its body (function block type {}, one instance per calling body, every variable started from its initial value on each call as matiec does); and in LD and FBD bodies likewise (one instance per block)", type_name(name)),
     }
 }
 
@@ -313,6 +376,68 @@ pub(super) fn default_of(t: plc_model::Type) -> Scalar<'static> {
     }
 }
 
+/// [`start`] for an FBD body (or an LD body read as data flow): a first network `F.start` of
+/// MOVE blocks from the initial values.
+fn start_network(body: &mut plc_syntax::FbdBody<'static>, sig: &FnSig) -> Result<(), String> {
+    use plc_syntax::fbd::{Block, Connection, Input, Inputs, Network, OutVar, Outputs};
+    let at = body.origin;
+    // Ids above every block id of the body (ids are unique in a POU).
+    let first = body
+        .networks
+        .iter()
+        .filter_map(|n| n.blocks.as_ref().ok())
+        .flatten()
+        .filter_map(|b| b.id.as_ref().ok().copied())
+        .max()
+        .unwrap_or(0)
+        + 1;
+    let mut blocks = Vec::new();
+    for (name, ty, init) in &sig.starts {
+        if sig.inputs.iter().any(|(n, _)| n == name) {
+            continue;
+        }
+        let Some(t) = plc_model::Type::parse(ty) else {
+            return Err(format!("its variable `{name}` is of type {ty}"));
+        };
+        let value = init.clone().unwrap_or_else(|| default_of(t));
+        blocks.push(Block {
+            origin: at,
+            id: Ok(first + blocks.len() as u32),
+            op: Ok(Cow::Borrowed("MOVE")),
+            inputs: Some(Ok(Inputs::List(vec![Input {
+                origin: at,
+                from: Connection::Constant(value),
+            }]))),
+            outputs: Some(Ok(Outputs::First(OutVar {
+                origin: at,
+                name: Cow::Owned(name.clone()),
+            }))),
+            instance: None,
+            label: None,
+            cond: None,
+            en: false,
+            after: None,
+            comment: None,
+            problem: None,
+        });
+    }
+    if !blocks.is_empty() {
+        body.networks.insert(
+            0,
+            Network {
+                origin: at,
+                id: Ok(Cow::Owned(format!("{}.start", sig.name))),
+                label: None,
+                comment: None,
+                blocks: Ok(blocks),
+                order: None,
+                problem: None,
+            },
+        );
+    }
+    Ok(())
+}
+
 /// Puts before function `sig`'s body the rungs that start its outputs, its result and its
 /// locals from their initial values on every call (its inputs the caller writes), as matiec's
 /// generated C declares them. An FBD body has no rungs to put them before: a function whose FBD
@@ -320,16 +445,7 @@ pub(super) fn default_of(t: plc_model::Type) -> Scalar<'static> {
 fn start(body: &mut Body<'static>, sig: &FnSig) -> Result<(), String> {
     let rungs = match body {
         Body::Rungs(r) => r,
-        Body::Fbd(_) => {
-            let locals =
-                (sig.starts.len()).saturating_sub(sig.inputs.len() + sig.outputs.len() + 1);
-            if locals > 0 {
-                return Err(
-                    "its FBD body has local variables, which a call cannot start yet".into(),
-                );
-            }
-            return Ok(());
-        }
+        Body::Fbd(f) => return start_network(f, sig),
     };
     let at = rungs.first().map_or(plc_diag::Origin::NONE, |r| r.origin);
     let l = |s: String| Located {

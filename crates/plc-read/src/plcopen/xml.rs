@@ -83,6 +83,9 @@ pub struct Notes {
     /// Read for execution (`run`, `c`): an ST body that lowers to rungs is those rungs
     /// ([`super::st_lower`]); otherwise (the analyses) a stand-in rung per statement.
     pub exec: bool,
+    /// Functions whose calls are not executed but read as black boxes (lower-case name, why):
+    /// those whose body the reader took but the resolver refused (`plc_load` reads again).
+    pub refuse_functions: Vec<(String, String)>,
 }
 
 impl Notes {

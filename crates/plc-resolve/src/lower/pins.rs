@@ -90,11 +90,35 @@ impl Cx<'_> {
     /// The variables output pin `pin` of `b` is written to, type-checked against `ty`.
     /// The type of the first variable block `b`'s first output writes, if it writes one (what
     /// an untyped input of an overloaded block takes its type from).
+    ///
+    /// A first output that writes no variable but feeds a data input of a block whose result
+    /// has that input's type (ADD … MOD, MOVE, SEL's IN0/IN1, MAX, MIN, LIMIT) takes that
+    /// block's type in turn, as Beremiz types the temporary between them from the variable at
+    /// the end of the chain (`PLCGenerator.ComputeConnectionTypes`): `SEL(g, 50, 100)` feeding
+    /// `SEL(h, …, 0)` that writes an INT is INT.
     pub(super) fn first_out_type(&self, nx: &Net, b: BlockId) -> Result<Option<Type>> {
-        Ok(self
-            .out_vars(nx, b, 0, None)?
-            .first()
-            .map(|&v| self.env.var(v).ty))
+        let mut at = b;
+        // A chain visits each block at most once.
+        for _ in 0..nx.net.blocks.len() {
+            if let Some(&v) = self.out_vars(nx, at, 0, None)?.first() {
+                return Ok(Some(self.env.var(v).ty));
+            }
+            let next = nx.net.blocks.iter().enumerate().find(|(_, c)| {
+                c.inputs.iter().enumerate().any(|(k, p)| {
+                    matches!(p.input, Some(Input::Arc { from, pin: 0 }) if from == at)
+                        && match c.op {
+                            Op::Arith(_) | Op::Move | Op::Max | Op::Min | Op::Limit => true,
+                            Op::Sel => k > 0,
+                            _ => false,
+                        }
+                })
+            });
+            match next {
+                Some((i, _)) => at = BlockId(i as u32),
+                None => return Ok(None),
+            }
+        }
+        Ok(None)
     }
 
     pub(super) fn out_vars(
