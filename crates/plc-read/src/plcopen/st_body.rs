@@ -11,9 +11,13 @@
 //! (`s.f`, the ST parser's access path) is its own variable, a structure named whole reads or
 //! writes every field, a field the structure lacks is an error naming the fields it has; a read of a standard function
 //! block instance reads its first output field (`T1.Q`, `B.Q1`, `C.QU`), which the analysis
-//! counts as reading the instance. The values of the project's enumerations are constants. Not seen by the analysis, and named in the POU's note: writes
-//! of instances (only an instance's own box writes it), reads of user function block
-//! instances, direct addresses (`%IX0.1`); a call of a function (standard, of the project or
+//! counts as reading the instance. A call of a standard function block instance (`T1(IN := x)`) is
+//! its box in the stand-in (with constant operands: the
+//! arguments are the statement's reads), which reads and writes the instance; a call of a user
+//! instance is a `call` of its POU. The values of the project's enumerations are constants. Not
+//! seen by the analysis, and named in the POU's note: writes of instances of types neither
+//! standard nor the project's, reads of user function block instances, direct addresses
+//! (`%IX0.1`); a call of a function (standard, of the project or
 //! unknown) is a black box whose arguments are read and whose result and outputs are written where
 //! the call assigns them. A name that is neither declared nor called (a
 //! function) is an error at its statement; so is an ST syntax error, at its line and column.
@@ -106,7 +110,7 @@ pub(super) fn rungs(
             }
             let here = at(s.at);
             let a = st::accesses(s);
-            let (mut reads, mut writes) =
+            let (mut reads, mut writes, boxes) =
                 resolve(&a, scope, &mut unseen, pou).map_err(|m| error(here, &place, m))?;
             if a.pragma {
                 everything(scope, &mut reads, &mut writes);
@@ -121,6 +125,11 @@ pub(super) fn rungs(
             // The analysis sees a call of a user instance as the call of its POU (what its
             // body reads and writes); a run never executes it from a stand-in.
             if !notes.exec {
+                // A standard instance it calls or writes: its box, reading and writing it.
+                for (inst, ty) in &boxes {
+                    let r = rung.get_or_insert_with(|| empty_rung(id.clone(), here));
+                    r.ld.extend(standard_box(inst, ty, here));
+                }
                 let calls = user_calls(&a, scope);
                 for (inst, ty) in function_calls(&a, scope) {
                     if !declared.contains(&inst) {
@@ -302,6 +311,72 @@ fn message(pou: &str, statements: usize, unseen: &Unseen, executed: &str) -> Str
     m
 }
 
+/// A statement's reads and writes as stand-in operands, and the standard function block
+/// instances it calls or writes (name, type).
+type Resolved = (Vec<Read>, Vec<String>, Vec<(String, String)>);
+
+/// The box of standard function block instance `name` of type `ty`, with constant operands: in
+/// a stand-in it reads and writes the instance (what a call `T1(IN := x, PT := t)` does; the
+/// arguments are the stand-in's reads), `None` for another type.
+fn standard_box(name: &str, ty: &str, at: Origin) -> Option<plc_syntax::Element<'static>> {
+    use plc_model::{BistableKind, TimerKind, TriggerKind};
+    use plc_syntax::{Bistable, Counter, Ctud, ElementKind, Timer};
+    let inst = plc_syntax::Located {
+        value: std::borrow::Cow::Owned(name.to_owned()),
+        origin: at,
+    };
+    let konst = |v: plc_syntax::Scalar<'static>| plc_syntax::Located {
+        value: v,
+        origin: at,
+    };
+    let zero = || konst(plc_syntax::Scalar::Number(0.into()));
+    let off = || konst(plc_syntax::Scalar::Bool(false));
+    let timer = |kind| {
+        ElementKind::Timer(Box::new(Timer {
+            kind,
+            instance: inst.clone(),
+            pt: konst(plc_syntax::Scalar::Str("T#0s".into())),
+        }))
+    };
+    let kind = match ty.to_ascii_uppercase().as_str() {
+        "TON" => timer(TimerKind::Ton),
+        "TOF" => timer(TimerKind::Tof),
+        "TP" => timer(TimerKind::Tp),
+        c @ ("CTU" | "CTD") => ElementKind::Counter(Box::new(Counter {
+            down: c == "CTD",
+            instance: inst,
+            pv: zero(),
+            aux: off(),
+        })),
+        "CTUD" => ElementKind::Ctud(Box::new(Ctud {
+            instance: inst,
+            cd: off(),
+            reset: off(),
+            load: off(),
+            pv: zero(),
+        })),
+        b @ ("SR" | "RS") => ElementKind::Bistable(Box::new(Bistable {
+            kind: if b == "SR" {
+                BistableKind::SetDominant
+            } else {
+                BistableKind::ResetDominant
+            },
+            instance: inst,
+            reset: off(),
+        })),
+        t @ ("R_TRIG" | "F_TRIG") => ElementKind::Trigger {
+            kind: if t == "R_TRIG" {
+                TriggerKind::Rising
+            } else {
+                TriggerKind::Falling
+            },
+            instance: inst,
+        },
+        _ => return None,
+    };
+    Some(plc_syntax::Element { origin: at, kind })
+}
+
 /// The reads and writes of a statement as stand-in operands, or the message of the first name
 /// that is neither declared nor called (or a structure's field it does not have).
 fn resolve(
@@ -309,7 +384,7 @@ fn resolve(
     scope: &Scope,
     unseen: &mut Unseen,
     pou: &str,
-) -> Result<(Vec<Read>, Vec<String>), String> {
+) -> Result<Resolved, String> {
     let called = |n: &str| a.calls.iter().any(|c| c.eq_ignore_ascii_case(n));
     // Named by its first part, the variable that is not declared.
     let undeclared = |n: &str| {
@@ -387,6 +462,7 @@ fn resolve(
         }
     }
     let mut writes = Vec::new();
+    let mut boxes: Vec<(String, String)> = Vec::new();
     for n in &a.writes {
         match find(scope, n)? {
             Some((Decl::Elementary { name, .. }, _)) => writes.push(name.clone()),
@@ -403,8 +479,14 @@ fn resolve(
             Some((Decl::Instance { ty, .. }, _)) if scope.fb(ty).is_some() => {
                 // Called: the stand-in's `call` writes what the instance writes.
             }
-            Some((Decl::Instance { name, .. }, _)) => {
-                push_once(&mut unseen.instances_written, name)
+            Some((Decl::Instance { name, ty, .. }, _)) => {
+                match standard_box(name, ty, Origin::NONE) {
+                    Some(_) if !boxes.iter().any(|(n, _)| n == name) => {
+                        boxes.push((name.clone(), ty.clone()))
+                    }
+                    Some(_) => {}
+                    None => push_once(&mut unseen.instances_written, name),
+                }
             }
             Some((Decl::Structure { leaves }, _)) => {
                 writes.extend(leaves.iter().map(|(name, _)| name.clone()))
@@ -420,7 +502,7 @@ fn resolve(
     reads.retain(|r| seen.insert(r.name.clone()));
     seen.clear();
     writes.retain(|w| seen.insert(w.clone()));
-    Ok((reads, writes))
+    Ok((reads, writes, boxes))
 }
 
 /// What access path `n` names ([`Scope::find`]); an array element whose constant subscripts
