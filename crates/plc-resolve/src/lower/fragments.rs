@@ -23,6 +23,23 @@ impl Cx<'_> {
             .iter()
             .map(|b| vec![false; b.outputs.len()])
             .collect();
+        // Per block, the first block (in block order) whose result has the type of what its
+        // first output feeds into it (`Net::type_heir`).
+        let mut type_heir: Vec<Option<BlockId>> = vec![None; n];
+        for (c, b) in net.blocks.iter().enumerate() {
+            for (k, p) in b.inputs.iter().enumerate() {
+                if let Some(Input::Arc { from, pin: 0 }) = p.input {
+                    let passes = match b.op {
+                        Op::Arith(_) | Op::Move | Op::Max | Op::Min | Op::Limit => true,
+                        Op::Sel => k > 0,
+                        _ => false,
+                    };
+                    if passes && type_heir[from.index()].is_none() {
+                        type_heir[from.index()] = Some(BlockId(c as u32));
+                    }
+                }
+            }
+        }
         for b in &net.blocks {
             for i in b
                 .inputs
@@ -42,6 +59,7 @@ impl Cx<'_> {
             .collect();
         let mut nx = Net {
             net,
+            type_heir,
             used,
             values,
             constants: HashMap::new(),

@@ -187,6 +187,10 @@ impl Val {
 /// The network being lowered: values of arcs so far.
 struct Net<'n> {
     net: &'n Network,
+    /// Per block, the block whose result type its first output takes when it writes no
+    /// variable: the first block that reads it on an input of the result's type (ADD … MOD,
+    /// MOVE, SEL's IN0/IN1, MAX, MIN, LIMIT).
+    type_heir: Vec<Option<BlockId>>,
     /// Per block, per output pin: does an arc read it?
     used: Vec<Vec<bool>>,
     /// Per block, per output pin: the operand an arc reads.

@@ -98,23 +98,13 @@ impl Cx<'_> {
     /// `SEL(h, …, 0)` that writes an INT is INT.
     pub(super) fn first_out_type(&self, nx: &Net, b: BlockId) -> Result<Option<Type>> {
         let mut at = b;
-        // A chain visits each block at most once.
+        // A chain visits each block at most once (arcs go forward in a network without loops).
         for _ in 0..nx.net.blocks.len() {
             if let Some(&v) = self.out_vars(nx, at, 0, None)?.first() {
                 return Ok(Some(self.env.var(v).ty));
             }
-            let next = nx.net.blocks.iter().enumerate().find(|(_, c)| {
-                c.inputs.iter().enumerate().any(|(k, p)| {
-                    matches!(p.input, Some(Input::Arc { from, pin: 0 }) if from == at)
-                        && match c.op {
-                            Op::Arith(_) | Op::Move | Op::Max | Op::Min | Op::Limit => true,
-                            Op::Sel => k > 0,
-                            _ => false,
-                        }
-                })
-            });
-            match next {
-                Some((i, _)) => at = BlockId(i as u32),
+            match nx.type_heir[at.index()] {
+                Some(next) => at = next,
                 None => return Ok(None),
             }
         }
