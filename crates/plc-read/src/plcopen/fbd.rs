@@ -134,11 +134,33 @@ pub(super) fn body(
     let k = networks.len();
     f.close_loops(&mut current);
     networks.push(network(pou, k, label, current, comments));
+    // Each network's statements, in order (a statement is its block's or its target's).
     let statements = statement_order(&g);
-    for n in &mut networks {
+    let mut owner: HashMap<Statement, usize> = HashMap::new();
+    for (k, n) in networks.iter().enumerate() {
+        for b in n.blocks.iter().flatten() {
+            if let Ok(&id) = b.id.as_ref() {
+                owner.insert(Statement::Run(id), k);
+            }
+            for at in write_places::target_origins(b) {
+                owner.insert(Statement::Write { at, local_id: 0 }, k);
+            }
+        }
+    }
+    let mut per_network: Vec<Vec<Statement>> = vec![Vec::new(); networks.len()];
+    for s in statements {
+        let key = match s {
+            Statement::Write { at, .. } => Statement::Write { at, local_id: 0 },
+            run => run,
+        };
+        if let Some(&k) = owner.get(&key) {
+            per_network[k].push(s);
+        }
+    }
+    for (n, statements) in networks.iter_mut().zip(&per_network) {
         if let Ok(blocks) = &mut n.blocks {
             super::user_functions::call_pins(blocks);
-            let roots = write_places::place_writes(blocks, &statements, &mut f.a.borrow_mut(), ctx);
+            let roots = write_places::place_writes(blocks, statements, &mut f.a.borrow_mut(), ctx);
             n.order = Some(Ok(roots.into_iter().map(Ok).collect()));
         }
     }

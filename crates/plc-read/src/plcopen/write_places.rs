@@ -30,7 +30,7 @@ use std::borrow::Cow;
 use std::collections::HashMap;
 
 /// One statement of Beremiz's order.
-#[derive(Copy, Clone, Debug)]
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
 pub(super) enum Statement {
     /// Compute a block (a block nothing reads, a jump, a return).
     Run(u32),
@@ -222,6 +222,11 @@ pub(super) fn calls_user_code(ctx: &Ctx, b: &Block) -> bool {
     let Ok(op) = &b.op else { return true };
     ctx.functions.contains_key(op.as_ref())
         || (b.instance.is_some() && !super::black_box::is_standard_fb(op))
+}
+
+/// The origins of the variables `b`'s outputs write (the statements that may be its).
+pub(super) fn target_origins(b: &Block<'static>) -> Vec<Origin> {
+    targets(b).into_iter().map(|(_, t)| t.origin).collect()
 }
 
 /// A variable's base name in lower case: `a` of `a.b`, `a[3]`, `A`.
