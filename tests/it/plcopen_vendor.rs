@@ -225,3 +225,26 @@ fn a_variable_of_an_undefined_enumeration_with_an_initial_value_is_no_instance()
         "{e}"
     );
 }
+
+#[test]
+fn codesys_qualified_type_names_and_enumeration_values_are_read() {
+    // `Standard.TON` is the standard TON (CODESYS's namespace of its standard library);
+    // `E_MODE.Auto` is E_MODE#Auto (= 1). T1 (PT 20 ms, CODESYS dialect) sets Q once 20 ms have
+    // passed since IN rose: at the third scan (0, 10, 20 ms).
+    let t = scans("codesys_qualified.xml", "Go\n1\n1\n1\n1\n", &["Y", "M"]);
+    assert_eq!(t[0], col(&["0", "0", "1", "1"]), "Y");
+    assert_eq!(t[1], col(&["1", "1", "1", "1"]), "M");
+}
+
+#[test]
+fn a_codesys_pointer_is_a_black_box_that_run_refuses_by_name() {
+    // POINTER TO INT: an address plc-deps does not follow; the analysis sees `p` as one whole
+    // variable, `run` refuses the POU naming it.
+    let w = warnings("codesys_pointer.xml");
+    assert!(w.contains("POINTER_TO_INT: PLC_PRG.p"), "{w}");
+    let e = refused("run", "codesys_pointer.xml");
+    assert!(
+        e.contains("variable `p` is of type `POINTER_TO_INT`, which the file does not define"),
+        "{e}"
+    );
+}

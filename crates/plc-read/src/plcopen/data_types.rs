@@ -63,7 +63,7 @@
 //! Deliberately not here: arrays of structures; whole-structure assignment in graphical bodies
 //! (a structure read or written as a whole is its fields in ST, [`super::st_body`]).
 
-use super::xml::{attr, error, identifier, origin, Tc6, R};
+use super::xml::{attr, error, identifier, origin, type_reference, Tc6, R};
 use plc_diag::Origin;
 use roxmltree::Node;
 use std::collections::HashMap;
@@ -312,12 +312,13 @@ impl DataTypes {
         out
     }
 
-    /// The integer of value `text` (`CLOSED` or `MYTYPE2#CLOSED`) of enumeration `t`.
+    /// The integer of value `text` (`CLOSED`, `MYTYPE2#CLOSED`, or CODESYS's `MYTYPE2.CLOSED`)
+    /// of enumeration `t`.
     pub(super) fn enum_value(t: &DataType, text: &str) -> Option<i64> {
         let Base::Enum(v) = &t.base else { return None };
         let text = text.trim();
-        let name = match text.split_once('#') {
-            Some((ty, n)) if ty == t.name => n,
+        let name = match text.split_once('#').or_else(|| text.split_once('.')) {
+            Some((ty, n)) if ty.eq_ignore_ascii_case(&t.name) => n,
             Some(_) => return None,
             None => text,
         };
@@ -402,7 +403,7 @@ pub(super) fn base(
     }
     match tag {
         "derived" => {
-            let of = identifier(attr(bt, "name", place)?, "type", bt, place)?;
+            let of = type_reference(attr(bt, "name", place)?, &|t| raw.contains_key(t), bt, place)?;
             if let Some(next) = raw.get(&of) {
                 let mut t = resolve(tc6, raw, &of, *next, depth + 1)?;
                 t.name = name.to_owned();
@@ -535,7 +536,12 @@ pub(super) fn members(
         let ty = match te.tag_name().name() {
             // A named data type keeps its name (for the notes and the enumeration values).
             "derived" => {
-                let of = identifier(attr(te, "name", place)?, "type", te, place)?;
+                let of = type_reference(
+                    attr(te, "name", place)?,
+                    &|t| raw.contains_key(t),
+                    te,
+                    place,
+                )?;
                 match (raw.get(&of), resolved.and_then(|r| r.get(&of))) {
                     (Some(dt), _) => resolve(tc6, raw, &of, *dt, depth + 1)?,
                     (None, Some(d)) => d,
@@ -808,7 +814,12 @@ pub(super) fn array(
             library: None,
         },
         "derived" => {
-            let of = identifier(attr(bt, "name", place)?, "type", bt, place)?;
+            let of = type_reference(
+                attr(bt, "name", place)?,
+                &|t| raw.contains_key(t),
+                bt,
+                place,
+            )?;
             match (raw.get(&of), resolved.and_then(|r| r.get(&of))) {
                 (Some(dt), _) => resolve(tc6, raw, &of, *dt, depth + 1)?,
                 (None, Some(d)) => d,

@@ -499,6 +499,24 @@ fn type_name(tc6: Tc6, ty: Node, var: &str, place: &str, known: &Known) -> R<Ty>
             }));
         }
         "derived" => {}
+        // CODESYS's POINTER TO and REFERENCE TO: an address, which plc-deps does not follow: a
+        // type nobody defines (the black box of `super::project`), named after what it points to.
+        "pointer" | "reference" => {
+            let to = tc6
+                .elements(t)
+                .find(|c| c.tag_name().name() == "baseType")
+                .and_then(|b| tc6.elements(b).next())
+                .map(|b| match b.tag_name().name() {
+                    "derived" => b.attribute("name").unwrap_or("ANY").to_owned(),
+                    other => other.to_owned(),
+                })
+                .unwrap_or_else(|| "ANY".to_owned());
+            let kind = if tag == "pointer" { "POINTER" } else { "REFERENCE" };
+            return Ok(Ty::Fb(format!(
+                "{kind}_TO_{}",
+                to.replace(|c: char| !c.is_ascii_alphanumeric(), "_")
+            )));
+        }
         _ => return Err(error(
             origin(t),
             place,
@@ -506,7 +524,8 @@ fn type_name(tc6: Tc6, ty: Node, var: &str, place: &str, known: &Known) -> R<Ty>
         )),
     }
     let name = super::xml::attr(t, "name", place)?;
-    let name = identifier(name, "type", t, place)?;
+    let name =
+        super::xml::type_reference(name, &|ty| known.data_types.get(ty).is_some(), t, place)?;
     if let Some(d) = known.data_types.get(&name) {
         return Ok(Ty::Data(d));
     }
@@ -535,10 +554,26 @@ fn fb_init(tc6: Tc6, iv: Node, var: &str, fb: &str, place: &str) -> R<FbInit> {
         })?;
         let text = super::xml::attr(simple, "value", place)?;
         let shown = format!("{var}.{member}");
-        members.push((
-            member,
-            literal_operand(text, origin(simple), &shown, place)?,
-        ));
+        // A STRING member's literal (`FriendlyName := 'Button 1'`) as STRING variables have it.
+        let value = if super::pins::is_string_literal(text) && text.trim().starts_with('\'') {
+            Located {
+                value: Scalar::Str(Cow::Owned(text.trim().to_owned())),
+                origin: origin(simple),
+            }
+        } else if let Some((ty, v)) = text
+            .trim()
+            .split_once(['.', '#'])
+            .filter(|(t, v)| super::xml::is_identifier(t) && super::xml::is_identifier(v))
+        {
+            // An enumeration value (`E_MODE.Auto`, CODESYS; `E_MODE#Auto`, IEC 61131-3).
+            Located {
+                value: Scalar::Str(Cow::Owned(format!("{ty}#{v}"))),
+                origin: origin(simple),
+            }
+        } else {
+            literal_operand(text, origin(simple), &shown, place)?
+        };
+        members.push((member, value));
     }
     Ok(FbInit {
         instance: var.to_owned(),

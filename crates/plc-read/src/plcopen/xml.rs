@@ -286,6 +286,30 @@ pub(super) fn is_identifier(s: &str) -> bool {
         && !s.contains("__")
 }
 
+/// Type name `s` as written where a type is named (`derived`): an identifier, or a CODESYS
+/// name qualified by its library's namespace (`Standard.R_TRIG`, `MQTT.QoS`), which is the type
+/// itself when `defined` says the file defines it or the standard does (`R_TRIG`), else the
+/// type `MQTT_QoS` that nobody defines (a black box, [`super::project`]).
+pub(super) fn type_reference(
+    s: &str,
+    defined: &dyn Fn(&str) -> bool,
+    n: Node,
+    place: &str,
+) -> R<String> {
+    if is_identifier(s) {
+        return Ok(s.to_owned());
+    }
+    if let Some((ns, ty)) = s.trim().rsplit_once('.') {
+        if ns.split('.').all(is_identifier) && is_identifier(ty) {
+            if defined(ty) || super::black_box::is_standard_fb(&ty.to_ascii_uppercase()) {
+                return Ok(ty.to_owned());
+            }
+            return Ok(format!("{}_{ty}", ns.replace('.', "_")));
+        }
+    }
+    identifier(s, "type", n, place)
+}
+
 /// `s` checked as an identifier (`what` names it in the message: "variable", "POU").
 pub(super) fn identifier(s: &str, what: &str, n: Node, place: &str) -> R<String> {
     if is_identifier(s) {
