@@ -164,6 +164,30 @@ fn il_program(body: &str) -> String {
 }
 
 #[test]
+fn il_formal_call_leaving_a_bool_input_out_keeps_its_last_value() {
+    // The second CAL leaves IN out: it keeps the TRUE the first call gave (the instance's
+    // input, as matiec's C leaves the field as it is), so the TON keeps timing: ET 20 ms after
+    // 3 scans of 10 ms. plc-deps refused such a call in IL before (tests/matiec/il-fbs.xml's
+    // CALC C1 without R).
+    let xml = il_program(
+        "LD TRUE\nST b\nCAL T1(\n  IN := b,\n  PT := T#50ms\n)\nCAL T1(\n  PT := T#50ms\n)",
+    );
+    let out = run_stdin(
+        &[
+            "run", "-", "--scans", "3", "--cycle", "10ms", "--format", "json",
+        ],
+        xml.as_bytes(),
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["state"]["T1"]["ET"], json!(20), "{v}");
+}
+
+#[test]
 fn what_il_cannot_execute_is_refused_by_run_and_c_with_its_place() {
     let cases = [
         (

@@ -17,10 +17,28 @@ use std::fs;
 
 const OUTCOMES: &str = "tests/matiec/outcomes.txt";
 
+/// The rows of a CSV file; a field in double quotes may hold commas (matiec's trace names a
+/// transition of a simultaneous divergence or convergence `"F1,E2->G"`, as Python's csv writes it).
 fn csv_rows(text: &str) -> Vec<Vec<String>> {
-    text.lines()
-        .map(|l| l.split(',').map(str::to_string).collect())
-        .collect()
+    text.lines().map(csv_fields).collect()
+}
+
+fn csv_fields(line: &str) -> Vec<String> {
+    let (mut fields, mut field, mut quoted) = (Vec::new(), String::new(), false);
+    let mut chars = line.chars().peekable();
+    while let Some(c) = chars.next() {
+        match c {
+            '"' if quoted && chars.peek() == Some(&'"') => {
+                chars.next();
+                field.push('"');
+            }
+            '"' => quoted = !quoted,
+            ',' if !quoted => fields.push(std::mem::take(&mut field)),
+            _ => field.push(c),
+        }
+    }
+    fields.push(field);
+    fields
 }
 
 fn same(a: &str, b: &str, typ: &str) -> bool {

@@ -18,7 +18,7 @@
 //! - `LD x` / `LDN x`: CR := x / NOT x; `ST x` / `STN x`: x := CR / NOT CR (CR unchanged);
 //!   `S x` / `R x` of a BOOL: x := TRUE / FALSE when CR is TRUE; `S`/`R` of an instance and
 //!   `S1 R1 CLK CU CD PV IN PT inst`: the instance called with that input := CR (an implicit
-//!   call, `XXX_CAL_operator`; the lowering refuses a call that leaves an input out);
+//!   call, `XXX_CAL_operator`; a BOOL input a call leaves out keeps its last value, as in ST);
 //! - `NOT`; `AND ANDN OR ORN XOR XORN ADD SUB MUL DIV MOD GT GE EQ NE LE LT` with an operand
 //!   or a deferred operand `OP( … )` (its list evaluated from its own operand, then CR := CR OP
 //!   result, `il_expression_c`); `N` negates the operand;
@@ -187,6 +187,18 @@ fn lower(
     tr.scope.int_arithmetic_in_dint = false;
     let mut lw = Lower::new(&tr.scope, pou);
     lw.text(map, base);
+    // A BOOL input a call leaves out keeps its value in a variable of its own, as in ST
+    // (`CALC C1(CU := …, PV := …)` without R). Only the calls (CALC and CALCN in an IF): not
+    // what reads an input, as `LD T1.PT`, which stays refused.
+    let stmts: Vec<Statement> = (tr.out.iter())
+        .filter_map(|p| match p {
+            Piece::Stmt(_, s) if matches!(s.kind, Stmt::Call { .. } | Stmt::If { .. }) => {
+                Some((**s).clone())
+            }
+            _ => None,
+        })
+        .collect();
+    lw.prepare(&stmts);
     let mut unit = 0;
     for p in &tr.out {
         match p {
