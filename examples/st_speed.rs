@@ -226,7 +226,7 @@ fn main() {
         x ^= x << 13;
         x ^= x >> 7;
         x ^= x << 17;
-        x % 2 == 0
+        x.is_multiple_of(2)
     };
     let raw: Vec<Vec<bool>> = (0..16)
         .map(|_| (0..INPUTS).map(|_| bits()).collect())

@@ -144,13 +144,11 @@ pub(super) fn body(
             }
             let e = ElemId(i as u32);
             match el.tag {
-                "coil" | "outVariable" | "inOutVariable" => {
-                    if f.write_out(e)?.is_some() {
-                        statements.push(Statement::Write {
-                            at: origin(el.node),
-                            local_id: el.local_id,
-                        });
-                    }
+                "coil" | "outVariable" | "inOutVariable" if f.write_out(e)?.is_some() => {
+                    statements.push(Statement::Write {
+                        at: origin(el.node),
+                        local_id: el.local_id,
+                    });
                 }
                 "jump" | "return" => statements.push(Statement::Run(f.control(e)?)),
                 _ => {}

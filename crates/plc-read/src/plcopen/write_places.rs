@@ -128,7 +128,6 @@ pub(super) fn place_writes(
             }
         }
     }
-    drop(run);
     // What each run touches: variables by lower-case base name, or everything; and the ticks
     // at which a statement's variable may be written (its holder's and its own).
     let mut touches: HashMap<String, Vec<usize>> = HashMap::new();
