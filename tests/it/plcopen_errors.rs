@@ -97,10 +97,12 @@ fn names_from_the_file_must_be_identifiers() {
 
 #[test]
 fn types_the_model_lacks_are_named_with_their_variable() {
-    let xml = project(&[("localVars", "n", "BOOL")], &rail(1))
-        .replace("<BOOL/>", "<pointer><baseType><INT/></baseType></pointer>");
+    let xml = project(&[("localVars", "n", "BOOL")], &rail(1)).replace(
+        "<BOOL/>",
+        "<bitfield><baseType><INT/></baseType></bitfield>",
+    );
     let e = error_of(&xml);
-    assert!(e.ends_with("at pou P, localVars, variable n: type pointer of variable `n` is not supported yet (supported: BOOL, SINT, INT, DINT, LINT, USINT, UINT, UDINT, ULINT, REAL, LREAL, BYTE, WORD, DWORD, LWORD, TIME, STRING, the other elementary types of IEC 61131-3, data types, arrays, structures and function block types)"), "{e}");
+    assert!(e.ends_with("at pou P, localVars, variable n: type bitfield of variable `n` is not supported yet (supported: BOOL, SINT, INT, DINT, LINT, USINT, UINT, UDINT, ULINT, REAL, LREAL, BYTE, WORD, DWORD, LWORD, TIME, STRING, the other elementary types of IEC 61131-3, data types, arrays, structures and function block types)"), "{e}");
 }
 
 #[test]

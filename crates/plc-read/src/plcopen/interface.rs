@@ -555,7 +555,8 @@ fn fb_init(tc6: Tc6, iv: Node, var: &str, fb: &str, place: &str) -> R<FbInit> {
         let text = super::xml::attr(simple, "value", place)?;
         let shown = format!("{var}.{member}");
         // A STRING member's literal (`FriendlyName := 'Button 1'`) as STRING variables have it.
-        let value = if super::pins::is_string_literal(text) && text.trim().starts_with('\'') {
+        let t = text.trim();
+        let value = if t.len() >= 2 && t.starts_with('\'') && t.ends_with('\'') {
             Located {
                 value: Scalar::Str(Cow::Owned(text.trim().to_owned())),
                 origin: origin(simple),

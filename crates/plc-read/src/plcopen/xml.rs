@@ -301,7 +301,11 @@ pub(super) fn type_reference(
     }
     if let Some((ns, ty)) = s.trim().rsplit_once('.') {
         if ns.split('.').all(is_identifier) && is_identifier(ty) {
-            if defined(ty) || super::black_box::is_standard_fb(&ty.to_ascii_uppercase()) {
+            let standard = matches!(
+                plc_model::Type::parse(&ty.to_ascii_uppercase()),
+                Some(plc_model::Type::Fb(_))
+            );
+            if defined(ty) || standard {
                 return Ok(ty.to_owned());
             }
             return Ok(format!("{}_{ty}", ns.replace('.', "_")));
