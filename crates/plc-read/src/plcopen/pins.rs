@@ -387,6 +387,29 @@ pub(super) fn bool_literal(
     i
 }
 
+/// The MOVE block `id` (at `at`) that writes what `from` gives into `to`.
+pub(super) fn move_block(
+    id: u32,
+    from: Input<'static>,
+    to: OutVar<'static>,
+    at: Origin,
+) -> Block<'static> {
+    Block {
+        origin: at,
+        id: Ok(id),
+        op: Ok(Cow::Borrowed("MOVE")),
+        inputs: Some(Ok(Inputs::List(vec![from]))),
+        outputs: Some(Ok(Outputs::First(to))),
+        instance: None,
+        label: None,
+        cond: None,
+        en: false,
+        after: None,
+        comment: None,
+        problem: None,
+    }
+}
+
 /// Adds `target` to output `pin` of block `b`.
 pub(super) fn add_target(b: &mut Block<'static>, pin: String, target: OutVar<'static>) {
     let mut outs = match b.outputs.take() {

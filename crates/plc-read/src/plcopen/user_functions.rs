@@ -376,10 +376,31 @@ pub(super) fn default_of(t: plc_model::Type) -> Scalar<'static> {
     }
 }
 
+/// The variables of function `sig` that a call starts, with their types and the values they
+/// start from: its outputs, its result and its locals (its inputs the caller writes), each at
+/// its initial value, its type's default without one.
+fn start_values(sig: &FnSig) -> Result<Vec<(&str, plc_model::Type, Scalar<'static>)>, String> {
+    let mut out = Vec::new();
+    for (name, ty, init) in &sig.starts {
+        if sig.inputs.iter().any(|(n, _)| n == name) {
+            continue;
+        }
+        let Some(t) = plc_model::Type::parse(ty) else {
+            return Err(format!("its variable `{name}` is of type {ty}"));
+        };
+        out.push((
+            name.as_str(),
+            t,
+            init.clone().unwrap_or_else(|| default_of(t)),
+        ));
+    }
+    Ok(out)
+}
+
 /// [`start`] for an FBD body (or an LD body read as data flow): a first network `F.start` of
 /// MOVE blocks from the initial values.
 fn start_network(body: &mut plc_syntax::FbdBody<'static>, sig: &FnSig) -> Result<(), String> {
-    use plc_syntax::fbd::{Block, Connection, Input, Inputs, Network, OutVar, Outputs};
+    use plc_syntax::fbd::{Connection, Input, Network, OutVar};
     let at = body.origin;
     // Ids above every block id of the body (ids are unique in a POU).
     let first = body
@@ -392,34 +413,16 @@ fn start_network(body: &mut plc_syntax::FbdBody<'static>, sig: &FnSig) -> Result
         .unwrap_or(0)
         + 1;
     let mut blocks = Vec::new();
-    for (name, ty, init) in &sig.starts {
-        if sig.inputs.iter().any(|(n, _)| n == name) {
-            continue;
-        }
-        let Some(t) = plc_model::Type::parse(ty) else {
-            return Err(format!("its variable `{name}` is of type {ty}"));
-        };
-        let value = init.clone().unwrap_or_else(|| default_of(t));
-        blocks.push(Block {
+    for (k, (name, _, value)) in start_values(sig)?.into_iter().enumerate() {
+        let from = Input {
             origin: at,
-            id: Ok(first + blocks.len() as u32),
-            op: Ok(Cow::Borrowed("MOVE")),
-            inputs: Some(Ok(Inputs::List(vec![Input {
-                origin: at,
-                from: Connection::Constant(value),
-            }]))),
-            outputs: Some(Ok(Outputs::First(OutVar {
-                origin: at,
-                name: Cow::Owned(name.clone()),
-            }))),
-            instance: None,
-            label: None,
-            cond: None,
-            en: false,
-            after: None,
-            comment: None,
-            problem: None,
-        });
+            from: Connection::Constant(value),
+        };
+        let to = OutVar {
+            origin: at,
+            name: Cow::Owned(name.to_owned()),
+        };
+        blocks.push(super::pins::move_block(first + k as u32, from, to, at));
     }
     if !blocks.is_empty() {
         body.networks.insert(
@@ -440,8 +443,8 @@ fn start_network(body: &mut plc_syntax::FbdBody<'static>, sig: &FnSig) -> Result
 
 /// Puts before function `sig`'s body the rungs that start its outputs, its result and its
 /// locals from their initial values on every call (its inputs the caller writes), as matiec's
-/// generated C declares them. An FBD body has no rungs to put them before: a function whose FBD
-/// body has locals (which would keep their values between calls) is refused.
+/// generated C declares them; an FBD body (or an LD body read as data flow) gets them as its
+/// first network ([`start_network`]).
 fn start(body: &mut Body<'static>, sig: &FnSig) -> Result<(), String> {
     let rungs = match body {
         Body::Rungs(r) => r,
@@ -453,20 +456,14 @@ fn start(body: &mut Body<'static>, sig: &FnSig) -> Result<(), String> {
         origin: at,
     };
     let mut pre = Vec::new();
-    for (name, ty, init) in &sig.starts {
-        if sig.inputs.iter().any(|(n, _)| n == name) {
-            continue;
-        }
-        let Some(t) = plc_model::Type::parse(ty) else {
-            return Err(format!("its variable `{name}` is of type {ty}"));
-        };
-        let value = init.clone().unwrap_or_else(|| default_of(t));
+    for (name, t, value) in start_values(sig)? {
+        let name = name.to_owned();
         let kind = match (t, &value) {
-            (plc_model::Type::Bool, Scalar::Bool(true)) => ElementKind::Set(l(name.clone())),
-            (plc_model::Type::Bool, Scalar::Bool(false)) => ElementKind::Reset(l(name.clone())),
+            (plc_model::Type::Bool, Scalar::Bool(true)) => ElementKind::Set(l(name)),
+            (plc_model::Type::Bool, Scalar::Bool(false)) => ElementKind::Reset(l(name)),
             _ => ElementKind::Move(Box::new(Move {
                 from: Located { value, origin: at },
-                to: l(name.clone()),
+                to: l(name),
             })),
         };
         pre.push(Rung {

@@ -184,23 +184,12 @@ pub(super) fn place_writes(
         added.declare(&temp, ty, target.origin);
         let id = added.next_id;
         added.next_id += 1;
-        blocks.push(Block {
+        let from = Input {
             origin: target.origin,
-            id: Ok(id),
-            op: Ok(Cow::Borrowed("MOVE")),
-            inputs: Some(Ok(Inputs::List(vec![Input {
-                origin: target.origin,
-                from: Connection::Variable(Cow::Owned(temp)),
-            }]))),
-            outputs: Some(Ok(Outputs::First(target))),
-            instance: None,
-            label: None,
-            cond: None,
-            en: false,
-            after: None,
-            comment: None,
-            problem: None,
-        });
+            from: Connection::Variable(Cow::Owned(temp)),
+        };
+        let at_target = target.origin;
+        blocks.push(super::pins::move_block(id, from, target, at_target));
         moved.insert(at, id);
     }
     statements
