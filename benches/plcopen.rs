@@ -26,7 +26,7 @@ fn plcopen(c: &mut Criterion) {
     group.bench_function("load", |b| {
         b.iter(|| {
             let (p, _, _) = plc_deps::load::plcopen(&xml).expect("the generated file loads");
-            assert_eq!(p.rungs.len(), rungs);
+            assert_eq!(p.rungs().len(), rungs);
             p
         })
     });

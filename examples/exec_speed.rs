@@ -58,7 +58,7 @@ fn main() {
     let patterns: Vec<Vec<(VarId, Value)>> = (0..16)
         .map(|_| {
             (0..inputs)
-                .map(|i| (VarId(i as u32), Value::Bool(rand() % 2 == 0)))
+                .map(|i| (VarId::from_raw(i as u32), Value::Bool(rand() % 2 == 0)))
                 .collect()
         })
         .collect();
@@ -79,7 +79,7 @@ fn main() {
         total += ns;
     }
     let on = (inputs..inputs + rungs)
-        .filter(|&v| machine.value(&state, VarId(v as u32)).as_bool() == Some(true))
+        .filter(|&v| machine.value(&state, VarId::from_raw(v as u32)).as_bool() == Some(true))
         .count();
     assert!(faults.is_empty());
     println!(

@@ -50,8 +50,8 @@ fn main() {
     let m = Machine::new(&p, Layout::dense(&p), &ExecConfig::default()).expect("lowers");
     let rungs = p.main().rungs.len();
     let scans = (20_000_000 / rungs).clamp(200, 20_000);
-    let inputs: Vec<VarId> = (0..p.vars.len() as u32)
-        .map(VarId)
+    let inputs: Vec<VarId> = (0..p.vars().len() as u32)
+        .map(VarId::from_raw)
         .filter(|&v| p.var(v).class == VarClass::Input && p.var(v).ty == Type::Bool)
         .collect();
     let mut x = 0x9E37_79B9_7F4A_7C15u64;

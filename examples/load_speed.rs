@@ -44,7 +44,7 @@ fn main() {
         let mb = text.len() as f64 / 1e6;
         eprintln!(
             "{} rungs, {mb:.1} MB: loaded in {total:.2?} = {:.0} MB/s",
-            p.rungs.len(),
+            p.rungs().len(),
             mb / total.as_secs_f64()
         );
         drop(p);

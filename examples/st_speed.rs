@@ -169,11 +169,11 @@ fn ids(p: &Program, names: &[String]) -> Vec<VarId> {
         .iter()
         .map(|n| {
             let i = p
-                .vars
+                .vars()
                 .iter()
                 .position(|v| v.name == *n || v.name.ends_with(&format!(".{n}")))
                 .unwrap_or_else(|| panic!("no variable {n}"));
-            VarId(i as u32)
+            p.vars().id(i)
         })
         .collect()
 }

@@ -11,7 +11,7 @@ fn main() {
     let text = std::fs::read_to_string(&path).expect("read");
     let t = Instant::now();
     let p = plc_deps::load::program_from_json(&text).expect("load");
-    eprintln!("load: {:?} ({} rungs)", t.elapsed(), p.rungs.len());
+    eprintln!("load: {:?} ({} rungs)", t.elapsed(), p.rungs().len());
     let all = Instant::now();
     let t = Instant::now();
     let acc = accesses(&p);
@@ -26,8 +26,12 @@ fn main() {
     let cfg = control_flow_graph(&p);
     eprintln!("cfg: {:?}", t.elapsed());
     let t = Instant::now();
-    let pairs: Vec<(u32, u32)> = cfg.edges.iter().map(|e| (e.from.0, e.to.0)).collect();
-    let pd = post_dominators(cfg.node_count(), &pairs, cfg.stop().0);
+    let pairs: Vec<(u32, u32)> = cfg
+        .edges
+        .iter()
+        .map(|e| (e.from.raw(), e.to.raw()))
+        .collect();
+    let pd = post_dominators(cfg.node_count(), &pairs, cfg.stop().raw());
     eprintln!("post-dominators: {:?}", t.elapsed());
     let t = Instant::now();
     let cd = control_dependences(&pairs, &pd, |_| true);

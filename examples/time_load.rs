@@ -13,7 +13,7 @@ fn main() {
     eprintln!("parse: {:?}", t.elapsed());
     let t = Instant::now();
     let p = plc_deps::load::program_from_value(&v).expect("load");
-    eprintln!("resolve: {:?} ({} rungs)", t.elapsed(), p.rungs.len());
+    eprintln!("resolve: {:?} ({} rungs)", t.elapsed(), p.rungs().len());
     let t = Instant::now();
     drop(v);
     eprintln!("drop: {:?}", t.elapsed());

@@ -72,7 +72,7 @@ fn main() {
     let rounds: usize = args.next().map_or(7, |a| a.parse().expect("round count"));
     let text = std::fs::read_to_string(&file).expect("reads the program");
     let program = plc_deps::load::program_from_json(&text).expect("the program loads");
-    let rungs = program.rungs.len();
+    let rungs = program.rungs().len();
     let scan_many = || {
         let machine = Machine::new(&program, Layout::dense(&program), &ExecConfig::default())
             .expect("lowers");
@@ -108,10 +108,10 @@ fn main() {
         let mid = level.len().div_ceil(2);
         for (h, part) in [&level[..mid], &level[mid..]].into_iter().enumerate() {
             for t in part {
-                for r in &analysis.schedule.tasks[t.0 as usize].rungs {
+                for r in &analysis.schedule.tasks[t.raw() as usize].rungs {
                     match halves[h].last_mut() {
-                        Some(last) if last.1 == r.0 => last.1 = r.0 + 1,
-                        _ => halves[h].push((r.0, r.0 + 1)),
+                        Some(last) if last.1 == r.raw() => last.1 = r.raw() + 1,
+                        _ => halves[h].push((r.raw(), r.raw() + 1)),
                     }
                 }
             }
@@ -124,8 +124,8 @@ fn main() {
             let mut ctx = machine.context(k, &mut faults);
             let mut mem = Unchecked(state.bytes_mut());
             for &(lo, hi) in &halves[h] {
-                machine.run_from(&mut mem, &mut ctx, RungId(lo), |r: RungId| {
-                    lo <= r.0 && r.0 < hi
+                machine.run_from(&mut mem, &mut ctx, RungId::from_raw(lo), |r: RungId| {
+                    lo <= r.raw() && r.raw() < hi
                 });
             }
         };
@@ -140,7 +140,7 @@ fn main() {
     };
     // `exchange`: per (level, half) the variables it writes; variables grouped by their writers
     // (the set of (level, half) keys), BOOL groups apart, each group on its own lines.
-    let nv = program.vars.len();
+    let nv = program.vars().len();
     let mut keys: Vec<Vec<u32>> = vec![Vec::new(); nv];
     let mut lvl_halves: Vec<[Vec<(u32, u32)>; 2]> = Vec::new();
     for (li, level) in analysis.schedule.levels.iter().enumerate() {
@@ -148,7 +148,7 @@ fn main() {
         let mut hs: [Vec<(u32, u32)>; 2] = [Vec::new(), Vec::new()];
         for (h, part) in [&level[..mid], &level[mid..]].into_iter().enumerate() {
             for t in part {
-                for r in &analysis.schedule.tasks[t.0 as usize].rungs {
+                for r in &analysis.schedule.tasks[t.raw() as usize].rungs {
                     for v in analysis.accesses.outs(*r) {
                         let k = (li * 2 + h) as u32;
                         if keys[v.index()].last() != Some(&k) {
@@ -156,8 +156,8 @@ fn main() {
                         }
                     }
                     match hs[h].last_mut() {
-                        Some(last) if last.1 == r.0 => last.1 = r.0 + 1,
-                        _ => hs[h].push((r.0, r.0 + 1)),
+                        Some(last) if last.1 == r.raw() => last.1 = r.raw() + 1,
+                        _ => hs[h].push((r.raw(), r.raw() + 1)),
                     }
                 }
             }
@@ -167,10 +167,10 @@ fn main() {
     let mut gmap: std::collections::BTreeMap<(bool, Vec<u32>), Vec<plc_deps::model::VarId>> =
         Default::default();
     for (v, key) in keys.iter().enumerate().filter(|(_, k)| !k.is_empty()) {
-        let isb = program.vars[v].ty == plc_deps::model::Type::Bool;
+        let isb = program.vars()[v].ty == plc_deps::model::Type::Bool;
         gmap.entry((!isb, key.clone()))
             .or_default()
-            .push(plc_deps::model::VarId(v as u32));
+            .push(plc_deps::model::VarId::from_raw(v as u32));
     }
     let glist: Vec<_> = gmap.into_iter().collect();
     let groups: Vec<Vec<plc_deps::model::VarId>> = glist.iter().map(|g| g.1.clone()).collect();
@@ -252,8 +252,8 @@ fn main() {
                 }
                 let mut mem = Unchecked(state.bytes_mut());
                 for &(lo, hi) in &hs[h] {
-                    xm.run_from(&mut mem, &mut ctx, RungId(lo), |r: RungId| {
-                        lo <= r.0 && r.0 < hi
+                    xm.run_from(&mut mem, &mut ctx, RungId::from_raw(lo), |r: RungId| {
+                        lo <= r.raw() && r.raw() < hi
                     });
                 }
                 // pack own writes

@@ -38,7 +38,7 @@ pub struct CCommand {
 pub fn c(cmd: &CCommand) -> Result<(), CliError> {
     let (mut p, fbd) = load_program_for_c(&cmd.input)?;
     if let Some(d) = cmd.dialect {
-        p.dialect = d;
+        p.set_dialect(d);
     }
     super::skipped::refuse_skipped(&p, &cmd.input, cmd.allow_skipped, Some("write the C"))?;
     let dir = &cmd.output;

@@ -192,10 +192,10 @@ fn dot_selection(c: &ReportConfig, p: &Program) -> Result<Option<HashSet<String>
     let drawn = select_rungs(p, &c.selection)
         .map_err(|e| CliError::Usage(format!("{}: {e}", c.input.display())))?;
     match &drawn {
-        None if p.rungs.len() > DOT_MAX_RUNGS => Err(CliError::Usage(format!(
+        None if p.rungs().len() > DOT_MAX_RUNGS => Err(CliError::Usage(format!(
             "{}: {} rungs are too many to draw ({} at most): Graphviz cannot lay out a graph this size usefully; draw a part with --pou NAME or --rungs FIRST..LAST, or use the text or JSON report",
             c.input.display(),
-            thousands(p.rungs.len()),
+            thousands(p.rungs().len()),
             thousands(DOT_MAX_RUNGS)
         ))),
         Some(s) if s.len() > DOT_MAX_RUNGS => Err(CliError::Usage(format!(

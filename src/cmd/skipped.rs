@@ -43,7 +43,7 @@ impl SkippedPou {
 
 /// The skipped POUs of `p`, in POU order.
 pub fn skipped_pous(p: &Program) -> Vec<SkippedPou> {
-    p.pous.iter().filter_map(skipped_pou).collect()
+    p.pous().iter().filter_map(skipped_pou).collect()
 }
 
 fn skipped_pou(pou: &Pou) -> Option<SkippedPou> {

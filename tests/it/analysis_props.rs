@@ -30,7 +30,7 @@ fn var_sets() -> impl Strategy<Value = (VarSets, VarSets)> {
                 let f = |l: Vec<Vec<u32>>| {
                     VarSets::from_lists(
                         l.into_iter()
-                            .map(|s| s.into_iter().map(VarId).collect::<Vec<_>>()),
+                            .map(|s| s.into_iter().map(VarId::from_raw).collect::<Vec<_>>()),
                     )
                 };
                 (f(r), f(w))
@@ -222,17 +222,20 @@ fn check_schedule(text: &str) -> Result<bool, TestCaseError> {
     let main = p.main().rungs.clone();
     for r in main.clone() {
         let in_task = s.task_of[r as usize].is_some();
-        let unreachable = s.unreachable.iter().any(|u| u.0 == r);
+        let unreachable = s.unreachable.iter().any(|u| u.raw() == r);
         prop_assert!(in_task != unreachable);
     }
     for e in &a.cfg.edges {
-        if main.contains(&e.from.0) && main.contains(&e.to.0) {
-            if let (Some(x), Some(y)) = (s.task_of[e.from.0 as usize], s.task_of[e.to.0 as usize]) {
+        if main.contains(&e.from.raw()) && main.contains(&e.to.raw()) {
+            if let (Some(x), Some(y)) = (
+                s.task_of[e.from.raw() as usize],
+                s.task_of[e.to.raw() as usize],
+            ) {
                 prop_assert!(
                     x <= y,
                     "edge {} → {} goes backwards between tasks",
-                    e.from.0,
-                    e.to.0
+                    e.from.raw(),
+                    e.to.raw()
                 );
             }
         }
@@ -273,7 +276,7 @@ proptest! {
         prop_assert_eq!(&all.data_levels, &direct.data_levels);
         prop_assert_eq!(&all.control_levels, &direct.control_levels);
         let tasks = |a: &plc_deps::analysis::Analysis| -> Vec<(Vec<u32>, u32)> {
-            a.schedule.tasks.iter().map(|t| (t.rungs.iter().map(|r| r.0).collect(), t.level)).collect()
+            a.schedule.tasks.iter().map(|t| (t.rungs.iter().map(|r| r.raw()).collect(), t.level)).collect()
         };
         prop_assert_eq!(tasks(&all), tasks(&direct));
         prop_assert_eq!(&all.counts, &direct.counts);

@@ -351,7 +351,7 @@ fn missing_kinds(
 ) -> Vec<&'static str> {
     use plc_deps::model::{walk_elements, ArithOp, ContactKind, Element, Field, Operand, Value};
     let mut seen = std::collections::HashSet::new();
-    for r in p.rungs.iter().filter(|r| ids.contains(&r.id)) {
+    for r in p.rungs().iter().filter(|r| ids.contains(&r.id)) {
         for e in &r.series {
             if let Element::Or(bs) = e {
                 let mut edge = false;
@@ -477,7 +477,7 @@ fn row_ids(tables: &str) -> Vec<String> {
 /// Whether some row comes before a row of an earlier rung (`p`'s rung order).
 fn reordered(p: &plc_deps::model::Program, ids: &[String]) -> bool {
     let at: std::collections::HashMap<&str, usize> = p
-        .rungs
+        .rungs()
         .iter()
         .enumerate()
         .map(|(i, r)| (r.id.as_str(), i))
@@ -506,10 +506,10 @@ fn rows_carry_the_contact_and_coil_rungs_and_stay_exact() {
     let (tables, kernels) = rows_text(&files);
     let ids = row_ids(&tables);
     assert!(
-        ids.len() * 100 >= p.rungs.len() * 95,
+        ids.len() * 100 >= p.rungs().len() * 95,
         "{} rows of {} rungs",
         ids.len(),
-        p.rungs.len()
+        p.rungs().len()
     );
     assert!(reordered(&p, &ids), "rows in program order");
     let set = ids.iter().cloned().collect();

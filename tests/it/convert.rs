@@ -19,18 +19,20 @@ fn model_of(text: &str) -> Option<String> {
         plc_deps::load::program_and_fbd_from_json(text)
     };
     // Where a rung or block stands in its file is not part of what the two texts mean.
-    loaded.ok().map(|(mut p, mut f)| {
-        for r in &mut p.rungs {
+    loaded.ok().map(|(p, mut f)| {
+        let mut parts = p.into_parts();
+        for r in parts.rungs.iter_mut() {
             r.origin = plc_deps::diag::Origin::NONE;
         }
         // Which bodies the XML reader read only as stand-in rungs (ST, IL, SFC) is its own
         // knowledge: the JSON has the stand-in rungs, not the language they stand for.
-        for pou in &mut p.pous {
+        for pou in parts.pous.iter_mut() {
             pou.skipped = None;
         }
+        let p = plc_deps::model::Program::new(parts).expect("a loaded program's parts");
         for n in f.pous.iter_mut().flat_map(|pou| &mut pou.networks) {
             n.origin = plc_deps::diag::Origin::NONE;
-            for b in &mut n.blocks {
+            for b in n.blocks.iter_mut() {
                 b.origin = plc_deps::diag::Origin::NONE;
             }
         }

@@ -31,8 +31,8 @@ const THREADS: [usize; 3] = [1, 2, 4];
 /// LINT input `kl` (`common::random_input`).
 fn input_table(p: &Program, seed: u64, scans: u64) -> Vec<Vec<(VarId, Value)>> {
     let mut rng = common::Rng::new(seed ^ 0xABCD);
-    let inputs: Vec<VarId> = (0..p.vars.len() as u32)
-        .map(VarId)
+    let inputs: Vec<VarId> = (0..p.vars().len() as u32)
+        .map(VarId::from_raw)
         .filter(|&v| p.var(v).class == VarClass::Input)
         .collect();
     (0..scans)
@@ -217,8 +217,8 @@ fn check_with(
         let got = &rec.states[scan as usize];
         if got[..] != *s.bytes() {
             let byte = got.iter().zip(s.bytes()).position(|(a, b)| a != b).unwrap();
-            let var = (0..p.vars.len() as u32)
-                .map(VarId)
+            let var = (0..p.vars().len() as u32)
+                .map(VarId::from_raw)
                 .find(|&v| seq.layout().bytes_of(v).contains(&(byte as u32)));
             panic!(
                 "{label}: state differs after scan {scan} at byte {byte} ({}): par {:#x}, seq {:#x}\n{}",
@@ -765,7 +765,7 @@ fn unconditional_backward_jump_refusal_is_a_cfg_edge_and_runs_in_parallel() {
         .edges
         .iter()
         .filter(|e| e.kind == plc_deps::analysis::EdgeKind::Refused)
-        .map(|e| (e.from.0, e.to.0))
+        .map(|e| (e.from.raw(), e.to.raw()))
         .collect();
     assert_eq!(refused, [(2, 3)]);
     let exec = ExecConfig {
@@ -808,8 +808,8 @@ fn a_refused_loop_back_followed_by_an_unconditional_jump_runs_in_parallel() {
         .cfg
         .edges
         .iter()
-        .filter(|e| e.from.0 == 2)
-        .map(|e| e.to.0)
+        .filter(|e| e.from.raw() == 2)
+        .map(|e| e.to.raw())
         .collect();
     from_r2.sort_unstable();
     assert_eq!(from_r2, [1, 4]);

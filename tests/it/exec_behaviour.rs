@@ -34,9 +34,9 @@ impl Sim {
     }
 
     fn id(&self, name: &str) -> VarId {
-        VarId(
+        VarId::from_raw(
             self.p
-                .vars
+                .vars()
                 .iter()
                 .position(|v| v.name == name)
                 .unwrap_or_else(|| panic!("no variable {name}")) as u32,
@@ -44,9 +44,9 @@ impl Sim {
     }
 
     fn rung(&self, id: &str) -> RungId {
-        RungId(
+        RungId::from_raw(
             self.p
-                .rungs
+                .rungs()
                 .iter()
                 .position(|r| r.id == id)
                 .unwrap_or_else(|| panic!("no rung {id}")) as u32,
@@ -588,7 +588,7 @@ fn long_series_of_contacts_with_negations() {
         let mut s = Sim::new(&json);
         for bits in 0..1u32 << n {
             let inputs: Vec<(VarId, Value)> = (0..n)
-                .map(|i| (VarId(i as u32), Value::Bool(bits >> i & 1 != 0)))
+                .map(|i| (VarId::from_raw(i as u32), Value::Bool(bits >> i & 1 != 0)))
                 .collect();
             s.step_values(&inputs);
             let expected = (0..n).all(|i| (bits >> i & 1 != 0) != (i % 3 == 2));
@@ -1038,7 +1038,7 @@ fn run_from_reports_where_control_leaves_a_region() {
     let (m, mut st) = (&s.m, s.st.clone());
     let mut faults = Vec::new();
     let mut ctx = m.context(0, &mut faults);
-    let r = RungId;
+    let r = RungId::from_raw;
     let store = st.bytes_mut();
     m.begin_scan(store);
     assert_eq!(
@@ -1067,7 +1067,7 @@ fn run_from_reports_where_control_leaves_a_region() {
     // Resuming at the test (i = 2 ≤ 2) enters the body again; then the test fails: exit R7.
     assert_eq!(
         m.resume(store, &mut ctx, Exit::ForTest(r(4)), |x| (4..=6)
-            .contains(&x.0)),
+            .contains(&x.raw())),
         Exit::Rung(r(7))
     );
     assert_eq!(m.run_from(store, &mut ctx, r(7), |_| true), Exit::Stop);
@@ -1177,7 +1177,7 @@ fn scan_by_schedule(
                         .collect();
                     match entered.as_slice() {
                         [e] => *e,
-                        other => panic!("{}: task {t:?} entered from {other:?}", p.name),
+                        other => panic!("{}: task {t:?} entered from {other:?}", p.name()),
                     }
                 }
             };
@@ -1204,8 +1204,8 @@ fn schedule_driven_scan_equals_sequential_scan() {
         };
         let m = Machine::new(&p, Layout::dense(&p), &config).unwrap();
         let (mut a, mut b) = (m.initial_state(), m.initial_state());
-        let inputs: Vec<VarId> = (0..p.vars.len() as u32)
-            .map(VarId)
+        let inputs: Vec<VarId> = (0..p.vars().len() as u32)
+            .map(VarId::from_raw)
             .filter(|&v| p.var(v).class == plc_deps::model::VarClass::Input)
             .collect();
         let mut x = 0x2545_F491_4F6C_DD1Du64;
@@ -1223,9 +1223,10 @@ fn schedule_driven_scan_equals_sequential_scan() {
             m.set_inputs(&mut b, &vals);
             let fb = scan_by_schedule(&m, &p, &sched, &mut b, scan);
             assert_eq!(
-                a, b,
+                a,
+                b,
                 "{} (cap {loop_cap}): states differ after scan {scan}",
-                p.name
+                p.name()
             );
             assert_eq!(fa, fb);
         }
@@ -1237,12 +1238,15 @@ fn padded_permuted_layout_gives_the_same_values() {
     let p = plc_deps::load::program_from_json(EXAMPLE_B).unwrap();
     let dense = Machine::new(&p, Layout::dense(&p), &ExecConfig::default()).unwrap();
     // Reverse order, one variable per 64-byte line.
-    let n = p.vars.len() as u32;
-    let groups: Vec<Vec<VarId>> = (0..n).rev().map(|v| vec![VarId(v)]).collect();
+    let n = p.vars().len() as u32;
+    let groups: Vec<Vec<VarId>> = (0..n).rev().map(|v| vec![VarId::from_raw(v)]).collect();
     let layout = Layout::from_groups(&p, &groups, 64).unwrap();
     assert_eq!(layout.size(), 64 * n);
-    assert_eq!(layout.bytes_of(VarId(0)), 64 * (n - 1)..64 * (n - 1) + 1);
-    let (idx, t1) = (VarId(7), VarId(13));
+    assert_eq!(
+        layout.bytes_of(VarId::from_raw(0)),
+        64 * (n - 1)..64 * (n - 1) + 1
+    );
+    let (idx, t1) = (VarId::from_raw(7), VarId::from_raw(13));
     assert_eq!(layout.bytes_of(idx).len(), 2, "an INT is 2 bytes");
     assert_eq!(
         layout.bytes_of(t1).len(),
@@ -1250,7 +1254,7 @@ fn padded_permuted_layout_gives_the_same_values() {
     );
     let padded = Machine::new(&p, layout.clone(), &ExecConfig::default()).unwrap();
     // The same layout through explicit starts.
-    let starts: Vec<u32> = (0..n).map(|v| layout.start(VarId(v)).0).collect();
+    let starts: Vec<u32> = (0..n).map(|v| layout.start(VarId::from_raw(v)).0).collect();
     assert_eq!(
         Layout::from_starts(&p, starts, layout.size()).unwrap(),
         layout
@@ -1258,9 +1262,9 @@ fn padded_permuted_layout_gives_the_same_values() {
     // Dense: the 12 BOOLs packed first (in declaration order), then the INT, then the timer
     // on its 8-byte alignment.
     let dense_layout = dense.layout();
-    assert_eq!(dense_layout.bytes_of(VarId(0)), 0..1);
+    assert_eq!(dense_layout.bytes_of(VarId::from_raw(0)), 0..1);
     assert_eq!(
-        dense_layout.bytes_of(VarId(8)),
+        dense_layout.bytes_of(VarId::from_raw(8)),
         7..8,
         "done follows the seven inputs"
     );
@@ -1272,19 +1276,19 @@ fn padded_permuted_layout_gives_the_same_values() {
         let vals: Vec<(VarId, Value)> = (0..7)
             .map(|i| {
                 (
-                    VarId(i),
+                    VarId::from_raw(i),
                     Value::Bool(!(scan * 7 + i as u64).is_multiple_of(3)),
                 )
             })
             .collect();
         dense.scan(&mut a, scan, &vals, &mut Vec::new());
         padded.scan(&mut b, scan, &vals, &mut Vec::new());
-        for v in 0..p.vars.len() as u32 {
+        for v in 0..p.vars().len() as u32 {
             assert_eq!(
-                dense.value(&a, VarId(v)),
-                padded.value(&b, VarId(v)),
+                dense.value(&a, VarId::from_raw(v)),
+                padded.value(&b, VarId::from_raw(v)),
                 "{} at scan {scan}",
-                p.vars[v as usize].name
+                p.vars()[v as usize].name
             );
         }
     }
@@ -1319,7 +1323,11 @@ fn bad_layouts_are_refused() {
     ));
     assert!(Layout::from_starts(&p, vec![6, 0], 8).is_ok());
     assert_eq!(
-        Layout::from_groups(&p, &[vec![VarId(1)], vec![VarId(1)]], 64),
+        Layout::from_groups(
+            &p,
+            &[vec![VarId::from_raw(1)], vec![VarId::from_raw(1)]],
+            64
+        ),
         Err(LayoutError::BadVar { var: 1 })
     );
     assert_eq!(Layout::from_groups(&p, &[], 48), Err(LayoutError::BadAlign));

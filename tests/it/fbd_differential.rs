@@ -23,8 +23,8 @@ const SCANS: u64 = 25;
 
 fn input_table(p: &Program, seed: u64) -> Vec<Vec<(VarId, Value)>> {
     let mut rng = Rng::new(seed ^ 0xABCD);
-    let inputs: Vec<VarId> = (0..p.vars.len() as u32)
-        .map(VarId)
+    let inputs: Vec<VarId> = (0..p.vars().len() as u32)
+        .map(VarId::from_raw)
         .filter(|&v| p.var(v).class == VarClass::Input)
         .collect();
     (0..SCANS)
@@ -144,8 +144,8 @@ fn parallel_scan_equals_sequential_scan_on_random_fbd_programs() {
                 let got = &rec.states[scan as usize];
                 if got[..] != *s.bytes() {
                     let byte = got.iter().zip(s.bytes()).position(|(x, y)| x != y).unwrap();
-                    let var = (0..p.vars.len() as u32)
-                        .map(VarId)
+                    let var = (0..p.vars().len() as u32)
+                        .map(VarId::from_raw)
                         .find(|&v| seq.layout().bytes_of(v).contains(&(byte as u32)));
                     panic!(
                         "{label}: state differs after scan {scan} at byte {byte} ({})\n{text}\n{}",

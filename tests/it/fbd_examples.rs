@@ -36,9 +36,9 @@ impl Sim {
     }
 
     fn id(&self, name: &str) -> VarId {
-        VarId(
+        VarId::from_raw(
             self.p
-                .vars
+                .vars()
                 .iter()
                 .position(|v| v.name == name)
                 .unwrap_or_else(|| panic!("no variable {name}")) as u32,
@@ -124,7 +124,7 @@ fn example_c_order_and_fragment_tree_are_the_seeds() {
     );
     // The lowered rungs follow the fragment tree as nested `if` blocks.
     let rungs: Vec<&str> =
-        s.p.pou_rungs(plc_deps::model::PouId(0))
+        s.p.pou_rungs(plc_deps::model::PouId::from_raw(0))
             .map(|r| s.p.rung(r).id.as_str())
             .collect();
     assert_eq!(
@@ -322,7 +322,7 @@ fn example_c_control_dependences_are_the_fragment_tree() {
     let s = Sim::load("example-c");
     let a = plc_deps::analysis::analyse(&s.p);
     let name = |n: u32| {
-        s.p.rungs
+        s.p.rungs()
             .get(n as usize)
             .map_or("START/STOP".to_string(), |r| r.id.clone())
     };

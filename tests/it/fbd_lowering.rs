@@ -31,9 +31,9 @@ impl Sim {
         }
     }
     fn id(&self, name: &str) -> VarId {
-        VarId(
+        VarId::from_raw(
             self.p
-                .vars
+                .vars()
                 .iter()
                 .position(|v| v.name == name)
                 .unwrap_or_else(|| panic!("no variable {name}")) as u32,
@@ -194,7 +194,7 @@ fn outputs_that_are_also_inputs_are_computed_through_a_temp() {
         ("x", Value::Int(2)),
     ]);
     assert_eq!((s.int("a"), s.int("x")), (9, 6));
-    assert!(s.p.vars.iter().any(|v| v.hidden && v.name == "_1_OUT"));
+    assert!(s.p.vars().iter().any(|v| v.hidden && v.name == "_1_OUT"));
 }
 
 /// EQ, GT, GE, LT, LE of n inputs compare each neighbouring pair (IEC 61131-3 2.5.1.5.4:
@@ -342,7 +342,9 @@ fn jumps_and_ret_between_networks() {
     s.step(&[("stop", Value::Bool(true))]);
     assert_eq!((s.int("n"), s.int("m")), (4, 1));
     assert_eq!(
-        s.p.rung(plc_deps::model::RungId(0)).label.as_deref(),
+        s.p.rung(plc_deps::model::RungId::from_raw(0))
+            .label
+            .as_deref(),
         Some("L0")
     );
 }
@@ -412,7 +414,7 @@ fn a_conditional_block_keeps_its_place_before_a_later_ret() {
         ]),
     ));
     assert_eq!(s.order(0), vec![1, 2, 3, 4, 5]);
-    let ids: Vec<&str> = s.p.rungs.iter().map(|r| r.id.as_str()).collect();
+    let ids: Vec<&str> = s.p.rungs().iter().map(|r| r.id.as_str()).collect();
     assert_eq!(
         ids,
         vec![
@@ -498,14 +500,16 @@ fn instances_keep_their_own_data_unconnected_inputs_keep_their_value() {
     // Three rising edges: C1 adds its default STEP 1, C2 its connected 10.
     assert_eq!((s.int("o1"), s.int("o2"), s.int("sum")), (3, 30, 33));
     // Each instance has its own POU, rungs and edge memory.
-    let names: Vec<&str> = s.p.pous.iter().map(|p| p.name.as_str()).collect();
+    let names: Vec<&str> = s.p.pous().iter().map(|p| p.name.as_str()).collect();
     assert_eq!(names, vec!["t", "C1", "C2"]);
-    assert!(s.p.rungs.iter().any(|r| r.id == "C1:R1") && s.p.rungs.iter().any(|r| r.id == "C2:R1"));
     assert!(
-        s.p.vars.iter().any(|v| v.name == "C1:R1:edge1")
-            && s.p.vars.iter().any(|v| v.name == "C2:R1:edge1")
+        s.p.rungs().iter().any(|r| r.id == "C1:R1") && s.p.rungs().iter().any(|r| r.id == "C2:R1")
     );
-    assert!(s.p.vars.iter().any(|v| v.name == "C2.STEP"));
+    assert!(
+        s.p.vars().iter().any(|v| v.name == "C1:R1:edge1")
+            && s.p.vars().iter().any(|v| v.name == "C2:R1:edge1")
+    );
+    assert!(s.p.vars().iter().any(|v| v.name == "C2.STEP"));
 }
 
 #[test]
@@ -530,11 +534,11 @@ fn nested_instances_and_ladder_main_calling_an_fbd_subroutine() {
         s.step(&[("p", Value::Bool(p))]);
     }
     assert_eq!((s.int("r"), s.int("calls"), s.int("SBR:k")), (20, 3, 3));
-    let names: Vec<&str> = s.p.pous.iter().map(|p| p.name.as_str()).collect();
+    let names: Vec<&str> = s.p.pous().iter().map(|p| p.name.as_str()).collect();
     assert_eq!(names, vec!["t", "SBR", "W", "W.INNER"]);
     assert!(
-        s.p.vars.iter().any(|v| v.name == "W.INNER.N")
-            && s.p.vars.iter().any(|v| v.name == "SBR:_2_OUT")
+        s.p.vars().iter().any(|v| v.name == "W.INNER.N")
+            && s.p.vars().iter().any(|v| v.name == "SBR:_2_OUT")
     );
     // The FBD bodies: the subroutine, then the two types; WRAP has one copy (instance W).
     let bodies: Vec<(&str, usize)> = s

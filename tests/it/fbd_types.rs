@@ -28,7 +28,7 @@ fn constant(v: Value) -> Option<Pin> {
 
 fn arc(block: u32, output: u32) -> Option<Pin> {
     Some(Pin::Arc {
-        block: BlockId(block),
+        block: BlockId::from_raw(block),
         output,
     })
 }
@@ -86,8 +86,8 @@ fn kaskad_5_keeps_the_generator_type_its_two_instances_and_typed_pins() {
     assert_eq!(
         instances,
         vec![
-            ("Gen1", "GENERATOR", FbTypeId(0), "Gen1"),
-            ("Gen2", "GENERATOR", FbTypeId(0), "Gen2")
+            ("Gen1", "GENERATOR", FbTypeId::from_raw(0), "Gen1"),
+            ("Gen2", "GENERATOR", FbTypeId::from_raw(0), "Gen2")
         ]
     );
     // Network G: 1 EQ(GEN_TIMER, T#0s); 2 TSTART(GEN_TIMER) if 1; 3 LT(GEN_TIMER, PERIOD);
@@ -174,7 +174,7 @@ fn nested_instances_timers_and_program_variables_are_named_relative_to_the_type(
         w.nested,
         vec![Nested {
             name: "INNER".into(),
-            ty: FbTypeId(0)
+            ty: FbTypeId::from_raw(0)
         }]
     );
     let instances: Vec<(&str, FbTypeId)> = fbd
@@ -184,9 +184,12 @@ fn nested_instances_timers_and_program_variables_are_named_relative_to_the_type(
         .collect();
     assert_eq!(
         instances,
-        vec![("W", FbTypeId(1)), ("W.INNER", FbTypeId(0))]
+        vec![
+            ("W", FbTypeId::from_raw(1)),
+            ("W.INNER", FbTypeId::from_raw(0))
+        ]
     );
-    let k = VarId(p.vars.iter().position(|v| v.name == "K").expect("K") as u32);
+    let k = VarId::from_raw(p.vars().iter().position(|v| v.name == "K").expect("K") as u32);
     let t = Slot::Local(0);
     let t_q = TypedRef {
         var: TypedVar::Own(t),

@@ -268,14 +268,14 @@ fn fbd_logic_blocks_of_words_are_bitwise() {
     ]}]}});
     let p = plc_deps::load::program_from_json(&doc.to_string()).unwrap();
     let words = p
-        .rungs
+        .rungs()
         .iter()
         .flat_map(|r| r.series.iter())
         .filter(|e| matches!(e, plc_deps::model::Element::Function { .. }))
         .count();
     assert_eq!(words, 4, "the four WORD blocks are functions");
     let m = Machine::new(&p, Layout::dense(&p), &ExecConfig::default()).unwrap();
-    let id = |n: &str| VarId(p.vars.iter().position(|v| v.name == n).unwrap() as u32);
+    let id = |n: &str| VarId::from_raw(p.vars().iter().position(|v| v.name == n).unwrap() as u32);
     let mut st = m.initial_state();
     let mut got = Vec::new();
     for (k, (status, mask, go, stop)) in [

@@ -72,7 +72,7 @@ fn run(p: &Program, scans: &[(bool, i16, i16)]) -> Vec<String> {
 /// [`run`] showing the variables `names`.
 fn run_named(p: &Program, names: &[&str], scans: &[(bool, i16, i16)]) -> Vec<String> {
     let m = Machine::new(p, Layout::dense(p), &ExecConfig::default()).unwrap();
-    let id = |n: &str| VarId(p.vars.iter().position(|v| v.name == n).unwrap() as u32);
+    let id = |n: &str| VarId::from_raw(p.vars().iter().position(|v| v.name == n).unwrap() as u32);
     let mut st = m.initial_state();
     let mut out = Vec::new();
     for (k, &(go, a, b)) in scans.iter().enumerate() {
@@ -146,7 +146,8 @@ fn a_counter_as_a_word_is_its_count() {
     let (abs, _) = plc_deps::load::stl(absolute).unwrap_or_else(|e| panic!("{e:?}"));
     let trace = |p: &Program, names: [&str; 5]| {
         let m = Machine::new(p, Layout::dense(p), &ExecConfig::default()).unwrap();
-        let id = |n: &str| VarId(p.vars.iter().position(|v| v.name == n).unwrap() as u32);
+        let id =
+            |n: &str| VarId::from_raw(p.vars().iter().position(|v| v.name == n).unwrap() as u32);
         let mut st = m.initial_state();
         (0..12u64)
             .map(|k| {

@@ -84,7 +84,7 @@ fn blocks_subroutines_interrupts_and_the_first_scan_bit() {
         "warning[W0104]: interrupt routine INT_0 never runs here: plc-deps run raises no interrupt events (`plc-deps report` lists what it shares with the main program)\n\n"    );
     let text = std::fs::read_to_string(common::cli::root().join("tests/stl/blocks.stl")).unwrap();
     let (p, _) = plc_deps::load::stl(&text).unwrap();
-    let pous: Vec<(&str, PouKind)> = p.pous.iter().map(|u| (u.name.as_str(), u.kind)).collect();
+    let pous: Vec<(&str, PouKind)> = p.pous().iter().map(|u| (u.name.as_str(), u.kind)).collect();
     assert_eq!(
         pous,
         [
@@ -103,7 +103,7 @@ fn blocks_subroutines_interrupts_and_the_first_scan_bit() {
         },
     )
     .unwrap();
-    let id = |n: &str| VarId(p.vars.iter().position(|v| v.name == n).unwrap() as u32);
+    let id = |n: &str| VarId::from_raw(p.vars().iter().position(|v| v.name == n).unwrap() as u32);
     let mut st = m.initial_state();
     let mut seen = Vec::new();
     for (k, i0) in [false, true, true].into_iter().enumerate() {
@@ -140,7 +140,7 @@ fn set_and_reset_of_n_bits_count_on_from_the_address() {
         },
     )
     .unwrap();
-    let id = |n: &str| VarId(p.vars.iter().position(|v| v.name == n).unwrap() as u32);
+    let id = |n: &str| VarId::from_raw(p.vars().iter().position(|v| v.name == n).unwrap() as u32);
     let mut st = m.initial_state();
     let bits = ["M0_6", "M0_7", "M1_0"];
     let mut seen = Vec::new();

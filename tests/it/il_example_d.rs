@@ -51,8 +51,8 @@ fn truth_table(p: &Program, outs: &[&str]) -> Vec<Vec<bool>> {
     )
     .unwrap();
     let id = |n: &str| {
-        VarId(
-            p.vars
+        VarId::from_raw(
+            p.vars()
                 .iter()
                 .position(|v| v.name == n)
                 .unwrap_or_else(|| panic!("{n}")) as u32,
@@ -130,7 +130,7 @@ fn the_verbatim_listing_writes_q0_3_twice_and_the_second_write_wins() {
     )
     .unwrap();
     let (p, _) = plc_deps::load::stl(&text).unwrap();
-    assert!(p.vars.iter().all(|v| v.name != "Q0_1"));
+    assert!(p.vars().iter().all(|v| v.name != "Q0_1"));
     let outs = ["Q0_0", "Q0_2", "Q0_3", "Q0_4", "Q1_0", "Q1_1"];
     let want: Vec<Vec<bool>> = expected()
         .into_iter()

@@ -43,7 +43,7 @@ fn states(
         },
     )
     .unwrap();
-    let id = |n: &str| VarId(p.vars.iter().position(|v| v.name == n).unwrap() as u32);
+    let id = |n: &str| VarId::from_raw(p.vars().iter().position(|v| v.name == n).unwrap() as u32);
     let mut st = m.initial_state();
     let mut out = Vec::new();
     for (k, row) in table.iter().enumerate() {
@@ -90,7 +90,7 @@ fn the_stl_of_each_example_is_the_committed_one_and_runs_the_same() {
             })
             .collect();
         let names: Vec<String> = p
-            .vars
+            .vars()
             .iter()
             .filter(|v| !v.hidden)
             .map(|v| v.name.clone())

@@ -73,13 +73,13 @@ fn states(p: &Program, names: &[&str], inputs: &[Vec<bool>]) -> Vec<String> {
         },
     )
     .unwrap();
-    let id = |n: &str| VarId(p.vars.iter().position(|v| v.name == n).unwrap() as u32);
+    let id = |n: &str| VarId::from_raw(p.vars().iter().position(|v| v.name == n).unwrap() as u32);
     let ins: Vec<VarId> = p
-        .vars
+        .vars()
         .iter()
         .enumerate()
         .filter(|(_, v)| v.class == VarClass::Input)
-        .map(|(i, _)| VarId(i as u32))
+        .map(|(i, _)| VarId::from_raw(i as u32))
         .collect();
     let mut st = m.initial_state();
     inputs

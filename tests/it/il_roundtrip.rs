@@ -91,8 +91,8 @@ fn states(p: &Program, names: &[String], inputs: &[Vec<(String, Value)>]) -> Vec
     };
     let m = Machine::new(p, Layout::dense(p), &exec).unwrap();
     let id = |n: &str| {
-        VarId(
-            p.vars
+        VarId::from_raw(
+            p.vars()
                 .iter()
                 .position(|v| v.name == n)
                 .unwrap_or_else(|| panic!("no {n}")) as u32,
@@ -150,7 +150,7 @@ fn round_trip(seed: u64, input_seed: u64) -> Outcome {
     let (back, _) = plc_deps::load::stl(&stl)
         .unwrap_or_else(|e| panic!("seed {seed}: {}\n{stl}", e.in_file("il.stl")));
     let names: Vec<String> = p
-        .vars
+        .vars()
         .iter()
         .filter(|v| !v.hidden)
         .map(|v| v.name.clone())
@@ -158,7 +158,7 @@ fn round_trip(seed: u64, input_seed: u64) -> Outcome {
     let mut rng = common::Rng::new(input_seed);
     let inputs: Vec<Vec<(String, Value)>> = (0..12)
         .map(|_| {
-            p.vars
+            p.vars()
                 .iter()
                 .filter(|v| v.class == VarClass::Input)
                 .map(|v| {

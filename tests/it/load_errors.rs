@@ -108,7 +108,7 @@ fn every_error_points_at_its_most_precise_node() {
 fn a_byte_order_mark_is_skipped() {
     let text =
         "\u{feff}{\"program\": \"p\", \"rungs\": [{\"id\": \"R1\", \"ld\": [{\"ret\": true}]}]}";
-    assert_eq!(program_from_json(text).expect("loads").rungs.len(), 1);
+    assert_eq!(program_from_json(text).expect("loads").rungs().len(), 1);
 }
 
 #[test]
@@ -191,7 +191,7 @@ fn a_configuration_that_does_not_fit_is_refused_where_it_goes_wrong() {
    {"name": "U", "interval": null, "instances": [{"name": "m", "program": "p"}]}]}]}"#;
     let p = program_from_json(&program(ok)).expect("loads");
     // Tasks in run order: by priority.
-    let c = p.configuration.expect("kept");
+    let c = p.configuration().expect("kept");
     let tasks: Vec<(&str, u32)> = c.resources[0]
         .tasks
         .iter()

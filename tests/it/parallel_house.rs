@@ -21,7 +21,9 @@ fn leads_to(sp: &ScanPlan, d: Decision) -> Option<Next> {
     match d {
         Decision::NotRun => None,
         Decision::Stop => Some(Next::Stop),
-        Decision::Rung(r) | Decision::ForTest(r) => sp.task_of_rung[r.0 as usize].map(Next::Task),
+        Decision::Rung(r) | Decision::ForTest(r) => {
+            sp.task_of_rung[r.raw() as usize].map(Next::Task)
+        }
     }
 }
 
@@ -60,9 +62,11 @@ fn run_item(
         return;
     };
     let exit = match it.inside {
-        ItemRegion::Rungs(lo, hi) => m.resume(mem, ctx, at, |r: RungId| lo <= r.0 && r.0 < hi),
+        ItemRegion::Rungs(lo, hi) => {
+            m.resume(mem, ctx, at, |r: RungId| lo <= r.raw() && r.raw() < hi)
+        }
         ItemRegion::Tasks(lo, hi) => m.resume(mem, ctx, at, |r: RungId| {
-            sp.task_of_rung[r.0 as usize].is_some_and(|t| lo <= t && t <= hi)
+            sp.task_of_rung[r.raw() as usize].is_some_and(|t| lo <= t && t <= hi)
         }),
     };
     if let Some(s) = it.decision {
@@ -124,7 +128,7 @@ fn walk_equals_sequential(p: &Program, sp: &ScanPlan, scans: u64, label: &str) {
         for it in &order {
             let mut ctx = m.context(scan, &mut buf);
             run_item(&m, sp, it, mem, &mut ctx, &mut decisions);
-            got.extend(buf.drain(..).map(|f| (it.first.0, f)));
+            got.extend(buf.drain(..).map(|f| (it.first.raw(), f)));
         }
         got.sort_by_key(|&(t, _)| t);
         let got: Vec<Fault> = got.into_iter().map(|(_, f)| f).collect();
@@ -141,7 +145,7 @@ fn covers_every_task_once(sp: &ScanPlan, tasks: usize, label: &str) {
         for (w, items) in ph.workers.iter().enumerate() {
             assert!(ph.parallel || w == 0 || items.is_empty(), "{label}");
             for it in items {
-                for t in it.first.0..=it.last.0 {
+                for t in it.first.raw()..=it.last.raw() {
                     seen[t as usize] += 1;
                 }
             }

@@ -92,10 +92,14 @@ fn asap<N, E>(g: &DiGraph<N, E>) -> Vec<u32> {
 #[test]
 fn dependence_graph_is_the_analysis_data_dependences() {
     for (name, p, a) in examples() {
-        let g = graphs::dependence_graph(&a);
-        assert_eq!(g.node_count(), p.rungs.len(), "{name}");
-        for r in 0..p.rungs.len() as u32 {
-            assert_eq!(g[graphs::rung_node(RungId(r))], RungId(r), "{name}");
+        let g = graphs::dependence_graph(&p, &a);
+        assert_eq!(g.node_count(), p.rungs().len(), "{name}");
+        for r in 0..p.rungs().len() as u32 {
+            assert_eq!(
+                g[graphs::rung_node(RungId::from_raw(r))],
+                RungId::from_raw(r),
+                "{name}"
+            );
         }
         assert_eq!(
             a.listed,
@@ -140,7 +144,7 @@ fn cfg_graph_is_the_analysis_cfg_edge_for_edge() {
         assert_eq!(g[graphs::cfg_node(a.cfg.stop())], a.cfg.stop(), "{name}");
         assert_eq!(g.edge_count(), a.cfg.edges.len(), "{name}");
         for e in g.edge_references() {
-            let cfg_edge = a.cfg.edge(CfgEdgeId(e.id().index() as u32));
+            let cfg_edge = a.cfg.edge(CfgEdgeId::from_raw(e.id().index() as u32));
             assert_eq!(e.weight(), cfg_edge, "{name}");
             assert_eq!(
                 (e.source(), e.target()),
@@ -184,10 +188,10 @@ fn post_dominator_tree_parents_are_the_ipdoms_and_petgraph_agrees() {
         }
         let theirs = dominators::simple_fast(Reversed(&paper), graphs::cfg_node(stop));
         for v in 0..n as u32 {
-            let node = graphs::cfg_node(CfgNode(v));
+            let node = graphs::cfg_node(CfgNode::from_raw(v));
             let parents: Vec<u32> = tree
                 .neighbors_directed(node, Direction::Incoming)
-                .map(|p| tree[p].0)
+                .map(|p| tree[p].raw())
                 .collect();
             let ipdom = a.post_dominators.immediate(v);
             assert_eq!(
@@ -201,7 +205,7 @@ fn post_dominator_tree_parents_are_the_ipdoms_and_petgraph_agrees() {
                 "{name}: node {v}"
             );
         }
-        assert_eq!(a.post_dominators.immediate(stop.0), None, "{name}");
+        assert_eq!(a.post_dominators.immediate(stop.raw()), None, "{name}");
     }
     // With the endless loop, the virtual exits were checked too.
     assert_eq!(virtual_edges, 1);
@@ -221,14 +225,20 @@ fn control_dependence_graphs_are_the_analysis_control_dependences() {
             .collect();
         let mut edges: Vec<(u32, u32, u32)> = cdg
             .edge_references()
-            .map(|e| (cdg[e.source()].0, cdg[e.target()].0, e.weight().0))
+            .map(|e| {
+                (
+                    cdg[e.source()].raw(),
+                    cdg[e.target()].raw(),
+                    e.weight().raw(),
+                )
+            })
             .collect();
         listed.sort_unstable();
         edges.sort_unstable();
         assert_eq!(edges, listed, "{name}");
 
-        let view = graphs::paper_control_graph(&a);
-        assert_eq!(view.node_count(), p.rungs.len(), "{name}");
+        let view = graphs::paper_control_graph(&p, &a);
+        assert_eq!(view.node_count(), p.rungs().len(), "{name}");
         assert_eq!(view.edge_count(), a.paper_control.len(), "{name}");
         for (e, d) in view.edge_references().zip(&a.paper_control) {
             assert_eq!(
@@ -251,7 +261,7 @@ fn control_dependence_graphs_are_the_analysis_control_dependences() {
         );
         let parts = condensation(no_self, true);
         let part_levels = asap(&parts);
-        let mut levels = vec![0u32; p.rungs.len()];
+        let mut levels = vec![0u32; p.rungs().len()];
         for part in parts.node_indices() {
             for r in &parts[part] {
                 levels[r.index()] = part_levels[part.index()];
@@ -269,7 +279,7 @@ fn schedule_graph_is_the_combined_schedule_with_its_levels() {
         let g = graphs::schedule_graph(&a);
         assert_eq!(g.node_count(), s.tasks.len(), "{name}");
         for (i, t) in s.tasks.iter().enumerate() {
-            let id = TaskId(i as u32);
+            let id = TaskId::from_raw(i as u32);
             assert_eq!(
                 g[graphs::task_node(id)],
                 ScheduledTask {

@@ -15,7 +15,7 @@ fn a_50_mb_ld_file_loads_whole() {
     let (p, _, notes) = plc_deps::load::plcopen(&xml).unwrap();
     let loaded = t.elapsed() - parsed;
     drop(syntax);
-    assert_eq!(p.rungs.len(), rungs);
+    assert_eq!(p.rungs().len(), rungs);
     assert!(rungs > 30_000, "{rungs}");
     assert!(notes.is_empty());
     eprintln!(

@@ -32,7 +32,7 @@ fn instances() -> Vec<Json> {
 }
 
 fn var(p: &Program, name: &str) -> VarId {
-    VarId(p.vars.iter().position(|v| v.name == name).unwrap() as u32)
+    VarId::from_raw(p.vars().iter().position(|v| v.name == name).unwrap() as u32)
 }
 
 /// The interpreter's value of each of `outs` (an instance as its JSON fields) after each scan
@@ -322,7 +322,7 @@ fn each_box_reads_and_writes_its_instance_and_reads_its_operands() {
         (&["C", "E1", "E2", "d", "n"], &["C"]),
     ];
     for (k, (ins, outs)) in expect.iter().enumerate() {
-        let r = RungId(k as u32);
+        let r = RungId::from_raw(k as u32);
         assert_eq!(names(acc.ins(r)), *ins, "IN of R{}", k + 1);
         assert_eq!(names(acc.outs(r)), *outs, "OUT of R{}", k + 1);
     }

@@ -89,11 +89,11 @@ impl Accesses {
 /// Computes IN and OUT for every rung of the program.
 pub fn accesses(p: &Program) -> Accesses {
     // Summaries of called subroutines, callees first (the call graph is acyclic).
-    let mut summary: Vec<(Vec<VarId>, Vec<VarId>)> = vec![(Vec::new(), Vec::new()); p.pous.len()];
+    let mut summary: Vec<(Vec<VarId>, Vec<VarId>)> = vec![(Vec::new(), Vec::new()); p.pous().len()];
     // Per rung, in POU order; rungs are stored in listing order afterwards.
     // Per rung, where its reads and its writes lie in `all_reads` and `all_writes`.
-    let mut read_at: Vec<Range<u32>> = vec![0..0; p.rungs.len()];
-    let mut write_at: Vec<Range<u32>> = vec![0..0; p.rungs.len()];
+    let mut read_at: Vec<Range<u32>> = vec![0..0; p.rungs().len()];
+    let mut write_at: Vec<Range<u32>> = vec![0..0; p.rungs().len()];
     let (mut all_reads, mut all_writes) = (Vec::new(), Vec::new());
     let mut reads = Vec::new();
     let mut writes = Vec::new();
@@ -174,7 +174,7 @@ fn one_rung(
 
 /// POUs ordered so that every callee comes before its callers.
 fn callee_first_order(p: &Program) -> Vec<PouId> {
-    let mut callees: Vec<Vec<PouId>> = vec![Vec::new(); p.pous.len()];
+    let mut callees: Vec<Vec<PouId>> = vec![Vec::new(); p.pous().len()];
     for r in p.rung_ids() {
         walk_elements(&p.rung(r).series, &mut |e| {
             if let Element::Call { pou } = e {
@@ -182,9 +182,9 @@ fn callee_first_order(p: &Program) -> Vec<PouId> {
             }
         });
     }
-    let mut done = vec![false; p.pous.len()];
-    let mut order = Vec::with_capacity(p.pous.len());
-    for root in 0..p.pous.len() {
+    let mut done = vec![false; p.pous().len()];
+    let mut order = Vec::with_capacity(p.pous().len());
+    for root in 0..p.pous().len() {
         if done[root] {
             continue;
         }
@@ -198,7 +198,7 @@ fn callee_first_order(p: &Program) -> Vec<PouId> {
                     stack.push((c.index(), 0));
                 }
             } else {
-                order.push(PouId(pou as u32));
+                order.push(p.pous().id(pou));
                 stack.pop();
             }
         }

@@ -78,7 +78,7 @@ plc_model::index_type!(
 
 impl From<RungId> for CfgNode {
     fn from(r: RungId) -> CfgNode {
-        CfgNode(r.0)
+        CfgNode(r.raw())
     }
 }
 
@@ -118,8 +118,8 @@ impl Cfg {
         self.rungs as usize + 2
     }
     /// The rung a node stands for; `None` for START and STOP.
-    pub fn rung(&self, n: CfgNode) -> Option<RungId> {
-        (n.0 < self.rungs).then_some(RungId(n.0))
+    pub fn rung(&self, p: &Program, n: CfgNode) -> Option<RungId> {
+        p.rungs().get_id(n.index())
     }
     /// The edge with index `e`.
     pub fn edge(&self, e: CfgEdgeId) -> &CfgEdge {
@@ -163,7 +163,7 @@ pub fn transfers(series: &[Element], out: &mut Vec<(Transfer, bool)>) -> bool {
 /// an unconditional jump back to `r` itself or an earlier rung: a loop-back the iteration cap
 /// may refuse, after which the rest of the rung runs ([`transfers_refusing`]).
 pub fn ends_in_loop_back(found: &[(Transfer, bool)], terminated: bool, r: RungId) -> bool {
-    terminated && matches!(found.last(), Some(&(Transfer::Jump(t), true)) if t.0 <= r.0)
+    terminated && matches!(found.last(), Some(&(Transfer::Jump(t), true)) if t.raw() <= r.raw())
 }
 
 /// [`transfers`] of rung `refused`'s series when the iteration cap refuses its backward jumps
@@ -190,7 +190,7 @@ fn walk_series(
     let walk = |series: &[Element], always: bool, out: &mut Vec<(Transfer, bool)>| {
         walk_series(series, always, refused, out)
     };
-    let back = |target: RungId| refused.is_some_and(|r| target.0 <= r.0);
+    let back = |target: RungId| refused.is_some_and(|r| target.raw() <= r.raw());
     for e in series {
         match e {
             Element::Contact { .. }
@@ -265,25 +265,25 @@ fn walk_conditions(series: &[Element], mut always: bool) -> (bool, ()) {
 
 /// Builds the CFG of a program.
 pub fn control_flow_graph(p: &Program) -> Cfg {
-    let n = p.rungs.len() as u32;
+    let n = p.rungs().len() as u32;
     let (start, stop) = (n, n + 1);
     // Callers of each POU.
-    let mut callers: Vec<Vec<u32>> = vec![Vec::new(); p.pous.len()];
+    let mut callers: Vec<Vec<u32>> = vec![Vec::new(); p.pous().len()];
     let mut found = Vec::new();
     for r in p.rung_ids() {
         found.clear();
         transfers(&p.rung(r).series, &mut found);
         for (t, _) in &found {
             if let Transfer::Call(c) = t {
-                if callers[c.index()].last() != Some(&r.0) {
-                    callers[c.index()].push(r.0);
+                if callers[c.index()].last() != Some(&r.raw()) {
+                    callers[c.index()].push(r.raw());
                 }
             }
         }
     }
-    let uncalled: Vec<PouId> = (1..p.pous.len())
+    let uncalled: Vec<PouId> = (1..p.pous().len())
         .filter(|&i| callers[i].is_empty())
-        .map(|i| PouId(i as u32))
+        .map(|i| p.pous().id(i))
         .collect();
     let mut edges = vec![CfgEdge {
         from: CfgNode(start),
@@ -318,30 +318,30 @@ pub fn control_flow_graph(p: &Program) -> Cfg {
     for r in p.rung_ids() {
         let rung = p.rung(r);
         let pou = p.pou(rung.pou);
-        let next = if r.0 + 1 < pou.rungs.end {
-            Some(r.0 + 1)
+        let next = if r.raw() + 1 < pou.rungs.end {
+            Some(r.raw() + 1)
         } else {
             None
         };
         match rung.series.last() {
             Some(Element::For { next: nx, .. }) => {
                 edges.push(CfgEdge {
-                    from: CfgNode(r.0),
-                    to: CfgNode(r.0 + 1),
+                    from: CfgNode(r.raw()),
+                    to: CfgNode(r.raw() + 1),
                     label: Some(Branch::T),
                     kind: EdgeKind::LoopEnter,
                 });
-                if nx.0 + 1 < pou.rungs.end {
+                if nx.raw() + 1 < pou.rungs.end {
                     edges.push(CfgEdge {
-                        from: CfgNode(r.0),
-                        to: CfgNode(nx.0 + 1),
+                        from: CfgNode(r.raw()),
+                        to: CfgNode(nx.raw() + 1),
                         label: Some(Branch::F),
                         kind: EdgeKind::LoopExit,
                     });
                 } else {
                     exit(
                         &mut edges,
-                        r.0,
+                        r.raw(),
                         rung.pou,
                         Some(Branch::F),
                         EdgeKind::LoopExit,
@@ -351,8 +351,8 @@ pub fn control_flow_graph(p: &Program) -> Cfg {
             }
             Some(Element::Next { head }) => {
                 edges.push(CfgEdge {
-                    from: CfgNode(r.0),
-                    to: CfgNode(head.0),
+                    from: CfgNode(r.raw()),
+                    to: CfgNode(head.raw()),
                     label: None,
                     kind: EdgeKind::LoopBack,
                 });
@@ -381,23 +381,23 @@ pub fn control_flow_graph(p: &Program) -> Cfg {
         for &(t, always) in &found {
             match t {
                 Transfer::Jump(target) => edges.push(CfgEdge {
-                    from: CfgNode(r.0),
-                    to: CfgNode(target.0),
+                    from: CfgNode(r.raw()),
+                    to: CfgNode(target.raw()),
                     label: label(always),
                     kind: EdgeKind::Jump,
                 }),
                 Transfer::End => edges.push(CfgEdge {
-                    from: CfgNode(r.0),
+                    from: CfgNode(r.raw()),
                     to: CfgNode(stop),
                     label: label(always),
                     kind: EdgeKind::End,
                 }),
-                Transfer::Ret => exit(&mut edges, r.0, rung.pou, label(always), EdgeKind::Ret),
+                Transfer::Ret => exit(&mut edges, r.raw(), rung.pou, label(always), EdgeKind::Ret),
                 Transfer::Call(c) => {
                     let callee = p.pou(c);
                     if !callee.rungs.is_empty() {
                         edges.push(CfgEdge {
-                            from: CfgNode(r.0),
+                            from: CfgNode(r.raw()),
                             to: CfgNode(callee.rungs.start),
                             label: label(always),
                             kind: EdgeKind::Call,
@@ -415,12 +415,12 @@ pub fn control_flow_graph(p: &Program) -> Cfg {
             };
             match next {
                 Some(nx) => edges.push(CfgEdge {
-                    from: CfgNode(r.0),
+                    from: CfgNode(r.raw()),
                     to: CfgNode(nx),
                     label: fl,
                     kind,
                 }),
-                None => exit(&mut edges, r.0, rung.pou, fl, kind),
+                None => exit(&mut edges, r.raw(), rung.pou, fl, kind),
             }
         }
     }

@@ -24,8 +24,8 @@ pub const COST_MAX: u64 = 1 << 40;
 
 pub fn rung_costs(p: &Program) -> Vec<u64> {
     // Callee-first: a POU's total is needed by its callers. POUs have no cycles.
-    let mut total: Vec<Option<u64>> = vec![None; p.pous.len()];
-    let mut cost = vec![0u64; p.rungs.len()];
+    let mut total: Vec<Option<u64>> = vec![None; p.pous().len()];
+    let mut cost = vec![0u64; p.rungs().len()];
     fn pou_total(
         p: &Program,
         pou: PouId,
@@ -61,8 +61,8 @@ pub fn rung_costs(p: &Program) -> Vec<u64> {
         total[pou.index()] = Some(t);
         t
     }
-    for pou in 0..p.pous.len() {
-        pou_total(p, PouId(pou as u32), &mut total, &mut cost);
+    for pou in p.pous().ids() {
+        pou_total(p, pou, &mut total, &mut cost);
     }
     for c in &mut cost {
         *c = (*c).min(COST_MAX);
@@ -116,9 +116,9 @@ pub fn multipliers(p: &Program, pou: PouId) -> Vec<u64> {
     let base = range.start;
     let mut mult = vec![1u64; range.len()];
     for r in range.clone() {
-        if let Some(e @ Element::For { next, .. }) = p.rungs[r as usize].series.last() {
+        if let Some(e @ Element::For { next, .. }) = p.rungs()[r as usize].series.last() {
             let trips = trip_count(e).unwrap_or(1);
-            for b in r + 1..=next.0 {
+            for b in r + 1..=next.raw() {
                 mult[(b - base) as usize] = mult[(b - base) as usize]
                     .saturating_mul(trips)
                     .min(COST_MAX);
@@ -309,7 +309,7 @@ impl TaskDag {
                 let finish = now + costs[t as usize];
                 running.push(Reverse((finish, t, core)));
                 started(Slot {
-                    task: TaskId(t),
+                    task: TaskId::new(t),
                     core,
                     start: now,
                     finish,
@@ -344,7 +344,7 @@ mod tests {
     fn figures_of_a_small_dag() {
         // 0 → 2, 1 → 2, 3 independent; costs 2, 3, 1, 4.
         let costs = [2, 3, 1, 4];
-        let preds = vec![vec![], vec![], vec![TaskId(0), TaskId(1)], vec![]];
+        let preds = vec![vec![], vec![], vec![TaskId::new(0), TaskId::new(1)], vec![]];
         let s = summarise(&costs, &preds, &[0, 0, 1, 0]);
         assert_eq!(s.work, 10);
         assert_eq!(s.span, 4);
@@ -358,9 +358,9 @@ mod tests {
         // The same DAG on 2 cores. Bottom levels 3, 4, 1, 4: tasks 1 and 3 start first (the tie
         // to the earlier task puts 1 on core 0), then 0 where 1 finished, then 2.
         let costs = [2, 3, 1, 4];
-        let preds = vec![vec![], vec![], vec![TaskId(0), TaskId(1)], vec![]];
+        let preds = vec![vec![], vec![], vec![TaskId::new(0), TaskId::new(1)], vec![]];
         let s = list_schedule(&costs, &preds, 2);
-        let slot = |t: u32| *s.iter().find(|x| x.task == TaskId(t)).unwrap();
+        let slot = |t: u32| *s.iter().find(|x| x.task == TaskId::new(t)).unwrap();
         assert_eq!((slot(1).core, slot(1).start), (0, 0));
         assert_eq!((slot(3).core, slot(3).start), (1, 0));
         assert_eq!((slot(0).core, slot(0).start), (0, 3));

@@ -167,24 +167,27 @@ pub fn dependence_counts(reads: &VarSets, writes: &VarSets) -> DependenceCounts 
     let vars = var_count(reads, writes);
     let readers = ByVar::new(reads, vars);
     let writers = ByVar::new(writes, vars);
-    let mut per = vec![(0u64, 0u64, 0u64); vars];
+    // Per variable: its id (once a task writes it: every pair has a writer) and its counts.
+    let mut per: Vec<(Option<VarId>, u64, u64, u64)> = vec![(None, 0, 0, 0); vars];
     for t in 0..reads.len() {
         let tu = t as u32;
         for &x in reads.list(t) {
-            per[x.index()].0 += writers.before(x, tu).len() as u64;
+            per[x.index()].1 += writers.before(x, tu).len() as u64;
         }
         for &x in writes.list(t) {
-            per[x.index()].1 += readers.before(x, tu).len() as u64;
-            per[x.index()].2 += writers.before(x, tu).len() as u64;
+            let e = &mut per[x.index()];
+            e.0 = Some(x);
+            e.2 += readers.before(x, tu).len() as u64;
+            e.3 += writers.before(x, tu).len() as u64;
         }
     }
     let mut c = DependenceCounts::default();
-    for (x, &(f, a, o)) in per.iter().enumerate() {
+    for &(x, f, a, o) in &per {
         c.flow += f;
         c.anti += a;
         c.output += o;
-        if f + a + o > 0 {
-            c.by_var.push((VarId(x as u32), f, a, o));
+        if let (Some(x), true) = (x, f + a + o > 0) {
+            c.by_var.push((x, f, a, o));
         }
     }
     c
@@ -348,7 +351,7 @@ mod tests {
         VarSets::from_lists(
             lists
                 .iter()
-                .map(|l| l.iter().map(|&v| VarId(v)).collect::<Vec<_>>()),
+                .map(|l| l.iter().map(|&v| VarId::from_raw(v)).collect::<Vec<_>>()),
         )
     }
 

@@ -79,7 +79,7 @@
 use super::schedule::TaskId;
 use super::{Analysis, CfgEdge, CfgEdgeId, CfgNode, ControlCause, DepKind};
 use petgraph::graph::{DiGraph, NodeIndex};
-use plc_model::{RungId, VarId};
+use plc_model::{Program, RungId, VarId};
 
 /// What a data dependence edge says: its kind (flow, anti or output) and the variable.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -114,11 +114,10 @@ pub fn task_node(t: TaskId) -> NodeIndex {
 }
 
 /// A graph with one node per rung, weighted by its id.
-fn rung_graph<E>(a: &Analysis, edges: usize) -> DiGraph<RungId, E> {
-    let n = a.cfg.rungs as usize;
-    let mut g = DiGraph::with_capacity(n, edges);
-    for r in 0..a.cfg.rungs {
-        g.add_node(RungId(r));
+fn rung_graph<E>(p: &Program, edges: usize) -> DiGraph<RungId, E> {
+    let mut g = DiGraph::with_capacity(p.rungs().len(), edges);
+    for r in p.rung_ids() {
+        g.add_node(r);
     }
     g
 }
@@ -128,7 +127,7 @@ fn cfg_nodes<E>(a: &Analysis, edges: usize) -> DiGraph<CfgNode, E> {
     let n = a.cfg.node_count();
     let mut g = DiGraph::with_capacity(n, edges);
     for v in 0..n as u32 {
-        g.add_node(CfgNode(v));
+        g.add_node(CfgNode::new(v));
     }
     g
 }
@@ -138,8 +137,8 @@ fn cfg_nodes<E>(a: &Analysis, edges: usize) -> DiGraph<CfgNode, E> {
 /// ones when there were too many to list: see [`Analysis::listed`]; either way their ASAP
 /// levels are [`Analysis::data_levels`]). Every edge goes forward in program order, so the
 /// graph is acyclic.
-pub fn dependence_graph(a: &Analysis) -> DiGraph<RungId, DataEdge> {
-    let mut g = rung_graph(a, a.data.len());
+pub fn dependence_graph(p: &Program, a: &Analysis) -> DiGraph<RungId, DataEdge> {
+    let mut g = rung_graph(p, a.data.len());
     for d in &a.data {
         g.add_edge(
             NodeIndex::new(d.from as usize),
@@ -173,7 +172,11 @@ pub fn post_dominator_tree(a: &Analysis) -> DiGraph<CfgNode, ()> {
     let mut g = cfg_nodes(a, n.saturating_sub(1));
     for v in 0..n as u32 {
         if let Some(parent) = a.post_dominators.immediate(v) {
-            g.add_edge(cfg_node(CfgNode(parent)), cfg_node(CfgNode(v)), ());
+            g.add_edge(
+                cfg_node(CfgNode::new(parent)),
+                cfg_node(CfgNode::new(v)),
+                (),
+            );
         }
     }
     g
@@ -186,9 +189,9 @@ pub fn control_dependence_graph(a: &Analysis) -> DiGraph<CfgNode, CfgEdgeId> {
     let mut g = cfg_nodes(a, a.control.len());
     for d in &a.control {
         g.add_edge(
-            cfg_node(CfgNode(d.controller)),
-            cfg_node(CfgNode(d.dependent)),
-            CfgEdgeId(d.edge),
+            cfg_node(CfgNode::new(d.controller)),
+            cfg_node(CfgNode::new(d.dependent)),
+            CfgEdgeId::new(d.edge),
         );
     }
     g
@@ -198,8 +201,8 @@ pub fn control_dependence_graph(a: &Analysis) -> DiGraph<CfgNode, CfgEdgeId> {
 /// dependences between rungs and the reads of a timer's or counter's fields after its box, each
 /// edge weighted by its cause. Its ASAP levels, with a strongly connected part on one level and
 /// self edges ignored, are [`Analysis::control_levels`].
-pub fn paper_control_graph(a: &Analysis) -> DiGraph<RungId, ControlCause> {
-    let mut g = rung_graph(a, a.paper_control.len());
+pub fn paper_control_graph(p: &Program, a: &Analysis) -> DiGraph<RungId, ControlCause> {
+    let mut g = rung_graph(p, a.paper_control.len());
     for d in &a.paper_control {
         g.add_edge(rung_node(d.from), rung_node(d.to), d.cause);
     }
@@ -217,14 +220,14 @@ pub fn schedule_graph(a: &Analysis) -> DiGraph<ScheduledTask, ()> {
     let mut g = DiGraph::with_capacity(s.tasks.len(), edges);
     for (i, t) in s.tasks.iter().enumerate() {
         g.add_node(ScheduledTask {
-            task: TaskId(i as u32),
+            task: TaskId::new(i as u32),
             head: t.rungs[0],
             level: t.level,
         });
     }
     for (i, preds) in s.preds.iter().enumerate() {
         for &q in preds {
-            g.add_edge(task_node(q), task_node(TaskId(i as u32)), ());
+            g.add_edge(task_node(q), task_node(TaskId::new(i as u32)), ());
         }
     }
     g

@@ -45,18 +45,17 @@ pub struct InterruptSharing {
 /// The sharing of every interrupt routine of `p`, in POU order.
 pub fn interrupt_sharing(p: &Program, acc: &Accesses) -> Vec<InterruptSharing> {
     let interrupts: Vec<_> = p
-        .pous
-        .iter()
-        .enumerate()
+        .pous()
+        .iter_enumerated()
         .filter(|(_, pou)| pou.kind == PouKind::Interrupt)
-        .map(|(i, _)| PouId(i as u32))
+        .map(|(i, _)| i)
         .collect();
     if interrupts.is_empty() {
         return Vec::new();
     }
     // Per variable, the main program's readers and writers.
     let mut main: BTreeMap<VarId, (Vec<RungId>, Vec<RungId>)> = BTreeMap::new();
-    for r in p.pou_rungs(PouId(0)) {
+    for r in p.pou_rungs(p.main_id()) {
         for &v in acc.ins(r) {
             main.entry(v).or_default().0.push(r);
         }
@@ -118,8 +117,12 @@ mod tests {
         let sharing = interrupt_sharing(&p, &accesses(&p));
         assert_eq!(sharing.len(), 1);
         assert_eq!(p.pou(sharing[0].pou).name, "INT0");
-        let id = |name: &str| RungId(p.rungs.iter().position(|r| r.id == name).unwrap() as u32);
-        let var = |name: &str| VarId(p.vars.iter().position(|v| v.name == name).unwrap() as u32);
+        let id = |name: &str| {
+            RungId::from_raw(p.rungs().iter().position(|r| r.id == name).unwrap() as u32)
+        };
+        let var = |name: &str| {
+            VarId::from_raw(p.vars().iter().position(|v| v.name == name).unwrap() as u32)
+        };
         // A is only read by both: not listed. X: the interrupt reads it, R1 and the call in R3
         // (through S) write it. Y: the interrupt writes it, R2 reads it.
         assert_eq!(

@@ -76,7 +76,7 @@ pub enum Warning {
 /// Per input variable the program writes ([`Program::written_inputs`]), the rungs that write
 /// it (listing order).
 fn input_writes(p: &Program, acc: &Accesses) -> Vec<(VarId, Vec<RungId>)> {
-    let written = &p.written_inputs;
+    let written = &p.written_inputs();
     let mut by: Vec<(VarId, Vec<RungId>)> = written.iter().map(|&v| (v, Vec::new())).collect();
     if by.is_empty() {
         return by;
@@ -216,7 +216,7 @@ fn listed_dependences(
 /// the accesses and the CFG are known, so they are computed on two threads (rayon).
 pub fn analyse_with(p: &Program, config: &AnalysisConfig) -> Analysis {
     let (acc, cfg) = rayon::join(|| accesses(p), || control_flow_graph(p));
-    let n = p.rungs.len();
+    let n = p.rungs().len();
     let paper = || {
         let ((counts, (data, listed)), data_lv) = rayon::join(
             || {
@@ -231,21 +231,21 @@ pub fn analyse_with(p: &Program, config: &AnalysisConfig) -> Analysis {
         let paper_edges = cfg.paper_edges();
         let pairs: Vec<(u32, u32)> = paper_edges
             .iter()
-            .map(|&e| (cfg.edge(e).from.0, cfg.edge(e).to.0))
+            .map(|&e| (cfg.edge(e).from.raw(), cfg.edge(e).to.raw()))
             .collect();
-        let pdom = post_dominators(cfg.node_count(), &pairs, cfg.stop().0);
+        let pdom = post_dominators(cfg.node_count(), &pairs, cfg.stop().raw());
         let reachable = plc_graph::reachable(
             &plc_graph::Csr::from_edges(cfg.node_count(), &pairs),
-            cfg.start().0,
+            cfg.start().raw(),
         );
         let mut control = control_dependences(&pairs, &pdom, |a| reachable[a as usize]);
         for d in &mut control {
-            d.edge = paper_edges[d.edge as usize].0; // an index into `cfg.edges`
+            d.edge = paper_edges[d.edge as usize].raw(); // an index into `cfg.edges`
         }
         let paper_control = paper_control_view(p, &control);
         let cv_edges: Vec<(u32, u32)> = paper_control
             .iter()
-            .map(|d| (d.from.0, d.to.0))
+            .map(|d| (d.from.raw(), d.to.raw()))
             .filter(|(a, b)| a != b)
             .collect();
         let control_lv = levels::asap_levels(n, &cv_edges);
@@ -264,8 +264,7 @@ pub fn analyse_with(p: &Program, config: &AnalysisConfig) -> Analysis {
         let schedule = combined_schedule(p, &cfg, &acc);
         let base = cost::rung_costs(p);
         let mut rung_costs = base.clone();
-        for pou in 0..p.pous.len() {
-            let pou = PouId(pou as u32);
+        for pou in p.pous().ids() {
             for (r, m) in p.pou_rungs(pou).zip(cost::multipliers(p, pou)) {
                 rung_costs[r.index()] = base[r.index()].saturating_mul(m).min(cost::COST_MAX);
             }
@@ -287,7 +286,7 @@ pub fn analyse_with(p: &Program, config: &AnalysisConfig) -> Analysis {
         let rungs: Vec<RungId> = region
             .iter()
             .filter(|&&v| (v as usize) < n)
-            .map(|&v| RungId(v))
+            .map(|&v| p.rungs().id(v as usize))
             .collect();
         if !rungs.is_empty() {
             warnings.push(Warning::Endless(rungs));
@@ -334,21 +333,21 @@ pub fn analyse_with(p: &Program, config: &AnalysisConfig) -> Analysis {
 /// The paper's control view: FOW dependences between rungs, and reads of a timer or counter
 /// instance's fields after the rung holding its box.
 fn paper_control_view(p: &Program, control: &[ControlDependence]) -> Vec<PaperControl> {
-    let n = p.rungs.len() as u32;
+    let n = p.rungs().len() as u32;
     let mut out: Vec<PaperControl> = control
         .iter()
         .filter(|d| d.controller < n && d.dependent < n)
         .map(|d| PaperControl {
-            from: RungId(d.controller),
-            to: RungId(d.dependent),
+            from: p.rungs().id(d.controller as usize),
+            to: p.rungs().id(d.dependent as usize),
             cause: ControlCause::Branch {
-                edge: CfgEdgeId(d.edge),
+                edge: CfgEdgeId::new(d.edge),
             },
         })
         .collect();
     // Box rungs per instance (a linked list, newest first, in one flat array: most variables are
     // not instances); then each field read pairs with the earlier box rungs.
-    let mut last_box: Vec<Option<u32>> = vec![None; p.vars.len()];
+    let mut last_box: Vec<Option<u32>> = vec![None; p.vars().len()];
     let mut box_nodes: Vec<(RungId, Option<u32>)> = Vec::new();
     let mut field_reads: Vec<VarId> = Vec::new();
     let mut own_boxes: Vec<VarId> = Vec::new();

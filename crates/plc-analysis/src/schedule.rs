@@ -99,12 +99,12 @@ impl Schedule {
 pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
     let main = p.main().rungs.clone();
     let n = cfg.node_count();
-    let (start, stop) = (cfg.start().0, cfg.stop().0);
+    let (start, stop) = (cfg.start().raw(), cfg.stop().raw());
     let live = live_main_cfg(cfg, main.clone());
     let unreachable: Vec<RungId> = main
         .clone()
         .filter(|&r| !live.reach[r as usize])
-        .map(RungId)
+        .map(|r| p.rungs().id(r as usize))
         .collect();
     let g = Csr::from_edges(n, &live.edges);
     let sccs = strongly_connected_components(&g);
@@ -112,7 +112,11 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
     let mut tasks: Vec<Task> = comps
         .iter()
         .map(|&c| Task {
-            rungs: sccs.members(c).iter().map(|&m| RungId(m)).collect(),
+            rungs: sccs
+                .members(c)
+                .iter()
+                .map(|&m| p.rungs().id(m as usize))
+                .collect(),
             is_loop: sccs.is_cyclic(c, &g),
             entries: Vec::new(),
             guard: Vec::new(),
@@ -123,7 +127,7 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
     for (i, &c) in comps.iter().enumerate() {
         task_of_comp[c as usize] = Some(TaskId(i as u32));
     }
-    let mut task_of: Vec<Option<TaskId>> = vec![None; p.rungs.len()];
+    let mut task_of: Vec<Option<TaskId>> = vec![None; p.rungs().len()];
     for r in main.filter(|&r| live.reach[r as usize]) {
         task_of[r as usize] = task_of_comp[sccs.component_of(r) as usize];
     }
@@ -138,9 +142,9 @@ pub fn combined_schedule(p: &Program, cfg: &Cfg, acc: &Accesses) -> Schedule {
             task_of[v as usize].expect("live rung").0
         }
     };
-    let condensed = condense(&live.edges, node, &mut tasks);
+    let condensed = condense(p, &live.edges, node, &mut tasks);
     let endless = guard_tasks(&condensed.edges, &mut tasks);
-    let preds = level_tasks(&mut tasks, &condensed.entry_preds, acc, p.vars.len());
+    let preds = level_tasks(&mut tasks, &condensed.entry_preds, acc, p.vars().len());
     let mut levels: Vec<Vec<TaskId>> = Vec::new();
     for (i, task) in tasks.iter().enumerate() {
         let l = task.level as usize;
@@ -175,17 +179,17 @@ struct LiveCfg {
 /// nodes START reaches. O(nodes + edges).
 fn live_main_cfg(cfg: &Cfg, main: std::ops::Range<u32>) -> LiveCfg {
     let n = cfg.node_count();
-    let (start, stop) = (cfg.start().0, cfg.stop().0);
+    let (start, stop) = (cfg.start().raw(), cfg.stop().raw());
     let in_main = |v: u32| main.contains(&v) || v == start || v == stop;
     let edges: Vec<(u32, u32)> = cfg
         .edges
         .iter()
         .filter(|e| {
             !matches!(e.kind, EdgeKind::Call | EdgeKind::Return)
-                && in_main(e.from.0)
-                && in_main(e.to.0)
+                && in_main(e.from.raw())
+                && in_main(e.to.raw())
         })
-        .map(|e| (e.from.0, e.to.0))
+        .map(|e| (e.from.raw(), e.to.raw()))
         .collect();
     let reach = plc_graph::reachable(&Csr::from_edges(n, &edges), start);
     let edges = edges
@@ -250,7 +254,12 @@ struct Condensed {
 
 /// Condenses the live edges over tasks (`node` maps a CFG node to its task, START to `t` and
 /// STOP to `t + 1` for `t` tasks) and records each task's entries.
-fn condense(live_edges: &[(u32, u32)], node: impl Fn(u32) -> u32, tasks: &mut [Task]) -> Condensed {
+fn condense(
+    p: &Program,
+    live_edges: &[(u32, u32)],
+    node: impl Fn(u32) -> u32,
+    tasks: &mut [Task],
+) -> Condensed {
     let t = tasks.len() as u32;
     let mut edges: Vec<(u32, u32)> = Vec::with_capacity(live_edges.len());
     let mut entry_preds: Vec<Vec<u32>> = vec![Vec::new(); t as usize];
@@ -262,8 +271,9 @@ fn condense(live_edges: &[(u32, u32)], node: impl Fn(u32) -> u32, tasks: &mut [T
         edges.push((ca, cb));
         if cb < t {
             let task = &mut tasks[cb as usize];
-            if !task.entries.contains(&RungId(b)) {
-                task.entries.push(RungId(b));
+            let entry = p.rungs().id(b as usize);
+            if !task.entries.contains(&entry) {
+                task.entries.push(entry);
             }
             if ca < t {
                 entry_preds[cb as usize].push(ca);

@@ -234,6 +234,8 @@ pub enum Invalid {
     FbRecursion { name: String, chain: String },
     #[error("`{name}` is declared, but the FBD body needs it for a hidden variable (names `_<block>_<pin>` and `_run_<network>_<fragment>` are reserved in FBD POUs)")]
     HiddenClash { name: String },
+    #[error("internal error: the resolved program is inconsistent: {what}; please report it with the file")]
+    Inconsistent { what: String },
     #[error("TIME variable `{var}` is accumulated (TSTART/TSTOP) in {first} and in {second}; accumulate it in one POU only")]
     AccumulatedTwice {
         var: String,

@@ -126,6 +126,7 @@ impl Invalid {
             HiddenClash { .. } => "E0413",
             AccumulatedTwice { .. } => "E0414",
             PlcOpen { .. } => "E0501",
+            Inconsistent { .. } => "E0901",
         }
     }
 }

@@ -16,7 +16,7 @@ use super::lower::{Op, Pc};
 use super::store::Addr;
 use super::strings::STR_SLOT;
 use super::Machine;
-use plc_model::{RungId, VarClass, VarId};
+use plc_model::{RungId, VarClass};
 
 /// A span of bytes an instruction reads or writes: (first byte, width).
 pub type Span = (Addr, u32);
@@ -37,10 +37,10 @@ impl Machine {
 
     /// The byte spans of the program's inputs: what a driver writes before every scan.
     pub fn input_spans(&self) -> Vec<Span> {
-        (self.vars.iter().enumerate())
+        (self.vars.iter_enumerated())
             .filter(|(_, v)| v.class == VarClass::Input)
             .map(|(i, v)| {
-                let at = self.layout.start(VarId(i as u32));
+                let at = self.layout.start(i);
                 (at, super::layout::type_size(v.ty))
             })
             .collect()

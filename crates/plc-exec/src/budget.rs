@@ -49,13 +49,13 @@ pub fn tasks(p: &Program) -> Vec<Option<u32>> {
         .iter()
         .filter(|e| {
             !matches!(e.kind, EdgeKind::Call | EdgeKind::Return)
-                && main.contains(&e.from.0)
-                && main.contains(&e.to.0)
+                && main.contains(&e.from.raw())
+                && main.contains(&e.to.raw())
         })
-        .map(|e| (e.from.0, e.to.0))
+        .map(|e| (e.from.raw(), e.to.raw()))
         .collect();
     let sccs = strongly_connected_components(&Csr::from_edges(cfg.node_count(), &edges));
-    (0..p.rungs.len() as u32)
+    (0..p.rungs().len() as u32)
         .map(|r| main.contains(&r).then(|| sccs.component_of(r)))
         .collect()
 }
@@ -67,13 +67,13 @@ pub fn call_charge(p: &Program, pou: PouId) -> u32 {
 
 /// What a taken backward jump of rung `from` to rung `to` (`to <= from`) charges.
 pub fn jump_back_charge(from: RungId, to: RungId) -> u32 {
-    from.0 - to.0 + 1
+    from.raw() - to.raw() + 1
 }
 
 /// What a NEXT at rung `next` back to the test of the FOR at rung `head` charges: the body and
 /// the NEXT rung (the head rung's conditions are not evaluated again).
 pub fn next_charge(head: RungId, next: RungId) -> u32 {
-    next.0 - head.0
+    next.raw() - head.raw()
 }
 
 #[cfg(test)]
@@ -98,7 +98,10 @@ mod tests {
         assert_ne!(t[4], t[3]);
         assert_ne!(t[4], t[0]);
         assert!(t.iter().all(Option::is_some));
-        assert_eq!(next_charge(RungId(1), RungId(3)), 2);
-        assert_eq!(jump_back_charge(RungId(4), RungId(4)), 1);
+        assert_eq!(next_charge(RungId::from_raw(1), RungId::from_raw(3)), 2);
+        assert_eq!(
+            jump_back_charge(RungId::from_raw(4), RungId::from_raw(4)),
+            1
+        );
     }
 }

@@ -18,8 +18,9 @@ fn compare(p: &Program, scans: u64, seed: u64) -> usize {
     };
     let fused = Machine::new(p, Layout::dense(p), &cfg).expect("lowers");
     let plain = Machine::new_unfused(p, Layout::dense(p), &cfg).expect("lowers");
-    let inputs: Vec<VarId> = (0..p.vars.len() as u32)
-        .map(VarId)
+    let inputs: Vec<VarId> = p
+        .vars()
+        .ids()
         .filter(|v| p.var(*v).class == VarClass::Input && p.var(*v).ty == Type::Bool)
         .collect();
     let (mut a, mut b) = (fused.initial_state(), plain.initial_state());

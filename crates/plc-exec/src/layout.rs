@@ -255,7 +255,7 @@ pub struct Layout {
 
 /// Sizes and alignments of the program's variables.
 fn shapes(p: &Program) -> (Vec<u32>, Vec<u32>) {
-    p.vars
+    p.vars()
         .iter()
         .map(|v| (type_size(v.ty), type_align(v.ty)))
         .unzip()
@@ -281,7 +281,7 @@ impl Layout {
     /// alignment), with only the padding alignment needs.
     pub fn dense(p: &Program) -> Layout {
         let (sizes, aligns) = shapes(p);
-        let all: Vec<VarId> = (0..p.vars.len() as u32).map(VarId).collect();
+        let all: Vec<VarId> = p.vars().ids().collect();
         let mut starts = vec![Addr(0); sizes.len()];
         let total = place(&all, &sizes, &aligns, &mut starts, 0);
         Layout {
@@ -349,7 +349,7 @@ impl Layout {
         if !align.is_power_of_two() {
             return Err(LayoutError::BadAlign);
         }
-        let n = p.vars.len();
+        let n = p.vars().len();
         let (sizes, aligns) = shapes(p);
         let mut starts = vec![Addr(0); n];
         let mut placed = vec![false; n];
@@ -357,7 +357,7 @@ impl Layout {
         for g in groups {
             for &v in g {
                 if v.index() >= n || placed[v.index()] {
-                    return Err(LayoutError::BadVar { var: v.0 });
+                    return Err(LayoutError::BadVar { var: v.raw() });
                 }
                 placed[v.index()] = true;
             }
@@ -369,10 +369,7 @@ impl Layout {
                 next.next_multiple_of(align),
             );
         }
-        let rest: Vec<VarId> = (0..n as u32)
-            .map(VarId)
-            .filter(|v| !placed[v.index()])
-            .collect();
+        let rest: Vec<VarId> = p.vars().ids().filter(|v| !placed[v.index()]).collect();
         next = place(
             &rest,
             &sizes,

@@ -162,7 +162,7 @@ pub use store::{load_bits, Addr, Store, Word};
 pub use value::{load_value, store_value, VarValue};
 
 use lower::{ForId, ForLoop, Op, Pc};
-use plc_model::{Program, RungId, Type, Value, VarClass, VarId, VarRef};
+use plc_model::{Arena, Program, RungId, Type, Value, VarClass, VarId, VarRef};
 use run::{everywhere, Flow};
 
 /// Execution parameters.
@@ -302,7 +302,7 @@ pub struct Machine {
     budget_task: Vec<Option<u32>>,
     size: u32,
     main_first: RungId,
-    vars: Vec<VarInfo>,
+    vars: Arena<VarId, VarInfo>,
     inits: Vec<Value>,
     layout: Layout,
     config: ExecConfig,
@@ -341,7 +341,7 @@ impl Machine {
     ) -> Result<Machine, LowerError> {
         let code = lower::lower(program, &layout, fuse)?;
         Ok(Machine {
-            main_first: RungId(program.main().rungs.start),
+            main_first: program.rungs().id(program.main().rungs.start as usize),
             ops: code.ops,
             consts: code.consts,
             fors: code.fors,
@@ -357,14 +357,14 @@ impl Machine {
             budget_task: budget::tasks(program),
             size: code.size,
             vars: program
-                .vars
+                .vars()
                 .iter()
                 .map(|v| VarInfo {
                     ty: v.ty,
                     class: v.class,
                 })
                 .collect(),
-            inits: program.vars.iter().map(|v| v.init).collect(),
+            inits: program.vars().iter().map(|v| v.init).collect(),
             layout,
             config: *config,
         })
@@ -407,8 +407,8 @@ impl Machine {
     /// length and widths, so states of different layouts compare value by value.
     pub fn canonical_values(&self) -> Vec<(Addr, u32)> {
         let mut out: Vec<(Addr, u32)> = Vec::new();
-        for (v, info) in self.vars.iter().enumerate() {
-            let at = self.layout.start(VarId(v as u32));
+        for (v, info) in self.vars.iter_enumerated() {
+            let at = self.layout.start(v);
             out.extend(parts(info.ty).iter().map(|&(o, w)| (at.offset(o), w)));
         }
         out.extend(self.counters.iter().map(|&(_, at)| (at, 8)));
@@ -442,13 +442,9 @@ impl Machine {
     /// The state at load: declared initial values, instances zero, padding zero, constants.
     pub fn initial_state(&self) -> State {
         let mut mem = Mem::zeroed(self.size as usize);
-        for (v, info) in self.vars.iter().enumerate() {
+        for (v, info) in self.vars.iter_enumerated() {
             if !matches!(info.ty, Type::Fb(_)) {
-                store_value(
-                    &mut mem[..],
-                    self.layout.start(VarId(v as u32)),
-                    self.inits[v],
-                );
+                store_value(&mut mem[..], self.layout.start(v), self.inits[v.index()]);
             }
         }
         for &(at, c) in &self.consts {
@@ -483,7 +479,7 @@ impl Machine {
             assert!(
                 value.ty() == ty,
                 "input {} is {ty}, given {value} ({})",
-                var.0,
+                var.raw(),
                 value.ty()
             );
             store_value(mem, self.layout.start(var), value);
@@ -581,7 +577,7 @@ impl Machine {
             Exit::Rung(r) => (self.rung_op[r.index()], r),
             Exit::ForTest(h) => {
                 let Some(f) = self.for_of_head[h.index()] else {
-                    panic!("rung {} is not a FOR head", h.0);
+                    panic!("rung {} is not a FOR head", h.raw());
                 };
                 if !inside(h) {
                     return at;
@@ -611,9 +607,8 @@ impl Machine {
 
     /// The output variables and their values, in declaration order.
     pub fn outputs(&self, state: &State) -> Vec<(VarId, VarValue)> {
-        (0..self.vars.len() as u32)
-            .map(VarId)
-            .filter(|v| self.vars[v.index()].class == VarClass::Output)
+        (self.vars.ids())
+            .filter(|&v| self.vars[v].class == VarClass::Output)
             .map(|v| (v, self.value(state, v)))
             .collect()
     }

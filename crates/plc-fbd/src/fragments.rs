@@ -46,7 +46,7 @@ pub fn fragments(net: &Network, topological: Vec<BlockId>) -> Result<Plan, LoadE
             blocks: Vec::new(),
         }],
     };
-    let mut of: Vec<FragmentId> = vec![FragmentId(0); n];
+    let mut of: Vec<FragmentId> = vec![FragmentId::new(0); n];
     let mut conditional: HashMap<(FragmentId, String), FragmentId> = HashMap::new();
     let mut compound: HashMap<Vec<FragmentId>, FragmentId> = HashMap::new();
     let mut names: HashMap<String, u32> = HashMap::new();
@@ -75,7 +75,7 @@ pub fn fragments(net: &Network, topological: Vec<BlockId>) -> Result<Plan, LoadE
             mc.retain(|&f| !all.iter().any(|&g| g != f && t.is_ancestor(g, f)));
         }
         // The data fragment: the deepest among the dependences (first one on ties).
-        let mut fd = FragmentId(0);
+        let mut fd = FragmentId::new(0);
         let candidates = deps
             .iter()
             .map(|(d, _)| of[d.index()])
@@ -181,7 +181,7 @@ pub fn fragments(net: &Network, topological: Vec<BlockId>) -> Result<Plan, LoadE
     Ok(Plan {
         topological,
         order,
-        fragments: frags,
+        fragments: plc_model::Arena::from(frags),
         fragment_of: of,
         steps,
     })
@@ -217,7 +217,7 @@ impl Tree {
         kind: FragmentKind,
         condition: String,
     ) -> FragmentId {
-        let id = FragmentId(self.frags.len() as u32);
+        let id = FragmentId::new(self.frags.len() as u32);
         let depth = self.depth(parent) + 1;
         self.frags.push(Fragment {
             name,
@@ -338,7 +338,7 @@ fn conditional_name(net: &Network, cond: &Input) -> (String, String) {
 
 fn cond_key(i: &Input) -> String {
     match i {
-        Input::Arc { from, pin } => format!("#{}:{pin}", from.0),
+        Input::Arc { from, pin } => format!("#{}:{pin}", from.raw()),
         Input::Variable(v) => format!("v:{v}"),
         Input::Constant(c) => format!("c:{}", c.text()),
     }
@@ -388,7 +388,7 @@ fn regroup(
     // Per fragment: (item, item, block arc it comes from).
     let mut edges: Vec<Vec<(usize, usize, BlockId, BlockId)>> = vec![Vec::new(); nf];
     for v in 0..n {
-        for u in net.predecessors(BlockId(v as u32)) {
+        for u in net.predecessors(BlockId::new(v as u32)) {
             let (a, b) = (of[u.index()], of[v]);
             let l = t.lca(a, b);
             let iu = if a == l {
@@ -402,7 +402,7 @@ fn regroup(
                 n + t.child_toward(l, b).index()
             };
             if iu != iv {
-                edges[l.index()].push((iu, iv, u, BlockId(v as u32)));
+                edges[l.index()].push((iu, iv, u, BlockId::new(v as u32)));
             }
         }
     }
@@ -447,14 +447,14 @@ fn regroup(
         if let Some(&item) = sorted[f].get(i) {
             top.1 += 1;
             if item < n {
-                steps.push(Step::Block(BlockId(item as u32)));
+                steps.push(Step::Block(BlockId::new(item as u32)));
             } else {
-                steps.push(Step::Enter(FragmentId((item - n) as u32)));
+                steps.push(Step::Enter(FragmentId::new((item - n) as u32)));
                 stack.push((item - n, 0));
             }
         } else {
             if f != 0 {
-                steps.push(Step::Leave(FragmentId(f as u32)));
+                steps.push(Step::Leave(FragmentId::new(f as u32)));
             }
             stack.pop();
         }

@@ -13,7 +13,7 @@ use plc_model::{
 use std::ops::Range;
 
 pub use super::ids::BlockId;
-use plc_model::index_type;
+use plc_model::{index_type, Arena};
 
 index_type!(
     /// A conditional fragment of one network: index into [`Plan::fragments`]; 0 is the root.
@@ -103,7 +103,7 @@ pub struct Network {
     /// Where the network starts in the program's text.
     pub origin: plc_diag::Origin,
     /// Sorted by [`Block::id`].
-    pub blocks: Vec<Block>,
+    pub blocks: Arena<BlockId, Block>,
     /// The blocks the depth-first order starts from first, in this order (Beremiz's statement
     /// order of a PLCopen body); empty: by id.
     pub roots: Vec<BlockId>,
@@ -118,7 +118,7 @@ impl Network {
         self.blocks
             .binary_search_by_key(&id, |b| b.id)
             .ok()
-            .map(|i| BlockId(i as u32))
+            .map(|i| BlockId::new(i as u32))
     }
     /// Every block `b` depends on (data and conditional arcs, control arcs), sorted, no duplicates.
     pub fn predecessors(&self, b: BlockId) -> Vec<BlockId> {
@@ -547,7 +547,7 @@ pub struct Plan {
     /// allow).
     pub order: Vec<BlockId>,
     /// The fragment tree; `fragments[0]` is the root, the others in creation order.
-    pub fragments: Vec<Fragment>,
+    pub fragments: Arena<FragmentId, Fragment>,
     /// Per block: its fragment.
     pub fragment_of: Vec<FragmentId>,
     /// The nesting of the execution order: what the lowering turns into `if` blocks.

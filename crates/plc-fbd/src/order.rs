@@ -26,7 +26,7 @@ pub fn topological_order(net: &Network) -> Result<Vec<BlockId>, Vec<BlockId>> {
     let mut preds = Vec::new();
     offsets.push(0u32);
     for b in 0..n {
-        preds.extend(net.predecessors(BlockId(b as u32)));
+        preds.extend(net.predecessors(BlockId::new(b as u32)));
         offsets.push(preds.len() as u32);
     }
     #[derive(Copy, Clone, PartialEq)]
@@ -39,7 +39,7 @@ pub fn topological_order(net: &Network) -> Result<Vec<BlockId>, Vec<BlockId>> {
     let mut order = Vec::with_capacity(n);
     // (block, next predecessor index)
     let mut stack: Vec<(u32, u32)> = Vec::new();
-    let roots = net.roots.iter().map(|b| b.0).chain(0..n as u32);
+    let roots = net.roots.iter().map(|b| b.raw()).chain(0..n as u32);
     for root in roots {
         if colour[root as usize] != Colour::White {
             continue;
@@ -54,16 +54,16 @@ pub fn topological_order(net: &Network) -> Result<Vec<BlockId>, Vec<BlockId>> {
                 match colour[p.index()] {
                     Colour::White => {
                         colour[p.index()] = Colour::Grey;
-                        stack.push((p.0, offsets[p.index()]));
+                        stack.push((p.raw(), offsets[p.index()]));
                     }
                     Colour::Grey => {
                         // p feeds v; each stack entry is fed by the entry above it.
                         let at = stack
                             .iter()
-                            .position(|&(b, _)| b == p.0)
+                            .position(|&(b, _)| b == p.raw())
                             .expect("grey blocks are on the stack");
                         let mut cycle: Vec<BlockId> = std::iter::once(p)
-                            .chain(stack[at + 1..].iter().rev().map(|&(b, _)| BlockId(b)))
+                            .chain(stack[at + 1..].iter().rev().map(|&(b, _)| BlockId::new(b)))
                             .collect();
                         let min = cycle
                             .iter()
@@ -78,7 +78,7 @@ pub fn topological_order(net: &Network) -> Result<Vec<BlockId>, Vec<BlockId>> {
                 }
             } else {
                 colour[v as usize] = Colour::Black;
-                order.push(BlockId(v));
+                order.push(BlockId::new(v));
                 stack.pop();
             }
         }
@@ -92,7 +92,7 @@ mod tests {
     use crate::model::*;
 
     fn net(edges: &[(u32, u32)], ids: &[u32]) -> Network {
-        let index = |id: u32| BlockId(ids.iter().position(|&x| x == id).unwrap() as u32);
+        let index = |id: u32| BlockId::new(ids.iter().position(|&x| x == id).unwrap() as u32);
         let blocks = ids
             .iter()
             .map(|&id| Block {

@@ -89,8 +89,8 @@ pub fn program_and_fbd_from_json_selected(
         }
     };
     let (mut p, f) = resolve::resolve(text, &syntax).map_err(|e| placed(text, e))?;
-    p.configuration = whole.configuration;
-    p.dialect = whole.dialect;
+    p.set_configuration(whole.configuration().cloned());
+    p.set_dialect(whole.dialect());
     Ok((p, f))
 }
 

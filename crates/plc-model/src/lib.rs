@@ -18,11 +18,13 @@
 //! Element semantics follow IEC 61131-3 (LD, §4.2) and the S7-200 shapes of Zhao & Yan (2012).
 #![forbid(unsafe_code)]
 
+pub mod arena;
 mod dialect;
 mod function;
 mod strings;
 mod tasks;
 mod types;
+pub use arena::{Arena, Idx, Numbering};
 pub use dialect::Dialect;
 pub use function::*;
 pub use strings::*;
@@ -31,23 +33,6 @@ pub use types::*;
 
 use plc_diag::Origin;
 use std::ops::Range;
-
-/// Declares a typed dense index (also used by the FBD, analysis and executor crates for theirs).
-#[macro_export]
-macro_rules! index_type {
-    ($(#[$m:meta])* $name:ident) => {
-        $(#[$m])*
-        #[derive(Copy, Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-        pub struct $name(pub u32);
-        impl $name {
-            /// The index into the owning `Vec`.
-            #[inline]
-            pub fn index(self) -> usize {
-                self.0 as usize
-            }
-        }
-    };
-}
 
 index_type!(
     /// A variable: index into [`Program::vars`].
@@ -62,13 +47,52 @@ index_type!(
     PouId
 );
 
-/// A whole resolved program.
+impl VarId {
+    /// The same variable once the variables before it in its arena grew by `by` (a reader that
+    /// numbers hidden variables while it reads and places them after the declarations at the
+    /// end). [`Program::new`] checks that every variable id it is given names a variable.
+    pub fn shifted(self, by: u32) -> VarId {
+        VarId(self.0 + by)
+    }
+}
+
+impl RungId {
+    /// A POU-relative rung id (the `i`-th rung of a body lowered on its own) made absolute: the
+    /// same rung once the body's rungs start at `start`.
+    pub fn shifted(self, start: u32) -> RungId {
+        RungId(self.0 + start)
+    }
+    /// The `i`-th rung of a body lowered on its own (an FBD body before it is placed in its
+    /// POU): meaningful only once [`shifted`](RungId::shifted) to where the body starts.
+    /// [`Program::new`] checks that every rung id it is given names a rung of its POU.
+    pub fn relative(i: u32) -> RungId {
+        RungId(i)
+    }
+}
+
+/// A whole resolved program. Made only by [`Program::new`], which checks the invariants the
+/// module documentation lists that concern ids and ranges; afterwards only its configuration,
+/// dialect and skipped bodies can change, so nothing downstream can break them.
 #[derive(Clone, Debug)]
 pub struct Program {
+    name: String,
+    vars: Arena<VarId, Var>,
+    pous: Arena<PouId, Pou>,
+    rungs: Arena<RungId, Rung>,
+    configuration: Option<Configuration>,
+    dialect: Dialect,
+    written_inputs: Vec<VarId>,
+}
+
+/// What a [`Program`] is made of, before [`Program::new`] checks it.
+#[derive(Clone, Debug, Default)]
+pub struct ProgramParts {
     pub name: String,
-    pub vars: Vec<Var>,
-    pub pous: Vec<Pou>,
-    pub rungs: Vec<Rung>,
+    pub vars: Arena<VarId, Var>,
+    /// `pous[0]` is the main program; their rung ranges follow one another from 0 and cover
+    /// every rung.
+    pub pous: Arena<PouId, Pou>,
+    pub rungs: Arena<RungId, Rung>,
     /// The PLCopen configuration that runs the program's POUs (tasks and program instances);
     /// `None` for programs without one (JSON, STL, a project without instances).
     pub configuration: Option<Configuration>,
@@ -76,10 +100,10 @@ pub struct Program {
     /// reader's choice by the file's editor, or the command line's `--dialect`.
     pub dialect: Dialect,
     /// The input variables the program itself writes (a coil, set/reset, move or block output
-    /// on an input, which matiec accepts), ascending: the scan copies the input image into them
-    /// before every scan, as the Beremiz/OpenPLC runtime copies its input image into the
-    /// located `%I` variables (docs/scan.md; warning W0208). An instance's inputs, which its
-    /// calls set, are not among them.
+    /// on an input, which matiec accepts): the scan copies the input image into them before
+    /// every scan, as the Beremiz/OpenPLC runtime copies its input image into the located `%I`
+    /// variables (docs/scan.md; warning W0208). An instance's inputs, which its calls set, are
+    /// not among them. Any order; [`Program::new`] sorts them.
     pub written_inputs: Vec<VarId>,
 }
 
@@ -94,6 +118,13 @@ pub struct Pou {
     /// rungs are stand-ins that read and write what the body does, for the analyses, and keep
     /// every value when run. `run` and `c` refuse such a POU unless told to skip it.
     pub skipped: Option<Box<SkippedBody>>,
+}
+
+impl Pou {
+    /// The POU's rung ids, in program order.
+    pub fn rung_ids(&self) -> impl DoubleEndedIterator<Item = RungId> + ExactSizeIterator {
+        self.rungs.clone().map(RungId)
+    }
 }
 
 /// A POU body that no command executes (see [`Pou::skipped`]).
@@ -324,26 +355,128 @@ pub enum ContactKind {
 }
 
 impl Program {
+    /// Checks `parts` and makes the program: POUs (at least the main one) whose rung ranges
+    /// follow one another from 0 and cover every rung; every rung in the POU it names; every
+    /// variable, rung and POU id an element, a variable's scope or the written inputs name held
+    /// by the program; every jump, FOR and NEXT target in its own POU. The resolver establishes
+    /// all of this; a failure here is a defect of the reader or resolver that made `parts`, and
+    /// the message says which rule broke where.
+    pub fn new(parts: ProgramParts) -> Result<Program, InvalidProgram> {
+        let ProgramParts {
+            name,
+            vars,
+            pous,
+            rungs,
+            configuration,
+            dialect,
+            mut written_inputs,
+        } = parts;
+        check_parts(&vars, &pous, &rungs, &written_inputs)?;
+        written_inputs.sort_unstable();
+        written_inputs.dedup();
+        Ok(Program {
+            name,
+            vars,
+            pous,
+            rungs,
+            configuration,
+            dialect,
+            written_inputs,
+        })
+    }
+
+    /// The program's name (the file's, or the PLCopen project's).
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+    /// Every variable, indexed by [`VarId`].
+    pub fn vars(&self) -> &Arena<VarId, Var> {
+        &self.vars
+    }
+    /// Every POU, indexed by [`PouId`]; the first is the main program.
+    pub fn pous(&self) -> &Arena<PouId, Pou> {
+        &self.pous
+    }
+    /// Every rung of every POU, in listing order, indexed by [`RungId`].
+    pub fn rungs(&self) -> &Arena<RungId, Rung> {
+        &self.rungs
+    }
+    /// The PLCopen configuration that runs the program's POUs (tasks and program instances);
+    /// `None` for programs without one (JSON, STL, a project without instances).
+    pub fn configuration(&self) -> Option<&Configuration> {
+        self.configuration.as_ref()
+    }
+    /// Whose rules `run` and `c` follow where toolchains differ (docs/dialects.md).
+    pub fn dialect(&self) -> Dialect {
+        self.dialect
+    }
+    /// The input variables the program itself writes, ascending (see
+    /// [`ProgramParts::written_inputs`]).
+    pub fn written_inputs(&self) -> &[VarId] {
+        &self.written_inputs
+    }
+    /// Replaces the configuration (a reader that reads it after the POUs).
+    pub fn set_configuration(&mut self, configuration: Option<Configuration>) {
+        self.configuration = configuration;
+    }
+    /// Replaces the dialect (the file's editor, or the command line's `--dialect`).
+    pub fn set_dialect(&mut self, dialect: Dialect) {
+        self.dialect = dialect;
+    }
+    /// Marks POU `pou`'s body as not read as logic: its rungs are stand-ins (see [`Pou::skipped`]).
+    pub fn mark_skipped(&mut self, pou: PouId, body: SkippedBody) {
+        self.pous[pou].skipped = Some(Box::new(body));
+    }
+    /// Takes the program apart (for a transformation that makes a new one with
+    /// [`Program::new`]).
+    pub fn into_parts(self) -> ProgramParts {
+        ProgramParts {
+            name: self.name,
+            vars: self.vars,
+            pous: self.pous,
+            rungs: self.rungs,
+            configuration: self.configuration,
+            dialect: self.dialect,
+            written_inputs: self.written_inputs,
+        }
+    }
+
     /// The main program.
     pub fn main(&self) -> &Pou {
         &self.pous[0]
     }
     pub fn var(&self, id: VarId) -> &Var {
-        &self.vars[id.index()]
+        &self.vars[id]
     }
     pub fn rung(&self, id: RungId) -> &Rung {
-        &self.rungs[id.index()]
+        &self.rungs[id]
     }
     pub fn pou(&self, id: PouId) -> &Pou {
-        &self.pous[id.index()]
+        &self.pous[id]
+    }
+    /// The main program's id.
+    pub fn main_id(&self) -> PouId {
+        self.pous.id(0)
     }
     /// All rung ids in listing order.
-    pub fn rung_ids(&self) -> impl ExactSizeIterator<Item = RungId> + '_ {
-        (0..self.rungs.len() as u32).map(RungId)
+    pub fn rung_ids(&self) -> impl DoubleEndedIterator<Item = RungId> + ExactSizeIterator {
+        self.rungs.ids()
     }
     /// The rung ids of one POU, in program order.
-    pub fn pou_rungs(&self, pou: PouId) -> impl ExactSizeIterator<Item = RungId> {
-        self.pous[pou.index()].rungs.clone().map(RungId)
+    pub fn pou_rungs(
+        &self,
+        pou: PouId,
+    ) -> impl DoubleEndedIterator<Item = RungId> + ExactSizeIterator {
+        self.pous[pou].rungs.clone().map(RungId)
+    }
+    /// The first rung of POU `pou`, if it has any.
+    pub fn first_rung(&self, pou: PouId) -> Option<RungId> {
+        let r = &self.pous[pou].rungs;
+        (r.start < r.end).then_some(RungId(r.start))
+    }
+    /// The POU that holds rung `r`.
+    pub fn pou_of(&self, r: RungId) -> PouId {
+        self.rungs[r].pou
     }
     /// Display text of a variable reference (`T1.Q`).
     pub fn var_ref_name(&self, r: VarRef) -> String {
@@ -351,6 +484,180 @@ impl Program {
             None => self.var(r.var).name.clone(),
             Some(f) => format!("{}.{}", self.var(r.var).name, f.name()),
         }
+    }
+}
+
+/// A [`ProgramParts`] that breaks an invariant of [`Program`]: the message says which and where.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct InvalidProgram(pub String);
+
+impl std::fmt::Display for InvalidProgram {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "the resolved program is inconsistent: {}", self.0)
+    }
+}
+
+impl std::error::Error for InvalidProgram {}
+
+fn check_parts(
+    vars: &[Var],
+    pous: &Arena<PouId, Pou>,
+    rungs: &Arena<RungId, Rung>,
+    written_inputs: &[VarId],
+) -> Result<(), InvalidProgram> {
+    let bad = |m: String| Err(InvalidProgram(m));
+    if pous.is_empty() {
+        return bad("no main program".into());
+    }
+    let mut next = 0u32;
+    for (p, pou) in pous.iter_enumerated() {
+        if pou.rungs.start != next || pou.rungs.end < pou.rungs.start {
+            return bad(format!(
+                "POU `{}`'s rungs {:?} do not follow on from {next}",
+                pou.name, pou.rungs
+            ));
+        }
+        next = pou.rungs.end;
+        for r in pou.rungs.clone() {
+            if rungs.get(r as usize).is_some_and(|rung| rung.pou != p) {
+                return bad(format!(
+                    "rung {r} lies in POU `{}` but names another",
+                    pou.name
+                ));
+            }
+        }
+    }
+    if next as usize != rungs.len() {
+        return bad(format!(
+            "the POUs hold {next} rungs, the program {}",
+            rungs.len()
+        ));
+    }
+    let var_ok = |v: VarId| v.index() < vars.len();
+    for v in vars {
+        if v.scope.is_some_and(|s| s.index() >= pous.len()) {
+            return bad(format!(
+                "variable `{}` is scoped to a POU the program does not hold",
+                v.name
+            ));
+        }
+    }
+    if let Some(v) = written_inputs.iter().find(|v| !var_ok(**v)) {
+        return bad(format!("written input {} is not a variable", v.0));
+    }
+    for rung in rungs.iter() {
+        let range = &pous[rung.pou].rungs;
+        let in_pou = |r: RungId| range.contains(&r.0);
+        let mut fault: Option<String> = None;
+        walk_elements(&rung.series, &mut |e| {
+            if fault.is_some() {
+                return;
+            }
+            let mut ok = true;
+            element_vars(e, &mut |v| ok &= var_ok(v));
+            let target_ok = match e {
+                Element::Jmp { target, .. } => in_pou(*target),
+                Element::For { next, .. } => in_pou(*next),
+                Element::Next { head } => in_pou(*head),
+                Element::Call { pou } => pou.index() < pous.len(),
+                _ => true,
+            };
+            if !ok {
+                fault = Some(format!(
+                    "rung `{}` names a variable the program does not hold",
+                    rung.id
+                ));
+            } else if !target_ok {
+                fault = Some(format!(
+                    "rung `{}` transfers control outside its POU's rungs",
+                    rung.id
+                ));
+            }
+        });
+        if let Some(m) = fault {
+            return bad(m);
+        }
+    }
+    Ok(())
+}
+
+/// Calls `f` on every variable element `e` itself names (not those of nested series).
+fn element_vars(e: &Element, f: &mut impl FnMut(VarId)) {
+    let op = |o: &Operand, f: &mut dyn FnMut(VarId)| {
+        if let Some(v) = o.var() {
+            f(v)
+        }
+    };
+    match e {
+        Element::Contact { var, kind } => {
+            f(var.var);
+            if let ContactKind::Rising { memory } | ContactKind::Falling { memory } = kind {
+                f(*memory)
+            }
+        }
+        Element::Compare { a, b, .. } => {
+            op(a, f);
+            op(b, f)
+        }
+        Element::Coil { var, .. } | Element::Set(var) | Element::Reset(var) => f(*var),
+        Element::Timer { instance, pt, .. } => {
+            f(*instance);
+            op(pt, f)
+        }
+        Element::Ctu {
+            instance,
+            pv,
+            reset,
+        } => {
+            f(*instance);
+            op(pv, f);
+            op(reset, f)
+        }
+        Element::Ctd { instance, pv, load } => {
+            f(*instance);
+            op(pv, f);
+            op(load, f)
+        }
+        Element::Bistable {
+            instance, reset, ..
+        } => {
+            f(*instance);
+            op(reset, f)
+        }
+        Element::Trigger { instance, .. } => f(*instance),
+        Element::Ctud { instance, inputs } => {
+            f(*instance);
+            for o in inputs.operands() {
+                op(o, f)
+            }
+        }
+        Element::Move { from, to } => {
+            op(from, f);
+            f(*to)
+        }
+        Element::Arith { a, b, out, .. } => {
+            op(a, f);
+            op(b, f);
+            f(*out)
+        }
+        Element::Function { args, out, .. } => {
+            for a in args.iter() {
+                op(a, f)
+            }
+            f(*out)
+        }
+        Element::For { var, bounds, .. } => {
+            f(*var);
+            op(&bounds.from, f);
+            op(&bounds.to, f)
+        }
+        Element::Or(_)
+        | Element::Branch(_)
+        | Element::Jmp { .. }
+        | Element::Ret
+        | Element::End
+        | Element::Call { .. }
+        | Element::Next { .. } => {}
     }
 }
 

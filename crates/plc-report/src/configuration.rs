@@ -146,7 +146,7 @@ pub fn task_shared_entries<'a>(
     a: &'a Analysis,
 ) -> Option<Vec<TaskSharedEntry<'a>>> {
     let ts = &a.task_sharing;
-    p.configuration.as_ref()?;
+    p.configuration().as_ref()?;
     let runs = |v: &[usize]| v.iter().map(|&i| run_entry(&ts.runs[i])).collect();
     Some(
         ts.shared

@@ -326,7 +326,7 @@ impl SkippedPouEntry<'_> {
 pub const SKIPPED_MEANING: &str = "analysed through stand-in rungs that read and write whole variables (ST: one per top-level statement; IL, SFC: one for the body, through its interface): its dependences are over-approximated at the grain of whole variables, except the writes of function block instances that warning W0501 names, which are not seen; `run` and `c` do not execute it (they refuse it without --allow-skipped)";
 
 fn skipped_of(p: &Program) -> Vec<SkippedPouEntry<'_>> {
-    p.pous
+    p.pous()
         .iter()
         .filter_map(|pou| {
             let s = pou.skipped.as_deref()?;
@@ -393,7 +393,7 @@ pub fn document<'a>(p: &'a Program, a: &'a Analysis) -> Report<'a> {
 /// Builds the report document; `fbd` says which rungs the FBD lowering made.
 pub fn document_with<'a>(p: &'a Program, a: &'a Analysis, fbd: Option<&'a FbdParts>) -> Report<'a> {
     let id = move |r: RungId| rung_id(p, r);
-    let rungs = Lazy::new(p.rungs.len(), move || {
+    let rungs = Lazy::new(p.rungs().len(), move || {
         p.rung_ids().map(move |r| {
             let rung = p.rung(r);
             RungEntry {
@@ -413,14 +413,14 @@ pub fn document_with<'a>(p: &'a Program, a: &'a Analysis, fbd: Option<&'a FbdPar
     let levels = levels_of(p, a);
     let count = |levels: &[u32]| levels.iter().map(|&l| l as usize + 1).max().unwrap_or(0);
     let cycles = Cycles {
-        before: p.rungs.len(),
+        before: p.rungs().len(),
         data: count(&a.data_levels),
         control: count(&a.control_levels),
         combined: a.schedule.levels.len(),
     };
     let (fbd_section, shown_levels) = fbd_of(p, fbd, &levels);
     Report {
-        program: &p.name,
+        program: &p.name(),
         rungs,
         dependences,
         dependences_listed: match a.listed {
@@ -451,8 +451,7 @@ pub fn document_with<'a>(p: &'a Program, a: &'a Analysis, fbd: Option<&'a FbdPar
         networks: networks_of(p, a),
         interrupts: interrupts_of(p, a),
         configuration: p
-            .configuration
-            .as_ref()
+            .configuration()
             .map(super::configuration::configuration_entry),
         programs: a
             .task_sharing
@@ -465,7 +464,7 @@ pub fn document_with<'a>(p: &'a Program, a: &'a Analysis, fbd: Option<&'a FbdPar
         skipped_pous: skipped_of(p),
         shown_levels,
         summary: Summary {
-            rungs: p.rungs.len(),
+            rungs: p.rungs().len(),
             main_rungs: p.main().rungs.len(),
         },
         post_dominator_tree: post_dominator_tree_of(p, a),
@@ -487,8 +486,8 @@ fn var_names<'a>(p: &'a Program, vs: &[VarId]) -> Vec<&'a str> {
 /// CFG edge `e` by its ends' names.
 fn cfg_edge<'a>(p: &'a Program, e: &plc_analysis::CfgEdge) -> CfgEdgeEntry<'a> {
     CfgEdgeEntry {
-        from: super::node_name(p, e.from.0),
-        to: super::node_name(p, e.to.0),
+        from: super::node_name(p, e.from.raw()),
+        to: super::node_name(p, e.to.raw()),
         label: label_name(e.label),
         kind: e.kind.name(),
     }
@@ -503,8 +502,8 @@ fn dependences_of<'a>(p: &'a Program, a: &'a Analysis) -> (Lazy<'a, DependenceEn
     let dependences = Lazy::new(a.data.len() + control_count, move || {
         let data = a.data.iter().map(move |d| DependenceEntry::Data {
             kind: d.kind.name(),
-            from: id(RungId(d.from)),
-            to: id(RungId(d.to)),
+            from: id(p.rungs().id(d.from as usize)),
+            to: id(p.rungs().id(d.to as usize)),
             var: var(d.var),
         });
         let pairs = pairs.clone();
@@ -567,7 +566,7 @@ fn dependence_counts_of<'a>(
 
 /// START and the rungs of `p`: the CFG nodes whose post-dominators are listed.
 fn listed_nodes(p: &Program, a: &Analysis) -> impl Iterator<Item = u32> {
-    std::iter::once(a.cfg.start().0).chain(0..p.rungs.len() as u32)
+    std::iter::once(a.cfg.start().raw()).chain(0..p.rungs().len() as u32)
 }
 
 /// Each listed node's immediate post-dominator, by name.
@@ -583,9 +582,9 @@ fn ipdom_of<'a>(p: &'a Program, a: &'a Analysis) -> Ipdom<'a> {
 /// The post-dominator tree, node by node (START, the rungs, STOP).
 fn post_dominator_tree_of<'a>(p: &'a Program, a: &'a Analysis) -> Lazy<'a, TreeNode<'a>> {
     let node = move |n: u32| super::node_name(p, n);
-    Lazy::new(p.rungs.len() + 2, move || {
+    Lazy::new(p.rungs().len() + 2, move || {
         listed_nodes(p, a)
-            .chain(std::iter::once(a.cfg.stop().0))
+            .chain(std::iter::once(a.cfg.stop().raw()))
             .map(move |n| TreeNode {
                 node: node(n),
                 ipdom: a.post_dominators.immediate(n).map(node),
@@ -704,7 +703,7 @@ fn landing_names<'a>(p: &'a Program, f: &FbdParts) -> std::collections::HashSet<
 fn levels_of<'a>(p: &'a Program, a: &'a Analysis) -> Levels<'a> {
     let id = move |r: RungId| p.rung(r).id.as_str();
     let groups = |levels: &[u32]| -> Vec<Vec<&'a str>> {
-        super::rung_groups(levels)
+        super::rung_groups(p, levels)
             .into_iter()
             .map(|g| g.into_iter().map(id).collect())
             .collect()

@@ -64,17 +64,17 @@ pub enum Selection {
 /// An unknown POU or rung id, or a range whose end comes before its start, is an error message.
 pub fn select_rungs(p: &Program, selection: &Selection) -> Result<Option<HashSet<String>>, String> {
     let position = |id: &str| {
-        p.rungs
+        p.rungs()
             .iter()
             .position(|r| r.id == id)
             .ok_or_else(|| format!("--rungs: no rung `{id}` in the program"))
     };
     let range = match selection {
         Selection::Whole => return Ok(None),
-        Selection::Pou(name) => match p.pous.iter().find(|u| u.name == *name) {
+        Selection::Pou(name) => match p.pous().iter().find(|u| u.name == *name) {
             Some(u) => u.rungs.start as usize..u.rungs.end as usize,
             None => {
-                let names: Vec<&str> = p.pous.iter().map(|u| u.name.as_str()).collect();
+                let names: Vec<&str> = p.pous().iter().map(|u| u.name.as_str()).collect();
                 return Err(format!(
                     "--pou: no POU `{name}` in the program (POUs: {})",
                     names.join(", ")
@@ -91,7 +91,9 @@ pub fn select_rungs(p: &Program, selection: &Selection) -> Result<Option<HashSet
             a..b + 1
         }
     };
-    Ok(Some(p.rungs[range].iter().map(|r| r.id.clone()).collect()))
+    Ok(Some(
+        p.rungs()[range].iter().map(|r| r.id.clone()).collect(),
+    ))
 }
 
 /// One drawn edge: every dependence between two rungs.

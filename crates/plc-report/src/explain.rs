@@ -36,14 +36,14 @@ pub(crate) struct Explainer<'a> {
 
 impl<'a> Explainer<'a> {
     pub(crate) fn new(p: &'a Program, a: &'a Analysis) -> Self {
-        let mut callers: Vec<Vec<RungId>> = vec![Vec::new(); p.pous.len()];
+        let mut callers: Vec<Vec<RungId>> = vec![Vec::new(); p.pous().len()];
         for e in &a.cfg.edges {
             if e.kind == EdgeKind::Call {
-                let pou = p.rungs[e.to.0 as usize].pou;
-                callers[pou.index()].push(RungId(e.from.0));
+                let pou = p.rungs()[e.to.index()].pou;
+                callers[pou.index()].push(p.rungs().id(e.from.index()));
             }
         }
-        let mut instance_read = vec![false; p.rungs.len()];
+        let mut instance_read = vec![false; p.rungs().len()];
         for d in &a.paper_control {
             if matches!(d.cause, ControlCause::Instance { .. }) {
                 instance_read[d.to.index()] = true;

@@ -49,9 +49,9 @@ pub enum View {
 
 /// Name of a CFG node: a rung id, `START` or `STOP`.
 pub(crate) fn node_name(p: &Program, n: u32) -> &str {
-    let rungs = p.rungs.len() as u32;
+    let rungs = p.rungs().len() as u32;
     if n < rungs {
-        &p.rungs[n as usize].id
+        &p.rungs()[n as usize].id
     } else if n == rungs {
         "START"
     } else {
@@ -90,10 +90,10 @@ pub(crate) fn self_controlled(a: &Analysis) -> Vec<RungId> {
 }
 
 /// Level groups (0-based level → rung ids in program order) from per-rung levels.
-pub(crate) fn rung_groups(levels: &[u32]) -> Vec<Vec<RungId>> {
+pub(crate) fn rung_groups(p: &Program, levels: &[u32]) -> Vec<Vec<RungId>> {
     plc_analysis::levels::group_by_level(levels)
         .into_iter()
-        .map(|g| g.into_iter().map(RungId).collect())
+        .map(|g| g.into_iter().map(|r| p.rungs().id(r as usize)).collect())
         .collect()
 }
 
@@ -129,7 +129,9 @@ pub(crate) fn networks(p: &Program, a: &Analysis) -> Vec<Network> {
         let rung = p.rung(r);
         let Some(net) = rung.network() else { continue };
         let same = out.last().is_some_and(|n| {
-            n.pou == rung.pou && n.id == net && n.rungs.last().is_some_and(|l| l.0 + 1 == r.0)
+            n.pou == rung.pou
+                && n.id == net
+                && n.rungs.last().is_some_and(|l| l.raw() + 1 == r.raw())
         });
         if !same {
             out.push(Network {
@@ -261,12 +263,12 @@ pub fn fbd_parts(p: &Program, fbd: &plc_fbd::Fbd) -> Option<FbdParts> {
     if fbd.pous.is_empty() {
         return None;
     }
-    let mut parts = vec![RungPart::Ladder; p.rungs.len()];
+    let mut parts = vec![RungPart::Ladder; p.rungs().len()];
     for pou in &fbd.pous {
         for copy in &pou.copies {
             for (range, blocks) in copy.networks.iter().zip(&copy.blocks) {
                 for r in range.clone() {
-                    parts[r as usize] = if p.rungs[r as usize].series.is_empty() {
+                    parts[r as usize] = if p.rungs()[r as usize].series.is_empty() {
                         RungPart::FragmentEnd
                     } else {
                         RungPart::FragmentGuard

@@ -6,7 +6,7 @@
 
 use plc_analysis::{accesses, Accesses};
 use plc_fbd::*;
-use plc_model::{Program, RungId, VarId};
+use plc_model::{Program, VarId};
 use serde_json::{json, Value as Json};
 use std::fmt::Write;
 
@@ -14,7 +14,7 @@ use std::fmt::Write;
 pub fn render_order_text(p: &Program, fbd: &Fbd) -> String {
     let acc = accesses(p);
     let mut o = String::new();
-    let _ = writeln!(o, "{}: FBD execution order (depth-first topological sort, ties by block id; conditional fragments as in the FBD text-generation paper)", p.name);
+    let _ = writeln!(o, "{}: FBD execution order (depth-first topological sort, ties by block id; conditional fragments as in the FBD text-generation paper)", p.name());
     if fbd.pous.is_empty() {
         let _ = writeln!(o, "\nno FBD bodies (the program is ladder only)");
         return o;
@@ -182,7 +182,11 @@ pub fn render_order_json(p: &Program, fbd: &Fbd) -> String {
 /// position.
 pub fn render_order_dot(p: &Program, fbd: &Fbd) -> String {
     let mut o = String::new();
-    let _ = writeln!(o, "digraph {} {{", quote(&format!("{} FBD order", p.name)));
+    let _ = writeln!(
+        o,
+        "digraph {} {{",
+        quote(&format!("{} FBD order", p.name()))
+    );
     let _ = writeln!(o, "  rankdir=LR;");
     let _ = writeln!(o, "  node [shape=box, fontname=\"Helvetica\"];");
     let _ = writeln!(o, "  edge [fontname=\"Helvetica\", fontsize=10];");
@@ -251,8 +255,8 @@ pub fn render_order_dot(p: &Program, fbd: &Fbd) -> String {
                 }
             }
             let _ = writeln!(o, "  }}");
-            for (bi, blk) in net.blocks.iter().enumerate() {
-                let to = node(BlockId(bi as u32));
+            for (bi, blk) in net.blocks.iter_enumerated() {
+                let to = node(bi);
                 for pin in &blk.inputs {
                     if let Some(Input::Arc { from, pin: out }) = &pin.input {
                         let label = format!(
@@ -328,8 +332,8 @@ fn op_text(b: &Block) -> String {
 fn network_sets(acc: &Accesses, rungs: std::ops::Range<u32>) -> (Vec<VarId>, Vec<VarId>) {
     let (mut ins, mut outs) = (Vec::new(), Vec::new());
     for r in rungs {
-        ins.extend_from_slice(acc.reads.list(RungId(r).index()));
-        outs.extend_from_slice(acc.writes.list(RungId(r).index()));
+        ins.extend_from_slice(acc.reads.list(r as usize));
+        outs.extend_from_slice(acc.writes.list(r as usize));
     }
     ins.sort_unstable();
     ins.dedup();

@@ -19,13 +19,14 @@ use plc_model::{PouKind, Program, ProgramInstance};
 /// Checks `p`'s configuration (if any) and puts its tasks in run order: every error, up to
 /// [`MAX_ERRORS`], or none.
 pub fn check(p: &mut Program) -> Result<()> {
-    let Some(c) = p.configuration.as_mut() else {
+    let Some(mut c) = p.configuration().cloned() else {
         return Ok(());
     };
     for r in &mut c.resources {
         r.tasks.sort_by_key(|t| t.priority);
     }
-    let c = p.configuration.as_ref().expect("checked above");
+    p.set_configuration(Some(c));
+    let c = p.configuration().expect("set above");
     let mut errors = Vec::new();
     let mut name = |n: &str, path: String| {
         if let Err(e) = check_name(n, || path, None) {
@@ -72,14 +73,14 @@ pub fn check(p: &mut Program) -> Result<()> {
 fn instance(p: &Program, i: &ProgramInstance, path: &str) -> Result<()> {
     check_name(&i.name, || format!("{path}.name"), None)?;
     let runs = |kind: PouKind| kind != PouKind::Interrupt;
-    if p.pous
+    if p.pous()
         .iter()
         .any(|pou| pou.name == i.program && runs(pou.kind))
     {
         return Ok(());
     }
     let pous: Vec<&str> = p
-        .pous
+        .pous()
         .iter()
         .filter(|pou| runs(pou.kind))
         .map(|pou| pou.name.as_str())

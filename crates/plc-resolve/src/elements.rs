@@ -251,7 +251,7 @@ impl<'a> Builder<'a> {
             }
             S::Ret => Element::Ret,
             S::End => {
-                if s.pou != PouId(0) {
+                if s.pou.index() != 0 {
                     return Err(err(
                         "end",
                         e.origin,
@@ -303,7 +303,7 @@ impl<'a> Builder<'a> {
                         )
                     })?;
                 Element::Call {
-                    pou: PouId(pou as u32),
+                    pou: self.pous.id(pou),
                 }
             }
             S::For(f) => {
@@ -416,12 +416,9 @@ impl<'a> Builder<'a> {
     pub(super) fn edge_memory(&mut self, s: &Scope) -> VarId {
         self.edge_count += 1;
         if let Some(next) = self.edge_reserved.as_mut() {
-            *next += 1;
-            return VarId(*next - 1);
+            return next.next_id();
         }
-        let id = VarId(self.vars.len() as u32);
-        self.vars.push(edge_var(s.rung_id, self.edge_count));
-        id
+        self.vars.push(edge_var(s.rung_id, self.edge_count))
     }
 }
 

@@ -73,7 +73,7 @@ impl<'a> Builder<'a> {
         let mut uses: Vec<Vec<(usize, String, Origin)>> = Vec::new();
         for f in 0..self.fb_types.len() {
             let (vars_mark, inst_mark) = (self.vars.len(), self.instances.len());
-            let scratch = PouId(self.locals.len() as u32);
+            let scratch = self.locals.next_id();
             self.locals.push(NameTable::default());
             self.local_instances.push(NameTable::default());
             let (path, prefix) = (
@@ -197,7 +197,7 @@ impl<'a> Builder<'a> {
             )
             .at(self.instances[idx].name_origin));
         }
-        let pou = PouId(self.pous.len() as u32);
+        let pou = self.pous.next_id();
         let t = &self.fb_types[f];
         let (path, inputs, outputs, vars, rungs, fbd) =
             (t.path.clone(), t.inputs, t.outputs, t.vars, t.rungs, t.fbd);
@@ -283,7 +283,7 @@ impl Builder<'_> {
                 let ty = *self.fb_index.get(&self.instances[i].fb)?;
                 Some(fbt::Nested {
                     name: v.name.value.to_string(),
-                    ty: fbt::FbTypeId(ty as u32),
+                    ty: self.fb_types.id(ty),
                 })
             })
             .collect();

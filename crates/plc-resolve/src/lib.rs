@@ -72,17 +72,21 @@ pub fn resolve(text: &str, syn: &syntax::Program<'_>) -> Result<(Program, Fbd)> 
 /// an instance's POU), with the line and column of the body in `text`.
 fn mark_skipped(program: &mut Program, fbd: &Fbd, skipped: &[syntax::SkippedBody], text: &str) {
     for s in skipped {
-        for (i, pou) in program.pous.iter_mut().enumerate() {
-            let of_type = |inst: &plc_fbd::FbInstance| inst.pou.index() == i && inst.fb == s.pou;
+        for id in program.pous().ids() {
+            let pou = program.pou(id);
+            let of_type = |inst: &plc_fbd::FbInstance| inst.pou == id && inst.fb == s.pou;
             if pou.skipped.is_none() && (pou.name == s.pou || fbd.instances.iter().any(of_type)) {
-                pou.skipped = Some(Box::new(SkippedBody {
-                    language: s.language.clone(),
-                    position: s.origin.line_column(text),
-                    why: s.why.as_ref().map(|(at, what)| match at.line_column(text) {
-                        Some((l, c)) => format!("{what} at {l}:{c}"),
-                        None => what.clone(),
-                    }),
-                }));
+                program.mark_skipped(
+                    id,
+                    SkippedBody {
+                        language: s.language.clone(),
+                        position: s.origin.line_column(text),
+                        why: s.why.as_ref().map(|(at, what)| match at.line_column(text) {
+                            Some((l, c)) => format!("{what} at {l}:{c}"),
+                            None => what.clone(),
+                        }),
+                    },
+                );
             }
         }
     }
@@ -126,7 +130,7 @@ impl<'a> Builder<'a> {
                     pou: i.pou?,
                     name: i.display.clone(),
                     fb: i.fb.clone(),
-                    ty: plc_fbd::FbTypeId(*b.fb_index.get(&i.fb)? as u32),
+                    ty: b.fb_types.id(*b.fb_index.get(&i.fb)?),
                     inputs: i.inputs.clone(),
                     outputs: i.outputs.clone(),
                 })
@@ -135,8 +139,8 @@ impl<'a> Builder<'a> {
         instances.sort_by_key(|i| i.pou);
         let types = b.fb_type_models(&bodies);
         let mut program = b.build(syn.name.to_string(), syn.origin)?;
-        program.configuration = syn.configuration.clone();
-        program.dialect = syn.dialect;
+        program.set_configuration(syn.configuration.clone());
+        program.set_dialect(syn.dialect);
         for body in &mut bodies {
             for copy in &mut body.copies {
                 let start = program.pou(copy.pou).rungs.start;
@@ -145,7 +149,7 @@ impl<'a> Builder<'a> {
                 }
                 for blocks in &mut copy.blocks {
                     for r in blocks.iter_mut() {
-                        r.0 += start;
+                        *r = r.shifted(start);
                     }
                 }
             }
@@ -241,20 +245,20 @@ struct InstanceDraft {
 struct Builder<'a> {
     /// Problems found so far, in program order (at most [`MAX_ERRORS`]).
     errors: Vec<Diagnostic>,
-    vars: Vec<Var>,
+    vars: Arena<VarId, Var>,
     /// Display names of all variables, built when the first hidden FBD variable is made (its
     /// name must not clash).
     var_names: Option<FastSet<String>>,
     globals: NameTable<VarId>,
     /// Per POU: its local variables.
-    locals: Vec<NameTable<VarId>>,
+    locals: Arena<PouId, NameTable<VarId>>,
     /// Program-wide and per-POU instances of user function blocks (index into `instances`).
     global_instances: NameTable<usize>,
     local_instances: Vec<NameTable<usize>>,
     instances: Vec<InstanceDraft>,
     /// Instances declared but not yet given their POU.
     pending: Vec<usize>,
-    fb_types: Vec<FbType<'a>>,
+    fb_types: Arena<plc_fbd::FbTypeId, FbType<'a>>,
     fb_index: FastMap<String, usize>,
     /// FBD bodies in reading order (function block types first, as they are read first), and
     /// where each starts in the text.
@@ -262,7 +266,7 @@ struct Builder<'a> {
     fbd_origins: Vec<syntax::Origin>,
     /// TIME variables accumulated by TSTART/TSTOP, with the POU that does it.
     accumulated: FastMap<VarId, PouId>,
-    pous: Vec<PouDraft<'a>>,
+    pous: Arena<PouId, PouDraft<'a>>,
     /// Per POU: label → rung.
     labels: Vec<FastMap<String, RungId>>,
     /// Per rung, during element resolution: number of edge contacts so far.
@@ -271,11 +275,11 @@ struct Builder<'a> {
     streamed: Option<stream::Streamed<'a>>,
     /// The variable of the next edge contact, when it was made before the rung was resolved
     /// (a rung resolved after the rungs read after it: [`stream`]).
-    edge_reserved: Option<u32>,
+    edge_reserved: Option<Numbering<VarId>>,
     /// The first parts of the dotted variable names (a structure flattened into its fields,
-    /// `Motor` of `Motor.Speed`) by scope (a POU's index, `u32::MAX` for the program's), so
-    /// that an unknown field of a structure is named as such.
-    structure_roots: FastSet<(u32, String)>,
+    /// `Motor` of `Motor.Speed`) by scope (a POU, `None` for the program's), so that an
+    /// unknown field of a structure is named as such.
+    structure_roots: FastSet<(Option<PouId>, String)>,
     /// The input variables that coils, set/reset, moves and block outputs write
     /// ([`Program::written_inputs`]).
     written_inputs: std::cell::RefCell<Vec<VarId>>,
@@ -366,7 +370,7 @@ impl<'a> Builder<'a> {
                 );
                 continue;
             }
-            let pou = PouId(self.pous.len() as u32);
+            let pou = self.pous.next_id();
             self.locals.push(NameTable::default());
             self.local_instances.push(NameTable::default());
             self.declare_vars(
@@ -449,7 +453,7 @@ impl<'a> Builder<'a> {
         let pou_paths: Vec<String> = self.pous.iter().map(|p| p.path.clone()).collect();
         let mut places: Vec<Option<structure::Place>> = Vec::with_capacity(next_id as usize);
         places.resize_with(rungs.len(), || None);
-        let mut pous = Vec::with_capacity(self.pous.len());
+        let mut pous: Arena<PouId, Pou> = Arena::with_capacity(self.pous.len());
         let mut start = 0u32;
         for (pi, pou) in self.pous.iter().enumerate() {
             let end = start
@@ -465,7 +469,7 @@ impl<'a> Builder<'a> {
             start = end;
         }
         for (pi, pou_heads) in heads.into_iter().enumerate() {
-            let pou = PouId(pi as u32);
+            let pou = pous.id(pi);
             if let Some(lowered) = self.pous[pi].lowered.take() {
                 let offset = pous[pi].rungs.start;
                 for mut r in lowered {
@@ -476,7 +480,7 @@ impl<'a> Builder<'a> {
                 }
             }
             for (rid, syn, id) in pou_heads {
-                let index = (rid.0 - pous[pi].rungs.start) as usize;
+                let index = (rid.raw() - pous[pi].rungs.start) as usize;
                 let partner = loops.partner(rid);
                 let at = (pou_paths[pi].as_str(), index);
                 let series = match self.ladder_series(pou, at, syn, &id, partner) {
@@ -503,18 +507,16 @@ impl<'a> Builder<'a> {
             }
         }
         self.phase_end()?;
-        let mut written_inputs = self.written_inputs.into_inner();
-        written_inputs.sort_unstable();
-        written_inputs.dedup();
-        let program = Program {
+        let program = Program::new(ProgramParts {
             name,
             vars: self.vars,
             pous,
-            rungs,
+            rungs: Arena::from(rungs),
             configuration: None,
             dialect: plc_model::Dialect::default(),
-            written_inputs,
-        };
+            written_inputs: self.written_inputs.into_inner(),
+        })
+        .map_err(|e| LoadError::invalid(None, "", Invalid::Inconsistent { what: e.0 }))?;
         structure::check(&program, &places, loops)?;
         Ok(program)
     }
@@ -563,13 +565,13 @@ impl<'a> Builder<'a> {
             None => String::new(),
         };
         let mut heads: Vec<Vec<RungHead<'a>>> = Vec::new();
-        let mut next_id = 0u32;
+        let mut numbering: Numbering<RungId> = Numbering::new();
         let mut errors = Vec::new();
         for (pi, pou) in self.pous.iter().enumerate() {
             let mut labels = FastMap::default();
             if let (0, Some(s)) = (pi, streamed) {
                 labels = s.labels.clone();
-                next_id += s.rungs.len() as u32;
+                numbering.skip(s.rungs.len());
             }
             let mut pou_heads = Vec::with_capacity(pou.rungs.len());
             if let Some(lowered) = &pou.lowered {
@@ -596,7 +598,7 @@ impl<'a> Builder<'a> {
                         ));
                     }
                     ids.insert(Cow::Owned(r.id.clone()), (pi, None));
-                    next_id += 1;
+                    numbering.skip(1);
                 }
             }
             for (i, r) in pou.rungs.iter().enumerate() {
@@ -648,8 +650,7 @@ impl<'a> Builder<'a> {
                     continue;
                 }
                 ids.insert(key, (pi, Some(i)));
-                let rid = RungId(next_id);
-                next_id += 1;
+                let rid = numbering.next_id();
                 if let Some(l) = &r.label {
                     let lp = format!("{}.label", path());
                     if let Err(e) = check_label(l.as_str(), || lp.clone(), Some(&id)) {
@@ -682,6 +683,6 @@ impl<'a> Builder<'a> {
         for e in errors {
             self.report(e);
         }
-        (heads, next_id)
+        (heads, numbering.count() as u32)
     }
 }

@@ -12,17 +12,16 @@ impl<'a> Builder<'a> {
     /// once per instance.
     pub(super) fn lower_fbd(&mut self) -> Result<()> {
         let mut bodies = std::mem::take(&mut self.fbd_bodies);
-        for pou in 0..self.pous.len() {
-            let Some(i) = self.pous[pou].fbd else {
+        for pid in self.pous.ids() {
+            let Some(i) = self.pous[pid].fbd else {
                 continue;
             };
-            let draft = &self.pous[pou];
+            let draft = &self.pous[pid];
             let names = Names {
                 pou: draft.name.clone(),
                 rung_prefix: draft.prefix.clone(),
                 var_prefix: draft.var_prefix.clone(),
             };
-            let pid = PouId(pou as u32);
             let origin = self.fbd_origins[i];
             let lowered =
                 super::lower::lower(&bodies[i], &mut PouEnv { b: self, pou: pid }, &names, pid)
@@ -36,10 +35,10 @@ impl<'a> Builder<'a> {
                 blocks: lowered
                     .blocks
                     .into_iter()
-                    .map(|bs| bs.into_iter().map(RungId).collect())
+                    .map(|bs| bs.into_iter().map(RungId::relative).collect())
                     .collect(),
             });
-            self.pous[pou].lowered = Some(lowered.rungs);
+            self.pous[pid].lowered = Some(lowered.rungs);
         }
         self.fbd_bodies = bodies;
         Ok(())
@@ -130,13 +129,12 @@ impl Env for PouEnv<'_, '_> {
         if !names.insert(name.clone()) {
             return Err(Invalid::HiddenClash { name });
         }
-        let id = VarId(self.b.vars.len() as u32);
         let scope = if self.pou.index() == 0 {
             None
         } else {
             Some(self.pou)
         };
-        self.b.vars.push(Var {
+        let id = self.b.vars.push(Var {
             name,
             ty,
             class: VarClass::Memory,
@@ -166,7 +164,7 @@ impl Env for PouEnv<'_, '_> {
 pub(super) fn relocate_jumps(series: &mut Series, offset: u32) {
     for e in series {
         match e {
-            Element::Jmp { target, .. } => target.0 += offset,
+            Element::Jmp { target, .. } => *target = target.shifted(offset),
             Element::Or(bs) | Element::Branch(bs) => {
                 bs.iter_mut().for_each(|b| relocate_jumps(b, offset))
             }

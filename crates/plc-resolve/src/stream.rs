@@ -29,7 +29,7 @@ use plc_syntax as syntax;
 #[derive(Default)]
 pub(super) struct Streamed<'a> {
     /// In file order; a held rung's series is empty until [`Builder::settle`].
-    pub(super) rungs: Vec<Rung>,
+    pub(super) rungs: Arena<RungId, Rung>,
     pub(super) held: Vec<Held<'a>>,
     /// The rung ids, by their index in `rungs`.
     pub(super) ids: IndexSet,
@@ -46,7 +46,7 @@ pub(super) struct Streamed<'a> {
 pub(super) struct Held<'a> {
     index: usize,
     rung: syntax::Rung<'a>,
-    edges: u32,
+    edges: VarId,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
@@ -97,7 +97,7 @@ impl<'t> syntax::RungSink<'t> for Stream<'t> {
         self.b.streamed = Some(Streamed {
             declared: self.b.vars.len(),
             // Sized up front: a million rungs would otherwise be moved twenty times.
-            rungs: Vec::with_capacity(rungs),
+            rungs: Arena::with_capacity(rungs),
             ids: IndexSet::with_capacity(rungs),
             ..Streamed::default()
         });
@@ -187,7 +187,7 @@ impl<'a> Builder<'a> {
         if let Some(l) = &r.label {
             check_label(l.as_str(), String::new, None).ok()?;
             if s.labels
-                .insert(l.value.to_string(), RungId(index as u32))
+                .insert(l.value.to_string(), s.rungs.next_id())
                 .is_some()
             {
                 return None;
@@ -197,13 +197,13 @@ impl<'a> Builder<'a> {
             id,
             label: r.label.as_ref().map(|l| l.value.to_string()),
             comment: r.comment.as_ref().map(|c| c.to_string()),
-            pou: PouId(0),
+            pou: self.pous.id(0),
             series: Vec::new(),
             lowered: None,
             origin: r.origin,
         };
         if refers_ahead(&r.ld) || loop_end(&r.ld).is_some() {
-            let edges = self.vars.len() as u32;
+            let edges = self.vars.next_id();
             for k in 1..=edge_contacts(&r.ld) {
                 self.vars.push(edge_var(&rung.id, k));
             }
@@ -216,7 +216,8 @@ impl<'a> Builder<'a> {
             });
             return Some(());
         }
-        rung.series = (self.ladder_series(PouId(0), ("", index), &r, &rung.id, None)).ok()?;
+        let main = self.pous.id(0);
+        rung.series = (self.ladder_series(main, ("", index), &r, &rung.id, None)).ok()?;
         self.streamed.as_mut()?.rungs.push(rung);
         Some(())
     }
@@ -230,26 +231,27 @@ impl<'a> Builder<'a> {
     ) -> super::Result<Vec<Rung>> {
         loops.pair_pou(s.held.iter().filter_map(|h| {
             let end = loop_end(&h.rung.ld)?;
-            Some((RungId(h.index as u32), end, h.rung.ld.len()))
+            Some((s.rungs.id(h.index), end, h.rung.ld.len()))
         }));
         let offset = (self.vars.len() - s.declared) as u32;
         self.vars.extend(s.edges);
         let mut rungs = s.rungs;
         if offset > 0 {
-            for r in &mut rungs {
+            for r in rungs.iter_mut() {
                 relocate_edges(&mut r.series, offset);
             }
         }
         for h in s.held {
-            self.edge_reserved = Some(h.edges + offset);
+            self.edge_reserved = Some(Numbering::starting_at(h.edges.shifted(offset)));
             let id = std::mem::take(&mut rungs[h.index].id);
-            let partner = loops.partner(RungId(h.index as u32));
-            let series = self.ladder_series(PouId(0), ("", h.index), &h.rung, &id, partner);
+            let partner = loops.partner(rungs.id(h.index));
+            let main = self.pous.id(0);
+            let series = self.ladder_series(main, ("", h.index), &h.rung, &id, partner);
             self.edge_reserved = None;
             rungs[h.index].id = id;
             rungs[h.index].series = series?;
         }
-        Ok(rungs)
+        Ok(rungs.into_vec())
     }
 }
 
@@ -298,7 +300,7 @@ fn relocate_edges(series: &mut [Element], offset: u32) {
             Element::Contact {
                 kind: ContactKind::Rising { memory } | ContactKind::Falling { memory },
                 ..
-            } => memory.0 += offset,
+            } => *memory = memory.shifted(offset),
             Element::Or(bs) | Element::Branch(bs) => {
                 for b in bs {
                     relocate_edges(b, offset);

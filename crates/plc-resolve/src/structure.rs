@@ -149,10 +149,10 @@ fn last_top(rung: &Rung) -> Option<&Element> {
 /// Jumps may leave loop bodies but not enter them.
 fn check_jumps(p: &Program, places: Places, errors: &mut Vec<Located>) {
     // body[r] = innermost FOR head whose body (head+1 ..= next) holds r.
-    let mut body: Vec<Option<RungId>> = vec![None; p.rungs.len()];
+    let mut body: Vec<Option<RungId>> = vec![None; p.rungs().len()];
     for r in p.rung_ids() {
         if let Some(Element::For { next, .. }) = last_top(p.rung(r)) {
-            for b in r.0 + 1..=next.0 {
+            for b in r.raw() + 1..=next.raw() {
                 body[b as usize] = Some(r);
             }
         }
@@ -163,7 +163,7 @@ fn check_jumps(p: &Program, places: Places, errors: &mut Vec<Located>) {
             Some(Element::For { next, .. }) => *next,
             _ => return false,
         };
-        r.0 >= head.0 && r.0 <= next.0
+        r.raw() >= head.raw() && r.raw() <= next.raw()
     };
     for r in p.rung_ids() {
         let mut bad = None;
@@ -174,7 +174,7 @@ fn check_jumps(p: &Program, places: Places, errors: &mut Vec<Located>) {
                     if !encloses(head, r) && bad.is_none() {
                         bad = Some((label.clone(), head));
                     }
-                    h = if head.0 == 0 {
+                    h = if head.raw() == 0 {
                         None
                     } else {
                         body[head.index()]
@@ -203,7 +203,7 @@ fn check_jumps(p: &Program, places: Places, errors: &mut Vec<Located>) {
 
 fn check_recursion(p: &Program, places: Places) -> Result<(), Located> {
     // Callees per POU, with the rung that makes the call.
-    let mut calls: Vec<Vec<(PouId, RungId)>> = vec![Vec::new(); p.pous.len()];
+    let mut calls: Vec<Vec<(PouId, RungId)>> = vec![Vec::new(); p.pous().len()];
     for r in p.rung_ids() {
         let pou = p.rung(r).pou;
         walk_elements(&p.rung(r).series, &mut |e| {
@@ -219,8 +219,8 @@ fn check_recursion(p: &Program, places: Places) -> Result<(), Located> {
         Grey,
         Black,
     }
-    let mut colour = vec![Colour::White; p.pous.len()];
-    for root in 0..p.pous.len() {
+    let mut colour = vec![Colour::White; p.pous().len()];
+    for root in 0..p.pous().len() {
         if colour[root] != Colour::White {
             continue;
         }
@@ -241,7 +241,7 @@ fn check_recursion(p: &Program, places: Places) -> Result<(), Located> {
                             .unwrap_or(0);
                         let mut chain: Vec<&str> = stack[start..]
                             .iter()
-                            .map(|&(q, _)| p.pous[q].name.as_str())
+                            .map(|&(q, _)| p.pous()[q].name.as_str())
                             .collect();
                         chain.push(&p.pou(callee).name);
                         let call = top_level(

@@ -169,7 +169,7 @@ impl<'a> Builder<'a> {
             }
         };
         // A plain name that is the first part of declared dotted names (a structure's fields).
-        let scope_key = scope.as_ref().map_or(u32::MAX, |(p, _)| p.index() as u32);
+        let scope_key = scope.as_ref().map(|(p, _)| *p);
         let structure = !self.structure_roots.is_empty()
             && !name.contains('.')
             && self.structure_roots.contains(&(scope_key, name.to_owned()));
@@ -212,7 +212,7 @@ impl<'a> Builder<'a> {
             self.pending.push(idx);
             return Ok(());
         }
-        let id = VarId(self.vars.len() as u32);
+        let id = self.vars.next_id();
         table.insert(name, id);
         if let Some(root) = root {
             self.structure_roots.insert((scope_key, root.to_owned()));

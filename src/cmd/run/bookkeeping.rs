@@ -28,8 +28,8 @@ pub(super) struct FaultTally {
 impl FaultTally {
     pub(super) fn add(&mut self, f: &Fault) {
         let rows = &mut self.rows;
-        let i = *self.index.entry((f.rung.0, f.kind)).or_insert_with(|| {
-            rows.push((f.rung.0, f.kind, 0, f.scan, f.scan));
+        let i = *self.index.entry((f.rung.raw(), f.kind)).or_insert_with(|| {
+            rows.push((f.rung.raw(), f.kind, 0, f.scan, f.scan));
             rows.len() - 1
         });
         let row = &mut self.rows[i];
@@ -212,7 +212,7 @@ impl ScanDriver for Driver<'_> {
         self.fault_count += faults.len() as u64;
         for f in faults {
             if self.faults.len() < FAULTS_KEPT {
-                self.faults.push((f.scan, f.rung.0, f.kind));
+                self.faults.push((f.scan, f.rung.raw(), f.kind));
             }
             self.tally.add(f);
         }

@@ -5,7 +5,7 @@
 use super::inputs::InputTable;
 use plc_exec::parallel::{ParallelMachine, RunLog};
 use plc_exec::{load_bits, parts, Addr, Fault, FaultKind, Machine};
-use plc_model::{Program, VarId};
+use plc_model::Program;
 use serde_json::{json, Value as Json};
 
 /// Stored values in an order independent of the layout (`Machine::canonical_values`): every
@@ -56,7 +56,7 @@ pub(super) fn digest(mem: &[u8], canon: &[(Addr, u32)], faults: &[Fault]) -> u12
             FaultKind::LoopCap => 2,
             FaultKind::ScanBudget => 3,
         };
-        feed(u64::MAX - i as u64, (f.rung.0 as u64) << 8 | kind);
+        feed(u64::MAX - i as u64, (f.rung.raw() as u64) << 8 | kind);
     }
     ((mix(a ^ mix(b)) as u128) << 64) | mix(b.wrapping_add(mix(a))) as u128
 }
@@ -74,7 +74,7 @@ pub(super) fn first_difference(
 ) -> Json {
     let (cs, cp) = (canonical_slots(seq), canonical_slots(par.machine()));
     let (mut a, mut b) = (seq.initial_state(), par.initial_state());
-    let n_var_slots: usize = p.vars.iter().map(|v| parts(v.ty).len()).sum();
+    let n_var_slots: usize = p.vars().iter().map(|v| parts(v.ty).len()).sum();
     let value = |mem: &[u8], (at, w): (Addr, u32)| load_bits(mem, at, w);
     for scan in 0..=until {
         let (mut fa, mut fb) = (Vec::new(), Vec::new());
@@ -96,7 +96,7 @@ pub(super) fn first_difference(
             if i < n_var_slots {
                 // Which variable holds canonical value i.
                 let mut k = 0;
-                for v in (0..p.vars.len() as u32).map(VarId) {
+                for v in p.vars().ids() {
                     let w = parts(p.var(v).ty).len();
                     if i < k + w {
                         let (va, vb) = (seq.value(&a, v), par.machine().value(&b, v));
@@ -189,7 +189,7 @@ mod tests {
         assert_ne!(base, digest(&state(1, 2, 3 << 16), &canon, &[]));
         let f = Fault {
             scan: 0,
-            rung: plc_model::RungId(0),
+            rung: plc_model::RungId::from_raw(0),
             kind: FaultKind::DivByZero,
         };
         assert_ne!(base, digest(&state(1, 2, 3), &canon, &[f]));

@@ -196,12 +196,12 @@ pub(super) fn prepare(c: &RunConfig, progress: &Progress) -> Result<Prepared, Cl
         load_program_for_run_selecting(&c.input, c.program.as_deref())?
     };
     if let Some(d) = c.dialect {
-        p.dialect = d;
+        p.set_dialect(d);
     }
     let what = Some("run the rest of the project");
     crate::cmd::skipped::refuse_skipped(&p, &c.input, c.allow_skipped, what)?;
     let mut warnings: Vec<RunWarning> = p
-        .pous
+        .pous()
         .iter()
         .filter(|pou| pou.kind == PouKind::Interrupt)
         .map(|pou| RunWarning::InterruptNotRun(pou.name.clone()))
@@ -255,7 +255,7 @@ pub(super) fn prepare(c: &RunConfig, progress: &Progress) -> Result<Prepared, Cl
     let needs_par = c.mode != RunMode::Seq || c.explain;
     let analysis = (needs_par || html).then(|| analyse(&p));
     // The inputs the program writes get their image copied in before every scan (W0208).
-    let inputs = inputs.with_image(&p, &p.written_inputs);
+    let inputs = inputs.with_image(&p, &p.written_inputs());
     let par = if let (true, Some(a)) = (needs_par, &analysis) {
         Some(
             ParallelMachine::new(
@@ -576,10 +576,7 @@ fn report(pr: &Prepared, c: &RunConfig, m: &Machine, pass: Pass, extra: Extra) -
         sequential_fallback,
     } = extra;
     let slots = pass.state.bytes();
-    let visible: Vec<VarId> = (0..p.vars.len() as u32)
-        .map(VarId)
-        .filter(|&v| !p.var(v).hidden)
-        .collect();
+    let visible: Vec<VarId> = p.vars().ids().filter(|&v| !p.var(v).hidden).collect();
     let state: Vec<(String, VarValue)> = visible
         .iter()
         .map(|&v| (p.var(v).name.clone(), m.value_in(slots, v)))
@@ -589,13 +586,13 @@ fn report(pr: &Prepared, c: &RunConfig, m: &Machine, pass: Pass, extra: Extra) -
         .filter(|&&v| p.var(v).class == VarClass::Output)
         .map(|&v| (p.var(v).name.clone(), m.value_in(slots, v)))
         .collect();
-    let rung_id = |r: u32| p.rungs[r as usize].id.clone();
+    let rung_id = |r: u32| p.rungs()[r as usize].id.clone();
     RunReport {
-        program: p.name.clone(),
+        program: p.name().to_owned(),
         skipped: crate::cmd::skipped::skipped_pous(p),
         instances: p.program_runs(),
         configured_instances: p
-            .configuration
+            .configuration()
             .as_ref()
             .map_or(0, |c| configuration_entry(c).instance_count()),
         scans: pr.scans,

@@ -56,18 +56,18 @@ impl InputTable {
 
 /// The input variables by name.
 fn input_var(p: &Program, name: &str) -> Result<VarId, String> {
-    match p.vars.iter().position(|v| v.name == name && !v.hidden) {
-        Some(i) if p.vars[i].class == VarClass::Input => Ok(VarId(i as u32)),
+    match p.vars().iter().position(|v| v.name == name && !v.hidden) {
+        Some(i) if p.vars()[i].class == VarClass::Input => Ok(p.vars().id(i)),
         Some(i) => Err(format!(
             "`{name}` is not an input variable (it is {})",
-            match p.vars[i].class {
+            match p.vars()[i].class {
                 VarClass::Output => "an output",
                 _ => "a memory variable",
             }
         )),
         None => {
             let inputs: Vec<&str> = p
-                .vars
+                .vars()
                 .iter()
                 .filter(|v| v.class == VarClass::Input && !v.hidden)
                 .map(|v| v.name.as_str())
@@ -467,7 +467,7 @@ pub fn parse_inputs_csv(p: &Program, text: &str, file: &str) -> Result<InputTabl
         rows,
         tail: Vec::new(),
     }
-    .with_image(p, &p.written_inputs))
+    .with_image(p, &p.written_inputs()))
 }
 
 /// Parses inputs in JSON: an array with one object per scan (element k is scan k) mapping input
@@ -578,7 +578,7 @@ pub fn parse_inputs_json(p: &Program, text: &str, file: &str) -> Result<InputTab
         rows,
         tail: Vec::new(),
     }
-    .with_image(p, &p.written_inputs))
+    .with_image(p, &p.written_inputs()))
 }
 
 /// The line and column to report for a `serde_json` error at `line`:`column`. serde_json

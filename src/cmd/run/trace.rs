@@ -70,10 +70,7 @@ pub(super) fn trace_columns(
     };
     match vars {
         None => {
-            for v in (0..p.vars.len() as u32)
-                .map(VarId)
-                .filter(|&v| !p.var(v).hidden)
-            {
+            for v in p.vars().ids().filter(|&v| !p.var(v).hidden) {
                 let fields = fields_of(v);
                 if fields.is_empty() {
                     add(v, None);
@@ -92,10 +89,10 @@ pub(super) fn trace_columns(
                     None => (name, None),
                 };
                 let Some(v) = p
-                    .vars
+                    .vars()
                     .iter()
                     .position(|x| x.name == base)
-                    .map(|i| VarId(i as u32))
+                    .map(|i| p.vars().id(i))
                 else {
                     return Err(CliError::Usage(format!(
                         "--trace-vars: unknown variable `{name}`"

@@ -148,9 +148,9 @@ pub(crate) fn run_interpreter(
 /// The `state` object of `plc-deps run --format json`, as one line.
 pub(crate) fn state_line(p: &Program, m: &Machine, st: &plc_deps::exec::State) -> String {
     let mut map = Map::new();
-    for (i, v) in p.vars.iter().enumerate() {
+    for (i, v) in p.vars().iter().enumerate() {
         if !v.hidden {
-            let value = m.value(st, plc_deps::model::VarId(i as u32));
+            let value = m.value(st, plc_deps::model::VarId::from_raw(i as u32));
             map.insert(v.name.clone(), value.to_json());
         }
     }
@@ -169,7 +169,7 @@ fn compare(c: (Vec<String>, Vec<String>), i: (Vec<String>, Vec<String>), tag: &s
 /// A CSV of random values for the program's inputs, `rows` rows (some cells empty).
 pub(crate) fn random_csv(p: &Program, rng: &mut Rng, rows: usize) -> String {
     let ins: Vec<_> = p
-        .vars
+        .vars()
         .iter()
         // A STRING input is not set from an inputs file (neither `run` nor the harness reads
         // one): it keeps its initial value.

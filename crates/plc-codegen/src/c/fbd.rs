@@ -80,7 +80,7 @@ pub(crate) fn pou(b: &mut Body, p: &Program, pou: &FbdPou, copy: &LoweredCopy) {
                 r = copy.networks[k].end;
             }
             None => {
-                b.rung(RungId(r));
+                b.rung(p.rungs().id(r as usize));
                 r += 1;
             }
         }
@@ -90,7 +90,7 @@ pub(crate) fn pou(b: &mut Body, p: &Program, pou: &FbdPou, copy: &LoweredCopy) {
 fn network(b: &mut Body, p: &Program, plan: &Plan, start: u32, blocks: &[RungId]) {
     let mut cursor = start;
     for step in &plan.steps {
-        let r = RungId(cursor);
+        let r = p.rungs().id(cursor as usize);
         cursor += 1;
         match *step {
             Step::Enter(f) => {
@@ -107,13 +107,13 @@ fn network(b: &mut Body, p: &Program, plan: &Plan, start: u32, blocks: &[RungId]
                 let target = blocks[blk.index()];
                 // An EN guard before the block's rung, its landing after it.
                 let gated = r != target;
-                for g in r.0..target.0 {
-                    b.rung(RungId(g));
+                for g in r.raw()..target.raw() {
+                    b.rung(p.rungs().id(g as usize));
                 }
                 b.rung(target);
-                cursor = target.0 + 1;
+                cursor = target.raw() + 1;
                 if gated {
-                    b.rung(RungId(cursor));
+                    b.rung(p.rungs().id(cursor as usize));
                     cursor += 1;
                 }
             }

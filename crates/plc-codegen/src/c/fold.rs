@@ -91,7 +91,7 @@ mod tests {
     use plc_model::{ArithOp, Value};
 
     fn v(i: u32) -> Operand {
-        whole(VarId(i))
+        whole(VarId::from_raw(i))
     }
 
     #[test]
@@ -100,7 +100,7 @@ mod tests {
             op: ArithOp::Add,
             a,
             b,
-            out: VarId(0),
+            out: VarId::from_raw(0),
         };
         let s = [
             step(v(1), v(2)),
@@ -115,7 +115,12 @@ mod tests {
 
     #[test]
     fn limit_is_a_max_then_a_min() {
-        let (d, x, mn, mx) = (VarId(0), v(1), Operand::Const(Value::Int(0)), v(2));
+        let (d, x, mn, mx) = (
+            VarId::from_raw(0),
+            v(1),
+            Operand::Const(Value::Int(0)),
+            v(2),
+        );
         let b = vec![
             vec![Element::Move { from: x, to: d }],
             vec![
@@ -142,7 +147,7 @@ mod tests {
         let mut other = b.clone();
         other[2][1] = Element::Move {
             from: mx,
-            to: VarId(5),
+            to: VarId::from_raw(5),
         };
         assert!(extreme(&other).is_none());
     }

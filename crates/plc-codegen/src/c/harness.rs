@@ -29,7 +29,7 @@ pub(crate) fn program_source(p: &Program, sh: &Shared, extra: &[String], cfg: &C
     );
     // The initial state: declared init values (zero is the default of a static object).
     let inits: Vec<String> = p
-        .vars
+        .vars()
         .iter()
         .enumerate()
         .filter(|(i, v)| !matches!(v.ty, Type::Fb(_)) && !is_zero(v.init) && !sh.local_only[*i])
@@ -46,8 +46,8 @@ pub(crate) fn program_source(p: &Program, sh: &Shared, extra: &[String], cfg: &C
     // The BOOLs, the INTs, the counters and the timers are the struct's first members (the
     // rows' tables hold their offsets): the last of each class where the generator put it.
     for c in super::CLASSES {
-        let last = (0..p.vars.len())
-            .filter(|&i| (c.is)(p.vars[i].ty))
+        let last = (0..p.vars().len())
+            .filter(|&i| (c.is)(p.vars()[i].ty))
             .filter_map(|i| Some((i, sh.at[i]?)))
             .next_back();
         if let Some((i, at)) = last {
@@ -73,7 +73,7 @@ pub(crate) fn program_source(p: &Program, sh: &Shared, extra: &[String], cfg: &C
     restore_inputs(p, sh, &mut s);
     print_state(p, sh, &mut s);
     s.push_str("const char *const _plc_rung_ids[] = {\n");
-    for r in &p.rungs {
+    for r in p.rungs().iter() {
         push(
             &mut s,
             format_args!("    {},\n", c_string(&json_string(&r.id))),
@@ -142,7 +142,7 @@ fn slot_kind(ty: Type) -> &'static str {
 fn slot_table(p: &Program, sh: &Shared, s: &mut String, name: &str, vars: &[usize]) -> usize {
     push(s, format_args!("static const _plc_slot {name}[] = {{\n"));
     for &i in vars {
-        let key = format!("{}:", json_string(&p.vars[i].name));
+        let key = format!("{}:", json_string(&p.vars()[i].name));
         // The offsets the generator computed (asserted below) as numbers: `cc` spent about a
         // quarter of this file's time on the `offsetof`s (1.2 of 4.6 s at 100,000 rungs).
         let at = match sh.at[i] {
@@ -154,7 +154,7 @@ fn slot_table(p: &Program, sh: &Shared, s: &mut String, name: &str, vars: &[usiz
             format_args!(
                 "    {{{}, {at}, {}}},\n",
                 c_string(&key),
-                slot_kind(p.vars[i].ty)
+                slot_kind(p.vars()[i].ty)
             ),
         );
     }
@@ -167,12 +167,12 @@ fn slot_table(p: &Program, sh: &Shared, s: &mut String, name: &str, vars: &[usiz
 
 /// The input names and `_plc_set_input`, through a table of the inputs.
 fn inputs(p: &Program, sh: &Shared, s: &mut String) {
-    let ins: Vec<usize> = (0..p.vars.len())
-        .filter(|&i| p.vars[i].class == VarClass::Input && !p.vars[i].hidden)
+    let ins: Vec<usize> = (0..p.vars().len())
+        .filter(|&i| p.vars()[i].class == VarClass::Input && !p.vars()[i].hidden)
         .collect();
     s.push_str("const char *const _plc_input_names[] = {\n");
     for &i in &ins {
-        push(s, format_args!("    {},\n", c_string(&p.vars[i].name)));
+        push(s, format_args!("    {},\n", c_string(&p.vars()[i].name)));
     }
     s.push_str("    NULL\n};\n\n");
     // What the driver needs to read the inputs CSV as `plc-deps run` does: each input's type
@@ -182,7 +182,7 @@ fn inputs(p: &Program, sh: &Shared, s: &mut String) {
     for &i in &ins {
         push(
             s,
-            format_args!("    {},\n", c_string(&cell_type(p.vars[i].ty))),
+            format_args!("    {},\n", c_string(&cell_type(p.vars()[i].ty))),
         );
     }
     s.push_str("    NULL\n};\n\n");
@@ -191,7 +191,7 @@ fn inputs(p: &Program, sh: &Shared, s: &mut String) {
         ("_plc_memory_names", None),
     ] {
         push(s, format_args!("static const char *const {table}[] = {{\n"));
-        for v in &p.vars {
+        for v in p.vars().iter() {
             let other = v.class != VarClass::Input && v.class != VarClass::Output;
             if !v.hidden && (Some(v.class) == class || (class.is_none() && other)) {
                 push(s, format_args!("    {},\n", c_string(&v.name)));
@@ -219,7 +219,7 @@ fn inputs(p: &Program, sh: &Shared, s: &mut String) {
 /// W0208) before every scan, as `plc-deps run` does (`InputTable::with_image`) and as the
 /// Beremiz/OpenPLC runtime copies its input image into the located `%I` variables.
 fn restore_inputs(p: &Program, sh: &Shared, s: &mut String) {
-    let written = &p.written_inputs;
+    let written = p.written_inputs();
     s.push_str("static void _plc_restore_inputs(_plc_state *self, const _plc_state *image) {\n");
     if written.is_empty() {
         s.push_str("    (void)self; (void)image;\n");
@@ -246,7 +246,9 @@ fn cell_type(ty: Type) -> String {
 
 /// `_plc_print_state`, through a table of the visible variables.
 fn print_state(p: &Program, sh: &Shared, s: &mut String) {
-    let vis: Vec<usize> = (0..p.vars.len()).filter(|&i| !p.vars[i].hidden).collect();
+    let vis: Vec<usize> = (0..p.vars().len())
+        .filter(|&i| !p.vars()[i].hidden)
+        .collect();
     let n = slot_table(p, sh, s, "_plc_state_slots", &vis);
     push(
         s,

@@ -168,9 +168,9 @@ impl<'a> Body<'a> {
     /// Rung `r` as a fault names it (an index into `_plc_rung_ids`).
     fn rung_no(&self, r: RungId) -> String {
         match &self.inst {
-            None => r.0.to_string(),
-            Some(c) if r.0 == c.rung0 => "self->_rung0".to_string(),
-            Some(c) => format!("self->_rung0 + {}", r.0 - c.rung0),
+            None => r.raw().to_string(),
+            Some(c) if r.raw() == c.rung0 => "self->_rung0".to_string(),
+            Some(c) => format!("self->_rung0 + {}", r.raw() - c.rung0),
         }
     }
 
@@ -406,7 +406,7 @@ impl<'a> Body<'a> {
                     self.var(*instance),
                     self.operand(pt),
                     Self::text(&pw),
-                    u8::from(self.sh.p.dialect.timer_compares_after_edge())
+                    u8::from(self.sh.p.dialect().timer_compares_after_edge())
                 );
                 self.boxed(call, last)
             }
@@ -431,7 +431,7 @@ impl<'a> Body<'a> {
                     self.operand(pv),
                     Self::text(&pw),
                     self.operand(reset),
-                    u8::from(self.sh.p.dialect.counters_stop_at_preset())
+                    u8::from(self.sh.p.dialect().counters_stop_at_preset())
                 );
                 self.boxed(call, last)
             }
@@ -469,7 +469,7 @@ impl<'a> Body<'a> {
                     self.operand(&inputs.cd),
                     self.operand(&inputs.reset),
                     self.operand(&inputs.load),
-                    u8::from(self.sh.p.dialect.counters_stop_at_preset())
+                    u8::from(self.sh.p.dialect().counters_stop_at_preset())
                 );
                 self.boxed(call, last)
             }
@@ -500,18 +500,18 @@ impl<'a> Body<'a> {
                     .map(|a| (self.operand(a), self.operand_type(a).unwrap_or(Type::Bool)))
                     .collect();
                 let ty = self.sh.p.var(*out).ty;
-                let unit = self.sh.p.dialect.time_unit_ms();
+                let unit = self.sh.p.dialect().time_unit_ms();
                 let value = super::functions::expr(*func, &args, ty, unit);
                 let stmt = format!("{} = {value};", self.var(*out));
                 self.when(&pw, &stmt);
                 pw
             }
             Element::Jmp { target, .. } => {
-                let goto = format!("goto _L{};", self.label_no(target.0));
+                let goto = format!("goto _L{};", self.label_no(target.raw()));
                 if !matches!(pw, Pw::False) {
-                    self.used_labels.insert(self.label_no(target.0));
+                    self.used_labels.insert(self.label_no(target.raw()));
                 }
-                if target.0 <= rung.0 {
+                if target.raw() <= rung.raw() {
                     let ctr = self.counter(rung);
                     let no = self.rung_no(rung);
                     let charge =
@@ -744,7 +744,7 @@ impl<'a> Body<'a> {
     /// `goto` names it).
     pub(super) fn label(&mut self, r: RungId) {
         if self.sh.labels[r.index()] {
-            let l = format!("_L{}: ;", self.label_no(r.0));
+            let l = format!("_L{}: ;", self.label_no(r.raw()));
             self.line(&l);
         }
     }

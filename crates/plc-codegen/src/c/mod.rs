@@ -115,7 +115,7 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
         let ty = &fbd.types[t].name;
         // A type whose body is not translated (its instances' POUs are skipped) says so.
         let skipped = fbd.instances.iter().find_map(|i| {
-            let pou = p.pous.get(i.pou.index())?;
+            let pou = p.pous().get(i.pou.index())?;
             (i.fb == *ty).then_some(pou.skipped.as_deref()?)
         });
         let note = skipped.map_or(String::new(), |s| {
@@ -133,7 +133,7 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
     }
     let structs = types::structs(p, fbd, &lay, &order, &sh.local_only);
     let stems: Vec<Option<String>> = p
-        .pous
+        .pous()
         .iter()
         .enumerate()
         .map(|(i, pou)| {
@@ -168,7 +168,7 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
         },
     ];
     // The ladder POUs (those with a function of their own, not written from an FBD body).
-    let ladder: Vec<bool> = (0..p.pous.len())
+    let ladder: Vec<bool> = (0..p.pous().len())
         .map(|i| stems[i].is_some() && !copies.contains_key(&i))
         .collect();
     let mut kernels = rows::Kernels::default();
@@ -176,7 +176,7 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
     if cfg.rows {
         sh.rows = order::rows(&sh, &ladder, &mut kernels);
     }
-    let plans: Vec<Option<order::Plan>> = (0..p.pous.len())
+    let plans: Vec<Option<order::Plan>> = (0..p.pous().len())
         .map(|i| ladder[i].then(|| order::plan(p, acc.as_ref(), &sh.rows, &sh.labels, i)))
         .collect();
     let per_file = chunks_per_file(p, &plans, cfg.chunk_rungs);
@@ -185,7 +185,7 @@ pub fn generate(p: &Program, fbd: &Fbd, cfg: &CConfig) -> Vec<CFile> {
         entry: kernels.entry_type(),
         files: Vec::new(),
     };
-    for (i, pou) in p.pous.iter().enumerate() {
+    for (i, pou) in p.pous().iter().enumerate() {
         let Some(stem) = &stems[i] else { continue };
         let f = &sh.pou_fns[i];
         let (sources, decls) = match (copies.get(&i), &plans[i]) {
@@ -277,19 +277,19 @@ fn instance_inits(sh: &Shared, fbd: &Fbd) -> Vec<String> {
 /// Names, labels and loop counters of the whole program.
 fn shared<'a>(p: &'a Program, fbd: &Fbd, lay: &types::Layout) -> Shared<'a> {
     let vars = lay.vars.iter().map(|(path, _)| path.clone()).collect();
-    let mut inst_of_pou = vec![None; p.pous.len()];
+    let mut inst_of_pou = vec![None; p.pous().len()];
     for (k, inst) in fbd.instances.iter().enumerate() {
         inst_of_pou[inst.pou.index()] = Some(k);
     }
     let pou_fns = p
-        .pous
+        .pous()
         .iter()
         .map(|pou| format!("_pou_{}", names::encode_ident(&pou.name)))
         .collect();
-    let mut labels = vec![false; p.rungs.len()];
-    let mut counters = vec![None; p.rungs.len()];
+    let mut labels = vec![false; p.rungs().len()];
+    let mut counters = vec![None; p.rungs().len()];
     let mut next = 0u32;
-    for (i, r) in p.rungs.iter().enumerate() {
+    for (i, r) in p.rungs().iter().enumerate() {
         let mut back = false;
         walk_elements(&r.series, &mut |e| match e {
             Element::Jmp { target, .. } => {
@@ -313,10 +313,10 @@ fn shared<'a>(p: &'a Program, fbd: &Fbd, lay: &types::Layout) -> Shared<'a> {
         inst_fns: vec![String::new(); fbd.instances.len()],
         labels,
         counters,
-        local_only: vec![false; p.vars.len()],
+        local_only: vec![false; p.vars().len()],
         at: Vec::new(),
         budget_task: plc_exec::budget::tasks(p),
-        rows: vec![None; p.rungs.len()],
+        rows: vec![None; p.rungs().len()],
     }
 }
 
@@ -362,12 +362,12 @@ pub(crate) const CLASSES: [Class; 4] = [
 /// alignments, `plc_program.c` the offset of the last member of each class).
 fn member_offsets(p: &Program, lay: &types::Layout, local_only: &[bool]) -> Vec<Option<u32>> {
     let member = |i: usize| lay.vars[i].1.is_none() && !local_only[i];
-    let mut out = vec![None; p.vars.len()];
+    let mut out = vec![None; p.vars().len()];
     let mut next = 0u32;
     for c in CLASSES {
         next = next.next_multiple_of(c.align);
         for (i, at) in out.iter_mut().enumerate() {
-            if member(i) && (c.is)(p.vars[i].ty) {
+            if member(i) && (c.is)(p.vars()[i].ty) {
                 *at = Some(next);
                 next += c.size;
             }
@@ -378,18 +378,17 @@ fn member_offsets(p: &Program, lay: &types::Layout, local_only: &[bool]) -> Vec<
 
 /// The program's hidden variables (the FBD lowering's arcs and run flags) by name.
 fn hidden_vars(p: &Program) -> HashMap<&str, VarId> {
-    p.vars
-        .iter()
-        .enumerate()
+    p.vars()
+        .iter_enumerated()
         .filter(|(_, v)| v.hidden)
-        .map(|(i, v)| (v.name.as_str(), VarId(i as u32)))
+        .map(|(i, v)| (v.name.as_str(), i))
         .collect()
 }
 
 /// The variables every FBD function holds in locals (arcs and run flags of each copy).
 fn local_only(p: &Program, fbd: &Fbd, copies: &HashMap<usize, (usize, String)>) -> Vec<bool> {
     let hidden = hidden_vars(p);
-    let mut out = vec![false; p.vars.len()];
+    let mut out = vec![false; p.vars().len()];
     for (fp, prefix) in copies.values() {
         for (v, _) in fbd::locals(p, &hidden, &fbd.pous[*fp], prefix) {
             out[v.index()] = true;
@@ -434,12 +433,14 @@ fn program_header(p: &Program, sh: &Shared, h: &Header, scan_budget: u64) -> Str
     let mut fields = 0;
     // The BOOLs, INTs, counters and timers first, at the offsets `member_offsets` gives (the rows' tables hold
     // them).
-    let mut known: Vec<usize> = (0..p.vars.len()).filter(|&i| sh.at[i].is_some()).collect();
+    let mut known: Vec<usize> = (0..p.vars().len())
+        .filter(|&i| sh.at[i].is_some())
+        .collect();
     known.sort_by_key(|&i| sh.at[i]);
-    let others = (0..p.vars.len())
+    let others = (0..p.vars().len())
         .filter(|&i| sh.at[i].is_none() && h.lay.vars[i].1.is_none() && !sh.local_only[i]);
     for i in known.into_iter().chain(others) {
-        let v = &p.vars[i];
+        let v = &p.vars()[i];
         let field = sh.vars[i].trim_start_matches("self->");
         let ty = c_type(v.ty);
         fields += 1;

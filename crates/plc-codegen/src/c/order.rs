@@ -34,13 +34,13 @@ pub(crate) struct Plan {
 /// Every rung's row (`None`: statements), for the ladder POUs `ladder` (true per POU).
 pub(crate) fn rows(sh: &Shared, ladder: &[bool], kernels: &mut Kernels) -> Vec<Option<Row>> {
     let p = sh.p;
-    let mut out = vec![None; p.rungs.len()];
-    for (i, pou) in p.pous.iter().enumerate() {
+    let mut out = vec![None; p.rungs().len()];
+    for (i, pou) in p.pous().iter().enumerate() {
         if !ladder[i] {
             continue;
         }
-        for r in pou.rungs.clone() {
-            out[r as usize] = kernels.row(sh, RungId(r));
+        for r in pou.rung_ids() {
+            out[r.index()] = kernels.row(sh, r);
         }
     }
     out
@@ -54,10 +54,10 @@ pub(crate) fn plan(
     labels: &[bool],
     pou: usize,
 ) -> Plan {
-    let range = p.pous[pou].rungs.clone();
-    let mut order: Vec<RungId> = range.clone().map(RungId).collect();
+    let range = p.pous()[pou].rungs.clone();
+    let mut order: Vec<RungId> = p.pous()[pou].rung_ids().collect();
     if let Some(acc) = acc {
-        let mut lev = Leveller::new(p.vars.len());
+        let mut lev = Leveller::new(p.vars().len());
         let (mut floor, mut top) = (0u32, 0u32);
         let mut key = Vec::with_capacity(order.len());
         for &r in &order {
@@ -76,7 +76,7 @@ pub(crate) fn plan(
         idx.sort_by_key(|&i| key[i]);
         order = idx
             .into_iter()
-            .map(|i| RungId(range.start + i as u32))
+            .map(|i| p.rungs().id(range.start as usize + i))
             .collect();
     }
     let mut weight = Vec::with_capacity(order.len());

@@ -169,7 +169,7 @@ fn split(sh: &Shared, threads: usize, all: bool) -> Result<Split, String> {
                             .into(),
                     );
                 }
-                tasks.extend(it.first.0..=it.last.0);
+                tasks.extend(it.first.raw()..=it.last.raw());
             }
             // The rungs of each task stay in it: no RET or END, every jump inside the task.
             for &t in &tasks {
@@ -181,7 +181,7 @@ fn split(sh: &Shared, threads: usize, all: bool) -> Result<Split, String> {
                         Element::Jmp { target, .. } => bad |= !rungs.contains(target),
                         _ => {}
                     });
-                    if bad || !main.contains(&r.0) {
+                    if bad || !main.contains(&r.raw()) {
                         return Err(format!(
                             "rung {} leaves its task (RET, END or a jump out of it)",
                             super::names::comment(&p.rung(*r).id)
@@ -216,8 +216,8 @@ fn split(sh: &Shared, threads: usize, all: bool) -> Result<Split, String> {
 /// The check of the plan against the C's accesses (module doc); the first conflict.
 fn check(p: &Program, sh: &Shared, acc: &plc_analysis::Accesses, s: &Split) -> Result<(), String> {
     let callees = counter_callees(p, sh);
-    let mut writer = vec![(u32::MAX, 0u32); p.vars.len()];
-    let mut caller = vec![(u32::MAX, 0u32); p.pous.len()];
+    let mut writer = vec![(u32::MAX, 0u32); p.vars().len()];
+    let mut caller = vec![(u32::MAX, 0u32); p.pous().len()];
     for (k, ph) in s.phases.iter().enumerate() {
         if !ph.parallel {
             continue;
@@ -275,7 +275,7 @@ fn conflict(p: &Program, v: plc_model::VarId, k: u32) -> String {
 fn counter_callees(p: &Program, sh: &Shared) -> Vec<Vec<PouId>> {
     let calls_of = |r: usize| {
         let mut out = Vec::new();
-        walk_elements(&p.rungs[r].series, &mut |e| {
+        walk_elements(&p.rungs()[r].series, &mut |e| {
             if let Element::Call { pou } = e {
                 out.push(*pou);
             }
@@ -284,7 +284,7 @@ fn counter_callees(p: &Program, sh: &Shared) -> Vec<Vec<PouId>> {
     };
     // Per POU: every POU it reaches (itself included), by a walk of the acyclic call graph.
     let reach = |start: PouId| {
-        let mut seen = vec![false; p.pous.len()];
+        let mut seen = vec![false; p.pous().len()];
         let mut stack = vec![start];
         while let Some(q) = stack.pop() {
             if std::mem::replace(&mut seen[q.index()], true) {
@@ -297,20 +297,19 @@ fn counter_callees(p: &Program, sh: &Shared) -> Vec<Vec<PouId>> {
         seen
     };
     let has_ctr: Vec<bool> = p
-        .pous
+        .pous()
         .iter()
         .map(|pou| pou.rungs.clone().any(|r| sh.counters[r as usize].is_some()))
         .collect();
-    let mut memo: Vec<Option<Vec<PouId>>> = vec![None; p.pous.len()];
-    (0..p.rungs.len())
+    let mut memo: Vec<Option<Vec<PouId>>> = vec![None; p.pous().len()];
+    (0..p.rungs().len())
         .map(|r| {
             let mut out = Vec::new();
             for q in calls_of(r) {
                 let list = memo[q.index()].get_or_insert_with(|| {
                     let seen = reach(q);
-                    (0..p.pous.len())
-                        .filter(|&i| seen[i] && has_ctr[i])
-                        .map(|i| PouId(i as u32))
+                    (p.pous().ids())
+                        .filter(|&i| seen[i.index()] && has_ctr[i.index()])
                         .collect()
                 });
                 out.extend(list.iter().copied());
@@ -460,7 +459,7 @@ fn task_of_rung(p: &Program, plan: &ScanPlan) -> String {
             .flatten()
             .filter(|_| main.contains(&r));
         match t {
-            Some(t) => push(&mut line, format_args!(" {},", t.0)),
+            Some(t) => push(&mut line, format_args!(" {},", t.raw())),
             None => line.push_str(" UINT32_MAX,"),
         }
         if line.len() > 90 {
@@ -561,7 +560,7 @@ fn crossing_lines(p: &Program, sh: &Shared, s: &Split) -> (usize, usize) {
     let size = |v: usize| {
         super::CLASSES
             .iter()
-            .find(|c| (c.is)(p.vars[v].ty))
+            .find(|c| (c.is)(p.vars()[v].ty))
             .map_or(1, |c| c.size)
     };
     let lines = |v: plc_model::VarId| {
@@ -588,9 +587,9 @@ fn crossing_lines(p: &Program, sh: &Shared, s: &Split) -> (usize, usize) {
             }
         }
     };
-    let inputs: Vec<_> = (0..p.vars.len())
-        .filter(|&i| p.vars[i].class == VarClass::Input)
-        .map(|i| plc_model::VarId(i as u32))
+    let inputs: Vec<_> = (p.vars().iter_enumerated())
+        .filter(|(_, v)| v.class == VarClass::Input)
+        .map(|(i, _)| i)
         .collect();
     for scan in 0..2 {
         let count = scan == 1;
@@ -612,7 +611,7 @@ fn crossing_lines(p: &Program, sh: &Shared, s: &Split) -> (usize, usize) {
             }
         }
     }
-    let unplaced = (0..p.vars.len())
+    let unplaced = (0..p.vars().len())
         .filter(|&i| sh.at[i].is_none() && !sh.local_only[i])
         .count();
     (cross, unplaced)

@@ -27,7 +27,7 @@ pub(crate) fn chunks(
     plan: &Plan,
     chunk: usize,
 ) -> Vec<std::ops::Range<usize>> {
-    let range = p.pous[pou].rungs.clone();
+    let range = p.pous()[pou].rungs.clone();
     let n = (range.end - range.start) as usize;
     // blocked[i]: the boundary before position i is crossed by a jump or a loop.
     let mut diff = vec![0i32; n + 1];
@@ -39,9 +39,9 @@ pub(crate) fn chunks(
         }
     };
     for r in range.clone() {
-        walk_elements(&p.rungs[r as usize].series, &mut |e| match e {
-            Element::Jmp { target, .. } => span(r, target.0),
-            Element::For { next, .. } => span(r, next.0),
+        walk_elements(&p.rungs()[r as usize].series, &mut |e| match e {
+            Element::Jmp { target, .. } => span(r, target.raw()),
+            Element::For { next, .. } => span(r, next.raw()),
             _ => {}
         });
     }
@@ -108,7 +108,7 @@ pub(crate) fn ladder_files(
 ) -> (Vec<(String, String)>, String) {
     let f = &sh.pou_fns[pou];
     let groups = chunks(p, pou, plan, cfg.chunk_rungs.max(1));
-    let name = names::comment(&p.pous[pou].name);
+    let name = names::comment(&p.pous()[pou].name);
     let head = "#include \"plc_program.h\"\n\n";
     // A new source file's rows, in the data file numbered after those written so far.
     let tables = |data: &DataFiles| cfg.rows.then(|| Tables::new(data.files.len(), data.entry));

@@ -265,8 +265,8 @@ fn action(sh: &Shared, r: RungId, e: &Element) -> Option<(Out, Vec<u32>)> {
                 ArithOp::Add => (Out::Arith(ca, cb), vec![to, 0, a, b]),
                 ArithOp::Sub => (Out::Arith(ca, cb), vec![to, 1, a, b]),
                 ArithOp::Mul => (Out::Arith(ca, cb), vec![to, 2, a, b]),
-                ArithOp::Div => (Out::DivMod(ca, cb), vec![to, 0, a, b, r.0]),
-                ArithOp::Mod => (Out::DivMod(ca, cb), vec![to, 1, a, b, r.0]),
+                ArithOp::Div => (Out::DivMod(ca, cb), vec![to, 0, a, b, r.raw()]),
+                ArithOp::Mod => (Out::DivMod(ca, cb), vec![to, 1, a, b, r.raw()]),
             })
         }
         Element::Timer { kind, instance, pt } => {
@@ -278,7 +278,7 @@ fn action(sh: &Shared, r: RungId, e: &Element) -> Option<(Out, Vec<u32>)> {
                 TimerKind::Ton => 0,
                 TimerKind::Tof => 1,
                 TimerKind::Tp => 2,
-            } | u32::from(sh.p.dialect.timer_compares_after_edge()) << 2;
+            } | u32::from(sh.p.dialect().timer_compares_after_edge()) << 2;
             let at = fb_at(sh, instance, &[FbKind::Ton, FbKind::Tof, FbKind::Tp])?;
             Some((Out::Timer, vec![at, kind, u32::from(ms)]))
         }
@@ -293,7 +293,7 @@ fn action(sh: &Shared, r: RungId, e: &Element) -> Option<(Out, Vec<u32>)> {
             load: r,
         } => {
             let kind = u32::from(matches!(e, Element::Ctd { .. }))
-                | u32::from(sh.p.dialect.counters_stop_at_preset()) << 1;
+                | u32::from(sh.p.dialect().counters_stop_at_preset()) << 1;
             let at = fb_at(sh, instance, &[FbKind::Ctu, FbKind::Ctd])?;
             let ((pv, cp), (r, cr)) = (int_slot(sh, &pv)?, bool_slot(sh, &r)?);
             Some((Out::Counter(cp, cr), vec![at, kind, pv, r]))

@@ -65,7 +65,7 @@ pub(crate) fn layout(p: &Program, fbd: &Fbd) -> Layout {
         paths.push(path);
     }
     let vars = p
-        .vars
+        .vars()
         .iter()
         .enumerate()
         .map(|(i, v)| match owner_of(&v.name, &by_name) {
@@ -139,7 +139,7 @@ pub(crate) fn structs(
             }
             let field = path[lay.paths[k].len() + 1..].to_string();
             if seen.insert(field.clone()) {
-                let v = &p.vars[i];
+                let v = &p.vars()[i];
                 let rel = &v.name[fbd.instances[k].name.len() + 1..];
                 let decl = format!("{} {field}; /* {} */", c_type(v.ty), names::comment(rel));
                 fields.push((field, decl));
@@ -272,11 +272,10 @@ fn body(
                 .find(|c| c.pou == inst.pou)
                 .expect("an instance's FBD body has its copy");
             let hidden: HashMap<&str, VarId> = p
-                .vars
-                .iter()
-                .enumerate()
+                .vars()
+                .iter_enumerated()
                 .filter(|(_, v)| v.hidden && v.name.starts_with(inst.name.as_str()))
-                .map(|(i, v)| (v.name.as_str(), VarId(i as u32)))
+                .map(|(i, v)| (v.name.as_str(), i))
                 .collect();
             let locals = fbd::locals(p, &hidden, fpou, &format!("{}.", inst.name));
             fbd::declare(&mut b, p, &locals);
@@ -284,7 +283,7 @@ fn body(
         }
         None => {
             for r in rungs {
-                b.rung(plc_model::RungId(r));
+                b.rung(p.rungs().id(r as usize));
             }
         }
     }

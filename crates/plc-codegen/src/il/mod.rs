@@ -85,14 +85,14 @@ impl Net {
 /// The STL of `p` (with its FBD bodies `fbd`), or the first construct that has none.
 pub fn generate(p: &Program, fbd: &Fbd) -> Result<String, IlError> {
     // STRINGs have no S7-200 STL form here: refused by name, never written as numbers.
-    if let Some(v) = p.vars.iter().find(|v| v.ty == Type::String) {
+    if let Some(v) = p.vars().iter().find(|v| v.ty == Type::String) {
         return Err(IlError {
             place: format!("variable {}", v.name),
             message: "STRING has no S7-200 STL form in plc-deps il (not yet)".into(),
         });
     }
     let mut textual = None;
-    for r in &p.rungs {
+    for r in p.rungs().iter() {
         plc_model::walk_elements(&r.series, &mut |e| {
             if let Element::Function { func, .. } = e {
                 if func.is_textual() && textual.is_none() {
@@ -112,11 +112,10 @@ pub fn generate(p: &Program, fbd: &Fbd) -> Result<String, IlError> {
     let names = Names::new(p);
     let mut out = String::new();
     let mut headers = Vec::new();
-    let _ = writeln!(out, "// {}: S7-200 STL written by plc-deps il", p.name);
+    let _ = writeln!(out, "// {}: S7-200 STL written by plc-deps il", p.name());
     declarations(&mut out, p, &names, None);
     let (mut subroutines, mut interrupts) = (0, 0);
-    for (i, pou) in p.pous.iter().enumerate() {
-        let id = PouId(i as u32);
+    for (id, pou) in p.pous().iter_enumerated() {
         if fbd.instances.iter().any(|inst| inst.pou == id) {
             return Err(IlError {
                 place: format!("function block instance {}", pou.name),
@@ -235,7 +234,7 @@ pub(crate) const INT_TO_REAL: plc_model::Function = plc_model::Function::Convert
 /// added while that names a variable of the program).
 fn scratch_words(p: &Program) -> Vec<(Type, String)> {
     let mut types: Vec<Type> = Vec::new();
-    for r in &p.rungs {
+    for r in p.rungs().iter() {
         walk_elements(&r.series, &mut |e| {
             let ty = match e {
                 Element::Arith { op, b, out, .. } if needs_scratch(*op, b, *out) => p.var(*out).ty,
@@ -247,7 +246,7 @@ fn scratch_words(p: &Program) -> Vec<(Type, String)> {
             }
         });
     }
-    let taken = |n: &str| p.vars.iter().any(|v| v.name.eq_ignore_ascii_case(n));
+    let taken = |n: &str| p.vars().iter().any(|v| v.name.eq_ignore_ascii_case(n));
     types
         .into_iter()
         .map(|ty| {
@@ -286,9 +285,9 @@ pub fn absolute_class(address: &str) -> VarClass {
 
 impl<'a> Names<'a> {
     fn new(p: &'a Program) -> Names<'a> {
-        let mut text = Vec::with_capacity(p.vars.len());
-        let mut absolute = Vec::with_capacity(p.vars.len());
-        for v in &p.vars {
+        let mut text = Vec::with_capacity(p.vars().len());
+        let mut absolute = Vec::with_capacity(p.vars().len());
+        for v in p.vars().iter() {
             let short = match v.scope {
                 Some(_) => format!("#{}", v.name.split_once(':').map_or(&*v.name, |x| x.1)),
                 None => v.name.clone(),
@@ -366,7 +365,7 @@ impl<'a> Names<'a> {
     /// The variable `base` of POU `pou` (its own, else a global), as an index into `p.vars`.
     fn position(&self, base: &str, pou: PouId) -> Option<usize> {
         let scoped = format!("{}:{base}", self.p.pou(pou).name);
-        let vars = &self.p.vars;
+        let vars = &self.p.vars();
         vars.iter()
             .position(|v| !v.hidden && v.scope == Some(pou) && v.name == scoped)
             .or_else(|| {
@@ -383,7 +382,7 @@ impl<'a> Names<'a> {
             Some((_, f)) => !matches!(f, "ET" | "PT" | "CV" | "PV"),
             None => self
                 .position(text, pou)
-                .is_none_or(|i| self.p.vars[i].ty == plc_model::Type::Bool),
+                .is_none_or(|i| self.p.vars()[i].ty == plc_model::Type::Bool),
         }
     }
 }
@@ -401,13 +400,13 @@ fn declarations(out: &mut String, p: &Program, names: &Names, scope: Option<PouI
         ("VAR_OUTPUT", VarClass::Output),
         ("VAR", VarClass::Memory),
     ] {
-        let mut lines: Vec<String> = (0..p.vars.len())
+        let mut lines: Vec<String> = (0..p.vars().len())
             .filter(|&i| {
-                let v = &p.vars[i];
+                let v = &p.vars()[i];
                 !v.hidden && v.scope == scope && v.class == class && !names.absolute[i]
             })
             .map(|i| {
-                let v = &p.vars[i];
+                let v = &p.vars()[i];
                 let name = names.text[i].trim_start_matches('#');
                 let init = match v.ty {
                     Type::Fb(_) => String::new(),

@@ -160,8 +160,7 @@ impl Tree<'_> {
 
     /// Only AND, OR, NOT on variables and arcs, without conditional or control arcs.
     fn check_blocks(&mut self) -> Result<(), IlError> {
-        for (i, blk) in self.net.blocks.iter().enumerate() {
-            let b = BlockId(i as u32);
+        for (b, blk) in self.net.blocks.iter_enumerated() {
             if !matches!(blk.op, Op::And | Op::Or | Op::Not) {
                 return self.fail(Some(b), format!("{} is not a boolean logic block: `plc-deps il` translates FBD networks of AND, OR and NOT (not yet: other blocks)", op_name(&blk.op)));
             }
@@ -219,8 +218,8 @@ impl Tree<'_> {
                     _ => None,
                 })
         };
-        for i in 0..n {
-            let mut stack = vec![(BlockId(i as u32), false)];
+        for i in self.net.blocks.ids() {
+            let mut stack = vec![(i, false)];
             while let Some((b, inputs_done)) = stack.pop() {
                 if depth[b.index()].is_some() {
                     continue;
@@ -276,8 +275,7 @@ impl Tree<'_> {
     /// The forks that no other fork feeds: each is one virtual root of the network.
     fn roots(&self) -> Result<Vec<BlockId>, IlError> {
         let mut roots = Vec::new();
-        for i in 0..self.net.blocks.len() {
-            let b = BlockId(i as u32);
+        for b in self.net.blocks.ids() {
             if self.is_fork(b) && self.fork_input(b)?.is_none() {
                 roots.push(b);
             }

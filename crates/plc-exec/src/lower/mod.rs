@@ -67,8 +67,7 @@ fn loops_back(rung: RungId, series: &[Element]) -> bool {
 fn loop_counters(p: &Program, layout: &Layout) -> (Vec<(RungId, Addr)>, u64) {
     let mut next = layout.size().next_multiple_of(LINE_BYTES) as u64;
     let mut counters = Vec::new();
-    for (r, rung) in p.rungs.iter().enumerate() {
-        let r = RungId(r as u32);
+    for (r, rung) in p.rungs().iter_enumerated() {
         if loops_back(r, &rung.series) {
             counters.push((r, Addr(next.min(u32::MAX as u64) as u32)));
             next += LINE_BYTES as u64;
@@ -80,14 +79,14 @@ fn loop_counters(p: &Program, layout: &Layout) -> (Vec<(RungId, Addr)>, u64) {
 /// Lowers `p` with `layout`; `fuse` chooses the fused instructions (the `fuse` module) where a
 /// rung allows them (off: only the general instructions, the reference they are tested against).
 pub(crate) fn lower(p: &Program, layout: &Layout, fuse: bool) -> Result<Code, LowerError> {
-    if layout.var_count() != p.vars.len() {
+    if layout.var_count() != p.vars().len() {
         return Err(LowerError::LayoutMismatch {
-            expected: p.vars.len(),
+            expected: p.vars().len(),
             found: layout.var_count(),
         });
     }
     let (counters, counters_end) = loop_counters(p, layout);
-    let mut counter_of = vec![None; p.rungs.len()];
+    let mut counter_of = vec![None; p.rungs().len()];
     for &(r, at) in &counters {
         counter_of[r.index()] = Some(at);
     }
@@ -102,12 +101,12 @@ pub(crate) fn lower(p: &Program, layout: &Layout, fuse: bool) -> Result<Code, Lo
             funcs: Vec::new(),
             fused: Vec::new(),
             tables: Vec::new(),
-            rung_op: vec![Pc(0); p.rungs.len()],
-            for_of_head: vec![None; p.rungs.len()],
-            pou_entry: Vec::with_capacity(p.pous.len()),
+            rung_op: vec![Pc::new(0); p.rungs().len()],
+            for_of_head: vec![None; p.rungs().len()],
+            pou_entry: Vec::with_capacity(p.pous().len()),
             counters,
             size: 0,
-            dialect: p.dialect,
+            dialect: p.dialect(),
         },
         jumps: Vec::new(),
         calls: Vec::new(),
@@ -119,19 +118,19 @@ pub(crate) fn lower(p: &Program, layout: &Layout, fuse: bool) -> Result<Code, Lo
         depth: 0,
         max_depth: 0,
     };
-    let mut pou_end = Vec::with_capacity(p.pous.len());
-    for pou in &p.pous {
+    let mut pou_end = Vec::with_capacity(p.pous().len());
+    for pou_id in p.pous().ids() {
         l.code.pou_entry.push(l.pc());
-        for r in pou.rungs.clone() {
-            let rung = &p.rungs[r as usize];
-            l.code.rung_op[r as usize] = l.pc();
-            let done = l.fused(RungId(r), &rung.series);
+        for r in p.pou_rungs(pou_id) {
+            let rung = &p.rungs()[r];
+            l.code.rung_op[r.index()] = l.pc();
+            let done = l.fused(r, &rung.series);
             if done == 0 {
-                l.code.ops.push(Op::Rung { id: RungId(r) });
+                l.code.ops.push(Op::Rung { id: r });
             }
             l.depth = 0;
             l.max_depth = 0;
-            l.series(RungId(r), &rung.series[done..]);
+            l.series(r, &rung.series[done..]);
             if l.max_depth > 64 {
                 return Err(LowerError::TooDeep {
                     rung: rung.id.clone(),
@@ -170,7 +169,7 @@ pub(crate) fn lower(p: &Program, layout: &Layout, fuse: bool) -> Result<Code, Lo
     }
     for (f, next) in for_nexts {
         let pou = p.rung(next).pou;
-        let after = next.0 + 1;
+        let after = next.raw() + 1;
         code.fors[f.index()].exit = if after < p.pou(pou).rungs.end {
             code.rung_op[after as usize]
         } else {
@@ -201,7 +200,7 @@ fn check(code: &Code) {
         _ => None,
     });
     for pc in pcs.copied().chain(loops).chain(jumps) {
-        assert!(pc.index() < n, "lowering: instruction {} of {n}", pc.0);
+        assert!(pc.index() < n, "lowering: instruction {} of {n}", pc.raw());
     }
     for op in &code.ops {
         if let Op::Fused { f, table, .. } | Op::FusedHead { f, table, .. } = *op {
@@ -219,7 +218,7 @@ fn check(code: &Code) {
 impl Lowerer<'_> {
     /// The next instruction's index.
     fn pc(&self) -> Pc {
-        Pc(self.code.ops.len() as u32)
+        Pc::new(self.code.ops.len() as u32)
     }
 
     /// The loop counter of loop-back rung `rung`.
@@ -349,7 +348,7 @@ impl Lowerer<'_> {
         let Some(start) = fuse::start(series, tables, addr, |v| layout.start(v)) else {
             return 0;
         };
-        let f = FusedId(self.code.fused.len() as u32);
+        let f = FusedId::new(self.code.fused.len() as u32);
         self.code.fused.push(start.operands);
         let (id, table, neg) = (rung, start.table, start.neg);
         self.push(match start.whole {
@@ -448,7 +447,7 @@ impl Lowerer<'_> {
                     load: self.operand(&inputs.load),
                     pv: self.operand(&inputs.pv),
                 };
-                let id = CtudId(self.code.ctuds.len() as u32);
+                let id = CtudId::new(self.code.ctuds.len() as u32);
                 self.code.ctuds.push(pins);
                 self.push(Op::Ctud { inst, pins: id });
             }
@@ -486,7 +485,7 @@ impl Lowerer<'_> {
                     out: self.layout.start(*out),
                     ty: self.p.var(*out).ty,
                 };
-                let id = FuncId(self.code.funcs.len() as u32);
+                let id = FuncId::new(self.code.funcs.len() as u32);
                 self.code.funcs.push(call);
                 self.push(Op::Func { call: id });
             }
@@ -496,12 +495,12 @@ impl Lowerer<'_> {
                     let ctr = self.counter(rung);
                     let charge = crate::budget::jump_back_charge(rung, *target);
                     self.push(Op::JmpBack {
-                        to: Pc(0),
+                        to: Pc::new(0),
                         ctr,
                         charge,
                     });
                 } else {
-                    self.push(Op::Jmp { to: Pc(0) });
+                    self.push(Op::Jmp { to: Pc::new(0) });
                 }
             }
             Element::Ret => self.push(Op::Ret),
@@ -509,19 +508,22 @@ impl Lowerer<'_> {
             Element::Call { pou } => {
                 self.calls.push((self.code.ops.len(), *pou));
                 let charge = crate::budget::call_charge(self.p, *pou);
-                self.push(Op::Call { to: Pc(0), charge });
+                self.push(Op::Call {
+                    to: Pc::new(0),
+                    charge,
+                });
             }
             Element::For { var, bounds, next } => {
-                let f = ForId(self.code.fors.len() as u32);
+                let f = ForId::new(self.code.fors.len() as u32);
                 let (from, to) = (self.operand(&bounds.from), self.operand(&bounds.to));
-                let test = Pc(self.pc().0 + 1);
+                let test = Pc::new(self.pc().raw() + 1);
                 self.code.fors.push(ForLoop {
                     var: self.layout.start(*var),
                     num: num_of(self.p.var(*var).ty),
                     from,
                     to,
                     test,
-                    exit: Pc(0),
+                    exit: Pc::new(0),
                     head: rung,
                     ctr: Addr(0),
                     charge: crate::budget::next_charge(rung, *next),

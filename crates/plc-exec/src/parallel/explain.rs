@@ -136,7 +136,7 @@ impl ParallelMachine {
                     );
                 }
             }
-            let dense: u32 = p.vars.iter().map(|v| crate::type_size(v.ty)).sum();
+            let dense: u32 = p.vars().iter().map(|v| crate::type_size(v.ty)).sum();
             let m = &self.machine;
             let _ = writeln!(
                 s,

@@ -59,8 +59,8 @@ impl Decision {
         match self {
             Decision::NotRun => NOT_RUN,
             Decision::Stop => STOP,
-            Decision::Rung(r) => r.0,
-            Decision::ForTest(r) => r.0 | FOR_TEST,
+            Decision::Rung(r) => r.raw(),
+            Decision::ForTest(r) => r.raw() | FOR_TEST,
         }
     }
 
@@ -70,8 +70,8 @@ impl Decision {
         match w {
             NOT_RUN => Decision::NotRun,
             STOP => Decision::Stop,
-            w if w & FOR_TEST != 0 => Decision::ForTest(RungId(w & !FOR_TEST)),
-            w => Decision::Rung(RungId(w)),
+            w if w & FOR_TEST != 0 => Decision::ForTest(RungId::from_raw(w & !FOR_TEST)),
+            w => Decision::Rung(RungId::from_raw(w)),
         }
     }
 
@@ -93,16 +93,16 @@ mod tests {
         for d in [
             Decision::NotRun,
             Decision::Stop,
-            Decision::Rung(RungId(0)),
-            Decision::Rung(RungId(12345)),
-            Decision::ForTest(RungId(0)),
-            Decision::ForTest(RungId(77)),
+            Decision::Rung(RungId::from_raw(0)),
+            Decision::Rung(RungId::from_raw(12345)),
+            Decision::ForTest(RungId::from_raw(0)),
+            Decision::ForTest(RungId::from_raw(77)),
         ] {
             assert_eq!(Decision::unpack(d.pack()), d);
         }
         assert_ne!(
-            Decision::Rung(RungId(3)).pack(),
-            Decision::ForTest(RungId(3)).pack()
+            Decision::Rung(RungId::from_raw(3)).pack(),
+            Decision::ForTest(RungId::from_raw(3)).pack()
         );
     }
 }

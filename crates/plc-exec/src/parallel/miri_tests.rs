@@ -32,7 +32,7 @@ const PROGRAM: &str = r#"{"program": "miri",
 /// The inputs of scan `k`: the four bits of `k`.
 fn inputs(scan: u64) -> Vec<(VarId, Value)> {
     (0..4u32)
-        .map(|i| (VarId(i), Value::Bool(scan >> i & 1 == 1)))
+        .map(|i| (VarId::from_raw(i), Value::Bool(scan >> i & 1 == 1)))
         .collect()
 }
 

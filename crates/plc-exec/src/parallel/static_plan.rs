@@ -156,7 +156,7 @@ pub fn plan(
         .next()
         .expect("one plan for a kind other than auto");
     if plan.sequential.is_none() {
-        let groups = bools_first(program, layout_groups(&[&plan], program.vars.len()));
+        let groups = bools_first(program, layout_groups(&[&plan], program.vars()));
         let layout = Layout::from_groups(program, &groups, LINE_BYTES)
             .expect("groups hold each variable once");
         let machine = Machine::new(program, layout, &ExecConfig::default())?;

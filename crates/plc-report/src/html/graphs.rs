@@ -21,7 +21,7 @@ use std::io::{self, Write};
 pub const MAX_GRAPH_NODES: usize = 600;
 
 fn node_widths(p: &Program) -> Vec<f64> {
-    let m = p.rungs.len() as u32;
+    let m = p.rungs().len() as u32;
     (0..m + 2)
         .map(|n| text_w(crate::node_name(p, n)) + 14.0)
         .collect()
@@ -29,7 +29,7 @@ fn node_widths(p: &Program) -> Vec<f64> {
 
 /// Writes the CFG and the post-dominator tree side by side, or why they are not drawn.
 pub(super) fn write_graphs(out: &mut impl Write, p: &Program, a: &Analysis) -> io::Result<()> {
-    let nodes = p.rungs.len() + 2;
+    let nodes = p.rungs().len() + 2;
     if nodes > MAX_GRAPH_NODES {
         return writeln!(
             out,
@@ -43,10 +43,10 @@ pub(super) fn write_graphs(out: &mut impl Write, p: &Program, a: &Analysis) -> i
         .cfg
         .edges
         .iter()
-        .map(|e| (e.from.0 as usize, e.to.0 as usize))
+        .map(|e| (e.from.raw() as usize, e.to.raw() as usize))
         .collect();
     let cfg = layered(&widths, &cfg_edges);
-    let m = p.rungs.len() as u32;
+    let m = p.rungs().len() as u32;
     let tree_edges: Vec<(usize, usize)> = (0..m + 2)
         .filter_map(|n| {
             a.post_dominators
@@ -123,7 +123,7 @@ fn write_graph(
     }
     for (n, &(x, y)) in l.pos.iter().enumerate() {
         let name = crate::node_name(p, n as u32);
-        let rung = if n < p.rungs.len() {
+        let rung = if n < p.rungs().len() {
             format!(r#" data-rung="{}""#, esc(name))
         } else {
             String::new()

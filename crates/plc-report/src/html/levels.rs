@@ -131,8 +131,8 @@ fn blocks<'a>(input: &HtmlInput<'_, 'a>) -> HashMap<RungId, (&'a Network, BlockI
     for pou in &fbd.pous {
         for copy in &pou.copies {
             for (net, rungs) in pou.networks.iter().zip(&copy.blocks) {
-                for (b, &r) in rungs.iter().enumerate() {
-                    m.insert(r, (net, BlockId(b as u32)));
+                for (b, &r) in net.blocks.ids().zip(rungs) {
+                    m.insert(r, (net, b));
                 }
             }
         }
@@ -154,7 +154,7 @@ fn place<'a>(input: &HtmlInput<'_, 'a>, cols: &[Column]) -> Placed<'a> {
     let p = input.program;
     let ids: HashMap<&str, RungId> = p.rung_ids().map(|r| (p.rung(r).id.as_str(), r)).collect();
     let blocks = blocks(input);
-    let mut cards: Vec<Option<Card<'a>>> = (0..p.rungs.len()).map(|_| None).collect();
+    let mut cards: Vec<Option<Card<'a>>> = (0..p.rungs().len()).map(|_| None).collect();
     let mut frames = Vec::new();
     let mut height: f64 = 0.0;
     let drawing_of = |r: RungId| match blocks.get(&r) {
@@ -347,7 +347,7 @@ fn write_card(out: &mut impl Write, input: &HtmlInput, c: &Card) -> io::Result<(
     if let Some(l) = &rung.label {
         meta.push(format!("label {l}"));
     }
-    if rung.pou.0 != 0 {
+    if rung.pou.raw() != 0 {
         meta.push(p.pou(rung.pou).name.clone());
     }
     meta.push(format!("cost {}", a.rung_costs[c.rung.index()]));
@@ -402,7 +402,7 @@ fn write_edges(
     p: &plc_model::Program,
 ) -> io::Result<()> {
     let ids: HashMap<&str, usize> = p
-        .rungs
+        .rungs()
         .iter()
         .enumerate()
         .map(|(i, r)| (r.id.as_str(), i))

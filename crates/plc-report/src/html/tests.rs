@@ -118,7 +118,7 @@ fn example_b_draws_subroutines_loops_and_control_edges() {
     let (html, p, _) = page("example-b");
     let c = cards(&html);
     let ids: BTreeSet<String> = c.iter().map(|(id, _)| id.clone()).collect();
-    let all: BTreeSet<String> = p.rungs.iter().map(|r| format!("rung-{}", r.id)).collect();
+    let all: BTreeSet<String> = p.rungs().iter().map(|r| format!("rung-{}", r.id)).collect();
     assert_eq!(ids, all, "one card per rung, subroutine rungs included");
     // Subroutine rungs run inside R10's task: no level of their own.
     let level = |id: &str| c.iter().find(|(x, _)| x == id).unwrap().1.clone();
@@ -155,7 +155,7 @@ fn every_example_page_is_well_formed_and_self_contained() {
             "{name}: a URL in the page"
         );
         assert!(!html.contains(" src="), "{name}: a loaded resource");
-        assert_eq!(cards(&html).len(), p.rungs.len(), "{name}");
+        assert_eq!(cards(&html).len(), p.rungs().len(), "{name}");
         n += 1;
     }
     assert!(n >= 11, "{n} examples");

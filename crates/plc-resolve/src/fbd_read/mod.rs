@@ -20,6 +20,7 @@ mod util;
 
 use plc_diag::{Invalid, LoadError};
 use plc_fbd::model::*;
+use plc_model::Numbering;
 use plc_syntax::fbd as syn;
 use plc_syntax::Problem;
 use std::collections::HashMap;
@@ -181,10 +182,13 @@ fn network(
         drafts.push(d);
     }
     drafts.sort_by_key(|d| d.id);
+    // The blocks are numbered in block id order; `blocks` below is built in the same order.
+    let mut numbering: Numbering<BlockId> = Numbering::new();
+    let block_ids: Vec<BlockId> = drafts.iter().map(|_| numbering.next_id()).collect();
     let index: HashMap<u32, BlockId> = drafts
         .iter()
-        .enumerate()
-        .map(|(i, d)| (d.id, BlockId(i as u32)))
+        .zip(&block_ids)
+        .map(|(d, &b)| (d.id, b))
         .collect();
     let out_pins: Vec<Vec<String>> = drafts
         .iter()
@@ -203,11 +207,8 @@ fn network(
     };
     let blocks = drafts
         .iter()
-        .enumerate()
-        .map(|(i, d)| {
-            net.block(BlockId(i as u32), d)
-                .map_err(|e| e.at(d.syn.origin))
-        })
+        .zip(&block_ids)
+        .map(|(d, &b)| net.block(b, d).map_err(|e| e.at(d.syn.origin)))
         .collect::<Result<Vec<_>>>()?;
     let mut roots = Vec::new();
     if let Some(order) = &n.order {
@@ -235,7 +236,7 @@ fn network(
         comment,
         path: path.to_owned(),
         origin: n.origin,
-        blocks,
+        blocks: blocks.into(),
         roots,
     })
 }

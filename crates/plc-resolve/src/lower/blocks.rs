@@ -474,7 +474,7 @@ impl Cx<'_> {
             }
             s.push(Element::Jmp {
                 label: label.clone(),
-                target: RungId(u32::MAX),
+                target: RungId::relative(u32::MAX),
             });
         } else {
             s.push(Element::Ret);

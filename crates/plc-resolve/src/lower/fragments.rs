@@ -35,7 +35,7 @@ impl Cx<'_> {
                         _ => false,
                     };
                     if passes && type_heir[from.index()].is_none() {
-                        type_heir[from.index()] = Some(BlockId(c as u32));
+                        type_heir[from.index()] = Some(net.blocks.id(c));
                     }
                 }
             }
@@ -70,11 +70,11 @@ impl Cx<'_> {
         let mut flags: HashMap<FragmentId, VarId> = HashMap::new();
         let mut sets: HashMap<FragmentId, Vec<VarId>> = HashMap::new();
         let mut pending: Vec<Element> = Vec::new();
-        for (f, frag) in plan.fragments.iter().enumerate() {
+        for (f, frag) in plan.fragments.iter_enumerated() {
             if let FragmentKind::Compound(mc) = &frag.kind {
                 let name = format!("{}_run_{}_{}", self.names.var_prefix, net.id, frag.name);
                 let flag = self.env.hidden(name, Type::Bool).map_err(e_net)?;
-                flags.insert(FragmentId(f as u32), flag);
+                flags.insert(f, flag);
                 pending.push(Element::Reset(flag));
                 for m in mc {
                     sets.entry(*m).or_default().push(flag);
@@ -106,7 +106,7 @@ impl Cx<'_> {
                     let landing = format!("{rp}{}.{}.end", net.id, frag.name);
                     series.push(Element::Jmp {
                         label: landing,
-                        target: RungId(u32::MAX),
+                        target: RungId::relative(u32::MAX),
                     });
                     series.splice(0..0, pending.drain(..));
                     let comment = Some(format!("if {}", frag.condition));
@@ -137,7 +137,7 @@ impl Cx<'_> {
                     if let Some(mut guard) = gate {
                         guard.push(Element::Jmp {
                             label: landing.clone(),
-                            target: RungId(u32::MAX),
+                            target: RungId::relative(u32::MAX),
                         });
                         guard.splice(0..0, pending.drain(..));
                         guards.push(self.push(
@@ -172,7 +172,7 @@ impl Cx<'_> {
                             (&blk.path, blk.origin),
                         );
                         let g = guards.pop().expect("pushed above");
-                        set_jump_target(&mut self.rungs[g], RungId(end as u32));
+                        set_jump_target(&mut self.rungs[g], RungId::relative(end as u32));
                     }
                 }
                 Step::Leave(f) => {
@@ -186,7 +186,7 @@ impl Cx<'_> {
                         (&net.path, net.origin),
                     );
                     let g = guards.pop().expect("entered");
-                    set_jump_target(&mut self.rungs[g], RungId(r as u32));
+                    set_jump_target(&mut self.rungs[g], RungId::relative(r as u32));
                 }
             }
         }

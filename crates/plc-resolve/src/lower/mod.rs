@@ -126,7 +126,7 @@ pub(crate) fn lower(fbd: &FbdPou, env: &mut dyn Env, names: &Names, pou: PouId) 
         blocks.push(block_rungs);
     }
     for (rung, target) in jumps {
-        let t = RungId(networks[target].start);
+        let t = RungId::relative(networks[target].start);
         set_jump_target(&mut cx.rungs[rung], t);
     }
     Ok(Lowered {

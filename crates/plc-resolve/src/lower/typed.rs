@@ -14,10 +14,8 @@ impl Cx<'_> {
         let blocks = nx
             .net
             .blocks
-            .iter()
-            .enumerate()
-            .map(|(bi, blk)| {
-                let b = BlockId(bi as u32);
+            .iter_enumerated()
+            .map(|(b, blk)| {
                 let inputs = blk
                     .inputs
                     .iter()

@@ -172,7 +172,8 @@ impl ParallelMachine {
                 // Release `done`).
                 unsafe { self.run_item(&self.machine, plan, it, store, ctx, sh) };
                 if !ctx.faults.is_empty() {
-                    faults_of(&sh.faults[w]).extend(ctx.faults.drain(..).map(|f| (it.first.0, f)));
+                    faults_of(&sh.faults[w])
+                        .extend(ctx.faults.drain(..).map(|f| (it.first.raw(), f)));
                 }
             }
             units.done();

@@ -84,7 +84,7 @@ impl ParallelMachine {
         // only through `take_phase`, on this thread.
         unsafe { self.run_item(m, plan, it, store, ctx, sh) };
         if !ctx.faults.is_empty() {
-            faults_of(&sh.faults[w]).extend(ctx.faults.drain(..).map(|f| (it.first.0, f)));
+            faults_of(&sh.faults[w]).extend(ctx.faults.drain(..).map(|f| (it.first.raw(), f)));
         }
     }
 

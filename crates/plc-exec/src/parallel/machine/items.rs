@@ -64,7 +64,7 @@ impl ParallelMachine {
         for &slot in &plan.entry_slots[it.entries.start as usize..it.entries.end as usize] {
             let d = sh.decisions.get(slot);
             if Self::successor_of(plan, d) == Some(Next::Task(it.first)) {
-                debug_assert!(at.is_none(), "task {} entered twice", it.first.0);
+                debug_assert!(at.is_none(), "task {} entered twice", it.first.raw());
                 at = match d {
                     Decision::ForTest(h) => Some(Exit::ForTest(h)),
                     Decision::Rung(r) => Some(Exit::Rung(r)),
@@ -105,7 +105,7 @@ impl ParallelMachine {
         // contract), which is `ItemStore::new`'s.
         let mut st = unsafe { ItemStore::new(*store, m) };
         let exit = match it.region {
-            Region::Rungs(lo, hi) => m.resume(&mut st, ctx, at, |r| lo <= r.0 && r.0 < hi),
+            Region::Rungs(lo, hi) => m.resume(&mut st, ctx, at, |r| lo <= r.raw() && r.raw() < hi),
             Region::Tasks(lo, hi) => {
                 let task_of = &plan.task_of_rung;
                 m.resume(&mut st, ctx, at, |r: RungId| {

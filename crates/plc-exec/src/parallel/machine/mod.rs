@@ -109,7 +109,7 @@ impl ParallelMachine {
         let (layout, groups) = if levelled.is_empty() {
             (Layout::dense(program), 0)
         } else {
-            let groups = bools_first(program, layout_groups(&levelled, program.vars.len()));
+            let groups = bools_first(program, layout_groups(&levelled, program.vars()));
             let layout = Layout::from_groups(program, &groups, LINE_BYTES)
                 .expect("groups hold each variable once");
             (layout, groups.len())

@@ -105,7 +105,7 @@ impl OwnLayout {
         common: &Machine,
         plan: &Plan,
     ) -> Option<OwnLayout> {
-        let groups = bools_first(program, layout_groups(&[plan], program.vars.len()));
+        let groups = bools_first(program, layout_groups(&[plan], program.vars()));
         let layout = Layout::from_groups(program, &groups, LINE_BYTES).ok()?;
         let machine = Machine::new(program, layout, exec).ok()?;
         check_plan(&machine, plan).ok()?;
@@ -138,7 +138,7 @@ mod tests {
         )
         .unwrap();
         let dense = Machine::new(&p, Layout::dense(&p), &ExecConfig::default()).unwrap();
-        let groups: Vec<Vec<VarId>> = (0..5).rev().map(|v| vec![VarId(v)]).collect();
+        let groups: Vec<Vec<VarId>> = (0..5).rev().map(|v| vec![VarId::from_raw(v)]).collect();
         let padded = Layout::from_groups(&p, &groups, LINE_BYTES).unwrap();
         let padded = Machine::new(&p, padded, &ExecConfig::default()).unwrap();
         let r = Relayout::new(&dense, &padded);

@@ -405,7 +405,7 @@ impl ParallelMachine {
                     }
                     if !ctx.faults.is_empty() {
                         faults_of(&sh.faults[w])
-                            .extend(ctx.faults.drain(..).map(|f| (it.first.0, f)));
+                            .extend(ctx.faults.drain(..).map(|f| (it.first.raw(), f)));
                     }
                 }
             }

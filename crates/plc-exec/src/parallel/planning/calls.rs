@@ -8,17 +8,17 @@
 use crate::parallel::ids::TaskId;
 use plc_analysis::cfg::{self, Transfer};
 use plc_analysis::{Analysis, EdgeKind};
-use plc_model::{Element, PouId, Program, RungId};
+use plc_model::{Element, Program, RungId};
 
 /// Subroutines (transitively) called from each POU, and whether each POU has loop-back rungs.
 pub(in crate::parallel) fn call_closure(p: &Program) -> Vec<Vec<u32>> {
-    let direct: Vec<Vec<u32>> = (0..p.pous.len())
+    let direct: Vec<Vec<u32>> = (p.pous().ids())
         .map(|pou| {
             let mut calls = Vec::new();
-            for r in p.pou_rungs(PouId(pou as u32)) {
+            for r in p.pou_rungs(pou) {
                 plc_model::walk_elements(&p.rung(r).series, &mut |e| {
                     if let Element::Call { pou } = e {
-                        calls.push(pou.0);
+                        calls.push(pou.raw());
                     }
                 });
             }
@@ -27,7 +27,7 @@ pub(in crate::parallel) fn call_closure(p: &Program) -> Vec<Vec<u32>> {
             calls
         })
         .collect();
-    let mut closure: Vec<Option<Vec<u32>>> = vec![None; p.pous.len()];
+    let mut closure: Vec<Option<Vec<u32>>> = vec![None; p.pous().len()];
     fn visit(pou: usize, direct: &[Vec<u32>], closure: &mut Vec<Option<Vec<u32>>>) -> Vec<u32> {
         if let Some(c) = &closure[pou] {
             return c.clone();
@@ -42,7 +42,7 @@ pub(in crate::parallel) fn call_closure(p: &Program) -> Vec<Vec<u32>> {
         closure[pou] = Some(all.clone());
         all
     }
-    (0..p.pous.len())
+    (0..p.pous().len())
         .map(|pou| visit(pou, &direct, &mut closure))
         .collect()
 }
@@ -52,7 +52,7 @@ pub(in crate::parallel) fn rung_callees(p: &Program, closure: &[Vec<u32>], r: Ru
     let mut out = Vec::new();
     plc_model::walk_elements(&p.rung(r).series, &mut |e| {
         if let Element::Call { pou } = e {
-            out.push(pou.0);
+            out.push(pou.raw());
             out.extend_from_slice(&closure[pou.index()]);
         }
     });
@@ -66,7 +66,7 @@ pub(in crate::parallel) fn is_loop_back(p: &Program, r: RungId) -> bool {
     let mut found = false;
     plc_model::walk_elements(&p.rung(r).series, &mut |e| match e {
         Element::Next { .. } => found = true,
-        Element::Jmp { target, .. } if target.0 <= r.0 => found = true,
+        Element::Jmp { target, .. } if target.raw() <= r.raw() => found = true,
         _ => {}
     });
     found
@@ -79,16 +79,16 @@ pub(in crate::parallel) fn uncovered_refusal(
     a: &Analysis,
     task_of: &[Option<TaskId>],
 ) -> Option<String> {
-    let n = p.rungs.len() as u32;
-    let stop = a.cfg.stop().0;
+    let n = p.rungs().len() as u32;
+    let stop = a.cfg.stop().raw();
     // Live CFG edges of the main program, by (task of source, target node).
     let mut edges: std::collections::HashSet<(TaskId, u32)> = std::collections::HashSet::new();
     for e in &a.cfg.edges {
-        if matches!(e.kind, EdgeKind::Call | EdgeKind::Return) || e.from.0 >= n {
+        if matches!(e.kind, EdgeKind::Call | EdgeKind::Return) || e.from.raw() >= n {
             continue;
         }
-        if let Some(t) = task_of[e.from.0 as usize] {
-            edges.insert((t, e.to.0));
+        if let Some(t) = task_of[e.from.raw() as usize] {
+            edges.insert((t, e.to.raw()));
         }
     }
     let main = p.main().rungs.clone();
@@ -97,7 +97,8 @@ pub(in crate::parallel) fn uncovered_refusal(
         let Some(t) = task_of[r as usize] else {
             continue;
         };
-        let rung = p.rung(RungId(r));
+        let rid = p.rungs().id(r as usize);
+        let rung = p.rung(rid);
         let next = if r + 1 < main.end { r + 1 } else { stop };
         let targets: Vec<u32> = match rung.series.last() {
             // A refused NEXT goes on to the rung after it: the FOR head's loop exit, which is in
@@ -106,17 +107,17 @@ pub(in crate::parallel) fn uncovered_refusal(
             _ => {
                 found.clear();
                 let terminated = cfg::transfers(&rung.series, &mut found);
-                if !cfg::ends_in_loop_back(&found, terminated, RungId(r)) {
+                if !cfg::ends_in_loop_back(&found, terminated, rid) {
                     continue; // a conditional backward jump's "not taken" paths are CFG edges
                 }
                 // After a refusal the rest of the rung runs: its transfers up to the next
                 // unconditional one, or onwards when there is none.
                 found.clear();
-                let ends = cfg::transfers_refusing(&rung.series, Some(RungId(r)), &mut found);
+                let ends = cfg::transfers_refusing(&rung.series, Some(rid), &mut found);
                 let mut ts: Vec<u32> = found
                     .iter()
                     .filter_map(|&(tr, _)| match tr {
-                        Transfer::Jump(x) => Some(x.0),
+                        Transfer::Jump(x) => Some(x.raw()),
                         Transfer::Ret | Transfer::End => Some(stop),
                         Transfer::Call(_) => None,
                     })
@@ -140,7 +141,7 @@ pub(in crate::parallel) fn uncovered_refusal(
                 let to = if x == stop {
                     "the end of the scan".to_string()
                 } else {
-                    format!("rung {}", p.rung(RungId(x)).id)
+                    format!("rung {}", p.rungs()[x as usize].id)
                 };
                 return Some(format!(
                     "rung {} loops back unconditionally; if the iteration cap refuses it, control goes on to {to}, a way the schedule does not know",

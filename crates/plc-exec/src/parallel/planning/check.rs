@@ -58,7 +58,10 @@ pub(in crate::parallel) fn check_plan(machine: &Machine, plan: &Plan) -> Result<
                 for &span in &writes {
                     for b in bytes(span) {
                         let Some(byte) = byte_writer.get_mut(b) else {
-                            return Err(format!("rung {} writes byte {b}, past the state", r.0));
+                            return Err(format!(
+                                "rung {} writes byte {b}, past the state",
+                                r.raw()
+                            ));
                         };
                         match *byte {
                             Some((p, w2)) if p == pi && w2 != w => {
@@ -136,7 +139,7 @@ mod tests {
         let p = program();
         let plan = all_parallel(&p);
         assert_eq!(plan.parallel_phases(), 1);
-        let groups = super::super::plan::layout_groups(&[&plan], p.vars.len());
+        let groups = super::super::plan::layout_groups(&[&plan], p.vars());
         let padded = Machine::new(
             &p,
             Layout::from_groups(&p, &groups, LINE_BYTES).unwrap(),
@@ -184,7 +187,7 @@ mod tests {
         );
         // Pretend R2 reads x: give task 1 the rungs of both tasks (R1 then writes x on worker 0
         // and worker 1 both).
-        plan.task_rungs[1] = vec![RungId(0), RungId(1)];
+        plan.task_rungs[1] = vec![RungId::from_raw(0), RungId::from_raw(1)];
         let m = Machine::new(&p, Layout::dense(&p), &ExecConfig::default()).unwrap();
         let e = check_plan(&m, &plan).unwrap_err();
         assert_eq!(e, "phase 0: byte 2 written by workers 0 and 1");

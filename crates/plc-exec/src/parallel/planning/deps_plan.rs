@@ -43,7 +43,7 @@ use super::tasks::{Item, Tasks};
 use crate::parallel::config::{DepsPartition, PlanConfig};
 use crate::parallel::ids::TaskId;
 use plc_analysis::Analysis;
-use plc_model::{PouId, Program};
+use plc_model::Program;
 
 /// The assignment: each task's worker and position in its worker's list, and the lists.
 struct Assignment {
@@ -126,7 +126,7 @@ pub(in crate::parallel) fn build(p: &Program, a: &Analysis, config: &PlanConfig)
         guards: Vec::new(),
         entry_slots: Vec::new(),
         decision_slots: 0,
-        write_keys: vec![Vec::new(); p.vars.len()],
+        write_keys: vec![Vec::new(); p.vars().len()],
         phase_lines: Vec::new(),
         est_sequential,
         est_plan,
@@ -230,10 +230,10 @@ fn task_preds(p: &Program, a: &Analysis) -> Vec<Vec<TaskId>> {
     let sched = &a.schedule;
     let mut preds = sched.preds.clone();
     let closure = call_closure(p);
-    let loops: Vec<bool> = (0..p.pous.len())
-        .map(|pou| p.pou_rungs(PouId(pou as u32)).any(|r| is_loop_back(p, r)))
+    let loops: Vec<bool> = (p.pous().ids())
+        .map(|pou| p.pou_rungs(pou).any(|r| is_loop_back(p, r)))
         .collect();
-    let mut last_user: Vec<Option<TaskId>> = vec![None; p.pous.len()];
+    let mut last_user: Vec<Option<TaskId>> = vec![None; p.pous().len()];
     for &t in sched.levels.iter().flatten() {
         let mut pous: Vec<u32> = sched
             .task(t)
@@ -381,7 +381,7 @@ fn items_and_waits(
                 end += 1;
             }
             for it in info.items(&list[start..end], config.item_cost) {
-                let n = (it.first.0..=it.last.0).count();
+                let n = (it.first.raw()..=it.last.raw()).count();
                 item_of_pos[w].extend(std::iter::repeat_n(items[w].len() as u32, n));
                 items[w].push(it);
             }
@@ -401,7 +401,7 @@ fn items_and_waits(
                 });
             }
             it.waits = w0..waits.len() as u32;
-            i += (it.first.0..=it.last.0).count();
+            i += (it.first.raw()..=it.last.raw()).count();
         }
     }
     for x in &waits {
@@ -460,7 +460,7 @@ fn model(
 /// private states, which touches all of it, ran 5 % slower for a plan it was not running.
 fn write_keys(p: &Program, a: &Analysis, asg: &Assignment) -> Vec<Vec<(u32, u32)>> {
     let sched = &a.schedule;
-    let mut writer: Vec<Option<u32>> = vec![None; p.vars.len()];
+    let mut writer: Vec<Option<u32>> = vec![None; p.vars().len()];
     for (t, task) in sched.tasks.iter().enumerate() {
         for r in &task.rungs {
             for &v in a.accesses.outs(*r) {

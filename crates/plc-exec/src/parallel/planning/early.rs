@@ -106,7 +106,7 @@ struct Piece {
 impl Piece {
     /// Fewer tasks than an early piece cut from its item must have (`early_min_tasks`).
     fn short(&self, min: u32) -> bool {
-        self.last.0 - self.first.0 + 1 < min
+        self.last.raw() - self.first.raw() + 1 < min
     }
 }
 
@@ -247,10 +247,10 @@ fn sub_item(plan: &Plan, it: &Item, first: TaskId, last: TaskId) -> Item {
         return it.clone();
     }
     let (mut lo, mut hi, mut count) = (u32::MAX, 0u32, 0u32);
-    for t in first.0..=last.0 {
+    for t in first.raw()..=last.raw() {
         for r in &plan.task_rungs[t as usize] {
-            lo = lo.min(r.0);
-            hi = hi.max(r.0 + 1);
+            lo = lo.min(r.raw());
+            hi = hi.max(r.raw() + 1);
             count += 1;
         }
     }
@@ -278,7 +278,7 @@ fn sub_item(plan: &Plan, it: &Item, first: TaskId, last: TaskId) -> Item {
 /// that ends closest past half of the early tasks, cutting that piece in two at a single-rung
 /// task when it is long; `None` when there is no early work before which it would be worth it.
 fn prefetch_point(plan: &Plan, early: &mut Vec<Item>, min: u32) -> Option<u32> {
-    let tasks = |it: &Item| it.last.0 - it.first.0 + 1;
+    let tasks = |it: &Item| it.last.raw() - it.first.raw() + 1;
     let total: u32 = early.iter().map(tasks).sum();
     if total < 2 * min {
         return None;
@@ -288,13 +288,13 @@ fn prefetch_point(plan: &Plan, early: &mut Vec<Item>, min: u32) -> Option<u32> {
         let it = &early[i];
         let n = tasks(it);
         if before + n >= total / 2 {
-            let want = TaskId(it.first.0 + (total / 2).saturating_sub(before));
-            let at = (want.0..=it.last.0)
-                .map(TaskId)
+            let want = it.first.raw() + (total / 2).saturating_sub(before);
+            let at = (want..=it.last.raw())
+                .map(TaskId::from_raw)
                 .find(|&t| t != it.first && plan.task_rungs[t.index()].len() == 1);
             if let Some(at) = at.filter(|_| n >= min) {
                 let (a, b) = (
-                    sub_item(plan, it, it.first, TaskId(at.0 - 1)),
+                    sub_item(plan, it, it.first, TaskId::from_raw(at.raw() - 1)),
                     sub_item(plan, it, at, it.last),
                 );
                 early.splice(i..=i, [a, b]);
@@ -357,7 +357,7 @@ mod tests {
         assert_eq!(plan.phases.len(), 2);
         let groups = super::super::plan::bools_first(
             &p,
-            super::super::plan::layout_groups(&[&plan], p.vars.len()),
+            super::super::plan::layout_groups(&[&plan], p.vars()),
         );
         let layout = Layout::from_groups(&p, &groups, LINE_BYTES).unwrap();
         let m = Machine::new(&p, layout, &ExecConfig::default()).unwrap();
@@ -371,7 +371,7 @@ mod tests {
             items
                 .iter()
                 .flat_map(|it| it.tasks())
-                .map(|t| t.0)
+                .map(|t| t.raw())
                 .collect()
         };
         let (early, late) = s.items.split_at(s.early as usize);
@@ -391,7 +391,7 @@ mod tests {
                     .items_of(w)
                     .iter()
                     .flat_map(|it| it.tasks())
-                    .map(|t| t.0)
+                    .map(|t| t.raw())
                     .collect::<Vec<_>>()
             );
         }
@@ -404,7 +404,7 @@ mod tests {
                 .items_of(w)
                 .iter()
                 .flat_map(|it| it.tasks())
-                .map(|t| t.0)
+                .map(|t| t.raw())
                 .collect();
             assert_eq!((early, late), (all, vec![]));
             assert_eq!((s.early, s.prefetch_after), (1, None));
@@ -415,7 +415,10 @@ mod tests {
             let s = &splits[2 + w];
             assert_eq!((s.early, s.prefetch_after), (2, Some(1)));
             let (a, b) = (&s.items[0], &s.items[1]);
-            assert_eq!((a.last.0 - a.first.0 + 1, b.first.0), (10, a.last.0 + 1));
+            assert_eq!(
+                (a.last.raw() - a.first.raw() + 1, b.first.raw()),
+                (10, a.last.raw() + 1)
+            );
             // The second piece starts at its first task's rung; the first records no decision.
             assert_eq!(b.start, plan.task_rungs[b.first.index()][0]);
             assert_eq!(a.decision, None);
@@ -427,13 +430,13 @@ mod tests {
         // B20 reads A19, which worker 0 wrote: worker 1 holds B20 back and runs B21..B39 first.
         let (plan, splits) = plan_of(true, 16);
         // Rungs A0..A39 then B0..B39: B20 is rung 60.
-        let b20 = plan.task_of_rung[60].unwrap().0;
+        let b20 = plan.task_of_rung[60].unwrap().raw();
         let w1 = (0..2)
             .find(|&w| {
                 plan.phases[1]
                     .items_of(w)
                     .iter()
-                    .any(|it| it.tasks().any(|t| t.0 == b20))
+                    .any(|it| it.tasks().any(|t| t.raw() == b20))
             })
             .unwrap();
         let (early, late) = tasks(&splits[2 + w1]);

@@ -20,7 +20,7 @@
 use super::early::{Split, Splitter};
 use super::plan::Plan;
 use crate::{Layout, Machine};
-use plc_model::{Program, Type, VarId};
+use plc_model::{Program, Type};
 
 /// Data words per exchange line; the eighth word of a line is its sequence number.
 pub(in crate::parallel) const LINE_WORDS: usize = 7;
@@ -112,9 +112,9 @@ impl Exchange {
 /// Which bytes of a state of `size` bytes hold a BOOL variable.
 fn bool_bytes(p: &Program, layout: &Layout, size: usize) -> Vec<bool> {
     let mut is_bool = vec![false; size];
-    for (v, var) in p.vars.iter().enumerate() {
+    for (v, var) in p.vars().iter_enumerated() {
         if var.ty == Type::Bool {
-            is_bool[layout.start(VarId(v as u32)).index()] = true;
+            is_bool[layout.start(v).index()] = true;
         }
     }
     is_bool
@@ -253,12 +253,12 @@ mod tests {
         assert_eq!(plan.phases.len(), 1);
         let groups = super::super::plan::bools_first(
             &p,
-            super::super::plan::layout_groups(&[&plan], p.vars.len()),
+            super::super::plan::layout_groups(&[&plan], p.vars()),
         );
         let layout = Layout::from_groups(&p, &groups, LINE_BYTES).unwrap();
         let m = Machine::new(&p, layout.clone(), &ExecConfig::default()).unwrap();
         let x = exchange_plan(&p, &m, &plan).unwrap();
-        let at = |v: u32| layout.start(VarId(v)).0;
+        let at = |v: u32| layout.start(plc_model::VarId::from_raw(v)).0;
         let seg = |at, len, bools, word| Segment {
             at,
             len,

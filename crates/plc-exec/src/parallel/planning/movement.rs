@@ -70,12 +70,13 @@ impl<'a> Movement<'a> {
             p,
             a,
             threads: threads.max(1),
-            last: vec![None; p.vars.len()],
+            last: vec![None; p.vars().len()],
             seen: HashMap::new(),
             groups: 0,
         };
-        let inputs: Vec<VarId> = (0..p.vars.len() as u32)
-            .map(VarId)
+        let inputs: Vec<VarId> = p
+            .vars()
+            .ids()
             .filter(|v| p.var(*v).class == VarClass::Input)
             .collect();
         m.place(0, &inputs);

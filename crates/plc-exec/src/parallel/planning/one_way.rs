@@ -172,7 +172,7 @@ mod tests {
         width: usize,
         reads: impl Fn(usize, usize) -> Vec<usize>,
     ) -> (Vec<Vec<TaskId>>, Vec<Vec<TaskId>>) {
-        let id = |l: usize, j: usize| TaskId((l * width + j) as u32);
+        let id = |l: usize, j: usize| TaskId::from_raw((l * width + j) as u32);
         let lv = (0..levels)
             .map(|l| (0..width).map(|j| id(l, j)).collect())
             .collect();
@@ -191,7 +191,7 @@ mod tests {
         for slices in &ow.slices {
             for (k, s) in slices.iter().enumerate() {
                 for t in s {
-                    assert!(w[t.index()].is_none(), "task {} placed twice", t.0);
+                    assert!(w[t.index()].is_none(), "task {} placed twice", t.raw());
                     w[t.index()] = Some(k);
                 }
             }

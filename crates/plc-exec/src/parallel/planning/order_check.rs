@@ -153,7 +153,7 @@ fn each_rung(
                 reads.clear();
                 writes.clear();
                 machine.rung_accesses(r, &mut reads, &mut writes);
-                f(at, r.0, &reads, &writes)?;
+                f(at, r.raw(), &reads, &writes)?;
             }
         }
     }
@@ -325,7 +325,7 @@ mod tests {
 
     /// The machine on the plan's padded layout.
     fn machine(p: &Program, plan: &Plan) -> Machine {
-        let groups = layout_groups(&[plan], p.vars.len());
+        let groups = layout_groups(&[plan], p.vars());
         let layout = Layout::from_groups(p, &groups, LINE_BYTES).unwrap();
         Machine::new(p, layout, &ExecConfig::default()).unwrap()
     }
@@ -340,7 +340,7 @@ mod tests {
         let tasks = |w: usize| -> Vec<u32> {
             items[w]
                 .iter()
-                .flat_map(|it| it.tasks().map(|t| t.0))
+                .flat_map(|it| it.tasks().map(|t| t.raw()))
                 .collect()
         };
         assert_eq!((tasks(0), tasks(1)), (vec![0, 2], vec![1]));
@@ -358,7 +358,7 @@ mod tests {
         // runs worker 0's items first: the read is seen before the write).
         let SlicesMut(slices) = parallel_mut(&mut plan);
         slices[0][1].waits = 0..0;
-        let y = m.layout().start(plc_model::VarId(3)).index();
+        let y = m.layout().start(plc_model::VarId::from_raw(3)).index();
         assert_eq!(
             check_ordered(&m, &plan),
             Err(format!(
@@ -407,14 +407,14 @@ mod tests {
             let items = worker_items(&plan).unwrap();
             let rungs = |w: usize| -> Vec<u32> {
                 (items[w].iter().flat_map(|it| it.tasks()))
-                    .flat_map(|t| plan.task_rungs[t.index()].iter().map(|r| r.0))
+                    .flat_map(|t| plan.task_rungs[t.index()].iter().map(|r| r.raw()))
                     .collect()
             };
             assert_eq!((rungs(0), rungs(1)), (vec![0, 2], vec![1, 3]));
             // Every variable on one line.
             let m = Machine::new(&p, Layout::dense(&p), &ExecConfig::default()).unwrap();
-            let x = m.layout().start(plc_model::VarId(2)).index();
-            let y = m.layout().start(plc_model::VarId(3)).index();
+            let x = m.layout().start(plc_model::VarId::from_raw(2)).index();
+            let y = m.layout().start(plc_model::VarId::from_raw(3)).index();
             assert_eq!(x / LINE_BYTES as usize, y / LINE_BYTES as usize);
             let got = check_ordered(&m, &plan);
             if z {

@@ -22,7 +22,7 @@ use super::tasks::{Item, Tasks};
 use crate::parallel::config::{PlanConfig, PlanKind, Strategy};
 use crate::parallel::ids::{DecisionSlot, Next, TaskId};
 use plc_analysis::{Analysis, EdgeKind, Successor};
-use plc_model::{PouId, Program, RungId, VarId};
+use plc_model::{Arena, Program, RungId, Var, VarId};
 use std::collections::HashMap;
 
 /// Decision slots per 64-byte line.
@@ -119,7 +119,7 @@ impl Plan {
             guards: Vec::new(),
             entry_slots: Vec::new(),
             decision_slots: 0,
-            write_keys: vec![Vec::new(); p.vars.len()],
+            write_keys: vec![Vec::new(); p.vars().len()],
             phase_lines,
             est_sequential,
             est_plan,
@@ -172,7 +172,7 @@ impl Plan {
             };
             for it in slices.into_iter().flatten() {
                 debug_assert!(
-                    (it.first.0..it.last.0).all(|t| slot_of_task[t as usize].is_none()),
+                    (it.first.raw()..it.last.raw()).all(|t| slot_of_task[t as usize].is_none()),
                     "only the last task of a run decides"
                 );
                 it.decision = slot_of_task[it.last.index()];
@@ -254,21 +254,21 @@ pub(in crate::parallel) fn task_facts<'a>(
     let rung_cost = interpreter_costs(p, a, config);
     let sched = &a.schedule;
     let nt = sched.tasks.len();
-    let n = p.rungs.len() as u32;
-    let stop = a.cfg.stop().0;
+    let n = p.rungs().len() as u32;
+    let stop = a.cfg.stop().raw();
     let mut succs: Vec<Vec<Next>> = vec![Vec::new(); nt];
     let mut entry_preds: Vec<Vec<TaskId>> = vec![Vec::new(); nt];
     for e in &a.cfg.edges {
-        if matches!(e.kind, EdgeKind::Call | EdgeKind::Return) || e.from.0 >= n {
+        if matches!(e.kind, EdgeKind::Call | EdgeKind::Return) || e.from.raw() >= n {
             continue;
         }
-        let Some(ta) = task_of[e.from.0 as usize] else {
+        let Some(ta) = task_of[e.from.raw() as usize] else {
             continue;
         };
-        let tb = if e.to.0 == stop {
+        let tb = if e.to.raw() == stop {
             Next::Stop
-        } else if e.to.0 < n {
-            match task_of[e.to.0 as usize] {
+        } else if e.to.raw() < n {
+            match task_of[e.to.raw() as usize] {
                 Some(tb) if tb != ta => Next::Task(tb),
                 _ => continue,
             }
@@ -326,8 +326,8 @@ pub(in crate::parallel) fn task_facts<'a>(
 pub(in crate::parallel) fn level_conflicts(p: &Program, a: &Analysis) -> Vec<Option<String>> {
     let sched = &a.schedule;
     let closure = call_closure(p);
-    let pou_loops: Vec<bool> = (0..p.pous.len())
-        .map(|pou| p.pou_rungs(PouId(pou as u32)).any(|r| is_loop_back(p, r)))
+    let pou_loops: Vec<bool> = (p.pous().ids())
+        .map(|pou| p.pou_rungs(pou).any(|r| is_loop_back(p, r)))
         .collect();
     let mut level_conflict: Vec<Option<String>> = vec![None; sched.levels.len()];
     for (l, level) in sched.levels.iter().enumerate() {
@@ -349,7 +349,7 @@ pub(in crate::parallel) fn level_conflicts(p: &Program, a: &Analysis) -> Vec<Opt
                         "tasks {} and {} both call {}, whose loop counters they would share",
                         p.rung(sched.head(other)).id,
                         p.rung(sched.head(t)).id,
-                        p.pous[c as usize].name
+                        p.pous()[c as usize].name
                     ));
                     break 'level;
                 }
@@ -592,7 +592,7 @@ fn build_phases(
 /// Per variable: the (phase, worker) pairs of parallel phases whose tasks write it.
 fn write_keys(p: &Program, a: &Analysis, phases: &[Phase]) -> Vec<Vec<(u32, u32)>> {
     let sched = &a.schedule;
-    let mut key_of: Vec<Vec<(u32, u32)>> = vec![Vec::new(); p.vars.len()];
+    let mut key_of: Vec<Vec<(u32, u32)>> = vec![Vec::new(); p.vars().len()];
     for (pi, ph) in phases.iter().enumerate() {
         if !ph.is_parallel() {
             continue;
@@ -616,11 +616,14 @@ fn write_keys(p: &Program, a: &Analysis, phases: &[Phase]) -> Vec<Vec<(u32, u32)
 /// Layout groups for several plans run on one state: variables keyed by every (plan, phase,
 /// worker) that writes them, one group per distinct key, groups ordered by their first writer.
 /// Variables of different groups never share a line once the layout aligns each group.
-pub(in crate::parallel) fn layout_groups(plans: &[&Plan], vars: usize) -> Vec<Vec<VarId>> {
+pub(in crate::parallel) fn layout_groups(
+    plans: &[&Plan],
+    vars: &Arena<VarId, Var>,
+) -> Vec<Vec<VarId>> {
     let mut group_of: HashMap<Vec<(u32, u32, u32)>, usize> = HashMap::new();
     let mut order: Vec<((u32, u32, u32), usize)> = Vec::new();
     let mut groups: Vec<Vec<VarId>> = Vec::new();
-    for v in 0..vars {
+    for (v, var) in vars.ids().enumerate() {
         let key: Vec<(u32, u32, u32)> = plans
             .iter()
             .enumerate()
@@ -640,7 +643,7 @@ pub(in crate::parallel) fn layout_groups(plans: &[&Plan], vars: usize) -> Vec<Ve
             order.push((first, groups.len() - 1));
             groups.len() - 1
         });
-        groups[g].push(VarId(v as u32));
+        groups[g].push(var);
     }
     order.sort_unstable();
     order
@@ -657,15 +660,12 @@ pub(in crate::parallel) fn layout_groups(plans: &[&Plan], vars: usize) -> Vec<Ve
 /// group. On gen 100k (188 KB of state) the plain order put the inputs after 64 KiB and left
 /// most rungs without fused contacts: 1.6–1.8× the sequential walk's time per rung.
 pub(in crate::parallel) fn bools_first(p: &Program, groups: Vec<Vec<VarId>>) -> Vec<Vec<VarId>> {
-    let mut written = vec![false; p.vars.len()];
+    let mut written = vec![false; p.vars().len()];
     for &v in groups.iter().flatten() {
         written[v.index()] = true;
     }
     let is_bool = |v: &VarId| p.var(*v).ty == plc_model::Type::Bool;
-    let unwritten: Vec<VarId> = (0..p.vars.len() as u32)
-        .map(VarId)
-        .filter(|v| !written[v.index()])
-        .collect();
+    let unwritten: Vec<VarId> = p.vars().ids().filter(|v| !written[v.index()]).collect();
     let split = |g: &[VarId]| -> (Vec<VarId>, Vec<VarId>) { g.iter().partition(|v| is_bool(v)) };
     let (unwritten_bools, unwritten_rest) = split(&unwritten);
     let (bools, rest): (Vec<Vec<VarId>>, Vec<Vec<VarId>>) = groups.iter().map(|g| split(g)).unzip();

@@ -17,7 +17,7 @@ use crate::fuse::{self, Tables};
 use crate::parallel::config::PlanConfig;
 use crate::Addr;
 use plc_analysis::Analysis;
-use plc_model::{Element, Program, RungId};
+use plc_model::{Element, Program};
 
 /// The interpreter's cost of every rung, in steps, at least 1.
 pub(in crate::parallel) fn interpreter_costs(
@@ -27,11 +27,10 @@ pub(in crate::parallel) fn interpreter_costs(
 ) -> Vec<u64> {
     let mut tables = Tables::default();
     let scaled = |steps: u64| (steps * config.step_tenths).div_ceil(10);
-    (0..p.rungs.len())
-        .map(|r| {
-            let rid = RungId(r as u32);
+    (p.rung_ids())
+        .map(|rid| {
             let series = &p.rung(rid).series;
-            let whole = a.rung_costs[r];
+            let whole = a.rung_costs[rid.index()];
             let c = match fuse::start(series, &mut tables, |_| Addr(0), |_| Addr(0)) {
                 Some(s) if s.whole => config.fused_rung_cost,
                 Some(s) => {

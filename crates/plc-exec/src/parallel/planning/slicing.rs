@@ -254,7 +254,7 @@ fn locality(
     let joins: Vec<bool> = (0..level.len())
         .map(|i| {
             i + 1 < level.len()
-                && level[i + 1].0 == level[i].0 + 1
+                && level[i + 1].raw() == level[i].raw() + 1
                 && info.unguarded_single(level[i])
                 && info.chains(level[i])
         })

@@ -48,7 +48,7 @@ pub(in crate::parallel) struct Item {
 impl Item {
     /// The tasks of the item, in order.
     pub(in crate::parallel) fn tasks(&self) -> impl Iterator<Item = TaskId> {
-        (self.first.0..=self.last.0).map(TaskId)
+        (self.first.raw()..=self.last.raw()).map(TaskId::from_raw)
     }
 }
 
@@ -71,7 +71,7 @@ impl Tasks<'_> {
 
     /// Whether `t` and `t + 1` can be one walk.
     pub(in crate::parallel) fn chains(&self, t: TaskId) -> bool {
-        let next = TaskId(t.0 + 1);
+        let next = TaskId::from_raw(t.raw() + 1);
         self.only_succ[t.index()] == Some(next)
             && !self.needs_decision[t.index()]
             && self.unguarded_single(next)
@@ -85,7 +85,7 @@ impl Tasks<'_> {
             let mut j = i;
             if self.unguarded_single(tasks[i]) {
                 while j + 1 < tasks.len()
-                    && tasks[j + 1].0 == tasks[j].0 + 1
+                    && tasks[j + 1].raw() == tasks[j].raw() + 1
                     && self.chains(tasks[j])
                 {
                     j += 1;
@@ -100,10 +100,10 @@ impl Tasks<'_> {
     fn item(&self, first: TaskId, last: TaskId, item_cost: u64) -> Item {
         let sched = &self.a.schedule;
         let (mut lo, mut hi, mut count) = (u32::MAX, 0u32, 0u64);
-        for t in first.0..=last.0 {
+        for t in first.raw()..=last.raw() {
             for r in &sched.tasks[t as usize].rungs {
-                lo = lo.min(r.0);
-                hi = hi.max(r.0 + 1);
+                lo = lo.min(r.raw());
+                hi = hi.max(r.raw() + 1);
                 count += 1;
             }
         }
@@ -123,7 +123,7 @@ impl Tasks<'_> {
             decision: None,
             waits: 0..0,
             publish: false,
-            cost: (first.0..=last.0)
+            cost: (first.raw()..=last.raw())
                 .map(|t| self.cost[t as usize])
                 .sum::<u64>()
                 + item_cost,
@@ -189,10 +189,13 @@ mod tests {
     }
     #[test]
     fn lpt_gives_each_task_to_the_least_loaded_worker() {
-        let t: Vec<TaskId> = (0..4).map(TaskId).collect();
+        let t: Vec<TaskId> = (0..4).map(TaskId::from_raw).collect();
         assert_eq!(
             lpt(&t, &[5, 4, 3, 3], 2),
-            vec![vec![TaskId(0), TaskId(3)], vec![TaskId(1), TaskId(2)]]
+            vec![
+                vec![TaskId::from_raw(0), TaskId::from_raw(3)],
+                vec![TaskId::from_raw(1), TaskId::from_raw(2)]
+            ]
         );
     }
 }
