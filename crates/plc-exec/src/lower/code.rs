@@ -237,6 +237,7 @@ pub(crate) struct ForLoop {
 }
 
 /// The lowered program.
+#[derive(Debug)]
 pub(crate) struct Code {
     pub ops: Vec<Op>,
     /// The constants and where they live (written by `Machine::initial_state`).

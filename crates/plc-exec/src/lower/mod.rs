@@ -177,43 +177,7 @@ pub(crate) fn lower(p: &Program, layout: &Layout, fuse: bool) -> Result<Code, Lo
             pou_end[pou.index()]
         };
     }
-    check(&code);
     Ok(code)
-}
-
-/// Checks what the interpreter's unchecked accesses rely on, once per machine: the last
-/// instruction is an `EndPou` (so falling through never leaves the array), every instruction
-/// index the code holds (jumps, calls, FOR tests and exits, rung starts, POU entries) is an
-/// instruction, and every fused rung's operands and table exist.
-///
-/// # Panics
-/// If lowering broke one of these (a bug, never bad input).
-fn check(code: &Code) {
-    let n = code.ops.len();
-    assert!(
-        matches!(code.ops.last(), Some(Op::EndPou)),
-        "lowering: the code ends with an EndPou"
-    );
-    let pcs = code.rung_op.iter().chain(&code.pou_entry);
-    let loops = code.fors.iter().flat_map(|l| [l.test, l.exit]);
-    let jumps = code.ops.iter().filter_map(|op| match *op {
-        Op::Jmp { to } | Op::JmpBack { to, .. } | Op::Call { to, .. } => Some(to),
-        _ => None,
-    });
-    for pc in pcs.copied().chain(loops).chain(jumps) {
-        assert!(pc.index() < n, "lowering: instruction {} of {n}", pc.0);
-    }
-    for op in &code.ops {
-        if let Op::Fused { f, table, .. } | Op::FusedHead { f, table, .. } = *op {
-            assert!(
-                f.index() < code.fused.len() && (table as usize) < code.tables.len(),
-                "lowering: a fused rung's operands"
-            );
-        }
-        if let Op::For { f } | Op::ForTest { f } | Op::Next { f } = *op {
-            assert!(f.index() < code.fors.len(), "lowering: a FOR loop");
-        }
-    }
 }
 
 impl Lowerer<'_> {
