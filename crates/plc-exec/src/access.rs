@@ -53,8 +53,8 @@ impl Code {
     /// (`raw::CheckedCode::new` checks it against the state size).
     ///
     /// # Panics
-    /// If an instruction index or operand index of the code is out of range (checked, before
-    /// this runs, by `CheckedCode::new`).
+    /// If an instruction or operand index of the code is out of range (`CheckedCode::new`
+    /// checks those first, with a message).
     pub(crate) fn access_end(&self) -> u64 {
         let (mut reads, mut writes, mut callees) = (Vec::new(), Vec::new(), Vec::new());
         let mut end = 0u64;

@@ -79,6 +79,8 @@ fn loop_counters(p: &Program, layout: &Layout) -> (Vec<(RungId, Addr)>, u64) {
 
 /// Lowers `p` with `layout`; `fuse` chooses the fused instructions (the `fuse` module) where a
 /// rung allows them (off: only the general instructions, the reference they are tested against).
+/// The code is not checked here: `raw::CheckedCode::new`, which the machine keeps it in, checks
+/// what the interpreter's unchecked reads rely on.
 pub(crate) fn lower(p: &Program, layout: &Layout, fuse: bool) -> Result<Code, LowerError> {
     if layout.var_count() != p.vars.len() {
         return Err(LowerError::LayoutMismatch {
