@@ -12,7 +12,7 @@
 //! strict, never too lax.
 
 use super::layout::{Repr, COUNTER_BYTES, CTUD_BYTES, TIMER_BYTES, TRIGGER_BYTES};
-use super::lower::{Op, Pc};
+use super::lower::{Code, Op, Pc};
 use super::store::Addr;
 use super::strings::STR_SLOT;
 use super::Machine;
@@ -25,12 +25,13 @@ impl Machine {
     /// Appends the byte spans `rung`'s instructions (and those of the POUs it calls) may read to
     /// `reads` and may write to `writes` (unsorted, maybe with repeats).
     pub fn rung_accesses(&self, rung: RungId, reads: &mut Vec<Span>, writes: &mut Vec<Span>) {
+        let code: &Code = &self.code;
         let mut pous: Vec<Pc> = Vec::new();
-        let start = self.rung_op[rung.index()].index();
-        self.op_accesses(start, true, reads, writes, &mut pous);
+        let start = code.rung_op[rung.index()].index();
+        code.op_accesses(start, true, reads, writes, &mut pous);
         let mut i = 0;
         while i < pous.len() {
-            self.op_accesses(pous[i].index(), false, reads, writes, &mut pous);
+            code.op_accesses(pous[i].index(), false, reads, writes, &mut pous);
             i += 1;
         }
     }
@@ -45,9 +46,16 @@ impl Machine {
             })
             .collect()
     }
+}
 
-    /// One past the last byte any instruction (of any POU) reads or writes.
-    pub(super) fn access_end(&self) -> u64 {
+impl Code {
+    /// One past the last byte any instruction (of any POU) or loop counter reads or writes
+    /// (`raw::CheckedCode::new` checks it against the state size).
+    ///
+    /// # Panics
+    /// If an instruction or operand index of the code is out of range (`CheckedCode::new`
+    /// checks those first, with a message).
+    pub(crate) fn access_end(&self) -> u64 {
         let (mut reads, mut writes, mut callees) = (Vec::new(), Vec::new(), Vec::new());
         let mut end = 0u64;
         for &entry in &self.pou_entry {

@@ -36,7 +36,7 @@ fn compare(p: &Program, scans: u64, seed: u64) -> usize {
         assert_eq!(a, b, "state after scan {scan} (seed {seed})");
         assert_eq!(fa, fb, "faults after scan {scan} (seed {seed})");
     }
-    fused.fused.len()
+    fused.code.fused.len()
 }
 
 #[test]

@@ -124,10 +124,11 @@
 //! several threads, bit-identical to [`Machine::run_scan`].
 #![warn(missing_docs)]
 #![warn(clippy::undocumented_unsafe_blocks)]
-// `unsafe` only where it is allowed by name: the state's memory (`mem`), the sequential walk's
-// unchecked store (`store`), the interpreter (`run`), the two calls into it below, and the
-// parallel machine's shared state (`parallel::machine`'s `shared`, `items`, `claimed`,
-// `workers`, `exchange`, `xlines`).
+// `unsafe` only where it is allowed by name: every raw memory access is in `raw` (the state's
+// lines, the checked code's unchecked reads, the sequential and the shared stores, the SIMD
+// packing); the other modules that say `unsafe` only call `raw`'s `unsafe fn`s (or their own,
+// built on them) and argue each call's `# Safety` in their file: the interpreter (`run`) and
+// the parallel machine's `items`, `claimed`, `exchange` and `workers`.
 #![deny(unsafe_code)]
 
 mod access;
@@ -139,13 +140,13 @@ mod fuse;
 mod fuse_tests;
 mod layout;
 mod lower;
-#[allow(unsafe_code)]
 mod mem;
 mod output_mode;
 pub mod parallel;
 #[allow(unsafe_code)]
-mod run;
+mod raw;
 #[allow(unsafe_code)]
+mod run;
 mod store;
 pub mod strings;
 mod value;
@@ -161,9 +162,7 @@ pub use mem::{Mem, LINE_BYTES};
 pub use store::{load_bits, Addr, Store, Word};
 pub use value::{load_value, store_value, VarValue};
 
-use lower::{ForId, ForLoop, Op, Pc};
 use plc_model::{Arena, Program, RungId, Type, Value, VarClass, VarId, VarRef};
-use run::{everywhere, Flow};
 
 /// Execution parameters.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
@@ -287,27 +286,16 @@ struct VarInfo {
 /// drive many states, and many threads can run it at once on disjoint (or shared) stores.
 #[derive(Debug)]
 pub struct Machine {
-    ops: Vec<Op>,
-    consts: Vec<(Addr, Value)>,
-    fors: Vec<ForLoop>,
-    ctuds: Vec<fb::CtudPins>,
-    funcs: Vec<lower::FuncCall>,
-    fused: Vec<fuse::FusedRung>,
-    tables: Vec<fuse::Table>,
-    rung_op: Vec<Pc>,
-    for_of_head: Vec<Option<ForId>>,
-    pou_entry: Vec<Pc>,
-    counters: Vec<(RungId, Addr)>,
+    /// The lowered code (instructions, their operands, entries, loop counters, constants, state
+    /// size, dialect), checked once for the interpreter's unchecked accesses.
+    code: raw::CheckedCode,
     /// The budget task of each rung (`budget::tasks`).
     budget_task: Vec<Option<u32>>,
-    size: u32,
     main_first: RungId,
     vars: Arena<VarId, VarInfo>,
     inits: Vec<Value>,
     layout: Layout,
     config: ExecConfig,
-    /// The rules where toolchains differ (counters, timers, TIME conversions).
-    dialect: plc_model::Dialect,
 }
 
 impl Machine {
@@ -339,23 +327,12 @@ impl Machine {
         config: &ExecConfig,
         fuse: bool,
     ) -> Result<Machine, LowerError> {
-        let code = lower::lower(program, &layout, fuse)?;
+        // What makes the interpreter's unchecked accesses sound is checked here, once.
+        let code = raw::CheckedCode::new(lower::lower(program, &layout, fuse)?);
         Ok(Machine {
             main_first: program.rungs().id(program.main().rungs.start as usize),
-            ops: code.ops,
-            consts: code.consts,
-            fors: code.fors,
-            ctuds: code.ctuds,
-            funcs: code.funcs,
-            fused: code.fused,
-            tables: code.tables,
-            rung_op: code.rung_op,
-            for_of_head: code.for_of_head,
-            pou_entry: code.pou_entry,
-            counters: code.counters,
-            dialect: code.dialect,
+            code,
             budget_task: budget::tasks(program),
-            size: code.size,
             vars: program
                 .vars()
                 .iter()
@@ -367,15 +344,6 @@ impl Machine {
             inits: program.vars().iter().map(|v| v.init).collect(),
             layout,
             config: *config,
-        })
-        .inspect(|m| {
-            // What makes the unchecked store of `run_scan_in` sound: every byte any instruction
-            // touches is inside the state (loop counters and constants included; `begin_scan`
-            // writes only the counters the loop-back instructions use).
-            assert!(
-                m.access_end() <= m.size as u64,
-                "lowering placed an access past the state"
-            );
         })
     }
 
@@ -392,13 +360,13 @@ impl Machine {
     /// Bytes a state must have: the layout's variables, then (if the program has loop-back
     /// rungs) the loop counters, one per 64-byte line from the next line, then the constants.
     pub fn state_size(&self) -> u32 {
-        self.size
+        self.code.size
     }
 
     /// The loop-back rungs (NEXT rungs and rungs with a backward jump, any POU) with the
     /// addresses of their counters (`u64`), in rung order.
     pub fn loop_counters(&self) -> impl ExactSizeIterator<Item = (RungId, Addr)> + '_ {
-        self.counters.iter().copied()
+        self.code.counters.iter().copied()
     }
 
     /// Every value the state holds but its constants, in an order that does not depend on the
@@ -411,14 +379,15 @@ impl Machine {
             let at = self.layout.start(v);
             out.extend(parts(info.ty).iter().map(|&(o, w)| (at.offset(o), w)));
         }
-        out.extend(self.counters.iter().map(|&(_, at)| (at, 8)));
+        out.extend(self.code.counters.iter().map(|&(_, at)| (at, 8)));
         out
     }
 
     /// How many times loop-back rung `rung` looped back (or was refused) in the current scan of
     /// `state`; `None` if it is not a loop-back rung.
     pub fn loop_count(&self, state: &State, rung: RungId) -> Option<u64> {
-        self.counters
+        self.code
+            .counters
             .iter()
             .find(|&&(r, _)| r == rung)
             .map(|&(_, at)| state.bytes().load::<u64>(at))
@@ -429,25 +398,25 @@ impl Machine {
     /// [`resume`](Self::resume) calls it once before the scan's first piece.
     #[inline]
     pub fn begin_scan<S: Store + ?Sized>(&self, store: &mut S) {
-        for &(_, at) in &self.counters {
+        for &(_, at) in &self.code.counters {
             store.store(at, 0u64);
         }
     }
 
     /// Number of lowered instructions (rung markers included).
     pub fn instruction_count(&self) -> usize {
-        self.ops.len()
+        self.code.ops.len()
     }
 
     /// The state at load: declared initial values, instances zero, padding zero, constants.
     pub fn initial_state(&self) -> State {
-        let mut mem = Mem::zeroed(self.size as usize);
+        let mut mem = Mem::zeroed(self.code.size as usize);
         for (v, info) in self.vars.iter_enumerated() {
             if !matches!(info.ty, Type::Fb(_)) {
                 store_value(&mut mem[..], self.layout.start(v), self.inits[v.index()]);
             }
         }
-        for &(at, c) in &self.consts {
+        for &(at, c) in &self.code.consts {
             store_value(&mut mem[..], at, c);
         }
         State { mem }
@@ -505,36 +474,6 @@ impl Machine {
         self.run_scan_in(state.bytes_mut(), scan, faults)
     }
 
-    /// [`run_scan`](Self::run_scan) on a state's bare bytes ([`State::bytes_mut`]).
-    ///
-    /// # Panics
-    /// If `mem` has fewer than [`Machine::state_size`] bytes.
-    #[inline]
-    #[allow(unsafe_code)]
-    pub fn run_scan_in(&self, mem: &mut [u8], scan: u64, faults: &mut Vec<Fault>) {
-        assert!(
-            mem.len() >= self.size as usize,
-            "state too small for this machine"
-        );
-        // SAFETY: `mem` has at least `size` bytes (asserted above), and every address the
-        // machine's instructions, loops and counters use ends inside `size` (asserted once in
-        // `Machine::new` from the same instructions, which are immutable); `exec` and
-        // `begin_scan` access nothing else.
-        let mut mem = unsafe { store::Trusted::new(mem) };
-        self.begin_scan(&mut mem);
-        let mut ctx = self.context(scan, faults);
-        // SAFETY: the main program's entry is an entry of the machine's checked instructions.
-        unsafe {
-            self.exec(
-                &mut mem,
-                &mut ctx,
-                self.pou_entry[0].index(),
-                self.main_first,
-                &everywhere,
-            )
-        };
-    }
-
     /// [`set_inputs`](Self::set_inputs) then [`run_scan`](Self::run_scan).
     pub fn scan(
         &self,
@@ -562,37 +501,6 @@ impl Machine {
         F: Fn(RungId) -> bool,
     {
         self.resume(store, ctx, Exit::Rung(start), inside)
-    }
-
-    /// Like [`run_from`](Self::run_from), starting where an earlier run left: at a rung, at a FOR
-    /// test (without the head rung's conditions), or nowhere (`Exit::Stop` returns `Stop`).
-    #[allow(unsafe_code)]
-    pub fn resume<S, F>(&self, store: &mut S, ctx: &mut ScanCtx<'_>, at: Exit, inside: F) -> Exit
-    where
-        S: Store + ?Sized,
-        F: Fn(RungId) -> bool,
-    {
-        let (pc, rung) = match at {
-            Exit::Stop => return Exit::Stop,
-            Exit::Rung(r) => (self.rung_op[r.index()], r),
-            Exit::ForTest(h) => {
-                let Some(f) = self.for_of_head[h.index()] else {
-                    panic!("rung {} is not a FOR head", h.raw());
-                };
-                if !inside(h) {
-                    return at;
-                }
-                (self.fors[f.index()].test, h)
-            }
-        };
-        // SAFETY: `pc` is a rung's start (`rung_op`, indexed with a bounds check) or a FOR
-        // loop's test (`fors`, of a rung `for_of_head` names as a head): entries of the checked
-        // instructions.
-        match unsafe { self.exec(store, ctx, pc.index(), rung, &inside) } {
-            Flow::Return | Flow::Stop => Exit::Stop,
-            Flow::Rung(r) => Exit::Rung(r),
-            Flow::ForTest(h) => Exit::ForTest(h),
-        }
     }
 
     /// The value of a variable: its scalar value, or an instance's readable fields.

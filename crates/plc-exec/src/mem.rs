@@ -2,35 +2,25 @@
 //! the cache line it lives on (what the parallel plan check counts) and no value straddles two
 //! lines (the layout aligns each value to its width).
 //!
-//! A [`Mem`] is a whole number of [`Line`]s viewed as one byte slice of the requested length
-//! (the bytes past it, up to the end of the last line, are zero and never seen). It does no
-//! typed access (`store`) and knows no layout (`layout`).
+//! A [`Mem`] is a whole number of lines viewed as one byte slice of the requested length (the
+//! bytes past it, up to the end of the last line, are zero and never seen; the view is
+//! `raw::LineBytes`). It does no typed access (`store`) and knows no layout (`layout`).
 
+use super::raw::LineBytes;
 use std::fmt;
 use std::ops::{Deref, DerefMut};
 
 /// Bytes per cache line (x86-64, most aarch64).
 pub const LINE_BYTES: u32 = 64;
 
-/// One cache line of state memory.
-#[repr(C, align(64))]
-#[derive(Copy, Clone, PartialEq, Eq)]
-struct Line([u8; LINE_BYTES as usize]);
-
 /// A state's memory: `len` bytes starting on a 64-byte boundary, zero-initialised.
 #[derive(Clone)]
-pub struct Mem {
-    lines: Vec<Line>,
-    len: usize,
-}
+pub struct Mem(LineBytes);
 
 impl Mem {
     /// `len` zero bytes.
     pub fn zeroed(len: usize) -> Mem {
-        Mem {
-            lines: vec![Line([0; LINE_BYTES as usize]); len.div_ceil(LINE_BYTES as usize)],
-            len,
-        }
+        Mem(LineBytes::zeroed(len))
     }
 }
 
@@ -38,17 +28,14 @@ impl Deref for Mem {
     type Target = [u8];
     #[inline(always)]
     fn deref(&self) -> &[u8] {
-        // SAFETY: `Line` is `repr(C)` around `[u8; 64]`: the lines are `64 × lines.len()`
-        // initialised bytes with no padding, and `len <= 64 × lines.len()` (see `zeroed`).
-        unsafe { std::slice::from_raw_parts(self.lines.as_ptr().cast::<u8>(), self.len) }
+        self.0.bytes()
     }
 }
 
 impl DerefMut for Mem {
     #[inline(always)]
     fn deref_mut(&mut self) -> &mut [u8] {
-        // SAFETY: as in `deref`; the `&mut self` borrow makes the slice the only access.
-        unsafe { std::slice::from_raw_parts_mut(self.lines.as_mut_ptr().cast::<u8>(), self.len) }
+        self.0.bytes_mut()
     }
 }
 

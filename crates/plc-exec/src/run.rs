@@ -4,14 +4,22 @@
 //! instructions. Integer arithmetic wraps in the type's width (two's complement for the signed
 //! types, modulo 2^n for the unsigned ones and the bit strings); a DIV or MOD by zero writes 0
 //! and records a fault.
+//!
+//! The instruction fetch, the fused rungs' operand reads and the sequential store are
+//! unchecked: `raw`'s `unsafe fn`s, whose preconditions this file argues from the machine's
+//! [`CheckedCode`](super::raw::CheckedCode) (checked once, by its only constructor, when the
+//! machine is built) and from how `exec` moves its instruction index. `exec` itself is an
+//! `unsafe fn` private to this file; its two entry points ([`Machine::run_scan_in`],
+//! [`Machine::resume`]) are here too.
 
 use super::fuse::{lookup, FusedId, FusedRung};
 use super::layout::{CV, ET, FLAGS, PREV, PT, PV, Q, START};
 use super::lower::{Num, Op, Width};
+use super::raw::Trusted;
 use super::store::{Addr, Word};
 use super::strings;
 use super::value::{load_value, store_value};
-use super::{BudgetSpent, Fault, FaultKind, Machine, ScanCtx, Store};
+use super::{BudgetSpent, Exit, Fault, FaultKind, Machine, ScanCtx, Store};
 use plc_model::{ArithOp, CmpOp, RungId, TimerKind, Type, Value};
 
 /// How a run of instructions ended.
@@ -206,7 +214,7 @@ impl Machine {
         }
         let mut buf = [Value::Bool(false); 8];
         let load = |&(at, ty): &(Addr, Type)| load_value(st, at, ty);
-        let unit = self.dialect.time_unit_ms();
+        let unit = self.code.dialect.time_unit_ms();
         let r = if let (plc_model::Function::Convert { from, to }, true) = (c.func, unit != 1) {
             super::functions::convert_time_in(load(&c.args[0]), from, to, unit)
         } else if c.args.len() <= buf.len() {
@@ -254,17 +262,69 @@ fn past<S: Store + ?Sized>(st: &S, num: Num, var: Addr, to: Addr) -> bool {
 }
 
 impl Machine {
+    /// [`run_scan`](Self::run_scan) on a state's bare bytes ([`State::bytes_mut`](super::State::bytes_mut)).
+    ///
+    /// # Panics
+    /// If `mem` has fewer than [`Machine::state_size`] bytes.
+    #[inline]
+    pub fn run_scan_in(&self, mem: &mut [u8], scan: u64, faults: &mut Vec<super::Fault>) {
+        // SAFETY: `mem` goes only to `begin_scan`, which stores at `self.code`'s loop counters,
+        // and `exec` on `self.code`, which loads and stores only at its instructions' addresses
+        // (`Trusted::new`'s contract; it asserts the size).
+        let mut mem = unsafe { Trusted::new(mem, &self.code) };
+        self.begin_scan(&mut mem);
+        let mut ctx = self.context(scan, faults);
+        // SAFETY: `pou_entry[0]` (indexed with a bounds check) is the main program's entry, an
+        // instruction index `self.code` holds.
+        unsafe {
+            self.exec(
+                &mut mem,
+                &mut ctx,
+                self.code.pou_entry[0].index(),
+                self.main_first,
+                &everywhere,
+            )
+        };
+    }
+
+    /// Like [`run_from`](Self::run_from), starting where an earlier run left: at a rung, at a FOR
+    /// test (without the head rung's conditions), or nowhere (`Exit::Stop` returns `Stop`).
+    pub fn resume<S, F>(&self, store: &mut S, ctx: &mut ScanCtx<'_>, at: Exit, inside: F) -> Exit
+    where
+        S: Store + ?Sized,
+        F: Fn(RungId) -> bool,
+    {
+        let (pc, rung) = match at {
+            Exit::Stop => return Exit::Stop,
+            Exit::Rung(r) => (self.code.rung_op[r.index()], r),
+            Exit::ForTest(h) => {
+                let Some(f) = self.code.for_of_head[h.index()] else {
+                    panic!("rung {} is not a FOR head", h.raw());
+                };
+                if !inside(h) {
+                    return at;
+                }
+                (self.code.fors[f.index()].test, h)
+            }
+        };
+        // SAFETY: `pc` is a rung's start (`self.code.rung_op`) or a FOR loop's test
+        // (`self.code.fors`), both indexed with a bounds check: an instruction index the code
+        // holds.
+        match unsafe { self.exec(store, ctx, pc.index(), rung, &inside) } {
+            Flow::Return | Flow::Stop => Exit::Stop,
+            Flow::Rung(r) => Exit::Rung(r),
+            Flow::ForTest(h) => Exit::ForTest(h),
+        }
+    }
+
     /// Runs instructions from `pc` until the POU ends, the scan stops, or control reaches a rung
     /// (or FOR test) for which `inside` is false. `rung` is the rung `pc` belongs to (for faults
     /// before the first rung marker, i.e. when resuming at a FOR test).
     ///
     /// # Safety
-    /// `pc` is an entry of this machine's instructions: a POU's entry (`pou_entry`), a rung's
-    /// start (`rung_op`) or a FOR test (`fors[_].test`). `Machine::new`, the only constructor,
-    /// ran `lower::check` on these instructions, which are never changed afterwards: every
-    /// entry and jump target is an instruction, and control falls through only from
-    /// instructions before the last, an `EndPou`, which returns.
-    pub(crate) unsafe fn exec<S, F>(
+    /// `pc` is an instruction index `self.code` holds: a POU's entry (`pou_entry`), a rung's
+    /// start (`rung_op`) or a FOR test (`fors[_].test`).
+    unsafe fn exec<S, F>(
         &self,
         st: &mut S,
         ctx: &mut ScanCtx<'_>,
@@ -276,15 +336,17 @@ impl Machine {
         S: Store + ?Sized,
         F: Fn(RungId) -> bool,
     {
-        let ops = &self.ops[..];
+        let ops = self.code.ops();
         let mut p: u64 = 1;
         let mut s: u64 = 0;
         let b = |st: &S, at: Addr| st.load::<u8>(at) as u64;
         loop {
-            // SAFETY: `pc` < `ops.len()`: it starts at an entry (this function's contract), every
-            // jump target is an instruction, and control falls through only from instructions
-            // before the last, an `EndPou`, which returns (the checked code, same contract).
-            let op = *unsafe { ops.get_unchecked(pc) };
+            // SAFETY: `CheckedOps::at`'s contract: `pc` is an instruction index the code holds
+            // (the first time: this function's contract; after a jump, a call's return or a FOR
+            // exit or test: the `to` of the instruction just fetched, or a `test` or `exit` of
+            // `self.code.fors`), or one past the instruction just fetched, which was not an
+            // `EndPou` (an `EndPou` returns: the match below).
+            let op = unsafe { ops.at(pc) };
             pc += 1;
             match op {
                 Op::Rung { id } => {
@@ -307,10 +369,12 @@ impl Machine {
                         return Flow::Rung(id);
                     }
                     rung = id;
-                    self.fused_rung(st, f, table, neg);
-                    // SAFETY: `pc` < `ops.len()`: a fused rung is never the last instruction
-                    // (`lower::check`, run by `Machine::new`).
-                    match *unsafe { ops.get_unchecked(pc) } {
+                    // SAFETY: `(f, table)` are the operands of the `Fused` instruction just
+                    // fetched from `self.code` (before the loop or at its end).
+                    unsafe { self.fused_rung(st, f, table, neg) };
+                    // SAFETY: `pc` is one past the fused rung just fetched, not an `EndPou`
+                    // (`CheckedOps::at`'s contract).
+                    match unsafe { ops.at(pc) } {
                         Op::Fused {
                             id: i,
                             f: g,
@@ -328,7 +392,8 @@ impl Machine {
                         return Flow::Rung(id);
                     }
                     rung = id;
-                    p = self.fused_power(st, f, table, neg) as u64;
+                    // SAFETY: the operands of the `FusedHead` just fetched from `self.code`.
+                    p = unsafe { self.fused_power(st, f, table, neg) } as u64;
                 }
                 Op::Contact { neg, at } => p &= b(st, at) ^ neg as u64,
                 Op::Contact2 { neg, a, b: c } => {
@@ -384,7 +449,7 @@ impl Machine {
                 }
                 Op::Timer { kind, inst, pt } => {
                     let pt = st.load::<i32>(pt) as i64;
-                    let late = self.dialect.timer_compares_after_edge();
+                    let late = self.code.dialect.timer_compares_after_edge();
                     let q = match kind {
                         TimerKind::Ton => ton(st, ctx.now, inst, pt, p != 0, late),
                         TimerKind::Tof => tof(st, ctx.now, inst, pt, p != 0, late),
@@ -395,13 +460,13 @@ impl Machine {
                 Op::Ctu { inst, pv, reset } => {
                     let pv = st.load::<i16>(pv);
                     let reset = st.load::<u8>(reset) != 0;
-                    let stop = self.dialect.counters_stop_at_preset();
+                    let stop = self.code.dialect.counters_stop_at_preset();
                     p = counter(st, inst, pv, p as u8, reset, true, stop) as u64;
                 }
                 Op::Ctd { inst, pv, load } => {
                     let pv = st.load::<i16>(pv);
                     let load = st.load::<u8>(load) != 0;
-                    let stop = self.dialect.counters_stop_at_preset();
+                    let stop = self.code.dialect.counters_stop_at_preset();
                     p = counter(st, inst, pv, p as u8, load, false, stop) as u64;
                 }
                 Op::Bistable { kind, inst, reset } => {
@@ -412,8 +477,8 @@ impl Machine {
                     p = super::fb::trigger(st, kind, inst, p != 0) as u64;
                 }
                 Op::Ctud { inst, pins } => {
-                    let pins = self.ctuds[pins.index()];
-                    let stop = self.dialect.counters_stop_at_preset();
+                    let pins = self.code.ctuds[pins.index()];
+                    let stop = self.code.dialect.counters_stop_at_preset();
                     p = super::fb::ctud(st, inst, pins, p != 0, stop) as u64;
                 }
                 Op::Move { width, from, to } => {
@@ -438,7 +503,7 @@ impl Machine {
                 }
                 Op::Func { call } => {
                     if p != 0 {
-                        self.call_function(st, &self.funcs[call.index()]);
+                        self.call_function(st, &self.code.funcs[call.index()]);
                     }
                 }
                 Op::Arith { op, num, a, b, out } => {
@@ -484,8 +549,8 @@ impl Machine {
                 Op::Call { to, charge } => {
                     if p != 0
                         && self.charge(ctx, rung, charge)
-                        // SAFETY: `to` is a POU entry of the checked code (`lower::check`
-                        // checks every CALL's target; this function's contract).
+                        // SAFETY: `to` is the target of a `Call` instruction of `self.code`
+                        // (just fetched): an instruction index the code holds.
                         && unsafe { self.exec(st, ctx, to.index(), rung, &everywhere) }
                             != Flow::Return
                     {
@@ -493,7 +558,7 @@ impl Machine {
                     }
                 }
                 Op::For { f } => {
-                    let l = &self.fors[f.index()];
+                    let l = &self.code.fors[f.index()];
                     if p != 0 {
                         by_num!(l.num, T => copy::<T, S>(st, l.from, l.var), {});
                     } else {
@@ -501,13 +566,13 @@ impl Machine {
                     }
                 }
                 Op::ForTest { f } => {
-                    let l = &self.fors[f.index()];
+                    let l = &self.code.fors[f.index()];
                     if past(st, l.num, l.var, l.to) {
                         pc = l.exit.index();
                     }
                 }
                 Op::Next { f } => {
-                    let l = &self.fors[f.index()];
+                    let l = &self.code.fors[f.index()];
                     if !(self.loop_back(st, ctx, l.ctr, rung) && self.charge(ctx, rung, l.charge)) {
                         pc = l.exit.index();
                         continue;
@@ -526,16 +591,13 @@ impl Machine {
 
     /// Runs fused rung `f` (its instruction's other operands given): its output's new value
     /// looked up from its contacts and its old value, written without a branch.
+    ///
+    /// # Safety
+    /// `(f, table)` are the operands of a `Fused` instruction of `self.code`.
     #[inline(always)]
-    fn fused_rung<S: Store + ?Sized>(&self, st: &mut S, f: FusedId, table: u16, neg: u8) {
-        // SAFETY: every fused rung's operands and table exist (`lower::check`, run by
-        // `Machine::new` on these immutable instructions).
-        let (r, t) = unsafe {
-            (
-                self.fused.get_unchecked(f.index()),
-                self.tables.get_unchecked(table as usize),
-            )
-        };
+    unsafe fn fused_rung<S: Store + ?Sized>(&self, st: &mut S, f: FusedId, table: u16, neg: u8) {
+        // SAFETY: this function's contract is `fused_operands`'.
+        let (r, t) = unsafe { self.code.fused_operands(f, table) };
         let old = st.load::<u8>(r.out) as usize;
         st.store(
             r.out,
@@ -544,15 +606,13 @@ impl Machine {
     }
 
     /// The power fused head `f` gives (its instruction's other operands given).
+    ///
+    /// # Safety
+    /// `(f, table)` are the operands of a `FusedHead` instruction of `self.code`.
     #[inline(always)]
-    fn fused_power<S: Store + ?Sized>(&self, st: &S, f: FusedId, table: u16, neg: u8) -> u8 {
-        // SAFETY: as in `fused_rung`.
-        let (r, t) = unsafe {
-            (
-                self.fused.get_unchecked(f.index()),
-                self.tables.get_unchecked(table as usize),
-            )
-        };
+    unsafe fn fused_power<S: Store + ?Sized>(&self, st: &S, f: FusedId, table: u16, neg: u8) -> u8 {
+        // SAFETY: this function's contract is `fused_operands`'.
+        let (r, t) = unsafe { self.code.fused_operands(f, table) };
         lookup(t, contact_bits(st, r) ^ neg as usize)
     }
 

@@ -88,35 +88,6 @@ impl Store for [u8] {
     }
 }
 
-/// A state's memory with the bounds already checked for every address the machine uses: the
-/// sequential interpreter's store, without a bounds check per access.
-pub(crate) struct Trusted<'a>(&'a mut [u8]);
-
-impl<'a> Trusted<'a> {
-    /// # Safety
-    /// Every `(address, T)` that will be loaded or stored through it has `address + T::SIZE <=
-    /// mem.len()`.
-    #[inline(always)]
-    pub(crate) unsafe fn new(mem: &'a mut [u8]) -> Trusted<'a> {
-        Trusted(mem)
-    }
-}
-
-impl Store for Trusted<'_> {
-    #[inline(always)]
-    fn load<T: Word>(&self, at: Addr) -> T {
-        debug_assert!(at.index() + T::SIZE <= self.0.len());
-        // SAFETY: in bounds by the contract of `Trusted::new`.
-        T::read(unsafe { self.0.get_unchecked(at.index()..at.index() + T::SIZE) })
-    }
-    #[inline(always)]
-    fn store<T: Word>(&mut self, at: Addr, v: T) {
-        debug_assert!(at.index() + T::SIZE <= self.0.len());
-        // SAFETY: in bounds by the contract of `Trusted::new`.
-        v.write(unsafe { self.0.get_unchecked_mut(at.index()..at.index() + T::SIZE) })
-    }
-}
-
 /// The bits of the `width`-byte value at `at` (1, 2, 4 or 8), zero-extended: a layout-free view
 /// of a stored value, for digests and comparisons.
 ///

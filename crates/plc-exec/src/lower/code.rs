@@ -1,7 +1,7 @@
 //! The interpreter's instruction set and the lowered program ([`Code`]): what lowering
 //! (the parent module) produces and the machine runs. Plain data: each instruction's operands
-//! are state addresses ([`Addr`]) and instruction indices ([`Pc`]), checked once by the
-//! parent's `check` after lowering.
+//! are state addresses ([`Addr`]) and instruction indices ([`Pc`]), checked once after lowering
+//! by `raw::CheckedCode::new`, the only way a machine holds code.
 //!
 //! Not here: how the model becomes these instructions (the parent), nor how they run
 //! (`super::super::run`).
@@ -237,6 +237,7 @@ pub(crate) struct ForLoop {
 }
 
 /// The lowered program.
+#[derive(Debug)]
 pub(crate) struct Code {
     pub ops: Vec<Op>,
     /// The constants and where they live (written by `Machine::initial_state`).

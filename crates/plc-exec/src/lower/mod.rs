@@ -78,6 +78,8 @@ fn loop_counters(p: &Program, layout: &Layout) -> (Vec<(RungId, Addr)>, u64) {
 
 /// Lowers `p` with `layout`; `fuse` chooses the fused instructions (the `fuse` module) where a
 /// rung allows them (off: only the general instructions, the reference they are tested against).
+/// The code is not checked here: `raw::CheckedCode::new`, which the machine keeps it in, checks
+/// what the interpreter's unchecked reads rely on.
 pub(crate) fn lower(p: &Program, layout: &Layout, fuse: bool) -> Result<Code, LowerError> {
     if layout.var_count() != p.vars().len() {
         return Err(LowerError::LayoutMismatch {
@@ -176,43 +178,7 @@ pub(crate) fn lower(p: &Program, layout: &Layout, fuse: bool) -> Result<Code, Lo
             pou_end[pou.index()]
         };
     }
-    check(&code);
     Ok(code)
-}
-
-/// Checks what the interpreter's unchecked accesses rely on, once per machine: the last
-/// instruction is an `EndPou` (so falling through never leaves the array), every instruction
-/// index the code holds (jumps, calls, FOR tests and exits, rung starts, POU entries) is an
-/// instruction, and every fused rung's operands and table exist.
-///
-/// # Panics
-/// If lowering broke one of these (a bug, never bad input).
-fn check(code: &Code) {
-    let n = code.ops.len();
-    assert!(
-        matches!(code.ops.last(), Some(Op::EndPou)),
-        "lowering: the code ends with an EndPou"
-    );
-    let pcs = code.rung_op.iter().chain(&code.pou_entry);
-    let loops = code.fors.iter().flat_map(|l| [l.test, l.exit]);
-    let jumps = code.ops.iter().filter_map(|op| match *op {
-        Op::Jmp { to } | Op::JmpBack { to, .. } | Op::Call { to, .. } => Some(to),
-        _ => None,
-    });
-    for pc in pcs.copied().chain(loops).chain(jumps) {
-        assert!(pc.index() < n, "lowering: instruction {} of {n}", pc.raw());
-    }
-    for op in &code.ops {
-        if let Op::Fused { f, table, .. } | Op::FusedHead { f, table, .. } = *op {
-            assert!(
-                f.index() < code.fused.len() && (table as usize) < code.tables.len(),
-                "lowering: a fused rung's operands"
-            );
-        }
-        if let Op::For { f } | Op::ForTest { f } | Op::Next { f } = *op {
-            assert!(f.index() < code.fors.len(), "lowering: a FOR loop");
-        }
-    }
 }
 
 impl Lowerer<'_> {

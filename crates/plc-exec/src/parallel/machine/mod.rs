@@ -29,6 +29,8 @@
 //! [`ParallelMachine`]'s implementation, so they use this module's types as this module uses
 //! their functions.
 
+// `unsafe` is allowed only where `crate::raw`'s `unsafe fn`s (or `items`' `run_item`, built on
+// them) are called, each call arguing its `# Safety` from the plan's discipline in its file.
 mod backoff;
 mod barrier;
 #[allow(unsafe_code)]
@@ -41,12 +43,10 @@ mod flags;
 mod items;
 mod relayout;
 mod run_log;
-#[allow(unsafe_code)]
 mod shared;
 mod units;
 #[allow(unsafe_code)]
 mod workers;
-#[allow(unsafe_code)]
 mod xlines;
 
 pub use barrier::SpinBarrier;

@@ -9,8 +9,9 @@
 //! (Relaxed atomics of each value's width compile to the same instructions one by one, but they
 //! keep the compiler from merging and reordering the interpreter's accesses: the parallel
 //! path's per-rung cost was 1.25× the sequential walk's with them, 1.05× without, one worker
-//! running every unit of gen 20k, four interleaved rounds.) Every `unsafe` states its argument. Depends on the barrier,
-//! padding and typed indices below it; it does not run anything.
+//! running every unit of gen 20k, four interleaved rounds.) The raw accesses themselves
+//! ([`SharedSlots`], `ItemStore`) are `crate::raw`'s; this module says no `unsafe`. Depends on
+//! the barrier, padding and typed indices below it; it does not run anything.
 
 use super::barrier::SpinBarrier;
 use super::flags::ReadyFlags;
@@ -18,135 +19,25 @@ use super::units::{Units, WindowBell};
 use crate::parallel::ids::{Decision, DecisionSlot};
 use crate::parallel::pad::Padded;
 use crate::parallel::planning::RemoteLines;
-use crate::{Addr, Fault, Machine, Store, Word, LINE_BYTES};
+use crate::{Fault, LINE_BYTES};
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::{Mutex, MutexGuard, PoisonError};
 
-/// The state's bytes, shared by all workers without locks.
-#[derive(Copy, Clone, Debug)]
-pub struct SharedSlots {
-    /// The first byte: on a 64-byte line (a `State`'s memory).
-    pub(super) ptr: *mut u8,
-    pub(super) len: usize,
-}
-
-// SAFETY: a `SharedSlots` is only created by `ParallelMachine::run` from the `&mut State` it
-// holds for the whole run, and only for plans that passed their check: in a phase, no byte
-// one worker writes is read or written by another, and phases are ordered by Release/Acquire
-// hand-overs, so sharing it between threads never lets two accesses to one byte race (the
-// module's argument; `ItemStore` below).
-unsafe impl Send for SharedSlots {}
-// SAFETY: as above.
-unsafe impl Sync for SharedSlots {}
+pub(super) use crate::raw::ItemStore;
+pub use crate::raw::SharedSlots;
 
 impl SharedSlots {
-    /// The slots of `mem`, for `machine`'s accesses.
-    ///
-    /// # Panics
-    /// If `mem` is smaller than the machine's state ([`Machine::state_size`]).
-    pub(super) fn new(mem: &mut [u8], machine: &Machine) -> SharedSlots {
-        assert!(
-            mem.len() >= machine.state_size() as usize,
-            "state too small for this machine"
-        );
-        SharedSlots {
-            ptr: mem.as_mut_ptr(),
-            len: mem.len(),
-        }
-    }
-
-    /// The pointer to the `T` at `at`, unchecked. Every address a [`Machine`]'s instructions,
-    /// loops and counters use ends inside its state size (asserted once by `Machine::new` from
-    /// the same immutable instructions), and `new` asserted that the memory has at least that
-    /// many bytes: the same argument as the sequential walk's trusted store. A bounds check per
-    /// access cost the parallel scan about a fifth of its time per rung (gen 20k, half the
-    /// rungs per worker: 55 µs a scan checked, 48 unchecked).
-    #[inline(always)]
-    fn at<T: Word>(&self, at: Addr) -> *mut u8 {
-        debug_assert!(at.index() + T::SIZE <= self.len, "access out of the state");
-        self.ptr.wrapping_add(at.index())
-    }
-
     /// Starts bringing a slice's remote lines into this core's cache: the ones it will write
     /// exclusive, the ones it will read shared (`planning::remote`; a hint, nothing else).
     #[inline]
     pub(super) fn prefetch(&self, lines: &RemoteLines) {
-        let line = |l: u32| self.ptr.wrapping_add(l as usize * LINE_BYTES as usize);
+        let line = |l: u32| self.byte_ptr(l as usize * LINE_BYTES as usize);
         for &l in &lines.writes {
             plc_hint::prefetch_write(line(l));
         }
         for &l in &lines.reads {
             plc_hint::prefetch_read(line(l));
         }
-    }
-
-    /// The memory as a slice, for worker 0 while every other worker waits at a barrier.
-    ///
-    /// # Safety
-    /// No other thread accesses the memory while the slice lives, and it does not outlive the
-    /// run (the `&mut State` the memory is borrowed from).
-    pub(super) unsafe fn bytes_mut<'a>(self) -> &'a mut [u8] {
-        // SAFETY: `ptr..ptr + len` is the state's memory, borrowed mutably for the whole run;
-        // the caller guarantees exclusive access while the slice lives.
-        unsafe { std::slice::from_raw_parts_mut(self.ptr, self.len) }
-    }
-
-    /// The memory as a shared slice, for workers that only read it while no thread writes it.
-    ///
-    /// # Safety
-    /// No thread writes the memory while the slice lives, and it does not outlive the run.
-    pub(super) unsafe fn bytes<'a>(self) -> &'a [u8] {
-        // SAFETY: as in `bytes_mut`; the caller guarantees that nobody writes meanwhile.
-        unsafe { std::slice::from_raw_parts(self.ptr, self.len) }
-    }
-}
-
-/// The shared state as the interpreter's [`Store`] while a worker runs one item of a checked
-/// plan with one machine's code: the only way the workers' interpreter reaches the shared
-/// bytes. It exists for one call of [`Machine::resume`]: every address it is given is then an
-/// address of that machine's code, which `Machine::new` checked to end inside the machine's
-/// state size, and [`new`](Self::new) asserts that the memory holds that many bytes.
-pub(super) struct ItemStore(SharedSlots);
-
-impl ItemStore {
-    /// The shared slots as `m`'s store, for one item.
-    ///
-    /// # Safety
-    /// The store is passed only to `m`'s interpreter ([`Machine::resume`]) and dropped when it
-    /// returns, so it is loaded from and stored to only at addresses of `m`'s code; and the
-    /// accesses of that item are allowed to this worker in this phase by the plan's check (no
-    /// byte it writes is touched by another worker, no byte it reads is written by another),
-    /// ordered after the phases before by a Release/Acquire hand-over.
-    ///
-    /// # Panics
-    /// If the memory is smaller than `m`'s state.
-    #[inline(always)]
-    pub(super) unsafe fn new(slots: SharedSlots, m: &Machine) -> ItemStore {
-        assert!(
-            slots.len >= m.state_size() as usize,
-            "state too small for this machine"
-        );
-        ItemStore(slots)
-    }
-}
-
-impl Store for ItemStore {
-    #[inline(always)]
-    fn load<T: Word>(&self, at: Addr) -> T {
-        let p = self.0.at::<T>(at);
-        // SAFETY: `p..p + T::SIZE` is inside the state's memory: `at` is an address of the code
-        // of the machine the store was made for (the contract of `ItemStore::new`), which ends
-        // inside its state size, and `new` asserted that the memory has at least that many
-        // bytes (initialised, borrowed for the whole run). No other worker writes these bytes
-        // meanwhile (the plan check, by the same contract), so this read races with nothing.
-        unsafe { T::read(std::slice::from_raw_parts(p, T::SIZE)) }
-    }
-    #[inline(always)]
-    fn store<T: Word>(&mut self, at: Addr, v: T) {
-        let p = self.0.at::<T>(at);
-        // SAFETY: in bounds as in `load`; no other worker reads or writes these bytes meanwhile
-        // (the plan check, by the contract of `new`), so no access races with this write.
-        unsafe { v.write(std::slice::from_raw_parts_mut(p, T::SIZE)) }
     }
 }
 

@@ -40,23 +40,14 @@ fn pack8(v: u64) -> u64 {
 }
 
 /// Bit 0 of each of 64 bytes as a word (byte i → bit i): a run of BOOL bytes (each 0 or 1) as
-/// bits.
+/// bits (on x86_64 16 bytes at a time by SSE2: `raw::pack_bools`).
 #[inline(always)]
 fn pack64(c: &[u8; 64]) -> u64 {
     #[cfg(target_arch = "x86_64")]
     {
-        use std::arch::x86_64::{_mm_loadu_si128, _mm_movemask_epi8, _mm_slli_epi64};
         let mut w = 0;
         for (k, q) in c.as_chunks::<16>().0.iter().enumerate() {
-            // Shifting each 64-bit lane left by 7 puts bit 0 of every byte into that byte's top
-            // bit, which the byte mask collects, byte i → bit i.
-            // SAFETY: SSE2 is in the x86_64 baseline (every x86_64 CPU has it and the target
-            // enables it), so the three intrinsics exist wherever this code runs; the load reads
-            // the 16 bytes of `q`, a `&[u8; 16]`, and allows any alignment.
-            let bits = unsafe {
-                _mm_movemask_epi8(_mm_slli_epi64::<7>(_mm_loadu_si128(q.as_ptr().cast())))
-            };
-            w |= u64::from(bits as u16) << (16 * k);
+            w |= u64::from(crate::raw::pack_bools(q)) << (16 * k);
         }
         w
     }
