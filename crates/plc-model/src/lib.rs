@@ -23,6 +23,7 @@ mod function;
 mod strings;
 mod tasks;
 mod types;
+pub mod untyped;
 pub use dialect::Dialect;
 pub use function::*;
 pub use strings::*;

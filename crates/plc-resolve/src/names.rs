@@ -175,8 +175,8 @@ impl<'a> Builder<'a> {
     /// The error of name `text` (first part `base`) that names nothing: the whole name when
     /// `base` is a structure (its field is unknown), else `base`.
     fn undefined(&self, text: &str, base: &str, pou: PouId) -> Invalid {
-        let root = |scope: u32| self.structure_roots.contains(&(scope, base.to_owned()));
-        let name = if text.len() > base.len() && (root(pou.index() as u32) || root(u32::MAX)) {
+        let root = |scope| self.structure_roots.contains(&(scope, base.to_owned()));
+        let name = if text.len() > base.len() && (root(Some(pou)) || root(None)) {
             text
         } else {
             base

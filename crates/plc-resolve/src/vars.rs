@@ -169,7 +169,7 @@ impl<'a> Builder<'a> {
             }
         };
         // A plain name that is the first part of declared dotted names (a structure's fields).
-        let scope_key = scope.as_ref().map_or(u32::MAX, |(p, _)| p.index() as u32);
+        let scope_key = scope.as_ref().map(|(p, _)| *p);
         let structure = !self.structure_roots.is_empty()
             && !name.contains('.')
             && self.structure_roots.contains(&(scope_key, name.to_owned()));

@@ -19,6 +19,13 @@
 //! elapsed time when `V` was last brought up to date) — and one extra rung `acc:V` at the start of
 //! the POU: `[contact V:acc, branch [[ton V:timer PT], [V := V − V:last], [V := V + V:timer.ET],
 //! [V:last := V:timer.ET]]]`.
+//!
+//! Invariants: a jump is made only once its target rung is known (a guard's when its landing
+//! rung is pushed, a JMP block's when every network's first rung is: [`ForwardJump`]), so no
+//! rung ever holds a placeholder target; targets are POU-relative ([`Lowered`]).
+//!
+//! Not here: names, declarations and scopes (the resolver's, through [`Env`]; it also places
+//! the rungs in the program and makes their jump targets absolute); the surface syntax.
 
 mod blocks;
 mod fragments;
@@ -29,21 +36,21 @@ mod standard;
 mod time;
 mod typed;
 
-use crate::operand::Untyped;
+use crate::model::*;
+use crate::types::TypedBody;
 use plc_diag::{Invalid, LoadError, Origin};
-use plc_fbd::model::*;
-use plc_fbd::types::TypedBody;
+use plc_model::untyped::Untyped;
 use plc_model::*;
 use std::collections::HashMap;
 use std::ops::Range;
 
 type Result<T> = std::result::Result<T, LoadError>;
 
-pub use plc_fbd::ACCUMULATE_PT_MS;
+use crate::ACCUMULATE_PT_MS;
 
 /// What the lowering needs from the reader: names resolved in the POU's scope, new hidden
 /// variables.
-pub(crate) trait Env {
+pub trait Env {
     /// A name read by a block: variable, instance field (`T1.Q`) or user instance member (`G1.OUT`).
     fn lookup(&self, text: &str) -> std::result::Result<(VarRef, Type), Invalid>;
     /// A variable a block writes.
@@ -58,7 +65,7 @@ pub(crate) trait Env {
 }
 
 /// What an `instance` names.
-pub(crate) enum InstanceRef {
+pub enum InstanceRef {
     /// A TON/TOF/TP/CTU/CTD instance.
     Builtin(VarId, FbKind),
     /// An instance of a user function block type, with its POU and its input and output variables.
@@ -73,7 +80,7 @@ pub(crate) enum InstanceRef {
 }
 
 /// Names of the POU being lowered.
-pub(crate) struct Names {
+pub struct Names {
     /// The POU's name, for messages (`undefined label … in P`).
     pub pou: String,
     /// Prepended to rung ids (`G1:` in an instance's POU).
@@ -83,7 +90,7 @@ pub(crate) struct Names {
 }
 
 /// A lowered body: rungs with POU-relative jump targets (`RungId(i)` = the POU's `i`-th rung).
-pub(crate) struct Lowered {
+pub struct Lowered {
     pub rungs: Vec<Rung>,
     /// Per network: its rungs (POU-relative).
     pub networks: Vec<Range<u32>>,
@@ -94,7 +101,7 @@ pub(crate) struct Lowered {
 }
 
 /// Lowers `fbd` in the scope `env` gives.
-pub(crate) fn lower(fbd: &FbdPou, env: &mut dyn Env, names: &Names, pou: PouId) -> Result<Lowered> {
+pub fn lower(fbd: &FbdPou, env: &mut dyn Env, names: &Names, pou: PouId) -> Result<Lowered> {
     let mut cx = Cx {
         env,
         names,
@@ -109,7 +116,7 @@ pub(crate) fn lower(fbd: &FbdPou, env: &mut dyn Env, names: &Names, pou: PouId) 
         .filter_map(|(i, n)| n.label.as_deref().map(|l| (l, i)))
         .collect();
     cx.accumulator_rungs(fbd)?;
-    let mut jumps: Vec<(usize, usize)> = Vec::new();
+    let mut jumps: Vec<ForwardJump> = Vec::new();
     let mut networks = Vec::with_capacity(fbd.networks.len());
     let mut blocks = Vec::with_capacity(fbd.networks.len());
     let mut typed = Vec::with_capacity(fbd.networks.len());
@@ -125,9 +132,9 @@ pub(crate) fn lower(fbd: &FbdPou, env: &mut dyn Env, names: &Names, pou: PouId) 
         networks.push(start..cx.rungs.len() as u32);
         blocks.push(block_rungs);
     }
-    for (rung, target) in jumps {
-        let t = RungId(networks[target].start);
-        set_jump_target(&mut cx.rungs[rung], t);
+    for j in jumps {
+        let target = RungId(networks[j.network].start);
+        end_with_jump(&mut cx.rungs[j.rung], j.label, target);
     }
     Ok(Lowered {
         rungs: cx.rungs,
@@ -137,11 +144,20 @@ pub(crate) fn lower(fbd: &FbdPou, env: &mut dyn Env, names: &Names, pou: PouId) 
     })
 }
 
-fn set_jump_target(rung: &mut Rung, t: RungId) {
-    match rung.series.last_mut() {
-        Some(Element::Jmp { target, .. }) => *target = t,
-        _ => unreachable!("jump rungs end with their jump"),
-    }
+/// A JMP block's jump, not yet on its rung: the labelled network may come later, so the jump
+/// is made (and its rung ends with it) once every network's first rung is known.
+struct ForwardJump {
+    /// The JMP block's rung (POU-relative).
+    rung: usize,
+    label: String,
+    /// The network that carries the label.
+    network: usize,
+}
+
+/// Ends `rung` with a jump to `label`, the rung `target`: a jump is made only once its target
+/// is known.
+fn end_with_jump(rung: &mut Rung, label: String, target: RungId) {
+    rung.series.push(Element::Jmp { label, target });
 }
 
 struct Acc {
