@@ -290,3 +290,164 @@ impl Cx<'_> {
         self.rungs.len() - 1
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A scope of BOOL variables `A`, `C`, `E`, `Y` and the hidden ones the lowering adds.
+    struct Scope(Vec<Var>);
+
+    impl Scope {
+        fn find(&self, text: &str) -> std::result::Result<VarId, Invalid> {
+            match self.0.iter().position(|v| v.name == text) {
+                Some(i) => Ok(VarId(i as u32)),
+                None => Err(Invalid::UndefinedVar {
+                    name: text.to_owned(),
+                }),
+            }
+        }
+    }
+
+    impl Env for Scope {
+        fn lookup(&self, text: &str) -> std::result::Result<(VarRef, Type), Invalid> {
+            let var = self.find(text)?;
+            Ok((VarRef { var, field: None }, self.0[var.index()].ty))
+        }
+        fn writable(&self, text: &str, _: &'static str) -> std::result::Result<VarId, Invalid> {
+            self.find(text)
+        }
+        fn instance(&self, text: &str) -> std::result::Result<InstanceRef, Invalid> {
+            Err(Invalid::UndefinedVar {
+                name: text.to_owned(),
+            })
+        }
+        fn var(&self, v: VarId) -> &Var {
+            &self.0[v.index()]
+        }
+        fn hidden(&mut self, name: String, ty: Type) -> std::result::Result<VarId, Invalid> {
+            self.0.push(Var {
+                name,
+                ty,
+                class: VarClass::Memory,
+                init: ty.zero(),
+                scope: None,
+                hidden: true,
+            });
+            Ok(VarId(self.0.len() as u32 - 1))
+        }
+        fn claim_accumulator(&mut self, _: VarId) -> std::result::Result<(), Invalid> {
+            Ok(())
+        }
+    }
+
+    fn block(id: u32, op: Op, input: Option<&str>, out: Option<&str>, cond: Option<&str>) -> Block {
+        Block {
+            id,
+            op,
+            path: String::new(),
+            origin: Origin::NONE,
+            inputs: input
+                .map(|i| InputPin {
+                    name: "IN".into(),
+                    input: Some(Input::Variable(i.into())),
+                    path: String::new(),
+                })
+                .into_iter()
+                .collect(),
+            outputs: out
+                .map(|o| OutputPin {
+                    name: "OUT".into(),
+                    vars: vec![(o.into(), String::new())],
+                })
+                .into_iter()
+                .collect(),
+            cond: cond.map(|c| Input::Variable(c.into())),
+            en: cond.is_some() && out.is_some(),
+            after: Vec::new(),
+            comment: None,
+        }
+    }
+
+    fn network(id: &str, label: Option<&str>, blocks: Vec<Block>) -> Network {
+        Network {
+            id: id.into(),
+            label: label.map(str::to_owned),
+            comment: None,
+            path: String::new(),
+            origin: Origin::NONE,
+            blocks,
+            roots: Vec::new(),
+        }
+    }
+
+    fn jump_of(r: &Rung) -> Option<(&str, RungId)> {
+        match r.series.last() {
+            Some(Element::Jmp { label, target }) => Some((label, *target)),
+            _ => None,
+        }
+    }
+
+    #[test]
+    fn jumps_forward_and_over_a_disabled_block_land_on_their_rungs() {
+        let jmp = Op::Jmp { label: "L2".into() };
+        let networks = vec![
+            network(
+                "N1",
+                None,
+                vec![
+                    block(1, Op::Move, Some("A"), Some("Y"), Some("E")),
+                    block(2, jmp, None, None, Some("C")),
+                ],
+            ),
+            network(
+                "N2",
+                Some("L2"),
+                vec![block(3, Op::Move, Some("A"), Some("Y"), None)],
+            ),
+        ];
+        let plans = networks
+            .iter()
+            .map(|n| crate::plan(n).expect("a plan"))
+            .collect();
+        let fbd = FbdPou {
+            name: "P".into(),
+            kind: FbdPouKind::Main,
+            path: String::new(),
+            networks,
+            plans,
+            copies: Vec::new(),
+        };
+        let bool_var = |name: &str| Var {
+            name: name.into(),
+            ty: Type::Bool,
+            class: VarClass::Memory,
+            init: Value::Bool(false),
+            scope: None,
+            hidden: false,
+        };
+        let mut scope = Scope(["A", "C", "E", "Y"].map(bool_var).to_vec());
+        let names = Names {
+            pou: "P".into(),
+            rung_prefix: String::new(),
+            var_prefix: String::new(),
+        };
+        let lowered = lower(&fbd, &mut scope, &names, PouId(0)).expect("lowered");
+        let rung = |id: &str| {
+            let i = lowered.rungs.iter().position(|r| r.id == id);
+            i.unwrap_or_else(|| panic!("no rung {id}"))
+        };
+        // The JMP block's rung jumps to the first rung of the labelled, later network.
+        let jmp = &lowered.rungs[lowered.blocks[0][1] as usize];
+        let second = RungId(lowered.networks[1].start);
+        assert_eq!(jump_of(jmp), Some(("L2", second)));
+        // The EN guard of block 1 jumps to its landing rung, right after the block's rung.
+        let guard = &lowered.rungs[rung("N1.1.en")];
+        let landing = RungId(rung("N1.1.en.end") as u32);
+        assert_eq!(jump_of(guard), Some(("N1.1.en.end", landing)));
+        assert_eq!(landing.index(), lowered.blocks[0][0] as usize + 1);
+        // Those are the only jumps.
+        let jumps = lowered.rungs.iter().filter_map(jump_of).count();
+        assert_eq!(jumps, 2);
+    }
+}
