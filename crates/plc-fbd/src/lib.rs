@@ -8,15 +8,18 @@
 //! - [`fragments`]: the conditional fragment tree, the rule of conditional fragments, the
 //!   regrouped order;
 //! - [`types`]: user function block types with their interface and typed bodies;
+//! - [`lower`]: an FBD body → ladder rungs of the program model, in the scope an [`lower::Env`]
+//!   gives (the resolver's).
 //!
-//! Only the model and the pure algorithms live here: reading FBD bodies and lowering them into
-//! rungs is the resolver's (`plc_resolve`), which calls [`plan`]; `plc-deps order` renders
-//! them (`plc_report::order`). The format and every
-//! lowering rule are in docs/fbd.md.
+//! Reading FBD bodies (names, declarations, arcs) is the resolver's (`plc_resolve`), which calls
+//! [`plan`] and [`lower::lower`]; this crate knows neither the surface syntax nor the resolver.
+//! `plc-deps order` renders the plans (`plc_report::order`). The format and every lowering rule
+//! are in docs/fbd.md.
 #![forbid(unsafe_code)]
 
 pub mod fragments;
 mod ids;
+pub mod lower;
 pub mod model;
 pub mod order;
 pub mod types;

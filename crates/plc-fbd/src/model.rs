@@ -241,6 +241,15 @@ impl Constant {
             Constant::Time(s) => s.clone(),
         }
     }
+
+    /// The constant's kind, as messages name a JSON value's (`boolean true`, `number 5`).
+    pub fn kind(&self) -> String {
+        match self {
+            Constant::Bool(b) => format!("boolean {b}"),
+            Constant::Number(n) => format!("number {n}"),
+            Constant::Time(s) => format!("string \"{s}\""),
+        }
+    }
 }
 
 /// The kind of an operation, without its data: what pins and messages depend on.

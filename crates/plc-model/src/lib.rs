@@ -25,6 +25,7 @@ mod strings;
 mod tasks;
 mod types;
 pub use arena::{Arena, Idx, Numbering};
+pub mod untyped;
 pub use dialect::Dialect;
 pub use function::*;
 pub use strings::*;

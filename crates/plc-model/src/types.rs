@@ -694,6 +694,15 @@ fn strip_prefix_ci<'s>(s: &'s str, prefixes: &[&str]) -> Option<&'s str> {
     })
 }
 
+/// True when an operand string is a TIME literal (`T#…`, `TIME#…`, LTIME's `LT#…`, `LTIME#…`,
+/// any case) rather than a name,
+/// as the operand syntax of docs/format.md tells them apart.
+pub fn is_time_literal(s: &str) -> bool {
+    let b = s.as_bytes();
+    let starts = |p: &[u8]| b.len() >= p.len() && b[..p.len()].eq_ignore_ascii_case(p);
+    starts(b"T#") || starts(b"TIME#") || starts(b"LT#") || starts(b"LTIME#")
+}
+
 /// Parses an IEC TIME literal (`T#1s`, `T#250ms`, `TIME#1m30s`, `T#1.5s`, `T#1h_30m`,
 /// `LTIME#5s`) into milliseconds.
 ///

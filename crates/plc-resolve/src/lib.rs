@@ -7,8 +7,9 @@
 //! (program-wide) and labels (per POU), FOR/NEXT nesting, no jump into a FOR body, no recursive
 //! calls, `end` in the main program only, no writes to inputs or instance fields, FBD networks
 //! (ids, arcs, labels; order and fragments by the pure algorithms of `plc_fbd`), user function
-//! block types (no type containing itself) expanded into one POU per instance, and the lowering
-//! of FBD bodies into rungs ([`lower`]).
+//! block types (no type containing itself) expanded into one POU per instance. The lowering of
+//! FBD bodies into rungs is `plc_fbd`'s ([`plc_fbd::lower`]): the resolver gives it each POU's
+//! scope through [`plc_fbd::lower::Env`] and keeps the rungs it returns.
 //!
 //! Errors are collected, in program order, up to [`MAX_ERRORS`], phase by phase: the reader's
 //! problems and the declarations; instances and FBD lowering; rung ids and labels; elements (the
@@ -30,7 +31,6 @@ pub mod configuration;
 mod elements;
 pub(crate) mod fbd_read;
 mod function_blocks;
-pub(crate) mod lower;
 mod lowering;
 mod names;
 pub(crate) mod operand;
@@ -41,7 +41,7 @@ mod table;
 pub(crate) mod util;
 mod vars;
 
-pub use lower::ACCUMULATE_PT_MS;
+pub use plc_fbd::ACCUMULATE_PT_MS;
 pub use stream::Stream;
 
 use fbd_read::FbSig;

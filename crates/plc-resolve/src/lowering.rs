@@ -1,9 +1,9 @@
 //! FBD bodies in the resolver: lowering each body into ladder rungs (once per POU that
 //! runs it), through the lowering's view of a POU's scope ([`Env`]).
 
-use super::lower::{Env, InstanceRef, Names};
 use super::{Builder, Result};
 use plc_diag::{Diagnostic, Invalid, LoadError};
+use plc_fbd::lower::{Env, InstanceRef, Names};
 use plc_fbd::{FbdPouKind, LoweredCopy};
 use plc_model::*;
 
@@ -24,7 +24,7 @@ impl<'a> Builder<'a> {
             };
             let origin = self.fbd_origins[i];
             let lowered =
-                super::lower::lower(&bodies[i], &mut PouEnv { b: self, pou: pid }, &names, pid)
+                plc_fbd::lower::lower(&bodies[i], &mut PouEnv { b: self, pou: pid }, &names, pid)
                     .map_err(|e| at_blocks(e, &bodies[i]).at(origin))?;
             if bodies[i].kind == FbdPouKind::FunctionBlock {
                 self.keep_typed_body(i, pid, &lowered.typed);

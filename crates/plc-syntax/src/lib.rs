@@ -441,11 +441,6 @@ const _: () = assert!(std::mem::size_of::<Element>() <= 48);
 const _: () = assert!(std::mem::size_of::<Rung>() <= 112);
 const _: () = assert!(std::mem::size_of::<Var>() <= 96);
 
-/// True when an operand string is a TIME literal (`T#…`, `TIME#…`, LTIME's `LT#…`, `LTIME#…`,
-/// any case) rather than a name,
-/// as the operand syntax of docs/format.md tells them apart.
-pub fn is_time_literal(s: &str) -> bool {
-    let b = s.as_bytes();
-    let starts = |p: &[u8]| b.len() >= p.len() && b[..p.len()].eq_ignore_ascii_case(p);
-    starts(b"T#") || starts(b"TIME#") || starts(b"LT#") || starts(b"LTIME#")
-}
+/// True when an operand string is a TIME literal rather than a name (the model's, which the
+/// FBD lowering shares).
+pub use plc_model::is_time_literal;

@@ -3,7 +3,8 @@
 //! run flag, a local reset at the network's start and set in each source fragment; every output
 //! that feeds an arc is one local named from the block id and output number (`_8_0`).
 //!
-//! A block's statements come from the rung the resolver lowered it to (so its semantics are the
+//! A block's statements come from the rung the FBD lowering (`plc_fbd::lower`) made of it (so its
+//! semantics are the
 //! interpreter's, by construction), but the structure comes from the [`Plan`]: the guard and
 //! landing rungs of the lowering become the `if (…) {` and `}` of their fragment, never jumps.
 //!

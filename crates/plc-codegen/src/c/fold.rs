@@ -13,7 +13,7 @@
 //! own wrap-around, faults (in order, on the same rung) and float rounding
 //! (`FLT_EVAL_METHOD == 0`); `_plc_max_T(m, x)` is `x > m ? x : m`, the lowered compare.
 //!
-//! Not here: writing the C (`ladder`), the lowering itself (`plc_resolve::lower`).
+//! Not here: writing the C (`ladder`), the lowering itself (`plc_fbd::lower`).
 
 use plc_model::{CmpOp, Element, Operand, Series, VarId, VarRef};
 

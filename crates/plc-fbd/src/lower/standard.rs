@@ -6,7 +6,7 @@
 //! Not here: the semantics (`crates/plc-exec/src/fb.rs`), the other blocks (`blocks`).
 
 use super::{condition, Cx, Net, Result, Val};
-use plc_fbd::model::*;
+use crate::model::*;
 use plc_model::*;
 
 impl Cx<'_> {

@@ -1,21 +1,23 @@
 //! One network → rungs: blocks in execution order, each conditional fragment an `if` block
 //! (guard rung, landing rung), compound fragments tested through their run flags.
 
-use super::{condition, contact, set_jump_target, Cx, Net, Result};
+use super::{condition, contact, end_with_jump, Cx, ForwardJump, Net, Result};
+use crate::model::*;
+use crate::types::TypedNetwork;
 use plc_diag::LoadError;
-use plc_fbd::model::*;
-use plc_fbd::types::TypedNetwork;
 use plc_model::*;
 use std::collections::HashMap;
 
 impl Cx<'_> {
-    /// Lowers one network; returns the rung of each block and the network's typed form.
+    /// Lowers one network; returns the rung of each block and the network's typed form. A
+    /// guard rung gets its jump when its landing rung is made; a JMP block's jump goes to
+    /// `jumps`, as the labelled network may come later.
     pub(super) fn network(
         &mut self,
         net: &Network,
         plan: &Plan,
         labels: &HashMap<&str, usize>,
-        jumps: &mut Vec<(usize, usize)>,
+        jumps: &mut Vec<ForwardJump>,
     ) -> Result<(Vec<u32>, TypedNetwork<VarRef>)> {
         let n = net.blocks.len();
         let mut used: Vec<Vec<bool>> = net
@@ -83,7 +85,8 @@ impl Cx<'_> {
         }
         let first = self.rungs.len();
         let mut block_rung: Vec<Option<u32>> = vec![None; n];
-        let mut guards: Vec<usize> = Vec::new();
+        // The guard rungs entered and not yet left, with their landings' labels.
+        let mut guards: Vec<(usize, String)> = Vec::new();
         for step in &plan.steps {
             match *step {
                 Step::Enter(f) => {
@@ -104,19 +107,16 @@ impl Cx<'_> {
                         FragmentKind::Root => unreachable!("the root is never entered"),
                     };
                     let landing = format!("{rp}{}.{}.end", net.id, frag.name);
-                    series.push(Element::Jmp {
-                        label: landing,
-                        target: RungId::relative(u32::MAX),
-                    });
                     series.splice(0..0, pending.drain(..));
                     let comment = Some(format!("if {}", frag.condition));
-                    guards.push(self.push(
+                    let g = self.push(
                         format!("{rp}{}.{}", net.id, frag.name),
                         None,
                         comment,
                         series,
                         (&net.path, net.origin),
-                    ));
+                    );
+                    guards.push((g, landing));
                     pending.extend(
                         sets.get(&f)
                             .into_iter()
@@ -135,18 +135,15 @@ impl Cx<'_> {
                     let landing = format!("{rp}{}.{}.en.end", net.id, blk.id);
                     let gated = gate.is_some();
                     if let Some(mut guard) = gate {
-                        guard.push(Element::Jmp {
-                            label: landing.clone(),
-                            target: RungId::relative(u32::MAX),
-                        });
                         guard.splice(0..0, pending.drain(..));
-                        guards.push(self.push(
+                        let g = self.push(
                             format!("{rp}{}.{}.en", net.id, blk.id),
                             None,
                             Some(format!("if EN of {}", blk.id)),
                             guard,
                             (&blk.path, blk.origin),
-                        ));
+                        );
+                        guards.push((g, landing.clone()));
                     }
                     series.splice(0..0, pending.drain(..));
                     let r = self.push(
@@ -158,8 +155,12 @@ impl Cx<'_> {
                     );
                     if let Op::Jmp { label } = &blk.op {
                         // Checked by the block's lowering: the label is defined.
-                        if let Some(&target) = labels.get(label.as_str()) {
-                            jumps.push((r, target));
+                        if let Some(&network) = labels.get(label.as_str()) {
+                            jumps.push(ForwardJump {
+                                rung: r,
+                                label: label.clone(),
+                                network,
+                            });
                         }
                     }
                     block_rung[b.index()] = Some(r as u32);
@@ -171,8 +172,8 @@ impl Cx<'_> {
                             Vec::new(),
                             (&blk.path, blk.origin),
                         );
-                        let g = guards.pop().expect("pushed above");
-                        set_jump_target(&mut self.rungs[g], RungId::relative(end as u32));
+                        let (g, label) = guards.pop().expect("pushed above");
+                        end_with_jump(&mut self.rungs[g], label, RungId::relative(end as u32));
                     }
                 }
                 Step::Leave(f) => {
@@ -185,8 +186,8 @@ impl Cx<'_> {
                         std::mem::take(&mut pending),
                         (&net.path, net.origin),
                     );
-                    let g = guards.pop().expect("entered");
-                    set_jump_target(&mut self.rungs[g], RungId::relative(r as u32));
+                    let (g, label) = guards.pop().expect("entered");
+                    end_with_jump(&mut self.rungs[g], label, RungId::relative(r as u32));
                 }
             }
         }

@@ -4,9 +4,9 @@
 //! looks up has already resolved; the resolver turns it into a function block type's own form.
 
 use super::{Cx, Net, PinSlot};
-use crate::operand;
-use plc_fbd::model::*;
-use plc_fbd::types::{Pin, TypedBlock, TypedNetwork};
+use crate::model::*;
+use crate::types::{Pin, TypedBlock, TypedNetwork};
+use plc_model::untyped;
 use plc_model::*;
 
 impl Cx<'_> {
@@ -55,9 +55,8 @@ impl Cx<'_> {
             Input::Constant(c) => match slot {
                 Some(s) => Pin::Constant(*nx.constants.get(&s)?),
                 None => {
-                    let scalar = super::pins::constant_scalar(c);
-                    let u = operand::parse(&scalar, &|n| self.env.lookup(n)).ok()?;
-                    match operand::typed(&u, Type::Bool, "a condition", &c.text()).ok()? {
+                    let u = super::pins::constant(c, &|n| self.env.lookup(n)).ok()?;
+                    match untyped::typed(&u, Type::Bool, "a condition", &c.text()).ok()? {
                         Operand::Const(v) => Pin::Constant(v),
                         Operand::Var(r) => Pin::Variable(r),
                     }

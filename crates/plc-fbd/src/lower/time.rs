@@ -2,8 +2,8 @@
 //! accumulates, one rung per variable at the start of the POU.
 
 use super::{contact, field_op, var_op, Acc, Cx, Result, ACCUMULATE_PT_MS};
+use crate::model::*;
 use plc_diag::{Invalid, LoadError};
-use plc_fbd::model::*;
 use plc_model::*;
 
 impl Cx<'_> {
@@ -94,7 +94,7 @@ impl Cx<'_> {
             Some(Input::Constant(c)) => {
                 return Err(e(Invalid::Shape {
                     expected: "a TIME variable",
-                    found: super::pins::constant_scalar(c).kind(),
+                    found: c.kind(),
                 }))
             }
             _ => {

@@ -2,9 +2,9 @@
 //! timers, counters, jumps, TSTART/TSTOP) as ladder elements. docs/fbd.md gives each rung.
 
 use super::{condition, contact, steps, var_op, Cx, Net, PinSlot, Result, Val, ACCUMULATE_PT_MS};
-use crate::operand;
+use crate::model::*;
 use plc_diag::{Invalid, LoadError};
-use plc_fbd::model::*;
+use plc_model::untyped;
 use plc_model::*;
 use std::collections::HashMap;
 
@@ -240,7 +240,7 @@ impl Cx<'_> {
             .ty()
             .or(out_ty)
             .unwrap_or_else(|| match &vals[0].0 {
-                Val::Const(u, ..) => operand::default_type(u),
+                Val::Const(u, ..) => untyped::default_type(u),
                 Val::Typed(_, t, _) => *t,
             });
         if matches!(ty, Type::Fb(_)) {
@@ -449,7 +449,9 @@ impl Cx<'_> {
         )
     }
 
-    /// JMP and RET: `[contact cond, jmp <label>]` / `[contact cond, ret]`.
+    /// JMP and RET: `[contact cond, jmp <label>]` / `[contact cond, ret]`. A JMP's series stops
+    /// before its jump: the network's lowering records it as a [`ForwardJump`](super::ForwardJump), which
+    /// [`lower`](super::lower) adds once the labelled network's first rung is known.
     fn jump(&mut self, nx: &mut Net, b: BlockId, labels: &HashMap<&str, usize>) -> Result<Series> {
         let net = nx.net;
         let blk = net.block(b);
@@ -472,10 +474,6 @@ impl Cx<'_> {
                     },
                 ));
             }
-            s.push(Element::Jmp {
-                label: label.clone(),
-                target: RungId::relative(u32::MAX),
-            });
         } else {
             s.push(Element::Ret);
         }
@@ -543,7 +541,7 @@ fn numeric_type(vals: &[(Val, &str)], fallback: Option<Type>) -> Type {
     }
     let real = vals
         .iter()
-        .any(|(v, _)| matches!(v, Val::Const(u, ..) if operand::default_type(u) == Type::Real));
+        .any(|(v, _)| matches!(v, Val::Const(u, ..) if untyped::default_type(u) == Type::Real));
     if real {
         Type::Real
     } else {

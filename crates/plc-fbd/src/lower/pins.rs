@@ -2,12 +2,10 @@
 //! on use, the variables an output is written to, hidden temps for outputs arcs read.
 
 use super::{var_op, Cx, Net, PinSlot, Result, Val};
-use crate::operand;
+use crate::model::*;
 use plc_diag::{Invalid, LoadError};
-use plc_fbd::model::*;
+use plc_model::untyped::{self, Lookup, Untyped};
 use plc_model::*;
-use plc_syntax::Scalar;
-use std::borrow::Cow;
 
 impl Cx<'_> {
     /// The value connected to an input (`slot`: the input pin, when it is one).
@@ -39,7 +37,7 @@ impl Cx<'_> {
             }
             Input::Constant(c) => {
                 let env = &*self.env;
-                let u = operand::parse(&constant_scalar(c), &|n| env.lookup(n))
+                let u = constant(c, &|n| env.lookup(n))
                     .map_err(|k| LoadError::fbd(&nx.net.id, block, path, k))?;
                 Ok(Val::Const(u, c.text(), slot))
             }
@@ -66,7 +64,7 @@ impl Cx<'_> {
             })),
             Val::Typed(o, _, _) => Ok(*o),
             Val::Const(u, text, slot) => {
-                let o = operand::typed(u, ty, what, text).map_err(e)?;
+                let o = untyped::typed(u, ty, what, text).map_err(e)?;
                 if let (Operand::Const(value), Some(slot)) = (o, slot) {
                     nx.constants.insert(*slot, value);
                 }
@@ -189,11 +187,12 @@ impl Cx<'_> {
     }
 }
 
-/// A constant as the operand parser reads it.
-pub(super) fn constant_scalar(c: &Constant) -> Scalar<'_> {
+/// A constant as an operand (a string one is a literal or a name `lookup` resolves), read as
+/// the resolver reads the same operand written in a rung.
+pub(super) fn constant(c: &Constant, lookup: &Lookup<'_>) -> std::result::Result<Untyped, Invalid> {
     match c {
-        Constant::Bool(b) => Scalar::Bool(*b),
-        Constant::Number(n) => Scalar::Number(n.clone()),
-        Constant::Time(s) => Scalar::Str(Cow::Borrowed(s)),
+        Constant::Bool(b) => Ok(Untyped::Bool(*b)),
+        Constant::Number(n) => Ok(Untyped::number(n.as_i64(), n.as_u64(), n.as_f64())),
+        Constant::Time(s) => untyped::parse_text(s, lookup),
     }
 }

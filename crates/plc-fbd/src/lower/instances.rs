@@ -2,8 +2,8 @@
 //! fields), and calls of user function block instances (each its own POU).
 
 use super::{field_op, steps, var_op, Cx, InstanceRef, Net, PinSlot, Result};
+use crate::model::*;
 use plc_diag::{Invalid, LoadError};
-use plc_fbd::model::*;
 use plc_model::*;
 
 impl Cx<'_> {

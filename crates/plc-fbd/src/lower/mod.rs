@@ -19,6 +19,13 @@
 //! elapsed time when `V` was last brought up to date) — and one extra rung `acc:V` at the start of
 //! the POU: `[contact V:acc, branch [[ton V:timer PT], [V := V − V:last], [V := V + V:timer.ET],
 //! [V:last := V:timer.ET]]]`.
+//!
+//! Invariants: a jump is made only once its target rung is known (a guard's when its landing
+//! rung is pushed, a JMP block's when every network's first rung is: [`ForwardJump`]), so no
+//! rung ever holds a placeholder target; targets are POU-relative ([`Lowered`]).
+//!
+//! Not here: names, declarations and scopes (the resolver's, through [`Env`]; it also places
+//! the rungs in the program and makes their jump targets absolute); the surface syntax.
 
 mod blocks;
 mod fragments;
@@ -29,21 +36,21 @@ mod standard;
 mod time;
 mod typed;
 
-use crate::operand::Untyped;
+use crate::model::*;
+use crate::types::TypedBody;
 use plc_diag::{Invalid, LoadError, Origin};
-use plc_fbd::model::*;
-use plc_fbd::types::TypedBody;
+use plc_model::untyped::Untyped;
 use plc_model::*;
 use std::collections::HashMap;
 use std::ops::Range;
 
 type Result<T> = std::result::Result<T, LoadError>;
 
-pub use plc_fbd::ACCUMULATE_PT_MS;
+use crate::ACCUMULATE_PT_MS;
 
 /// What the lowering needs from the reader: names resolved in the POU's scope, new hidden
 /// variables.
-pub(crate) trait Env {
+pub trait Env {
     /// A name read by a block: variable, instance field (`T1.Q`) or user instance member (`G1.OUT`).
     fn lookup(&self, text: &str) -> std::result::Result<(VarRef, Type), Invalid>;
     /// A variable a block writes.
@@ -58,7 +65,7 @@ pub(crate) trait Env {
 }
 
 /// What an `instance` names.
-pub(crate) enum InstanceRef {
+pub enum InstanceRef {
     /// A TON/TOF/TP/CTU/CTD instance.
     Builtin(VarId, FbKind),
     /// An instance of a user function block type, with its POU and its input and output variables.
@@ -73,7 +80,7 @@ pub(crate) enum InstanceRef {
 }
 
 /// Names of the POU being lowered.
-pub(crate) struct Names {
+pub struct Names {
     /// The POU's name, for messages (`undefined label … in P`).
     pub pou: String,
     /// Prepended to rung ids (`G1:` in an instance's POU).
@@ -83,7 +90,7 @@ pub(crate) struct Names {
 }
 
 /// A lowered body: rungs with POU-relative jump targets (`RungId(i)` = the POU's `i`-th rung).
-pub(crate) struct Lowered {
+pub struct Lowered {
     pub rungs: Vec<Rung>,
     /// Per network: its rungs (POU-relative).
     pub networks: Vec<Range<u32>>,
@@ -94,7 +101,7 @@ pub(crate) struct Lowered {
 }
 
 /// Lowers `fbd` in the scope `env` gives.
-pub(crate) fn lower(fbd: &FbdPou, env: &mut dyn Env, names: &Names, pou: PouId) -> Result<Lowered> {
+pub fn lower(fbd: &FbdPou, env: &mut dyn Env, names: &Names, pou: PouId) -> Result<Lowered> {
     let mut cx = Cx {
         env,
         names,
@@ -109,7 +116,7 @@ pub(crate) fn lower(fbd: &FbdPou, env: &mut dyn Env, names: &Names, pou: PouId) 
         .filter_map(|(i, n)| n.label.as_deref().map(|l| (l, i)))
         .collect();
     cx.accumulator_rungs(fbd)?;
-    let mut jumps: Vec<(usize, usize)> = Vec::new();
+    let mut jumps: Vec<ForwardJump> = Vec::new();
     let mut networks = Vec::with_capacity(fbd.networks.len());
     let mut blocks = Vec::with_capacity(fbd.networks.len());
     let mut typed = Vec::with_capacity(fbd.networks.len());
@@ -125,9 +132,9 @@ pub(crate) fn lower(fbd: &FbdPou, env: &mut dyn Env, names: &Names, pou: PouId) 
         networks.push(start..cx.rungs.len() as u32);
         blocks.push(block_rungs);
     }
-    for (rung, target) in jumps {
-        let t = RungId::relative(networks[target].start);
-        set_jump_target(&mut cx.rungs[rung], t);
+    for j in jumps {
+        let target = RungId::relative(networks[j.network].start);
+        end_with_jump(&mut cx.rungs[j.rung], j.label, target);
     }
     Ok(Lowered {
         rungs: cx.rungs,
@@ -137,11 +144,20 @@ pub(crate) fn lower(fbd: &FbdPou, env: &mut dyn Env, names: &Names, pou: PouId) 
     })
 }
 
-fn set_jump_target(rung: &mut Rung, t: RungId) {
-    match rung.series.last_mut() {
-        Some(Element::Jmp { target, .. }) => *target = t,
-        _ => unreachable!("jump rungs end with their jump"),
-    }
+/// A JMP block's jump, not yet on its rung: the labelled network may come later, so the jump
+/// is made (and its rung ends with it) once every network's first rung is known.
+struct ForwardJump {
+    /// The JMP block's rung (POU-relative).
+    rung: usize,
+    label: String,
+    /// The network that carries the label.
+    network: usize,
+}
+
+/// Ends `rung` with a jump to `label`, the rung `target`: a jump is made only once its target
+/// is known.
+fn end_with_jump(rung: &mut Rung, label: String, target: RungId) {
+    rung.series.push(Element::Jmp { label, target });
 }
 
 struct Acc {
@@ -272,5 +288,165 @@ impl Cx<'_> {
             })),
         });
         self.rungs.len() - 1
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A scope of BOOL variables `A`, `C`, `E`, `Y` and the hidden ones the lowering adds.
+    struct Scope(Arena<VarId, Var>);
+
+    impl Scope {
+        fn find(&self, text: &str) -> std::result::Result<VarId, Invalid> {
+            match self.0.iter().position(|v| v.name == text) {
+                Some(i) => Ok(self.0.id(i)),
+                None => Err(Invalid::UndefinedVar {
+                    name: text.to_owned(),
+                }),
+            }
+        }
+    }
+
+    impl Env for Scope {
+        fn lookup(&self, text: &str) -> std::result::Result<(VarRef, Type), Invalid> {
+            let var = self.find(text)?;
+            Ok((VarRef { var, field: None }, self.0[var.index()].ty))
+        }
+        fn writable(&self, text: &str, _: &'static str) -> std::result::Result<VarId, Invalid> {
+            self.find(text)
+        }
+        fn instance(&self, text: &str) -> std::result::Result<InstanceRef, Invalid> {
+            Err(Invalid::UndefinedVar {
+                name: text.to_owned(),
+            })
+        }
+        fn var(&self, v: VarId) -> &Var {
+            &self.0[v.index()]
+        }
+        fn hidden(&mut self, name: String, ty: Type) -> std::result::Result<VarId, Invalid> {
+            Ok(self.0.push(Var {
+                name,
+                ty,
+                class: VarClass::Memory,
+                init: ty.zero(),
+                scope: None,
+                hidden: true,
+            }))
+        }
+        fn claim_accumulator(&mut self, _: VarId) -> std::result::Result<(), Invalid> {
+            Ok(())
+        }
+    }
+
+    fn block(id: u32, op: Op, input: Option<&str>, out: Option<&str>, cond: Option<&str>) -> Block {
+        Block {
+            id,
+            op,
+            path: String::new(),
+            origin: Origin::NONE,
+            inputs: input
+                .map(|i| InputPin {
+                    name: "IN".into(),
+                    input: Some(Input::Variable(i.into())),
+                    path: String::new(),
+                })
+                .into_iter()
+                .collect(),
+            outputs: out
+                .map(|o| OutputPin {
+                    name: "OUT".into(),
+                    vars: vec![(o.into(), String::new())],
+                })
+                .into_iter()
+                .collect(),
+            cond: cond.map(|c| Input::Variable(c.into())),
+            en: cond.is_some() && out.is_some(),
+            after: Vec::new(),
+            comment: None,
+        }
+    }
+
+    fn network(id: &str, label: Option<&str>, blocks: Vec<Block>) -> Network {
+        Network {
+            id: id.into(),
+            label: label.map(str::to_owned),
+            comment: None,
+            path: String::new(),
+            origin: Origin::NONE,
+            blocks: blocks.into(),
+            roots: Vec::new(),
+        }
+    }
+
+    fn jump_of(r: &Rung) -> Option<(&str, RungId)> {
+        match r.series.last() {
+            Some(Element::Jmp { label, target }) => Some((label, *target)),
+            _ => None,
+        }
+    }
+
+    #[test]
+    fn jumps_forward_and_over_a_disabled_block_land_on_their_rungs() {
+        let jmp = Op::Jmp { label: "L2".into() };
+        let networks = vec![
+            network(
+                "N1",
+                None,
+                vec![
+                    block(1, Op::Move, Some("A"), Some("Y"), Some("E")),
+                    block(2, jmp, None, None, Some("C")),
+                ],
+            ),
+            network(
+                "N2",
+                Some("L2"),
+                vec![block(3, Op::Move, Some("A"), Some("Y"), None)],
+            ),
+        ];
+        let plans = networks
+            .iter()
+            .map(|n| crate::plan(n).expect("a plan"))
+            .collect();
+        let fbd = FbdPou {
+            name: "P".into(),
+            kind: FbdPouKind::Main,
+            path: String::new(),
+            networks,
+            plans,
+            copies: Vec::new(),
+        };
+        let bool_var = |name: &str| Var {
+            name: name.into(),
+            ty: Type::Bool,
+            class: VarClass::Memory,
+            init: Value::Bool(false),
+            scope: None,
+            hidden: false,
+        };
+        let mut scope = Scope(["A", "C", "E", "Y"].map(bool_var).to_vec().into());
+        let names = Names {
+            pou: "P".into(),
+            rung_prefix: String::new(),
+            var_prefix: String::new(),
+        };
+        let lowered = lower(&fbd, &mut scope, &names, PouId::from_raw(0)).expect("lowered");
+        let rung = |id: &str| {
+            let i = lowered.rungs.iter().position(|r| r.id == id);
+            i.unwrap_or_else(|| panic!("no rung {id}"))
+        };
+        // The JMP block's rung jumps to the first rung of the labelled, later network.
+        let jmp = &lowered.rungs[lowered.blocks[0][1] as usize];
+        let second = RungId::relative(lowered.networks[1].start);
+        assert_eq!(jump_of(jmp), Some(("L2", second)));
+        // The EN guard of block 1 jumps to its landing rung, right after the block's rung.
+        let guard = &lowered.rungs[rung("N1.1.en")];
+        let landing = RungId::relative(rung("N1.1.en.end") as u32);
+        assert_eq!(jump_of(guard), Some(("N1.1.en.end", landing)));
+        assert_eq!(landing.index(), lowered.blocks[0][0] as usize + 1);
+        // Those are the only jumps.
+        let jumps = lowered.rungs.iter().filter_map(jump_of).count();
+        assert_eq!(jumps, 2);
     }
 }

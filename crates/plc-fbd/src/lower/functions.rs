@@ -6,9 +6,9 @@
 //! Not here: what the function computes (`plc_exec::functions`).
 
 use super::{Cx, Net, Result, Val};
-use crate::operand;
+use crate::model::*;
 use plc_diag::{Invalid, LoadError};
-use plc_fbd::model::*;
+use plc_model::untyped;
 use plc_model::*;
 
 impl Cx<'_> {
@@ -27,7 +27,7 @@ impl Cx<'_> {
             .iter()
             .map(|(v, _)| match v {
                 Val::Typed(_, t, _) => (Some(*t), false),
-                Val::Const(u, ..) => (u.ty(), operand::default_type(u) == Type::Real),
+                Val::Const(u, ..) => (u.ty(), untyped::default_type(u) == Type::Real),
             })
             .collect();
         let typing = func.types(&own, out_ty).map_err(|m| {
