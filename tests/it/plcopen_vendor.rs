@@ -248,3 +248,96 @@ fn a_codesys_pointer_is_a_black_box_that_run_refuses_by_name() {
         "{e}"
     );
 }
+
+#[test]
+fn of_two_configurations_the_first_is_read_with_a_warning_naming_the_other() {
+    // Lab runs PLC_LAB (Y := A + 1); Virtual's PLC_VIRT is a POU no task runs (W0203).
+    let p = path("two_configurations.xml");
+    let out = common::cli::run(&["report", p.to_str().unwrap()]);
+    let raw = String::from_utf8_lossy(&out.stderr);
+    assert!(raw.contains("warning[W0502]: the project has 2 configurations"), "{raw}");
+    let w = warnings("two_configurations.xml");
+    assert!(
+        w.contains("the project has 2 configurations")
+            && w.contains("reads one: `Lab`, the first in the file; not read: `Virtual`")
+            && w.contains("--configuration NAME")
+            && w.contains("subroutine PLC_VIRT is never called"),
+        "{w}"
+    );
+    let t = scans(
+        "two_configurations.xml",
+        "PLC_LAB:A\n3\n-4\n",
+        &["PLC_LAB:Y"],
+    );
+    assert_eq!(t[0], col(&["4", "-3"]), "PLC_LAB:Y");
+}
+
+#[test]
+fn configuration_chooses_the_configuration_that_report_and_run_read() {
+    let p = path("two_configurations.xml");
+    let p = p.to_str().unwrap();
+    // Any case, as IEC names are.
+    let out = common::cli::run(&["report", p, "--configuration", "virtual"]);
+    let err = common::cli::one_line(&String::from_utf8_lossy(&out.stderr));
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(!err.contains("W0502") && err.contains("subroutine PLC_LAB is never called"), "{err}");
+    let report = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        report.contains("Tasks of configuration Virtual")
+            && report.contains("the only program instance: MainTask.PLC_VIRT"),
+        "{report}"
+    );
+    // Z := B * Factor, Factor = 3 from Virtual's own global list.
+    let inputs = common::cli::tmp("vendor-two-configurations.csv");
+    std::fs::write(&inputs, "PLC_VIRT:B\n2\n-5\n").unwrap();
+    let tr = common::cli::tmp("vendor-two-configurations-trace.csv");
+    let out = common::cli::run(&[
+        "run",
+        p,
+        "--configuration",
+        "Virtual",
+        "--inputs",
+        inputs.to_str().unwrap(),
+        "--mode",
+        "both",
+        "--trace",
+        tr.to_str().unwrap(),
+    ]);
+    let err = common::cli::one_line(&String::from_utf8_lossy(&out.stderr));
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    let t = crate::plcopen_common::trace_columns(&tr, &["PLC_VIRT:Z"]);
+    assert_eq!(t[0], col(&["6", "-15"]), "PLC_VIRT:Z");
+}
+
+#[test]
+fn an_unknown_configuration_is_refused_listing_the_configurations() {
+    let p = path("two_configurations.xml");
+    let dir = common::cli::tmp("vendor-two-configurations-c.out");
+    for args in [
+        vec!["report", p.to_str().unwrap(), "--configuration", "Virtul"],
+        vec!["run", p.to_str().unwrap(), "--configuration", "Virtul"],
+        vec![
+            "c",
+            p.to_str().unwrap(),
+            "--configuration",
+            "Virtul",
+            "--output",
+            dir.to_str().unwrap(),
+        ],
+    ] {
+        let out = common::cli::run(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains("error[E0501]: --configuration Virtul: the project has no configuration of that name; its configurations are `Lab`, `Virtual`")
+                && err.contains("did you mean `Virtual`?"),
+            "{args:?}: {err}"
+        );
+    }
+    // A JSON program is not a PLCopen project.
+    let json = common::cli::root().join("analyses/example-a/program.json");
+    let out = common::cli::run(&["report", json.to_str().unwrap(), "--configuration", "Lab"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("is not a PLCopen project"), "{err}");
+}
