@@ -341,3 +341,56 @@ fn an_unknown_configuration_is_refused_listing_the_configurations() {
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("is not a PLCopen project"), "{err}");
 }
+
+#[test]
+fn an_action_called_from_st_runs_its_body_on_the_instance_and_not_the_main_body() {
+    // Cyl's main body: Count := Count + 1; Pos := Count * 10. Extend: Pos := 100, Ext := TRUE.
+    // Retract: Pos := -100, Ext := FALSE, Count := 0. P calls C.Extend() (Cmd = 1),
+    // C.retract() (Cmd = 2, any case) or C(), and D() every scan. Cmd 0 0 1 0 2 0:
+    // C: Count 1 2 2 3 0 1 (an action does not run the main body), Pos 10 20 100 30 -100 10,
+    // Ext F F T T F F; D, another instance, counts on: Pos 10 … 60.
+    let w = warnings("fb_actions_st.xml");
+    assert!(
+        w.contains("its actions Extend, Retract are part of the body")
+            && !w.contains("not executed"),
+        "{w}"
+    );
+    let t = scans(
+        "fb_actions_st.xml",
+        "Cmd\n0\n0\n1\n0\n2\n0\n",
+        &["Y", "E", "Z", "C.Count"],
+    );
+    assert_eq!(t[0], col(&["10", "20", "100", "30", "-100", "10"]), "Y");
+    assert_eq!(t[1], col(&["0", "0", "1", "1", "0", "0"]), "E");
+    assert_eq!(t[2], col(&["10", "20", "30", "40", "50", "60"]), "Z");
+    assert_eq!(t[3], col(&["1", "2", "2", "3", "0", "1"]), "C.Count");
+}
+
+#[test]
+fn the_analysis_sees_what_an_action_reads_and_writes_through_the_instance_call() {
+    // P.st1 calls C.Extend() or C.retract() or C(): it reads and writes what the actions do
+    // (C.Ext, C.Count through Retract) as well as the main body.
+    let p = path("fb_actions_st.xml");
+    let out = common::cli::run(&["report", p.to_str().unwrap(), "--format", "json"]);
+    assert_eq!(out.status.code(), Some(0));
+    let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let io = crate::plcopen_common::io(&r);
+    let st1 = io
+        .iter()
+        .find(|x| x.0 == "P.st1")
+        .unwrap_or_else(|| panic!("{io:?}"));
+    for v in ["C.Ext", "C.Pos", "C.Count"] {
+        let outs = st1.2.as_array().unwrap();
+        assert!(outs.iter().any(|w| w == v), "{v} not written: {st1:?}");
+    }
+    // The action's own rungs: Extend writes Pos and Ext of the instance.
+    let ext: Vec<_> = io
+        .iter()
+        .filter(|x| x.0 == "C:Cyl.st3" || x.0 == "C:Cyl.st4")
+        .collect();
+    assert_eq!(ext.len(), 2, "{io:?}");
+    assert!(
+        ext[0].2 == serde_json::json!(["C.Pos"]) && ext[1].2 == serde_json::json!(["C.Ext"]),
+        "{ext:?}"
+    );
+}

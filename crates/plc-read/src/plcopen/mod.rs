@@ -22,6 +22,7 @@ mod block_types;
 mod data_types;
 mod elementary;
 mod expression;
+mod fb_actions;
 mod fbd;
 mod fbd_loops;
 mod il_body;

@@ -27,8 +27,8 @@ use super::data_types::DataTypes;
 use super::interface::{self, name, Interface, Known};
 use super::xml::{add_data_note, attr, error, identifier, origin, Note, Notes, Tc6, R};
 use super::{
-    fbd, il_body, ld, ld_flow, library, matiec_lib, sfc, sfc_lower, st_body, st_scope, textual,
-    user_functions,
+    fb_actions, fbd, il_body, ld, ld_flow, library, matiec_lib, sfc, sfc_lower, st_body, st_scope,
+    textual, user_functions,
 };
 use plc_diag::LoadError;
 use plc_model::{Configuration, ProgramInstance, Resource, Task};
@@ -110,6 +110,9 @@ pub(super) fn program(
         if kind == "function" {
             user_functions::add_result(&pname, &mut iface);
         }
+        if kind == "functionBlock" {
+            fb_actions::add_selector(tc6, pou, &mut iface);
+        }
         read.push((pou, pname, kind, iface));
     }
     let mut later = Notes::default();
@@ -151,10 +154,14 @@ pub(super) fn program(
     let user_fbs: Vec<st_scope::FbPins> = read
         .iter()
         .filter(|r| r.2 == "functionBlock")
-        .map(|(_, n, _, i)| st_scope::FbPins {
+        .map(|(pou, n, _, i)| st_scope::FbPins {
             name: n.clone(),
-            inputs: pins(&i.inputs),
+            inputs: pins(&i.inputs)
+                .into_iter()
+                .filter(|(p, _)| p != fb_actions::SELECTOR)
+                .collect(),
             outputs: pins(&i.outputs),
+            actions: fb_actions::names(tc6, *pou),
         })
         .collect();
     // The functions first: which of them an ST body can call (user_functions).
@@ -696,7 +703,13 @@ fn body(
         ));
     };
     let tag = lang.tag_name().name();
-    if tag != "SFC" {
+    let actions = match (tag, fb_actions::names(tc6, pou).is_empty()) {
+        ("ST", false) if iface.inputs.iter().any(|v| v.name.as_str() == fb_actions::SELECTOR) => {
+            fb_actions::bodies(tc6, pou, name)?
+        }
+        _ => Vec::new(),
+    };
+    if tag != "SFC" && actions.is_empty() {
         for extra in ["actions", "transitions"] {
             if let Some(a) = tc6.child(pou, extra) {
                 return Err(error(
@@ -747,6 +760,9 @@ fn body(
     Ok(match tag {
         "LD" => ld_body(tc6, lang, name, ctx, notes)?,
         "FBD" => Body::Fbd(fbd::body(tc6, lang, name, ctx, notes)?),
+        "ST" if !actions.is_empty() => Body::Rungs(st_body::rungs_with_actions(
+            lang, &actions, name, scope, notes,
+        )?),
         "ST" => Body::Rungs(st_body::rungs(lang, name, scope, notes)?),
         "SFC" => Body::Rungs(sfc_body(tc6, pou, lang, name, iface, scope, ctx, notes)),
         "IL" => {

@@ -68,6 +68,30 @@ pub(super) fn rungs(
     scope: &Scope,
     notes: &mut Notes,
 ) -> R<Vec<Rung<'static>>> {
+    rungs_with_actions(node, &[], pou, scope, notes)
+}
+
+/// A part of a function block's body with actions ([`super::fb_actions`]).
+enum Piece<'a, 'i> {
+    /// The statements of an ST text.
+    Texts(Node<'a, 'i>),
+    /// The jumps to the actions (how many, where the first is).
+    Dispatch(usize, Origin),
+    /// The start of action `k` (1-based): a `ret` ending what comes before, then its label on
+    /// the rung that puts the selector back to 0.
+    Enter(usize, String, Origin),
+}
+
+/// [`rungs`] of the main body `node` of a function block and of its `actions`, one body
+/// dispatching on the selector input ([`super::fb_actions`]); the statements are numbered on
+/// from the main body's through each action's, in file order.
+pub(super) fn rungs_with_actions(
+    node: Node,
+    actions: &[super::fb_actions::Action],
+    pou: &str,
+    scope: &Scope,
+    notes: &mut Notes,
+) -> R<Vec<Rung<'static>>> {
     let place = format!("pou {pou}, ST");
     let source = node.document().input_text();
     let mut out = Vec::new();
@@ -77,7 +101,24 @@ pub(super) fn rungs(
     let mut refused: Option<(Origin, String)> = None;
     // The instances the stand-ins call the project's functions through.
     let mut declared: Vec<String> = Vec::new();
-    for t in node.descendants().filter(|d| d.is_text()) {
+    let mut pieces = Vec::new();
+    if let Some(first) = actions.first() {
+        pieces.push(Piece::Dispatch(actions.len(), first.origin));
+    }
+    pieces.push(Piece::Texts(node));
+    for (i, a) in actions.iter().enumerate() {
+        pieces.push(Piece::Enter(i + 1, a.name.clone(), a.origin));
+        pieces.push(Piece::Texts(a.st));
+    }
+    for piece in pieces {
+    let body = match piece {
+        Piece::Texts(b) => b,
+        other => {
+            synthetic(other, pou, &mut out, &mut lower);
+            continue;
+        }
+    };
+    for t in body.descendants().filter(|d| d.is_text()) {
         let text = t.text().unwrap_or("");
         if text.trim().is_empty() {
             continue;
@@ -154,6 +195,7 @@ pub(super) fn rungs(
             out.extend(rung);
         }
     }
+    }
     lower.finish();
     let executed = match &refused {
         None => {
@@ -167,7 +209,7 @@ pub(super) fn rungs(
     };
     notes.push(Note {
         origin: origin(node),
-        message: message(pou, k, &unseen, &executed),
+        message: message(pou, k, &unseen, &executed) + &actions_note(actions),
     });
     match refused {
         Some(why) => notes.skipped.push(plc_syntax::SkippedBody {
@@ -186,6 +228,88 @@ pub(super) fn rungs(
         None => {}
     }
     Ok(out)
+}
+
+/// What the note of a function block's ST body says of its actions (nothing without).
+fn actions_note(actions: &[super::fb_actions::Action]) -> String {
+    if actions.is_empty() {
+        return String::new();
+    }
+    let names: Vec<&str> = actions.iter().map(|a| a.name.as_str()).collect();
+    format!(
+        "; its actions {} are part of the body, after the main body's statements, numbered on from them: a call `Inst.A()` moves A's number into `Inst.{}` and calls the instance, which runs A (docs/plcopen.md, Actions of function blocks)",
+        names.join(", "),
+        super::fb_actions::SELECTOR
+    )
+}
+
+/// The rungs of a [`Piece`] that is not ST text, as stand-ins (`out`) and as lowered rungs.
+fn synthetic(piece: Piece, pou: &str, out: &mut Vec<Rung<'static>>, lower: &mut Lower) {
+    use super::fb_actions::{label, SELECTOR};
+    use plc_syntax::{Compare, ElementKind, Move, Scalar};
+    let (unit, here, rungs): (String, Origin, Vec<(Option<String>, Vec<ElementKind>)>) =
+        match piece {
+            Piece::Texts(_) => return,
+            Piece::Dispatch(n, here) => {
+                let l = |s: String| plc_syntax::Located {
+                    value: s.into(),
+                    origin: here,
+                };
+                let jumps = (1..=n)
+                    .map(|k| {
+                        let cmp = ElementKind::Compare(Box::new(Compare {
+                            op: plc_model::CmpOp::Eq,
+                            a: plc_syntax::Located {
+                                value: Scalar::Str(SELECTOR.into()),
+                                origin: here,
+                            },
+                            b: plc_syntax::Located {
+                                value: Scalar::Number((k as u64).into()),
+                                origin: here,
+                            },
+                        }));
+                        (None, vec![cmp, ElementKind::Jmp(l(label(k)))])
+                    })
+                    .collect();
+                (format!("{pou}.actions"), here, jumps)
+            }
+            Piece::Enter(k, name, here) => {
+                let reset = ElementKind::Move(Box::new(Move {
+                    from: plc_syntax::Located {
+                        value: Scalar::Number(0u64.into()),
+                        origin: here,
+                    },
+                    to: plc_syntax::Located {
+                        value: SELECTOR.into(),
+                        origin: here,
+                    },
+                }));
+                (
+                    format!("{pou}.{name}"),
+                    here,
+                    vec![(None, vec![ElementKind::Ret]), (Some(label(k)), vec![reset])],
+                )
+            }
+        };
+    lower.unit_at(unit.clone(), here);
+    for (n, (lab, ld)) in rungs.into_iter().enumerate() {
+        if let Some(x) = &lab {
+            lower.put_label(x.clone());
+        }
+        lower.rung(ld.clone());
+        let mut r = empty_rung(format!("{unit}.{}", n + 1), here);
+        r.label = lab.map(|x| {
+            Box::new(plc_syntax::Located {
+                value: x.into(),
+                origin: here,
+            })
+        });
+        r.ld = ld
+            .into_iter()
+            .map(|kind| plc_syntax::Element { origin: here, kind })
+            .collect();
+        out.push(r);
+    }
 }
 
 /// Adds to a statement holding a pragma every elementary variable the body sees (the POU's and
