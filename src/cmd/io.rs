@@ -28,9 +28,9 @@ pub(crate) use super::temp::{
 use super::temp::{create_temp_file, put_file_in_place};
 #[cfg(test)]
 use super::temp::{random_suffix, temp_name};
-pub use plc_load::Pick;
 use plc_diag::Shown;
 use plc_fbd::Fbd;
+pub use plc_load::Pick;
 use plc_model::Program;
 use plc_read::LoadError;
 use std::io::Read;
@@ -319,10 +319,7 @@ pub fn load_program_for_run(path: &Path) -> Result<(Program, Fbd), CliError> {
 /// project ([`plc_load::plcopen_selected`]), and reading the configuration `pick.configuration`
 /// (`--configuration`) of a project with several; `--configuration` on another kind of file
 /// is an error.
-pub fn load_program_for_run_selecting(
-    path: &Path,
-    pick: Pick,
-) -> Result<(Program, Fbd), CliError> {
+pub fn load_program_for_run_selecting(path: &Path, pick: Pick) -> Result<(Program, Fbd), CliError> {
     let (file, text) = read_program_text(path)?;
     load_text_for(file, &text, Purpose::Run, pick)
 }
@@ -432,7 +429,12 @@ fn load_text_for(
             Purpose::Generate => plc_load::plcopen_lowered_selected,
         };
         let read = load(text, pick).map_err(|error| CliError::load(file.clone(), text, error))?;
-        warn_notes(CONFIGURATIONS_NOTE, &file, text, read.configurations.as_slice());
+        warn_notes(
+            CONFIGURATIONS_NOTE,
+            &file,
+            text,
+            read.configurations.as_slice(),
+        );
         warn_notes(PLCOPEN_NOTE, &file, text, &read.notes);
         return Ok((read.program, read.fbd));
     }

@@ -4,7 +4,7 @@
 //! phases show progress on a terminal.
 
 use super::io::{
-    check_output_path, load_text_selecting, Pick, read_program_text, write_output_with, FileRole,
+    check_output_path, load_text_selecting, read_program_text, write_output_with, FileRole, Pick,
 };
 use super::progress::Progress;
 use super::CliError;

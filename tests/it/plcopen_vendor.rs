@@ -255,7 +255,10 @@ fn of_two_configurations_the_first_is_read_with_a_warning_naming_the_other() {
     let p = path("two_configurations.xml");
     let out = common::cli::run(&["report", p.to_str().unwrap()]);
     let raw = String::from_utf8_lossy(&out.stderr);
-    assert!(raw.contains("warning[W0502]: the project has 2 configurations"), "{raw}");
+    assert!(
+        raw.contains("warning[W0502]: the project has 2 configurations"),
+        "{raw}"
+    );
     let w = warnings("two_configurations.xml");
     assert!(
         w.contains("the project has 2 configurations")
@@ -280,7 +283,10 @@ fn configuration_chooses_the_configuration_that_report_and_run_read() {
     let out = common::cli::run(&["report", p, "--configuration", "virtual"]);
     let err = common::cli::one_line(&String::from_utf8_lossy(&out.stderr));
     assert_eq!(out.status.code(), Some(0), "{err}");
-    assert!(!err.contains("W0502") && err.contains("subroutine PLC_LAB is never called"), "{err}");
+    assert!(
+        !err.contains("W0502") && err.contains("subroutine PLC_LAB is never called"),
+        "{err}"
+    );
     let report = String::from_utf8(out.stdout).unwrap();
     assert!(
         report.contains("Tasks of configuration Virtual")

@@ -8,9 +8,7 @@ use super::compare::first_difference;
 use super::config::{RunConfig, RunFormat, RunMode, RunWarning};
 use super::inputs::{load_inputs, InputTable};
 use super::trace::{trace_columns, Trace};
-use crate::cmd::io::{
-    check_output_path, load_program_for_run_selecting, CliError, FileRole, Pick,
-};
+use crate::cmd::io::{check_output_path, load_program_for_run_selecting, CliError, FileRole, Pick};
 use crate::cmd::progress::Progress;
 use plc_analysis::{analyse, Analysis};
 use plc_exec::parallel::{

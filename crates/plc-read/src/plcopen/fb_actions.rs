@@ -58,8 +58,7 @@ fn action_nodes<'a, 'i>(tc6: Tc6, pou: Node<'a, 'i>) -> Vec<Node<'a, 'i>> {
 /// The names of the actions of function block `pou` that ST calls run, in file order: those
 /// of a POU whose main body is ST (none otherwise).
 pub(super) fn names(tc6: Tc6, pou: Node) -> Vec<String> {
-    if pou.attribute("pouType") != Some("functionBlock") || main_language(tc6, pou) != Some("ST")
-    {
+    if pou.attribute("pouType") != Some("functionBlock") || main_language(tc6, pou) != Some("ST") {
         return Vec::new();
     }
     action_nodes(tc6, pou)

@@ -704,7 +704,12 @@ fn body(
     };
     let tag = lang.tag_name().name();
     let actions = match (tag, fb_actions::names(tc6, pou).is_empty()) {
-        ("ST", false) if iface.inputs.iter().any(|v| v.name.as_str() == fb_actions::SELECTOR) => {
+        ("ST", false)
+            if iface
+                .inputs
+                .iter()
+                .any(|v| v.name.as_str() == fb_actions::SELECTOR) =>
+        {
             fb_actions::bodies(tc6, pou, name)?
         }
         _ => Vec::new(),
@@ -944,12 +949,10 @@ fn chosen<'a, 'i>(
         .map(|c| c.attribute("name").unwrap_or(""))
         .collect();
     if let Some(c) = choose {
-        return Some(
-            match names.iter().position(|n| n.eq_ignore_ascii_case(c)) {
-                Some(k) => Ok(configurations[k]),
-                None => Err(unknown_configuration(root, c, &names)),
-            },
-        );
+        return Some(match names.iter().position(|n| n.eq_ignore_ascii_case(c)) {
+            Some(k) => Ok(configurations[k]),
+            None => Err(unknown_configuration(root, c, &names)),
+        });
     }
     if let [read, others @ ..] = &names[..] {
         if !others.is_empty() {

@@ -111,90 +111,90 @@ pub(super) fn rungs_with_actions(
         pieces.push(Piece::Texts(a.st));
     }
     for piece in pieces {
-    let body = match piece {
-        Piece::Texts(b) => b,
-        other => {
-            synthetic(other, pou, &mut out, &mut lower);
-            continue;
-        }
-    };
-    for t in body.descendants().filter(|d| d.is_text()) {
-        let text = t.text().unwrap_or("");
-        if text.trim().is_empty() {
-            continue;
-        }
-        let map = file_offsets(source, t.range().start, text);
-        let at = |off: usize| match &map {
-            Some(m) => Origin::at(m.get(off).copied().unwrap_or(t.range().start)),
-            None => origin(t),
-        };
-        let statements = st::statements(text)
-            .map_err(|e| error(at(e.at), &place, format!("ST syntax error: {}", e.message)))?;
-        if let (None, Some(p)) = (&refused, st_lower::first_pragma(text)) {
-            refused = Some((
-                at(p),
-                "a pragma `{…}` (matiec copies its text, C code, into what it generates)"
-                    .to_owned(),
-            ));
-        }
-        lower.text(map.clone(), origin(t));
-        lower.prepare(&statements);
-        for s in &statements {
-            k += 1;
-            if refused.is_none() {
-                if let Err(r) = lower.top(k, s) {
-                    refused = Some((lower.origin(r.at), r.what));
-                }
-            }
-            if s.kind == st::ast::Stmt::Empty {
+        let body = match piece {
+            Piece::Texts(b) => b,
+            other => {
+                synthetic(other, pou, &mut out, &mut lower);
                 continue;
             }
-            let here = at(s.at);
-            let a = st::accesses(s);
-            let (mut reads, mut writes, boxes) =
-                resolve(&a, scope, &mut unseen, pou).map_err(|m| error(here, &place, m))?;
-            if a.pragma {
-                everything(scope, &mut reads, &mut writes);
-                let (l, c) = here.line_column(source).unwrap_or((0, 0));
-                notes.push(Note {
+        };
+        for t in body.descendants().filter(|d| d.is_text()) {
+            let text = t.text().unwrap_or("");
+            if text.trim().is_empty() {
+                continue;
+            }
+            let map = file_offsets(source, t.range().start, text);
+            let at = |off: usize| match &map {
+                Some(m) => Origin::at(m.get(off).copied().unwrap_or(t.range().start)),
+                None => origin(t),
+            };
+            let statements = st::statements(text)
+                .map_err(|e| error(at(e.at), &place, format!("ST syntax error: {}", e.message)))?;
+            if let (None, Some(p)) = (&refused, st_lower::first_pragma(text)) {
+                refused = Some((
+                    at(p),
+                    "a pragma `{…}` (matiec copies its text, C code, into what it generates)"
+                        .to_owned(),
+                ));
+            }
+            lower.text(map.clone(), origin(t));
+            lower.prepare(&statements);
+            for s in &statements {
+                k += 1;
+                if refused.is_none() {
+                    if let Err(r) = lower.top(k, s) {
+                        refused = Some((lower.origin(r.at), r.what));
+                    }
+                }
+                if s.kind == st::ast::Stmt::Empty {
+                    continue;
+                }
+                let here = at(s.at);
+                let a = st::accesses(s);
+                let (mut reads, mut writes, boxes) =
+                    resolve(&a, scope, &mut unseen, pou).map_err(|m| error(here, &place, m))?;
+                if a.pragma {
+                    everything(scope, &mut reads, &mut writes);
+                    let (l, c) = here.line_column(source).unwrap_or((0, 0));
+                    notes.push(Note {
                     origin: here,
                     message: format!("{place}: statement {k} (at {l}:{c}) holds a pragma `{{…}}`, C code that matiec copies into what it generates and plc-deps cannot see into: the analysis takes it as reading and writing every variable of `{pou}`, and `run` and `c` refuse `{pou}`"),
                 });
-            }
-            let id = format!("{pou}.st{k}");
-            let mut rung = stand_in(id.clone(), here, &reads, &writes);
-            // The analysis sees a call of a user instance as the call of its POU (what its
-            // body reads and writes); a run never executes it from a stand-in.
-            if !notes.exec {
-                // A standard instance it calls or writes: its box, reading and writing it.
-                for (inst, ty) in &boxes {
-                    let r = rung.get_or_insert_with(|| empty_rung(id.clone(), here));
-                    r.ld.extend(standard_box(inst, ty, here));
                 }
-                let calls = user_calls(&a, scope);
-                for (inst, ty) in function_calls(&a, scope) {
-                    if !declared.contains(&inst) {
-                        notes
-                            .ld_vars
-                            .push((pou.to_owned(), instance_var(&inst, &ty, here)));
-                        declared.push(inst.clone());
+                let id = format!("{pou}.st{k}");
+                let mut rung = stand_in(id.clone(), here, &reads, &writes);
+                // The analysis sees a call of a user instance as the call of its POU (what its
+                // body reads and writes); a run never executes it from a stand-in.
+                if !notes.exec {
+                    // A standard instance it calls or writes: its box, reading and writing it.
+                    for (inst, ty) in &boxes {
+                        let r = rung.get_or_insert_with(|| empty_rung(id.clone(), here));
+                        r.ld.extend(standard_box(inst, ty, here));
+                    }
+                    let calls = user_calls(&a, scope);
+                    for (inst, ty) in function_calls(&a, scope) {
+                        if !declared.contains(&inst) {
+                            notes
+                                .ld_vars
+                                .push((pou.to_owned(), instance_var(&inst, &ty, here)));
+                            declared.push(inst.clone());
+                        }
+                    }
+                    let fns = function_calls(&a, scope).into_iter().map(|(i, _)| i);
+                    for inst in calls.into_iter().chain(fns) {
+                        let r = rung.get_or_insert_with(|| empty_rung(id.clone(), here));
+                        r.ld.push(plc_syntax::Element {
+                            origin: here,
+                            kind: plc_syntax::ElementKind::Call(plc_syntax::Located {
+                                value: inst.into(),
+                                origin: here,
+                            }),
+                        });
                     }
                 }
-                let fns = function_calls(&a, scope).into_iter().map(|(i, _)| i);
-                for inst in calls.into_iter().chain(fns) {
-                    let r = rung.get_or_insert_with(|| empty_rung(id.clone(), here));
-                    r.ld.push(plc_syntax::Element {
-                        origin: here,
-                        kind: plc_syntax::ElementKind::Call(plc_syntax::Located {
-                            value: inst.into(),
-                            origin: here,
-                        }),
-                    });
-                }
+                out.extend(rung);
             }
-            out.extend(rung);
         }
-    }
     }
     lower.finish();
     let executed = match &refused {
@@ -243,54 +243,59 @@ fn actions_note(actions: &[super::fb_actions::Action]) -> String {
     )
 }
 
+/// A rung of a [`Piece`]: its label, if any, and its elements.
+type LabelledRung = (Option<String>, Vec<plc_syntax::ElementKind<'static>>);
+
 /// The rungs of a [`Piece`] that is not ST text, as stand-ins (`out`) and as lowered rungs.
 fn synthetic(piece: Piece, pou: &str, out: &mut Vec<Rung<'static>>, lower: &mut Lower) {
     use super::fb_actions::{label, SELECTOR};
     use plc_syntax::{Compare, ElementKind, Move, Scalar};
-    let (unit, here, rungs): (String, Origin, Vec<(Option<String>, Vec<ElementKind>)>) =
-        match piece {
-            Piece::Texts(_) => return,
-            Piece::Dispatch(n, here) => {
-                let l = |s: String| plc_syntax::Located {
-                    value: s.into(),
+    let (unit, here, rungs): (String, Origin, Vec<LabelledRung>) = match piece {
+        Piece::Texts(_) => return,
+        Piece::Dispatch(n, here) => {
+            let l = |s: String| plc_syntax::Located {
+                value: s.into(),
+                origin: here,
+            };
+            let jumps = (1..=n)
+                .map(|k| {
+                    let cmp = ElementKind::Compare(Box::new(Compare {
+                        op: plc_model::CmpOp::Eq,
+                        a: plc_syntax::Located {
+                            value: Scalar::Str(SELECTOR.into()),
+                            origin: here,
+                        },
+                        b: plc_syntax::Located {
+                            value: Scalar::Number((k as u64).into()),
+                            origin: here,
+                        },
+                    }));
+                    (None, vec![cmp, ElementKind::Jmp(l(label(k)))])
+                })
+                .collect();
+            (format!("{pou}.actions"), here, jumps)
+        }
+        Piece::Enter(k, name, here) => {
+            let reset = ElementKind::Move(Box::new(Move {
+                from: plc_syntax::Located {
+                    value: Scalar::Number(0u64.into()),
                     origin: here,
-                };
-                let jumps = (1..=n)
-                    .map(|k| {
-                        let cmp = ElementKind::Compare(Box::new(Compare {
-                            op: plc_model::CmpOp::Eq,
-                            a: plc_syntax::Located {
-                                value: Scalar::Str(SELECTOR.into()),
-                                origin: here,
-                            },
-                            b: plc_syntax::Located {
-                                value: Scalar::Number((k as u64).into()),
-                                origin: here,
-                            },
-                        }));
-                        (None, vec![cmp, ElementKind::Jmp(l(label(k)))])
-                    })
-                    .collect();
-                (format!("{pou}.actions"), here, jumps)
-            }
-            Piece::Enter(k, name, here) => {
-                let reset = ElementKind::Move(Box::new(Move {
-                    from: plc_syntax::Located {
-                        value: Scalar::Number(0u64.into()),
-                        origin: here,
-                    },
-                    to: plc_syntax::Located {
-                        value: SELECTOR.into(),
-                        origin: here,
-                    },
-                }));
-                (
-                    format!("{pou}.{name}"),
-                    here,
-                    vec![(None, vec![ElementKind::Ret]), (Some(label(k)), vec![reset])],
-                )
-            }
-        };
+                },
+                to: plc_syntax::Located {
+                    value: SELECTOR.into(),
+                    origin: here,
+                },
+            }));
+            (
+                format!("{pou}.{name}"),
+                here,
+                vec![
+                    (None, vec![ElementKind::Ret]),
+                    (Some(label(k)), vec![reset]),
+                ],
+            )
+        }
+    };
     lower.unit_at(unit.clone(), here);
     for (n, (lab, ld)) in rungs.into_iter().enumerate() {
         if let Some(x) = &lab {

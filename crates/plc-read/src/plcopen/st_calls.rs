@@ -247,11 +247,11 @@ impl Lower<'_> {
         let Some(Decl::Instance { name, ty, .. }) = self.scope.get(&callee.base) else {
             return Ok(false);
         };
-        let Some(k) = self
-            .scope
-            .fb(ty)
-            .and_then(|fb| fb.actions.iter().position(|a| a.eq_ignore_ascii_case(action)))
-        else {
+        let Some(k) = self.scope.fb(ty).and_then(|fb| {
+            fb.actions
+                .iter()
+                .position(|a| a.eq_ignore_ascii_case(action))
+        }) else {
             return Ok(false);
         };
         let inst = name.clone();
@@ -265,10 +265,7 @@ impl Lower<'_> {
             from: self.operand(&super::Val::Lit(plc_syntax::Scalar::Number(
                 (k as u64 + 1).into(),
             ))),
-            to: self.name(&format!(
-                "{inst}.{}",
-                super::super::fb_actions::SELECTOR
-            )),
+            to: self.name(&format!("{inst}.{}", super::super::fb_actions::SELECTOR)),
         }));
         self.emit(vec![select]);
         let call = ElementKind::Call(self.name(&inst));
