@@ -39,6 +39,11 @@ enum Command {
         /// Output format.
         #[arg(long, value_enum, default_value_t = OrderFormat::Text)]
         format: OrderFormat,
+        /// The configuration of a PLCopen project with several (IEC 61131-3: each a controller
+        /// of its own) to read [default: the first in the file, with a warning W0502 naming the
+        /// others].
+        #[arg(long, value_name = "NAME")]
+        configuration: Option<String>,
         /// Write to this file instead of standard output.
         #[arg(short, long)]
         output: Option<PathBuf>,
@@ -54,6 +59,11 @@ enum Command {
         /// Without it, such a POU is an error.
         #[arg(long)]
         allow_skipped: bool,
+        /// The configuration of a PLCopen project with several (IEC 61131-3: each a controller
+        /// of its own) to read [default: the first in the file, with a warning W0502 naming the
+        /// others].
+        #[arg(long, value_name = "NAME")]
+        configuration: Option<String>,
         /// Write to this file instead of standard output.
         #[arg(short, long)]
         output: Option<PathBuf>,
@@ -64,6 +74,11 @@ enum Command {
     Il {
         /// The program (JSON program format, PLCopen XML or STL; `-`: standard input).
         file: PathBuf,
+        /// The configuration of a PLCopen project with several (IEC 61131-3: each a controller
+        /// of its own) to read [default: the first in the file, with a warning W0502 naming the
+        /// others].
+        #[arg(long, value_name = "NAME")]
+        configuration: Option<String>,
         /// Write to this file instead of standard output.
         #[arg(short, long)]
         output: Option<PathBuf>,
@@ -111,6 +126,11 @@ struct ReportArgs {
     /// DOT only: draw the rungs from FIRST to LAST in file order (`R10..R50`, or one id).
     #[arg(long, value_name = "FIRST..LAST")]
     rungs: Option<String>,
+    /// The configuration of a PLCopen project with several (IEC 61131-3: each a controller
+    /// of its own) to read [default: the first in the file, with a warning W0502 naming the
+    /// others].
+    #[arg(long, value_name = "NAME")]
+    configuration: Option<String>,
     /// Write to this file instead of standard output.
     #[arg(short, long)]
     output: Option<PathBuf>,
@@ -220,6 +240,11 @@ struct RunArgs {
     /// instance, in task order].
     #[arg(long)]
     pou: Option<String>,
+    /// The configuration of a PLCopen project with several (IEC 61131-3: each a controller
+    /// of its own) to read [default: the first in the file, with a warning W0502 naming the
+    /// others].
+    #[arg(long, value_name = "NAME")]
+    configuration: Option<String>,
     /// Go on when a POU's body is not executed (a PLCopen ST, IL or SFC body, read only as
     /// stand-in rungs that keep every value): the output lists those POUs. Without it, such
     /// a POU is an error.
@@ -277,6 +302,11 @@ struct CArgs {
     /// Whose rules to follow where toolchains differ, as `run --dialect` (docs/dialects.md).
     #[arg(long, value_parser = parse_dialect)]
     dialect: Option<plc_deps::model::Dialect>,
+    /// The configuration of a PLCopen project with several (IEC 61131-3: each a controller
+    /// of its own) to read [default: the first in the file, with a warning W0502 naming the
+    /// others].
+    #[arg(long, value_name = "NAME")]
+    configuration: Option<String>,
     /// Accepted for compatibility: rows are the default.
     #[arg(long, hide = true)]
     rows: bool,
@@ -299,24 +329,33 @@ fn run(cli: Cli) -> Result<(), CliError> {
         Command::Order {
             file,
             format,
+            configuration,
             output,
         } => cmd::order::order(&cmd::order::OrderConfig {
             input: file,
             format,
+            configuration,
             output,
         }),
         Command::Convert {
             file,
             allow_skipped,
+            configuration,
             output,
         } => cmd::convert::convert(&cmd::convert::ConvertConfig {
             input: file,
             allow_skipped,
+            configuration,
             output,
         }),
         Command::C(args) => cmd::c::c(&args.command()?),
-        Command::Il { file, output } => cmd::il::il(&cmd::il::IlCommand {
+        Command::Il {
+            file,
+            configuration,
+            output,
+        } => cmd::il::il(&cmd::il::IlCommand {
             input: file,
+            configuration,
             output,
         }),
         Command::Schema { output } => {
@@ -381,6 +420,7 @@ impl ReportArgs {
             },
             selection,
             program,
+            configuration: self.configuration,
             output: self.output,
         })
     }
@@ -395,6 +435,7 @@ impl CArgs {
             force: self.force,
             allow_skipped: self.allow_skipped,
             dialect: self.dialect,
+            configuration: self.configuration,
             config: plc_deps::codegen::c::CConfig {
                 cycle_ms: cmd::run::parse_cycle(&self.cycle)?,
                 loop_cap: self.loop_cap,
@@ -452,6 +493,7 @@ impl RunArgs {
         config.scan_budget = self.scan_budget;
         config.output = self.output;
         config.program = self.pou;
+        config.configuration = self.configuration;
         config.allow_skipped = self.allow_skipped;
         config.dialect = self.dialect;
         Ok(config)

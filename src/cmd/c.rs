@@ -31,12 +31,15 @@ pub struct CCommand {
     pub allow_skipped: bool,
     /// `--dialect` (docs/dialects.md); `None`: the file's.
     pub dialect: Option<plc_model::Dialect>,
+    /// The configuration of a PLCopen project with several (`--configuration`); `None`: the
+    /// first in file order.
+    pub configuration: Option<String>,
     pub config: CConfig,
 }
 
 /// `plc-deps c`: generates and writes the files.
 pub fn c(cmd: &CCommand) -> Result<(), CliError> {
-    let (mut p, fbd) = load_program_for_c(&cmd.input)?;
+    let (mut p, fbd) = load_program_for_c(&cmd.input, cmd.configuration.as_deref())?;
     if let Some(d) = cmd.dialect {
         p.set_dialect(d);
     }

@@ -19,6 +19,9 @@ pub struct ConvertConfig {
     pub input: PathBuf,
     /// Write the JSON even when a POU's body is only stand-in rungs.
     pub allow_skipped: bool,
+    /// The configuration of a PLCopen project with several (`--configuration`); `None`: the
+    /// first in file order.
+    pub configuration: Option<String>,
     pub output: Option<PathBuf>,
 }
 
@@ -26,11 +29,18 @@ pub struct ConvertConfig {
 /// as every command recognises it ([`format_of`]: STL, PLCopen TC6 XML or JSON).
 pub fn convert(c: &ConvertConfig) -> Result<(), CliError> {
     let (file, text) = read_program_text(&c.input)?;
-    let (p, _) = load_text_lowered(file.clone(), &text)?;
+    let (p, _) = load_text_lowered(file.clone(), &text, c.configuration.as_deref())?;
     super::skipped::refuse_skipped(&p, &c.input, c.allow_skipped, Some("write the JSON"))?;
     let syntax = match format_of(&file, &text) {
         Format::Stl => stl::parse(&text),
-        Format::PlcOpen => plc_load::plcopen_syntax(&text, None, true),
+        Format::PlcOpen => plc_load::plcopen_syntax(
+            &text,
+            super::io::Pick {
+                pou: None,
+                configuration: c.configuration.as_deref(),
+            },
+            true,
+        ),
         Format::Json => json::parse(&text),
     }
     .map_err(|error| CliError::load(file.clone(), &text, error))?;

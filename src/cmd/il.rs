@@ -10,6 +10,9 @@ use std::path::PathBuf;
 #[derive(Clone, Debug)]
 pub struct IlCommand {
     pub input: PathBuf,
+    /// The configuration of a PLCopen project with several (`--configuration`); `None`: the
+    /// first in file order.
+    pub configuration: Option<String>,
     pub output: Option<PathBuf>,
 }
 
@@ -18,7 +21,7 @@ pub fn il(cmd: &IlCommand) -> Result<(), CliError> {
     if let Some(out) = &cmd.output {
         check_output_path(out, FileRole::Output)?;
     }
-    let (p, fbd) = load_program_for_c(&cmd.input)?;
+    let (p, fbd) = load_program_for_c(&cmd.input, cmd.configuration.as_deref())?;
     super::skipped::refuse_skipped(&p, &cmd.input, false, None)?;
     let text = generate(&p, &fbd).map_err(|e| {
         let file = if cmd.input.as_os_str() == "-" {

@@ -30,6 +30,7 @@ use super::temp::{create_temp_file, put_file_in_place};
 use super::temp::{random_suffix, temp_name};
 use plc_diag::Shown;
 use plc_fbd::Fbd;
+pub use plc_load::Pick;
 use plc_model::Program;
 use plc_read::LoadError;
 use std::io::Read;
@@ -311,40 +312,51 @@ pub fn load_program(path: &Path) -> Result<Program, CliError> {
 /// PLCopen project with something `run` cannot execute (a string in an LD or FBD body) is an
 /// error.
 pub fn load_program_for_run(path: &Path) -> Result<(Program, Fbd), CliError> {
-    load_program_for_run_selecting(path, None)
+    load_program_for_run_selecting(path, Pick::default())
 }
 
-/// [`load_program_for_run`] keeping, with `select` (`--pou`), only that program of a PLCopen
-/// project ([`plc_load::plcopen_selected`]); `select` on another kind of file is an error.
-pub fn load_program_for_run_selecting(
-    path: &Path,
-    select: Option<&str>,
-) -> Result<(Program, Fbd), CliError> {
+/// [`load_program_for_run`] keeping, with `pick.pou` (`--pou`), only that program of a PLCopen
+/// project ([`plc_load::plcopen_selected`]), and reading the configuration `pick.configuration`
+/// (`--configuration`) of a project with several; `--configuration` on another kind of file
+/// is an error.
+pub fn load_program_for_run_selecting(path: &Path, pick: Pick) -> Result<(Program, Fbd), CliError> {
     let (file, text) = read_program_text(path)?;
-    load_text_for(file, &text, Purpose::Run, select)
+    load_text_for(file, &text, Purpose::Run, pick)
 }
 
-/// [`load_text`] keeping, with `select` (`--pou`), only that program of a PLCopen project;
-/// `select` on another kind of text is an error.
+/// [`load_text`] keeping, with `pick` (`--pou`, `--configuration`), only that program and
+/// configuration of a PLCopen project, as [`load_program_for_run_selecting`].
 pub fn load_text_selecting(
     file: String,
     text: &str,
-    select: Option<&str>,
+    pick: Pick,
 ) -> Result<(Program, Fbd), CliError> {
-    load_text_for(file, text, Purpose::Analyse, select)
+    load_text_for(file, text, Purpose::Analyse, pick)
 }
 
 /// [`load_program_and_fbd`] for code generation: a PLCopen ST body that lowers to rungs is
-/// those rungs, as `run` executes them.
-pub fn load_program_for_c(path: &Path) -> Result<(Program, Fbd), CliError> {
+/// those rungs, as `run` executes them; `configuration` as [`load_text_selecting`].
+pub fn load_program_for_c(
+    path: &Path,
+    configuration: Option<&str>,
+) -> Result<(Program, Fbd), CliError> {
     let (file, text) = read_program_text(path)?;
-    load_text_lowered(file, &text)
+    load_text_lowered(file, &text, configuration)
 }
 
 /// [`load_text`] for what writes a program out (`c`, `il`, `convert`): a PLCopen ST body that
-/// lowers to rungs is those rungs, as `run` executes them, not the analysis's stand-ins.
-pub fn load_text_lowered(file: String, text: &str) -> Result<(Program, Fbd), CliError> {
-    load_text_for(file, text, Purpose::Generate, None)
+/// lowers to rungs is those rungs, as `run` executes them, not the analysis's stand-ins;
+/// `configuration` as [`load_text_selecting`].
+pub fn load_text_lowered(
+    file: String,
+    text: &str,
+    configuration: Option<&str>,
+) -> Result<(Program, Fbd), CliError> {
+    let pick = Pick {
+        pou: None,
+        configuration,
+    };
+    load_text_for(file, text, Purpose::Generate, pick)
 }
 
 /// Reads and checks a program file (`-`: standard input), with its FBD bodies as written.
@@ -357,7 +369,7 @@ pub fn load_program_and_fbd(path: &Path) -> Result<(Program, Fbd), CliError> {
 /// block or a declaration section (or the file is named `.stl`/`.awl`), PLCopen TC6 XML when it
 /// starts with `<` (the PLCopen reader's notes go to standard error as warnings W0501), else the JSON format.
 pub fn load_text(file: String, text: &str) -> Result<(Program, Fbd), CliError> {
-    load_text_for(file, text, Purpose::Analyse, None)
+    load_text_for(file, text, Purpose::Analyse, Pick::default())
 }
 
 /// What a program is loaded for: `run` refuses what it cannot execute, the analyses do not.
@@ -394,9 +406,15 @@ fn load_text_for(
     file: String,
     text: &str,
     purpose: Purpose,
-    select: Option<&str>,
+    pick: Pick,
 ) -> Result<(Program, Fbd), CliError> {
     let format = format_of(&file, text);
+    let select = pick.pou;
+    if let (Some(c), Format::Stl | Format::Json) = (pick.configuration, format) {
+        return Err(CliError::Usage(format!(
+            "--configuration {c}: {file} is not a PLCopen project; --configuration chooses one of a PLCopen project's configurations"
+        )));
+    }
     if format == Format::Stl {
         return match select {
             Some(name) => plc_load::stl_selected(text, name),
@@ -410,10 +428,15 @@ fn load_text_for(
             Purpose::Run => plc_load::plcopen_for_run_selected,
             Purpose::Generate => plc_load::plcopen_lowered_selected,
         };
-        let (p, f, notes) =
-            load(text, select).map_err(|error| CliError::load(file.clone(), text, error))?;
-        warn_notes(PLCOPEN_NOTE, &file, text, &notes);
-        return Ok((p, f));
+        let read = load(text, pick).map_err(|error| CliError::load(file.clone(), text, error))?;
+        warn_notes(
+            CONFIGURATIONS_NOTE,
+            &file,
+            text,
+            read.configurations.as_slice(),
+        );
+        warn_notes(PLCOPEN_NOTE, &file, text, &read.notes);
+        return Ok((read.program, read.fbd));
     }
     match select {
         Some(name) => plc_load::program_and_fbd_from_json_selected(text, name),
@@ -425,6 +448,9 @@ fn load_text_for(
 /// The code of a PLCopen reader's note (what it read only through an interface, ignored, or
 /// ordered otherwise than the file).
 pub const PLCOPEN_NOTE: &str = "W0501";
+/// The code of the note that a PLCopen project has several configurations and the first is
+/// read (`--configuration` chooses another).
+pub const CONFIGURATIONS_NOTE: &str = "W0502";
 /// Prints a reader's notes as warnings with `code`.
 fn warn_notes(code: &'static str, file: &str, text: &str, notes: &[plc_read::plcopen::Note]) {
     for n in notes {

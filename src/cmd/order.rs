@@ -19,6 +19,9 @@ pub enum OrderFormat {
 pub struct OrderConfig {
     pub input: PathBuf,
     pub format: OrderFormat,
+    /// The configuration of a PLCopen project with several (`--configuration`); `None`: the
+    /// first in file order.
+    pub configuration: Option<String>,
     pub output: Option<PathBuf>,
 }
 
@@ -35,6 +38,10 @@ pub fn render_order(p: &Program, fbd: &plc_fbd::Fbd, format: OrderFormat) -> Str
 /// a fragment-rule violation is a load error naming the blocks (exit code 2).
 pub fn order(c: &OrderConfig) -> Result<(), CliError> {
     let (file, text) = read_program_text(&c.input)?;
-    let (p, fbd) = super::io::load_text(file, &text)?;
+    let pick = super::io::Pick {
+        pou: None,
+        configuration: c.configuration.as_deref(),
+    };
+    let (p, fbd) = super::io::load_text_selecting(file, &text, pick)?;
     write_output(c.output.as_deref(), &render_order(&p, &fbd, c.format))
 }

@@ -4,7 +4,7 @@
 //! phases show progress on a terminal.
 
 use super::io::{
-    check_output_path, load_text_selecting, read_program_text, write_output_with, FileRole,
+    check_output_path, load_text_selecting, read_program_text, write_output_with, FileRole, Pick,
 };
 use super::progress::Progress;
 use super::CliError;
@@ -47,6 +47,9 @@ pub struct ReportConfig {
     /// The program of a PLCopen project to analyse (`--pou` with the text, JSON and HTML
     /// reports); `None`: every program instance, in task order.
     pub program: Option<String>,
+    /// The configuration of a PLCopen project with several (`--configuration`); `None`: the
+    /// first in file order.
+    pub configuration: Option<String>,
     pub output: Option<PathBuf>,
 }
 
@@ -132,7 +135,14 @@ pub fn report(c: &ReportConfig) -> Result<(), CliError> {
     let (file, source) = read_program_text(&c.input)?;
     let (p, fbd) = {
         let _phase = progress.phase("reading the program");
-        load_text_selecting(file.clone(), &source, c.program.as_deref())?
+        load_text_selecting(
+            file.clone(),
+            &source,
+            Pick {
+                pou: c.program.as_deref(),
+                configuration: c.configuration.as_deref(),
+            },
+        )?
     };
     // The text places the warnings, which are known only after the analysis. It is kept: a big
     // program file is mapped, not read (`SourceText`), so keeping it costs no memory of ours.

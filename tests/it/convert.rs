@@ -14,7 +14,8 @@ use std::path::{Path, PathBuf};
 fn model_of(text: &str) -> Option<String> {
     // `convert` writes an ST body that lowers to rungs as those rungs (what `run` executes).
     let loaded = if plc_deps::read::plcopen::looks_like_xml(text) {
-        plc_deps::load::plcopen_lowered_selected(text, None).map(|(p, f, _)| (p, f))
+        plc_deps::load::plcopen_lowered_selected(text, plc_deps::load::Pick::default())
+            .map(|r| (r.program, r.fbd))
     } else {
         plc_deps::load::program_and_fbd_from_json(text)
     };

@@ -887,9 +887,11 @@ fn run_case(
                 Reader::Json => plc_deps::read::json::parse(text)
                     .map_err(|e| format!("loads but does not parse again: {e}"))
                     .map(|s| plc_deps::write::json::program(&s, &mut out)),
-                Reader::PlcOpen => plc_deps::load::plcopen_syntax(text, None, true)
-                    .map_err(|e| format!("loads but does not parse again: {e}"))
-                    .map(|s| plc_deps::write::json::program(&s, &mut out)),
+                Reader::PlcOpen => {
+                    plc_deps::load::plcopen_syntax(text, plc_deps::load::Pick::default(), true)
+                        .map_err(|e| format!("loads but does not parse again: {e}"))
+                        .map(|s| plc_deps::write::json::program(&s, &mut out))
+                }
                 // `plc-deps convert` reads no STL (it takes an STL file for JSON).
                 _ => return Ok(Outcome::Loaded),
             }?;

@@ -248,3 +248,155 @@ fn a_codesys_pointer_is_a_black_box_that_run_refuses_by_name() {
         "{e}"
     );
 }
+
+#[test]
+fn of_two_configurations_the_first_is_read_with_a_warning_naming_the_other() {
+    // Lab runs PLC_LAB (Y := A + 1); Virtual's PLC_VIRT is a POU no task runs (W0203).
+    let p = path("two_configurations.xml");
+    let out = common::cli::run(&["report", p.to_str().unwrap()]);
+    let raw = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        raw.contains("warning[W0502]: the project has 2 configurations"),
+        "{raw}"
+    );
+    let w = warnings("two_configurations.xml");
+    assert!(
+        w.contains("the project has 2 configurations")
+            && w.contains("reads one: `Lab`, the first in the file; not read: `Virtual`")
+            && w.contains("--configuration NAME")
+            && w.contains("subroutine PLC_VIRT is never called"),
+        "{w}"
+    );
+    let t = scans(
+        "two_configurations.xml",
+        "PLC_LAB:A\n3\n-4\n",
+        &["PLC_LAB:Y"],
+    );
+    assert_eq!(t[0], col(&["4", "-3"]), "PLC_LAB:Y");
+}
+
+#[test]
+fn configuration_chooses_the_configuration_that_report_and_run_read() {
+    let p = path("two_configurations.xml");
+    let p = p.to_str().unwrap();
+    // Any case, as IEC names are.
+    let out = common::cli::run(&["report", p, "--configuration", "virtual"]);
+    let err = common::cli::one_line(&String::from_utf8_lossy(&out.stderr));
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(
+        !err.contains("W0502") && err.contains("subroutine PLC_LAB is never called"),
+        "{err}"
+    );
+    let report = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        report.contains("Tasks of configuration Virtual")
+            && report.contains("the only program instance: MainTask.PLC_VIRT"),
+        "{report}"
+    );
+    // Z := B * Factor, Factor = 3 from Virtual's own global list.
+    let inputs = common::cli::tmp("vendor-two-configurations.csv");
+    std::fs::write(&inputs, "PLC_VIRT:B\n2\n-5\n").unwrap();
+    let tr = common::cli::tmp("vendor-two-configurations-trace.csv");
+    let out = common::cli::run(&[
+        "run",
+        p,
+        "--configuration",
+        "Virtual",
+        "--inputs",
+        inputs.to_str().unwrap(),
+        "--mode",
+        "both",
+        "--trace",
+        tr.to_str().unwrap(),
+    ]);
+    let err = common::cli::one_line(&String::from_utf8_lossy(&out.stderr));
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    let t = crate::plcopen_common::trace_columns(&tr, &["PLC_VIRT:Z"]);
+    assert_eq!(t[0], col(&["6", "-15"]), "PLC_VIRT:Z");
+}
+
+#[test]
+fn an_unknown_configuration_is_refused_listing_the_configurations() {
+    let p = path("two_configurations.xml");
+    let dir = common::cli::tmp("vendor-two-configurations-c.out");
+    for args in [
+        vec!["report", p.to_str().unwrap(), "--configuration", "Virtul"],
+        vec!["run", p.to_str().unwrap(), "--configuration", "Virtul"],
+        vec![
+            "c",
+            p.to_str().unwrap(),
+            "--configuration",
+            "Virtul",
+            "--output",
+            dir.to_str().unwrap(),
+        ],
+    ] {
+        let out = common::cli::run(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains("error[E0501]: --configuration Virtul: the project has no configuration of that name; its configurations are `Lab`, `Virtual`")
+                && err.contains("did you mean `Virtual`?"),
+            "{args:?}: {err}"
+        );
+    }
+    // A JSON program is not a PLCopen project.
+    let json = common::cli::root().join("analyses/example-a/program.json");
+    let out = common::cli::run(&["report", json.to_str().unwrap(), "--configuration", "Lab"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("is not a PLCopen project"), "{err}");
+}
+
+#[test]
+fn an_action_called_from_st_runs_its_body_on_the_instance_and_not_the_main_body() {
+    // Cyl's main body: Count := Count + 1; Pos := Count * 10. Extend: Pos := 100, Ext := TRUE.
+    // Retract: Pos := -100, Ext := FALSE, Count := 0. P calls C.Extend() (Cmd = 1),
+    // C.retract() (Cmd = 2, any case) or C(), and D() every scan. Cmd 0 0 1 0 2 0:
+    // C: Count 1 2 2 3 0 1 (an action does not run the main body), Pos 10 20 100 30 -100 10,
+    // Ext F F T T F F; D, another instance, counts on: Pos 10 … 60.
+    let w = warnings("fb_actions_st.xml");
+    assert!(
+        w.contains("its actions Extend, Retract are part of the body")
+            && !w.contains("not executed"),
+        "{w}"
+    );
+    let t = scans(
+        "fb_actions_st.xml",
+        "Cmd\n0\n0\n1\n0\n2\n0\n",
+        &["Y", "E", "Z", "C.Count"],
+    );
+    assert_eq!(t[0], col(&["10", "20", "100", "30", "-100", "10"]), "Y");
+    assert_eq!(t[1], col(&["0", "0", "1", "1", "0", "0"]), "E");
+    assert_eq!(t[2], col(&["10", "20", "30", "40", "50", "60"]), "Z");
+    assert_eq!(t[3], col(&["1", "2", "2", "3", "0", "1"]), "C.Count");
+}
+
+#[test]
+fn the_analysis_sees_what_an_action_reads_and_writes_through_the_instance_call() {
+    // P.st1 calls C.Extend() or C.retract() or C(): it reads and writes what the actions do
+    // (C.Ext, C.Count through Retract) as well as the main body.
+    let p = path("fb_actions_st.xml");
+    let out = common::cli::run(&["report", p.to_str().unwrap(), "--format", "json"]);
+    assert_eq!(out.status.code(), Some(0));
+    let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let io = crate::plcopen_common::io(&r);
+    let st1 = io
+        .iter()
+        .find(|x| x.0 == "P.st1")
+        .unwrap_or_else(|| panic!("{io:?}"));
+    for v in ["C.Ext", "C.Pos", "C.Count"] {
+        let outs = st1.2.as_array().unwrap();
+        assert!(outs.iter().any(|w| w == v), "{v} not written: {st1:?}");
+    }
+    // The action's own rungs: Extend writes Pos and Ext of the instance.
+    let ext: Vec<_> = io
+        .iter()
+        .filter(|x| x.0 == "C:Cyl.st3" || x.0 == "C:Cyl.st4")
+        .collect();
+    assert_eq!(ext.len(), 2, "{io:?}");
+    assert!(
+        ext[0].2 == serde_json::json!(["C.Pos"]) && ext[1].2 == serde_json::json!(["C.Ext"]),
+        "{ext:?}"
+    );
+}

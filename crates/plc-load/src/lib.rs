@@ -14,6 +14,7 @@ use plc_diag::LoadError;
 use plc_fbd::Fbd;
 use plc_model::Program;
 use plc_read as read;
+pub use plc_read::plcopen::Pick;
 use plc_read::plcopen::{ExecOrder, Note};
 use plc_resolve as resolve;
 
@@ -135,69 +136,93 @@ pub fn program_and_fbd_from_value(doc: &serde_json::Value) -> Result<(Program, F
 /// (with one for each FBD body whose executionOrderIds order its blocks otherwise than plc-deps,
 /// and one for what `run` could not execute).
 pub fn plcopen(text: &str) -> Result<(Program, Fbd, Vec<Note>), LoadError> {
-    plcopen_selected(text, None)
+    plcopen_selected(text, Pick::default()).map(|r| {
+        let notes = r.configurations.into_iter().chain(r.notes).collect();
+        (r.program, r.fbd, notes)
+    })
 }
 
-/// [`plcopen`] with only the program POU `select` (any case), when given, as the main program
-/// (`--pou`): an error listing the programs when the project has none of that name.
-pub fn plcopen_selected(
-    text: &str,
-    select: Option<&str>,
-) -> Result<(Program, Fbd, Vec<Note>), LoadError> {
-    let (p, f, notes, no_run) = plcopen_all(text, select, false)?;
-    Ok((p, f, notes.into_iter().chain(no_run).collect()))
+/// A PLCopen project read and resolved for a [`Pick`].
+#[derive(Debug)]
+pub struct PlcOpenRead {
+    pub program: Program,
+    pub fbd: Fbd,
+    /// The reader's notes (W0501).
+    pub notes: Vec<Note>,
+    /// The project has several configurations and the pick chose none: which was read and
+    /// which were not (W0502).
+    pub configurations: Option<Note>,
+}
+
+/// [`plcopen`] with only the program POU `pick.pou` (any case), when given, as the main program
+/// (`--pou`): an error listing the programs when the project has none of that name; and the
+/// configuration `pick.configuration` (`--configuration`), an error listing them when the
+/// project has none of that name.
+pub fn plcopen_selected(text: &str, pick: Pick) -> Result<PlcOpenRead, LoadError> {
+    let mut r = plcopen_all(text, pick, false)?;
+    r.read.notes.extend(r.no_run.take());
+    Ok(r.read)
 }
 
 /// [`plcopen_selected`] for code generation (`c`): each ST body that lowers to rungs is those
 /// rungs, as `run` executes them ([`plcopen_for_run`]), instead of a stand-in per statement.
-pub fn plcopen_lowered_selected(
-    text: &str,
-    select: Option<&str>,
-) -> Result<(Program, Fbd, Vec<Note>), LoadError> {
-    let (p, f, notes, no_run) = plcopen_all(text, select, true)?;
-    Ok((p, f, notes.into_iter().chain(no_run).collect()))
+pub fn plcopen_lowered_selected(text: &str, pick: Pick) -> Result<PlcOpenRead, LoadError> {
+    let mut r = plcopen_all(text, pick, true)?;
+    r.read.notes.extend(r.no_run.take());
+    Ok(r.read)
 }
 
 /// [`plcopen`] for `run`: an error (located) when the project has something `run` cannot execute
 /// (a string in an LD or FBD body).
 pub fn plcopen_for_run(text: &str) -> Result<(Program, Fbd, Vec<Note>), LoadError> {
-    plcopen_for_run_selected(text, None)
+    plcopen_for_run_selected(text, Pick::default()).map(|r| {
+        let notes = r.configurations.into_iter().chain(r.notes).collect();
+        (r.program, r.fbd, notes)
+    })
 }
 
-/// [`plcopen_for_run`] with only the program POU `select`, as [`plcopen_selected`].
-pub fn plcopen_for_run_selected(
-    text: &str,
-    select: Option<&str>,
-) -> Result<(Program, Fbd, Vec<Note>), LoadError> {
-    let (p, f, notes, no_run) = plcopen_all(text, select, true)?;
-    match no_run {
+/// [`plcopen_for_run`] with the program and configuration `pick`, as [`plcopen_selected`].
+pub fn plcopen_for_run_selected(text: &str, pick: Pick) -> Result<PlcOpenRead, LoadError> {
+    let r = plcopen_all(text, pick, true)?;
+    match r.no_run {
         Some(n) => Err(read::plcopen::run_refusal(n, text)),
-        None => Ok((p, f, notes)),
+        None => Ok(r.read),
     }
 }
 
-/// The program, its FBD bodies, the reader's notes, and the note of what `run` cannot execute.
-type PlcOpenLoaded = (Program, Fbd, Vec<Note>, Option<Note>);
+/// The project read, and the note of what `run` cannot execute.
+struct PlcOpenLoaded {
+    read: PlcOpenRead,
+    no_run: Option<Note>,
+}
 
-fn plcopen_all(text: &str, select: Option<&str>, exec: bool) -> Result<PlcOpenLoaded, LoadError> {
-    let (_, mut notes, (p, f)) = plcopen_read(text, select, exec)?;
+fn plcopen_all(text: &str, pick: Pick, exec: bool) -> Result<PlcOpenLoaded, LoadError> {
+    let (_, mut notes, (p, f)) = plcopen_read(text, pick, exec)?;
     for x in &notes.exec_orders {
         if let Some(n) = exec_order_note(&f, x) {
             notes.list.push(n);
         }
     }
     let no_run = notes.no_run.into_iter().next().map(|(_, n)| n);
-    Ok((p, f, notes.list, no_run))
+    Ok(PlcOpenLoaded {
+        read: PlcOpenRead {
+            program: p,
+            fbd: f,
+            notes: notes.list,
+            configurations: notes.configurations,
+        },
+        no_run,
+    })
 }
 
 /// The syntax of PLCopen `text` as the loaders read it ([`plcopen_read`]): what `convert`
 /// writes.
 pub fn plcopen_syntax(
     text: &str,
-    select: Option<&str>,
+    pick: Pick,
     exec: bool,
 ) -> Result<plc_syntax::Program<'static>, LoadError> {
-    plcopen_read(text, select, exec).map(|(syntax, _, _)| syntax)
+    plcopen_read(text, pick, exec).map(|(syntax, _, _)| syntax)
 }
 
 /// PLCopen `text` read and resolved. A function whose body the reader takes but the resolver
@@ -205,7 +230,7 @@ pub fn plcopen_syntax(
 /// before its calls were executed: once per such function.
 fn plcopen_read(
     text: &str,
-    select: Option<&str>,
+    pick: Pick,
     exec: bool,
 ) -> Result<
     (
@@ -217,7 +242,7 @@ fn plcopen_read(
 > {
     let mut refuse: Vec<(String, String)> = Vec::new();
     loop {
-        let (syntax, notes) = read::plcopen::parse_refusing(text, select, exec, refuse.clone())?;
+        let (syntax, notes) = read::plcopen::parse_refusing(text, pick, exec, refuse.clone())?;
         match resolve::resolve(text, &syntax) {
             Ok(pf) => return Ok((syntax, notes, pf)),
             Err(e) => match failed_function(&e) {

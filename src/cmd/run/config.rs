@@ -72,6 +72,9 @@ pub struct RunConfig {
     /// The program of a PLCopen project to run (`--pou`); `None`: every program instance, in
     /// task order.
     pub program: Option<String>,
+    /// The configuration of a PLCopen project with several (`--configuration`); `None`: the
+    /// first in file order.
+    pub configuration: Option<String>,
     /// `--allow-skipped`: run a project whose ST, IL or SFC bodies are not executed (the
     /// report lists them); false: such a project is refused.
     pub allow_skipped: bool,
@@ -106,6 +109,7 @@ impl RunConfig {
             progress: std::io::stderr().is_terminal(),
             calibrate: true,
             program: None,
+            configuration: None,
             allow_skipped: false,
             dialect: None,
         }

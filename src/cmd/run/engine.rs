@@ -8,7 +8,7 @@ use super::compare::first_difference;
 use super::config::{RunConfig, RunFormat, RunMode, RunWarning};
 use super::inputs::{load_inputs, InputTable};
 use super::trace::{trace_columns, Trace};
-use crate::cmd::io::{check_output_path, load_program_for_run_selecting, CliError, FileRole};
+use crate::cmd::io::{check_output_path, load_program_for_run_selecting, CliError, FileRole, Pick};
 use crate::cmd::progress::Progress;
 use plc_analysis::{analyse, Analysis};
 use plc_exec::parallel::{
@@ -193,7 +193,13 @@ pub(super) fn prepare(c: &RunConfig, progress: &Progress) -> Result<Prepared, Cl
     }
     let (mut p, fbd) = {
         let _phase = progress.phase(&format!("reading {}", c.input.display()));
-        load_program_for_run_selecting(&c.input, c.program.as_deref())?
+        load_program_for_run_selecting(
+            &c.input,
+            Pick {
+                pou: c.program.as_deref(),
+                configuration: c.configuration.as_deref(),
+            },
+        )?
     };
     if let Some(d) = c.dialect {
         p.set_dialect(d);

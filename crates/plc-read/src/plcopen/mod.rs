@@ -22,6 +22,7 @@ mod block_types;
 mod data_types;
 mod elementary;
 mod expression;
+mod fb_actions;
 mod fbd;
 mod fbd_loops;
 mod il_body;
@@ -59,37 +60,59 @@ pub fn looks_like_xml(text: &str) -> bool {
         .starts_with('<')
 }
 
+/// Which part of a project to read: the program POU `pou` alone (`--pou`, any case), and the
+/// configuration `configuration` (`--configuration`, any case) of a project with several
+/// (IEC 61131-3 2.7: each configuration is its own controller); `None`: every program instance
+/// of the configuration, and the first configuration in file order (a [`Notes::configurations`]
+/// warning names the others).
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
+pub struct Pick<'a> {
+    pub pou: Option<&'a str>,
+    pub configuration: Option<&'a str>,
+}
+
+impl<'a> Pick<'a> {
+    /// Only the program POU `pou`, when given.
+    pub fn pou(pou: Option<&'a str>) -> Pick<'a> {
+        Pick {
+            pou,
+            configuration: None,
+        }
+    }
+}
+
 /// Reads a PLCopen project into the surface syntax, with the reader's notes (errors carry line
 /// and column).
 pub fn parse(text: &str) -> Result<(syntax::Program<'static>, Notes), LoadError> {
-    parse_selected(text, None)
+    parse_selected(text, Pick::default())
 }
 
-/// [`parse`], keeping only the program POU named `select` (any case) when it is given: it is
+/// [`parse`], keeping only the program POU named `pick.pou` (any case) when it is given: it is
 /// then the main program, as if the project had no other (an error listing the programs when
-/// there is none of that name).
+/// there is none of that name); and reading the configuration `pick.configuration` (an error
+/// listing the configurations when there is none of that name).
 pub fn parse_selected(
     text: &str,
-    select: Option<&str>,
+    pick: Pick,
 ) -> Result<(syntax::Program<'static>, Notes), LoadError> {
-    parse_for(text, select, false)
+    parse_for(text, pick, false)
 }
 
 /// [`parse_selected`]; with `exec` (for `run` and `c`), each ST body that lowers to rungs is
 /// read as those rungs ([`st_lower`]), not as a stand-in rung per statement.
 pub fn parse_for(
     text: &str,
-    select: Option<&str>,
+    pick: Pick,
     exec: bool,
 ) -> Result<(syntax::Program<'static>, Notes), LoadError> {
-    parse_refusing(text, select, exec, Vec::new())
+    parse_refusing(text, pick, exec, Vec::new())
 }
 
 /// [`parse_for`], the calls of the functions `refuse` names (lower-case name, why) read as
 /// black boxes.
 pub fn parse_refusing(
     text: &str,
-    select: Option<&str>,
+    pick: Pick,
     exec: bool,
     refuse: Vec<(String, String)>,
 ) -> Result<(syntax::Program<'static>, Notes), LoadError> {
@@ -101,7 +124,7 @@ pub fn parse_refusing(
         ..Notes::default()
     };
     let mut program =
-        project::program(xml::Tc6 { ns }, &doc, select, &mut notes).map_err(|e| e.locate(text))?;
+        project::program(xml::Tc6 { ns }, &doc, pick, &mut notes).map_err(|e| e.locate(text))?;
     program.skipped = std::mem::take(&mut notes.skipped);
     Ok((program, notes))
 }

@@ -14,16 +14,21 @@
 //! boxes (the ST reader reads the arguments and writes what the call assigns), and a note says
 //! its body is not read.
 //!
+//! A project with several configurations (IEC 61131-3 2.7: each a controller of its own) is
+//! read for one of them, [`super::Pick::configuration`] or else the first in file order (a
+//! note, W0502, names the others): its globals and program instances; the program POUs only the
+//! others instantiate stay in the program as POUs no task runs, as any program no instance runs.
+//!
 //! Deliberately not here (errors naming the POU): a program instantiated twice,
-//! several configurations or resources, POUs with actions or transitions outside SFC.
+//! several resources in one configuration, POUs with actions or transitions outside SFC.
 
 use super::block_types::{Ctx, Sig};
 use super::data_types::DataTypes;
 use super::interface::{self, name, Interface, Known};
 use super::xml::{add_data_note, attr, error, identifier, origin, Note, Notes, Tc6, R};
 use super::{
-    fbd, il_body, ld, ld_flow, library, matiec_lib, sfc, sfc_lower, st_body, st_scope, textual,
-    user_functions,
+    fb_actions, fbd, il_body, ld, ld_flow, library, matiec_lib, sfc, sfc_lower, st_body, st_scope,
+    textual, user_functions,
 };
 use plc_diag::LoadError;
 use plc_model::{Configuration, ProgramInstance, Resource, Task};
@@ -42,13 +47,15 @@ struct ProgramPou {
 }
 
 /// Reads the whole project.
-/// With `select`, only the program POU of that name (any case) is kept, as the main program.
+/// With `pick.pou`, only the program POU of that name (any case) is kept, as the main program;
+/// with `pick.configuration`, that configuration's instances and globals are read.
 pub(super) fn program(
     tc6: Tc6,
     doc: &Document,
-    select: Option<&str>,
+    pick: super::Pick,
     notes: &mut Notes,
 ) -> R<Program<'static>> {
+    let select = pick.pou;
     let root = doc.root_element();
     add_data_note(tc6, root, notes);
     if let Some(ch) = tc6.child(root, "contentHeader") {
@@ -103,12 +110,22 @@ pub(super) fn program(
         if kind == "function" {
             user_functions::add_result(&pname, &mut iface);
         }
+        if kind == "functionBlock" {
+            fb_actions::add_selector(tc6, pou, &mut iface);
+        }
         read.push((pou, pname, kind, iface));
     }
     let mut later = Notes::default();
     let mut mapped_globals = Vec::new();
-    let (mut globals, order, configuration) =
-        instances(tc6, root, &known, &mut later, &mut mapped_globals)?;
+    let (mut globals, order, configuration) = instances(
+        tc6,
+        root,
+        pick.configuration,
+        &known,
+        &mut later,
+        &mut mapped_globals,
+    )?;
+    notes.configurations = later.configurations.take();
     undeclared_globals(&read, &mut globals, &mut mapped_globals, notes);
     let mapped: Vec<(Option<String>, interface::Mapped)> = read
         .iter()
@@ -137,10 +154,14 @@ pub(super) fn program(
     let user_fbs: Vec<st_scope::FbPins> = read
         .iter()
         .filter(|r| r.2 == "functionBlock")
-        .map(|(_, n, _, i)| st_scope::FbPins {
+        .map(|(pou, n, _, i)| st_scope::FbPins {
             name: n.clone(),
-            inputs: pins(&i.inputs),
+            inputs: pins(&i.inputs)
+                .into_iter()
+                .filter(|(p, _)| p != fb_actions::SELECTOR)
+                .collect(),
             outputs: pins(&i.outputs),
+            actions: fb_actions::names(tc6, *pou),
         })
         .collect();
     // The functions first: which of them an ST body can call (user_functions).
@@ -682,7 +703,18 @@ fn body(
         ));
     };
     let tag = lang.tag_name().name();
-    if tag != "SFC" {
+    let actions = match (tag, fb_actions::names(tc6, pou).is_empty()) {
+        ("ST", false)
+            if iface
+                .inputs
+                .iter()
+                .any(|v| v.name.as_str() == fb_actions::SELECTOR) =>
+        {
+            fb_actions::bodies(tc6, pou, name)?
+        }
+        _ => Vec::new(),
+    };
+    if tag != "SFC" && actions.is_empty() {
         for extra in ["actions", "transitions"] {
             if let Some(a) = tc6.child(pou, extra) {
                 return Err(error(
@@ -733,6 +765,9 @@ fn body(
     Ok(match tag {
         "LD" => ld_body(tc6, lang, name, ctx, notes)?,
         "FBD" => Body::Fbd(fbd::body(tc6, lang, name, ctx, notes)?),
+        "ST" if !actions.is_empty() => Body::Rungs(st_body::rungs_with_actions(
+            lang, &actions, name, scope, notes,
+        )?),
         "ST" => Body::Rungs(st_body::rungs(lang, name, scope, notes)?),
         "SFC" => Body::Rungs(sfc_body(tc6, pou, lang, name, iface, scope, ctx, notes)),
         "IL" => {
@@ -835,6 +870,7 @@ type Instances<'a, 'i> = (Vec<Var<'static>>, Order<'a, 'i>, Option<Configuration
 fn instances<'a, 'i>(
     tc6: Tc6,
     root: Node<'a, 'i>,
+    choose: Option<&str>,
     known: &Known,
     notes: &mut Notes,
     mapped: &mut Vec<interface::Mapped>,
@@ -847,15 +883,8 @@ fn instances<'a, 'i>(
         .into_iter()
         .flat_map(|c| tc6.children(c, "configuration"))
         .collect();
-    if configurations.len() > 1 {
-        return Err(error(
-            origin(configurations[1]),
-            "instances",
-            "several configurations are not supported yet",
-        ));
-    }
     let place = "instances/configuration";
-    let Some(conf) = configurations.first().copied() else {
+    let Some(conf) = chosen(&configurations, choose, root, notes) else {
         // TwinCAT leaves `instances` empty and keeps its resource (tasks, global variable
         // lists) in the project's application data: read it as the resource of a configuration
         // of the same name.
@@ -864,18 +893,26 @@ fn instances<'a, 'i>(
             .flat_map(|a| tc6.children(a, "data"))
             .find_map(|d| tc6.child(d, "resource"))
         else {
-            return Ok((globals, order, None));
+            return match choose {
+                Some(c) => Err(unknown_configuration(root, c, &[])),
+                None => Ok((globals, order, None)),
+            };
         };
+        let name = identifier(attr(res, "name", place)?, "resource", res, place)?;
+        if let Some(c) = choose.filter(|c| !c.eq_ignore_ascii_case(&name)) {
+            return Err(unknown_configuration(root, c, &[name.as_str()]));
+        }
         notes.push(Note {
             origin: origin(res),
             message: "the resource is read from vendor data (addData, as TwinCAT exports it): the project's instances/configurations is empty".into(),
         });
         let configuration = Configuration {
-            name: identifier(attr(res, "name", place)?, "resource", res, place)?,
+            name,
             resources: Vec::new(),
         };
         return resource(tc6, res, configuration, known, notes, mapped, globals);
     };
+    let conf = conf?;
     add_data_note(tc6, conf, notes);
     let configuration = Configuration {
         name: identifier(attr(conf, "name", place)?, "configuration", conf, place)?,
@@ -894,6 +931,70 @@ fn instances<'a, 'i>(
         return Ok((globals, order, Some(configuration)));
     };
     resource(tc6, res, configuration, known, notes, mapped, globals)
+}
+
+/// The configuration to read (IEC 61131-3 2.7: each configuration is a controller of its own,
+/// and plc-deps runs one): the one named `choose` (any case; an error listing them when none
+/// is), else the first in file order, with the note [`Notes::configurations`] when there are
+/// others. `None` when the project has none.
+fn chosen<'a, 'i>(
+    configurations: &[Node<'a, 'i>],
+    choose: Option<&str>,
+    root: Node,
+    notes: &mut Notes,
+) -> Option<R<Node<'a, 'i>>> {
+    let first = *configurations.first()?;
+    let names: Vec<&str> = configurations
+        .iter()
+        .map(|c| c.attribute("name").unwrap_or(""))
+        .collect();
+    if let Some(c) = choose {
+        return Some(match names.iter().position(|n| n.eq_ignore_ascii_case(c)) {
+            Some(k) => Ok(configurations[k]),
+            None => Err(unknown_configuration(root, c, &names)),
+        });
+    }
+    if let [read, others @ ..] = &names[..] {
+        if !others.is_empty() {
+            notes.configurations = Some(Note {
+                origin: origin(first),
+                message: format!(
+                    "the project has {} configurations (IEC 61131-3: each a controller of its own) and plc-deps reads one: `{read}`, the first in the file; not read: {} (their program POUs are analysed as POUs no task runs); choose one with --configuration NAME",
+                    names.len(),
+                    others
+                        .iter()
+                        .map(|n| format!("`{n}`"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            });
+        }
+    }
+    Some(Ok(first))
+}
+
+/// `--configuration NAME` naming no configuration of the project (`names`: those it has).
+fn unknown_configuration(root: Node, choose: &str, names: &[&str]) -> LoadError {
+    let has = match names {
+        [] => "it has none".to_owned(),
+        _ => format!(
+            "its configurations are {}",
+            names
+                .iter()
+                .map(|n| format!("`{n}`"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    };
+    let e = error(
+        origin(root),
+        "instances/configurations",
+        format!("--configuration {choose}: the project has no configuration of that name; {has}"),
+    );
+    match plc_diag::suggest::did_you_mean(choose, names.iter().copied()) {
+        Some(h) => e.with_hint(&h),
+        None => e,
+    }
 }
 
 /// The global variables of a configuration or resource, appended to `globals`.

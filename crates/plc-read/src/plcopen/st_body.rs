@@ -68,6 +68,30 @@ pub(super) fn rungs(
     scope: &Scope,
     notes: &mut Notes,
 ) -> R<Vec<Rung<'static>>> {
+    rungs_with_actions(node, &[], pou, scope, notes)
+}
+
+/// A part of a function block's body with actions ([`super::fb_actions`]).
+enum Piece<'a, 'i> {
+    /// The statements of an ST text.
+    Texts(Node<'a, 'i>),
+    /// The jumps to the actions (how many, where the first is).
+    Dispatch(usize, Origin),
+    /// The start of action `k` (1-based): a `ret` ending what comes before, then its label on
+    /// the rung that puts the selector back to 0.
+    Enter(usize, String, Origin),
+}
+
+/// [`rungs`] of the main body `node` of a function block and of its `actions`, one body
+/// dispatching on the selector input ([`super::fb_actions`]); the statements are numbered on
+/// from the main body's through each action's, in file order.
+pub(super) fn rungs_with_actions(
+    node: Node,
+    actions: &[super::fb_actions::Action],
+    pou: &str,
+    scope: &Scope,
+    notes: &mut Notes,
+) -> R<Vec<Rung<'static>>> {
     let place = format!("pou {pou}, ST");
     let source = node.document().input_text();
     let mut out = Vec::new();
@@ -77,81 +101,99 @@ pub(super) fn rungs(
     let mut refused: Option<(Origin, String)> = None;
     // The instances the stand-ins call the project's functions through.
     let mut declared: Vec<String> = Vec::new();
-    for t in node.descendants().filter(|d| d.is_text()) {
-        let text = t.text().unwrap_or("");
-        if text.trim().is_empty() {
-            continue;
-        }
-        let map = file_offsets(source, t.range().start, text);
-        let at = |off: usize| match &map {
-            Some(m) => Origin::at(m.get(off).copied().unwrap_or(t.range().start)),
-            None => origin(t),
-        };
-        let statements = st::statements(text)
-            .map_err(|e| error(at(e.at), &place, format!("ST syntax error: {}", e.message)))?;
-        if let (None, Some(p)) = (&refused, st_lower::first_pragma(text)) {
-            refused = Some((
-                at(p),
-                "a pragma `{…}` (matiec copies its text, C code, into what it generates)"
-                    .to_owned(),
-            ));
-        }
-        lower.text(map.clone(), origin(t));
-        lower.prepare(&statements);
-        for s in &statements {
-            k += 1;
-            if refused.is_none() {
-                if let Err(r) = lower.top(k, s) {
-                    refused = Some((lower.origin(r.at), r.what));
-                }
-            }
-            if s.kind == st::ast::Stmt::Empty {
+    let mut pieces = Vec::new();
+    if let Some(first) = actions.first() {
+        pieces.push(Piece::Dispatch(actions.len(), first.origin));
+    }
+    pieces.push(Piece::Texts(node));
+    for (i, a) in actions.iter().enumerate() {
+        pieces.push(Piece::Enter(i + 1, a.name.clone(), a.origin));
+        pieces.push(Piece::Texts(a.st));
+    }
+    for piece in pieces {
+        let body = match piece {
+            Piece::Texts(b) => b,
+            other => {
+                synthetic(other, pou, &mut out, &mut lower);
                 continue;
             }
-            let here = at(s.at);
-            let a = st::accesses(s);
-            let (mut reads, mut writes, boxes) =
-                resolve(&a, scope, &mut unseen, pou).map_err(|m| error(here, &place, m))?;
-            if a.pragma {
-                everything(scope, &mut reads, &mut writes);
-                let (l, c) = here.line_column(source).unwrap_or((0, 0));
-                notes.push(Note {
+        };
+        for t in body.descendants().filter(|d| d.is_text()) {
+            let text = t.text().unwrap_or("");
+            if text.trim().is_empty() {
+                continue;
+            }
+            let map = file_offsets(source, t.range().start, text);
+            let at = |off: usize| match &map {
+                Some(m) => Origin::at(m.get(off).copied().unwrap_or(t.range().start)),
+                None => origin(t),
+            };
+            let statements = st::statements(text)
+                .map_err(|e| error(at(e.at), &place, format!("ST syntax error: {}", e.message)))?;
+            if let (None, Some(p)) = (&refused, st_lower::first_pragma(text)) {
+                refused = Some((
+                    at(p),
+                    "a pragma `{…}` (matiec copies its text, C code, into what it generates)"
+                        .to_owned(),
+                ));
+            }
+            lower.text(map.clone(), origin(t));
+            lower.prepare(&statements);
+            for s in &statements {
+                k += 1;
+                if refused.is_none() {
+                    if let Err(r) = lower.top(k, s) {
+                        refused = Some((lower.origin(r.at), r.what));
+                    }
+                }
+                if s.kind == st::ast::Stmt::Empty {
+                    continue;
+                }
+                let here = at(s.at);
+                let a = st::accesses(s);
+                let (mut reads, mut writes, boxes) =
+                    resolve(&a, scope, &mut unseen, pou).map_err(|m| error(here, &place, m))?;
+                if a.pragma {
+                    everything(scope, &mut reads, &mut writes);
+                    let (l, c) = here.line_column(source).unwrap_or((0, 0));
+                    notes.push(Note {
                     origin: here,
                     message: format!("{place}: statement {k} (at {l}:{c}) holds a pragma `{{…}}`, C code that matiec copies into what it generates and plc-deps cannot see into: the analysis takes it as reading and writing every variable of `{pou}`, and `run` and `c` refuse `{pou}`"),
                 });
-            }
-            let id = format!("{pou}.st{k}");
-            let mut rung = stand_in(id.clone(), here, &reads, &writes);
-            // The analysis sees a call of a user instance as the call of its POU (what its
-            // body reads and writes); a run never executes it from a stand-in.
-            if !notes.exec {
-                // A standard instance it calls or writes: its box, reading and writing it.
-                for (inst, ty) in &boxes {
-                    let r = rung.get_or_insert_with(|| empty_rung(id.clone(), here));
-                    r.ld.extend(standard_box(inst, ty, here));
                 }
-                let calls = user_calls(&a, scope);
-                for (inst, ty) in function_calls(&a, scope) {
-                    if !declared.contains(&inst) {
-                        notes
-                            .ld_vars
-                            .push((pou.to_owned(), instance_var(&inst, &ty, here)));
-                        declared.push(inst.clone());
+                let id = format!("{pou}.st{k}");
+                let mut rung = stand_in(id.clone(), here, &reads, &writes);
+                // The analysis sees a call of a user instance as the call of its POU (what its
+                // body reads and writes); a run never executes it from a stand-in.
+                if !notes.exec {
+                    // A standard instance it calls or writes: its box, reading and writing it.
+                    for (inst, ty) in &boxes {
+                        let r = rung.get_or_insert_with(|| empty_rung(id.clone(), here));
+                        r.ld.extend(standard_box(inst, ty, here));
+                    }
+                    let calls = user_calls(&a, scope);
+                    for (inst, ty) in function_calls(&a, scope) {
+                        if !declared.contains(&inst) {
+                            notes
+                                .ld_vars
+                                .push((pou.to_owned(), instance_var(&inst, &ty, here)));
+                            declared.push(inst.clone());
+                        }
+                    }
+                    let fns = function_calls(&a, scope).into_iter().map(|(i, _)| i);
+                    for inst in calls.into_iter().chain(fns) {
+                        let r = rung.get_or_insert_with(|| empty_rung(id.clone(), here));
+                        r.ld.push(plc_syntax::Element {
+                            origin: here,
+                            kind: plc_syntax::ElementKind::Call(plc_syntax::Located {
+                                value: inst.into(),
+                                origin: here,
+                            }),
+                        });
                     }
                 }
-                let fns = function_calls(&a, scope).into_iter().map(|(i, _)| i);
-                for inst in calls.into_iter().chain(fns) {
-                    let r = rung.get_or_insert_with(|| empty_rung(id.clone(), here));
-                    r.ld.push(plc_syntax::Element {
-                        origin: here,
-                        kind: plc_syntax::ElementKind::Call(plc_syntax::Located {
-                            value: inst.into(),
-                            origin: here,
-                        }),
-                    });
-                }
+                out.extend(rung);
             }
-            out.extend(rung);
         }
     }
     lower.finish();
@@ -167,7 +209,7 @@ pub(super) fn rungs(
     };
     notes.push(Note {
         origin: origin(node),
-        message: message(pou, k, &unseen, &executed),
+        message: message(pou, k, &unseen, &executed) + &actions_note(actions),
     });
     match refused {
         Some(why) => notes.skipped.push(plc_syntax::SkippedBody {
@@ -186,6 +228,93 @@ pub(super) fn rungs(
         None => {}
     }
     Ok(out)
+}
+
+/// What the note of a function block's ST body says of its actions (nothing without).
+fn actions_note(actions: &[super::fb_actions::Action]) -> String {
+    if actions.is_empty() {
+        return String::new();
+    }
+    let names: Vec<&str> = actions.iter().map(|a| a.name.as_str()).collect();
+    format!(
+        "; its actions {} are part of the body, after the main body's statements, numbered on from them: a call `Inst.A()` moves A's number into `Inst.{}` and calls the instance, which runs A (docs/plcopen.md, Actions of function blocks)",
+        names.join(", "),
+        super::fb_actions::SELECTOR
+    )
+}
+
+/// A rung of a [`Piece`]: its label, if any, and its elements.
+type LabelledRung = (Option<String>, Vec<plc_syntax::ElementKind<'static>>);
+
+/// The rungs of a [`Piece`] that is not ST text, as stand-ins (`out`) and as lowered rungs.
+fn synthetic(piece: Piece, pou: &str, out: &mut Vec<Rung<'static>>, lower: &mut Lower) {
+    use super::fb_actions::{label, SELECTOR};
+    use plc_syntax::{Compare, ElementKind, Move, Scalar};
+    let (unit, here, rungs): (String, Origin, Vec<LabelledRung>) = match piece {
+        Piece::Texts(_) => return,
+        Piece::Dispatch(n, here) => {
+            let l = |s: String| plc_syntax::Located {
+                value: s.into(),
+                origin: here,
+            };
+            let jumps = (1..=n)
+                .map(|k| {
+                    let cmp = ElementKind::Compare(Box::new(Compare {
+                        op: plc_model::CmpOp::Eq,
+                        a: plc_syntax::Located {
+                            value: Scalar::Str(SELECTOR.into()),
+                            origin: here,
+                        },
+                        b: plc_syntax::Located {
+                            value: Scalar::Number((k as u64).into()),
+                            origin: here,
+                        },
+                    }));
+                    (None, vec![cmp, ElementKind::Jmp(l(label(k)))])
+                })
+                .collect();
+            (format!("{pou}.actions"), here, jumps)
+        }
+        Piece::Enter(k, name, here) => {
+            let reset = ElementKind::Move(Box::new(Move {
+                from: plc_syntax::Located {
+                    value: Scalar::Number(0u64.into()),
+                    origin: here,
+                },
+                to: plc_syntax::Located {
+                    value: SELECTOR.into(),
+                    origin: here,
+                },
+            }));
+            (
+                format!("{pou}.{name}"),
+                here,
+                vec![
+                    (None, vec![ElementKind::Ret]),
+                    (Some(label(k)), vec![reset]),
+                ],
+            )
+        }
+    };
+    lower.unit_at(unit.clone(), here);
+    for (n, (lab, ld)) in rungs.into_iter().enumerate() {
+        if let Some(x) = &lab {
+            lower.put_label(x.clone());
+        }
+        lower.rung(ld.clone());
+        let mut r = empty_rung(format!("{unit}.{}", n + 1), here);
+        r.label = lab.map(|x| {
+            Box::new(plc_syntax::Located {
+                value: x.into(),
+                origin: here,
+            })
+        });
+        r.ld = ld
+            .into_iter()
+            .map(|kind| plc_syntax::Element { origin: here, kind })
+            .collect();
+        out.push(r);
+    }
 }
 
 /// Adds to a statement holding a pragma every elementary variable the body sees (the POU's and

@@ -237,6 +237,42 @@ impl Lower<'_> {
         Ok(())
     }
 
+    /// `Inst.A();`, a call of action A of a user instance ([`super::super::fb_actions`]): A's
+    /// number moved into the instance's selector, then a `call` of the instance. False when
+    /// `callee` is not an action of an instance.
+    pub(super) fn action_call(&mut self, callee: &Place, args: &[Arg]) -> L<bool> {
+        let [Selector::Field(action)] = &callee.selectors[..] else {
+            return Ok(false);
+        };
+        let Some(Decl::Instance { name, ty, .. }) = self.scope.get(&callee.base) else {
+            return Ok(false);
+        };
+        let Some(k) = self.scope.fb(ty).and_then(|fb| {
+            fb.actions
+                .iter()
+                .position(|a| a.eq_ignore_ascii_case(action))
+        }) else {
+            return Ok(false);
+        };
+        let inst = name.clone();
+        if !args.is_empty() {
+            return refuse(
+                callee.base_at,
+                format!("arguments in the call of action `{inst}.{action}` (an action has none)"),
+            );
+        }
+        let select = ElementKind::Move(Box::new(Move {
+            from: self.operand(&super::Val::Lit(plc_syntax::Scalar::Number(
+                (k as u64 + 1).into(),
+            ))),
+            to: self.name(&format!("{inst}.{}", super::super::fb_actions::SELECTOR)),
+        }));
+        self.emit(vec![select]);
+        let call = ElementKind::Call(self.name(&inst));
+        self.emit(vec![call]);
+        Ok(true)
+    }
+
     /// `to := from` of two variables of type `ty`.
     pub(super) fn copy(&mut self, from: &str, to: &str, ty: Type) {
         if ty == Type::Bool {

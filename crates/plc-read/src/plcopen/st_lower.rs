@@ -840,6 +840,9 @@ impl<'s> Lower<'s> {
         if self.user_function_call(callee, args, None, None)?.is_some() {
             return Ok(());
         }
+        if self.action_call(callee, args)? {
+            return Ok(());
+        }
         let (inst, ty) = match self.scope.find(&place_path(callee)) {
             Ok(Some((Decl::Instance { name, ty, .. }, true))) if callee.selectors.is_empty() => {
                 (name.clone(), ty.clone())

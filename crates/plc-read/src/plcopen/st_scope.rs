@@ -105,6 +105,9 @@ pub(super) struct FbPins {
     pub name: String,
     pub inputs: Vec<(String, String)>,
     pub outputs: Vec<(String, String)>,
+    /// Its actions called from ST (`Inst.A()`, [`super::fb_actions`]), in file order: action
+    /// `k` (0-based) runs when its selector input holds `k + 1`.
+    pub actions: Vec<String>,
 }
 
 impl Scope {

@@ -86,6 +86,9 @@ pub struct Notes {
     /// Functions whose calls are not executed but read as black boxes (lower-case name, why):
     /// those whose body the reader took but the resolver refused (`plc_load` reads again).
     pub refuse_functions: Vec<(String, String)>,
+    /// The project has several configurations and no [`super::Pick::configuration`] chose
+    /// one: the first in file order is read, and this note names the others (W0502).
+    pub configurations: Option<Note>,
 }
 
 impl Notes {
