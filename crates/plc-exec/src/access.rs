@@ -103,6 +103,7 @@ impl Machine {
                 | Op::BrClose
                 | Op::Jmp { .. }
                 | Op::Ret
+                | Op::RangeFault
                 | Op::End => {}
                 Op::Contact { at, .. } => reads.push(byte(at)),
                 Op::Contact2 { a, b, .. } => reads.extend([byte(a), byte(b)]),

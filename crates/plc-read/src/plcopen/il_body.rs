@@ -48,8 +48,8 @@ use super::il_parse::{self, Cond, Instr, Item, Op};
 use super::st_body::file_offsets;
 use super::st_lower::{self, Lower, Refusal};
 use super::st_scope::{Decl, Scope};
-use super::user_functions::FnSig;
 use super::textual::{stand_in, Read};
+use super::user_functions::FnSig;
 use super::xml::{origin, Note, Notes, R};
 use crate::st::ast::*;
 use plc_diag::Origin;
@@ -675,7 +675,11 @@ impl Tr {
             }
             Op::Function { name, args } if self.scope.func(name).is_some() => {
                 let cr = self.cr(i)?;
-                let sig = self.scope.func(name).cloned().expect("a function of the project");
+                let sig = self
+                    .scope
+                    .func(name)
+                    .cloned()
+                    .expect("a function of the project");
                 let args = informal(i, &sig, cr, args)?;
                 self.user_call(i, name, &sig, args)?;
             }
@@ -686,7 +690,10 @@ impl Tr {
                         format!("the formal call of function `{name}` in IL (only the project's functions are called formally in IL)"),
                     );
                 };
-                if args.iter().any(|a| matches!(a, Arg::Input { name: None, .. })) {
+                if args
+                    .iter()
+                    .any(|a| matches!(a, Arg::Input { name: None, .. }))
+                {
                     return refuse(
                         at,
                         format!("an informal argument in the formal call of function `{name}` (IEC 61131-3 7.2.3: `F( … )` in IL takes formal arguments)"),
