@@ -673,16 +673,6 @@ impl Tr {
                 }
                 self.cr = Cr::Val(Expr::Binary(*op, Box::new(left), Box::new(right)));
             }
-            Op::Function { name, args } if self.scope.func(name).is_some() => {
-                let cr = self.cr(i)?;
-                let sig = self
-                    .scope
-                    .func(name)
-                    .cloned()
-                    .expect("a function of the project");
-                let args = informal(i, &sig, cr, args)?;
-                self.user_call(i, name, &sig, args)?;
-            }
             Op::FormalCall { name, args } => {
                 let Some(sig) = self.scope.func(name).cloned() else {
                     return refuse(
@@ -703,6 +693,10 @@ impl Tr {
             }
             Op::Function { name, args } => {
                 let cr = self.cr(i)?;
+                if let Some(sig) = self.scope.func(name).cloned() {
+                    let args = informal(i, &sig, cr, args)?;
+                    return self.user_call(i, name, &sig, args);
+                }
                 let mut all = vec![Arg::Input {
                     name: None,
                     value: cr,
