@@ -147,6 +147,44 @@ fn beremiz_first_steps_counter_il_counts_like_its_st_twin() {
     assert!(!skipped.contains(&"CounterIL0"), "{skipped:?}");
 }
 
+#[test]
+fn il_calls_the_projects_functions_informally_formally_and_with_en_eno() {
+    let f = "tests/il_iec/functions.xml";
+    // n counts the scans, k1 = 1. ADD3 := a + b + c; DIVMOD := a / b, rr := a MOD b;
+    // KEEP (x := 5 declared) := x * 10 + y; ISPOS := x > 0; SQ (an IL body) := x * x.
+    // Informal (matiec's il_function_call: the CR the first input, the operands the next
+    // inputs, then the outputs): y1 = ADD3(1, 2, n); y2 = ADD3(n, n, k1) * 2 (the result is
+    // the CR); q = DIVMOD(17, 5, rr => rm). Formal (the CR 99 is no input): y3 = ADD3(c := n,
+    // a := 1, b := 1). EN := n > 1: y4 = ADD3(1, 1, 1) = 3 and ENO TRUE, else the result's
+    // default 0 and ENO FALSE; dummy = DIVMOD(a := n, b := 1, rr => rm2) = n with rm2 0, else
+    // 0 with rm2 the 77 stored before. y6 = KEEP(y := n) = 50 + n (x its declared 5).
+    // pos counts the scans where ISPOS(n - 1) (JMPCN past the count): n - 1. y7 = SQ(n) + 1.
+    let names = [
+        "y1", "y2", "q", "rm", "y3", "y4", "done", "rm2", "dummy", "y6", "pos", "y7",
+    ];
+    for n in [1i64, 2, 3] {
+        let en = n > 1;
+        let expected = [
+            ("y1", json!(3 + n)),
+            ("y2", json!((2 * n + 1) * 2)),
+            ("q", json!(3)),
+            ("rm", json!(2)),
+            ("y3", json!(2 + n)),
+            ("y4", json!(if en { 3 } else { 0 })),
+            ("done", json!(en)),
+            ("rm2", json!(if en { 0 } else { 77 })),
+            ("dummy", json!(if en { n } else { 0 })),
+            ("y6", json!(50 + n)),
+            ("pos", json!(n - 1)),
+            ("y7", json!(n * n + 1)),
+        ];
+        let v = run_json(f, n as u32, None);
+        assert_eq!(values(&v, &names), pairs(&expected), "after scan {n}");
+        assert_eq!(v["fault_count"], json!(0));
+    }
+    c_equals_run(f, 3, None);
+}
+
 /// An IL program P with an INT x, an INT y, a BOOL b, a TON T1 and the body `body`.
 fn il_program(body: &str) -> String {
     px::project_in(
@@ -208,7 +246,7 @@ fn what_il_cannot_execute_is_refused_by_run_and_c_with_its_place() {
         (
             "LD x\nLIMIT(MN := 0, IN := x, MX := 5)\nST y",
             "LIMIT(",
-            "the formal call of function `LIMIT` in IL",
+            "the formal call of function `LIMIT` in IL (only the project's functions are called formally in IL)",
         ),
         (
             "LD x y\nST y",
@@ -250,4 +288,69 @@ fn what_il_cannot_execute_is_refused_by_run_and_c_with_its_place() {
             );
         }
     }
+}
+
+#[test]
+fn il_calls_of_the_projects_functions_that_cannot_bind_are_refused_with_their_place() {
+    // F has inputs a and b and an output o: the CR takes a, one operand b, a second one o.
+    let project = |body: &str| {
+        format!(
+            r#"<?xml version="1.0" encoding="utf-8"?>
+<project xmlns="http://www.plcopen.org/xml/tc6_0201">
+  <fileHeader companyName="t" productName="t" productVersion="1" creationDateTime="2026-12-08T00:00:00"/>
+  <contentHeader name="t"><coordinateInfo><fbd><scaling x="1" y="1"/></fbd><ld><scaling x="1" y="1"/></ld><sfc><scaling x="1" y="1"/></sfc></coordinateInfo></contentHeader>
+  <types><dataTypes/><pous>
+    <pou name="F" pouType="function">
+      <interface><returnType><INT/></returnType><inputVars><variable name="a"><type><INT/></type></variable><variable name="b"><type><INT/></type></variable></inputVars><outputVars><variable name="o"><type><INT/></type></variable></outputVars></interface>
+      <body><ST><xhtml:p xmlns:xhtml="http://www.w3.org/1999/xhtml"><![CDATA[F := a - b; o := a + b;]]></xhtml:p></ST></body>
+    </pou>
+    <pou name="P" pouType="program">
+      <interface><localVars><variable name="x"><type><INT/></type></variable><variable name="y"><type><INT/></type></variable></localVars></interface>
+      <body><IL><xhtml:p xmlns:xhtml="http://www.w3.org/1999/xhtml"><![CDATA[{body}]]></xhtml:p></IL></body>
+    </pou>
+  </pous></types>
+  <instances><configurations/></instances>
+</project>
+"#
+        )
+    };
+    let cases = [
+        (
+            "LD x\nF 1, y, 3\nST y",
+            "F 1",
+            "3 operands of `F`: function `F` takes 2 at most (its inputs after the current result, then its outputs)",
+        ),
+        (
+            "LD x\nF 1, 2\nST y",
+            "F 1",
+            "operand 2 of `F` goes to output `o` of function `F`, and is not a variable",
+        ),
+        (
+            "F(\n  a := 1,\n  2\n)\nST y",
+            "F(",
+            "an informal argument in the formal call of function `F` (IEC 61131-3 7.2.3: `F( … )` in IL takes formal arguments)",
+        ),
+        (
+            "F(\n  a := 1,\n  c := 2\n)\nST y",
+            "F(",
+            "input `c` in the call of function `F` (its inputs: a, b)",
+        ),
+    ];
+    for (body, at, what) in cases {
+        let xml = project(body);
+        let body_at = px::line_col(&xml, "<IL>");
+        let place = px::line_col(&xml, at);
+        let e = refusal(&run_stdin(&["run", "-"], xml.as_bytes()), body);
+        assert_eq!(
+            e,
+            format!("error: <stdin>:{body_at}: pou P: its IL body is not executed: {what} at {place} is not executed yet (it is read only as stand-in rungs that keep every value); give --allow-skipped to run the rest of the project without it"),
+            "{body}"
+        );
+    }
+    // Bound as they should, the same calls run: y = F(x := 0, 1, o => y)... = 0 - 1 = -1, the
+    // output o = 1 written first, then overwritten by the result.
+    let xml = project("LD x\nF 1, y\nST y");
+    let out = run_stdin(&["run", "-", "--format", "json"], xml.as_bytes());
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["state"]["y"], json!(-1), "{v}");
 }

@@ -663,6 +663,39 @@ fn text_report_and_explain() {
 }
 
 #[test]
+fn a_range_fault_element_records_index_range_when_powered_and_passes_the_power_on() {
+    // go = TRUE, FALSE, TRUE: the fault in scans 0 and 2; x counts the powered scans (the
+    // power goes on through the element).
+    let program = write(
+        "range_fault.json",
+        r#"{"program": "rf",
+        "vars": [{"name": "go", "type": "BOOL", "class": "input"}, {"name": "x", "type": "INT", "class": "output"}],
+        "rungs": [{"id": "R", "ld": [{"contact": "go"}, {"range_fault": true}, {"op": "ADD", "in": ["x", 1], "out": "x"}]}]}"#,
+    );
+    let inputs = write("range_fault.csv", "go\n1\n0\n1\n");
+    let j = faulted_json(
+        &run(&["run", &program, "--inputs", &inputs, "--format", "json"]),
+        "2 faults (first: index-range on rung R in scan 0;",
+    );
+    assert_eq!(
+        j["faults"],
+        serde_json::json!([
+            {"scan": 0, "rung": "R", "kind": "index-range"},
+            {"scan": 2, "rung": "R", "kind": "index-range"}
+        ])
+    );
+    assert_eq!(j["state"]["x"], serde_json::json!(2));
+    // `convert` writes it back as it was read.
+    let out = run(&["convert", &program]);
+    assert!(
+        String::from_utf8_lossy(&out.stdout).contains(r#"{"range_fault":true}"#)
+            || String::from_utf8_lossy(&out.stdout).contains(r#""range_fault": true"#),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
 fn faults_are_reported_with_scan_rung_and_kind() {
     let program = write(
         "faulty.json",

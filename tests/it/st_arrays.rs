@@ -9,6 +9,8 @@
 //! IEC 61131-3 7.3.3's statements; seq == par after every scan, and the generated C prints the
 //! interpreter's state after every scan.
 
+use crate::common::c::{assert_ok, run_with_input};
+use crate::common::cli::{run, tmp};
 use crate::plcopen_common as px;
 use crate::st_exec::{c_equals_run, pairs, run_json, values};
 use serde_json::json;
@@ -128,14 +130,32 @@ fn an_out_of_bounds_subscript_is_a_fault_of_its_scan_and_statement() {
     assert_eq!(
         v["faults"],
         json!([
-            {"scan": 1, "rung": "P.st1.2", "kind": "div-by-zero"},
-            {"scan": 2, "rung": "P.st1.2", "kind": "div-by-zero"},
+            {"scan": 1, "rung": "P.st1.2", "kind": "index-range"},
+            {"scan": 2, "rung": "P.st1.2", "kind": "index-range"},
             // Statement 2's bounds rung comes after the rungs of `k - 1` and `40 + k`, each
             // computed in DINT and cut to INT as matiec's C does (docs/dialects.md).
-            {"scan": 2, "rung": "P.st2.7", "kind": "div-by-zero"},
+            {"scan": 2, "rung": "P.st2.7", "kind": "index-range"},
         ])
     );
     c_equals_run(f, 3, Some(csv));
+    // The generated C prints the same faults, one JSON line each on standard error.
+    let dir = tmp("st-arrays-range-c-faults");
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_ok(&run(&["c", f, "-o", dir.to_str().unwrap()]), "plc-deps c");
+    let make = std::process::Command::new("make")
+        .arg("-s")
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert_ok(&make, "make");
+    let input = std::fs::read(crate::common::cli::root().join(csv)).unwrap();
+    let out = run_with_input(&dir.join("plc_program"), &["3".to_owned()], &input);
+    let faults: Vec<serde_json::Value> = String::from_utf8(out.stderr)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(json!(faults), v["faults"]);
 }
 
 /// The analysis: a constant subscript (`a[2]`, `a[1 + 1]`) is its element's variable, so

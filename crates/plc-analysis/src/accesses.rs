@@ -292,7 +292,11 @@ pub(crate) fn rung_accesses(
                 }
                 writes.push(*out);
             }
-            Element::Jmp { .. } | Element::Ret | Element::End | Element::Next { .. } => {}
+            Element::Jmp { .. }
+            | Element::Ret
+            | Element::End
+            | Element::Next { .. }
+            | Element::RangeFault => {}
             Element::Call { pou } => call(*pou, reads, writes),
             Element::For { var, bounds, .. } => {
                 operand(&bounds.from, reads);

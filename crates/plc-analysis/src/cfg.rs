@@ -247,7 +247,8 @@ fn walk_series(
             | Element::Arith { .. }
             | Element::Function { .. }
             | Element::For { .. }
-            | Element::Next { .. } => {}
+            | Element::Next { .. }
+            | Element::RangeFault => {}
         }
     }
     (always, false)

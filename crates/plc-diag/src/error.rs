@@ -111,7 +111,7 @@ pub enum Invalid {
         what: &'static str,
         allowed: String,
     },
-    #[error("unknown element {{{keys}}} (an element has one of the keys contact, compare, or, coil, set, reset, branch, ton, tof, tp, ctu, ctd, ctud, sr, rs, r_trig, f_trig, move, op, jmp, ret, end, call, for, next)")]
+    #[error("unknown element {{{keys}}} (an element has one of the keys contact, compare, or, coil, set, reset, branch, ton, tof, tp, ctu, ctd, ctud, sr, rs, r_trig, f_trig, move, op, jmp, ret, end, call, for, next, range_fault)")]
     UnknownElement { keys: String },
     #[error("`{name}` is not a valid name (letters, digits and _, not starting with a digit)")]
     BadName { name: String },

@@ -111,6 +111,7 @@ impl Code {
                 | Op::BrClose
                 | Op::Jmp { .. }
                 | Op::Ret
+                | Op::RangeFault
                 | Op::End => {}
                 Op::Contact { at, .. } => reads.push(byte(at)),
                 Op::Contact2 { a, b, .. } => reads.extend([byte(a), byte(b)]),

@@ -54,6 +54,8 @@
 //!     DIV truncates toward zero and MOD takes the sign of the dividend (IEC); an integer DIV or
 //!     MOD by zero gives 0 and records [`FaultKind::DivByZero`]; REAL is IEEE 754 `f32` (DIV by
 //!     zero gives ±inf or NaN, no fault).
+//!   - range fault: if power, records [`FaultKind::IndexRange`] (a PLCopen ST array subscript
+//!     outside its bounds, lowered to a rung that reaches it only then); power out = power in.
 //!   - jmp: if power, execution continues at the first element of the target rung; nothing after
 //!     the jump in this rung is evaluated. ret: if power, the current POU ends (in the main
 //!     program: the scan ends). end: if power, the scan ends. call: if power, the subroutine runs
@@ -218,15 +220,19 @@ pub enum FaultKind {
     /// A call or loop-back would have taken its task of the scan past the scan budget: it was
     /// refused, and so is every later one of the task in the scan.
     ScanBudget,
+    /// An array subscript outside its bounds (a read gave the type's default, a write wrote
+    /// nothing).
+    IndexRange,
 }
 
 impl FaultKind {
-    /// Short name (`div-by-zero`, `loop-cap`, `scan-budget`).
+    /// Short name (`div-by-zero`, `loop-cap`, `scan-budget`, `index-range`).
     pub fn name(self) -> &'static str {
         match self {
             FaultKind::DivByZero => "div-by-zero",
             FaultKind::LoopCap => "loop-cap",
             FaultKind::ScanBudget => "scan-budget",
+            FaultKind::IndexRange => "index-range",
         }
     }
 }

@@ -536,6 +536,15 @@ impl Machine {
                         }
                     }
                 }
+                Op::RangeFault => {
+                    if p != 0 {
+                        ctx.faults.push(Fault {
+                            scan: ctx.scan,
+                            rung,
+                            kind: FaultKind::IndexRange,
+                        });
+                    }
+                }
                 Op::Ret => {
                     if p != 0 {
                         return Flow::Return;

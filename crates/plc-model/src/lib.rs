@@ -289,6 +289,9 @@ pub enum Element {
     End,
     /// Subroutine call, when powered.
     Call { pou: PouId },
+    /// When powered, records an index-range fault of the scan (an array subscript outside
+    /// its bounds); power out = power in. Reads and writes nothing.
+    RangeFault,
     /// FOR head (last element of its rung). When powered: `var := from`, then loop while
     /// `var <= to`; the body is the rungs up to `next`.
     For {

@@ -250,6 +250,7 @@ impl<'a> Builder<'a> {
                 }
             }
             S::Ret => Element::Ret,
+            S::RangeFault => Element::RangeFault,
             S::End => {
                 if s.pou.index() != 0 {
                     return Err(err(

@@ -339,6 +339,10 @@ pub enum ElementKind<'a> {
     Call(Name<'a>),
     For(Box<For<'a>>),
     Next,
+    /// `{"range_fault": true}`: when powered, records an `index-range` fault of the scan (an
+    /// array subscript outside its bounds, as the PLCopen ST reader lowers it); power out =
+    /// power in.
+    RangeFault,
     /// The element is malformed (`at` is relative to the element).
     Invalid(Box<Problem>),
 }

@@ -307,6 +307,7 @@ fn element(e: &Element) -> io::Result<Value> {
                     "to": operand(&f.to.value)}
         }),
         K::Next => json!({ "next": true }),
+        K::RangeFault => json!({ "range_fault": true }),
         K::Invalid(p) => return Err(malformed(p)),
     })
 }

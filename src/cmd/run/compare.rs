@@ -55,6 +55,7 @@ pub(super) fn digest(mem: &[u8], canon: &[(Addr, u32)], faults: &[Fault]) -> u12
             FaultKind::DivByZero => 1,
             FaultKind::LoopCap => 2,
             FaultKind::ScanBudget => 3,
+            FaultKind::IndexRange => 4,
         };
         feed(u64::MAX - i as u64, (f.rung.raw() as u64) << 8 | kind);
     }

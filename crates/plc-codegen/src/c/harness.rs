@@ -424,7 +424,8 @@ static double seconds(void) {
 static void on_fault(_plc_ctx *ctx, uint32_t rung, int kind) {
     const _plc_program *prog = ctx->user;
     const char *name = kind == _PLC_DIV_BY_ZERO ? "div-by-zero"
-                       : kind == _PLC_LOOP_CAP ? "loop-cap" : "scan-budget";
+                       : kind == _PLC_LOOP_CAP ? "loop-cap"
+                       : kind == _PLC_SCAN_BUDGET ? "scan-budget" : "index-range";
     fprintf(stderr, "{\"scan\":%llu,\"rung\":%s,\"kind\":\"%s\"}\n", (unsigned long long)ctx->scan,
             prog->rung_ids[rung], name);
 }

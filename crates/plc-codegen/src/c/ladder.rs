@@ -528,6 +528,11 @@ impl<'a> Body<'a> {
                 self.when(&pw, r);
                 Pw::False
             }
+            Element::RangeFault => {
+                let stmt = format!("_plc_fault(ctx, {}, _PLC_INDEX_RANGE);", self.rung_no(rung));
+                self.when(&pw, &stmt);
+                pw
+            }
             Element::Call { pou } => {
                 let pw = self.materialize(pw);
                 let g = self.state();

@@ -284,6 +284,11 @@ impl Emit<'_> {
                 PouKind::Interrupt => self.net.emit("CRETI", &[], 0),
             },
             Element::End => self.net.emit("END", &[], 0),
+            Element::RangeFault => {
+                return self.fail(
+                    "an index-range fault (an array subscript outside its bounds) has no S7-200 instruction",
+                )
+            }
             Element::Call { pou } => self.net.emit("CALL", &[&n.p.pou(*pou).name], 0),
             Element::For { var, bounds, .. } => self.net.emit(
                 "FOR",

@@ -187,6 +187,8 @@ pub(crate) enum Op {
     JmpBack { to: Pc, ctr: Addr, charge: u32 },
     /// RET.
     Ret,
+    /// When powered, records an index-range fault of the scan at this rung.
+    RangeFault,
     /// END.
     End,
     /// CALL: charge `charge` rungs to the scan budget, then (unless refused) run the POU whose

@@ -470,6 +470,7 @@ impl Lowerer<'_> {
                 }
             }
             Element::Ret => self.push(Op::Ret),
+            Element::RangeFault => self.push(Op::RangeFault),
             Element::End => self.push(Op::End),
             Element::Call { pou } => {
                 self.calls.push((self.code.ops.len(), *pou));

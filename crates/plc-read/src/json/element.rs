@@ -58,6 +58,7 @@ const ELEMENT_KINDS: &[(&str, &[&str])] = &[
     ("call", &["call"]),
     ("for", &["for"]),
     ("next", &["next"]),
+    ("range_fault", &["range_fault"]),
 ];
 
 fn element_what(key: &str) -> &'static str {
@@ -86,6 +87,7 @@ fn element_what(key: &str) -> &'static str {
         "end" => "an end",
         "call" => "a call",
         "for" => "a FOR",
+        "range_fault" => "a range fault",
         _ => "a NEXT",
     }
 }
@@ -339,6 +341,10 @@ pub(super) fn classify<'a>(
         "next" => {
             f.flag("next")?;
             ElementKind::Next
+        }
+        "range_fault" => {
+            f.flag("range_fault")?;
+            ElementKind::RangeFault
         }
         "call" => ElementKind::Call(f.string("call")?),
         _ => for_loop(&mut f)?,

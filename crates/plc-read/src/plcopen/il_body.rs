@@ -23,6 +23,12 @@
 //!   or a deferred operand `OP( … )` (its list evaluated from its own operand, then CR := CR OP
 //!   result, `il_expression_c`); `N` negates the operand;
 //! - a function name: CR := F(CR, operands…) (`il_function_call_c`: CR the first input);
+//!   a function of the project likewise (CR its first input, the operands its next inputs,
+//!   then its outputs in declaration order, as matiec binds them), or called formally
+//!   `F( EN := e, IN1 := x, OUT => y, ENO => ok )` (`il_formal_funct_call_c`: CR is no input),
+//!   CR := its result; either is the ST call of the function ([`super::user_functions`],
+//!   EN/ENO as in ST) into a temporary at that instruction, so that a call whose result no
+//!   instruction uses is still made, once, where it is written;
 //! - `JMP JMPC JMPCN L`, `RET RETC RETCN` (a jump to the body's end), `CAL CALC CALCN
 //!   inst(…)`: as ST's jump, RETURN and call statements; none changes CR (stage 3 keeps the
 //!   previous instruction's type for them).
@@ -34,14 +40,16 @@
 //! stand-in rung (every input read; outputs, locals and externals written).
 //!
 //! Deliberately not here: analysis per instruction (the interface stands for the body),
-//! formal function calls `F(IN1 := …)`, an instruction list as a call argument, user function
-//! block and function calls (the lowering refuses them), S7-200 STL (`crate::stl`).
+//! formal calls of standard functions `LIMIT(MN := …)`, an instruction list as a call
+//! argument, user function block calls other than `CAL` (the lowering refuses them), S7-200
+//! STL (`crate::stl`).
 
 use super::il_parse::{self, Cond, Instr, Item, Op};
 use super::st_body::file_offsets;
 use super::st_lower::{self, Lower, Refusal};
 use super::st_scope::{Decl, Scope};
 use super::textual::{stand_in, Read};
+use super::user_functions::FnSig;
 use super::xml::{origin, Note, Notes, R};
 use crate::st::ast::*;
 use plc_diag::Origin;
@@ -231,7 +239,7 @@ fn live_from(items: &[Item], mut j: usize, seen: &mut HashSet<String>) -> bool {
         j += 1;
         let Item::Instr(i) = it else { continue };
         match &i.op {
-            Op::Ld { .. } | Op::Ret(Cond::Always) => return false,
+            Op::Ld { .. } | Op::FormalCall { .. } | Op::Ret(Cond::Always) => return false,
             Op::Cal {
                 cond: Cond::Always, ..
             } => {}
@@ -327,21 +335,24 @@ fn reads(e: &Expr, out: &mut Vec<String>) {
     }
 }
 
-/// Whether instructions `items` write anything (so that a CR kept as an expression must be
-/// computed before them).
-fn stores(items: &[Item]) -> bool {
-    items.iter().any(|it| match it {
-        Item::Label(..) => false,
-        Item::Instr(i) => {
-            !matches!(
-                i.op,
-                Op::Ld { .. } | Op::Not | Op::Binary { .. } | Op::Function { .. }
-            ) || i.nested.as_deref().is_some_and(stores)
-        }
-    })
-}
-
 impl Tr {
+    /// Whether instructions `items` write anything (so that a CR kept as an expression must be
+    /// computed before them): a call of the project's function may write its outputs' targets
+    /// and globals.
+    fn stores(&self, items: &[Item]) -> bool {
+        items.iter().any(|it| match it {
+            Item::Label(..) => false,
+            Item::Instr(i) => {
+                let pure = match &i.op {
+                    Op::Ld { .. } | Op::Not | Op::Binary { .. } => true,
+                    Op::Function { name, .. } => self.scope.func(name).is_none(),
+                    _ => false,
+                };
+                !pure || i.nested.as_deref().is_some_and(|n| self.stores(n))
+            }
+        })
+    }
+
     fn stmt(&mut self, at: usize, kind: Stmt) {
         self.out
             .push(Piece::Stmt(self.k, Box::new(Statement { at, kind })));
@@ -627,7 +638,7 @@ impl Tr {
                 let mut right = match &i.nested {
                     None => i.operand.clone().unwrap_or(Expr::Literal(String::new())),
                     Some(list) => {
-                        if stores(list) {
+                        if self.stores(list) {
                             self.settle(at, None)?;
                         }
                         let outer = self.cr.clone();
@@ -662,8 +673,30 @@ impl Tr {
                 }
                 self.cr = Cr::Val(Expr::Binary(*op, Box::new(left), Box::new(right)));
             }
+            Op::FormalCall { name, args } => {
+                let Some(sig) = self.scope.func(name).cloned() else {
+                    return refuse(
+                        at,
+                        format!("the formal call of function `{name}` in IL (only the project's functions are called formally in IL)"),
+                    );
+                };
+                if args
+                    .iter()
+                    .any(|a| matches!(a, Arg::Input { name: None, .. }))
+                {
+                    return refuse(
+                        at,
+                        format!("an informal argument in the formal call of function `{name}` (IEC 61131-3 7.2.3: `F( … )` in IL takes formal arguments)"),
+                    );
+                }
+                self.user_call(i, name, &sig, args.clone())?;
+            }
             Op::Function { name, args } => {
                 let cr = self.cr(i)?;
+                if let Some(sig) = self.scope.func(name).cloned() {
+                    let args = informal(i, &sig, cr, args)?;
+                    return self.user_call(i, name, &sig, args);
+                }
                 let mut all = vec![Arg::Input {
                     name: None,
                     value: cr,
@@ -721,8 +754,49 @@ impl Tr {
                     },
                 )?;
             }
-            Op::Unsupported(what) => return refuse(at, what.clone()),
         }
+        Ok(())
+    }
+
+    /// The call of the project's function `name` (`sig`) with `args`, made at instruction `i`
+    /// into a new temporary of its result type, which becomes the CR (matiec's
+    /// `__IL_DEFVAR = F(…)`).
+    fn user_call(&mut self, i: &Instr, name: &str, sig: &FnSig, args: Vec<Arg>) -> L<()> {
+        if let Some(why) = &sig.refused {
+            return refuse(
+                i.at,
+                format!(
+                    "the call of function `{}`, which is not executed: {why}",
+                    sig.name
+                ),
+            );
+        }
+        let Some(ty) = Type::parse(&sig.ret).filter(|t| !matches!(t, Type::Fb(_))) else {
+            return refuse(
+                i.at,
+                format!("the call of function `{}` of type {}", sig.name, sig.ret),
+            );
+        };
+        let t = self.temp(ty, i.at);
+        let Expr::Var(target) = &t else {
+            unreachable!()
+        };
+        let value = Expr::Call {
+            callee: Place {
+                base: name.to_owned(),
+                base_at: i.at,
+                selectors: Vec::new(),
+            },
+            args,
+        };
+        self.stmt(
+            i.at,
+            Stmt::Assign {
+                target: target.clone(),
+                value,
+            },
+        );
+        self.cr = Cr::Val(t);
         Ok(())
     }
 
@@ -787,6 +861,63 @@ impl Tr {
             }
         }
     }
+}
+
+/// The arguments of the informal call of the project's function `sig` at instruction `i`: the
+/// CR `cr` its first input, the operands `ops` its next inputs, then its outputs, in
+/// declaration order (matiec's `il_function_call_c`: the first parameter that is not EN or ENO
+/// takes the CR, the operands the parameters that follow).
+fn informal(i: &Instr, sig: &FnSig, cr: Expr, ops: &[Expr]) -> L<Vec<Arg>> {
+    let Some((first, _)) = sig.inputs.first() else {
+        return refuse(
+            i.at,
+            format!(
+                "`{}` as an IL operator: function `{}` has no input to take the current result",
+                i.name, sig.name
+            ),
+        );
+    };
+    let mut args = vec![Arg::Input {
+        name: Some(first.clone()),
+        value: cr,
+    }];
+    for (k, op) in ops.iter().enumerate() {
+        if let Some((pin, _)) = sig.inputs.get(k + 1) {
+            args.push(Arg::Input {
+                name: Some(pin.clone()),
+                value: op.clone(),
+            });
+            continue;
+        }
+        let Some((pin, _)) = sig.outputs.get(k + 1 - sig.inputs.len()) else {
+            return refuse(
+                i.at,
+                format!(
+                    "{} operands of `{}`: function `{}` takes {} at most (its inputs after the current result, then its outputs)",
+                    ops.len(),
+                    i.name,
+                    sig.name,
+                    sig.inputs.len() - 1 + sig.outputs.len()
+                ),
+            );
+        };
+        let Expr::Var(target) = op else {
+            return refuse(
+                i.at,
+                format!(
+                    "operand {} of `{}` goes to output `{pin}` of function `{}`, and is not a variable",
+                    k + 1,
+                    i.name,
+                    sig.name
+                ),
+            );
+        };
+        args.push(Arg::Output {
+            name: pin.clone(),
+            target: target.clone(),
+        });
+    }
+    Ok(args)
 }
 
 /// `a.b.c` of a place of fields.

@@ -8,7 +8,8 @@
 //! `CAL CALC CALCN instance[(arguments)]` (formal `IN := x`, `Q => y`, or informal), the
 //! function block input operators `S1 R1 CLK CU CD PV IN PT instance` (an implicit call),
 //! and any other name as a function called with the current result as its first argument and
-//! the operands that follow (`LIMIT 0, 100`, matiec's `il_function_call`). Labels `L1:` stand
+//! the operands that follow (`LIMIT 0, 100`, matiec's `il_function_call`), or called formally
+//! `F( IN1 := x, OUT => y )` (its arguments as `CAL`'s, one a line or not). Labels `L1:` stand
 //! before an instruction or alone on a line. Comments are the ST lexer's (`(* … *)`, nesting,
 //! and `// …`); an instruction ends at the end of its line (an argument list or a deferred
 //! operand's list in parentheses may span lines).
@@ -18,8 +19,7 @@
 //!
 //! Invariant: a syntax error is one [`LexError`] at the offset of the token that is wrong.
 //! Deliberately not here: types and meaning (`super::il_body` translates the list to ST and
-//! refuses what it cannot execute), formal function calls `F(IN1 := …)` (parsed into
-//! [`Op::Unsupported`] so that the refusal names them).
+//! refuses what it cannot execute).
 
 use crate::st::ast::{Arg, BinaryOp, Expr, Place, Selector};
 use crate::st::lexer::{tokens, Tok, Token};
@@ -70,8 +70,12 @@ pub(super) enum Op {
         name: String,
         args: Vec<Expr>,
     },
-    /// A construct parsed only to be refused by name.
-    Unsupported(String),
+    /// A formal function call `F( IN1 := x, OUT => y )`: the current result is not an input,
+    /// the result becomes the current result.
+    FormalCall {
+        name: String,
+        args: Vec<Arg>,
+    },
 }
 
 /// An instruction: its operator, its operand (for operators that take one) and, for a
@@ -316,23 +320,15 @@ impl<'a> P<'a> {
                     };
                     Op::Cal { cond: c, fb, args }
                 } else if self.is_sym("(") && !self.at_eol() {
-                    // A formal function call `F( IN1 := … )`: skipped to its `)`, refused.
-                    let mut depth = 0usize;
-                    while let Some(t) = self.peek() {
-                        match t.kind {
-                            Tok::Sym("(") => depth += 1,
-                            Tok::Sym(")") => {
-                                depth -= 1;
-                                if depth == 0 {
-                                    self.i += 1;
-                                    break;
-                                }
-                            }
-                            _ => {}
-                        }
-                        self.i += 1;
+                    // A formal function call `F( IN1 := …, OUT => … )`.
+                    let Tok::Ident(orig) = t.kind else {
+                        return self.err(at, format!("`{name}` is not an IL operator"));
+                    };
+                    self.i += 1;
+                    Op::FormalCall {
+                        name: orig.to_owned(),
+                        args: self.call_args()?,
                     }
-                    Op::Unsupported(format!("the formal call of function `{name}` in IL"))
                 } else if let Tok::Ident(orig) = t.kind {
                     let mut args = Vec::new();
                     if !self.line_ends(nested) {
@@ -588,6 +584,21 @@ mod tests {
                 args: vec![Expr::Literal("0".into()), Expr::Literal("-5".into())]
             }
         );
+        let items = parse("F(\n  EN := go,\n  a := 1,\n  ENO => ok\n)\nST y").unwrap();
+        let Item::Instr(f) = &items[0] else { panic!() };
+        let Op::FormalCall { name, args } = &f.op else {
+            panic!("{:?}", f.op)
+        };
+        assert_eq!(name, "F");
+        let names: Vec<&str> = args
+            .iter()
+            .map(|a| match a {
+                Arg::Input { name, .. } => name.as_deref().unwrap_or("?"),
+                Arg::Output { name, .. } => name,
+            })
+            .collect();
+        assert_eq!(names, ["EN", "a", "ENO"]);
+        assert_eq!(items.len(), 2);
     }
 
     #[test]

@@ -59,8 +59,8 @@
 //!   is a SELECTION, one rung per element it may choose (a compare per variable subscript): a
 //!   read moves the chosen element into a temporary that first gets the type's default, a write
 //!   moves the value (evaluated once, first) into it. A subscript outside its bounds reads the
-//!   default, writes nothing, and records a fault on the statement's bounds rung (a DIV of 1 by
-//!   the never-written `st__zero`: the executor's `div-by-zero`, docs/plcopen.md, Arrays).
+//!   default, writes nothing, and records an `index-range` fault on the statement's bounds rung
+//!   (a range-fault element, docs/plcopen.md, Arrays).
 //!
 //! Invariants: a body is lowered whole or not at all; what the lowering does not handle is a
 //! [`Refusal`] naming the construct and where it is, and then the body keeps its stand-in
@@ -150,8 +150,6 @@ pub(super) struct Lower<'s> {
     /// The innermost loops: (label CONTINUE jumps to, label EXIT jumps to).
     loops: Vec<(String, String)>,
     false_var: bool,
-    /// `st__zero` and `st__range` (an out-of-bounds subscript's fault) are declared.
-    zero_var: bool,
     /// The variables holding inputs of standard instances ([`calls`]).
     held: Vec<String>,
     /// The instances the body calls the project's functions through ([`functions`]).
@@ -205,7 +203,6 @@ impl<'s> Lower<'s> {
             pending: None,
             loops: Vec::new(),
             false_var: false,
-            zero_var: false,
             held: Vec::new(),
             fn_instances: Vec::new(),
         }
@@ -1289,22 +1286,11 @@ impl<'s> Lower<'s> {
         Ok(out)
     }
 
-    /// The rung that records a fault of the scan when a subscript is outside its bounds:
-    /// an integer DIV by the never-written `st__zero`, which records `div-by-zero` at this
-    /// statement's rung (docs/plcopen.md, Arrays).
+    /// The rung that records an `index-range` fault of the scan at this statement's rung when
+    /// a subscript is outside its bounds (docs/plcopen.md, Arrays).
     fn range_fault(&mut self, outside: Option<Series>) {
         let Some(mut ld) = outside else { return };
-        if !self.zero_var {
-            self.zero_var = true;
-            self.declare("st__zero", Type::Dint);
-            self.declare("st__range", Type::Dint);
-        }
-        ld.push(ElementKind::Arith(Box::new(Arith {
-            op: ArithOp::Div,
-            a: self.operand(&Val::Lit(Scalar::Number(1.into()))),
-            b: self.operand(&Val::Var("st__zero".to_owned(), Type::Dint)),
-            out: self.name("st__range"),
-        })));
+        ld.push(ElementKind::RangeFault);
         self.emit(ld);
     }
 

@@ -26,8 +26,10 @@
 //! ([`call_pins`]). A function whose body is read but refused by the resolver is read again as
 //! a black box (`plc_load` names it in `Notes::refuse_functions`).
 //!
-//! Deliberately not here: VAR_IN_OUT of functions (refused), calls of user functions in IL
-//! bodies (black boxes, [`super::black_box`]).
+//! An IL body calls a function as ST does: `super::il_body` translates `F x` and `F( a := x )`
+//! into the ST call.
+//!
+//! Deliberately not here: VAR_IN_OUT of functions (refused).
 
 use super::xml::{Note, Notes, R};
 use plc_syntax::{Body, Element, ElementKind, Located, Move, Rung, Scalar, Var};

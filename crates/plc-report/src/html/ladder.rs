@@ -171,6 +171,7 @@ fn shape(p: &Program, e: &Element) -> Shape {
             ),
         ]),
         Element::Next { .. } => boxed(vec!["NEXT".into()]),
+        Element::RangeFault => boxed(vec!["FAULT".into(), "index-range".into()]),
     }
 }
 
