@@ -661,7 +661,8 @@ fn element_vars(e: &Element, f: &mut impl FnMut(VarId)) {
         | Element::Ret
         | Element::End
         | Element::Call { .. }
-        | Element::Next { .. } => {}
+        | Element::Next { .. }
+        | Element::RangeFault => {}
     }
 }
 
