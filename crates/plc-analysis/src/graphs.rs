@@ -5,7 +5,7 @@
 //!
 //! Each function copies one result of an [`Analysis`] into a fresh [`DiGraph`]; nothing is
 //! computed again, so a view holds exactly what the analysis holds (`plc-deps report` shows the
-//! same). Node indices are the library's dense ids: node `i` of the rung graphs is `RungId(i)`,
+//! same). Node indices are the library's dense ids: node `i` of the rung graphs is the rung `p.rungs().id(i)`,
 //! of the CFG graphs `CfgNode(i)` (START and STOP last, see [`Cfg`](super::Cfg)), of the
 //! schedule `TaskId(i)`; [`rung_node`], [`cfg_node`] and [`task_node`] convert, and every node
 //! weight is its id too. Edges are added in the analysis' order, so in [`cfg_graph`] edge
@@ -27,7 +27,6 @@
 //! # }
 //! use petgraph::algo::{has_path_connecting, toposort};
 //! use plc_deps::analysis::{analyse, graphs, DepKind};
-//! use plc_deps::model::RungId;
 //!
 //! // R2 and R3 both write X (output), R4 reads it (flow); R1 jumps over R2 when A is on.
 //! let program = r#"{
@@ -49,8 +48,8 @@
 //! let a = analyse(&p);
 //!
 //! // Data dependences: node i is rung i, each edge says its kind and variable.
-//! let deps = graphs::dependence_graph(&a);
-//! let (r2, r4) = (graphs::rung_node(RungId(1)), graphs::rung_node(RungId(3)));
+//! let deps = graphs::dependence_graph(&p, &a);
+//! let (r2, r4) = (graphs::rung_node(p.rungs().id(1)), graphs::rung_node(p.rungs().id(3)));
 //! assert!(has_path_connecting(&deps, r2, r4, None));
 //! let flows = deps.edge_weights().filter(|e| e.kind == DepKind::Flow).count();
 //! assert_eq!(flows, 2); // R2 → R4 and R3 → R4, both through X
@@ -61,13 +60,13 @@
 //!
 //! // The control dependences: R2 runs only if R1 does not jump.
 //! let cdg = graphs::control_dependence_graph(&a);
-//! let r1 = graphs::cfg_node(RungId(0).into());
-//! let r2 = graphs::cfg_node(RungId(1).into());
+//! let r1 = graphs::cfg_node(p.rungs().id(0).into());
+//! let r2 = graphs::cfg_node(p.rungs().id(1).into());
 //! assert!(cdg.contains_edge(r1, r2));
 //!
 //! // The post-dominator tree: R3 is where both ways from R1 meet again.
 //! let pdom = graphs::post_dominator_tree(&a);
-//! let r3 = graphs::cfg_node(RungId(2).into());
+//! let r3 = graphs::cfg_node(p.rungs().id(2).into());
 //! assert!(pdom.contains_edge(r3, r1));
 //!
 //! // The combined schedule: tasks with their levels, edges to the tasks that must wait.

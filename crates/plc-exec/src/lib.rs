@@ -3,16 +3,17 @@
 //! # Use
 //! ```
 //! use plc_exec::{ExecConfig, Layout, Machine};
-//! use plc_model::{Value, VarId};
+//! use plc_model::Value;
 //! let p = plc_load::program_from_json(r#"{"program": "p",
 //!     "vars": [{"name": "a", "type": "BOOL", "class": "input"}, {"name": "q", "type": "BOOL", "class": "output"}],
 //!     "rungs": [{"id": "R1", "ld": [{"contact": "a"}, {"coil": "q"}]}]}"#).unwrap();
 //! let m = Machine::new(&p, Layout::dense(&p), &ExecConfig::default()).unwrap();
 //! let mut state = m.initial_state();
 //! let mut faults = Vec::new();
-//! m.set_inputs(&mut state, &[(VarId(0), Value::Bool(true))]);
+//! let (a, q) = (p.vars().id(0), p.vars().id(1));
+//! m.set_inputs(&mut state, &[(a, Value::Bool(true))]);
 //! m.run_scan(&mut state, 0, &mut faults);
-//! assert_eq!(m.value(&state, VarId(1)).as_bool(), Some(true));
+//! assert_eq!(m.value(&state, q).as_bool(), Some(true));
 //! ```
 //!
 //! # Scan semantics (the contract)
@@ -141,6 +142,7 @@ mod fuse;
 #[cfg(test)]
 mod fuse_tests;
 mod layout;
+mod line;
 mod lower;
 mod mem;
 mod output_mode;

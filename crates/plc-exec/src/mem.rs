@@ -6,12 +6,10 @@
 //! bytes past it, up to the end of the last line, are zero and never seen; the view is
 //! `raw::LineBytes`). It does no typed access (`store`) and knows no layout (`layout`).
 
+pub use super::line::LINE_BYTES;
 use super::raw::LineBytes;
 use std::fmt;
 use std::ops::{Deref, DerefMut};
-
-/// Bytes per cache line (x86-64, most aarch64).
-pub const LINE_BYTES: u32 = 64;
 
 /// A state's memory: `len` bytes starting on a 64-byte boundary, zero-initialised.
 #[derive(Clone)]

@@ -23,8 +23,8 @@
 //! the standard the arguments follow.
 
 use super::fuse::{FusedId, FusedRung, Table};
+use super::line::LINE_BYTES;
 use super::lower::{Code, Op};
-use super::mem::LINE_BYTES;
 use super::store::{Addr, Store, Word};
 use super::Machine;
 use std::ops::Deref;

@@ -13,6 +13,27 @@
 //! it is the one way to make an id from a number outside its crate, and is named so that a
 //! review finds every use (`grep from_raw`).
 //!
+//! Outside the declaring crate, neither the number nor a constructor is reachable:
+//!
+//! ```compile_fail
+//! let v = plc_model::VarId(3); // the field is private
+//! ```
+//! ```compile_fail
+//! let v = plc_model::VarId::new(3); // `new` is the declaring crate's own
+//! ```
+//! ```compile_fail
+//! let n = plc_model::VarId::from_raw(3).0; // read the number with `raw()`
+//! ```
+//! ```
+//! use plc_model::{Arena, VarId};
+//! let mut names: Arena<VarId, &str> = Arena::new();
+//! let a = names.push("A");
+//! let b = names.push("B");
+//! assert_eq!(names[b], "B");
+//! assert_eq!(names.ids().collect::<Vec<_>>(), [a, b]);
+//! assert_eq!(names.get_id(2), None);
+//! ```
+//!
 //! It deliberately does not tag an id with the arena it came from (as rustc's `IndexVec` does
 //! not): an id of one program used with another is a logic error that bounds checks catch.
 //! The shape follows rust-analyzer's `la_arena` and rustc's `IndexVec`.

@@ -1,12 +1,14 @@
 //! The program model: one resolved, type-checked representation of a ladder program that every
 //! analysis and every output works from.
 //!
-//! Readers (`plc_read`) turn the JSON program format into a [`Program`]; nothing downstream
-//! ever sees names that are not resolved. Invariants a `Program` always holds (the reader checks
-//! them and refuses anything else):
-//! - variables, rungs and POUs live in dense `Vec`s indexed by the newtypes [`VarId`], [`RungId`]
-//!   and [`PouId`]; `pous[0]` is the main program; the rungs of a POU are a contiguous
-//!   [`RungId`] range, POUs in file order (main first, then subroutines);
+//! Readers (`plc_read`) and the resolver (`plc_resolve`) turn a file into a [`Program`]; nothing
+//! downstream ever sees names that are not resolved. Invariants a `Program` always holds (the
+//! resolver establishes them; [`Program::new`], its only constructor, checks the first and the
+//! third, and its fields are private, so nothing downstream can break them):
+//! - variables, rungs and POUs live in [`Arena`]s that hand out the opaque ids [`VarId`],
+//!   [`RungId`] and [`PouId`] ([`arena`]); `pous[0]` is the main program; the rungs of a POU are
+//!   a contiguous [`RungId`] range, POUs in file order (main first, then subroutines); every id
+//!   an element names is one the program holds;
 //! - every operand has a known IEC type and every element's operands have the types it needs;
 //! - every `jmp` names a rung of the same POU, every FOR has its NEXT in the same POU (properly
 //!   nested) and no jump enters a FOR body from outside it; no subroutine calls itself, directly or
@@ -690,6 +692,130 @@ mod tests {
     #[test]
     fn an_element_is_32_bytes() {
         assert_eq!(std::mem::size_of::<Element>(), 32);
+    }
+
+    fn var(name: &str) -> Var {
+        Var {
+            name: name.into(),
+            ty: Type::Bool,
+            class: VarClass::Memory,
+            init: Value::Bool(false),
+            scope: None,
+            hidden: false,
+        }
+    }
+
+    fn rung(id: &str, pou: PouId, series: Series) -> Rung {
+        Rung {
+            id: id.into(),
+            label: None,
+            comment: None,
+            pou,
+            series,
+            lowered: None,
+            origin: Origin::NONE,
+        }
+    }
+
+    /// A main program of two rungs and a subroutine of one, over variables A and B.
+    fn parts() -> ProgramParts {
+        let vars: Arena<VarId, Var> = [var("A"), var("B")].into_iter().collect();
+        let mut pous: Arena<PouId, Pou> = Arena::new();
+        let main = pous.push(Pou {
+            name: "main".into(),
+            kind: PouKind::Main,
+            rungs: 0..2,
+            skipped: None,
+        });
+        let sub = pous.push(Pou {
+            name: "SBR".into(),
+            kind: PouKind::Subroutine,
+            rungs: 2..3,
+            skipped: None,
+        });
+        let (a, b) = (vars.id(0), vars.id(1));
+        let contact = Element::Contact {
+            var: VarRef {
+                var: a,
+                field: None,
+            },
+            kind: ContactKind::Normal,
+        };
+        let rungs: Arena<RungId, Rung> = [
+            rung(
+                "R1",
+                main,
+                vec![contact.clone(), Element::Call { pou: sub }],
+            ),
+            rung(
+                "R2",
+                main,
+                vec![
+                    contact.clone(),
+                    Element::Coil {
+                        var: b,
+                        negated: false,
+                    },
+                ],
+            ),
+            rung("S1", sub, vec![contact, Element::Set(b)]),
+        ]
+        .into_iter()
+        .collect();
+        ProgramParts {
+            name: "p".into(),
+            vars,
+            pous,
+            rungs,
+            written_inputs: vec![b, a, b],
+            ..ProgramParts::default()
+        }
+    }
+
+    #[test]
+    fn a_consistent_program_is_made_and_its_written_inputs_sorted() {
+        let p = Program::new(parts()).expect("consistent");
+        assert_eq!(p.rung_ids().count(), 3);
+        assert_eq!(p.written_inputs(), [p.vars().id(0), p.vars().id(1)]);
+        assert_eq!(
+            p.pou_rungs(p.pous().id(1)).collect::<Vec<_>>(),
+            [p.rungs().id(2)]
+        );
+        assert_eq!(p.first_rung(p.main_id()), Some(p.rungs().id(0)));
+    }
+
+    #[test]
+    fn program_new_refuses_what_breaks_an_invariant() {
+        let refused = |change: &dyn Fn(&mut ProgramParts), why: &str| {
+            let mut bad = parts();
+            change(&mut bad);
+            let e = Program::new(bad).expect_err(why);
+            assert!(e.0.contains(why), "{e}");
+        };
+        refused(&|p| p.pous[1].rungs = 3..3, "do not follow on");
+        refused(&|p| p.pous[0].rungs = 0..1, "do not follow on");
+        refused(&|p| p.rungs[2].pou = p.pous.id(0), "names another");
+        refused(&|p| p.pous = Arena::new(), "no main program");
+        // A variable id from a bigger arena.
+        let mut more: Arena<VarId, Var> = Arena::new();
+        let far = (0..3)
+            .map(|i| more.push(var(&i.to_string())))
+            .last()
+            .unwrap();
+        refused(
+            &|p| p.rungs[1].series.push(Element::Reset(far)),
+            "names a variable",
+        );
+        refused(&|p| p.written_inputs.push(far), "written input");
+        // A jump from the subroutine into the main program.
+        let into_main = |p: &mut ProgramParts| {
+            let target = p.rungs.id(0);
+            p.rungs[2].series.push(Element::Jmp {
+                label: "L".into(),
+                target,
+            });
+        };
+        refused(&into_main, "outside its POU");
     }
 
     /// The same for rungs: what only FBD-lowered rungs carry is behind one pointer.

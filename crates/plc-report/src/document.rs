@@ -420,7 +420,7 @@ pub fn document_with<'a>(p: &'a Program, a: &'a Analysis, fbd: Option<&'a FbdPar
     };
     let (fbd_section, shown_levels) = fbd_of(p, fbd, &levels);
     Report {
-        program: &p.name(),
+        program: p.name(),
         rungs,
         dependences,
         dependences_listed: match a.listed {

@@ -261,7 +261,7 @@ pub(super) fn prepare(c: &RunConfig, progress: &Progress) -> Result<Prepared, Cl
     let needs_par = c.mode != RunMode::Seq || c.explain;
     let analysis = (needs_par || html).then(|| analyse(&p));
     // The inputs the program writes get their image copied in before every scan (W0208).
-    let inputs = inputs.with_image(&p, &p.written_inputs());
+    let inputs = inputs.with_image(&p, p.written_inputs());
     let par = if let (true, Some(a)) = (needs_par, &analysis) {
         Some(
             ParallelMachine::new(

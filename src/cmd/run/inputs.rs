@@ -467,7 +467,7 @@ pub fn parse_inputs_csv(p: &Program, text: &str, file: &str) -> Result<InputTabl
         rows,
         tail: Vec::new(),
     }
-    .with_image(p, &p.written_inputs()))
+    .with_image(p, p.written_inputs()))
 }
 
 /// Parses inputs in JSON: an array with one object per scan (element k is scan k) mapping input
@@ -578,7 +578,7 @@ pub fn parse_inputs_json(p: &Program, text: &str, file: &str) -> Result<InputTab
         rows,
         tail: Vec::new(),
     }
-    .with_image(p, &p.written_inputs()))
+    .with_image(p, p.written_inputs()))
 }
 
 /// The line and column to report for a `serde_json` error at `line`:`column`. serde_json

@@ -25,7 +25,7 @@ pub(crate) use code::*;
 use super::fb::{CtudId, CtudPins};
 use super::fuse::{self, FusedId, Tables};
 use super::layout::{field_offset, type_align, Layout};
-use super::mem::LINE_BYTES;
+use super::line::LINE_BYTES;
 use super::store::Addr;
 use plc_model::*;
 
