@@ -96,13 +96,12 @@ impl<I: Idx, T> Arena<I, T> {
     ///
     /// # Panics
     /// If the arena holds no value there.
+    #[inline]
     #[track_caller]
     pub fn id(&self, index: usize) -> I {
-        assert!(
-            index < self.items.len(),
-            "no value at {index} in an arena of {}",
-            self.items.len()
-        );
+        if index >= self.items.len() {
+            no_value_at(index, self.items.len())
+        }
         I::from_arena(index as u32, ArenaMade(()))
     }
 
@@ -147,6 +146,13 @@ impl<I: Idx, T> Arena<I, T> {
     pub fn truncate(&mut self, len: usize) {
         self.items.truncate(len);
     }
+}
+
+#[cold]
+#[inline(never)]
+#[track_caller]
+fn no_value_at(index: usize, len: usize) -> ! {
+    panic!("no value at {index} in an arena of {len}")
 }
 
 impl<I: Idx, T> Default for Arena<I, T> {

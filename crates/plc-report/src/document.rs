@@ -496,14 +496,16 @@ fn cfg_edge<'a>(p: &'a Program, e: &plc_analysis::CfgEdge) -> CfgEdgeEntry<'a> {
 /// The dependences (data, then the paper's control pairs) and the number of control pairs.
 fn dependences_of<'a>(p: &'a Program, a: &'a Analysis) -> (Lazy<'a, DependenceEntry<'a>>, usize) {
     let id = move |r: RungId| rung_id(p, r);
+    // A dependence names its rungs by position (dense CSR numbering).
+    let at = move |i: u32| p.rungs()[i as usize].id.as_str();
     let var = move |v: VarId| p.var(v).name.as_str();
     let pairs = std::rc::Rc::new(super::paper_control_pairs(a));
     let control_count = pairs.len();
     let dependences = Lazy::new(a.data.len() + control_count, move || {
         let data = a.data.iter().map(move |d| DependenceEntry::Data {
             kind: d.kind.name(),
-            from: id(p.rungs().id(d.from as usize)),
-            to: id(p.rungs().id(d.to as usize)),
+            from: at(d.from),
+            to: at(d.to),
             var: var(d.var),
         });
         let pairs = pairs.clone();
