@@ -118,10 +118,12 @@ mod tests {
         assert_eq!(sharing.len(), 1);
         assert_eq!(p.pou(sharing[0].pou).name, "INT0");
         let id = |name: &str| {
-            RungId::from_raw(p.rungs().iter().position(|r| r.id == name).unwrap() as u32)
+            p.rungs()
+                .id(p.rungs().iter().position(|r| r.id == name).unwrap())
         };
         let var = |name: &str| {
-            VarId::from_raw(p.vars().iter().position(|v| v.name == name).unwrap() as u32)
+            p.vars()
+                .id(p.vars().iter().position(|v| v.name == name).unwrap())
         };
         // A is only read by both: not listed. X: the interrupt reads it, R1 and the call in R3
         // (through S) write it. Y: the interrupt writes it, R2 reads it.

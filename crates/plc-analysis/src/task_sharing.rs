@@ -135,8 +135,10 @@ mod tests {
             .map(|r| (r.task.as_deref(), r.instance.as_str()))
             .collect();
         assert_eq!(names, [(Some("T1"), "a"), (Some("T2"), "b"), (None, "c")]);
-        let var =
-            |n: &str| VarId::from_raw(p.vars().iter().position(|v| v.name == n).unwrap() as u32);
+        let var = |n: &str| {
+            p.vars()
+                .id(p.vars().iter().position(|v| v.name == n).unwrap())
+        };
         // G1 is only read (A, C): not listed. G2: A writes, B reads. G3: B and C (the
         // resource's own, a task of its own) both write it.
         assert_eq!(
